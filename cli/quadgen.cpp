@@ -1,0 +1,23 @@
+// quadgen: vehicle file -> symbolic model -> generated code -> runtime -> fit -> diagnosis.
+#include <iostream>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
+  app.require_subcommand(1);
+  quadgen::cli::DeriveArgs derive;
+  quadgen::cli::add_derive(app, derive);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
+  } catch (const std::exception& e) {
+    std::cerr << "quadgen: error: " << e.what() << "\n";
+    return 2;
+  }
+  return 1;
+}

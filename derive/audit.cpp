@@ -1,0 +1,255 @@
+#include "audit.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "kinematics.hpp"
+
+namespace quadgen {
+using namespace GiNaC;
+
+bool AuditResult::all_passed() const {
+  for (const auto& c : checks)
+    if (!c.passed) return false;
+  return true;
+}
+
+namespace {
+
+AuditCheck make(const std::string& group, const std::string& name, bool ok, const std::string& detail) {
+  return AuditCheck{group, name, ok, detail};
+}
+
+bool is_zero_matrix(const matrix& m) {
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.cols(); ++j)
+      if (!normal(m(i, j)).is_zero()) return false;
+  return true;
+}
+
+DimensionChecker dimension_checker(const SymbolicModel& m) {
+  DimensionChecker dc;
+  for (const auto* list : {&m.states, &m.inputs, &m.params, &m.constants})
+    for (const auto& v : *list) dc.declare(v.sym, v.dim);
+  return dc;
+}
+
+std::vector<AuditCheck> check_rotation() {
+  std::vector<AuditCheck> out;
+  realsymbol phi("phi"), theta("theta"), psi("psi");
+  const matrix R = rotation_zyx(psi, theta, phi);
+  matrix RtR = R.transpose().mul(R);
+  bool orth = true;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!reduce_trig(RtR(i, j) - (i == j ? 1 : 0), {phi, theta, psi}).is_zero()) orth = false;
+  out.push_back(make("rotation", "Z-Y-X matrix orthogonal", orth,
+                     "R = Rz(psi) Ry(theta) Rx(phi); every entry of R^T R - I reduces to 0 modulo sin^2 + cos^2 = 1"));
+  const ex det = reduce_trig(R.determinant() - 1, {phi, theta, psi});
+  out.push_back(make("rotation", "Z-Y-X matrix proper (det = +1)", det.is_zero(),
+                     "det R - 1 reduces to 0 modulo sin^2 + cos^2 = 1"));
+
+  realsymbol qw("qw"), qx("qx"), qy("qy"), qz("qz");
+  const matrix q = quaternion(qw, qx, qy, qz);
+  const matrix Rq = rotation_from_quaternion(q);
+  const matrix QtQ = Rq.transpose().mul(Rq);
+  bool qorth = true;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!reduce_unit_quaternion(QtQ(i, j) - (i == j ? 1 : 0), qw, qx, qy, qz).is_zero()) qorth = false;
+  out.push_back(make("rotation", "quaternion matrix orthogonal", qorth,
+                     "R(q)^T R(q) - I reduces to 0 modulo |q|^2 = 1"));
+  out.push_back(make("rotation", "quaternion matrix proper (det = +1)",
+                     reduce_unit_quaternion(Rq.determinant() - 1, qw, qx, qy, qz).is_zero(),
+                     "det R(q) - 1 reduces to 0 modulo |q|^2 = 1"));
+  // R(q) for the Z-Y-X quaternion equals the Z-Y-X matrix: the two attitude forms agree.
+  const matrix qzyx = quaternion_product(quaternion_product(axis_quaternion(2, psi), axis_quaternion(1, theta)),
+                                         axis_quaternion(0, phi));
+  lst half;
+  for (const ex& a : {ex(phi), ex(theta), ex(psi)}) {
+    half.append(sin(a) == 2 * sin(a / 2) * cos(a / 2));
+    half.append(cos(a) == 1 - 2 * pow(sin(a / 2), 2));
+  }
+  const matrix diff = rotation_from_quaternion(qzyx).sub(ex_to<matrix>(ex(R).subs(half)));
+  bool same = true;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!reduce_trig(diff(i, j), {phi / 2, theta / 2, psi / 2}).is_zero()) same = false;
+  out.push_back(make("rotation", "quaternion and Z-Y-X matrix agree", same,
+                     "R(q_z(psi) q_y(theta) q_x(phi)) - Rz Ry Rx reduces to 0 (half-angle identities)"));
+  return out;
+}
+
+std::vector<AuditCheck> check_quaternion_norm(const SymbolicModel& m) {
+  // d/dt |q|^2 = 2 q . dq/dt must vanish identically for the model's own quaternion rows.
+  ex s = 0;
+  for (int i = 0; i < 4; ++i) s += m.states[6 + i].sym * m.f(6 + i, 0);
+  const bool ok = expand(s).is_zero();
+  return {make("rotation", "quaternion kinematics preserve |q|", ok,
+               "q . dq/dt of the model's rows 7-10 expands to 0")};
+}
+
+std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
+  std::vector<AuditCheck> out;
+  bool sym = true;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!normal(mp.inertia_cog(i, j) - mp.inertia_cog(j, i)).is_zero()) sym = false;
+  out.push_back(make("inertia", "symmetric", sym, "J_cg - J_cg^T = 0 symbolically"));
+
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) J(i, j) = mp.inertia_cog_value[i][j];
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(J);
+  const Eigen::Vector3d l = es.eigenvalues();
+  std::ostringstream os;
+  os << "principal moments " << l(0) << ", " << l(1) << ", " << l(2) << " kg m^2";
+  out.push_back(make("inertia", "positive definite", l.minCoeff() > 0, os.str()));
+  const bool tri = l(0) + l(1) >= l(2) * (1 - 1e-12) && l(0) + l(2) >= l(1) && l(1) + l(2) >= l(0);
+  out.push_back(make("inertia", "triangle inequalities of principal moments", tri,
+                     "each principal moment <= sum of the other two"));
+
+  bool closed = true;
+  std::string bad;
+  for (size_t b = 0; b < mp.blocks.size(); ++b) {
+    const matrix d = closed_form_block_inertia(mp.symbols[b]).sub(mp.blocks[b].inertia_origin);
+    if (!is_zero_matrix(d)) {
+      closed = false;
+      bad += mp.blocks[b].name + " ";
+    }
+  }
+  out.push_back(make("inertia", "integrals match closed form + parallel axis", closed,
+                     closed ? "for every block, symbolically: m/12 diag(b^2+c^2, a^2+c^2, a^2+b^2) rotated, "
+                              "plus m(|c|^2 I - c c^T), equals the integrated tensor"
+                            : "mismatch in " + bad));
+  return out;
+}
+
+// With thrust (c_t = 0) and gravity (g = 0) removed there are no torques; the model's
+// rotational rows must then conserve 1/2 ω·Jω and |Jω|^2.
+std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
+  lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
+  matrix w(3, 1), wdot(3, 1);
+  for (int i = 0; i < 3; ++i) {
+    w(i, 0) = m.states[10 + i].sym;
+    wdot(i, 0) = m.f(10 + i, 0).subs(off);
+  }
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
+                           P("J_xz"), P("J_yz"), P("J_zz")});
+  const matrix Jw = J.mul(w), Jwdot = J.mul(wdot);
+  ex dE = 0, dL = 0;
+  for (int i = 0; i < 3; ++i) {
+    dE += w(i, 0) * Jwdot(i, 0);
+    dL += Jw(i, 0) * Jwdot(i, 0);
+  }
+  return {make("energy", "rotational kinetic energy conserved", normal(dE).is_zero(),
+               "d/dt (1/2 ω^T J ω) = ω^T J dω/dt of the model's rows with c_t = g = 0 normalises to 0 "
+               "for a general symmetric J"),
+          make("energy", "angular momentum magnitude conserved", normal(dL).is_zero(),
+               "d/dt |Jω|^2 / 2 = (Jω)^T J dω/dt normalises to 0")};
+}
+
+}  // namespace
+
+ex reduce_trig(const ex& e, const std::vector<ex>& angles) {
+  // Replace sin(a), cos(a) by symbols s, c and divide out c^2 + s^2 - 1 as a polynomial in c.
+  std::vector<std::pair<symbol, symbol>> sc;
+  lst to_symbols;
+  for (const ex& a : angles) {
+    symbol s("s"), c("c");
+    to_symbols.append(sin(a) == s);
+    to_symbols.append(cos(a) == c);
+    sc.push_back({s, c});
+  }
+  ex r = expand(e.subs(to_symbols));
+  for (const auto& [s, c] : sc) r = expand(rem(r, pow(c, 2) + pow(s, 2) - 1, c));
+  return r;
+}
+
+ex reduce_unit_quaternion(const ex& e, const ex& qw, const ex& qx, const ex& qy, const ex& qz) {
+  const ex r = rem(expand(e), pow(qw, 2) + pow(qx, 2) + pow(qy, 2) + pow(qz, 2) - 1, qw);
+  return expand(r);
+}
+
+matrix closed_form_block_inertia(const BlockSymbols& s) {
+  const ex k = s.m / 12;
+  const matrix Jc(3, 3, lst{k * (s.b * s.b + s.c * s.c), 0, 0, 0, k * (s.a * s.a + s.c * s.c), 0, 0, 0,
+                            k * (s.a * s.a + s.b * s.b)});
+  const matrix c = vec3(s.cx, s.cy, s.cz);
+  const ex cc = s.cx * s.cx + s.cy * s.cy + s.cz * s.cz;
+  matrix shift(3, 3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) shift(i, j) = s.m * ((i == j ? cc : ex(0)) - c(i, 0) * c(j, 0));
+  return s.R.mul(Jc).mul(s.R.transpose()).add(shift);
+}
+
+std::vector<AuditCheck> check_units(const SymbolicModel& m) {
+  std::vector<AuditCheck> out;
+  const DimensionChecker dc = dimension_checker(m);
+  const Dimension per_second = parse_unit("1/s").dim;
+  for (size_t i = 0; i < m.states.size(); ++i) {
+    const std::string name = "d" + m.states[i].name + "/dt";
+    try {
+      const Dimension d = dc.infer(m.f(i, 0));
+      const Dimension want = m.states[i].dim * per_second;
+      out.push_back(make("units", name, d == want,
+                         "every term has [" + d.str() + "], expected [" + want.str() + "]"));
+    } catch (const UnitError& e) {
+      out.push_back(make("units", name, false, e.what()));
+    }
+  }
+  for (size_t i = 0; i < m.outputs.size(); ++i) {
+    try {
+      const Dimension d = dc.infer(m.h(i, 0));
+      out.push_back(make("units", "output " + m.outputs[i].name, d == m.outputs[i].dim,
+                         "[" + d.str() + "], expected [" + m.outputs[i].dim.str() + "]"));
+    } catch (const UnitError& e) {
+      out.push_back(make("units", "output " + m.outputs[i].name, false, e.what()));
+    }
+  }
+  return out;
+}
+
+namespace {
+std::vector<AuditCheck> check_mass_property_units(const MassProperties& mp) {
+  DimensionChecker dc;
+  const Dimension m = parse_unit("m").dim, kg = parse_unit("kg").dim;
+  for (const auto& s : mp.symbols) {
+    dc.declare(s.m, kg);
+    for (const symbol* l : {&s.a, &s.b, &s.c, &s.cx, &s.cy, &s.cz}) dc.declare(*l, m);
+  }
+  std::vector<AuditCheck> out;
+  auto check = [&](const std::string& what, const ex& e, const Dimension& want) {
+    try {
+      const Dimension d = dc.infer(e);
+      out.push_back(make("units", what, d == want, "[" + d.str() + "], expected [" + want.str() + "]"));
+    } catch (const UnitError& err) {
+      out.push_back(make("units", what, false, err.what()));
+    }
+  };
+  check("mass", mp.mass, kg);
+  check("centre of gravity", mp.cog(2, 0), m);
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j)
+      check(std::string("inertia J_") + "xyz"[i] + "xyz"[j], mp.inertia_cog(i, j), kg * m * m);
+  for (int i = 0; i < 3; ++i) check(std::string("area A_") + "xyz"[i], mp.areas(i, 0), m * m);
+  return out;
+}
+}  // namespace
+
+AuditResult audit(const SymbolicModel& m, const MassProperties& mp) {
+  AuditResult r;
+  auto add = [&](std::vector<AuditCheck> v) { r.checks.insert(r.checks.end(), v.begin(), v.end()); };
+  add(check_units(m));
+  add(check_mass_property_units(mp));
+  add(check_rotation());
+  add(check_quaternion_norm(m));
+  add(check_inertia(mp));
+  add(check_energy(m));
+  return r;
+}
+
+}  // namespace quadgen

@@ -1,0 +1,38 @@
+// The audit: independent checks that make the derivation trustworthy: units,
+// rotation properties, inertia validity and cross-checks, energy conservation.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "geometry.hpp"
+#include "symbolic_model.hpp"
+
+namespace quadgen {
+
+struct AuditCheck {
+  std::string group;   // "units", "rotation", "inertia", "energy"
+  std::string name;
+  bool passed = false;
+  std::string detail;  // what was computed, in words a reviewer can follow
+};
+
+struct AuditResult {
+  std::vector<AuditCheck> checks;
+  bool all_passed() const;
+};
+
+AuditResult audit(const SymbolicModel& m, const MassProperties& mp);
+
+// Individual checks, exposed for tests.
+// Dimension of every f_i against state_i / s, and of every term of every sum.
+std::vector<AuditCheck> check_units(const SymbolicModel& m);
+// Reduces a polynomial in sin/cos of the given angles modulo sin^2 + cos^2 = 1.
+GiNaC::ex reduce_trig(const GiNaC::ex& e, const std::vector<GiNaC::ex>& angles);
+// Reduces modulo qw^2 + qx^2 + qy^2 + qz^2 = 1 (eliminating qw^2).
+GiNaC::ex reduce_unit_quaternion(const GiNaC::ex& e, const GiNaC::ex& qw, const GiNaC::ex& qx,
+                                 const GiNaC::ex& qy, const GiNaC::ex& qz);
+// Closed-form inertia of a cuboid about its centre, m/12 diag(b^2+c^2, a^2+c^2, a^2+b^2),
+// rotated and moved to the origin with the parallel-axis theorem.
+GiNaC::matrix closed_form_block_inertia(const BlockSymbols& s);
+
+}  // namespace quadgen

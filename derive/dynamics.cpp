@@ -1,0 +1,264 @@
+#include "dynamics.hpp"
+
+#include <set>
+#include <stdexcept>
+
+#include "effects.hpp"
+#include "exact_number.hpp"
+#include "kinematics.hpp"
+#include "symbolic_functions.hpp"
+
+namespace quadgen {
+using namespace GiNaC;
+
+namespace {
+
+std::string tex_of(const std::string& name) {
+  // "motor_gain.A" -> "\mathrm{motor\_gain.A}"; short names keep math italics.
+  static const std::map<std::string, std::string> greek = {
+      {"rho", "\\rho"}, {"kappa", "\\kappa"}, {"c_w", "c_w"}, {"c_t", "c_t"}, {"g", "g"},
+      {"mass", "m"},    {"p", "p"},           {"q", "q"},     {"r", "r"}};
+  auto it = greek.find(name);
+  if (it != greek.end()) return it->second;
+  std::string out;
+  for (char c : name) out += (c == '_') ? std::string("\\_") : std::string(1, c);
+  return "\\mathrm{" + out + "}";
+}
+
+Variable make_variable(const std::string& name, const std::string& unit, const std::string& doc) {
+  Variable v;
+  v.name = name;
+  v.sym = symbol(name, tex_of(name));
+  v.unit = unit;
+  v.dim = parse_unit(unit).dim;
+  v.doc = doc;
+  return v;
+}
+
+void declare_base(ModelContext& c, const MassProperties& mp) {
+  const char* st[][3] = {{"x", "m", "position x, world"},      {"y", "m", "position y, world"},
+                         {"z", "m", "position z (up), world"}, {"vx", "m/s", "velocity x, world"},
+                         {"vy", "m/s", "velocity y, world"},   {"vz", "m/s", "velocity z, world"},
+                         {"qw", "1", "attitude quaternion w"}, {"qx", "1", "attitude quaternion x"},
+                         {"qy", "1", "attitude quaternion y"}, {"qz", "1", "attitude quaternion z"},
+                         {"p", "rad/s", "body rate about x"},  {"q", "rad/s", "body rate about y"},
+                         {"r", "rad/s", "body rate about z"}};
+  std::vector<ex> s;
+  for (auto& row : st) s.push_back(c.add_state(row[0], row[1], row[2]));
+  c.position = vec3(s[0], s[1], s[2]);
+  c.velocity = vec3(s[3], s[4], s[5]);
+  c.q = quaternion(s[6], s[7], s[8], s[9]);
+  c.omega = vec3(s[10], s[11], s[12]);
+  c.R = rotation_from_quaternion(c.q);
+  c.measured_q = c.q;
+  c.air_velocity_world = c.velocity;
+  c.extra_body_force = vec3(0, 0, 0);
+
+  for (const Rotor& r : c.vehicle.rotors)
+    c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
+
+  for (const char* n : {"g", "rho", "c_w", "c_t", "kappa", "a0", "a1", "a2"}) {
+    const Parameter& vp = param(c.vehicle, n);
+    const std::string name = (n[0] == 'a' && n[1] != 0 && isdigit(n[1])) ? std::string("motor_") + n : n;
+    c.add_param(name, vp.unit, vp.value, vp.lower, vp.upper, vp.fit, vp.doc);
+  }
+  // Mass properties derived from the blocks become parameters with those nominal values,
+  // so that a fit may free them and the generated code precomputes J^-1 once.
+  auto derived = [&](const std::string& name, const std::string& unit, double value, const std::string& doc) {
+    auto it = c.vehicle.derived_overrides.find(name);
+    if (it != c.vehicle.derived_overrides.end())
+      c.add_param(name, unit, value, it->second.lower, it->second.upper, it->second.fit, doc);
+    else
+      c.add_param(name, unit, value, value, value, false, doc);
+  };
+  derived("mass", "kg", mp.mass_value, "total mass (sum of blocks)");
+  const char* axes = "xyz";
+  for (int i = 0; i < 3; ++i)
+    derived(std::string("cog_") + axes[i], "m", mp.cog_value[i], "centre of gravity, body frame");
+  const auto& J = mp.inertia_cog_value;
+  derived("J_xx", "kg m^2", J[0][0], "inertia tensor about the CoG");
+  derived("J_yy", "kg m^2", J[1][1], "inertia tensor about the CoG");
+  derived("J_zz", "kg m^2", J[2][2], "inertia tensor about the CoG");
+  derived("J_xy", "kg m^2", J[0][1], "inertia tensor entry (= -product of inertia)");
+  derived("J_xz", "kg m^2", J[0][2], "inertia tensor entry (= -product of inertia)");
+  derived("J_yz", "kg m^2", J[1][2], "inertia tensor entry (= -product of inertia)");
+  for (int i = 0; i < 3; ++i)
+    derived(std::string("A_") + axes[i], "m^2", mp.areas_value[i], "exposed area along the body axis");
+
+  c.cog = vec3(c.p("cog_x"), c.p("cog_y"), c.p("cog_z"));
+  for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
+    const ex u = c.model.inputs[i].sym;
+    const ex w = c.p("motor_a0") + c.p("motor_a1") * u + c.p("motor_a2") * u * u;
+    c.commanded_speed.push_back(w);
+    c.rotor_speed.push_back(w);
+    c.thrust_scale.push_back(1);
+  }
+}
+
+matrix inertia_matrix(const ModelContext& c) {
+  const ex xx = c.p("J_xx"), yy = c.p("J_yy"), zz = c.p("J_zz");
+  const ex xy = c.p("J_xy"), xz = c.p("J_xz"), yz = c.p("J_yz");
+  return matrix(3, 3, lst{xx, xy, xz, xy, yy, yz, xz, yz, zz});
+}
+
+// Closes the equations once every effect has had its say.
+void assemble(ModelContext& c) {
+  SymbolicModel& m = c.model;
+  const auto& rotors = c.vehicle.rotors;
+  matrix force_body = c.extra_body_force;
+  matrix torque = vec3(0, 0, 0);
+  ex total_thrust = 0;
+  for (size_t i = 0; i < rotors.size(); ++i) {
+    const Rotor& r = rotors[i];
+    const ex w = c.rotor_speed[i];
+    const std::string n = r.name;
+    const ex A_p = c.add_constant(n + ".A_p", "m^2", r.disc_area, "disc area of rotor " + n);
+    const ex r_p = c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n);
+    const ex thrust = c.thrust_scale[i] * c.p("c_t") * c.p("rho") * A_p * pow(r_p, 2) * w * w;
+    m.intermediates.push_back({"F_" + r.name, thrust});
+    total_thrust += thrust;
+    const matrix position = vec3(c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x"),
+                                 c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
+                                 c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z"));
+    const matrix arm = position.sub(c.cog);
+    torque = torque.add(cross(arm, vec3(0, 0, thrust)));
+    // Reaction torque opposes the spin: a ccw rotor (seen from above) pushes the body along -z.
+    const int reaction = (r.spin == Spin::ccw) ? -1 : 1;
+    torque = torque.add(vec3(0, 0, reaction * c.p("kappa") * thrust));
+  }
+  force_body = force_body.add(vec3(0, 0, total_thrust));
+  // Frame drag per body axis, 1/2 c_w rho A v|v|, on the air-relative velocity.
+  const matrix v_air_body = c.R.transpose().mul(c.air_velocity_world);
+  const char* areas[] = {"A_x", "A_y", "A_z"};
+  matrix drag(3, 1);
+  for (int k = 0; k < 3; ++k) {
+    const ex vk = v_air_body(k, 0);
+    drag(k, 0) = -numeric(1, 2) * c.p("c_w") * c.p("rho") * c.p(areas[k]) * vk * abs_value(vk);
+  }
+  force_body = force_body.add(drag);
+  m.intermediates.push_back({"F_{drag}", drag});
+  m.intermediates.push_back({"F_{body}", force_body});
+  m.intermediates.push_back({"\\tau", torque});
+
+  // Rotation about the centre of gravity: J dω/dt = τ − ω × Jω.
+  const matrix J = inertia_matrix(c);
+  const matrix Jinv = J.inverse();
+  const matrix omega_dot = Jinv.mul(torque.sub(cross(c.omega, J.mul(c.omega))));
+  // Translation: the CoG obeys m a_cg = R F_b − m g e_z; the origin is offset from it
+  // by −c, so a_o = a_cg − R(ω̇ × c + ω × (ω × c)).
+  const matrix transport = cross(omega_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
+  const matrix accel_body = force_body.mul_scalar(1 / c.p("mass")).sub(transport);
+  const matrix accel_world = c.R.mul(accel_body).sub(vec3(0, 0, c.p("g")));
+  const matrix q_dot = quaternion_rate(c.q, c.omega);
+
+  const size_t n = m.states.size();
+  m.f = matrix(n, 1);
+  for (int i = 0; i < 3; ++i) {
+    m.f(i, 0) = c.velocity(i, 0);
+    m.f(3 + i, 0) = accel_world(i, 0);
+    m.f(10 + i, 0) = omega_dot(i, 0);
+  }
+  for (int i = 0; i < 4; ++i) m.f(6 + i, 0) = q_dot(i, 0);
+  for (size_t i = 0; i < c.extra_rates.size(); ++i) m.f(13 + i, 0) = c.extra_rates[i];
+
+  const char* out[][3] = {{"x", "m", "position x"}, {"y", "m", "position y"}, {"z", "m", "position z"},
+                          {"qw", "1", "logged attitude w"}, {"qx", "1", "logged attitude x"},
+                          {"qy", "1", "logged attitude y"}, {"qz", "1", "logged attitude z"}};
+  m.h = matrix(7, 1);
+  for (int i = 0; i < 7; ++i) {
+    m.outputs.push_back(make_variable(out[i][0], out[i][1], out[i][2]));
+    m.h(i, 0) = i < 3 ? c.position(i, 0) : c.measured_q(i - 3, 0);
+  }
+}
+
+}  // namespace
+
+symbol ModelContext::add_param(const std::string& name, const std::string& unit, double nominal,
+                               double lower, double upper, bool fit, const std::string& doc) {
+  Variable v = make_variable(name, unit, doc);
+  v.nominal = nominal;
+  v.lower = lower;
+  v.upper = upper;
+  v.fit = fit;
+  model.params.push_back(v);
+  return v.sym;
+}
+symbol ModelContext::add_state(const std::string& name, const std::string& unit, const std::string& doc) {
+  model.states.push_back(make_variable(name, unit, doc));
+  return model.states.back().sym;
+}
+symbol ModelContext::add_input(const std::string& name, const std::string& unit, const std::string& doc) {
+  model.inputs.push_back(make_variable(name, unit, doc));
+  return model.inputs.back().sym;
+}
+symbol ModelContext::add_constant(const std::string& name, const std::string& unit, double value,
+                                  const std::string& doc) {
+  Variable v = make_variable(name, unit, doc);
+  v.nominal = v.lower = v.upper = value;
+  model.constants.push_back(v);
+  return v.sym;
+}
+ex ModelContext::p(const std::string& name) const { return model.params[model.param_index(name)].sym; }
+
+size_t SymbolicModel::state_index(const std::string& n) const {
+  for (size_t i = 0; i < states.size(); ++i)
+    if (states[i].name == n) return i;
+  throw std::out_of_range("no state " + n);
+}
+size_t SymbolicModel::param_index(const std::string& n) const {
+  for (size_t i = 0; i < params.size(); ++i)
+    if (params[i].name == n) return i;
+  throw std::out_of_range("no parameter " + n);
+}
+size_t SymbolicModel::input_index(const std::string& n) const {
+  for (size_t i = 0; i < inputs.size(); ++i)
+    if (inputs[i].name == n) return i;
+  throw std::out_of_range("no input " + n);
+}
+lst SymbolicModel::nominal_substitution() const {
+  lst l;
+  for (const auto& p : params) l.append(p.sym == exact(p.nominal));
+  return l;
+}
+lst SymbolicModel::constant_substitution() const {
+  lst l;
+  for (const auto& c : constants) l.append(c.sym == exact(c.nominal));
+  return l;
+}
+
+void differentiate(SymbolicModel& m) {
+  auto jac = [](const matrix& f, const std::vector<Variable>& vars) {
+    matrix J(f.rows(), vars.size());
+    for (unsigned i = 0; i < f.rows(); ++i)
+      for (size_t j = 0; j < vars.size(); ++j) J(i, j) = f(i, 0).diff(vars[j].sym);
+    return J;
+  };
+  m.dfdx = jac(m.f, m.states);
+  m.dfdu = jac(m.f, m.inputs);
+  m.dfdp = jac(m.f, m.params);
+  m.dhdx = jac(m.h, m.states);
+  m.dhdp = jac(m.h, m.params);
+}
+
+SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt) {
+  SymbolicModel m;
+  m.vehicle_name = v.name;
+  m.vehicle_hash = v.content_hash;
+  std::set<std::string> wanted;
+  for (const auto& e : opt.effects)
+    if (!wanted.insert(e).second) throw std::invalid_argument("effect '" + e + "' named twice");
+  ModelContext c{v, m};
+  declare_base(c, mp);
+  for (const Effect& e : effect_catalogue()) {
+    if (!wanted.count(e.name)) continue;
+    e.apply(c);
+    m.effects.push_back(e.name);
+    wanted.erase(e.name);
+  }
+  if (!wanted.empty()) throw std::invalid_argument("unknown effect '" + *wanted.begin() + "'");
+  assemble(c);
+  differentiate(m);
+  return m;
+}
+
+}  // namespace quadgen

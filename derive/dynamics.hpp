@@ -1,0 +1,49 @@
+// Assembles the rigid-body flight model of a multirotor from its vehicle description,
+// mass properties and a set of effects: forces and torques, translation (Newton /
+// D'Alembert for the centre of gravity, expressed for the body origin), rotation
+// (angular-momentum balance J dω/dt = τ − ω × Jω), quaternion kinematics.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "geometry.hpp"
+#include "symbolic_model.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen {
+
+// Intermediate quantities an effect may change before the equations are closed.
+struct ModelContext {
+  const Vehicle& vehicle;
+  SymbolicModel& model;
+
+  // Body-frame geometry and state pieces.
+  GiNaC::matrix position{3, 1}, velocity{3, 1}, q{4, 1}, omega{3, 1};
+  GiNaC::matrix R{3, 3};  // body -> world
+  GiNaC::matrix cog{3, 1};
+  GiNaC::matrix air_velocity_world{3, 1};
+  GiNaC::matrix extra_body_force{3, 1};
+  std::vector<GiNaC::ex> rotor_speed;   // rad/s, per rotor
+  std::vector<GiNaC::ex> thrust_scale;  // multiplies each rotor's thrust
+  std::vector<GiNaC::ex> commanded_speed;  // motor map of the command, per rotor
+  GiNaC::matrix measured_q{4, 1};       // attitude as logged
+
+  GiNaC::symbol add_param(const std::string& name, const std::string& unit, double nominal,
+                          double lower, double upper, bool fit, const std::string& doc);
+  GiNaC::symbol add_state(const std::string& name, const std::string& unit, const std::string& doc);
+  GiNaC::symbol add_input(const std::string& name, const std::string& unit, const std::string& doc);
+  GiNaC::symbol add_constant(const std::string& name, const std::string& unit, double value, const std::string& doc);
+  GiNaC::ex p(const std::string& name) const;  // symbol of a declared parameter
+  std::vector<GiNaC::ex> extra_rates;          // d/dt of states added by effects, in order
+};
+
+struct DeriveOptions {
+  std::vector<std::string> effects;  // any order; duplicates rejected
+};
+
+SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt);
+
+// Computes dfdx, dfdu, dfdp, dhdx, dhdp from f and h.
+void differentiate(SymbolicModel& m);
+
+}  // namespace quadgen

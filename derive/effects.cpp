@@ -1,0 +1,142 @@
+#include "effects.hpp"
+
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "kinematics.hpp"
+
+namespace quadgen {
+using namespace GiNaC;
+
+namespace {
+
+// Thrust of rotor i scaled by (1 + gain_i).
+void motor_gain(ModelContext& c) {
+  for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
+    const std::string n = c.vehicle.rotors[i].name;
+    const ex g = c.add_param("motor_gain." + n, "1", 0.0, -0.5, 0.5, true,
+                             "relative thrust error of rotor " + n);
+    c.thrust_scale[i] = c.thrust_scale[i] * (1 + g);
+  }
+}
+
+// First-order lag from commanded to actual rotor speed: tau dw/dt = w_cmd − w.
+// The rotor speeds become states; started at w_cmd they reproduce the base model for
+// any tau, and as tau -> 0 the trajectories converge to it (a singular perturbation),
+// so the nominal tau is small rather than zero.
+void motor_lag(ModelContext& c) {
+  const ex tau = c.add_param("motor_lag.tau", "s", 1e-3, 1e-4, 1.0, true,
+                             "time constant of the rotor speed response");
+  for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
+    const std::string n = c.vehicle.rotors[i].name;
+    const ex w = c.add_state("w_" + n, "rad/s", "rotor speed of rotor " + n);
+    c.extra_rates.push_back((c.commanded_speed[i] - w) / tau);
+    c.rotor_speed[i] = w;
+  }
+}
+
+// A pure delay of the inputs. Not an ODE term: the runtime evaluates u(t − d) and
+// the model only carries the parameter (see SymbolicModel::input_delay_param).
+void input_delay(ModelContext& c) {
+  c.add_param("input_delay.seconds", "s", 0.0, 0.0, 0.2, true,
+              "time shift between logged commands and their effect");
+  c.model.input_delay_param = c.model.params.size() - 1;
+}
+
+void cog_offset(ModelContext& c) {
+  const ex dx = c.add_param("cog_offset.x", "m", 0.0, -0.05, 0.05, true, "CoG displacement x");
+  const ex dy = c.add_param("cog_offset.y", "m", 0.0, -0.05, 0.05, true, "CoG displacement y");
+  c.cog = c.cog.add(vec3(dx, dy, 0));
+}
+
+// Horizontal body force −k (Σ w_i) v_air,body,xy: blade flapping / induced drag.
+void rotor_drag(ModelContext& c) {
+  const ex k = c.add_param("rotor_drag.k", "N s^2/m", 0.0, 0.0, 1e-3, true,
+                           "rotor drag per rotor speed sum");
+  ex sum_w = 0;
+  for (const ex& w : c.rotor_speed) sum_w += w;
+  const matrix vb = c.R.transpose().mul(c.air_velocity_world);
+  c.extra_body_force = c.extra_body_force.add(vec3(-k * sum_w * vb(0, 0), -k * sum_w * vb(1, 0), 0));
+}
+
+void wind(ModelContext& c) {
+  const ex wx = c.add_param("wind.x", "m/s", 0.0, -10.0, 10.0, true, "steady wind x, world");
+  const ex wy = c.add_param("wind.y", "m/s", 0.0, -10.0, 10.0, true, "steady wind y, world");
+  c.air_velocity_world = c.air_velocity_world.sub(vec3(wx, wy, 0));
+}
+
+// Logged attitude = true attitude rotated by a fixed roll and pitch: q_log = q ⊗ q_bias.
+void attitude_bias(ModelContext& c) {
+  const ex roll = c.add_param("attitude_bias.roll", "rad", 0.0, -0.2, 0.2, true, "logged roll offset");
+  const ex pitch = c.add_param("attitude_bias.pitch", "rad", 0.0, -0.2, 0.2, true, "logged pitch offset");
+  const matrix q_bias = quaternion_product(axis_quaternion(1, pitch), axis_quaternion(0, roll));
+  c.measured_q = quaternion_product(c.measured_q, q_bias);
+}
+
+void thrust_decay(ModelContext& c) {
+  const ex rate = c.add_param("thrust_decay.rate", "1/s", 0.0, -0.05, 0.05, true,
+                              "relative thrust loss per second");
+  const ex t = c.add_input("t", "s", "time since the start of the log");
+  for (ex& s : c.thrust_scale) s = s * (1 - rate * t);
+}
+
+void battery_sag(ModelContext& c) {
+  const ex e = c.add_param("battery_sag.exponent", "1", 0.0, -1.0, 4.0, true,
+                           "thrust ~ (vbat/vbat_ref)^exponent");
+  const Parameter& ref = param(c.vehicle, "vbat_ref");
+  const ex vref = c.add_param("vbat_ref", "V", ref.value, ref.value, ref.value, false, ref.doc);
+  const ex vbat = c.add_input("vbat", "V", "battery voltage");
+  for (ex& s : c.thrust_scale) s = s * pow(vbat / vref, e);
+}
+
+// Thrust near the ground scaled by 1/(1 − (R/4z)^2) (Cheeseman & Bennett 1955).
+void ground_effect(ModelContext& c) {
+  const ex radius = c.add_param("ground_effect.radius", "m", 0.0, 0.0, 0.5, true,
+                                "rotor radius in the ground-effect law");
+  const ex z = c.position(2, 0);
+  for (ex& s : c.thrust_scale) s = s / (1 - pow(radius / (4 * z), 2));
+}
+
+}  // namespace
+
+const std::vector<Effect>& effect_catalogue() {
+  static const std::vector<Effect> list = {
+      {"motor_gain", "thrust of each rotor scaled by (1 + value)", motor_gain},
+      {"motor_lag", "first-order lag from commanded to actual rotor speed", motor_lag},
+      {"input_delay", "pure time shift between logged commands and their effect", input_delay},
+      {"cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset},
+      {"rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag},
+      {"wind", "steady air velocity in the world frame, through the drag terms", wind},
+      {"attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias},
+      {"thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay},
+      {"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag},
+      {"ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", ground_effect},
+  };
+  return list;
+}
+
+std::vector<std::string> parse_effect_list(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  if (text == "all") {
+    for (const auto& e : effect_catalogue()) out.push_back(e.name);
+    return out;
+  }
+  std::set<std::string> known, seen;
+  for (const auto& e : effect_catalogue()) known.insert(e.name);
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!known.count(item)) {
+      std::string list;
+      for (const auto& e : effect_catalogue()) list += (list.empty() ? "" : ", ") + e.name;
+      throw std::invalid_argument("unknown effect '" + item + "' (known: " + list + ", or all)");
+    }
+    if (!seen.insert(item).second) throw std::invalid_argument("effect '" + item + "' named twice");
+    out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace quadgen

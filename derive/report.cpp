@@ -1,0 +1,236 @@
+#include "report.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace quadgen {
+using namespace GiNaC;
+
+namespace {
+
+std::string tex(const ex& e) {
+  std::ostringstream os;
+  os << latex << e;
+  return os.str();
+}
+
+std::string tex_matrix(const matrix& m) {
+  std::ostringstream os;
+  os << "\\begin{pmatrix}";
+  for (unsigned i = 0; i < m.rows(); ++i) {
+    for (unsigned j = 0; j < m.cols(); ++j) os << (j ? " & " : "") << tex(m(i, j));
+    os << (i + 1 < m.rows() ? " \\\\ " : "");
+  }
+  os << "\\end{pmatrix}";
+  return os.str();
+}
+
+std::string num(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+void section_vehicle(std::ostringstream& md, const Derivation& d) {
+  md << "## 1. Vehicle\n\n" << d.vehicle.description << "\n\n";
+  md << "| block | mass [kg] | size a × b × c [m] | centre [m] | yaw, pitch, roll [deg] |\n|---|---|---|---|---|\n";
+  for (const Block& b : d.vehicle.blocks)
+    md << "| " << b.name << " | " << num(b.mass) << " | " << num(b.size[0]) << " × " << num(b.size[1]) << " × "
+       << num(b.size[2]) << " | (" << num(b.centre[0]) << ", " << num(b.centre[1]) << ", " << num(b.centre[2])
+       << ") | " << num(b.yaw_pitch_roll_deg[0]) << ", " << num(b.yaw_pitch_roll_deg[1]) << ", "
+       << num(b.yaw_pitch_roll_deg[2]) << " |\n";
+  md << "\n| rotor | position [m] | spin (from above) | r_p [m] | A_p [m²] |\n|---|---|---|---|---|\n";
+  for (const Rotor& r : d.vehicle.rotors)
+    md << "| " << r.name << " | (" << num(r.position[0]) << ", " << num(r.position[1]) << ", "
+       << num(r.position[2]) << ") | " << (r.spin == Spin::ccw ? "ccw" : "cw") << " | " << num(r.radius)
+       << " | " << num(r.disc_area) << " |\n";
+  md << "\n";
+}
+
+void section_mass(std::ostringstream& md, const Derivation& d) {
+  const MassProperties& mp = d.mass;
+  md << "## 2. Mass properties by exact integration\n\n"
+     << "Each block is a cuboid of constant density $\\rho = m/(abc)$. In its own frame GiNaC "
+        "integrates the second moment $S = \\int \\xi\\xi^T\\,dm$ exactly over "
+        "$[-a/2,a/2]\\times[-b/2,b/2]\\times[-c/2,c/2]$";
+  if (!mp.blocks.empty()) {
+    md << "; for block `" << mp.blocks[0].name << "`:\n\n$$S = " << tex_matrix(mp.blocks[0].local_second_moment)
+       << "$$\n\n";
+  }
+  md << "It is rotated and moved into the body frame, $S_b = R S R^T + m\\,c\\,c^T$, and the inertia tensor "
+        "about the origin is $J_o = \\operatorname{tr}(S_b) I - S_b$.";
+  if (!mp.blocks.empty())
+    md << " For `" << mp.blocks[0].name << "`:\n\n$$J_o = " << tex_matrix(mp.blocks[0].inertia_origin) << "$$\n\n";
+  md << "Contributions of every block about the body origin [kg m²] and projected areas [m²]:\n\n"
+     << "| block | J_xx | J_yy | J_zz | J_xy | J_xz | J_yz | A_x | A_y | A_z |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& b : mp.blocks) {
+    const auto& J = b.inertia_origin_value;
+    md << "| " << b.name << " | " << num(J[0][0]) << " | " << num(J[1][1]) << " | " << num(J[2][2]) << " | "
+       << num(J[0][1]) << " | " << num(J[0][2]) << " | " << num(J[1][2]) << " | " << num(b.areas_value[0])
+       << " | " << num(b.areas_value[1]) << " | " << num(b.areas_value[2]) << " |\n";
+  }
+  const auto& Jc = mp.inertia_cog_value;
+  md << "\nTotals: $m = " << tex(mp.mass) << "$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
+     << "$c = \\frac{1}{m}\\sum m_i c_i$ = **(" << num(mp.cog_value[0]) << ", " << num(mp.cog_value[1]) << ", "
+     << num(mp.cog_value[2]) << ") m**; exposed areas **(" << num(mp.areas_value[0]) << ", "
+     << num(mp.areas_value[1]) << ", " << num(mp.areas_value[2]) << ") m²**.\n\n"
+     << "Inertia about the centre of gravity, $J_{cg} = J_o - m(|c|^2 I - c c^T)$ [kg m²]:\n\n"
+     << "$$J_{cg} = \\begin{pmatrix}" << num(Jc[0][0]) << " & " << num(Jc[0][1]) << " & " << num(Jc[0][2])
+     << " \\\\ " << num(Jc[1][0]) << " & " << num(Jc[1][1]) << " & " << num(Jc[1][2]) << " \\\\ "
+     << num(Jc[2][0]) << " & " << num(Jc[2][1]) << " & " << num(Jc[2][2]) << "\\end{pmatrix}$$\n\n"
+     << "These stay expressions in the block symbols ($m_i, a_i, b_i, c_i, x_i, y_i, z_i$): a changed "
+        "vehicle file re-derives them. They enter the dynamics as parameters `mass`, `cog_*`, `J_*`, `A_*` "
+        "with these nominal values, so that a fit may free them.\n\n";
+}
+
+void section_equations(std::ostringstream& md, const Derivation& d) {
+  const SymbolicModel& m = d.model;
+  md << "## 3. Kinematics\n\n"
+     << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton). Its rotation "
+        "matrix and rate:\n\n"
+     << "$$R(q) = \\begin{pmatrix} 1-2(q_y^2+q_z^2) & 2(q_xq_y-q_wq_z) & 2(q_xq_z+q_wq_y) \\\\ "
+        "2(q_xq_y+q_wq_z) & 1-2(q_x^2+q_z^2) & 2(q_yq_z-q_wq_x) \\\\ 2(q_xq_z-q_wq_y) & 2(q_yq_z+q_wq_x) & "
+        "1-2(q_x^2+q_y^2)\\end{pmatrix},\\qquad \\dot q = \\tfrac12\\, q \\otimes (0, \\omega)$$\n\n"
+     << "For reports, Z-Y-X Euler angles give $R = R_z(\\psi) R_y(\\theta) R_x(\\phi)$; the audit shows both "
+        "forms agree.\n\n";
+  md << "## 4. Forces and torques\n\n";
+  for (const auto& [name, e] : m.intermediates) {
+    md << "$$" << name << " = ";
+    if (is_a<matrix>(e)) md << tex_matrix(ex_to<matrix>(e));
+    else md << tex(e);
+    md << "$$\n\n";
+  }
+  md << "Thrust acts along body $+z$ at each rotor; a counter-clockwise rotor (seen from above) pushes "
+        "the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$. Drag acts at the centre "
+        "of gravity on the air-relative velocity in body axes.\n\n";
+  md << "## 5. Equations of motion\n\n"
+     << "Translation (D'Alembert: the inertial force balances the applied forces) for the centre of "
+        "gravity, expressed for the body origin that the logs record:\n\n"
+     << "$$\\dot v = R\\left(\\frac{F_{body}}{m} - \\dot\\omega\\times c - \\omega\\times(\\omega\\times c)\\right) - "
+        "g\\,e_z$$\n\n"
+     << "Rotation (angular-momentum balance about the centre of gravity, body axes):\n\n"
+     << "$$J\\dot\\omega = \\tau - \\omega \\times J\\omega$$\n\n"
+     << "Right-hand side rows short enough to read (the others are these vector equations written out; "
+        "the generated code holds them in full):\n\n";
+  for (size_t i = 0; i < m.states.size(); ++i) {
+    const std::string t = tex(m.f(i, 0));
+    if (t.size() < 600) md << "$$\\dot{" << tex(m.states[i].sym) << "} = " << t << "$$\n\n";
+  }
+  md << "Measured outputs: position and the logged attitude quaternion";
+  if (std::find(m.effects.begin(), m.effects.end(), "attitude_bias") != m.effects.end())
+    md << " $q_{log} = q \\otimes q_{bias}$";
+  md << ".\n\n";
+}
+
+void variable_table(std::ostringstream& md, const std::string& title, const std::vector<Variable>& vars, bool params) {
+  md << "### " << title << "\n\n";
+  if (params) md << "| # | name | unit | nominal | bounds | fit | meaning |\n|---|---|---|---|---|---|---|\n";
+  else md << "| # | name | unit | meaning |\n|---|---|---|---|\n";
+  for (size_t i = 0; i < vars.size(); ++i) {
+    const auto& v = vars[i];
+    md << "| " << i << " | `" << v.name << "` | " << v.unit << " | ";
+    if (params)
+      md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
+         << " | " << (v.fit ? "yes" : "no") << " | ";
+    md << v.doc << " |\n";
+  }
+  md << "\n";
+}
+
+void section_audit(std::ostringstream& md, const Derivation& d) {
+  md << "## 7. Audit\n\n**" << (d.audit.all_passed() ? "All checks passed." : "SOME CHECKS FAILED.") << "**\n\n"
+     << "| group | check | result | how |\n|---|---|---|---|\n";
+  for (const auto& c : d.audit.checks)
+    md << "| " << c.group << " | " << c.name << " | " << (c.passed ? "pass" : "**FAIL**") << " | " << c.detail << " |\n";
+  md << "\n";
+}
+
+void section_thesis(std::ostringstream& md, const Derivation& d) {
+  if (d.thesis.empty()) return;
+  md << "## 8. Comparison with the thesis\n\n"
+     << "The thesis' equations and numbers are encoded in `derive/thesis_reference.cpp`; each row compares "
+        "them with the derived model at its nominal parameters.\n\n"
+     << "| ref | topic | thesis | derived | verdict | cause | size |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& t : d.thesis)
+    md << "| " << t.ref << " | " << t.topic << " | " << t.thesis << " | " << t.derived << " | "
+       << (t.agrees ? "agrees" : "**differs**") << " | " << t.cause << " | " << t.size << " |\n";
+  md << "\n";
+}
+
+}  // namespace
+
+std::string derivation_markdown(const Derivation& d) {
+  std::ostringstream md;
+  md << "# Derivation of the flight model: " << d.vehicle.name << "\n\n"
+     << "Generated by quadgen " << QUADGEN_VERSION << " from `" << d.vehicle.source_path << "` (FNV-1a "
+     << d.vehicle.content_hash << "). Effects: "
+     << (d.model.effects.empty() ? std::string("none (base model)") : [&] {
+          std::string s;
+          for (const auto& e : d.model.effects) s += (s.empty() ? "" : ", ") + e;
+          return s;
+        }())
+     << ".\n\n";
+  section_vehicle(md, d);
+  section_mass(md, d);
+  section_equations(md, d);
+  md << "## 6. Variables\n\n";
+  variable_table(md, "States x", d.model.states, false);
+  variable_table(md, "Inputs u", d.model.inputs, false);
+  variable_table(md, "Parameters p", d.model.params, true);
+  section_audit(md, d);
+  section_thesis(md, d);
+  return md.str();
+}
+
+std::string model_json(const Derivation& d) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["quadgen_version"] = QUADGEN_VERSION;
+  j["vehicle"] = d.vehicle.name;
+  j["vehicle_hash"] = d.vehicle.content_hash;
+  j["effects"] = d.model.effects;
+  j["mass"] = d.mass.mass_value;
+  j["cog"] = d.mass.cog_value;
+  j["inertia"] = d.mass.inertia_cog_value;
+  j["inertia_about_origin"] = d.mass.inertia_origin_value;
+  j["areas"] = d.mass.areas_value;
+  auto vars = [](const std::vector<Variable>& vs, bool params) {
+    ordered_json a = ordered_json::array();
+    for (const auto& v : vs) {
+      ordered_json o;
+      o["name"] = v.name;
+      if (params) o["value"] = v.nominal;
+      o["unit"] = v.unit;
+      if (params) {
+        o["lower"] = v.lower;
+        o["upper"] = v.upper;
+        o["fit"] = v.fit;
+      }
+      o["meaning"] = v.doc;
+      a.push_back(o);
+    }
+    return a;
+  };
+  j["states"] = vars(d.model.states, false);
+  j["inputs"] = vars(d.model.inputs, false);
+  j["parameters"] = vars(d.model.params, true);
+  j["outputs"] = vars(d.model.outputs, false);
+  ordered_json blocks = ordered_json::array();
+  for (const auto& b : d.mass.blocks)
+    blocks.push_back({{"name", b.name}, {"inertia_about_origin", b.inertia_origin_value}, {"areas", b.areas_value}});
+  j["blocks"] = blocks;
+  ordered_json checks = ordered_json::array();
+  for (const auto& c : d.audit.checks)
+    checks.push_back({{"group", c.group}, {"check", c.name}, {"passed", c.passed}, {"detail", c.detail}});
+  j["audit"] = {{"passed", d.audit.all_passed()}, {"checks", checks}};
+  ordered_json th = ordered_json::array();
+  for (const auto& t : d.thesis)
+    th.push_back({{"ref", t.ref}, {"topic", t.topic}, {"thesis", t.thesis}, {"derived", t.derived},
+                  {"agrees", t.agrees}, {"cause", t.cause}, {"size", t.size}});
+  j["thesis_comparison"] = th;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace quadgen

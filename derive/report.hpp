@@ -1,0 +1,26 @@
+// What `quadgen derive` writes for people and programs: derivation.md (each step with
+// its equations in LaTeX, the audit, the thesis comparison) and model.json.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "audit.hpp"
+#include "geometry.hpp"
+#include "symbolic_model.hpp"
+#include "thesis_reference.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen {
+
+struct Derivation {
+  const Vehicle& vehicle;
+  const MassProperties& mass;
+  const SymbolicModel& model;
+  const AuditResult& audit;
+  const std::vector<ThesisItem>& thesis;  // empty for vehicles other than the FINken 3
+};
+
+std::string derivation_markdown(const Derivation& d);
+std::string model_json(const Derivation& d);
+
+}  // namespace quadgen

@@ -1,0 +1,56 @@
+// The symbolic flight model handed from the derivation to the code generator,
+// the audit and the report: named variables with units, f(x,u,p), the measurement
+// h(x,p), and their Jacobians, all as GiNaC expressions.
+#pragma once
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <ginac/ginac.h>
+
+#include "units.hpp"
+
+namespace quadgen {
+
+struct Variable {
+  std::string name;  // e.g. "vx", "u_A", "motor_gain.A"
+  GiNaC::symbol sym;
+  std::string unit;  // SI
+  Dimension dim;
+  double nominal = 0;
+  double lower = 0, upper = 0;
+  bool fit = false;
+  std::string doc;
+};
+
+struct SymbolicModel {
+  std::string vehicle_name;
+  std::string vehicle_hash;
+  std::vector<std::string> effects;  // canonical order
+  std::vector<Variable> states, inputs, params;
+  // Fixed numbers with units (rotor geometry): symbols in the derivation so that the
+  // unit audit sees their units, replaced by their exact values in generated code.
+  std::vector<Variable> constants;
+
+  GiNaC::matrix f;  // dx/dt, states.size() x 1
+  std::vector<Variable> outputs;  // what is measured (pose), names and units
+  GiNaC::matrix h;  // outputs.size() x 1, depends on x and p
+
+  GiNaC::matrix dfdx, dfdu, dfdp, dhdx, dhdp;
+
+  // Set when the input_delay effect is on: the runtime feeds u(t - delay) and uses
+  // dfdu * du/dt for the delay's sensitivity (a pure delay is not an ODE term).
+  std::optional<size_t> input_delay_param;
+
+  // Named intermediate expressions for the report (forces, torques, thrusts).
+  std::vector<std::pair<std::string, GiNaC::ex>> intermediates;
+
+  size_t state_index(const std::string& name) const;
+  size_t param_index(const std::string& name) const;
+  size_t input_index(const std::string& name) const;
+  GiNaC::lst nominal_substitution() const;  // params == nominal values
+  GiNaC::lst constant_substitution() const;  // constants == exact values
+};
+
+}  // namespace quadgen

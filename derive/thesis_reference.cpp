@@ -1,0 +1,282 @@
+#include "thesis_reference.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "audit.hpp"
+#include "kinematics.hpp"
+
+namespace quadgen {
+using namespace GiNaC;
+
+namespace {
+
+std::string fmt(const char* f, double a) {
+  char b[128];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+std::string fmt(const char* f, double a, double c) {
+  char b[160];
+  std::snprintf(b, sizeof b, f, a, c);
+  return b;
+}
+std::string fmt(const char* f, double a, double c, double d) {
+  char b[200];
+  std::snprintf(b, sizeof b, f, a, c, d);
+  return b;
+}
+double pct(double ours, double theirs) { return 100.0 * (theirs - ours) / ours; }
+
+struct Numbers {  // the derived model at its nominal parameters
+  double m, g, rho, c_w, Jxx, Jyy, Jzz, l;
+  std::array<double, 3> A, cog;
+};
+
+Numbers nominal(const SymbolicModel& model, const MassProperties& mp) {
+  auto P = [&](const char* n) { return model.params[model.param_index(n)].nominal; };
+  return Numbers{mp.mass_value, P("g"), P("rho"), P("c_w"),
+                 mp.inertia_cog_value[0][0], mp.inertia_cog_value[1][1], mp.inertia_cog_value[2][2],
+                 0.07465, mp.areas_value, mp.cog_value};
+}
+
+void transformation_items(std::vector<ThesisItem>& out) {
+  realsymbol phi("phi"), theta("theta"), psi("psi");
+  const matrix T = thesis_transformation(phi, theta, psi);
+  const matrix R = rotation_zyx(psi, theta, phi);
+  const ex det = reduce_trig(T.determinant(), {phi, theta, psi});
+  std::string entries;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!reduce_trig(T(i, j) - R(i, j), {phi, theta, psi}).is_zero())
+        entries += "(" + std::to_string(i + 1) + "," + std::to_string(j + 1) + ") ";
+  std::ostringstream d;
+  d << det;
+  out.push_back({"(3), (77)-(81)", "transformation matrix",
+                 "T = Tz Ty Tx with Ty(1,1) = -cos(theta) (78); det T = " + d.str(),
+                 "R = Rz(psi) Ry(theta) Rx(phi), R^T R = I, det R = +1 (audit)", false,
+                 "Ty of (78) has -cos(theta) where a rotation has +cos(theta), so T is a reflection "
+                 "(det -1), and Tx, Tz (77), (79) are transposed (world->body) while T is used "
+                 "body->world. Entries that differ from R: " + entries,
+                 "thrust direction (third column): entry (2,3) has the wrong sign, so a roll angle "
+                 "phi accelerates the wrong way in y: at phi = 10 deg, 1.70 m/s^2 of hover thrust "
+                 "points the other way"});
+}
+
+void translation_items(std::vector<ThesisItem>& out, const Numbers& n) {
+  out.push_back({"(22)-(24), (53)", "translation: gyroscopic term",
+                 "a = (dphi/dt, dtheta/dt, dpsi/dt) x (dX/dt, dY/dt, dZ/dt) + ...",
+                 "a_world = R F_body / m - g e_z - R(dω/dt x c + ω x (ω x c)); no ω x v term", false,
+                 "with velocity in world axes, Newton's law has no ω x v term; it appears only for "
+                 "velocity in body axes (and then with body rates, not Euler-angle rates)",
+                 "|ω x v| = 1 m/s^2 for 1 rad/s and 1 m/s at right angles: the size of the "
+                 "thrust-induced acceleration of a 10 deg tilt"});
+  const double k_thesis[3] = {0.5 * 0.7 * 7.985e-3 * 1.225, 0.5 * 0.7 * 7.575e-3 * 1.225,
+                              0.5 * 0.7 * 1.2672e-2 * 1.225};
+  double k_ours[3];
+  for (int i = 0; i < 3; ++i) k_ours[i] = 0.5 * n.c_w * n.rho * n.A[i];
+  out.push_back({"(29), (33), (62)", "air drag",
+                 fmt("F = 1/2 c_w A rho v^2, rho = 1.225; coefficients %.4g, %.4g, %.4g N s^2/m^2", k_thesis[0],
+                     k_thesis[1], k_thesis[2]),
+                 fmt("F_body = -1/2 c_w rho A_i v_i |v_i| per body axis, rho = %.5g; coefficients ", n.rho) +
+                     fmt("%.4g, %.4g, %.4g N s^2/m^2", k_ours[0], k_ours[1], k_ours[2]),
+                 false,
+                 "v^2 loses the sign (drag must oppose motion: v|v|); the thesis applies body-axis "
+                 "areas to world-axis velocities; (62) squares the acceleration instead of the velocity "
+                 "and does not divide by m; rho differs between (27) and 2.3.4",
+                 fmt("coefficients differ by %+.0f %%, %+.0f %%, ", pct(k_ours[0], k_thesis[0]),
+                     pct(k_ours[1], k_thesis[1])) +
+                     fmt("%+.0f %% (thesis relative to derived; areas and rho); with v^2 a descent at 1 m/s "
+                         "gets %.3g N of drag pushing down instead of up", pct(k_ours[2], k_thesis[2]), k_thesis[2]) +
+                     fmt(" (%.2g m/s^2 each way)", k_thesis[2] / n.m)});
+}
+
+void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, const Numbers& n) {
+  // Torque (34) against the model's torque with the CoG at the origin and D_i = kappa F_i.
+  ex tau;
+  for (const auto& [name, e] : model.intermediates)
+    if (name == "\\tau") tau = e;
+  auto P = [&](const char* s) { return model.params[model.param_index(s)].sym; };
+  lst at_origin{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
+  bool torque_agrees = true;
+  if (model.vehicle_name == "finken3" && model.effects.empty()) {
+    ex F[4];
+    for (int i = 0; i < 4; ++i)
+      for (const auto& [name, e] : model.intermediates)
+        if (name == std::string("F_") + "ABCD"[i]) F[i] = e;
+    const ex kappa = P("kappa");
+    ex l;
+    for (const auto& c : model.constants)
+      if (c.name == "C.x") l = c.sym;  // the thesis' l, rotor C at (+l, +l)
+    const ex thesis[3] = {((F[2] + F[3]) - (F[0] + F[1])) * l, ((F[0] + F[3]) - (F[1] + F[2])) * l,
+                          kappa * (-F[0] + F[1] - F[2] + F[3])};
+    lst same_arm;  // the thesis' single l: every rotor at (±l, ±l, 0)
+    for (const auto& c : model.constants) {
+      const double v = c.nominal;
+      if (c.name.size() == 3 && (c.name[2] == 'x' || c.name[2] == 'y')) same_arm.append(c.sym == (v > 0 ? l : -l));
+      if (c.name.size() == 3 && c.name[2] == 'z') same_arm.append(c.sym == 0);
+    }
+    const matrix t = ex_to<matrix>(tau.subs(at_origin).subs(same_arm));
+    for (int i = 0; i < 3; ++i)
+      if (!normal(t(i, 0) - thesis[i]).is_zero()) torque_agrees = false;
+  }
+  out.push_back({"(34)", "torques from thrust and rotor drag",
+                 "M = (((F_C+F_D)-(F_A+F_B)) l, ((F_A+F_D)-(F_B+F_C)) l, -D_A+D_B-D_C+D_D)",
+                 "τ = Σ (r_i - c) × F_i e_z + Σ ∓kappa F_i e_z, symbolically", torque_agrees,
+                 torque_agrees ? "" : "torque differs",
+                 torque_agrees ? "identical when the CoG is at the origin and D_i = kappa F_i; the derived "
+                                 "model adds the CoG lever arm (c_z = " +
+                                     fmt("%.2f mm)", n.cog[2] * 1e3)
+                               : ""});
+  out.push_back({"(35)-(38), (54)", "rotation: gyroscopic term",
+                 "J d^2(phi,theta,psi)/dt^2 = +((J_zz-J_yy) dtheta dpsi, (J_xx-J_zz) dphi dpsi, (J_yy-J_xx) dphi dtheta) + M",
+                 "J dω/dt = τ - ω × Jω, i.e. J_xx dp/dt = (J_yy - J_zz) q r + ... for diagonal J", false,
+                 "the sign of ω × Jω is reversed in (35)/(36); Euler-angle rates stand in for body rates "
+                 "(equal only at zero attitude); d/dt(Jω) = J dω/dt holds only in body axes",
+                 fmt("at q = r = 1 rad/s the gyroscopic roll acceleration is off by %.3g rad/s^2: the "
+                     "opposite sign of %.3g",
+                     2 * std::fabs(n.Jyy - n.Jzz) / n.Jxx, std::fabs(n.Jyy - n.Jzz) / n.Jxx)});
+}
+
+void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
+  // Table 1 per thesis block index, about the body origin: 1 = motor blocks at -x (A, D),
+  // 2 = arms at -x, 3 = lower block, 4 = upper block, 5 = arms at +x, 6 = motor blocks at +x.
+  const double t1[6][4] = {{4.079e-4, 2.058e-4, 4.033e-4, 0.144e-4}, {0.596e-4, 0.465e-4, 1.646e-4, 1.4e-8},
+                           {1.198e-4, 2.539e-4, 0.792e-4, 0},        {1.956e-4, 1.956e-4, 0.495e-4, 0},
+                           {0.596e-4, 0.465e-4, 1.646e-4, -1.4e-8},  {4.079e-4, 2.058e-4, 4.033e-4, -0.144e-4}};
+  const char* groups[6][2] = {{"motor_A", "motor_D"}, {"arm_A", "arm_D"}, {"lower_body", ""},
+                              {"upper_body", ""},     {"arm_B", "arm_C"}, {"motor_B", "motor_C"}};
+  std::ostringstream thesis, ours;
+  double worst = 0;
+  for (int g = 0; g < 6; ++g) {
+    double J[4] = {0, 0, 0, 0};
+    for (const auto& bc : mp.blocks)
+      if (bc.name == groups[g][0] || bc.name == groups[g][1]) {
+        J[0] += bc.inertia_origin_value[0][0];
+        J[1] += bc.inertia_origin_value[1][1];
+        J[2] += bc.inertia_origin_value[2][2];
+        J[3] += bc.inertia_origin_value[0][2];
+      }
+    thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[g][0], t1[g][1]) << fmt("%.4g; ", t1[g][2]);
+    ours << fmt("%.0f: %.4g, %.4g, ", g + 1, J[0], J[1]) << fmt("%.4g; ", J[2]);
+    for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(pct(J[k], t1[g][k])));
+  }
+  out.push_back({"Table 1", "inertia per block (J_xx, J_yy, J_zz about the origin, kg m^2)", thesis.str(),
+                 ours.str(), false,
+                 "the thesis integrates motor blocks and arms over parallelograms between y = ±x ± w "
+                 "(2.2.4.3) instead of rotated cuboids, and leaves the integration variable x in the "
+                 "result (J_xx = 0.0932 x^2 + 7.309e-4, then x := 0.07465 m): a definite integral cannot "
+                 "depend on its integration variable",
+                 fmt("largest per-entry difference %.0f %%", worst)});
+  const double thesis_J[3] = {1.25e-3, 9.541e-4, 1.43e-3};
+  const double ours_J[3] = {n.Jxx, n.Jyy, n.Jzz};
+  out.push_back({"(41)-(45), (52)", "inertia tensor",
+                 fmt("J = diag(%.4g, %.4g, %.4g) kg m^2, off-diagonal 0", thesis_J[0], thesis_J[1], thesis_J[2]),
+                 fmt("J_cg = diag(%.4g, %.4g, %.4g) kg m^2", ours_J[0], ours_J[1], ours_J[2]) +
+                     fmt(", J_xz = %.3g (about the CoG)", mp.inertia_cog_value[0][2]),
+                 false,
+                 "besides the per-block causes: J_xx != J_yy although arms and motors are symmetric "
+                 "under a 90 deg turn; Table 1 sums to J_zz = 1.2645e-3 but (45) states 1.43e-3 "
+                 "(the x^2 term); the thesis' J is about the origin, the dynamics need it about the CoG",
+                 fmt("J_xx %+.0f %%, J_yy %+.0f %%, J_zz %+.0f %% (thesis relative to derived)",
+                     pct(ours_J[0], thesis_J[0]), pct(ours_J[1], thesis_J[1]), pct(ours_J[2], thesis_J[2]))});
+}
+
+void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
+  const double tA[3] = {7.985e-3, 7.575e-3, 1.2672e-2};
+  out.push_back({"(30)-(32)", "exposed areas",
+                 fmt("A = (%.4g, %.4g, %.4g) m^2", tA[0], tA[1], tA[2]),
+                 fmt("A = (%.4g, %.4g, %.4g) m^2 (sum of block projections)", n.A[0], n.A[1], n.A[2]), false,
+                 "the thesis does not state how blocks were combined; quadgen sums each block's "
+                 "projected area without occlusion (an upper bound), rotated blocks included",
+                 fmt("%+.0f %%, %+.0f %%, %+.0f %% (thesis relative to derived)", pct(n.A[0], tA[0]),
+                     pct(n.A[1], tA[1]), pct(n.A[2], tA[2]))});
+  out.push_back({"(16)-(18)", "centre of gravity",
+                 "R_sp = (0, 0, 0.94 mm) [printed as 0,00094 cm; 0.832 % of 113 mm], then set to 0 (18)",
+                 fmt("c = (%.3g, %.3g, %.3g) mm", n.cog[0] * 1e3, n.cog[1] * 1e3, n.cog[2] * 1e3), false,
+                 "quadgen keeps the CoG offset in the equations (torque arms, origin kinematics); "
+                 "the thesis' 0.94 mm cannot be reproduced from its own blocks and limits",
+                 fmt("c_z differs by %.2f mm; at 10 deg tilt the weight's lever arm gives %.2g N m", 1e3 * n.cog[2] - 0.94,
+                     n.m * n.g * n.cog[2] * std::sin(10 * M_PI / 180))});
+  out.push_back({"1.1, appendix A, (14)", "mass",
+                 "387 g in total; arm mass 0.039 kg (appendix A) but density (14) implies 0.019 kg",
+                 fmt("m = %.4g kg from the blocks with 0.019 kg per arm", mp.mass_value),
+                 std::fabs(mp.mass_value - 0.387) < 1e-9, "",
+                 "total agrees; with 0.039 kg per arm the blocks would weigh 0.467 kg"});
+}
+
+// Vertical climb from rest with drag, m z'' = 4.4 N - m g - k z'|z'|, by RK4 (1 ms steps).
+double climb_height(const Numbers& n, double force, double seconds) {
+  const double k = 0.5 * n.c_w * n.rho * n.A[2];
+  auto acc = [&](double v) { return force / n.m - n.g - k * v * std::fabs(v) / n.m; };
+  double z = 0, v = 0;
+  const double h = 1e-3;
+  for (int i = 0; i < static_cast<int>(seconds / h + 0.5); ++i) {
+    const double k1v = acc(v), k1z = v;
+    const double k2v = acc(v + h / 2 * k1v), k2z = v + h / 2 * k1v;
+    const double k3v = acc(v + h / 2 * k2v), k3z = v + h / 2 * k2v;
+    const double k4v = acc(v + h * k3v), k4z = v + h * k3v;
+    v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    z += h / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
+  }
+  return z;
+}
+
+void evaluation_items(std::vector<ThesisItem>& out, const Numbers& n) {
+  const double hover = n.m * n.g;
+  out.push_back({"(59), (60)", "hover thrust", "F_M = 3.7965 N, 0.9491 N per rotor",
+                 fmt("F_M = m g = %.5g N, %.4g N per rotor", hover, hover / 4),
+                 std::fabs(hover - 3.7965) < 5e-4, "", "agrees"});
+  const double a = 4.4 / n.m - n.g;
+  const double z1 = climb_height(n, 4.4, 1.0);
+  out.push_back({"(63), (64)", "climb with 1.1 N per rotor", "a_z = 1.56 m/s^2, z(1 s) = 0.78 m",
+                 fmt("a_z(0) = %.3g m/s^2; z(1 s) = %.4g m with drag (0.5 a t^2 = ", a, z1) +
+                     fmt("%.3g m without)", 0.5 * a),
+                 std::fabs(a - 1.56) < 0.005 && std::fabs(0.5 * a - 0.78) < 0.005, "",
+                 fmt("agrees; drag at the final 1.56 m/s lowers z(1 s) by %.2g mm", (0.5 * a - z1) * 1e3)});
+  const double tau = 0.2 * n.l;
+  const double theta_dd = tau / n.Jyy, phi_dd = tau / n.Jxx;
+  out.push_back({"(65), (67), (68)", "fly right: F_A = F_D = 1.1 N, F_B = F_C = 1.0 N",
+                 "theta'' = 15.648 deg/s^2, theta(1 s) = 7.824 deg, a = (1.476, 0, 0.94) m/s^2, x(1 s) = 0.738 m",
+                 fmt("theta'' = %.4g rad/s^2 (= %.4g deg/s^2) with the derived J_yy; a = (0, 0, ", theta_dd,
+                     theta_dd * 180 / M_PI) +
+                     fmt("%.3g) m/s^2 at t = 0", 4.2 / n.m - n.g),
+                 false,
+                 "0.2 N x 0.07465 m / 9.541e-4 kg m^2 = 15.648 rad/s^2, not deg/s^2: a unit error. "
+                 "The single-step evaluation then takes the tilt reached after 1 s as if present from "
+                 "the start; the true tilt after 1 s at this torque is 7.8 rad (the vehicle flips)",
+                 fmt("factor 57.3 in the angular acceleration; at t = 0 the derived a_x is 0 (thrust still "
+                     "vertical), and it reaches 1.48 m/s^2 after %.3g s, not 1 s",
+                     std::sqrt(2 * 7.824 * M_PI / 180 / theta_dd))});
+  out.push_back({"(69), (71), (72)", "fly forward: F_A = F_B = 1.0 N, F_C = F_D = 1.1 N",
+                 "phi'' = 11.944 deg/s^2, a = (0, +1.129, 0.984) m/s^2, y(1 s) = +0.565 m",
+                 fmt("phi'' = %.4g rad/s^2; positive roll tilts thrust towards -y, so a_y < 0", phi_dd), false,
+                 "the same unit error, and the sign error of T(2,3): with R = Rz Ry Rx, raising C and D "
+                 "(+y side) rolls positive and accelerates the vehicle in -y",
+                 "sign of a_y reversed; magnitude off by the unit error as in (65)"});
+}
+
+}  // namespace
+
+matrix thesis_transformation(const ex& phi, const ex& theta, const ex& psi) {
+  const ex cf = cos(phi), sf = sin(phi), ct = cos(theta), st = sin(theta), cp = cos(psi), sp = sin(psi);
+  return matrix(3, 3,
+                lst{-cp * ct, sp * cf - cp * st * sf, sp * sf + cp * st * cf,  //
+                    sp * ct, cp * cf + sp * st * sf, cp * sf - sp * st * cf,   //
+                    st, -ct * sf, ct * cf});
+}
+
+std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp) {
+  std::vector<ThesisItem> out;
+  const Numbers n = nominal(m, mp);
+  transformation_items(out);
+  translation_items(out, n);
+  rotation_items(out, m, n);
+  inertia_items(out, mp, n);
+  geometry_items(out, mp, n);
+  evaluation_items(out, n);
+  return out;
+}
+
+}  // namespace quadgen

@@ -1,0 +1,28 @@
+// The thesis' published equations and numbers, encoded as a reference, and their
+// comparison with the derived model: what agrees, what differs, why, and by how much.
+// Only meaningful for the FINken 3 (vehicle name "finken3").
+#pragma once
+#include <string>
+#include <vector>
+
+#include "geometry.hpp"
+#include "symbolic_model.hpp"
+
+namespace quadgen {
+
+struct ThesisItem {
+  std::string ref;      // equation numbers, e.g. "(42)-(45), Table 1"
+  std::string topic;
+  std::string thesis;   // what the thesis says
+  std::string derived;  // what quadgen derives
+  bool agrees = false;
+  std::string cause;    // why they differ (physics or algebra), empty when they agree
+  std::string size;     // how large the difference is numerically
+};
+
+std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp);
+
+// The thesis' transformation matrix (3)/(81), as printed.
+GiNaC::matrix thesis_transformation(const GiNaC::ex& phi, const GiNaC::ex& theta, const GiNaC::ex& psi);
+
+}  // namespace quadgen

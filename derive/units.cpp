@@ -1,0 +1,187 @@
+#include "units.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "symbolic_functions.hpp"
+
+namespace quadgen {
+
+Dimension Dimension::operator*(const Dimension& o) const {
+  Dimension r;
+  for (int i = 0; i < 4; ++i) r.exp[i] = exp[i] + o.exp[i];
+  return r;
+}
+Dimension Dimension::operator/(const Dimension& o) const {
+  Dimension r;
+  for (int i = 0; i < 4; ++i) r.exp[i] = exp[i] - o.exp[i];
+  return r;
+}
+Dimension Dimension::pow(int n) const {
+  Dimension r;
+  for (int i = 0; i < 4; ++i) r.exp[i] = exp[i] * n;
+  return r;
+}
+std::string Dimension::str() const {
+  static const char* names[] = {"m", "kg", "s", "A"};
+  std::ostringstream os;
+  bool first = true;
+  for (int i = 0; i < 4; ++i) {
+    if (exp[i] == 0) continue;
+    if (!first) os << ' ';
+    first = false;
+    os << names[i];
+    if (exp[i] != 1) os << '^' << exp[i];
+  }
+  return first ? "1" : os.str();
+}
+
+namespace {
+
+Unit base(double scale, int m, int kg, int s, int a) {
+  Unit u;
+  u.scale = scale;
+  u.dim.exp = {m, kg, s, a};
+  return u;
+}
+
+const std::map<std::string, Unit>& unit_table() {
+  const double pi = 3.14159265358979323846;
+  static const std::map<std::string, Unit> table = {
+      {"1", base(1, 0, 0, 0, 0)},        {"rad", base(1, 0, 0, 0, 0)},
+      {"deg", base(pi / 180, 0, 0, 0, 0)}, {"m", base(1, 1, 0, 0, 0)},
+      {"mm", base(1e-3, 1, 0, 0, 0)},    {"cm", base(1e-2, 1, 0, 0, 0)},
+      {"kg", base(1, 0, 1, 0, 0)},       {"g", base(1e-3, 0, 1, 0, 0)},
+      {"s", base(1, 0, 0, 1, 0)},        {"ms", base(1e-3, 0, 0, 1, 0)},
+      {"min", base(60, 0, 0, 1, 0)},     {"A", base(1, 0, 0, 0, 1)},
+      {"N", base(1, 1, 1, -2, 0)},       {"V", base(1, 2, 1, -3, -1)},
+      {"W", base(1, 2, 1, -3, 0)},       {"Hz", base(1, 0, 0, -1, 0)},
+      {"rpm", base(2 * pi / 60, 0, 0, -1, 0)},  // revolutions per minute -> rad/s
+  };
+  return table;
+}
+
+// One factor "name" or "name^k".
+Unit parse_factor(const std::string& tok, const std::string& whole) {
+  std::string name = tok;
+  int power = 1;
+  auto caret = tok.find('^');
+  if (caret != std::string::npos) {
+    name = tok.substr(0, caret);
+    std::string p = tok.substr(caret + 1);
+    try {
+      size_t used = 0;
+      power = std::stoi(p, &used);
+      if (used != p.size()) throw std::invalid_argument(p);
+    } catch (const std::exception&) {
+      throw UnitError("unit '" + whole + "': exponent '" + p + "' is not an integer");
+    }
+  }
+  auto it = unit_table().find(name);
+  if (it == unit_table().end())
+    throw UnitError("unit '" + whole + "': unknown unit '" + name + "'");
+  Unit u;
+  u.scale = std::pow(it->second.scale, power);
+  u.dim = it->second.dim.pow(power);
+  return u;
+}
+
+}  // namespace
+
+Unit parse_unit(const std::string& text) {
+  // Grammar: factors separated by spaces or '*'; one optional '/' after which all
+  // factors are in the denominator ("N s/m", "kg/m^3", "1/s").
+  Unit result;
+  bool denominator = false;
+  std::string tok;
+  auto flush = [&]() {
+    if (tok.empty()) return;
+    Unit f = parse_factor(tok, text);
+    if (denominator) {
+      result.scale /= f.scale;
+      result.dim = result.dim / f.dim;
+    } else {
+      result.scale *= f.scale;
+      result.dim = result.dim * f.dim;
+    }
+    tok.clear();
+  };
+  if (text.empty()) throw UnitError("empty unit (write \"1\" for dimensionless)");
+  for (char c : text) {
+    if (c == ' ' || c == '*') {
+      flush();
+    } else if (c == '/') {
+      flush();
+      if (denominator) throw UnitError("unit '" + text + "': more than one '/'");
+      denominator = true;
+    } else {
+      tok += c;
+    }
+  }
+  flush();
+  return result;
+}
+
+void DimensionChecker::declare(const GiNaC::symbol& s, const Dimension& d) { dims_[s] = d; }
+
+Dimension DimensionChecker::infer(const GiNaC::ex& e) const {
+  using namespace GiNaC;
+  auto fail = [&](const std::string& why) {
+    std::ostringstream os;
+    os << why << " in " << e;
+    throw UnitError(os.str());
+  };
+  if (is_a<numeric>(e) || is_a<constant>(e)) return Dimension{};
+  if (is_a<symbol>(e)) {
+    auto it = dims_.find(e);
+    if (it == dims_.end()) fail("symbol without a unit");
+    return it->second;
+  }
+  if (is_a<add>(e)) {
+    Dimension d = infer(e.op(0));
+    for (size_t i = 1; i < e.nops(); ++i) {
+      Dimension di = infer(e.op(i));
+      if (di != d) {
+        std::ostringstream os;
+        os << "sum of terms with different units: [" << d.str() << "] " << e.op(0) << " vs ["
+           << di.str() << "] " << e.op(i);
+        fail(os.str());
+      }
+    }
+    return d;
+  }
+  if (is_a<mul>(e)) {
+    Dimension d;
+    for (size_t i = 0; i < e.nops(); ++i) d = d * infer(e.op(i));
+    return d;
+  }
+  if (is_a<power>(e)) {
+    Dimension b = infer(e.op(0));
+    const ex& x = e.op(1);
+    if (b.dimensionless()) {
+      if (!infer(x).dimensionless()) fail("exponent with a unit");
+      return b;
+    }
+    if (!is_a<numeric>(x) || !ex_to<numeric>(x).is_rational()) fail("non-rational power of a quantity with a unit");
+    const numeric n = ex_to<numeric>(x);
+    Dimension r;
+    for (int i = 0; i < 4; ++i) {
+      numeric v = n * b.exp[i];
+      if (!v.is_integer()) fail("fractional power leaves a fractional unit");
+      r.exp[i] = v.to_int();
+    }
+    return r;
+  }
+  if (is_a<function>(e)) {
+    // |x| and sign(x) keep or drop the unit; every other function needs a pure number.
+    if (is_ex_the_function(e, abs_value)) return infer(e.op(0));
+    if (is_ex_the_function(e, sign_of)) return Dimension{};
+    for (size_t i = 0; i < e.nops(); ++i)
+      if (!infer(e.op(i)).dimensionless()) fail("function of a quantity with a unit");
+    return Dimension{};
+  }
+  fail("expression type the unit checker does not know");
+  return Dimension{};
+}
+
+}  // namespace quadgen

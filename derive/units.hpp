@@ -1,0 +1,53 @@
+// Physical units: parsing unit strings into a scale to SI and a dimension vector,
+// and dimensional analysis of GiNaC expressions.
+#pragma once
+#include <array>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include <ginac/ginac.h>
+
+namespace quadgen {
+
+// Exponents of the SI base dimensions the models use: length, mass, time, current.
+// Angles (rad) are dimensionless, as in SI.
+struct Dimension {
+  std::array<int, 4> exp{0, 0, 0, 0};  // m, kg, s, A
+
+  bool dimensionless() const { return exp == std::array<int, 4>{0, 0, 0, 0}; }
+  bool operator==(const Dimension& o) const { return exp == o.exp; }
+  bool operator!=(const Dimension& o) const { return exp != o.exp; }
+  Dimension operator*(const Dimension& o) const;
+  Dimension operator/(const Dimension& o) const;
+  Dimension pow(int n) const;
+  std::string str() const;  // e.g. "kg m s^-2", "1"
+};
+
+// A parsed unit: value_in_SI = value_in_unit * scale.
+struct Unit {
+  double scale = 1.0;
+  Dimension dim;
+};
+
+struct UnitError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Parses "kg m^2", "N s/m", "m/s^2", "rpm", "deg", "1". Throws UnitError.
+Unit parse_unit(const std::string& text);
+
+// Dimensional analysis: maps every symbol to its dimension and infers the dimension
+// of an expression, requiring every term of a sum to agree and every function
+// argument and symbolic exponent to be dimensionless.
+class DimensionChecker {
+ public:
+  void declare(const GiNaC::symbol& s, const Dimension& d);
+  // Returns the dimension or throws UnitError naming the offending sub-expression.
+  Dimension infer(const GiNaC::ex& e) const;
+
+ private:
+  std::map<GiNaC::ex, Dimension, GiNaC::ex_is_less> dims_;
+};
+
+}  // namespace quadgen

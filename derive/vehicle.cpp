@@ -1,0 +1,298 @@
+#include "vehicle.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace quadgen {
+namespace {
+
+// Parsing context: builds "file:line: message" errors.
+struct Reader {
+  std::string path;
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    std::ostringstream os;
+    os << path;
+    if (at.IsDefined() && at.Mark().line >= 0) os << ':' << at.Mark().line + 1;
+    os << ": " << what;
+    throw VehicleError(os.str());
+  }
+  [[noreturn]] void fail_at(const YAML::Mark& m, const std::string& what) const {
+    std::ostringstream os;
+    os << path << ':' << m.line + 1 << ": " << what;
+    throw VehicleError(os.str());
+  }
+
+  void require_map(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsMap()) fail(n, "expected " + what + " (a mapping of keys)");
+  }
+
+  // Rejects keys not in `allowed`, so that a typo never silently drops a number.
+  void only_keys(const YAML::Node& n, const std::set<std::string>& allowed,
+                 const std::string& where) const {
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (!allowed.count(key)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(kv.first, "unknown key '" + key + "' in " + where + " (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  const YAML::Node need(const YAML::Node& parent, const std::string& key,
+                        const std::string& where) const {
+    const YAML::Node n = parent[key];
+    if (!n) fail(parent, "missing key '" + key + "' in " + where);
+    return n;
+  }
+
+  double number(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected a number for " + what);
+    double v;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(n, "expected a number for " + what + ", got '" + n.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + n.Scalar() + "'");
+    return v;
+  }
+
+  double positive(const YAML::Node& n, const std::string& what) const {
+    double v = number(n, what);
+    if (!(v > 0)) fail(n, "expected a positive number for " + what + ", got " + n.Scalar());
+    return v;
+  }
+
+  Vec3 vec3(const YAML::Node& n, const std::string& what, bool must_be_positive = false) const {
+    if (!n.IsSequence() || n.size() != 3) fail(n, "expected a list of 3 numbers for " + what);
+    Vec3 v;
+    for (int i = 0; i < 3; ++i)
+      v[i] = must_be_positive ? positive(n[i], what) : number(n[i], what);
+    return v;
+  }
+
+  std::string text(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected text for " + what);
+    return n.Scalar();
+  }
+
+  // A parameter is either a bare number (in the SI unit) or
+  // {value, unit, bounds: [lo, hi], fit: bool}.
+  Parameter parameter(const YAML::Node& n, const std::string& name, const std::string& si_unit,
+                      const std::string& doc) const {
+    Parameter p;
+    p.name = name;
+    p.unit = si_unit;
+    p.doc = doc;
+    const Unit si = parse_unit(si_unit);
+    p.dim = si.dim;
+    double scale = 1.0;
+    if (n.IsScalar()) {
+      p.value = number(n, name);
+    } else {
+      require_map(n, "parameter " + name);
+      only_keys(n, {"value", "unit", "bounds", "fit", "source"}, "parameter " + name);
+      if (n["unit"]) {
+        Unit u;
+        try {
+          u = parse_unit(text(n["unit"], "unit of " + name));
+        } catch (const UnitError& e) {
+          fail(n["unit"], e.what());
+        }
+        if (u.dim != si.dim)
+          fail(n["unit"], "unit of " + name + " must have dimension " + si.dim.str() + ", got " + u.dim.str());
+        scale = u.scale / si.scale;
+      }
+      p.value = number(need(n, "value", "parameter " + name), name) * scale;
+      if (n["bounds"]) {
+        const YAML::Node b = n["bounds"];
+        if (!b.IsSequence() || b.size() != 2) fail(b, "expected bounds [lower, upper] for " + name);
+        p.lower = number(b[0], "lower bound of " + name) * scale;
+        p.upper = number(b[1], "upper bound of " + name) * scale;
+        if (!(p.lower < p.upper)) fail(b, "expected lower < upper in bounds of " + name);
+        if (p.value < p.lower || p.value > p.upper)
+          fail(b, "nominal value of " + name + " lies outside its bounds");
+      }
+      if (n["fit"]) {
+        try {
+          p.fit = n["fit"].as<bool>();
+        } catch (const YAML::Exception&) {
+          fail(n["fit"], "expected true or false for fit of " + name);
+        }
+      }
+      if (p.fit && !n["bounds"]) fail(n, "parameter " + name + " is to be fitted but has no bounds");
+    }
+    if (p.lower == 0 && p.upper == 0) {  // no bounds given: the nominal value only
+      p.lower = p.upper = p.value;
+    }
+    return p;
+  }
+};
+
+Block read_block(const Reader& r, const YAML::Node& n) {
+  r.require_map(n, "a block");
+  r.only_keys(n, {"name", "mass", "size", "centre", "orientation_deg", "source"}, "block");
+  Block b;
+  b.line = n.Mark().line + 1;
+  b.name = r.text(r.need(n, "name", "block"), "block name");
+  const std::string where = "block '" + b.name + "'";
+  b.mass = r.positive(r.need(n, "mass", where), "mass of " + where + " [kg]");
+  b.size = r.vec3(r.need(n, "size", where), "size of " + where + " [m]", true);
+  b.centre = r.vec3(r.need(n, "centre", where), "centre of " + where + " [m]");
+  if (n["orientation_deg"])
+    b.yaw_pitch_roll_deg = r.vec3(n["orientation_deg"], "orientation of " + where + " [yaw, pitch, roll in deg]");
+  return b;
+}
+
+Rotor read_rotor(const Reader& r, const YAML::Node& n) {
+  r.require_map(n, "a rotor");
+  r.only_keys(n, {"name", "position", "spin", "radius", "disc_area", "source"}, "rotor");
+  Rotor ro;
+  ro.line = n.Mark().line + 1;
+  ro.name = r.text(r.need(n, "name", "rotor"), "rotor name");
+  const std::string where = "rotor '" + ro.name + "'";
+  for (char c : ro.name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
+      r.fail(n["name"], "rotor name '" + ro.name + "' must be letters, digits and '_' (it becomes a CSV column u_" + ro.name + ")");
+  ro.position = r.vec3(r.need(n, "position", where), "position of " + where + " [m]");
+  const std::string spin = r.text(r.need(n, "spin", where), "spin of " + where);
+  if (spin == "ccw") ro.spin = Spin::ccw;
+  else if (spin == "cw") ro.spin = Spin::cw;
+  else r.fail(n["spin"], "expected spin 'ccw' or 'cw' (seen from above) for " + where + ", got '" + spin + "'");
+  ro.radius = r.positive(r.need(n, "radius", where), "radius of " + where + " [m]");
+  ro.disc_area = r.positive(r.need(n, "disc_area", where), "disc_area of " + where + " [m^2]");
+  return ro;
+}
+
+void read_section(const Reader& r, const YAML::Node& root, Vehicle& v, const std::string& section,
+                  const std::vector<std::array<std::string, 4>>& specs) {
+  // specs: {key, SI unit, required ("1") or optional ("0"), doc}
+  const YAML::Node s = root[section];
+  if (!s) r.fail(root, "missing section '" + section + "'");
+  r.require_map(s, "section '" + section + "'");
+  std::set<std::string> keys{"source"};
+  for (const auto& sp : specs) keys.insert(sp[0]);
+  r.only_keys(s, keys, "section '" + section + "'");
+  for (const auto& sp : specs) {
+    if (!s[sp[0]]) {
+      if (sp[2] == "1") r.fail(s, "missing key '" + sp[0] + "' in section '" + section + "'");
+      continue;
+    }
+    v.params[sp[0]] = r.parameter(s[sp[0]], sp[0], sp[1], sp[3]);
+  }
+}
+
+}  // namespace
+
+std::string fnv1a_hex(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+Vehicle parse_vehicle(const std::string& content, const std::string& path) {
+  Reader r{path};
+  YAML::Node root;
+  try {
+    root = YAML::Load(content);
+  } catch (const YAML::ParserException& e) {
+    r.fail_at(e.mark, "malformed YAML: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
+  r.require_map(root, "a vehicle description");
+  r.only_keys(root, {"name", "description", "environment", "frame", "rotor_model", "motor_map",
+                     "battery", "blocks", "rotors", "derived"},
+              "the vehicle file");
+  Vehicle v;
+  v.source_path = path;
+  v.content_hash = fnv1a_hex(content);
+  v.name = r.text(r.need(root, "name", "the vehicle file"), "vehicle name");
+  if (root["description"]) v.description = r.text(root["description"], "description");
+
+  read_section(r, root, v, "environment",
+               {{{"g", "m/s^2", "1", "gravitational acceleration"},
+                 {"rho", "kg/m^3", "1", "air density"}}});
+  read_section(r, root, v, "frame", {{{"c_w", "1", "drag coefficient of the frame"}}});
+  read_section(r, root, v, "rotor_model",
+               {{{"c_t", "1", "thrust coefficient of F = c_t rho A_p (omega r_p)^2"},
+                 {"kappa", "m", "yaw torque per thrust, Q = kappa F"}}});
+  read_section(r, root, v, "motor_map",
+               {{{"a0", "rad/s", "1", "rotor speed at zero command"},
+                 {"a1", "rad/s", "1", "rotor speed per command"},
+                 {"a2", "rad/s", "1", "rotor speed per command squared"}}});
+  if (root["battery"])
+    read_section(r, root, v, "battery", {{{"vbat_ref", "V", "1", "reference battery voltage"}}});
+  else
+    v.params["vbat_ref"] = Parameter{"vbat_ref", 4.0, "V", parse_unit("V").dim, 4.0, 4.0, false,
+                                     "reference battery voltage"};
+
+  const YAML::Node blocks = r.need(root, "blocks", "the vehicle file");
+  if (!blocks.IsSequence() || blocks.size() == 0) r.fail(blocks, "expected a non-empty list of blocks");
+  std::set<std::string> names;
+  for (const auto& b : blocks) {
+    v.blocks.push_back(read_block(r, b));
+    if (!names.insert(v.blocks.back().name).second)
+      r.fail(b["name"], "duplicate block name '" + v.blocks.back().name + "'");
+  }
+  const YAML::Node rotors = r.need(root, "rotors", "the vehicle file");
+  if (!rotors.IsSequence() || rotors.size() == 0) r.fail(rotors, "expected a non-empty list of rotors");
+  names.clear();
+  for (const auto& ro : rotors) {
+    v.rotors.push_back(read_rotor(r, ro));
+    if (!names.insert(v.rotors.back().name).second)
+      r.fail(ro["name"], "duplicate rotor name '" + v.rotors.back().name + "'");
+  }
+  if (root["derived"]) {
+    const YAML::Node d = root["derived"];
+    r.require_map(d, "section 'derived'");
+    static const std::map<std::string, std::string> derived_units = {
+        {"mass", "kg"},       {"cog_x", "m"},        {"cog_y", "m"},        {"cog_z", "m"},
+        {"J_xx", "kg m^2"},   {"J_yy", "kg m^2"},    {"J_zz", "kg m^2"},    {"J_xy", "kg m^2"},
+        {"J_xz", "kg m^2"},   {"J_yz", "kg m^2"},    {"A_x", "m^2"},        {"A_y", "m^2"},
+        {"A_z", "m^2"}};
+    std::set<std::string> allowed;
+    for (const auto& kv : derived_units) allowed.insert(kv.first);
+    r.only_keys(d, allowed, "section 'derived'");
+    for (const auto& kv : d) {
+      const std::string key = kv.first.as<std::string>();
+      const YAML::Node spec = kv.second;
+      r.require_map(spec, "fit and bounds of derived quantity " + key);
+      r.only_keys(spec, {"fit", "bounds"}, "derived quantity " + key);
+      if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds");
+      // The nominal value comes from the blocks; parse bounds via a dummy value inside them.
+      YAML::Node tmp;
+      tmp["value"] = spec["bounds"][0];
+      tmp["bounds"] = spec["bounds"];
+      if (spec["fit"]) tmp["fit"] = spec["fit"];
+      v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
+    }
+  }
+  return v;
+}
+
+Vehicle load_vehicle(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw VehicleError(path + ": cannot open vehicle file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_vehicle(ss.str(), path);
+}
+
+const Parameter& param(const Vehicle& v, const std::string& name) {
+  auto it = v.params.find(name);
+  if (it == v.params.end()) throw VehicleError(v.source_path + ": no parameter '" + name + "'");
+  return it->second;
+}
+
+}  // namespace quadgen

@@ -1,0 +1,74 @@
+// The vehicle description: what a user writes in vehicles/*.yaml, read and validated.
+// Everything is converted to SI on load; every error names file, line and what was expected.
+#pragma once
+#include <array>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "units.hpp"
+
+namespace quadgen {
+
+using Vec3 = std::array<double, 3>;
+
+// A scalar the model treats as a parameter: nominal value (SI), unit, bounds, fit flag.
+struct Parameter {
+  std::string name;
+  double value = 0;
+  std::string unit;  // SI unit text, e.g. "m/s^2"
+  Dimension dim;
+  double lower = 0, upper = 0;  // bounds in SI
+  bool fit = false;
+  std::string doc;  // what it is
+};
+
+// A cuboid of constant density, given in its own frame (edges along its axes, centred),
+// placed in the body frame by a rotation (Z-Y-X Euler angles) and its centre.
+struct Block {
+  std::string name;
+  double mass = 0;             // kg
+  Vec3 size{};                 // m, edge lengths along the block's own x, y, z
+  Vec3 centre{};               // m, body frame
+  Vec3 yaw_pitch_roll_deg{};   // deg, block frame -> body frame, R = Rz Ry Rx
+  int line = 0;
+};
+
+enum class Spin { ccw, cw };  // seen from above (body +z)
+
+struct Rotor {
+  std::string name;
+  Vec3 position{};  // m, body frame (point where thrust acts)
+  Spin spin = Spin::ccw;
+  double radius = 0;     // m, propeller radius r_p
+  double disc_area = 0;  // m^2, A_p of the thrust law
+  int line = 0;
+};
+
+struct Vehicle {
+  std::string name;
+  std::string source_path;
+  std::string content_hash;  // FNV-1a of the file bytes, hex
+  std::string description;
+  std::vector<Block> blocks;
+  std::vector<Rotor> rotors;
+  // Named scalar parameters: g, rho, c_w, c_t, kappa, motor_a0..a2, vbat_ref.
+  std::map<std::string, Parameter> params;
+  // Fit flags and bounds for quantities derived from the blocks (mass, J_xx, ...).
+  std::map<std::string, Parameter> derived_overrides;
+};
+
+struct VehicleError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+Vehicle load_vehicle(const std::string& path);
+Vehicle parse_vehicle(const std::string& text, const std::string& path_for_messages);
+
+const Parameter& param(const Vehicle& v, const std::string& name);
+
+std::string fnv1a_hex(const std::string& bytes);
+
+}  // namespace quadgen

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian packages quadgen builds with, only those that are missing.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config
+  libginac-dev libcln-dev ginac-tools   # symbolic derivation
+  libeigen3-dev libceres-dev            # linear algebra, fitting
+  libgtest-dev libbenchmark-dev         # tests, benchmarks
+  libyaml-cpp-dev                       # vehicle files (keeps line numbers for error messages)
+  libcli11-dev                          # command line
+  nlohmann-json3-dev                    # model.json and friends
+  libkainjow-mustache-dev               # text templates for generated code
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "installing: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO=sudo
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "all build dependencies present"
+fi
