@@ -1,0 +1,205 @@
+// The assembled model: units audit, effects at nominal values, physics spot checks.
+#include <gtest/gtest.h>
+
+#include "audit.hpp"
+#include "effects.hpp"
+#include "test_helpers.hpp"
+#include "thesis_reference.hpp"
+
+using namespace quadgen;
+using namespace GiNaC;
+
+namespace {
+SymbolicModel derive(const Vehicle& v, std::vector<std::string> effects = {}) {
+  DeriveOptions o;
+  o.effects = std::move(effects);
+  return derive_model(v, derive_mass_properties(v), o);
+}
+}  // namespace
+
+TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
+  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml"}) {
+    const Vehicle v = load_vehicle(test::source_path(file));
+    const MassProperties mp = derive_mass_properties(v);
+    DeriveOptions all;
+    all.effects = parse_effect_list("all");
+    for (const auto& opt : {DeriveOptions{}, all}) {
+      const AuditResult r = audit(derive_model(v, mp, opt), mp);
+      for (const auto& c : r.checks) EXPECT_TRUE(c.passed) << file << ": " << c.group << " " << c.name << ": " << c.detail;
+    }
+  }
+}
+
+TEST(Model, UnitCheckerRejectsInconsistentEquation) {
+  SymbolicModel m = derive(test::finken3());
+  // Add a velocity [m/s] to an acceleration [m/s^2]: a typical slip in hand derivations.
+  m.f(3, 0) = m.f(3, 0) + m.states[m.state_index("vx")].sym;
+  const auto checks = check_units(m);
+  bool rejected = false;
+  for (const auto& c : checks)
+    if (c.name == "dvx/dt") rejected = !c.passed;
+  EXPECT_TRUE(rejected);
+  // ... and a right-hand side whose every term has the wrong unit.
+  m.f(4, 0) = m.f(4, 0) * m.states[m.state_index("p")].sym;
+  for (const auto& c : check_units(m))
+    if (c.name == "dvy/dt") EXPECT_FALSE(c.passed);
+}
+
+TEST(Model, EnergyCheckCatchesWrongGyroscopicSign) {
+  // The thesis' (35) sign: J dω/dt = τ + ω × Jω. The energy audit must reject it.
+  SymbolicModel m = derive(test::finken3());
+  const AuditResult good = audit(m, derive_mass_properties(test::finken3()));
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  const ex p = m.states[10].sym, q = m.states[11].sym, r = m.states[12].sym;
+  // Diagonal-J form with the thesis' sign, thrust and gravity left in.
+  m.f(10, 0) = (P("J_zz") - P("J_yy")) * q * r / P("J_xx");
+  m.f(11, 0) = (P("J_xx") - P("J_zz")) * p * r / P("J_yy");
+  m.f(12, 0) = (P("J_yy") - P("J_xx")) * p * q / P("J_zz");
+  const AuditResult bad = audit(m, derive_mass_properties(test::finken3()));
+  auto energy_ok = [](const AuditResult& a) {
+    for (const auto& c : a.checks)
+      if (c.name == "rotational kinetic energy conserved") return c.passed;
+    return false;
+  };
+  EXPECT_TRUE(energy_ok(good));
+  EXPECT_FALSE(energy_ok(bad));
+}
+
+TEST(Model, HoverIsAnEquilibrium) {
+  // Level attitude, at rest, commands giving thrust m g: all accelerations vanish
+  // when the CoG is on the thrust axis (it is, for the symmetric FINken 3).
+  const Vehicle v = test::finken3();
+  const SymbolicModel m = derive(v);
+  // Solve the motor map for the command that gives m g / 4 per rotor.
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].nominal; };
+  const double F = P("mass") * P("g") / 4;
+  const double w = std::sqrt(F / (P("c_t") * P("rho") * 1.646e-3 * 0.0635 * 0.0635));
+  const double a2 = P("motor_a2"), a1 = P("motor_a1"), a0 = P("motor_a0") - w;
+  const double u = (-a1 + std::sqrt(a1 * a1 - 4 * a2 * a0)) / (2 * a2);
+  std::vector<double> x(13, 0.0);
+  x[2] = 1;
+  x[6] = 1;
+  const auto f = test::eval_f(m, x, {u, u, u, u});
+  for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(f[i], 0.0, 1e-12) << m.states[i].name;
+}
+
+TEST(Model, EveryEffectAtNominalValuesReproducesTheBaseModel) {
+  const Vehicle v = test::finken3();
+  const SymbolicModel base = derive(v);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> cmd(0.2, 0.8);
+  for (const Effect& e : effect_catalogue()) {
+    const SymbolicModel ext = derive(v, {e.name});
+    for (int trial = 0; trial < 3; ++trial) {
+      const std::vector<double> x = test::random_state(rng);
+      std::vector<double> u(4);
+      for (double& ui : u) ui = cmd(rng);
+      std::vector<double> xe = x, ue = u;
+      // Extra states (rotor speeds) start at their commanded steady state.
+      for (size_t i = 13; i < ext.states.size(); ++i) {
+        const auto& P = base.params;
+        auto nom = [&](const char* n) { return P[base.param_index(n)].nominal; };
+        const double ui = u[i - 13];
+        xe.push_back(nom("motor_a0") + nom("motor_a1") * ui + nom("motor_a2") * ui * ui);
+      }
+      // Extra inputs: any time, a battery at its reference voltage does not matter at nominal.
+      for (size_t i = 4; i < ext.inputs.size(); ++i) ue.push_back(ext.inputs[i].name == "t" ? 12.5 : 3.7);
+      const auto fb = test::eval_f(base, x, u);
+      const auto fe = test::eval_f(ext, xe, ue);
+      for (size_t i = 0; i < fb.size(); ++i)
+        EXPECT_NEAR(fe[i], fb[i], 1e-12 * (1 + std::fabs(fb[i]))) << e.name << " row " << base.states[i].name;
+      for (size_t i = fb.size(); i < fe.size(); ++i) EXPECT_NEAR(fe[i], 0.0, 1e-9) << e.name;
+    }
+  }
+}
+
+TEST(Model, EffectsChangeTheModelAwayFromNominal) {
+  // Guard against an effect that is silently a no-op: move its parameters and f must change.
+  const Vehicle v = test::finken3();
+  for (const char* name : {"motor_gain", "cog_offset", "rotor_drag", "wind", "thrust_decay", "battery_sag",
+                           "ground_effect"}) {
+    SymbolicModel m = derive(v, {name});
+    std::vector<double> x(13, 0.0);
+    x[2] = 0.05;
+    x[3] = 1.0;
+    x[6] = 1;
+    std::vector<double> u{0.4, 0.4, 0.4, 0.4};
+    for (size_t i = 4; i < m.inputs.size(); ++i) u.push_back(m.inputs[i].name == "t" ? 2.0 : 3.7);
+    const auto f0 = test::eval_f(m, x, u);
+    for (auto& p : m.params)
+      if (p.name.find('.') != std::string::npos) p.nominal = 0.5 * p.upper + 0.25 * p.lower + 1e-3;
+    const auto f1 = test::eval_f(m, x, u);
+    double diff = 0;
+    for (size_t i = 0; i < f0.size(); ++i) diff += std::fabs(f1[i] - f0[i]);
+    EXPECT_GT(diff, 1e-6) << name;
+  }
+}
+
+TEST(Model, AttitudeBiasChangesOnlyTheMeasurement) {
+  SymbolicModel m = derive(test::finken3(), {"attitude_bias"});
+  const SymbolicModel base = derive(test::finken3());
+  // The dynamics rows are those of the base model, symbolically.
+  for (unsigned i = 0; i < base.f.rows(); ++i) {
+    lst rename;  // the two derivations have distinct symbols with the same names
+    for (size_t k = 0; k < base.states.size(); ++k) rename.append(base.states[k].sym == m.states[k].sym);
+    for (size_t k = 0; k < base.inputs.size(); ++k) rename.append(base.inputs[k].sym == m.inputs[k].sym);
+    for (size_t k = 0; k < base.params.size(); ++k)
+      rename.append(base.params[k].sym == m.params[m.param_index(base.params[k].name)].sym);
+    for (size_t k = 0; k < base.constants.size(); ++k) rename.append(base.constants[k].sym == m.constants[k].sym);
+    EXPECT_TRUE(normal(m.f(i, 0) - base.f(i, 0).subs(rename)).is_zero()) << base.states[i].name;
+  }
+  // q_log = q ⊗ q_bias: at q = identity and roll bias 0.1, the logged quaternion is the bias.
+  lst s = m.nominal_substitution();
+  s.remove_all();
+  s.append(m.params[m.param_index("attitude_bias.roll")].sym == 0.1);
+  s.append(m.params[m.param_index("attitude_bias.pitch")].sym == 0);
+  for (int i = 0; i < 13; ++i) s.append(m.states[i].sym == (i == 6 ? 1 : 0));
+  EXPECT_NEAR(to_double(m.h(3, 0).subs(s)), std::cos(0.05), 1e-14);
+  EXPECT_NEAR(to_double(m.h(4, 0).subs(s)), std::sin(0.05), 1e-14);
+}
+
+TEST(Model, JacobiansAreDerivativesOfF) {
+  // dfdx against central finite differences of the symbolic f, at one random point.
+  const SymbolicModel m = derive(test::finken3(), {"motor_lag"});
+  std::mt19937 rng(11);
+  std::vector<double> x = test::random_state(rng);
+  for (int i = 0; i < 4; ++i) x.push_back(900 + 50 * i);
+  const std::vector<double> u{0.3, 0.4, 0.5, 0.6};
+  lst at = m.nominal_substitution();
+  for (const auto& c : m.constant_substitution()) at.append(c);
+  for (size_t i = 0; i < x.size(); ++i) at.append(m.states[i].sym == x[i]);
+  for (size_t i = 0; i < u.size(); ++i) at.append(m.inputs[i].sym == u[i]);
+  for (size_t j = 0; j < x.size(); ++j) {
+    const double h = 1e-6 * (1 + std::fabs(x[j]));
+    auto xp = x, xm = x;
+    xp[j] += h;
+    xm[j] -= h;
+    const auto fp = test::eval_f(m, xp, u), fm = test::eval_f(m, xm, u);
+    for (size_t i = 0; i < fp.size(); ++i) {
+      const double fd = (fp[i] - fm[i]) / (2 * h);
+      const double an = to_double(m.dfdx(i, j).subs(at));
+      EXPECT_NEAR(an, fd, 1e-6 * (1 + std::fabs(fd))) << "d" << m.states[i].name << "/d" << m.states[j].name;
+    }
+  }
+}
+
+TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  const auto items = compare_with_thesis(derive_model(v, mp, {}), mp);
+  std::map<std::string, bool> verdict;
+  for (const auto& t : items) {
+    verdict[t.ref] = t.agrees;
+    if (!t.agrees) {
+      EXPECT_FALSE(t.cause.empty()) << t.ref;
+      EXPECT_FALSE(t.size.empty()) << t.ref;
+    }
+  }
+  EXPECT_FALSE(verdict.at("(3), (77)-(81)"));  // T is a reflection
+  EXPECT_TRUE(verdict.at("(34)"));             // torques agree symbolically
+  EXPECT_TRUE(verdict.at("(59), (60)"));       // hover thrust
+  EXPECT_TRUE(verdict.at("(63), (64)"));       // climb
+  EXPECT_FALSE(verdict.at("(65), (67), (68)"));  // rad vs deg
+  realsymbol a("a"), b("b"), c("c");
+  EXPECT_TRUE(reduce_trig(thesis_transformation(a, b, c).determinant() + 1, {a, b, c}).is_zero());
+}

@@ -1,0 +1,163 @@
+// Bad vehicle files, unknown effects, and the command line's behaviour on them:
+// one-line errors naming file and line, non-zero exit, no output left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <Eigen/Dense>
+
+#include "effects.hpp"
+#include "test_helpers.hpp"
+
+using namespace quadgen;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string finken_text() {
+  std::ifstream in(test::source_path("vehicles/finken3.yaml"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
+// Expects parse failure with "bad.yaml:LINE: <something matching want>".
+void expect_error(const std::string& text, const std::string& want) {
+  try {
+    parse_vehicle(text, "bad.yaml");
+    ADD_FAILURE() << "accepted a bad file, expected: " << want;
+  } catch (const VehicleError& e) {
+    const std::string msg = e.what();
+    EXPECT_TRUE(std::regex_search(msg, std::regex("^bad\\.yaml:[0-9]+: "))) << msg;
+    EXPECT_NE(msg.find(want), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "not one line: " << msg;
+  }
+}
+
+}  // namespace
+
+TEST(VehicleInput, BundledFilesLoad) {
+  EXPECT_NO_THROW(load_vehicle(test::source_path("vehicles/finken3.yaml")));
+  EXPECT_NO_THROW(load_vehicle(test::source_path("vehicles/crazyflie21.yaml")));
+}
+
+TEST(VehicleInput, MalformedYaml) { expect_error("name: x\nblocks: [\n", "malformed YAML"); }
+TEST(VehicleInput, MissingKey) { expect_error(replace(finken_text(), "name: finken3\n", ""), "missing key 'name'"); }
+TEST(VehicleInput, UnknownKey) {
+  expect_error(replace(finken_text(), "  c_w:", "  cw_typo: 1\n  c_w:"), "unknown key 'cw_typo'");
+}
+TEST(VehicleInput, NegativeMass) {
+  expect_error(replace(finken_text(), "mass: 0.099", "mass: -0.099"), "expected a positive number for mass");
+}
+TEST(VehicleInput, ZeroSize) {
+  expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "size: [0.056, 0, 0.072]"),
+               "expected a positive number for size");
+}
+TEST(VehicleInput, DuplicateRotor) {
+  expect_error(replace(finken_text(), "{name: B, position", "{name: A, position"), "duplicate rotor name 'A'");
+}
+TEST(VehicleInput, NonFiniteNumber) {
+  expect_error(replace(finken_text(), "mass: 0.132", "mass: .nan"), "finite");
+  expect_error(replace(finken_text(), "value: 9.81", "value: .inf"), "finite");
+}
+TEST(VehicleInput, NotANumber) { expect_error(replace(finken_text(), "mass: 0.132", "mass: heavy"), "expected a number"); }
+TEST(VehicleInput, WrongUnitDimension) {
+  expect_error(replace(finken_text(), "{value: 9.81, unit: m/s^2}", "{value: 9.81, unit: kg}"), "must have dimension");
+}
+TEST(VehicleInput, BadSpin) { expect_error(replace(finken_text(), "spin: ccw", "spin: left"), "expected spin"); }
+TEST(VehicleInput, FitWithoutBounds) {
+  expect_error(replace(finken_text(), "kappa: {value: 0.01, unit: m, bounds: [0.0001, 0.1], fit: true}",
+                       "kappa: {value: 0.01, unit: m, fit: true}"),
+               "has no bounds");
+}
+TEST(VehicleInput, ErrorNamesTheRightLine) {
+  const std::string text = replace(finken_text(), "mass: 0.132", "mass: -1");
+  size_t line = 1;
+  for (size_t i = 0; i < text.find("mass: -1"); ++i) line += text[i] == '\n';
+  try {
+    parse_vehicle(text, "bad.yaml");
+    FAIL();
+  } catch (const VehicleError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("bad.yaml:" + std::to_string(line) + ":", 0), 0u) << e.what();
+  }
+}
+TEST(VehicleInput, UnknownEffect) {
+  EXPECT_THROW(parse_effect_list("motor_gain,warp_drive"), std::invalid_argument);
+  EXPECT_THROW(parse_effect_list("motor_gain,motor_gain"), std::invalid_argument);
+  EXPECT_EQ(parse_effect_list("motor_lag,motor_gain").size(), 2u);
+}
+
+// The motor map of vehicles/finken3.yaml is the least-squares quadratic through the
+// steady states of thesis Table 2, recomputed here from the CSV.
+TEST(VehicleFiles, Finken3MotorMapIsTheTable2Fit) {
+  std::ifstream in(test::source_path("data/finken3_motor_steps.csv"));
+  std::string line;
+  std::getline(in, line);
+  std::map<int, double> last;  // throttle percent -> last rpm of that step
+  while (std::getline(in, line)) {
+    int t, pct;
+    double rpm;
+    ASSERT_EQ(sscanf(line.c_str(), "%d,%d,%lf", &t, &pct, &rpm), 3) << line;
+    last[pct] = rpm;
+  }
+  Eigen::MatrixXd A(10, 3);
+  Eigen::VectorXd b(10);
+  int k = 0;
+  for (const auto& [pct, rpm] : last) {
+    if (pct == 0) continue;
+    const double u = pct / 100.0;
+    A.row(k) << 1, u, u * u;
+    b(k++) = rpm;
+  }
+  ASSERT_EQ(k, 10);
+  const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(b);
+  const Vehicle v = test::finken3();
+  const double rpm_to_rad = 2 * M_PI / 60;
+  EXPECT_NEAR(param(v, "a0").value, coef(0) * rpm_to_rad, 1e-6);
+  EXPECT_NEAR(param(v, "a1").value, coef(1) * rpm_to_rad, 1e-6);
+  EXPECT_NEAR(param(v, "a2").value, coef(2) * rpm_to_rad, 1e-6);
+}
+
+// The command line: bad input exits non-zero with one line and leaves no files.
+TEST(Cli, BadInputLeavesNoOutput) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_cli_bad";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path bad = dir / "bad.yaml";
+  std::ofstream(bad) << replace(finken_text(), "mass: 0.132", "mass: -1");
+  const fs::path out = dir / "out";
+  const std::string cmd = std::string(QUADGEN_BINARY) + " derive " + bad.string() + " --out " + out.string() +
+                          " > " + (dir / "stdout").string() + " 2> " + (dir / "stderr").string();
+  const int rc = std::system(cmd.c_str());
+  EXPECT_NE(rc, 0);
+  EXPECT_FALSE(fs::exists(out / "model.json"));
+  EXPECT_FALSE(fs::exists(out / "derivation.md"));
+  std::ifstream err(dir / "stderr");
+  std::string all((std::istreambuf_iterator<char>(err)), {});
+  EXPECT_NE(all.find("bad.yaml:"), std::string::npos) << all;
+  const std::string effects_cmd = std::string(QUADGEN_BINARY) + " derive " +
+                                  test::source_path("vehicles/finken3.yaml") + " --out " + out.string() +
+                                  " --effects warp_drive 2> /dev/null";
+  EXPECT_NE(std::system(effects_cmd.c_str()), 0);
+  EXPECT_FALSE(fs::exists(out / "model.json"));
+}
+
+TEST(Cli, DeriveWritesModelJsonAndReport) {
+  const fs::path out = fs::temp_directory_path() / "quadgen_cli_ok";
+  fs::remove_all(out);
+  const std::string cmd = std::string(QUADGEN_BINARY) + " derive " + test::source_path("vehicles/crazyflie21.yaml") +
+                          " --out " + out.string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(fs::exists(out / "model.json"));
+  EXPECT_TRUE(fs::exists(out / "derivation.md"));
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << "left a temporary: " << e.path();
+}
