@@ -8,6 +8,7 @@
 #include "dynamics.hpp"
 #include "effects.hpp"
 #include "geometry.hpp"
+#include "header_writer.hpp"
 #include "report.hpp"
 #include "thesis_reference.hpp"
 #include "vehicle.hpp"
@@ -26,25 +27,34 @@ int run_derive(const DeriveArgs& args) {
   const Vehicle vehicle = load_vehicle(args.vehicle);
   DeriveOptions opt;
   opt.effects = parse_effect_list(args.effects);
-  std::cerr << "[1/4] mass properties of " << vehicle.blocks.size() << " blocks\n";
+  std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
   const MassProperties mp = derive_mass_properties(vehicle);
-  std::cerr << "[2/4] equations of motion and Jacobians\n";
+  std::cerr << "[2/5] equations of motion and Jacobians\n";
   const SymbolicModel model = derive_model(vehicle, mp, opt);
-  std::cerr << "[3/4] audit\n";
+  std::cerr << "[3/5] audit\n";
   const AuditResult result = audit(model, mp);
   std::vector<ThesisItem> thesis;
   if (vehicle.name == "finken3") thesis = compare_with_thesis(model, mp);
-  std::cerr << "[4/4] writing " << args.out << "\n";
+  std::cerr << "[4/5] generating C++\n";
+  emission::EmitOptions eo;
+  eo.vehicle_file = args.vehicle;
+  eo.effects_flag = args.effects.empty() ? "" : " --effects " + args.effects;
+  const emission::GeneratedHeader header = emission::generate_header(model, eo);
+  std::cerr << "[5/5] writing " << args.out << "\n";
   const Derivation d{vehicle, mp, model, result, thesis};
   OutputSet out(args.out);
   out.add("model.json", model_json(d));
   out.add("derivation.md", derivation_markdown(d));
+  out.add("model.hpp", header.content);
   out.commit();
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << "derived " << vehicle.name << ": " << model.states.size() << " states, " << model.inputs.size()
             << " inputs, " << model.params.size() << " parameters; audit "
             << (result.all_passed() ? "passed" : "FAILED") << " (" << result.checks.size() << " checks); "
-            << secs << " s\n";
+            << secs << " s\n"
+            << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
+            << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
+            << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n";
   return result.all_passed() ? 0 : 3;
 }
 

@@ -1,0 +1,187 @@
+#include "header_writer.hpp"
+
+#include <kainjow/mustache.hpp>
+
+#include "cpp_emitter.hpp"
+#include "effects.hpp"
+#include "vehicle.hpp"
+
+extern const char* const kModelHeaderTemplate;  // templates/model.hpp.mustache, embedded by CMake
+
+namespace quadgen::emission {
+using namespace GiNaC;
+using kainjow::mustache::data;
+using kainjow::mustache::list;
+using kainjow::mustache::mustache;
+
+namespace {
+
+std::string ident(const std::string& name) {
+  std::string s;
+  for (char c : name) s += (std::isalnum(static_cast<unsigned char>(c)) ? c : '_');
+  return s;
+}
+
+std::string quoted_list(const std::vector<Variable>& vs) {
+  std::string s = "{";
+  for (size_t i = 0; i < vs.size(); ++i) s += (i ? ", " : "") + std::string("\"") + vs[i].name + "\"";
+  return s + "}";
+}
+
+std::string number(double v) {
+  char buf[40];
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
+data variables(const std::vector<Variable>& vs) {
+  list l;
+  for (size_t i = 0; i < vs.size(); ++i) {
+    data d;
+    d.set("ident", ident(vs[i].name));
+    d.set("index", std::to_string(i));
+    d.set("name", vs[i].name);
+    d.set("unit", vs[i].unit);
+    d.set("doc", vs[i].doc);
+    l.push_back(d);
+  }
+  return data{l};
+}
+
+// Jacobian entries that are not structurally zero, row-major.
+struct Sparse {
+  std::vector<int> rows, cols;
+  std::vector<ex> values;
+};
+Sparse nonzeros(const matrix& J) {
+  Sparse s;
+  for (unsigned i = 0; i < J.rows(); ++i)
+    for (unsigned j = 0; j < J.cols(); ++j)
+      if (!J(i, j).is_zero()) {
+        s.rows.push_back(static_cast<int>(i));
+        s.cols.push_back(static_cast<int>(j));
+        s.values.push_back(J(i, j));
+      }
+  return s;
+}
+
+std::string int_list(const std::vector<int>& v) {
+  std::string s = "{";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + (v.empty() ? "0}" : "}");
+}
+
+}  // namespace
+
+std::string model_name(const SymbolicModel& m) {
+  if (m.effects.empty()) return ident(m.vehicle_name);
+  if (m.effects.size() == effect_catalogue().size()) return ident(m.vehicle_name) + "_all_effects";
+  std::string s = ident(m.vehicle_name) + "_with";
+  for (const auto& e : m.effects) s += "_" + e;
+  return s;
+}
+
+GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
+  ExpressionGraph g;
+  auto decl = [](const std::vector<Variable>& vs) {
+    std::vector<std::pair<symbol, std::string>> out;
+    for (const auto& v : vs) out.push_back({v.sym, v.name});
+    return out;
+  };
+  g.declare(VarKind::state, decl(m.states));
+  g.declare(VarKind::input, decl(m.inputs));
+  g.declare(VarKind::param, decl(m.params));
+  const lst constants = m.constant_substitution();
+  auto nodes = [&](const std::string& target, const std::vector<ex>& values) {
+    std::vector<Output> out;
+    for (size_t i = 0; i < values.size(); ++i)
+      out.push_back({target + "[" + std::to_string(i) + "]", g.add(values[i].subs(constants))});
+    return out;
+  };
+  std::vector<ex> f, h;
+  for (unsigned i = 0; i < m.f.rows(); ++i) f.push_back(m.f(i, 0));
+  for (unsigned i = 0; i < m.h.rows(); ++i) h.push_back(m.h(i, 0));
+  const Sparse fx = nonzeros(m.dfdx), fu = nonzeros(m.dfdu), fp = nonzeros(m.dfdp);
+  const Sparse hx = nonzeros(m.dhdx), hp = nonzeros(m.dhdp);
+  const std::vector<OutputGroup> rhs = {{"", nodes("f", f)},
+                                        {"dfdx", nodes("dfdx", fx.values)},
+                                        {"dfdu", nodes("dfdu", fu.values)},
+                                        {"dfdp", nodes("dfdp", fp.values)}};
+  const std::vector<OutputGroup> meas = {
+      {"", nodes("h", h)}, {"dhdx", nodes("dhdx", hx.values)}, {"dhdp", nodes("dhdp", hp.values)}};
+  CppEmitter em(g);
+  std::vector<OutputGroup> all = rhs;
+  all.insert(all.end(), meas.begin(), meas.end());
+  em.plan_precompute(all);
+  const EmittedPrecompute pre = em.emit_precompute();
+  const EmittedFunction f_only = em.emit_function({rhs[0]});
+  const EmittedFunction rhs_code = em.emit_function(rhs);
+  const EmittedFunction meas_code = em.emit_function(meas);
+
+  GeneratedHeader out;
+  out.name = model_name(m);
+  out.ops_before = rhs_code.ops_before;
+  out.ops_after = rhs_code.ops_after;
+  out.ops_f_before = f_only.ops_before;
+  out.ops_f_after = f_only.ops_after;
+  out.pre_ops = pre.ops;
+  out.pre_count = pre.count;
+
+  data d;
+  d.set("namespace", out.name);
+  d.set("version", QUADGEN_VERSION);
+  d.set("vehicle_file", opt.vehicle_file);
+  d.set("effects_flag", opt.effects_flag);
+  d.set("vehicle", m.vehicle_name);
+  d.set("vehicle_hash", m.vehicle_hash);
+  std::string effects;
+  for (const auto& e : m.effects) effects += (effects.empty() ? "" : ", ") + e;
+  d.set("effects", effects.empty() ? "none" : effects);
+  d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + effects + "|" + QUADGEN_VERSION));
+  d.set("ops_f_before", number(out.ops_f_before));
+  d.set("ops_f_after", number(out.ops_f_after));
+  d.set("ops_before", number(out.ops_before));
+  d.set("ops_after", number(out.ops_after));
+  d.set("pre_ops", number(out.pre_ops));
+  d.set("pre_count", std::to_string(out.pre_count));
+  d.set("n_states", std::to_string(m.states.size()));
+  d.set("n_inputs", std::to_string(m.inputs.size()));
+  d.set("n_params", std::to_string(m.params.size()));
+  d.set("n_outputs", std::to_string(m.outputs.size()));
+  d.set("pre_size", std::to_string(out.pre_count));
+  d.set("states", variables(m.states));
+  d.set("inputs", variables(m.inputs));
+  d.set("params", variables(m.params));
+  d.set("state_names", quoted_list(m.states));
+  d.set("input_names", quoted_list(m.inputs));
+  d.set("param_names", quoted_list(m.params));
+  d.set("output_names", quoted_list(m.outputs));
+  std::string nominal = "{";
+  for (size_t i = 0; i < m.params.size(); ++i) nominal += (i ? ", " : "") + number(m.params[i].nominal);
+  d.set("nominal_params", nominal + "}");
+  d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
+  list sparsity;
+  const std::pair<const char*, const Sparse*> sp[] = {{"Dfdx", &fx}, {"Dfdu", &fu}, {"Dfdp", &fp}, {"Dhdx", &hx}, {"Dhdp", &hp}};
+  for (const auto& [name, s] : sp) {
+    data e;
+    e.set("name", name);
+    e.set("nnz", std::to_string(s->rows.size()));
+    e.set("size", std::to_string(std::max<size_t>(1, s->rows.size())));
+    e.set("rows", int_list(s->rows));
+    e.set("cols", int_list(s->cols));
+    sparsity.push_back(e);
+  }
+  d.set("sparsity", data{sparsity});
+  d.set("precompute_body", pre.body);
+  d.set("rhs_body", rhs_code.body);
+  d.set("measurement_body", meas_code.body);
+  mustache tmpl{std::string(kModelHeaderTemplate)};
+  if (!tmpl.is_valid()) throw std::runtime_error("templates/model.hpp.mustache: " + tmpl.error_message());
+  out.content = tmpl.render(d);
+  return out;
+}
+
+}  // namespace quadgen::emission

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Regenerates the checked-in generated/ headers (the golden files tests/test_generated.cpp
+# compares byte for byte). Run after changing the generator, templates or vehicle files:
+#   scripts/regenerate.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --build build --target quadgen -j"$(nproc)" > /dev/null
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+regen() {  # vehicle-file folder-name [effects]
+  local args=(derive "$1" --out "$tmp/$2")
+  [ -n "${3:-}" ] && args+=(--effects "$3")
+  build/quadgen "${args[@]}" > /dev/null 2>&1
+  mkdir -p "generated/$2"
+  cp "$tmp/$2/model.hpp" "generated/$2/model.hpp"
+  echo "generated/$2/model.hpp"
+}
+regen vehicles/finken3.yaml finken3
+regen vehicles/finken3.yaml finken3_all_effects all
+regen vehicles/crazyflie21.yaml crazyflie21
