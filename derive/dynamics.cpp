@@ -95,6 +95,22 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   }
 }
 
+// J^-1 = adj(J) / det(J) written out. GiNaC's matrix::inverse() normalises its result,
+// and the shape of a normalised expression depends on GiNaC's internal term order
+// (symbol serial numbers and address-based hash seeds), which would make generated code
+// differ between runs.
+matrix inverse_by_adjugate(const matrix& J) {
+  auto cof = [&](int i, int j) {
+    const int r0 = (i + 1) % 3, r1 = (i + 2) % 3, c0 = (j + 1) % 3, c1 = (j + 2) % 3;
+    return J(r0, c0) * J(r1, c1) - J(r0, c1) * J(r1, c0);
+  };
+  const ex det = J(0, 0) * cof(0, 0) + J(0, 1) * cof(0, 1) + J(0, 2) * cof(0, 2);
+  matrix inv(3, 3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) inv(i, j) = cof(j, i) / det;
+  return inv;
+}
+
 matrix inertia_matrix(const ModelContext& c) {
   const ex xx = c.p("J_xx"), yy = c.p("J_yy"), zz = c.p("J_zz");
   const ex xy = c.p("J_xy"), xz = c.p("J_xz"), yz = c.p("J_yz");
@@ -142,7 +158,7 @@ void assemble(ModelContext& c) {
 
   // Rotation about the centre of gravity: J dω/dt = τ − ω × Jω.
   const matrix J = inertia_matrix(c);
-  const matrix Jinv = J.inverse();
+  const matrix Jinv = inverse_by_adjugate(J);
   const matrix omega_dot = Jinv.mul(torque.sub(cross(c.omega, J.mul(c.omega))));
   // Translation: the CoG obeys m a_cg = R F_b − m g e_z; the origin is offset from it
   // by −c, so a_o = a_cg − R(ω̇ × c + ω × (ω × c)).

@@ -85,76 +85,109 @@ int ExpressionGraph::make_sorted(Op op, std::vector<int> args) {
   return intern(Node{op, args, 0, "", -1});
 }
 
-int ExpressionGraph::convert_power(const ex& base, const ex& exponent) {
-  const int b = add(base);
-  if (is_a<numeric>(exponent) && ex_to<numeric>(exponent).is_integer()) {
-    Node n{Op::ipow, {b}, ex_to<numeric>(exponent).to_long(), "", -1};
-    return intern(n);
-  }
-  return intern(Node{Op::pow, {b, add(exponent)}, 0, "", -1});
-}
-
-// Products split into numerator and denominator so that x^-1 becomes a division.
-int ExpressionGraph::convert_mul(const ex& e) {
-  std::vector<int> num, den;
-  for (size_t i = 0; i < e.nops(); ++i) {
-    const ex f = e.op(i);
-    if (is_a<power>(f) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_integer() &&
-        ex_to<numeric>(f.op(1)).is_negative()) {
-      const long k = -ex_to<numeric>(f.op(1)).to_long();
-      den.push_back(k == 1 ? add(f.op(0)) : intern(Node{Op::ipow, {add(f.op(0))}, k, "", -1}));
-    } else {
-      num.push_back(add(f));
-    }
-  }
-  const int top = num.empty() ? constant(1) : make_sorted(Op::mul, num);
-  if (den.empty()) return top;
-  return intern(Node{Op::div, {top, make_sorted(Op::mul, den)}, 0, "", -1});
+int ExpressionGraph::scaled(const numeric& c, int id) {
+  if (c.is_equal(numeric(1))) return id;
+  if (nodes_[id].op == Op::constant) return constant(c * numeric(std::strtod(nodes_[id].literal.c_str(), nullptr)));
+  std::vector<int> args{constant(c)};
+  if (nodes_[id].op == Op::mul) args.insert(args.end(), nodes_[id].args.begin(), nodes_[id].args.end());
+  else args.push_back(id);
+  return make_sorted(Op::mul, args);
 }
 
 int ExpressionGraph::add(const ex& e) {
+  const auto [c, id] = canon(e);
+  return scaled(c, id);
+}
+
+std::pair<numeric, int> ExpressionGraph::canon(const ex& e) {
   auto m = memo_.find(e);
   if (m != memo_.end()) return m->second;
-  int id;
+  std::pair<numeric, int> r;
   if (is_a<numeric>(e)) {
-    id = constant(ex_to<numeric>(e));
+    r = {ex_to<numeric>(e), constant(1)};
   } else if (is_a<GiNaC::constant>(e)) {
-    id = constant(ex_to<numeric>(e.evalf()));
+    r = {1, constant(ex_to<numeric>(e.evalf()))};
   } else if (is_a<symbol>(e)) {
     auto v = vars_.find(e);
     if (v == vars_.end()) throw std::runtime_error("emission: undeclared symbol " + ex_to<symbol>(e).get_name());
     const Op op = v->second.first == VarKind::state ? Op::state : v->second.first == VarKind::input ? Op::input : Op::param;
-    id = intern(Node{op, {}, 0, names_[e], v->second.second});
+    r = {1, intern(Node{op, {}, 0, names_[e], v->second.second})};
   } else if (is_a<GiNaC::add>(e)) {
-    std::vector<int> args;
-    for (size_t i = 0; i < e.nops(); ++i) args.push_back(add(e.op(i)));
-    id = make_sorted(Op::add, args);
-  } else if (is_a<GiNaC::mul>(e)) {
-    id = convert_mul(e);
-  } else if (is_a<power>(e)) {
-    if (is_a<numeric>(e.op(1)) && ex_to<numeric>(e.op(1)).is_integer() && ex_to<numeric>(e.op(1)).is_negative()) {
-      const long k = -ex_to<numeric>(e.op(1)).to_long();
-      const int den = k == 1 ? add(e.op(0)) : intern(Node{Op::ipow, {add(e.op(0))}, k, "", -1});
-      id = intern(Node{Op::div, {constant(1), den}, 0, "", -1});
-    } else
-      id = convert_power(e.op(0), e.op(1));
-  } else if (is_ex_the_function(e, sin)) {
-    id = intern(Node{Op::sin, {add(e.op(0))}, 0, "", -1});
-  } else if (is_ex_the_function(e, cos)) {
-    id = intern(Node{Op::cos, {add(e.op(0))}, 0, "", -1});
-  } else if (is_ex_the_function(e, log)) {
-    id = intern(Node{Op::log, {add(e.op(0))}, 0, "", -1});
-  } else if (is_ex_the_function(e, abs_value)) {
-    id = intern(Node{Op::abs, {add(e.op(0))}, 0, "", -1});
-  } else if (is_ex_the_function(e, sign_of)) {
-    id = intern(Node{Op::sign, {add(e.op(0))}, 0, "", -1});
+    r = canon_add(e);
+  } else if (is_a<GiNaC::mul>(e) || is_a<power>(e)) {
+    r = canon_mul(e);
+  } else if (is_a<function>(e)) {
+    r = canon_function(e);
   } else {
     std::ostringstream os;
     os << e;
     throw std::runtime_error("emission: unsupported expression " + os.str());
   }
-  memo_[e] = id;
-  return id;
+  memo_[e] = r;
+  return r;
+}
+
+// Terms as (coefficient, unit node); sorted by the unit's key; the first coefficient is
+// made positive and its sign returned to the caller.
+std::pair<numeric, int> ExpressionGraph::canon_add(const ex& e) {
+  std::vector<std::pair<numeric, int>> terms;
+  for (size_t i = 0; i < e.nops(); ++i) terms.push_back(canon(e.op(i)));
+  std::sort(terms.begin(), terms.end(), [&](const auto& a, const auto& b) {
+    if (nodes_[a.second].key != nodes_[b.second].key) return nodes_[a.second].key < nodes_[b.second].key;
+    return a.first < b.first;
+  });
+  const numeric sign = terms.front().first.is_negative() ? numeric(-1) : numeric(1);
+  std::vector<int> args;
+  for (const auto& [c, id] : terms) args.push_back(scaled(c * sign, id));
+  return {sign, make_sorted(Op::add, args)};
+}
+
+// Products and integer powers: coefficients of all factors multiply into one; negative
+// powers go to a denominator.
+std::pair<numeric, int> ExpressionGraph::canon_mul(const ex& e) {
+  numeric coeff = 1;
+  std::vector<int> num, den;
+  auto factor = [&](const ex& f) {
+    ex base = f, expo = 1;
+    if (is_a<power>(f)) {
+      base = f.op(0);
+      expo = f.op(1);
+    }
+    if (!(is_a<numeric>(expo) && ex_to<numeric>(expo).is_integer())) {
+      num.push_back(intern(Node{Op::pow, {add(base), add(expo)}, 0, "", -1}));
+      return;
+    }
+    const long k = ex_to<numeric>(expo).to_long();
+    const auto [c, id] = canon(base);
+    coeff *= c.power(k);
+    if (nodes_[id].op == Op::constant && nodes_[id].literal == "1.0") return;
+    const long a = std::labs(k);
+    const int node = a == 1 ? id : intern(Node{Op::ipow, {id}, a, "", -1});
+    (k > 0 ? num : den).push_back(node);
+  };
+  if (is_a<GiNaC::mul>(e))
+    for (size_t i = 0; i < e.nops(); ++i) factor(e.op(i));
+  else
+    factor(e);
+  int top = num.empty() ? constant(1) : make_sorted(Op::mul, num);
+  if (!den.empty()) top = intern(Node{Op::div, {top, make_sorted(Op::mul, den)}, 0, "", -1});
+  return {coeff, top};
+}
+
+std::pair<numeric, int> ExpressionGraph::canon_function(const ex& e) {
+  const auto [c, id] = canon(e.op(0));
+  auto unary = [&](Op op, int arg) { return intern(Node{op, {arg}, 0, "", -1}); };
+  if (is_ex_the_function(e, abs_value)) return {abs(c), unary(Op::abs, id)};          // |cA| = |c||A|
+  if (is_ex_the_function(e, sign_of)) return {numeric(c.csgn()), unary(Op::sign, id)};  // sgn(cA)
+  if (is_ex_the_function(e, cos) && c.is_equal(numeric(-1))) return {1, unary(Op::cos, id)};
+  if (is_ex_the_function(e, sin) && c.is_equal(numeric(-1))) return {-1, unary(Op::sin, id)};
+  const int arg = scaled(c, id);
+  if (is_ex_the_function(e, sin)) return {1, unary(Op::sin, arg)};
+  if (is_ex_the_function(e, cos)) return {1, unary(Op::cos, arg)};
+  if (is_ex_the_function(e, log)) return {1, unary(Op::log, arg)};
+  std::ostringstream os;
+  os << e;
+  throw std::runtime_error("emission: unsupported function " + os.str());
 }
 
 double ExpressionGraph::tree_ops(int id) {

@@ -41,12 +41,18 @@ class ExpressionGraph {
   int intern(Node n);
   int constant(const GiNaC::numeric& v);
   int make_sorted(Op op, std::vector<int> args);
-  int convert_mul(const GiNaC::ex& e);
-  int convert_power(const GiNaC::ex& base, const GiNaC::ex& exponent);
+  // e = coefficient * node, with the node's sign canonical: GiNaC writes a sum as
+  // (a - b) or -(b - a) depending on its internal term order, so signs of sums are
+  // pulled out into the coefficient of the enclosing product.
+  std::pair<GiNaC::numeric, int> canon(const GiNaC::ex& e);
+  std::pair<GiNaC::numeric, int> canon_add(const GiNaC::ex& e);
+  std::pair<GiNaC::numeric, int> canon_mul(const GiNaC::ex& e);
+  std::pair<GiNaC::numeric, int> canon_function(const GiNaC::ex& e);
+  int scaled(const GiNaC::numeric& c, int id);  // node for c * node
 
   std::vector<Node> nodes_;
   std::map<std::tuple<int, std::vector<int>, long, std::string, int>, int> unique_;
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> memo_;
+  std::map<GiNaC::ex, std::pair<GiNaC::numeric, int>, GiNaC::ex_is_less> memo_;
   std::map<GiNaC::ex, std::pair<VarKind, int>, GiNaC::ex_is_less> vars_;
   std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> names_;
   std::map<int, double> tree_ops_;

@@ -1,5 +1,7 @@
 #include "header_writer.hpp"
 
+#include <cmath>
+
 #include <kainjow/mustache.hpp>
 
 #include "cpp_emitter.hpp"
@@ -141,11 +143,11 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   for (const auto& e : m.effects) effects += (effects.empty() ? "" : ", ") + e;
   d.set("effects", effects.empty() ? "none" : effects);
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + effects + "|" + QUADGEN_VERSION));
-  d.set("ops_f_before", number(out.ops_f_before));
-  d.set("ops_f_after", number(out.ops_f_after));
-  d.set("ops_before", number(out.ops_before));
-  d.set("ops_after", number(out.ops_after));
-  d.set("pre_ops", number(out.pre_ops));
+  d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
+  d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));
+  d.set("ops_before", std::to_string(std::llround(out.ops_before)));
+  d.set("ops_after", std::to_string(std::llround(out.ops_after)));
+  d.set("pre_ops", std::to_string(std::llround(out.pre_ops)));
   d.set("pre_count", std::to_string(out.pre_count));
   d.set("n_states", std::to_string(m.states.size()));
   d.set("n_inputs", std::to_string(m.inputs.size()));

@@ -1,0 +1,51 @@
+// A consumer that sees only a generated header: built with -O2 -Wall -Wextra -Werror
+// -Wdouble-promotion -Wconversion (see tests/CMakeLists.txt), instantiated for float and
+// double; exits non-zero if float disagrees with double beyond float precision.
+#include <cmath>
+#include <cstdio>
+
+#include "generated/finken3_all_effects/model.hpp"
+
+namespace m = quadgen_generated::finken3_all_effects;
+
+template <typename S>
+void evaluate(const double* xd, const double* ud, S* f, S* dfdx, S* dfdp) {
+  S x[m::kNumStates], u[m::kNumInputs], p[m::kNumParams];
+  for (int i = 0; i < m::kNumStates; ++i) x[i] = static_cast<S>(xd[i]);
+  for (int i = 0; i < m::kNumInputs; ++i) u[i] = static_cast<S>(ud[i]);
+  for (int i = 0; i < m::kNumParams; ++i) p[i] = static_cast<S>(m::kNominalParams[i]);
+  p[m::Param::motor_lag_tau] = static_cast<S>(0.03);
+  p[m::Param::ground_effect_radius] = static_cast<S>(0.06);
+  m::Precomputed<S> pre;
+  m::precompute(p, &pre);
+  m::rhs(x, u, p, pre, f, dfdx, static_cast<S*>(nullptr), dfdp);
+  S h[m::kNumOutputs];
+  m::measurement(x, p, pre, h, static_cast<S*>(nullptr), static_cast<S*>(nullptr));
+}
+
+int main() {
+  double x[m::kNumStates] = {0.1, -0.2, 1.2, 0.5, -0.3, 0.1, 0.98, 0.1, -0.1, 0.1, 0.4, -0.2, 0.3};
+  const double qn = std::sqrt(0.98 * 0.98 + 0.03);
+  for (int i = 6; i < 10; ++i) x[i] /= qn;
+  for (int i = 13; i < m::kNumStates; ++i) x[i] = 900.0 + 10.0 * i;
+  double u[m::kNumInputs] = {0.4, 0.45, 0.5, 0.42, 3.0, 3.9};
+  double fd[m::kNumStates], Jd[m::kDfdxNnz], Pd[m::kDfdpNnz];
+  float ff[m::kNumStates], Jf[m::kDfdxNnz], Pf[m::kDfdpNnz];
+  evaluate<double>(x, u, fd, Jd, Pd);
+  evaluate<float>(x, u, ff, Jf, Pf);
+  int bad = 0;
+  auto check = [&](const double* d, const float* f, int n, const char* what) {
+    double scale = 0;
+    for (int i = 0; i < n; ++i) scale = std::fmax(scale, std::fabs(d[i]));
+    for (int i = 0; i < n; ++i)
+      if (std::fabs(static_cast<double>(f[i]) - d[i]) > 1e-4 * (std::fabs(d[i]) + 1e-3 * scale)) {
+        std::printf("%s[%d]: float %g vs double %g\n", what, i, static_cast<double>(f[i]), d[i]);
+        ++bad;
+      }
+  };
+  check(fd, ff, m::kNumStates, "f");
+  check(Jd, Jf, m::kDfdxNnz, "dfdx");
+  check(Pd, Pf, m::kDfdpNnz, "dfdp");
+  std::printf("float vs double: %d mismatches\n", bad);
+  return bad == 0 ? 0 : 1;
+}
