@@ -15,4 +15,16 @@ struct DeriveArgs {
 void add_derive(CLI::App& app, DeriveArgs& args);
 int run_derive(const DeriveArgs& args);
 
+struct SimulateArgs {
+  std::string vehicle, scenario, inputs, out, effects;
+  double duration = 0;
+  std::string integrator = "rk4";
+  double step = 1e-3;
+  double rate = 100;
+  std::string interpolation = "hold";
+};
+
+void add_simulate(CLI::App& app, SimulateArgs& args);
+int run_simulate(const SimulateArgs& args);
+
 }  // namespace quadgen::cli

@@ -8,6 +8,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   quadgen::cli::DeriveArgs derive;
   quadgen::cli::add_derive(app, derive);
+  quadgen::cli::SimulateArgs simulate;
+  quadgen::cli::add_simulate(app, simulate);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -15,6 +17,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
+    if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
   } catch (const std::exception& e) {
     std::cerr << "quadgen: error: " << e.what() << "\n";
     return 2;

@@ -10,6 +10,7 @@ packages=(
   libcli11-dev                          # command line
   nlohmann-json3-dev                    # model.json and friends
   libkainjow-mustache-dev               # text templates for generated code
+  gnuplot-nox                           # plots (SVG) of simulations and fits
 )
 missing=()
 for p in "${packages[@]}"; do

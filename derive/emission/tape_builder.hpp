@@ -1,0 +1,9 @@
+// Builds the runtime's interpreted model (runtime/tape.hpp) from a symbolic model, through
+// the same canonical expression DAG the C++ emitter uses.
+#pragma once
+#include "symbolic_model.hpp"
+#include "tape.hpp"
+
+namespace quadgen::emission {
+runtime::Tape build_tape(const SymbolicModel& m);
+}

@@ -1,0 +1,80 @@
+// The runtime's view of a flight model: sizes, names, parameters and a right-hand side
+// with optional dense Jacobians. Two implementations: CompiledModel wraps a generated
+// header (fast, fixed at compile time); TapeModel interprets the same expression DAG at
+// run time, so `quadgen simulate` works for any vehicle file without a compiler.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace quadgen::runtime {
+
+class DynamicModel {
+ public:
+  virtual ~DynamicModel() = default;
+  virtual int num_states() const = 0;
+  virtual int num_inputs() const = 0;
+  virtual int num_params() const = 0;
+  virtual const std::vector<std::string>& state_names() const = 0;
+  virtual const std::vector<std::string>& input_names() const = 0;
+  virtual const std::vector<std::string>& param_names() const = 0;
+  virtual const std::vector<double>& params() const = 0;
+  virtual void set_params(const std::vector<double>& p) = 0;  // reruns the precompute step
+  // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
+  // row-major; any of A, B, Bu may be nullptr.
+  virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
+
+  int state_index(const std::string& name) const;
+  int input_index(const std::string& name) const;
+  int param_index(const std::string& name) const;
+};
+
+inline int index_in(const std::vector<std::string>& names, const std::string& n) {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == n) return static_cast<int>(i);
+  return -1;
+}
+inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
+inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
+inline int DynamicModel::param_index(const std::string& n) const { return index_in(param_names(), n); }
+
+// Adapts a generated header's Model struct.
+template <class M>
+class CompiledModel : public DynamicModel {
+ public:
+  CompiledModel() : p_(M::kNominalParams, M::kNominalParams + M::kNumParams) {
+    for (int i = 0; i < M::kNumStates; ++i) states_.push_back(M::kStateNames[i]);
+    for (int i = 0; i < M::kNumInputs; ++i) inputs_.push_back(M::kInputNames[i]);
+    for (int i = 0; i < M::kNumParams; ++i) param_names_.push_back(M::kParamNames[i]);
+    M::precompute(p_.data(), &pre_);
+  }
+  int num_states() const override { return M::kNumStates; }
+  int num_inputs() const override { return M::kNumInputs; }
+  int num_params() const override { return M::kNumParams; }
+  const std::vector<std::string>& state_names() const override { return states_; }
+  const std::vector<std::string>& input_names() const override { return inputs_; }
+  const std::vector<std::string>& param_names() const override { return param_names_; }
+  const std::vector<double>& params() const override { return p_; }
+  void set_params(const std::vector<double>& p) override {
+    p_ = p;
+    M::precompute(p_.data(), &pre_);
+  }
+  void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override {
+    double sx[M::kDfdxNnz + 1], sp[M::kDfdpNnz + 1], su[M::kDfduNnz + 1];
+    M::rhs(x, u, p_.data(), pre_, f, A ? sx : nullptr, Bu ? su : nullptr, B ? sp : nullptr);
+    constexpr int n = M::kNumStates;
+    if (A) scatter(A, n, sx, M::kDfdxNnz, M::kDfdxRow, M::kDfdxCol);
+    if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
+    if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
+  }
+
+ private:
+  static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col) {
+    for (int i = 0; i < M::kNumStates * cols; ++i) dense[i] = 0;
+    for (int k = 0; k < nnz; ++k) dense[row[k] * cols + col[k]] = v[k];
+  }
+  std::vector<double> p_;
+  typename M::template Precomputed<double> pre_;
+  std::vector<std::string> states_, inputs_, param_names_;
+};
+
+}  // namespace quadgen::runtime

@@ -1,0 +1,96 @@
+#include "scenarios.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace quadgen::runtime {
+
+double ThrustLaw::command_for(double thrust) const {
+  if (thrust < 0) throw std::invalid_argument("negative thrust requested");
+  const double w = std::sqrt(thrust / k);
+  // Solve a2 u^2 + a1 u + (a0 - w) = 0 for the root in [0, 1].
+  double u;
+  if (std::fabs(a2) < 1e-12) {
+    u = (w - a0) / a1;
+  } else {
+    const double disc = a1 * a1 - 4 * a2 * (a0 - w);
+    if (disc < 0) throw std::invalid_argument("thrust beyond the motor map");
+    u = (-a1 + std::sqrt(disc)) / (2 * a2);
+    if (u < 0 || u > 1) u = (-a1 - std::sqrt(disc)) / (2 * a2);
+  }
+  if (!(u >= 0 && u <= 1))
+    throw std::invalid_argument("thrust " + std::to_string(thrust) + " N needs a command outside [0, 1]");
+  return u;
+}
+
+namespace {
+
+// Rotor positions in the X layout of the FINken 3 (A rear-left ... D front-left) are what
+// the thesis' manoeuvres name; other vehicles map rotor i to the same role by order.
+bool in(size_t i, std::initializer_list<size_t> set) {
+  for (size_t s : set)
+    if (s == i) return true;
+  return false;
+}
+bool between(double t, double a, double b) { return t >= a && t < b; }
+
+const double kDelta = 0.02;  // N: step of the manoeuvre thrusts (a few % of hover)
+
+std::vector<double> hover(double, double h, const std::vector<std::string>& r) { return std::vector<double>(r.size(), h); }
+
+// Thesis 2.3.1 b): 1.1 N on every rotor.
+std::vector<double> climb(double, double, const std::vector<std::string>& r) { return std::vector<double>(r.size(), 1.1); }
+
+// Tilt doublet, hold, reverse doublet: raise `first` then `second`, later the reverse.
+std::vector<double> doublet(double t, double h, const std::vector<std::string>& r, std::initializer_list<size_t> first,
+                            std::initializer_list<size_t> second) {
+  std::vector<double> F(r.size(), h);
+  for (size_t i = 0; i < r.size(); ++i) {
+    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && in(i, first)) F[i] += kDelta;
+    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && in(i, second)) F[i] += kDelta;
+  }
+  return F;
+}
+// Thesis 2.3.2 a): raise A and D (the -x side) to tilt towards +x.
+std::vector<double> right(double t, double h, const std::vector<std::string>& r) { return doublet(t, h, r, {0, 3}, {1, 2}); }
+// Thesis 2.3.2 b): raise C and D, as the thesis does for "forward (+y)".
+std::vector<double> forward(double t, double h, const std::vector<std::string>& r) { return doublet(t, h, r, {2, 3}, {0, 1}); }
+// Thesis 2.3.2 c): raise A and C (same spin) for a second.
+std::vector<double> yaw(double t, double h, const std::vector<std::string>& r) {
+  std::vector<double> F(r.size(), h);
+  for (size_t i = 0; i < r.size(); ++i)
+    if (between(t, 0.5, 1.5) && in(i, {0, 2})) F[i] += kDelta;
+  return F;
+}
+// Thesis 2.3.2 d): all up, coast, all down by the same amount: a new constant height.
+std::vector<double> new_height(double t, double h, const std::vector<std::string>& r) {
+  double d = 0;
+  if (between(t, 0.5, 1.0)) d = 5 * kDelta;
+  if (between(t, 2.0, 2.5)) d = -5 * kDelta;
+  return std::vector<double>(r.size(), h + d);
+}
+
+}  // namespace
+
+const std::vector<Scenario>& scenario_catalogue() {
+  static const std::vector<Scenario> list = {
+      {"hover", "every rotor at hover thrust m g / n (thesis (60))", hover},
+      {"climb", "1.1 N on every rotor (thesis 2.3.1 b, (63)-(64))", climb},
+      {"right", "A and D raised 0.02 N for 0.1 s, then B and C; reversed at 1.5 s (thesis 2.3.2 a)", right},
+      {"forward", "C and D raised 0.02 N for 0.1 s, then A and B; reversed at 1.5 s (thesis 2.3.2 b)", forward},
+      {"yaw", "A and C raised 0.02 N from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
+      {"new_height", "all rotors +0.1 N from 0.5 to 1.0 s, -0.1 N from 2.0 to 2.5 s (thesis 2.3.2 d)", new_height},
+  };
+  return list;
+}
+
+const Scenario& find_scenario(const std::string& name) {
+  std::string known;
+  for (const auto& s : scenario_catalogue()) {
+    if (s.name == name) return s;
+    known += (known.empty() ? "" : ", ") + s.name;
+  }
+  throw std::invalid_argument("unknown scenario '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace quadgen::runtime

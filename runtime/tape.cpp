@@ -1,0 +1,61 @@
+#include "tape.hpp"
+
+#include <cmath>
+
+namespace quadgen::runtime {
+
+namespace {
+void run(const std::vector<Instruction>& code, double* r) {
+  for (const Instruction& in : code) {
+    const double a = r[in.a];
+    double v = 0;
+    switch (in.op) {
+      case TapeOp::add: v = a + r[in.b]; break;
+      case TapeOp::mul: v = a * r[in.b]; break;
+      case TapeOp::div: v = a / r[in.b]; break;
+      case TapeOp::ipow: {
+        v = 1;
+        for (long i = 0; i < in.k; ++i) v *= a;
+        break;
+      }
+      case TapeOp::pow: v = std::pow(a, r[in.b]); break;
+      case TapeOp::sin: v = std::sin(a); break;
+      case TapeOp::cos: v = std::cos(a); break;
+      case TapeOp::log: v = std::log(a); break;
+      case TapeOp::abs: v = std::fabs(a); break;
+      case TapeOp::sign: v = a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); break;
+    }
+    r[in.dst] = v;
+  }
+}
+void scatter(double* dense, int rows, int cols, const SparseOutputs& s, const double* r) {
+  for (int i = 0; i < rows * cols; ++i) dense[i] = 0;
+  for (size_t k = 0; k < s.reg.size(); ++k) dense[s.row[k] * cols + s.col[k]] = r[s.reg[k]];
+}
+}  // namespace
+
+TapeModel::TapeModel(Tape t) : tape_(std::move(t)), reg_(tape_.num_registers, 0.0) {
+  for (const auto& [r, v] : tape_.constants) reg_[r] = v;
+  set_params(tape_.nominal);
+}
+
+void TapeModel::set_params(const std::vector<double>& p) {
+  p_ = p;
+  for (int i = 0; i < tape_.np; ++i) reg_[tape_.p_reg(i)] = p[i];
+  run(tape_.precompute, reg_.data());
+}
+
+void TapeModel::rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const {
+  double* r = reg_.data();
+  for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];
+  for (int i = 0; i < tape_.nu; ++i) r[tape_.nx + i] = u[i];
+  run(tape_.f_code, r);
+  for (int i = 0; i < tape_.nx; ++i) f[i] = r[tape_.f_out[i]];
+  if (!A && !B && !Bu) return;
+  run(tape_.jac_code, r);
+  if (A) scatter(A, tape_.nx, tape_.nx, tape_.dfdx, r);
+  if (B) scatter(B, tape_.nx, tape_.np, tape_.dfdp, r);
+  if (Bu) scatter(Bu, tape_.nx, tape_.nu, tape_.dfdu, r);
+}
+
+}  // namespace quadgen::runtime
