@@ -914,5 +914,51 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
   }
 }
 
+// The model as one type, for code templated on the model (runtime/ integrators, fits).
+struct Model {
+  static constexpr int kNumStates = crazyflie21::kNumStates;
+  static constexpr int kNumInputs = crazyflie21::kNumInputs;
+  static constexpr int kNumParams = crazyflie21::kNumParams;
+  static constexpr int kNumOutputs = crazyflie21::kNumOutputs;
+  static constexpr int kInputDelayParam = crazyflie21::kInputDelayParam;
+  static constexpr int kDfdxNnz = crazyflie21::kDfdxNnz;
+  static constexpr const int* kDfdxRow = crazyflie21::kDfdxRow;
+  static constexpr const int* kDfdxCol = crazyflie21::kDfdxCol;
+  static constexpr int kDfduNnz = crazyflie21::kDfduNnz;
+  static constexpr const int* kDfduRow = crazyflie21::kDfduRow;
+  static constexpr const int* kDfduCol = crazyflie21::kDfduCol;
+  static constexpr int kDfdpNnz = crazyflie21::kDfdpNnz;
+  static constexpr const int* kDfdpRow = crazyflie21::kDfdpRow;
+  static constexpr const int* kDfdpCol = crazyflie21::kDfdpCol;
+  static constexpr int kDhdxNnz = crazyflie21::kDhdxNnz;
+  static constexpr const int* kDhdxRow = crazyflie21::kDhdxRow;
+  static constexpr const int* kDhdxCol = crazyflie21::kDhdxCol;
+  static constexpr int kDhdpNnz = crazyflie21::kDhdpNnz;
+  static constexpr const int* kDhdpRow = crazyflie21::kDhdpRow;
+  static constexpr const int* kDhdpCol = crazyflie21::kDhdpCol;
+  static constexpr const char* const* kStateNames = crazyflie21::kStateNames;
+  static constexpr const char* const* kInputNames = crazyflie21::kInputNames;
+  static constexpr const char* const* kParamNames = crazyflie21::kParamNames;
+  static constexpr const char* const* kOutputNames = crazyflie21::kOutputNames;
+  static constexpr const double* kNominalParams = crazyflie21::kNominalParams;
+  template <typename Scalar>
+  using Precomputed = crazyflie21::Precomputed<Scalar>;
+
+  template <typename Scalar>
+  static void precompute(const Scalar* p, Precomputed<Scalar>* pre) {
+    crazyflie21::precompute(p, pre);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
+                  Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
+    crazyflie21::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,
+                          Scalar* dhdx, Scalar* dhdp) {
+    crazyflie21::measurement(x, p, pre, h, dhdx, dhdp);
+  }
+};
+
 }  // namespace crazyflie21
 }  // namespace quadgen_generated

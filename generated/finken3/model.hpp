@@ -916,5 +916,51 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
   }
 }
 
+// The model as one type, for code templated on the model (runtime/ integrators, fits).
+struct Model {
+  static constexpr int kNumStates = finken3::kNumStates;
+  static constexpr int kNumInputs = finken3::kNumInputs;
+  static constexpr int kNumParams = finken3::kNumParams;
+  static constexpr int kNumOutputs = finken3::kNumOutputs;
+  static constexpr int kInputDelayParam = finken3::kInputDelayParam;
+  static constexpr int kDfdxNnz = finken3::kDfdxNnz;
+  static constexpr const int* kDfdxRow = finken3::kDfdxRow;
+  static constexpr const int* kDfdxCol = finken3::kDfdxCol;
+  static constexpr int kDfduNnz = finken3::kDfduNnz;
+  static constexpr const int* kDfduRow = finken3::kDfduRow;
+  static constexpr const int* kDfduCol = finken3::kDfduCol;
+  static constexpr int kDfdpNnz = finken3::kDfdpNnz;
+  static constexpr const int* kDfdpRow = finken3::kDfdpRow;
+  static constexpr const int* kDfdpCol = finken3::kDfdpCol;
+  static constexpr int kDhdxNnz = finken3::kDhdxNnz;
+  static constexpr const int* kDhdxRow = finken3::kDhdxRow;
+  static constexpr const int* kDhdxCol = finken3::kDhdxCol;
+  static constexpr int kDhdpNnz = finken3::kDhdpNnz;
+  static constexpr const int* kDhdpRow = finken3::kDhdpRow;
+  static constexpr const int* kDhdpCol = finken3::kDhdpCol;
+  static constexpr const char* const* kStateNames = finken3::kStateNames;
+  static constexpr const char* const* kInputNames = finken3::kInputNames;
+  static constexpr const char* const* kParamNames = finken3::kParamNames;
+  static constexpr const char* const* kOutputNames = finken3::kOutputNames;
+  static constexpr const double* kNominalParams = finken3::kNominalParams;
+  template <typename Scalar>
+  using Precomputed = finken3::Precomputed<Scalar>;
+
+  template <typename Scalar>
+  static void precompute(const Scalar* p, Precomputed<Scalar>* pre) {
+    finken3::precompute(p, pre);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
+                  Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
+    finken3::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,
+                          Scalar* dhdx, Scalar* dhdp) {
+    finken3::measurement(x, p, pre, h, dhdx, dhdp);
+  }
+};
+
 }  // namespace finken3
 }  // namespace quadgen_generated

@@ -1317,5 +1317,51 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
   }
 }
 
+// The model as one type, for code templated on the model (runtime/ integrators, fits).
+struct Model {
+  static constexpr int kNumStates = finken3_all_effects::kNumStates;
+  static constexpr int kNumInputs = finken3_all_effects::kNumInputs;
+  static constexpr int kNumParams = finken3_all_effects::kNumParams;
+  static constexpr int kNumOutputs = finken3_all_effects::kNumOutputs;
+  static constexpr int kInputDelayParam = finken3_all_effects::kInputDelayParam;
+  static constexpr int kDfdxNnz = finken3_all_effects::kDfdxNnz;
+  static constexpr const int* kDfdxRow = finken3_all_effects::kDfdxRow;
+  static constexpr const int* kDfdxCol = finken3_all_effects::kDfdxCol;
+  static constexpr int kDfduNnz = finken3_all_effects::kDfduNnz;
+  static constexpr const int* kDfduRow = finken3_all_effects::kDfduRow;
+  static constexpr const int* kDfduCol = finken3_all_effects::kDfduCol;
+  static constexpr int kDfdpNnz = finken3_all_effects::kDfdpNnz;
+  static constexpr const int* kDfdpRow = finken3_all_effects::kDfdpRow;
+  static constexpr const int* kDfdpCol = finken3_all_effects::kDfdpCol;
+  static constexpr int kDhdxNnz = finken3_all_effects::kDhdxNnz;
+  static constexpr const int* kDhdxRow = finken3_all_effects::kDhdxRow;
+  static constexpr const int* kDhdxCol = finken3_all_effects::kDhdxCol;
+  static constexpr int kDhdpNnz = finken3_all_effects::kDhdpNnz;
+  static constexpr const int* kDhdpRow = finken3_all_effects::kDhdpRow;
+  static constexpr const int* kDhdpCol = finken3_all_effects::kDhdpCol;
+  static constexpr const char* const* kStateNames = finken3_all_effects::kStateNames;
+  static constexpr const char* const* kInputNames = finken3_all_effects::kInputNames;
+  static constexpr const char* const* kParamNames = finken3_all_effects::kParamNames;
+  static constexpr const char* const* kOutputNames = finken3_all_effects::kOutputNames;
+  static constexpr const double* kNominalParams = finken3_all_effects::kNominalParams;
+  template <typename Scalar>
+  using Precomputed = finken3_all_effects::Precomputed<Scalar>;
+
+  template <typename Scalar>
+  static void precompute(const Scalar* p, Precomputed<Scalar>* pre) {
+    finken3_all_effects::precompute(p, pre);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
+                  Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
+    finken3_all_effects::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,
+                          Scalar* dhdx, Scalar* dhdp) {
+    finken3_all_effects::measurement(x, p, pre, h, dhdx, dhdp);
+  }
+};
+
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated

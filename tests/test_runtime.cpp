@@ -1,0 +1,260 @@
+// The runtime: integrator order and error control, conservation laws, hover, forward
+// sensitivities against finite differences of whole trajectories, the interpreted tape
+// against the compiled header, and bad replay logs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "dynamic_model.hpp"
+#include "flight_log.hpp"
+#include "generated/finken3/model.hpp"
+#include "integrator.hpp"
+#include "tape_builder.hpp"
+#include "test_helpers.hpp"
+
+using namespace quadgen;
+using namespace quadgen::runtime;
+
+namespace {
+
+TapeModel finken3_tape(std::vector<std::string> effects = {}) {
+  const Vehicle v = test::finken3();
+  DeriveOptions o;
+  o.effects = std::move(effects);
+  return TapeModel(emission::build_tape(derive_model(v, derive_mass_properties(v), o)));
+}
+
+std::vector<double> at_rest() {
+  std::vector<double> x(13, 0.0);
+  x[6] = 1;
+  return x;
+}
+
+// Constant, slightly unequal commands: a smooth, rotating, accelerating flight.
+InputFunction constant_inputs(std::vector<double> u) {
+  return [u](double, double* out) {
+    for (size_t i = 0; i < u.size(); ++i) out[i] = u[i];
+  };
+}
+
+double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0;
+  for (size_t i = 0; i < a.size(); ++i) d = std::fmax(d, std::fabs(a[i] - b[i]));
+  return d;
+}
+
+}  // namespace
+
+TEST(Runtime, TapeModelMatchesCompiledHeader) {
+  TapeModel tape = finken3_tape();
+  CompiledModel<quadgen_generated::finken3::Model> compiled;
+  std::mt19937 rng(1);
+  for (int k = 0; k < 20; ++k) {
+    const auto x = test::random_state(rng);
+    const std::vector<double> u{0.3, 0.4, 0.5, 0.6};
+    std::vector<double> f1(13), f2(13), A1(169), A2(169), B1(13 * 21), B2(13 * 21);
+    tape.rhs(x.data(), u.data(), f1.data(), A1.data(), B1.data(), nullptr);
+    compiled.rhs(x.data(), u.data(), f2.data(), A2.data(), B2.data(), nullptr);
+    EXPECT_LT(max_diff(f1, f2), 1e-9);
+    EXPECT_LT(max_diff(A1, A2), 1e-7);
+    EXPECT_LT(max_diff(B1, B2), 1e-4);  // dfdp entries reach 1e6 (1/J): 1e-10 relative
+  }
+}
+
+TEST(Runtime, Rk4ConvergesWithFourthOrder) {
+  TapeModel m = finken3_tape();
+  const auto u = constant_inputs({0.40, 0.42, 0.41, 0.43});
+  IntegratorOptions ref;
+  ref.rtol = 1e-12;
+  ref.atol = 1e-14;
+  ref.quaternion_offset = -1;  // keep the plain ODE for an order test
+  const auto exact = integrate_dopri5(m, at_rest(), u, {0.0, 1.0}, ref).x.back();
+  double err[3];
+  const double steps[3] = {0.04, 0.02, 0.01};
+  for (int i = 0; i < 3; ++i) {
+    IntegratorOptions o;
+    o.step = steps[i];
+    o.quaternion_offset = -1;
+    err[i] = max_diff(integrate_rk4(m, at_rest(), u, 0.0, 1.0, o).x.back(), exact);
+  }
+  const double order1 = std::log2(err[0] / err[1]), order2 = std::log2(err[1] / err[2]);
+  EXPECT_NEAR(order1, 4.0, 0.3) << err[0] << " " << err[1];
+  RecordProperty("rk4_errors", std::to_string(err[0]) + " " + std::to_string(err[1]) + " " + std::to_string(err[2]));
+  EXPECT_NEAR(order2, 4.0, 0.3) << err[1] << " " << err[2];
+}
+
+TEST(Runtime, Dopri5MeetsRequestedTolerance) {
+  TapeModel m = finken3_tape();
+  const auto u = constant_inputs({0.40, 0.42, 0.41, 0.43});
+  IntegratorOptions fine;
+  fine.step = 1e-4;
+  const auto exact = integrate_rk4(m, at_rest(), u, 0.0, 1.0, fine).x.back();
+  for (double tol : {1e-5, 1e-7, 1e-9}) {
+    IntegratorOptions o;
+    o.rtol = tol;
+    o.atol = tol;
+    Stats st;
+    const auto got = integrate_dopri5(m, at_rest(), u, {0.0, 0.5, 1.0}, o, &st).x.back();
+    // Global error stays within a small multiple of the local tolerance over 1 s.
+    EXPECT_LT(max_diff(got, exact), 20 * tol) << "tol " << tol << ", steps " << st.accepted_steps;
+  }
+}
+
+TEST(Runtime, FreeRotationConservesEnergyAndAngularMomentum) {
+  TapeModel m = finken3_tape();
+  std::vector<double> p = m.params();
+  for (const char* n : {"c_t", "c_w", "g"}) p[m.param_index(n)] = 0;
+  p[m.param_index("J_xz")] = 3e-5;  // a product of inertia makes the motion non-trivial
+  m.set_params(p);
+  std::vector<double> x0 = at_rest();
+  x0[10] = 1.0;
+  x0[11] = -2.0;
+  x0[12] = 3.0;
+  IntegratorOptions o;
+  o.rtol = o.atol = 1e-11;
+  std::vector<double> times;
+  for (int k = 0; k <= 100; ++k) times.push_back(0.1 * k);
+  const auto tr = integrate_dopri5(m, x0, constant_inputs({0, 0, 0, 0}), times, o);
+  auto J = [&](int i, int j) {
+    static const char* n[3][3] = {{"J_xx", "J_xy", "J_xz"}, {"J_xy", "J_yy", "J_yz"}, {"J_xz", "J_yz", "J_zz"}};
+    return p[m.param_index(n[i][j])];
+  };
+  auto invariants = [&](const std::vector<double>& x) {
+    double L[3] = {0, 0, 0}, E = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) L[i] += J(i, j) * x[10 + j];
+    for (int i = 0; i < 3; ++i) E += 0.5 * x[10 + i] * L[i];
+    return std::make_pair(E, std::sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2]));
+  };
+  const auto [E0, L0] = invariants(x0);
+  for (const auto& x : tr.x) {
+    const auto [E, L] = invariants(x);
+    EXPECT_NEAR(E, E0, 1e-8 * E0);
+    EXPECT_NEAR(L, L0, 1e-8 * L0);
+  }
+  EXPECT_NEAR(tr.t.back(), 10.0, 1e-12);
+}
+
+TEST(Runtime, HoverStaysAtRest) {
+  TapeModel m = finken3_tape();
+  const auto& p = m.params();
+  auto P = [&](const char* n) { return p[m.param_index(n)]; };
+  const double w = std::sqrt(P("mass") * P("g") / 4 / (P("c_t") * P("rho") * 1.646e-3 * 0.0635 * 0.0635));
+  const double a2 = P("motor_a2"), a1 = P("motor_a1"), a0 = P("motor_a0") - w;
+  const double u = (-a1 + std::sqrt(a1 * a1 - 4 * a2 * a0)) / (2 * a2);
+  IntegratorOptions o;
+  const auto tr = integrate_rk4(m, at_rest(), constant_inputs({u, u, u, u}), 0.0, 10.0, o);
+  EXPECT_LT(max_diff(tr.x.back(), at_rest()), 1e-9);
+}
+
+TEST(Runtime, SensitivitiesMatchFiniteDifferencesOfTrajectories) {
+  TapeModel m = finken3_tape({"motor_gain"});
+  const auto u = constant_inputs({0.40, 0.42, 0.41, 0.43});
+  std::vector<double> x0 = at_rest();
+  x0[3] = 0.5;
+  x0[11] = 0.3;
+  IntegratorOptions o;
+  o.step = 2e-3;
+  o.quaternion_offset = -1;  // the sensitivity system integrates the plain ODE
+  const auto sens = integrate_rk4_sensitivities(m, x0, u, 0.0, 1.0, o);
+  const int n = m.num_states(), np = m.num_params(), cols = n + np;
+  const auto& S = sens.S.back();
+  auto final_state = [&](const std::vector<double>& xs) { return integrate_rk4(m, xs, u, 0.0, 1.0, o).x.back(); };
+  // d x(1) / d x0 for a few initial-state components.
+  for (int j : {3, 5, 8, 11}) {
+    const double h = 1e-6;
+    auto xp = x0, xm = x0;
+    xp[j] += h;
+    xm[j] -= h;
+    const auto fp = final_state(xp), fm = final_state(xm);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(S[i * cols + j], (fp[i] - fm[i]) / (2 * h), 1e-5 * (1 + std::fabs(S[i * cols + j])));
+  }
+  // d x(1) / d p for thrust coefficient, drag, a motor gain and an inertia.
+  const std::vector<double> p0 = m.params();
+  for (const char* name : {"c_t", "c_w", "motor_gain.B", "J_yy"}) {
+    const int j = m.param_index(name);
+    const double h = 1e-6 * std::fmax(std::fabs(p0[j]), 1e-3);
+    auto pp = p0, pm = p0;
+    pp[j] += h;
+    pm[j] -= h;
+    m.set_params(pp);
+    const auto fp = final_state(x0);
+    m.set_params(pm);
+    const auto fm = final_state(x0);
+    m.set_params(p0);
+    for (int i = 0; i < n; ++i) {
+      const double fd = (fp[i] - fm[i]) / (2 * h), an = S[i * cols + n + j];
+      EXPECT_NEAR(an, fd, 1e-4 * (1 + std::fabs(fd))) << name << " state " << m.state_names()[i];
+    }
+  }
+}
+
+TEST(Runtime, DivergenceIsReportedWithTimeAndState) {
+  TapeModel m = finken3_tape();
+  std::vector<double> p = m.params();
+  p[m.param_index("J_xx")] = 1e-12;  // absurd inertia: roll explodes
+  m.set_params(p);
+  IntegratorOptions o;
+  o.divergence_bound = 1e4;
+  try {
+    integrate_rk4(m, at_rest(), constant_inputs({0.3, 0.5, 0.5, 0.3}), 0.0, 5.0, o);
+    FAIL() << "no divergence reported";
+  } catch (const DivergenceError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("diverged at t = "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("state "), std::string::npos) << msg;
+  }
+}
+
+TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
+  const std::vector<std::string> rotors{"A", "B", "C", "D"};
+  const auto ok = parse_csv("t,u_A,u_B,u_C,u_D\n0,0.3,0.3,0.3,0.3\n0.01,0.3,0.3,0.3,0.3\n", "ok.csv");
+  EXPECT_NO_THROW(validate_canonical(ok, rotors));
+  auto message = [&](const std::string& text) {
+    try {
+      validate_canonical(parse_csv(text, "log.csv"), rotors);
+    } catch (const LogError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_E\n0,1,1,1,1\n1,1,1,1,1\n").find("'u_E' names no rotor"), std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C\n0,1,1,1\n1,1,1,1\n").find("missing column 'u_D'"), std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n0,1,1,1,1\n").find("log.csv:3: time not strictly increasing"),
+            std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,x,1,1\n").find("log.csv:3: column 'u_B'"), std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,nan,1,1\n").find("not finite"), std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n").find("too few samples"), std::string::npos);
+}
+
+// contracts.md §4 / issue: `quadgen simulate vehicles/finken3.yaml --scenario climb
+// --duration 1 --out traj.csv` reproduces thesis (63)-(64).
+TEST(Simulate, ClimbReproducesThesis63And64) {
+  const std::string dir = testing::TempDir() + "quadgen_sim";
+  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                          " --scenario climb --duration 1 --out " + dir + "/traj.csv > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const CsvTable t = read_csv(dir + "/traj.csv");
+  validate_canonical(t, {"A", "B", "C", "D"});
+  const auto z = t.values("z"), vz = t.values("vz"), time = t.values("t");
+  EXPECT_NEAR(time.back(), 1.0, 1e-12);
+  EXPECT_NEAR(vz[1] / time[1], 1.56, 0.005);  // (63): 1.56 m/s^2 at the start
+  EXPECT_NEAR(z.back(), 0.78, 0.005);         // (64): 0.78 m after 1 s (0.776 with drag)
+  for (const char* c : {"x", "y", "qw", "phi", "theta", "psi", "u_A"}) EXPECT_GE(t.column(c), 0) << c;
+}
+
+TEST(Simulate, BadReplayLogFailsWithOneLineAndNoOutput) {
+  const std::string dir = testing::TempDir() + "quadgen_sim_bad";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/log.csv") << "t,u_A,u_B,u_C,u_X\n0,0.3,0.3,0.3,0.3\n0.1,0.3,0.3,0.3,0.3\n";
+  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                          " --inputs " + dir + "/log.csv --duration 1 --out " + dir + "/traj.csv > /dev/null 2> " + dir +
+                          "/err.txt";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/traj.csv"));
+  std::ifstream err(dir + "/err.txt");
+  std::string msg((std::istreambuf_iterator<char>(err)), {});
+  EXPECT_NE(msg.find("u_X"), std::string::npos) << msg;
+}
