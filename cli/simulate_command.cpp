@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "atomic_output.hpp"
+#include "attitude.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
@@ -160,10 +161,10 @@ int run_simulate(const SimulateArgs& a) {
   }
   Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
   for (const auto& x : tr.x) {
-    const double w = x[6], qx = x[7], qy = x[8], qz = x[9], d = 180 / M_PI;
-    phi.y.push_back(d * std::atan2(2 * (w * qx + qy * qz), 1 - 2 * (qx * qx + qy * qy)));
-    theta.y.push_back(d * std::asin(std::fmax(-1.0, std::fmin(1.0, 2 * (w * qy - qz * qx)))));
-    psi.y.push_back(d * std::atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)));
+    const auto e = euler_zyx(x[6], x[7], x[8], x[9]);
+    phi.y.push_back(e[0] * 180 / M_PI);
+    theta.y.push_back(e[1] * 180 / M_PI);
+    psi.y.push_back(e[2] * 180 / M_PI);
   }
   rot.series = {phi, theta, psi};
   std::vector<double> ub(m.num_inputs());

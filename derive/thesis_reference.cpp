@@ -5,6 +5,7 @@
 #include <functional>
 #include <sstream>
 
+#include "attitude.hpp"
 #include "audit.hpp"
 #include "integrator.hpp"
 #include "kinematics.hpp"
@@ -254,10 +255,9 @@ Flight fly(const SymbolicModel& model, const ThrustProfile& thrust, double secon
   x0[6] = 1;
   runtime::IntegratorOptions o;
   const auto x = runtime::integrate_rk4(m, x0, inputs, 0.0, seconds, o).x.back();
-  const double w = x[6], qx = x[7], qy = x[8], qz = x[9], d = 180 / M_PI;
-  return Flight{x[0], x[1], x[2], d * std::atan2(2 * (w * qx + qy * qz), 1 - 2 * (qx * qx + qy * qy)),
-                d * std::asin(std::fmax(-1.0, std::fmin(1.0, 2 * (w * qy - qz * qx)))),
-                d * std::atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)), x[5]};
+  const auto e = runtime::euler_zyx(x[6], x[7], x[8], x[9]);
+  const double d = 180 / M_PI;
+  return Flight{x[0], x[1], x[2], d * e[0], d * e[1], d * e[2], x[5]};
 }
 
 std::string describe(const Flight& f) {

@@ -1,5 +1,7 @@
 #include "flight_log.hpp"
 
+#include "attitude.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -108,12 +110,9 @@ std::string trajectory_csv(const DynamicModel& m, const Trajectory& tr, const In
     u(tr.t[k], ub.data());
     os << tr.t[k];
     for (size_t r = 0; r < rotors.size(); ++r) os << "," << ub[r];
-    const double w = x[6], qx = x[7], qy = x[8], qz = x[9];
-    const double phi = std::atan2(2 * (w * qx + qy * qz), 1 - 2 * (qx * qx + qy * qy));
-    const double theta = std::asin(std::fmax(-1.0, std::fmin(1.0, 2 * (w * qy - qz * qx))));
-    const double psi = std::atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
-    os << "," << x[0] << "," << x[1] << "," << x[2] << "," << w << "," << qx << "," << qy << "," << qz << "," << phi
-       << "," << theta << "," << psi << "," << x[3] << "," << x[4] << "," << x[5] << "," << x[10] << "," << x[11]
+    const auto [phi, theta, psi] = euler_zyx(x[6], x[7], x[8], x[9]);
+    os << "," << x[0] << "," << x[1] << "," << x[2] << "," << x[6] << "," << x[7] << "," << x[8] << "," << x[9]
+       << "," << phi << "," << theta << "," << psi << "," << x[3] << "," << x[4] << "," << x[5] << "," << x[10] << "," << x[11]
        << "," << x[12];
     for (int i = 13; i < m.num_states(); ++i) os << "," << x[i];
     os << "\n";

@@ -37,6 +37,17 @@ Vec axpy(const Vec& x, double h, const Vec& k) {
   return r;
 }
 
+// One classical Runge-Kutta step of dz/dt = deriv(t, z) (shared by states and sensitivities).
+template <class Deriv>
+void rk4_step(const Deriv& deriv, double t, Vec& z, double h) {
+  Vec k1, k2, k3, k4;
+  deriv(t, z, k1);
+  deriv(t + h / 2, axpy(z, h / 2, k1), k2);
+  deriv(t + h / 2, axpy(z, h / 2, k2), k3);
+  deriv(t + h, axpy(z, h, k3), k4);
+  for (size_t i = 0; i < z.size(); ++i) z[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+}
+
 }  // namespace
 
 void check_finite(const DynamicModel& m, const Vec& x, double t, double bound) {
@@ -56,14 +67,9 @@ Trajectory integrate_rk4(const DynamicModel& m, Vec x, const InputFunction& u, d
   tr.x.push_back(x);
   const long steps = std::max(1L, std::lround((t1 - t0) / opt.step));
   const double h = (t1 - t0) / static_cast<double>(steps);
-  Vec k1, k2, k3, k4;
   for (long s = 0; s < steps; ++s) {
     const double t = t0 + static_cast<double>(s) * h;
-    f(t, x, k1);
-    f(t + h / 2, axpy(x, h / 2, k1), k2);
-    f(t + h / 2, axpy(x, h / 2, k2), k3);
-    f(t + h, axpy(x, h, k3), k4);
-    for (size_t i = 0; i < x.size(); ++i) x[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    rk4_step(f, t, x, h);
     normalize_quaternion(x, opt.quaternion_offset);
     check_finite(m, x, t + h, opt.divergence_bound);
     if (stats) ++stats->accepted_steps;
@@ -193,14 +199,9 @@ SensitivityTrajectory integrate_rk4_sensitivities(const DynamicModel& m, Vec x, 
   record(t0);
   const long steps = std::max(1L, std::lround((t1 - t0) / opt.step));
   const double h = (t1 - t0) / static_cast<double>(steps);
-  Vec k1, k2, k3, k4;
   for (long s = 0; s < steps; ++s) {
     const double t = t0 + static_cast<double>(s) * h;
-    deriv(t, z, k1);
-    deriv(t + h / 2, axpy(z, h / 2, k1), k2);
-    deriv(t + h / 2, axpy(z, h / 2, k2), k3);
-    deriv(t + h, axpy(z, h, k3), k4);
-    for (size_t i = 0; i < z.size(); ++i) z[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    rk4_step(deriv, t, z, h);
     check_finite(m, Vec(z.begin(), z.begin() + n), t + h, opt.divergence_bound);
     record(t + h);
   }

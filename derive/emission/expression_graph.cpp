@@ -190,6 +190,17 @@ std::pair<numeric, int> ExpressionGraph::canon_function(const ex& e) {
   throw std::runtime_error("emission: unsupported function " + os.str());
 }
 
+void declare_model_variables(ExpressionGraph& g, const SymbolicModel& m) {
+  auto decl = [](const std::vector<Variable>& vs) {
+    std::vector<std::pair<symbol, std::string>> out;
+    for (const auto& v : vs) out.push_back({v.sym, v.name});
+    return out;
+  };
+  g.declare(VarKind::state, decl(m.states));
+  g.declare(VarKind::input, decl(m.inputs));
+  g.declare(VarKind::param, decl(m.params));
+}
+
 double ExpressionGraph::tree_ops(int id) {
   auto it = tree_ops_.find(id);
   if (it != tree_ops_.end()) return it->second;

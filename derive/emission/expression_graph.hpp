@@ -11,6 +11,8 @@
 
 #include <ginac/ginac.h>
 
+#include "symbolic_model.hpp"
+
 namespace quadgen::emission {
 
 enum class Op { constant, state, input, param, add, mul, div, ipow, pow, sin, cos, log, abs, sign };
@@ -57,5 +59,8 @@ class ExpressionGraph {
   std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> names_;
   std::map<int, double> tree_ops_;
 };
+
+// A graph with the model's states, inputs and parameters declared.
+void declare_model_variables(ExpressionGraph& g, const SymbolicModel& m);
 
 }  // namespace quadgen::emission

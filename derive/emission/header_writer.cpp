@@ -88,14 +88,7 @@ std::string model_name(const SymbolicModel& m) {
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
   ExpressionGraph g;
-  auto decl = [](const std::vector<Variable>& vs) {
-    std::vector<std::pair<symbol, std::string>> out;
-    for (const auto& v : vs) out.push_back({v.sym, v.name});
-    return out;
-  };
-  g.declare(VarKind::state, decl(m.states));
-  g.declare(VarKind::input, decl(m.inputs));
-  g.declare(VarKind::param, decl(m.params));
+  declare_model_variables(g, m);
   const lst constants = m.constant_substitution();
   auto nodes = [&](const std::string& target, const std::vector<ex>& values) {
     std::vector<Output> out;

@@ -96,14 +96,7 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   t.input_delay_param = m.input_delay_param ? static_cast<int>(*m.input_delay_param) : -1;
 
   ExpressionGraph g;
-  auto decl = [](const std::vector<Variable>& vs) {
-    std::vector<std::pair<symbol, std::string>> out;
-    for (const auto& v : vs) out.push_back({v.sym, v.name});
-    return out;
-  };
-  g.declare(VarKind::state, decl(m.states));
-  g.declare(VarKind::input, decl(m.inputs));
-  g.declare(VarKind::param, decl(m.params));
+  declare_model_variables(g, m);
   const lst constants = m.constant_substitution();
   std::vector<int> f_nodes;
   for (unsigned i = 0; i < m.f.rows(); ++i) f_nodes.push_back(g.add(m.f(i, 0).subs(constants)));
