@@ -27,4 +27,11 @@ struct SimulateArgs {
 void add_simulate(CLI::App& app, SimulateArgs& args);
 int run_simulate(const SimulateArgs& args);
 
+struct FitArgs {
+  std::string vehicle, log, out;
+  bool robust = false;
+};
+void add_fit(CLI::App& app, FitArgs& args);
+int run_fit(const FitArgs& args);
+
 }  // namespace quadgen::cli

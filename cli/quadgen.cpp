@@ -10,6 +10,8 @@ int main(int argc, char** argv) {
   quadgen::cli::add_derive(app, derive);
   quadgen::cli::SimulateArgs simulate;
   quadgen::cli::add_simulate(app, simulate);
+  quadgen::cli::FitArgs fit;
+  quadgen::cli::add_fit(app, fit);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -18,6 +20,7 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
     if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
+    if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
   } catch (const std::exception& e) {
     std::cerr << "quadgen: error: " << e.what() << "\n";
     return 2;

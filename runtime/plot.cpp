@@ -28,7 +28,8 @@ bool plot_svg(const std::string& path, const std::string& title, const std::vect
       std::ofstream out(data);
       out.precision(10);
       for (size_t i = 0; i < p.series[s].x.size(); ++i) out << p.series[s].x[i] << ' ' << p.series[s].y[i] << '\n';
-      script << (s ? ", " : "") << "'" << data.string() << "' using 1:2 with lines lw 1.5 title '" << p.series[s].label << "'";
+      script << (s ? ", " : "") << "'" << data.string() << "' using 1:2 with " << (p.series[s].points ? "points pt 7 ps 0.5" : "lines lw 1.5")
+             << " title '" << p.series[s].label << "'";
     }
     script << "\n";
   }

@@ -9,6 +9,7 @@ namespace quadgen::runtime {
 struct Series {
   std::string label;
   std::vector<double> x, y;
+  bool points = false;  // markers instead of a line (measurements)
 };
 
 struct Panel {

@@ -9,6 +9,7 @@ packages=(
   libyaml-cpp-dev                       # vehicle files (keeps line numbers for error messages)
   libcli11-dev                          # command line
   nlohmann-json3-dev                    # model.json and friends
+  libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds
   libkainjow-mustache-dev               # text templates for generated code
   gnuplot-nox                           # plots (SVG) of simulations and fits
 )

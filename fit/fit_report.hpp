@@ -1,0 +1,21 @@
+// fit.json (estimates, standard errors, profile-likelihood intervals, verdicts, noise per
+// channel) and the profile plots.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "least_squares.hpp"
+#include "profile_likelihood.hpp"
+
+namespace quadgen::fit {
+
+nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles);
+
+// One panel per profile: delta chi2 against the parameter, with both thresholds.
+// Returns false with a reason when plotting is impossible (no gnuplot).
+bool plot_profiles(const std::string& svg_path, const std::string& title, const std::vector<Profile>& profiles,
+                   std::string* error);
+
+}  // namespace quadgen::fit

@@ -1,0 +1,175 @@
+#include "least_squares.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <ceres/ceres.h>
+#include <Eigen/Dense>
+
+namespace quadgen::fit {
+
+namespace {
+
+// All parameters in one block; the residual model's Jacobian is passed through, each row
+// scaled by its channel's weight.
+class WeightedCost : public ceres::CostFunction {
+ public:
+  WeightedCost(const ResidualModel& m, int n_params, const std::vector<double>& w) : m_(m), n_(n_params), w_(w) {
+    set_num_residuals(m.num_residuals());
+    mutable_parameter_block_sizes()->push_back(n_params);
+  }
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    const int nr = m_.num_residuals();
+    if (J && J[0]) {
+      m_.evaluate(p[0], r, J[0]);
+    } else {
+      m_.evaluate(p[0], r, nullptr);
+    }
+    for (int i = 0; i < nr; ++i) {
+      const double w = w_[m_.channel_of(i)];
+      r[i] *= w;
+      if (J && J[0])
+        for (int j = 0; j < n_; ++j) J[0][i * n_ + j] *= w;
+      if (!std::isfinite(r[i])) return false;
+    }
+    return true;
+  }
+
+ private:
+  const ResidualModel& m_;
+  int n_;
+  std::vector<double> w_;
+};
+
+std::vector<double> values(const std::vector<FitParameter>& ps) {
+  std::vector<double> v;
+  for (const auto& p : ps) v.push_back(p.value);
+  return v;
+}
+
+}  // namespace
+
+double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
+                      const FitOptions& opt, bool* converged, std::string* report) {
+  const int n = static_cast<int>(params.size());
+  std::vector<double> x = values(params);
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
+  problem.AddResidualBlock(new WeightedCost(model, n, w), loss, x.data());
+  std::vector<int> fixed;
+  for (int i = 0; i < n; ++i) {
+    if (!params[i].free) {
+      fixed.push_back(i);
+      continue;
+    }
+    if (params[i].lower < params[i].upper) {
+      problem.SetParameterLowerBound(x.data(), i, params[i].lower);
+      problem.SetParameterUpperBound(x.data(), i, params[i].upper);
+    }
+  }
+  if (static_cast<int>(fixed.size()) == n) {
+    double cost = 0;
+    problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+    if (converged) *converged = true;
+    return 2 * cost;
+  }
+  if (!fixed.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(n, fixed));
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = opt.max_iterations;
+  so.function_tolerance = opt.function_tolerance;
+  so.parameter_tolerance = opt.parameter_tolerance;
+  so.gradient_tolerance = 1e-14;
+  so.minimizer_progress_to_stdout = opt.verbose;
+  so.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  for (int i = 0; i < n; ++i) params[i].value = x[i];
+  if (converged) *converged = summary.termination_type == ceres::CONVERGENCE;
+  if (report) *report = summary.BriefReport();
+  return 2 * summary.final_cost;
+}
+
+FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt) {
+  const int nr = model.num_residuals();
+  const int n = static_cast<int>(params.size());
+  const auto channels = model.channels();
+  const int nc = static_cast<int>(channels.size());
+  int n_free = 0;
+  for (const auto& p : params) n_free += p.free;
+  if (nr <= n_free) throw FitError("too few samples: " + std::to_string(nr) + " residuals for " + std::to_string(n_free) + " free parameters");
+  for (const auto& p : params)
+    if (p.free && !(p.lower < p.upper))
+      throw FitError("parameter " + p.name + " is to be fitted but has no bounds (add bounds: [lower, upper])");
+
+  FitResult res;
+  // Pass 1: unit weights, to estimate the noise of each channel.
+  std::vector<double> w(nc, 1.0);
+  solve_weighted(model, params, w, opt);
+  std::vector<double> r(nr);
+  model.evaluate(values(params).data(), r.data(), nullptr);
+  res.channels.resize(nc);
+  for (int c = 0; c < nc; ++c) res.channels[c].name = channels[c];
+  std::vector<std::vector<double>> per(nc);
+  for (int i = 0; i < nr; ++i) per[model.channel_of(i)].push_back(r[i]);
+  for (int c = 0; c < nc; ++c) {
+    auto& s = res.channels[c];
+    const auto& v = per[c];
+    s.count = static_cast<int>(v.size());
+    if (v.size() < 2) throw FitError("channel " + channels[c] + " has fewer than 2 samples");
+    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+    double ss = 0, lag = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      ss += (v[i] - mean) * (v[i] - mean);
+      if (i) lag += (v[i] - mean) * (v[i - 1] - mean);
+    }
+    // Degrees of freedom shared out over channels in proportion to their size.
+    const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
+    double rss = 0;
+    for (double x : v) rss += x * x;
+    s.sigma = std::sqrt(rss / std::max(dof, 1.0));
+    if (s.sigma == 0) s.sigma = std::numeric_limits<double>::min() * 1e10;
+    s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
+    const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
+    s.effective_n = static_cast<double>(v.size()) * (1 - rho) / (1 + rho);
+    w[c] = std::sqrt(s.effective_n / static_cast<double>(v.size())) / s.sigma;
+  }
+  // Pass 2: weighted, so chi2 is in units of the noise with autocorrelation accounted for.
+  bool conv = false;
+  res.chi2 = solve_weighted(model, params, w, opt, &conv, &res.solver_report);
+  res.converged = conv;
+  res.weights = w;
+  res.num_residuals = nr;
+  res.num_free = n_free;
+  // Covariance of the free parameters: (J^T J)^-1 of the weighted residuals.
+  std::vector<double> J(static_cast<size_t>(nr) * n);
+  model.evaluate(values(params).data(), r.data(), J.data());
+  std::vector<int> free_idx;
+  for (int i = 0; i < n; ++i)
+    if (params[i].free) free_idx.push_back(i);
+  Eigen::MatrixXd Jf(nr, free_idx.size());
+  for (int i = 0; i < nr; ++i)
+    for (size_t k = 0; k < free_idx.size(); ++k) Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
+  const Eigen::MatrixXd H = Jf.transpose() * Jf;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(H);
+  const Eigen::MatrixXd C = cod.pseudoInverse();
+  const bool singular = cod.rank() < static_cast<long>(free_idx.size());
+  res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
+  res.covariance.assign(free_idx.size(), std::vector<double>(free_idx.size()));
+  for (size_t a = 0; a < free_idx.size(); ++a) {
+    for (size_t b = 0; b < free_idx.size(); ++b) res.covariance[a][b] = C(a, b);
+    res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(C(a, a));
+  }
+  for (int i : free_idx) {
+    const auto& p = params[i];
+    const double tol = 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
+    if (std::fabs(p.value - p.lower) < tol || std::fabs(p.value - p.upper) < tol) res.at_bound.push_back(p.name);
+  }
+  res.parameters = params;
+  return res;
+}
+
+}  // namespace quadgen::fit

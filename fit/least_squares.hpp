@@ -1,0 +1,74 @@
+// Weighted nonlinear least squares with Ceres: parameters with bounds and a free/fixed
+// flag, residuals from a model that supplies its own analytic Jacobian, per-channel noise
+// levels estimated from the fit, autocorrelation accounted for by effective sample sizes,
+// and the covariance of the free parameters. The problem (ResidualModel) is kept apart
+// from the solver (fit_least_squares) and its options (FitOptions).
+#pragma once
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace quadgen::fit {
+
+struct FitParameter {
+  std::string name, unit;
+  double value = 0, lower = 0, upper = 0;
+  bool free = true;
+};
+
+// r(p) and dr/dp over all parameters (row-major, num_residuals x num_params).
+class ResidualModel {
+ public:
+  virtual ~ResidualModel() = default;
+  virtual int num_residuals() const = 0;
+  virtual void evaluate(const double* p, double* r, double* J) const = 0;
+  // Channel of each residual (e.g. "rpm", "ax"): noise and autocorrelation are per channel.
+  virtual int channel_of(int residual) const = 0;
+  virtual std::vector<std::string> channels() const = 0;
+};
+
+struct FitError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct FitOptions {
+  int max_iterations = 200;
+  double function_tolerance = 1e-12;
+  double parameter_tolerance = 1e-12;
+  bool robust = false;           // Huber loss (scale 1 in units of sigma)
+  bool account_autocorrelation = true;
+  bool verbose = false;
+};
+
+struct ChannelStats {
+  std::string name;
+  int count = 0;
+  double sigma = 0;          // residual standard deviation (noise estimate)
+  double lag1 = 0;           // lag-1 autocorrelation of the residuals
+  double effective_n = 0;    // n (1 - rho) / (1 + rho)
+};
+
+struct FitResult {
+  std::vector<FitParameter> parameters;  // estimates
+  std::vector<double> standard_errors;   // NaN for fixed parameters
+  std::vector<std::vector<double>> covariance;  // free parameters, in order of `parameters`
+  std::vector<ChannelStats> channels;
+  double chi2 = 0;           // weighted residual sum of squares (autocorrelation-scaled)
+  int num_residuals = 0;
+  int num_free = 0;
+  std::vector<std::string> at_bound;  // free parameters that ended on a bound
+  std::vector<double> weights;        // per channel: multiplies residuals
+  bool converged = false;
+  std::string solver_report;
+};
+
+// Two passes: fit, estimate sigma and autocorrelation per channel, refit with weights.
+FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt);
+
+// One weighted solve from the given start with fixed channel weights (used by profiles).
+// Returns chi2 and updates params in place.
+double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params,
+                      const std::vector<double>& channel_weights, const FitOptions& opt, bool* converged = nullptr,
+                      std::string* report = nullptr);
+
+}  // namespace quadgen::fit

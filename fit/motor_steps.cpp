@@ -1,0 +1,88 @@
+#include "motor_steps.hpp"
+
+#include <cmath>
+
+#include "flight_log.hpp"
+
+namespace quadgen::fit {
+
+std::vector<MotorStep> read_motor_steps(const std::string& path) {
+  const runtime::CsvTable t = runtime::read_csv(path);
+  for (const char* c : {"time_ms", "throttle_percent", "rpm"})
+    if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (motor step layout)");
+  const auto time = t.values("time_ms"), thr = t.values("throttle_percent"), rpm = t.values("rpm");
+  std::vector<MotorStep> steps;
+  for (size_t i = 1; i < time.size(); ++i) {
+    if (!(time[i] > time[i - 1]))
+      throw FitError(path + ":" + std::to_string(i + 2) + ": time not strictly increasing");
+    if (thr[i] == thr[i - 1]) {
+      if (!steps.empty() && thr[i] == steps.back().u_new * 100 && time[i] > steps.back().t_first) {
+        steps.back().t.push_back(time[i] / 1000);
+        steps.back().rpm.push_back(rpm[i]);
+      }
+      continue;
+    }
+    MotorStep s;
+    s.t_before = time[i - 1] / 1000;
+    s.t_first = time[i] / 1000;
+    s.u_old = thr[i - 1] / 100;
+    s.u_new = thr[i] / 100;
+    s.t.push_back(time[i] / 1000);
+    s.rpm.push_back(rpm[i]);
+    steps.push_back(s);
+  }
+  if (steps.empty()) throw FitError(path + ": no throttle steps found");
+  return steps;
+}
+
+MotorStepModel::MotorStepModel(std::vector<MotorStep> steps) : steps_(std::move(steps)) {
+  for (const auto& s : steps_) n_ += static_cast<int>(s.t.size());
+}
+
+std::vector<FitParameter> MotorStepModel::parameters() const {
+  std::vector<FitParameter> p = {{"a0", "rpm", 1500, -20000, 20000, true},
+                                 {"a1", "rpm", 20000, 0, 100000, true},
+                                 {"a2", "rpm", -3000, -100000, 100000, true},
+                                 {"tau", "s", 0.05, 1e-4, 1.0, true}};
+  for (size_t k = 0; k < steps_.size(); ++k) {
+    const double gap = steps_[k].t_first - steps_[k].t_before;
+    p.push_back({"step_" + std::to_string(k + 1), "s", gap / 2, 0.0, gap, true});
+  }
+  return p;
+}
+
+double MotorStepModel::predict(const double* p, size_t k, double t) const {
+  const MotorStep& s = steps_[k];
+  auto ss = [&](double u) { return u == 0 ? 0.0 : p[0] + p[1] * u + p[2] * u * u; };
+  const double ts = s.t_before + p[4 + k];
+  if (t < ts) return ss(s.u_old);
+  return ss(s.u_new) + (ss(s.u_old) - ss(s.u_new)) * std::exp(-(t - ts) / p[3]);
+}
+
+void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
+  const int np = 4 + static_cast<int>(steps_.size());
+  int row = 0;
+  for (size_t k = 0; k < steps_.size(); ++k) {
+    const MotorStep& s = steps_[k];
+    const double uo = s.u_old, un = s.u_new, on = uo == 0 ? 0.0 : 1.0;
+    const double ss_old = on * (p[0] + p[1] * uo + p[2] * uo * uo), ss_new = p[0] + p[1] * un + p[2] * un * un;
+    const double ts = s.t_before + p[4 + k], tau = p[3];
+    for (size_t i = 0; i < s.t.size(); ++i, ++row) {
+      const double t = s.t[i];
+      const double e = t < ts ? 1.0 : std::exp(-(t - ts) / tau);
+      r[row] = ss_new + (ss_old - ss_new) * e - s.rpm[i];
+      if (!J) continue;
+      double* Jr = J + static_cast<size_t>(row) * np;
+      for (int j = 0; j < np; ++j) Jr[j] = 0;
+      Jr[0] = (1 - e) + e * on;
+      Jr[1] = (1 - e) * un + e * on * uo;
+      Jr[2] = (1 - e) * un * un + e * on * uo * uo;
+      if (t >= ts) {
+        Jr[3] = (ss_old - ss_new) * e * (t - ts) / (tau * tau);
+        Jr[4 + k] = (ss_old - ss_new) * e / tau;
+      }
+    }
+  }
+}
+
+}  // namespace quadgen::fit

@@ -1,0 +1,44 @@
+// Profile likelihood (Raue et al., Bioinformatics 25(15):1923-1929, 2009): for each fitted
+// parameter, fix it along a grid, re-optimise the others, and read confidence intervals
+// off the crossings of chi2 quantile thresholds. The profile's shape gives the verdict:
+// identifiable (crosses on both sides), practically non-identifiable (open on a side),
+// structurally non-identifiable (flat: other parameters compensate exactly).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "least_squares.hpp"
+
+namespace quadgen::fit {
+
+struct ProfilePoint {
+  double value;
+  double delta_chi2;            // chi2(value) - chi2(best)
+  std::vector<double> others;   // re-optimised parameter vector at this point
+};
+
+struct Profile {
+  std::string parameter;
+  int index = -1;
+  std::vector<ProfilePoint> points;  // sorted by value
+  double threshold_pointwise = 0;    // chi2_{1, 0.95}
+  double threshold_simultaneous = 0; // chi2_{#free, 0.95}
+  double lower = 0, upper = 0;       // 95 % pointwise interval (NaN side = open)
+  bool lower_open = false, upper_open = false;
+  std::string verdict;  // identifiable | practically non-identifiable | structurally non-identifiable
+  std::string compensated_by;  // for a flat profile: which parameters move with it, and how
+};
+
+struct ProfileOptions {
+  int max_steps_each_side = 30;
+  double confidence = 0.95;
+};
+
+Profile profile_parameter(const ResidualModel& model, const FitResult& best, int index, const FitOptions& fo,
+                          const ProfileOptions& po);
+std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& best, const FitOptions& fo,
+                                 const ProfileOptions& po);
+
+double chi2_quantile(double p, double dof);
+
+}  // namespace quadgen::fit
