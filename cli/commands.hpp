@@ -28,8 +28,9 @@ void add_simulate(CLI::App& app, SimulateArgs& args);
 int run_simulate(const SimulateArgs& args);
 
 struct FitArgs {
-  std::string vehicle, log, out;
+  std::string vehicle, log, out, mapping, effects, free, channels;
   bool robust = false;
+  double validation = 0.3;
 };
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);

@@ -2,10 +2,18 @@
 // The kind of fit follows the log's layout: motor step tests (time_ms, throttle_percent,
 // rpm) fit the motor map and its lag.
 #include <cmath>
+#include <algorithm>
 #include <iostream>
+#include <sstream>
 
 #include "atomic_output.hpp"
 #include "commands.hpp"
+#include "dynamics.hpp"
+#include "effects.hpp"
+#include "equation_error.hpp"
+#include "flight_data.hpp"
+#include "geometry.hpp"
+#include "model_registry.hpp"
 #include "fit_report.hpp"
 #include "flight_log.hpp"
 #include "motor_steps.hpp"
@@ -22,6 +30,12 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("log", a.log, "measurements (CSV)")->required();
   c->add_option("--out", a.out, "output directory")->required();
   c->add_flag("--robust", a.robust, "Huber loss instead of squares");
+  c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
+  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
+  c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out for validation")
+      ->check(CLI::Range(0.0, 0.9));
+  c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
+  c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
 }
 
 namespace {
@@ -85,13 +99,128 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v) {
   return 0;
 }
 
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// RMS of each channel of an equation-error model at the given parameters.
+std::vector<double> channel_rms(const EquationErrorModel& m, const std::vector<FitParameter>& ps) {
+  std::vector<double> p;
+  for (const auto& q : ps) p.push_back(q.value);
+  std::vector<double> r(m.num_residuals());
+  m.evaluate(p.data(), r.data(), nullptr);
+  const size_t nc = m.channels().size();
+  std::vector<double> ss(nc, 0.0);
+  std::vector<int> n(nc, 0);
+  for (int i = 0; i < m.num_residuals(); ++i) {
+    ss[m.channel_of(i)] += r[i] * r[i];
+    ++n[m.channel_of(i)];
+  }
+  for (size_t c = 0; c < nc; ++c) ss[c] = std::sqrt(ss[c] / std::max(1, n[c]));
+  return ss;
+}
+
+int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw) {
+  const runtime::CsvTable log = a.mapping.empty() ? raw : apply_mapping(raw, load_mapping(a.mapping));
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const Flight flight = load_flight(log, rotors, {});
+  DeriveOptions opt;
+  opt.effects = parse_effect_list(a.effects);
+  const SymbolicModel sm = derive_model(v, derive_mass_properties(v), opt);
+  bool compiled = false;
+  const auto model_ptr = make_model(sm, &compiled);
+  runtime::DynamicModel& model = *model_ptr;
+  std::cerr << "model: " << (compiled ? "compiled header from generated/" : "interpreted (no matching generated header)") << "\n";
+  std::vector<FitParameter> params;
+  const auto free_list = split_list(a.free);
+  for (const auto& p : sm.params) {
+    bool free = p.fit;
+    if (!free_list.empty()) free = std::find(free_list.begin(), free_list.end(), p.name) != free_list.end();
+    params.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, free});
+  }
+  for (const auto& name : free_list)
+    if (sm.params.end() == std::find_if(sm.params.begin(), sm.params.end(), [&](const auto& p) { return p.name == name; }))
+      throw std::invalid_argument("--free: no parameter '" + name + "' in the model");
+  const auto [train, valid] = split_by_time(flight, 1.0 - a.validation);
+  const bool accel = flight.has_accelerometer;
+  const auto channels = split_list(a.channels);
+  EquationErrorModel train_m(model, train, accel, channels), valid_m(model, valid, accel);
+  FitOptions fo;
+  fo.robust = a.robust;
+  std::cerr << "[1/3] equation-error fit on " << train.samples.size() << " samples (" << train_m.num_residuals()
+            << " residuals), " << std::count_if(params.begin(), params.end(), [](auto& p) { return p.free; })
+            << " free parameters\n";
+  const FitResult best = fit_least_squares(train_m, params, fo);
+  std::cerr << "[2/3] profile likelihood\n";
+  const auto profiles = profile_all(train_m, best, fo, {});
+  std::cerr << "[3/3] validation on the last " << valid.samples.size() << " samples\n";
+  const auto before = channel_rms(valid_m, params), after = channel_rms(valid_m, best.parameters);
+  auto j = fit_json(best, profiles);
+  j["kind"] = "flight_equation_error";
+  j["vehicle"] = v.name;
+  j["log"] = a.log;
+  j["mapping"] = a.mapping;
+  j["formulation"] = accel ? "equation error: accelerometer specific force and gyro derivative"
+                           : "equation error: differentiated velocity and gyro derivative";
+  nlohmann::ordered_json val = nlohmann::ordered_json::array();
+  const auto ch = valid_m.channels();
+  for (size_t c = 0; c < ch.size(); ++c)
+    val.push_back({{"channel", ch[c]}, {"rms_nominal", before[c]}, {"rms_fitted", after[c]},
+                   {"reduction_percent", before[c] > 0 ? 100 * (before[c] - after[c]) / before[c] : 0.0}});
+  j["validation"] = {{"fraction", a.validation}, {"samples", valid.samples.size()}, {"channels", val}};
+  j["fitted_channels"] = train_m.channels();
+  OutputSet out(a.out);
+  out.add("fit.json", j.dump(2) + "\n");
+  out.commit();
+  std::string err;
+  if (!plot_profiles(a.out + "/profiles.svg", v.name + ": profile likelihood", profiles, &err))
+    std::cerr << "no plot: " << err << "\n";
+  // Measured and modelled vertical specific force and roll acceleration over the flight.
+  std::vector<double> pv;
+  for (const auto& q : best.parameters) pv.push_back(q.value);
+  EquationErrorModel all(model, flight, accel);
+  std::vector<double> r;
+  all.all_channels(pv.data(), r);
+  runtime::Series meas{"measured", {}, {}, true}, fitted{"model (fitted)", {}, {}}, pm{"measured", {}, {}, true},
+      pf{"model (fitted)", {}, {}};
+  for (size_t k = 0; k < flight.samples.size(); ++k) {
+    const auto& s = flight.samples[k];
+    const double mz = accel ? s.specific_force[2] : s.acc_world[2];
+    meas.x.push_back(s.t);
+    meas.y.push_back(mz);
+    fitted.x.push_back(s.t);
+    fitted.y.push_back(mz + r[6 * k + 2]);
+    pm.x.push_back(s.t);
+    pm.y.push_back(s.rate_dot[0]);
+    pf.x.push_back(s.t);
+    pf.y.push_back(s.rate_dot[0] + r[6 * k + 3]);
+  }
+  const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
+  if (!runtime::plot_svg(a.out + "/fit.svg",
+                         v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
+                         {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
+                          {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}},
+                         &err))
+    std::cerr << "no plot: " << err << "\n";
+  for (const auto& pr : profiles)
+    std::cout << pr.parameter << " = " << best.parameters[pr.index].value << " [" << pr.lower << ", " << pr.upper
+              << "] " << pr.verdict << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   const runtime::CsvTable head = runtime::read_csv(a.log);
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return fit_motor_steps(a, v);
-  throw std::invalid_argument(a.log + ":1: unrecognised log layout (expected motor steps: time_ms, throttle_percent, rpm)");
+  return fit_flight(a, v, head);
 }
 
 }  // namespace quadgen::cli

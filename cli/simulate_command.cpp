@@ -13,7 +13,7 @@
 #include "integrator.hpp"
 #include "plot.hpp"
 #include "scenarios.hpp"
-#include "tape_builder.hpp"
+#include "model_registry.hpp"
 
 namespace quadgen::cli {
 
@@ -64,13 +64,14 @@ int run_simulate(const SimulateArgs& a) {
   DeriveOptions opt;
   opt.effects = parse_effect_list(a.effects);
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
-  TapeModel m(emission::build_tape(model));
+  const auto model_ptr = make_model(model);
+  DynamicModel& m = *model_ptr;
+  const int delay = model.input_delay_param ? static_cast<int>(*model.input_delay_param) : -1;
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
   const size_t nr = rotors.size();
   const auto laws = thrust_laws(vehicle, m);
   const double vbat_ref = param(vehicle, "vbat_ref").value;
-  const int delay = m.input_delay_param();
 
   std::vector<double> x0(m.num_states(), 0.0);
   x0[6] = 1.0;

@@ -106,36 +106,41 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
       throw FitError("parameter " + p.name + " is to be fitted but has no bounds (add bounds: [lower, upper])");
 
   FitResult res;
-  // Pass 1: unit weights, to estimate the noise of each channel.
-  std::vector<double> w(nc, 1.0);
-  solve_weighted(model, params, w, opt);
-  std::vector<double> r(nr);
-  model.evaluate(values(params).data(), r.data(), nullptr);
   res.channels.resize(nc);
   for (int c = 0; c < nc; ++c) res.channels[c].name = channels[c];
-  std::vector<std::vector<double>> per(nc);
-  for (int i = 0; i < nr; ++i) per[model.channel_of(i)].push_back(r[i]);
-  for (int c = 0; c < nc; ++c) {
-    auto& s = res.channels[c];
-    const auto& v = per[c];
-    s.count = static_cast<int>(v.size());
-    if (v.size() < 2) throw FitError("channel " + channels[c] + " has fewer than 2 samples");
-    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-    double ss = 0, lag = 0;
-    for (size_t i = 0; i < v.size(); ++i) {
-      ss += (v[i] - mean) * (v[i] - mean);
-      if (i) lag += (v[i] - mean) * (v[i - 1] - mean);
+  std::vector<double> w(nc, 1.0), r(nr);
+  // Noise per channel from the residuals: first at the starting point (so that no channel's
+  // units dominate the first solve), then at the estimate, re-solving in between.
+  auto estimate_noise = [&]() {
+    model.evaluate(values(params).data(), r.data(), nullptr);
+    std::vector<std::vector<double>> per(nc);
+    for (int i = 0; i < nr; ++i) per[model.channel_of(i)].push_back(r[i]);
+    for (int c = 0; c < nc; ++c) {
+      auto& s = res.channels[c];
+      const auto& v = per[c];
+      s.count = static_cast<int>(v.size());
+      if (v.size() < 2) throw FitError("channel " + channels[c] + " has fewer than 2 samples");
+      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+      double ss = 0, lag = 0, rss = 0;
+      for (size_t i = 0; i < v.size(); ++i) {
+        ss += (v[i] - mean) * (v[i] - mean);
+        rss += v[i] * v[i];
+        if (i) lag += (v[i] - mean) * (v[i - 1] - mean);
+      }
+      // Degrees of freedom shared out over channels in proportion to their size.
+      const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
+      s.sigma = std::sqrt(rss / std::max(dof, 1.0));
+      if (!(s.sigma > 0)) s.sigma = 1e-300;
+      s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
+      const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
+      s.effective_n = static_cast<double>(v.size()) * (1 - rho) / (1 + rho);
+      w[c] = std::sqrt(s.effective_n / static_cast<double>(v.size())) / s.sigma;
     }
-    // Degrees of freedom shared out over channels in proportion to their size.
-    const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
-    double rss = 0;
-    for (double x : v) rss += x * x;
-    s.sigma = std::sqrt(rss / std::max(dof, 1.0));
-    if (s.sigma == 0) s.sigma = std::numeric_limits<double>::min() * 1e10;
-    s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
-    const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
-    s.effective_n = static_cast<double>(v.size()) * (1 - rho) / (1 + rho);
-    w[c] = std::sqrt(s.effective_n / static_cast<double>(v.size())) / s.sigma;
+  };
+  estimate_noise();
+  for (int pass = 0; pass < 2; ++pass) {
+    solve_weighted(model, params, w, opt);
+    estimate_noise();
   }
   // Pass 2: weighted, so chi2 is in units of the noise with autocorrelation accounted for.
   bool conv = false;

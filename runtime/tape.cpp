@@ -51,11 +51,20 @@ void TapeModel::rhs(const double* x, const double* u, double* f, double* A, doub
   for (int i = 0; i < tape_.nu; ++i) r[tape_.nx + i] = u[i];
   run(tape_.f_code, r);
   for (int i = 0; i < tape_.nx; ++i) f[i] = r[tape_.f_out[i]];
-  if (!A && !B && !Bu) return;
-  run(tape_.jac_code, r);
-  if (A) scatter(A, tape_.nx, tape_.nx, tape_.dfdx, r);
-  if (B) scatter(B, tape_.nx, tape_.np, tape_.dfdp, r);
-  if (Bu) scatter(Bu, tape_.nx, tape_.nu, tape_.dfdu, r);
+  // Each Jacobian's code computes only what it needs beyond f; nodes shared between
+  // Jacobians are recomputed, which is cheaper than computing Jacobians nobody asked for.
+  if (A) {
+    run(tape_.dfdx_code, r);
+    scatter(A, tape_.nx, tape_.nx, tape_.dfdx, r);
+  }
+  if (B) {
+    run(tape_.dfdp_code, r);
+    scatter(B, tape_.nx, tape_.np, tape_.dfdp, r);
+  }
+  if (Bu) {
+    run(tape_.dfdu_code, r);
+    scatter(Bu, tape_.nx, tape_.nu, tape_.dfdu, r);
+  }
 }
 
 }  // namespace quadgen::runtime

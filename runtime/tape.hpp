@@ -27,7 +27,7 @@ struct Tape {
   std::vector<std::pair<int, double>> constants;  // register, value
   std::vector<Instruction> precompute;  // parameters only: run on set_params
   std::vector<Instruction> f_code;      // enough for f
-  std::vector<Instruction> jac_code;    // the rest, for the Jacobians
+  std::vector<Instruction> dfdx_code, dfdp_code, dfdu_code;  // the rest, per Jacobian
   std::vector<int> f_out;
   SparseOutputs dfdx, dfdp, dfdu;
   std::vector<std::string> state_names, input_names, param_names;

@@ -4,13 +4,13 @@
 #   scripts/regenerate.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake --build build --target quadgen -j"$(nproc)" > /dev/null
+cmake --build build --target quadgen-derive -j"$(nproc)" > /dev/null
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 regen() {  # vehicle-file folder-name [effects]
   local args=(derive "$1" --out "$tmp/$2")
   [ -n "${3:-}" ] && args+=(--effects "$3")
-  build/quadgen "${args[@]}" > /dev/null 2>&1
+  build/quadgen-derive "${args[@]}" > /dev/null 2>&1
   mkdir -p "generated/$2"
   cp "$tmp/$2/model.hpp" "generated/$2/model.hpp"
   echo "generated/$2/model.hpp"

@@ -135,6 +135,9 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   std::string effects;
   for (const auto& e : m.effects) effects += (effects.empty() ? "" : ", ") + e;
   d.set("effects", effects.empty() ? "none" : effects);
+  std::string effects_list;
+  for (const auto& e : m.effects) effects_list += (effects_list.empty() ? "" : ",") + e;
+  d.set("effects_list", effects_list);
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + effects + "|" + QUADGEN_VERSION));
   d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));

@@ -103,9 +103,12 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   struct Jac {
     const matrix* J;
     runtime::SparseOutputs* out;
+    std::vector<Instruction>* code;
     std::vector<int> nodes;
   };
-  std::vector<Jac> jacs = {{&m.dfdx, &t.dfdx, {}}, {&m.dfdp, &t.dfdp, {}}, {&m.dfdu, &t.dfdu, {}}};
+  std::vector<Jac> jacs = {{&m.dfdx, &t.dfdx, &t.dfdx_code, {}},
+                           {&m.dfdp, &t.dfdp, &t.dfdp_code, {}},
+                           {&m.dfdu, &t.dfdu, &t.dfdu_code, {}}};
   for (auto& j : jacs)
     for (unsigned r = 0; r < j.J->rows(); ++r)
       for (unsigned c = 0; c < j.J->cols(); ++c)
@@ -119,11 +122,19 @@ runtime::Tape build_tape(const SymbolicModel& m) {
     b.emit_split(id, t.f_code);
     t.f_out.push_back(b.reg[id]);
   }
-  for (auto& j : jacs)
+  // Registers of f (and of precomputed nodes) are shared; each Jacobian gets its own code
+  // for the rest, starting from the state after f.
+  const std::vector<int> after_f = b.reg;
+  for (auto& j : jacs) {
+    std::vector<int> own = after_f;
+    for (size_t k = 0; k < own.size(); ++k)  // precompute nodes emitted meanwhile stay shared
+      if (b.reg[k] >= 0 && !g.node(static_cast<int>(k)).dynamic) own[k] = b.reg[k];
+    b.reg = own;
     for (int id : j.nodes) {
-      b.emit_split(id, t.jac_code);
+      b.emit_split(id, *j.code);
       j.out->reg.push_back(b.reg[id]);
     }
+  }
   t.num_registers = b.next;
   return t;
 }

@@ -22,6 +22,10 @@ inline constexpr int kNumInputs = 4;
 inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 20;
+// What this header was generated from: a runtime may use it only for the same vehicle
+// file (FNV-1a of its bytes) and effect list.
+inline constexpr const char* kVehicleHash = "b65fbcadee484ef6";
+inline constexpr const char* kEffects = "";
 
 struct State {
   enum : int {
@@ -941,6 +945,8 @@ struct Model {
   static constexpr const char* const* kParamNames = crazyflie21::kParamNames;
   static constexpr const char* const* kOutputNames = crazyflie21::kOutputNames;
   static constexpr const double* kNominalParams = crazyflie21::kNominalParams;
+  static constexpr const char* kVehicleHash = crazyflie21::kVehicleHash;
+  static constexpr const char* kEffects = crazyflie21::kEffects;
   template <typename Scalar>
   using Precomputed = crazyflie21::Precomputed<Scalar>;
 

@@ -22,6 +22,10 @@ inline constexpr int kNumInputs = 4;
 inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 20;
+// What this header was generated from: a runtime may use it only for the same vehicle
+// file (FNV-1a of its bytes) and effect list.
+inline constexpr const char* kVehicleHash = "8e4bece764378d0e";
+inline constexpr const char* kEffects = "";
 
 struct State {
   enum : int {
@@ -943,6 +947,8 @@ struct Model {
   static constexpr const char* const* kParamNames = finken3::kParamNames;
   static constexpr const char* const* kOutputNames = finken3::kOutputNames;
   static constexpr const double* kNominalParams = finken3::kNominalParams;
+  static constexpr const char* kVehicleHash = finken3::kVehicleHash;
+  static constexpr const char* kEffects = finken3::kEffects;
   template <typename Scalar>
   using Precomputed = finken3::Precomputed<Scalar>;
 

@@ -22,6 +22,10 @@ inline constexpr int kNumInputs = 6;
 inline constexpr int kNumParams = 38;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 40;
+// What this header was generated from: a runtime may use it only for the same vehicle
+// file (FNV-1a of its bytes) and effect list.
+inline constexpr const char* kVehicleHash = "8e4bece764378d0e";
+inline constexpr const char* kEffects = "motor_gain,motor_lag,input_delay,cog_offset,rotor_drag,wind,attitude_bias,thrust_decay,battery_sag,ground_effect";
 
 struct State {
   enum : int {
@@ -1344,6 +1348,8 @@ struct Model {
   static constexpr const char* const* kParamNames = finken3_all_effects::kParamNames;
   static constexpr const char* const* kOutputNames = finken3_all_effects::kOutputNames;
   static constexpr const double* kNominalParams = finken3_all_effects::kNominalParams;
+  static constexpr const char* kVehicleHash = finken3_all_effects::kVehicleHash;
+  static constexpr const char* kEffects = finken3_all_effects::kEffects;
   template <typename Scalar>
   using Precomputed = finken3_all_effects::Precomputed<Scalar>;
 

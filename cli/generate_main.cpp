@@ -1,0 +1,23 @@
+// quadgen-derive: the `derive` subcommand alone. It does not link the compiled models of
+// generated/, so it can regenerate them even when they are stale (scripts/regenerate.sh).
+#include <iostream>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"quadgen-derive: derive, audit and emit a flight model (bootstrap for generated/)"};
+  quadgen::cli::DeriveArgs derive;
+  quadgen::cli::add_derive(app, derive);
+  app.require_subcommand(1);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    return quadgen::cli::run_derive(derive);
+  } catch (const std::exception& e) {
+    std::cerr << "quadgen: error: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,62 @@
+// Flight logs prepared for fitting: a column mapping (source column, scale, offset, unit)
+// turns a dataset's own layout into the canonical one; the samples are checked, the
+// attitude normalised, accelerations estimated where the log has none, and the flight
+// split by time into a training and a validation part.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "flight_log.hpp"
+
+namespace quadgen::fit {
+
+struct ColumnMapping {
+  std::string name;
+  struct Entry {
+    std::string target, source, unit;
+    double scale = 1, offset = 0;
+  };
+  std::vector<Entry> entries;
+};
+
+ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
+runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);
+
+// One time-aligned sample of a flight in canonical units.
+struct FlightSample {
+  double t = 0;
+  std::vector<double> x;     // 13 base states: x y z vx vy vz qw qx qy qz p q r
+  std::vector<double> u;     // rotor commands in vehicle rotor order
+  double vbat = 0;
+  double acc_world[3] = {0, 0, 0};  // d(v)/dt, world frame (smoothed derivative)
+  double rate_dot[3] = {0, 0, 0};   // d(p,q,r)/dt, body (smoothed derivative)
+  double specific_force[3] = {0, 0, 0};  // accelerometer, body frame, where logged
+};
+
+struct Flight {
+  std::string source;
+  std::vector<FlightSample> samples;
+  bool has_accelerometer = false, has_gyro = false, has_pose = false, has_vbat = false;
+};
+
+struct FlightOptions {
+  double derivative_window = 0.05;  // s, half-width of the local quadratic fit
+  double min_samples = 20;
+  // Keep only airborne samples: every command above min_command and, with a pose, the
+  // height above min_height. Ground contact is not in the model.
+  bool airborne_only = true;
+  double min_command = 0.05;
+  double min_height = 0.1;
+};
+
+// Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
+Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);
+
+// Samples with t - t0 < fraction * duration (training) and the rest (validation).
+std::pair<Flight, Flight> split_by_time(const Flight& f, double train_fraction);
+
+// Derivative at each sample by a local quadratic least-squares fit over +-window seconds
+// (a Savitzky–Golay filter that also works for uneven sampling).
+std::vector<double> smoothed_derivative(const std::vector<double>& t, const std::vector<double>& y, double window);
+
+}  // namespace quadgen::fit
