@@ -79,9 +79,23 @@ Profile profile_parameter(const ResidualModel& model, const FitResult& best, int
   pr.upper = crossing(right, p.value, pr.threshold_pointwise);
   pr.lower_open = std::isnan(pr.lower);
   pr.upper_open = std::isnan(pr.upper);
+  // Flatness is judged where the other parameters were free to compensate: points at which
+  // another parameter sits on its bound are blocked, not informative.
   double max_delta = 0;
+  int interior = 0;
   for (const auto* side : {&left, &right})
-    for (const auto& q : *side) max_delta = std::max(max_delta, q.delta_chi2);
+    for (const auto& q : *side) {
+      bool blocked = false;
+      for (size_t j = 0; j < best.parameters.size(); ++j) {
+        const auto& o = best.parameters[j];
+        if (static_cast<int>(j) == k || !o.free) continue;
+        const double tol = 1e-6 * (o.upper - o.lower);
+        blocked = blocked || q.others[j] <= o.lower + tol || q.others[j] >= o.upper - tol;
+      }
+      if (blocked) continue;
+      ++interior;
+      max_delta = std::max(max_delta, q.delta_chi2);
+    }
   std::vector<double> best_vals;
   for (const auto& q : best.parameters) best_vals.push_back(q.value);
   pr.points.push_back({p.value, 0.0, best_vals});
@@ -90,7 +104,7 @@ Profile profile_parameter(const ResidualModel& model, const FitResult& best, int
   std::sort(pr.points.begin(), pr.points.end(), [](const auto& a, const auto& b) { return a.value < b.value; });
   if (!pr.lower_open && !pr.upper_open) {
     pr.verdict = "identifiable";
-  } else if (max_delta < 1e-3 * pr.threshold_pointwise) {
+  } else if (interior >= 3 && max_delta < 1e-3 * pr.threshold_pointwise) {
     pr.verdict = "structurally non-identifiable";
     // Which parameters moved along the flat profile, and their log-log slope against it.
     const auto& a = pr.points.front();
