@@ -17,6 +17,7 @@
 #include "fit_report.hpp"
 #include "flight_log.hpp"
 #include "motor_steps.hpp"
+#include "thrust_stand.hpp"
 #include "plot.hpp"
 #include "vehicle.hpp"
 
@@ -214,12 +215,78 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
   return 0;
 }
 
+// Published Crazyflie 2.x values the stand results are compared with.
+nlohmann::ordered_json published_crazyflie() {
+  return {{"thrust_coefficient_N_s2",
+           {{"2.2e-8", "crazyflie_mhmp simulation model of the Crazyflie 2.0 (k = 2.2e-8 N s^2)"},
+            {"2.3e-8", "UPenn MEAM 620 flightsim crazyflie_params.py, inferred from 14.5 g at 2500 rad/s"}}},
+          {"torque_to_thrust_m", {{"0.005964552", "Förster 2015 (ETH Zürich), as used in Crazyflie firmware ports"}}}};
+}
+
+int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
+  const auto samples = read_thrust_stand(a.log);
+  FitOptions fo;
+  fo.robust = a.robust;
+  std::cerr << "[1/2] thrust vs rotor speed, " << samples.size() << " samples\n";
+  ThrustVsSpeed thrust(samples);
+  const FitResult tr = fit_least_squares(thrust, ThrustVsSpeed::parameters(), fo);
+  const auto tp = profile_all(thrust, tr, fo, {});
+  std::cerr << "[2/2] rotor speed vs command and battery voltage\n";
+  const double vref = param(v, "vbat_ref").value;
+  SpeedVsCommand speed(samples, vref);
+  const FitResult sr = fit_least_squares(speed, SpeedVsCommand::parameters(), fo);
+  const auto sp = profile_all(speed, sr, fo, {});
+  double k_mean = 0;
+  for (int i = 0; i < 4; ++i) k_mean += tr.parameters[i].value / 4;
+  const Rotor& r0 = v.rotors.front();
+  const double ct = k_mean / (param(v, "rho").value * r0.disc_area * r0.radius * r0.radius);
+  nlohmann::ordered_json j;
+  j["kind"] = "thrust_stand";
+  j["vehicle"] = v.name;
+  j["log"] = a.log;
+  j["thrust_vs_speed"] = fit_json(tr, tp);
+  j["speed_vs_command"] = fit_json(sr, sp);
+  j["summary"] = {{"k_mean_N_s2", k_mean},
+                  {"c_t", ct},
+                  {"c_t_in_vehicle_file", param(v, "c_t").value},
+                  {"battery_sag_exponent_implied", 2 * sr.parameters[3].value},
+                  {"vbat_ref_V", vref}};
+  j["published"] = published_crazyflie();
+  OutputSet out(a.out);
+  out.add("fit.json", j.dump(2) + "\n");
+  out.commit();
+  std::vector<Profile> all = tp;
+  all.insert(all.end(), sp.begin(), sp.end());
+  std::string err;
+  if (!plot_profiles(a.out + "/profiles.svg", v.name + ": thrust stand profiles", all, &err))
+    std::cerr << "no plot: " << err << "\n";
+  runtime::Series meas{"measured (all motors)", {}, {}, true}, model{"sum k_i w_i^2 + tare", {}, {}, true};
+  std::vector<double> pv;
+  for (const auto& q : tr.parameters) pv.push_back(q.value);
+  std::vector<double> r(thrust.num_residuals());
+  thrust.evaluate(pv.data(), r.data(), nullptr);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const double wm = (samples[k].w[0] + samples[k].w[1] + samples[k].w[2] + samples[k].w[3]) / 4;
+    meas.x.push_back(wm);
+    meas.y.push_back(samples[k].thrust);
+    model.x.push_back(wm);
+    model.y.push_back(samples[k].thrust + r[k]);
+  }
+  if (!runtime::plot_svg(a.out + "/fit.svg", v.name + ": thrust stand", {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}}, &err))
+    std::cerr << "no plot: " << err << "\n";
+  std::cout << "k per motor:";
+  for (int i = 0; i < 4; ++i) std::cout << " " << tr.parameters[i].value << " (" << tp[i].verdict << ")";
+  std::cout << "; mean " << k_mean << " N s^2 -> c_t = " << ct << "; speed ~ vbat^" << sr.parameters[3].value << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   const runtime::CsvTable head = runtime::read_csv(a.log);
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return fit_motor_steps(a, v);
+  if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) return fit_thrust_stand(a, v);
   return fit_flight(a, v, head);
 }
 
