@@ -1,0 +1,72 @@
+// Fit time for a 60 s, 100 Hz flight (6000 samples, equation error, FINken 3 compiled model,
+// c_t, c_w and kappa free) and for the full profile of one parameter.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "dynamic_model.hpp"
+#include "equation_error.hpp"
+#include "generated/finken3/model.hpp"
+#include "profile_likelihood.hpp"
+
+using namespace quadgen;
+using namespace quadgen::fit;
+
+namespace {
+
+struct Setup {
+  runtime::CompiledModel<quadgen_generated::finken3::Model> model;
+  Flight flight;
+  std::vector<FitParameter> params;
+  std::vector<double> truth;
+  Setup() {
+    truth = model.params();
+    std::mt19937 rng(1);
+    std::normal_distribution<double> n(0, 1);
+    std::uniform_real_distribution<double> u(0.3, 0.5);
+    flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
+    for (int k = 0; k < 6000; ++k) {
+      FlightSample s;
+      s.t = 0.01 * k;
+      s.x = {0, 0, 1, n(rng), n(rng), 0.3 * n(rng), 1, 0.05 * n(rng), 0.05 * n(rng), 0.3 * n(rng), 0.5 * n(rng), 0.5 * n(rng), 0.5 * n(rng)};
+      double q = 0;
+      for (int i = 6; i < 10; ++i) q += s.x[i] * s.x[i];
+      for (int i = 6; i < 10; ++i) s.x[i] /= std::sqrt(q);
+      for (int i = 0; i < 4; ++i) s.u.push_back(u(rng));
+      std::vector<double> f(13);
+      model.rhs(s.x.data(), s.u.data(), f.data(), nullptr, nullptr, nullptr);
+      for (int i = 0; i < 3; ++i) {
+        s.acc_world[i] = f[3 + i] + 0.05 * n(rng);
+        s.rate_dot[i] = f[10 + i] + 0.5 * n(rng);
+      }
+      flight.samples.push_back(s);
+    }
+    for (int i = 0; i < model.num_params(); ++i) {
+      const std::string nm = model.param_names()[i];
+      const bool free = nm == "c_t" || nm == "c_w" || nm == "kappa";
+      const double v = truth[i];
+      params.push_back({nm, "", free ? v * 1.2 : v, free ? v * 0.2 : v, free ? v * 5 : v, free});
+    }
+  }
+};
+
+void BM_FitEquationError60s100Hz(benchmark::State& st) {
+  Setup s;
+  EquationErrorModel m(s.model, s.flight, false);
+  for (auto _ : st) benchmark::DoNotOptimize(fit_least_squares(m, s.params, {}).chi2);
+}
+
+void BM_ProfileOneParameter60s100Hz(benchmark::State& st) {
+  Setup s;
+  EquationErrorModel m(s.model, s.flight, false);
+  const FitResult best = fit_least_squares(m, s.params, {});
+  const int ct = s.model.param_index("c_t");
+  for (auto _ : st) benchmark::DoNotOptimize(profile_parameter(m, best, ct, {}, {}).points.size());
+}
+
+BENCHMARK(BM_FitEquationError60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ProfileOneParameter60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
