@@ -31,6 +31,8 @@ struct FitArgs {
   std::string vehicle, log, out, mapping, effects, free, channels;
   bool robust = false;
   double validation = 0.3;
+  std::string formulation = "equation_error";
+  double window = 0.5;
 };
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);

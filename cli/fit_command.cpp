@@ -3,6 +3,8 @@
 // rpm) fit the motor map and its lag.
 #include <cmath>
 #include <algorithm>
+#include <chrono>
+#include <memory>
 #include <iostream>
 #include <sstream>
 
@@ -17,6 +19,7 @@
 #include "fit_report.hpp"
 #include "flight_log.hpp"
 #include "motor_steps.hpp"
+#include "multiple_shooting.hpp"
 #include "thrust_stand.hpp"
 #include "plot.hpp"
 #include "vehicle.hpp"
@@ -35,6 +38,9 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
   c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out for validation")
       ->check(CLI::Range(0.0, 0.9));
+  c->add_option("--formulation", a.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
+      ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
+  c->add_option("--window", a.window, "multiple shooting: window length [s]")->check(CLI::PositiveNumber);
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
 }
@@ -110,7 +116,7 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 // RMS of each channel of an equation-error model at the given parameters.
-std::vector<double> channel_rms(const EquationErrorModel& m, const std::vector<FitParameter>& ps) {
+std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps) {
   std::vector<double> p;
   for (const auto& q : ps) p.push_back(q.value);
   std::vector<double> r(m.num_residuals());
@@ -151,24 +157,39 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
   const auto [train, valid] = split_by_time(flight, 1.0 - a.validation);
   const bool accel = flight.has_accelerometer;
   const auto channels = split_list(a.channels);
-  EquationErrorModel train_m(model, train, accel, channels), valid_m(model, valid, accel);
+  const bool shooting = a.formulation == "multiple_shooting";
+  std::unique_ptr<ResidualModel> train_ptr, valid_ptr;
+  if (shooting) {
+    train_ptr = std::make_unique<MultipleShootingModel>(model, train, a.window);
+    valid_ptr = std::make_unique<MultipleShootingModel>(model, valid, a.window);
+  } else {
+    train_ptr = std::make_unique<EquationErrorModel>(model, train, accel, channels);
+    valid_ptr = std::make_unique<EquationErrorModel>(model, valid, accel);
+  }
+  const ResidualModel& train_m = *train_ptr;
+  const ResidualModel& valid_m = *valid_ptr;
   FitOptions fo;
   fo.robust = a.robust;
-  std::cerr << "[1/3] equation-error fit on " << train.samples.size() << " samples (" << train_m.num_residuals()
+  std::cerr << "[1/3] " << a.formulation << " fit on " << train.samples.size() << " samples (" << train_m.num_residuals()
             << " residuals), " << std::count_if(params.begin(), params.end(), [](auto& p) { return p.free; })
             << " free parameters\n";
+  auto clock0 = std::chrono::steady_clock::now();
   const FitResult best = fit_least_squares(train_m, params, fo);
-  std::cerr << "[2/3] profile likelihood\n";
+  const double fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
+  std::cerr << "[2/3] profile likelihood (fit took " << fit_seconds << " s)\n";
+  clock0 = std::chrono::steady_clock::now();
   const auto profiles = profile_all(train_m, best, fo, {});
+  const double profile_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   std::cerr << "[3/3] validation on the last " << valid.samples.size() << " samples\n";
   const auto before = channel_rms(valid_m, params), after = channel_rms(valid_m, best.parameters);
   auto j = fit_json(best, profiles);
-  j["kind"] = "flight_equation_error";
+  j["kind"] = shooting ? "flight_multiple_shooting" : "flight_equation_error";
   j["vehicle"] = v.name;
   j["log"] = a.log;
   j["mapping"] = a.mapping;
-  j["formulation"] = accel ? "equation error: accelerometer specific force and gyro derivative"
-                           : "equation error: differentiated velocity and gyro derivative";
+  j["formulation"] = shooting ? "multiple shooting: " + std::to_string(a.window) + " s windows from measured states, pose residuals"
+                     : accel  ? "equation error: accelerometer specific force and gyro derivative"
+                              : "equation error: differentiated velocity and gyro derivative";
   nlohmann::ordered_json val = nlohmann::ordered_json::array();
   const auto ch = valid_m.channels();
   for (size_t c = 0; c < ch.size(); ++c)
@@ -176,6 +197,7 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
                    {"reduction_percent", before[c] > 0 ? 100 * (before[c] - after[c]) / before[c] : 0.0}});
   j["validation"] = {{"fraction", a.validation}, {"samples", valid.samples.size()}, {"channels", val}};
   j["fitted_channels"] = train_m.channels();
+  j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
   OutputSet out(a.out);
   out.add("fit.json", j.dump(2) + "\n");
   out.commit();

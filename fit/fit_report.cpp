@@ -43,6 +43,7 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
   j["residuals"] = r.num_residuals;
   j["free_parameters"] = r.num_free;
   j["converged"] = r.converged;
+  j["solver"] = r.solver_report;
   j["parameters_at_bounds"] = r.at_bound;
   if (!profiles.empty())
     j["thresholds"] = {{"pointwise_chi2_1_95", profiles.front().threshold_pointwise},

@@ -54,6 +54,9 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
   std::vector<double> x = values(params);
+  std::vector<bool> free_mask;
+  for (const auto& p : params) free_mask.push_back(p.free);
+  model.set_free(free_mask);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);

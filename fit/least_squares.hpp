@@ -25,6 +25,9 @@ class ResidualModel {
   // Channel of each residual (e.g. "rpm", "ax"): noise and autocorrelation are per channel.
   virtual int channel_of(int residual) const = 0;
   virtual std::vector<std::string> channels() const = 0;
+  // Which parameters are free in the next solve: a model may skip Jacobian columns of
+  // fixed parameters (they are then left zero).
+  virtual void set_free(const std::vector<bool>& /*free*/) const {}
 };
 
 struct FitError : std::runtime_error {

@@ -168,9 +168,13 @@ Trajectory integrate_dopri5(const DynamicModel& m, Vec x, const InputFunction& u
 }
 
 SensitivityTrajectory integrate_rk4_sensitivities(const DynamicModel& m, Vec x, const InputFunction& u, double t0,
-                                                  double t1, const IntegratorOptions& opt) {
-  const int n = m.num_states(), np = m.num_params(), cols = n + np;
-  Vec ubuf(m.num_inputs()), A(n * n), B(n * np);
+                                                  double t1, const IntegratorOptions& opt, const std::vector<int>* subset) {
+  const int n = m.num_states(), np_all = m.num_params();
+  std::vector<int> all(np_all);
+  for (int j = 0; j < np_all; ++j) all[j] = j;
+  const std::vector<int>& pcols = subset ? *subset : all;
+  const int np = static_cast<int>(pcols.size()), cols = n + np;
+  Vec ubuf(m.num_inputs()), A(n * n), B(n * np_all);
   // z = [x, S] with S row-major n x cols; S(0) = [I | 0].
   auto deriv = [&](double t, const Vec& z, Vec& dz) {
     u(t, ubuf.data());
@@ -184,7 +188,7 @@ SensitivityTrajectory integrate_rk4_sensitivities(const DynamicModel& m, Vec x, 
         if (a == 0) continue;
         for (int j = 0; j < cols; ++j) dS[i * cols + j] += a * S[k * cols + j];
       }
-      for (int j = 0; j < np; ++j) dS[i * cols + n + j] += B[i * np + j];
+      for (int j = 0; j < np; ++j) dS[i * cols + n + j] += B[i * np_all + pcols[j]];
     }
   };
   Vec z(n + n * cols, 0.0);

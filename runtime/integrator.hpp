@@ -53,9 +53,12 @@ struct SensitivityTrajectory {
   Trajectory states;
   std::vector<std::vector<double>> S;  // per time: n x (n + np)
 };
+// `params`, when given, restricts the parameter columns to these indices (S is then
+// n x (n + params.size())), which is what a fit with few free parameters needs.
 SensitivityTrajectory integrate_rk4_sensitivities(const DynamicModel& m, std::vector<double> x0,
                                                   const InputFunction& u, double t0, double t1,
-                                                  const IntegratorOptions& opt);
+                                                  const IntegratorOptions& opt,
+                                                  const std::vector<int>* params = nullptr);
 
 void check_finite(const DynamicModel& m, const std::vector<double>& x, double t, double bound);
 

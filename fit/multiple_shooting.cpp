@@ -1,0 +1,91 @@
+#include "multiple_shooting.hpp"
+
+#include <cmath>
+
+#include "integrator.hpp"
+
+namespace quadgen::fit {
+
+MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Flight flight, double window)
+    : model_(model), flight_(std::move(flight)) {
+  if (!flight_.has_pose) throw FitError(flight_.source + ": multiple shooting needs the pose (x, y, z, qw..qz)");
+  if (model.num_states() != 13)
+    throw FitError("multiple shooting needs every state at the window starts; this model has unlogged states (" +
+                   model.state_names()[13] + ")");
+  const auto& s = flight_.samples;
+  size_t start = 0;
+  for (size_t k = 1; k <= s.size(); ++k) {
+    const bool gap = k < s.size() && s[k].t - s[k - 1].t > 0.1;  // trimmed (on the ground) part
+    if (k == s.size() || gap || s[k].t - s[start].t > window) {
+      if (k - 1 > start) {
+        windows_.push_back({start, k - 1});
+        num_residuals_ += 6 * static_cast<int>(k - 1 - start);
+      }
+      start = k;
+    }
+  }
+  if (windows_.empty()) throw FitError(flight_.source + ": flight shorter than one window");
+}
+
+void MultipleShootingModel::set_free(const std::vector<bool>& free) const {
+  free_.clear();
+  for (size_t j = 0; j < free.size(); ++j)
+    if (free[j]) free_.push_back(static_cast<int>(j));
+}
+
+void MultipleShootingModel::evaluate(const double* p, double* r, double* J) const {
+  const int n = 13, np = model_.num_params(), nu = model_.num_inputs();
+  if (free_.empty() && J) {  // no set_free yet: all columns
+    for (int j = 0; j < np; ++j) free_.push_back(j);
+  }
+  const int nf = static_cast<int>(free_.size()), cols = n + nf;
+  model_.set_params(std::vector<double>(p, p + np));
+  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
+  int row = 0;
+  for (const auto& [first, last] : windows_) {
+    const auto& s = flight_.samples;
+    // Inputs held from each sample to the next, as the flight controller applied them.
+    runtime::InputFunction u = [&, first = first, last = last](double t, double* out) {
+      size_t k = first;
+      while (k < last && s[k + 1].t - s[first].t <= t + 1e-9) ++k;
+      for (size_t i = 0; i < s[k].u.size(); ++i) out[i] = s[k].u[i];
+      if (t_in >= 0) out[t_in] = s[k].t;
+      if (v_in >= 0) out[v_in] = s[k].vbat;
+      (void)nu;
+    };
+    runtime::IntegratorOptions o;
+    o.quaternion_offset = -1;
+    const double dt = (s[last].t - s[first].t) / static_cast<double>(last - first);
+    o.step = dt;
+    const auto tr = runtime::integrate_rk4_sensitivities(model_, s[first].x, u, 0.0, s[last].t - s[first].t, o, &free_);
+    for (size_t k = first + 1; k <= last; ++k, row += 6) {
+      const auto& xp = tr.states.x[k - first];
+      const auto& S = tr.S[k - first];
+      const auto& xm = s[k].x;
+      for (int i = 0; i < 3; ++i) r[row + i] = xp[i] - xm[i];
+      // Attitude error: 2 vec(q_meas^-1 ⊗ q_pred), small angles about body axes.
+      const double mw = xm[6], mx = -xm[7], my = -xm[8], mz = -xm[9];
+      // Rows of the linear map q_pred -> vec(q_meas^-1 ⊗ q_pred).
+      const double L[3][4] = {{mx, mw, -mz, my}, {my, mz, mw, -mx}, {mz, -my, mx, mw}};
+      for (int i = 0; i < 3; ++i) {
+        double e = 0;
+        for (int c = 0; c < 4; ++c) e += L[i][c] * xp[6 + c];
+        r[row + 3 + i] = 2 * e;
+      }
+      if (!J) continue;
+      for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < np; ++j) J[static_cast<size_t>(row + i) * np + j] = 0;
+      for (int f = 0; f < nf; ++f) {
+        const int j = free_[f];
+        for (int i = 0; i < 3; ++i) J[static_cast<size_t>(row + i) * np + j] = S[i * cols + n + f];
+        for (int i = 0; i < 3; ++i) {
+          double d = 0;
+          for (int c = 0; c < 4; ++c) d += L[i][c] * S[(6 + c) * cols + n + f];
+          J[static_cast<size_t>(row + 3 + i) * np + j] = 2 * d;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace quadgen::fit
