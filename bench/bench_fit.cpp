@@ -6,6 +6,8 @@
 
 #include "dynamic_model.hpp"
 #include "equation_error.hpp"
+#include "integrator.hpp"
+#include "multiple_shooting.hpp"
 #include "generated/finken3/model.hpp"
 #include "profile_likelihood.hpp"
 
@@ -64,6 +66,37 @@ void BM_ProfileOneParameter60s100Hz(benchmark::State& st) {
   for (auto _ : st) benchmark::DoNotOptimize(profile_parameter(m, best, ct, {}, {}).points.size());
 }
 
+// 60 s of pose at 100 Hz: fifteen 4 s wobbling flights from hover, 0.3 s windows.
+void BM_FitMultipleShooting60s100Hz(benchmark::State& st) {
+  Setup s;
+  Flight f;
+  f.has_pose = f.has_gyro = true;
+  auto u = [](double t, double* out) {
+    for (int i = 0; i < 4; ++i) out[i] = 0.4216 + 0.01 * std::sin((2.5 + 0.3 * i) * t + i);
+  };
+  std::vector<double> x0(13, 0.0);
+  x0[2] = 1;
+  x0[6] = 1;
+  runtime::IntegratorOptions o;
+  o.step = 0.01;
+  const auto tr = runtime::integrate_rk4(s.model, x0, u, 0.0, 4.0, o);
+  for (int seg = 0; seg < 15; ++seg)
+    for (size_t k = 0; k < tr.t.size(); ++k) {
+      FlightSample fs;
+      fs.t = seg * 4.2 + tr.t[k];  // 0.2 s gaps separate the segments
+      fs.x = tr.x[k];
+      fs.u.resize(4);
+      u(tr.t[k], fs.u.data());
+      f.samples.push_back(fs);
+    }
+  MultipleShootingModel m(s.model, f, 0.3);
+  auto ps = s.params;
+  for (auto& p : ps)
+    if (p.name == "c_w") p.free = false, p.value = s.truth[s.model.param_index("c_w")];
+  for (auto _ : st) benchmark::DoNotOptimize(fit_least_squares(m, ps, {}).chi2);
+}
+
+BENCHMARK(BM_FitMultipleShooting60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_FitEquationError60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_ProfileOneParameter60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
 
