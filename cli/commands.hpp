@@ -33,6 +33,7 @@ struct FitArgs {
   double validation = 0.3;
   std::string formulation = "equation_error";
   double window = 0.5;
+  double resample = 0;
 };
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);

@@ -41,6 +41,8 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--formulation", a.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
       ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
   c->add_option("--window", a.window, "multiple shooting: window length [s]")->check(CLI::PositiveNumber);
+  c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
+      ->check(CLI::PositiveNumber);
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
 }
@@ -133,7 +135,8 @@ std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitPar
 }
 
 int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw) {
-  const runtime::CsvTable log = a.mapping.empty() ? raw : apply_mapping(raw, load_mapping(a.mapping));
+  runtime::CsvTable log = a.mapping.empty() ? raw : apply_mapping(raw, load_mapping(a.mapping));
+  if (a.resample > 0) log = resample(log, a.resample);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const Flight flight = load_flight(log, rotors, {});

@@ -1,5 +1,6 @@
 #include "flight_data.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -54,6 +55,31 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
     std::vector<double> r;
     for (size_t i = 0; i < src.size(); ++i) r.push_back(row[src[i]] * m.entries[i].scale + m.entries[i].offset);
     out.rows.push_back(r);
+  }
+  return out;
+}
+
+runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
+  const int tc = log.column("t");
+  if (tc < 0) throw FitError(log.path + ":1: missing column 't'");
+  if (log.rows.size() < 2) throw FitError(log.path + ": too few samples to resample");
+  runtime::CsvTable out;
+  out.path = log.path;
+  out.columns = log.columns;
+  const double t0 = log.rows.front()[tc], t1 = log.rows.back()[tc];
+  size_t i = 0;
+  for (long k = 0;; ++k) {
+    const double t = t0 + static_cast<double>(k) / rate_hz;
+    if (t > t1) break;
+    while (i + 2 < log.rows.size() && log.rows[i + 1][tc] <= t) ++i;
+    const auto& a = log.rows[i];
+    const auto& b = log.rows[i + 1];
+    if (!(b[tc] > a[tc])) throw FitError(log.path + ": time not strictly increasing near t = " + std::to_string(t));
+    const double w = std::clamp((t - a[tc]) / (b[tc] - a[tc]), 0.0, 1.0);
+    std::vector<double> row(a.size());
+    for (size_t c = 0; c < a.size(); ++c) row[c] = (1 - w) * a[c] + w * b[c];
+    row[tc] = t;
+    out.rows.push_back(row);
   }
   return out;
 }

@@ -49,6 +49,10 @@ struct FlightOptions {
   double min_height = 0.1;
 };
 
+// Linear interpolation of every column onto a uniform grid at `rate_hz` (streams logged at
+// different rates and forward-filled, or irregular sample times).
+runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz);
+
 // Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
 Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);
 

@@ -259,3 +259,16 @@ TEST(Fit, MultipleShootingRecoversParametersFromPose) {
     EXPECT_NEAR(best.parameters[k].value, truth[k], 0.05 * truth[k]) << name;
   }
 }
+
+TEST(FitData, ResampleInterpolatesOntoAUniformGrid) {
+  const auto t = runtime::parse_csv("t,a,b\n0,0,5\n0.3,3,5\n0.4,4,6\n1.0,10,6\n", "x.csv");
+  const auto r = resample(t, 10.0);
+  ASSERT_EQ(r.rows.size(), 11u);
+  for (size_t k = 0; k < r.rows.size(); ++k) {
+    EXPECT_NEAR(r.rows[k][0], 0.1 * k, 1e-12);
+    EXPECT_NEAR(r.rows[k][1], 10 * 0.1 * k, 1e-9);  // a = 10 t, linear throughout
+  }
+  EXPECT_NEAR(r.rows[3][2], 5.0, 1e-12);
+  EXPECT_NEAR(r.rows[4][2], 6.0, 1e-12);
+  EXPECT_NEAR(r.rows[2][2], 5.0, 1e-12);
+}
