@@ -152,24 +152,48 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   res.weights = w;
   res.num_residuals = nr;
   res.num_free = n_free;
-  // Covariance of the free parameters: (J^T J)^-1 of the weighted residuals.
-  std::vector<double> J(static_cast<size_t>(nr) * n);
-  model.evaluate(values(params).data(), r.data(), J.data());
+  // Covariance of the free parameters from Ceres (dense SVD, so a rank-deficient problem
+  // gives a pseudo-inverse instead of failing), in the tangent space of the fixed-subset
+  // manifold, i.e. over the free parameters in order.
   std::vector<int> free_idx;
   for (int i = 0; i < n; ++i)
     if (params[i].free) free_idx.push_back(i);
-  Eigen::MatrixXd Jf(nr, free_idx.size());
-  for (int i = 0; i < nr; ++i)
-    for (size_t k = 0; k < free_idx.size(); ++k) Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
-  const Eigen::MatrixXd H = Jf.transpose() * Jf;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(H);
-  const Eigen::MatrixXd C = cod.pseudoInverse();
-  const bool singular = cod.rank() < static_cast<long>(free_idx.size());
-  res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
-  res.covariance.assign(free_idx.size(), std::vector<double>(free_idx.size()));
-  for (size_t a = 0; a < free_idx.size(); ++a) {
-    for (size_t b = 0; b < free_idx.size(); ++b) res.covariance[a][b] = C(a, b);
-    res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(C(a, a));
+  std::vector<double> x = values(params);
+  {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    problem.AddResidualBlock(new WeightedCost(model, n, w), nullptr, x.data());
+    std::vector<int> fixed;
+    for (int i = 0; i < n; ++i)
+      if (!params[i].free) fixed.push_back(i);
+    if (!fixed.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(n, fixed));
+    ceres::Covariance::Options co;
+    co.algorithm_type = ceres::DENSE_SVD;
+    co.null_space_rank = -1;
+    co.min_reciprocal_condition_number = 1e-14;
+    ceres::Covariance cov(co);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+    std::vector<double> C(free_idx.size() * free_idx.size(), std::numeric_limits<double>::quiet_NaN());
+    if (cov.Compute(blocks, &problem)) cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data());
+    // Rank of the weighted Jacobian over the free parameters: a deficient one means some
+    // combination is not determined at all, whatever the pseudo-inverse says.
+    std::vector<double> J(static_cast<size_t>(nr) * n);
+    model.evaluate(x.data(), r.data(), J.data());
+    Eigen::MatrixXd Jf(nr, free_idx.size());
+    for (int i = 0; i < nr; ++i)
+      for (size_t k = 0; k < free_idx.size(); ++k)
+        Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jf);
+    qr.setThreshold(1e-10);
+    const bool singular = qr.rank() < static_cast<long>(free_idx.size());
+    res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
+    res.covariance.assign(free_idx.size(), std::vector<double>(free_idx.size()));
+    const size_t nf = free_idx.size();
+    for (size_t a = 0; a < nf; ++a) {
+      for (size_t b = 0; b < nf; ++b) res.covariance[a][b] = C[a * nf + b];
+      res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(C[a * nf + a]);
+    }
   }
   for (int i : free_idx) {
     const auto& p = params[i];
