@@ -22,6 +22,11 @@ struct SimulateArgs {
   double step = 1e-3;
   double rate = 100;
   std::string interpolation = "hold";
+  // Closed-loop flight generator.
+  bool closed_loop = false;
+  unsigned seed = 1;
+  std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters
+  double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
 };
 
 void add_simulate(CLI::App& app, SimulateArgs& args);

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "atomic_output.hpp"
+#include "closed_loop.hpp"
 #include "attitude.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
@@ -24,7 +25,17 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
   auto* sc = c->add_option("--scenario", a.scenario, "hover, climb, right, forward, yaw, new_height");
   auto* in = c->add_option("--inputs", a.inputs, "replay the motor commands of a canonical flight log (CSV)");
+  auto* cl = c->add_flag("--closed-loop", a.closed_loop,
+                         "fly a smooth random trajectory under a cascaded controller (test flights)");
   sc->excludes(in);
+  cl->excludes(sc)->excludes(in);
+  c->add_option("--seed", a.seed, "closed loop: random trajectory and noise seed");
+  c->add_option("--set", a.set, "closed loop: NAME=VALUE for a parameter of the true model (repeatable)");
+  c->add_option("--pose-noise", a.pose_noise, "closed loop: mocap noise [m, rad]");
+  c->add_option("--gyro-noise", a.gyro_noise, "closed loop: gyro noise [rad/s]");
+  c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]");
+  c->add_option("--accel-noise", a.accel_noise, "closed loop: accelerometer noise [m/s^2]");
+  c->add_option("--accel-bias", a.accel_bias, "closed loop: accelerometer bias [m/s^2]");
   c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
@@ -58,14 +69,78 @@ void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) 
 
 }  // namespace
 
+// A closed-loop test flight: the true model (effects and --set values) flown by a
+// controller that believes the nominal base model.
+int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const SymbolicModel& model, DynamicModel& truth) {
+  std::vector<double> p = truth.params();
+  for (const std::string& kv : a.set) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--set expects NAME=VALUE, got '" + kv + "'");
+    const int i = truth.param_index(kv.substr(0, eq));
+    if (i < 0) throw std::invalid_argument("--set: no parameter '" + kv.substr(0, eq) + "' in the model (add its effect with --effects)");
+    p[i] = std::stod(kv.substr(eq + 1));
+  }
+  truth.set_params(p);
+  auto P = [&](const char* n) { return model.params[model.param_index(n)].nominal; };
+  ControllerModel belief;
+  belief.mass = P("mass");
+  belief.g = P("g");
+  belief.J[0] = P("J_xx");
+  belief.J[1] = P("J_yy");
+  belief.J[2] = P("J_zz");
+  belief.kappa = P("kappa");
+  std::vector<std::string> rotors;
+  for (const Rotor& r : vehicle.rotors) {
+    rotors.push_back(r.name);
+    belief.rotor_x.push_back(r.position[0] - P("cog_x"));
+    belief.rotor_y.push_back(r.position[1] - P("cog_y"));
+    belief.spin.push_back(r.spin == Spin::ccw ? 1.0 : -1.0);
+    belief.thrust_laws.push_back(
+        ThrustLaw{P("c_t") * P("rho") * r.disc_area * r.radius * r.radius, P("motor_a0"), P("motor_a1"), P("motor_a2")});
+  }
+  ClosedLoopOptions o;
+  o.duration = a.duration;
+  o.seed = a.seed;
+  o.pose_noise = a.pose_noise;
+  o.gyro_noise = a.gyro_noise;
+  o.gyro_bias = a.gyro_bias;
+  o.accel_noise = a.accel_noise;
+  o.accel_bias = a.accel_bias;
+  std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
+  const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
+  const std::filesystem::path out_path(a.out);
+  OutputSet out(out_path.parent_path().empty() ? "." : out_path.parent_path().string());
+  out.add(out_path.filename().string(), flight.csv());
+  out.commit();
+  // Plot: position against reference, commands.
+  auto col = [&](const std::string& n) {
+    std::vector<double> v;
+    const int c = index_in(flight.columns, n);
+    for (const auto& r : flight.rows) v.push_back(r[c]);
+    return v;
+  };
+  const auto t = col("t");
+  Panel pos{"position and its reference", "t [s]", "m", {}};
+  for (const char* n : {"x", "y", "z", "x_ref", "y_ref", "z_ref"}) pos.series.push_back({n, t, col(n)});
+  Panel cmd{"motor commands", "t [s]", "1", {}};
+  for (const auto& r : rotors) cmd.series.push_back({"u_" + r, t, col("u_" + r)});
+  std::string err;
+  const std::string svg = std::filesystem::path(a.out).replace_extension(".svg").string();
+  if (!plot_svg(svg, vehicle.name + ": closed-loop test flight", {pos, cmd}, &err)) std::cerr << "no plot: " << err << "\n";
+  std::cout << "flew " << a.duration << " s closed loop; wrote " << a.out << "\n";
+  return 0;
+}
+
 int run_simulate(const SimulateArgs& a) {
-  if (a.scenario.empty() == a.inputs.empty()) throw std::invalid_argument("give either --scenario or --inputs");
+  if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
+    throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   const Vehicle vehicle = load_vehicle(a.vehicle);
   DeriveOptions opt;
   opt.effects = parse_effect_list(a.effects);
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
+  if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
   const int delay = model.input_delay_param ? static_cast<int>(*model.input_delay_param) : -1;
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);

@@ -9,6 +9,19 @@
 
 namespace quadgen::runtime {
 
+namespace {
+// gnuplot's enhanced text reads _ and ^ as sub- and superscripts; labels are plain text.
+std::string plain(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '_' || c == '^' || c == '@' || c == '{' || c == '}') out += "\\";
+    if (c == '\'') out += '\'';
+    out += c;
+  }
+  return out;
+}
+}  // namespace
+
 bool plot_svg(const std::string& path, const std::string& title, const std::vector<Panel>& panels, std::string* error) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("quadgen_plot_" + std::to_string(getpid()));
@@ -18,18 +31,19 @@ bool plot_svg(const std::string& path, const std::string& title, const std::vect
   const int height = 260 * static_cast<int>(panels.size()) + 40;
   script << "set terminal svg size 900," << height << " dynamic enhanced font 'sans,11'\n"
          << "set output '" << tmp_svg << "'\n"
-         << "set multiplot layout " << panels.size() << ",1 title '" << title << "'\n"
+         << "set multiplot layout " << panels.size() << ",1 title '" << plain(title) << "'\n"
          << "set grid\nset key outside right\n";
   int file_no = 0;
   for (const Panel& p : panels) {
-    script << "set title '" << p.title << "'\nset xlabel '" << p.xlabel << "'\nset ylabel '" << p.ylabel << "'\nplot ";
+    script << "set title '" << plain(p.title) << "'\nset xlabel '" << plain(p.xlabel) << "'\nset ylabel '"
+           << plain(p.ylabel) << "'\nplot ";
     for (size_t s = 0; s < p.series.size(); ++s) {
       const fs::path data = dir / ("d" + std::to_string(file_no++) + ".dat");
       std::ofstream out(data);
       out.precision(10);
       for (size_t i = 0; i < p.series[s].x.size(); ++i) out << p.series[s].x[i] << ' ' << p.series[s].y[i] << '\n';
       script << (s ? ", " : "") << "'" << data.string() << "' using 1:2 with " << (p.series[s].points ? "points pt 7 ps 0.5" : "lines lw 1.5")
-             << " title '" << p.series[s].label << "'";
+             << " title '" << plain(p.series[s].label) << "'";
     }
     script << "\n";
   }

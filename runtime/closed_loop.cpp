@@ -1,0 +1,194 @@
+#include "closed_loop.hpp"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "integrator.hpp"
+
+namespace quadgen::runtime {
+
+namespace {
+
+using V3 = Eigen::Vector3d;
+using M3 = Eigen::Matrix3d;
+
+// Smooth random reference: a sum of a few sinusoids per axis, with its derivatives.
+struct Reference {
+  struct Wave {
+    double a, w, phase;
+  };
+  std::vector<Wave> axis[4];  // x, y, z, yaw
+  double offset[4] = {0, 0, 0, 0};
+  Reference(const ClosedLoopOptions& o, std::mt19937& rng) {
+    std::uniform_real_distribution<double> freq(0.08, 0.35), ph(0, 2 * M_PI);
+    const double amp[4] = {o.amplitude, o.amplitude, o.height_amplitude, o.yaw_amplitude};
+    offset[2] = o.height;
+    for (int a = 0; a < 4; ++a)
+      for (int k = 0; k < 3; ++k) axis[a].push_back({amp[a] / 3.0, 2 * M_PI * freq(rng), ph(rng)});
+  }
+  // value, first and second derivative; faded in over the first seconds from rest.
+  void at(double t, int a, double out[3]) const {
+    const double T = 3.0, s = t < T ? t / T : 1.0;
+    const double fade = s * s * (3 - 2 * s), dfade = t < T ? 6 * s * (1 - s) / T : 0.0,
+                 ddfade = t < T ? (6 - 12 * s) / (T * T) : 0.0;
+    double v = 0, dv = 0, ddv = 0;
+    for (const auto& w : axis[a]) {
+      v += w.a * (std::sin(w.w * t + w.phase) - std::sin(w.phase));
+      dv += w.a * w.w * std::cos(w.w * t + w.phase);
+      ddv -= w.a * w.w * w.w * std::sin(w.w * t + w.phase);
+    }
+    out[0] = offset[a] + fade * v;
+    out[1] = dfade * v + fade * dv;
+    out[2] = ddfade * v + 2 * dfade * dv + fade * ddv;
+  }
+};
+
+M3 rotation(const std::vector<double>& x) {
+  const Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
+  return q.normalized().toRotationMatrix();
+}
+
+V3 vee(const M3& S) { return V3(S(2, 1), S(0, 2), S(1, 0)); }
+
+// Per-rotor thrusts for a total thrust and body torques, by the (pseudo-)inverse of the
+// allocation matrix of the believed rotor layout.
+std::vector<double> allocate(const ControllerModel& b, double thrust, const V3& torque) {
+  const int n = static_cast<int>(b.rotor_x.size());
+  Eigen::MatrixXd A(4, n);
+  for (int i = 0; i < n; ++i) {
+    A(0, i) = 1;
+    A(1, i) = b.rotor_y[i];
+    A(2, i) = -b.rotor_x[i];
+    A(3, i) = -b.spin[i] * b.kappa;
+  }
+  Eigen::Vector4d w(thrust, torque.x(), torque.y(), torque.z());
+  const Eigen::VectorXd F = A.completeOrthogonalDecomposition().solve(w);
+  return std::vector<double>(F.data(), F.data() + n);
+}
+
+}  // namespace
+
+std::string GeneratedFlight::csv() const {
+  std::ostringstream os;
+  os.precision(10);
+  for (size_t i = 0; i < columns.size(); ++i) os << (i ? "," : "") << columns[i];
+  os << "\n";
+  for (const auto& r : rows) {
+    for (size_t i = 0; i < r.size(); ++i) os << (i ? "," : "") << r[i];
+    os << "\n";
+  }
+  return os.str();
+}
+
+GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel& b,
+                                const std::vector<std::string>& rotors, const ClosedLoopOptions& o) {
+  std::mt19937 rng(o.seed);
+  const Reference ref(o, rng);
+  std::normal_distribution<double> gauss(0, 1);
+  const int nr = static_cast<int>(rotors.size());
+  const int t_in = truth.input_index("t"), v_in = truth.input_index("vbat");
+  std::vector<double> x(truth.num_states(), 0.0);
+  double r0[3];
+  for (int a = 0; a < 3; ++a) {
+    ref.at(0, a, r0);
+    x[a] = r0[0];
+  }
+  x[6] = 1;
+  // Rotor-speed states (motor_lag) start at the hover command's speed.
+  const double hover_u = b.thrust_laws[0].command_for(b.mass * b.g / nr);
+  for (int i = 0; i < nr; ++i) {
+    const int w = truth.state_index("w_" + rotors[i]);
+    const auto& L = b.thrust_laws[i];
+    if (w >= 0) x[w] = L.a0 + L.a1 * hover_u + L.a2 * hover_u * hover_u;
+  }
+  GeneratedFlight out;
+  out.columns = {"t"};
+  for (const auto& r : rotors) out.columns.push_back("u_" + r);
+  for (const char* c : {"x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "p", "q", "r", "ax", "ay", "az", "vbat",
+                        "x_ref", "y_ref", "z_ref", "psi_ref"})
+    out.columns.push_back(c);
+  const double dt = 1.0 / o.log_rate;
+  const long steps = std::lround(o.duration * o.log_rate);
+  V3 int_pos = V3::Zero(), int_rate = V3::Zero();
+  const V3 gyro_bias(o.gyro_bias, -o.gyro_bias, 0.5 * o.gyro_bias), acc_bias(o.accel_bias, -o.accel_bias, 0);
+  std::vector<double> u(truth.num_inputs(), 0.0), f(truth.num_states());
+  IntegratorOptions io;
+  io.step = o.sim_step;
+  io.divergence_bound = 1e4;
+  for (long k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    const double vbat = o.vbat_start + (o.vbat_end - o.vbat_start) * t / o.duration;
+    // --- controller (it sees the true state; the log below adds sensor noise) ---
+    double rx[3], ry[3], rz[3], ryaw[3];
+    ref.at(t, 0, rx);
+    ref.at(t, 1, ry);
+    ref.at(t, 2, rz);
+    ref.at(t, 3, ryaw);
+    const V3 p(x[0], x[1], x[2]), v(x[3], x[4], x[5]), w(x[10], x[11], x[12]);
+    const V3 e_p = V3(rx[0], ry[0], rz[0]) - p, e_v = V3(rx[1], ry[1], rz[1]) - v;
+    int_pos += e_p * dt;
+    const V3 a_cmd = V3(rx[2], ry[2], rz[2]) + o.kp_pos * e_p + o.kd_pos * e_v + o.ki_pos * int_pos + V3(0, 0, b.g);
+    const M3 R = rotation(x);
+    const double thrust = b.mass * a_cmd.dot(R.col(2));
+    const V3 b3 = a_cmd.normalized();
+    const V3 c1(std::cos(ryaw[0]), std::sin(ryaw[0]), 0);
+    const V3 b2 = b3.cross(c1).normalized();
+    M3 Rd;
+    Rd.col(0) = b2.cross(b3);
+    Rd.col(1) = b2;
+    Rd.col(2) = b3;
+    const V3 e_R = 0.5 * vee(Rd.transpose() * R - R.transpose() * Rd);
+    const V3 w_d = -o.kp_att * e_R + V3(0, 0, ryaw[1]);
+    const V3 e_w = w - w_d;
+    int_rate += e_w * dt;
+    const V3 Jd(b.J[0], b.J[1], b.J[2]);
+    const V3 torque = Jd.cwiseProduct(-o.kp_rate * e_w - o.ki_rate * int_rate) + w.cross(Jd.cwiseProduct(w));
+    const auto F = allocate(b, thrust, torque);
+    for (int i = 0; i < nr; ++i) {
+      double ui;
+      try {
+        ui = b.thrust_laws[i].command_for(std::max(0.0, F[i]));
+      } catch (const std::invalid_argument&) {
+        ui = F[i] <= 0 ? 0.0 : 1.0;  // saturated
+      }
+      ui = std::clamp(ui, 0.0, 1.0);
+      u[i] = std::round(ui * o.command_levels) / o.command_levels;
+    }
+    if (t_in >= 0) u[t_in] = t;
+    if (v_in >= 0) u[v_in] = vbat;
+    // --- log: noisy sensors ---
+    truth.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);
+    std::vector<double> row{t};
+    for (int i = 0; i < nr; ++i) row.push_back(u[i]);
+    const double an = o.pose_noise;
+    Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
+    const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
+    q = (q * dq).normalized();
+    for (int i = 0; i < 3; ++i) row.push_back(x[i] + an * gauss(rng));
+    for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);
+    for (int i = 3; i < 6; ++i) row.push_back(x[i] + an * 10 * gauss(rng));
+    for (int i = 0; i < 3; ++i) row.push_back(x[10 + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
+    const V3 sf = R.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, b.g));
+    for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
+    row.push_back(vbat);
+    for (double c : {rx[0], ry[0], rz[0], ryaw[0]}) row.push_back(c);
+    out.rows.push_back(row);
+    if (k == steps) break;
+    // --- plant: the true model over one control period, commands held ---
+    const std::vector<double> held = u;
+    const double t0 = t;
+    auto inputs = [&](double tt, double* uu) {
+      for (size_t i = 0; i < held.size(); ++i) uu[i] = held[i];
+      if (t_in >= 0) uu[t_in] = t0 + tt;
+    };
+    x = integrate_rk4(truth, x, inputs, 0.0, dt, io).x.back();
+    if (x[2] < -5 || (p - V3(rx[0], ry[0], rz[0])).norm() > 20)
+      throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
+  }
+  return out;
+}
+
+}  // namespace quadgen::runtime

@@ -1,0 +1,54 @@
+// A closed-loop flight generator: a cascaded controller with integrators (position ->
+// attitude -> body rates, as real autopilots have, so that it compensates what it does not
+// know) flies the "true" model along a smooth random trajectory with yaw and height
+// changes; commands are quantised as a flight controller logs them, and the log gets
+// mocap-like pose noise and optional IMU noise and bias. Used to hide effects in flights
+// that the diagnosis must then find, and as a simulator feature in its own right.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "dynamic_model.hpp"
+#include "scenarios.hpp"
+
+namespace quadgen::runtime {
+
+// What the controller believes about the vehicle (nominal values, not the truth).
+struct ControllerModel {
+  double mass = 0, g = 9.81;
+  double J[3] = {0, 0, 0};  // principal inertia
+  double kappa = 0;
+  std::vector<double> rotor_x, rotor_y, spin;  // spin +1 ccw seen from above
+  std::vector<ThrustLaw> thrust_laws;          // command <-> thrust
+};
+
+struct ClosedLoopOptions {
+  double duration = 60;        // s
+  unsigned seed = 1;
+  double log_rate = 100;       // Hz; the controller runs at this rate and its commands are logged
+  double sim_step = 1e-3;      // s, RK4
+  double amplitude = 0.8;      // m, horizontal excursions of the trajectory
+  double height = 1.0;         // m, mean height
+  double height_amplitude = 0.3;
+  double yaw_amplitude = 0.8;  // rad
+  double pose_noise = 1e-3;    // m, and pose_noise rad on attitude (mocap-like)
+  double gyro_noise = 0, gyro_bias = 0;    // rad/s
+  double accel_noise = 0, accel_bias = 0;  // m/s^2
+  int command_levels = 65535;  // quantisation of logged/applied commands (16-bit PWM)
+  double vbat_start = 4.15, vbat_end = 3.75;  // V, linear sag over the flight (logged)
+  // Gains (per axis): position PD + I, attitude P, rate P + I.
+  double kp_pos = 3.0, kd_pos = 3.5, ki_pos = 0.6, kp_att = 9.0, kp_rate = 18.0, ki_rate = 4.0;
+};
+
+struct GeneratedFlight {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  std::string csv() const;
+};
+
+// `truth` is integrated; `belief` drives the controller. Throws DivergenceError if the
+// flight is lost.
+GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel& belief,
+                                const std::vector<std::string>& rotor_names, const ClosedLoopOptions& opt);
+
+}  // namespace quadgen::runtime
