@@ -5,6 +5,7 @@
 
 #include "atomic_output.hpp"
 #include "closed_loop.hpp"
+#include "runtime_bridge.hpp"
 #include "attitude.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
@@ -50,15 +51,6 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
 
 namespace {
 
-std::vector<ThrustLaw> thrust_laws(const Vehicle& v, const DynamicModel& m) {
-  auto P = [&](const char* n) { return m.params()[m.param_index(n)]; };
-  std::vector<ThrustLaw> laws;
-  for (const Rotor& r : v.rotors)
-    laws.push_back(ThrustLaw{P("c_t") * P("rho") * r.disc_area * r.radius * r.radius, P("motor_a0"), P("motor_a1"),
-                             P("motor_a2")});
-  return laws;
-}
-
 // Fills the inputs that effects add (t, vbat) after the rotor commands.
 void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) {
   for (int i = 0; i < m.num_inputs(); ++i) {
@@ -81,23 +73,9 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
     p[i] = std::stod(kv.substr(eq + 1));
   }
   truth.set_params(p);
-  auto P = [&](const char* n) { return model.params[model.param_index(n)].nominal; };
-  ControllerModel belief;
-  belief.mass = P("mass");
-  belief.g = P("g");
-  belief.J[0] = P("J_xx");
-  belief.J[1] = P("J_yy");
-  belief.J[2] = P("J_zz");
-  belief.kappa = P("kappa");
+  const ControllerModel belief = nominal_controller_belief(vehicle, model);
   std::vector<std::string> rotors;
-  for (const Rotor& r : vehicle.rotors) {
-    rotors.push_back(r.name);
-    belief.rotor_x.push_back(r.position[0] - P("cog_x"));
-    belief.rotor_y.push_back(r.position[1] - P("cog_y"));
-    belief.spin.push_back(r.spin == Spin::ccw ? 1.0 : -1.0);
-    belief.thrust_laws.push_back(
-        ThrustLaw{P("c_t") * P("rho") * r.disc_area * r.radius * r.radius, P("motor_a0"), P("motor_a1"), P("motor_a2")});
-  }
+  for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
   ClosedLoopOptions o;
   o.duration = a.duration;
   o.seed = a.seed;
@@ -145,7 +123,7 @@ int run_simulate(const SimulateArgs& a) {
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
   const size_t nr = rotors.size();
-  const auto laws = thrust_laws(vehicle, m);
+  const auto laws = nominal_thrust_laws(vehicle, model);
   const double vbat_ref = param(vehicle, "vbat_ref").value;
 
   std::vector<double> x0(m.num_states(), 0.0);

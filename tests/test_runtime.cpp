@@ -263,25 +263,8 @@ TEST(Simulate, BadReplayLogFailsWithOneLineAndNoOutput) {
 // integrators compensate a weak motor with a larger command (what the thesis saw as
 // motor signals offset from each other).
 #include "closed_loop.hpp"
-#include "scenarios.hpp"
+#include "runtime_bridge.hpp"
 namespace {
-ControllerModel finken3_belief(const SymbolicModel& m) {
-  auto P = [&](const char* n) { return m.params[m.param_index(n)].nominal; };
-  ControllerModel b;
-  b.mass = P("mass");
-  b.g = P("g");
-  b.J[0] = P("J_xx");
-  b.J[1] = P("J_yy");
-  b.J[2] = P("J_zz");
-  b.kappa = P("kappa");
-  const double l = 0.07465;
-  b.rotor_x = {-l, l, l, -l};
-  b.rotor_y = {-l, -l, l, l};
-  b.spin = {1, -1, 1, -1};
-  for (int i = 0; i < 4; ++i)
-    b.thrust_laws.push_back({P("c_t") * P("rho") * 1.646e-3 * 0.0635 * 0.0635, P("motor_a0"), P("motor_a1"), P("motor_a2")});
-  return b;
-}
 double column_mean(const GeneratedFlight& f, const std::string& name, size_t from) {
   const int c = index_in(f.columns, name);
   double s = 0;
@@ -297,7 +280,7 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   o.effects = {"motor_gain"};
   const SymbolicModel sm = derive_model(v, mp, o);
   TapeModel truth(emission::build_tape(sm));
-  const ControllerModel belief = finken3_belief(derive_model(v, mp, {}));
+  const ControllerModel belief = nominal_controller_belief(v, derive_model(v, mp, {}));
   ClosedLoopOptions co;
   co.duration = 20;
   co.seed = 4;

@@ -1,0 +1,35 @@
+#include "runtime_bridge.hpp"
+
+namespace quadgen {
+
+namespace {
+double nominal(const SymbolicModel& m, const char* name) { return m.params[m.param_index(name)].nominal; }
+}  // namespace
+
+std::vector<runtime::ThrustLaw> nominal_thrust_laws(const Vehicle& v, const SymbolicModel& m) {
+  std::vector<runtime::ThrustLaw> laws;
+  const double k = nominal(m, "c_t") * nominal(m, "rho");
+  for (const Rotor& r : v.rotors)
+    laws.push_back({k * r.disc_area * r.radius * r.radius, nominal(m, "motor_a0"), nominal(m, "motor_a1"),
+                    nominal(m, "motor_a2")});
+  return laws;
+}
+
+runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const SymbolicModel& m) {
+  runtime::ControllerModel b;
+  b.mass = nominal(m, "mass");
+  b.g = nominal(m, "g");
+  b.J[0] = nominal(m, "J_xx");
+  b.J[1] = nominal(m, "J_yy");
+  b.J[2] = nominal(m, "J_zz");
+  b.kappa = nominal(m, "kappa");
+  for (const Rotor& r : v.rotors) {
+    b.rotor_x.push_back(r.position[0] - nominal(m, "cog_x"));
+    b.rotor_y.push_back(r.position[1] - nominal(m, "cog_y"));
+    b.spin.push_back(r.spin == Spin::ccw ? 1.0 : -1.0);
+  }
+  b.thrust_laws = nominal_thrust_laws(v, m);
+  return b;
+}
+
+}  // namespace quadgen

@@ -1,0 +1,17 @@
+// What the runtime needs to know about a derived vehicle at its nominal parameters: each
+// rotor's thrust law (command <-> thrust) and the controller's belief for closed-loop
+// flights. One place, so simulation, tests and reports build them alike.
+#pragma once
+#include <vector>
+
+#include "closed_loop.hpp"
+#include "scenarios.hpp"
+#include "symbolic_model.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen {
+
+std::vector<runtime::ThrustLaw> nominal_thrust_laws(const Vehicle& v, const SymbolicModel& m);
+runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const SymbolicModel& m);
+
+}  // namespace quadgen
