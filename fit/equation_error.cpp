@@ -26,6 +26,13 @@ std::vector<std::string> EquationErrorModel::all_names() const {
   return {"ax", "ay", "az", "pdot", "qdot", "rdot"};  // world-frame accelerations when no accelerometer
 }
 
+void EquationErrorModel::set_free(const std::vector<bool>& free) const {
+  std::vector<int> cols;
+  for (size_t j = 0; j < free.size(); ++j)
+    if (free[j]) cols.push_back(static_cast<int>(j));
+  model_.restrict_param_jacobian(cols);
+}
+
 std::vector<std::string> EquationErrorModel::channels() const {
   const auto names = all_names();
   std::vector<std::string> out;

@@ -25,6 +25,7 @@ class EquationErrorModel : public ResidualModel {
   void evaluate(const double* p, double* r, double* J) const override;
   int channel_of(int i) const override { return i % static_cast<int>(used_.size()); }
   std::vector<std::string> channels() const override;
+  void set_free(const std::vector<bool>& free) const override;
   // Residuals of all six channels at sample k (for plots), after evaluate-able parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
   const Flight& flight() const { return flight_; }

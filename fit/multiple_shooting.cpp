@@ -31,6 +31,7 @@ void MultipleShootingModel::set_free(const std::vector<bool>& free) const {
   free_.clear();
   for (size_t j = 0; j < free.size(); ++j)
     if (free[j]) free_.push_back(static_cast<int>(j));
+  model_.restrict_param_jacobian(free_);
 }
 
 void MultipleShootingModel::evaluate(const double* p, double* r, double* J) const {

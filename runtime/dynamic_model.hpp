@@ -22,6 +22,9 @@ class DynamicModel {
   // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
+  // A fit with few free parameters needs only their columns of B; a model may then skip
+  // the others (left zero). Empty: all columns.
+  virtual void restrict_param_jacobian(const std::vector<int>& /*columns*/) {}
 
   int state_index(const std::string& name) const;
   int input_index(const std::string& name) const;

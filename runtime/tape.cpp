@@ -36,7 +36,37 @@ void scatter(double* dense, int rows, int cols, const SparseOutputs& s, const do
 
 TapeModel::TapeModel(Tape t) : tape_(std::move(t)), reg_(tape_.num_registers, 0.0) {
   for (const auto& [r, v] : tape_.constants) reg_[r] = v;
+  dfdp_code_ = tape_.dfdp_code;
+  dfdp_ = tape_.dfdp;
   set_params(tape_.nominal);
+}
+
+void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
+  if (columns.empty()) {
+    dfdp_code_ = tape_.dfdp_code;
+    dfdp_ = tape_.dfdp;
+    return;
+  }
+  std::vector<char> want_col(tape_.np, 0), live(tape_.num_registers, 0);
+  for (int c : columns) want_col[c] = 1;
+  dfdp_ = SparseOutputs{};
+  for (size_t k = 0; k < tape_.dfdp.reg.size(); ++k)
+    if (want_col[tape_.dfdp.col[k]]) {
+      dfdp_.row.push_back(tape_.dfdp.row[k]);
+      dfdp_.col.push_back(tape_.dfdp.col[k]);
+      dfdp_.reg.push_back(tape_.dfdp.reg[k]);
+      live[tape_.dfdp.reg[k]] = 1;
+    }
+  // Each register is written once in this straight-line code: walking backwards, an
+  // instruction is needed when its result is, and then so are its operands.
+  std::vector<Instruction> kept;
+  for (auto it = tape_.dfdp_code.rbegin(); it != tape_.dfdp_code.rend(); ++it) {
+    if (!live[it->dst]) continue;
+    kept.push_back(*it);
+    live[it->a] = 1;
+    if (it->op == TapeOp::add || it->op == TapeOp::mul || it->op == TapeOp::div || it->op == TapeOp::pow) live[it->b] = 1;
+  }
+  dfdp_code_.assign(kept.rbegin(), kept.rend());
 }
 
 void TapeModel::set_params(const std::vector<double>& p) {
@@ -58,8 +88,8 @@ void TapeModel::rhs(const double* x, const double* u, double* f, double* A, doub
     scatter(A, tape_.nx, tape_.nx, tape_.dfdx, r);
   }
   if (B) {
-    run(tape_.dfdp_code, r);
-    scatter(B, tape_.nx, tape_.np, tape_.dfdp, r);
+    run(dfdp_code_, r);
+    scatter(B, tape_.nx, tape_.np, dfdp_, r);
   }
   if (Bu) {
     run(tape_.dfdu_code, r);

@@ -51,11 +51,15 @@ class TapeModel : public DynamicModel {
   const std::vector<double>& params() const override { return p_; }
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
+  void restrict_param_jacobian(const std::vector<int>& columns) override;
   int input_delay_param() const { return tape_.input_delay_param; }
 
  private:
   Tape tape_;
   std::vector<double> p_;
+  // dfdp code and outputs pruned to the requested columns (backward liveness).
+  std::vector<Instruction> dfdp_code_;
+  SparseOutputs dfdp_;
   mutable std::vector<double> reg_;
 };
 

@@ -3,6 +3,7 @@
 // against the compiled header, and bad replay logs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -61,6 +62,27 @@ TEST(Runtime, TapeModelMatchesCompiledHeader) {
     EXPECT_LT(max_diff(A1, A2), 1e-7);
     EXPECT_LT(max_diff(B1, B2), 1e-4);  // dfdp entries reach 1e6 (1/J): 1e-10 relative
   }
+}
+
+TEST(Runtime, RestrictedParameterJacobianKeepsRequestedColumns) {
+  TapeModel tape = finken3_tape({"motor_gain"});
+  std::mt19937 rng(8);
+  const auto x = test::random_state(rng);
+  const std::vector<double> u{0.3, 0.4, 0.5, 0.6};
+  const int n = 13, np = tape.num_params();
+  std::vector<double> f(n), full(n * np), part(n * np);
+  tape.rhs(x.data(), u.data(), f.data(), nullptr, full.data(), nullptr);
+  const std::vector<int> cols{tape.param_index("c_t"), tape.param_index("motor_gain.C"), tape.param_index("J_yy")};
+  tape.restrict_param_jacobian(cols);
+  tape.rhs(x.data(), u.data(), f.data(), nullptr, part.data(), nullptr);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < np; ++j) {
+      const bool kept = std::find(cols.begin(), cols.end(), j) != cols.end();
+      EXPECT_EQ(part[i * np + j], kept ? full[i * np + j] : 0.0) << i << " " << j;
+    }
+  tape.restrict_param_jacobian({});
+  tape.rhs(x.data(), u.data(), f.data(), nullptr, part.data(), nullptr);
+  EXPECT_EQ(part, full);
 }
 
 TEST(Runtime, Rk4ConvergesWithFourthOrder) {
