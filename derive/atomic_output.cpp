@@ -1,6 +1,7 @@
 #include "atomic_output.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -33,10 +34,18 @@ void OutputSet::add(const std::string& filename, const std::string& content) {
 }
 
 void OutputSet::commit() {
+  // Test hook: die here, after the temporaries are written and before anything is renamed,
+  // as a killed process would (tests/test_robustness.cpp).
+  if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
   for (const auto& p : pending_) {
     std::error_code ec;
     fs::rename(p.first, p.second, ec);
     if (ec) throw OutputError(p.second + ": cannot move into place: " + ec.message());
+    // Temporaries an earlier, interrupted run left beside this file.
+    const fs::path final_path(p.second);
+    for (const auto& e : fs::directory_iterator(final_path.parent_path(), ec))
+      if (e.path().filename().string().rfind(final_path.filename().string() + ".tmp.", 0) == 0)
+        fs::remove(e.path(), ec);
   }
   committed_ = true;
 }
