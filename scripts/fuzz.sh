@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for SECONDS
+# (default 60) on a copy of its seed corpus. A crash input is printed and saved under
+# fuzz/crashes/; keep it as a regression by moving it to fuzz/regressions/<target>/.
+#   scripts/fuzz.sh            about a minute per target (what CI runs)
+#   scripts/fuzz.sh 600        the longer run (10 minutes per target)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+command -v clang++ >/dev/null || { echo "clang++ is needed for fuzzing (apt-get install clang)"; exit 1; }
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQUADGEN_FUZZ=ON > /dev/null
+cmake --build build-fuzz -j"$(nproc)" > /dev/null
+mkdir -p fuzz/crashes
+status=0
+for t in vehicle flight_log template; do
+  work=$(mktemp -d)
+  cp -r "fuzz/corpus/$t/." "$work/"
+  echo "fuzzing $t for $seconds s"
+  if ! build-fuzz/fuzz/fuzz_$t "$work" -max_total_time="$seconds" -max_len=4096 -timeout=10 \
+       -artifact_prefix="fuzz/crashes/${t}-" -print_final_stats=1 > "build-fuzz/fuzz_$t.log" 2>&1; then
+    echo "  FOUND a failure: see build-fuzz/fuzz_$t.log and fuzz/crashes/"; tail -30 "build-fuzz/fuzz_$t.log"; status=1
+  else
+    grep -E "stat::number_of_executed_units|cov:" "build-fuzz/fuzz_$t.log" | tail -2 | sed 's/^/  /'
+  fi
+  rm -rf "$work"
+done
+exit $status
