@@ -35,7 +35,8 @@ struct Reader {
   void only_keys(const YAML::Node& n, const std::set<std::string>& allowed,
                  const std::string& where) const {
     for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) fail(kv.first, "expected a plain key in " + where + " (found a list or mapping as a key)");
+      const std::string key = kv.first.Scalar();
       if (!allowed.count(key)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -201,7 +202,22 @@ std::string fnv1a_hex(const std::string& bytes) {
   return buf;
 }
 
+namespace {
+Vehicle parse_vehicle_checked(const std::string& content, const std::string& path);
+}
+
+// yaml-cpp reports type mismatches anywhere in a document by exception; each becomes a
+// one-line error with its position rather than escaping to the caller.
 Vehicle parse_vehicle(const std::string& content, const std::string& path) {
+  try {
+    return parse_vehicle_checked(content, path);
+  } catch (const YAML::Exception& e) {
+    throw VehicleError(path + ":" + std::to_string(e.mark.line + 1) + ": unexpected YAML structure: " + e.msg);
+  }
+}
+
+namespace {
+Vehicle parse_vehicle_checked(const std::string& content, const std::string& path) {
   Reader r{path};
   YAML::Node root;
   try {
@@ -280,6 +296,7 @@ Vehicle parse_vehicle(const std::string& content, const std::string& path) {
   }
   return v;
 }
+}  // namespace
 
 Vehicle load_vehicle(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
