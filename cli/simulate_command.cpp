@@ -51,6 +51,12 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
 
 namespace {
 
+// The output set for one file named on the command line (its folder, or the current one).
+OutputSet output_for(const std::string& file) {
+  const std::filesystem::path dir = std::filesystem::path(file).parent_path();
+  return OutputSet(dir.empty() ? "." : dir.string());
+}
+
 // Fills the inputs that effects add (t, vbat) after the rotor commands.
 void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) {
   for (int i = 0; i < m.num_inputs(); ++i) {
@@ -86,9 +92,8 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   o.accel_bias = a.accel_bias;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
-  const std::filesystem::path out_path(a.out);
-  OutputSet out(out_path.parent_path().empty() ? "." : out_path.parent_path().string());
-  out.add(out_path.filename().string(), flight.csv());
+  OutputSet out = output_for(a.out);
+  out.add(std::filesystem::path(a.out).filename().string(), flight.csv());
   out.commit();
   // Plot: position against reference, commands.
   auto col = [&](const std::string& n) {
@@ -130,7 +135,6 @@ int run_simulate(const SimulateArgs& a) {
   x0[6] = 1.0;
   InputFunction inputs;
   std::unique_ptr<InputSignal> signal;
-  std::vector<double> vbat_t, vbat_v;
   if (!a.scenario.empty()) {
     const Scenario& s = find_scenario(a.scenario);
     const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
@@ -154,7 +158,6 @@ int run_simulate(const SimulateArgs& a) {
     const bool has_vbat = log.column("vbat") >= 0;
     if (m.input_index("vbat") >= 0 && !has_vbat)
       throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
-    InputSignal vb(t, std::vector<std::vector<double>>(t.size(), std::vector<double>(1, vbat_ref)), Interpolation::linear);
     std::shared_ptr<InputSignal> vbat_signal;
     if (has_vbat) {
       const auto v = log.values("vbat");
@@ -203,7 +206,7 @@ int run_simulate(const SimulateArgs& a) {
     }
   }
 
-  OutputSet out(std::filesystem::path(a.out).parent_path().empty() ? "." : std::filesystem::path(a.out).parent_path().string());
+  OutputSet out = output_for(a.out);
   out.add(std::filesystem::path(a.out).filename().string(), trajectory_csv(m, tr, inputs, rotors));
   // Plot like the thesis' figures: translation, rotation, thrust per rotor.
   Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{"thrust per rotor", "t [s]", "N", {}};
