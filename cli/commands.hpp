@@ -43,4 +43,13 @@ struct FitArgs {
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);
 
+struct DiagnoseArgs {
+  std::string vehicle, log, out, mapping, candidates;
+  std::string translational = "auto";
+  double resample = 0, validation = 0.3, alpha = 0.01, window = 1.0;
+  int max_effects = 3;
+};
+void add_diagnose(CLI::App& app, DiagnoseArgs& args);
+int run_diagnose(const DiagnoseArgs& args);
+
 }  // namespace quadgen::cli

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   quadgen::cli::add_simulate(app, simulate);
   quadgen::cli::FitArgs fit;
   quadgen::cli::add_fit(app, fit);
+  quadgen::cli::DiagnoseArgs diagnose;
+  quadgen::cli::add_diagnose(app, diagnose);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -21,6 +23,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
     if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
     if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
+    if (app.got_subcommand("diagnose")) return quadgen::cli::run_diagnose(diagnose);
   } catch (const std::exception& e) {
     std::cerr << "quadgen: error: " << e.what() << "\n";
     return 2;

@@ -1,7 +1,11 @@
 // Equation-error residuals: at every logged sample, the model's accelerations evaluated at
 // the measured state and commands against the measured ones: specific force from the
 // accelerometer (or the derivative of the velocity), and the derivative of the gyro.
-// Jacobians come from the model's analytic df/dp. Suits logs with good state estimates
+// Jacobians come from the model's analytic df/dp.
+// Effects that act before the dynamics are applied to the data instead: input_delay shifts
+// the logged commands, motor_lag filters the commanded rotor speeds into the rotor-speed
+// states, attitude_bias turns the logged attitude back into the true one; their Jacobian
+// columns are central differences of the residuals. Suits logs with good state estimates
 // and IMU data; it needs no integration and so cannot drift. (Multiple shooting, which
 // compares integrated windows with the pose, is the other formulation; see README.)
 #pragma once
@@ -36,8 +40,16 @@ class EquationErrorModel : public ResidualModel {
   bool accel_;
   int g_index_;
   std::vector<int> used_;  // indices into the six channels
+  // Parameters applied to the data (-1 when the model lacks the effect).
+  int lag_ = -1, delay_ = -1, roll_ = -1, pitch_ = -1;
+  std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
+  mutable std::vector<bool> free_;
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J) const;
+  // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
+  void prepare(const double* p, std::vector<double>& X, std::vector<double>& U) const;
+  void commands_at(double t, double* u) const;  // rotor commands interpolated at t
+  void residuals(const double* p, double* r, double* J) const;
 };
 
 

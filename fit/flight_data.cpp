@@ -166,7 +166,8 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
     bool airborne = true;
     for (double uc : fs.u) airborne = airborne && uc > o.min_command;
     if (f.has_pose) airborne = airborne && fs.x[2] > o.min_height;
-    if (!o.airborne_only || airborne) f.samples.push_back(fs);
+    const bool edge = trel[k] < o.edge_trim || trel.back() - trel[k] < o.edge_trim;
+    if ((!o.airborne_only || airborne) && !edge) f.samples.push_back(fs);
   }
   if (static_cast<double>(f.samples.size()) < o.min_samples)
     throw FitError(log.path + ": too few airborne samples (" + std::to_string(f.samples.size()) + ")");

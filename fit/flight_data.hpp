@@ -47,6 +47,9 @@ struct FlightOptions {
   bool airborne_only = true;
   double min_command = 0.05;
   double min_height = 0.1;
+  // Derivatives within this many seconds of the log's ends come from one-sided windows;
+  // those samples are dropped.
+  double edge_trim = 0.1;
 };
 
 // Linear interpolation of every column onto a uniform grid at `rate_hz` (streams logged at

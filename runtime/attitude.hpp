@@ -12,4 +12,23 @@ inline std::array<double, 3> euler_zyx(double w, double x, double y, double z) {
           std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))};
 }
 
+// Hamilton product a ⊗ b, scalar first.
+inline void quaternion_product(const double* a, const double* b, double* q) {
+  q[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+  q[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+  q[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+  q[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+}
+
+// True attitude from a logged one under attitude_bias (contracts.md §3: q_log = q ⊗ q_bias,
+// q_bias = q_y(pitch) ⊗ q_x(roll)): q = q_log ⊗ conj(q_bias).
+inline void unbias_attitude(const double* q_log, double roll, double pitch, double* q) {
+  const double qp[4] = {std::cos(pitch / 2), 0, std::sin(pitch / 2), 0};
+  const double qr[4] = {std::cos(roll / 2), std::sin(roll / 2), 0, 0};
+  double qb[4];
+  quaternion_product(qp, qr, qb);
+  for (int i = 1; i < 4; ++i) qb[i] = -qb[i];
+  quaternion_product(q_log, qb, q);
+}
+
 }  // namespace quadgen::runtime

@@ -31,9 +31,12 @@ struct Reference {
   }
   // value, first and second derivative; faded in over the first seconds from rest.
   void at(double t, int a, double out[3]) const {
+    // Quintic smoothstep: the reference's acceleration (and so the commands) stays
+    // continuous when the fade ends.
     const double T = 3.0, s = t < T ? t / T : 1.0;
-    const double fade = s * s * (3 - 2 * s), dfade = t < T ? 6 * s * (1 - s) / T : 0.0,
-                 ddfade = t < T ? (6 - 12 * s) / (T * T) : 0.0;
+    const double fade = s * s * s * (10 - 15 * s + 6 * s * s),
+                 dfade = t < T ? 30 * s * s * (1 - s) * (1 - s) / T : 0.0,
+                 ddfade = t < T ? 60 * s * (1 - s) * (1 - 2 * s) / (T * T) : 0.0;
     double v = 0, dv = 0, ddv = 0;
     for (const auto& w : axis[a]) {
       v += w.a * (std::sin(w.w * t + w.phase) - std::sin(w.phase));
@@ -45,11 +48,6 @@ struct Reference {
     out[2] = ddfade * v + 2 * dfade * dv + fade * ddv;
   }
 };
-
-M3 rotation(const std::vector<double>& x) {
-  const Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
-  return q.normalized().toRotationMatrix();
-}
 
 V3 vee(const M3& S) { return V3(S(2, 1), S(0, 2), S(1, 0)); }
 
@@ -114,6 +112,20 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   const long steps = std::lround(o.duration * o.log_rate);
   V3 int_pos = V3::Zero(), int_rate = V3::Zero();
   const V3 gyro_bias(o.gyro_bias, -o.gyro_bias, 0.5 * o.gyro_bias), acc_bias(o.accel_bias, -o.accel_bias, 0);
+  // Effects outside the ODE, taken from the true model's parameters: the attitude the
+  // autopilot estimates and logs is q ⊗ q_bias (it flies on that estimate), and the motors
+  // act on the commands of `delay` seconds ago.
+  auto truth_param = [&](const char* name) {
+    const int i = truth.param_index(name);
+    return i >= 0 ? truth.params()[i] : 0.0;
+  };
+  const Eigen::Quaterniond q_bias =
+      Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.pitch"), V3::UnitY())) *
+      Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.roll"), V3::UnitX()));
+  const double delay = truth_param("input_delay.seconds");
+  const long delay_steps = static_cast<long>(std::floor(delay / dt));
+  const double delay_rest = delay - static_cast<double>(delay_steps) * dt;
+  std::vector<std::vector<double>> sent;  // commands of every control step
   std::vector<double> u(truth.num_inputs(), 0.0), f(truth.num_states());
   IntegratorOptions io;
   io.step = o.sim_step;
@@ -131,7 +143,9 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     const V3 e_p = V3(rx[0], ry[0], rz[0]) - p, e_v = V3(rx[1], ry[1], rz[1]) - v;
     int_pos += e_p * dt;
     const V3 a_cmd = V3(rx[2], ry[2], rz[2]) + o.kp_pos * e_p + o.kd_pos * e_v + o.ki_pos * int_pos + V3(0, 0, b.g);
-    const M3 R = rotation(x);
+    const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[6], x[7], x[8], x[9]).normalized();
+    const Eigen::Quaterniond q_est = q_true * q_bias;
+    const M3 R = q_est.toRotationMatrix(), R_true = q_true.toRotationMatrix();
     const double thrust = b.mass * a_cmd.dot(R.col(2));
     const V3 b3 = a_cmd.normalized();
     const V3 c1(std::cos(ryaw[0]), std::sin(ryaw[0]), 0);
@@ -159,30 +173,37 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     }
     if (t_in >= 0) u[t_in] = t;
     if (v_in >= 0) u[v_in] = vbat;
-    // --- log: noisy sensors ---
-    truth.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);
+    sent.push_back(u);
+    auto sent_at = [&](long i) -> const std::vector<double>& { return sent[static_cast<size_t>(std::max(0L, i))]; };
+    const std::vector<double>& early = sent_at(k - delay_steps - 1);
+    const std::vector<double>& late = sent_at(k - delay_steps);
+    // --- log: noisy sensors (the accelerometer feels the commands in effect now) ---
+    std::vector<double> acting = u;
+    for (int i = 0; i < nr; ++i) acting[i] = (delay_rest > 0 ? early : late)[i];
+    truth.rhs(x.data(), acting.data(), f.data(), nullptr, nullptr, nullptr);
     std::vector<double> row{t};
     for (int i = 0; i < nr; ++i) row.push_back(u[i]);
     const double an = o.pose_noise;
-    Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
+    Eigen::Quaterniond q = q_est;
     const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
     q = (q * dq).normalized();
     for (int i = 0; i < 3; ++i) row.push_back(x[i] + an * gauss(rng));
     for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);
     for (int i = 3; i < 6; ++i) row.push_back(x[i] + an * 10 * gauss(rng));
     for (int i = 0; i < 3; ++i) row.push_back(x[10 + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
-    const V3 sf = R.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, b.g));
+    const V3 sf = R_true.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, b.g));
     for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
     row.push_back(vbat);
     for (double c : {rx[0], ry[0], rz[0], ryaw[0]}) row.push_back(c);
     out.rows.push_back(row);
     if (k == steps) break;
     // --- plant: the true model over one control period, commands held ---
-    const std::vector<double> held = u;
     const double t0 = t;
     auto inputs = [&](double tt, double* uu) {
-      for (size_t i = 0; i < held.size(); ++i) uu[i] = held[i];
+      const std::vector<double>& held = tt < delay_rest ? early : late;
+      for (int i = 0; i < nr; ++i) uu[i] = held[i];
       if (t_in >= 0) uu[t_in] = t0 + tt;
+      if (v_in >= 0) uu[v_in] = vbat;
     };
     x = integrate_rk4(truth, x, inputs, 0.0, dt, io).x.back();
     if (x[2] < -5 || (p - V3(rx[0], ry[0], rz[0])).norm() > 20)

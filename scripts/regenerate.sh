@@ -18,3 +18,4 @@ regen() {  # vehicle-file folder-name [effects]
 regen vehicles/finken3.yaml finken3
 regen vehicles/finken3.yaml finken3_all_effects all
 regen vehicles/crazyflie21.yaml crazyflie21
+regen vehicles/crazyflie21.yaml crazyflie21_all_effects all

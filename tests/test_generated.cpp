@@ -227,7 +227,8 @@ TEST(Generated, CheckedInHeadersAreUpToDate) {
     const char* effects;
   } cases[] = {{"vehicles/finken3.yaml", "finken3", ""},
                {"vehicles/finken3.yaml", "finken3_all_effects", "all"},
-               {"vehicles/crazyflie21.yaml", "crazyflie21", ""}};
+               {"vehicles/crazyflie21.yaml", "crazyflie21", ""},
+               {"vehicles/crazyflie21.yaml", "crazyflie21_all_effects", "all"}};
   for (const auto& c : cases) {
     std::string cmd = "cd " + src + " && " + QUADGEN_BINARY + " derive " + c.vehicle + " --out " +
                       (tmp / c.name).string() + (std::string(c.effects).empty() ? "" : std::string(" --effects ") + c.effects) +

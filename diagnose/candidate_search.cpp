@@ -1,0 +1,356 @@
+#include "candidate_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <boost/math/distributions/chi_squared.hpp>
+
+#include "effects.hpp"
+#include "residual_analysis.hpp"
+
+namespace quadgen::diagnose {
+
+using fit::FitParameter;
+
+namespace {
+
+// A start away from the neutral value for effects whose cost is flat there (a lag or a
+// delay of zero, a ground-effect radius of zero): fits start from both and keep the better.
+double typical_start(const std::string& param) {
+  if (param == "motor_lag.tau") return 0.03;
+  if (param == "input_delay.seconds") return 0.015;
+  if (param == "ground_effect.radius") return 0.05;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string effect_of(const std::string& param) { return param.substr(0, param.find('.')); }
+
+double chi2_upper(double x, double dof) {
+  if (x <= 0) return 1.0;
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
+}
+
+std::vector<double> values(const std::vector<FitParameter>& ps) {
+  std::vector<double> v;
+  for (const auto& p : ps) v.push_back(p.value);
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> applicable_effects(const fit::Flight& f) {
+  std::vector<std::string> out;
+  for (const auto& effect : effect_catalogue()) {
+    const std::string& e = effect.name;
+    if (e == "battery_sag" && !f.has_vbat) continue;
+    if (e == "ground_effect" && !f.has_pose) continue;
+    out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::string& effect) {
+  std::vector<std::string> out;
+  for (const auto& p : all.params)
+    if (p.name.rfind(effect + ".", 0) == 0) out.push_back(p.name);
+  return out;
+}
+
+std::string separating_manoeuvre(const std::string& a, const std::string& b) {
+  auto is = [&](const char* x, const char* y) { return (a == x && b == y) || (a == y && b == x); };
+  if (is("motor_gain", "cog_offset"))
+    return "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
+           "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)";
+  if (is("motor_lag", "input_delay"))
+    return "fast throttle steps or chirps (1-10 Hz): a lag rounds and attenuates the response, a delay "
+           "shifts it without changing its shape";
+  if (is("attitude_bias", "wind"))
+    return "hover while turning through a full yaw circle: an attitude bias turns with the body, a steady "
+           "wind stays fixed in the world";
+  if (is("thrust_decay", "battery_sag"))
+    return "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)";
+  return "a flight that excites the two effects differently (vary speed, height, thrust and heading)";
+}
+
+CandidateSearch::CandidateSearch(const SymbolicModel& all, runtime::DynamicModel& model,
+                                 const fit::EquationErrorModel& train, const fit::EquationErrorModel& valid,
+                                 SearchOptions opt)
+    : all_(all), model_(model), train_(train), valid_(valid), opt_(std::move(opt)) {
+  candidates_ = opt_.candidates.empty() ? applicable_effects(train.flight()) : opt_.candidates;
+  for (const auto& e : candidates_) {
+    if (std::find(all.effects.begin(), all.effects.end(), e) == all.effects.end())
+      throw fit::FitError("candidate effect '" + e + "' is not in the model");
+    for (const auto& name : effect_parameters(all, e)) effect_params_[e].push_back(model.param_index(name));
+  }
+}
+
+std::vector<FitParameter> CandidateSearch::initial_parameters() const {
+  std::vector<FitParameter> ps;
+  for (const auto& p : all_.params) {
+    const bool effect_param = p.name.find('.') != std::string::npos;
+    ps.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, p.fit && !effect_param});
+  }
+  return ps;
+}
+
+std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>& effects,
+                                                    const std::vector<FitParameter>& start, double* cost) const {
+  std::vector<FitParameter> ps = start;
+  for (size_t i = 0; i < ps.size(); ++i) {
+    const std::string e = effect_of(ps[i].name);
+    if (ps[i].name.find('.') == std::string::npos) continue;
+    const bool on = effects.count(e) > 0 && all_.params[i].fit;
+    ps[i].free = on;
+    if (!on) ps[i].value = all_.params[i].nominal;
+  }
+  // Only ratios of motor gains are identifiable beside c_t: the first rotor is the reference.
+  for (auto& p : ps)
+    if (p.name.rfind("motor_gain.", 0) == 0) {
+      p.free = false;
+      break;
+    }
+  fit::FitOptions fo;
+  fo.max_iterations = 100;
+  fo.function_tolerance = 1e-10;
+  fo.parameter_tolerance = 1e-10;
+  *cost = fit::solve_weighted(train_, ps, weights_, fo);
+  return ps;
+}
+
+double CandidateSearch::cost(const fit::ResidualModel& m, const std::vector<FitParameter>& ps) const {
+  const auto p = values(ps);
+  std::vector<double> r(m.num_residuals());
+  m.evaluate(p.data(), r.data(), nullptr);
+  double c = 0;
+  for (int i = 0; i < m.num_residuals(); ++i) c += std::pow(weights_[m.channel_of(i)] * r[i], 2);
+  return c;
+}
+
+namespace {
+// Per channel: sum of squares, and the noise variance times the integrated autocorrelation
+// time of the residuals (the variance of one independent sample's worth of them).
+struct ChannelNoise {
+  std::vector<double> ss, var_tau;
+  double n_eff = 0;
+};
+ChannelNoise channel_noise(const fit::ResidualModel& m, const std::vector<FitParameter>& ps) {
+  const auto p = values(ps);
+  std::vector<double> r(m.num_residuals());
+  m.evaluate(p.data(), r.data(), nullptr);
+  const size_t nc = m.channels().size();
+  std::vector<std::vector<double>> by(nc);
+  for (int i = 0; i < m.num_residuals(); ++i) by[m.channel_of(i)].push_back(r[i]);
+  ChannelNoise out;
+  for (const auto& x : by) {
+    double ss = 0;
+    for (double v : x) ss += v * v;
+    const double tau = integrated_autocorrelation_time(x, 100);
+    out.ss.push_back(ss);
+    out.var_tau.push_back(std::max(1e-300, ss / static_cast<double>(x.size()) * tau));
+    out.n_eff += static_cast<double>(x.size()) / tau;
+  }
+  return out;
+}
+// Likelihood-ratio statistic of the larger model against the smaller, with the larger
+// model's noise level and correlation time.
+double lr_statistic(const ChannelNoise& small, const ChannelNoise& large) {
+  double s = 0;
+  for (size_t c = 0; c < small.ss.size(); ++c) s += (small.ss[c] - large.ss[c]) / large.var_tau[c];
+  return std::max(0.0, s);
+}
+}  // namespace
+
+std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>& ps) const {
+  const ChannelNoise n = channel_noise(train_, ps);
+  std::vector<double> w;
+  for (double v : n.var_tau) w.push_back(1 / std::sqrt(v));
+  return w;
+}
+
+CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std::set<std::string>& base,
+                                            const std::vector<FitParameter>& base_fit, double base_cost,
+                                            double base_valid_cost) const {
+  CandidateEvidence ev;
+  ev.effect = effect;
+  std::set<std::string> with = base;
+  with.insert(effect);
+  ev.model_effects.assign(with.begin(), with.end());
+  double c = 0;
+  ev.parameters = fit_with(with, base_fit, &c);
+  // Second start away from a flat neutral value.
+  std::vector<FitParameter> start = base_fit;
+  bool other_start = false;
+  for (int i : effect_params_.at(effect)) {
+    const double s = typical_start(start[i].name);
+    if (!std::isnan(s)) start[i].value = s, other_start = true;
+  }
+  if (other_start) {
+    double c2 = 0;
+    auto ps2 = fit_with(with, start, &c2);
+    if (c2 < c) ev.parameters = ps2, c = c2;
+  }
+  ev.cost = c;
+  const ChannelNoise small = channel_noise(train_, base_fit), large = channel_noise(train_, ev.parameters);
+  ev.statistic = lr_statistic(small, large);
+  for (int i : effect_params_.at(effect)) ev.dof += ev.parameters[i].free ? 1 : 0;
+  const auto& p0 = all_.params[effect_params_.at(effect).front()];
+  ev.boundary = ev.dof == 1 && p0.nominal <= p0.lower + 0.01 * (p0.upper - p0.lower);
+  ev.p_value = ev.boundary ? 0.5 * chi2_upper(ev.statistic, 1) : chi2_upper(ev.statistic, ev.dof);
+  ev.level = opt_.alpha / static_cast<double>(candidates_.size());
+  ev.delta_bic = -ev.statistic + ev.dof * std::log(large.n_eff);
+  ev.delta_aic = -ev.statistic + 2.0 * ev.dof;
+  (void)base_cost;
+  ev.validation_cost_before = base_valid_cost;
+  ev.validation_cost_after = cost(valid_, ev.parameters);
+  ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
+  if (!(ev.p_value < ev.level))
+    ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
+  else if (!(ev.delta_bic < 0))
+    ev.why_not = "BIC does not improve";
+  else if (!(ev.validation_cost_after < ev.validation_cost_before))
+    ev.why_not = "no gain on the validation part";
+  ev.significant = ev.why_not.empty();
+  return ev;
+}
+
+std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& step, const std::set<std::string>& base,
+                                                          const std::vector<FitParameter>& base_fit) const {
+  std::vector<Ambiguity> out;
+  const CandidateEvidence& a = step.candidates.front();
+  for (size_t k = 1; k < step.candidates.size() && k < 3; ++k) {
+    const CandidateEvidence& b = step.candidates[k];
+    if (!b.significant || b.statistic < opt_.ambiguity_ratio * a.statistic) continue;
+    std::set<std::string> both = base;
+    both.insert(a.effect);
+    both.insert(b.effect);
+    // Start from the winner's fit with the runner-up's estimates filled in.
+    std::vector<FitParameter> start = a.parameters;
+    for (int i : effect_params_.at(b.effect)) start[i].value = b.parameters[i].value;
+    double c = 0;
+    const auto ab = fit_with(both, start, &c);
+    const ChannelNoise na = channel_noise(train_, a.parameters), nb = channel_noise(train_, b.parameters),
+                       nab = channel_noise(train_, ab);
+    Ambiguity am;
+    am.a = a.effect;
+    am.b = b.effect;
+    am.statistic_a = a.statistic;
+    am.statistic_b = b.statistic;
+    am.b_given_a_p = chi2_upper(lr_statistic(na, nab), b.dof);
+    am.a_given_b_p = chi2_upper(lr_statistic(nb, nab), a.dof);
+    am.manoeuvre = separating_manoeuvre(a.effect, b.effect);
+    (void)base_fit;
+    if (am.a_given_b_p >= a.level && am.b_given_a_p >= a.level) out.push_back(am);
+  }
+  return out;
+}
+
+double CandidateSearch::n_effective() const { return channel_noise(train_, initial_parameters()).n_eff; }
+
+SearchResult CandidateSearch::run() {
+  SearchResult res;
+  std::set<std::string> base;
+  std::vector<FitParameter> current = initial_parameters();
+  // The base fit, weighted by the nominal model's residual noise; then the weights of the
+  // search are the base fit's.
+  weights_.assign(train_.channels().size(), 1.0);
+  weights_ = weights_at(current);
+  double c = 0;
+  current = fit_with(base, current, &c);
+  weights_ = weights_at(current);
+  res.base_fit = current;
+  for (int round = 0; round < opt_.max_effects; ++round) {
+    SelectionStep step;
+    step.base_effects.assign(base.begin(), base.end());
+    const double base_cost = cost(train_, current), base_valid = cost(valid_, current);
+    int k = 0;
+    for (const auto& e : candidates_) {
+      ++k;
+      if (base.count(e)) continue;
+      if (opt_.verbose_progress)
+        std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
+                  << e << "                    " << std::flush;
+      step.candidates.push_back(evaluate(e, base, current, base_cost, base_valid));
+    }
+    if (opt_.verbose_progress) std::cerr << "\n";
+    std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) {
+      if (a.significant != b.significant) return a.significant;
+      return a.statistic > b.statistic;
+    });
+    if (step.candidates.empty() || !step.candidates.front().significant) {
+      res.steps.push_back(step);
+      break;
+    }
+    step.ambiguities = check_look_alikes(step, base, current);
+    if (!step.ambiguities.empty()) {
+      res.unresolved = step.ambiguities;
+      res.steps.push_back(step);
+      break;
+    }
+    step.selected = step.candidates.front().effect;
+    base.insert(step.selected);
+    res.selected.push_back(step.selected);
+    current = step.candidates.front().parameters;
+    // New weights for the new model's noise; refit under them so that the next step's
+    // candidates are compared with an optimum, not with a start they could improve on.
+    weights_ = weights_at(current);
+    current = fit_with(base, current, &c);
+    res.steps.push_back(step);
+  }
+  res.final_fit = current;
+  res.final_weights = weights_;
+  estimate_intervals(res);
+  return res;
+}
+
+// Intervals for the selected effects' parameters: profile likelihood with the final
+// model's noise and correlation time in the weights, so the chi2 thresholds hold.
+void CandidateSearch::estimate_intervals(SearchResult& r) const {
+  if (r.selected.empty()) return;
+  fit::FitResult best;
+  best.parameters = r.final_fit;
+  best.weights = r.final_weights;
+  best.chi2 = cost(train_, r.final_fit);
+  std::vector<bool> free;
+  std::vector<int> cols;
+  for (size_t i = 0; i < r.final_fit.size(); ++i) {
+    free.push_back(r.final_fit[i].free);
+    if (r.final_fit[i].free) cols.push_back(static_cast<int>(i));
+  }
+  best.num_free = static_cast<int>(cols.size());
+  // Standard errors from the Gauss-Newton approximation J^T W J.
+  train_.set_free(free);
+  const int np = static_cast<int>(r.final_fit.size()), nr = train_.num_residuals();
+  std::vector<double> p = values(r.final_fit), res(nr), J(static_cast<size_t>(nr) * np);
+  train_.evaluate(p.data(), res.data(), J.data());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
+  for (int i = 0; i < nr; ++i) {
+    const double w2 = std::pow(r.final_weights[train_.channel_of(i)], 2);
+    for (size_t a = 0; a < cols.size(); ++a)
+      for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
+  }
+  H = H.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd C = H.completeOrthogonalDecomposition().pseudoInverse();
+  best.standard_errors.assign(np, std::numeric_limits<double>::quiet_NaN());
+  for (size_t a = 0; a < cols.size(); ++a) best.standard_errors[cols[a]] = std::sqrt(std::max(0.0, C(a, a)));
+  fit::FitOptions fo;
+  fo.max_iterations = 50;
+  fit::ProfileOptions po;
+  po.max_steps_each_side = 12;
+  for (const auto& e : r.selected)
+    for (int i : effect_params_.at(e)) {
+      if (!r.final_fit[i].free) continue;
+      if (opt_.verbose_progress) std::cerr << "\r[diagnose] profile of " << r.final_fit[i].name << "        " << std::flush;
+      fit::Profile pr = fit::profile_parameter(train_, best, i, fo, po);
+      EffectEstimate est{r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
+                         pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
+                         pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, pr.verdict};
+      r.estimates.push_back(est);
+      r.profiles.push_back(std::move(pr));
+    }
+  if (opt_.verbose_progress) std::cerr << "\n";
+}
+
+}  // namespace quadgen::diagnose

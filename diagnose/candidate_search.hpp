@@ -1,0 +1,127 @@
+// Naming the cause: every effect of the catalogue is a candidate extension of the current
+// model; each is fitted (equation error, the full-catalogue model with the other effects at
+// their neutral values, which is the extended model's equations exactly) and weighed by
+//   - the drop of the weighted cost, as a likelihood-ratio statistic whose weights hold each
+//     channel's noise level and integrated autocorrelation time (so autocorrelated residuals
+//     do not count as independent evidence), with the chi-bar-square null distribution for a
+//     parameter whose neutral value is its bound (Self & Liang 1987),
+//   - a Bonferroni level over the candidates of a step, the change of BIC, and
+//   - the change of the cost on the held-out validation part.
+// Forward selection adds the best significant candidate and searches again, so two
+// simultaneous effects are found; it stops when nothing more is significant. A runner-up
+// that explains almost as much is fitted together with the winner: if neither adds
+// anything significant to the other, the data cannot tell them apart and the step reports
+// an ambiguity with the manoeuvre that would separate them instead of a guess.
+#pragma once
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "dynamic_model.hpp"
+#include "equation_error.hpp"
+#include "least_squares.hpp"
+#include "profile_likelihood.hpp"
+#include "symbolic_model.hpp"
+
+namespace quadgen::diagnose {
+
+struct SearchOptions {
+  double alpha = 0.01;   // family-wise level of one selection step
+  int max_effects = 3;
+  double ambiguity_ratio = 0.5;  // runner-up statistic / winner's above which both are tested together
+  std::vector<std::string> candidates;  // effects to consider (default: all that the log supports)
+  bool verbose_progress = true;
+};
+
+struct EffectEstimate {
+  std::string name, unit;
+  double value = 0, standard_error = 0, lower = 0, upper = 0;
+  std::string verdict;  // from the profile likelihood
+};
+
+struct CandidateEvidence {
+  std::string effect;
+  std::vector<std::string> model_effects;  // the model this candidate was fitted in
+  std::vector<fit::FitParameter> parameters;
+  double cost = 0;         // weighted training cost
+  double statistic = 0;    // cost drop against the step's base model (LR statistic)
+  int dof = 0;
+  bool boundary = false;   // neutral value on the bound: chi-bar-square null
+  double p_value = 1, level = 0;
+  double delta_bic = 0, delta_aic = 0;
+  double validation_cost_before = 0, validation_cost_after = 0, validation_gain_percent = 0;
+  bool significant = false;
+  std::string why_not;  // when not significant: which gate it failed
+};
+
+struct Ambiguity {
+  std::string a, b;
+  double statistic_a = 0, statistic_b = 0;
+  double a_given_b_p = 1, b_given_a_p = 1;  // p of adding one to the other
+  std::string manoeuvre;
+};
+
+struct SelectionStep {
+  std::vector<std::string> base_effects;
+  std::vector<CandidateEvidence> candidates;  // strongest first
+  std::string selected;                       // empty: stop
+  std::vector<Ambiguity> ambiguities;
+};
+
+struct SearchResult {
+  std::vector<SelectionStep> steps;
+  std::vector<std::string> selected;  // effects found, in order
+  std::vector<fit::FitParameter> base_fit, final_fit;
+  std::vector<double> final_weights;
+  std::vector<EffectEstimate> estimates;  // parameters of the selected effects
+  std::vector<fit::Profile> profiles;
+  std::vector<Ambiguity> unresolved;  // ambiguities that stopped the search
+};
+
+// Effects the log can speak to (battery_sag needs vbat; ground_effect a height).
+std::vector<std::string> applicable_effects(const fit::Flight& flight);
+
+// The parameters of an effect, in model order ("motor_gain" -> motor_gain.A, ...).
+std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::string& effect);
+
+// What would separate two look-alike effects.
+std::string separating_manoeuvre(const std::string& a, const std::string& b);
+
+class CandidateSearch {
+ public:
+  // `all` is the full-catalogue symbolic model and `model` its runtime form; train and
+  // valid are the equation-error problems on the two parts of the flight.
+  CandidateSearch(const SymbolicModel& all, runtime::DynamicModel& model, const fit::EquationErrorModel& train,
+                  const fit::EquationErrorModel& valid, SearchOptions opt);
+  SearchResult run();
+
+  // Fits the model with these effects active (others neutral) from `start`.
+  std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
+                                          const std::vector<fit::FitParameter>& start, double* cost) const;
+  // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals at these parameters.
+  std::vector<double> weights_at(const std::vector<fit::FitParameter>& ps) const;
+  double cost(const fit::ResidualModel& m, const std::vector<fit::FitParameter>& ps) const;
+
+ private:
+  const SymbolicModel& all_;
+  runtime::DynamicModel& model_;
+  const fit::EquationErrorModel& train_;
+  const fit::EquationErrorModel& valid_;
+  SearchOptions opt_;
+  std::vector<double> weights_;
+  std::vector<std::string> candidates_;
+  std::map<std::string, std::vector<int>> effect_params_;  // indices into the parameter vector
+
+  std::vector<fit::FitParameter> initial_parameters() const;
+  CandidateEvidence evaluate(const std::string& effect, const std::set<std::string>& base,
+                             const std::vector<fit::FitParameter>& base_fit, double base_cost,
+                             double base_valid_cost) const;
+  std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base,
+                                           const std::vector<fit::FitParameter>& base_fit) const;
+  void estimate_intervals(SearchResult& r) const;
+  double n_effective() const;
+};
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,72 @@
+// The diagnosis pipeline (issue: fit the base model, show what is wrong, name the cause,
+// extend the model, measure the gain): flight in, Diagnosis out. Writing files and the
+// report is diagnosis_report's job; the command line is cli/diagnose_command.cpp.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "candidate_search.hpp"
+#include "flight_data.hpp"
+#include "residual_analysis.hpp"
+#include "validation.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen::diagnose {
+
+struct DiagnoseOptions {
+  double validation_fraction = 0.3;  // end of the flight, held out
+  double window = 1.0;               // s, validation simulation windows
+  // Translational channels: "pose" (differentiated mocap velocity, world frame),
+  // "accelerometer" (specific force, body frame) or "auto" (pose when logged).
+  std::string translational = "auto";
+  SearchOptions search;
+  // Unexplained discrepancy: slow residual structure beyond this many times what the noise
+  // gives, at this significance, after the selected effects.
+  double unexplained_ratio = 3.0, unexplained_p = 1e-6;
+};
+
+struct Finding {
+  std::string effect;
+  std::vector<EffectEstimate> parameters;
+  CandidateEvidence evidence;
+  std::string metric;  // of the gain
+  double before = 0, after = 0;
+};
+
+struct Unexplained {
+  std::string channel, unit;
+  double slow_rms = 0, ratio = 0, p_value = 1;
+  double t0 = 0, t1 = 0, worst_mean = 0;
+  std::string signal;  // most correlated physical signal
+  double r = 0;
+};
+
+struct ChannelGain {
+  std::string channel;
+  double before = 0, after = 0;  // validation equation-error RMS
+};
+
+struct Diagnosis {
+  std::string vehicle, formulation;
+  std::vector<std::string> channel_names, channel_units;
+  size_t train_samples = 0, valid_samples = 0;
+  double t_split = 0;
+  std::vector<std::string> candidates;
+  SearchResult search;
+  ResidualAnalysis before, after;  // whole flight, base fit and final model
+  std::vector<double> t, residual_before, residual_after;  // ns x 6, for plots
+  std::vector<Finding> findings;
+  std::vector<Unexplained> unexplained;
+  std::vector<ChannelGain> channel_gain;
+  std::string metric;
+  double metric_before = 0, metric_after = 0;
+  WindowedSimulation sim_before, sim_after;  // validation part
+  double seconds = 0;
+};
+
+// Runs the whole diagnosis. `all` is the full-catalogue symbolic model of the vehicle and
+// `model` its runtime form.
+Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
+                          const fit::Flight& flight, const DiagnoseOptions& opt, fit::Flight* validation_out);
+
+}  // namespace quadgen::diagnose

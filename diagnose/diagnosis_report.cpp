@@ -1,0 +1,363 @@
+#include "diagnosis_report.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "fit_report.hpp"
+#include "plot.hpp"
+
+namespace quadgen::diagnose {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+double reduction(double before, double after) {
+  return before > 0 && std::isfinite(before) && std::isfinite(after) ? 100 * (before - after) / before : 0.0;
+}
+
+json evidence_json(const CandidateEvidence& e) {
+  return {{"statistic", e.statistic},
+          {"dof", e.dof},
+          {"null_distribution", e.boundary ? "chi-bar-square 0.5 chi2_0 + 0.5 chi2_1 (neutral value on the bound)"
+                                           : "chi2_" + std::to_string(e.dof)},
+          {"p_value", e.p_value},
+          {"level", e.level},
+          {"delta_bic", e.delta_bic},
+          {"delta_aic", e.delta_aic},
+          {"training_cost", e.cost},
+          {"validation_cost_before", e.validation_cost_before},
+          {"validation_cost_after", e.validation_cost_after},
+          {"validation_gain_percent", e.validation_gain_percent},
+          {"significant", e.significant},
+          {"why_not", e.why_not}};
+}
+
+json parameters_json(const std::vector<fit::FitParameter>& ps) {
+  json j = json::object();
+  for (const auto& p : ps)
+    if (p.free) j[p.name] = {{"value", p.value}, {"unit", p.unit}};
+  return j;
+}
+
+json channels_json(const ResidualAnalysis& a) {
+  json arr = json::array();
+  for (const auto& c : a.channels) {
+    json cor = json::array();
+    for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)
+      cor.push_back({{"signal", c.correlations[i].signal}, {"r", c.correlations[i].r}, {"p_value", c.correlations[i].p_value}});
+    arr.push_back({{"channel", c.name},
+                   {"unit", c.unit},
+                   {"rms", c.rms},
+                   {"bias", c.bias},
+                   {"sigma", c.sigma},
+                   {"integrated_autocorrelation_time", c.tau_int},
+                   {"acf_fraction_outside_band", c.acf_outside},
+                   {"slow_rms", c.slow_rms},
+                   {"slow_ratio", c.slow_ratio},
+                   {"slow_p_value", c.slow_p_value},
+                   {"worst_window", {c.worst_window_t0, c.worst_window_t1}},
+                   {"strongest_correlations", cor}});
+  }
+  return arr;
+}
+
+}  // namespace
+
+json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
+  json j;
+  j["vehicle"] = d.vehicle;
+  j["log"] = log_path;
+  j["formulation"] = d.formulation;
+  j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
+  json findings = json::array();
+  for (const auto& f : d.findings) {
+    json ps = json::object();
+    if (f.effect == "motor_gain")
+      for (const auto& p : f.evidence.parameters)
+        if (p.name.rfind("motor_gain.", 0) == 0 && !p.free)
+          ps[p.name] = {{"value", 0.0}, {"ci95", {0.0, 0.0}}, {"unit", "1"}, {"reference", true}};
+    for (const auto& e : f.parameters)
+      ps[e.name] = {{"value", e.value},
+                    {"ci95", {number_or_null(e.lower), number_or_null(e.upper)}},
+                    {"unit", e.unit},
+                    {"standard_error", number_or_null(e.standard_error)},
+                    {"identifiability", e.verdict}};
+    json fj = {{"effect", f.effect},
+               {"parameters", ps},
+               {"gain", {{"metric", f.metric},
+                         {"before", number_or_null(f.before)},
+                         {"after", number_or_null(f.after)},
+                         {"reduction_percent", reduction(f.before, f.after)}}},
+               {"evidence", evidence_json(f.evidence)}};
+    if (f.effect == "motor_gain")
+      fj["note"] = "c_t is fitted with the gains, so only ratios between rotors are identifiable: the first rotor is the reference (gain 0)";
+    findings.push_back(fj);
+  }
+  j["findings"] = findings;
+  json amb = json::array();
+  for (const auto& a : d.search.unresolved)
+    amb.push_back({{"effects", {a.a, a.b}},
+                   {"statistics", {a.statistic_a, a.statistic_b}},
+                   {"p_value_adding_second_to_first", a.b_given_a_p},
+                   {"p_value_adding_first_to_second", a.a_given_b_p},
+                   {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
+                   {"separating_manoeuvre", a.manoeuvre}});
+  j["ambiguous"] = amb;
+  json un = json::array();
+  for (const auto& u : d.unexplained)
+    un.push_back({{"channel", u.channel},
+                  {"unit", u.unit},
+                  {"slow_rms", u.slow_rms},
+                  {"ratio_to_noise", u.ratio},
+                  {"p_value", u.p_value},
+                  {"largest_in", {u.t0, u.t1}},
+                  {"mean_there", u.worst_mean},
+                  {"most_correlated_signal", u.signal},
+                  {"r", u.r}});
+  j["unexplained"] = un;
+  j["gain"] = {{"metric", d.metric},
+               {"before", number_or_null(d.metric_before)},
+               {"after", number_or_null(d.metric_after)},
+               {"reduction_percent", reduction(d.metric_before, d.metric_after)}};
+  json cg = json::array();
+  for (const auto& c : d.channel_gain)
+    cg.push_back({{"channel", c.channel}, {"rms_before", c.before}, {"rms_after", c.after},
+                  {"reduction_percent", reduction(c.before, c.after)}});
+  j["validation_channels"] = cg;
+  json steps = json::array();
+  for (const auto& s : d.search.steps) {
+    json cands = json::array();
+    for (const auto& c : s.candidates) {
+      json cj = {{"effect", c.effect}};
+      cj.update(evidence_json(c));
+      json ps = json::object();
+      for (const auto& p : c.parameters)
+        if (p.name.rfind(c.effect + ".", 0) == 0 && p.free) ps[p.name] = p.value;
+      cj["estimates"] = ps;
+      cands.push_back(cj);
+    }
+    steps.push_back({{"base_effects", s.base_effects}, {"selected", s.selected}, {"candidates", cands}});
+  }
+  j["selection"] = steps;
+  j["candidates_considered"] = d.candidates;
+  j["base_fit"] = parameters_json(d.search.base_fit);
+  j["final_fit"] = parameters_json(d.search.final_fit);
+  j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
+  j["extended_model"] = {{"effects", d.search.selected},
+                         {"header", "extended_model.hpp"},
+                         {"model_json", "extended_model.json"},
+                         {"fitted_parameters", "fitted_parameters.yaml"}};
+  j["timing_s"] = d.seconds;
+  return j;
+}
+
+namespace {
+
+runtime::Series series(const std::string& label, const std::vector<double>& x, const std::vector<double>& y,
+                       size_t stride = 1, bool points = false) {
+  runtime::Series s{label, {}, {}, points};
+  for (size_t i = 0; i < x.size() && i < y.size(); i += stride) {
+    s.x.push_back(x[i]);
+    s.y.push_back(y[i]);
+  }
+  return s;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis& d, const fit::Flight& valid,
+                                                                 std::string* error) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, std::string>> out;
+  const fs::path tmp = fs::temp_directory_path() / ("quadgen_diag_" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  auto render = [&](const std::string& name, const std::string& title, const std::vector<runtime::Panel>& panels) {
+    const std::string path = (tmp / name).string();
+    if (runtime::plot_svg(path, title, panels, error)) out.emplace_back(name, read_file(path));
+  };
+  const size_t stride = std::max<size_t>(1, d.t.size() / 3000);
+  // Measured vs simulated positions on the validation part.
+  if (!d.sim_before.t.empty()) {
+    std::vector<runtime::Panel> panels;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> tm, ym;
+      for (const auto& s : valid.samples) tm.push_back(s.t), ym.push_back(s.x[a]);
+      const auto& yb = a == 0 ? d.sim_before.x : a == 1 ? d.sim_before.y : d.sim_before.z;
+      const auto& ya = a == 0 ? d.sim_after.x : a == 1 ? d.sim_after.y : d.sim_after.z;
+      panels.push_back({std::string("position ") + axes[a] + " (validation, open-loop windows)", "t [s]", "m",
+                        {series("measured", tm, ym, 1, true), series("base model", d.sim_before.t, yb),
+                         series("extended model", d.sim_after.t, ya)}});
+    }
+    render("validation.svg", d.vehicle + ": measured vs simulated, before and after", panels);
+  }
+  // Residuals over time.
+  std::vector<runtime::Panel> res;
+  for (int c = 0; c < 6; ++c) {
+    std::vector<double> rb, ra;
+    for (size_t k = 0; k < d.t.size(); ++k) rb.push_back(d.residual_before[k * 6 + c]), ra.push_back(d.residual_after[k * 6 + c]);
+    res.push_back({d.channel_names[c] + " residual (model - measured)", "t [s]", d.channel_units[c],
+                   {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)}});
+  }
+  render("residuals.svg", d.vehicle + ": equation-error residuals (validation from t = " +
+                              std::to_string(d.t_split).substr(0, 5) + " s)", res);
+  // Autocorrelation with the white-noise band.
+  std::vector<runtime::Panel> acf;
+  for (size_t c = 0; c < d.before.channels.size(); ++c) {
+    const auto& b = d.before.channels[c];
+    const auto& a = d.after.channels[c];
+    std::vector<double> lag, band, nband;
+    const double dt = d.t.size() > 1 ? (d.t.back() - d.t.front()) / static_cast<double>(d.t.size() - 1) : 0.01;
+    for (size_t k = 0; k < b.acf.size(); ++k) lag.push_back(static_cast<double>(k) * dt), band.push_back(b.acf_band), nband.push_back(-b.acf_band);
+    acf.push_back({b.name + " autocorrelation", "lag [s]", "1",
+                   {series("base model", lag, b.acf), series("extended model", lag, a.acf), series("95 % white-noise band", lag, band),
+                    series("", lag, nband)}});
+  }
+  render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
+  if (!d.search.profiles.empty()) {
+    const std::string path = (tmp / "profiles.svg").string();
+    if (fit::plot_profiles(path, d.vehicle + ": profile likelihood of the found parameters", d.search.profiles, error))
+      out.emplace_back("profiles.svg", read_file(path));
+  }
+  fs::remove_all(tmp);
+  return out;
+}
+
+namespace {
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+std::string num(double v, int prec = 4) {
+  if (!std::isfinite(v)) return "–";
+  std::ostringstream os;
+  os.precision(prec);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+std::string diagnosis_summary(const Diagnosis& d) {
+  std::ostringstream os;
+  if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
+    os << "no significant discrepancy: the base model explains the flight\n";
+  for (const auto& f : d.findings) {
+    os << "found " << f.effect << ":";
+    for (const auto& p : f.parameters)
+      os << " " << p.name << " = " << num(p.value) << " [" << num(p.lower) << ", " << num(p.upper) << "]";
+    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n";
+  }
+  for (const auto& a : d.search.unresolved)
+    os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart); to separate them: " << a.manoeuvre << "\n";
+  for (const auto& u : d.unexplained)
+    os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
+       << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
+       << u.signal << " (r = " << num(u.r, 2) << ")\n";
+  return os.str();
+}
+
+std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
+                           const std::vector<std::pair<std::string, std::string>>& plots) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>quadgen diagnosis: " << esc(d.vehicle)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+       "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+       "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
+       "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em}</style></head><body>\n";
+  h << "<h1>Diagnosis of " << esc(log_path) << " (" << esc(d.vehicle) << ")</h1>\n";
+  h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples
+    << " validation samples from t = " << num(d.t_split, 4) << " s; " << num(d.seconds, 3) << " s.</p>\n";
+  h << "<h2>Verdict</h2>\n<pre>" << esc(diagnosis_summary(d)) << "</pre>\n";
+  h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
+    << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
+  h << "<h2>Findings</h2>\n";
+  if (d.findings.empty()) h << "<p>None.</p>\n";
+  for (const auto& f : d.findings) {
+    h << "<h3>" << esc(f.effect) << "</h3>\n<table><tr><th>parameter</th><th>value</th><th>95 % profile interval</th><th>unit</th><th>identifiability</th></tr>\n";
+    for (const auto& p : f.parameters)
+      h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>[" << num(p.lower) << ", " << num(p.upper)
+        << "]</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+    h << "</table>\n<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
+      << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
+      << ", validation cost " << num(f.evidence.validation_gain_percent, 3) << " % lower; " << esc(f.metric) << " "
+      << num(f.before) << " &rarr; " << num(f.after) << ".</p>\n";
+  }
+  if (!d.search.unresolved.empty()) {
+    h << "<h2>Ambiguous</h2>\n";
+    for (const auto& a : d.search.unresolved)
+      h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b)
+        << "</b>: both explain the discrepancy and neither adds anything significant to the other (p = "
+        << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
+        << ".</p>\n";
+  }
+  if (!d.unexplained.empty()) {
+    h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
+    for (const auto& u : d.unexplained)
+      h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << esc(u.unit) << "</td><td>" << num(u.ratio, 3)
+        << "</td><td>" << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
+        << "</td></tr>\n";
+    h << "</table>\n";
+  }
+  h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>RMS base</th><th>RMS extended</th><th>reduction %</th></tr>\n";
+  for (const auto& c : d.channel_gain)
+    h << "<tr><td>" << esc(c.channel) << "</td><td>" << num(c.before) << "</td><td>" << num(c.after) << "</td><td>"
+      << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
+  h << "</table>\n<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>RMS</th><th>bias</th><th>corr. time [samples]</th>"
+       "<th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
+  for (const auto& c : d.before.channels) {
+    h << "<tr><td>" << esc(c.name) << "</td><td>" << num(c.rms) << "</td><td>" << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
+      << "</td><td>" << num(c.slow_ratio, 3) << "</td><td>";
+    for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)
+      h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << num(c.correlations[i].r, 2) << ")";
+    h << "</td></tr>\n";
+  }
+  h << "</table>\n<h2>Candidates</h2>\n";
+  for (size_t s = 0; s < d.search.steps.size(); ++s) {
+    const auto& st = d.search.steps[s];
+    h << "<h3>Step " << s + 1 << " (model: base";
+    for (const auto& e : st.base_effects) h << " + " << esc(e);
+    h << ")</h3>\n<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
+    for (const auto& c : st.candidates)
+      h << "<tr><td>" << esc(c.effect) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
+        << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
+        << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not)) << "</td></tr>\n";
+    h << "</table>\n";
+  }
+  h << "<h2>Plots</h2>\n";
+  if (plots.empty()) h << "<p>No plots (gnuplot unavailable).</p>\n";
+  for (const auto& [name, svg] : plots) {
+    const size_t at = svg.find("<svg");
+    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name) << "</figcaption></figure>\n";
+  }
+  h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
+       "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
+       "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
+       "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the validation part. "
+       "Intervals are profile-likelihood intervals with the same weights.</p>\n</body></html>\n";
+  return h.str();
+}
+
+}  // namespace quadgen::diagnose

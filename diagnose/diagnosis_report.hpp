@@ -1,0 +1,27 @@
+// diagnosis.json (contracts.md §5 plus the evidence behind every finding) and the report a
+// person reads: one self-contained HTML page with its plots inlined as SVG, so it renders
+// in a browser without network access.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "diagnosis.hpp"
+
+namespace quadgen::diagnose {
+
+nlohmann::ordered_json diagnosis_json(const Diagnosis& d, const std::string& log_path);
+
+// Plots as (file name, SVG text); empty when gnuplot is unavailable (`error` says why).
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis& d, const fit::Flight& validation,
+                                                                 std::string* error);
+
+std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
+                           const std::vector<std::pair<std::string, std::string>>& plots);
+
+// One line per finding / ambiguity / unexplained discrepancy, for the terminal.
+std::string diagnosis_summary(const Diagnosis& d);
+
+}  // namespace quadgen::diagnose

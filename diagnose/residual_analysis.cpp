@@ -1,0 +1,181 @@
+#include "residual_analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/students_t.hpp>
+
+namespace quadgen::diagnose {
+
+namespace {
+
+double mean(const std::vector<double>& x) {
+  double s = 0;
+  for (double v : x) s += v;
+  return x.empty() ? 0 : s / static_cast<double>(x.size());
+}
+
+// Autocorrelation at lags 0..max_lag (biased estimator, as usual for ACF plots).
+std::vector<double> autocorrelation(const std::vector<double>& x, int max_lag) {
+  const size_t n = x.size();
+  const double m = mean(x);
+  double c0 = 0;
+  for (double v : x) c0 += (v - m) * (v - m);
+  std::vector<double> acf(static_cast<size_t>(max_lag) + 1, 0.0);
+  if (c0 <= 0) return acf;
+  for (int k = 0; k <= max_lag && static_cast<size_t>(k) < n; ++k) {
+    double c = 0;
+    for (size_t i = 0; i + k < n; ++i) c += (x[i] - m) * (x[i + k] - m);
+    acf[k] = c / c0;
+  }
+  return acf;
+}
+
+double tau_from_acf(const std::vector<double>& acf) {
+  double tau = 1;
+  for (size_t k = 1; k < acf.size() && acf[k] > 0; ++k) tau += 2 * acf[k];
+  return tau;
+}
+
+}  // namespace
+
+double integrated_autocorrelation_time(const std::vector<double>& x, int max_lag) {
+  return tau_from_acf(autocorrelation(x, max_lag));
+}
+
+SignalSet physical_signals(const fit::Flight& f, const std::vector<std::string>& rotors) {
+  SignalSet s;
+  const size_t ns = f.samples.size(), nr = rotors.size();
+  auto add = [&](const std::string& name, auto fn) {
+    s.names.push_back(name);
+    std::vector<double> v(ns);
+    for (size_t k = 0; k < ns; ++k) v[k] = fn(k);
+    s.values.push_back(std::move(v));
+  };
+  for (size_t i = 0; i < nr; ++i) add("u_" + rotors[i], [&](size_t k) { return f.samples[k].u[i]; });
+  add("total command", [&](size_t k) {
+    double sum = 0;
+    for (double u : f.samples[k].u) sum += u * u;  // thrust ~ speed^2 ~ command^2 near hover
+    return sum;
+  });
+  for (int a = 0; a < 3; ++a)
+    add(std::string("body velocity ") + "xyz"[a], [&](size_t k) {
+      const auto& x = f.samples[k].x;
+      const double w = x[6], qx = x[7], qy = x[8], qz = x[9];
+      const double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - w * qz), 2 * (qx * qz + w * qy)},
+                              {2 * (qx * qy + w * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - w * qx)},
+                              {2 * (qx * qz - w * qy), 2 * (qy * qz + w * qx), 1 - 2 * (qx * qx + qy * qy)}};
+      return R[0][a] * x[3] + R[1][a] * x[4] + R[2][a] * x[5];
+    });
+  if (f.has_pose) add("height", [&](size_t k) { return f.samples[k].x[2]; });
+  add("time", [&](size_t k) { return f.samples[k].t; });
+  if (f.has_vbat) add("battery voltage", [&](size_t k) { return f.samples[k].vbat; });
+  for (size_t i = 0; i < nr; ++i)
+    add("du_" + rotors[i] + "/dt", [&](size_t k) {
+      const size_t a = k == 0 ? 0 : k - 1, b = std::min(ns - 1, k + 1);
+      const double dt = f.samples[b].t - f.samples[a].t;
+      return dt > 0 ? (f.samples[b].u[i] - f.samples[a].u[i]) / dt : 0.0;
+    });
+  return s;
+}
+
+ResidualAnalysis analyse_residuals(const std::vector<double>& r6, const std::vector<std::string>& names,
+                                   const std::vector<std::string>& units, const std::vector<double>& t,
+                                   const SignalSet& signals) {
+  constexpr int kMaxLag = 300;
+  const size_t ns = t.size();
+  const int lag = static_cast<int>(std::min<size_t>(kMaxLag, ns / 4));
+  std::vector<std::vector<double>> signal_acf;
+  for (const auto& v : signals.values) signal_acf.push_back(autocorrelation(v, lag));
+  const double dt = ns > 1 ? (t.back() - t.front()) / static_cast<double>(ns - 1) : 0.01;
+  ResidualAnalysis out;
+  for (size_t c = 0; c < names.size(); ++c) {
+    ChannelAnalysis a;
+    a.name = names[c];
+    a.unit = units[c];
+    a.samples = static_cast<int>(ns);
+    std::vector<double> x(ns);
+    for (size_t k = 0; k < ns; ++k) x[k] = r6[k * 6 + c];
+    a.bias = mean(x);
+    double ss = 0;
+    for (double v : x) ss += v * v;
+    a.rms = std::sqrt(ss / std::max<size_t>(1, ns));
+    a.sigma = std::sqrt(std::max(0.0, a.rms * a.rms - a.bias * a.bias));
+    a.acf = autocorrelation(x, lag);
+    a.tau_int = tau_from_acf(a.acf);
+    a.acf_band = 1.96 / std::sqrt(static_cast<double>(std::max<size_t>(ns, 1)));
+    // Slow structure: 1 s window means against the high-passed noise.
+    const size_t w = std::max<size_t>(10, static_cast<size_t>(std::lround(1.0 / dt)));
+    std::vector<double> means, highpass;
+    std::vector<size_t> starts;
+    for (size_t k0 = 0; k0 + w <= ns; k0 += w) {
+      double m = 0;
+      for (size_t k = k0; k < k0 + w; ++k) m += x[k];
+      m /= static_cast<double>(w);
+      means.push_back(m);
+      starts.push_back(k0);
+      for (size_t k = k0; k < k0 + w; ++k) highpass.push_back(x[k] - m);
+    }
+    if (means.size() >= 3) {
+      // The noise's correlation length, read from the high-passed residual's short lags.
+      auto hp_acf = autocorrelation(highpass, static_cast<int>(std::min<size_t>(w / 2, highpass.size() / 4)));
+      const double tau = tau_from_acf(hp_acf);
+      double hv = 0;
+      for (double v : highpass) hv += v * v;
+      // Within-window variance is biased low by 1 - tau/w; undo it.
+      hv = hv / static_cast<double>(highpass.size()) / std::max(0.05, 1.0 - tau / static_cast<double>(w));
+      const double var_mean = hv * tau / static_cast<double>(w);
+      double S = 0, worst = 0;
+      for (size_t j = 0; j < means.size(); ++j) {
+        S += means[j] * means[j] / var_mean;
+        if (std::abs(means[j]) > std::abs(worst)) {
+          worst = means[j];
+          a.worst_window_t0 = t[starts[j]];
+          a.worst_window_t1 = t[starts[j] + w - 1];
+        }
+      }
+      double ms = 0;
+      for (double m : means) ms += m * m;
+      a.slow_rms = std::sqrt(ms / static_cast<double>(means.size()));
+      a.worst_window_mean = worst;
+      const double J = static_cast<double>(means.size());
+      a.slow_ratio = S / J;
+      a.slow_p_value = boost::math::cdf(boost::math::complement(boost::math::chi_squared(J), S));
+      int outside = 0, counted = 0;
+      for (size_t k = static_cast<size_t>(std::ceil(tau)) + 1; k < a.acf.size(); ++k, ++counted)
+        if (std::abs(a.acf[k]) > a.acf_band) ++outside;
+      a.acf_outside = counted ? static_cast<double>(outside) / counted : 0.0;
+    }
+    // Correlations with the signals; effective n by Bartlett's formula for two
+    // autocorrelated series, n / (1 + 2 sum rho_x rho_y).
+    const double sx = a.sigma;
+    for (size_t s = 0; s < signals.names.size(); ++s) {
+      const auto& y = signals.values[s];
+      const double my = mean(y);
+      double sy = 0, cxy = 0;
+      for (size_t k = 0; k < ns; ++k) {
+        sy += (y[k] - my) * (y[k] - my);
+        cxy += (x[k] - a.bias) * (y[k] - my);
+      }
+      sy = std::sqrt(sy / static_cast<double>(ns));
+      if (sx <= 0 || sy <= 0) continue;
+      Correlation cr;
+      cr.signal = signals.names[s];
+      cr.r = cxy / static_cast<double>(ns) / (sx * sy);
+      double inflate = 1;
+      for (int k = 1; k <= lag; ++k) inflate += 2 * a.acf[k] * signal_acf[s][k];
+      const double n_eff = std::clamp(static_cast<double>(ns) / std::max(1.0, inflate), 3.0, static_cast<double>(ns));
+      const double r2 = std::min(cr.r * cr.r, 1 - 1e-12);
+      const double tstat = std::abs(cr.r) * std::sqrt((n_eff - 2) / (1 - r2));
+      cr.p_value = 2 * boost::math::cdf(boost::math::complement(boost::math::students_t(n_eff - 2), tstat));
+      a.correlations.push_back(cr);
+    }
+    std::sort(a.correlations.begin(), a.correlations.end(),
+              [](const Correlation& p, const Correlation& q) { return std::abs(p.r) > std::abs(q.r); });
+    out.channels.push_back(std::move(a));
+  }
+  return out;
+}
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,23 @@
+// The gain on data the fit did not see, in the quantity a user cares about: the position
+// error of the simulation. The validation part is cut into windows; each is simulated from
+// the measured state at its start with the logged commands (open loop: a whole flight would
+// drift off, as the thesis' did) and compared with the measured positions.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "dynamic_model.hpp"
+#include "flight_data.hpp"
+
+namespace quadgen::diagnose {
+
+struct WindowedSimulation {
+  double position_rmse = 0;  // m, over every sample of every window
+  std::vector<double> t, x, y, z;  // simulated positions (NaN between windows) for plots
+};
+
+// `model` must be the full-catalogue model with `params` (effects off at their neutral values).
+WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
+                                    const fit::Flight& flight, double window_seconds);
+
+}  // namespace quadgen::diagnose
