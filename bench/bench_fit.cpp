@@ -54,13 +54,13 @@ struct Setup {
 
 void BM_FitEquationError60s100Hz(benchmark::State& st) {
   Setup s;
-  EquationErrorModel m(s.model, s.flight, false);
+  EquationErrorModel m(s.model, s.flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
   for (auto _ : st) benchmark::DoNotOptimize(fit_least_squares(m, s.params, {}).chi2);
 }
 
 void BM_ProfileOneParameter60s100Hz(benchmark::State& st) {
   Setup s;
-  EquationErrorModel m(s.model, s.flight, false);
+  EquationErrorModel m(s.model, s.flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
   const FitResult best = fit_least_squares(m, s.params, {});
   const int ct = s.model.param_index("c_t");
   for (auto _ : st) benchmark::DoNotOptimize(profile_parameter(m, best, ct, {}, {}).points.size());

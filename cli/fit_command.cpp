@@ -215,8 +215,9 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
   all.all_channels(pv.data(), r);
   runtime::Series meas{"measured", {}, {}, true}, fitted{"model (fitted)", {}, {}}, pm{"measured", {}, {}, true},
       pf{"model (fitted)", {}, {}};
-  for (size_t k = 0; k < flight.samples.size(); ++k) {
-    const auto& s = flight.samples[k];
+  for (size_t row = 0; row < all.rows().size(); ++row) {
+    const size_t k = row;  // index into r
+    const auto& s = flight.samples[all.rows()[row]];
     const double mz = accel ? s.specific_force[2] : s.acc_world[2];
     meas.x.push_back(s.t);
     meas.y.push_back(mz);

@@ -37,6 +37,13 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]");
   c->add_option("--accel-noise", a.accel_noise, "closed loop: accelerometer noise [m/s^2]");
   c->add_option("--accel-bias", a.accel_bias, "closed loop: accelerometer bias [m/s^2]");
+  c->add_option("--amplitude", a.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
+      ->check(CLI::Range(0.0, 20.0));
+  c->add_option("--height", a.height, "closed loop: mean height [m]")->check(CLI::Range(0.05, 100.0));
+  c->add_option("--height-amplitude", a.height_amplitude, "closed loop: height excursions [m]")->check(CLI::Range(0.0, 10.0));
+  c->add_option("--yaw-amplitude", a.yaw_amplitude, "closed loop: heading excursions [rad]")->check(CLI::Range(0.0, 10.0));
+  c->add_option("--excitation", a.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
+      ->check(CLI::Range(0.0, 5.0));
   c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
@@ -90,6 +97,11 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   o.gyro_bias = a.gyro_bias;
   o.accel_noise = a.accel_noise;
   o.accel_bias = a.accel_bias;
+  o.amplitude = a.amplitude;
+  o.height = a.height;
+  o.height_amplitude = a.height_amplitude;
+  o.yaw_amplitude = a.yaw_amplitude;
+  o.excitation = a.excitation;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
   OutputSet out = output_for(a.out);

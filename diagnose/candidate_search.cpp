@@ -26,6 +26,11 @@ double typical_start(const std::string& param) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+// The value at which an effect is off. The derived model's nominal values are neutral
+// except the rotor lag, whose nominal 1 ms keeps simulations non-stiff; equation error
+// has no such limit, so "no lag" is its lower bound (0.1 ms).
+double neutral_value(const Variable& p) { return p.name == "motor_lag.tau" ? p.lower : p.nominal; }
+
 std::string effect_of(const std::string& param) { return param.substr(0, param.find('.')); }
 
 double chi2_upper(double x, double dof) {
@@ -91,7 +96,7 @@ std::vector<FitParameter> CandidateSearch::initial_parameters() const {
   std::vector<FitParameter> ps;
   for (const auto& p : all_.params) {
     const bool effect_param = p.name.find('.') != std::string::npos;
-    ps.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, p.fit && !effect_param});
+    ps.push_back({p.name, p.unit, neutral_value(p), p.lower, p.upper, p.fit && !effect_param});
   }
   return ps;
 }
@@ -104,7 +109,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
     if (ps[i].name.find('.') == std::string::npos) continue;
     const bool on = effects.count(e) > 0 && all_.params[i].fit;
     ps[i].free = on;
-    if (!on) ps[i].value = all_.params[i].nominal;
+    if (!on) ps[i].value = neutral_value(all_.params[i]);
   }
   // Only ratios of motor gains are identifiable beside c_t: the first rotor is the reference.
   for (auto& p : ps)
@@ -197,7 +202,7 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.statistic = lr_statistic(small, large);
   for (int i : effect_params_.at(effect)) ev.dof += ev.parameters[i].free ? 1 : 0;
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
-  ev.boundary = ev.dof == 1 && p0.nominal <= p0.lower + 0.01 * (p0.upper - p0.lower);
+  ev.boundary = ev.dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
   ev.p_value = ev.boundary ? 0.5 * chi2_upper(ev.statistic, 1) : chi2_upper(ev.statistic, ev.dof);
   ev.level = opt_.alpha / static_cast<double>(candidates_.size());
   ev.delta_bic = -ev.statistic + ev.dof * std::log(large.n_eff);

@@ -67,13 +67,16 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   d.search = search.run();
   const SearchResult& s = d.search;
   // What is wrong, before and after, over the whole flight.
-  for (const auto& smp : flight.samples) d.t.push_back(smp.t);
+  fit::Flight used = flight;  // the samples with residuals (full derivative windows)
+  used.samples.clear();
+  for (size_t k : all_ee.rows()) used.samples.push_back(flight.samples[k]);
+  for (const auto& smp : used.samples) d.t.push_back(smp.t);
   const auto pb = values(s.base_fit), pa = values(s.final_fit);
   all_ee.all_channels(pb.data(), d.residual_before);
   all_ee.all_channels(pa.data(), d.residual_after);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
-  const SignalSet signals = physical_signals(flight, rotors);
+  const SignalSet signals = physical_signals(used, rotors);
   d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
   d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
   // The gain on the validation part.

@@ -20,10 +20,15 @@ size_t held_index(const fit::Flight& f, double t) {
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window) {
-  model.set_params(params);
+  // A rotor lag below 1 ms (the equation error's "no lag") would make RK4 at 1 ms steps
+  // unstable; over 1 s windows 1 ms of lag is invisible, so it is simulated as 1 ms.
+  std::vector<double> sim_params = params;
+  const int lag = model.param_index("motor_lag.tau");
+  if (lag >= 0 && sim_params[lag] < 1e-3) sim_params[lag] = 1e-3;
+  model.set_params(sim_params);
   auto param = [&](const char* n) {
     const int i = model.param_index(n);
-    return i >= 0 ? params[i] : 0.0;
+    return i >= 0 ? sim_params[i] : 0.0;
   };
   const double delay = param("input_delay.seconds"), roll = param("attitude_bias.roll"),
                pitch = param("attitude_bias.pitch"), tau = param("motor_lag.tau");

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 namespace quadgen::fit {
 
 EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flight, bool use_accelerometer,
-                                       std::vector<std::string> use)
-    : model_(model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")) {
+                                       std::vector<std::string> use, Derivatives d, double window)
+    : model_(model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
+      derivatives_(d) {
   const auto names = all_names();
   if (use.empty()) use = names;
   for (const auto& u : use) {
@@ -31,6 +34,61 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     throw FitError("more rotor-speed states than logged commands");
   if (accel_ && !flight_.has_accelerometer) throw FitError(flight_.source + ": no accelerometer columns ax, ay, az");
   if (!accel_ && !flight_.has_pose) throw FitError(flight_.source + ": no pose to differentiate");
+  if (derivatives_ == Derivatives::kPointwise) {
+    for (size_t k = 0; k < flight_.samples.size(); ++k) rows_.push_back(k);
+  } else {
+    build_filter(window);
+    if (rows_.empty()) throw FitError(flight_.source + ": no stretch of the log is long enough for the derivative window");
+  }
+}
+
+// Savitzky-Golay derivative weights c_i (local quadratic over +-window), and the weights
+// of the interval accelerations that give the same derivative of a signal whose rate is
+// those accelerations: y_i - y_k is the sum of (t_{j+1} - t_j) a_{j+1/2} over the
+// intervals in between, so interval j carries (t_{j+1} - t_j) * sum_{i > j} c_i.
+void EquationErrorModel::build_filter(double window) {
+  const auto& S = flight_.samples;
+  const size_t ns = S.size();
+  std::vector<double> dts;
+  for (size_t k = 1; k < ns; ++k) dts.push_back(S[k].t - S[k - 1].t);
+  if (dts.empty()) return;
+  std::vector<double> sorted = dts;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double gap = 1.5 * sorted[sorted.size() / 2];
+  interval_ok_.assign(ns, false);
+  for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap;
+  for (size_t k = 0; k < ns; ++k) {
+    size_t lo = k, hi = k;
+    while (lo > 0 && interval_ok_[lo - 1] && S[k].t - S[lo - 1].t <= window + 1e-9) --lo;
+    while (hi + 1 < ns && interval_ok_[hi] && S[hi + 1].t - S[k].t <= window + 1e-9) ++hi;
+    // A full window on both sides (one sample of slack for uneven sampling).
+    if (lo == k || hi == k || S[k].t - S[lo].t < window - gap || S[hi].t - S[k].t < window - gap) continue;
+    const size_t m = hi - lo + 1;
+    if (m < 5) continue;
+    Eigen::MatrixXd A(m, 3);
+    for (size_t i = 0; i < m; ++i) {
+      const double dt = S[lo + i].t - S[k].t;
+      A.row(i) << 1, dt, dt * dt;
+    }
+    const Eigen::MatrixXd P = (A.transpose() * A).ldlt().solve(A.transpose());  // 3 x m
+    std::vector<double> c(m), W(m - 1);
+    for (size_t i = 0; i < m; ++i) c[i] = P(1, i);
+    double tail = 0;
+    for (size_t j = m - 1; j-- > 0;) {
+      tail += c[j + 1];
+      W[j] = (S[lo + j + 1].t - S[lo + j].t) * tail;
+    }
+    std::array<double, 6> meas{};
+    for (int a = 0; a < 3; ++a)
+      for (size_t i = 0; i < m; ++i) {
+        meas[a] += c[i] * S[lo + i].x[3 + a];
+        meas[3 + a] += c[i] * S[lo + i].x[10 + a];
+      }
+    rows_.push_back(k);
+    window_start_.push_back(lo);
+    interval_weights_.push_back(std::move(W));
+    measured_.push_back(meas);
+  }
 }
 
 std::vector<std::string> EquationErrorModel::all_names() const {
@@ -56,7 +114,7 @@ std::vector<std::string> EquationErrorModel::channels() const {
 void EquationErrorModel::evaluate(const double* p, double* r, double* J) const {
   if (used_.size() == 6) return evaluate6(p, r, J);
   const int np = model_.num_params();
-  const size_t ns = flight_.samples.size();
+  const size_t ns = rows_.size();
   std::vector<double> r6(ns * 6), J6(J ? ns * 6 * np : 0);
   evaluate6(p, r6.data(), J ? J6.data() : nullptr);
   const size_t nu = used_.size();
@@ -69,7 +127,7 @@ void EquationErrorModel::evaluate(const double* p, double* r, double* J) const {
 }
 
 void EquationErrorModel::all_channels(const double* p, std::vector<double>& r6) const {
-  r6.resize(flight_.samples.size() * 6);
+  r6.resize(rows_.size() * 6);
   evaluate6(p, r6.data(), nullptr);
 }
 
@@ -100,30 +158,39 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
     runtime::unbias_attitude(&s.x[6], roll, pitch, x + 6);
-    // Commands are held until the next sample (zero-order hold), so the smoothed
-    // derivative centred on t_k sees them half a sample late on average.
-    const double hold = k > 0 ? 0.5 * (s.t - flight_.samples[k - 1].t) : 0.0;
-    commands_at(s.t - delay - hold, u);
+    // The commands logged at t_k - d act now (held until the next sample; between
+    // samples the linear interpolation is their average over the interval).
+    commands_at(s.t - delay, u);
     if (t_in >= 0) u[t_in] = s.t;
     if (v_in >= 0) u[v_in] = s.vbat;
   }
   if (speed_states_.empty()) return;
   // Rotor speeds: the commanded speed (the model's dw/dt at w = 0, times tau) through the
-  // first-order lag, exact for commands held between samples, started in steady state.
+  // first-order lag, started in steady state; the commands are held between samples, for
+  // which the discretisation is exact. The mean over each interval (what its mid-interval
+  // acceleration sees) goes to mean_speed_; as tau -> 0 it is the held command's speed.
   const double tau = p[lag_];
-  std::vector<double> f(n), prev(speed_states_.size());
+  const size_t nr = speed_states_.size();
+  mean_speed_.assign(ns * nr, 0.0);
+  std::vector<double> f(n), c(nr);
   for (size_t k = 0; k < ns; ++k) {
     double* x = &X[k * n];
-    model_.rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
-    for (size_t i = 0; i < speed_states_.size(); ++i) {
-      const double w_cmd = tau * f[speed_states_[i]];
-      if (k == 0) {
-        x[speed_states_[i]] = w_cmd;
-      } else {
-        const double a = std::exp(-(flight_.samples[k].t - flight_.samples[k - 1].t) / tau);
-        x[speed_states_[i]] = a * X[(k - 1) * n + speed_states_[i]] + (1 - a) * prev[i];
+    if (k > 0) {
+      const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
+      const double a = std::exp(-h / tau);
+      for (size_t i = 0; i < nr; ++i) {
+        const double w0 = X[(k - 1) * n + speed_states_[i]];
+        x[speed_states_[i]] = a * w0 + (1 - a) * c[i];
+        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * tau / h * (1 - a);
       }
-      prev[i] = w_cmd;
+    }
+    // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
+    std::vector<double> w_now(nr);
+    for (size_t i = 0; i < nr; ++i) w_now[i] = x[speed_states_[i]], x[speed_states_[i]] = 0;
+    model_.rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
+    for (size_t i = 0; i < nr; ++i) {
+      c[i] = tau * f[speed_states_[i]];
+      x[speed_states_[i]] = k == 0 ? c[i] : w_now[i];
     }
   }
 }
@@ -133,7 +200,7 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const 
   residuals(p, r, J);
   if (!J) return;
   // Columns of the parameters applied to the data: central differences.
-  std::vector<double> pp(p, p + np), rp(flight_.samples.size() * 6), rm(rp.size());
+  std::vector<double> pp(p, p + np), rp(rows_.size() * 6), rm(rp.size());
   for (int c : {lag_, delay_, roll_, pitch_}) {
     if (c < 0 || (!free_.empty() && !free_[c])) continue;
     const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
@@ -147,17 +214,75 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const 
   model_.set_params(pp);
 }
 
+// Model accelerations (rows 3..5 and 10..12 of f, and of df/dp) at the middle of every
+// interval k -> k+1: state averaged, the commands of t_k held over it.
+void EquationErrorModel::interval_accelerations(const std::vector<double>& X, const std::vector<double>& U,
+                                                std::vector<double>& F, std::vector<double>* Bm) const {
+  const int n = model_.num_states(), np = model_.num_params(), nu = model_.num_inputs();
+  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
+  const size_t ns = flight_.samples.size();
+  F.assign(ns * 6, 0.0);
+  if (Bm) Bm->assign(ns * 6 * np, 0.0);
+  std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
+  static const int kRows[6] = {3, 4, 5, 10, 11, 12};
+  for (size_t k = 0; k + 1 < ns; ++k) {
+    if (!interval_ok_[k]) continue;
+    for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
+    const double qn = std::sqrt(xm[6] * xm[6] + xm[7] * xm[7] + xm[8] * xm[8] + xm[9] * xm[9]);
+    for (int i = 6; i < 10; ++i) xm[i] /= qn;
+    for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = mean_speed_[k * speed_states_.size() + i];
+    std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
+    if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
+    if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
+    model_.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+    for (int c = 0; c < 6; ++c) {
+      F[k * 6 + c] = f[kRows[c]];
+      if (Bm) std::copy(&B[kRows[c] * np], &B[kRows[c] * np] + np, &(*Bm)[(k * 6 + c) * np]);
+    }
+  }
+}
+
 void EquationErrorModel::residuals(const double* p, double* r, double* J) const {
   const int n = model_.num_states(), np = model_.num_params(), nu = model_.num_inputs();
   model_.set_params(std::vector<double>(p, p + np));
   std::vector<double> X, U;
   prepare(p, X, U);
-  std::vector<double> f(n), B(J ? n * np : 0);
-  for (size_t k = 0; k < flight_.samples.size(); ++k) {
+  const bool filtered = derivatives_ == Derivatives::kFiltered;
+  std::vector<double> F, Bm;
+  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr);
+  const bool pointwise_needed = !filtered || accel_;
+  std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
+  // Model accelerations seen by the measurement at this row: the six rows of f (and of B).
+  std::vector<double> a6(6), Ba6(J ? 6 * np : 0);
+  for (size_t row = 0; row < rows_.size(); ++row) {
+    const size_t k = rows_[row];
     const FlightSample& s = flight_.samples[k];
     const double* xk = &X[k * n];
-    model_.rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
-    double* rk = r + 6 * k;
+    if (pointwise_needed) model_.rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
+    double meas[6];
+    if (filtered) {
+      std::fill(a6.begin(), a6.end(), 0.0);
+      if (J) std::fill(Ba6.begin(), Ba6.end(), 0.0);
+      const auto& W = interval_weights_[row];
+      const size_t lo = window_start_[row];
+      for (size_t j = 0; j < W.size(); ++j)
+        for (int c = 0; c < 6; ++c) {
+          a6[c] += W[j] * F[(lo + j) * 6 + c];
+          if (J)
+            for (int q = 0; q < np; ++q) Ba6[c * np + q] += W[j] * Bm[((lo + j) * 6 + c) * np + q];
+        }
+      for (int c = 0; c < 6; ++c) meas[c] = measured_[row][c];
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        a6[c] = f[3 + c];
+        a6[3 + c] = f[10 + c];
+        meas[c] = s.acc_world[c];
+        meas[3 + c] = s.rate_dot[c];
+        if (J)
+          for (int q = 0; q < np; ++q) Ba6[c * np + q] = B[(3 + c) * np + q], Ba6[(3 + c) * np + q] = B[(10 + c) * np + q];
+      }
+    }
+    double* rk = r + 6 * row;
     // Body -> world rotation of the (true) attitude.
     const double w = xk[6], x = xk[7], y = xk[8], z = xk[9];
     const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
@@ -165,17 +290,17 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
                             {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
     const double g = p[g_index_];
     for (int i = 0; i < 3; ++i) {
-      if (accel_) {  // specific force in body axes: R^T (a + g e_z)
+      if (accel_) {  // specific force in body axes at the sample: R^T (a + g e_z)
         double sf = 0;
         for (int j = 0; j < 3; ++j) sf += R[j][i] * (f[3 + j] + (j == 2 ? g : 0.0));
         rk[i] = sf - s.specific_force[i];
       } else {
-        rk[i] = f[3 + i] - s.acc_world[i];
+        rk[i] = a6[i] - meas[i];
       }
-      rk[3 + i] = f[10 + i] - s.rate_dot[i];
+      rk[3 + i] = a6[3 + i] - meas[3 + i];
     }
     if (!J) continue;
-    double* Jk = J + static_cast<size_t>(6 * k) * np;
+    double* Jk = J + static_cast<size_t>(6 * row) * np;
     for (int c = 0; c < np; ++c) {
       for (int i = 0; i < 3; ++i) {
         double d;
@@ -183,10 +308,10 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
           d = 0;
           for (int j = 0; j < 3; ++j) d += R[j][i] * (B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
         } else {
-          d = B[(3 + i) * np + c];
+          d = Ba6[i * np + c];
         }
         Jk[i * np + c] = d;
-        Jk[(3 + i) * np + c] = B[(10 + i) * np + c];
+        Jk[(3 + i) * np + c] = Ba6[(3 + i) * np + c];
       }
     }
   }

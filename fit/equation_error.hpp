@@ -9,6 +9,7 @@
 // and IMU data; it needs no integration and so cannot drift. (Multiple shooting, which
 // compares integrated windows with the pose, is the other formulation; see README.)
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -23,14 +24,26 @@ class EquationErrorModel : public ResidualModel {
   // The model's parameters are the fit parameters; `use_accelerometer` picks specific
   // force (body) over differentiated velocity (world) for the translational channels.
   // `use` selects channels by name (empty: all six).
+  // Differentiated channels (gyro, and velocity without an accelerometer):
+  //  - kFiltered: the log's derivative is a local quadratic (Savitzky-Golay) fit over
+  //    +-window, and the model's accelerations, evaluated at the middle of every sample
+  //    interval with the commands held over it, go through the same filter. Exact for
+  //    any signal content, zero-order-held commands included; samples whose window leaves
+  //    a contiguous stretch of the log are not used.
+  //  - kPointwise: the model at each sample against the derivatives stored in the flight
+  //    (acc_world, rate_dot); right only for slowly varying signals.
+  enum class Derivatives { kFiltered, kPointwise };
   EquationErrorModel(runtime::DynamicModel& model, Flight flight, bool use_accelerometer,
-                     std::vector<std::string> use = {});
-  int num_residuals() const override { return static_cast<int>(flight_.samples.size() * used_.size()); }
+                     std::vector<std::string> use = {}, Derivatives d = Derivatives::kFiltered,
+                     double window = 0.05);
+  int num_residuals() const override { return static_cast<int>(rows_.size() * used_.size()); }
+  // Sample (index into flight().samples) of each residual row.
+  const std::vector<size_t>& rows() const { return rows_; }
   void evaluate(const double* p, double* r, double* J) const override;
   int channel_of(int i) const override { return i % static_cast<int>(used_.size()); }
   std::vector<std::string> channels() const override;
   void set_free(const std::vector<bool>& free) const override;
-  // Residuals of all six channels at sample k (for plots), after evaluate-able parameters.
+  // Residuals of all six channels of every row (rows() x 6), at these parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
   const Flight& flight() const { return flight_; }
 
@@ -43,13 +56,25 @@ class EquationErrorModel : public ResidualModel {
   // Parameters applied to the data (-1 when the model lacks the effect).
   int lag_ = -1, delay_ = -1, roll_ = -1, pitch_ = -1;
   std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
+  Derivatives derivatives_;
+  std::vector<size_t> rows_;
+  // kFiltered: for each row, the first sample of its window, the weights of the model's
+  // interval accelerations, and the measured derivatives (velocity world, gyro body).
+  std::vector<size_t> window_start_;
+  std::vector<std::vector<double>> interval_weights_;
+  std::vector<std::array<double, 6>> measured_;
+  std::vector<bool> interval_ok_;  // interval k -> k+1 lies inside a contiguous stretch
+  void build_filter(double window);
   mutable std::vector<bool> free_;
+  mutable std::vector<double> mean_speed_;  // rotor speeds averaged over each interval (motor_lag)
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
   void prepare(const double* p, std::vector<double>& X, std::vector<double>& U) const;
   void commands_at(double t, double* u) const;  // rotor commands interpolated at t
   void residuals(const double* p, double* r, double* J) const;
+  void interval_accelerations(const std::vector<double>& X, const std::vector<double>& U, std::vector<double>& F,
+                              std::vector<double>* Bm) const;
 };
 
 

@@ -86,6 +86,17 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   std::mt19937 rng(o.seed);
   const Reference ref(o, rng);
   std::normal_distribution<double> gauss(0, 1);
+  // Multisine per channel (roll, pitch, yaw rate, thrust): unit RMS.
+  const double freqs[5] = {1.1, 2.3, 3.7, 5.3, 7.9};
+  double phase[4][5];
+  std::uniform_real_distribution<double> uphase(0, 2 * M_PI);
+  for (auto& ch : phase)
+    for (double& p : ch) p = uphase(rng);
+  auto multisine = [&](double t, int ch) {
+    double s = 0;
+    for (int i = 0; i < 5; ++i) s += std::sin(2 * M_PI * freqs[i] * t + phase[ch][i]);
+    return s * std::sqrt(2.0 / 5.0);
+  };
   const int nr = static_cast<int>(rotors.size());
   const int t_in = truth.input_index("t"), v_in = truth.input_index("vbat");
   std::vector<double> x(truth.num_states(), 0.0);
@@ -132,7 +143,12 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   io.divergence_bound = 1e4;
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
-    const double vbat = o.vbat_start + (o.vbat_end - o.vbat_start) * t / o.duration;
+    // Battery: open-circuit voltage falling over the flight, and a drop under load (the
+    // last commands' thrust above hover), so that voltage is not simply a function of time.
+    double load = 0;
+    for (int i = 0; i < nr; ++i) load += u[i] * u[i] / (hover_u * hover_u) / nr;
+    const double vbat = o.vbat_start + (o.vbat_end - o.vbat_start) * t / o.duration -
+                        o.vbat_load_drop * (k == 0 ? 0.0 : load - 1.0);
     // --- controller (it sees the true state; the log below adds sensor noise) ---
     double rx[3], ry[3], rz[3], ryaw[3];
     ref.at(t, 0, rx);
@@ -155,12 +171,18 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     Rd.col(1) = b2;
     Rd.col(2) = b3;
     const V3 e_R = 0.5 * vee(Rd.transpose() * R - R.transpose() * Rd);
-    const V3 w_d = -o.kp_att * e_R + V3(0, 0, ryaw[1]);
+    V3 w_d = -o.kp_att * e_R + V3(0, 0, ryaw[1]);
+    double thrust_scale = 1;
+    if (o.excitation > 0) {
+      const V3 ms(multisine(t, 0), multisine(t, 1), multisine(t, 2));
+      w_d += o.excitation * ms;
+      thrust_scale += 0.1 * o.excitation * multisine(t, 3);
+    }
     const V3 e_w = w - w_d;
     int_rate += e_w * dt;
     const V3 Jd(b.J[0], b.J[1], b.J[2]);
     const V3 torque = Jd.cwiseProduct(-o.kp_rate * e_w - o.ki_rate * int_rate) + w.cross(Jd.cwiseProduct(w));
-    const auto F = allocate(b, thrust, torque);
+    const auto F = allocate(b, thrust * thrust_scale, torque);
     for (int i = 0; i < nr; ++i) {
       double ui;
       try {

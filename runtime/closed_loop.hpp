@@ -34,8 +34,13 @@ struct ClosedLoopOptions {
   double pose_noise = 1e-3;    // m, and pose_noise rad on attitude (mocap-like)
   double gyro_noise = 0, gyro_bias = 0;    // rad/s
   double accel_noise = 0, accel_bias = 0;  // m/s^2
+  // System-identification excitation: a multisine (1-8 Hz, random phases) of this
+  // amplitude [rad/s] added to the body-rate set points, and of a tenth of it (relative)
+  // to the collective thrust. Fast content separates look-alikes such as a lag and a delay.
+  double excitation = 0;
   int command_levels = 65535;  // quantisation of logged/applied commands (16-bit PWM)
-  double vbat_start = 4.15, vbat_end = 3.75;  // V, linear sag over the flight (logged)
+  double vbat_start = 4.15, vbat_end = 3.75;  // V, open-circuit sag over the flight (logged)
+  double vbat_load_drop = 0.15;  // V, extra drop per unit of relative load above hover (internal resistance)
   // Gains (per axis): position PD + I, attitude P, rate P + I.
   double kp_pos = 3.0, kd_pos = 3.5, ki_pos = 0.6, kp_att = 9.0, kp_rate = 18.0, ki_rate = 4.0;
 };

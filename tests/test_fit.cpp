@@ -112,7 +112,7 @@ TEST(Fit, MassAndThrustCoefficientAreStructurallyNonIdentifiable) {
     flight.samples.push_back(s);
   }
   const std::vector<double> truth = model.params();  // the fit below moves the model's own
-  EquationErrorModel m(model, flight, false, {"ax", "ay", "az"});
+  EquationErrorModel m(model, flight, false, {"ax", "ay", "az"}, EquationErrorModel::Derivatives::kPointwise);
   std::vector<FitParameter> ps;
   for (int i = 0; i < model.num_params(); ++i) {
     const std::string n = model.param_names()[i];
