@@ -44,6 +44,8 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--yaw-amplitude", a.yaw_amplitude, "closed loop: heading excursions [rad]")->check(CLI::Range(0.0, 10.0));
   c->add_option("--excitation", a.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
       ->check(CLI::Range(0.0, 5.0));
+  c->add_option("--tether", a.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
+      ->check(CLI::Range(0.0, 100.0));
   c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
@@ -102,6 +104,7 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   o.height_amplitude = a.height_amplitude;
   o.yaw_amplitude = a.yaw_amplitude;
   o.excitation = a.excitation;
+  o.tether_stiffness = a.tether;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
   OutputSet out = output_for(a.out);

@@ -5,6 +5,8 @@
 #include <iostream>
 #include <limits>
 
+#include <unistd.h>
+
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
 
@@ -274,12 +276,14 @@ SearchResult CandidateSearch::run() {
     for (const auto& e : candidates_) {
       ++k;
       if (base.count(e)) continue;
-      if (opt_.verbose_progress)
+      if (opt_.verbose_progress && isatty(2))
         std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
                   << e << "                    " << std::flush;
       step.candidates.push_back(evaluate(e, base, current, base_cost, base_valid));
     }
-    if (opt_.verbose_progress) std::cerr << "\n";
+    if (opt_.verbose_progress)
+      std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
+                << " candidates fitted                              \n";
     std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) {
       if (a.significant != b.significant) return a.significant;
       return a.statistic > b.statistic;
@@ -347,7 +351,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   for (const auto& e : r.selected)
     for (int i : effect_params_.at(e)) {
       if (!r.final_fit[i].free) continue;
-      if (opt_.verbose_progress) std::cerr << "\r[diagnose] profile of " << r.final_fit[i].name << "        " << std::flush;
+      if (opt_.verbose_progress && isatty(2))
+        std::cerr << "\r[diagnose] profile of " << r.final_fit[i].name << "        " << std::flush;
       fit::Profile pr = fit::profile_parameter(train_, best, i, fo, po);
       EffectEstimate est{r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
                          pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
@@ -355,7 +360,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
       r.estimates.push_back(est);
       r.profiles.push_back(std::move(pr));
     }
-  if (opt_.verbose_progress) std::cerr << "\n";
+  if (opt_.verbose_progress)
+    std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profiles of " << r.profiles.size() << " parameters done        \n";
 }
 
 }  // namespace quadgen::diagnose

@@ -111,8 +111,17 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
     step_base = f.evidence.parameters;
     d.findings.push_back(f);
   }
-  // Left over: slow structure the noise cannot explain.
-  for (const auto& c : d.after.channels) {
+  // Left over: slow structure the noise cannot explain. After an ambiguity, what is left
+  // over is judged with the stronger of the two look-alikes in the model (either
+  // explains the discrepancy; only the name is open).
+  ResidualAnalysis left = d.after;
+  if (!s.unresolved.empty()) {
+    const auto pu = values(s.steps.back().candidates.front().parameters);
+    std::vector<double> r;
+    all_ee.all_channels(pu.data(), r);
+    left = analyse_residuals(r, d.channel_names, d.channel_units, d.t, signals);
+  }
+  for (const auto& c : left.channels) {
     if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
     Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,
                   c.worst_window_mean, "", 0};

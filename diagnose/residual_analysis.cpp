@@ -68,7 +68,11 @@ SignalSet physical_signals(const fit::Flight& f, const std::vector<std::string>&
                               {2 * (qx * qz - w * qy), 2 * (qy * qz + w * qx), 1 - 2 * (qx * qx + qy * qy)}};
       return R[0][a] * x[3] + R[1][a] * x[4] + R[2][a] * x[5];
     });
-  if (f.has_pose) add("height", [&](size_t k) { return f.samples[k].x[2]; });
+  if (f.has_pose) {
+    add("position x", [&](size_t k) { return f.samples[k].x[0]; });
+    add("position y", [&](size_t k) { return f.samples[k].x[1]; });
+    add("height", [&](size_t k) { return f.samples[k].x[2]; });
+  }
   add("time", [&](size_t k) { return f.samples[k].t; });
   if (f.has_vbat) add("battery voltage", [&](size_t k) { return f.samples[k].vbat; });
   for (size_t i = 0; i < nr; ++i)

@@ -228,6 +228,13 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
       if (v_in >= 0) uu[v_in] = vbat;
     };
     x = integrate_rk4(truth, x, inputs, 0.0, dt, io).x.back();
+    if (o.tether_stiffness > 0) {  // impulse of the tether force over the period
+      double start[3];
+      for (int a = 0; a < 2; ++a) {
+        ref.at(0, a, start);
+        x[3 + a] -= o.tether_stiffness * (x[a] - start[0]) / b.mass * dt;
+      }
+    }
     if (x[2] < -5 || (p - V3(rx[0], ry[0], rz[0])).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
   }

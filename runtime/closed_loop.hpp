@@ -38,6 +38,10 @@ struct ClosedLoopOptions {
   // amplitude [rad/s] added to the body-rate set points, and of a tenth of it (relative)
   // to the collective thrust. Fast content separates look-alikes such as a lag and a delay.
   double excitation = 0;
+  // A disturbance outside the effect catalogue (for testing that the diagnosis reports it
+  // as unexplained instead of naming a wrong cause): a horizontal tether pulling the
+  // vehicle back to the start point with this stiffness [N/m].
+  double tether_stiffness = 0;
   int command_levels = 65535;  // quantisation of logged/applied commands (16-bit PWM)
   double vbat_start = 4.15, vbat_end = 3.75;  // V, open-circuit sag over the flight (logged)
   double vbat_load_drop = 0.15;  // V, extra drop per unit of relative load above hover (internal resistance)
