@@ -26,7 +26,7 @@ void motor_gain(ModelContext& c) {
 // any tau, and as tau -> 0 the trajectories converge to it (a singular perturbation),
 // so the nominal tau is small rather than zero.
 void motor_lag(ModelContext& c) {
-  const ex tau = c.add_param("motor_lag.tau", "s", 1e-3, 1e-4, 1.0, true,
+  const ex tau = c.add_param("motor_lag.tau", "s", 1e-3, 1e-6, 1.0, true,
                              "time constant of the rotor speed response");
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
     const std::string n = c.vehicle.rotors[i].name;

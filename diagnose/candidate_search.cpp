@@ -30,8 +30,27 @@ double typical_start(const std::string& param) {
 
 // The value at which an effect is off. The derived model's nominal values are neutral
 // except the rotor lag, whose nominal 1 ms keeps simulations non-stiff; equation error
-// has no such limit, so "no lag" is its lower bound (0.1 ms).
+// has no such limit, so "no lag" is its lower bound (1 us).
 double neutral_value(const Variable& p) { return p.name == "motor_lag.tau" ? p.lower : p.nominal; }
+
+// Below these magnitudes an effect is physically negligible for a flight model, however
+// significant statistically (a long, clean log makes micrometre CoG offsets "significant"
+// through the smallest model error). A candidate must exceed them in at least one
+// parameter to be named. README "Diagnosis" lists them with their reasons.
+double negligible_magnitude(const std::string& param) {
+  const std::string e = param.substr(0, param.find('.'));
+  if (e == "motor_gain") return 0.005;          // 0.5 % thrust
+  if (e == "motor_lag") return 0.002;           // s
+  if (e == "input_delay") return 0.002;         // s
+  if (e == "cog_offset") return 0.0005;         // m
+  if (e == "rotor_drag") return 1e-6;           // N s/m per rad/s: ~0.1 % of hover thrust at 1 m/s
+  if (e == "wind") return 0.2;                  // m/s
+  if (e == "attitude_bias") return 0.002;       // rad (0.11 deg)
+  if (e == "thrust_decay") return 1e-4;         // 1/s: 0.6 % per minute
+  if (e == "battery_sag") return 0.1;           // exponent
+  if (e == "ground_effect") return 0.01;        // m
+  return 0;
+}
 
 std::string effect_of(const std::string& param) { return param.substr(0, param.find('.')); }
 
@@ -213,12 +232,18 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.validation_cost_before = base_valid_cost;
   ev.validation_cost_after = cost(valid_, ev.parameters);
   ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
+  bool relevant = false;
+  for (int i : effect_params_.at(effect))
+    if (ev.parameters[i].free && std::abs(ev.parameters[i].value - neutral_value(all_.params[i])) >= negligible_magnitude(ev.parameters[i].name))
+      relevant = true;
   if (!(ev.p_value < ev.level))
     ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
   else if (!(ev.delta_bic < 0))
     ev.why_not = "BIC does not improve";
   else if (!(ev.validation_cost_after < ev.validation_cost_before))
     ev.why_not = "no gain on the validation part";
+  else if (!relevant)
+    ev.why_not = "physically negligible size";
   ev.significant = ev.why_not.empty();
   return ev;
 }
@@ -356,10 +381,22 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
       fit::Profile pr = fit::profile_parameter(train_, best, i, fo, po);
       EffectEstimate est{r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
                          pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
-                         pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, pr.verdict};
+                         pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict};
       r.estimates.push_back(est);
       r.profiles.push_back(std::move(pr));
     }
+  // Discretisation allowance: refit with the other quadrature rule.
+  std::set<std::string> sel(r.selected.begin(), r.selected.end());
+  train_.set_quadrature(fit::EquationErrorModel::Quadrature::kTrapezoid);
+  double c = 0;
+  const auto alt = fit_with(sel, r.final_fit, &c);
+  train_.set_quadrature(fit::EquationErrorModel::Quadrature::kMidpoint);
+  for (auto& e : r.estimates) {
+    const int i = model_.param_index(e.name);
+    e.numerical_allowance = std::abs(alt[i].value - e.value);
+    if (!std::isnan(e.lower)) e.lower -= e.numerical_allowance;
+    if (!std::isnan(e.upper)) e.upper += e.numerical_allowance;
+  }
   if (opt_.verbose_progress)
     std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profiles of " << r.profiles.size() << " parameters done        \n";
 }

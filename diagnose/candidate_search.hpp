@@ -38,6 +38,9 @@ struct SearchOptions {
 struct EffectEstimate {
   std::string name, unit;
   double value = 0, standard_error = 0, lower = 0, upper = 0;
+  // Added to both sides of the interval: the estimate's change when the interval
+  // accelerations use the trapezoid instead of the midpoint rule.
+  double numerical_allowance = 0;
   std::string verdict;  // from the profile likelihood
 };
 

@@ -88,6 +88,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                     {"ci95", {number_or_null(e.lower), number_or_null(e.upper)}},
                     {"unit", e.unit},
                     {"standard_error", number_or_null(e.standard_error)},
+                    {"numerical_allowance", e.numerical_allowance},
                     {"identifiability", e.verdict}};
     json fj = {{"effect", f.effect},
                {"parameters", ps},
@@ -356,7 +357,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
        "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
        "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
        "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the validation part. "
-       "Intervals are profile-likelihood intervals with the same weights.</p>\n</body></html>\n";
+       "Intervals are profile-likelihood intervals with the same weights, widened on both sides by the change of the "
+       "estimate when the interval accelerations use the trapezoid instead of the midpoint rule (discretisation error).</p>\n</body></html>\n";
   return h.str();
 }
 

@@ -234,10 +234,25 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
     std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
     if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
     if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
-    model_.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
-    for (int c = 0; c < 6; ++c) {
-      F[k * 6 + c] = f[kRows[c]];
-      if (Bm) std::copy(&B[kRows[c] * np], &B[kRows[c] * np] + np, &(*Bm)[(k * 6 + c) * np]);
+    if (quadrature_ == Quadrature::kMidpoint) {
+      model_.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+      for (int c = 0; c < 6; ++c) {
+        F[k * 6 + c] = f[kRows[c]];
+        if (Bm) std::copy(&B[kRows[c] * np], &B[kRows[c] * np] + np, &(*Bm)[(k * 6 + c) * np]);
+      }
+      continue;
+    }
+    // Trapezoid: the rigid-body state at both ends, the held command and the interval's
+    // mean rotor speeds (a rotor speed at the switching instant belongs to neither side).
+    for (size_t end = k; end <= k + 1; ++end) {
+      std::vector<double> xe(&X[end * n], &X[end * n] + n);
+      for (size_t i = 0; i < speed_states_.size(); ++i) xe[speed_states_[i]] = xm[speed_states_[i]];
+      model_.rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+      for (int c = 0; c < 6; ++c) {
+        F[k * 6 + c] += 0.5 * f[kRows[c]];
+        if (Bm)
+          for (int q = 0; q < np; ++q) (*Bm)[(k * 6 + c) * np + q] += 0.5 * B[kRows[c] * np + q];
+      }
     }
   }
 }

@@ -37,6 +37,11 @@ class EquationErrorModel : public ResidualModel {
                      std::vector<std::string> use = {}, Derivatives d = Derivatives::kFiltered,
                      double window = 0.05);
   int num_residuals() const override { return static_cast<int>(rows_.size() * used_.size()); }
+  // How the acceleration over a sample interval is approximated: at the interval's middle
+  // (state averaged), or as the mean of its ends. Their difference bounds the
+  // discretisation error of estimates (diagnose adds it to intervals).
+  enum class Quadrature { kMidpoint, kTrapezoid };
+  void set_quadrature(Quadrature q) const { quadrature_ = q; }
   // Sample (index into flight().samples) of each residual row.
   const std::vector<size_t>& rows() const { return rows_; }
   void evaluate(const double* p, double* r, double* J) const override;
@@ -66,6 +71,7 @@ class EquationErrorModel : public ResidualModel {
   std::vector<bool> interval_ok_;  // interval k -> k+1 lies inside a contiguous stretch
   void build_filter(double window);
   mutable std::vector<bool> free_;
+  mutable Quadrature quadrature_ = Quadrature::kMidpoint;
   mutable std::vector<double> mean_speed_;  // rotor speeds averaged over each interval (motor_lag)
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J) const;

@@ -134,8 +134,11 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
       Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.pitch"), V3::UnitY())) *
       Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.roll"), V3::UnitX()));
   const double delay = truth_param("input_delay.seconds");
-  const long delay_steps = static_cast<long>(std::floor(delay / dt));
-  const double delay_rest = delay - static_cast<double>(delay_steps) * dt;
+  // Whole control periods of delay, and the rest (below 1 us counts as none: 0.03 / 0.01
+  // is 2.9999999999999996 in floating point).
+  const long delay_steps = static_cast<long>(std::floor(delay / dt + 1e-6));
+  double delay_rest = delay - static_cast<double>(delay_steps) * dt;
+  if (delay_rest < 1e-6) delay_rest = 0;
   std::vector<std::vector<double>> sent;  // commands of every control step
   std::vector<double> u(truth.num_inputs(), 0.0), f(truth.num_states());
   IntegratorOptions io;
@@ -221,13 +224,21 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     if (k == steps) break;
     // --- plant: the true model over one control period, commands held ---
     const double t0 = t;
+    bool before_switch = false;
     auto inputs = [&](double tt, double* uu) {
-      const std::vector<double>& held = tt < delay_rest ? early : late;
+      const std::vector<double>& held = before_switch ? early : late;
       for (int i = 0; i < nr; ++i) uu[i] = held[i];
       if (t_in >= 0) uu[t_in] = t0 + tt;
       if (v_in >= 0) uu[v_in] = vbat;
     };
-    x = integrate_rk4(truth, x, inputs, 0.0, dt, io).x.back();
+    // The delayed command switches at delay_rest into the period: integrate up to the
+    // switch and on from it, so that no RK4 step straddles it.
+    if (delay_rest > 0) {
+      before_switch = true;
+      x = integrate_rk4(truth, x, inputs, 0.0, delay_rest, io).x.back();
+      before_switch = false;
+    }
+    x = integrate_rk4(truth, x, inputs, delay_rest, dt, io).x.back();
     if (o.tether_stiffness > 0) {  // impulse of the tether force over the period
       double start[3];
       for (int a = 0; a < 2; ++a) {

@@ -16,7 +16,7 @@ cases=(
   "clean||"
   "motor_gain|motor_gain|motor_gain.C=-0.08"
   "motor_lag|motor_lag|motor_lag.tau=0.05"
-  "input_delay|input_delay|input_delay.seconds=0.03"
+  "input_delay|input_delay|input_delay.seconds=0.025"
   "cog_offset|cog_offset|cog_offset.x=0.01 cog_offset.y=-0.005"
   "rotor_drag|rotor_drag|rotor_drag.k=2e-5"
   "wind|wind|wind.x=1.5 wind.y=-1.0"

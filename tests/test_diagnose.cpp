@@ -6,7 +6,7 @@
 // the catalogue as unexplained instead of naming a wrong cause.
 //
 // Magnitudes (README "Hidden-effect suite" cites where they come from): 8 % thrust loss on
-// one rotor, 50 ms rotor lag, 30 ms delay, 1 cm CoG offset, rotor drag 2e-5, 1.8 m/s wind,
+// one rotor, 50 ms rotor lag, 25 ms delay, 1 cm CoG offset, rotor drag 2e-5, 1.8 m/s wind,
 // 1.7 deg attitude offset, 12 % thrust decay per minute, exponent 1.5 battery sag,
 // ground effect with the true rotor radius at 0.25 m height.
 #include <algorithm>
@@ -33,6 +33,8 @@ struct HiddenCase {
   std::string flight_flags;              // extra simulate flags
   unsigned seed = 1;
 };
+
+void PrintTo(const HiddenCase& c, std::ostream* os) { *os << c.name << " seed " << c.seed; }
 
 std::string run(const std::string& cmd) {
   const int rc = std::system(cmd.c_str());
@@ -95,7 +97,7 @@ std::vector<HiddenCase> single_effects() {
   std::vector<HiddenCase> base = {
       {"motor_gain", "motor_gain", {{"motor_gain.C", -0.08}}, {{"motor_gain.C", 0.01}}, ""},
       {"motor_lag", "motor_lag", {{"motor_lag.tau", 0.05}}, {{"motor_lag.tau", 0.01}}, excite},
-      {"input_delay", "input_delay", {{"input_delay.seconds", 0.03}}, {{"input_delay.seconds", 0.005}}, excite},
+      {"input_delay", "input_delay", {{"input_delay.seconds", 0.025}}, {{"input_delay.seconds", 0.005}}, excite},
       {"cog_offset", "cog_offset", {{"cog_offset.x", 0.01}, {"cog_offset.y", -0.005}},
        {{"cog_offset.x", 0.002}, {"cog_offset.y", 0.002}}, ""},
       {"rotor_drag", "rotor_drag", {{"rotor_drag.k", 2e-5}}, {{"rotor_drag.k", 4e-6}}, ""},
