@@ -50,14 +50,17 @@ void cog_offset(ModelContext& c) {
   c.cog = c.cog.add(vec3(dx, dy, 0));
 }
 
-// Horizontal body force −k (Σ w_i) v_air,body,xy: blade flapping / induced drag.
+// Horizontal body force −k (Σ w_i) v_air,body,xy (blade flapping / induced drag), each
+// rotor's share −k w_i v acting at its hub, so that a hub above or below the CoG also
+// feels the moment (the pitch-up of a multirotor flying forward).
 void rotor_drag(ModelContext& c) {
   const ex k = c.add_param("rotor_drag.k", "N s^2/m", 0.0, 0.0, 1e-3, true,
                            "rotor drag per rotor speed sum");
-  ex sum_w = 0;
-  for (const ex& w : c.rotor_speed) sum_w += w;
   const matrix vb = c.R.transpose().mul(c.air_velocity_world);
-  c.extra_body_force = c.extra_body_force.add(vec3(-k * sum_w * vb(0, 0), -k * sum_w * vb(1, 0), 0));
+  for (size_t i = 0; i < c.rotor_speed.size(); ++i) {
+    const ex w = c.rotor_speed[i];
+    c.rotor_hub_force[i] = c.rotor_hub_force[i].add(vec3(-k * w * vb(0, 0), -k * w * vb(1, 0), 0));
+  }
 }
 
 void wind(ModelContext& c) {

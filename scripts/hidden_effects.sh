@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_hidden}
 seeds=${2:-"1 2"}
-q=build/quadgen
+q=${QUADGEN:-build/quadgen}
 v=vehicles/finken3.yaml
 mkdir -p "$out"
 noise=(--gyro-noise 0.01 --accel-noise 0.05)
