@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # First command of the README: install what is missing, build, and run the main job on bundled data.
-#   ./setup.sh            install + build + derive the bundled vehicles into out/
+#   ./setup.sh            install + build + derive the bundled vehicles into out/, diagnose a
+#                         test flight with a hidden weak motor and the NanoBench flight
 #   ./setup.sh --no-run   install + build only (used by .ci/run)
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -12,5 +13,14 @@ if [ "${1:-}" != "--no-run" ]; then
     build/quadgen derive "vehicles/$v.yaml" --out "out/$v"
   done
   build/quadgen derive vehicles/finken3.yaml --out out/finken3_all_effects --effects all
-  echo "derivation reports: out/*/derivation.md"
+  # The main job end to end: a test flight with a weak motor C hidden in it, diagnosed.
+  build/quadgen simulate vehicles/finken3.yaml --closed-loop --duration 60 --seed 1 \
+      --effects motor_gain --set motor_gain.C=-0.08 --gyro-noise 0.01 --accel-noise 0.05 --out out/weak_motor_C.csv
+  build/quadgen diagnose vehicles/finken3.yaml out/weak_motor_C.csv --out out/diagnosis_weak_motor_C
+  # The real flights, when the shared data sits beside the clone.
+  nb=../shared/data/crazyflie/nanobench/B3_figure8_medium_rep2.csv
+  if [ -f "$nb" ]; then
+    build/quadgen diagnose vehicles/crazyflie21.yaml "$nb" --mapping data/mappings/nanobench.yaml --out out/diagnosis_nanobench
+  fi
+  echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html"
 fi

@@ -197,8 +197,7 @@ std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>&
 }
 
 CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std::set<std::string>& base,
-                                            const std::vector<FitParameter>& base_fit, double base_cost,
-                                            double base_valid_cost) const {
+                                            const std::vector<FitParameter>& base_fit, double base_valid_cost) const {
   CandidateEvidence ev;
   ev.effect = effect;
   std::set<std::string> with = base;
@@ -228,7 +227,6 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.level = opt_.alpha / static_cast<double>(candidates_.size());
   ev.delta_bic = -ev.statistic + ev.dof * std::log(large.n_eff);
   ev.delta_aic = -ev.statistic + 2.0 * ev.dof;
-  (void)base_cost;
   ev.validation_cost_before = base_valid_cost;
   ev.validation_cost_after = cost(valid_, ev.parameters);
   ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
@@ -248,8 +246,8 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   return ev;
 }
 
-std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& step, const std::set<std::string>& base,
-                                                          const std::vector<FitParameter>& base_fit) const {
+std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& step,
+                                                          const std::set<std::string>& base) const {
   std::vector<Ambiguity> out;
   const CandidateEvidence& a = step.candidates.front();
   for (size_t k = 1; k < step.candidates.size() && k < 3; ++k) {
@@ -273,13 +271,10 @@ std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& s
     am.b_given_a_p = chi2_upper(lr_statistic(na, nab), b.dof);
     am.a_given_b_p = chi2_upper(lr_statistic(nb, nab), a.dof);
     am.manoeuvre = separating_manoeuvre(a.effect, b.effect);
-    (void)base_fit;
     if (am.a_given_b_p >= a.level && am.b_given_a_p >= a.level) out.push_back(am);
   }
   return out;
 }
-
-double CandidateSearch::n_effective() const { return channel_noise(train_, initial_parameters()).n_eff; }
 
 SearchResult CandidateSearch::run() {
   SearchResult res;
@@ -296,7 +291,7 @@ SearchResult CandidateSearch::run() {
   for (int round = 0; round < opt_.max_effects; ++round) {
     SelectionStep step;
     step.base_effects.assign(base.begin(), base.end());
-    const double base_cost = cost(train_, current), base_valid = cost(valid_, current);
+    const double base_valid = cost(valid_, current);
     int k = 0;
     for (const auto& e : candidates_) {
       ++k;
@@ -304,7 +299,7 @@ SearchResult CandidateSearch::run() {
       if (opt_.verbose_progress && isatty(2))
         std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
                   << e << "                    " << std::flush;
-      step.candidates.push_back(evaluate(e, base, current, base_cost, base_valid));
+      step.candidates.push_back(evaluate(e, base, current, base_valid));
     }
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
@@ -317,7 +312,7 @@ SearchResult CandidateSearch::run() {
       res.steps.push_back(step);
       break;
     }
-    step.ambiguities = check_look_alikes(step, base, current);
+    step.ambiguities = check_look_alikes(step, base);
     if (!step.ambiguities.empty()) {
       res.unresolved = step.ambiguities;
       res.steps.push_back(step);

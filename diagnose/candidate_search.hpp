@@ -119,12 +119,9 @@ class CandidateSearch {
 
   std::vector<fit::FitParameter> initial_parameters() const;
   CandidateEvidence evaluate(const std::string& effect, const std::set<std::string>& base,
-                             const std::vector<fit::FitParameter>& base_fit, double base_cost,
-                             double base_valid_cost) const;
-  std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base,
-                                           const std::vector<fit::FitParameter>& base_fit) const;
+                             const std::vector<fit::FitParameter>& base_fit, double base_valid_cost) const;
+  std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   void estimate_intervals(SearchResult& r) const;
-  double n_effective() const;
 };
 
 }  // namespace quadgen::diagnose

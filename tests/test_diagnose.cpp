@@ -166,4 +166,14 @@ TEST(OutOfCatalogue, TetherIsReportedAsUnexplained) {
   EXPECT_TRUE(horizontal) << j["unexplained"].dump(1);
 }
 
+// Same flight, two processes: the same diagnosis.json (timing aside).
+TEST(Determinism, SameFlightGivesTheSameDiagnosis) {
+  const HiddenCase c{"determinism", "motor_gain", {{"motor_gain.B", 0.05}}, {}, "", 3};
+  json a = diagnose(c);
+  json b = diagnose(c);
+  a.erase("timing_s");
+  b.erase("timing_s");
+  EXPECT_EQ(a.dump(), b.dump());
+}
+
 }  // namespace
