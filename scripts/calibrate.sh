@@ -2,8 +2,8 @@
 # Detection rate against effect size and noise level (README "Calibration"):
 #   scripts/calibrate.sh [OUT_DIR] [SEEDS]
 # For each effect, size and noise level, closed-loop flights over the seeds are diagnosed;
-# a detection counts when the hidden effect is named (and nothing else). Prints a
-# markdown table.
+# "named" counts flights where the hidden effect is named and nothing else, "detected"
+# also those reporting it ambiguous with a look-alike. Prints a markdown table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_calibration}
@@ -18,29 +18,38 @@ declare -A sizes=(
   [attitude_bias.roll]="0.0025 0.005 0.01 0.02"
 )
 noises=("low|--pose-noise 0.001 --gyro-noise 0.01 --accel-noise 0.05" "high|--pose-noise 0.005 --gyro-noise 0.05 --accel-noise 0.25")
-one() {  # param value noise-name noise-flags seed -> 1 if found alone
+# One flight: prints "N A" — N = 1 if the hidden effect is named alone, A = 1 if it is at
+# least detected (named, or reported ambiguous with a look-alike). Reuses earlier results.
+one() {  # param value noise-name noise-flags seed
   local p=$1 val=$2 nn=$3 flags=$4 seed=$5 e=${1%%.*}
   local f="$out/$p=$val-$nn-$seed"
-  # shellcheck disable=SC2086
-  $q simulate "$v" --closed-loop --duration 60 --seed "$seed" --effects "$e" --set "$p=$val" $flags --out "$f.csv" > /dev/null 2>&1 || { echo 0; return; }
-  $q diagnose "$v" "$f.csv" --out "$f.d" > /dev/null 2>&1 || { echo 0; return; }
-  # Only the findings block (the selection table repeats effect names).
-  local found
+  if [ ! -f "$f.d/diagnosis.json" ]; then
+    # shellcheck disable=SC2086
+    $q simulate "$v" --closed-loop --duration 60 --seed "$seed" --effects "$e" --set "$p=$val" $flags --out "$f.csv" > /dev/null 2>&1 || { echo "0 0"; return; }
+    $q diagnose "$v" "$f.csv" --out "$f.d" > /dev/null 2>&1 || { echo "0 0"; return; }
+  fi
+  # Only the findings / ambiguous blocks (the selection table repeats effect names).
+  local found amb
   found=$(sed -n '/^  "findings"/,/^  "ambiguous"/p' "$f.d/diagnosis.json" | grep -o '"effect": "[a-z_]*"' || true)
-  if [ "$found" = "\"effect\": \"$e\"" ]; then echo 1; else echo 0; fi
+  amb=$(sed -n '/^  "ambiguous"/,/^  "unexplained"/p' "$f.d/diagnosis.json" | grep -c "\"$e\"" || true)
+  local named=0 detected=0
+  [ "$found" = "\"effect\": \"$e\"" ] && named=1
+  if [ "$named" = 1 ] || [ "$amb" -gt 0 ]; then detected=1; fi
+  echo "$named $detected"
 }
-echo "| parameter | noise | sizes: detected / flights |"
+echo "| parameter | noise | size: named alone / detected (named or ambiguous with a look-alike) / flights |"
 echo "|---|---|---|"
 for p in motor_gain.C wind.x thrust_decay.rate attitude_bias.roll; do
   for n in "${noises[@]}"; do
     IFS='|' read -r nn flags <<<"$n"
     row="| $p | $nn |"
     for val in ${sizes[$p]}; do
-      hits=0; total=0
+      named=0; detected=0; total=0
       for seed in $seeds; do
-        hits=$((hits + $(one "$p" "$val" "$nn" "$flags" "$seed"))); total=$((total + 1))
+        read -r a b <<<"$(one "$p" "$val" "$nn" "$flags" "$seed")"
+        named=$((named + a)); detected=$((detected + b)); total=$((total + 1))
       done
-      row="$row $val: $hits/$total;"
+      row="$row $val: $named/$detected/$total;"
     done
     echo "$row"
   done

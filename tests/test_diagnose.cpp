@@ -147,6 +147,14 @@ TEST(LookAlikes, AttitudeBiasAndWindAmbiguousInAFixedHeadingHover) {
   EXPECT_TRUE(j["findings"].empty()) << j["findings"].dump(1);
 }
 
+// In a level hover at constant thrust a weak motor's roll/pitch torque is what a CoG
+// offset gives; the regular flight (thrust and heading changes) separates them (above).
+TEST(LookAlikes, MotorGainAndCogOffsetAmbiguousInAHover) {
+  const json j = diagnose({"gain_hover", "motor_gain", {{"motor_gain.C", -0.08}}, {}, "--amplitude 0 --height-amplitude 0 --yaw-amplitude 0", 1});
+  EXPECT_TRUE(ambiguous_between(j, "motor_gain", "cog_offset")) << j["ambiguous"].dump(1) << j["findings"].dump(1);
+  EXPECT_TRUE(j["findings"].empty()) << j["findings"].dump(1);
+}
+
 // Two effects at once: forward selection finds both.
 TEST(TwoEffects, MotorGainAndThrustDecayBothFound) {
   const json j = diagnose({"two", "motor_gain,thrust_decay", {{"motor_gain.C", -0.08}, {"thrust_decay.rate", 0.002}}, {}, "", 1});
