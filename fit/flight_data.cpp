@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include <Eigen/Dense>
 #include <yaml-cpp/yaml.h>
@@ -11,32 +13,44 @@
 namespace quadgen::fit {
 
 ColumnMapping load_mapping(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FitError(path + ": cannot open column mapping");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_mapping(ss.str(), path);
+}
+
+ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw FitError(path + ": cannot open column mapping");
+    root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
   }
+  if (!root.IsMap() || !root["columns"] || !root["columns"].IsMap())
+    throw FitError(path + ":1: expected a 'columns' mapping");
   ColumnMapping m;
-  if (!root["columns"] || !root["columns"].IsMap()) throw FitError(path + ":1: expected a 'columns' mapping");
-  m.name = root["name"] ? root["name"].as<std::string>() : path;
-  for (const auto& kv : root["columns"]) {
-    ColumnMapping::Entry e;
-    e.target = kv.first.as<std::string>();
-    const YAML::Node n = kv.second;
-    const int line = n.Mark().line + 1;
-    if (!n.IsMap() || !n["source"]) throw FitError(path + ":" + std::to_string(line) + ": expected {source: COLUMN, scale, offset, unit}");
-    e.source = n["source"].as<std::string>();
-    try {
+  int line = 1;
+  try {  // yaml-cpp's conversion errors (a list where a name belongs, ...) end as one line
+    m.name = root["name"] ? root["name"].as<std::string>() : path;
+    for (const auto& kv : root["columns"]) {
+      ColumnMapping::Entry e;
+      line = kv.first.Mark().line + 1;
+      e.target = kv.first.as<std::string>();
+      const YAML::Node n = kv.second;
+      if (!n.IsMap() || !n["source"])
+        throw FitError(path + ":" + std::to_string(line) + ": expected {source: COLUMN, scale, offset, unit}");
+      e.source = n["source"].as<std::string>();
       if (n["scale"]) e.scale = n["scale"].as<double>();
       if (n["offset"]) e.offset = n["offset"].as<double>();
-    } catch (const YAML::Exception&) {
-      throw FitError(path + ":" + std::to_string(line) + ": scale and offset must be numbers");
+      if (!std::isfinite(e.scale) || !std::isfinite(e.offset))
+        throw FitError(path + ":" + std::to_string(line) + ": scale and offset must be finite numbers");
+      if (n["unit"]) e.unit = n["unit"].as<std::string>();
+      m.entries.push_back(e);
     }
-    if (n["unit"]) e.unit = n["unit"].as<std::string>();
-    m.entries.push_back(e);
+  } catch (const YAML::Exception& e) {
+    throw FitError(path + ":" + std::to_string(e.mark.line >= 0 ? e.mark.line + 1 : line) +
+                   ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: TEXT}");
   }
   return m;
 }

@@ -20,6 +20,7 @@ struct ColumnMapping {
 };
 
 ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
+ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);
 
 // One time-aligned sample of a flight in canonical units.
