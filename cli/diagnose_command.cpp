@@ -61,6 +61,10 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const fit::Flight flight = fit::load_flight(log, rotors, {});
+  diagnose::DiagnoseOptions o;
+  if (!a.candidates.empty()) o.search.candidates = parse_effect_list(a.candidates);
+  // Fail before the long work if the results could not be written.
+  OutputSet out(a.out);
   std::cerr << "[diagnose] " << flight.samples.size() << " airborne samples; deriving the full-catalogue model\n";
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
@@ -69,13 +73,11 @@ int run_diagnose(const DiagnoseArgs& a) {
   bool compiled = false;
   const auto model = make_model(all, &compiled);
   std::cerr << "[diagnose] model: " << (compiled ? "compiled header from generated/" : "interpreted tape") << "\n";
-  diagnose::DiagnoseOptions o;
   o.validation_fraction = a.validation;
   o.window = a.window;
   o.translational = a.translational;
   o.search.alpha = a.alpha;
   o.search.max_effects = a.max_effects;
-  if (!a.candidates.empty()) o.search.candidates = parse_effect_list(a.candidates);
   fit::Flight valid;
   const diagnose::Diagnosis d = diagnose::diagnose_flight(v, all, *model, flight, o, &valid);
   // The extended model, regenerated with exactly the effects found.
@@ -95,7 +97,6 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::string err;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err);
   if (plots.empty()) std::cerr << "no plots: " << err << "\n";
-  OutputSet out(a.out);
   out.add("diagnosis.json", diagnose::diagnosis_json(d, a.log).dump(2) + "\n");
   out.add("report.html", diagnose::diagnosis_html(d, a.log, plots));
   out.add("extended_model.hpp", header.content);

@@ -174,6 +174,48 @@ TEST(OutOfCatalogue, TetherIsReportedAsUnexplained) {
   EXPECT_TRUE(horizontal) << j["unexplained"].dump(1);
 }
 
+// Bad input ends in one line and a non-zero exit, without outputs; an interrupted write
+// leaves the previous diagnosis as it was.
+TEST(DiagnoseInput, BadInputAndInterruptedWrite) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_diagnose_input";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string bin = QUADGEN_BINARY, veh = std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml";
+  const std::string flight = (dir / "flight.csv").string(), out = (dir / "out").string();
+  ASSERT_EQ(run(bin + " simulate " + veh + " --closed-loop --duration 12 --out " + flight + " > /dev/null 2>&1"), "");
+  // A log shorter than the derivative window and the validation split need.
+  {
+    std::ifstream in(flight);
+    std::ofstream shortlog(dir / "short.csv");
+    std::string line;
+    for (int i = 0; i < 25 && std::getline(in, line); ++i) shortlog << line << "\n";
+  }
+  const std::string err = (dir / "err.txt").string();
+  auto one_line_error = [&](const std::string& args) {
+    const int rc = std::system((bin + " diagnose " + args + " > /dev/null 2> " + err).c_str());
+    std::ifstream in(err);
+    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(rc, 0) << args;
+    const auto pos = text.find("quadgen: error: ");
+    ASSERT_NE(pos, std::string::npos) << text;
+    EXPECT_EQ(std::count(text.begin() + static_cast<long>(pos), text.end(), '\n'), 1) << text;
+  };
+  one_line_error(veh + " " + (dir / "missing.csv").string() + " --out " + out);
+  one_line_error(veh + " " + (dir / "short.csv").string() + " --out " + out);
+  one_line_error(veh + " " + flight + " --out " + out + " --candidates motor_gain,nonsense");
+  one_line_error(veh + " " + flight + " --out /proc/quadgen_cannot_write_here");
+  EXPECT_FALSE(fs::exists(out));
+  // A complete run, then one killed between writing and renaming.
+  ASSERT_EQ(run(bin + " diagnose " + veh + " " + flight + " --out " + out + " > /dev/null 2>&1"), "");
+  std::ifstream first(fs::path(out) / "diagnosis.json");
+  const std::string before((std::istreambuf_iterator<char>(first)), {});
+  const int rc = std::system(("QUADGEN_TEST_DIE_BEFORE_COMMIT=1 " + bin + " diagnose " + veh + " " + flight + " --out " + out +
+                              " --max-effects 1 > /dev/null 2>&1").c_str());
+  EXPECT_NE(rc, 0);
+  std::ifstream again(fs::path(out) / "diagnosis.json");
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again)), {}), before);
+}
+
 // Same flight, two processes: the same diagnosis.json (timing aside).
 TEST(Determinism, SameFlightGivesTheSameDiagnosis) {
   const HiddenCase c{"determinism", "motor_gain", {{"motor_gain.B", 0.05}}, {}, "", 3};
