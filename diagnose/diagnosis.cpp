@@ -52,7 +52,8 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   d.channel_names = accel ? std::vector<std::string>{"ax", "ay", "az", "pdot", "qdot", "rdot"}
                           : std::vector<std::string>{"ax_world", "ay_world", "az_world", "pdot", "qdot", "rdot"};
   d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
-  auto [train, valid] = fit::split_by_time(flight, 1.0 - opt.validation_fraction);
+  const auto parts = fit::split_by_time(flight, 1.0 - opt.validation_fraction);
+  const fit::Flight &train = parts.first, &valid = parts.second;  // (lambdas below capture valid)
   if (train.samples.size() < 50 || valid.samples.size() < 50)
     throw fit::FitError(flight.source + ": too short to hold out " + std::to_string(opt.validation_fraction) +
                         " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples)");
