@@ -87,9 +87,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   const SymbolicModel ext = derive_model(v, mp, ext_opt);
   emission::EmitOptions eo;
   eo.vehicle_file = a.vehicle;
-  std::string joined;
-  for (const auto& e : ext.effects) joined += (joined.empty() ? "" : ",") + e;
-  eo.effects_flag = joined.empty() ? "" : " --effects " + joined;
+  eo.effects_flag = ext.effects.empty() ? "" : " --effects " + ext.effect_list();
   const auto header = emission::generate_header(ext, eo);
   const AuditResult ext_audit = audit(ext, mp);
   const std::vector<ThesisItem> no_thesis;

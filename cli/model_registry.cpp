@@ -11,9 +11,7 @@ namespace quadgen::cli {
 namespace {
 template <class M>
 bool matches(const SymbolicModel& m) {
-  std::string effects;
-  for (const auto& e : m.effects) effects += (effects.empty() ? "" : ",") + e;
-  return m.vehicle_hash == M::kVehicleHash && effects == M::kEffects;
+  return m.vehicle_hash == M::kVehicleHash && m.effect_list() == M::kEffects;
 }
 }  // namespace
 

@@ -220,6 +220,12 @@ symbol ModelContext::add_constant(const std::string& name, const std::string& un
 }
 ex ModelContext::p(const std::string& name) const { return model.params[model.param_index(name)].sym; }
 
+std::string SymbolicModel::effect_list(const std::string& separator) const {
+  std::string out;
+  for (const auto& e : effects) out += (out.empty() ? "" : separator) + e;
+  return out;
+}
+
 size_t SymbolicModel::state_index(const std::string& n) const {
   for (size_t i = 0; i < states.size(); ++i)
     if (states[i].name == n) return i;

@@ -51,6 +51,9 @@ struct SymbolicModel {
   size_t input_index(const std::string& name) const;
   GiNaC::lst nominal_substitution() const;  // params == nominal values
   GiNaC::lst constant_substitution() const;  // constants == exact values
+  // The effects in canonical order joined by `separator` ("motor_gain,motor_lag"): the
+  // --effects flag that regenerates this model, and a generated header's kEffects.
+  std::string effect_list(const std::string& separator = ",") const;
 };
 
 }  // namespace quadgen

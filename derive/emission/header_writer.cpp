@@ -132,13 +132,10 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("effects_flag", opt.effects_flag);
   d.set("vehicle", m.vehicle_name);
   d.set("vehicle_hash", m.vehicle_hash);
-  std::string effects;
-  for (const auto& e : m.effects) effects += (effects.empty() ? "" : ", ") + e;
-  d.set("effects", effects.empty() ? "none" : effects);
-  std::string effects_list;
-  for (const auto& e : m.effects) effects_list += (effects_list.empty() ? "" : ",") + e;
+  d.set("effects", m.effects.empty() ? "none" : m.effect_list(", "));
+  const std::string effects_list = m.effect_list();
   d.set("effects_list", effects_list);
-  d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + effects + "|" + QUADGEN_VERSION));
+  d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
   d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));
   d.set("ops_before", std::to_string(std::llround(out.ops_before)));
