@@ -58,6 +58,9 @@ struct Diagnosis {
   std::vector<Finding> findings;
   std::vector<Unexplained> unexplained;
   std::vector<ChannelGain> channel_gain;
+  // Free parameters of the final model that ended on a bound: the model is strained there,
+  // and a finding may stand in for physics the catalogue lacks.
+  std::vector<std::string> at_bounds;
   std::string metric;
   double metric_before = 0, metric_after = 0;
   WindowedSimulation sim_before, sim_after;  // validation part

@@ -123,6 +123,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});
   j["unexplained"] = un;
+  j["parameters_at_bounds"] = d.at_bounds;
   j["gain"] = {{"metric", d.metric},
                {"before", number_or_null(d.metric_before)},
                {"after", number_or_null(d.metric_after)},
@@ -273,6 +274,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
   }
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart); to separate them: " << a.manoeuvre << "\n";
+  for (const auto& b : d.at_bounds)
+    os << "caution: " << b << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
