@@ -128,6 +128,13 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                {"before", number_or_null(d.metric_before)},
                {"after", number_or_null(d.metric_after)},
                {"reduction_percent", reduction(d.metric_before, d.metric_after)}};
+  if (!d.sim_before.t.empty()) {
+    auto sim = [](const WindowedSimulation& w) {
+      return json{{"position_m", number_or_null(w.position_rmse)}, {"velocity_m_s", number_or_null(w.velocity_rmse)},
+                  {"attitude_rad", number_or_null(w.attitude_rmse)}, {"body_rates_rad_s", number_or_null(w.rate_rmse)}};
+    };
+    j["validation_simulation_rmse"] = {{"before", sim(d.sim_before)}, {"after", sim(d.sim_after)}};
+  }
   json cg = json::array();
   for (const auto& c : d.channel_gain)
     cg.push_back({{"channel", c.channel}, {"rms_before", c.before}, {"rms_after", c.after},
@@ -206,6 +213,21 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis
                          series("extended model", d.sim_after.t, ya)}});
     }
     render("validation.svg", d.vehicle + ": measured vs simulated, before and after", panels);
+    // The simulation's error over time, per quantity.
+    const struct {
+      const char* title;
+      const char* unit;
+      std::vector<double> WindowedSimulation::*err;
+    } quantities[] = {{"position error", "m", &WindowedSimulation::e_pos},
+                      {"velocity error", "m/s", &WindowedSimulation::e_vel},
+                      {"attitude error (rotation angle)", "rad", &WindowedSimulation::e_att},
+                      {"body-rate error", "rad/s", &WindowedSimulation::e_rate}};
+    std::vector<runtime::Panel> errs;
+    for (const auto& q : quantities)
+      errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", q.unit,
+                      {series("base model", d.sim_before.t, d.sim_before.*q.err),
+                       series("extended model", d.sim_after.t, d.sim_after.*q.err)}});
+    render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", errs);
   }
   // Residuals over time.
   std::vector<runtime::Panel> res;

@@ -45,7 +45,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   io.step = 1e-3;  // well inside RK4's stability limit for rotor lags down to 0.4 ms
   io.divergence_bound = 1e6;
   WindowedSimulation out;
-  double se = 0;
+  double se = 0, sv = 0, sa = 0, sw = 0;
   size_t count = 0;
   const auto& S = f.samples;
   std::vector<double> u(nu), fx(n);
@@ -68,14 +68,31 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
         lost = true;
         break;
       }
-      double e2 = 0;
-      for (int a = 0; a < 3; ++a) e2 += std::pow(x[a] - S[k + 1].x[a], 2);
+      const auto& m = S[k + 1].x;
+      double e2 = 0, v2 = 0, w2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        e2 += std::pow(x[a] - m[a], 2);
+        v2 += std::pow(x[3 + a] - m[3 + a], 2);
+        w2 += std::pow(x[10 + a] - m[10 + a], 2);
+      }
+      // Attitude error: angle of q_sim^-1 ⊗ q_true(logged, unbiased).
+      double qt[4];
+      runtime::unbias_attitude(&m[6], roll, pitch, qt);
+      const double dot = std::abs(x[6] * qt[0] + x[7] * qt[1] + x[8] * qt[2] + x[9] * qt[3]);
+      const double angle = 2 * std::acos(std::min(1.0, dot));
       se += e2;
+      sv += v2;
+      sa += angle * angle;
+      sw += w2;
       ++count;
       out.t.push_back(S[k + 1].t);
       out.x.push_back(x[0]);
       out.y.push_back(x[1]);
       out.z.push_back(x[2]);
+      out.e_pos.push_back(std::sqrt(e2));
+      out.e_vel.push_back(std::sqrt(v2));
+      out.e_att.push_back(angle);
+      out.e_rate.push_back(std::sqrt(w2));
     }
     if (lost) {  // diverged: count the rest of the window at the last error
       out.position_rmse = std::numeric_limits<double>::infinity();
@@ -83,12 +100,14 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
     out.t.push_back(S[k].t);
-    out.x.push_back(nan);
-    out.y.push_back(nan);
-    out.z.push_back(nan);
+    for (auto* v : {&out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->push_back(nan);
     k0 = std::max(k, k0 + 1);
   }
-  out.position_rmse = count ? std::sqrt(se / static_cast<double>(count)) : 0.0;
+  const double samples = static_cast<double>(std::max<size_t>(count, 1));
+  out.position_rmse = std::sqrt(se / samples);
+  out.velocity_rmse = std::sqrt(sv / samples);
+  out.attitude_rmse = std::sqrt(sa / samples);
+  out.rate_rmse = std::sqrt(sw / samples);
   return out;
 }
 

@@ -13,7 +13,12 @@ namespace quadgen::diagnose {
 
 struct WindowedSimulation {
   double position_rmse = 0;  // m, over every sample of every window
+  double velocity_rmse = 0;  // m/s
+  double attitude_rmse = 0;  // rad, angle of the rotation between simulated and logged attitude
+  double rate_rmse = 0;      // rad/s, body rates against the gyro
   std::vector<double> t, x, y, z;  // simulated positions (NaN between windows) for plots
+  // Error norms at the same times: position, velocity, attitude angle, body rates.
+  std::vector<double> e_pos, e_vel, e_att, e_rate;
 };
 
 // `model` must be the full-catalogue model with `params` (effects off at their neutral values).
