@@ -6,6 +6,8 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
+#include "attitude.hpp"
+
 namespace quadgen::diagnose {
 
 namespace {
@@ -62,11 +64,8 @@ SignalSet physical_signals(const fit::Flight& f, const std::vector<std::string>&
   for (int a = 0; a < 3; ++a)
     add(std::string("body velocity ") + "xyz"[a], [&](size_t k) {
       const auto& x = f.samples[k].x;
-      const double w = x[6], qx = x[7], qy = x[8], qz = x[9];
-      const double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - w * qz), 2 * (qx * qz + w * qy)},
-                              {2 * (qx * qy + w * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - w * qx)},
-                              {2 * (qx * qz - w * qy), 2 * (qy * qz + w * qx), 1 - 2 * (qx * qx + qy * qy)}};
-      return R[0][a] * x[3] + R[1][a] * x[4] + R[2][a] * x[5];
+      const runtime::Rotation R = runtime::rotation_matrix(&x[6]);  // v_body = R^T v_world
+      return R.m[0][a] * x[3] + R.m[1][a] * x[4] + R.m[2][a] * x[5];
     });
   if (f.has_pose) {
     add("position x", [&](size_t k) { return f.samples[k].x[0]; });

@@ -299,10 +299,8 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
     }
     double* rk = r + 6 * row;
     // Body -> world rotation of the (true) attitude.
-    const double w = xk[6], x = xk[7], y = xk[8], z = xk[9];
-    const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-                            {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-                            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+    const runtime::Rotation rotation = runtime::rotation_matrix(xk + 6);
+    const auto& R = rotation.m;
     const double g = p[g_index_];
     for (int i = 0; i < 3; ++i) {
       if (accel_) {  // specific force in body axes at the sample: R^T (a + g e_z)

@@ -12,6 +12,17 @@ inline std::array<double, 3> euler_zyx(double w, double x, double y, double z) {
           std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))};
 }
 
+// Body -> world rotation matrix of a unit quaternion (w, x, y, z).
+struct Rotation {
+  double m[3][3];
+};
+inline Rotation rotation_matrix(const double* q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+           {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+           {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+}
+
 // Hamilton product a ⊗ b, scalar first.
 inline void quaternion_product(const double* a, const double* b, double* q) {
   q[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
