@@ -79,8 +79,7 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v) {
     std::cerr << "no plot: " << err << "\n";
   // Like the thesis' Figure 24: every step normalised to 0..1 and aligned at its fitted
   // step instant; a first-order lag is then one curve, 1 - exp(-t / tau).
-  std::vector<double> pv;
-  for (const auto& q : best.parameters) pv.push_back(q.value);
+  const std::vector<double> pv = parameter_values(best.parameters);
   runtime::Series meas{"Table 2, normalised", {}, {}, true}, fitted{"fitted tau", {}, {}}, thesis{"thesis tau = 0.128 s", {}, {}};
   for (size_t k = 0; k < model.steps().size(); ++k) {
     const auto& s = model.steps()[k];
@@ -119,8 +118,7 @@ std::vector<std::string> split_list(const std::string& s) {
 
 // RMS of each channel of an equation-error model at the given parameters.
 std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps) {
-  std::vector<double> p;
-  for (const auto& q : ps) p.push_back(q.value);
+  const std::vector<double> p = parameter_values(ps);
   std::vector<double> r(m.num_residuals());
   m.evaluate(p.data(), r.data(), nullptr);
   const size_t nc = m.channels().size();
@@ -208,8 +206,7 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
   if (!plot_profiles(a.out + "/profiles.svg", v.name + ": profile likelihood", profiles, &err))
     std::cerr << "no plot: " << err << "\n";
   // Measured and modelled vertical specific force and roll acceleration over the flight.
-  std::vector<double> pv;
-  for (const auto& q : best.parameters) pv.push_back(q.value);
+  const std::vector<double> pv = parameter_values(best.parameters);
   EquationErrorModel all(model, flight, accel);
   std::vector<double> r;
   all.all_channels(pv.data(), r);
@@ -287,8 +284,7 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
   if (!plot_profiles(a.out + "/profiles.svg", v.name + ": thrust stand profiles", all, &err))
     std::cerr << "no plot: " << err << "\n";
   runtime::Series meas{"measured (all motors)", {}, {}, true}, model{"sum k_i w_i^2 + tare", {}, {}, true};
-  std::vector<double> pv;
-  for (const auto& q : tr.parameters) pv.push_back(q.value);
+  const std::vector<double> pv = parameter_values(tr.parameters);
   std::vector<double> r(thrust.num_residuals());
   thrust.evaluate(pv.data(), r.data(), nullptr);
   for (size_t k = 0; k < samples.size(); ++k) {

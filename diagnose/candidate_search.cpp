@@ -59,12 +59,6 @@ double chi2_upper(double x, double dof) {
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
 }
 
-std::vector<double> values(const std::vector<FitParameter>& ps) {
-  std::vector<double> v;
-  for (const auto& p : ps) v.push_back(p.value);
-  return v;
-}
-
 }  // namespace
 
 std::vector<std::string> applicable_effects(const fit::Flight& f) {
@@ -147,7 +141,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
 }
 
 double CandidateSearch::cost(const fit::ResidualModel& m, const std::vector<FitParameter>& ps) const {
-  const auto p = values(ps);
+  const auto p = fit::parameter_values(ps);
   std::vector<double> r(m.num_residuals());
   m.evaluate(p.data(), r.data(), nullptr);
   double c = 0;
@@ -163,7 +157,7 @@ struct ChannelNoise {
   double n_eff = 0;
 };
 ChannelNoise channel_noise(const fit::ResidualModel& m, const std::vector<FitParameter>& ps) {
-  const auto p = values(ps);
+  const auto p = fit::parameter_values(ps);
   std::vector<double> r(m.num_residuals());
   m.evaluate(p.data(), r.data(), nullptr);
   const size_t nc = m.channels().size();
@@ -352,7 +346,7 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   // Standard errors from the Gauss-Newton approximation J^T W J.
   train_.set_free(free);
   const int np = static_cast<int>(r.final_fit.size()), nr = train_.num_residuals();
-  std::vector<double> p = values(r.final_fit), res(nr), J(static_cast<size_t>(nr) * np);
+  std::vector<double> p = fit::parameter_values(r.final_fit), res(nr), J(static_cast<size_t>(nr) * np);
   train_.evaluate(p.data(), res.data(), J.data());
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
   for (int i = 0; i < nr; ++i) {

@@ -9,14 +9,8 @@ namespace quadgen::diagnose {
 
 namespace {
 
-std::vector<double> values(const std::vector<fit::FitParameter>& ps) {
-  std::vector<double> v;
-  for (const auto& p : ps) v.push_back(p.value);
-  return v;
-}
-
 std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  const auto p = values(ps);
+  const auto p = fit::parameter_values(ps);
   std::vector<double> r6;
   m.all_channels(p.data(), r6);
   std::vector<double> rms(6, 0.0);
@@ -73,7 +67,7 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   used.samples.clear();
   for (size_t k : all_ee.rows()) used.samples.push_back(flight.samples[k]);
   for (const auto& smp : used.samples) d.t.push_back(smp.t);
-  const auto pb = values(s.base_fit), pa = values(s.final_fit);
+  const auto pb = fit::parameter_values(s.base_fit), pa = fit::parameter_values(s.final_fit);
   all_ee.all_channels(pb.data(), d.residual_before);
   all_ee.all_channels(pa.data(), d.residual_after);
   std::vector<std::string> rotors;
@@ -88,7 +82,7 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
                   : "validation equation-error cost (weighted, no pose logged)";
   auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
     if (!pose) return search.cost(valid_ee, ps);
-    WindowedSimulation w = simulate_windows(model, values(ps), valid, opt.window);
+    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window);
     if (sim) *sim = w;
     return w.position_rmse;
   };
@@ -118,7 +112,7 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   // explains the discrepancy; only the name is open).
   ResidualAnalysis left = d.after;
   if (!s.unresolved.empty()) {
-    const auto pu = values(s.steps.back().candidates.front().parameters);
+    const auto pu = fit::parameter_values(s.steps.back().candidates.front().parameters);
     std::vector<double> r;
     all_ee.all_channels(pu.data(), r);
     left = analyse_residuals(r, d.channel_names, d.channel_units, d.t, signals);

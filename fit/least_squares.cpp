@@ -42,18 +42,13 @@ class WeightedCost : public ceres::CostFunction {
   std::vector<double> w_;
 };
 
-std::vector<double> values(const std::vector<FitParameter>& ps) {
-  std::vector<double> v;
-  for (const auto& p : ps) v.push_back(p.value);
-  return v;
-}
 
 }  // namespace
 
 double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
-  std::vector<double> x = values(params);
+  std::vector<double> x = parameter_values(params);
   std::vector<bool> free_mask;
   for (const auto& p : params) free_mask.push_back(p.free);
   model.set_free(free_mask);
@@ -115,7 +110,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   // Noise per channel from the residuals: first at the starting point (so that no channel's
   // units dominate the first solve), then at the estimate, re-solving in between.
   auto estimate_noise = [&]() {
-    model.evaluate(values(params).data(), r.data(), nullptr);
+    model.evaluate(parameter_values(params).data(), r.data(), nullptr);
     std::vector<std::vector<double>> per(nc);
     for (int i = 0; i < nr; ++i) per[model.channel_of(i)].push_back(r[i]);
     for (int c = 0; c < nc; ++c) {
@@ -158,7 +153,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   std::vector<int> free_idx;
   for (int i = 0; i < n; ++i)
     if (params[i].free) free_idx.push_back(i);
-  std::vector<double> x = values(params);
+  std::vector<double> x = parameter_values(params);
   {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -202,6 +197,12 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   }
   res.parameters = params;
   return res;
+}
+
+std::vector<double> parameter_values(const std::vector<FitParameter>& ps) {
+  std::vector<double> v;
+  for (const auto& p : ps) v.push_back(p.value);
+  return v;
 }
 
 }  // namespace quadgen::fit

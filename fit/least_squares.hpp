@@ -65,6 +65,9 @@ struct FitResult {
   std::string solver_report;
 };
 
+// The parameters' current values, in order (what ResidualModel::evaluate takes).
+std::vector<double> parameter_values(const std::vector<FitParameter>& ps);
+
 // Two passes: fit, estimate sigma and autocorrelation per channel, refit with weights.
 FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt);
 
