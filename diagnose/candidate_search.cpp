@@ -176,9 +176,9 @@ ChannelNoise channel_noise(const fit::ResidualModel& m, const std::vector<FitPar
 }
 // Likelihood-ratio statistic of the larger model against the smaller, with the larger
 // model's noise level and correlation time.
-double lr_statistic(const ChannelNoise& small, const ChannelNoise& large) {
+double lr_statistic(const std::vector<double>& small_ss, const ChannelNoise& large) {
   double s = 0;
-  for (size_t c = 0; c < small.ss.size(); ++c) s += (small.ss[c] - large.ss[c]) / large.var_tau[c];
+  for (size_t c = 0; c < small_ss.size(); ++c) s += (small_ss[c] - large.ss[c]) / large.var_tau[c];
   return std::max(0.0, s);
 }
 }  // namespace
@@ -191,7 +191,8 @@ std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>&
 }
 
 CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std::set<std::string>& base,
-                                            const std::vector<FitParameter>& base_fit, double base_valid_cost) const {
+                                            const std::vector<FitParameter>& base_fit, const std::vector<double>& base_ss,
+                                            double base_valid_cost) const {
   CandidateEvidence ev;
   ev.effect = effect;
   std::set<std::string> with = base;
@@ -212,8 +213,8 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
     if (c2 < c) ev.parameters = ps2, c = c2;
   }
   ev.cost = c;
-  const ChannelNoise small = channel_noise(train_, base_fit), large = channel_noise(train_, ev.parameters);
-  ev.statistic = lr_statistic(small, large);
+  const ChannelNoise large = channel_noise(train_, ev.parameters);
+  ev.statistic = lr_statistic(base_ss, large);
   for (int i : effect_params_.at(effect)) ev.dof += ev.parameters[i].free ? 1 : 0;
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
   ev.boundary = ev.dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
@@ -262,8 +263,8 @@ std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& s
     am.b = b.effect;
     am.statistic_a = a.statistic;
     am.statistic_b = b.statistic;
-    am.b_given_a_p = chi2_upper(lr_statistic(na, nab), b.dof);
-    am.a_given_b_p = chi2_upper(lr_statistic(nb, nab), a.dof);
+    am.b_given_a_p = chi2_upper(lr_statistic(na.ss, nab), b.dof);
+    am.a_given_b_p = chi2_upper(lr_statistic(nb.ss, nab), a.dof);
     am.manoeuvre = separating_manoeuvre(a.effect, b.effect);
     if (am.a_given_b_p >= a.level && am.b_given_a_p >= a.level) out.push_back(am);
   }
@@ -286,6 +287,7 @@ SearchResult CandidateSearch::run() {
     SelectionStep step;
     step.base_effects.assign(base.begin(), base.end());
     const double base_valid = cost(valid_, current);
+    const std::vector<double> base_ss = channel_noise(train_, current).ss;
     int k = 0;
     for (const auto& e : candidates_) {
       ++k;
@@ -293,7 +295,7 @@ SearchResult CandidateSearch::run() {
       if (opt_.verbose_progress && isatty(2))
         std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
                   << e << "                    " << std::flush;
-      step.candidates.push_back(evaluate(e, base, current, base_valid));
+      step.candidates.push_back(evaluate(e, base, current, base_ss, base_valid));
     }
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()

@@ -118,8 +118,11 @@ class CandidateSearch {
   std::map<std::string, std::vector<int>> effect_params_;  // indices into the parameter vector
 
   std::vector<fit::FitParameter> initial_parameters() const;
+  // base_ss: the step's base model's residual sum of squares per channel (computed once
+  // per step, not once per candidate).
   CandidateEvidence evaluate(const std::string& effect, const std::set<std::string>& base,
-                             const std::vector<fit::FitParameter>& base_fit, double base_valid_cost) const;
+                             const std::vector<fit::FitParameter>& base_fit, const std::vector<double>& base_ss,
+                             double base_valid_cost) const;
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   void estimate_intervals(SearchResult& r) const;
 };
