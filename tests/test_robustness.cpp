@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <string>
 #include <fstream>
 
 #include "test_helpers.hpp"
@@ -17,7 +18,9 @@ struct CliResult {
   std::string err;
 };
 CliResult quadgen_cli(const std::string& args, const std::string& env = "") {
-  const fs::path err = fs::temp_directory_path() / "quadgen_robust_err.txt";
+  // One file per test: ctest runs the tests of this binary as parallel processes.
+  const fs::path err = fs::temp_directory_path() /
+                       ("quadgen_robust_err_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
   const std::string cmd = env + " " + std::string(QUADGEN_BINARY) + " " + args + " > /dev/null 2> " + err.string();
   CliResult r{std::system(cmd.c_str()), ""};
   std::ifstream in(err);
