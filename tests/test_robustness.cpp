@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <string>
 #include <fstream>
+#include <string>
 
 #include "test_helpers.hpp"
 
