@@ -94,8 +94,9 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       out.e_att.push_back(angle);
       out.e_rate.push_back(std::sqrt(w2));
     }
-    if (lost) {  // diverged: count the rest of the window at the last error
-      out.position_rmse = std::numeric_limits<double>::infinity();
+    if (lost) {  // diverged: no error measure is meaningful (diagnosis.json shows null)
+      const double inf = std::numeric_limits<double>::infinity();
+      out.position_rmse = out.velocity_rmse = out.attitude_rmse = out.rate_rmse = inf;
       return out;
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
