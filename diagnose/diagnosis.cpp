@@ -125,9 +125,10 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
     d.unexplained.push_back(u);
   }
   for (const auto& p : s.final_fit)
-    if (p.free && (p.value <= p.lower + 1e-9 * std::max(1.0, std::abs(p.lower)) ||
-                   p.value >= p.upper - 1e-9 * std::max(1.0, std::abs(p.upper))))
-      d.at_bounds.push_back(p.name + " = " + std::to_string(p.value) + (p.value <= p.lower ? " (lower bound)" : " (upper bound)"));
+    if (p.free && fit::on_bound(p)) {
+      const bool lower = std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper);
+      d.at_bounds.push_back(p.name + " = " + std::to_string(p.value) + (lower ? " (lower bound)" : " (upper bound)"));
+    }
   d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return d;
 }

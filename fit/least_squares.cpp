@@ -191,12 +191,15 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
     }
   }
   for (int i : free_idx) {
-    const auto& p = params[i];
-    const double tol = 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
-    if (std::fabs(p.value - p.lower) < tol || std::fabs(p.value - p.upper) < tol) res.at_bound.push_back(p.name);
+    if (on_bound(params[i])) res.at_bound.push_back(params[i].name);
   }
   res.parameters = params;
   return res;
+}
+
+bool on_bound(const FitParameter& p) {
+  const double tol = 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
+  return std::fabs(p.value - p.lower) < tol || std::fabs(p.value - p.upper) < tol;
 }
 
 std::vector<double> parameter_values(const std::vector<FitParameter>& ps) {

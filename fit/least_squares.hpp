@@ -68,6 +68,9 @@ struct FitResult {
 // The parameters' current values, in order (what ResidualModel::evaluate takes).
 std::vector<double> parameter_values(const std::vector<FitParameter>& ps);
 
+// Whether p's value sits on its lower or upper bound (to 1e-9 of the bounds' span).
+bool on_bound(const FitParameter& p);
+
 // Two passes: fit, estimate sigma and autocorrelation per channel, refit with weights.
 FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt);
 

@@ -272,3 +272,18 @@ TEST(FitData, ResampleInterpolatesOntoAUniformGrid) {
   EXPECT_NEAR(r.rows[4][2], 6.0, 1e-12);
   EXPECT_NEAR(r.rows[2][2], 5.0, 1e-12);
 }
+
+// A bound is hit when the value is within 1e-9 of the bounds' span of it, on either side.
+TEST(Fit, OnBoundSeesBothBoundsAndNothingInside) {
+  FitParameter p;
+  p.lower = 0.1;
+  p.upper = 2.0;
+  p.value = 0.1;
+  EXPECT_TRUE(on_bound(p));
+  p.value = 2.0 - 1e-12;
+  EXPECT_TRUE(on_bound(p));
+  p.value = 0.1 + 1e-6;
+  EXPECT_FALSE(on_bound(p));
+  p.value = 1.0;
+  EXPECT_FALSE(on_bound(p));
+}
