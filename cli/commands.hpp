@@ -1,5 +1,6 @@
 // Subcommands of the quadgen executable (contracts.md §4).
 #pragma once
+#include <set>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -28,6 +29,7 @@ struct SimulateArgs {
   std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters
   double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
   double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0;
+  bool no_size_limit = false;
 };
 
 void add_simulate(CLI::App& app, SimulateArgs& args);
@@ -40,6 +42,7 @@ struct FitArgs {
   std::string formulation = "equation_error";
   double window = 0.5;
   double resample = 0;
+  std::set<std::string> given;  // options on the command line (each fit kind refuses those it does not use)
 };
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);

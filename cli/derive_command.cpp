@@ -2,13 +2,13 @@
 #include <chrono>
 #include <iostream>
 
-#include "atomic_output.hpp"
 #include "audit.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
 #include "geometry.hpp"
 #include "header_writer.hpp"
+#include "output_set.hpp"
 #include "report.hpp"
 #include "thesis_reference.hpp"
 #include "vehicle.hpp"
@@ -25,6 +25,7 @@ void add_derive(CLI::App& app, DeriveArgs& args) {
 int run_derive(const DeriveArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Vehicle vehicle = load_vehicle(args.vehicle);
+  output::OutputDirectory out(args.out, {args.vehicle});  // refused before the work, not after
   DeriveOptions opt;
   opt.effects = parse_effect_list(args.effects);
   std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
@@ -42,7 +43,6 @@ int run_derive(const DeriveArgs& args) {
   const emission::GeneratedHeader header = emission::generate_header(model, eo);
   std::cerr << "[5/5] writing " << args.out << "\n";
   const Derivation d{vehicle, mp, model, result, thesis};
-  OutputSet out(args.out);
   out.add("model.json", model_json(d));
   out.add("derivation.md", derivation_markdown(d));
   out.add("model.hpp", header.content);

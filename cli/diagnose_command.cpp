@@ -4,7 +4,6 @@
 #include <iostream>
 #include <sstream>
 
-#include "atomic_output.hpp"
 #include "audit.hpp"
 #include "commands.hpp"
 #include "diagnosis.hpp"
@@ -13,6 +12,10 @@
 #include "effects.hpp"
 #include "geometry.hpp"
 #include "header_writer.hpp"
+#include "json_document.hpp"
+#include "options.hpp"
+#include "output_set.hpp"
+#include "sinks.hpp"
 #include "model_registry.hpp"
 #include "report.hpp"
 #include "vehicle.hpp"
@@ -26,14 +29,14 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(CLI::PositiveNumber);
-  c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out")->check(CLI::Range(0.1, 0.6));
-  c->add_option("--alpha", a.alpha, "family-wise significance level of each selection step")->check(CLI::Range(1e-9, 0.2));
+      ->check(finite_range(0.1, 1e5));
+  c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out")->check(finite_range(0.1, 0.6));
+  c->add_option("--alpha", a.alpha, "family-wise significance level of each selection step")->check(finite_range(1e-9, 0.2));
   c->add_option("--max-effects", a.max_effects, "stop after this many effects")->check(CLI::Range(1, 10));
   c->add_option("--candidates", a.candidates, "comma-separated effects to consider (default: all the log supports)");
   c->add_option("--translational", a.translational, "translational channels: auto, pose or accelerometer")
       ->check(CLI::IsMember({"auto", "pose", "accelerometer"}));
-  c->add_option("--window", a.window, "validation simulation window [s]")->check(CLI::Range(0.1, 10.0));
+  c->add_option("--window", a.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
 }
 
 namespace {
@@ -41,7 +44,7 @@ namespace {
 std::string fitted_parameters_yaml(const Vehicle& v, const diagnose::Diagnosis& d) {
   std::ostringstream y;
   y.precision(10);
-  y << "# Parameters of " << v.name << " fitted by quadgen diagnose; effects: ";
+  y << "# Parameters of " << output::printable(v.name) << " fitted by quadgen diagnose; effects: ";
   for (const auto& e : d.search.selected) y << e << " ";
   y << "\neffects: [";
   for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
@@ -64,7 +67,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   diagnose::DiagnoseOptions o;
   if (!a.candidates.empty()) o.search.candidates = parse_effect_list(a.candidates);
   // Fail before the long work if the results could not be written.
-  OutputSet out(a.out);
+  output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});
   std::cerr << "[diagnose] " << flight.samples.size() << " airborne samples; deriving the full-catalogue model\n";
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
@@ -95,7 +98,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::string err;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err);
   if (plots.empty()) std::cerr << "no plots: " << err << "\n";
-  out.add("diagnosis.json", diagnose::diagnosis_json(d, a.log).dump(2) + "\n");
+  out.add("diagnosis.json", output::json_document(diagnose::diagnosis_json(d, a.log)));
   out.add("report.html", diagnose::diagnosis_html(d, a.log, plots));
   out.add("extended_model.hpp", header.content);
   out.add("extended_model.json", model_json(der));

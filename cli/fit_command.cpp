@@ -6,15 +6,19 @@
 #include <chrono>
 #include <memory>
 #include <iostream>
+#include <set>
 #include <sstream>
 
-#include "atomic_output.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
 #include "equation_error.hpp"
 #include "flight_data.hpp"
 #include "geometry.hpp"
+#include "json_document.hpp"
+#include "options.hpp"
+#include "output_set.hpp"
+#include "sinks.hpp"
 #include "model_registry.hpp"
 #include "fit_report.hpp"
 #include "flight_log.hpp"
@@ -37,19 +41,33 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
   c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out for validation")
-      ->check(CLI::Range(0.0, 0.9));
+      ->check(finite_range(0.0, 0.9));
   c->add_option("--formulation", a.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
       ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
-  c->add_option("--window", a.window, "multiple shooting: window length [s]")->check(CLI::PositiveNumber);
+  c->add_option("--window", a.window, "multiple shooting: window length [s]")->check(finite_range(0.01, 100));
   c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_range(0.1, 1e5));
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
 }
 
 namespace {
 
-int fit_motor_steps(const FitArgs& a, const Vehicle& v) {
+// A plot joins the output set when gnuplot can draw it; without one the fit still counts.
+void add_plot(output::OutputDirectory& out, const std::string& file, const std::string& title,
+              const std::vector<runtime::Panel>& panels) {
+  std::string svg, err;
+  if (runtime::render_svg(title, panels, &svg, &err)) out.add(file, svg);
+  else std::cerr << "no plot " << file << ": " << err << "\n";
+}
+
+void add_profile_plot(output::OutputDirectory& out, const std::string& title, const std::vector<Profile>& profiles) {
+  std::string svg, err;
+  if (plot_profiles(title, profiles, &svg, &err)) out.add("profiles.svg", svg);
+  else std::cerr << "no plot profiles.svg: " << err << "\n";
+}
+
+int fit_motor_steps(const FitArgs& a, const Vehicle& v, output::OutputDirectory& out) {
   MotorStepModel model(read_motor_steps(a.log));
   FitOptions fo;
   fo.robust = a.robust;
@@ -71,12 +89,8 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v) {
                      {"tau_ci95", {tau && !tau->lower_open ? nlohmann::ordered_json(tau->lower) : nullptr,
                                    tau && !tau->upper_open ? nlohmann::ordered_json(tau->upper) : nullptr}},
                      {"tau_verdict", tau ? tau->verdict : ""}};
-  OutputSet out(a.out);
-  out.add("fit.json", j.dump(2) + "\n");
-  out.commit();
-  std::string err;
-  if (!plot_profiles(a.out + "/profiles.svg", v.name + ": motor step profiles", profiles, &err))
-    std::cerr << "no plot: " << err << "\n";
+  out.add("fit.json", output::json_document(j));
+  add_profile_plot(out, v.name + ": motor step profiles", profiles);
   // Like the thesis' Figure 24: every step normalised to 0..1 and aligned at its fitted
   // step instant; a first-order lag is then one curve, 1 - exp(-t / tau).
   const std::vector<double> pv = parameter_values(best.parameters);
@@ -98,9 +112,9 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v) {
     thesis.x.push_back(t);
     thesis.y.push_back(1 - std::exp(-t / 0.128));
   }
-  if (!runtime::plot_svg(a.out + "/fit.svg", v.name + ": motor steps (thesis Table 2)",
-                         {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", {meas, fitted, thesis}}}, &err))
-    std::cerr << "no plot: " << err << "\n";
+  add_plot(out, "fit.svg", v.name + ": motor steps (thesis Table 2)",
+           {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", {meas, fitted, thesis}}});
+  out.commit();
   std::cout << "tau = " << best.parameters[3].value << " s";
   if (tau) std::cout << ", 95 % profile interval [" << tau->lower << ", " << tau->upper << "] (" << tau->verdict << ")";
   std::cout << "; thesis: 0.128 s\n";
@@ -132,7 +146,7 @@ std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitPar
   return ss;
 }
 
-int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw) {
+int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw, output::OutputDirectory& out) {
   runtime::CsvTable log = a.mapping.empty() ? raw : apply_mapping(raw, load_mapping(a.mapping));
   if (a.resample > 0) log = resample(log, a.resample);
   std::vector<std::string> rotors;
@@ -199,12 +213,8 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
   j["validation"] = {{"fraction", a.validation}, {"samples", valid.samples.size()}, {"channels", val}};
   j["fitted_channels"] = train_m.channels();
   j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
-  OutputSet out(a.out);
-  out.add("fit.json", j.dump(2) + "\n");
-  out.commit();
-  std::string err;
-  if (!plot_profiles(a.out + "/profiles.svg", v.name + ": profile likelihood", profiles, &err))
-    std::cerr << "no plot: " << err << "\n";
+  out.add("fit.json", output::json_document(j));
+  add_profile_plot(out, v.name + ": profile likelihood", profiles);
   // Measured and modelled vertical specific force and roll acceleration over the flight.
   const std::vector<double> pv = parameter_values(best.parameters);
   EquationErrorModel all(model, flight, accel);
@@ -226,12 +236,10 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw)
     pf.y.push_back(s.rate_dot[0] + r[6 * k + 3]);
   }
   const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
-  if (!runtime::plot_svg(a.out + "/fit.svg",
-                         v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
-                         {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
-                          {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}},
-                         &err))
-    std::cerr << "no plot: " << err << "\n";
+  add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
+           {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
+            {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}});
+  out.commit();
   for (const auto& pr : profiles)
     std::cout << pr.parameter << " = " << best.parameters[pr.index].value << " [" << pr.lower << ", " << pr.upper
               << "] " << pr.verdict << "\n";
@@ -246,7 +254,7 @@ nlohmann::ordered_json published_crazyflie() {
           {"torque_to_thrust_m", {{"0.005964552", "Förster 2015 (ETH Zürich), as used in Crazyflie firmware ports"}}}};
 }
 
-int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
+int fit_thrust_stand(const FitArgs& a, const Vehicle& v, output::OutputDirectory& out) {
   const auto samples = read_thrust_stand(a.log);
   FitOptions fo;
   fo.robust = a.robust;
@@ -275,14 +283,10 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
                   {"battery_sag_exponent_implied", 2 * sr.parameters[3].value},
                   {"vbat_ref_V", vref}};
   j["published"] = published_crazyflie();
-  OutputSet out(a.out);
-  out.add("fit.json", j.dump(2) + "\n");
-  out.commit();
+  out.add("fit.json", output::json_document(j));
   std::vector<Profile> all = tp;
   all.insert(all.end(), sp.begin(), sp.end());
-  std::string err;
-  if (!plot_profiles(a.out + "/profiles.svg", v.name + ": thrust stand profiles", all, &err))
-    std::cerr << "no plot: " << err << "\n";
+  add_profile_plot(out, v.name + ": thrust stand profiles", all);
   runtime::Series meas{"measured (all motors)", {}, {}, true}, model{"sum k_i w_i^2 + tare", {}, {}, true};
   const std::vector<double> pv = parameter_values(tr.parameters);
   std::vector<double> r(thrust.num_residuals());
@@ -294,12 +298,31 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
     model.x.push_back(wm);
     model.y.push_back(samples[k].thrust + r[k]);
   }
-  if (!runtime::plot_svg(a.out + "/fit.svg", v.name + ": thrust stand", {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}}, &err))
-    std::cerr << "no plot: " << err << "\n";
+  add_plot(out, "fit.svg", v.name + ": thrust stand", {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}});
+  out.commit();
   std::cout << "k per motor:";
   for (int i = 0; i < 4; ++i) std::cout << " " << tr.parameters[i].value << " (" << tp[i].verdict << ")";
   std::cout << "; mean " << k_mean << " N s^2 -> c_t = " << ct << "; speed ~ vbat^" << sr.parameters[3].value << "\n";
   return 0;
+}
+
+// The kind of fit follows the log's columns; an option that kind does not use is an error,
+// never silently dropped.
+void refuse_options(const FitArgs& a, const std::string& kind, const std::set<std::string>& used) {
+  for (const auto& opt : a.given)
+    if (!used.count(opt)) {
+      std::string list;
+      for (const auto& u : used) list += (list.empty() ? "" : ", ") + u;
+      throw std::invalid_argument(opt + ": not used when fitting " + kind +
+                                  " (the log's columns choose the kind of fit); this kind takes " + list);
+    }
+}
+
+void check_flight_options(const FitArgs& a) {
+  const bool shooting = a.formulation == "multiple_shooting";
+  if (a.given.count("--window") && !shooting) throw std::invalid_argument("--window: only with --formulation multiple_shooting");
+  if (a.given.count("--channels") && shooting)
+    throw std::invalid_argument("--channels: only with --formulation equation_error (multiple shooting fits the pose)");
 }
 
 }  // namespace
@@ -307,9 +330,17 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v) {
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   const runtime::CsvTable head = runtime::read_csv(a.log);
-  if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return fit_motor_steps(a, v);
-  if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) return fit_thrust_stand(a, v);
-  return fit_flight(a, v, head);
+  output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});  // refused before the work, not after
+  if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) {
+    refuse_options(a, "a motor-step log", {"--out", "--robust"});
+    return fit_motor_steps(a, v, out);
+  }
+  if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) {
+    refuse_options(a, "a thrust-stand log", {"--out", "--robust"});
+    return fit_thrust_stand(a, v, out);
+  }
+  check_flight_options(a);
+  return fit_flight(a, v, head, out);
 }
 
 }  // namespace quadgen::cli

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "sinks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"quadgen-derive: derive, audit and emit a flight model (bootstrap for generated/)"};
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
   try {
     return quadgen::cli::run_derive(derive);
   } catch (const std::exception& e) {
-    std::cerr << "quadgen: error: " << e.what() << "\n";
+    std::cerr << "quadgen: error: " << quadgen::output::printable(e.what()) << "\n";
     return 2;
   }
 }

@@ -1,7 +1,10 @@
 // quadgen: vehicle file -> symbolic model -> generated code -> runtime -> fit -> diagnosis.
 #include <iostream>
+#include <new>
 
 #include "commands.hpp"
+#include "options.hpp"
+#include "sinks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
@@ -19,13 +22,18 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  fit.given = quadgen::cli::given_options(app.get_subcommand("fit"));
   try {
     if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
     if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
     if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
     if (app.got_subcommand("diagnose")) return quadgen::cli::run_diagnose(diagnose);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "quadgen: error: out of memory: the input or the requested work is too large for this machine\n";
+    return 2;
   } catch (const std::exception& e) {
-    std::cerr << "quadgen: error: " << e.what() << "\n";
+    // One line, whatever the message quotes from a hostile input (newlines, escape sequences).
+    std::cerr << "quadgen: error: " << quadgen::output::printable(e.what()) << "\n";
     return 2;
   }
   return 1;

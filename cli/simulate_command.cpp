@@ -3,11 +3,13 @@
 #include <filesystem>
 #include <iostream>
 
-#include "atomic_output.hpp"
 #include "closed_loop.hpp"
 #include "runtime_bridge.hpp"
 #include "attitude.hpp"
 #include "commands.hpp"
+#include "options.hpp"
+#include "output_set.hpp"
+#include "sinks.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
 #include "flight_log.hpp"
@@ -30,40 +32,82 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
                          "fly a smooth random trajectory under a cascaded controller (test flights)");
   sc->excludes(in);
   cl->excludes(sc)->excludes(in);
-  c->add_option("--seed", a.seed, "closed loop: random trajectory and noise seed");
-  c->add_option("--set", a.set, "closed loop: NAME=VALUE for a parameter of the true model (repeatable)");
-  c->add_option("--pose-noise", a.pose_noise, "closed loop: mocap noise [m, rad]");
-  c->add_option("--gyro-noise", a.gyro_noise, "closed loop: gyro noise [rad/s]");
-  c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]");
-  c->add_option("--accel-noise", a.accel_noise, "closed loop: accelerometer noise [m/s^2]");
-  c->add_option("--accel-bias", a.accel_bias, "closed loop: accelerometer bias [m/s^2]");
+  // Options of one mode are refused in the others (needs/excludes), never silently ignored.
+  c->add_option("--seed", a.seed, "closed loop: random trajectory and noise seed")->needs(cl);
+  c->add_option("--set", a.set, "closed loop: NAME=VALUE for a parameter of the true model (repeatable)")->needs(cl);
+  c->add_option("--pose-noise", a.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
+  c->add_option("--gyro-noise", a.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
+  c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
+  c->add_option("--accel-noise", a.accel_noise, "closed loop: accelerometer noise [m/s^2]")
+      ->check(finite_range(0, 100))->needs(cl);
+  c->add_option("--accel-bias", a.accel_bias, "closed loop: accelerometer bias [m/s^2]")
+      ->check(finite_range(-100, 100))->needs(cl);
   c->add_option("--amplitude", a.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
-      ->check(CLI::Range(0.0, 20.0));
-  c->add_option("--height", a.height, "closed loop: mean height [m]")->check(CLI::Range(0.05, 100.0));
-  c->add_option("--height-amplitude", a.height_amplitude, "closed loop: height excursions [m]")->check(CLI::Range(0.0, 10.0));
-  c->add_option("--yaw-amplitude", a.yaw_amplitude, "closed loop: heading excursions [rad]")->check(CLI::Range(0.0, 10.0));
+      ->check(finite_range(0.0, 20.0))->needs(cl);
+  c->add_option("--height", a.height, "closed loop: mean height [m]")->check(finite_range(0.05, 100.0))->needs(cl);
+  c->add_option("--height-amplitude", a.height_amplitude, "closed loop: height excursions [m]")
+      ->check(finite_range(0.0, 10.0))->needs(cl);
+  c->add_option("--yaw-amplitude", a.yaw_amplitude, "closed loop: heading excursions [rad]")
+      ->check(finite_range(0.0, 10.0))->needs(cl);
   c->add_option("--excitation", a.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
-      ->check(CLI::Range(0.0, 5.0));
+      ->check(finite_range(0.0, 5.0))->needs(cl);
   c->add_option("--tether", a.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
-      ->check(CLI::Range(0.0, 100.0));
-  c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
+      ->check(finite_range(0.0, 100.0))->needs(cl);
+  c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(finite_range(1e-6, 1e9));
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
   c->add_option("--integrator", a.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
-      ->check(CLI::IsMember({"rk4", "dopri5"}));
-  c->add_option("--step", a.step, "RK4 step [s]")->check(CLI::PositiveNumber);
-  c->add_option("--rate", a.rate, "output rate [Hz]")->check(CLI::PositiveNumber);
+      ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);
+  c->add_option("--step", a.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
+  c->add_option("--rate", a.rate, "output rate [Hz]")->check(finite_range(1e-3, 1e6))->excludes(cl);
   c->add_option("--interpolation", a.interpolation, "inputs between samples: hold or linear")
-      ->check(CLI::IsMember({"hold", "linear"}));
+      ->check(CLI::IsMember({"hold", "linear"}))->needs(in);
+  c->add_flag("--no-size-limit", a.no_size_limit,
+              "run even when the estimated work exceeds the limits (1e7 integration steps or output rows)");
 }
 
 namespace {
 
-// The output set for one file named on the command line (its folder, or the current one).
-OutputSet output_for(const std::string& file) {
-  const std::filesystem::path dir = std::filesystem::path(file).parent_path();
-  return OutputSet(dir.empty() ? "." : dir.string());
+// The trajectory and its plot beside it (TRAJ.csv, TRAJ.svg): neither may be an input, and
+// they may not be one file.
+std::string plot_path(const std::string& out) { return std::filesystem::path(out).replace_extension(".svg").string(); }
+
+output::OutputFiles output_for(const SimulateArgs& a) {
+  if (std::filesystem::path(a.out).extension() == ".svg")
+    throw std::invalid_argument("--out " + output::printable(a.out) + ": the plot goes to the .svg beside the trajectory; name the trajectory .csv");
+  return output::OutputFiles({a.out, plot_path(a.out)}, {a.vehicle, a.inputs});
+}
+
+// The plot as the output set's second file, when gnuplot can draw it.
+void set_plot(output::OutputFiles& out, const std::string& title, const std::vector<Panel>& panels) {
+  std::string svg, err;
+  if (render_svg(title, panels, &svg, &err)) out.set(1, svg);
+  else std::cerr << "no plot: " << err << "\n";
+}
+
+// Work beyond these sizes is refused before it starts unless --no-size-limit is given: each
+// stored sample costs ~0.2 kB, so 1e7 of them is about 2 GB.
+constexpr double kMaxSteps = 1e7, kMaxRows = 1e7;
+
+void check_size(const SimulateArgs& a, double steps, double rows) {
+  if (a.no_size_limit) return;
+  std::ostringstream os;
+  if (steps > kMaxSteps) os << "about " << steps << " integration steps (limit " << kMaxSteps << ")";
+  else if (rows > kMaxRows) os << "about " << rows << " output rows (limit " << kMaxRows << ")";
+  else return;
+  throw std::invalid_argument("--duration " + std::to_string(a.duration) + ": " + os.str() +
+                              "; shorten it, raise --step or lower --rate, or pass --no-size-limit");
+}
+
+// NAME=VALUE of --set; the value a finite number.
+std::pair<std::string, double> parse_setting(const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("--set expects NAME=VALUE, got '" + output::printable(kv) + "'");
+  double value = 0;
+  if (!parse_finite(kv.substr(eq + 1), &value))
+    throw std::invalid_argument("--set " + output::printable(kv) + ": '" + output::printable(kv.substr(eq + 1)) + "' is not a finite number");
+  return {kv.substr(0, eq), value};
 }
 
 // Fills the inputs that effects add (t, vbat) after the rotor commands.
@@ -78,14 +122,14 @@ void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) 
 
 // A closed-loop test flight: the true model (effects and --set values) flown by a
 // controller that believes the nominal base model.
-int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const SymbolicModel& model, DynamicModel& truth) {
+int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const SymbolicModel& model, DynamicModel& truth,
+                    output::OutputFiles& out) {
   std::vector<double> p = truth.params();
   for (const std::string& kv : a.set) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw std::invalid_argument("--set expects NAME=VALUE, got '" + kv + "'");
-    const int i = truth.param_index(kv.substr(0, eq));
-    if (i < 0) throw std::invalid_argument("--set: no parameter '" + kv.substr(0, eq) + "' in the model (add its effect with --effects)");
-    p[i] = std::stod(kv.substr(eq + 1));
+    const auto [name, value] = parse_setting(kv);
+    const int i = truth.param_index(name);
+    if (i < 0) throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model (add its effect with --effects)");
+    p[i] = value;
   }
   truth.set_params(p);
   const ControllerModel belief = nominal_controller_belief(vehicle, model);
@@ -107,9 +151,7 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   o.tether_stiffness = a.tether;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
-  OutputSet out = output_for(a.out);
-  out.add(std::filesystem::path(a.out).filename().string(), flight.csv());
-  out.commit();
+  out.set(0, flight.csv());
   // Plot: position against reference, commands.
   auto col = [&](const std::string& n) {
     std::vector<double> v;
@@ -122,9 +164,8 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   for (const char* n : {"x", "y", "z", "x_ref", "y_ref", "z_ref"}) pos.series.push_back({n, t, col(n)});
   Panel cmd{"motor commands", "t [s]", "1", {}};
   for (const auto& r : rotors) cmd.series.push_back({"u_" + r, t, col("u_" + r)});
-  std::string err;
-  const std::string svg = std::filesystem::path(a.out).replace_extension(".svg").string();
-  if (!plot_svg(svg, vehicle.name + ": closed-loop test flight", {pos, cmd}, &err)) std::cerr << "no plot: " << err << "\n";
+  set_plot(out, vehicle.name + ": closed-loop test flight", {pos, cmd});
+  out.commit();
   std::cout << "flew " << a.duration << " s closed loop; wrote " << a.out << "\n";
   return 0;
 }
@@ -133,12 +174,15 @@ int run_simulate(const SimulateArgs& a) {
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   const Vehicle vehicle = load_vehicle(a.vehicle);
+  if (a.closed_loop) check_size(a, 0, a.duration * ClosedLoopOptions{}.log_rate);
+  else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
+  output::OutputFiles out = output_for(a);  // refused before the work, not after
   DeriveOptions opt;
   opt.effects = parse_effect_list(a.effects);
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
-  if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
+  if (a.closed_loop) return run_closed_loop(a, vehicle, model, m, out);
   const int delay = model.input_delay_param ? static_cast<int>(*model.input_delay_param) : -1;
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
@@ -163,6 +207,10 @@ int run_simulate(const SimulateArgs& a) {
     const CsvTable log = read_csv(a.inputs);
     validate_canonical(log, rotors);
     std::vector<double> t = log.values("t");
+    if (a.duration > t.back() - t.front() + 1e-9)
+      throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
+                                  std::to_string(t.back() - t.front()) +
+                                  " s of commands; a longer replay would hold the last command for the rest");
     std::vector<std::vector<double>> u(t.size(), std::vector<double>(nr));
     for (size_t r = 0; r < nr; ++r) {
       const auto col = log.values("u_" + rotors[r]);
@@ -221,8 +269,7 @@ int run_simulate(const SimulateArgs& a) {
     }
   }
 
-  OutputSet out = output_for(a.out);
-  out.add(std::filesystem::path(a.out).filename().string(), trajectory_csv(m, tr, inputs, rotors));
+  out.set(0, trajectory_csv(m, tr, inputs, rotors));
   // Plot like the thesis' figures: translation, rotation, thrust per rotor.
   Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{"thrust per rotor", "t [s]", "N", {}};
   const char* pos[] = {"x", "y", "z"};
@@ -251,11 +298,9 @@ int run_simulate(const SimulateArgs& a) {
     }
     thrust.series.push_back(s);
   }
-  out.commit();
-  const std::string svg = std::filesystem::path(a.out).replace_extension(".svg").string();
-  std::string err;
   const std::string what = a.scenario.empty() ? "replay of " + a.inputs : "scenario " + a.scenario;
-  if (!plot_svg(svg, vehicle.name + ": " + what, {trans, rot, thrust}, &err)) std::cerr << "no plot: " << err << "\n";
+  set_plot(out, vehicle.name + ": " + what, {trans, rot, thrust});
+  out.commit();
   const auto& xe = tr.x.back();
   std::cout << "simulated " << a.duration << " s (" << stats.rhs_evaluations << " rhs evaluations): final position ("
             << xe[0] << ", " << xe[1] << ", " << xe[2] << ") m; wrote " << a.out << "\n";

@@ -1,11 +1,14 @@
 #include "dynamics.hpp"
 
+#include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <stdexcept>
 
 #include "effects.hpp"
 #include "exact_number.hpp"
 #include "kinematics.hpp"
+#include "sinks.hpp"
 #include "symbolic_functions.hpp"
 
 namespace quadgen {
@@ -20,9 +23,7 @@ std::string tex_of(const std::string& name) {
       {"mass", "m"},    {"p", "p"},           {"q", "q"},     {"r", "r"}};
   auto it = greek.find(name);
   if (it != greek.end()) return it->second;
-  std::string out;
-  for (char c : name) out += (c == '_') ? std::string("\\_") : std::string(1, c);
-  return "\\mathrm{" + out + "}";
+  return "\\mathrm{" + output::latex_text(name) + "}";
 }
 
 Variable make_variable(const std::string& name, const std::string& unit, const std::string& doc) {
@@ -33,6 +34,38 @@ Variable make_variable(const std::string& name, const std::string& unit, const s
   v.dim = parse_unit(unit).dim;
   v.doc = doc;
   return v;
+}
+
+// A bound as the file wrote it: the shortest text that reads back as the same double.
+std::string exact_text(double x) {
+  char buf[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+// A value outside [lower, upper] to 6 digits, or to more where 6 would read as inside.
+std::string outside_text(double x, double lower, double upper) {
+  char buf[32];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    const double shown = std::strtod(buf, nullptr);
+    if (!(shown >= lower && shown <= upper)) break;
+  }
+  return buf;
+}
+
+// The vehicle file's `derived:` entry for a quantity (the file does not keep the entry's
+// line: the message names the file and the quantity).
+void check_derived_bounds(const Vehicle& v, const std::string& name, const std::string& unit, double value,
+                          const Parameter& declared) {
+  if (value >= declared.lower && value <= declared.upper) return;
+  throw VehicleError(v.source_path + ": derived quantity " + name + ": the blocks give " +
+                     outside_text(value, declared.lower, declared.upper) + " " + unit +
+                     ", outside its bounds [" + exact_text(declared.lower) + ", " + exact_text(declared.upper) +
+                     "]");
 }
 
 void declare_base(ModelContext& c, const MassProperties& mp) {
@@ -65,11 +98,13 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   }
   // Mass properties derived from the blocks become parameters with those nominal values,
   // so that a fit may free them and the generated code precomputes J^-1 once.
+  // Declared bounds must hold the value the blocks give: a fit would start outside them.
   auto derived = [&](const std::string& name, const std::string& unit, double value, const std::string& doc) {
     auto it = c.vehicle.derived_overrides.find(name);
-    if (it != c.vehicle.derived_overrides.end())
+    if (it != c.vehicle.derived_overrides.end()) {
+      check_derived_bounds(c.vehicle, name, unit, value, it->second);
       c.add_param(name, unit, value, it->second.lower, it->second.upper, it->second.fit, doc);
-    else
+    } else
       c.add_param(name, unit, value, value, value, false, doc);
   };
   derived("mass", "kg", mp.mass_value, "total mass (sum of blocks)");

@@ -7,6 +7,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "names.hpp"
+#include "sinks.hpp"
+
 namespace quadgen {
 namespace {
 
@@ -32,15 +35,18 @@ struct Reader {
   }
 
   // Rejects keys not in `allowed`, so that a typo never silently drops a number.
+  // Rejects keys not in `allowed`, and keys given twice (yaml-cpp keeps the first silently).
   void only_keys(const YAML::Node& n, const std::set<std::string>& allowed,
                  const std::string& where) const {
+    std::set<std::string> seen;
     for (const auto& kv : n) {
       if (!kv.first.IsScalar()) fail(kv.first, "expected a plain key in " + where + " (found a list or mapping as a key)");
       const std::string key = kv.first.Scalar();
+      if (!seen.insert(key).second) fail(kv.first, "key '" + output::printable(key) + "' given twice in " + where);
       if (!allowed.count(key)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, "unknown key '" + key + "' in " + where + " (expected one of: " + list + ")");
+        fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " + list + ")");
       }
     }
   }
@@ -78,9 +84,23 @@ struct Reader {
     return v;
   }
 
+  // Free text (a description): any printable characters and line breaks, no other control
+  // characters (escape sequences would reach terminals and reports).
   std::string text(const YAML::Node& n, const std::string& what) const {
     if (!n.IsScalar()) fail(n, "expected text for " + what);
+    for (unsigned char c : n.Scalar())
+      if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) fail(n, "control character in " + what);
     return n.Scalar();
+  }
+
+  // A name that becomes a C++ identifier, a CSV column, a plot label and report text: one
+  // rule for all of them (output/names.hpp).
+  std::string name(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected a name for " + what);
+    const std::string s = n.Scalar();
+    if (const auto problem = output::name_problem(s))
+      fail(n, what + " '" + output::printable(s) + "': " + *problem + " (allowed: " + output::name_rule() + ")");
+    return s;
   }
 
   // A parameter is either a bare number (in the SI unit) or
@@ -141,7 +161,7 @@ Block read_block(const Reader& r, const YAML::Node& n) {
   r.only_keys(n, {"name", "mass", "size", "centre", "orientation_deg", "source"}, "block");
   Block b;
   b.line = n.Mark().line + 1;
-  b.name = r.text(r.need(n, "name", "block"), "block name");
+  b.name = r.name(r.need(n, "name", "block"), "block name");
   const std::string where = "block '" + b.name + "'";
   b.mass = r.positive(r.need(n, "mass", where), "mass of " + where + " [kg]");
   b.size = r.vec3(r.need(n, "size", where), "size of " + where + " [m]", true);
@@ -156,11 +176,8 @@ Rotor read_rotor(const Reader& r, const YAML::Node& n) {
   r.only_keys(n, {"name", "position", "spin", "radius", "disc_area", "source"}, "rotor");
   Rotor ro;
   ro.line = n.Mark().line + 1;
-  ro.name = r.text(r.need(n, "name", "rotor"), "rotor name");
+  ro.name = r.name(r.need(n, "name", "rotor"), "rotor name");  // also the CSV column u_<name>
   const std::string where = "rotor '" + ro.name + "'";
-  for (char c : ro.name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
-      r.fail(n["name"], "rotor name '" + ro.name + "' must be letters, digits and '_' (it becomes a CSV column u_" + ro.name + ")");
   ro.position = r.vec3(r.need(n, "position", where), "position of " + where + " [m]");
   const std::string spin = r.text(r.need(n, "spin", where), "spin of " + where);
   if (spin == "ccw") ro.spin = Spin::ccw;
@@ -191,16 +208,6 @@ void read_section(const Reader& r, const YAML::Node& root, Vehicle& v, const std
 
 }  // namespace
 
-std::string fnv1a_hex(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
 
 namespace {
 Vehicle parse_vehicle_checked(const std::string& content, const std::string& path);
@@ -233,7 +240,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   Vehicle v;
   v.source_path = path;
   v.content_hash = fnv1a_hex(content);
-  v.name = r.text(r.need(root, "name", "the vehicle file"), "vehicle name");
+  v.name = r.name(r.need(root, "name", "the vehicle file"), "vehicle name");
   if (root["description"]) v.description = r.text(root["description"], "description");
 
   read_section(r, root, v, "environment",

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fnv1a.hpp"
 #include "units.hpp"
 
 namespace quadgen {
@@ -69,6 +70,6 @@ Vehicle parse_vehicle(const std::string& text, const std::string& path_for_messa
 
 const Parameter& param(const Vehicle& v, const std::string& name);
 
-std::string fnv1a_hex(const std::string& bytes);
+using output::fnv1a_hex;
 
 }  // namespace quadgen

@@ -1,14 +1,11 @@
 #include "diagnosis_report.hpp"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
-
-#include <unistd.h>
 
 #include "fit_report.hpp"
 #include "plot.hpp"
+#include "sinks.hpp"
 
 namespace quadgen::diagnose {
 
@@ -179,24 +176,15 @@ runtime::Series series(const std::string& label, const std::vector<double>& x, c
   return s;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis& d, const fit::Flight& valid,
                                                                  std::string* error) {
-  namespace fs = std::filesystem;
   std::vector<std::pair<std::string, std::string>> out;
-  const fs::path tmp = fs::temp_directory_path() / ("quadgen_diag_" + std::to_string(::getpid()));
-  fs::create_directories(tmp);
   auto render = [&](const std::string& name, const std::string& title, const std::vector<runtime::Panel>& panels) {
-    const std::string path = (tmp / name).string();
-    if (runtime::plot_svg(path, title, panels, error)) out.emplace_back(name, read_file(path));
+    std::string svg;
+    if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
   };
   const size_t stride = std::max<size_t>(1, d.t.size() / 3000);
   // Measured vs simulated positions on the validation part.
@@ -252,27 +240,16 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis
                     series("", lag, nband)}});
   }
   render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
-  if (!d.search.profiles.empty()) {
-    const std::string path = (tmp / "profiles.svg").string();
-    if (fit::plot_profiles(path, d.vehicle + ": profile likelihood of the found parameters", d.search.profiles, error))
-      out.emplace_back("profiles.svg", read_file(path));
-  }
-  fs::remove_all(tmp);
+  std::string svg;
+  if (!d.search.profiles.empty() &&
+      fit::plot_profiles(d.vehicle + ": profile likelihood of the found parameters", d.search.profiles, &svg, error))
+    out.emplace_back("profiles.svg", svg);
   return out;
 }
 
 namespace {
 
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
-  }
-  return o;
-}
+std::string esc(const std::string& s) { return output::html_text(s); }
 
 std::string num(double v, int prec = 4) {
   if (!std::isfinite(v)) return "–";

@@ -58,7 +58,7 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
   return j;
 }
 
-bool plot_profiles(const std::string& svg, const std::string& title, const std::vector<Profile>& profiles,
+bool plot_profiles(const std::string& title, const std::vector<Profile>& profiles, std::string* svg,
                    std::string* error) {
   std::vector<runtime::Panel> panels;
   for (const auto& pr : profiles) {
@@ -74,7 +74,7 @@ bool plot_profiles(const std::string& svg, const std::string& title, const std::
     p.series.push_back({"simultaneous 95 %", {a, b}, {pr.threshold_simultaneous, pr.threshold_simultaneous}});
     panels.push_back(p);
   }
-  return runtime::plot_svg(svg, title, panels, error);
+  return runtime::render_svg(title, panels, svg, error);
 }
 
 }  // namespace quadgen::fit

@@ -15,7 +15,7 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
 
 // One panel per profile: delta chi2 against the parameter, with both thresholds.
 // Returns false with a reason when plotting is impossible (no gnuplot).
-bool plot_profiles(const std::string& svg_path, const std::string& title, const std::vector<Profile>& profiles,
+bool plot_profiles(const std::string& title, const std::vector<Profile>& profiles, std::string* svg,
                    std::string* error);
 
 }  // namespace quadgen::fit

@@ -1,68 +1,187 @@
 #include "plot.hpp"
 
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <fcntl.h>
+#include <poll.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
-namespace quadgen::runtime {
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <tuple>
 
+#include "sinks.hpp"
+
+extern char** environ;
+
+namespace quadgen::runtime {
 namespace {
-// gnuplot's enhanced text reads _ and ^ as sub- and superscripts; labels are plain text.
-std::string plain(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '_' || c == '^' || c == '@' || c == '{' || c == '}') out += "\\";
-    if (c == '\'') out += '\'';
-    out += c;
-  }
-  return out;
+
+using output::gnuplot_string;
+
+void write_number(std::ostream& os, double v) {
+  if (std::isfinite(v)) os << v;
+  else os << "NaN";  // gnuplot skips it; "inf" or "nan" as printed by iostreams are not numbers to it
 }
+
+// One file descriptor pair end, closed when it goes out of scope.
+struct Fd {
+  int fd = -1;
+  ~Fd() { reset(); }
+  void reset() {
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+  }
+};
+
+struct GnuplotRun {
+  int status = -1;
+  std::string out, err;
+  std::string failure;  // set when gnuplot could not be run at all
+};
+
+// Runs gnuplot with `script` on standard input, collecting standard output and error. No
+// shell is involved. Sockets instead of pipes: send() with MSG_NOSIGNAL cannot raise SIGPIPE
+// in this process if gnuplot exits before reading everything.
+GnuplotRun run_gnuplot(const std::string& script) {
+  GnuplotRun run;
+  int in[2], out[2], err[2];
+  if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, in) || socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, out) ||
+      socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, err)) {
+    run.failure = std::string("cannot start gnuplot: ") + std::strerror(errno);
+    return run;
+  }
+  Fd in_r{in[0]}, in_w{in[1]}, out_r{out[0]}, out_w{out[1]}, err_r{err[0]}, err_w{err[1]};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, in_r.fd, 0);
+  posix_spawn_file_actions_adddup2(&actions, out_w.fd, 1);
+  posix_spawn_file_actions_adddup2(&actions, err_w.fd, 2);
+  char arg0[] = "gnuplot";
+  char* argv[] = {arg0, nullptr};
+  pid_t pid = -1;
+  const int rc = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    run.failure = rc == ENOENT ? "gnuplot is not installed" : std::string("cannot start gnuplot: ") + std::strerror(rc);
+    return run;
+  }
+  in_r.reset();
+  out_w.reset();
+  err_w.reset();
+  size_t sent = 0;
+  char buf[1 << 16];
+  while (out_r.fd >= 0 || err_r.fd >= 0) {
+    pollfd fds[3] = {{in_w.fd, POLLOUT, 0}, {out_r.fd, POLLIN, 0}, {err_r.fd, POLLIN, 0}};
+    if (::poll(fds, 3, -1) < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    if (in_w.fd >= 0 && (fds[0].revents & (POLLOUT | POLLERR | POLLHUP))) {
+      const ssize_t n = ::send(in_w.fd, script.data() + sent, std::min<size_t>(script.size() - sent, sizeof buf), MSG_NOSIGNAL);
+      if (n > 0) sent += static_cast<size_t>(n);
+      if (n < 0 && errno != EINTR && errno != EAGAIN) in_w.reset();  // gnuplot stopped reading
+      if (sent == script.size()) in_w.reset();                        // end of script
+    }
+    for (auto [k, fd, sink] : {std::tuple{1, &out_r, &run.out}, std::tuple{2, &err_r, &run.err}}) {
+      if (fd->fd < 0 || !(fds[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+      const ssize_t n = ::read(fd->fd, buf, sizeof buf);
+      if (n > 0) sink->append(buf, static_cast<size_t>(n));
+      else if (n == 0 || errno != EINTR) fd->reset();
+    }
+  }
+  while (::waitpid(pid, &run.status, 0) < 0 && errno == EINTR) {
+  }
+  return run;
+}
+
+// A whole SVG document, and nothing that would run as script when the SVG is inlined into a
+// page (gnuplot escapes < and & in text; this is the second line of defence).
+bool whole_svg(const std::string& svg) {
+  const size_t end = svg.find_last_not_of(" \n\r\t");
+  if (svg.find("<svg") == std::string::npos || end == std::string::npos || end < 5 || svg.compare(end - 5, 6, "</svg>") != 0)
+    return false;
+  std::string lower(svg);
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  return lower.find("<script") == std::string::npos && lower.find("javascript:") == std::string::npos;
+}
+
 }  // namespace
 
-bool plot_svg(const std::string& path, const std::string& title, const std::vector<Panel>& panels, std::string* error) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_plot_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  const std::string tmp_svg = path + ".tmp." + std::to_string(getpid());
-  std::ostringstream script;
-  const int height = 260 * static_cast<int>(panels.size()) + 40;
-  script << "set terminal svg size 900," << height << " dynamic enhanced font 'sans,11'\n"
-         << "set output '" << tmp_svg << "'\n"
-         << "set multiplot layout " << panels.size() << ",1 title '" << plain(title) << "'\n"
-         << "set grid\nset key outside right\n";
-  int file_no = 0;
-  for (const Panel& p : panels) {
-    script << "set title '" << plain(p.title) << "'\nset xlabel '" << plain(p.xlabel) << "'\nset ylabel '"
-           << plain(p.ylabel) << "'\nplot ";
-    for (size_t s = 0; s < p.series.size(); ++s) {
-      const fs::path data = dir / ("d" + std::to_string(file_no++) + ".dat");
-      std::ofstream out(data);
-      out.precision(10);
-      for (size_t i = 0; i < p.series[s].x.size(); ++i) out << p.series[s].x[i] << ' ' << p.series[s].y[i] << '\n';
-      script << (s ? ", " : "") << "'" << data.string() << "' using 1:2 with " << (p.series[s].points ? "points pt 7 ps 0.5" : "lines lw 1.5")
-             << " title '" << plain(p.series[s].label) << "'";
+Series decimated(const Series& s) {
+  const size_t n = std::min(s.x.size(), s.y.size());
+  if (n <= kMaxPlotPointsPerSeries) return s;
+  Series d{s.label, {}, {}, s.points};
+  const size_t buckets = kMaxPlotPointsPerSeries / 2;
+  for (size_t b = 0; b < buckets; ++b) {
+    const size_t lo = b * n / buckets, hi = (b + 1) * n / buckets;
+    size_t imin = lo, imax = lo;
+    for (size_t i = lo; i < hi; ++i) {
+      if (s.y[i] < s.y[imin]) imin = i;
+      if (s.y[i] > s.y[imax]) imax = i;
     }
-    script << "\n";
+    for (size_t i : {std::min(imin, imax), std::max(imin, imax)}) {
+      d.x.push_back(s.x[i]);
+      d.y.push_back(s.y[i]);
+      if (imin == imax) break;
+    }
+  }
+  return d;
+}
+
+std::string gnuplot_script(const std::string& title, const std::vector<Panel>& panels) {
+  std::ostringstream script;
+  script.precision(10);
+  const int height = 260 * static_cast<int>(panels.size()) + 40;
+  script << "set encoding utf8\n"
+         << "set terminal svg size 900," << height << " dynamic noenhanced font 'sans,11'\n"
+         << "set multiplot layout " << panels.size() << ",1 title " << gnuplot_string(title) << " noenhanced\n"
+         << "set grid\nset key outside right noenhanced\n";
+  int block = 0;
+  for (const Panel& p : panels) {
+    script << "set title " << gnuplot_string(p.title) << " noenhanced\n"
+           << "set xlabel " << gnuplot_string(p.xlabel) << " noenhanced\n"
+           << "set ylabel " << gnuplot_string(p.ylabel) << " noenhanced\n";
+    std::ostringstream plot;
+    for (const Series& full : p.series) {
+      const Series s = decimated(full);
+      if (s.x.empty() || s.y.empty()) continue;
+      const std::string name = "$d" + std::to_string(block++);
+      script << name << " << EOD\n";
+      for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+        write_number(script, s.x[i]);
+        script << ' ';
+        write_number(script, s.y[i]);
+        script << '\n';
+      }
+      script << "EOD\n";
+      plot << (plot.tellp() > 0 ? ", " : "") << name << " using 1:2 with "
+           << (s.points ? "points pt 7 ps 0.5" : "lines lw 1.5") << " title " << gnuplot_string(s.label) << " noenhanced";
+    }
+    // A panel without data still gets its axes, so the layout of the figure stays the same.
+    script << "plot " << (plot.tellp() > 0 ? plot.str() : "[0:1][0:1] -1 notitle") << "\n";
   }
   script << "unset multiplot\n";
-  const fs::path script_path = dir / "plot.gp";
-  std::ofstream(script_path) << script.str();
-  const std::string cmd = "gnuplot " + script_path.string() + " 2> " + (dir / "err.txt").string();
-  const int rc = std::system(cmd.c_str());
-  bool ok = rc == 0 && fs::exists(tmp_svg);
-  if (ok) {
-    fs::rename(tmp_svg, path);
-  } else if (error) {
-    std::ifstream err(dir / "err.txt");
-    std::string msg((std::istreambuf_iterator<char>(err)), {});
-    *error = rc == 127 * 256 || msg.find("not found") != std::string::npos ? "gnuplot is not installed" : "gnuplot failed: " + msg.substr(0, 200);
-    std::remove(tmp_svg.c_str());
+  return script.str();
+}
+
+bool render_svg(const std::string& title, const std::vector<Panel>& panels, std::string* svg, std::string* error) {
+  const GnuplotRun run = run_gnuplot(gnuplot_script(title, panels));
+  std::string why;
+  if (!run.failure.empty()) why = run.failure;
+  else if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0)
+    why = "gnuplot failed: " + output::printable(run.err.substr(0, 300));
+  else if (!whole_svg(run.out)) why = "gnuplot returned no complete SVG document";
+  if (!why.empty()) {
+    if (error) *error = why;
+    return false;
   }
-  fs::remove_all(dir);
-  return ok;
+  *svg = run.out;
+  return true;
 }
 
 }  // namespace quadgen::runtime

@@ -1,5 +1,7 @@
-// Plots through gnuplot (Debian's gnuplot-nox): a person would rather look at a flight
-// than read it. Writes SVG; the data goes through a temporary file.
+// Plots through gnuplot (Debian's gnuplot-nox): a person would rather look at a flight than
+// read it. gnuplot runs without a shell; the script and the data go to its standard input and
+// the SVG comes back on its standard output, so no path and no temporary file is ever part of
+// the script, and every label is passed as an escaped, non-enhanced string (output/sinks.hpp).
 #pragma once
 #include <string>
 #include <vector>
@@ -17,8 +19,20 @@ struct Panel {
   std::vector<Series> series;
 };
 
-// Stacks the panels vertically in one SVG. Returns false (and says why in `error`) when
-// gnuplot is missing or fails; the caller decides whether that is fatal.
-bool plot_svg(const std::string& path, const std::string& title, const std::vector<Panel>& panels, std::string* error);
+// At most this many points of one series reach gnuplot; longer series are thinned to the
+// minimum and maximum of each bucket, which keeps spikes visible (a 1e6-sample log would
+// otherwise give a 200 MB SVG).
+inline constexpr size_t kMaxPlotPointsPerSeries = 4000;
+
+// Renders the panels, stacked vertically, as one SVG document into `svg`. Returns false (and
+// says why in `error`) when gnuplot is missing, fails, or returns something that is not a
+// whole SVG document; the caller decides whether that is fatal.
+bool render_svg(const std::string& title, const std::vector<Panel>& panels, std::string* svg, std::string* error);
+
+// The gnuplot script render_svg sends (exposed for tests and the fuzz target).
+std::string gnuplot_script(const std::string& title, const std::vector<Panel>& panels);
+
+// `s` thinned to at most kMaxPlotPointsPerSeries points (bucket minimum and maximum, in order).
+Series decimated(const Series& s);
 
 }  // namespace quadgen::runtime

@@ -5,6 +5,8 @@
 #include <kainjow/mustache.hpp>
 
 #include "cpp_emitter.hpp"
+#include "names.hpp"
+#include "sinks.hpp"
 #include "effects.hpp"
 #include "vehicle.hpp"
 
@@ -18,15 +20,17 @@ using kainjow::mustache::mustache;
 
 namespace {
 
+// A variable's enumerator: its name with '.' (effect parameters) as '_', checked to be an
+// identifier whatever the vehicle parser let through.
 std::string ident(const std::string& name) {
   std::string s;
-  for (char c : name) s += (std::isalnum(static_cast<unsigned char>(c)) ? c : '_');
-  return s;
+  for (char c : name) s += (c == '.' ? '_' : c);
+  return output::checked_cpp_identifier(s, "generated name");
 }
 
 std::string quoted_list(const std::vector<Variable>& vs) {
   std::string s = "{";
-  for (size_t i = 0; i < vs.size(); ++i) s += (i ? ", " : "") + std::string("\"") + vs[i].name + "\"";
+  for (size_t i = 0; i < vs.size(); ++i) s += (i ? ", " : "") + output::cpp_string_literal(vs[i].name);
   return s + "}";
 }
 
@@ -45,9 +49,9 @@ data variables(const std::vector<Variable>& vs) {
     data d;
     d.set("ident", ident(vs[i].name));
     d.set("index", std::to_string(i));
-    d.set("name", vs[i].name);
-    d.set("unit", vs[i].unit);
-    d.set("doc", vs[i].doc);
+    d.set("name", output::cpp_comment(vs[i].name));
+    d.set("unit", output::cpp_comment(vs[i].unit));
+    d.set("doc", output::cpp_comment(vs[i].doc));
     l.push_back(d);
   }
   return data{l};
@@ -79,11 +83,14 @@ std::string int_list(const std::vector<int>& v) {
 }  // namespace
 
 std::string model_name(const SymbolicModel& m) {
-  if (m.effects.empty()) return ident(m.vehicle_name);
-  if (m.effects.size() == effect_catalogue().size()) return ident(m.vehicle_name) + "_all_effects";
-  std::string s = ident(m.vehicle_name) + "_with";
-  for (const auto& e : m.effects) s += "_" + e;
-  return s;
+  std::string s = m.vehicle_name;
+  if (m.effects.size() == effect_catalogue().size()) s += "_all_effects";
+  else if (!m.effects.empty()) s += "_with";
+  if (m.effects.size() != effect_catalogue().size())
+    for (const auto& e : m.effects) s += "_" + e;
+  if (const auto problem = output::name_problem(m.vehicle_name))
+    throw std::invalid_argument("vehicle name '" + output::printable(m.vehicle_name) + "': " + *problem);
+  return output::checked_cpp_identifier(s, "model namespace");
 }
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
@@ -128,13 +135,15 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   data d;
   d.set("namespace", out.name);
   d.set("version", QUADGEN_VERSION);
-  d.set("vehicle_file", opt.vehicle_file);
-  d.set("effects_flag", opt.effects_flag);
-  d.set("vehicle", m.vehicle_name);
-  d.set("vehicle_hash", m.vehicle_hash);
-  d.set("effects", m.effects.empty() ? "none" : m.effect_list(", "));
-  const std::string effects_list = m.effect_list();
-  d.set("effects_list", effects_list);
+  // Everything from a vehicle file or the command line goes through the sink's escaping:
+  // comments cannot end early or splice the next line, literals cannot end early.
+  d.set("vehicle_file", output::cpp_comment(opt.vehicle_file));
+  d.set("effects_flag", output::cpp_comment(opt.effects_flag));
+  d.set("vehicle", output::cpp_comment(m.vehicle_name));
+  d.set("vehicle_hash", output::cpp_comment(m.vehicle_hash));
+  d.set("vehicle_hash_literal", output::cpp_string_literal(m.vehicle_hash));
+  d.set("effects", output::cpp_comment(m.effects.empty() ? "none" : m.effect_list(", ")));
+  d.set("effects_list", output::cpp_string_literal(m.effect_list()));
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
   d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));

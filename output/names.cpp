@@ -1,0 +1,62 @@
+#include "names.hpp"
+
+#include <algorithm>
+#include <set>
+
+namespace quadgen::output {
+namespace {
+
+bool ascii_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+bool ascii_digit(char c) { return c >= '0' && c <= '9'; }
+
+// Names the generated header (templates/model.hpp.mustache) declares next to or inside the
+// vehicle's namespace, and the namespaces it opens: a vehicle called "Model" or "std" would
+// shadow them and the header would not compile, or compile to something else.
+const std::set<std::string>& generated_header_names() {
+  static const std::set<std::string> names = {
+      "std", "quadgen_generated", "Model", "Scalar", "State", "Input", "Param", "Precomputed",
+      "abs_value", "sign_of", "precompute", "rhs", "measurement", "kNumStates", "kNumInputs",
+      "kNumParams", "kNumOutputs", "kNumPrecomputed", "kVehicleHash", "kEffects", "kStateNames",
+      "kInputNames", "kParamNames", "kOutputNames", "kNominalParams", "kInputDelayParam"};
+  return names;
+}
+
+}  // namespace
+
+bool is_cpp_keyword(const std::string& w) {
+  static const std::set<std::string> keywords = {
+      "alignas", "alignof", "and", "and_eq", "asm", "auto", "bitand", "bitor", "bool", "break", "case",
+      "catch", "char", "char8_t", "char16_t", "char32_t", "class", "compl", "concept", "const",
+      "consteval", "constexpr", "constinit", "const_cast", "continue", "co_await", "co_return",
+      "co_yield", "decltype", "default", "delete", "do", "double", "dynamic_cast", "else", "enum",
+      "explicit", "export", "extern", "false", "float", "for", "friend", "goto", "if", "inline", "int",
+      "long", "mutable", "namespace", "new", "noexcept", "not", "not_eq", "nullptr", "operator", "or",
+      "or_eq", "private", "protected", "public", "register", "reinterpret_cast", "requires", "return",
+      "short", "signed", "sizeof", "static", "static_assert", "static_cast", "struct", "switch",
+      "template", "this", "thread_local", "throw", "true", "try", "typedef", "typeid", "typename",
+      "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t", "while", "xor", "xor_eq",
+      // Predefined macros and identifiers with special meaning that a header must not redefine.
+      "final", "override", "import", "module", "assert", "errno", "NULL", "EOF"};
+  return keywords.count(w) > 0;
+}
+
+const char* name_rule() {
+  return "a letter (A-Z, a-z), then letters, digits and single underscores, at most 64 characters, "
+         "not a C++ keyword";
+}
+
+std::optional<std::string> name_problem(const std::string& name) {
+  if (name.empty()) return "the name is empty";
+  if (name.size() > kMaxNameLength) return "the name is longer than 64 characters";
+  if (!ascii_letter(name[0])) return "the name must start with a letter";
+  for (char c : name)
+    if (!ascii_letter(c) && !ascii_digit(c) && c != '_')
+      return "the name may hold only letters, digits and '_' (found a character outside them)";
+  if (name.find("__") != std::string::npos || name.back() == '_')
+    return "the name may not hold '__' or end in '_' (reserved in C++)";
+  if (is_cpp_keyword(name)) return "'" + name + "' is a C++ keyword";
+  if (generated_header_names().count(name)) return "'" + name + "' is a name the generated header uses";
+  return std::nullopt;
+}
+
+}  // namespace quadgen::output

@@ -1,0 +1,24 @@
+// The one rule for names that leave the program: vehicle, block and rotor names end up as C++
+// namespaces and identifiers, CSV columns, gnuplot labels, HTML, Markdown and LaTeX. A name that
+// passes this rule is inert in every one of those sinks; each sink escapes anyway
+// (output/sinks.hpp), so that one missed check cannot become an injection.
+#pragma once
+#include <optional>
+#include <string>
+
+namespace quadgen::output {
+
+inline constexpr std::size_t kMaxNameLength = 64;
+
+// What is wrong with `name` as a vehicle, block or rotor name, or nothing when it is allowed:
+// an ASCII letter, then letters, digits and single '_' (no "__", no trailing '_'), at most
+// kMaxNameLength characters, and neither a C++ keyword nor a name the generated header uses.
+std::optional<std::string> name_problem(const std::string& name);
+
+// The rule in words, for error messages and docs.
+const char* name_rule();
+
+// True for a C++ keyword or alternative token (class, int, and, ...).
+bool is_cpp_keyword(const std::string& word);
+
+}  // namespace quadgen::output

@@ -1,0 +1,344 @@
+#include "output_set.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "fnv1a.hpp"
+#include "sinks.hpp"
+
+namespace quadgen::output {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kManifestHeader = "quadgen output set 1";
+const std::string kStagingInfix = ".quadgen-tmp.";
+
+[[noreturn]] void fail(const fs::path& p, const std::string& what) {
+  throw OutputError(printable(p.string()) + ": " + what);
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+void fsync_path(const fs::path& p, int flags) {
+  const int fd = ::open(p.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) fail(p, "cannot open to sync: " + errno_text());
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  if (rc != 0) fail(p, "cannot sync to disk: " + errno_text());
+}
+
+// The absolute, normalised form of a path named on the command line (symbolic links of an
+// existing path resolved, a trailing '/' dropped).
+fs::path resolved(const std::string& name) {
+  if (name.empty()) throw OutputError("an output path is empty");
+  std::error_code ec;
+  fs::path p = fs::absolute(fs::path(name), ec).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();
+  if (fs::exists(p, ec)) p = fs::canonical(p, ec);
+  return p;
+}
+
+// A file path named on the command line: its folder resolved, the file itself not (so that a
+// symbolic link there is replaced, never the file it points to).
+fs::path resolved_file(const std::string& name) {
+  if (name.empty()) throw OutputError("an output path is empty");
+  std::error_code ec;
+  const fs::path p = fs::absolute(fs::path(name), ec).lexically_normal();
+  if (!p.has_filename()) fail(p, "names a directory; expected a file name");
+  fs::path parent = p.parent_path();
+  if (fs::exists(parent, ec)) parent = fs::canonical(parent, ec);
+  return parent / p.filename();
+}
+
+bool inside(const fs::path& child, const fs::path& parent) {
+  const auto c = child.lexically_normal(), pa = parent.lexically_normal();
+  auto ci = c.begin();
+  for (auto pi = pa.begin(); pi != pa.end(); ++pi, ++ci)
+    if (ci == c.end() || *ci != *pi) return false;
+  return true;
+}
+
+struct FileId {
+  dev_t dev;
+  ino_t ino;
+  bool operator<(const FileId& o) const { return dev != o.dev ? dev < o.dev : ino < o.ino; }
+};
+
+std::map<FileId, std::string> identities(const std::vector<std::string>& paths) {
+  std::map<FileId, std::string> ids;
+  for (const auto& p : paths) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0) ids[{st.st_dev, st.st_ino}] = p;
+  }
+  return ids;
+}
+
+// The manifest of an output directory: file name -> "hash size"; empty if there is none.
+std::map<std::string, std::string> read_manifest(const fs::path& dir, bool* present) {
+  std::map<std::string, std::string> files;
+  std::ifstream in(dir / kManifestName);
+  *present = static_cast<bool>(in);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != kManifestHeader) return files;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string hash, size, name;
+    if (ls >> hash >> size && std::getline(ls >> std::ws, name)) files[name] = hash + " " + size;
+  }
+  return files;
+}
+
+// Refuses to replace a directory that holds anything an earlier quadgen run did not write.
+void check_replaceable(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return;
+  if (!fs::is_directory(dir, ec)) fail(dir, "exists and is not a directory");
+  bool has_manifest = false;
+  const auto listed = read_manifest(dir, &has_manifest);
+  std::vector<std::string> foreign;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name == kManifestName) continue;
+    if (!listed.count(name) || !e.is_regular_file()) foreign.push_back(printable(name));
+  }
+  if (ec) fail(dir, "cannot list the directory: " + ec.message());
+  if (foreign.empty()) return;
+  std::string names;
+  for (size_t i = 0; i < foreign.size() && i < 3; ++i) names += (i ? ", " : "") + foreign[i];
+  if (foreign.size() > 3) names += ", ...";
+  fail(dir, "holds files quadgen did not write (" + names + "); choose a new --out directory or remove them");
+}
+
+// Files `inputs` names that `dir` is or contains, by path and by file identity (hard links).
+void check_not_input(const fs::path& target, const std::vector<std::string>& inputs) {
+  std::error_code ec;
+  for (const auto& in : inputs) {
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    const fs::path p = fs::canonical(in, ec);
+    if (!ec && inside(p, target)) fail(target, "is or contains the input " + printable(in) + "; write the output elsewhere");
+  }
+  if (!fs::is_directory(target, ec)) return;
+  const auto ids = identities(inputs);
+  for (const auto& e : fs::directory_iterator(target, ec)) {
+    struct stat st {};
+    if (::stat(e.path().c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
+      fail(target, "holds the input " + printable(ids.at({st.st_dev, st.st_ino})) + " (a link to it); write the output elsewhere");
+  }
+}
+
+void check_not_above_working_directory(const fs::path& target) {
+  std::error_code ec;
+  const fs::path cwd = fs::canonical(fs::current_path(ec), ec);
+  if (target == target.root_path() || (!ec && inside(cwd, target)))
+    fail(target, "is the working directory or above it; name a directory of its own for the output");
+}
+
+bool process_alive(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+
+void remove_tree_quietly(const fs::path& p) {
+  std::error_code ec;
+  fs::remove_all(p, ec);
+}
+
+}  // namespace
+
+// A private directory beside the target (same file system, so renames are atomic), named
+// .<target>.quadgen-tmp.<pid>.XXXXXX. Removed with everything in it unless released.
+class StagingDirectory {
+ public:
+  StagingDirectory(const fs::path& parent, const std::string& target_name) {
+    const std::string stem = "." + target_name.substr(0, 100) + kStagingInfix;
+    remove_stale(parent, stem);
+    std::string templ = (parent / (stem + std::to_string(::getpid()) + ".XXXXXX")).string();
+    if (!::mkdtemp(templ.data())) fail(parent, "cannot create a staging directory: " + errno_text());
+    path_ = templ;
+  }
+  ~StagingDirectory() {
+    if (!released_) remove_tree_quietly(path_);
+  }
+  const fs::path& path() const { return path_; }
+  void release() { released_ = true; }
+
+  void write(const std::string& name, const std::string& content) {
+    const fs::path p = path_ / name;
+    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) fail(p, "cannot create: " + errno_text());
+    size_t done = 0;
+    while (done < content.size()) {
+      const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const std::string why = errno_text();
+        ::close(fd);
+        fail(p, "write failed (" + why + ")");
+      }
+      done += static_cast<size_t>(n);
+    }
+    const bool synced = ::fsync(fd) == 0;
+    const std::string why = errno_text();
+    if (::close(fd) != 0 || !synced) fail(p, "write failed (" + why + ")");
+  }
+
+ private:
+  // Staging directories of runs that were killed: their process is gone. Those of running
+  // processes are never touched.
+  static void remove_stale(const fs::path& parent, const std::string& stem) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(parent, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(stem, 0) != 0) continue;
+      const long pid = std::strtol(name.c_str() + stem.size(), nullptr, 10);
+      if (!process_alive(pid)) remove_tree_quietly(e.path());
+    }
+  }
+
+  fs::path path_;
+  bool released_ = false;
+};
+
+namespace {
+
+// Test hook: die after everything is staged and before anything is renamed, as a killed
+// process would (tests/test_robustness.cpp).
+void test_hook_die_before_commit() {
+  if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
+}
+
+void check_file_name(const std::string& name) {
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos ||
+      name.find('\0') != std::string::npos || name.rfind(".quadgen", 0) == 0)
+    throw OutputError("internal: '" + printable(name) + "' is not a plain output file name");
+}
+
+}  // namespace
+
+OutputDirectory::OutputDirectory(const std::string& dir, const std::vector<std::string>& inputs) : inputs_(inputs) {
+  const fs::path target = resolved(dir);
+  dir_ = target.string();
+  check_not_above_working_directory(target);
+  check_not_input(target, inputs_);
+  check_replaceable(target);
+  std::error_code ec;
+  fs::create_directories(target.parent_path(), ec);
+  if (ec) fail(target.parent_path(), "cannot create the directory: " + ec.message());
+  staging_ = std::make_unique<StagingDirectory>(target.parent_path(), target.filename().string());
+}
+
+OutputDirectory::~OutputDirectory() = default;
+
+void OutputDirectory::add(const std::string& filename, const std::string& content) {
+  check_file_name(filename);
+  for (const auto& m : manifest_)
+    if (m.first == filename) throw OutputError("internal: " + filename + " added twice to one output set");
+  staging_->write(filename, content);
+  manifest_.push_back({filename, fnv1a_hex(content) + " " + std::to_string(content.size())});
+}
+
+void OutputDirectory::commit() {
+  std::string manifest = std::string(kManifestHeader) + "\n";
+  for (const auto& [name, hash_size] : manifest_) manifest += hash_size + " " + name + "\n";
+  staging_->write(kManifestName, manifest);
+  fsync_path(staging_->path(), O_RDONLY | O_DIRECTORY);
+  test_hook_die_before_commit();
+  const fs::path target(dir_), staged = staging_->path();
+  // A new or empty target: one plain rename. An earlier run in the way: one atomic exchange,
+  // after which the earlier run sits in the staging path and is removed file by file.
+  if (::rename(staged.c_str(), target.c_str()) != 0) {
+    if (errno != ENOTEMPTY && errno != EEXIST) fail(target, "cannot move the output into place: " + errno_text());
+    check_replaceable(target);
+    check_not_input(target, inputs_);
+    if (::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
+      fail(target, "cannot switch the output into place: " + errno_text());
+    bool had_manifest = false;
+    std::error_code ec;
+    for (const auto& [name, unused] : read_manifest(staged, &had_manifest)) fs::remove(staged / name, ec);
+    fs::remove(staged / kManifestName, ec);
+    if (!fs::remove(staged, ec))
+      std::cerr << "quadgen: note: the previous output was kept at " << printable(staged.string())
+                << " (it held files that appeared while this run wrote)\n";
+  }
+  staging_->release();
+  fsync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
+}
+
+OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::vector<std::string>& inputs)
+    : written_(paths.size(), false) {
+  const auto ids = identities(inputs);
+  std::set<fs::path> seen;
+  std::error_code ec;
+  for (const auto& name : paths) {
+    const fs::path p = resolved_file(name);
+    if (!seen.insert(p).second) fail(p, "is named for two outputs of one run (the trajectory and its plot)");
+    if (p.parent_path() != resolved_file(paths.front()).parent_path()) throw OutputError("internal: outputs in two folders");
+    if (fs::exists(p, ec) && !fs::is_regular_file(p, ec)) fail(p, "exists and is not a regular file");
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
+      fail(p, "is the input " + printable(ids.at({st.st_dev, st.st_ino})) + "; choose another output path");
+    paths_.push_back(p.string());
+  }
+  const fs::path parent = fs::path(paths_.front()).parent_path();
+  fs::create_directories(parent, ec);
+  if (ec) fail(parent, "cannot create the directory: " + ec.message());
+  staging_ = std::make_unique<StagingDirectory>(parent, fs::path(paths_.front()).filename().string());
+}
+
+OutputFiles::~OutputFiles() = default;
+
+void OutputFiles::set(size_t i, const std::string& content) {
+  staging_->write(fs::path(paths_.at(i)).filename().string(), content);
+  written_[i] = true;
+}
+
+void OutputFiles::commit() {
+  test_hook_die_before_commit();
+  std::error_code ec;
+  for (size_t i = 1; i < paths_.size(); ++i) fs::remove(paths_[i], ec);  // no companion of another run
+  for (size_t i = 0; i < paths_.size(); ++i) {
+    if (!written_[i]) continue;
+    const fs::path staged = staging_->path() / fs::path(paths_[i]).filename();
+    if (::rename(staged.c_str(), paths_[i].c_str()) != 0) fail(paths_[i], "cannot move into place: " + errno_text());
+  }
+  fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
+}
+
+bool complete_output_directory(const std::string& dir, std::string* why) {
+  auto no = [&](const std::string& w) {
+    if (why) *why = w;
+    return false;
+  };
+  bool present = false;
+  const auto listed = read_manifest(dir, &present);
+  if (!present || listed.empty()) return no("no manifest");
+  std::error_code ec;
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name == kManifestName) continue;
+    ++files;
+    const auto it = listed.find(name);
+    if (it == listed.end()) return no(name + " is not in the manifest");
+    std::ifstream in(e.path(), std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    const std::string content = ss.str();
+    if (it->second != fnv1a_hex(content) + " " + std::to_string(content.size())) return no(name + " differs from the manifest");
+  }
+  if (files != listed.size()) return no("files listed in the manifest are missing");
+  return true;
+}
+
+}  // namespace quadgen::output

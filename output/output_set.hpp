@@ -1,0 +1,77 @@
+// Output appears whole or not at all, never destroys a file quadgen did not write, and never
+// replaces one of the run's own inputs.
+//
+// OutputDirectory (derive, fit, diagnose --out DIR): every file is written into a private
+// staging directory beside DIR and the set is switched in by one rename (an atomic exchange
+// when DIR already holds an earlier run). DIR is replaced only if it is new, empty, or holds
+// exactly what an earlier quadgen run wrote (listed in its manifest, kManifestName); a kill at
+// any moment leaves either the earlier run or the new one, and two runs into one DIR leave one
+// of them whole.
+//
+// OutputFiles (simulate --out TRAJ.csv, with TRAJ.svg beside it): files among other files.
+// Each file is renamed into place from the staging directory; a companion of the previous run
+// is removed first, so a kill leaves a missing plot, never a plot of another run.
+#pragma once
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace quadgen::output {
+
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Lists the files of one run with their sizes and FNV-1a hashes, so that a later run (and a
+// test) can tell a complete quadgen output directory from anything else.
+inline constexpr const char* kManifestName = ".quadgen-manifest";
+
+class StagingDirectory;
+
+class OutputDirectory {
+ public:
+  // Checks at once (before any long work) that `dir` may be written: not one of `inputs`, no
+  // input inside it, not the working directory or above it, and replaceable (see above).
+  OutputDirectory(const std::string& dir, const std::vector<std::string>& inputs);
+  ~OutputDirectory();  // a set never committed leaves nothing behind
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+
+  // Writes one file of the set (a plain file name) into the staging directory.
+  void add(const std::string& filename, const std::string& content);
+  // Switches the whole set in.
+  void commit();
+  const std::string& dir() const { return dir_; }
+
+ private:
+  std::string dir_;
+  std::vector<std::string> inputs_;
+  std::unique_ptr<StagingDirectory> staging_;
+  std::vector<std::pair<std::string, std::string>> manifest_;  // file name, "hash size"
+};
+
+class OutputFiles {
+ public:
+  // `paths`: the files this run writes; they must be distinct, none an input, none a directory.
+  OutputFiles(const std::vector<std::string>& paths, const std::vector<std::string>& inputs);
+  ~OutputFiles();
+  OutputFiles(const OutputFiles&) = delete;
+  OutputFiles& operator=(const OutputFiles&) = delete;
+
+  // Content of paths[i]; a path never set is not written, and a previous file there is removed.
+  void set(size_t i, const std::string& content);
+  void commit();
+
+ private:
+  std::vector<std::string> paths_;
+  std::vector<bool> written_;
+  std::unique_ptr<StagingDirectory> staging_;
+};
+
+// True if `filename` holds what a complete quadgen run wrote into `dir` according to its
+// manifest (every listed file present with its size and hash, nothing else). For tests and
+// for users checking an output directory.
+bool complete_output_directory(const std::string& dir, std::string* why = nullptr);
+
+}  // namespace quadgen::output

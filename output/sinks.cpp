@@ -1,0 +1,154 @@
+#include "sinks.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "names.hpp"
+
+namespace quadgen::output {
+namespace {
+
+std::string hex_byte(unsigned char c, const char* prefix) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%s%02X", prefix, static_cast<unsigned>(c));
+  return buf;
+}
+
+bool control(unsigned char c) { return c < 0x20 || c == 0x7f; }
+
+// Length of the valid UTF-8 sequence starting at s[i] (1 for ASCII), or 0 if it is not one.
+size_t utf8_length(const std::string& s, size_t i) {
+  const auto c = static_cast<unsigned char>(s[i]);
+  if (c < 0x80) return 1;
+  size_t n = 0;
+  unsigned min = 0;
+  if ((c & 0xE0) == 0xC0) n = 2, min = 0x80;
+  else if ((c & 0xF0) == 0xE0) n = 3, min = 0x800;
+  else if ((c & 0xF8) == 0xF0) n = 4, min = 0x10000;
+  else return 0;
+  if (i + n > s.size()) return 0;
+  unsigned cp = c & (0x7F >> n);
+  for (size_t k = 1; k < n; ++k) {
+    const auto b = static_cast<unsigned char>(s[i + k]);
+    if ((b & 0xC0) != 0x80) return 0;
+    cp = (cp << 6) | (b & 0x3F);
+  }
+  if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
+  return n;
+}
+
+// Calls emit(piece) for each character: ASCII bytes one by one, valid multi-byte UTF-8
+// sequences whole, and "?" for each byte of invalid UTF-8.
+template <typename Emit>
+void for_each_char(const std::string& s, Emit emit) {
+  for (size_t i = 0; i < s.size();) {
+    const size_t n = utf8_length(s, i);
+    if (n == 0) {
+      emit(std::string("?"));
+      ++i;
+    } else {
+      emit(s.substr(i, n));
+      i += n;
+    }
+  }
+}
+
+}  // namespace
+
+std::string printable(const std::string& s) {
+  std::string out;
+  for_each_char(s, [&](const std::string& c) {
+    out += c.size() == 1 && control(static_cast<unsigned char>(c[0])) ? hex_byte(static_cast<unsigned char>(c[0]), "\\x") : c;
+  });
+  return out;
+}
+
+std::string cpp_comment(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const bool trigraph = c == '?' && i + 1 < s.size() && s[i + 1] == '?';
+    if (c < 0x20 || c >= 0x7f || c == '\\' || c == '%' || trigraph) out += hex_byte(c, "%");
+    else out += static_cast<char>(c);
+  }
+  return out;
+}
+
+std::string cpp_string_literal(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c < 0x20 || c >= 0x7f || c == '"' || c == '\\' || c == '?') {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\%03o", static_cast<unsigned>(c));
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+const std::string& checked_cpp_identifier(const std::string& s, const std::string& what) {
+  bool ok = !s.empty() && !(s[0] >= '0' && s[0] <= '9') && s.find("__") == std::string::npos &&
+            !(s[0] == '_' && s.size() > 1 && s[1] >= 'A' && s[1] <= 'Z') && !is_cpp_keyword(s);
+  for (char c : s)
+    ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_');
+  if (!ok) throw std::invalid_argument(what + " '" + printable(s) + "' is not a valid C++ identifier");
+  return s;
+}
+
+std::string gnuplot_string(const std::string& s) {
+  std::string out = "'";
+  for_each_char(s, [&](const std::string& c) {
+    if (c == "'") out += "''";
+    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
+    else out += c;
+  });
+  return out + "'";
+}
+
+std::string html_text(const std::string& s) {
+  std::string out;
+  for_each_char(s, [&](const std::string& c) {
+    if (c == "&") out += "&amp;";
+    else if (c == "<") out += "&lt;";
+    else if (c == ">") out += "&gt;";
+    else if (c == "\"") out += "&quot;";
+    else if (c == "'") out += "&#39;";
+    else if (c == "\n" || c == "\t") out += ' ';
+    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) return;
+    else out += c;
+  });
+  return out;
+}
+
+std::string markdown_text(const std::string& s) {
+  // Inline Markdown (and GitHub's $ math): these change how the text around them renders.
+  static const std::string punctuation = "\\`*_[]|$~";
+  std::string out;
+  for_each_char(s, [&](const std::string& c) {
+    if (c.size() == 1 && punctuation.find(c[0]) != std::string::npos) out += "\\" + c;
+    else out += html_text(c);
+  });
+  return out;
+}
+
+std::string markdown_code(const std::string& s) {
+  const bool plain = printable(s) == s && s.find('`') == std::string::npos && s.find('|') == std::string::npos;
+  return plain ? "`" + s + "`" : markdown_text(s);
+}
+
+std::string latex_text(const std::string& s) {
+  std::string out;
+  for_each_char(s, [&](const std::string& c) {
+    if (c == "\\") out += "\\textbackslash{}";
+    else if (c == "~") out += "\\textasciitilde{}";
+    else if (c == "^") out += "\\textasciicircum{}";
+    else if (c == "{" || c == "}" || c == "$" || c == "&" || c == "#" || c == "_" || c == "%") out += "\\" + c;
+    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
+    else out += c;
+  });
+  return out;
+}
+
+}  // namespace quadgen::output

@@ -1,0 +1,46 @@
+// Escaping at every place text leaves the program. Names are validated where they are read
+// (output/names.hpp), and every sink escapes again, so that a string that slipped past one check
+// (a path from the command line, a description, a future field) stays text wherever it lands.
+// Each function returns text that is inert in its sink: it cannot end a comment, a string, a
+// line of script or an element, whatever bytes it was given.
+#pragma once
+#include <string>
+
+namespace quadgen::output {
+
+// One line for a terminal or a log: control characters (newline, escape sequences) become
+// \xNN, invalid UTF-8 becomes '?'.
+std::string printable(const std::string& s);
+
+// Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
+// trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);
+// those and every other byte become %XX.
+std::string cpp_comment(const std::string& s);
+
+// A C++ string literal, quotes included; anything but plain printable ASCII is an octal escape.
+std::string cpp_string_literal(const std::string& s);
+
+// `s` if it is a C++ identifier that is not a keyword or reserved name (leading '_', "__");
+// throws std::invalid_argument naming `what` otherwise. The generator's last line of defence.
+const std::string& checked_cpp_identifier(const std::string& s, const std::string& what);
+
+// A gnuplot single-quoted string, quotes included. Inside single quotes gnuplot expands neither
+// backquotes nor macros and knows one escape ('' for '); control characters, which would end
+// the command line, become spaces. Labels are set `noenhanced`, so _ ^ @ { } stay literal.
+std::string gnuplot_string(const std::string& s);
+
+// HTML text or attribute value: & < > " ' as entities, control characters dropped.
+std::string html_text(const std::string& s);
+
+// Markdown text on one line (table cells, headings): HTML-escaped, Markdown punctuation
+// backslash-escaped, line breaks become spaces.
+std::string markdown_text(const std::string& s);
+
+// Inline code (`name`) when `s` can be one (no backtick, no control character); otherwise the
+// same text escaped as markdown_text.
+std::string markdown_code(const std::string& s);
+
+// Text inside LaTeX \text{...} or prose: the ten special characters replaced by their commands.
+std::string latex_text(const std::string& s);
+
+}  // namespace quadgen::output

@@ -1,0 +1,441 @@
+// Hostile input at every sink: names and paths from a vehicle file or the command line must
+// never run a command, change generated code, or destroy a file. Each case checks the exit
+// code, a one-line reason naming the file or option, that no output was created or changed,
+// and that no input was changed.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+
+#include "diagnosis_report.hpp"
+#include "dynamics.hpp"
+#include "geometry.hpp"
+#include "json_document.hpp"
+#include "header_writer.hpp"
+#include "names.hpp"
+#include "output_set.hpp"
+#include "plot.hpp"
+#include "report.hpp"
+#include "sinks.hpp"
+#include "test_helpers.hpp"
+#include "vehicle.hpp"
+
+namespace fs = std::filesystem;
+using quadgen::test::source_path;
+namespace out = quadgen::output;
+
+namespace {
+
+// Strings that break out of a naive sink: quotes, newlines, backslash splices, gnuplot's
+// system(), a preprocessor directive, comment ends, HTML script, LaTeX and Markdown controls.
+const std::vector<std::string>& hostile_strings() {
+  static const std::vector<std::string> s = {
+      "a'b\"c",
+      "x\nsystem \"touch PWNED\"\n#",
+      "x'\nsystem \"touch PWNED\"\nset title 'y",
+      "`touch PWNED`",
+      "@PWNED",
+      "finken3\n#define Scalar(v) (2*(v))\n//",
+      "trailing backslash \\",
+      "trigraph ??/",
+      "end */ of comment /*",
+      "</script><script>alert(1)</script>",
+      "</svg><img src=x onerror=alert(1)>",
+      "$\\input{/etc/passwd}$ & % # _ ^ ~ { }",
+      "| table | break |\n# heading",
+      std::string("nul\0byte", 8),
+      "\x1b[31mred\x1b[0m",
+      "\xff\xfe invalid utf-8",
+  };
+  return s;
+}
+
+// A scratch directory per test (ctest runs tests as parallel processes), removed afterwards.
+struct Scratch {
+  fs::path dir;
+  Scratch() {
+    dir = fs::temp_directory_path() /
+          ("quadgen_hostile_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+           std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  ~Scratch() { fs::remove_all(dir); }
+  std::string operator/(const std::string& name) const { return (dir / name).string(); }
+};
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+void write(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
+
+struct CliResult {
+  int rc;
+  std::string err;
+};
+
+// Runs quadgen with `args` (each one argv element: no shell parses them) in `cwd`.
+CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd, double kill_after_s = -1) {
+  const fs::path err = cwd / ".stderr";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::chdir(cwd.c_str()) != 0) _exit(99);
+    FILE* e = std::freopen(err.c_str(), "w", stderr);
+    FILE* o = std::freopen("/dev/null", "w", stdout);
+    (void)e;
+    (void)o;
+    std::vector<char*> argv;
+    std::string bin = QUADGEN_BINARY;
+    argv.push_back(bin.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(bin.c_str(), argv.data());
+    _exit(98);
+  }
+  if (kill_after_s >= 0) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(kill_after_s));
+    ::kill(pid, SIGKILL);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read(err)};
+  fs::remove(err);
+  return r;
+}
+
+// The error line: "quadgen: error: ..." as the last line, alone.
+void expect_one_line_error(const CliResult& r, const std::string& must_contain, const std::string& what) {
+  EXPECT_NE(r.rc, 0) << what;
+  const auto pos = r.err.find("quadgen: error: ");
+  ASSERT_NE(pos, std::string::npos) << what << ": " << r.err;
+  const std::string line = r.err.substr(pos);
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << what << ": " << r.err;
+  EXPECT_NE(line.find(must_contain), std::string::npos) << what << ": expected '" << must_contain << "' in " << line;
+}
+
+// The bundled FINken 3 file with one line replaced.
+std::string finken3_with(const std::string& from, const std::string& to) {
+  std::string s = read(source_path("vehicles/finken3.yaml"));
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+// A YAML double-quoted scalar holding any bytes.
+std::string yaml_quoted(const std::string& s) {
+  std::string q = "\"";
+  for (unsigned char c : s) {
+    char buf[8];
+    if (c == '"' || c == '\\') q += std::string("\\") + static_cast<char>(c);
+    else if (c < 0x20 || c >= 0x7f) std::snprintf(buf, sizeof buf, "\\x%02X", c), q += buf;
+    else q += static_cast<char>(c);
+  }
+  return q + "\"";
+}
+
+}  // namespace
+
+// ---- the name rule -------------------------------------------------------------------------
+
+TEST(NameRule, AcceptsIdentifiersAndRefusesEverythingElse) {
+  for (const char* ok : {"finken3", "crazyflie21", "A", "M1", "upper_body", "arm_A"})
+    EXPECT_FALSE(out::name_problem(ok)) << ok;
+  for (const char* bad : {"", "3d", "class", "int", "std", "Model", "Scalar", "a__b", "a_", "_a", "a-b", "a b", "a.b",
+                          "ä", "a\nb"})
+    EXPECT_TRUE(out::name_problem(bad)) << bad;
+  EXPECT_TRUE(out::name_problem(std::string(65, 'a')));
+  for (const auto& s : hostile_strings()) EXPECT_TRUE(out::name_problem(s)) << out::printable(s);
+}
+
+TEST(NameRule, VehicleParserRefusesHostileNamesWithFileAndLine) {
+  for (const auto& s : hostile_strings()) {
+    for (const auto& [from, what] : std::vector<std::pair<std::string, std::string>>{
+             {"name: finken3", "vehicle name"}, {"{name: upper_body,", "block name"}, {"{name: A,", "rotor name"}}) {
+      const std::string to = from.back() == ',' ? "{name: " + yaml_quoted(s) + "," : "name: " + yaml_quoted(s);
+      try {
+        quadgen::parse_vehicle(finken3_with(from, to), "hostile.yaml");
+        ADD_FAILURE() << what << " accepted: " << out::printable(s);
+      } catch (const quadgen::VehicleError& e) {
+        const std::string msg = e.what();
+        EXPECT_EQ(msg.rfind("hostile.yaml:", 0), 0u) << msg;
+        EXPECT_NE(msg.find(what), std::string::npos) << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << "message quotes the raw name: " << out::printable(msg);
+      }
+    }
+  }
+}
+
+TEST(NameRule, DuplicateKeysInVehicleFilesAreRefused) {
+  try {
+    quadgen::parse_vehicle(finken3_with("name: finken3", "name: finken3\nname: other"), "dup.yaml");
+    ADD_FAILURE() << "duplicate key accepted";
+  } catch (const quadgen::VehicleError& e) {
+    EXPECT_NE(std::string(e.what()).find("dup.yaml:13: key 'name' given twice"), std::string::npos) << e.what();
+  }
+}
+
+// ---- one test per sink ---------------------------------------------------------------------
+
+TEST(Sinks, CppCommentAndLiteralCannotEndEarly) {
+  for (const auto& s : hostile_strings()) {
+    const std::string c = out::cpp_comment(s);
+    for (unsigned char ch : c) EXPECT_TRUE(ch >= 0x20 && ch < 0x7f && ch != '\\') << out::printable(c);
+    EXPECT_EQ(c.find("??"), std::string::npos);
+    const std::string l = out::cpp_string_literal(s);
+    EXPECT_EQ(l.front(), '"');
+    EXPECT_EQ(l.back(), '"');
+    EXPECT_EQ(l.substr(1, l.size() - 2).find('"'), std::string::npos) << l;
+    EXPECT_THROW(out::checked_cpp_identifier(s, "test"), std::invalid_argument) << out::printable(s);
+  }
+}
+
+TEST(Sinks, GeneratedHeaderChangesOnlyInItsCommentWhatEverThePath) {
+  const quadgen::Vehicle v = quadgen::test::finken3();
+  const auto model = quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
+  quadgen::emission::EmitOptions plain;
+  plain.vehicle_file = "vehicles/finken3.yaml";
+  const std::string reference = quadgen::emission::generate_header(model, plain).content;
+  for (const auto& s : hostile_strings()) {
+    quadgen::emission::EmitOptions o = plain;
+    o.vehicle_file = s;
+    o.effects_flag = s;
+    const std::string h = quadgen::emission::generate_header(model, o).content;
+    // Line 2 (the regenerate command) is the only one that may differ, and stays one line.
+    const auto line2 = [](const std::string& x) {
+      const size_t a = x.find('\n') + 1;
+      return std::make_pair(a, x.find('\n', a));
+    };
+    const auto [ra, rb] = line2(reference);
+    const auto [ha, hb] = line2(h);
+    EXPECT_EQ(h.substr(0, ha), reference.substr(0, ra));
+    EXPECT_EQ(h.substr(hb), reference.substr(rb)) << out::printable(s);
+    EXPECT_EQ(h.substr(ha, hb - ha).find('\\'), std::string::npos);
+  }
+  // A name that got past the parser is refused by the generator, never emitted.
+  auto bad = model;
+  bad.vehicle_name = "finken3\n#define Scalar(v) (2*(v))\n//";
+  EXPECT_THROW(quadgen::emission::generate_header(bad, plain), std::invalid_argument);
+  bad.vehicle_name = "class";
+  EXPECT_THROW(quadgen::emission::generate_header(bad, plain), std::invalid_argument);
+}
+
+TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
+  Scratch tmp;
+  const fs::path cwd = fs::current_path();
+  fs::current_path(tmp.dir);  // a `system "touch PWNED"` would create the file here
+  for (const auto& s : hostile_strings()) {
+    quadgen::runtime::Panel p{s, s, s, {{s, {0, 1, 2}, {1, 0, 1}}, {s, {0, 1}, {0, 1}, true}}};
+    std::string svg, err;
+    const bool drawn = quadgen::runtime::render_svg(s, {p}, &svg, &err);
+    if (err == "gnuplot is not installed") GTEST_SKIP() << err;
+    EXPECT_TRUE(drawn) << out::printable(s) << ": " << err;
+    EXPECT_FALSE(fs::exists(tmp.dir / "PWNED")) << out::printable(s);
+    std::string lower = svg;
+    std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
+    EXPECT_EQ(lower.find("<script"), std::string::npos);
+    EXPECT_EQ(lower.find("<img"), std::string::npos);
+  }
+  fs::current_path(cwd);
+  EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
+}
+
+TEST(Sinks, HtmlReportQuotesNoMarkup) {
+  quadgen::diagnose::Diagnosis d;
+  for (const auto& s : hostile_strings()) {
+    d.vehicle = s;
+    const std::string html = quadgen::diagnose::diagnosis_html(d, s, {{s, "<svg></svg>"}});
+    EXPECT_EQ(html.find("<script>alert"), std::string::npos) << out::printable(s);
+    EXPECT_EQ(html.find("<img"), std::string::npos) << out::printable(s);
+    // The JSON beside it stays valid JSON whatever the bytes of the path.
+    EXPECT_NO_THROW(nlohmann::json::parse(out::json_document(quadgen::diagnose::diagnosis_json(d, s))));
+  }
+}
+
+TEST(Sinks, MarkdownAndLatexTextStayText) {
+  for (const auto& s : hostile_strings()) {
+    const std::string md = out::markdown_text(s);
+    EXPECT_EQ(md.find('\n'), std::string::npos);
+    EXPECT_EQ(md.find('<'), std::string::npos);
+    for (size_t i = 0; i < md.size(); ++i)
+      if (md[i] == '|' || md[i] == '`' || md[i] == '$') EXPECT_TRUE(i > 0 && md[i - 1] == '\\') << md;
+    const std::string tex = out::latex_text(s);
+    for (size_t i = 0; i < tex.size(); ++i)
+      if (std::string("$&%#_{}").find(tex[i]) != std::string::npos && tex[i] != '{' && tex[i] != '}')
+        EXPECT_TRUE(i > 0 && tex[i - 1] == '\\') << tex;
+  }
+  // The derivation report of a vehicle with a hostile description.
+  quadgen::Vehicle v = quadgen::test::finken3();
+  v.description = "</p><script>alert(1)</script> | $x$ `code`";
+  const auto mp = quadgen::derive_mass_properties(v);
+  const auto model = quadgen::derive_model(v, mp, {});
+  const quadgen::AuditResult no_audit;
+  const std::vector<quadgen::ThesisItem> no_thesis;
+  const quadgen::Derivation d{v, mp, model, no_audit, no_thesis};
+  const std::string md = quadgen::derivation_markdown(d);
+  EXPECT_EQ(md.find("<script>"), std::string::npos);
+  EXPECT_NE(md.find("&lt;script&gt;"), std::string::npos);
+}
+
+TEST(Sinks, LongSeriesAreThinnedKeepingTheirExtremes) {
+  quadgen::runtime::Series s{"long", {}, {}};
+  for (int i = 0; i < 1000000; ++i) s.x.push_back(i), s.y.push_back(i == 123457 ? 50.0 : std::sin(i * 1e-3));
+  const auto d = quadgen::runtime::decimated(s);
+  EXPECT_LE(d.x.size(), quadgen::runtime::kMaxPlotPointsPerSeries);
+  EXPECT_EQ(*std::max_element(d.y.begin(), d.y.end()), 50.0);
+  EXPECT_TRUE(std::is_sorted(d.x.begin(), d.x.end()));
+  EXPECT_LT(quadgen::runtime::gnuplot_script("t", {{"p", "x", "y", {s}}}).size(), 200000u);
+}
+
+// ---- data loss -----------------------------------------------------------------------------
+
+TEST(DataLoss, SimulateRefusesToWriteOverItsInputs) {
+  Scratch tmp;
+  const std::string vehicle = tmp / "v.yaml";
+  fs::copy_file(source_path("vehicles/finken3.yaml"), vehicle);
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.2", "--out", tmp / "log.csv"}, tmp.dir).rc, 0);
+  const std::string log = tmp / "log.csv";
+  const std::string v_before = read(vehicle), log_before = read(log);
+  fs::create_hard_link(log, tmp / "hardlink.csv");
+  fs::create_symlink(vehicle, tmp / "symlink.csv");
+  const std::vector<std::vector<std::string>> cases = {
+      {"simulate", vehicle, "--inputs", log, "--duration", "0.1", "--out", log},
+      {"simulate", vehicle, "--inputs", log, "--duration", "0.1", "--out", "./log.csv"},
+      {"simulate", vehicle, "--inputs", log, "--duration", "0.1", "--out", tmp / "hardlink.csv"},
+      {"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", vehicle},
+      {"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", tmp / "symlink.csv"},
+      {"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", tmp / "x.svg"},
+  };
+  for (const auto& c : cases) {
+    const CliResult r = run_quadgen(c, tmp.dir);
+    expect_one_line_error(r, "", c.back());
+    EXPECT_EQ(read(vehicle), v_before) << c.back();
+    EXPECT_EQ(read(log), log_before) << c.back();
+  }
+  EXPECT_FALSE(fs::exists(tmp / "x.svg"));
+}
+
+TEST(DataLoss, OutputDirectoriesHoldingOtherFilesOrInputsAreRefused) {
+  Scratch tmp;
+  const std::string vehicle = tmp / "v.yaml";
+  fs::copy_file(source_path("vehicles/finken3.yaml"), vehicle);
+  fs::create_directories(tmp / "mine");
+  write(tmp / "mine/notes.txt", "my notes");
+  const CliResult foreign = run_quadgen({"derive", vehicle, "--out", tmp / "mine"}, tmp.dir);
+  expect_one_line_error(foreign, "holds files quadgen did not write (notes.txt)", "foreign files");
+  EXPECT_EQ(read(tmp / "mine/notes.txt"), "my notes");
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", "."}, tmp.dir), "working directory", "--out .");
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp.dir.string()}, tmp.dir), "", "--out holding the input");
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", vehicle}, tmp.dir), "is or contains the input", "--out = input");
+  // The earlier run of quadgen itself is replaced.
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d", "--effects", "motor_lag"}, tmp.dir).rc, 0);
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
+  EXPECT_NE(read(tmp / "d/model.hpp").find("motor_lag"), std::string::npos);
+  // Nothing but the outputs beside them: no staging directories, no temporaries.
+  for (const auto& e : fs::directory_iterator(tmp.dir))
+    EXPECT_EQ(e.path().filename().string().find(".quadgen-tmp."), std::string::npos) << e.path();
+}
+
+// Killed at random moments, a run leaves its --out directory holding one complete run: the
+// earlier one or the new one, every file matching the manifest.
+TEST(DataLoss, SigkillAtRandomMomentsLeavesOneCompleteRun) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const std::string dir = tmp / "out";
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", dir}, tmp.dir).rc, 0);
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> when(0.0, 2.0);
+  int replaced = 0;
+  for (int k = 0; k < 12; ++k) {
+    const std::string before = read(fs::path(dir) / ".quadgen-manifest");
+    const std::vector<std::string> args =
+        k % 2 ? std::vector<std::string>{"derive", vehicle, "--out", dir, "--effects", k % 4 == 1 ? "motor_lag" : "wind"}
+              : std::vector<std::string>{"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", dir};
+    run_quadgen(args, tmp.dir, when(rng));
+    std::string why;
+    EXPECT_TRUE(out::complete_output_directory(dir, &why)) << "after kill " << k << ": " << why;
+    replaced += read(fs::path(dir) / ".quadgen-manifest") != before;
+  }
+  EXPECT_GT(replaced, 0);  // some runs finished: the kills did hit both phases
+}
+
+TEST(DataLoss, TwoRunsIntoOneDirectoryLeaveOneWhole) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const std::string dir = tmp / "out";
+  for (int round = 0; round < 3; ++round) {
+    CliResult a{}, b{};
+    std::thread ta([&] { a = run_quadgen({"derive", vehicle, "--out", dir}, tmp.dir); });
+    std::thread tb([&] { b = run_quadgen({"derive", vehicle, "--out", dir, "--effects", "motor_lag"}, tmp.dir); });
+    ta.join();
+    tb.join();
+    EXPECT_EQ(a.rc, 0) << a.err;
+    EXPECT_EQ(b.rc, 0) << b.err;
+    std::string why;
+    EXPECT_TRUE(out::complete_output_directory(dir, &why)) << why;
+  }
+  for (const auto& e : fs::directory_iterator(tmp.dir))
+    EXPECT_EQ(e.path().filename().string().find(".quadgen-tmp."), std::string::npos) << e.path();
+}
+
+// ---- options -------------------------------------------------------------------------------
+
+TEST(Options, EveryNumberIsCheckedAndNothingIsSilentlyIgnored) {
+  Scratch tmp;
+  const std::string f3 = source_path("vehicles/finken3.yaml");
+  const std::string steps = source_path("data/finken3_motor_steps.csv");
+  const std::string stand = source_path("../shared/data/crazyflie/thrust-stand/cf21_stock2.csv");
+  const std::string traj = tmp / "t.csv";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"simulate", f3, "--scenario", "hover", "--duration", "nan", "--out", traj}, "--duration"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "inf", "--out", traj}, "--duration"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--rate", "nan", "--out", traj}, "--rate"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--step", "-1", "--out", traj}, "--step"},
+      {{"simulate", f3, "--closed-loop", "--duration", "1", "--pose-noise", "-1", "--out", traj}, "--pose-noise"},
+      {{"simulate", f3, "--closed-loop", "--duration", "1", "--set", "c_t=abc", "--out", traj}, "--set"},
+      {{"simulate", f3, "--closed-loop", "--duration", "1", "--set", "c_t=nan", "--out", traj}, "--set"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--seed", "3", "--out", traj}, "--seed"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--set", "c_t=1", "--out", traj}, "--set"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--pose-noise", "0.1", "--out", traj}, "--pose-noise"},
+      {{"simulate", f3, "--closed-loop", "--duration", "1", "--step", "0.01", "--out", traj}, "--step"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1e8", "--out", traj}, "--no-size-limit"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1e12", "--out", traj}, "--duration"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "2", "--step", "1e-7", "--out", traj}, "integration steps"},
+      {{"fit", f3, steps, "--out", tmp / "f", "--effects", "motor_lag"}, "--effects: not used when fitting a motor-step log"},
+      {{"fit", f3, steps, "--out", tmp / "f", "--free", "c_t"}, "--free"},
+      {{"fit", f3, steps, "--out", tmp / "f", "--validation", "0.2"}, "--validation"},
+      {{"fit", f3, steps, "--out", tmp / "f", "--validation", "nan"}, "--validation"},
+      {{"fit", f3, stand, "--out", tmp / "f", "--channels", "ax"}, "--channels: not used when fitting a thrust-stand log"},
+      {{"diagnose", f3, steps, "--out", tmp / "g", "--alpha", "nan"}, "--alpha"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const CliResult r = run_quadgen(args, tmp.dir);
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    EXPECT_NE(r.rc, 0) << joined;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << joined << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(traj)) << joined;
+    EXPECT_FALSE(fs::exists(tmp / "f")) << joined;
+  }
+}
+
+TEST(Options, ReplayLongerThanTheLogIsRefused) {
+  Scratch tmp;
+  const std::string f3 = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", f3, "--scenario", "hover", "--duration", "0.5", "--out", tmp / "log.csv"}, tmp.dir).rc, 0);
+  const CliResult r = run_quadgen({"simulate", f3, "--inputs", tmp / "log.csv", "--duration", "10000", "--out", tmp / "r.csv"}, tmp.dir);
+  expect_one_line_error(r, "holds 0.5", "long replay");
+  EXPECT_FALSE(fs::exists(tmp / "r.csv"));
+}
