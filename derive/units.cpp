@@ -55,10 +55,40 @@ const std::map<std::string, Unit>& unit_table() {
       {"s", base(1, 0, 0, 1, 0)},        {"ms", base(1e-3, 0, 0, 1, 0)},
       {"min", base(60, 0, 0, 1, 0)},     {"A", base(1, 0, 0, 0, 1)},
       {"N", base(1, 1, 1, -2, 0)},       {"V", base(1, 2, 1, -3, -1)},
-      {"W", base(1, 2, 1, -3, 0)},       {"Hz", base(1, 0, 0, -1, 0)},
+      {"W", base(1, 2, 1, -3, 0)},
+      {"rev", base(2 * pi, 0, 0, 0, 0)},        // one revolution = 2 pi rad
       {"rpm", base(2 * pi / 60, 0, 0, -1, 0)},  // revolutions per minute -> rad/s
   };
   return table;
+}
+
+// Units that are refused rather than given one of two meanings (see units.hpp).
+const std::map<std::string, std::string>& refused_units() {
+  static const std::map<std::string, std::string> refused = {
+      {"Hz", "is ambiguous here (rad is dimensionless, so 1 Hz could be 1/s or 2 pi rad/s): write '1/s' for a rate "
+             "or 'rev/s' for a rotation rate (2 pi rad/s)"},
+  };
+  return refused;
+}
+
+// The exponent after '^': an optional sign and decimal digits, at most kMaxUnitExponent in
+// magnitude. Parsed by hand: std::stoi would overflow (UB in the multiplication later) or
+// throw out_of_range for long digit strings.
+int parse_exponent(const std::string& p, const std::string& whole) {
+  size_t i = 0;
+  bool negative = false;
+  if (i < p.size() && (p[i] == '+' || p[i] == '-')) negative = p[i++] == '-';
+  if (i == p.size()) throw UnitError("unit '" + whole + "': exponent '" + p + "' is not an integer");
+  int value = 0;
+  for (; i < p.size(); ++i) {
+    if (p[i] < '0' || p[i] > '9') throw UnitError("unit '" + whole + "': exponent '" + p + "' is not an integer");
+    value = value * 10 + (p[i] - '0');
+    if (value > kMaxUnitExponent) break;  // stop before the digits can overflow
+  }
+  if (value > kMaxUnitExponent)
+    throw UnitError("unit '" + whole + "': exponent '" + p + "' is out of range (expected |n| <= " +
+                    std::to_string(kMaxUnitExponent) + ")");
+  return negative ? -value : value;
 }
 
 // One factor "name" or "name^k".
@@ -68,18 +98,16 @@ Unit parse_factor(const std::string& tok, const std::string& whole) {
   auto caret = tok.find('^');
   if (caret != std::string::npos) {
     name = tok.substr(0, caret);
-    std::string p = tok.substr(caret + 1);
-    try {
-      size_t used = 0;
-      power = std::stoi(p, &used);
-      if (used != p.size()) throw std::invalid_argument(p);
-    } catch (const std::exception&) {
-      throw UnitError("unit '" + whole + "': exponent '" + p + "' is not an integer");
-    }
+    power = parse_exponent(tok.substr(caret + 1), whole);
   }
+  const auto refused = refused_units().find(name);
+  if (refused != refused_units().end()) throw UnitError("unit '" + whole + "': '" + name + "' " + refused->second);
   auto it = unit_table().find(name);
-  if (it == unit_table().end())
-    throw UnitError("unit '" + whole + "': unknown unit '" + name + "'");
+  if (it == unit_table().end()) {
+    std::string known;
+    for (const auto& [n, u] : unit_table()) known += (known.empty() ? "" : ", ") + n;
+    throw UnitError("unit '" + whole + "': unknown unit '" + name + "' (known: " + known + ", combined as in \"kg m^2\", \"N s/m\")");
+  }
   Unit u;
   u.scale = std::pow(it->second.scale, power);
   u.dim = it->second.dim.pow(power);
@@ -105,6 +133,11 @@ Unit parse_unit(const std::string& text) {
       result.dim = result.dim * f.dim;
     }
     tok.clear();
+    // Many bounded factors could still add up ("m^12 m^12 ..."): bound the whole unit too.
+    for (int e : result.dim.exp)
+      if (e > kMaxUnitExponent || e < -kMaxUnitExponent)
+        throw UnitError("unit '" + text + "': combined exponent " + std::to_string(e) + " is out of range (expected |n| <= " +
+                        std::to_string(kMaxUnitExponent) + ")");
   };
   if (text.empty()) throw UnitError("empty unit (write \"1\" for dimensionless)");
   for (char c : text) {

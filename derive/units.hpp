@@ -34,7 +34,16 @@ struct UnitError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Parses "kg m^2", "N s/m", "m/s^2", "rpm", "deg", "1". Throws UnitError.
+// Exponents ("m^n") are bounded, per factor and per base dimension of the whole unit.
+constexpr int kMaxUnitExponent = 12;
+
+// Parses "kg m^2", "N s/m", "m/s^2", "rpm", "rev/s", "deg", "1". Throws UnitError.
+//
+// Angles: rad is dimensionless (as in SI), so "rad/s" and "1/s" are the same unit, deg is
+// pi/180 and rev is 2 pi; rpm is rev/min = 2 pi/60 rad/s. "Hz" is refused with a hint
+// ("1/s" or "rev/s"): with rad dimensionless it would have to mean either 1/s or 2 pi rad/s,
+// and whichever were chosen, a value written with the other meaning in mind would pass
+// the dimension check and be off by 2 pi. Exponents beyond kMaxUnitExponent are refused.
 Unit parse_unit(const std::string& text);
 
 // Dimensional analysis: maps every symbol to its dimension and infers the dimension

@@ -15,3 +15,38 @@ TEST(Units, ParsesCompoundUnits) {
   EXPECT_THROW(parse_unit("furlong"), UnitError);
   EXPECT_THROW(parse_unit("m^x"), UnitError);
 }
+
+// Exponents are parsed without std::stoi (whose overflow would reach Dimension::pow as UB)
+// and bounded, per factor and for the unit as a whole.
+TEST(Units, RefusesExponentsBeyondTheBound) {
+  EXPECT_EQ(parse_unit("m^12").dim.exp[0], 12);
+  EXPECT_EQ(parse_unit("s^-12").dim.exp[2], -12);
+  EXPECT_EQ(parse_unit("m^+2").dim.exp[0], 2);
+  for (const char* bad : {"m^13", "m^-13", "m^2147483647", "m^-2147483648", "m^99999999999999999999", "m^", "m^-", "m^1.5"})
+    EXPECT_THROW(parse_unit(bad), UnitError) << bad;
+  EXPECT_THROW(parse_unit("m^12 m^12"), UnitError);  // combined exponent 24
+  try {
+    parse_unit("m^2147483647");
+    FAIL();
+  } catch (const UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("out of range"), std::string::npos) << e.what();
+  }
+}
+
+// rad is dimensionless, so Hz would pass for rad/s whatever it meant: it is refused, with
+// the two unambiguous spellings suggested; rev is 2 pi rad, consistent with rpm.
+TEST(Units, RefusesHzAndOffersRevPerSecond) {
+  for (const char* bad : {"Hz", "1/Hz", "N/Hz", "Hz^2"}) {
+    try {
+      parse_unit(bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const UnitError& e) {
+      EXPECT_NE(std::string(e.what()).find("rev/s"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("1/s"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NEAR(parse_unit("rev/s").scale, 2 * M_PI, 1e-15);
+  EXPECT_NEAR(parse_unit("rev/min").scale, parse_unit("rpm").scale, 1e-15);
+  EXPECT_EQ(parse_unit("rev/s").dim, parse_unit("rad/s").dim);
+  EXPECT_EQ(parse_unit("1/s").scale, 1.0);
+}
