@@ -2,10 +2,18 @@
 
 #include "attitude.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <cstring>
+#include <limits>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -17,59 +25,215 @@ std::vector<double> CsvTable::values(const std::string& name) const {
   const int c = column(name);
   if (c < 0) throw LogError(path + ": no column '" + name + "'");
   std::vector<double> v;
+  v.reserve(rows.size());
   for (const auto& r : rows) v.push_back(r[c]);
   return v;
 }
 
-CsvTable parse_csv(const std::string& text, const std::string& path) {
+int CsvTable::line_of(size_t row) const {
+  return row < lines.size() ? lines[row] : static_cast<int>(row) + 2;
+}
+
+namespace {
+
+[[noreturn]] void fail_at(const std::string& path, int line, const std::string& what) {
+  throw LogError(path + ":" + std::to_string(line) + ": " + what);
+}
+
+std::string number_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+// A cell as it may appear in a one-line message: long or binary junk is cut short.
+std::string quoted_cell(const std::string& cell) {
+  std::string shown;
+  for (char c : cell.substr(0, 40)) shown += (c >= 0x20 && c < 0x7f) ? c : '?';
+  return "'" + shown + (cell.size() > 40 ? "...'" : "'");
+}
+
+std::vector<std::string> split_header(const std::string& s) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream ss(s);
+  while (std::getline(ss, cell, ',')) cells.push_back(cell);
+  if (!s.empty() && s.back() == ',') cells.push_back("");
+  return cells;
+}
+
+// One data line into `row`. Each cell must be a finite number in full: strtod alone would
+// accept "1\0junk" (it stops at the NUL) and turn "1e400" into inf.
+void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vector<double>& row) {
+  const size_t n = static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+  if (n != t.columns.size())
+    fail_at(t.path, lineno, "expected " + std::to_string(t.columns.size()) + " values, got " + std::to_string(n));
+  row.clear();
+  row.reserve(n);
+  std::string cell;
+  size_t start = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t comma = line.find(',', start);
+    const size_t stop = comma == std::string::npos ? line.size() : comma;
+    cell.assign(line, start, stop - start);
+    start = stop + 1;
+    char* end = nullptr;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (cell.empty() || end != cell.c_str() + cell.size())
+      fail_at(t.path, lineno, "column '" + t.columns[i] + "': expected a number, got " + quoted_cell(cell));
+    if (!std::isfinite(v))
+      fail_at(t.path, lineno, "column '" + t.columns[i] + "' is not finite (" + quoted_cell(cell) + "; expected a finite number)");
+    row.push_back(v);
+  }
+}
+
+// The table from a source of lines ('\n' removed). size_hint (bytes, 0 if unknown) only
+// sizes the row vector, so that a large log is not copied again and again as it grows.
+template <class NextLine>
+CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned long long size_hint) {
   CsvTable t;
   t.path = path;
-  std::istringstream in(text);
   std::string line;
+  std::vector<double> row;
   int lineno = 0;
-  auto fail = [&](const std::string& what) { throw LogError(path + ":" + std::to_string(lineno) + ": " + what); };
-  auto split = [](const std::string& s) {
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream ss(s);
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    if (!s.empty() && s.back() == ',') cells.push_back("");
-    return cells;
-  };
-  while (std::getline(in, line)) {
+  while (next_line(line)) {
+    if (lineno == std::numeric_limits<int>::max()) fail_at(path, lineno, "too many lines (line numbers are int)");
     ++lineno;
+    if (lineno == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 BOM
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     if (t.columns.empty()) {
-      t.columns = split(line);
+      t.columns = split_header(line);
       std::set<std::string> seen;
       for (const auto& c : t.columns)
-        if (!seen.insert(c).second) fail("duplicate column '" + c + "'");
+        if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column '" + c + "'");
       continue;
     }
-    const auto cells = split(line);
-    if (cells.size() != t.columns.size())
-      fail("expected " + std::to_string(t.columns.size()) + " values, got " + std::to_string(cells.size()));
-    std::vector<double> row;
-    for (size_t i = 0; i < cells.size(); ++i) {
-      char* end = nullptr;
-      const double v = std::strtod(cells[i].c_str(), &end);
-      if (cells[i].empty() || end == cells[i].c_str() || *end != '\0')
-        fail("column '" + t.columns[i] + "': expected a number, got '" + cells[i] + "'");
-      row.push_back(v);
+    parse_row(line, t, lineno, row);
+    try {
+      if (t.rows.empty() && size_hint > 0) {
+        const size_t estimate = static_cast<size_t>(size_hint / (line.size() + 1)) + 16;
+        t.rows.reserve(estimate);
+        t.lines.reserve(estimate);
+      }
+      t.rows.push_back(row);
+      t.lines.push_back(lineno);
+    } catch (const std::bad_alloc&) {  // a narrow table costs more than its text: say so
+      fail_at(path, lineno, "out of memory holding the log (" + std::to_string(t.rows.size()) + " rows of " +
+                                std::to_string(t.columns.size()) + " columns read)");
     }
-    t.rows.push_back(std::move(row));
   }
-  if (t.columns.empty()) throw LogError(path + ":1: empty log (expected a header line)");
+  if (t.columns.empty()) fail_at(path, 1, "empty log (expected a header line)");
   return t;
 }
 
+// Lines of an open file descriptor, read in blocks; refuses to read past `limit` bytes
+// (the file may grow after its size was checked).
+class FdLines {
+ public:
+  FdLines(int fd, const std::string& path, unsigned long long limit) : fd_(fd), path_(path), limit_(limit) {}
+  bool operator()(std::string& line) {
+    line.clear();
+    for (;;) {
+      if (pos_ == len_ && !fill()) return !line.empty();
+      const char* begin = buf_.data() + pos_;
+      const void* nl = std::memchr(begin, '\n', len_ - pos_);
+      const size_t take = nl ? static_cast<const char*>(nl) - begin : len_ - pos_;
+      line.append(begin, take);
+      pos_ += take;
+      if (nl) {
+        ++pos_;
+        return true;
+      }
+    }
+  }
+
+ private:
+  bool fill() {
+    ssize_t got;
+    do got = ::read(fd_, buf_.data(), buf_.size());
+    while (got < 0 && errno == EINTR);
+    if (got < 0) throw LogError(path_ + ": read error: " + std::strerror(errno));
+    total_ += static_cast<unsigned long long>(got);
+    if (total_ > limit_)
+      throw LogError(path_ + ": grew beyond the limit of " + std::to_string(limit_) +
+                     " bytes while being read (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+    pos_ = 0;
+    len_ = static_cast<size_t>(got);
+    return got > 0;
+  }
+  int fd_;
+  const std::string& path_;
+  unsigned long long limit_, total_ = 0;
+  std::vector<char> buf_ = std::vector<char>(1 << 16);
+  size_t pos_ = 0, len_ = 0;
+};
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+const char* file_kind(mode_t m) {
+  if (S_ISDIR(m)) return "a directory";
+  if (S_ISFIFO(m)) return "a FIFO";
+  if (S_ISCHR(m)) return "a character device";
+  if (S_ISBLK(m)) return "a block device";
+  if (S_ISSOCK(m)) return "a socket";
+  return "not a regular file";
+}
+
+}  // namespace
+
+unsigned long long max_input_bytes() {
+  const char* env = std::getenv("QUADGEN_MAX_INPUT_BYTES");
+  if (!env) return kDefaultMaxInputBytes;
+  const std::string s = env;
+  unsigned long long v = 0;
+  bool ok = !s.empty() && s.size() <= 19;  // 19 digits cannot overflow 64 bits
+  for (char c : s) ok = ok && c >= '0' && c <= '9';
+  if (ok) v = std::stoull(s);
+  if (!ok || v == 0)
+    throw LogError("QUADGEN_MAX_INPUT_BYTES='" + s + "': expected a positive whole number of bytes");
+  return v;
+}
+
+CsvTable parse_csv(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
+  return parse_lines([&](std::string& line) { return static_cast<bool>(std::getline(in, line)); }, path, text.size());
+}
+
 CsvTable read_csv(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw LogError(path + ": cannot open log");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_csv(ss.str(), path);
+  // O_NONBLOCK so that opening a FIFO cannot block; the checks then use fstat on what was
+  // opened, not a second look-up of the path.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
+  const FdCloser closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw LogError(path + ": cannot stat log: " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    throw LogError(path + ": " + file_kind(st.st_mode) + ", not a regular file (expected a CSV log)");
+  const unsigned long long size = static_cast<unsigned long long>(st.st_size), limit = max_input_bytes();
+  if (size > limit)
+    throw LogError(path + ": " + std::to_string(size) + " bytes, above the limit of " + std::to_string(limit) +
+                   " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  FdLines lines(fd, path, limit);
+  return parse_lines(lines, path, size);
+}
+
+void check_values(const CsvTable& log) {
+  const int tc = log.column("t");
+  for (size_t i = 0; i < log.rows.size(); ++i)
+    for (size_t c = 0; c < log.columns.size(); ++c) {
+      const double v = log.rows[i][c];
+      if (!std::isfinite(v)) fail_at(log.path, log.line_of(i), "column '" + log.columns[c] + "' is not finite");
+      const double bound = static_cast<int>(c) == tc ? kMaxAbsTime : kMaxAbsValue;
+      if (std::fabs(v) > bound)
+        fail_at(log.path, log.line_of(i),
+                "column '" + log.columns[c] + "' is " + number_text(v) + ", beyond the sanity bound |value| <= " +
+                    number_text(bound) + " (canonical SI units)");
+    }
 }
 
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors) {
@@ -84,14 +248,13 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   for (const auto& r : rotors)
     if (log.column("u_" + r) < 0) throw LogError(log.path + ":1: missing column 'u_" + r + "'");
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
+  check_values(log);
   const int tc = log.column("t");
   for (size_t i = 0; i < log.rows.size(); ++i) {
-    for (size_t c = 0; c < log.columns.size(); ++c)
-      if (!std::isfinite(log.rows[i][c]))
-        throw LogError(log.path + ":" + std::to_string(i + 2) + ": column '" + log.columns[c] + "' is not finite");
+    const int line = log.line_of(i);
     if (i > 0 && !(log.rows[i][tc] > log.rows[i - 1][tc]))
-      throw LogError(log.path + ":" + std::to_string(i + 2) + ": time not strictly increasing (" +
-                     std::to_string(log.rows[i - 1][tc]) + " then " + std::to_string(log.rows[i][tc]) + ")");
+      fail_at(log.path, line, "time not strictly increasing (" + std::to_string(log.rows[i - 1][tc]) + " then " +
+                                  std::to_string(log.rows[i][tc]) + ")");
   }
 }
 

@@ -18,16 +18,40 @@ struct CsvTable {
   std::string path;
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;
+  // Line in `path` of each row (blank lines and the header are skipped, so row k is not
+  // always on line k + 2). Tables built in code may leave it empty: see line_of.
+  std::vector<int> lines;
   int column(const std::string& name) const;  // -1 if absent
   std::vector<double> values(const std::string& name) const;
+  int line_of(size_t row) const;  // lines[row], or row + 2 where no line was recorded
 };
 
-// Numbers only (an empty cell is an error); throws LogError "path:line: ...".
+// Sanity bounds on numbers in logs: a value beyond them is a corrupt or mis-scaled log,
+// and letting it through overflows the fit (squares of 1e160 are inf). In canonical SI
+// units every column satisfies |v| <= kMaxAbsValue, except t, which may be a Unix time
+// in seconds (|t| <= kMaxAbsTime, i.e. before the year 2286).
+constexpr double kMaxAbsValue = 1e9;
+constexpr double kMaxAbsTime = 1e10;
+
+// Largest log read_csv accepts, in bytes: 2 GiB unless the environment variable
+// QUADGEN_MAX_INPUT_BYTES (a positive whole number of bytes) says otherwise.
+constexpr unsigned long long kDefaultMaxInputBytes = 2ULL << 30;
+unsigned long long max_input_bytes();  // throws LogError for a malformed variable
+
+// Finite numbers only (an empty cell, nan, inf or an overflowing literal is an error); a
+// UTF-8 byte-order mark before the header is skipped; throws LogError "path:line: ...".
+// read_csv refuses anything but a regular file (a FIFO or a device would block or never
+// end) and files above max_input_bytes(), and parses line by line.
 CsvTable read_csv(const std::string& path);
 CsvTable parse_csv(const std::string& text, const std::string& path);
 
+// Every value finite and within the sanity bounds above (a column named t against
+// kMaxAbsTime); throws LogError "path:line: ..." naming the column.
+void check_values(const CsvTable& log);
+
 // Checks the canonical layout for these rotors: t strictly increasing, u_<rotor> present
-// for every rotor and no u_ column for an unknown rotor, finite values, at least 2 rows.
+// for every rotor and no u_ column for an unknown rotor, finite values within the sanity
+// bounds above, at least 2 rows.
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotor_names);
 
 // Canonical-layout CSV of a trajectory: t, u_*, x, y, z, qw..qz, phi, theta, psi, vx, vy,
