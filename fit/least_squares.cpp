@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
@@ -13,9 +14,13 @@ namespace {
 
 // All parameters in one block; the residual model's Jacobian is passed through, each row
 // scaled by its channel's weight.
+// A point whose residuals or (free) Jacobian columns are not finite is reported as not
+// evaluable: Ceres then rejects the step, or fails at the start (solve_weighted throws).
+// Fixed columns are not looked at: a model may leave them unwritten (set_free).
 class WeightedCost : public ceres::CostFunction {
  public:
-  WeightedCost(const ResidualModel& m, int n_params, const std::vector<double>& w) : m_(m), n_(n_params), w_(w) {
+  WeightedCost(const ResidualModel& m, int n_params, const std::vector<double>& w, std::vector<bool> free)
+      : m_(m), n_(n_params), w_(w), free_(std::move(free)) {
     set_num_residuals(m.num_residuals());
     mutable_parameter_block_sizes()->push_back(n_params);
   }
@@ -29,9 +34,13 @@ class WeightedCost : public ceres::CostFunction {
     for (int i = 0; i < nr; ++i) {
       const double w = w_[m_.channel_of(i)];
       r[i] *= w;
-      if (J && J[0])
-        for (int j = 0; j < n_; ++j) J[0][i * n_ + j] *= w;
       if (!std::isfinite(r[i])) return false;
+      if (!(J && J[0])) continue;
+      double* row = J[0] + static_cast<size_t>(i) * n_;
+      for (int j = 0; j < n_; ++j) {
+        row[j] *= w;
+        if (free_[j] && !std::isfinite(row[j])) return false;
+      }
     }
     return true;
   }
@@ -40,7 +49,34 @@ class WeightedCost : public ceres::CostFunction {
   const ResidualModel& m_;
   int n_;
   std::vector<double> w_;
+  std::vector<bool> free_;
 };
+
+std::vector<bool> free_mask(const std::vector<FitParameter>& ps) {
+  std::vector<bool> m;
+  for (const auto& p : ps) m.push_back(p.free);
+  return m;
+}
+
+std::string values_text(const std::vector<FitParameter>& ps) {
+  std::ostringstream os;
+  for (const auto& p : ps) os << (os.tellp() ? ", " : "") << p.name << " = " << p.value;
+  return os.str();
+}
+
+// The covariance of the free parameters needs a finite information matrix J^T J (Ceres
+// forms it and hands it to Eigen's JacobiSVD, which crashes or never ends on inf/NaN).
+void require_finite_information(const Eigen::MatrixXd& Jf, const std::vector<FitParameter>& ps,
+                                const std::vector<int>& free_idx) {
+  for (Eigen::Index k = 0; k < Jf.cols(); ++k)
+    if (!Jf.col(k).allFinite())
+      throw FitError("covariance: the Jacobian column of " + ps[free_idx[k]].name +
+                     " is not finite at the estimate (" + values_text(ps) + ")");
+  const Eigen::MatrixXd info = Jf.transpose() * Jf;
+  if (!info.allFinite())
+    throw FitError("covariance: J^T J overflows at the estimate (a residual or Jacobian entry beyond ~1e150 in units of "
+                   "the noise: a corrupt or mis-scaled sample?)");
+}
 
 
 }  // namespace
@@ -49,14 +85,13 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
   std::vector<double> x = parameter_values(params);
-  std::vector<bool> free_mask;
-  for (const auto& p : params) free_mask.push_back(p.free);
-  model.set_free(free_mask);
+  const std::vector<bool> free = free_mask(params);
+  model.set_free(free);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
-  problem.AddResidualBlock(new WeightedCost(model, n, w), loss, x.data());
+  problem.AddResidualBlock(new WeightedCost(model, n, w, free), loss, x.data());
   std::vector<int> fixed;
   for (int i = 0; i < n; ++i) {
     if (!params[i].free) {
@@ -70,7 +105,8 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   }
   if (static_cast<int>(fixed.size()) == n) {
     double cost = 0;
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+    if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr) || !std::isfinite(cost))
+      throw FitError("least squares: a residual is not finite at " + values_text(params));
     if (converged) *converged = true;
     return 2 * cost;
   }
@@ -85,6 +121,11 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   so.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  // FAILURE is an evaluation or linear-solver error, most often a residual or Jacobian
+  // entry that is not finite at the start; its cost (-1 when never evaluated) means nothing.
+  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.initial_cost) || !std::isfinite(summary.final_cost))
+    throw FitError("least squares failed (" + summary.message + ") starting from " + values_text(params) +
+                   ": a residual or Jacobian entry is not finite there");
   for (int i = 0; i < n; ++i) params[i].value = x[i];
   if (converged) *converged = summary.termination_type == ceres::CONVERGENCE;
   if (report) *report = summary.BriefReport();
@@ -112,7 +153,12 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   auto estimate_noise = [&]() {
     model.evaluate(parameter_values(params).data(), r.data(), nullptr);
     std::vector<std::vector<double>> per(nc);
-    for (int i = 0; i < nr; ++i) per[model.channel_of(i)].push_back(r[i]);
+    for (int i = 0; i < nr; ++i) {
+      if (!std::isfinite(r[i]))
+        throw FitError("residual " + std::to_string(i) + " (channel " + channels[model.channel_of(i)] +
+                       ") is not finite at " + values_text(params));
+      per[model.channel_of(i)].push_back(r[i]);
+    }
     for (int c = 0; c < nc; ++c) {
       auto& s = res.channels[c];
       const auto& v = per[c];
@@ -128,6 +174,9 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
       // Degrees of freedom shared out over channels in proportion to their size.
       const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
       s.sigma = std::sqrt(rss / std::max(dof, 1.0));
+      if (!std::isfinite(s.sigma))
+        throw FitError("channel " + channels[c] + ": the residuals' sum of squares overflows (residuals beyond ~1e150: a "
+                       "corrupt or mis-scaled sample?)");
       if (!(s.sigma > 0)) s.sigma = 1e-300;
       s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
       const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
@@ -158,7 +207,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
     ceres::Problem problem(po);
-    problem.AddResidualBlock(new WeightedCost(model, n, w), nullptr, x.data());
+    problem.AddResidualBlock(new WeightedCost(model, n, w, free_mask(params)), nullptr, x.data());
     std::vector<int> fixed;
     for (int i = 0; i < n; ++i)
       if (!params[i].free) fixed.push_back(i);
@@ -169,16 +218,22 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
     co.min_reciprocal_condition_number = 1e-14;
     ceres::Covariance cov(co);
     const std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
-    std::vector<double> C(free_idx.size() * free_idx.size(), std::numeric_limits<double>::quiet_NaN());
-    if (cov.Compute(blocks, &problem)) cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data());
-    // Rank of the weighted Jacobian over the free parameters: a deficient one means some
-    // combination is not determined at all, whatever the pseudo-inverse says.
+    // The weighted Jacobian over the free parameters, checked before Ceres sees it.
     std::vector<double> J(static_cast<size_t>(nr) * n);
     model.evaluate(x.data(), r.data(), J.data());
     Eigen::MatrixXd Jf(nr, free_idx.size());
     for (int i = 0; i < nr; ++i)
       for (size_t k = 0; k < free_idx.size(); ++k)
         Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
+    require_finite_information(Jf, params, free_idx);
+    std::vector<double> C(free_idx.size() * free_idx.size(), std::numeric_limits<double>::quiet_NaN());
+    if (!free_idx.empty() &&
+        (!cov.Compute(blocks, &problem) || !cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data())))
+      throw FitError("covariance of the free parameters could not be computed at " + values_text(params));
+    for (double c : C)
+      if (!std::isfinite(c)) throw FitError("covariance of the free parameters is not finite at " + values_text(params));
+    // Rank of the weighted Jacobian over the free parameters: a deficient one means some
+    // combination is not determined at all, whatever the pseudo-inverse says.
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jf);
     qr.setThreshold(1e-10);
     const bool singular = qr.rank() < static_cast<long>(free_idx.size());

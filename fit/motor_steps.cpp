@@ -1,20 +1,56 @@
 #include "motor_steps.hpp"
 
 #include <cmath>
+#include <sstream>
 
 #include "flight_log.hpp"
 
 namespace quadgen::fit {
 
+namespace {
+
+// The CSV reader's errors (file:line, non-finite cells, size) as this layer's FitError.
+runtime::CsvTable read_table(const std::string& path) {
+  try {
+    return runtime::read_csv(path);
+  } catch (const runtime::LogError& e) {
+    throw FitError(e.what());
+  }
+}
+
+// Sanity bounds (the file's units; parse_csv has refused non-finite values):
+// |time_ms| <= 1e13 (a Unix time in ms is allowed), 0 <= throttle_percent <= 100,
+// 0 <= rpm <= 1e9.
+void check_row(const runtime::CsvTable& t, size_t row) {
+  struct Bound {
+    const char* column;
+    double lo, hi;
+    const char* expected;
+  };
+  static const Bound bounds[] = {{"time_ms", -1e13, 1e13, "|time_ms| <= 1e13"},
+                                 {"throttle_percent", 0, 100, "a throttle in [0, 100] %"},
+                                 {"rpm", 0, 1e9, "a rotor speed in [0, 1e9] rpm"}};
+  for (const auto& b : bounds) {
+    const double v = t.rows[row][t.column(b.column)];
+    if (v >= b.lo && v <= b.hi) continue;
+    std::ostringstream os;
+    os << t.path << ":" << t.line_of(row) << ": column '" << b.column << "' is " << v << ", expected " << b.expected;
+    throw FitError(os.str());
+  }
+}
+
+}  // namespace
+
 std::vector<MotorStep> read_motor_steps(const std::string& path) {
-  const runtime::CsvTable t = runtime::read_csv(path);
+  const runtime::CsvTable t = read_table(path);
   for (const char* c : {"time_ms", "throttle_percent", "rpm"})
     if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (motor step layout)");
+  for (size_t i = 0; i < t.rows.size(); ++i) check_row(t, i);
   const auto time = t.values("time_ms"), thr = t.values("throttle_percent"), rpm = t.values("rpm");
   std::vector<MotorStep> steps;
   for (size_t i = 1; i < time.size(); ++i) {
     if (!(time[i] > time[i - 1]))
-      throw FitError(path + ":" + std::to_string(i + 2) + ": time not strictly increasing");
+      throw FitError(path + ":" + std::to_string(t.line_of(i)) + ": time not strictly increasing");
     if (thr[i] == thr[i - 1]) {
       if (!steps.empty() && thr[i] == steps.back().u_new * 100 && time[i] > steps.back().t_first) {
         steps.back().t.push_back(time[i] / 1000);

@@ -29,7 +29,12 @@ void walk(const ResidualModel& model, const FitResult& best, int k, double dir, 
       *reached_bound = true;
     }
     ps[k].value = next;
-    const double c = solve_weighted(model, ps, best.weights, fo);
+    double c = 0;
+    try {
+      c = solve_weighted(model, ps, best.weights, fo);
+    } catch (const FitError& e) {  // say which profile point could not be fitted
+      throw FitError("profile of " + ps[k].name + " at " + std::to_string(next) + ": " + e.what());
+    }
     std::vector<double> vals;
     for (const auto& p : ps) vals.push_back(p.value);
     const double d = c - best.chi2;

@@ -1,24 +1,57 @@
 #include "thrust_stand.hpp"
 
 #include <cmath>
+#include <sstream>
 
 #include "flight_log.hpp"
 
 namespace quadgen::fit {
 
+namespace {
+
+// The CSV reader's errors (file:line, non-finite cells, size) as this layer's FitError.
+runtime::CsvTable read_table(const std::string& path) {
+  try {
+    return runtime::read_csv(path);
+  } catch (const runtime::LogError& e) {
+    throw FitError(e.what());
+  }
+}
+
+// A value of the stand file within [lo, hi], else FitError "path:line: ...".
+double checked(const runtime::CsvTable& t, size_t row, int col, double lo, double hi, const char* expected) {
+  const double v = t.rows[row][col];
+  if (!(v >= lo && v <= hi)) {
+    std::ostringstream os;
+    os << t.path << ":" << t.line_of(row) << ": column '" << t.columns[col] << "' is " << v << ", expected " << expected;
+    throw FitError(os.str());
+  }
+  return v;
+}
+
+}  // namespace
+
+// Sanity bounds (the file's units): weight[g] is signed, the tared scale reads a little
+// below zero at rest, but |weight| <= 1e9 g; 0 <= pwm <= 65535 (a 16-bit command);
+// 0 <= vbat[V] <= 1000 and > 0 where the motors run (the speed model takes log(vbat));
+// 0 <= rpm_i <= 1e9. parse_csv has already refused non-finite values.
 std::vector<StandSample> read_thrust_stand(const std::string& path) {
-  const runtime::CsvTable t = runtime::read_csv(path);
+  const runtime::CsvTable t = read_table(path);
   for (const char* c : {"weight[g]", "pwm", "vbat[V]", "rpm1", "rpm2", "rpm3", "rpm4"})
     if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (thrust-stand layout)");
   const double rpm = 2 * M_PI / 60;
+  const int cw = t.column("weight[g]"), cu = t.column("pwm"), cv = t.column("vbat[V]");
   std::vector<StandSample> out;
-  for (const auto& row : t.rows) {
+  for (size_t k = 0; k < t.rows.size(); ++k) {
     StandSample s;
-    s.thrust = row[t.column("weight[g]")] * 1e-3 * 9.80665;  // grams-force -> N
-    s.u = row[t.column("pwm")] / 65535.0;
-    s.vbat = row[t.column("vbat[V]")];
-    for (int i = 0; i < 4; ++i) s.w[i] = row[t.column("rpm" + std::to_string(i + 1))] * rpm;
-    if (s.u > 0 && s.w[0] > 0) out.push_back(s);
+    s.thrust = checked(t, k, cw, -1e9, 1e9, "|weight| <= 1e9 g") * 1e-3 * 9.80665;  // grams-force -> N
+    s.u = checked(t, k, cu, 0, 65535, "a PWM command in [0, 65535]") / 65535.0;
+    s.vbat = checked(t, k, cv, 0, 1000, "a battery voltage in [0, 1000] V");
+    for (int i = 0; i < 4; ++i)
+      s.w[i] = checked(t, k, t.column("rpm" + std::to_string(i + 1)), 0, 1e9, "a rotor speed in [0, 1e9] rpm") * rpm;
+    if (!(s.u > 0 && s.w[0] > 0)) continue;
+    if (!(s.vbat > 0)) checked(t, k, cv, 1e-300, 1000, "a positive battery voltage where the motors run");
+    out.push_back(s);
   }
   if (out.size() < 10) throw FitError(path + ": too few samples with the motors running");
   return out;
