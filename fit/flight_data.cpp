@@ -3,14 +3,127 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Dense>
 #include <yaml-cpp/yaml.h>
 
 #include "least_squares.hpp"
+#include "units.hpp"
 
 namespace quadgen::fit {
+
+// Column mappings (e.g. data/mappings/nanobench.yaml):
+//
+//   name: TEXT                       optional, names the mapping in messages
+//   columns:
+//     CANONICAL: {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}
+//
+// canonical value = (source * scale + offset) converted from `unit` to the canonical
+// column's SI unit: `unit` is the unit of (source * scale + offset), parsed by the same
+// unit module as the vehicle files (derive/units.hpp, parse_unit), and its dimension must
+// be the canonical column's (t: s; x, y, z: m; vx, vy, vz: m/s; p, q, r: rad/s;
+// ax, ay, az: m/s^2; qw..qz, u_*: 1; phi, theta, psi: rad; w_*: rad/s; vbat: V). So
+// "deg/s" for p converts to rad/s by itself, and "m/s" for p is an error. Without `unit`
+// the value is taken as already in the canonical unit. scale defaults to 1, offset to 0.
+// Only the keys above are allowed, each once (at the top level, in `columns` and in each
+// entry), and every target must be a canonical column; anything else is a file:line
+// error, so that a typo ("sacle") cannot silently leave a column unscaled.
+
+namespace {
+
+[[noreturn]] void mapping_error(const std::string& path, const YAML::Node& at, const std::string& what) {
+  throw FitError(path + ":" + std::to_string(at.Mark().line >= 0 ? at.Mark().line + 1 : 1) + ": " + what);
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::string scalar_text(const std::string& path, const YAML::Node& n, const std::string& what) {
+  if (!n.IsScalar()) mapping_error(path, n, what + ": expected a single value");
+  return n.Scalar();
+}
+
+double number_field(const std::string& path, const YAML::Node& n, const std::string& what) {
+  const std::string text = scalar_text(path, n, what);
+  double v = 0;
+  if (!YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+    mapping_error(path, n, what + ": expected a finite number, got '" + text + "'");
+  return v;
+}
+
+// The keys of a YAML map, each allowed and present once; returns key -> value node.
+std::map<std::string, YAML::Node> checked_keys(const std::string& path, const YAML::Node& map, const std::string& where,
+                                               const std::vector<std::string>& allowed) {
+  std::map<std::string, YAML::Node> out;
+  for (const auto& kv : map) {
+    const std::string key = scalar_text(path, kv.first, where + ": key");
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + join(allowed) + ")");
+    if (!out.emplace(key, kv.second).second)
+      mapping_error(path, kv.first, where + ": duplicate key '" + key + "' (each of " + join(allowed) + " at most once)");
+  }
+  return out;
+}
+
+// The unit conversion of one entry: checked against the canonical column's dimension.
+double unit_scale(const std::string& path, const YAML::Node& at, const std::string& target, const std::string& unit) {
+  const std::string canonical = canonical_unit(target);
+  Unit u, want;
+  try {
+    u = parse_unit(unit);
+  } catch (const UnitError& e) {
+    mapping_error(path, at, "column '" + target + "': " + e.what());
+  }
+  want = parse_unit(canonical);
+  if (u.dim != want.dim)
+    mapping_error(path, at, "column '" + target + "': unit '" + unit + "' has dimension " + u.dim.str() + ", but '" + target +
+                                "' is in " + canonical + " (dimension " + want.dim.str() + ")");
+  return u.scale / want.scale;
+}
+
+const char* const kCanonicalColumns =
+    "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>";
+
+ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key, const YAML::Node& value) {
+  ColumnMapping::Entry e;
+  e.target = scalar_text(path, key, "column name");
+  if (canonical_unit(e.target).empty())
+    mapping_error(path, key, "'" + e.target + "' is not a canonical column (expected one of " + kCanonicalColumns + ")");
+  const std::string where = "column '" + e.target + "'";
+  if (!value.IsMap()) mapping_error(path, key, where + ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}");
+  const auto f = checked_keys(path, value, where, {"source", "scale", "offset", "unit"});
+  if (!f.count("source")) mapping_error(path, key, where + ": missing 'source' (the log's column)");
+  e.source = scalar_text(path, f.at("source"), where + ": source");
+  if (f.count("scale")) e.scale = number_field(path, f.at("scale"), where + ": scale");
+  if (f.count("offset")) e.offset = number_field(path, f.at("offset"), where + ": offset");
+  if (f.count("unit")) {
+    e.unit = scalar_text(path, f.at("unit"), where + ": unit");
+    e.unit_scale = unit_scale(path, f.at("unit"), e.target, e.unit);
+  }
+  return e;
+}
+
+}  // namespace
+
+std::string canonical_unit(const std::string& c) {
+  static const std::map<std::string, std::string> units = {
+      {"t", "s"},       {"x", "m"},       {"y", "m"},         {"z", "m"},       {"vx", "m/s"},    {"vy", "m/s"},
+      {"vz", "m/s"},    {"qw", "1"},      {"qx", "1"},        {"qy", "1"},      {"qz", "1"},      {"phi", "rad"},
+      {"theta", "rad"}, {"psi", "rad"},   {"p", "rad/s"},     {"q", "rad/s"},   {"r", "rad/s"},   {"ax", "m/s^2"},
+      {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},
+  };
+  const auto it = units.find(c);
+  if (it != units.end()) return it->second;
+  if (c.size() > 2 && c.rfind("u_", 0) == 0) return "1";
+  if (c.size() > 2 && c.rfind("w_", 0) == 0) return "rad/s";
+  return "";
+}
 
 ColumnMapping load_mapping(const std::string& path) {
   std::ifstream in(path);
@@ -27,30 +140,23 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   } catch (const YAML::ParserException& e) {
     throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
   }
-  if (!root.IsMap() || !root["columns"] || !root["columns"].IsMap())
-    throw FitError(path + ":1: expected a 'columns' mapping");
+  if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
-  int line = 1;
-  try {  // yaml-cpp's conversion errors (a list where a name belongs, ...) end as one line
-    m.name = root["name"] ? root["name"].as<std::string>() : path;
-    for (const auto& kv : root["columns"]) {
-      ColumnMapping::Entry e;
-      line = kv.first.Mark().line + 1;
-      e.target = kv.first.as<std::string>();
-      const YAML::Node n = kv.second;
-      if (!n.IsMap() || !n["source"])
-        throw FitError(path + ":" + std::to_string(line) + ": expected {source: COLUMN, scale, offset, unit}");
-      e.source = n["source"].as<std::string>();
-      if (n["scale"]) e.scale = n["scale"].as<double>();
-      if (n["offset"]) e.offset = n["offset"].as<double>();
-      if (!std::isfinite(e.scale) || !std::isfinite(e.offset))
-        throw FitError(path + ":" + std::to_string(line) + ": scale and offset must be finite numbers");
-      if (n["unit"]) e.unit = n["unit"].as<std::string>();
-      m.entries.push_back(e);
+  try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
+    const auto top = checked_keys(path, root, "mapping", {"name", "columns"});
+    if (!top.count("columns") || !top.at("columns").IsMap())
+      throw FitError(path + ":1: expected a 'columns' mapping (canonical column: {source, scale, offset, unit})");
+    m.name = top.count("name") ? scalar_text(path, top.at("name"), "name") : path;
+    std::set<std::string> targets;
+    for (const auto& kv : top.at("columns")) {
+      ColumnMapping::Entry e = parse_entry(path, kv.first, kv.second);
+      if (!targets.insert(e.target).second)
+        mapping_error(path, kv.first, "columns: duplicate key '" + e.target + "' (each canonical column at most once)");
+      m.entries.push_back(std::move(e));
     }
   } catch (const YAML::Exception& e) {
-    throw FitError(path + ":" + std::to_string(e.mark.line >= 0 ? e.mark.line + 1 : line) +
-                   ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: TEXT}");
+    throw FitError(path + ":" + std::to_string(e.mark.line >= 0 ? e.mark.line + 1 : 1) + ": " + e.msg +
+                   " (expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT})");
   }
   return m;
 }
@@ -58,6 +164,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m) {
   runtime::CsvTable out;
   out.path = raw.path;
+  out.lines = raw.lines;
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);
@@ -65,10 +172,16 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
     src.push_back(c);
     out.columns.push_back(e.target);
   }
+  out.rows.reserve(raw.rows.size());
   for (const auto& row : raw.rows) {
     std::vector<double> r;
-    for (size_t i = 0; i < src.size(); ++i) r.push_back(row[src[i]] * m.entries[i].scale + m.entries[i].offset);
-    out.rows.push_back(r);
+    r.reserve(src.size());
+    for (size_t i = 0; i < src.size(); ++i) {
+      const auto& e = m.entries[i];
+      const double v = row[src[i]] * e.scale + e.offset;
+      r.push_back(e.unit_scale == 1 ? v : v * e.unit_scale);  // exactly v in the canonical unit
+    }
+    out.rows.push_back(std::move(r));
   }
   return out;
 }
@@ -77,10 +190,21 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   const int tc = log.column("t");
   if (tc < 0) throw FitError(log.path + ":1: missing column 't'");
   if (log.rows.size() < 2) throw FitError(log.path + ": too few samples to resample");
+  // Checked here, where the rows still have their lines: interpolation would spread a
+  // bad value over its neighbours and the error would name a resampled row.
+  runtime::check_values(log);
+  const double t0 = log.rows.front()[tc], t1 = log.rows.back()[tc];
+  if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw FitError("resample: rate must be a positive number of Hz");
+  // A bound on the resampled table's size, so that a high rate ends in a message rather
+  // than in std::bad_alloc: 1e8 values (800 MB).
+  const double n_out = std::floor(std::max(0.0, t1 - t0) * rate_hz) + 1;
+  if (n_out * static_cast<double>(log.columns.size()) > 1e8)
+    throw FitError(log.path + ": resampling " + std::to_string(t1 - t0) + " s at " + std::to_string(rate_hz) + " Hz gives " +
+                   std::to_string(static_cast<long long>(std::min(n_out, 1e18))) + " samples of " +
+                   std::to_string(log.columns.size()) + " columns, above the limit of 1e8 values");
   runtime::CsvTable out;
   out.path = log.path;
   out.columns = log.columns;
-  const double t0 = log.rows.front()[tc], t1 = log.rows.back()[tc];
   size_t i = 0;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;

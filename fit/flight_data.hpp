@@ -10,11 +10,14 @@
 
 namespace quadgen::fit {
 
+// canonical = (source * scale + offset) * unit_scale, where unit_scale converts `unit` to
+// the canonical column's SI unit (see load_mapping in flight_data.cpp for the rules).
 struct ColumnMapping {
   std::string name;
   struct Entry {
     std::string target, source, unit;
     double scale = 1, offset = 0;
+    double unit_scale = 1;  // from parse_unit(unit); 1 without a unit
   };
   std::vector<Entry> entries;
 };
@@ -22,6 +25,10 @@ struct ColumnMapping {
 ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);
+
+// The SI unit of a canonical column (contracts.md §2): "s", "m", "m/s", "rad/s", "m/s^2",
+// "1", "rad", "V"; empty for a name that is no canonical column.
+std::string canonical_unit(const std::string& column);
 
 // One time-aligned sample of a flight in canonical units.
 struct FlightSample {

@@ -1,6 +1,10 @@
 // Fuzz target: a column mapping (YAML) applied to a raw log (CSV), the result validated,
 // prepared for fitting and turned into equation-error residuals of the FINken 3 model.
 // Input: the mapping, a line "%%", the CSV. Only LogError / FitError may come out.
+// The mapping's `unit:` entries go through parse_unit (derive/units.cpp) and are checked
+// against the canonical columns' dimensions; whatever a unit parses to, its conversion
+// factor must be a finite positive number (exponents are bounded), else the target traps.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -19,6 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<std::string> rotors{"A", "B", "C", "D"};
   try {
     const auto mapping = quadgen::fit::parse_mapping(text.substr(0, cut), "fuzz.yaml");
+    for (const auto& e : mapping.entries)
+      if (!(std::isfinite(e.unit_scale) && e.unit_scale > 0)) __builtin_trap();
     const auto raw = quadgen::runtime::parse_csv(text.substr(cut + 4), "fuzz.csv");
     const auto table = quadgen::fit::apply_mapping(raw, mapping);
     quadgen::fit::FlightOptions o;
