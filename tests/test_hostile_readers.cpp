@@ -1,0 +1,344 @@
+// Hostile input for every reader below the vehicle parser: flight logs, thrust-stand and
+// motor-step files, column mappings and their units, and the least-squares layer fed
+// numbers beyond double range. Each must end in one line "file:line: cause" of the
+// layer's error type: never a crash, a hang, a silent wrong value or a bare library message.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "flight_data.hpp"
+#include "flight_log.hpp"
+#include "least_squares.hpp"
+#include "motor_steps.hpp"
+#include "thrust_stand.hpp"
+
+using namespace quadgen;
+using namespace quadgen::fit;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A directory of its own per test, in the build tree (beside the quadgen binary), removed
+// again at the end.
+class Hostile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(QUADGEN_BINARY).parent_path() /
+           ("hostile_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    fs::remove_all(dir_);
+    ::unsetenv("QUADGEN_MAX_INPUT_BYTES");
+  }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return (dir_ / name).string();
+  }
+  fs::path dir_;
+};
+
+// The message of the exception E that f throws ("" and a test failure if none or another).
+template <class E, class F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "wrong exception type: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "no exception";
+  return "";
+}
+
+// "file:line: " followed by a message containing `cause`.
+void expect_located(const std::string& msg, const std::string& file, int line, const std::string& cause) {
+  EXPECT_EQ(msg.rfind(file + ":" + std::to_string(line) + ": ", 0), 0u) << msg;
+  EXPECT_NE(msg.find(cause), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+}
+
+const char* const kCanonicalHeader = "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz,p,q,r\n";
+std::string canonical_row(double t, const std::string& p = "0.01") {
+  return std::to_string(t) + ",0.5,0.5,0.5,0.5,0,0,1,1,0,0,0," + p + ",0,0\n";
+}
+
+const char* const kStandHeader = "weight[g],pwm,vbat[V],rpm1,rpm2,rpm3,rpm4\n";
+std::string stand_rows(int n) {
+  std::string s;
+  for (int k = 1; k <= n; ++k) {
+    const int rpm = 5000 + 1000 * k;
+    s += std::to_string(2.0 * k) + "," + std::to_string(3000 * k) + ",3.9," + std::to_string(rpm) + "," +
+         std::to_string(rpm) + "," + std::to_string(rpm) + "," + std::to_string(rpm) + "\n";
+  }
+  return s;
+}
+
+}  // namespace
+
+// Defect 1: the thrust-stand and motor-step readers had no finiteness check, and a sample
+// of 1e160 in a flight log reached Ceres' covariance (SIGSEGV in JacobiSVD).
+TEST_F(Hostile, FitReadersRefuseNonFiniteAndAbsurdValues) {
+  // inf in a thrust-stand file, on line 4 (header, two good rows)
+  const std::string inf_stand =
+      write("inf_stand.csv", std::string(kStandHeader) + stand_rows(2) + "1,3000,3.9,inf,1,1,1\n");
+  expect_located(message_of<FitError>([&] { read_thrust_stand(inf_stand); }), inf_stand, 4,
+                 "column 'rpm1' is not finite ('inf'; expected a finite number)");
+  // a negative rotor speed and an absurd weight
+  const std::string neg = write("neg_stand.csv", std::string(kStandHeader) + stand_rows(12) + "1,3000,3.9,-5,1,1,1\n");
+  expect_located(message_of<FitError>([&] { read_thrust_stand(neg); }), neg, 14,
+                 "'rpm1' is -5, expected a rotor speed in [0, 1e9] rpm");
+  const std::string heavy =
+      write("heavy_stand.csv", std::string(kStandHeader) + "1e12,3000,3.9,1,1,1,1\n" + stand_rows(12));
+  expect_located(message_of<FitError>([&] { read_thrust_stand(heavy); }), heavy, 2, "|weight| <= 1e9 g");
+  EXPECT_EQ(read_thrust_stand(write("good_stand.csv", std::string(kStandHeader) + stand_rows(12))).size(), 12u);
+
+  // nan and 1e160 in motor-step files
+  const std::string head = "time_ms,throttle_percent,rpm\n0,0,0\n100,10,2000\n";
+  const std::string nan_steps = write("nan_steps.csv", head + "200,10,nan\n");
+  expect_located(message_of<FitError>([&] { read_motor_steps(nan_steps); }), nan_steps, 4,
+                 "column 'rpm' is not finite ('nan'");
+  const std::string big_steps = write("big_steps.csv", head + "\n200,10,1e160\n");  // a blank line before it
+  expect_located(message_of<FitError>([&] { read_motor_steps(big_steps); }), big_steps, 5, "'rpm' is 1e+160");
+  const std::string thr_steps = write("thr_steps.csv", head + "200,150,3000\n");
+  expect_located(message_of<FitError>([&] { read_motor_steps(thr_steps); }), thr_steps, 4, "throttle in [0, 100]");
+
+  // one sample of 1e160 in a canonical flight log, found before any fitting
+  std::string log = kCanonicalHeader;
+  for (int k = 0; k < 30; ++k) log += canonical_row(0.01 * k, k == 7 ? "1e160" : "0.01");
+  const std::string big_log = write("big_log.csv", log);
+  const auto table = runtime::read_csv(big_log);
+  expect_located(message_of<runtime::LogError>([&] {
+                   load_flight(table, {"A", "B", "C", "D"}, {});
+                 }),
+                 big_log, 9, "column 'p' is 1e+160, beyond the sanity bound |value| <= 1e+09");
+}
+
+namespace {
+
+// r_i = p0 - y_i: one channel, Jacobian 1 (times `jscale`).
+class Mean : public ResidualModel {
+ public:
+  Mean(std::vector<double> y, double jscale = 1) : y_(std::move(y)), jscale_(jscale) {}
+  int num_residuals() const override { return static_cast<int>(y_.size()); }
+  void evaluate(const double* p, double* r, double* J) const override {
+    for (size_t i = 0; i < y_.size(); ++i) {
+      r[i] = (p[0] - y_[i]) * jscale_;
+      if (J) J[i] = jscale_;
+    }
+  }
+  int channel_of(int) const override { return 0; }
+  std::vector<std::string> channels() const override { return {"y"}; }
+
+ private:
+  std::vector<double> y_;
+  double jscale_;
+};
+
+std::vector<FitParameter> one_parameter() { return {{"m", "1", 0.5, -1e300, 1e300, true}}; }
+
+}  // namespace
+
+// Defect 1, the numeric side: whatever reaches the least-squares layer, a non-finite
+// cost, Jacobian or covariance ends in one FitError, and a good fit has no NaN in it.
+TEST_F(Hostile, LeastSquaresRefusesNonFiniteNumbers) {
+  std::vector<double> y(20, 1.0);
+  y[5] = 1e160;  // its square overflows
+  EXPECT_NE(message_of<FitError>([&] { fit_least_squares(Mean(y), one_parameter(), {}); }).find("overflows"),
+            std::string::npos);
+  y[5] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message_of<FitError>([&] {
+              fit_least_squares(Mean(y), one_parameter(), {});
+            }).find("residual 5 (channel y) is not finite"),
+            std::string::npos);
+  // Residuals fine at the start, Jacobian 1e200: J^T J is inf.
+  const std::string big_j =
+      message_of<FitError>([&] { fit_least_squares(Mean(std::vector<double>(20, 1.0), 1e200), one_parameter(), {}); });
+  EXPECT_TRUE(big_j.find("not finite") != std::string::npos || big_j.find("overflows") != std::string::npos) << big_j;
+  // A start at which the cost cannot be evaluated (solve_weighted alone, as profiles use it).
+  std::vector<FitParameter> ps = one_parameter();
+  ps[0].value = std::numeric_limits<double>::infinity();
+  ps[0].lower = -std::numeric_limits<double>::infinity();
+  ps[0].upper = std::numeric_limits<double>::infinity();
+  const std::string start =
+      message_of<FitError>([&] { solve_weighted(Mean(std::vector<double>(20, 1.0)), ps, {1.0}, {}); });
+  EXPECT_NE(start.find("least squares failed"), std::string::npos) << start;
+  // and the sane case still works, every number finite
+  std::vector<double> good(20);
+  for (int i = 0; i < 20; ++i) good[i] = 1.0 + 0.01 * ((i * 7) % 5 - 2);
+  const FitResult r = fit_least_squares(Mean(good), one_parameter(), {});
+  EXPECT_NEAR(r.parameters[0].value, 1.0, 0.01);
+  EXPECT_TRUE(std::isfinite(r.standard_errors[0]));
+  EXPECT_TRUE(std::isfinite(r.covariance[0][0]));
+}
+
+// Defect 2: `unit:` in a column mapping is applied and checked; unknown and duplicate
+// keys and conversion errors are file:line errors.
+TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
+  const std::string raw_path = write("raw.csv", "time_ms,gyro\n0,90\n10,180\n");
+  const auto raw = runtime::read_csv(raw_path);
+  // deg/s converts to rad/s; ms (with no scale) to s
+  const auto deg =
+      parse_mapping("columns:\n  t: {source: time_ms, unit: ms}\n  p: {source: gyro, unit: deg/s}\n", "deg.yaml");
+  const auto out = apply_mapping(raw, deg);
+  EXPECT_NEAR(out.rows[0][1], M_PI / 2, 1e-15);
+  EXPECT_NEAR(out.rows[1][1], M_PI, 1e-15);
+  EXPECT_NEAR(out.rows[1][0], 0.01, 1e-18);
+  EXPECT_EQ(out.line_of(1), 3);  // rows keep their lines through the mapping
+  // `unit` is the unit of (source * scale + offset): (90 * 2 + 1) deg/s
+  const auto scaled = parse_mapping("columns:\n  p: {source: gyro, scale: 2, offset: 1, unit: deg/s}\n", "s.yaml");
+  EXPECT_NEAR(apply_mapping(raw, scaled).rows[0][0], (90 * 2 + 1) * M_PI / 180, 1e-15);
+
+  struct Case {
+    std::string name, yaml;
+    int line;
+    std::string cause;
+  } cases[] = {
+      {"furlong.yaml", "name: x\ncolumns:\n  t: {source: time_ms, unit: furlong}\n", 3, "unknown unit 'furlong'"},
+      {"sacle.yaml", "columns:\n  t: {source: time_ms, unit: s}\n  p: {source: gyro, sacle: 0.01}\n", 3,
+       "column 'p': unknown key 'sacle' (allowed: source, scale, offset, unit)"},
+      {"dup_entry.yaml", "columns:\n  p:\n    source: gyro\n    scale: 2\n    scale: 3\n", 5,
+       "column 'p': duplicate key 'scale'"},
+      {"dup_column.yaml", "columns:\n  p: {source: gyro}\n  t: {source: time_ms}\n  p: {source: time_ms}\n", 4,
+       "columns: duplicate key 'p'"},
+      {"dup_top.yaml", "name: a\ncolumns:\n  p: {source: gyro}\nname: b\n", 4, "mapping: duplicate key 'name'"},
+      {"top_key.yaml", "name: a\ncolumn:\n  p: {source: gyro}\n", 2,
+       "mapping: unknown key 'column' (allowed: name, columns)"},
+      {"dimension.yaml", "columns:\n  p: {source: gyro, unit: m/s}\n", 2,
+       "unit 'm/s' has dimension m s^-1, but 'p' is in rad/s (dimension s^-1)"},
+      {"target.yaml", "columns:\n  vbatt: {source: gyro, unit: V}\n", 2, "'vbatt' is not a canonical column"},
+      {"scale_list.yaml", "columns:\n  p: {source: gyro,\n      scale: [1, 2]}\n", 3,
+       "column 'p': scale: expected a single value"},
+      {"scale_text.yaml", "columns:\n  p: {source: gyro, scale: fast}\n", 2,
+       "column 'p': scale: expected a finite number, got 'fast'"},
+      {"hz.yaml", "columns:\n  p: {source: gyro, unit: Hz}\n", 2, "'rev/s'"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = write(c.name, c.yaml);
+    expect_located(message_of<FitError>([&] { load_mapping(path); }), path, c.line, c.cause);
+  }
+}
+
+// Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,
+// so its columns are exactly source * scale + offset, bit for bit.
+TEST_F(Hostile, NanobenchMappingValuesUnchanged) {
+  const auto m = load_mapping(std::string(QUADGEN_SOURCE_DIR) + "/data/mappings/nanobench.yaml");
+  std::string header, row;
+  for (const auto& e : m.entries) {
+    header += (header.empty() ? "" : ",") + e.source;
+    row += std::string(row.empty() ? "" : ",") + "0.123456789012345";
+  }
+  const auto raw = runtime::parse_csv(header + "\n" + row + "\n", "nb.csv");
+  const auto out = apply_mapping(raw, m);
+  for (size_t i = 0; i < m.entries.size(); ++i) {
+    EXPECT_EQ(m.entries[i].unit_scale, 1.0) << m.entries[i].target;
+    const double want = 0.123456789012345 * m.entries[i].scale + m.entries[i].offset;
+    EXPECT_EQ(std::memcmp(&out.rows[0][i], &want, sizeof want), 0) << m.entries[i].target;
+  }
+}
+
+// Defect 3: exponents beyond int (UB in the old std::stoi path) and Hz, through the
+// mapping reader that now uses the unit parser.
+TEST_F(Hostile, MappingUnitParserBoundsExponents) {
+  const std::string path =
+      write("exp.yaml", "columns:\n  t: {source: a, unit: s}\n  x: {source: b, unit: \"m^2147483647\"}\n");
+  expect_located(message_of<FitError>([&] { load_mapping(path); }), path, 3,
+                 "exponent '2147483647' is out of range (expected |n| <= 12)");
+  const std::string sum = write("sum.yaml", "columns:\n  x: {source: b, unit: \"m^12 m^12 m^-23\"}\n");
+  expect_located(message_of<FitError>([&] { load_mapping(sum); }), sum, 2, "combined exponent 24 is out of range");
+}
+
+// Defect 4: the flight-log reader. A byte-order mark, blank lines and CRLF.
+TEST_F(Hostile, FlightLogLinesBomAndCrlf) {
+  std::string text = "\xEF\xBB\xBF" + std::string(kCanonicalHeader);
+  for (int k = 0; k < 3; ++k) text += canonical_row(0.01 * k);
+  const auto bom = runtime::read_csv(write("bom.csv", text));
+  EXPECT_EQ(bom.columns.front(), "t");
+  EXPECT_NO_THROW(runtime::validate_canonical(bom, {"A", "B", "C", "D"}));
+
+  // CRLF, blank lines; the decreasing time is on line 7 of the file (row 3)
+  const std::string crlf =
+      write("crlf.csv", std::string("t,u_A,u_B,u_C,u_D\r\n\r\n0,1,1,1,1\r\n\r\n0.1,1,1,1,1\r\n\n0.05,1,1,1,1\r\n"));
+  const auto t = runtime::read_csv(crlf);
+  expect_located(message_of<runtime::LogError>([&] {
+                   runtime::validate_canonical(t, {"A", "B", "C", "D"});
+                 }),
+                 crlf, 7, "time not strictly increasing");
+  // a NUL inside a cell is no number (strtod alone would stop at it and accept "1")
+  const std::string nul = write("nul.csv", std::string("t,u_A\n0,1\n0.1,1\0junk\n", 22));
+  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(nul); }), nul, 3,
+                 "column 'u_A': expected a number");
+  const std::string over = write("over.csv", "t,u_A\n0,1\n0.1,1e400\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(over); }), over, 3,
+                 "column 'u_A' is not finite ('1e400'; expected a finite number)");
+}
+
+// Defect 4: what is not a regular file is refused at once (a FIFO would block, /dev/zero
+// never ends), and so is a file above the size limit.
+TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
+  const std::string fifo = (dir_ / "log.fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(fifo); }).find(fifo + ": a FIFO, not a regular file"),
+            std::string::npos);
+  EXPECT_NE(
+      message_of<runtime::LogError>([&] { runtime::read_csv("/dev/zero"); }).find("/dev/zero: a character device"),
+      std::string::npos);
+  EXPECT_NE(message_of<runtime::LogError>([&] {
+              runtime::read_csv(dir_.string());
+            }).find(": a directory, not a regular file"),
+            std::string::npos);
+
+  std::string text = kCanonicalHeader;
+  for (int k = 0; k < 3; ++k) text += canonical_row(0.01 * k);
+  const std::string path = write("big.csv", text);
+  ::setenv("QUADGEN_MAX_INPUT_BYTES", "100", 1);
+  EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(path); })
+                .find(path + ": " + std::to_string(text.size()) +
+                      " bytes, above the limit of 100 bytes (set QUADGEN_MAX_INPUT_BYTES"),
+            std::string::npos);
+  ::setenv("QUADGEN_MAX_INPUT_BYTES", "lots", 1);
+  EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(path); }).find("QUADGEN_MAX_INPUT_BYTES='lots'"),
+            std::string::npos);
+  ::setenv("QUADGEN_MAX_INPUT_BYTES", std::to_string(text.size()).c_str(), 1);
+  EXPECT_EQ(runtime::read_csv(path).rows.size(), 3u);
+  ::unsetenv("QUADGEN_MAX_INPUT_BYTES");
+  EXPECT_EQ(runtime::max_input_bytes(), 2ULL << 30);
+}
+
+// Defect 4: non-finite and absurd values in a canonical log, with their lines, also
+// through resampling (which would otherwise spread them over the grid).
+TEST_F(Hostile, FlightLogRefusesAbsurdValues) {
+  std::string text = kCanonicalHeader;
+  text += canonical_row(0);
+  text += "\n";
+  text += canonical_row(0.01, "-2e9");
+  text += canonical_row(0.02);
+  const std::string path = write("absurd.csv", text);
+  const auto t = runtime::read_csv(path);
+  expect_located(message_of<runtime::LogError>([&] {
+                   runtime::validate_canonical(t, {"A", "B", "C", "D"});
+                 }),
+                 path, 4, "column 'p' is -2e+09, beyond the sanity bound");
+  expect_located(message_of<runtime::LogError>([&] { resample(t, 100); }), path, 4, "column 'p' is -2e+09");
+  // a Unix time stamp is a valid t (the NanoBench logs have them)
+  std::string unix_text = kCanonicalHeader;
+  for (int k = 0; k < 3; ++k) unix_text += canonical_row(1772419726.25 + 0.01 * k);
+  EXPECT_NO_THROW(runtime::validate_canonical(runtime::read_csv(write("unix.csv", unix_text)), {"A", "B", "C", "D"}));
+  // a resampling rate that would need terabytes is refused, not attempted
+  EXPECT_NE(message_of<FitError>([&] {
+              resample(runtime::read_csv(write("unix2.csv", unix_text)), 1e12);
+            }).find("above the limit"),
+            std::string::npos);
+}
