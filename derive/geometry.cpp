@@ -1,6 +1,9 @@
 #include "geometry.hpp"
 
+#include <array>
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "exact_number.hpp"
 #include "kinematics.hpp"
@@ -36,7 +39,7 @@ std::string tex_name(const std::string& s) {
   return out;
 }
 
-BlockSymbols make_symbols(const Block& b) {
+BlockSymbols make_symbols(const Block& b, const matrix& R) {
   const std::string n = b.name;
   const std::string t = "{\\mathrm{" + tex_name(n) + "}}";
   return BlockSymbols{n,
@@ -47,25 +50,7 @@ BlockSymbols make_symbols(const Block& b) {
                       symbol("cx_" + n, "x_" + t),
                       symbol("cy_" + n, "y_" + t),
                       symbol("cz_" + n, "z_" + t),
-                      block_rotation(b.yaw_pitch_roll_deg)};
-}
-
-// ∫ ξ_i ξ_j dm over the centred cuboid [-a/2,a/2]x[-b/2,b/2]x[-c/2,c/2] with
-// constant density m/(abc), by GiNaC's exact definite integration.
-matrix local_second_moment(const BlockSymbols& s) {
-  realsymbol xi("xi"), eta("eta"), zeta("zeta");
-  const ex rho = s.m / (s.a * s.b * s.c);
-  const ex coords[3] = {xi, eta, zeta};
-  matrix S(3, 3);
-  for (int i = 0; i < 3; ++i)
-    for (int j = i; j < 3; ++j) {
-      ex integrand = rho * coords[i] * coords[j];
-      ex in_z = integral(zeta, -s.c / 2, s.c / 2, integrand).eval_integ();
-      ex in_y = integral(eta, -s.b / 2, s.b / 2, in_z).eval_integ();
-      ex in_x = integral(xi, -s.a / 2, s.a / 2, in_y).eval_integ();
-      S(i, j) = S(j, i) = normal(in_x);
-    }
-  return S;
+                      R};
 }
 
 // Inertia tensor from a second-moment matrix S = ∫ r r^T dm: J = tr(S) I - S.
@@ -79,20 +64,96 @@ matrix inertia_from_second_moment(const matrix& S) {
 
 // Projected area of the rotated cuboid seen along each body axis:
 // sum over its three face pairs of face area times |cos| between face normal and axis.
-matrix projected_areas(const BlockSymbols& s) {
-  const ex face[3] = {s.b * s.c, s.a * s.c, s.a * s.b};
+matrix projected_areas(const matrix& R, const ex& a, const ex& b, const ex& c) {
+  const ex face[3] = {b * c, a * c, a * b};
   matrix A(3, 1);
   for (int k = 0; k < 3; ++k) {
     ex sum = 0;
     for (int j = 0; j < 3; ++j) {
-      const double c = to_double(s.R(k, j));
-      if (std::fabs(c) < 1e-15) continue;
-      sum += (c < 0 ? -s.R(k, j) : s.R(k, j)) * face[j];
+      const double cosine = to_double(R(k, j));
+      if (std::fabs(cosine) < 1e-15) continue;
+      sum += (cosine < 0 ? -R(k, j) : R(k, j)) * face[j];
     }
     A(k, 0) = sum;
   }
   return A;
 }
+
+// One generic block: mass m, edges a, b, c, centre (x, y, z). The cuboid is integrated
+// once per derivation, ∫ ξ_i ξ_j dm over [-a/2,a/2]x[-b/2,b/2]x[-c/2,c/2] with constant
+// density m/(abc), by GiNaC's exact definite integration; per orientation the second
+// moment is rotated and shifted into the body frame once. A block then costs the
+// substitution of its own symbols (for the expressions) and of its own numbers (for the
+// values) into these closed forms, the same whatever the size of the vehicle. Integrating
+// and normalising every block anew cost about 1 ms per block.
+struct GenericBlock {
+  symbol m{"m"}, a{"a"}, b{"b"}, c{"c"}, x{"x"}, y{"y"}, z{"z"};
+  matrix S{3, 3};  // ∫ ξ ξ^T dm in the block frame
+
+  // The generic block in one orientation, in the body frame.
+  struct Placed {
+    matrix R;
+    matrix S_body{3, 3};   // ∫ r r^T dm about the body origin, normalised
+    matrix inertia{3, 3};  // tr(S_body) I - S_body
+    matrix areas{3, 1};
+    bool symmetric = false;  // S_body(i, j) and S_body(j, i) the same expression
+
+    // subs into a symmetric 3x3 matrix, the lower triangle copied where it is the same.
+    matrix substitute(const matrix& M, const exmap& values) const {
+      matrix r(3, 3);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          r(i, j) = j < i && symmetric ? r(j, i) : M(i, j).subs(values, subs_options::no_pattern | subs_options::pattern_is_not_product);
+      return r;
+    }
+  };
+
+  GenericBlock() {
+    realsymbol xi("xi"), eta("eta"), zeta("zeta");
+    const ex rho = m / (a * b * c);
+    const ex coords[3] = {xi, eta, zeta};
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) {
+        ex integrand = rho * coords[i] * coords[j];
+        ex in_z = integral(zeta, -c / 2, c / 2, integrand).eval_integ();
+        ex in_y = integral(eta, -b / 2, b / 2, in_z).eval_integ();
+        ex in_x = integral(xi, -a / 2, a / 2, in_y).eval_integ();
+        S(i, j) = S(j, i) = normal(in_x);
+      }
+  }
+
+  const Placed& placed(const Vec3& ypr) {
+    const std::array<long, 3> key = {std::lround(ypr[0] * 1000.0), std::lround(ypr[1] * 1000.0),
+                                     std::lround(ypr[2] * 1000.0)};
+    auto it = orientations.find(key);
+    if (it != orientations.end()) return it->second;
+    Placed p;
+    p.R = block_rotation(ypr);
+    // Shift and rotate: ∫ (R ξ + c)(R ξ + c)^T dm = R S R^T + m c c^T (∫ ξ dm = 0).
+    const matrix centre = matrix(3, 1, lst{x, y, z});
+    const matrix S_body = p.R.mul(S).mul(p.R.transpose()).add(centre.mul(centre.transpose()).mul_scalar(m));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) p.S_body(i, j) = normal(S_body(i, j));
+    p.inertia = inertia_from_second_moment(p.S_body);
+    p.symmetric = true;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < i; ++j)
+        p.symmetric = p.symmetric && p.S_body(i, j).is_equal(p.S_body(j, i)) && p.inertia(i, j).is_equal(p.inertia(j, i));
+    p.areas = projected_areas(p.R, a, b, c);
+    return orientations.emplace(key, std::move(p)).first->second;
+  }
+
+  exmap to_symbols(const BlockSymbols& s) const {
+    return {{m, s.m}, {a, s.a}, {b, s.b}, {c, s.c}, {x, s.cx}, {y, s.cy}, {z, s.cz}};
+  }
+  exmap to_numbers(const Block& bl) const {
+    return {{m, exact(bl.mass)},      {a, exact(bl.size[0])},   {b, exact(bl.size[1])}, {c, exact(bl.size[2])},
+            {x, exact(bl.centre[0])}, {y, exact(bl.centre[1])}, {z, exact(bl.centre[2])}};
+  }
+
+ private:
+  std::map<std::array<long, 3>, Placed> orientations;  // by thousandths of a degree, as exact_angle
+};
 
 }  // namespace
 
@@ -100,58 +161,101 @@ matrix block_rotation(const Vec3& ypr) {
   return rotation_zyx(exact_angle(ypr[0]), exact_angle(ypr[1]), exact_angle(ypr[2]));
 }
 
+// Linear in the number of blocks. Each block costs two substitutions into the generic
+// block's closed forms (its symbols, its numbers); the symbolic sums are built in one go
+// from the collected terms (adding term by term copies the growing sum each time); the
+// totals' values are the same formulas applied to the sums of the blocks' exact values
+// (exact arithmetic, so the same numbers as substituting all values into the symbolic
+// totals, which costs a walk over expressions of the vehicle's size per entry). Before,
+// every block was evaluated with a list of all 7N values (subs with a list matches every
+// symbol against every relation in turn): 1,000 blocks took about a minute.
 MassProperties derive_mass_properties(const Vehicle& v) {
+  const unsigned by_lookup = subs_options::no_pattern | subs_options::pattern_is_not_product;
+  GenericBlock generic;
   MassProperties mp;
-  mp.mass = 0;
-  matrix first_moment(3, 1), second_moment(3, 3);
+  mp.symbols.reserve(v.blocks.size());
+  mp.blocks.reserve(v.blocks.size());
+  exvector mass_terms, mass_numbers;
+  std::array<exvector, 3> first_terms, first_numbers, area_terms, area_numbers;
+  std::array<std::array<exvector, 3>, 3> second_terms, inertia_numbers;
   for (const Block& b : v.blocks) {
-    BlockSymbols s = make_symbols(b);
-    mp.values.append(s.m == exact(b.mass));
-    mp.values.append(s.a == exact(b.size[0]));
-    mp.values.append(s.b == exact(b.size[1]));
-    mp.values.append(s.c == exact(b.size[2]));
-    mp.values.append(s.cx == exact(b.centre[0]));
-    mp.values.append(s.cy == exact(b.centre[1]));
-    mp.values.append(s.cz == exact(b.centre[2]));
+    const GenericBlock::Placed& placed = generic.placed(b.yaw_pitch_roll_deg);
+    BlockSymbols s = make_symbols(b, placed.R);
+    const exmap to_symbols = generic.to_symbols(s), to_numbers = generic.to_numbers(b);
+    for (const symbol* g : {&generic.m, &generic.a, &generic.b, &generic.c, &generic.x, &generic.y, &generic.z})
+      mp.values.append(to_symbols.at(*g) == to_numbers.at(*g));
 
     BlockContribution bc;
     bc.name = b.name;
-    bc.local_second_moment = local_second_moment(s);
-    // Shift and rotate: ∫ (R ξ + c)(R ξ + c)^T dm = R S R^T + m c c^T (∫ ξ dm = 0).
-    const matrix c = matrix(3, 1, lst{s.cx, s.cy, s.cz});
-    const matrix S_body =
-        s.R.mul(bc.local_second_moment).mul(s.R.transpose()).add(c.mul(c.transpose()).mul_scalar(s.m));
-    matrix S_simpl(3, 3);
+    bc.local_second_moment = ex_to<matrix>(ex(generic.S).subs(to_symbols, by_lookup));
+    const matrix S_body = placed.substitute(placed.S_body, to_symbols);
+    bc.inertia_origin = inertia_from_second_moment(S_body);
+    bc.areas = ex_to<matrix>(ex(placed.areas).subs(to_symbols, by_lookup));
+    const matrix inertia_exact = placed.substitute(placed.inertia, to_numbers);
+    const matrix areas_exact = ex_to<matrix>(ex(placed.areas).subs(to_numbers, by_lookup));
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) S_simpl(i, j) = normal(S_body(i, j));
-    bc.inertia_origin = inertia_from_second_moment(S_simpl);
-    bc.areas = projected_areas(s);
-    mp.mass += s.m;
-    first_moment = first_moment.add(c.mul_scalar(s.m));
-    second_moment = second_moment.add(S_simpl);
-    mp.areas = mp.areas.add(bc.areas);
-    mp.symbols.push_back(s);
-    mp.blocks.push_back(bc);
-  }
-  for (int i = 0; i < 3; ++i) mp.cog(i, 0) = first_moment(i, 0) / mp.mass;
-  mp.inertia_origin = inertia_from_second_moment(second_moment);
-  // Parallel-axis shift to the centre of gravity: J_cg = J_o - m (|c|^2 I - c c^T).
-  const ex cc = (mp.cog.transpose().mul(mp.cog))(0, 0);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      mp.inertia_cog(i, j) = mp.inertia_origin(i, j) - mp.mass * ((i == j ? cc : ex(0)) - mp.cog(i, 0) * mp.cog(j, 0));
+      for (int j = 0; j < 3; ++j)
+        bc.inertia_origin_value[i][j] = j < i && placed.symmetric ? bc.inertia_origin_value[j][i] : to_double(inertia_exact(i, j));
+    for (int i = 0; i < 3; ++i) bc.areas_value[i] = to_double(areas_exact(i, 0));
 
-  mp.mass_value = to_double(mp.mass.subs(mp.values));
+    const ex m = to_numbers.at(generic.m);
+    const ex centre[3] = {to_numbers.at(generic.x), to_numbers.at(generic.y), to_numbers.at(generic.z)};
+    mass_terms.push_back(s.m);
+    mass_numbers.push_back(m);
+    const ex c[3] = {s.cx, s.cy, s.cz};
+    for (int i = 0; i < 3; ++i) {
+      first_terms[i].push_back(s.m * c[i]);
+      first_numbers[i].push_back(m * centre[i]);
+      area_terms[i].push_back(bc.areas(i, 0));
+      area_numbers[i].push_back(areas_exact(i, 0));
+      for (int j = 0; j < 3; ++j) {
+        second_terms[i][j].push_back(S_body(i, j));
+        inertia_numbers[i][j].push_back(inertia_exact(i, j));
+      }
+    }
+    mp.symbols.push_back(std::move(s));
+    mp.blocks.push_back(std::move(bc));
+  }
+
+  // The same steps for the expressions and for the exact values.
+  struct Totals {
+    ex mass;
+    matrix cog{3, 1}, inertia_origin{3, 3}, inertia_cog{3, 3}, areas{3, 1};
+  };
+  auto totals = [](const exvector& mass, const std::array<exvector, 3>& first,
+                   const std::array<std::array<exvector, 3>, 3>& second_or_inertia, bool is_second_moment,
+                   const std::array<exvector, 3>& areas) {
+    Totals t;
+    t.mass = add(mass);
+    matrix sum(3, 3);
+    for (int i = 0; i < 3; ++i) {
+      t.cog(i, 0) = add(first[i]) / t.mass;
+      t.areas(i, 0) = add(areas[i]);
+      for (int j = 0; j < 3; ++j) sum(i, j) = add(second_or_inertia[i][j]);
+    }
+    t.inertia_origin = is_second_moment ? inertia_from_second_moment(sum) : sum;
+    // Parallel-axis shift to the centre of gravity: J_cg = J_o - m (|c|^2 I - c c^T).
+    const ex cc = (t.cog.transpose().mul(t.cog))(0, 0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        t.inertia_cog(i, j) = t.inertia_origin(i, j) - t.mass * ((i == j ? cc : ex(0)) - t.cog(i, 0) * t.cog(j, 0));
+    return t;
+  };
+  Totals sym = totals(mass_terms, first_terms, second_terms, true, area_terms);
+  mp.mass = sym.mass;
+  mp.cog = sym.cog;
+  mp.inertia_origin = sym.inertia_origin;
+  mp.inertia_cog = sym.inertia_cog;
+  mp.areas = sym.areas;
+
+  const Totals num = totals(mass_numbers, first_numbers, inertia_numbers, false, area_numbers);
+  mp.mass_value = to_double(num.mass);
   for (int i = 0; i < 3; ++i) {
-    mp.cog_value[i] = to_double(mp.cog(i, 0).subs(mp.values));
-    mp.areas_value[i] = to_double(mp.areas(i, 0).subs(mp.values));
+    mp.cog_value[i] = to_double(num.cog(i, 0));
+    mp.areas_value[i] = to_double(num.areas(i, 0));
   }
-  mp.inertia_origin_value = to_mat3(ex_to<matrix>(ex(mp.inertia_origin).subs(mp.values)));
-  mp.inertia_cog_value = to_mat3(ex_to<matrix>(ex(mp.inertia_cog).subs(mp.values)));
-  for (auto& bc : mp.blocks) {
-    bc.inertia_origin_value = to_mat3(ex_to<matrix>(ex(bc.inertia_origin).subs(mp.values)));
-    for (int i = 0; i < 3; ++i) bc.areas_value[i] = to_double(bc.areas(i, 0).subs(mp.values));
-  }
+  mp.inertia_origin_value = to_mat3(num.inertia_origin);
+  mp.inertia_cog_value = to_mat3(num.inertia_cog);
   return mp;
 }
 

@@ -1,7 +1,9 @@
 // Mass properties of a vehicle made of cuboid blocks, derived by exact symbolic
-// integration: each block is integrated in its own frame, then rotated and shifted
-// into the body frame. Results stay expressions in the geometry symbols (so a changed
-// vehicle file re-derives them) and are also evaluated.
+// integration: a generic cuboid is integrated in its own frame (once per derivation),
+// rotated and shifted into the body frame (once per orientation), and each block gets
+// that closed form with its own symbols and, for the values, its own numbers, so the
+// cost is linear in the number of blocks. Results stay expressions in the geometry
+// symbols (so a changed vehicle file re-derives them) and are also evaluated.
 #pragma once
 #include <string>
 #include <vector>
