@@ -1,9 +1,12 @@
 // Mass properties: exact integration against closed forms computed here in plain
 // doubles, against brute-force numerical integration, and the FINken 3 regression;
-// a 1,000-block vehicle.
+// a 1,000-block vehicle; derived quantities' declared bounds checked against the blocks.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <Eigen/Dense>
@@ -175,4 +178,57 @@ TEST(Geometry, ThousandBlockGridMatchesParallelAxisSums) {
   for (const GiNaC::ex& r : mp.values) values[r.lhs()] = r.rhs();
   EXPECT_NEAR(to_double(mp.inertia_cog(0, 1).subs(values, GiNaC::subs_options::no_pattern)), J_cg(0, 1),
               1e-12 * J_cg.norm());
+}
+
+namespace {
+
+Parameter derived_bounds(const std::string& name, const std::string& unit, double lower, double upper) {
+  return Parameter{name, lower, unit, parse_unit(unit).dim, lower, upper, false, ""};
+}
+
+std::string derive_error(const Vehicle& v) {
+  try {
+    derive_model(v, derive_mass_properties(v), {});
+  } catch (const VehicleError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Geometry, DerivedQuantityOutsideItsBoundsIsAnError) {
+  Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  const double Jxx = mp.inertia_cog_value[0][0];
+  // Bounds that hold the blocks' value: accepted (the bundled file's mass bounds included).
+  v.derived_overrides["J_xx"] = derived_bounds("J_xx", "kg m^2", 0.5 * Jxx, 2 * Jxx);
+  EXPECT_EQ(derive_error(v), "");
+
+  v.derived_overrides["J_xx"] = derived_bounds("J_xx", "kg m^2", 2e-5, 3e-5);
+  char want[200];
+  std::snprintf(want, sizeof want, "%s: derived quantity J_xx: the blocks give %.6g kg m^2, outside its bounds [2e-05, 3e-05]",
+                v.source_path.c_str(), Jxx);
+  EXPECT_EQ(derive_error(v), want);
+
+  // Just outside a bound: the message does not show the value as equal to it.
+  v.derived_overrides.erase("J_xx");
+  v.derived_overrides["mass"] = derived_bounds("mass", "kg", 0.2, 0.38699999);
+  EXPECT_EQ(derive_error(v), v.source_path + ": derived quantity mass: the blocks give 0.387 kg, outside its bounds [0.2, 0.38699999]");
+  v.derived_overrides["mass"] = derived_bounds("mass", "kg", 0.2, std::nextafter(0.387, 0.0));
+  const std::string msg = derive_error(v);
+  EXPECT_NE(msg.find("the blocks give 0.387 kg, outside its bounds [0.2, 0.38699999999999996]"), std::string::npos) << msg;
+}
+
+TEST(Geometry, DerivedBoundsFromTheVehicleFileAreChecked) {
+  // The `derived:` section as a user writes it: the file's path and the quantity named.
+  std::ifstream in(test::source_path("vehicles/crazyflie21.yaml"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str() + "  A_z: {fit: true, bounds: [0.5, 2.0]}\n";
+  const Vehicle v = parse_vehicle(text, "vehicles/x.yaml");
+  ASSERT_TRUE(v.derived_overrides.count("A_z"));
+  const std::string msg = derive_error(v);
+  EXPECT_EQ(msg.rfind("vehicles/x.yaml: derived quantity A_z: the blocks give ", 0), 0u) << msg;
+  EXPECT_NE(msg.find(" m^2, outside its bounds [0.5, 2]"), std::string::npos) << msg;
 }
