@@ -170,6 +170,17 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   return 0;
 }
 
+// Hover must be within reach of every rotor's motor map, or no manoeuvre can be flown; said
+// once, naming the vehicle file, instead of failing somewhere inside the flight.
+void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws, double hover_thrust) {
+  for (size_t i = 0; i < laws.size(); ++i) try {
+      laws[i].command_for(hover_thrust);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: " + e.what() +
+                                  "; check c_t (rotor_model) and a0, a1, a2 (motor_map)");
+    }
+}
+
 int run_simulate(const SimulateArgs& a) {
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
@@ -182,13 +193,14 @@ int run_simulate(const SimulateArgs& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
+  const size_t nr = vehicle.rotors.size();
+  const auto laws = nominal_thrust_laws(vehicle, model);
+  const double vbat_ref = param(vehicle, "vbat_ref").value;
+  check_hover_reachable(vehicle, laws, m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr));
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m, out);
   const int delay = model.input_delay_param ? static_cast<int>(*model.input_delay_param) : -1;
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
-  const size_t nr = rotors.size();
-  const auto laws = nominal_thrust_laws(vehicle, model);
-  const double vbat_ref = param(vehicle, "vbat_ref").value;
 
   std::vector<double> x0(m.num_states(), 0.0);
   x0[6] = 1.0;

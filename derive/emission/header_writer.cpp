@@ -82,6 +82,18 @@ std::string int_list(const std::vector<int>& v) {
 
 }  // namespace
 
+void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p) {
+  // Everything from a vehicle file or the command line goes through the sink's escaping:
+  // comments cannot end early or splice the next line, literals cannot end early.
+  d.set("vehicle_file", output::cpp_comment(p.vehicle_file));
+  d.set("effects_flag", output::cpp_comment(p.effects_flag));
+  d.set("vehicle", output::cpp_comment(p.vehicle_name));
+  d.set("vehicle_hash", output::cpp_comment(p.vehicle_hash));
+  d.set("vehicle_hash_literal", output::cpp_string_literal(p.vehicle_hash));
+  d.set("effects", output::cpp_comment(p.effects_text));
+  d.set("effects_list", output::cpp_string_literal(p.effects_list));
+}
+
 std::string model_name(const SymbolicModel& m) {
   std::string s = m.vehicle_name;
   if (m.effects.size() == effect_catalogue().size()) s += "_all_effects";
@@ -135,15 +147,8 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   data d;
   d.set("namespace", out.name);
   d.set("version", QUADGEN_VERSION);
-  // Everything from a vehicle file or the command line goes through the sink's escaping:
-  // comments cannot end early or splice the next line, literals cannot end early.
-  d.set("vehicle_file", output::cpp_comment(opt.vehicle_file));
-  d.set("effects_flag", output::cpp_comment(opt.effects_flag));
-  d.set("vehicle", output::cpp_comment(m.vehicle_name));
-  d.set("vehicle_hash", output::cpp_comment(m.vehicle_hash));
-  d.set("vehicle_hash_literal", output::cpp_string_literal(m.vehicle_hash));
-  d.set("effects", output::cpp_comment(m.effects.empty() ? "none" : m.effect_list(", ")));
-  d.set("effects_list", output::cpp_string_literal(m.effect_list()));
+  set_provenance_fields(d, {m.vehicle_name, m.vehicle_hash, m.effects.empty() ? "none" : m.effect_list(", "),
+                            m.effect_list(), opt.vehicle_file, opt.effects_flag});
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
   d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));

@@ -2,6 +2,8 @@
 #pragma once
 #include <string>
 
+#include <kainjow/mustache.hpp>
+
 #include "symbolic_model.hpp"
 
 namespace quadgen::emission {
@@ -19,6 +21,16 @@ struct GeneratedHeader {
 };
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt);
+
+// Where a header came from, as its comments and string constants tell it: text from a vehicle
+// file and a command line.
+struct Provenance {
+  std::string vehicle_name, vehicle_hash, effects_text, effects_list, vehicle_file, effects_flag;
+};
+
+// Sets the template fields that carry provenance, each escaped for the C++ comment or string
+// literal it lands in (exposed for fuzz/fuzz_template.cpp).
+void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p);
 
 // The model's name: vehicle, plus effects.
 std::string model_name(const SymbolicModel& m);
