@@ -57,12 +57,12 @@ std::string outside_text(double x, double lower, double upper) {
   return buf;
 }
 
-// The vehicle file's `derived:` entry for a quantity (the file does not keep the entry's
-// line: the message names the file and the quantity).
+// The vehicle file's `derived:` entry for a quantity, against what the blocks give.
 void check_derived_bounds(const Vehicle& v, const std::string& name, const std::string& unit, double value,
                           const Parameter& declared) {
   if (value >= declared.lower && value <= declared.upper) return;
-  throw VehicleError(v.source_path + ": derived quantity " + name + ": the blocks give " +
+  const std::string where = declared.line > 0 ? ":" + std::to_string(declared.line) : "";
+  throw VehicleError(v.source_path + where + ": derived quantity " + name + ": the blocks give " +
                      outside_text(value, declared.lower, declared.upper) + " " + unit +
                      ", outside its bounds [" + exact_text(declared.lower) + ", " + exact_text(declared.upper) +
                      "]");

@@ -111,6 +111,7 @@ struct Reader {
     p.name = name;
     p.unit = si_unit;
     p.doc = doc;
+    if (n.Mark().line >= 0) p.line = n.Mark().line + 1;
     const Unit si = parse_unit(si_unit);
     p.dim = si.dim;
     double scale = 1.0;
@@ -299,6 +300,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
       tmp["bounds"] = spec["bounds"];
       if (spec["fit"]) tmp["fit"] = spec["fit"];
       v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
+      v.derived_overrides[key].line = kv.first.Mark().line + 1;
     }
   }
   return v;

@@ -24,6 +24,7 @@ struct Parameter {
   double lower = 0, upper = 0;  // bounds in SI
   bool fit = false;
   std::string doc;  // what it is
+  int line = 0;     // where the vehicle file gives it (0: not from a file), for error messages
 };
 
 // A cuboid of constant density, given in its own frame (edges along its axes, centred),

@@ -3,6 +3,7 @@
 // a 1,000-block vehicle; derived quantities' declared bounds checked against the blocks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -221,7 +222,7 @@ TEST(Geometry, DerivedQuantityOutsideItsBoundsIsAnError) {
 }
 
 TEST(Geometry, DerivedBoundsFromTheVehicleFileAreChecked) {
-  // The `derived:` section as a user writes it: the file's path and the quantity named.
+  // The `derived:` section as a user writes it: the file, line and quantity named.
   std::ifstream in(test::source_path("vehicles/crazyflie21.yaml"));
   std::stringstream ss;
   ss << in.rdbuf();
@@ -229,6 +230,8 @@ TEST(Geometry, DerivedBoundsFromTheVehicleFileAreChecked) {
   const Vehicle v = parse_vehicle(text, "vehicles/x.yaml");
   ASSERT_TRUE(v.derived_overrides.count("A_z"));
   const std::string msg = derive_error(v);
-  EXPECT_EQ(msg.rfind("vehicles/x.yaml: derived quantity A_z: the blocks give ", 0), 0u) << msg;
+  // The line of the entry: the one appended after the bundled file's lines.
+  const std::string line = std::to_string(std::count(text.begin(), text.end(), '\n'));
+  EXPECT_EQ(msg.rfind("vehicles/x.yaml:" + line + ": derived quantity A_z: the blocks give ", 0), 0u) << msg;
   EXPECT_NE(msg.find(" m^2, outside its bounds [0.5, 2]"), std::string::npos) << msg;
 }
