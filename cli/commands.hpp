@@ -56,4 +56,12 @@ struct DiagnoseArgs {
 void add_diagnose(CLI::App& app, DiagnoseArgs& args);
 int run_diagnose(const DiagnoseArgs& args);
 
+struct PredictArgs {
+  std::string vehicle, out, mapping, params;
+  std::vector<std::string> logs;
+  double validation = 0.3, resample = 0, stride = 0.05;
+};
+void add_predict(CLI::App& app, PredictArgs& args);
+int run_predict(const PredictArgs& args);
+
 }  // namespace quadgen::cli

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   quadgen::cli::add_fit(app, fit);
   quadgen::cli::DiagnoseArgs diagnose;
   quadgen::cli::add_diagnose(app, diagnose);
+  quadgen::cli::PredictArgs predict;
+  quadgen::cli::add_predict(app, predict);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -28,6 +30,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
     if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
     if (app.got_subcommand("diagnose")) return quadgen::cli::run_diagnose(diagnose);
+    if (app.got_subcommand("predict")) return quadgen::cli::run_predict(predict);
   } catch (const std::bad_alloc&) {
     std::cerr << "quadgen: error: out of memory: the input or the requested work is too large for this machine\n";
     return 2;

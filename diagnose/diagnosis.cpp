@@ -21,17 +21,6 @@ std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vec
   return rms;
 }
 
-// Samples lacking what the full-catalogue model reads get neutral values: without a
-// battery log the voltage is the reference one, without a pose the height is far from
-// the ground (neither effect is then a candidate).
-fit::Flight neutral_fill(fit::Flight f, double vbat_ref) {
-  for (auto& s : f.samples) {
-    if (!f.has_vbat) s.vbat = vbat_ref;
-    if (!f.has_pose) s.x[2] = 1e3;
-  }
-  return f;
-}
-
 }  // namespace
 
 Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
@@ -39,7 +28,8 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   const auto clock0 = std::chrono::steady_clock::now();
   Diagnosis d;
   d.vehicle = v.name;
-  const fit::Flight flight = neutral_fill(flight_in, all.params[all.param_index("vbat_ref")].nominal);
+  // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
+  const fit::Flight flight = predict::fill_missing_signals(flight_in, all.params[all.param_index("vbat_ref")].nominal);
   bool accel = opt.translational == "accelerometer" || (opt.translational == "auto" && !flight.has_pose);
   if (opt.translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
   d.formulation = accel ? "equation error: accelerometer specific force (body) and gyro derivative"
@@ -89,6 +79,12 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   std::cerr << "[diagnose] validation of " << s.selected.size() + 1 << " models\n";
   d.metric_before = metric(s.base_fit, &d.sim_before);
   d.metric_after = metric(s.final_fit, &d.sim_after);
+  if (pose) {
+    std::cerr << "[diagnose] prediction error at horizons, before and after\n";
+    d.has_prediction = true;
+    d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
+    d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
+  }
   const auto rb = channel_rms(valid_ee, s.base_fit), ra = channel_rms(valid_ee, s.final_fit);
   for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
   std::vector<fit::FitParameter> step_base = s.base_fit;

@@ -7,6 +7,7 @@
 
 #include "candidate_search.hpp"
 #include "flight_data.hpp"
+#include "prediction.hpp"
 #include "residual_analysis.hpp"
 #include "validation.hpp"
 #include "vehicle.hpp"
@@ -64,6 +65,9 @@ struct Diagnosis {
   std::string metric;
   double metric_before = 0, metric_after = 0;
   WindowedSimulation sim_before, sim_after;  // validation part
+  // Prediction error on the validation part as published models report it (with a pose).
+  bool has_prediction = false;
+  predict::Prediction prediction_before, prediction_after;
   double seconds = 0;
 };
 

@@ -137,6 +137,9 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     cg.push_back({{"channel", c.channel}, {"rms_before", c.before}, {"rms_after", c.after},
                   {"reduction_percent", reduction(c.before, c.after)}});
   j["validation_channels"] = cg;
+  if (d.has_prediction)
+    j["prediction"] = {{"before", predict::prediction_json(d.prediction_before)},
+                       {"after", predict::prediction_json(d.prediction_after)}};
   json steps = json::array();
   for (const auto& s : d.search.steps) {
     json cands = json::array();
@@ -240,6 +243,9 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis
                     series("", lag, nband)}});
   }
   render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
+  if (d.has_prediction)
+    render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
+           predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
   std::string svg;
   if (!d.search.profiles.empty() &&
       fit::plot_profiles(d.vehicle + ": profile likelihood of the found parameters", d.search.profiles, &svg, error))
@@ -323,6 +329,25 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << "</td><td>" << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
         << "</td></tr>\n";
     h << "</table>\n";
+  }
+  if (d.has_prediction) {
+    // Comparable with published models: the error AT a horizon, averaged over start points.
+    h << "<h2>Prediction on the validation part</h2>\n<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
+         "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
+         "<th>position, attitude replayed [m]</th></tr>\n";
+    const auto& b = d.prediction_before;
+    const auto& a = d.prediction_after;
+    for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
+      h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << num(b.open_loop[i].position.mean()) << "</td><td>"
+        << num(a.open_loop[i].position.mean()) << "</td><td>" << num(a.open_loop[i].tilt.mean()) << "</td><td>"
+        << num(a.open_loop[i].heading.mean()) << "</td><td>"
+        << (i < a.attitude_replayed.size() ? num(a.attitude_replayed[i].position.mean()) : "–") << "</td></tr>\n";
+    h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
+      << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "
+      << num(a.one_step.specific_force[2].rms(), 3) << " m/s², angular acceleration "
+      << num(a.one_step.angular_acceleration[0].rms(), 3) << " / " << num(a.one_step.angular_acceleration[1].rms(), 3) << " / "
+      << num(a.one_step.angular_acceleration[2].rms(), 3) << " rad/s², world vertical acceleration "
+      << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
   }
   h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>RMS base</th><th>RMS extended</th><th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)

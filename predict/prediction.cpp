@@ -1,0 +1,399 @@
+#include "prediction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "attitude.hpp"
+#include "equation_error.hpp"
+
+namespace quadgen::predict {
+
+double ErrorStats::mean() const { return count ? sum / static_cast<double>(count) : std::nan(""); }
+double ErrorStats::rms() const { return count ? std::sqrt(sum_sq / static_cast<double>(count)) : std::nan(""); }
+
+void Prediction::merge(const Prediction& o) {
+  auto merge_rows = [](std::vector<HorizonErrors>& a, const std::vector<HorizonErrors>& b) {
+    if (a.empty()) a = b;
+    else
+      for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+        for (auto m : {&HorizonErrors::position, &HorizonErrors::velocity, &HorizonErrors::tilt, &HorizonErrors::heading,
+                       &HorizonErrors::body_rates})
+          (a[i].*m).merge(b[i].*m);
+        a[i].diverged += b[i].diverged;
+      }
+  };
+  merge_rows(open_loop, o.open_loop);
+  merge_rows(attitude_replayed, o.attitude_replayed);
+  for (int a = 0; a < 3; ++a) {
+    one_step.specific_force[a].merge(o.one_step.specific_force[a]);
+    one_step.angular_acceleration[a].merge(o.one_step.angular_acceleration[a]);
+  }
+  one_step.vertical_acceleration_world.merge(o.one_step.vertical_acceleration_world);
+  if (one_step.source.empty()) one_step.source = o.one_step.source;
+  else if (!o.one_step.source.empty() && o.one_step.source != one_step.source) one_step.source = "mixed";
+  start_points += o.start_points;
+  seconds_of_data += o.seconds_of_data;
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The effects that act outside the ODE, read from the parameter vector by name.
+struct DataSideEffects {
+  double delay = 0, roll = 0, pitch = 0, tau = 0;
+};
+
+DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<double>& p) {
+  auto get = [&](const char* n) {
+    const int i = model.param_index(n);
+    return i >= 0 ? p[i] : 0.0;
+  };
+  return {get("input_delay.seconds"), get("attitude_bias.roll"), get("attitude_bias.pitch"), get("motor_lag.tau")};
+}
+
+// One rollout integrator over a flight: commands held at the log's samples (delayed by the
+// model's input delay), and optionally the log's attitude and body rates imposed.
+class Rollout {
+ public:
+  Rollout(runtime::DynamicModel& model, const fit::Flight& f, const DataSideEffects& e, double step)
+      : m_(model), f_(f), e_(e), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
+        k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
+    t_in_ = model.input_index("t");
+    v_in_ = model.input_index("vbat");
+  }
+
+  // The measured state at sample k (attitude unbiased), rotor speeds in steady state.
+  std::vector<double> initial_state(size_t k) {
+    std::vector<double> x(n_, 0.0);
+    const auto& s = f_.samples[k];
+    std::copy(s.x.begin(), s.x.end(), x.begin());
+    runtime::unbias_attitude(&s.x[6], e_.roll, e_.pitch, &x[6]);
+    if (n_ > 13) {  // the model's dw/dt at w = 0, times tau, is the commanded speed
+      std::vector<double> f(n_);
+      inputs(s.t, u_.data());
+      m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
+      for (int i = 13; i < n_; ++i) x[i] = e_.tau * f[i];
+    }
+    return x;
+  }
+
+  // Integrates x from sample k to sample k + 1; false if it left the finite numbers.
+  bool advance(std::vector<double>& x, size_t k, bool replay_attitude) {
+    const double t0 = f_.samples[k].t, t1 = f_.samples[k + 1].t;
+    const int steps = std::max(1, static_cast<int>(std::ceil((t1 - t0) / step_ - 1e-9)));
+    const double h = (t1 - t0) / steps;
+    for (int i = 0; i < steps; ++i) {
+      const double t = t0 + i * h;
+      deriv(t, x, k, replay_attitude, k1_);
+      stage(x, k1_, h / 2);
+      deriv(t + h / 2, tmp_, k, replay_attitude, k2_);
+      stage(x, k2_, h / 2);
+      deriv(t + h / 2, tmp_, k, replay_attitude, k3_);
+      stage(x, k3_, h);
+      deriv(t + h, tmp_, k, replay_attitude, k4_);
+      for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
+      if (replay_attitude) impose_attitude(t + h, k, x);
+      else normalise_quaternion(x);
+    }
+    for (double v : x)
+      if (!std::isfinite(v) || std::fabs(v) > 1e6) return false;
+    return true;
+  }
+
+  // The logged attitude (unbiased) and body rates at time t in [t_k, t_k+1], interpolated.
+  void impose_attitude(double t, size_t k, std::vector<double>& x) const {
+    const auto& a = f_.samples[k];
+    const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
+    const double w = b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
+    double qa[4], qb[4];
+    runtime::unbias_attitude(&a.x[6], e_.roll, e_.pitch, qa);
+    runtime::unbias_attitude(&b.x[6], e_.roll, e_.pitch, qb);
+    const double sign = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 4; ++i) x[6 + i] = (1 - w) * qa[i] + w * sign * qb[i];
+    normalise_quaternion(x);
+    for (int i = 0; i < 3; ++i) x[10 + i] = (1 - w) * a.x[10 + i] + w * b.x[10 + i];
+  }
+
+ private:
+  size_t held_index(double t) const {
+    const auto& S = f_.samples;
+    const auto it = std::upper_bound(S.begin(), S.end(), t, [](double v, const fit::FlightSample& s) { return v < s.t; });
+    return it == S.begin() ? 0 : static_cast<size_t>(it - S.begin()) - 1;
+  }
+  void inputs(double t, double* u) const {
+    const auto& s = f_.samples[held_index(t - e_.delay)];
+    std::copy(s.u.begin(), s.u.end(), u);
+    if (t_in_ >= 0) u[t_in_] = t;
+    if (v_in_ >= 0) u[v_in_] = f_.samples[held_index(t)].vbat;
+  }
+  void deriv(double t, const std::vector<double>& x, size_t k, bool replay, std::vector<double>& f) {
+    const std::vector<double>* state = &x;
+    if (replay) {
+      forced_ = x;
+      impose_attitude(t, k, forced_);
+      state = &forced_;
+    }
+    inputs(t, u_.data());
+    m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
+  }
+  void stage(const std::vector<double>& x, const std::vector<double>& k, double h) {
+    for (int j = 0; j < n_; ++j) tmp_[j] = x[j] + h * k[j];
+  }
+  static void normalise_quaternion(std::vector<double>& x) {
+    const double n = std::sqrt(x[6] * x[6] + x[7] * x[7] + x[8] * x[8] + x[9] * x[9]);
+    if (n > 0)
+      for (int i = 6; i < 10; ++i) x[i] /= n;
+  }
+
+  runtime::DynamicModel& m_;
+  const fit::Flight& f_;
+  DataSideEffects e_;
+  double step_;
+  int n_, t_in_ = -1, v_in_ = -1;
+  std::vector<double> u_, k1_, k2_, k3_, k4_, tmp_, forced_;
+};
+
+double heading_of(const runtime::Rotation& r) { return std::atan2(r.m[1][0], r.m[0][0]); }
+
+// Errors of a simulated state against the measured sample (attitude unbiased).
+void add_errors(const std::vector<double>& x, const fit::FlightSample& s, const DataSideEffects& e, HorizonErrors& h) {
+  double pos = 0, vel = 0, rate = 0;
+  for (int a = 0; a < 3; ++a) {
+    pos += std::pow(x[a] - s.x[a], 2);
+    vel += std::pow(x[3 + a] - s.x[3 + a], 2);
+    rate += std::pow(x[10 + a] - s.x[10 + a], 2);
+  }
+  double q[4];
+  runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
+  const runtime::Rotation rs = runtime::rotation_matrix(&x[6]), rm = runtime::rotation_matrix(q);
+  double zz = 0;
+  for (int a = 0; a < 3; ++a) zz += rs.m[a][2] * rm.m[a][2];
+  double dh = std::fmod(heading_of(rs) - heading_of(rm) + 3 * kPi, 2 * kPi) - kPi;
+  h.position.add(std::sqrt(pos));
+  h.velocity.add(std::sqrt(vel));
+  h.tilt.add(std::acos(std::clamp(zz, -1.0, 1.0)));
+  h.heading.add(std::fabs(dh));
+  h.body_rates.add(std::sqrt(rate));
+}
+
+double median_spacing(const fit::Flight& f) {
+  std::vector<double> dt;
+  for (size_t k = 1; k < f.samples.size(); ++k) dt.push_back(f.samples[k].t - f.samples[k - 1].t);
+  if (dt.empty()) return 0.01;
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  return dt[dt.size() / 2];
+}
+
+// Rollouts from start points every `stride` seconds; the error at each horizon is taken at
+// the first sample at or after start + horizon (within a quarter of a sample spacing).
+std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const DataSideEffects& e,
+                                    const PredictionOptions& o, bool replay, size_t* starts) {
+  std::vector<HorizonErrors> rows;
+  for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
+  const auto& S = f.samples;
+  const double dt = median_spacing(f), longest = *std::max_element(o.horizons.begin(), o.horizons.end());
+  double next_start = S.empty() ? 0 : S.front().t;
+  for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
+    if (S[k0].t + 1e-9 < next_start) continue;
+    next_start = S[k0].t + o.start_stride;
+    if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
+    ++*starts;
+    std::vector<double> x = roll.initial_state(k0);
+    if (replay) roll.impose_attitude(S[k0].t, k0, x);
+    size_t next = 0;  // the next horizon to score
+    for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
+      if (S[k + 1].t - S[k].t > o.max_gap) break;
+      if (!roll.advance(x, k, replay)) {
+        for (; next < rows.size(); ++next) ++rows[next].diverged;
+        break;
+      }
+      while (next < rows.size() && S[k + 1].t - S[k0].t >= rows[next].horizon - 0.25 * dt) {
+        if (S[k + 1].t - S[k0].t <= rows[next].horizon + dt) add_errors(x, S[k + 1], e, rows[next]);
+        ++next;
+      }
+    }
+  }
+  return rows;
+}
+
+// One-step residuals of the equation error (the fit's own formulation: lag, delay and bias
+// applied to the data), rotated into body and world axes.
+OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f,
+                       const DataSideEffects& e) {
+  OneStepErrors out;
+  const bool accel = f.has_accelerometer;
+  out.source = accel ? "accelerometer (specific force) and differentiated gyro"
+                     : "differentiated velocity and differentiated gyro";
+  std::vector<double> r6;
+  try {
+    const fit::EquationErrorModel ee(model, f, accel);
+    ee.all_channels(p.data(), r6);
+    for (size_t row = 0; row < ee.rows().size(); ++row) {
+      const auto& s = f.samples[ee.rows()[row]];
+      double q[4];
+      runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
+      const runtime::Rotation R = runtime::rotation_matrix(q);
+      const double* r = &r6[row * 6];
+      double body[3], world[3];
+      for (int a = 0; a < 3; ++a) {
+        body[a] = accel ? r[a] : R.m[0][a] * r[0] + R.m[1][a] * r[1] + R.m[2][a] * r[2];
+        world[a] = accel ? R.m[a][0] * r[0] + R.m[a][1] * r[1] + R.m[a][2] * r[2] : r[a];
+      }
+      for (int a = 0; a < 3; ++a) {
+        out.specific_force[a].add(body[a]);
+        out.angular_acceleration[a].add(r[3 + a]);
+      }
+      out.vertical_acceleration_world.add(world[2]);
+    }
+  } catch (const fit::FitError&) {
+    out.source = "not available: too few samples for the derivative filter";
+  }
+  return out;
+}
+
+}  // namespace
+
+fit::Flight fill_missing_signals(fit::Flight f, double vbat_ref) {
+  for (auto& s : f.samples) {
+    if (!f.has_vbat) s.vbat = vbat_ref;
+    if (!f.has_pose) s.x[2] = 1e3;
+  }
+  return f;
+}
+
+Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<double>& params, const fit::Flight& f,
+                               const PredictionOptions& o) {
+  Prediction out;
+  if (f.samples.size() < 2) return out;
+  out.seconds_of_data = f.samples.back().t - f.samples.front().t;
+  // A rotor lag below 1 ms (the equation error's "no lag") would make RK4 at 1 ms steps
+  // unstable; over a second 1 ms of lag is invisible, so it is simulated as 1 ms.
+  std::vector<double> p = params;
+  const int lag = model.param_index("motor_lag.tau");
+  if (lag >= 0 && p[lag] < 1e-3) p[lag] = 1e-3;
+  const DataSideEffects e = data_side(model, p);
+  out.one_step = one_step(model, params, f, e);
+  model.set_params(p);
+  Rollout roll(model, f, e, o.step);
+  size_t starts = 0;
+  out.open_loop = rollouts(roll, f, e, o, false, &out.start_points);
+  out.attitude_replayed = rollouts(roll, f, e, o, true, &starts);
+  return out;
+}
+
+namespace {
+
+nlohmann::ordered_json stats_json(const ErrorStats& s) {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
+  return {{"mean", num(s.mean())}, {"rms", num(s.rms())}, {"count", s.count}};
+}
+
+double rms_of(const ErrorStats& s) { return s.rms(); }
+
+}  // namespace
+
+nlohmann::ordered_json prediction_json(const Prediction& p) {
+  using J = nlohmann::ordered_json;
+  J open = J::array(), replayed = J::array();
+  for (const auto& h : p.open_loop)
+    open.push_back({{"horizon_s", h.horizon},
+                    {"position_m", stats_json(h.position)},
+                    {"velocity_m_s", stats_json(h.velocity)},
+                    {"tilt_rad", stats_json(h.tilt)},
+                    {"heading_rad", stats_json(h.heading)},
+                    {"body_rates_rad_s", stats_json(h.body_rates)},
+                    {"diverged", h.diverged}});
+  for (const auto& h : p.attitude_replayed)
+    replayed.push_back({{"horizon_s", h.horizon},
+                        {"position_m", stats_json(h.position)},
+                        {"velocity_m_s", stats_json(h.velocity)},
+                        {"diverged", h.diverged}});
+  auto num = [](double v) { return std::isfinite(v) ? J(v) : J(nullptr); };
+  const auto& o = p.one_step;
+  J one = {{"specific_force_m_s2",
+            {{"x", num(rms_of(o.specific_force[0]))}, {"y", num(rms_of(o.specific_force[1]))}, {"z", num(rms_of(o.specific_force[2]))}}},
+           {"angular_acceleration_rad_s2",
+            {{"x", num(rms_of(o.angular_acceleration[0]))},
+             {"y", num(rms_of(o.angular_acceleration[1]))},
+             {"z", num(rms_of(o.angular_acceleration[2]))}}},
+           {"vertical_acceleration_world_m_s2", num(rms_of(o.vertical_acceleration_world))},
+           {"samples", o.vertical_acceleration_world.count},
+           {"measured_from", o.source},
+           {"statistic", "RMS of model - measured over samples"}};
+  return {{"open_loop", open},
+          {"attitude_replayed", replayed},
+          {"one_step", one},
+          {"start_points", p.start_points},
+          {"seconds_of_data", p.seconds_of_data},
+          {"definition",
+           "error at each horizon after a start from the measured state, averaged over start points; "
+           "tilt = angle between body z axes, heading = yaw difference"}};
+}
+
+std::string prediction_csv(const Prediction& p) {
+  std::ostringstream os;
+  os.precision(6);
+  os << "view,horizon_s,quantity,unit,mean,rms,count\n";
+  auto row = [&](const char* view, double h, const char* q, const char* unit, const ErrorStats& s) {
+    os << view << ',' << h << ',' << q << ',' << unit << ',' << s.mean() << ',' << s.rms() << ',' << s.count << '\n';
+  };
+  for (const auto& h : p.open_loop) {
+    row("open_loop", h.horizon, "position", "m", h.position);
+    row("open_loop", h.horizon, "velocity", "m/s", h.velocity);
+    row("open_loop", h.horizon, "tilt", "rad", h.tilt);
+    row("open_loop", h.horizon, "heading", "rad", h.heading);
+    row("open_loop", h.horizon, "body_rates", "rad/s", h.body_rates);
+  }
+  for (const auto& h : p.attitude_replayed) {
+    row("attitude_replayed", h.horizon, "position", "m", h.position);
+    row("attitude_replayed", h.horizon, "velocity", "m/s", h.velocity);
+  }
+  const char* axes[] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    row("one_step", 0, (std::string("specific_force_") + axes[a]).c_str(), "m/s^2", p.one_step.specific_force[a]);
+    row("one_step", 0, (std::string("angular_acceleration_") + axes[a]).c_str(), "rad/s^2", p.one_step.angular_acceleration[a]);
+  }
+  row("one_step", 0, "vertical_acceleration_world", "m/s^2", p.one_step.vertical_acceleration_world);
+  return os.str();
+}
+
+const std::vector<PublishedPoint>& published_position_errors() {
+  // Mean position-error norm at a horizon, as the papers report it.
+  static const std::vector<PublishedPoint> points = {
+      {"IDSIA nano-drone benchmark, best (Busetto et al. 2026)", 0.1, 0.0126,
+       "Crazyflie 2.1 Brushless, 10 steps at 100 Hz"},
+      {"IDSIA nano-drone benchmark, best hybrid (Busetto et al. 2026)", 0.5, 0.112,
+       "Crazyflie 2.1 Brushless, 50 steps at 100 Hz"},
+      {"NanoBench learned dynamics, MLP", 0.5, 0.193, "figure-8 of this airframe, 50 steps"},
+      {"NanoBench learned dynamics, MLP", 1.0, 0.533, "100 steps"},
+  };
+  return points;
+}
+
+std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::string, const Prediction*>>& predictions) {
+  runtime::Panel open{"open loop: mean position error at a horizon", "horizon [s]", "m", {}};
+  runtime::Panel replay{"attitude replayed (force model alone): mean position error", "horizon [s]", "m", {}};
+  runtime::Panel tilt{"open loop: mean tilt and heading error", "horizon [s]", "rad", {}};
+  for (const auto& [label, p] : predictions) {
+    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}};
+    for (const auto& h : p->open_loop) {
+      so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
+      st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());
+      sh.x.push_back(h.horizon), sh.y.push_back(h.heading.mean());
+    }
+    for (const auto& h : p->attitude_replayed) sr.x.push_back(h.horizon), sr.y.push_back(h.position.mean());
+    open.series.push_back(so);
+    replay.series.push_back(sr);
+    tilt.series.push_back(st);
+    tilt.series.push_back(sh);
+  }
+  runtime::Series published{"published (IDSIA, NanoBench)", {}, {}, true};
+  for (const auto& pt : published_position_errors()) published.x.push_back(pt.horizon_s), published.y.push_back(pt.position_m);
+  open.series.push_back(published);
+  return {open, replay, tilt};
+}
+
+}  // namespace quadgen::predict

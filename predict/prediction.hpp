@@ -1,0 +1,96 @@
+// Prediction error measured the way published quadrotor models report it, so that ours can be
+// set beside theirs:
+//  - open loop: from many start points (every sample, or a dense stride), the model is
+//    integrated from the measured state with the logged commands; the error AT a horizon
+//    (0.1, 0.25, 0.5, 1 s) is averaged over the start points (IDSIA nano-drone benchmark,
+//    NanoBench rollouts). Tilt (angle between body z axes) and heading are reported apart.
+//  - attitude replayed: the same with attitude and body rates taken from the log at every
+//    step, integrating only translation (and rotor speeds): the force model alone.
+//  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
+//    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
+// Evaluated on the data given: callers pass held-out data.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dynamic_model.hpp"
+#include "flight_data.hpp"
+#include "plot.hpp"
+
+namespace quadgen::predict {
+
+struct PredictionOptions {
+  std::vector<double> horizons = {0.1, 0.25, 0.5, 1.0};  // s, both rollout views
+  double start_stride = 0.05;  // s between start points (5 samples at 100 Hz)
+  double step = 1e-3;          // s, RK4 step
+  // A start whose horizon crosses a gap in the log (trimmed ground contact) is not counted.
+  double max_gap = 0.1;  // s
+};
+
+// Mean and RMS of an error over start points; kept as sums so that flights can be pooled.
+struct ErrorStats {
+  double sum = 0, sum_sq = 0;
+  size_t count = 0;
+  void add(double e) {
+    sum += e;
+    sum_sq += e * e;
+    ++count;
+  }
+  void merge(const ErrorStats& o) {
+    sum += o.sum;
+    sum_sq += o.sum_sq;
+    count += o.count;
+  }
+  double mean() const;  // NaN without samples
+  double rms() const;
+};
+
+struct HorizonErrors {
+  double horizon = 0;  // s
+  ErrorStats position, velocity, tilt, heading, body_rates;  // m, m/s, rad, rad, rad/s
+  size_t diverged = 0;  // rollouts that left any bound (counted in no statistic)
+};
+
+struct OneStepErrors {
+  ErrorStats specific_force[3];        // m/s^2, body x y z (model - measured)
+  ErrorStats angular_acceleration[3];  // rad/s^2, body x y z
+  ErrorStats vertical_acceleration_world;
+  std::string source;  // where the measured accelerations come from
+};
+
+struct Prediction {
+  std::vector<HorizonErrors> open_loop, attitude_replayed;
+  OneStepErrors one_step;
+  size_t start_points = 0;
+  double seconds_of_data = 0;
+  void merge(const Prediction& o);  // pools another flight's errors (same horizons)
+};
+
+// Samples lacking what the full-catalogue model reads get neutral values: without a battery
+// log the voltage is the reference one, without a pose the height is far from the ground.
+fit::Flight fill_missing_signals(fit::Flight f, double vbat_ref);
+
+// `model` with `params` (a full parameter vector of it) on `flight`.
+Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<double>& params,
+                               const fit::Flight& flight, const PredictionOptions& options);
+
+// The layout of contracts §6: open_loop, attitude_replayed, one_step.
+nlohmann::ordered_json prediction_json(const Prediction& p);
+
+// One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.
+std::string prediction_csv(const Prediction& p);
+
+// Published results this measure is comparable with (mean position error at a horizon).
+struct PublishedPoint {
+  std::string source;
+  double horizon_s, position_m;
+  std::string caveat;
+};
+const std::vector<PublishedPoint>& published_position_errors();
+
+// Position error against horizon for each labelled prediction, with the published points.
+std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::string, const Prediction*>>& predictions);
+
+}  // namespace quadgen::predict
