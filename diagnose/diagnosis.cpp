@@ -79,12 +79,11 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   std::cerr << "[diagnose] validation of " << s.selected.size() + 1 << " models\n";
   d.metric_before = metric(s.base_fit, &d.sim_before);
   d.metric_after = metric(s.final_fit, &d.sim_after);
-  if (pose) {
-    std::cerr << "[diagnose] prediction error at horizons, before and after\n";
-    d.has_prediction = true;
-    d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
-    d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
-  }
+  // Without a pose only the one-step view can be measured.
+  std::cerr << "[diagnose] prediction error at horizons, before and after\n";
+  d.has_prediction = true;
+  d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
+  d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
   const auto rb = channel_rms(valid_ee, s.base_fit), ra = channel_rms(valid_ee, s.final_fit);
   for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
   std::vector<fit::FitParameter> step_base = s.base_fit;

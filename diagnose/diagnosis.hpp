@@ -65,7 +65,8 @@ struct Diagnosis {
   std::string metric;
   double metric_before = 0, metric_after = 0;
   WindowedSimulation sim_before, sim_after;  // validation part
-  // Prediction error on the validation part as published models report it (with a pose).
+  // Prediction error on the validation part as published models report it (one step only
+  // without a pose).
   bool has_prediction = false;
   predict::Prediction prediction_before, prediction_after;
   double seconds = 0;

@@ -277,6 +277,7 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   const DataSideEffects e = data_side(model, p);
   out.one_step = one_step(model, params, f, e);
   model.set_params(p);
+  if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with
   Rollout roll(model, f, e, o.step);
   size_t starts = 0;
   out.open_loop = rollouts(roll, f, e, o, false, &out.start_points);

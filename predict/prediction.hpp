@@ -8,7 +8,8 @@
 //    step, integrating only translation (and rotor speeds): the force model alone.
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
-// Evaluated on the data given: callers pass held-out data.
+// Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
+// gets the one-step view alone.
 #pragma once
 #include <string>
 #include <vector>

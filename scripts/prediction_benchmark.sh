@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Prediction error on real flights, the way published models report it, for the nominal
+# Crazyflie model and for the model `quadgen diagnose` fits and extends (base fit and
+# extended model, on each flight's held-out last 30 %). Prints one table with the published
+# numbers beside ours (scripts/prediction_table.py). Not part of CI: about 2-5 minutes per
+# flight on 2 cores, most of it the diagnoses.
+#   scripts/prediction_benchmark.sh [OUT_DIR]        (default out/prediction_benchmark)
+# Needs the build (./setup.sh --no-run), ../shared/data beside the clone, and python3.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-out/prediction_benchmark}"
+data=../shared/data/crazyflie
+command -v python3 > /dev/null || { echo "python3 is needed for the table (apt-get install python3)"; exit 1; }
+vehicle=vehicles/crazyflie21.yaml
+run() {  # name log mapping [extra diagnose flags...]
+  local name=$1 log=$2 mapping=$3; shift 3
+  echo "== $name" >&2
+  build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/nominal" > /dev/null
+  build/quadgen diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
+}
+for log in "$data"/nanobench/*.csv; do
+  run "$(basename "$log" .csv)" "$log" data/mappings/nanobench.yaml
+done
+run arpl_log10 "$data/arpl/log10.csv" data/mappings/arpl.yaml --resample 200
+python3 scripts/prediction_table.py "$out"
