@@ -1,107 +1,574 @@
 #include "cpp_emitter.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace quadgen::emission {
 
 namespace {
-bool is_leaf(const Node& n) {
-  return n.op == Op::constant || n.op == Op::state || n.op == Op::input || n.op == Op::param;
+
+// Shortest decimal that reads back as the same double.
+std::string double_literal(double v) {
+  char buf[40];
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  std::string s(buf);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+double power_of(double c, int k) {
+  double r = 1;
+  for (int i = 0; i < std::abs(k); ++i) r *= c;
+  return k < 0 ? 1 / r : r;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Emission-form nodes, hash-consed.
+
+int CppEmitter::intern(INode n) {
+  if (n.kind != Kind::leaf) {
+    n.dynamic = false;
+    for (int a : n.args) n.dynamic = n.dynamic || ir_[a].dynamic;
+  }
+  auto key = std::make_tuple(static_cast<int>(n.kind), n.args, n.sign, n.text);
+  auto it = unique_.find(key);
+  if (it != unique_.end()) return it->second;
+  ir_.push_back(std::move(n));
+  unique_[key] = static_cast<int>(ir_.size() - 1);
+  return static_cast<int>(ir_.size() - 1);
+}
+
+int CppEmitter::leaf(const std::string& text, bool dynamic) { return intern(INode{Kind::leaf, {}, {}, text, dynamic}); }
+
+int CppEmitter::constant(double v) { return leaf("Scalar(" + double_literal(v) + ")", false); }
+
+int CppEmitter::prod(std::vector<int> factors) {
+  if (factors.empty()) return constant(1);
+  if (factors.size() == 1) return factors[0];
+  std::sort(factors.begin(), factors.end());
+  return intern(INode{Kind::prod, factors, {}, "", false});
+}
+
+int CppEmitter::sum(std::vector<std::pair<int, int>> terms) {
+  std::sort(terms.begin(), terms.end());
+  if (terms.size() == 1 && terms[0].second > 0) return terms[0].first;
+  if (terms.size() == 1) return negate(terms[0].first);
+  INode n{Kind::sum, {}, {}, "", false};
+  for (const auto& [id, s] : terms) {
+    n.args.push_back(id);
+    n.sign.push_back(static_cast<signed char>(s));
+  }
+  return intern(n);
+}
+
+int CppEmitter::negate(int id) {
+  const INode& n = ir_[id];
+  if (n.kind == Kind::sum && n.args.size() == 1 && n.sign[0] < 0) return n.args[0];
+  return intern(INode{Kind::sum, {id}, {-1}, "", false});
+}
+
+int CppEmitter::recip(int id) { return intern(INode{Kind::recip, {id}, {}, "", false}); }
+
+int CppEmitter::call(const std::string& name, std::vector<int> args) {
+  return intern(INode{Kind::call, std::move(args), {}, name, false});
+}
+
+// ---------------------------------------------------------------------------------------
+// From the canonical graph to monomials over emission nodes.
+
+namespace {
+using Factors = std::vector<std::pair<int, int>>;
+Factors merge(const Factors& a, const Factors& b, int scale_b = 1) {
+  Factors out;
+  size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && a[i].first < b[j].first)) out.push_back(a[i++]);
+    else if (i == a.size() || b[j].first < a[i].first) out.push_back({b[j].first, b[j].second * scale_b}), ++j;
+    else {
+      const int e = a[i].second + b[j].second * scale_b;
+      if (e != 0) out.push_back({a[i].first, e});
+      ++i, ++j;
+    }
+  }
+  return out;
 }
 }  // namespace
 
-double CppEmitter::node_ops(int id) const {
-  const Node& n = g_.node(id);
+CppEmitter::Mono CppEmitter::convert(int gid) {
+  auto it = memo_.find(gid);
+  if (it != memo_.end()) return it->second;
+  const Node& n = g_.node(gid);
+  Mono m;
+  auto single = [&](int id) {
+    Mono r;
+    r.f.push_back({id, 1});
+    return r;
+  };
+  auto times = [](const Mono& a, const Mono& b, int k = 1) {
+    Mono r;
+    r.coeff = a.coeff * power_of(b.coeff, k);
+    r.f = merge(a.f, b.f, k);
+    return r;
+  };
   switch (n.op) {
-    case Op::constant: case Op::state: case Op::input: case Op::param: return 0;
-    case Op::add: case Op::mul: return static_cast<double>(n.args.size() - 1);
-    case Op::ipow: return static_cast<double>(std::labs(n.exponent) - 1);
-    default: return 1;
+    case Op::constant: m.coeff = std::strtod(n.literal.c_str(), nullptr); break;
+    case Op::state: m = single(leaf("x[" + std::to_string(n.index) + "]", true)); break;
+    case Op::input: m = single(leaf("u[" + std::to_string(n.index) + "]", true)); break;
+    case Op::param: m = single(leaf("p[" + std::to_string(n.index) + "]", false)); break;
+    case Op::mul:
+      for (int a : n.args) m = times(m, convert(a));
+      break;
+    case Op::div: m = times(convert(n.args[0]), convert(n.args[1]), -1); break;
+    case Op::ipow: m = times(m, convert(n.args[0]), static_cast<int>(n.exponent)); break;
+    case Op::add: {
+      std::vector<Mono> terms;
+      for (int a : n.args) terms.push_back(convert(a));
+      m = make_sum(terms);
+      break;
+    }
+    case Op::pow:
+      m = single(call("pow", {materialize_positive(convert(n.args[0])), materialize_positive(convert(n.args[1]))}));
+      break;
+    case Op::sin: m = single(call("sin", {materialize_positive(convert(n.args[0]))})); break;
+    case Op::cos: m = single(call("cos", {materialize_positive(convert(n.args[0]))})); break;
+    case Op::log: m = single(call("log", {materialize_positive(convert(n.args[0]))})); break;
+    case Op::abs: m = single(call("abs_value", {materialize_positive(convert(n.args[0]))})); break;
+    case Op::sign: m = single(call("sign_of", {materialize_positive(convert(n.args[0]))})); break;
   }
+  memo_[gid] = m;
+  return m;
 }
 
-// Parameter-only nodes that dynamic code (or an output) reads get a precompute slot.
-void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
-  pre_slot_.assign(g_.size(), -1);
-  std::vector<char> seen(g_.size(), 0);
+// A sum of monomials: like terms combined, factors common to every term (and a common
+// coefficient magnitude) taken out, parameter-only terms combined into one (precomputed)
+// term, the sign normalised so that the term with the lowest id is added.
+CppEmitter::Mono CppEmitter::make_sum(std::vector<Mono> in) {
+  std::map<Factors, double> like;
+  std::vector<Factors> order;
+  for (const auto& t : in) {
+    auto [it, fresh] = like.emplace(t.f, 0.0);
+    if (fresh) order.push_back(t.f);
+    it->second += t.coeff;
+  }
+  std::vector<Mono> terms;
+  for (const auto& f : order)
+    if (like[f] != 0) terms.push_back(Mono{like[f], f});
+  if (terms.empty()) return Mono{0, {}};
+  if (terms.size() == 1) return terms[0];
+
+  // Common factors: a base present in every term with exponents of one sign.
+  Factors common = terms[0].f;
+  for (size_t k = 1; k < terms.size() && !common.empty(); ++k) {
+    Factors next;
+    for (const auto& [b, e] : common) {
+      for (const auto& [b2, e2] : terms[k].f)
+        if (b2 == b && (e > 0) == (e2 > 0)) next.push_back({b, e > 0 ? std::min(e, e2) : std::max(e, e2)});
+    }
+    common = next;
+  }
+  double ccoeff = std::fabs(terms[0].coeff);
+  for (const auto& t : terms)
+    if (std::fabs(t.coeff) != ccoeff) ccoeff = 1;
+  for (auto& t : terms) {
+    t.f = merge(t.f, common, -1);
+    t.coeff /= ccoeff;
+  }
+
+  auto is_static = [&](const Mono& t) {
+    for (const auto& [b, e] : t.f)
+      if (ir_[b].dynamic) return false;
+    return true;
+  };
+
+  // Greedy factoring: the factor shared by the most terms (a dynamic base, or a whole
+  // parameter-only part, which is one precomputed value) is taken out of those terms,
+  // c*a + c*b -> c*(a + b), until no factor is shared by two terms.
+  if (terms.size() > 2) {
+    for (;;) {
+      // Candidates: (dynamic base, exponent direction) or the parameter-only part.
+      using Cand = std::tuple<int, int, double, Factors>;  // (kind 0 base / 1 static part, base or 0, coeff, statics)
+      std::map<Cand, int> count;
+      auto static_part = [&](const Mono& t) {
+        Factors st;
+        for (const auto& fe : t.f)
+          if (!ir_[fe.first].dynamic) st.push_back(fe);
+        return Cand{1, 0, std::fabs(t.coeff), st};
+      };
+      for (const auto& t : terms) {
+        if (is_static(t)) continue;
+        const Cand sp = static_part(t);
+        if (std::get<2>(sp) != 1 || !std::get<3>(sp).empty()) count[sp]++;
+        for (const auto& [b, e] : t.f)
+          if (ir_[b].dynamic) count[Cand{0, b, e > 0 ? 1.0 : -1.0, {}}]++;
+      }
+      const Cand* best = nullptr;
+      int best_n = 1;
+      for (const auto& [c, n] : count)
+        if (n > best_n) best = &c, best_n = n;
+      if (!best) break;
+      const Cand cand = *best;
+      std::vector<Mono> group, rest;
+      for (const auto& t : terms) {
+        bool has = false;
+        if (!is_static(t)) {
+          if (std::get<0>(cand) == 1) has = static_part(t) == cand;
+          else
+            for (const auto& [b, e] : t.f)
+              if (b == std::get<1>(cand) && (e > 0 ? 1.0 : -1.0) == std::get<2>(cand)) has = true;
+        }
+        (has ? group : rest).push_back(t);
+      }
+      Mono taken;
+      if (std::get<0>(cand) == 1) {
+        taken = Mono{std::get<2>(cand), std::get<3>(cand)};
+      } else {
+        taken = Mono{1, {{std::get<1>(cand), static_cast<int>(std::get<2>(cand))}}};
+      }
+      for (auto& t : group) {
+        t.f = merge(t.f, taken.f, -1);
+        t.coeff /= taken.coeff;
+      }
+      const Mono inner = make_sum(group);
+      rest.push_back(Mono{inner.coeff * taken.coeff, merge(inner.f, taken.f)});
+      terms = rest;
+      if (terms.size() == 1) return terms[0];
+    }
+  }
+
+  // Parameter-only terms: one term.
+  std::vector<Mono> kept, statics;
+  for (const auto& t : terms) (is_static(t) ? statics : kept).push_back(t);
+  std::vector<Signed> mat;
+  if (statics.size() >= 2 && !kept.empty()) {
+    const Mono s = make_sum(statics);  // all static: no further split happens inside
+    mat.push_back(materialize(s));
+  } else {
+    for (const auto& t : statics) kept.push_back(t);
+  }
+  for (const auto& t : kept) mat.push_back(materialize(t));
+  std::sort(mat.begin(), mat.end(), [](const Signed& a, const Signed& b) { return a.id < b.id; });
+  const int outer = mat.front().sign;
+  std::vector<std::pair<int, int>> st;
+  for (const auto& s : mat) st.push_back({s.id, s.sign * outer});
+  const int id = sum(st);
+  Mono r{outer * ccoeff, merge(common, Factors{{id, 1}})};
+  return r;
+}
+
+// A monomial as sign * node: constants and parameter-only factors are one factor (a
+// precompute candidate), dynamic denominators one reciprocal.
+CppEmitter::Signed CppEmitter::materialize(const Mono& m) {
+  if (m.coeff == 0) return {1, constant(0)};
+  const int sign = m.coeff < 0 ? -1 : 1;
+  const double a = std::fabs(m.coeff);
+  std::vector<int> snum, sden, dnum, dden;
+  for (const auto& [b, e] : m.f) {
+    auto& num = ir_[b].dynamic ? dnum : snum;
+    auto& den = ir_[b].dynamic ? dden : sden;
+    for (int i = 0; i < std::abs(e); ++i) (e > 0 ? num : den).push_back(b);
+  }
+  int stat = -1;
+  if (snum.empty() && sden.empty()) {
+    if (a != 1 || (dnum.empty() && dden.empty())) stat = constant(a);
+  } else if (a == 1 && snum.size() == 1 && sden.empty()) {
+    stat = snum[0];
+  } else {
+    if (a != 1) snum.push_back(constant(a));
+    if (!sden.empty()) snum.push_back(recip(prod(sden)));
+    stat = prod(snum);
+  }
+  if (dnum.empty() && dden.empty()) return {sign, stat};
+  if (stat >= 0) dnum.push_back(stat);
+  if (!dden.empty()) dnum.push_back(recip(prod(dden)));
+  return {sign, prod(dnum)};
+}
+
+int CppEmitter::materialize_positive(const Mono& m) {
+  const Signed s = materialize(m);
+  return s.sign < 0 ? negate(s.id) : s.id;
+}
+
+// ---------------------------------------------------------------------------------------
+// Greedy pair extraction.
+
+std::vector<int> CppEmitter::reachable(Kind kind) const {
+  std::vector<char> seen(ir_.size(), 0);
+  std::vector<int> out;
   std::function<void(int)> visit = [&](int id) {
     if (seen[id]) return;
     seen[id] = 1;
-    const Node& n = g_.node(id);
+    const INode& n = ir_[id];
+    if (!n.dynamic) return;
+    for (int a : n.args) visit(a);
+    if (n.kind == kind && n.args.size() >= 2) out.push_back(id);
+  };
+  for (const auto& r : roots_) visit(r.id);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void CppEmitter::extract_pairs(Kind kind) {
+  const bool is_sum = kind == Kind::sum;
+  const std::vector<int> nodes = reachable(kind);
+  std::vector<std::vector<int>> args(ir_.size());
+  std::vector<std::vector<signed char>> sign(ir_.size());
+  for (int id : nodes) {
+    args[id] = ir_[id].args;
+    sign[id] = ir_[id].sign;
+  }
+  using Key = std::tuple<int, int, int>;  // a <= b, relative sign (sums) or 0
+  std::map<Key, std::set<int>> where;
+  std::set<std::tuple<int, int, int, int>> queue;  // (-count, a, b, rel)
+  auto pairs_of = [&](int id) {
+    std::set<Key> ks;
+    const auto& l = args[id];
+    for (size_t i = 0; i < l.size(); ++i)
+      for (size_t j = i + 1; j < l.size(); ++j) {
+        int a = l[i], b = l[j];
+        int sa = is_sum ? sign[id][i] : 1, sb = is_sum ? sign[id][j] : 1;
+        if (a > b) std::swap(a, b), std::swap(sa, sb);
+        if (is_sum && a == b) continue;
+        ks.insert({a, b, is_sum ? sa * sb : 0});
+      }
+    return ks;
+  };
+  auto update = [&](const Key& k, int id, bool add) {
+    auto& s = where[k];
+    if (!s.empty()) queue.erase({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
+    if (add) s.insert(id);
+    else s.erase(id);
+    if (!s.empty()) queue.insert({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
+  };
+  for (int id : nodes)
+    for (const auto& k : pairs_of(id)) update(k, id, true);
+
+  std::vector<char> modified(ir_.size(), 0);
+  while (!queue.empty()) {
+    const auto [negcount, a, b, rel] = *queue.begin();
+    if (-negcount < 2) break;
+    const int p = is_sum ? sum({{a, 1}, {b, rel}}) : prod({a, b});
+    if (static_cast<size_t>(p) >= args.size()) {
+      args.resize(ir_.size());
+      sign.resize(ir_.size());
+      modified.resize(ir_.size(), 0);
+    }
+    const std::set<int> holders = where[{a, b, rel}];
+    bool changed = false;
+    for (int id : holders) {
+      if (id == p) continue;
+      for (const auto& k : pairs_of(id)) update(k, id, false);
+      auto& l = args[id];
+      auto& s = sign[id];
+      // Find one occurrence of a and one of b (with the right relative sign).
+      int ia = -1, ib = -1;
+      for (size_t i = 0; i < l.size() && ia < 0; ++i)
+        if (l[i] == a) ia = static_cast<int>(i);
+      for (size_t j = 0; j < l.size() && ib < 0; ++j)
+        if (static_cast<int>(j) != ia && l[j] == b && (!is_sum || s[ia] * s[j] == rel)) ib = static_cast<int>(j);
+      const int sa = is_sum ? s[ia] : 1;
+      std::vector<int> nl;
+      std::vector<signed char> ns;
+      for (size_t i = 0; i < l.size(); ++i)
+        if (static_cast<int>(i) != ia && static_cast<int>(i) != ib) {
+          nl.push_back(l[i]);
+          if (is_sum) ns.push_back(s[i]);
+        }
+      nl.push_back(p);
+      if (is_sum) ns.push_back(static_cast<signed char>(sa));
+      l = nl;
+      s = ns;
+      modified[id] = 1;
+      changed = true;
+      for (const auto& k : pairs_of(id)) update(k, id, true);
+    }
+    if (!changed) {  // only the pair node itself holds the pair: drop it from the queue
+      queue.erase(queue.begin());
+    }
+  }
+
+  std::vector<std::vector<int>> final_args(ir_.size());
+  std::vector<std::vector<signed char>> final_sign(ir_.size());
+  for (size_t id = 0; id < modified.size(); ++id)
+    if (modified[id]) {
+      final_args[id] = args[id];
+      final_sign[id] = sign[id];
+    }
+  std::vector<int> memo(ir_.size(), -1);
+  for (auto& r : roots_) r.id = rebuild(r.id, final_args, final_sign, memo);
+  for (auto& [gid, s] : out_) s.id = rebuild(s.id, final_args, final_sign, memo);
+}
+
+int CppEmitter::rebuild(int id, const std::vector<std::vector<int>>& args,
+                        const std::vector<std::vector<signed char>>& sign, std::vector<int>& memo) {
+  if (static_cast<size_t>(id) < memo.size() && memo[id] >= 0) return memo[id];
+  const bool mod = static_cast<size_t>(id) < args.size() && !args[id].empty();
+  const INode n = ir_[id];
+  std::vector<int> a = mod ? args[id] : n.args;
+  const std::vector<signed char> s = mod ? sign[id] : n.sign;
+  for (int& x : a) x = rebuild(x, args, sign, memo);
+  int r = id;
+  switch (n.kind) {
+    case Kind::leaf: r = id; break;
+    case Kind::prod: r = prod(a); break;
+    case Kind::recip: r = recip(a[0]); break;
+    case Kind::call: r = call(n.text, a); break;
+    case Kind::sum: {
+      std::vector<std::pair<int, int>> t;
+      for (size_t i = 0; i < a.size(); ++i) t.push_back({a[i], s[i]});
+      r = sum(t);
+      break;
+    }
+  }
+  if (memo.size() < ir_.size()) memo.resize(ir_.size(), -1);
+  memo[id] = r;
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------
+// Planning: emission form of every output, pair extraction, precompute slots.
+
+void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
+  for (const auto& grp : all_groups)
+    for (const auto& o : grp.outputs) {
+      if (out_.count(o.node)) continue;
+      Signed s = materialize(convert(o.node));
+      if (!ir_[s.id].dynamic && s.sign < 0) {
+        const INode& n = ir_[s.id];
+        if (n.kind == Kind::leaf && n.text.rfind("Scalar(", 0) == 0)
+          s.id = constant(-std::strtod(n.text.c_str() + 7, nullptr));
+        else
+          s.id = negate(s.id);
+        s.sign = 1;
+      }
+      out_[o.node] = s;
+      roots_.push_back(s);
+    }
+  // Products first (their pairs feed the terms of sums), then sums; a second round picks
+  // up what the first made identical.
+  for (int round = 0; round < 2; ++round) {
+    extract_pairs(Kind::prod);
+    extract_pairs(Kind::sum);
+  }
+  pre_slot_.assign(ir_.size(), -1);
+  std::vector<char> seen(ir_.size(), 0);
+  auto slot = [&](int id) {
+    const INode& c = ir_[id];
+    if (!c.dynamic && c.kind != Kind::leaf && pre_slot_[id] < 0) {
+      pre_slot_[id] = static_cast<int>(pre_order_.size());
+      pre_order_.push_back(id);
+    }
+  };
+  std::function<void(int)> visit = [&](int id) {
+    if (seen[id]) return;
+    seen[id] = 1;
+    const INode& n = ir_[id];
+    if (!n.dynamic) return;
     for (int a : n.args) {
       visit(a);
-      const Node& c = g_.node(a);
-      if (n.dynamic && !c.dynamic && !is_leaf(c) && pre_slot_[a] < 0) {
-        pre_slot_[a] = static_cast<int>(pre_order_.size());
-        pre_order_.push_back(a);
-      }
+      slot(a);
     }
   };
   for (const auto& grp : all_groups)
     for (const auto& o : grp.outputs) {
-      visit(o.node);
-      const Node& n = g_.node(o.node);
-      if (!n.dynamic && !is_leaf(n) && pre_slot_[o.node] < 0) {
-        pre_slot_[o.node] = static_cast<int>(pre_order_.size());
-        pre_order_.push_back(o.node);
-      }
+      const int id = out_.at(o.node).id;
+      visit(id);
+      slot(id);
     }
 }
 
-std::string CppEmitter::leaf(int id) const {
-  const Node& n = g_.node(id);
-  switch (n.op) {
-    case Op::constant: return "Scalar(" + n.literal + ")";
-    case Op::state: return "x[" + std::to_string(n.index) + "]";
-    case Op::input: return "u[" + std::to_string(n.index) + "]";
-    case Op::param: return "p[" + std::to_string(n.index) + "]";
-    default: return "";
-  }
-}
+// ---------------------------------------------------------------------------------------
+// Rendering. `uses` decides what is inlined: a node is a temporary (temp[id] >= 0) when
+// used more than once; a reciprocal used once by a product becomes a division there.
 
-std::string CppEmitter::render(int id, const std::vector<int>& temp_id, bool as_operand) const {
-  const Node& n = g_.node(id);
-  if (is_leaf(n)) return leaf(id);
-  if (temp_id[id] >= 0) return "t" + std::to_string(temp_id[id]);
-  if (pre_slot_[id] >= 0 && !n.dynamic && temp_id.size() == g_.size() && temp_id[id] != -2)
-    return "pre.c[" + std::to_string(pre_slot_[id]) + "]";
-  auto sub = [&](int a) { return render(a, temp_id, true); };
+std::string CppEmitter::render_sum(int id, int outer, const std::vector<int>& temp, const std::vector<int>& uses,
+                                   bool pre_region, double& ops) const {
+  const INode& n = ir_[id];
+  std::vector<size_t> order;
+  for (size_t i = 0; i < n.args.size(); ++i)
+    if (n.sign[i] * outer > 0) {
+      order.push_back(i);
+      break;
+    }
+  for (size_t i = 0; i < n.args.size(); ++i)
+    if (order.empty() || i != order[0]) order.push_back(i);
   std::string s;
-  switch (n.op) {
-    case Op::add:
-      for (size_t i = 0; i < n.args.size(); ++i) s += (i ? " + " : "") + render(n.args[i], temp_id, false);
-      return as_operand ? "(" + s + ")" : s;
-    case Op::mul:
-      for (size_t i = 0; i < n.args.size(); ++i) s += (i ? "*" : "") + sub(n.args[i]);
-      return s;
-    case Op::div: return sub(n.args[0]) + "/" + (g_.node(n.args[1]).op == Op::mul ? "(" + sub(n.args[1]) + ")" : sub(n.args[1]));
-    case Op::ipow: {
-      const std::string b = sub(n.args[0]);
-      for (long i = 0; i < n.exponent; ++i) s += (i ? "*" : "") + b;
-      return n.exponent > 1 && as_operand ? "(" + s + ")" : s;
-    }
-    case Op::pow: return "pow(" + render(n.args[0], temp_id, false) + ", " + render(n.args[1], temp_id, false) + ")";
-    case Op::sin: return "sin(" + render(n.args[0], temp_id, false) + ")";
-    case Op::cos: return "cos(" + render(n.args[0], temp_id, false) + ")";
-    case Op::log: return "log(" + render(n.args[0], temp_id, false) + ")";
-    case Op::abs: return "abs_value(" + render(n.args[0], temp_id, false) + ")";
-    case Op::sign: return "sign_of(" + render(n.args[0], temp_id, false) + ")";
-    default: return "";
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t i = order[k];
+    const bool plus = n.sign[i] * outer > 0;
+    const std::string term = render(n.args[i], temp, uses, pre_region, ops, true);
+    if (k == 0) s += plus ? term : "-" + term;
+    else s += (plus ? " + " : " - ") + term;
+    if (k > 0 || !plus) ops += 1;
   }
+  return s;
+}
+
+std::string CppEmitter::render(int id, const std::vector<int>& temp, const std::vector<int>& uses, bool pre_region,
+                               double& ops, bool as_operand) const {
+  const INode& n = ir_[id];
+  if (n.kind == Kind::leaf) return n.text;
+  if (temp[id] >= 0) return "t" + std::to_string(temp[id]);
+  if (!pre_region && !n.dynamic) return "pre.c[" + std::to_string(pre_slot_[id]) + "]";
+  auto operand = [&](int a) { return render(a, temp, uses, pre_region, ops, true); };
+  auto paren = [&](int a) {  // sums parenthesise themselves as operands
+    const std::string s = operand(a);
+    const INode& c = ir_[a];
+    const bool inline_node = c.kind != Kind::leaf && temp[a] < 0 && (pre_region || c.dynamic);
+    return inline_node && (c.kind == Kind::prod || c.kind == Kind::recip) ? "(" + s + ")" : s;
+  };
+  switch (n.kind) {
+    case Kind::sum: {
+      const std::string s = render_sum(id, 1, temp, uses, pre_region, ops);
+      return as_operand ? "(" + s + ")" : s;
+    }
+    case Kind::prod: {
+      std::string num, den;
+      int nn = 0;
+      for (int a : n.args) {
+        const INode& c = ir_[a];
+        if (c.kind == Kind::recip && temp[a] < 0 && uses[a] == 1 && (pre_region || c.dynamic)) {
+          den += "/" + paren(c.args[0]);
+          ops += 1;
+        } else {
+          num += (nn ? "*" : "") + paren(a);
+          if (nn) ops += 1;
+          ++nn;
+        }
+      }
+      if (nn == 0) num = "Scalar(1.0)";
+      return num + den;
+    }
+    case Kind::recip:
+      ops += 1;
+      return "Scalar(1.0)/" + paren(n.args[0]);
+    case Kind::call: {
+      ops += 1;
+      std::string s = n.text + "(";
+      for (size_t i = 0; i < n.args.size(); ++i) s += (i ? ", " : "") + render(n.args[i], temp, uses, pre_region, ops, false);
+      return s + ")";
+    }
+    case Kind::leaf: break;
+  }
+  return "";
 }
 
 EmittedPrecompute CppEmitter::emit_precompute() {
-  // Inside the precompute step every slot is computed from parameters; shared interior
-  // nodes become locals, the rest is inlined.
-  std::vector<int> uses(g_.size(), 0), temp(g_.size(), -1);
-  std::vector<char> seen(g_.size(), 0);
+  std::vector<int> uses(ir_.size(), 0), temp(ir_.size(), -1);
+  std::vector<char> seen(ir_.size(), 0);
   std::function<void(int)> count = [&](int id) {
-    const Node& n = g_.node(id);
-    for (int a : n.args) {
-      uses[a] += n.op == Op::ipow ? static_cast<int>(n.exponent) : 1;
+    for (int a : ir_[id].args) {
+      uses[a]++;
       if (!seen[a]) {
         seen[a] = 1;
         count(a);
@@ -118,16 +585,13 @@ EmittedPrecompute CppEmitter::emit_precompute() {
   EmittedPrecompute out;
   std::ostringstream os;
   int next = 0;
-  std::vector<char> done(g_.size(), 0);
+  std::vector<char> done(ir_.size(), 0);
   std::function<void(int)> emit = [&](int id) {
-    if (done[id] || is_leaf(g_.node(id))) return;
+    if (done[id] || ir_[id].kind == Kind::leaf) return;
     done[id] = 1;
-    for (int a : g_.node(id).args) emit(a);
-    out.ops += node_ops(id);
+    for (int a : ir_[id].args) emit(a);
     if (uses[id] > 1) {
-      // Render the node itself with temp[id] = -2 so it is not replaced by its own slot.
-      temp[id] = -2;
-      const std::string expr = render(id, temp, false);
+      const std::string expr = render(id, temp, uses, true, out.ops, false);
       temp[id] = next++;
       os << "  const Scalar t" << temp[id] << " = " << expr << ";\n";
     }
@@ -142,15 +606,14 @@ EmittedPrecompute CppEmitter::emit_precompute() {
 }
 
 EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups) {
-  // Use counts over the dynamic part of the graph reachable from these outputs.
-  std::vector<int> uses(g_.size(), 0), temp(g_.size(), -1);
-  std::vector<char> seen(g_.size(), 0);
+  std::vector<int> uses(ir_.size(), 0), temp(ir_.size(), -1);
+  std::vector<char> seen(ir_.size(), 0);
   EmittedFunction out;
   std::function<void(int)> count = [&](int id) {
-    const Node& n = g_.node(id);
+    const INode& n = ir_[id];
     if (!n.dynamic) return;
     for (int a : n.args) {
-      uses[a] += n.op == Op::ipow ? static_cast<int>(n.exponent) : 1;
+      uses[a]++;
       if (!seen[a]) {
         seen[a] = 1;
         count(a);
@@ -160,27 +623,41 @@ EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups
   for (const auto& grp : groups)
     for (const auto& o : grp.outputs) {
       out.ops_before += g_.tree_ops(o.node);
-      uses[o.node]++;
-      if (!seen[o.node]) {
-        seen[o.node] = 1;
-        count(o.node);
+      const int id = out_.at(o.node).id;
+      uses[id]++;
+      if (!seen[id]) {
+        seen[id] = 1;
+        count(id);
       }
     }
   std::ostringstream os;
   int next = 0;
-  std::vector<char> done(g_.size(), 0);
+  std::vector<char> done(ir_.size(), 0);
   std::string indent = "  ";
   std::function<void(int)> emit = [&](int id) {
-    const Node& n = g_.node(id);
-    if (done[id] || is_leaf(n) || !n.dynamic) return;
+    const INode& n = ir_[id];
+    if (done[id] || n.kind == Kind::leaf || !n.dynamic) return;
     done[id] = 1;
     for (int a : n.args) emit(a);
-    out.ops_after += node_ops(id);
     if (uses[id] > 1) {
-      const std::string expr = render(id, temp, false);
+      const std::string expr = render(id, temp, uses, false, out.ops_after, false);
       temp[id] = next++;
       os << indent << "const Scalar t" << temp[id] << " = " << expr << ";\n";
     }
+  };
+  auto assign = [&](const Output& o, const std::string& ind) {
+    const Signed s = out_.at(o.node);
+    std::string expr;
+    const INode& n = ir_[s.id];
+    if (s.sign > 0) {
+      expr = render(s.id, temp, uses, false, out.ops_after, false);
+    } else if (n.kind == Kind::sum && n.dynamic && temp[s.id] < 0) {
+      expr = render_sum(s.id, -1, temp, uses, false, out.ops_after);
+    } else {
+      expr = "-" + render(s.id, temp, uses, false, out.ops_after, true);
+      out.ops_after += 1;
+    }
+    os << ind << o.target << " = " << expr << ";\n";
   };
   // Unguarded groups (f) first; guarded groups (Jacobians) share one outer block in
   // which all their temporaries are computed, each group then written under its guard.
@@ -188,8 +665,8 @@ EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups
   for (const auto& grp : groups) {
     if (grp.guard.empty()) {
       for (const auto& o : grp.outputs) {
-        emit(o.node);
-        os << indent << o.target << " = " << render(o.node, temp, false) << ";\n";
+        emit(out_.at(o.node).id);
+        assign(o, indent);
       }
     } else {
       outer += (outer.empty() ? "" : " || ") + grp.guard;
@@ -200,11 +677,11 @@ EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups
     indent = "    ";
     for (const auto& grp : groups)
       if (!grp.guard.empty())
-        for (const auto& o : grp.outputs) emit(o.node);
+        for (const auto& o : grp.outputs) emit(out_.at(o.node).id);
     for (const auto& grp : groups) {
       if (grp.guard.empty()) continue;
       os << "    if (" << grp.guard << ") {\n";
-      for (const auto& o : grp.outputs) os << "      " << o.target << " = " << render(o.node, temp, false) << ";\n";
+      for (const auto& o : grp.outputs) assign(o, "      ");
       os << "    }\n";
     }
     os << "  }\n";
