@@ -97,6 +97,38 @@ TEST(Generated, NullJacobianPointersGiveTheSameF) {
   for (int i = 0; i < finken3_all_effects_traits::kNumStates; ++i) EXPECT_EQ(f1[i], f2[i]);
 }
 
+// rhs(x, u, p, pre, f) is the f part of rhs(x, u, p, pre, f, dfdx, dfdu, dfdp), alone.
+template <class NS_PRE, class Fn8, class Fn5>
+void check_f_only(const double* x, const double* u, const NS_PRE& pre, const double* p, int n, Fn8 full, Fn5 f_only) {
+  double f1[64], f2[64];
+  full(x, u, p, pre, f1);
+  f_only(x, u, p, pre, f2);
+  for (int i = 0; i < n; ++i) EXPECT_NEAR(f1[i], f2[i], 1e-14 * (1 + std::fabs(f1[i]))) << i;
+}
+TEST(Generated, FOnlyEntryPointGivesTheSameF) {
+  std::mt19937 rng(11);
+  for (int t = 0; t < 10; ++t) {
+    {
+      namespace m = gen::finken3;
+      auto pt = random_point<finken3_traits>(rng);
+      m::Precomputed<double> pre;
+      m::precompute(pt.p, &pre);
+      double dx[m::kDfdxNnz], du[m::kDfduNnz], dp[m::kDfdpNnz];
+      check_f_only(pt.x, pt.u, pre, pt.p, m::kNumStates,
+                   [&](auto... a) { m::rhs(a..., dx, du, dp); }, [](auto... a) { m::rhs(a...); });
+    }
+    {
+      namespace m = gen::finken3_all_effects;
+      auto pt = random_point<finken3_all_effects_traits>(rng);
+      m::Precomputed<double> pre;
+      m::precompute(pt.p, &pre);
+      double dx[m::kDfdxNnz], du[m::kDfduNnz], dp[m::kDfdpNnz];
+      check_f_only(pt.x, pt.u, pre, pt.p, m::kNumStates,
+                   [&](auto... a) { m::rhs(a..., dx, du, dp); }, [](auto... a) { m::rhs(a...); });
+    }
+  }
+}
+
 // The checked-in generated/ is what the generator produces now (update: scripts/regenerate.sh).
 TEST(Generated, CheckedInHeadersAreUpToDate) {
   const fs::path tmp = fs::temp_directory_path() / "quadgen_golden";

@@ -186,6 +186,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("sparsity", data{sparsity});
   d.set("precompute_body", pre.body);
   d.set("rhs_body", rhs_code.body);
+  d.set("rhs_f_body", f_only.body);
   d.set("measurement_body", meas_code.body);
   mustache tmpl{std::string(kModelHeaderTemplate)};
   if (!tmpl.is_valid()) throw std::runtime_error("templates/model.hpp.mustache: " + tmpl.error_message());

@@ -9,7 +9,8 @@
 //
 // Self-contained: only the C++ standard library. Scalar may be float, double or ceres::Jet.
 // No heap allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of
-// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need.
+// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need,
+// or call rhs(x, u, p, pre, f) for f alone.
 #pragma once
 
 #include <cmath>
@@ -1268,6 +1269,73 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   }
 }
 
+// dx/dt = f(x, u, p) alone: rhs() without its Jacobian code, so that callers that
+// differentiate f themselves (ceres::Jet) instantiate only f.
+template <typename Scalar>
+inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre;
+  f[0] = x[3];
+  f[1] = x[4];
+  f[2] = x[5];
+  const Scalar t0 = x[9]*x[9];
+  const Scalar t1 = x[8]*x[8];
+  const Scalar t2 = (t0 + t1)*Scalar(2.0) - Scalar(1.0);
+  const Scalar t3 = p[5] + u[2]*(p[6] + u[2]*p[7]);
+  const Scalar t4 = t3*t3;
+  const Scalar t5 = p[5] + u[3]*(p[6] + p[7]*u[3]);
+  const Scalar t6 = t5*t5;
+  const Scalar t7 = t4 + t6;
+  const Scalar t8 = p[5] + u[0]*(p[6] + p[7]*u[0]);
+  const Scalar t9 = t8*t8;
+  const Scalar t10 = p[5] + u[1]*(p[6] + p[7]*u[1]);
+  const Scalar t11 = t10*t10;
+  const Scalar t12 = t9 + t11;
+  const Scalar t13 = x[10]*p[15] + p[13]*x[11] + x[12]*p[17];
+  const Scalar t14 = x[12]*p[14] + p[17]*x[11] + x[10]*p[16];
+  const Scalar t15 = t7*pre.c[1] + t12*pre.c[2] - (x[12]*t13 - x[11]*t14)*Scalar(2e+13);
+  const Scalar t16 = x[12]*p[16] + p[15]*x[11] + x[10]*p[12];
+  const Scalar t17 = (t4 + t11)*pre.c[3] - (t6 + t9)*pre.c[4] + Scalar(2e+13)*(x[10]*t14 - x[12]*t16);
+  const Scalar t18 = (t4 - t6 + t9 - t11)*pre.c[6] - (x[11]*t16 - x[10]*t13)*Scalar(5e+10);
+  const Scalar t19 = pre.c[0]*t15 + t17*pre.c[5] + t18*pre.c[7];
+  const Scalar t20 = pre.c[9]*t15 + t18*pre.c[10] + t17*pre.c[11];
+  const Scalar t21 = x[12]*p[9] - x[10]*p[11];
+  const Scalar t22 = p[9]*x[11] - x[10]*p[10];
+  const Scalar t23 = x[8]*x[7];
+  const Scalar t24 = x[9]*x[6];
+  const Scalar t25 = t23 + t24;
+  const Scalar t26 = x[8]*x[6];
+  const Scalar t27 = x[9]*x[7];
+  const Scalar t28 = t26 - t27;
+  const Scalar t29 = x[3]*t2 - Scalar(2.0)*(x[4]*t25 - x[5]*t28);
+  const Scalar t30 = t19*pre.c[8] + t20*pre.c[12] + Scalar(2e+13)*(x[12]*t21 + x[11]*t22) + pre.c[13]*(t29*abs_value(t29));
+  const Scalar t31 = t23 - t24;
+  const Scalar t32 = pre.c[14]*t15 - pre.c[0]*t17 - t18*pre.c[15];
+  const Scalar t33 = p[11]*x[11] - x[12]*p[10];
+  const Scalar t34 = x[7]*x[7];
+  const Scalar t35 = Scalar(1.0) - Scalar(2.0)*(t0 + t34);
+  const Scalar t36 = x[7]*x[6];
+  const Scalar t37 = x[9]*x[8];
+  const Scalar t38 = t36 + t37;
+  const Scalar t39 = x[4]*t35 + Scalar(2.0)*(x[5]*t38 + x[3]*t31);
+  const Scalar t40 = pre.c[8]*t32 + t20*pre.c[16] + Scalar(2e+13)*(x[10]*t22 + x[12]*t33) + pre.c[17]*(t39*abs_value(t39));
+  const Scalar t41 = t26 + t27;
+  const Scalar t42 = Scalar(1.0) - Scalar(2.0)*(t1 + t34);
+  const Scalar t43 = t36 - t37;
+  const Scalar t44 = x[5]*t42 - Scalar(2.0)*(x[4]*t43 - x[3]*t41);
+  const Scalar t45 = pre.c[12]*t32 - t19*pre.c[16] - Scalar(2e+13)*(x[10]*t21 - x[11]*t33) - pre.c[18]*(pre.c[19]*(t44*abs_value(t44)) - pre.c[20]*(t7 + t12));
+  f[3] = Scalar(1e-13)*(t41*t45 - t31*t40) - (t2*Scalar(5e-14))*t30;
+  f[4] = -(t35*Scalar(5e-14))*t40 - Scalar(1e-13)*(t43*t45 - t25*t30);
+  f[5] = (t42*Scalar(5e-14))*t45 - p[0] - Scalar(1e-13)*(t28*t30 + t38*t40);
+  f[6] = -(x[8]*x[11] + x[10]*x[7] + x[9]*x[12])*Scalar(0.5);
+  f[7] = Scalar(0.5)*(x[8]*x[12] + x[10]*x[6] - x[9]*x[11]);
+  f[8] = Scalar(0.5)*(x[9]*x[10] - x[12]*x[7] + x[6]*x[11]);
+  f[9] = Scalar(0.5)*(x[7]*x[11] - x[8]*x[10] + x[12]*x[6]);
+  f[10] = pre.c[21]*(t18*pre.c[22] - t15*pre.c[23] + t17*pre.c[24]);
+  f[11] = -pre.c[21]*(t15*pre.c[24] + t18*pre.c[25] + t17*pre.c[26]);
+  f[12] = pre.c[21]*(t15*pre.c[27] + t18*pre.c[28] + t17*pre.c[29]);
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1336,6 +1404,10 @@ struct Model {
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
                   Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
     crazyflie21::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+    crazyflie21::rhs(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

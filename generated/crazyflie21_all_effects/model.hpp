@@ -9,7 +9,8 @@
 //
 // Self-contained: only the C++ standard library. Scalar may be float, double or ceres::Jet.
 // No heap allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of
-// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need.
+// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need,
+// or call rhs(x, u, p, pre, f) for f alone.
 #pragma once
 
 #include <cmath>
@@ -1815,6 +1816,85 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   }
 }
 
+// dx/dt = f(x, u, p) alone: rhs() without its Jacobian code, so that callers that
+// differentiate f themselves (ceres::Jet) instantiate only f.
+template <typename Scalar>
+inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre;
+  f[0] = x[3];
+  f[1] = x[4];
+  f[2] = x[5];
+  const Scalar t0 = x[9]*x[9];
+  const Scalar t1 = x[8]*x[8];
+  const Scalar t2 = (t0 + t1)*Scalar(2.0) - Scalar(1.0);
+  const Scalar t3 = x[10]*p[11] - pre.c[0]*x[12];
+  const Scalar t4 = pre.c[0]*x[11] - x[10]*pre.c[1];
+  const Scalar t5 = x[12]*p[14] + p[17]*x[11] + x[10]*p[16];
+  const Scalar t6 = x[12]*p[16] + p[15]*x[11] + x[10]*p[12];
+  const Scalar t7 = ((Scalar(1.0) - p[34]*u[4])*pow(u[5]*pre.c[6], p[35]))/(pre.c[5]/(x[2]*x[2]) - Scalar(16.0));
+  const Scalar t8 = pre.c[4]*t7;
+  const Scalar t9 = x[16]*x[16];
+  const Scalar t10 = x[15]*x[15];
+  const Scalar t11 = x[14]*x[14];
+  const Scalar t12 = x[13]*x[13];
+  const Scalar t13 = x[8]*x[7];
+  const Scalar t14 = x[9]*x[6];
+  const Scalar t15 = t13 + t14;
+  const Scalar t16 = x[8]*x[6];
+  const Scalar t17 = x[9]*x[7];
+  const Scalar t18 = t16 - t17;
+  const Scalar t19 = x[5]*t18;
+  const Scalar t20 = x[3]*t2 - Scalar(2.0)*(x[4]*t15 - t19);
+  const Scalar t21 = x[15] + x[16];
+  const Scalar t22 = x[14] + x[13];
+  const Scalar t23 = t21 + t22;
+  const Scalar t24 = (x[10]*t5 - x[12]*t6)*Scalar(1.25e+12) - t8*(pre.c[7]*t9 + pre.c[8]*t10 + pre.c[9]*t11 + pre.c[10]*t12) + pre.c[11]*(t20*t23);
+  const Scalar t25 = x[7]*x[7];
+  const Scalar t26 = Scalar(1.0) - Scalar(2.0)*(t0 + t25);
+  const Scalar t27 = x[9]*x[8];
+  const Scalar t28 = x[7]*x[6];
+  const Scalar t29 = t27 + t28;
+  const Scalar t30 = x[5]*t29;
+  const Scalar t31 = t13 - t14;
+  const Scalar t32 = x[4]*t26 + Scalar(2.0)*(t30 + x[3]*t31);
+  const Scalar t33 = x[10]*p[15] + p[13]*x[11] + x[12]*p[17];
+  const Scalar t34 = pre.c[19]*t11 + pre.c[20]*t9;
+  const Scalar t35 = pre.c[21]*t10 + pre.c[22]*t12;
+  const Scalar t36 = (t20*(pre.c[13]*t21 - pre.c[14]*t22) - t32*(pre.c[15]*(x[16] + x[13]) + pre.c[16]*(x[15] + x[14])))*pre.c[17] + (x[10]*t33 - x[11]*t6)*Scalar(3.125e+09) + pre.c[18]*(t7*(t34 - t35));
+  const Scalar t37 = Scalar(1.25e+12)*(x[11]*t5 - x[12]*t33) + t8*(pre.c[24]*t9 - pre.c[25]*t12 + pre.c[26]*t10 - pre.c[27]*t11) - pre.c[11]*(t32*t23);
+  const Scalar t38 = pre.c[3]*t24 + pre.c[12]*t36 + pre.c[23]*t37;
+  const Scalar t39 = pre.c[29]*t24 + pre.c[30]*t36 + pre.c[31]*t37;
+  const Scalar t40 = x[3] - p[30];
+  const Scalar t41 = x[4] - p[31];
+  const Scalar t42 = t2*t40 + Scalar(2.0)*(t19 - t15*t41);
+  const Scalar t43 = pre.c[34]*t23;
+  const Scalar t44 = pre.c[2]*t38 - Scalar(1.25e+12)*(x[12]*t3 - x[11]*t4) + pre.c[28]*t39 + pre.c[32]*(pre.c[33]*(t42*abs_value(-t42)) + t20*t43);
+  const Scalar t45 = t16 + t17;
+  const Scalar t46 = x[12]*pre.c[1] - p[11]*x[11];
+  const Scalar t47 = Scalar(1.0) - Scalar(2.0)*(t1 + t25);
+  const Scalar t48 = t27 - t28;
+  const Scalar t49 = x[5]*t47 + Scalar(2.0)*(t40*t45 + t41*t48);
+  const Scalar t50 = pre.c[31]*t24 - pre.c[39]*t37 + pre.c[40]*t36;
+  const Scalar t51 = pre.c[35]*t39 - Scalar(1.25e+12)*(x[10]*t3 - x[11]*t46) + pre.c[36]*(pre.c[37]*(t49*abs_value(-t49)) + pre.c[38]*(t7*(t34 + t35))) + pre.c[2]*t50;
+  const Scalar t52 = t26*t41 + Scalar(2.0)*(t30 + t31*t40);
+  const Scalar t53 = pre.c[35]*t38 - Scalar(1.25e+12)*(x[12]*t46 - x[10]*t4) + pre.c[32]*(pre.c[41]*(t52*abs_value(t52)) + t32*t43) - pre.c[28]*t50;
+  f[3] = -(t2*Scalar(8e-13))*t44 - Scalar(1.6e-12)*(t45*t51 + t31*t53);
+  f[4] = -(t26*Scalar(8e-13))*t53 - Scalar(1.6e-12)*(t48*t51 - t15*t44);
+  f[5] = -p[0] - (t47*Scalar(8e-13))*t51 - Scalar(1.6e-12)*(t29*t53 + t18*t44);
+  f[6] = -(x[8]*x[11] + x[10]*x[7] + x[9]*x[12])*Scalar(0.5);
+  f[7] = Scalar(0.5)*(x[8]*x[12] + x[10]*x[6] - x[9]*x[11]);
+  f[8] = Scalar(0.5)*(x[9]*x[10] - x[12]*x[7] + x[6]*x[11]);
+  f[9] = Scalar(0.5)*(x[7]*x[11] - x[8]*x[10] + x[12]*x[6]);
+  f[10] = pre.c[42]*(pre.c[43]*t24 + pre.c[44]*t36 - pre.c[45]*t37);
+  f[11] = -pre.c[42]*(pre.c[46]*t36 + pre.c[43]*t37 + pre.c[47]*t24);
+  f[12] = pre.c[42]*(pre.c[48]*t36 + pre.c[49]*t24 + pre.c[50]*t37);
+  f[13] = -(x[13] - p[5] - u[0]*(p[6] + u[0]*p[7]))*pre.c[51];
+  f[14] = -pre.c[51]*(x[14] - p[5] - u[1]*(p[6] + p[7]*u[1]));
+  f[15] = -pre.c[51]*(x[15] - p[5] - u[2]*(p[6] + p[7]*u[2]));
+  f[16] = -pre.c[51]*(x[16] - p[5] - u[3]*(p[6] + p[7]*u[3]));
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1915,6 +1995,10 @@ struct Model {
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
                   Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
     crazyflie21_all_effects::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+    crazyflie21_all_effects::rhs(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

@@ -9,7 +9,8 @@
 //
 // Self-contained: only the C++ standard library. Scalar may be float, double or ceres::Jet.
 // No heap allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of
-// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need.
+// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need,
+// or call rhs(x, u, p, pre, f) for f alone.
 #pragma once
 
 #include <cmath>
@@ -1270,6 +1271,73 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   }
 }
 
+// dx/dt = f(x, u, p) alone: rhs() without its Jacobian code, so that callers that
+// differentiate f themselves (ceres::Jet) instantiate only f.
+template <typename Scalar>
+inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre;
+  f[0] = x[3];
+  f[1] = x[4];
+  f[2] = x[5];
+  const Scalar t0 = x[9]*x[9];
+  const Scalar t1 = x[8]*x[8];
+  const Scalar t2 = (t0 + t1)*Scalar(2.0) - Scalar(1.0);
+  const Scalar t3 = x[12]*p[9] - x[10]*p[11];
+  const Scalar t4 = p[9]*x[11] - x[10]*p[10];
+  const Scalar t5 = x[8]*x[7];
+  const Scalar t6 = x[9]*x[6];
+  const Scalar t7 = t5 + t6;
+  const Scalar t8 = x[8]*x[6];
+  const Scalar t9 = x[9]*x[7];
+  const Scalar t10 = t8 - t9;
+  const Scalar t11 = x[3]*t2 - Scalar(2.0)*(x[4]*t7 - x[5]*t10);
+  const Scalar t12 = p[5] + u[1]*(p[6] + p[7]*u[1]);
+  const Scalar t13 = t12*t12;
+  const Scalar t14 = p[5] + u[0]*(p[6] + p[7]*u[0]);
+  const Scalar t15 = t14*t14;
+  const Scalar t16 = p[5] + u[3]*(p[6] + u[3]*p[7]);
+  const Scalar t17 = t16*t16;
+  const Scalar t18 = p[5] + u[2]*(p[6] + p[7]*u[2]);
+  const Scalar t19 = t18*t18;
+  const Scalar t20 = x[12]*p[14] + x[11]*p[17] + x[10]*p[16];
+  const Scalar t21 = x[10]*p[15] + x[11]*p[13] + x[12]*p[17];
+  const Scalar t22 = (t13 + t15)*pre.c[3] - (t17 + t19)*pre.c[4] + (x[11]*t20 - x[12]*t21)*Scalar(4e+16);
+  const Scalar t23 = x[12]*p[16] + x[11]*p[15] + x[10]*p[12];
+  const Scalar t24 = (t13 + t19)*pre.c[5] - (t17 + t15)*pre.c[6] - Scalar(4e+16)*(x[10]*t20 - x[12]*t23);
+  const Scalar t25 = t17 + t13;
+  const Scalar t26 = t19 + t15;
+  const Scalar t27 = pre.c[9]*(t25 - t26) - (x[10]*t21 - x[11]*t23)*Scalar(2e+12);
+  const Scalar t28 = t24*pre.c[7] - pre.c[2]*t22 + pre.c[8]*t27;
+  const Scalar t29 = t24*pre.c[11] - pre.c[12]*t22 + pre.c[13]*t27;
+  const Scalar t30 = pre.c[1]*t28 - Scalar(4e+16)*(x[12]*t3 + x[11]*t4) - pre.c[0]*(t11*abs_value(t11)) + pre.c[10]*t29;
+  const Scalar t31 = t5 - t6;
+  const Scalar t32 = p[11]*x[11] - x[12]*p[10];
+  const Scalar t33 = x[7]*x[7];
+  const Scalar t34 = Scalar(1.0) - Scalar(2.0)*(t0 + t33);
+  const Scalar t35 = x[9]*x[8];
+  const Scalar t36 = x[7]*x[6];
+  const Scalar t37 = t35 + t36;
+  const Scalar t38 = x[4]*t34 + Scalar(2.0)*(x[5]*t37 + x[3]*t31);
+  const Scalar t39 = pre.c[12]*t24 + pre.c[16]*t22 + pre.c[17]*t27;
+  const Scalar t40 = pre.c[15]*t28 - Scalar(4e+16)*(x[10]*t4 + x[12]*t32) - pre.c[14]*(t38*abs_value(t38)) - pre.c[10]*t39;
+  const Scalar t41 = t8 + t9;
+  const Scalar t42 = Scalar(1.0) - Scalar(2.0)*(t1 + t33);
+  const Scalar t43 = t35 - t36;
+  const Scalar t44 = x[5]*t42 + Scalar(2.0)*(x[4]*t43 + x[3]*t41);
+  const Scalar t45 = Scalar(4e+16)*(x[10]*t3 - x[11]*t32) - pre.c[15]*t29 - pre.c[1]*t39 + pre.c[18]*(pre.c[19]*(t44*abs_value(t44)) - pre.c[20]*(t25 + t26));
+  f[3] = (t2*Scalar(2.5e-17))*t30 + Scalar(5e-17)*(t31*t40 - t41*t45);
+  f[4] = (t34*Scalar(2.5e-17))*t40 - Scalar(5e-17)*(t43*t45 + t7*t30);
+  f[5] = Scalar(5e-17)*(t10*t30 + t37*t40) - p[0] - (t42*Scalar(2.5e-17))*t45;
+  f[6] = -(x[8]*x[11] + x[10]*x[7] + x[9]*x[12])*Scalar(0.5);
+  f[7] = Scalar(0.5)*(x[8]*x[12] + x[10]*x[6] - x[9]*x[11]);
+  f[8] = Scalar(0.5)*(x[9]*x[10] - x[12]*x[7] + x[11]*x[6]);
+  f[9] = Scalar(0.5)*(x[11]*x[7] - x[8]*x[10] + x[12]*x[6]);
+  f[10] = -pre.c[21]*(t24*pre.c[22] + t22*pre.c[23] + pre.c[24]*t27);
+  f[11] = pre.c[21]*(t24*pre.c[25] - t22*pre.c[22] + pre.c[26]*t27);
+  f[12] = -pre.c[21]*(t24*pre.c[28] - t22*pre.c[27] + pre.c[29]*t27);
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1338,6 +1406,10 @@ struct Model {
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
                   Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
     finken3::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+    finken3::rhs(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

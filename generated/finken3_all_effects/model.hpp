@@ -9,7 +9,8 @@
 //
 // Self-contained: only the C++ standard library. Scalar may be float, double or ceres::Jet.
 // No heap allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of
-// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need.
+// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need,
+// or call rhs(x, u, p, pre, f) for f alone.
 #pragma once
 
 #include <cmath>
@@ -1785,6 +1786,85 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   }
 }
 
+// dx/dt = f(x, u, p) alone: rhs() without its Jacobian code, so that callers that
+// differentiate f themselves (ceres::Jet) instantiate only f.
+template <typename Scalar>
+inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre;
+  f[0] = x[3];
+  f[1] = x[4];
+  f[2] = x[5];
+  const Scalar t0 = x[9]*x[9];
+  const Scalar t1 = x[8]*x[8];
+  const Scalar t2 = Scalar(1.0) - (t0 + t1)*Scalar(2.0);
+  const Scalar t3 = pre.c[0]*x[11] - x[10]*pre.c[1];
+  const Scalar t4 = p[11]*x[10] - pre.c[0]*x[12];
+  const Scalar t5 = p[15]*x[10] + p[13]*x[11] + p[17]*x[12];
+  const Scalar t6 = p[14]*x[12] + p[17]*x[11] + p[16]*x[10];
+  const Scalar t7 = ((Scalar(1.0) - p[34]*u[4])*pow(u[5]*pre.c[6], p[35]))/(pre.c[5]/(x[2]*x[2]) - Scalar(16.0));
+  const Scalar t8 = pre.c[4]*t7;
+  const Scalar t9 = x[13]*x[13];
+  const Scalar t10 = x[16]*x[16];
+  const Scalar t11 = x[15]*x[15];
+  const Scalar t12 = x[14]*x[14];
+  const Scalar t13 = x[7]*x[7];
+  const Scalar t14 = Scalar(1.0) - Scalar(2.0)*(t0 + t13);
+  const Scalar t15 = x[9]*x[8];
+  const Scalar t16 = x[7]*x[6];
+  const Scalar t17 = t15 + t16;
+  const Scalar t18 = x[5]*t17;
+  const Scalar t19 = x[8]*x[7];
+  const Scalar t20 = x[9]*x[6];
+  const Scalar t21 = t19 - t20;
+  const Scalar t22 = x[4]*t14 + Scalar(2.0)*(t18 + x[3]*t21);
+  const Scalar t23 = x[13] + x[14];
+  const Scalar t24 = x[15] + x[16];
+  const Scalar t25 = t23 + t24;
+  const Scalar t26 = Scalar(2.5e+15)*(x[12]*t5 - x[11]*t6) + t8*(pre.c[7]*t9 - pre.c[8]*t10 - pre.c[9]*t11 + pre.c[10]*t12) - pre.c[11]*(t22*t25);
+  const Scalar t27 = t19 + t20;
+  const Scalar t28 = x[8]*x[6];
+  const Scalar t29 = x[9]*x[7];
+  const Scalar t30 = t28 - t29;
+  const Scalar t31 = x[5]*t30;
+  const Scalar t32 = x[3]*t2 + Scalar(2.0)*(x[4]*t27 - t31);
+  const Scalar t33 = p[16]*x[12] + p[15]*x[11] + p[12]*x[10];
+  const Scalar t34 = pre.c[19]*t11 + pre.c[20]*t9;
+  const Scalar t35 = pre.c[21]*t10 + pre.c[22]*t12;
+  const Scalar t36 = (x[11]*t33 - x[10]*t5)*Scalar(1.25e+11) - (t32*(pre.c[13]*t23 - pre.c[14]*t24) - t22*(pre.c[15]*(x[13] + x[16]) - pre.c[16]*(x[14] + x[15])))*pre.c[17] + pre.c[18]*(t7*(t34 - t35));
+  const Scalar t37 = (x[12]*t33 - x[10]*t6)*Scalar(2.5e+15) + t8*(pre.c[24]*t9 - pre.c[25]*t11 + pre.c[26]*t10 - pre.c[27]*t12) - pre.c[11]*(t32*t25);
+  const Scalar t38 = pre.c[3]*t26 + pre.c[12]*t36 + pre.c[23]*t37;
+  const Scalar t39 = x[3] - p[30];
+  const Scalar t40 = x[4] - p[31];
+  const Scalar t41 = t2*t39 - Scalar(2.0)*(t31 - t27*t40);
+  const Scalar t42 = pre.c[30]*t25;
+  const Scalar t43 = pre.c[32]*t37 + pre.c[33]*t26 + pre.c[34]*t36;
+  const Scalar t44 = pre.c[2]*t38 - Scalar(2.5e+15)*(x[11]*t3 - x[12]*t4) + pre.c[28]*(pre.c[29]*(t41*abs_value(t41)) + t32*t42) + pre.c[31]*t43;
+  const Scalar t45 = t28 + t29;
+  const Scalar t46 = x[12]*pre.c[1] - p[11]*x[11];
+  const Scalar t47 = Scalar(1.0) - Scalar(2.0)*(t1 + t13);
+  const Scalar t48 = t15 - t16;
+  const Scalar t49 = x[5]*t47 + Scalar(2.0)*(t39*t45 + t48*t40);
+  const Scalar t50 = pre.c[39]*t26 - pre.c[40]*t36 - pre.c[33]*t37;
+  const Scalar t51 = pre.c[35]*t43 - Scalar(2.5e+15)*(x[11]*t46 - x[10]*t4) - pre.c[36]*(pre.c[37]*(t49*abs_value(-t49)) + pre.c[38]*(t7*(t34 + t35))) - pre.c[2]*t50;
+  const Scalar t52 = t14*t40 + Scalar(2.0)*(t18 + t21*t39);
+  const Scalar t53 = pre.c[28]*(pre.c[41]*(t52*abs_value(t52)) + t22*t42) - Scalar(2.5e+15)*(x[12]*t46 - x[10]*t3) - pre.c[35]*t38 - pre.c[31]*t50;
+  f[3] = Scalar(8e-16)*(t45*t51 - t21*t53) - (t2*Scalar(4e-16))*t44;
+  f[4] = -(t14*Scalar(4e-16))*t53 - Scalar(8e-16)*(t27*t44 - t48*t51);
+  f[5] = (t47*Scalar(4e-16))*t51 - p[0] - Scalar(8e-16)*(t17*t53 - t30*t44);
+  f[6] = -(x[8]*x[11] + x[7]*x[10] + x[9]*x[12])*Scalar(0.5);
+  f[7] = Scalar(0.5)*(x[8]*x[12] + x[6]*x[10] - x[9]*x[11]);
+  f[8] = Scalar(0.5)*(x[9]*x[10] - x[7]*x[12] + x[6]*x[11]);
+  f[9] = Scalar(0.5)*(x[7]*x[11] - x[8]*x[10] + x[6]*x[12]);
+  f[10] = pre.c[42]*(pre.c[43]*t26 - pre.c[44]*t37 - pre.c[45]*t36);
+  f[11] = pre.c[42]*(pre.c[46]*t37 + pre.c[47]*t36 + pre.c[44]*t26);
+  f[12] = -pre.c[42]*(pre.c[48]*t26 + pre.c[49]*t37 + pre.c[50]*t36);
+  f[13] = -(x[13] - p[5] - u[0]*(p[6] + p[7]*u[0]))*pre.c[51];
+  f[14] = -pre.c[51]*(x[14] - p[5] - u[1]*(p[6] + p[7]*u[1]));
+  f[15] = -pre.c[51]*(x[15] - p[5] - u[2]*(p[6] + p[7]*u[2]));
+  f[16] = -pre.c[51]*(x[16] - p[5] - u[3]*(p[6] + p[7]*u[3]));
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1885,6 +1965,10 @@ struct Model {
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f,
                   Scalar* dfdx, Scalar* dfdu, Scalar* dfdp) {
     finken3_all_effects::rhs(x, u, p, pre, f, dfdx, dfdu, dfdp);
+  }
+  template <typename Scalar>
+  static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
+    finken3_all_effects::rhs(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,
