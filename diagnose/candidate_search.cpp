@@ -28,30 +28,6 @@ double typical_start(const std::string& param) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-// The value at which an effect is off. The derived model's nominal values are neutral
-// except the rotor lag, whose nominal 1 ms keeps simulations non-stiff; equation error
-// has no such limit, so "no lag" is its lower bound (1 us).
-double neutral_value(const Variable& p) { return p.name == "motor_lag.tau" ? p.lower : p.nominal; }
-
-// Below these magnitudes an effect is physically negligible for a flight model, however
-// significant statistically (a long, clean log makes micrometre CoG offsets "significant"
-// through the smallest model error). A candidate must exceed them in at least one
-// parameter to be named. README "Diagnosis" lists them with their reasons.
-double negligible_magnitude(const std::string& param) {
-  const std::string e = param.substr(0, param.find('.'));
-  if (e == "motor_gain") return 0.005;          // 0.5 % thrust
-  if (e == "motor_lag") return 0.002;           // s
-  if (e == "input_delay") return 0.002;         // s
-  if (e == "cog_offset") return 0.0005;         // m
-  if (e == "rotor_drag") return 1e-6;           // N s/m per rad/s: ~0.1 % of hover thrust at 1 m/s
-  if (e == "wind") return 0.2;                  // m/s
-  if (e == "attitude_bias") return 0.002;       // rad (0.11 deg)
-  if (e == "thrust_decay") return 1e-4;         // 1/s: 0.6 % per minute
-  if (e == "battery_sag") return 0.1;           // exponent
-  if (e == "ground_effect") return 0.01;        // m
-  return 0;
-}
-
 std::string effect_of(const std::string& param) { return param.substr(0, param.find('.')); }
 
 double chi2_upper(double x, double dof) {
@@ -60,6 +36,15 @@ double chi2_upper(double x, double dof) {
 }
 
 }  // namespace
+
+double neutral_value(const Variable& p) { return p.name == "motor_lag.tau" ? p.lower : p.nominal; }
+
+std::vector<std::string> SearchResult::named() const {
+  std::vector<std::string> out;
+  for (const auto& e : selected)
+    if (std::find(carried.begin(), carried.end(), e) == carried.end()) out.push_back(e);
+  return out;
+}
 
 std::vector<std::string> applicable_effects(const fit::Flight& f) {
   std::vector<std::string> out;
@@ -218,17 +203,15 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   for (int i : effect_params_.at(effect)) ev.dof += ev.parameters[i].free ? 1 : 0;
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
   ev.boundary = ev.dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
-  ev.p_value = ev.boundary ? 0.5 * chi2_upper(ev.statistic, 1) : chi2_upper(ev.statistic, ev.dof);
+  ev.p_value = p_value_of(effect, ev.statistic, ev.dof);
   ev.level = opt_.alpha / static_cast<double>(candidates_.size());
   ev.delta_bic = -ev.statistic + ev.dof * std::log(large.n_eff);
   ev.delta_aic = -ev.statistic + 2.0 * ev.dof;
   ev.validation_cost_before = base_valid_cost;
   ev.validation_cost_after = cost(valid_, ev.parameters);
   ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
-  bool relevant = false;
-  for (int i : effect_params_.at(effect))
-    if (ev.parameters[i].free && std::abs(ev.parameters[i].value - neutral_value(all_.params[i])) >= negligible_magnitude(ev.parameters[i].name))
-      relevant = true;
+  effect_size(effect, ev.parameters, ev);
+  const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
   if (!(ev.p_value < ev.level))
     ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
   else if (!(ev.delta_bic < 0))
@@ -239,6 +222,31 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
     ev.why_not = "physically negligible size";
   ev.significant = ev.why_not.empty();
   return ev;
+}
+
+// A parameter whose neutral value is its bound has a chi-bar-square null (Self & Liang 1987).
+double CandidateSearch::p_value_of(const std::string& effect, double statistic, int dof) const {
+  const auto& p0 = all_.params[effect_params_.at(effect).front()];
+  const bool boundary = dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
+  return boundary ? 0.5 * chi2_upper(statistic, 1) : chi2_upper(statistic, std::max(1, dof));
+}
+
+void CandidateSearch::effect_size(const std::string& effect, const std::vector<FitParameter>& ps,
+                                  CandidateEvidence& ev) const {
+  std::vector<double> on = fit::parameter_values(ps), off = on, r_on, r_off;
+  for (int i : effect_params_.at(effect)) off[i] = neutral_value(all_.params[i]);
+  train_.all_channels(on.data(), r_on);
+  train_.all_channels(off.data(), r_off);
+  double trans = 0, rot = 0;
+  const size_t rows = r_on.size() / 6;
+  for (size_t k = 0; k < rows; ++k)
+    for (int c = 0; c < 3; ++c) {
+      trans += std::pow(r_on[k * 6 + c] - r_off[k * 6 + c], 2);
+      rot += std::pow(r_on[k * 6 + 3 + c] - r_off[k * 6 + 3 + c], 2);
+    }
+  const double n = static_cast<double>(std::max<size_t>(rows, 1));
+  ev.size_translation = std::sqrt(trans / n) / 9.81;
+  ev.size_rotation = opt_.rotation_scale > 0 ? std::sqrt(rot / n) / opt_.rotation_scale : 0.0;
 }
 
 std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& step,
@@ -295,7 +303,14 @@ SearchResult CandidateSearch::run() {
       if (opt_.verbose_progress && isatty(2))
         std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
                   << e << "                    " << std::flush;
-      step.candidates.push_back(evaluate(e, base, current, base_ss, base_valid));
+      try {
+        step.candidates.push_back(evaluate(e, base, current, base_ss, base_valid));
+      } catch (const fit::FitError& err) {  // a candidate the solver cannot fit is no candidate
+        CandidateEvidence failed;
+        failed.effect = e;
+        failed.why_not = std::string("the fit failed: ") + err.what();
+        step.candidates.push_back(failed);
+      }
     }
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
@@ -305,16 +320,17 @@ SearchResult CandidateSearch::run() {
       return a.statistic > b.statistic;
     });
     if (step.candidates.empty() || !step.candidates.front().significant) {
+      step.outcome = "nothing significant";
       res.steps.push_back(step);
       break;
     }
     step.ambiguities = check_look_alikes(step, base);
-    if (!step.ambiguities.empty()) {
-      res.unresolved = step.ambiguities;
-      res.steps.push_back(step);
-      break;
-    }
     step.selected = step.candidates.front().effect;
+    step.outcome = step.ambiguities.empty() ? "selected" : "ambiguous";
+    if (!step.ambiguities.empty()) {  // the group is reported; its stronger member stands in
+      res.unresolved.insert(res.unresolved.end(), step.ambiguities.begin(), step.ambiguities.end());
+      res.carried.push_back(step.selected);
+    }
     base.insert(step.selected);
     res.selected.push_back(step.selected);
     current = step.candidates.front().parameters;
@@ -324,10 +340,58 @@ SearchResult CandidateSearch::run() {
     current = fit_with(base, current, &c);
     res.steps.push_back(step);
   }
+  backward_pass(res, base, current);
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res);
   return res;
+}
+
+void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<FitParameter>& current) {
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (const auto& e : r.named()) {
+      std::set<std::string> without = base;
+      without.erase(e);
+      double c = 0;
+      const auto smaller = fit_with(without, current, &c);
+      const ChannelNoise full = channel_noise(train_, current);
+      const double statistic = lr_statistic(channel_noise(train_, smaller).ss, full);
+      int dof = 0;
+      for (int i : effect_params_.at(e)) dof += current[i].free ? 1 : 0;
+      const double p = p_value_of(e, statistic, dof), level = opt_.alpha / static_cast<double>(candidates_.size());
+      const double vb = cost(valid_, smaller), va = cost(valid_, current);
+      const double gain = 100 * (vb - va) / std::max(1e-300, vb);
+      std::string reason;
+      if (!(p < level)) reason = "no longer significant beside the effects found after it (p = " + std::to_string(p) + ")";
+      else if (!(va < vb)) reason = "no gain on the held-out part beside the effects found after it";
+      if (reason.empty()) continue;
+      r.removed.push_back({e, reason, p, gain});
+      r.selected.erase(std::find(r.selected.begin(), r.selected.end(), e));
+      base = without;
+      current = smaller;
+      weights_ = weights_at(current);
+      current = fit_with(base, current, &c);
+      removed = true;
+      break;  // the others are tested again against the smaller model
+    }
+  }
+}
+
+void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::string>& effects) const {
+  if (effects.empty()) return;
+  std::set<std::string> keep;
+  for (const auto& e : r.selected)
+    if (std::find(effects.begin(), effects.end(), e) == effects.end()) keep.insert(e);
+  std::vector<std::string> selected;
+  for (const auto& e : r.selected)
+    if (keep.count(e)) selected.push_back(e);
+  r.selected = selected;
+  double c = 0;
+  r.final_fit = fit_with(keep, r.final_fit, &c);
+  r.estimates.clear();
+  r.profiles.clear();
+  estimate_intervals(r);
 }
 
 // Intervals for the selected effects' parameters: profile likelihood with the final

@@ -10,8 +10,16 @@
 // Forward selection adds the best significant candidate and searches again, so two
 // simultaneous effects are found; it stops when nothing more is significant. A runner-up
 // that explains almost as much is fitted together with the winner: if neither adds
-// anything significant to the other, the data cannot tell them apart and the step reports
-// an ambiguity with the manoeuvre that would separate them instead of a guess.
+// anything significant to the other, the data cannot tell them apart: the step reports the
+// pair as a group with the manoeuvre that would separate them, the model carries the
+// stronger of the two (unnamed), and the search goes on. A backward pass then tests each
+// named effect against the final model without it and drops those that no longer earn
+// their place (significance on training data, gain on the held-out part).
+//
+// "Physically negligible" is relative to the vehicle and the flight: an effect's size is
+// the RMS change of the model's accelerations over the training flight when it is switched
+// off, against g (translation) and the angular acceleration that the vehicle's weight gives
+// at its rotor arm (rotation).
 #pragma once
 #include <map>
 #include <memory>
@@ -33,6 +41,10 @@ struct SearchOptions {
   double ambiguity_ratio = 0.5;  // runner-up statistic / winner's above which both are tested together
   std::vector<std::string> candidates;  // effects to consider (default: all that the log supports)
   bool verbose_progress = true;
+  // Sizes below this fraction of the vehicle's scales (g; weight x arm / inertia) are
+  // physically negligible, however significant statistically.
+  double negligible_fraction = 2e-4;
+  double rotation_scale = 0;  // rad/s^2, m g arm / J; 0: translation alone decides
 };
 
 struct EffectEstimate {
@@ -55,6 +67,9 @@ struct CandidateEvidence {
   double p_value = 1, level = 0;
   double delta_bic = 0, delta_aic = 0;
   double validation_cost_before = 0, validation_cost_after = 0, validation_gain_percent = 0;
+  // RMS change of the model's accelerations over the training flight with the effect
+  // switched off, as fractions of g and of the rotation scale (SearchOptions).
+  double size_translation = 0, size_rotation = 0;
   bool significant = false;
   std::string why_not;  // when not significant: which gate it failed
 };
@@ -69,19 +84,35 @@ struct Ambiguity {
 struct SelectionStep {
   std::vector<std::string> base_effects;
   std::vector<CandidateEvidence> candidates;  // strongest first
-  std::string selected;                       // empty: stop
+  std::string selected;                       // the effect added to the model (empty: stop)
+  std::string outcome;  // "selected", "ambiguous" (the stronger look-alike carried, not named), "nothing significant"
   std::vector<Ambiguity> ambiguities;
+};
+
+// An effect the backward pass took out of the final model, and why.
+struct Removal {
+  std::string effect, reason;
+  double p_value = 1, validation_gain_percent = 0;
 };
 
 struct SearchResult {
   std::vector<SelectionStep> steps;
-  std::vector<std::string> selected;  // effects found, in order
+  std::vector<std::string> selected;  // effects in the final model, in order (named ones and carried look-alikes)
+  std::vector<std::string> carried;   // of those, the stronger of an ambiguous pair: in the model, not named
+  std::vector<Removal> removed;       // taken out again by the backward pass
   std::vector<fit::FitParameter> base_fit, final_fit;
   std::vector<double> final_weights;
   std::vector<EffectEstimate> estimates;  // parameters of the selected effects
   std::vector<fit::Profile> profiles;
-  std::vector<Ambiguity> unresolved;  // ambiguities that stopped the search
+  std::vector<Ambiguity> unresolved;  // look-alike groups the data cannot separate
+  // Effects named (selected and not carried).
+  std::vector<std::string> named() const;
 };
+
+// The value at which an effect parameter is off. The derived model's nominal values are
+// neutral except the rotor lag, whose nominal 1 ms keeps simulations non-stiff; equation
+// error has no such limit, so "no lag" is its lower bound (1 us).
+double neutral_value(const Variable& p);
 
 // Effects the log can speak to (battery_sag needs vbat; ground_effect a height).
 std::vector<std::string> applicable_effects(const fit::Flight& flight);
@@ -99,6 +130,9 @@ class CandidateSearch {
   CandidateSearch(const SymbolicModel& all, runtime::DynamicModel& model, const fit::EquationErrorModel& train,
                   const fit::EquationErrorModel& valid, SearchOptions opt);
   SearchResult run();
+  // Takes `effects` out of the result's final model (refit, new intervals): for candidates
+  // that a later test (held-out prediction, interval) does not stand behind.
+  void remove_effects(SearchResult& r, const std::vector<std::string>& effects) const;
 
   // Fits the model with these effects active (others neutral) from `start`.
   std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
@@ -124,6 +158,9 @@ class CandidateSearch {
                              const std::vector<fit::FitParameter>& base_fit, const std::vector<double>& base_ss,
                              double base_valid_cost) const;
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
+  void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
+  void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev) const;
+  double p_value_of(const std::string& effect, double statistic, int dof) const;
   void estimate_intervals(SearchResult& r) const;
 };
 

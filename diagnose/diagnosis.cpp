@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <set>
 
 namespace quadgen::diagnose {
 
@@ -19,6 +20,52 @@ std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vec
     for (int c = 0; c < 6; ++c) rms[c] += r6[k * 6 + c] * r6[k * 6 + c];
   for (double& v : rms) v = std::sqrt(v / static_cast<double>(std::max<size_t>(1, ns)));
   return rms;
+}
+
+// m g arm / J: the angular acceleration the vehicle's weight gives at its rotor arm, the scale
+// against which a moment is negligible.
+double rotation_scale(const Vehicle& v, const SymbolicModel& all) {
+  double arm = 0;
+  for (const auto& r : v.rotors) arm = std::max(arm, std::hypot(r.position[0], r.position[1]));
+  const auto nominal = [&](const char* n) { return all.params[all.param_index(n)].nominal; };
+  const double J = std::max(nominal("J_xx"), nominal("J_yy"));
+  return J > 0 ? nominal("mass") * nominal("g") * arm / J : 0.0;
+}
+
+// The validation part cut into `k` consecutive blocks of equal duration.
+std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
+  std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
+  for (auto& f : folds) f.samples.clear();
+  const double t0 = valid.samples.front().t, span = valid.samples.back().t - t0 + 1e-9;
+  for (const auto& s : valid.samples)
+    folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>((s.t - t0) / span * k))].samples.push_back(s);
+  return folds;
+}
+
+void mean_and_standard_error(const std::vector<double>& x, double* mean, double* se) {
+  const double n = static_cast<double>(x.size());
+  *mean = 0;
+  for (double v : x) *mean += v / n;
+  double ss = 0;
+  for (double v : x) ss += (v - *mean) * (v - *mean);
+  *se = x.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+}
+
+// What a named cause must show beyond significance on training data (issue: what diagnose
+// may name): a closed 95 % interval for every parameter, at least one excluding "off", and
+// a held-out gain larger than its own uncertainty across the validation folds. Empty: passed.
+std::string acceptance_failure(const Finding& f, const SymbolicModel& all) {
+  bool excludes_off = false;
+  for (const auto& p : f.parameters) {
+    if (std::isnan(p.lower) || std::isnan(p.upper)) return "the 95 % interval of " + p.name + " is open";
+    const double off = neutral_value(all.params[all.param_index(p.name)]);
+    excludes_off = excludes_off || off < p.lower || off > p.upper;
+  }
+  if (!f.parameters.empty() && !excludes_off) return "every 95 % interval contains the value that means \"off\"";
+  if (!(f.gain_mean > 0 && f.gain_mean > f.gain_standard_error))
+    return "held-out gain " + std::to_string(f.gain_mean) + " is not above its uncertainty (standard error " +
+           std::to_string(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) + " validation folds)";
+  return "";
 }
 
 }  // namespace
@@ -48,9 +95,61 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   *validation_out = valid;
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
       all_ee(model, flight, accel);
-  CandidateSearch search(all, model, train_ee, valid_ee, opt.search);
+  SearchOptions so = opt.search;
+  so.rotation_scale = rotation_scale(v, all);
+  CandidateSearch search(all, model, train_ee, valid_ee, so);
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
   d.search = search.run();
+  const bool pose = flight.has_pose;
+  d.metric = pose ? "validation position RMSE (" + std::to_string(opt.window).substr(0, 3) +
+                        " s open-loop windows from measured states) [m]"
+                  : "validation equation-error cost (weighted, no pose logged)";
+  // The held-out metric the report prints, per fold of the validation part.
+  const std::vector<fit::Flight> folds = validation_folds(valid, 4);
+  auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
+    std::vector<double> m;
+    if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};
+    for (const auto& f : folds) m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window).position_rmse);
+    return m;
+  };
+  auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
+    if (!pose) return search.cost(valid_ee, ps);
+    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window);
+    if (sim) *sim = w;
+    return w.position_rmse;
+  };
+  // Each named effect against the final model without it: what it buys on held-out data.
+  auto finding_for = [&](const std::string& e) {
+    Finding f;
+    f.effect = e;
+    for (const auto& step : d.search.steps)
+      if (step.selected == e) f.evidence = step.candidates.front();
+    for (const auto& est : d.search.estimates)
+      if (est.name.rfind(e + ".", 0) == 0) f.parameters.push_back(est);
+    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
+    others.erase(e);
+    double c = 0;
+    const auto without = search.fit_with(others, d.search.final_fit, &c);
+    f.metric = d.metric;
+    f.before = metric(without, nullptr);
+    f.after = metric(d.search.final_fit, nullptr);
+    const auto mb = fold_metrics(without), ma = fold_metrics(d.search.final_fit);
+    for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
+    mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
+    return f;
+  };
+  std::cerr << "[diagnose] acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
+  std::vector<std::string> drop;
+  for (const auto& e : d.search.named()) {
+    Finding f = finding_for(e);
+    const std::string failed = acceptance_failure(f, all);
+    if (failed.empty()) d.findings.push_back(f);
+    else d.suspected.push_back({f, failed}), drop.push_back(e);
+  }
+  if (!drop.empty()) {  // the extended model keeps only what is named (and carried look-alikes)
+    search.remove_effects(d.search, drop);
+    for (auto& f : d.findings) f = finding_for(f.effect);
+  }
   const SearchResult& s = d.search;
   // What is wrong, before and after, over the whole flight.
   fit::Flight used = flight;  // the samples with residuals (full derivative windows)
@@ -66,17 +165,7 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
   d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
   // The gain on the validation part.
-  const bool pose = flight.has_pose;
-  d.metric = pose ? "validation position RMSE (" + std::to_string(opt.window).substr(0, 3) +
-                        " s open-loop windows from measured states) [m]"
-                  : "validation equation-error cost (weighted, no pose logged)";
-  auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
-    if (!pose) return search.cost(valid_ee, ps);
-    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window);
-    if (sim) *sim = w;
-    return w.position_rmse;
-  };
-  std::cerr << "[diagnose] validation of " << s.selected.size() + 1 << " models\n";
+  std::cerr << "[diagnose] validation of the base and the extended model\n";
   d.metric_before = metric(s.base_fit, &d.sim_before);
   d.metric_after = metric(s.final_fit, &d.sim_after);
   // Without a pose only the one-step view can be measured.
@@ -86,32 +175,9 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
   const auto rb = channel_rms(valid_ee, s.base_fit), ra = channel_rms(valid_ee, s.final_fit);
   for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
-  std::vector<fit::FitParameter> step_base = s.base_fit;
-  double step_metric = d.metric_before;
-  for (const auto& step : s.steps) {
-    if (step.selected.empty()) continue;
-    Finding f;
-    f.effect = step.selected;
-    f.evidence = step.candidates.front();
-    for (const auto& e : s.estimates)
-      if (e.name.rfind(f.effect + ".", 0) == 0) f.parameters.push_back(e);
-    f.metric = d.metric;
-    f.before = step_metric;
-    f.after = metric(f.evidence.parameters, nullptr);
-    step_metric = f.after;
-    step_base = f.evidence.parameters;
-    d.findings.push_back(f);
-  }
-  // Left over: slow structure the noise cannot explain. After an ambiguity, what is left
-  // over is judged with the stronger of the two look-alikes in the model (either
-  // explains the discrepancy; only the name is open).
-  ResidualAnalysis left = d.after;
-  if (!s.unresolved.empty()) {
-    const auto pu = fit::parameter_values(s.steps.back().candidates.front().parameters);
-    std::vector<double> r;
-    all_ee.all_channels(pu.data(), r);
-    left = analyse_residuals(r, d.channel_names, d.channel_units, d.t, signals);
-  }
+  // Left over: slow structure the noise cannot explain. The final model carries the stronger
+  // of each look-alike pair (either explains the discrepancy; only the name is open).
+  const ResidualAnalysis& left = d.after;
   for (const auto& c : left.channels) {
     if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
     Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,

@@ -30,8 +30,18 @@ struct Finding {
   std::string effect;
   std::vector<EffectEstimate> parameters;
   CandidateEvidence evidence;
-  std::string metric;  // of the gain
+  std::string metric;  // of the gain: the final model without this effect -> with it
   double before = 0, after = 0;
+  // Held-out gain per validation fold (before - after), its mean and standard error.
+  std::vector<double> fold_gains;
+  double gain_mean = 0, gain_standard_error = 0;
+};
+
+// A candidate significant on the training data that a later test does not stand behind:
+// reported with the test it failed, never as a finding, and not in the extended model.
+struct Suspected {
+  Finding candidate;
+  std::string failed;
 };
 
 struct Unexplained {
@@ -57,6 +67,7 @@ struct Diagnosis {
   ResidualAnalysis before, after;  // whole flight, base fit and final model
   std::vector<double> t, residual_before, residual_after;  // ns x 6, for plots
   std::vector<Finding> findings;
+  std::vector<Suspected> suspected;
   std::vector<Unexplained> unexplained;
   std::vector<ChannelGain> channel_gain;
   // Free parameters of the final model that ended on a bound: the model is strained there,

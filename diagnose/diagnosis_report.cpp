@@ -32,6 +32,8 @@ json evidence_json(const CandidateEvidence& e) {
           {"validation_cost_before", e.validation_cost_before},
           {"validation_cost_after", e.validation_cost_after},
           {"validation_gain_percent", e.validation_gain_percent},
+          {"size_fraction_of_g", e.size_translation},
+          {"size_fraction_of_rotation_scale", e.size_rotation},
           {"significant", e.significant},
           {"why_not", e.why_not}};
 }
@@ -41,6 +43,36 @@ json parameters_json(const std::vector<fit::FitParameter>& ps) {
   for (const auto& p : ps)
     if (p.free) j[p.name] = {{"value", p.value}, {"unit", p.unit}};
   return j;
+}
+
+// A finding (or a suspected one): its parameters, the one gain figure (the final model
+// without it -> with it, on held-out data, with its spread over validation folds), evidence.
+json finding_json(const Finding& f) {
+  json ps = json::object();
+  if (f.effect == "motor_gain")
+    for (const auto& p : f.evidence.parameters)
+      if (p.name.rfind("motor_gain.", 0) == 0 && !p.free)
+        ps[p.name] = {{"value", 0.0}, {"ci95", {0.0, 0.0}}, {"unit", "1"}, {"reference", true}};
+  for (const auto& e : f.parameters)
+    ps[e.name] = {{"value", e.value},
+                  {"ci95", {number_or_null(e.lower), number_or_null(e.upper)}},
+                  {"unit", e.unit},
+                  {"standard_error", number_or_null(e.standard_error)},
+                  {"numerical_allowance", e.numerical_allowance},
+                  {"identifiability", e.verdict}};
+  json fj = {{"effect", f.effect},
+             {"parameters", ps},
+             {"gain", {{"metric", f.metric},
+                       {"before", number_or_null(f.before)},
+                       {"after", number_or_null(f.after)},
+                       {"reduction_percent", reduction(f.before, f.after)},
+                       {"fold_gains", f.fold_gains},
+                       {"gain_mean", number_or_null(f.gain_mean)},
+                       {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
+             {"evidence", evidence_json(f.evidence)}};
+  if (f.effect == "motor_gain")
+    fj["note"] = "c_t is fitted with the gains, so only ratios between rotors are identifiable: the first rotor is the reference (gain 0)";
+  return fj;
 }
 
 json channels_json(const ResidualAnalysis& a) {
@@ -74,31 +106,20 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["formulation"] = d.formulation;
   j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
   json findings = json::array();
-  for (const auto& f : d.findings) {
-    json ps = json::object();
-    if (f.effect == "motor_gain")
-      for (const auto& p : f.evidence.parameters)
-        if (p.name.rfind("motor_gain.", 0) == 0 && !p.free)
-          ps[p.name] = {{"value", 0.0}, {"ci95", {0.0, 0.0}}, {"unit", "1"}, {"reference", true}};
-    for (const auto& e : f.parameters)
-      ps[e.name] = {{"value", e.value},
-                    {"ci95", {number_or_null(e.lower), number_or_null(e.upper)}},
-                    {"unit", e.unit},
-                    {"standard_error", number_or_null(e.standard_error)},
-                    {"numerical_allowance", e.numerical_allowance},
-                    {"identifiability", e.verdict}};
-    json fj = {{"effect", f.effect},
-               {"parameters", ps},
-               {"gain", {{"metric", f.metric},
-                         {"before", number_or_null(f.before)},
-                         {"after", number_or_null(f.after)},
-                         {"reduction_percent", reduction(f.before, f.after)}}},
-               {"evidence", evidence_json(f.evidence)}};
-    if (f.effect == "motor_gain")
-      fj["note"] = "c_t is fitted with the gains, so only ratios between rotors are identifiable: the first rotor is the reference (gain 0)";
-    findings.push_back(fj);
-  }
+  for (const auto& f : d.findings) findings.push_back(finding_json(f));
   j["findings"] = findings;
+  json suspected = json::array();
+  for (const auto& x : d.suspected) {
+    json sj = finding_json(x.candidate);
+    sj["failed"] = x.failed;
+    suspected.push_back(sj);
+  }
+  j["suspected"] = suspected;
+  json removed = json::array();
+  for (const auto& r : d.search.removed)
+    removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value},
+                       {"validation_gain_percent", r.validation_gain_percent}});
+  j["removed_by_backward_pass"] = removed;
   json amb = json::array();
   for (const auto& a : d.search.unresolved)
     amb.push_back({{"effects", {a.a, a.b}},
@@ -152,7 +173,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
       cj["estimates"] = ps;
       cands.push_back(cj);
     }
-    steps.push_back({{"base_effects", s.base_effects}, {"selected", s.selected}, {"candidates", cands}});
+    steps.push_back({{"base_effects", s.base_effects}, {"selected", s.selected}, {"outcome", s.outcome}, {"candidates", cands}});
   }
   j["selection"] = steps;
   j["candidates_considered"] = d.candidates;
@@ -160,6 +181,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["final_fit"] = parameters_json(d.search.final_fit);
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
   j["extended_model"] = {{"effects", d.search.selected},
+                         {"carried_look_alikes", d.search.carried},
                          {"header", "extended_model.hpp"},
                          {"model_json", "extended_model.json"},
                          {"fitted_parameters", "fitted_parameters.yaml"}};
@@ -278,7 +300,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n";
   }
   for (const auto& a : d.search.unresolved)
-    os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart); to separate them: " << a.manoeuvre << "\n";
+    os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
+       << "); to separate them: " << a.manoeuvre << "\n";
+  for (const auto& x : d.suspected)
+    os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
+  for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
   for (const auto& b : d.at_bounds)
     os << "caution: " << b << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
