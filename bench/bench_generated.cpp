@@ -42,6 +42,28 @@ void BM_GeneratedF(benchmark::State& st) {
   }
 }
 
+void BM_GeneratedFOnlyEntryPoint(benchmark::State& st) {  // rhs(x, u, p, pre, f)
+  Point pt;
+  gen::Precomputed<double> pre;
+  gen::precompute(pt.p, &pre);
+  double f[NX];
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(pt.x);
+    gen::rhs(pt.x, pt.u, pt.p, pre, f);
+    benchmark::DoNotOptimize(f);
+  }
+}
+
+void BM_GeneratedPrecompute(benchmark::State& st) {  // once per parameter vector
+  Point pt;
+  gen::Precomputed<double> pre;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(pt.p);
+    gen::precompute(pt.p, &pre);
+    benchmark::DoNotOptimize(pre);
+  }
+}
+
 void BM_GeneratedFAndJacobians(benchmark::State& st) {
   Point pt;
   gen::Precomputed<double> pre;
@@ -120,6 +142,8 @@ void BM_DeriveAndEmitFinken3AllEffects(benchmark::State& st) {
 }
 
 BENCHMARK(BM_GeneratedF);
+BENCHMARK(BM_GeneratedFOnlyEntryPoint);
+BENCHMARK(BM_GeneratedPrecompute);
 BENCHMARK(BM_GeneratedFAndJacobians);
 BENCHMARK(BM_HandWrittenF);
 BENCHMARK(BM_CeresAutodiffJacobians);
