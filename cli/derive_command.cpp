@@ -19,7 +19,9 @@ void add_derive(CLI::App& app, DeriveArgs& args) {
   CLI::App* c = app.add_subcommand("derive", "derive, audit and emit the flight model of a vehicle");
   c->add_option("vehicle", args.vehicle, "vehicle description (YAML)")->required();
   c->add_option("--out", args.out, "output directory")->required();
-  c->add_option("--effects", args.effects, "comma-separated effects to add, or 'all'");
+  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
+  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  c->add_option("--effects", args.effects, "comma-separated effects to add, or 'all': " + effect_names);
 }
 
 int run_derive(const DeriveArgs& args) {

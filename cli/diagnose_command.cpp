@@ -33,7 +33,10 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out")->check(finite_range(0.1, 0.6));
   c->add_option("--alpha", a.alpha, "family-wise significance level of each selection step")->check(finite_range(1e-9, 0.2));
   c->add_option("--max-effects", a.max_effects, "stop after this many effects")->check(CLI::Range(1, 10));
-  c->add_option("--candidates", a.candidates, "comma-separated effects to consider (default: all the log supports)");
+  std::string effect_names;  // the catalogue, so --help lists what --candidates accepts
+  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  c->add_option("--candidates", a.candidates,
+                "comma-separated effects to consider (default: all the log supports): " + effect_names);
   c->add_option("--translational", a.translational, "translational channels: auto, pose or accelerometer")
       ->check(CLI::IsMember({"auto", "pose", "accelerometer"}));
   c->add_option("--window", a.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));

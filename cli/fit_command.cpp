@@ -39,7 +39,9 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--out", a.out, "output directory")->required();
   c->add_flag("--robust", a.robust, "Huber loss instead of squares");
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
-  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
+  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
+  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out for validation")
       ->check(finite_range(0.0, 0.9));
   c->add_option("--formulation", a.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")

@@ -1,12 +1,15 @@
 // quadgen-derive: the `derive` subcommand alone. It does not link the compiled models of
 // generated/, so it can regenerate them even when they are stale (scripts/regenerate.sh).
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "sinks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"quadgen-derive: derive, audit and emit a flight model (bootstrap for generated/)"};
+  app.set_version_flag("--version", std::string("quadgen-derive ") + QUADGEN_VERSION);
+  app.option_defaults()->always_capture_default();
   quadgen::cli::DeriveArgs derive;
   quadgen::cli::add_derive(app, derive);
   app.require_subcommand(1);

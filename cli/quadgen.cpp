@@ -1,6 +1,7 @@
 // quadgen: vehicle file -> symbolic model -> generated code -> runtime -> fit -> diagnosis.
 #include <iostream>
 #include <new>
+#include <string>
 
 #include "commands.hpp"
 #include "options.hpp"
@@ -9,6 +10,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("quadgen ") + QUADGEN_VERSION);
+  app.option_defaults()->always_capture_default();  // --help shows each option's default
   quadgen::cli::DeriveArgs derive;
   quadgen::cli::add_derive(app, derive);
   quadgen::cli::SimulateArgs simulate;

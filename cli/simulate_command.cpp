@@ -53,10 +53,13 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
       ->check(finite_range(0.0, 5.0))->needs(cl);
   c->add_option("--tether", a.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
       ->check(finite_range(0.0, 100.0))->needs(cl);
-  c->add_option("--duration", a.duration, "simulated time [s]")->required()->check(finite_range(1e-6, 1e9));
+  c->add_option("--duration", a.duration, "simulated time [s]")
+      ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
-  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all'");
+  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
+  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--integrator", a.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
       ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);
   c->add_option("--step", a.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
