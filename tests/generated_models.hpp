@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "generated/crazyflie21/model.hpp"
+#include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
 
@@ -39,6 +40,7 @@ struct Point {
     static constexpr const char* const* input_names = gen::NS::kInputNames;                 \
     static constexpr const char* const* param_names = gen::NS::kParamNames;                 \
     static constexpr const double* nominal = gen::NS::kNominalParams;                       \
+    static constexpr const char* effects = gen::NS::kEffects;                               \
     template <typename S>                                                                   \
     static void f(const S* x, const S* u, const S* p, S* out, S* dx, S* du, S* dp) {        \
       gen::NS::Precomputed<S> pre;                                                          \
@@ -55,6 +57,7 @@ struct Point {
 QUADGEN_MODEL_TRAITS(finken3)
 QUADGEN_MODEL_TRAITS(finken3_all_effects)
 QUADGEN_MODEL_TRAITS(crazyflie21)
+QUADGEN_MODEL_TRAITS(crazyflie21_all_effects)
 
 template <class M>
 int index_of_param(const std::string& name) {

@@ -1,6 +1,7 @@
 // The generated headers: byte-identical to what the generator produces now, Jacobians
 // against central finite differences (against Jets: test_generated_jets.cpp), agreement with
-// the symbolic model and a hand-written reference, independence from symbol creation order.
+// the symbolic model (every model, effects on) and a hand-written reference, independence
+// from symbol creation order.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -70,6 +71,9 @@ TEST(Generated, AllEffectsJacobiansMatchFiniteDifferences) {
 TEST(Generated, CrazyflieJacobiansMatchFiniteDifferences) {
   check_jacobians_against_finite_differences<crazyflie21_traits>(20);
 }
+TEST(Generated, CrazyflieAllEffectsJacobiansMatchFiniteDifferences) {
+  check_jacobians_against_finite_differences<crazyflie21_all_effects_traits>(20);
+}
 
 TEST(Generated, MatchesSymbolicModel) {
   // The emitted f equals the GiNaC f it came from, at random points with nominal parameters.
@@ -85,6 +89,61 @@ TEST(Generated, MatchesSymbolicModel) {
                       (double*)nullptr);
     for (int i = 0; i < 13; ++i) EXPECT_NEAR(f[i], want[i], 1e-12 * (1 + std::fabs(want[i]))) << i;
   }
+}
+
+// The emitted f of model M (vehicle file, effects M::effects) equals the GiNaC f it came
+// from at random states, inputs and parameters with every effect away from its neutral
+// value: each effect parameter 10-50 % of the way from its nominal (neutral) value to one
+// of its bounds. At nominal parameters the effect terms vanish, and a wrong rewrite of
+// them in the emitter would pass unseen.
+template <class M>
+void check_f_against_symbolic_model(const char* vehicle_file, int trials, unsigned seed) {
+  const quadgen::Vehicle v = quadgen::load_vehicle(quadgen::test::source_path(vehicle_file));
+  quadgen::DeriveOptions o;
+  o.effects = quadgen::parse_effect_list(M::effects);
+  const quadgen::SymbolicModel m = quadgen::derive_model(v, quadgen::derive_mass_properties(v), o);
+  ASSERT_EQ(m.states.size(), static_cast<size_t>(M::kNumStates));
+  ASSERT_EQ(m.inputs.size(), static_cast<size_t>(M::kNumInputs));
+  ASSERT_EQ(m.params.size(), static_cast<size_t>(M::kNumParams));
+  for (int i = 0; i < M::kNumStates; ++i) ASSERT_EQ(m.states[i].name, M::state_names[i]);
+  for (int i = 0; i < M::kNumInputs; ++i) ASSERT_EQ(m.inputs[i].name, M::input_names[i]);
+  for (int i = 0; i < M::kNumParams; ++i) ASSERT_EQ(m.params[i].name, M::param_names[i]);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  int effect_params = 0;
+  for (int t = 0; t < trials; ++t) {
+    Point<M> pt = random_point<M>(rng);
+    for (int i = 0; i < M::kNumParams; ++i) {
+      const quadgen::Variable& par = m.params[i];
+      if (par.name.find('.') == std::string::npos) continue;  // not an effect parameter
+      const bool up = par.upper > par.nominal, down = par.lower < par.nominal;
+      ASSERT_TRUE(up || down) << par.name << " cannot move off its neutral value";
+      const double bound = up && down ? (unit(rng) < 0.5 ? par.lower : par.upper) : up ? par.upper : par.lower;
+      pt.p[i] = par.nominal + (0.1 + 0.4 * unit(rng)) * (bound - par.nominal);
+      ++effect_params;
+    }
+    GiNaC::lst s = m.constant_substitution();
+    for (int i = 0; i < M::kNumStates; ++i) s.append(m.states[i].sym == pt.x[i]);
+    for (int i = 0; i < M::kNumInputs; ++i) s.append(m.inputs[i].sym == pt.u[i]);
+    for (int i = 0; i < M::kNumParams; ++i) s.append(m.params[i].sym == pt.p[i]);
+    double f[M::kNumStates];
+    M::f(pt.x, pt.u, pt.p, f, (double*)nullptr, (double*)nullptr, (double*)nullptr);
+    for (int i = 0; i < M::kNumStates; ++i) {
+      const double want = quadgen::to_double(m.f(i, 0).subs(s));
+      EXPECT_NEAR(f[i], want, 1e-10 * (1 + std::fabs(want)))
+          << vehicle_file << ", effects \"" << M::effects << "\": f[" << i << "] (" << M::state_names[i]
+          << "-dot), trial " << t;
+    }
+  }
+  if (std::string(M::effects).empty()) EXPECT_EQ(effect_params, 0);
+  else EXPECT_GT(effect_params, 0);
+}
+
+TEST(Generated, MatchesSymbolicModelAwayFromNeutral) {
+  check_f_against_symbolic_model<finken3_traits>("vehicles/finken3.yaml", 5, 31);
+  check_f_against_symbolic_model<finken3_all_effects_traits>("vehicles/finken3.yaml", 10, 32);
+  check_f_against_symbolic_model<crazyflie21_traits>("vehicles/crazyflie21.yaml", 5, 33);
+  check_f_against_symbolic_model<crazyflie21_all_effects_traits>("vehicles/crazyflie21.yaml", 10, 34);
 }
 
 TEST(Generated, NullJacobianPointersGiveTheSameF) {

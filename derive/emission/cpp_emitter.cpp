@@ -242,9 +242,12 @@ CppEmitter::Mono CppEmitter::make_sum(std::vector<Mono> in) {
       const Mono inner = make_sum(group);
       rest.push_back(Mono{inner.coeff * taken.coeff, merge(inner.f, taken.f)});
       terms = rest;
-      if (terms.size() == 1) return terms[0];
+      if (terms.size() == 1) break;
     }
   }
+  // Everything factored into one term, (c*a + c*b) -> c*(a + b): the factors and the
+  // coefficient common to all terms, divided out above, go back on it.
+  if (terms.size() == 1) return Mono{terms[0].coeff * ccoeff, merge(terms[0].f, common)};
 
   // Parameter-only terms: one term.
   std::vector<Mono> kept, statics;
