@@ -86,6 +86,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   c.measured_q = c.q;
   c.air_velocity_world = c.velocity;
   c.extra_body_force = vec3(0, 0, 0);
+  c.extra_body_torque = vec3(0, 0, 0);
   c.rotor_hub_force.assign(c.vehicle.rotors.size(), vec3(0, 0, 0));
 
   for (const Rotor& r : c.vehicle.rotors)
@@ -158,7 +159,7 @@ void assemble(ModelContext& c) {
   SymbolicModel& m = c.model;
   const auto& rotors = c.vehicle.rotors;
   matrix force_body = c.extra_body_force;
-  matrix torque = vec3(0, 0, 0);
+  matrix torque = c.extra_body_torque;
   ex total_thrust = 0;
   for (size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];

@@ -63,6 +63,25 @@ void rotor_drag(ModelContext& c) {
   }
 }
 
+// Moment from blade flapping: flying through the air tilts each rotor disc away from the
+// relative wind, and the stiff hub of a small propeller passes the tilt to the body as a
+// moment proportional to rotor speed and airspeed (blade flapping, as in Mahony, Kumar and
+// Corke, "Multirotor Aerial Vehicles", IEEE Robotics & Automation Magazine 19(3), 2012).
+// With its own coefficient rather than through an assumed hub height (rotor_drag's moment
+// depends on where the CoG sits, which the blocks give only roughly):
+//   tau_body = k (sum of rotor speeds) (v_y, -v_x, 0), body-frame air velocity;
+// k > 0 pitches the nose up when flying forward. Typical size: the NanoBench Crazyflie's
+// residuals give 2-2.7e-4 N m per m/s at a rotor speed sum near 9,000 rad/s, k ~ 3e-8 N s^2
+// (docs/crazyflie_evidence.md); no published Crazyflie value was found.
+void blade_flapping(ModelContext& c) {
+  const ex k = c.add_param("blade_flapping.k", "N s^2", 0.0, -1e-4, 1e-4, true,
+                           "flapping moment per rotor speed sum and airspeed");
+  const matrix vb = c.R.transpose().mul(c.air_velocity_world);
+  ex speed_sum = 0;
+  for (const ex& w : c.rotor_speed) speed_sum += w;
+  c.extra_body_torque = c.extra_body_torque.add(vec3(k * speed_sum * vb(1, 0), -k * speed_sum * vb(0, 0), 0));
+}
+
 void wind(ModelContext& c) {
   const ex wx = c.add_param("wind.x", "m/s", 0.0, -10.0, 10.0, true, "steady wind x, world");
   const ex wy = c.add_param("wind.y", "m/s", 0.0, -10.0, 10.0, true, "steady wind y, world");
@@ -109,8 +128,11 @@ const std::vector<Effect>& effect_catalogue() {
       {"motor_lag", "first-order lag from commanded to actual rotor speed", motor_lag},
       {"input_delay", "pure time shift between logged commands and their effect", input_delay},
       {"cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset},
-      {"rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag},
+      // wind first among the airspeed effects: rotor_drag and blade_flapping act on the
+      // air-relative velocity it changes.
       {"wind", "steady air velocity in the world frame, through the drag terms", wind},
+      {"rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag},
+      {"blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", blade_flapping},
       {"attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias},
       {"thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay},
       {"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag},

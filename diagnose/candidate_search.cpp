@@ -75,6 +75,9 @@ std::string separating_manoeuvre(const std::string& a, const std::string& b) {
   if (is("attitude_bias", "wind"))
     return "hover while turning through a full yaw circle: an attitude bias turns with the body, a steady "
            "wind stays fixed in the world";
+  if (is("rotor_drag", "blade_flapping"))
+    return "straight legs at several constant speeds: rotor drag slows the vehicle (a horizontal force), "
+           "flapping only tilts it (a moment the attitude loop must hold)";
   if (is("thrust_decay", "battery_sag"))
     return "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)";
   return "a flight that excites the two effects differently (vary speed, height, thrust and heading)";

@@ -7,8 +7,9 @@
 //
 // Magnitudes (README "Hidden-effect suite" cites where they come from): 8 % thrust loss on
 // one rotor, 50 ms rotor lag, 25 ms delay, 1 cm CoG offset, rotor drag 2e-5, 1.8 m/s wind,
-// 1.7 deg attitude offset, 12 % thrust decay per minute, exponent 1.5 battery sag,
-// ground effect with the true rotor radius, flying at 0.1-0.3 m.
+// blade flapping 2e-6 N s^2 (about 2 rad/s^2 of pitch per m/s), 1.7 deg attitude offset,
+// 12 % thrust decay per minute, exponent 1.5 battery sag, ground effect with the true
+// rotor radius, flying at 0.1-0.3 m.
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -102,6 +103,7 @@ std::vector<HiddenCase> single_effects() {
       {"cog_offset", "cog_offset", {{"cog_offset.x", 0.01}, {"cog_offset.y", -0.005}},
        {{"cog_offset.x", 0.002}, {"cog_offset.y", 0.002}}, ""},
       {"rotor_drag", "rotor_drag", {{"rotor_drag.k", 2e-5}}, {{"rotor_drag.k", 4e-6}}, ""},
+      {"blade_flapping", "blade_flapping", {{"blade_flapping.k", 2e-6}}, {{"blade_flapping.k", 4e-7}}, ""},
       {"wind", "wind", {{"wind.x", 1.5}, {"wind.y", -1.0}}, {{"wind.x", 0.4}, {"wind.y", 0.4}}, ""},
       {"attitude_bias", "attitude_bias", {{"attitude_bias.roll", 0.03}, {"attitude_bias.pitch", -0.02}},
        {{"attitude_bias.roll", 0.005}, {"attitude_bias.pitch", 0.005}}, ""},

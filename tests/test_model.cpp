@@ -1,6 +1,8 @@
 // The assembled model: units audit, effects at nominal values, physics spot checks.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include "audit.hpp"
 #include "effects.hpp"
 #include "test_helpers.hpp"
@@ -116,8 +118,8 @@ TEST(Model, EveryEffectAtNominalValuesReproducesTheBaseModel) {
 TEST(Model, EffectsChangeTheModelAwayFromNominal) {
   // Guard against an effect that is silently a no-op: move its parameters and f must change.
   const Vehicle v = test::finken3();
-  for (const char* name : {"motor_gain", "cog_offset", "rotor_drag", "wind", "thrust_decay", "battery_sag",
-                           "ground_effect"}) {
+  for (const char* name : {"motor_gain", "cog_offset", "rotor_drag", "blade_flapping", "wind", "thrust_decay",
+                           "battery_sag", "ground_effect"}) {
     SymbolicModel m = derive(v, {name});
     std::vector<double> x(13, 0.0);
     x[2] = 0.05;
@@ -133,6 +135,37 @@ TEST(Model, EffectsChangeTheModelAwayFromNominal) {
     for (size_t i = 0; i < f0.size(); ++i) diff += std::fabs(f1[i] - f0[i]);
     EXPECT_GT(diff, 1e-6) << name;
   }
+}
+
+// The flapping moment against its closed form, computed here: level attitude, flying along
+// body x at 1 m/s, every rotor at the speed its command gives. The angular accelerations
+// change by dw = J^-1 (0, -k sum(w), 0); the body origin's acceleration by -(dw x c), c the
+// CoG (the translation equation is written for the origin); nothing else changes.
+TEST(Model, BladeFlappingMomentMatchesItsClosedForm) {
+  SymbolicModel m = derive(test::finken3(), {"blade_flapping"});
+  std::vector<double> x(13, 0.0);
+  x[2] = 1.0;
+  x[3] = 1.0;  // vx, world = body at level attitude
+  x[6] = 1;
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  const auto f0 = test::eval_f(m, x, u);
+  const double k = 2e-6;
+  m.params[m.param_index("blade_flapping.k")].nominal = k;
+  const auto f1 = test::eval_f(m, x, u);
+  auto nom = [&](const char* n) { return m.params[m.param_index(n)].nominal; };
+  double speed_sum = 0;
+  for (double ui : u) speed_sum += nom("motor_a0") + nom("motor_a1") * ui + nom("motor_a2") * ui * ui;
+  Eigen::Matrix3d J;
+  J << nom("J_xx"), nom("J_xy"), nom("J_xz"), nom("J_xy"), nom("J_yy"), nom("J_yz"), nom("J_xz"), nom("J_yz"), nom("J_zz");
+  const Eigen::Vector3d expected = J.inverse() * Eigen::Vector3d(0, -k * speed_sum * 1.0, 0);
+  const Eigen::Vector3d cog(nom("cog_x"), nom("cog_y"), nom("cog_z"));
+  const Eigen::Vector3d dv = -expected.cross(cog);
+  for (int i : {0, 1, 2, 6, 7, 8, 9}) EXPECT_NEAR(f1[i], f0[i], 1e-12 * (1 + std::fabs(f0[i]))) << m.states[i].name;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(f1[3 + a] - f0[3 + a], dv[a], 1e-9 * (1 + std::fabs(dv[a]))) << "velocity row " << a;
+    EXPECT_NEAR(f1[10 + a] - f0[10 + a], expected[a], 1e-9 * (1 + std::fabs(expected[a]))) << "rate row " << a;
+  }
+  EXPECT_GT(std::fabs(expected[1]), 0.1);  // a moment worth checking: rad/s^2
 }
 
 TEST(Model, AttitudeBiasChangesOnlyTheMeasurement) {
