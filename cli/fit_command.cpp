@@ -55,6 +55,18 @@ void add_fit(CLI::App& app, FitArgs& a) {
 
 namespace {
 
+// Profiles take minutes: say which one is running.
+ProfileOptions profile_options() {
+  ProfileOptions po;
+  po.progress = [](const std::string& name, int i, int n) {
+    std::cerr << "  profile " << i << "/" << n << ": " << output::printable(name) << "\n";
+  };
+  return po;
+}
+
+// An interval side the profile never crossed is open, not a number.
+std::string side(double v, bool open) { return open ? std::string("open") : std::to_string(v); }
+
 // A plot joins the output set when gnuplot can draw it; without one the fit still counts.
 void add_plot(output::OutputDirectory& out, const std::string& file, const std::string& title,
               const std::vector<runtime::Panel>& panels) {
@@ -77,7 +89,7 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v, output::OutputDirectory&
             << " samples)\n";
   const FitResult best = fit_least_squares(model, model.parameters(), fo);
   std::cerr << "[2/2] profile likelihood of " << best.num_free << " parameters\n";
-  const auto profiles = profile_all(model, best, fo, {});
+  const auto profiles = profile_all(model, best, fo, profile_options());
   auto j = fit_json(best, profiles);
   j["kind"] = "motor_steps";
   j["vehicle"] = v.name;
@@ -118,7 +130,9 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v, output::OutputDirectory&
            {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", {meas, fitted, thesis}}});
   out.commit();
   std::cout << "tau = " << best.parameters[3].value << " s";
-  if (tau) std::cout << ", 95 % profile interval [" << tau->lower << ", " << tau->upper << "] (" << tau->verdict << ")";
+  if (tau)
+    std::cout << ", 95 % profile interval [" << side(tau->lower, tau->lower_open) << ", " << side(tau->upper, tau->upper_open)
+              << "] (" << tau->verdict << ")";
   std::cout << "; thesis: 0.128 s\n";
   return 0;
 }
@@ -195,7 +209,7 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw,
   const double fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   std::cerr << "[2/3] profile likelihood (fit took " << fit_seconds << " s)\n";
   clock0 = std::chrono::steady_clock::now();
-  const auto profiles = profile_all(train_m, best, fo, {});
+  const auto profiles = profile_all(train_m, best, fo, profile_options());
   const double profile_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   std::cerr << "[3/3] validation on the last " << valid.samples.size() << " samples\n";
   const auto before = channel_rms(valid_m, params), after = channel_rms(valid_m, best.parameters);
@@ -243,7 +257,8 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw,
             {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}});
   out.commit();
   for (const auto& pr : profiles)
-    std::cout << pr.parameter << " = " << best.parameters[pr.index].value << " [" << pr.lower << ", " << pr.upper
+    std::cout << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
+              << side(pr.upper, pr.upper_open)
               << "] " << pr.verdict << "\n";
   return 0;
 }
@@ -263,12 +278,12 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v, output::OutputDirectory
   std::cerr << "[1/2] thrust vs rotor speed, " << samples.size() << " samples\n";
   ThrustVsSpeed thrust(samples);
   const FitResult tr = fit_least_squares(thrust, ThrustVsSpeed::parameters(), fo);
-  const auto tp = profile_all(thrust, tr, fo, {});
+  const auto tp = profile_all(thrust, tr, fo, profile_options());
   std::cerr << "[2/2] rotor speed vs command and battery voltage\n";
   const double vref = param(v, "vbat_ref").value;
   SpeedVsCommand speed(samples, vref);
   const FitResult sr = fit_least_squares(speed, SpeedVsCommand::parameters(), fo);
-  const auto sp = profile_all(speed, sr, fo, {});
+  const auto sp = profile_all(speed, sr, fo, profile_options());
   double k_mean = 0;
   for (int i = 0; i < 4; ++i) k_mean += tr.parameters[i].value / 4;
   const Rotor& r0 = v.rotors.front();

@@ -137,8 +137,12 @@ Profile profile_parameter(const ResidualModel& model, const FitResult& best, int
 std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& best, const FitOptions& fo,
                                  const ProfileOptions& po) {
   std::vector<Profile> out;
+  const int count = best.num_free;
   for (size_t k = 0; k < best.parameters.size(); ++k)
-    if (best.parameters[k].free) out.push_back(profile_parameter(model, best, static_cast<int>(k), fo, po));
+    if (best.parameters[k].free) {
+      if (po.progress) po.progress(best.parameters[k].name, static_cast<int>(out.size()) + 1, count);
+      out.push_back(profile_parameter(model, best, static_cast<int>(k), fo, po));
+    }
   return out;
 }
 

@@ -4,6 +4,7 @@
 // identifiable (crosses on both sides), practically non-identifiable (open on a side),
 // structurally non-identifiable (flat: other parameters compensate exactly).
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct Profile {
 struct ProfileOptions {
   int max_steps_each_side = 30;
   double confidence = 0.95;
+  // Called before each parameter's profile (profiles of many parameters take minutes).
+  std::function<void(const std::string& parameter, int index, int count)> progress;
 };
 
 Profile profile_parameter(const ResidualModel& model, const FitResult& best, int index, const FitOptions& fo,
