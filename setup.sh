@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # First command of the README: install what is missing, build, and run the main job on bundled data.
 #   ./setup.sh            install + build + derive the bundled vehicles into out/, diagnose a
-#                         test flight with a hidden weak motor and the NanoBench flight
+#                         test flight with a hidden weak motor and the NanoBench flight, and
+#                         measure the extended model's prediction error on the latter
 #   ./setup.sh --no-run   install + build only (used by .ci/run)
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -21,6 +22,9 @@ if [ "${1:-}" != "--no-run" ]; then
   nb=../shared/data/crazyflie/nanobench/B3_figure8_medium_rep2.csv
   if [ -f "$nb" ]; then
     build/quadgen diagnose vehicles/crazyflie21.yaml "$nb" --mapping data/mappings/nanobench.yaml --out out/diagnosis_nanobench
+    # The measuring stick: prediction error at horizons, as published models report it.
+    build/quadgen predict vehicles/crazyflie21.yaml "$nb" --mapping data/mappings/nanobench.yaml \
+        --params out/diagnosis_nanobench/diagnosis.json --out out/prediction_nanobench
   fi
-  echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html"
+  echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html; prediction: out/prediction_*/prediction.json"
 fi
