@@ -15,6 +15,14 @@
 
 namespace quadgen::fit {
 
+runtime::CsvTable read_measurement_csv(const std::string& path) {
+  try {
+    return runtime::read_csv(path);
+  } catch (const runtime::LogError& e) {
+    throw FitError(e.what());
+  }
+}
+
 // Column mappings (e.g. data/mappings/nanobench.yaml):
 //
 //   name: TEXT                       optional, names the mapping in messages

@@ -22,6 +22,10 @@ struct ColumnMapping {
   std::vector<Entry> entries;
 };
 
+// A CSV file of measurements (thrust stand, motor steps): the reader's errors (file:line,
+// non-finite cells, size) as this layer's FitError.
+runtime::CsvTable read_measurement_csv(const std::string& path);
+
 ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);

@@ -3,20 +3,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "flight_data.hpp"
 #include "flight_log.hpp"
 
 namespace quadgen::fit {
 
 namespace {
-
-// The CSV reader's errors (file:line, non-finite cells, size) as this layer's FitError.
-runtime::CsvTable read_table(const std::string& path) {
-  try {
-    return runtime::read_csv(path);
-  } catch (const runtime::LogError& e) {
-    throw FitError(e.what());
-  }
-}
 
 // Sanity bounds (the file's units; parse_csv has refused non-finite values):
 // |time_ms| <= 1e13 (a Unix time in ms is allowed), 0 <= throttle_percent <= 100,
@@ -42,7 +34,7 @@ void check_row(const runtime::CsvTable& t, size_t row) {
 }  // namespace
 
 std::vector<MotorStep> read_motor_steps(const std::string& path) {
-  const runtime::CsvTable t = read_table(path);
+  const runtime::CsvTable t = read_measurement_csv(path);
   for (const char* c : {"time_ms", "throttle_percent", "rpm"})
     if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (motor step layout)");
   for (size_t i = 0; i < t.rows.size(); ++i) check_row(t, i);

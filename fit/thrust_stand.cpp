@@ -3,20 +3,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "flight_data.hpp"
 #include "flight_log.hpp"
 
 namespace quadgen::fit {
 
 namespace {
-
-// The CSV reader's errors (file:line, non-finite cells, size) as this layer's FitError.
-runtime::CsvTable read_table(const std::string& path) {
-  try {
-    return runtime::read_csv(path);
-  } catch (const runtime::LogError& e) {
-    throw FitError(e.what());
-  }
-}
 
 // A value of the stand file within [lo, hi], else FitError "path:line: ...".
 double checked(const runtime::CsvTable& t, size_t row, int col, double lo, double hi, const char* expected) {
@@ -36,7 +28,7 @@ double checked(const runtime::CsvTable& t, size_t row, int col, double lo, doubl
 // 0 <= vbat[V] <= 1000 and > 0 where the motors run (the speed model takes log(vbat));
 // 0 <= rpm_i <= 1e9. parse_csv has already refused non-finite values.
 std::vector<StandSample> read_thrust_stand(const std::string& path) {
-  const runtime::CsvTable t = read_table(path);
+  const runtime::CsvTable t = read_measurement_csv(path);
   for (const char* c : {"weight[g]", "pwm", "vbat[V]", "rpm1", "rpm2", "rpm3", "rpm4"})
     if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (thrust-stand layout)");
   const double rpm = 2 * M_PI / 60;
