@@ -1,5 +1,7 @@
 // Fit time for a 60 s, 100 Hz flight (6000 samples, equation error, FINken 3 compiled model,
-// c_t, c_w and kappa free) and for the full profile of one parameter.
+// c_t, c_w and kappa free), for the full profile of one parameter, and for the profiles of
+// all three on one thread against two (the ratio of the two is the parallel speed-up on
+// this machine).
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -66,6 +68,15 @@ void BM_ProfileOneParameter60s100Hz(benchmark::State& st) {
   for (auto _ : st) benchmark::DoNotOptimize(profile_parameter(m, best, ct, {}, {}).points.size());
 }
 
+void BM_ProfileAllThreads60s100Hz(benchmark::State& st) {
+  Setup s;
+  EquationErrorModel m(s.model, s.flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
+  const FitResult best = fit_least_squares(m, s.params, {});
+  ProfileOptions po;
+  po.threads = static_cast<int>(st.range(0));
+  for (auto _ : st) benchmark::DoNotOptimize(profile_all(m, best, {}, po).size());
+}
+
 // 60 s of pose at 100 Hz: fifteen 4 s wobbling flights from hover, 0.3 s windows.
 void BM_FitMultipleShooting60s100Hz(benchmark::State& st) {
   Setup s;
@@ -99,6 +110,7 @@ void BM_FitMultipleShooting60s100Hz(benchmark::State& st) {
 BENCHMARK(BM_FitMultipleShooting60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_FitEquationError60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_ProfileOneParameter60s100Hz)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ProfileAllThreads60s100Hz)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(2)->UseRealTime();
 
 }  // namespace
 

@@ -42,6 +42,8 @@ struct FitArgs {
   std::string formulation = "equation_error";
   double window = 0.5;
   double resample = 0;
+  std::string profiles = "all";  // all | none | comma-separated parameter names
+  int threads = 0;               // profile threads; 0: one per core
   std::set<std::string> given;  // options on the command line (each fit kind refuses those it does not use)
 };
 void add_fit(CLI::App& app, FitArgs& args);

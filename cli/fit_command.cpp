@@ -51,21 +51,71 @@ void add_fit(CLI::App& app, FitArgs& a) {
       ->check(finite_range(0.1, 1e5));
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
+  c->add_option("--profiles", a.profiles,
+                "profile likelihood of: all free parameters, none (estimates and standard errors only), or "
+                "comma-separated names")
+      ->capture_default_str();
+  c->add_option("--threads", a.threads, "threads for the profiles (0: one per core)")
+      ->check(CLI::Range(0, 256))
+      ->capture_default_str();
 }
 
 namespace {
 
-// Profiles take minutes: say which one is running.
-ProfileOptions profile_options() {
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// Profiles take minutes: say as each one is done.
+ProfileOptions profile_options(const FitArgs& a) {
   ProfileOptions po;
-  po.progress = [](const std::string& name, int i, int n) {
-    std::cerr << "  profile " << i << "/" << n << ": " << output::printable(name) << "\n";
+  po.threads = a.threads;
+  po.progress = [](const std::string& name, int i, int n, double seconds) {
+    std::cerr << "  profile " << i << "/" << n << " done: " << output::printable(name) << " (" << std::round(seconds * 10) / 10
+              << " s)\n";
   };
   return po;
 }
 
+// --profiles: which free parameters to profile (indices into best.parameters); a name
+// that is not a free parameter of this fit is refused, not skipped.
+std::vector<int> profile_selection(const FitArgs& a, const FitResult& best) {
+  std::vector<int> which;
+  if (a.profiles == "none") return which;
+  if (a.profiles == "all" || a.profiles.empty()) {
+    for (size_t k = 0; k < best.parameters.size(); ++k)
+      if (best.parameters[k].free) which.push_back(static_cast<int>(k));
+    return which;
+  }
+  for (const auto& name : split_list(a.profiles)) {
+    const auto it = std::find_if(best.parameters.begin(), best.parameters.end(), [&](const auto& p) { return p.name == name; });
+    if (it == best.parameters.end())
+      throw std::invalid_argument("--profiles: no parameter '" + output::printable(name) + "' in this fit");
+    if (!it->free) throw std::invalid_argument("--profiles: '" + output::printable(name) + "' is not a free parameter of this fit");
+    which.push_back(static_cast<int>(it - best.parameters.begin()));
+  }
+  return which;
+}
+
+std::vector<Profile> run_profiles(const FitArgs& a, const ResidualModel& m, const FitResult& best, const FitOptions& fo) {
+  const auto which = profile_selection(a, best);
+  if (which.empty()) return {};
+  return profile_all(m, best, fo, profile_options(a), which);
+}
+
 // An interval side the profile never crossed is open, not a number.
-std::string side(double v, bool open) { return open ? std::string("open") : std::to_string(v); }
+std::string side(double v, bool open) {
+  if (open) return "open";
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
 
 // A plot joins the output set when gnuplot can draw it; without one the fit still counts.
 void add_plot(output::OutputDirectory& out, const std::string& file, const std::string& title,
@@ -88,8 +138,8 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v, output::OutputDirectory&
   std::cerr << "[1/2] fitting motor map and lag to " << model.steps().size() << " steps (" << model.num_residuals()
             << " samples)\n";
   const FitResult best = fit_least_squares(model, model.parameters(), fo);
-  std::cerr << "[2/2] profile likelihood of " << best.num_free << " parameters\n";
-  const auto profiles = profile_all(model, best, fo, profile_options());
+  std::cerr << "[2/2] profile likelihood\n";
+  const auto profiles = run_profiles(a, model, best, fo);
   auto j = fit_json(best, profiles);
   j["kind"] = "motor_steps";
   j["vehicle"] = v.name;
@@ -135,15 +185,6 @@ int fit_motor_steps(const FitArgs& a, const Vehicle& v, output::OutputDirectory&
               << "] (" << tau->verdict << ")";
   std::cout << "; thesis: 0.128 s\n";
   return 0;
-}
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 // RMS of each channel of an equation-error model at the given parameters.
@@ -209,7 +250,7 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw,
   const double fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   std::cerr << "[2/3] profile likelihood (fit took " << fit_seconds << " s)\n";
   clock0 = std::chrono::steady_clock::now();
-  const auto profiles = profile_all(train_m, best, fo, profile_options());
+  const auto profiles = run_profiles(a, train_m, best, fo);
   const double profile_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   std::cerr << "[3/3] validation on the last " << valid.samples.size() << " samples\n";
   const auto before = channel_rms(valid_m, params), after = channel_rms(valid_m, best.parameters);
@@ -275,51 +316,73 @@ int fit_thrust_stand(const FitArgs& a, const Vehicle& v, output::OutputDirectory
   const auto samples = read_thrust_stand(a.log);
   FitOptions fo;
   fo.robust = a.robust;
-  std::cerr << "[1/2] thrust vs rotor speed, " << samples.size() << " samples\n";
-  ThrustVsSpeed thrust(samples);
-  const FitResult tr = fit_least_squares(thrust, ThrustVsSpeed::parameters(), fo);
-  const auto tp = profile_all(thrust, tr, fo, profile_options());
-  std::cerr << "[2/2] rotor speed vs command and battery voltage\n";
+  std::cerr << "thrust vs rotor speed and rotor speed vs command, " << samples.size() << " samples\n";
   const double vref = param(v, "vbat_ref").value;
-  SpeedVsCommand speed(samples, vref);
-  const FitResult sr = fit_least_squares(speed, SpeedVsCommand::parameters(), fo);
-  const auto sp = profile_all(speed, sr, fo, profile_options());
-  double k_mean = 0;
-  for (int i = 0; i < 4; ++i) k_mean += tr.parameters[i].value / 4;
+  const StandFit f = fit_stand(samples, vref, fo, profile_options(a));
+  const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
+  double k = 0;
+  for (int i = 0; i < (shared ? 1 : 4); ++i) k += f.thrust.parameters[i].value / (shared ? 1 : 4);
   const Rotor& r0 = v.rotors.front();
-  const double ct = k_mean / (param(v, "rho").value * r0.disc_area * r0.radius * r0.radius);
+  const double ct = k / (param(v, "rho").value * r0.disc_area * r0.radius * r0.radius);
   nlohmann::ordered_json j;
   j["kind"] = "thrust_stand";
   j["vehicle"] = v.name;
   j["log"] = a.log;
-  j["thrust_vs_speed"] = fit_json(tr, tp);
-  j["speed_vs_command"] = fit_json(sr, sp);
-  j["summary"] = {{"k_mean_N_s2", k_mean},
+  j["thrust_vs_speed"] = fit_json(f.thrust, f.thrust_profiles);
+  j["thrust_vs_speed"]["coefficients"] = shared ? "shared" : "per_motor";
+  j["thrust_vs_speed"]["motor_speed_ratio_variation_rms"] = f.ratio_variation;
+  if (shared) {
+    j["thrust_vs_speed"]["why"] = f.coefficients_reason;
+    nlohmann::ordered_json attempt = nlohmann::ordered_json::object();  // verdicts only: no value at a bound is an estimate
+    for (const auto& pr : f.per_motor_profiles)
+      attempt[pr.parameter] = {{"verdict", pr.verdict},
+                               {"at_bound", std::count(f.per_motor.at_bound.begin(), f.per_motor.at_bound.end(), pr.parameter) > 0}};
+    j["thrust_vs_speed"]["per_motor_attempt"] = attempt;
+  }
+  j["speed_vs_command"] = fit_json(f.speed, f.speed_profiles);
+  if (!f.voltage_exponent_identified) j["speed_vs_command"]["why"] = f.voltage_reason;
+  const Profile* kp = shared ? &f.thrust_profiles.front() : nullptr;
+  j["summary"] = {{"k_mean_N_s2", k},
+                  {"k_ci95_N_s2", kp ? nlohmann::ordered_json{kp->lower_open ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(kp->lower),
+                                                             kp->upper_open ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(kp->upper)}
+                                     : nlohmann::ordered_json(nullptr)},
+                  {"coefficients", shared ? "one shared by all motors" : "mean of the per-motor coefficients"},
                   {"c_t", ct},
                   {"c_t_in_vehicle_file", param(v, "c_t").value},
-                  {"battery_sag_exponent_implied", 2 * sr.parameters[3].value},
+                  {"battery_sag_exponent_implied", f.voltage_exponent_identified ? nlohmann::ordered_json(2 * f.speed.parameters[3].value)
+                                                                                : nlohmann::ordered_json(nullptr)},
                   {"vbat_ref_V", vref}};
   j["published"] = published_crazyflie();
   out.add("fit.json", output::json_document(j));
-  std::vector<Profile> all = tp;
-  all.insert(all.end(), sp.begin(), sp.end());
+  std::vector<Profile> all = f.thrust_profiles;
+  all.insert(all.end(), f.speed_profiles.begin(), f.speed_profiles.end());
   add_profile_plot(out, v.name + ": thrust stand profiles", all);
-  runtime::Series meas{"measured (all motors)", {}, {}, true}, model{"sum k_i w_i^2 + tare", {}, {}, true};
-  const std::vector<double> pv = parameter_values(tr.parameters);
+  runtime::Series meas{"measured (all motors)", {}, {}, true},
+      model{shared ? "k sum w_i^2 + tare" : "sum k_i w_i^2 + tare", {}, {}, true};
+  const ThrustVsSpeed thrust(samples, f.coefficients);
+  const std::vector<double> pv = parameter_values(f.thrust.parameters);
   std::vector<double> r(thrust.num_residuals());
   thrust.evaluate(pv.data(), r.data(), nullptr);
-  for (size_t k = 0; k < samples.size(); ++k) {
-    const double wm = (samples[k].w[0] + samples[k].w[1] + samples[k].w[2] + samples[k].w[3]) / 4;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const double wm = (samples[i].w[0] + samples[i].w[1] + samples[i].w[2] + samples[i].w[3]) / 4;
     meas.x.push_back(wm);
-    meas.y.push_back(samples[k].thrust);
+    meas.y.push_back(samples[i].thrust);
     model.x.push_back(wm);
-    model.y.push_back(samples[k].thrust + r[k]);
+    model.y.push_back(samples[i].thrust + r[i]);
   }
   add_plot(out, "fit.svg", v.name + ": thrust stand", {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}});
   out.commit();
-  std::cout << "k per motor:";
-  for (int i = 0; i < 4; ++i) std::cout << " " << tr.parameters[i].value << " (" << tp[i].verdict << ")";
-  std::cout << "; mean " << k_mean << " N s^2 -> c_t = " << ct << "; speed ~ vbat^" << sr.parameters[3].value << "\n";
+  if (shared) {
+    std::cout << "k = " << k << " N s^2 [" << side(kp->lower, kp->lower_open) << ", " << side(kp->upper, kp->upper_open)
+              << "] (" << kp->verdict << "), shared by all motors: " << f.coefficients_reason << "\n";
+  } else {
+    std::cout << "k per motor:";
+    for (int i = 0; i < 4; ++i) std::cout << " " << f.thrust.parameters[i].value << " (" << f.thrust_profiles[i].verdict << ")";
+    std::cout << "; mean " << k << " N s^2\n";
+  }
+  std::cout << "c_t = " << ct << "; ";
+  if (f.voltage_exponent_identified) std::cout << "speed ~ vbat^" << f.speed.parameters[3].value << "\n";
+  else std::cout << f.voltage_reason << "\n";
   return 0;
 }
 
@@ -349,11 +412,11 @@ int run_fit(const FitArgs& a) {
   const runtime::CsvTable head = runtime::read_csv(a.log);
   output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});  // refused before the work, not after
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) {
-    refuse_options(a, "a motor-step log", {"--out", "--robust"});
+    refuse_options(a, "a motor-step log", {"--out", "--robust", "--profiles", "--threads"});
     return fit_motor_steps(a, v, out);
   }
   if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) {
-    refuse_options(a, "a thrust-stand log", {"--out", "--robust"});
+    refuse_options(a, "a thrust-stand log", {"--out", "--robust", "--threads"});
     return fit_thrust_stand(a, v, out);
   }
   check_flight_options(a);

@@ -11,7 +11,7 @@ namespace quadgen::fit {
 
 EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flight, bool use_accelerometer,
                                        std::vector<std::string> use, Derivatives d, double window)
-    : model_(model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
+    : model_(&model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
       derivatives_(d) {
   const auto names = all_names();
   if (use.empty()) use = names;
@@ -101,7 +101,7 @@ void EquationErrorModel::set_free(const std::vector<bool>& free) const {
   std::vector<int> cols;
   for (size_t j = 0; j < free.size(); ++j)
     if (free[j]) cols.push_back(static_cast<int>(j));
-  model_.restrict_param_jacobian(cols);
+  model_->restrict_param_jacobian(cols);
 }
 
 std::vector<std::string> EquationErrorModel::channels() const {
@@ -113,7 +113,7 @@ std::vector<std::string> EquationErrorModel::channels() const {
 
 void EquationErrorModel::evaluate(const double* p, double* r, double* J) const {
   if (used_.size() == 6) return evaluate6(p, r, J);
-  const int np = model_.num_params();
+  const int np = model_->num_params();
   const size_t ns = rows_.size();
   std::vector<double> r6(ns * 6), J6(J ? ns * 6 * np : 0);
   evaluate6(p, r6.data(), J ? J6.data() : nullptr);
@@ -145,11 +145,11 @@ void EquationErrorModel::commands_at(double t, double* u) const {
 }
 
 void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::vector<double>& U) const {
-  const int n = model_.num_states(), nu = model_.num_inputs();
+  const int n = model_->num_states(), nu = model_->num_inputs();
   const size_t ns = flight_.samples.size();
   X.assign(ns * n, 0.0);
   U.assign(ns * nu, 0.0);
-  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
+  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   const double delay = delay_ >= 0 ? p[delay_] : 0.0;
   const double roll = roll_ >= 0 ? p[roll_] : 0.0, pitch = pitch_ >= 0 ? p[pitch_] : 0.0;
   for (size_t k = 0; k < ns; ++k) {
@@ -187,7 +187,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
     std::vector<double> w_now(nr);
     for (size_t i = 0; i < nr; ++i) w_now[i] = x[speed_states_[i]], x[speed_states_[i]] = 0;
-    model_.rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
+    model_->rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
     for (size_t i = 0; i < nr; ++i) {
       c[i] = tau * f[speed_states_[i]];
       x[speed_states_[i]] = k == 0 ? c[i] : w_now[i];
@@ -196,7 +196,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
 }
 
 void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const {
-  const int np = model_.num_params();
+  const int np = model_->num_params();
   residuals(p, r, J);
   if (!J) return;
   // Columns of the parameters applied to the data: central differences.
@@ -211,15 +211,15 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const 
     pp[c] = p[c];
     for (size_t i = 0; i < rp.size(); ++i) J[i * np + c] = (rp[i] - rm[i]) / (2 * h);
   }
-  model_.set_params(pp);
+  model_->set_params(pp);
 }
 
 // Model accelerations (rows 3..5 and 10..12 of f, and of df/dp) at the middle of every
 // interval k -> k+1: state averaged, the commands of t_k held over it.
 void EquationErrorModel::interval_accelerations(const std::vector<double>& X, const std::vector<double>& U,
                                                 std::vector<double>& F, std::vector<double>* Bm) const {
-  const int n = model_.num_states(), np = model_.num_params(), nu = model_.num_inputs();
-  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
+  const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
+  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   const size_t ns = flight_.samples.size();
   F.assign(ns * 6, 0.0);
   if (Bm) Bm->assign(ns * 6 * np, 0.0);
@@ -235,7 +235,7 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
     if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
     if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
     if (quadrature_ == Quadrature::kMidpoint) {
-      model_.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+      model_->rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
       for (int c = 0; c < 6; ++c) {
         F[k * 6 + c] = f[kRows[c]];
         if (Bm) std::copy(&B[kRows[c] * np], &B[kRows[c] * np] + np, &(*Bm)[(k * 6 + c) * np]);
@@ -247,7 +247,7 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
     for (size_t end = k; end <= k + 1; ++end) {
       std::vector<double> xe(&X[end * n], &X[end * n] + n);
       for (size_t i = 0; i < speed_states_.size(); ++i) xe[speed_states_[i]] = xm[speed_states_[i]];
-      model_.rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+      model_->rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
       for (int c = 0; c < 6; ++c) {
         F[k * 6 + c] += 0.5 * f[kRows[c]];
         if (Bm)
@@ -258,8 +258,8 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
 }
 
 void EquationErrorModel::residuals(const double* p, double* r, double* J) const {
-  const int n = model_.num_states(), np = model_.num_params(), nu = model_.num_inputs();
-  model_.set_params(std::vector<double>(p, p + np));
+  const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
+  model_->set_params(std::vector<double>(p, p + np));
   std::vector<double> X, U;
   prepare(p, X, U);
   const bool filtered = derivatives_ == Derivatives::kFiltered;
@@ -273,7 +273,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
     const size_t k = rows_[row];
     const FlightSample& s = flight_.samples[k];
     const double* xk = &X[k * n];
-    if (pointwise_needed) model_.rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
+    if (pointwise_needed) model_->rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
     double meas[6];
     if (filtered) {
       std::fill(a6.begin(), a6.end(), 0.0);
@@ -328,6 +328,19 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
       }
     }
   }
+}
+
+}  // namespace quadgen::fit
+
+namespace quadgen::fit {
+
+std::unique_ptr<ResidualModel> EquationErrorModel::clone() const {
+  std::shared_ptr<runtime::DynamicModel> own = model_->clone();
+  if (!own) return nullptr;
+  auto copy = std::make_unique<EquationErrorModel>(*this);
+  copy->owned_model_ = own;
+  copy->model_ = own.get();
+  return copy;
 }
 
 }  // namespace quadgen::fit

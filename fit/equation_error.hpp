@@ -10,6 +10,7 @@
 // compares integrated windows with the pose, is the other formulation; see README.)
 #pragma once
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -48,12 +49,14 @@ class EquationErrorModel : public ResidualModel {
   int channel_of(int i) const override { return i % static_cast<int>(used_.size()); }
   std::vector<std::string> channels() const override;
   void set_free(const std::vector<bool>& free) const override;
+  std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
   // Residuals of all six channels of every row (rows() x 6), at these parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
   const Flight& flight() const { return flight_; }
 
  private:
-  runtime::DynamicModel& model_;
+  runtime::DynamicModel* model_;  // the caller's, or owned_model_ in a clone
+  std::shared_ptr<runtime::DynamicModel> owned_model_;
   Flight flight_;
   bool accel_;
   int g_index_;

@@ -4,6 +4,7 @@
 // and the covariance of the free parameters. The problem (ResidualModel) is kept apart
 // from the solver (fit_least_squares) and its options (FitOptions).
 #pragma once
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,6 +29,9 @@ class ResidualModel {
   // Which parameters are free in the next solve: a model may skip Jacobian columns of
   // fixed parameters (they are then left zero).
   virtual void set_free(const std::vector<bool>& /*free*/) const {}
+  // An independent copy for another thread (a model may keep scratch state between
+  // evaluations, so one instance serves one thread). nullptr: work on it stays sequential.
+  virtual std::unique_ptr<ResidualModel> clone() const { return nullptr; }
 };
 
 struct FitError : std::runtime_error {

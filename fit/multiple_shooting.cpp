@@ -7,7 +7,7 @@
 namespace quadgen::fit {
 
 MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Flight flight, double window)
-    : model_(model), flight_(std::move(flight)) {
+    : model_(&model), flight_(std::move(flight)) {
   if (!flight_.has_pose) throw FitError(flight_.source + ": multiple shooting needs the pose (x, y, z, qw..qz)");
   if (model.num_states() != 13)
     throw FitError("multiple shooting needs every state at the window starts; this model has unlogged states (" +
@@ -31,17 +31,17 @@ void MultipleShootingModel::set_free(const std::vector<bool>& free) const {
   free_.clear();
   for (size_t j = 0; j < free.size(); ++j)
     if (free[j]) free_.push_back(static_cast<int>(j));
-  model_.restrict_param_jacobian(free_);
+  model_->restrict_param_jacobian(free_);
 }
 
 void MultipleShootingModel::evaluate(const double* p, double* r, double* J) const {
-  const int n = 13, np = model_.num_params(), nu = model_.num_inputs();
+  const int n = 13, np = model_->num_params(), nu = model_->num_inputs();
   if (free_.empty() && J) {  // no set_free yet: all columns
     for (int j = 0; j < np; ++j) free_.push_back(j);
   }
   const int nf = static_cast<int>(free_.size()), cols = n + nf;
-  model_.set_params(std::vector<double>(p, p + np));
-  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
+  model_->set_params(std::vector<double>(p, p + np));
+  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   int row = 0;
   for (const auto& [first, last] : windows_) {
     const auto& s = flight_.samples;
@@ -58,7 +58,7 @@ void MultipleShootingModel::evaluate(const double* p, double* r, double* J) cons
     o.quaternion_offset = -1;
     const double dt = (s[last].t - s[first].t) / static_cast<double>(last - first);
     o.step = dt;
-    const auto tr = runtime::integrate_rk4_sensitivities(model_, s[first].x, u, 0.0, s[last].t - s[first].t, o, &free_);
+    const auto tr = runtime::integrate_rk4_sensitivities(*model_, s[first].x, u, 0.0, s[last].t - s[first].t, o, &free_);
     for (size_t k = first + 1; k <= last; ++k, row += 6) {
       const auto& xp = tr.states.x[k - first];
       const auto& S = tr.S[k - first];
@@ -87,6 +87,19 @@ void MultipleShootingModel::evaluate(const double* p, double* r, double* J) cons
       }
     }
   }
+}
+
+}  // namespace quadgen::fit
+
+namespace quadgen::fit {
+
+std::unique_ptr<ResidualModel> MultipleShootingModel::clone() const {
+  std::shared_ptr<runtime::DynamicModel> own = model_->clone();
+  if (!own) return nullptr;
+  auto copy = std::make_unique<MultipleShootingModel>(*this);
+  copy->owned_model_ = own;
+  copy->model_ = own.get();
+  return copy;
 }
 
 }  // namespace quadgen::fit

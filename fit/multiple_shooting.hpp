@@ -6,6 +6,7 @@
 // the pose alone suffices (no IMU needed), but the state at each window start must be
 // known (velocities and rates from the log or differentiated).
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,9 +25,11 @@ class MultipleShootingModel : public ResidualModel {
   std::vector<std::string> channels() const override { return {"x", "y", "z", "roll_err", "pitch_err", "yaw_err"}; }
   size_t num_windows() const { return windows_.size(); }
   void set_free(const std::vector<bool>& free) const override;
+  std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
 
  private:
-  runtime::DynamicModel& model_;
+  runtime::DynamicModel* model_;  // the caller's, or owned_model_ in a clone
+  std::shared_ptr<runtime::DynamicModel> owned_model_;
   Flight flight_;
   std::vector<std::pair<size_t, size_t>> windows_;  // [first, last] sample indices
   int num_residuals_ = 0;

@@ -1,9 +1,14 @@
 #include "profile_likelihood.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include <boost/math/distributions/chi_squared.hpp>
 
@@ -13,20 +18,45 @@ double chi2_quantile(double p, double dof) { return boost::math::quantile(boost:
 
 namespace {
 
-// Walks from the optimum in one direction until the simultaneous threshold is exceeded,
-// a bound is reached, or the step budget is spent. Steps grow when the profile is flat.
-void walk(const ResidualModel& model, const FitResult& best, int k, double dir, double step, const FitOptions& fo,
-          const ProfileOptions& po, double stop, std::vector<ProfilePoint>& out, bool* reached_bound) {
+struct Side {
+  std::vector<ProfilePoint> points;  // outward from the optimum
+  bool reached_bound = false;
+};
+
+// The first step: a fraction of the standard error (a profile is quadratic near the
+// optimum), kept within the bounds' span.
+double first_step(const FitResult& best, int k) {
+  const auto& p = best.parameters[k];
+  const double range = p.upper - p.lower;
+  double step = best.standard_errors[k];
+  if (!std::isfinite(step) || step <= 0) step = range / 100;
+  return std::clamp(step * 0.5, range * 1e-6, range / 10);
+}
+
+double stop_level(const FitResult& best, const ProfileOptions& po) {
+  const double pointwise = chi2_quantile(po.confidence, 1);
+  const double simultaneous = chi2_quantile(po.confidence, std::max(1, best.num_free));
+  return 1.5 * (po.walk_past_simultaneous ? std::max(pointwise, simultaneous) : pointwise);
+}
+
+// Walks from the optimum in one direction until `stop` is exceeded, a bound is reached, or
+// the step budget is spent. Each point starts from the previous point's re-optimised
+// parameters. For a quadratic profile sqrt(delta chi2) grows linearly with the distance, so
+// the last point predicts where sqrt(delta chi2) will have grown by a quarter of
+// sqrt(stop): about four points a side; flat stretches grow the step fourfold at most.
+Side walk(const ResidualModel& model, const FitResult& best, int k, double dir, const FitOptions& fo,
+          const ProfileOptions& po, double stop) {
+  Side side;
   std::vector<FitParameter> ps = best.parameters;
   ps[k].free = false;
-  const double lo = best.parameters[k].lower, hi = best.parameters[k].upper;
-  double v = best.parameters[k].value;
-  *reached_bound = false;
+  const double lo = best.parameters[k].lower, hi = best.parameters[k].upper, v0 = best.parameters[k].value;
+  const double root_step = std::sqrt(stop) / 4;
+  double offset = first_step(best, k);
   for (int s = 0; s < po.max_steps_each_side; ++s) {
-    double next = v + dir * step;
+    double next = v0 + dir * offset;
     if (next <= lo || next >= hi) {
       next = dir < 0 ? lo : hi;
-      *reached_bound = true;
+      side.reached_bound = true;
     }
     ps[k].value = next;
     double c = 0;
@@ -38,48 +68,42 @@ void walk(const ResidualModel& model, const FitResult& best, int k, double dir, 
     std::vector<double> vals;
     for (const auto& p : ps) vals.push_back(p.value);
     const double d = c - best.chi2;
-    out.push_back({next, d, vals});
-    if (d > stop || *reached_bound) return;
-    // Aim for about a tenth of the threshold per step.
-    if (d < 0.02 * stop) step *= 2.0;
-    else if (d > 0.3 * stop && s > 0) step *= 0.7;
-    v = next;
+    side.points.push_back({next, d, vals});
+    if (d > stop || side.reached_bound) break;
+    const double grow = d > 1e-9 * stop ? (std::sqrt(d) + root_step) / std::sqrt(d) : 4.0;
+    offset *= std::clamp(grow, 1.2, 4.0);
   }
+  return side;
 }
 
-// Where the profile crosses `level` on one side, by linear interpolation; NaN if never.
+// Where the profile crosses `level` on one side, NaN if never. Interpolated linearly in
+// sqrt(delta chi2), which is linear in the parameter where the profile is quadratic, so
+// the few points of a walk place the crossing accurately.
 double crossing(const std::vector<ProfilePoint>& side, double best_value, double level) {
-  double prev_v = best_value, prev_d = 0;
+  const auto root = [](double d) { return std::sqrt(std::max(0.0, d)); };
+  double prev_v = best_value, prev_r = 0;
   for (const auto& p : side) {
+    const double r = root(p.delta_chi2);
     if (p.delta_chi2 >= level) {
-      const double f = (level - prev_d) / (p.delta_chi2 - prev_d);
+      const double f = (root(level) - prev_r) / (r - prev_r);
       return prev_v + f * (p.value - prev_v);
     }
     prev_v = p.value;
-    prev_d = p.delta_chi2;
+    prev_r = r;
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-}  // namespace
-
-Profile profile_parameter(const ResidualModel& model, const FitResult& best, int k, const FitOptions& fo,
-                          const ProfileOptions& po) {
+// A profile from its two walks: interval, verdict, and for a flat one what compensates it.
+Profile assemble(const FitResult& best, int k, const ProfileOptions& po, const Side& left_side, const Side& right_side) {
   Profile pr;
   pr.parameter = best.parameters[k].name;
   pr.index = k;
   pr.threshold_pointwise = chi2_quantile(po.confidence, 1);
   pr.threshold_simultaneous = chi2_quantile(po.confidence, std::max(1, best.num_free));
   const auto& p = best.parameters[k];
-  double step = best.standard_errors[k];
-  const double range = p.upper - p.lower;
-  if (!std::isfinite(step) || step <= 0) step = range / 100;
-  step = std::clamp(step * 0.3, range * 1e-6, range / 10);
-  const double stop = 1.2 * std::max(pr.threshold_simultaneous, pr.threshold_pointwise);
-  std::vector<ProfilePoint> left, right;
-  bool lb = false, ub = false;
-  walk(model, best, k, -1, step, fo, po, stop, left, &lb);
-  walk(model, best, k, +1, step, fo, po, stop, right, &ub);
+  const auto& left = left_side.points;
+  const auto& right = right_side.points;
   pr.lower = crossing(left, p.value, pr.threshold_pointwise);
   pr.upper = crossing(right, p.value, pr.threshold_pointwise);
   pr.lower_open = std::isnan(pr.lower);
@@ -134,15 +158,75 @@ Profile profile_parameter(const ResidualModel& model, const FitResult& best, int
   return pr;
 }
 
+}  // namespace
+
+Profile profile_parameter(const ResidualModel& model, const FitResult& best, int k, const FitOptions& fo,
+                          const ProfileOptions& po) {
+  const double stop = stop_level(best, po);
+  const Side left = walk(model, best, k, -1, fo, po, stop);
+  const Side right = walk(model, best, k, +1, fo, po, stop);
+  return assemble(best, k, po, left, right);
+}
+
+// The sides of all profiles are independent jobs (two per parameter, for balance on few
+// cores); each worker thread owns a copy of the model.
 std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& best, const FitOptions& fo,
-                                 const ProfileOptions& po) {
-  std::vector<Profile> out;
-  const int count = best.num_free;
-  for (size_t k = 0; k < best.parameters.size(); ++k)
-    if (best.parameters[k].free) {
-      if (po.progress) po.progress(best.parameters[k].name, static_cast<int>(out.size()) + 1, count);
-      out.push_back(profile_parameter(model, best, static_cast<int>(k), fo, po));
+                                 const ProfileOptions& po, const std::vector<int>& which) {
+  std::vector<int> params = which;
+  if (params.empty())
+    for (size_t k = 0; k < best.parameters.size(); ++k)
+      if (best.parameters[k].free) params.push_back(static_cast<int>(k));
+  for (int k : params)
+    if (k < 0 || k >= static_cast<int>(best.parameters.size()) || !best.parameters[k].free)
+      throw FitError("profile: parameter index " + std::to_string(k) + " is not a free parameter");
+  const size_t jobs = 2 * params.size();
+  unsigned threads = po.threads > 0 ? po.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<size_t>(threads, jobs));
+  std::vector<std::unique_ptr<ResidualModel>> copies;
+  for (unsigned t = 1; t < threads; ++t) {
+    copies.push_back(model.clone());
+    if (!copies.back()) {
+      threads = 1;
+      break;
     }
+  }
+  const double stop = stop_level(best, po);
+  std::vector<Side> sides(jobs);
+  std::vector<int> sides_done(params.size(), 0);
+  std::vector<std::chrono::steady_clock::time_point> started(params.size());
+  std::atomic<size_t> next_job{0};
+  std::mutex mutex;  // guards sides_done, started, first_error and the progress callback
+  std::exception_ptr first_error;
+  int profiles_done = 0;
+  const auto worker = [&](const ResidualModel& m) {
+    for (size_t j; (j = next_job++) < jobs;) {
+      const size_t i = j / 2;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (first_error) return;
+        if (j % 2 == 0) started[i] = std::chrono::steady_clock::now();
+      }
+      try {
+        sides[j] = walk(m, best, params[i], j % 2 == 0 ? -1.0 : 1.0, fo, po, stop);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!first_error) first_error = std::current_exception();
+        return;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      if (++sides_done[i] == 2 && po.progress) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[i]).count();
+        po.progress(best.parameters[params[i]].name, ++profiles_done, static_cast<int>(params.size()), s);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker, std::cref(*copies[t - 1]));
+  worker(model);
+  for (auto& t : pool) t.join();
+  if (first_error) std::rethrow_exception(first_error);
+  std::vector<Profile> out;
+  for (size_t i = 0; i < params.size(); ++i) out.push_back(assemble(best, params[i], po, sides[2 * i], sides[2 * i + 1]));
   return out;
 }
 

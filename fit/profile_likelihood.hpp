@@ -33,14 +33,23 @@ struct Profile {
 struct ProfileOptions {
   int max_steps_each_side = 30;
   double confidence = 0.95;
-  // Called before each parameter's profile (profiles of many parameters take minutes).
-  std::function<void(const std::string& parameter, int index, int count)> progress;
+  // How far each side is walked: past the pointwise threshold (what the intervals and the
+  // verdict need), or on past the simultaneous one (for a plot of the joint region).
+  bool walk_past_simultaneous = false;
+  // profile_all: sides of profiles run on this many threads (0: one per core), each with
+  // its own copy of the model (ResidualModel::clone); a model without copies runs on one.
+  int threads = 1;
+  // Called as each parameter's profile is finished (profiles of many parameters take
+  // minutes): its name, how many are done, of how many, and its wall-clock seconds.
+  std::function<void(const std::string& parameter, int done, int count, double seconds)> progress;
 };
 
 Profile profile_parameter(const ResidualModel& model, const FitResult& best, int index, const FitOptions& fo,
                           const ProfileOptions& po);
+// Profiles of the free parameters in `which` (indices into best.parameters; empty: all
+// free ones), in that order.
 std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& best, const FitOptions& fo,
-                                 const ProfileOptions& po);
+                                 const ProfileOptions& po, const std::vector<int>& which = {});
 
 double chi2_quantile(double p, double dof);
 

@@ -1,5 +1,6 @@
 #include "thrust_stand.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -49,21 +50,44 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
   return out;
 }
 
-std::vector<FitParameter> ThrustVsSpeed::parameters() {
+double motor_speed_ratio_variation(const std::vector<StandSample>& s) {
+  if (s.size() < 2) return 0.0;
+  double variance_sum = 0;
+  for (int i = 0; i < 4; ++i) {
+    double sum = 0, sum2 = 0;
+    for (const auto& q : s) {
+      const double ratio = q.w[i] / ((q.w[0] + q.w[1] + q.w[2] + q.w[3]) / 4);
+      sum += ratio;
+      sum2 += ratio * ratio;
+    }
+    const double n = static_cast<double>(s.size()), mean = sum / n;
+    variance_sum += std::max(0.0, sum2 / n - mean * mean);
+  }
+  return std::sqrt(variance_sum / 4);
+}
+
+std::vector<FitParameter> ThrustVsSpeed::parameters() const {
   std::vector<FitParameter> p;
-  for (int i = 1; i <= 4; ++i) p.push_back({"k_" + std::to_string(i), "N s^2", 2e-8, 1e-10, 1e-6, true});
+  if (c_ == Coefficients::kShared) {
+    p.push_back({"k", "N s^2", 2e-8, 1e-10, 1e-6, true});
+  } else {
+    for (int i = 1; i <= 4; ++i) p.push_back({"k_" + std::to_string(i), "N s^2", 2e-8, 1e-10, 1e-6, true});
+  }
   p.push_back({"tare", "N", 0.0, -0.1, 0.1, true});
   return p;
 }
 
 void ThrustVsSpeed::evaluate(const double* p, double* r, double* J) const {
+  const bool shared = c_ == Coefficients::kShared;
+  const int np = shared ? 2 : 5, tare = np - 1;
   for (size_t k = 0; k < s_.size(); ++k) {
-    double T = p[4];
-    for (int i = 0; i < 4; ++i) T += p[i] * s_[k].w[i] * s_[k].w[i];
+    double T = p[tare];
+    for (int i = 0; i < 4; ++i) T += p[shared ? 0 : i] * s_[k].w[i] * s_[k].w[i];
     r[k] = T - s_[k].thrust;
     if (!J) continue;
-    for (int i = 0; i < 4; ++i) J[k * 5 + i] = s_[k].w[i] * s_[k].w[i];
-    J[k * 5 + 4] = 1;
+    for (int j = 0; j < np; ++j) J[k * np + j] = 0;
+    for (int i = 0; i < 4; ++i) J[k * np + (shared ? 0 : i)] += s_[k].w[i] * s_[k].w[i];
+    J[k * np + tare] = 1;
   }
 }
 
@@ -87,6 +111,59 @@ void SpeedVsCommand::evaluate(const double* p, double* r, double* J) const {
     J[k * 4 + 2] = s.u * s.u * scale;
     J[k * 4 + 3] = map * scale * std::log(s.vbat / vref_);
   }
+}
+
+namespace {
+
+// Every free parameter's profile closed on both sides and no estimate on a bound.
+bool all_identified(const FitResult& r, const std::vector<Profile>& profiles) {
+  if (!r.at_bound.empty()) return false;
+  return std::all_of(profiles.begin(), profiles.end(), [](const Profile& p) { return p.verdict == "identifiable"; });
+}
+
+std::string percent(double fraction) {
+  std::ostringstream os;
+  os.precision(2);
+  os << 100 * fraction << " %";
+  return os.str();
+}
+
+}  // namespace
+
+StandFit fit_stand(const std::vector<StandSample>& samples, double vref, const FitOptions& fo, const ProfileOptions& po) {
+  StandFit out;
+  out.ratio_variation = motor_speed_ratio_variation(samples);
+  ThrustVsSpeed per_motor(samples, ThrustVsSpeed::Coefficients::kPerMotor);
+  out.per_motor = fit_least_squares(per_motor, per_motor.parameters(), fo);
+  out.per_motor_profiles = profile_all(per_motor, out.per_motor, fo, po);
+  if (all_identified(out.per_motor, out.per_motor_profiles)) {
+    out.thrust = out.per_motor;
+    out.thrust_profiles = out.per_motor_profiles;
+  } else {
+    out.coefficients = ThrustVsSpeed::Coefficients::kShared;
+    out.coefficients_reason = "the per-motor coefficients are not identifiable from this run (the four speeds moved "
+                              "together: their ratios to the mean varied by " + percent(out.ratio_variation) +
+                              " RMS, too little to separate them against the thrust noise, so total thrust fixes only "
+                              "sum k_i w_i^2): one coefficient k is fitted for all four";
+    ThrustVsSpeed shared(samples, ThrustVsSpeed::Coefficients::kShared);
+    out.thrust = fit_least_squares(shared, shared.parameters(), fo);
+    out.thrust_profiles = profile_all(shared, out.thrust, fo, po);
+  }
+  SpeedVsCommand speed(samples, vref);
+  std::vector<FitParameter> sp = SpeedVsCommand::parameters();
+  out.speed = fit_least_squares(speed, sp, fo);
+  out.speed_profiles = profile_all(speed, out.speed, fo, po);
+  if (!all_identified(out.speed, out.speed_profiles)) {
+    out.voltage_exponent_identified = false;
+    out.voltage_reason = "the voltage exponent e is not identifiable from this run (its profile is open or it ends on a "
+                         "bound: the battery voltage varied only with the load, confounded with the command); the "
+                         "motor map is fitted without it (e fixed at 0)";
+    sp[3].value = 0;
+    sp[3].free = false;
+    out.speed = fit_least_squares(speed, sp, fo);
+    out.speed_profiles = profile_all(speed, out.speed, fo, po);
+  }
+  return out;
 }
 
 }  // namespace quadgen::fit

@@ -1,15 +1,18 @@
 // Thrust-stand measurements (Bitcraze's Crazyflie 2.1 stand): total thrust of the four
 // rotors, each rotor's speed, the PWM command and the battery voltage.
 //  - ThrustVsSpeed: T = b + sum_i k_i w_i^2, a thrust coefficient per motor plus the
-//    scale's tare offset.
+//    scale's tare offset; or T = b + k sum_i w_i^2, one coefficient for all, which is all
+//    that total thrust determines when the motors run at nearly the same speed.
 //  - SpeedVsCommand: mean rotor speed = (a0 + a1 u + a2 u^2) (vbat / vref)^e: the motor
 //    map and how it scales with battery voltage (thrust then scales with (vbat/vref)^(2e),
 //    the battery_sag effect's exponent).
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "least_squares.hpp"
+#include "profile_likelihood.hpp"
 
 namespace quadgen::fit {
 
@@ -22,17 +25,28 @@ struct StandSample {
 
 std::vector<StandSample> read_thrust_stand(const std::string& path);  // rows with PWM > 0
 
+// How independently the motors' speeds moved: RMS over motors of the standard deviation,
+// over samples, of each motor's speed relative to the four motors' mean. Total thrust
+// separates per-motor coefficients only through this variation (a constant ratio makes
+// the columns w_i^2 proportional).
+double motor_speed_ratio_variation(const std::vector<StandSample>& s);
+
 class ThrustVsSpeed : public ResidualModel {
  public:
-  explicit ThrustVsSpeed(std::vector<StandSample> s) : s_(std::move(s)) {}
+  enum class Coefficients { kPerMotor, kShared };
+  explicit ThrustVsSpeed(std::vector<StandSample> s, Coefficients c = Coefficients::kPerMotor)
+      : s_(std::move(s)), c_(c) {}
   int num_residuals() const override { return static_cast<int>(s_.size()); }
   void evaluate(const double* p, double* r, double* J) const override;
   int channel_of(int) const override { return 0; }
   std::vector<std::string> channels() const override { return {"thrust"}; }
-  static std::vector<FitParameter> parameters();  // k_1..k_4 [N s^2], tare [N]
+  std::unique_ptr<ResidualModel> clone() const override { return std::make_unique<ThrustVsSpeed>(*this); }
+  // Per motor: k_1..k_4 [N s^2], tare [N]. Shared: k [N s^2], tare [N].
+  std::vector<FitParameter> parameters() const;
 
  private:
   std::vector<StandSample> s_;
+  Coefficients c_;
 };
 
 class SpeedVsCommand : public ResidualModel {
@@ -42,11 +56,34 @@ class SpeedVsCommand : public ResidualModel {
   void evaluate(const double* p, double* r, double* J) const override;
   int channel_of(int) const override { return 0; }
   std::vector<std::string> channels() const override { return {"rotor_speed"}; }
+  std::unique_ptr<ResidualModel> clone() const override { return std::make_unique<SpeedVsCommand>(*this); }
   static std::vector<FitParameter> parameters();  // a0, a1, a2 [rad/s], e [1]
 
  private:
   std::vector<StandSample> s_;
   double vref_;
 };
+
+// What a stand run determines, fitted so that no reported value sits on a bound or rests
+// on an open profile:
+//  - thrust: per-motor coefficients when every one is identifiable, else one coefficient
+//    shared by the four (total thrust fixes only the sum when the speeds barely differ);
+//  - rotor speed: the motor map with the voltage exponent when it is identifiable, else
+//    without it (the voltage then varied only with the load, confounded with the command).
+struct StandFit {
+  ThrustVsSpeed::Coefficients coefficients = ThrustVsSpeed::Coefficients::kPerMotor;
+  FitResult thrust;
+  std::vector<Profile> thrust_profiles;
+  FitResult per_motor;  // the per-motor attempt (kept for the report when it was rejected)
+  std::vector<Profile> per_motor_profiles;
+  std::string coefficients_reason;  // why shared, empty when per motor
+  FitResult speed;
+  std::vector<Profile> speed_profiles;
+  bool voltage_exponent_identified = true;
+  std::string voltage_reason;  // why the exponent was left out, empty when fitted
+  double ratio_variation = 0;  // motor_speed_ratio_variation of the run
+};
+
+StandFit fit_stand(const std::vector<StandSample>& samples, double vref, const FitOptions& fo, const ProfileOptions& po);
 
 }  // namespace quadgen::fit

@@ -3,6 +3,7 @@
 // header (fast, fixed at compile time); TapeModel interprets the same expression DAG at
 // run time, so `quadgen simulate` works for any vehicle file without a compiler.
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ class DynamicModel {
   // A fit with few free parameters needs only their columns of B; a model may then skip
   // the others (left zero). Empty: all columns.
   virtual void restrict_param_jacobian(const std::vector<int>& /*columns*/) {}
+  // An independent copy (parameters, caches and all), for work on another thread: a model
+  // holds its parameters and scratch space, so one instance serves one thread. nullptr:
+  // this model cannot be copied, and its users stay on one thread.
+  virtual std::unique_ptr<DynamicModel> clone() const { return nullptr; }
 
   int state_index(const std::string& name) const;
   int input_index(const std::string& name) const;
@@ -69,6 +74,7 @@ class CompiledModel : public DynamicModel {
     if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
   }
+  std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<CompiledModel>(*this); }
 
  private:
   static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col) {

@@ -52,6 +52,7 @@ class TapeModel : public DynamicModel {
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
+  std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<TapeModel>(*this); }
   int input_delay_param() const { return tape_.input_delay_param; }
 
  private:

@@ -287,3 +287,147 @@ TEST(Fit, OnBoundSeesBothBoundsAndNothingInside) {
   p.value = 1.0;
   EXPECT_FALSE(on_bound(p));
 }
+
+// Profiles run on several threads, each on its own copy of the model, and give exactly
+// what one thread gives: every walk starts from the same optimum and its own state.
+TEST(Fit, ParallelProfilesEqualSequentialOnes) {
+  runtime::CompiledModel<quadgen_generated::finken3::Model> model;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, 0.05);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  Flight flight;
+  flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
+  for (int k = 0; k < 300; ++k) {
+    FlightSample s;
+    s.t = 0.01 * k;
+    s.x = test::random_state(rng);
+    for (int i = 0; i < 4; ++i) s.u.push_back(cmd(rng));
+    std::vector<double> f(13);
+    model.rhs(s.x.data(), s.u.data(), f.data(), nullptr, nullptr, nullptr);
+    for (int i = 0; i < 3; ++i) {
+      s.acc_world[i] = f[3 + i] + noise(rng);
+      s.rate_dot[i] = f[10 + i] + noise(rng);
+    }
+    flight.samples.push_back(s);
+  }
+  const std::vector<double> truth = model.params();
+  EquationErrorModel m(model, flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
+  ASSERT_NE(m.clone(), nullptr);
+  std::vector<FitParameter> ps;
+  for (int i = 0; i < model.num_params(); ++i) {
+    const std::string n = model.param_names()[i];
+    const bool free = n == "c_t" || n == "c_w" || n == "kappa";
+    ps.push_back({n, "", free ? truth[i] * 1.2 : truth[i], free ? truth[i] * 0.2 : truth[i], free ? truth[i] * 5 : truth[i], free});
+  }
+  FitOptions fo;
+  fo.account_autocorrelation = false;
+  const FitResult best = fit_least_squares(m, ps, fo);
+  ProfileOptions one, two;
+  two.threads = 2;
+  int reported = 0;
+  two.progress = [&](const std::string&, int done, int count, double) { reported = std::max(reported, done) + 0 * count; };
+  const auto a = profile_all(m, best, fo, one), b = profile_all(m, best, fo, two);
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(reported, 3);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].parameter, b[i].parameter);
+    EXPECT_EQ(a[i].verdict, "identifiable") << a[i].parameter;
+    EXPECT_EQ(a[i].lower, b[i].lower) << a[i].parameter;
+    EXPECT_EQ(a[i].upper, b[i].upper) << a[i].parameter;
+    ASSERT_EQ(a[i].points.size(), b[i].points.size());
+    // The interval covers the truth within a generous margin (one seed).
+    const int k = a[i].index;
+    const double half = (a[i].upper - a[i].lower) / 2;
+    EXPECT_NEAR(best.parameters[k].value, truth[k], 3 * half) << a[i].parameter;
+  }
+  // A selection profiles only what it names, in the order named.
+  const int kappa = model.param_index("kappa"), ct = model.param_index("c_t");
+  const auto sel = profile_all(m, best, fo, two, {kappa, ct});
+  ASSERT_EQ(sel.size(), 2u);
+  EXPECT_EQ(sel[0].parameter, "kappa");
+  EXPECT_EQ(sel[1].parameter, "c_t");
+  EXPECT_THROW(profile_all(m, best, fo, two, {model.param_index("mass")}), FitError);  // not free
+}
+
+#include "thrust_stand.hpp"
+namespace {
+// A synthetic stand run: thrust sum k w_i^2 + tare with noise; each motor's speed is the
+// common speed times its own factor, varied per sample by `independent`; the battery
+// voltage varies independently of the command when `voltage_varies`.
+std::vector<StandSample> synthetic_stand(double independent, bool voltage_varies, std::mt19937& rng) {
+  std::uniform_real_distribution<double> cmd(0.1, 1.0), indep(-independent, independent), volt(3.0, 4.1);
+  std::normal_distribution<double> thrust_noise(0, 0.002), speed_noise(0, 1);
+  const double k = 2e-8, tare = 0.01, vref = 3.7, e = 0.5;
+  std::vector<StandSample> out;
+  for (int n = 0; n < 600; ++n) {
+    StandSample s;
+    s.u = cmd(rng);
+    s.vbat = voltage_varies ? volt(rng) : 3.7;
+    const double w = (300 + 2700 * s.u - 600 * s.u * s.u) * std::pow(s.vbat / vref, e);
+    const double ratio[4] = {1.03, 0.98, 1.01, 0.98};
+    for (int i = 0; i < 4; ++i) s.w[i] = w * ratio[i] * (1 + indep(rng));
+    const double mean = (s.w[0] + s.w[1] + s.w[2] + s.w[3]) / 4;
+    s.thrust = tare + thrust_noise(rng);
+    for (int i = 0; i < 4; ++i) {
+      s.w[i] += w - mean;  // the mean speed follows the motor map
+      s.thrust += k * s.w[i] * s.w[i];
+      s.w[i] += speed_noise(rng);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+}  // namespace
+
+// The stand fit reports what the data determine: per-motor coefficients only when the
+// speeds moved independently enough; otherwise one shared coefficient (and never a value
+// on a bound); the voltage exponent only when the voltage varied apart from the command.
+TEST(Fit, ThrustStandFitsWhatTheDataIdentify) {
+  std::mt19937 rng(7);
+  FitOptions fo;
+  fo.account_autocorrelation = false;
+  const StandFit together = fit_stand(synthetic_stand(0.0, false, rng), 3.7, fo, {});
+  EXPECT_EQ(together.coefficients, ThrustVsSpeed::Coefficients::kShared);
+  EXPECT_FALSE(together.coefficients_reason.empty());
+  ASSERT_EQ(together.thrust.parameters.size(), 2u);
+  EXPECT_EQ(together.thrust_profiles.front().verdict, "identifiable");
+  EXPECT_NEAR(together.thrust.parameters[0].value, 2e-8, 0.02e-8);
+  EXPECT_TRUE(together.thrust.at_bound.empty());
+  EXPECT_FALSE(together.voltage_exponent_identified);  // constant voltage: e is confounded
+  EXPECT_FALSE(together.speed.parameters[3].free);
+
+  const StandFit apart = fit_stand(synthetic_stand(0.15, true, rng), 3.7, fo, {});
+  EXPECT_EQ(apart.coefficients, ThrustVsSpeed::Coefficients::kPerMotor);
+  ASSERT_EQ(apart.thrust.parameters.size(), 5u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(apart.thrust_profiles[i].verdict, "identifiable");
+    EXPECT_NEAR(apart.thrust.parameters[i].value, 2e-8, 0.05e-8) << i;
+  }
+  EXPECT_TRUE(apart.voltage_exponent_identified);
+  EXPECT_NEAR(apart.speed.parameters[3].value, 0.5, 0.05);
+}
+
+TEST(FitCli, ProfilesOnDemand) {
+  const fs::path out = fs::temp_directory_path() / "quadgen_fit_profiles";
+  const std::string v = test::source_path("vehicles/finken3.yaml"), log = test::source_path("data/finken3_motor_steps.csv");
+  fs::remove_all(out);
+  CliRun r = run_fit(v, log, out.string(), "--profiles tau --threads 2");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  auto j = nlohmann::json::parse(std::ifstream(out / "fit.json"));
+  EXPECT_EQ(j["profiles"].size(), 1u);
+  EXPECT_TRUE(j["profiles"].contains("tau"));
+  EXPECT_EQ(j["estimates"]["tau"]["verdict"], "identifiable");
+  EXPECT_FALSE(j["estimates"]["a1"].contains("verdict"));
+  r = run_fit(v, log, out.string(), "--profiles none");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  j = nlohmann::json::parse(std::ifstream(out / "fit.json"));
+  EXPECT_TRUE(j["profiles"].empty());
+  EXPECT_TRUE(j["comparison"]["tau_ci95"][0].is_null());
+  const fs::path bad = fs::temp_directory_path() / "quadgen_fit_profiles_bad";
+  fs::remove_all(bad);
+  r = run_fit(v, log, bad.string(), "--profiles nope");
+  EXPECT_NE(r.rc, 0);
+  EXPECT_NE(r.err.find("--profiles: no parameter 'nope'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad / "fit.json"));
+}
