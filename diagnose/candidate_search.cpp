@@ -224,6 +224,7 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   else if (!relevant)
     ev.why_not = "physically negligible size";
   ev.significant = ev.why_not.empty();
+  ev.training_only = ev.why_not == "no gain on the validation part" && relevant;
   return ev;
 }
 
@@ -318,6 +319,7 @@ SearchResult CandidateSearch::run() {
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
                 << " candidates fitted                              \n";
+    for (const auto& ev : step.candidates) note_training_only(res, ev);
     std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) {
       if (a.significant != b.significant) return a.significant;
       return a.statistic > b.statistic;
@@ -344,10 +346,26 @@ SearchResult CandidateSearch::run() {
     res.steps.push_back(step);
   }
   backward_pass(res, base, current);
+  const auto in_model = [&](const CandidateEvidence& ev) {
+    return std::find(res.selected.begin(), res.selected.end(), ev.effect) != res.selected.end();
+  };
+  res.training_only.erase(std::remove_if(res.training_only.begin(), res.training_only.end(), in_model),
+                          res.training_only.end());
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res);
   return res;
+}
+
+// Keeps the strongest training-only evidence of each effect.
+void CandidateSearch::note_training_only(SearchResult& r, const CandidateEvidence& ev) {
+  if (!ev.training_only) return;
+  for (auto& seen : r.training_only)
+    if (seen.effect == ev.effect) {
+      if (ev.statistic > seen.statistic) seen = ev;
+      return;
+    }
+  r.training_only.push_back(ev);
 }
 
 void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<FitParameter>& current) {
@@ -365,11 +383,12 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       const double p = p_value_of(e, statistic, dof), level = opt_.alpha / static_cast<double>(candidates_.size());
       const double vb = cost(valid_, smaller), va = cost(valid_, current);
       const double gain = 100 * (vb - va) / std::max(1e-300, vb);
+      const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
       std::string reason;
-      if (!(p < level)) reason = "no longer significant beside the effects found after it (p = " + std::to_string(p) + ")";
-      else if (!(va < vb)) reason = "no gain on the held-out part beside the effects found after it";
+      if (!(p < level)) reason = "no longer significant" + beside + " (p = " + std::to_string(p) + ")";
+      else if (!(va < vb)) reason = "no gain on the held-out part" + beside;
       if (reason.empty()) continue;
-      r.removed.push_back({e, reason, p, gain});
+      r.removed.push_back({e, reason, p, gain, p < level, vb, va});
       r.selected.erase(std::find(r.selected.begin(), r.selected.end(), e));
       base = without;
       current = smaller;

@@ -72,6 +72,9 @@ struct CandidateEvidence {
   double size_translation = 0, size_rotation = 0;
   bool significant = false;
   std::string why_not;  // when not significant: which gate it failed
+  // Significant on the training data, of a relevant size, but no gain on the held-out
+  // part: reported as suspected, never selected.
+  bool training_only = false;
 };
 
 struct Ambiguity {
@@ -93,6 +96,10 @@ struct SelectionStep {
 struct Removal {
   std::string effect, reason;
   double p_value = 1, validation_gain_percent = 0;
+  // Still significant on the training data, but the held-out part is better without it:
+  // a suspected cause (the other reason, no longer significant, is plain redundancy).
+  bool held_out_failure = false;
+  double validation_cost_without = 0, validation_cost_with = 0;
 };
 
 struct SearchResult {
@@ -105,6 +112,9 @@ struct SearchResult {
   std::vector<EffectEstimate> estimates;  // parameters of the selected effects
   std::vector<fit::Profile> profiles;
   std::vector<Ambiguity> unresolved;  // look-alike groups the data cannot separate
+  // Candidates that improved the training data but not the held-out part, and were never
+  // selected: the strongest evidence for each.
+  std::vector<CandidateEvidence> training_only;
   // Effects named (selected and not carried).
   std::vector<std::string> named() const;
 };
@@ -158,6 +168,7 @@ class CandidateSearch {
                              const std::vector<fit::FitParameter>& base_fit, const std::vector<double>& base_ss,
                              double base_valid_cost) const;
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
+  static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev) const;
   double p_value_of(const std::string& effect, double statistic, int dof) const;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iostream>
 #include <set>
+#include <sstream>
 
 namespace quadgen::diagnose {
 
@@ -145,6 +146,36 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
     const std::string failed = acceptance_failure(f, all);
     if (failed.empty()) d.findings.push_back(f);
     else d.suspected.push_back({f, failed}), drop.push_back(e);
+  }
+  // Significant on the training data but no held-out gain in the search itself: suspected.
+  for (const auto& ev : d.search.training_only) {
+    Finding f;
+    f.effect = ev.effect;
+    f.evidence = ev;
+    f.metric = "validation equation-error cost (weighted)";
+    f.before = ev.validation_cost_before;
+    f.after = ev.validation_cost_after;
+    std::ostringstream why;
+    why.precision(3);
+    why << "improves the training data (p = " << ev.p_value << ") but not the held-out part (its equation-error cost "
+        << "rises by " << -ev.validation_gain_percent << " %)";
+    d.suspected.push_back({f, why.str()});
+  }
+  // Taken out by the backward pass because the held-out part is better without it, while
+  // the training data still want it: suspected too.
+  for (const auto& rm : d.search.removed) {
+    if (!rm.held_out_failure) continue;
+    Finding f;
+    f.effect = rm.effect;
+    f.metric = "validation equation-error cost (weighted)";
+    f.before = rm.validation_cost_without;
+    f.after = rm.validation_cost_with;
+    std::ostringstream why;
+    why.precision(3);
+    why << "significant on the training data in the final model (p = " << rm.p_value
+        << "), but the held-out part is better without it (its equation-error cost rises by "
+        << -rm.validation_gain_percent << " %); removed by the backward pass";
+    d.suspected.push_back({f, why.str()});
   }
   if (!drop.empty()) {  // the extended model keeps only what is named (and carried look-alikes)
     search.remove_effects(d.search, drop);
