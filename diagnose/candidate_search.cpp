@@ -293,8 +293,12 @@ SearchResult CandidateSearch::run() {
   weights_ = weights_at(current);
   double c = 0;
   current = fit_with(base, current, &c);
+  // Refit under the base fit's own weights, as every extended model is below, so that a
+  // final model that ends with no effect is this one.
   weights_ = weights_at(current);
+  current = fit_with(base, current, &c);
   res.base_fit = current;
+  res.base_weights = weights_;
   for (int round = 0; round < opt_.max_effects; ++round) {
     SelectionStep step;
     step.base_effects.assign(base.begin(), base.end());
@@ -391,9 +395,14 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       r.removed.push_back({e, reason, p, gain, p < level, vb, va});
       r.selected.erase(std::find(r.selected.begin(), r.selected.end(), e));
       base = without;
-      current = smaller;
-      weights_ = weights_at(current);
-      current = fit_with(base, current, &c);
+      if (base.empty()) {  // back to the base model, fitted as it was
+        current = r.base_fit;
+        weights_ = r.base_weights;
+      } else {
+        current = smaller;
+        weights_ = weights_at(current);
+        current = fit_with(base, current, &c);
+      }
       removed = true;
       break;  // the others are tested again against the smaller model
     }
@@ -410,7 +419,12 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
     if (keep.count(e)) selected.push_back(e);
   r.selected = selected;
   double c = 0;
-  r.final_fit = fit_with(keep, r.final_fit, &c);
+  if (keep.empty()) {  // back to the base model, fitted as it was
+    r.final_fit = r.base_fit;
+    r.final_weights = r.base_weights;
+  } else {
+    r.final_fit = fit_with(keep, r.final_fit, &c);
+  }
   r.estimates.clear();
   r.profiles.clear();
   estimate_intervals(r);

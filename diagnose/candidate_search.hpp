@@ -107,8 +107,8 @@ struct SearchResult {
   std::vector<std::string> selected;  // effects in the final model, in order (named ones and carried look-alikes)
   std::vector<std::string> carried;   // of those, the stronger of an ambiguous pair: in the model, not named
   std::vector<Removal> removed;       // taken out again by the backward pass
-  std::vector<fit::FitParameter> base_fit, final_fit;
-  std::vector<double> final_weights;
+  std::vector<fit::FitParameter> base_fit, final_fit;  // a final model without effects is the base fit
+  std::vector<double> base_weights, final_weights;
   std::vector<EffectEstimate> estimates;  // parameters of the selected effects
   std::vector<fit::Profile> profiles;
   std::vector<Ambiguity> unresolved;  // look-alike groups the data cannot separate

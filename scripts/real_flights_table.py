@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Summarises the diagnoses written by scripts/real_flights.sh as a markdown table and
+checks every finding against the naming rules: a closed 95 % interval, not containing the
+parameter's "off" value (for at least one parameter), and a held-out gain above its
+standard error. Exit status 1 on a violation."""
+import json
+import math
+import pathlib
+import sys
+
+
+def fmt(v, digits=3):
+    return "open" if v is None else f"{v:.{digits}g}"
+
+
+def finding_text(f):
+    parts = []
+    for name, p in f["parameters"].items():
+        if p.get("reference"):
+            continue
+        lo, hi = p["ci95"]
+        parts.append(f"{name} = {fmt(p['value'])} [{fmt(lo)}, {fmt(hi)}]")
+    return f"**{f['effect']}** " + "; ".join(parts)
+
+
+def violations(f):
+    out = []
+    params = [p for p in f["parameters"].values() if not p.get("reference")]
+    if any(p["ci95"][0] is None or p["ci95"][1] is None for p in params):
+        out.append("open interval")
+    excludes = any(p["ci95"][0] is not None and p["ci95"][1] is not None and not (p["ci95"][0] <= 0 <= p["ci95"][1])
+                   for p in params)
+    if not excludes:
+        out.append("every interval contains off")
+    g = f["gain"]
+    if g.get("gain_mean") is None or g.get("gain_standard_error") is None or not g["gain_mean"] > g["gain_standard_error"]:
+        out.append("no held-out gain beyond its standard error")
+    return out
+
+
+def main(root):
+    rows, bad = [], 0
+    for d in sorted(pathlib.Path(root).iterdir()):
+        j_path = d / "diagnosis.json"
+        if not j_path.is_file():
+            continue
+        j = json.loads(j_path.read_text())
+        named = []
+        for f in j["findings"]:
+            v = violations(f)
+            bad += len(v)
+            named.append(finding_text(f) + (" ⚠ " + ", ".join(v) if v else ""))
+        suspected = [f"{s['effect']} ({s['failed'].split(' (')[0]})" for s in j["suspected"]]
+        groups = [" or ".join(a["effects"]) for a in j.get("ambiguous", [])]
+        removed = [r["effect"] for r in j.get("removed_by_backward_pass", [])]
+        pb, pa = j.get("prediction", {}).get("before", {}), j.get("prediction", {}).get("after", {})
+
+        def at(p, h):  # mean position error at horizon h of the open-loop view
+            for e in p.get("open_loop", []):
+                if abs(e.get("horizon_s", -1) - h) < 1e-9:
+                    return e["position_m"]["mean"]
+            return None
+        pred = f"{fmt(at(pb, 0.5))} → {fmt(at(pa, 0.5))}"
+        rows.append((d.name, "<br>".join(named) or "—", ", ".join(suspected) or "—", ", ".join(groups) or "—", pred,
+                     f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
+    print("| flight | named (95 % interval) | suspected (failed) | look-alike groups | 0.5 s open-loop error before → after [m] | s |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        print("| " + " | ".join(r) + " |")
+    print(f"\n{bad} rule violations in {len(rows)} diagnoses")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "/tmp/quadgen_real_flights"))
