@@ -189,21 +189,28 @@ Rotor read_rotor(const Reader& r, const YAML::Node& n) {
   return ro;
 }
 
+// One parameter a section may hold. A struct, not a row of strings: a row with an item
+// missing once put c_t's doc text in the "required" slot, so a file without c_t parsed.
+struct ParameterSpec {
+  std::string key, unit;  // unit: SI, what the value is converted to
+  bool required;
+  std::string doc;
+};
+
 void read_section(const Reader& r, const YAML::Node& root, Vehicle& v, const std::string& section,
-                  const std::vector<std::array<std::string, 4>>& specs) {
-  // specs: {key, SI unit, required ("1") or optional ("0"), doc}
+                  const std::vector<ParameterSpec>& specs) {
   const YAML::Node s = root[section];
   if (!s) r.fail(root, "missing section '" + section + "'");
   r.require_map(s, "section '" + section + "'");
   std::set<std::string> keys{"source"};
-  for (const auto& sp : specs) keys.insert(sp[0]);
+  for (const auto& sp : specs) keys.insert(sp.key);
   r.only_keys(s, keys, "section '" + section + "'");
   for (const auto& sp : specs) {
-    if (!s[sp[0]]) {
-      if (sp[2] == "1") r.fail(s, "missing key '" + sp[0] + "' in section '" + section + "'");
+    if (!s[sp.key]) {
+      if (sp.required) r.fail(s, "missing key '" + sp.key + "' in section '" + section + "'");
       continue;
     }
-    v.params[sp[0]] = r.parameter(s[sp[0]], sp[0], sp[1], sp[3]);
+    v.params[sp.key] = r.parameter(s[sp.key], sp.key, sp.unit, sp.doc);
   }
 }
 
@@ -245,18 +252,17 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (root["description"]) v.description = r.text(root["description"], "description");
 
   read_section(r, root, v, "environment",
-               {{{"g", "m/s^2", "1", "gravitational acceleration"},
-                 {"rho", "kg/m^3", "1", "air density"}}});
-  read_section(r, root, v, "frame", {{{"c_w", "1", "drag coefficient of the frame"}}});
+               {{"g", "m/s^2", true, "gravitational acceleration"}, {"rho", "kg/m^3", true, "air density"}});
+  read_section(r, root, v, "frame", {{"c_w", "1", true, "drag coefficient of the frame"}});
   read_section(r, root, v, "rotor_model",
-               {{{"c_t", "1", "thrust coefficient of F = c_t rho A_p (omega r_p)^2"},
-                 {"kappa", "m", "yaw torque per thrust, Q = kappa F"}}});
+               {{"c_t", "1", true, "thrust coefficient of F = c_t rho A_p (omega r_p)^2"},
+                {"kappa", "m", true, "yaw torque per thrust, Q = kappa F"}});
   read_section(r, root, v, "motor_map",
-               {{{"a0", "rad/s", "1", "rotor speed at zero command"},
-                 {"a1", "rad/s", "1", "rotor speed per command"},
-                 {"a2", "rad/s", "1", "rotor speed per command squared"}}});
+               {{"a0", "rad/s", true, "rotor speed at zero command"},
+                {"a1", "rad/s", true, "rotor speed per command"},
+                {"a2", "rad/s", true, "rotor speed per command squared"}});
   if (root["battery"])
-    read_section(r, root, v, "battery", {{{"vbat_ref", "V", "1", "reference battery voltage"}}});
+    read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});
   else
     v.params["vbat_ref"] = Parameter{"vbat_ref", 4.0, "V", parse_unit("V").dim, 4.0, 4.0, false,
                                      "reference battery voltage"};

@@ -51,6 +51,25 @@ TEST(VehicleInput, BundledFilesLoad) {
 
 TEST(VehicleInput, MalformedYaml) { expect_error("name: x\nblocks: [\n", "malformed YAML"); }
 TEST(VehicleInput, MissingKey) { expect_error(replace(finken_text(), "name: finken3\n", ""), "missing key 'name'"); }
+// Every section parameter is required, the rotor model's and the frame's too (they once
+// parsed without: a row of strings had their doc text in the "required" slot).
+TEST(VehicleInput, MissingRotorModelOrFrameKey) {
+  const std::string text = finken_text();
+  const std::pair<const char*, const char*> cases[] = {
+      {"c_t", "missing key 'c_t'"}, {"kappa", "missing key 'kappa'"},
+      {"c_w", "expected section 'frame'"}};  // c_w is the frame's only key: the section is left empty
+  for (const auto& [key, want] : cases) {
+    const std::string start = std::string("  ") + key + ":";
+    const auto pos = text.find(start);
+    ASSERT_NE(pos, std::string::npos) << key;
+    const auto end = text.find('\n', pos);
+    expect_error(std::string(text).erase(pos, end - pos + 1), want);
+  }
+  // and their meaning reaches the model's documentation
+  const Vehicle v = parse_vehicle(text, "good.yaml");
+  EXPECT_NE(v.params.at("c_t").doc.find("thrust coefficient"), std::string::npos);
+  EXPECT_NE(v.params.at("kappa").doc.find("yaw torque"), std::string::npos);
+}
 TEST(VehicleInput, UnknownKey) {
   expect_error(replace(finken_text(), "  c_w:", "  cw_typo: 1\n  c_w:"), "unknown key 'cw_typo'");
 }

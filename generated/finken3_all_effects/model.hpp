@@ -63,9 +63,9 @@ struct Param {
   enum : int {
     g = 0,  // g [m/s^2] gravitational acceleration
     rho = 1,  // rho [kg/m^3] air density
-    c_w = 2,  // c_w [1] 
-    c_t = 3,  // c_t [1] 
-    kappa = 4,  // kappa [m] 
+    c_w = 2,  // c_w [1] drag coefficient of the frame
+    c_t = 3,  // c_t [1] thrust coefficient of F = c_t rho A_p (omega r_p)^2
+    kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F
     motor_a0 = 5,  // motor_a0 [rad/s] rotor speed at zero command
     motor_a1 = 6,  // motor_a1 [rad/s] rotor speed per command
     motor_a2 = 7,  // motor_a2 [rad/s] rotor speed per command squared
