@@ -223,6 +223,17 @@ int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw,
     if (!free_list.empty()) free = std::find(free_list.begin(), free_list.end(), p.name) != free_list.end();
     params.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, free});
   }
+  if (free_list.empty()) {  // the vehicle's fit flags: only what the data can identify
+    std::vector<std::string> names;
+    for (const auto& p : params) names.push_back(p.name);
+    for (const auto& ref : reference_parameters(names))
+      for (auto& p : params)
+        if (p.name == ref && p.free) {
+          p.free = false;
+          std::cerr << "holding " << output::printable(ref)
+                    << " at 0: beside c_t only ratios to it are identifiable (--free overrides)\n";
+        }
+  }
   for (const auto& name : free_list)
     if (sm.params.end() == std::find_if(sm.params.begin(), sm.params.end(), [&](const auto& p) { return p.name == name; }))
       throw std::invalid_argument("--free: no parameter '" + name + "' in the model");

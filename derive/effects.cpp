@@ -122,23 +122,85 @@ void ground_effect(ModelContext& c) {
 
 }  // namespace
 
-const std::vector<Effect>& effect_catalogue() {
-  static const std::vector<Effect> list = {
-      {"motor_gain", "thrust of each rotor scaled by (1 + value)", motor_gain},
-      {"motor_lag", "first-order lag from commanded to actual rotor speed", motor_lag},
-      {"input_delay", "pure time shift between logged commands and their effect", input_delay},
-      {"cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset},
-      // wind first among the airspeed effects: rotor_drag and blade_flapping act on the
-      // air-relative velocity it changes.
-      {"wind", "steady air velocity in the world frame, through the drag terms", wind},
-      {"rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag},
-      {"blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", blade_flapping},
-      {"attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias},
-      {"thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay},
-      {"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag},
-      {"ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", ground_effect},
+namespace {
+
+// The catalogue, built one entry at a time so that each effect's facts sit together.
+std::vector<Effect> build_catalogue() {
+  std::vector<Effect> list;
+  auto add = [&](std::string name, std::string meaning, std::function<void(ModelContext&)> apply) -> Effect& {
+    list.push_back({std::move(name), std::move(meaning), std::move(apply)});
+    return list.back();
   };
+  {
+    Effect& e = add("motor_gain", "thrust of each rotor scaled by (1 + value)", motor_gain);
+    e.first_parameter_is_reference = true;
+    e.look_alikes = {{"cog_offset",
+                      "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
+                      "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)"}};
+  }
+  {
+    Effect& e = add("motor_lag", "first-order lag from commanded to actual rotor speed", motor_lag);
+    e.typical_start = {{"motor_lag.tau", 0.03}};
+    e.off_at_lower_bound = true;
+    e.look_alikes = {{"input_delay", "fast throttle steps or chirps (1-10 Hz): a lag rounds and attenuates the response, a "
+                                     "delay shifts it without changing its shape"}};
+  }
+  add("input_delay", "pure time shift between logged commands and their effect", input_delay).typical_start = {
+      {"input_delay.seconds", 0.015}};
+  add("cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset);
+  // wind first among the airspeed effects: rotor_drag and blade_flapping act on the
+  // air-relative velocity it changes.
+  add("wind", "steady air velocity in the world frame, through the drag terms", wind);
+  add("rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag).look_alikes = {
+      {"blade_flapping", "straight legs at several constant speeds: rotor drag slows the vehicle (a horizontal force), "
+                         "flapping only tilts it (a moment the attitude loop must hold)"}};
+  add("blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", blade_flapping);
+  add("attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias).look_alikes = {
+      {"wind", "hover while turning through a full yaw circle: an attitude bias turns with the body, a steady wind "
+               "stays fixed in the world"}};
+  add("thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay).look_alikes = {
+      {"battery_sag", "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)"}};
+  add("battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag).needs = EffectNeeds::kBatteryVoltage;
+  {
+    Effect& e = add("ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", ground_effect);
+    e.needs = EffectNeeds::kPose;
+    e.typical_start = {{"ground_effect.radius", 0.05}};
+  }
   return list;
+}
+
+}  // namespace
+
+const std::vector<Effect>& effect_catalogue() {
+  static const std::vector<Effect> list = build_catalogue();
+  return list;
+}
+
+const Effect& find_effect(const std::string& name) {
+  for (const auto& e : effect_catalogue())
+    if (e.name == name) return e;
+  throw std::invalid_argument("unknown effect '" + name + "'");
+}
+
+std::string effect_of_parameter(const std::string& parameter) {
+  const auto dot = parameter.find('.');
+  return dot == std::string::npos ? std::string() : parameter.substr(0, dot);
+}
+
+std::vector<std::string> reference_parameters(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (const auto& n : names) {
+    const std::string e = effect_of_parameter(n);
+    if (e.empty() || !seen.insert(e).second) continue;
+    if (find_effect(e).first_parameter_is_reference) out.push_back(n);
+  }
+  return out;
+}
+
+double off_value(const Variable& p) {
+  const std::string e = effect_of_parameter(p.name);
+  return !e.empty() && find_effect(e).off_at_lower_bound ? p.lower : p.nominal;
 }
 
 std::vector<std::string> parse_effect_list(const std::string& text) {

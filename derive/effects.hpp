@@ -10,14 +10,52 @@
 
 namespace quadgen {
 
+// What a log must hold for an effect to be estimated from it.
+enum class EffectNeeds { kNothing, kBatteryVoltage, kPose };
+
+// Another effect that a flight can mistake for this one, and the manoeuvre that tells
+// the two apart.
+struct LookAlike {
+  std::string effect, separating_manoeuvre;
+};
+
+// One home per effect: its symbolic change, and what fits and the diagnosis need to know
+// about it.
 struct Effect {
   std::string name;
   std::string meaning;
   std::function<void(ModelContext&)> apply;
+  EffectNeeds needs = EffectNeeds::kNothing;
+  // Where the cost is flat at "off" (a lag or a delay of zero, a radius of zero), fits
+  // also start here: parameter -> value.
+  std::vector<std::pair<std::string, double>> typical_start;
+  // "Off" is the parameters' lower bound, not their nominal value (a nominal rotor lag of
+  // 1 ms keeps simulations non-stiff; equation error has no such limit).
+  bool off_at_lower_bound = false;
+  // Beside c_t only ratios between the parameters are identifiable: the first is the
+  // reference, held at off.
+  bool first_parameter_is_reference = false;
+  std::vector<LookAlike> look_alikes;
 };
 
 // All effects in canonical order (the order they are applied in, whatever the user wrote).
 const std::vector<Effect>& effect_catalogue();
+
+// The catalogue entry of this name; std::invalid_argument if there is none.
+const Effect& find_effect(const std::string& name);
+
+// The effect a parameter belongs to ("motor_gain.A" -> "motor_gain"); "" for a parameter of
+// the base model.
+std::string effect_of_parameter(const std::string& parameter);
+
+// Of these parameter names (in model order), those held at off whatever the fit flags
+// say: the first parameter of each effect identifiable only as ratios (motor_gain's first
+// rotor, when c_t is fitted beside the gains).
+std::vector<std::string> reference_parameters(const std::vector<std::string>& parameter_names);
+
+// The value at which an effect parameter means "off" (its nominal value, or its lower bound
+// for effects off there); a base-model parameter's nominal value.
+double off_value(const Variable& parameter);
 
 // Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
 std::vector<std::string> parse_effect_list(const std::string& text);

@@ -19,16 +19,15 @@ using fit::FitParameter;
 
 namespace {
 
-// A start away from the neutral value for effects whose cost is flat there (a lag or a
-// delay of zero, a ground-effect radius of zero): fits start from both and keep the better.
+// A start away from the neutral value for effects whose cost is flat there (the effect's
+// typical_start); NaN for the others.
 double typical_start(const std::string& param) {
-  if (param == "motor_lag.tau") return 0.03;
-  if (param == "input_delay.seconds") return 0.015;
-  if (param == "ground_effect.radius") return 0.05;
+  const std::string e = effect_of_parameter(param);
+  if (e.empty()) return std::numeric_limits<double>::quiet_NaN();
+  for (const auto& [name, value] : find_effect(e).typical_start)
+    if (name == param) return value;
   return std::numeric_limits<double>::quiet_NaN();
 }
-
-std::string effect_of(const std::string& param) { return param.substr(0, param.find('.')); }
 
 double chi2_upper(double x, double dof) {
   if (x <= 0) return 1.0;
@@ -37,7 +36,7 @@ double chi2_upper(double x, double dof) {
 
 }  // namespace
 
-double neutral_value(const Variable& p) { return p.name == "motor_lag.tau" ? p.lower : p.nominal; }
+double neutral_value(const Variable& p) { return off_value(p); }
 
 std::vector<std::string> SearchResult::named() const {
   std::vector<std::string> out;
@@ -49,10 +48,9 @@ std::vector<std::string> SearchResult::named() const {
 std::vector<std::string> applicable_effects(const fit::Flight& f) {
   std::vector<std::string> out;
   for (const auto& effect : effect_catalogue()) {
-    const std::string& e = effect.name;
-    if (e == "battery_sag" && !f.has_vbat) continue;
-    if (e == "ground_effect" && !f.has_pose) continue;
-    out.push_back(e);
+    if (effect.needs == EffectNeeds::kBatteryVoltage && !f.has_vbat) continue;
+    if (effect.needs == EffectNeeds::kPose && !f.has_pose) continue;
+    out.push_back(effect.name);
   }
   return out;
 }
@@ -65,21 +63,9 @@ std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::
 }
 
 std::string separating_manoeuvre(const std::string& a, const std::string& b) {
-  auto is = [&](const char* x, const char* y) { return (a == x && b == y) || (a == y && b == x); };
-  if (is("motor_gain", "cog_offset"))
-    return "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
-           "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)";
-  if (is("motor_lag", "input_delay"))
-    return "fast throttle steps or chirps (1-10 Hz): a lag rounds and attenuates the response, a delay "
-           "shifts it without changing its shape";
-  if (is("attitude_bias", "wind"))
-    return "hover while turning through a full yaw circle: an attitude bias turns with the body, a steady "
-           "wind stays fixed in the world";
-  if (is("rotor_drag", "blade_flapping"))
-    return "straight legs at several constant speeds: rotor drag slows the vehicle (a horizontal force), "
-           "flapping only tilts it (a moment the attitude loop must hold)";
-  if (is("thrust_decay", "battery_sag"))
-    return "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)";
+  for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}})
+    for (const auto& l : find_effect(x).look_alikes)
+      if (l.effect == y) return l.separating_manoeuvre;
   return "a flight that excites the two effects differently (vary speed, height, thrust and heading)";
 }
 
@@ -108,18 +94,18 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
                                                     const std::vector<FitParameter>& start, double* cost) const {
   std::vector<FitParameter> ps = start;
   for (size_t i = 0; i < ps.size(); ++i) {
-    const std::string e = effect_of(ps[i].name);
+    const std::string e = effect_of_parameter(ps[i].name);
     if (ps[i].name.find('.') == std::string::npos) continue;
     const bool on = effects.count(e) > 0 && all_.params[i].fit;
     ps[i].free = on;
     if (!on) ps[i].value = neutral_value(all_.params[i]);
   }
-  // Only ratios of motor gains are identifiable beside c_t: the first rotor is the reference.
-  for (auto& p : ps)
-    if (p.name.rfind("motor_gain.", 0) == 0) {
-      p.free = false;
-      break;
-    }
+  // Only ratios are identifiable for some effects beside c_t: their reference is held.
+  std::vector<std::string> names;
+  for (const auto& p : ps) names.push_back(p.name);
+  for (const auto& ref : reference_parameters(names))
+    for (auto& p : ps)
+      if (p.name == ref) p.free = false;
   fit::FitOptions fo;
   fo.max_iterations = 100;
   fo.function_tolerance = 1e-10;

@@ -431,3 +431,22 @@ TEST(FitCli, ProfilesOnDemand) {
   EXPECT_NE(r.err.find("--profiles: no parameter 'nope'"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(bad / "fit.json"));
 }
+
+// With c_t fitted, motor gains are identifiable only as ratios: a flight fit with the
+// motor_gain effect holds the first rotor's gain at 0 (unless --free names it) and says so.
+TEST(FitCli, MotorGainReferenceIsHeld) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fit_reference";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string v = test::source_path("vehicles/finken3.yaml"), log = (dir / "flight.csv").string();
+  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + v + " --closed-loop --duration 12 --effects motor_gain " +
+                         "--set motor_gain.C=-0.08 --out " + log + " > /dev/null 2>&1").c_str()),
+            0);
+  const CliRun r = run_fit(v, log, (dir / "out").string(), "--effects motor_gain --profiles none");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.err.find("holding motor_gain.A at 0"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "out" / "fit.json"));
+  EXPECT_FALSE(j["estimates"]["motor_gain.A"]["fitted"].get<bool>());
+  EXPECT_TRUE(j["estimates"]["motor_gain.C"]["fitted"].get<bool>());
+  EXPECT_NEAR(j["estimates"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.01);
+}

@@ -1,6 +1,9 @@
 // The assembled model: units audit, effects at nominal values, physics spot checks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <set>
+
 #include <Eigen/Dense>
 
 #include "audit.hpp"
@@ -214,6 +217,41 @@ TEST(Model, JacobiansAreDerivativesOfF) {
       EXPECT_NEAR(an, fd, 1e-6 * (1 + std::fabs(fd))) << "d" << m.states[i].name << "/d" << m.states[j].name;
     }
   }
+}
+
+// Each effect's facts live in its catalogue entry; they must refer to what the effect
+// actually declares, or a search would start a parameter that does not exist.
+TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
+  const SymbolicModel all = derive(test::finken3(), parse_effect_list("all"));
+  std::set<std::string> params, effects(all.effects.begin(), all.effects.end());
+  for (const auto& p : all.params) params.insert(p.name);
+  for (const auto& e : effect_catalogue()) {
+    for (const auto& [name, value] : e.typical_start) {
+      ASSERT_TRUE(params.count(name)) << e.name << ": " << name;
+      EXPECT_EQ(effect_of_parameter(name), e.name);
+      const auto& p = *std::find_if(all.params.begin(), all.params.end(), [&](const auto& q) { return q.name == name; });
+      EXPECT_GT(value, p.lower) << name;
+      EXPECT_LT(value, p.upper) << name;
+    }
+    for (const auto& l : e.look_alikes) {
+      EXPECT_TRUE(effects.count(l.effect)) << e.name << " -> " << l.effect;
+      EXPECT_NE(l.effect, e.name);
+      EXPECT_FALSE(l.separating_manoeuvre.empty());
+    }
+  }
+  for (const auto& p : all.params) {
+    const std::string e = effect_of_parameter(p.name);
+    if (e.empty()) {
+      EXPECT_EQ(off_value(p), p.nominal) << p.name;
+    } else {
+      EXPECT_TRUE(effects.count(e)) << p.name;
+      EXPECT_EQ(off_value(p), e == "motor_lag" ? p.lower : p.nominal) << p.name;
+    }
+  }
+  std::vector<std::string> names;
+  for (const auto& p : all.params) names.push_back(p.name);
+  EXPECT_EQ(reference_parameters(names), std::vector<std::string>{"motor_gain.A"});
+  EXPECT_THROW(find_effect("tether"), std::invalid_argument);
 }
 
 TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
