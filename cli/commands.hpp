@@ -50,7 +50,8 @@ void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);
 
 struct DiagnoseArgs {
-  std::string vehicle, log, out, mapping, candidates;
+  std::string vehicle, out, mapping, candidates;
+  std::vector<std::string> logs;  // one flight, or several of the same vehicle (diagnosed jointly)
   std::string translational = "auto";
   double resample = 0, validation = 0.3, alpha = 0.01, window = 1.0;
   int max_effects = 3;

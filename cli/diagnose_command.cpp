@@ -1,6 +1,7 @@
-// quadgen diagnose VEHICLE.yaml LOG.csv --out DIR
+// quadgen diagnose VEHICLE.yaml LOG.csv [LOG2.csv ...] --out DIR
 // Fits the base model, shows what it gets wrong, names the cause from the effect catalogue,
-// regenerates the model with it and measures the gain on the held-out end of the flight.
+// regenerates the model with it and measures the gain on the held-out end of the flight
+// (of each flight, when several flights of the vehicle are diagnosed jointly).
 #include <iostream>
 #include <sstream>
 
@@ -25,7 +26,10 @@ namespace quadgen::cli {
 void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   CLI::App* c = app.add_subcommand("diagnose", "find what the model gets wrong in a flight, name the cause, extend the model");
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
-  c->add_option("log", a.log, "flight log (CSV)")->required();
+  c->add_option("logs", a.logs,
+                "flight log(s) (CSV): several flights of the same vehicle are diagnosed jointly, with one set of "
+                "vehicle parameters and the end of each flight held out")
+      ->required();
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
@@ -61,17 +65,28 @@ std::string fitted_parameters_yaml(const Vehicle& v, const diagnose::Diagnosis& 
 
 int run_diagnose(const DiagnoseArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
-  runtime::CsvTable log = runtime::read_csv(a.log);
-  if (!a.mapping.empty()) log = fit::apply_mapping(log, fit::load_mapping(a.mapping));
-  if (a.resample > 0) log = fit::resample(log, a.resample);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
-  const fit::Flight flight = fit::load_flight(log, rotors, {});
+  std::vector<fit::Flight> flights;
+  for (const auto& path : a.logs) {
+    runtime::CsvTable log = runtime::read_csv(path);
+    if (!a.mapping.empty()) log = fit::apply_mapping(log, fit::load_mapping(a.mapping));
+    if (a.resample > 0) log = fit::resample(log, a.resample);
+    flights.push_back(fit::load_flight(log, rotors, {}));
+  }
+  std::string logs_label;  // what the outputs say was diagnosed
+  for (const auto& path : a.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
+  size_t samples = 0;
+  for (const auto& f : flights) samples += f.samples.size();
   diagnose::DiagnoseOptions o;
   if (!a.candidates.empty()) o.search.candidates = parse_effect_list(a.candidates);
   // Fail before the long work if the results could not be written.
-  output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});
-  std::cerr << "[diagnose] " << flight.samples.size() << " airborne samples; deriving the full-catalogue model\n";
+  std::vector<std::string> inputs = a.logs;
+  inputs.push_back(a.vehicle);
+  inputs.push_back(a.mapping);
+  output::OutputDirectory out(a.out, inputs);
+  std::cerr << "[diagnose] " << samples << " airborne samples in " << flights.size()
+            << (flights.size() > 1 ? " flights (diagnosed jointly)" : " flight") << "; deriving the full-catalogue model\n";
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
@@ -85,7 +100,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   o.search.alpha = a.alpha;
   o.search.max_effects = a.max_effects;
   fit::Flight valid;
-  const diagnose::Diagnosis d = diagnose::diagnose_flight(v, all, *model, flight, o, &valid);
+  const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
   // The extended model, regenerated with exactly the effects found.
   std::cerr << "[diagnose] generating the extended model\n";
   DeriveOptions ext_opt;
@@ -101,8 +116,8 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::string err;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err);
   if (plots.empty()) std::cerr << "no plots: " << err << "\n";
-  out.add("diagnosis.json", output::json_document(diagnose::diagnosis_json(d, a.log)));
-  out.add("report.html", diagnose::diagnosis_html(d, a.log, plots));
+  out.add("diagnosis.json", output::json_document(diagnose::diagnosis_json(d, logs_label)));
+  out.add("report.html", diagnose::diagnosis_html(d, logs_label, plots));
   out.add("extended_model.hpp", header.content);
   out.add("extended_model.json", model_json(der));
   out.add("extended_derivation.md", derivation_markdown(der));

@@ -71,13 +71,30 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all) {
 
 }  // namespace
 
-Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
-                          const fit::Flight& flight_in, const DiagnoseOptions& opt, fit::Flight* validation_out) {
+Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
+                           const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
+                           fit::Flight* validation_out) {
   const auto clock0 = std::chrono::steady_clock::now();
+  if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
   // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
-  const fit::Flight flight = predict::fill_missing_signals(flight_in, all.params[all.param_index("vbat_ref")].nominal);
+  std::vector<fit::Flight> flights;
+  for (const auto& f : flights_in) {
+    flights.push_back(predict::fill_missing_signals(f, all.params[all.param_index("vbat_ref")].nominal));
+    d.flights.push_back(f.source);
+  }
+  const bool joint = flights.size() > 1;
+  const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
+  DiagnoseOptions opt = opt_in;
+  if (joint) {
+    auto& c = opt.search.candidates;
+    if (std::find(c.begin(), c.end(), "thrust_decay") != c.end())
+      throw fit::FitError("thrust_decay: runs on the time since each log's start, a per-flight battery state; it is no "
+                          "candidate when several flights are diagnosed together");
+    if (c.empty()) c = applicable_effects(flight);
+    c.erase(std::remove(c.begin(), c.end(), "thrust_decay"), c.end());
+  }
   bool accel = opt.translational == "accelerometer" || (opt.translational == "auto" && !flight.has_pose);
   if (opt.translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
   d.formulation = accel ? "equation error: accelerometer specific force (body) and gyro derivative"
@@ -85,7 +102,8 @@ Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::D
   d.channel_names = accel ? std::vector<std::string>{"ax", "ay", "az", "pdot", "qdot", "rdot"}
                           : std::vector<std::string>{"ax_world", "ay_world", "az_world", "pdot", "qdot", "rdot"};
   d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
-  const auto parts = fit::split_by_time(flight, 1.0 - opt.validation_fraction);
+  const auto parts = joint ? fit::split_each_by_time(flights, 1.0 - opt.validation_fraction)
+                           : fit::split_by_time(flight, 1.0 - opt.validation_fraction);
   const fit::Flight &train = parts.first, &valid = parts.second;  // (lambdas below capture valid)
   if (train.samples.size() < 50 || valid.samples.size() < 50)
     throw fit::FitError(flight.source + ": too short to hold out " + std::to_string(opt.validation_fraction) +

@@ -59,6 +59,7 @@ struct ChannelGain {
 
 struct Diagnosis {
   std::string vehicle, formulation;
+  std::vector<std::string> flights;  // the source of each flight diagnosed
   std::vector<std::string> channel_names, channel_units;
   size_t train_samples = 0, valid_samples = 0;
   double t_split = 0;
@@ -84,8 +85,12 @@ struct Diagnosis {
 };
 
 // Runs the whole diagnosis. `all` is the full-catalogue symbolic model of the vehicle and
-// `model` its runtime form.
-Diagnosis diagnose_flight(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
-                          const fit::Flight& flight, const DiagnoseOptions& opt, fit::Flight* validation_out);
+// `model` its runtime form. Several flights of one vehicle are diagnosed jointly: one set
+// of parameters for all, the end of each flight held out, the flights joined on one clock
+// (fit::join_flights). thrust_decay, which runs on the time since each log's start, is
+// then no candidate (a per-flight battery state, not a property of the airframe).
+Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
+                           const std::vector<fit::Flight>& flights, const DiagnoseOptions& opt,
+                           fit::Flight* validation_out);
 
 }  // namespace quadgen::diagnose

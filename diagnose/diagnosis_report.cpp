@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "effects.hpp"
 #include "fit_report.hpp"
 #include "plot.hpp"
 #include "sinks.hpp"
@@ -49,9 +50,10 @@ json parameters_json(const std::vector<fit::FitParameter>& ps) {
 // without it -> with it, on held-out data, with its spread over validation folds), evidence.
 json finding_json(const Finding& f) {
   json ps = json::object();
-  if (f.effect == "motor_gain")
+  const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
+  if (has_reference)
     for (const auto& p : f.evidence.parameters)
-      if (p.name.rfind("motor_gain.", 0) == 0 && !p.free)
+      if (effect_of_parameter(p.name) == f.effect && !p.free)
         ps[p.name] = {{"value", 0.0}, {"ci95", {0.0, 0.0}}, {"unit", "1"}, {"reference", true}};
   for (const auto& e : f.parameters)
     ps[e.name] = {{"value", e.value},
@@ -70,8 +72,8 @@ json finding_json(const Finding& f) {
                        {"gain_mean", number_or_null(f.gain_mean)},
                        {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
              {"evidence", evidence_json(f.evidence)}};
-  if (f.effect == "motor_gain")
-    fj["note"] = "c_t is fitted with the gains, so only ratios between rotors are identifiable: the first rotor is the reference (gain 0)";
+  if (has_reference)
+    fj["note"] = "c_t is fitted with these parameters, so only their ratios are identifiable: the first is the reference, held at 0";
   return fj;
 }
 
@@ -103,6 +105,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   json j;
   j["vehicle"] = d.vehicle;
   j["log"] = log_path;
+  j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
   j["formulation"] = d.formulation;
   j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
   json findings = json::array();
@@ -250,8 +253,11 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis
     res.push_back({d.channel_names[c] + " residual (model - measured)", "t [s]", d.channel_units[c],
                    {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)}});
   }
-  render("residuals.svg", d.vehicle + ": equation-error residuals (validation from t = " +
-                              std::to_string(d.t_split).substr(0, 5) + " s)", res);
+  render("residuals.svg",
+         d.vehicle + ": equation-error residuals (" +
+             (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
+                                   : "validation from t = " + std::to_string(d.t_split).substr(0, 5) + " s") + ")",
+         res);
   // Autocorrelation with the white-noise band.
   std::vector<runtime::Panel> acf;
   for (size_t c = 0; c < d.before.channels.size(); ++c) {
@@ -323,8 +329,13 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em}</style></head><body>\n";
   h << "<h1>Diagnosis of " << esc(log_path) << " (" << esc(d.vehicle) << ")</h1>\n";
-  h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples
-    << " validation samples from t = " << num(d.t_split, 4) << " s; " << num(d.seconds, 3) << " s.</p>\n";
+  h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples;
+  if (d.flights.size() > 1)
+    h << " validation samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
+      << "vehicle parameters)";
+  else
+    h << " validation samples from t = " << num(d.t_split, 4) << " s";
+  h << "; " << num(d.seconds, 3) << " s.</p>\n";
   h << "<h2>Verdict</h2>\n<pre>" << esc(diagnosis_summary(d)) << "</pre>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";

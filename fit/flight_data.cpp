@@ -329,4 +329,60 @@ std::pair<Flight, Flight> split_by_time(const Flight& f, double frac) {
   return {a, b};
 }
 
+namespace {
+
+// Each flight's clock offset in the joined log (see join_flights).
+std::vector<double> join_offsets(const std::vector<Flight>& flights, double gap) {
+  std::vector<double> offsets;
+  double end = 0;
+  for (size_t i = 0; i < flights.size(); ++i) {
+    if (flights[i].samples.empty()) throw FitError(flights[i].source + ": no samples to join");
+    const double t0 = flights[i].samples.front().t;
+    offsets.push_back(i == 0 ? 0.0 : end + gap - t0);
+    end = flights[i].samples.back().t + offsets.back();
+  }
+  return offsets;
+}
+
+Flight empty_join(const std::vector<Flight>& flights) {
+  Flight out;
+  out.has_accelerometer = out.has_gyro = out.has_pose = out.has_vbat = true;
+  for (const auto& f : flights) {
+    out.source += (out.source.empty() ? "" : " + ") + f.source;
+    out.has_accelerometer = out.has_accelerometer && f.has_accelerometer;
+    out.has_gyro = out.has_gyro && f.has_gyro;
+    out.has_pose = out.has_pose && f.has_pose;
+    out.has_vbat = out.has_vbat && f.has_vbat;
+  }
+  return out;
+}
+
+}  // namespace
+
+Flight join_flights(const std::vector<Flight>& flights, double gap) {
+  const auto offsets = join_offsets(flights, gap);
+  Flight out = empty_join(flights);
+  for (size_t i = 0; i < flights.size(); ++i)
+    for (FlightSample s : flights[i].samples) {
+      s.t += offsets[i];
+      out.samples.push_back(std::move(s));
+    }
+  return out;
+}
+
+std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights, double train_fraction, double gap) {
+  const auto offsets = join_offsets(flights, gap);
+  Flight train = empty_join(flights), valid = empty_join(flights);
+  for (size_t i = 0; i < flights.size(); ++i) {
+    const auto& S = flights[i].samples;
+    const double cut = S.front().t + train_fraction * (S.back().t - S.front().t);
+    for (FlightSample s : S) {
+      Flight& part = s.t < cut ? train : valid;
+      s.t += offsets[i];
+      part.samples.push_back(std::move(s));
+    }
+  }
+  return {train, valid};
+}
+
 }  // namespace quadgen::fit

@@ -74,6 +74,15 @@ Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::st
 // Samples with t - t0 < fraction * duration (training) and the rest (validation).
 std::pair<Flight, Flight> split_by_time(const Flight& f, double train_fraction);
 
+// Several flights of one vehicle as one log: each next flight's clock continues the
+// previous one's after `gap` seconds, longer than any sample interval, so derivative
+// windows, contiguous stretches and simulation windows never run from one flight into the
+// next. The flags are those every flight has. split_each_by_time holds out the end of each
+// flight (its own `1 - train_fraction` of its duration) on the same joined clock.
+Flight join_flights(const std::vector<Flight>& flights, double gap = 1.0);
+std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights, double train_fraction,
+                                             double gap = 1.0);
+
 // Derivative at each sample by a local quadratic least-squares fit over +-window seconds
 // (a Savitzky–Golay filter that also works for uneven sampling).
 std::vector<double> smoothed_derivative(const std::vector<double>& t, const std::vector<double>& y, double window);

@@ -28,13 +28,18 @@ one() {  # param value noise-name noise-flags seed
     $q simulate "$v" --closed-loop --duration 60 --seed "$seed" --effects "$e" --set "$p=$val" $flags --out "$f.csv" > /dev/null 2>&1 || { echo "0 0"; return; }
     $q diagnose "$v" "$f.csv" --out "$f.d" > /dev/null 2>&1 || { echo "0 0"; return; }
   fi
-  # Only the findings / ambiguous blocks (the selection table repeats effect names).
-  local found amb
-  found=$(sed -n '/^  "findings"/,/^  "ambiguous"/p' "$f.d/diagnosis.json" | grep -o '"effect": "[a-z_]*"' || true)
-  amb=$(sed -n '/^  "ambiguous"/,/^  "unexplained"/p' "$f.d/diagnosis.json" | grep -c "\"$e\"" || true)
-  local named=0 detected=0
-  [ "$found" = "\"effect\": \"$e\"" ] && named=1
-  if [ "$named" = 1 ] || [ "$amb" -gt 0 ]; then detected=1; fi
+  # Named alone: the findings are exactly this effect; detected: named, or in a look-alike
+  # group. (Suspected candidates count as neither.)
+  local named detected
+  read -r named detected < <(python3 - "$f.d/diagnosis.json" "$e" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+e = sys.argv[2]
+named = [f["effect"] for f in j["findings"]] == [e]
+grouped = any(e in a["effects"] for a in j.get("ambiguous", []))
+print(int(named), int(named or grouped))
+PY
+)
   echo "$named $detected"
 }
 echo "| parameter | noise | size: named alone / detected (named or ambiguous with a look-alike) / flights |"

@@ -57,7 +57,7 @@ fs::path fly(const HiddenCase& c, const fs::path& dir, const std::string& file, 
   return dir / file;
 }
 
-// Diagnoses a log into dir/out; returns diagnosis.json.
+// Diagnoses a log (or several, space-separated) into dir/out; returns diagnosis.json.
 json diagnose_log(const std::string& vehicle, const fs::path& log, const fs::path& dir) {
   EXPECT_EQ(run(std::string(QUADGEN_BINARY) + " diagnose " + vehicle + " " + log.string() + " --out " + (dir / "out").string() +
                 " > " + (dir / "diagnose.log").string() + " 2>&1"),
@@ -310,6 +310,28 @@ TEST(Acceptance, CauseOnlyInTheTrainingPartIsSuspectedNotNamed) {
       EXPECT_NE(x["failed"].get<std::string>().find("held-out"), std::string::npos) << x["failed"];
     }
   EXPECT_TRUE(suspected) << j["suspected"].dump(1) << j["selection"].dump(1).substr(0, 3000);
+}
+
+// Several flights of one vehicle diagnosed jointly: the weak motor of two flights with
+// different trajectories is named once, with one estimate that holds for both, and the
+// end of each flight is held out.
+TEST(MultiFlight, OneCauseAcrossTwoFlightsIsNamedOnce) {
+  const fs::path dir = fresh_directory("quadgen_two_flights");
+  const HiddenCase a{"a", "motor_gain", {{"motor_gain.C", -0.08}}, {}, "", 1};
+  HiddenCase b = a;
+  b.seed = 2;
+  const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
+  const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
+  ASSERT_EQ(j["flights"].size(), 2u) << j["flights"].dump();
+  ASSERT_EQ(named(j), std::vector<std::string>{"motor_gain"}) << j["findings"].dump(1) << j["suspected"].dump(1);
+  const json& c = j["findings"][0]["parameters"]["motor_gain.C"];
+  EXPECT_NEAR(c["value"].get<double>(), -0.08, 0.01);
+  EXPECT_LE(c["ci95"][0].get<double>(), -0.08);
+  EXPECT_GE(c["ci95"][1].get<double>(), -0.08);
+  for (const auto& e : j["candidates_considered"]) EXPECT_NE(e, "thrust_decay");  // a per-flight state
+  // about 30 % of each flight held out, both flights in the validation part
+  const double train = j["samples"]["training"], valid = j["samples"]["validation"];
+  EXPECT_NEAR(valid / (train + valid), 0.3, 0.05);
 }
 
 }  // namespace
