@@ -105,10 +105,15 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::cerr << "[diagnose] generating the extended model\n";
   DeriveOptions ext_opt;
   ext_opt.effects = d.search.selected;
-  const SymbolicModel ext = derive_model(v, mp, ext_opt);
+  SymbolicModel ext = derive_model(v, mp, ext_opt);
+  // The extended header is the fitted model: its nominal values are the estimates.
+  for (const auto& p : d.search.final_fit)
+    if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
   emission::EmitOptions eo;
   eo.vehicle_file = a.vehicle;
   eo.effects_flag = ext.effects.empty() ? "" : " --effects " + ext.effect_list();
+  eo.parameter_source = "fitted by quadgen diagnose to " + logs_label +
+                        " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
   const auto header = emission::generate_header(ext, eo);
   const AuditResult ext_audit = audit(ext, mp);
   const std::vector<ThesisItem> no_thesis;

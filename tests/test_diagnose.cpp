@@ -332,6 +332,10 @@ TEST(MultiFlight, OneCauseAcrossTwoFlightsIsNamedOnce) {
   // about 30 % of each flight held out, both flights in the validation part
   const double train = j["samples"]["training"], valid = j["samples"]["validation"];
   EXPECT_NEAR(valid / (train + valid), 0.3, 0.05);
+  // The extended header is the fitted model, and says so.
+  std::ifstream h(dir / "out" / "extended_model.hpp");
+  const std::string header((std::istreambuf_iterator<char>(h)), {});
+  EXPECT_NE(header.find("Parameter values (kNominalParams): fitted by quadgen diagnose to"), std::string::npos);
 }
 
 }  // namespace

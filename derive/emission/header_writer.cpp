@@ -149,6 +149,9 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("version", QUADGEN_VERSION);
   set_provenance_fields(d, {m.vehicle_name, m.vehicle_hash, m.effects.empty() ? "none" : m.effect_list(", "),
                             m.effect_list(), opt.vehicle_file, opt.effects_flag});
+  // A whole comment line or nothing (a mustache section would leave an empty line).
+  d.set("parameter_source_line", opt.parameter_source.empty() ? std::string()
+                                 : "// Parameter values (kNominalParams): " + output::cpp_comment(opt.parameter_source) + ".\n");
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
   d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));

@@ -11,6 +11,10 @@ namespace quadgen::emission {
 struct EmitOptions {
   std::string vehicle_file;  // as named on the command line, for the regenerate comment
   std::string effects_flag;  // "--effects ..." or ""
+  // Where kNominalParams come from when not the vehicle file (e.g. "fitted by quadgen
+  // diagnose to LOG"): said in the header's comment, since regenerating with derive gives
+  // the vehicle file's values. Empty: the vehicle file's.
+  std::string parameter_source;
 };
 
 struct GeneratedHeader {
