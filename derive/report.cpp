@@ -1,6 +1,8 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -13,10 +15,155 @@ using namespace GiNaC;
 
 namespace {
 
-std::string tex(const ex& e) {
+// GiNaC's own printing, for leaves only (a symbol's TeX name, a number): deterministic.
+std::string ginac_tex(const ex& e) {
   std::ostringstream os;
   os << latex << e;
   return os.str();
+}
+
+std::string tex(const ex& e);
+
+// Wrapped in parentheses when it would otherwise bind wrongly as a factor or a base.
+std::string tex_operand(const ex& e, bool as_base) {
+  const bool wrap = is_a<add>(e) || (as_base && (is_a<mul>(e) || is_a<power>(e))) ||
+                    (is_a<numeric>(e) && (ex_to<numeric>(e).is_negative() || !ex_to<numeric>(e).is_integer()));
+  return wrap ? "\\left(" + tex(e) + "\\right)" : tex(e);
+}
+
+// Terms of a sum sorted by their text, a sign in front of each: the order GiNaC keeps
+// depends on symbol serial numbers, i.e. on the process, and a reviewer diffs reports.
+std::string tex_add(const ex& e) {
+  std::vector<std::pair<std::string, bool>> terms;  // text without sign, negative
+  for (const auto& t : e) {
+    const std::string text = tex(t);  // a term's sign is what its own canonical text shows
+    const bool negative = !text.empty() && text[0] == '-';
+    terms.push_back({negative ? text.substr(1) : text, negative});
+  }
+  std::sort(terms.begin(), terms.end());
+  std::string out;
+  for (size_t i = 0; i < terms.size(); ++i)
+    out += (terms[i].second ? (i ? " - " : "-") : (i ? " + " : "")) + terms[i].first;
+  return out;
+}
+
+// GiNaC may keep -(a - b) c as (b - a) c, depending on the process: a sum that is a factor
+// is written with its first term (in text order) positive, the sign moved to the product.
+bool leading_term_negative(const ex& sum) {
+  std::string first;
+  bool negative = false;
+  for (const auto& t : sum) {
+    const std::string text = tex(t);
+    const bool neg = !text.empty() && text[0] == '-';
+    const std::string unsigned_text = neg ? text.substr(1) : text;
+    if (first.empty() || unsigned_text < first) first = unsigned_text, negative = neg;
+  }
+  return negative;
+}
+
+// The sum with every term negated, built term by term (-sum may come back as the product
+// (-1) sum, which would be turned around again without end).
+ex negated_sum(const ex& sum) {
+  exvector terms;
+  for (const auto& t : sum) terms.push_back(-t);
+  return add(terms);
+}
+
+// The text of a factor of a product with any sum in it in its canonical sign; flips *sign
+// when that text is the factor's negative. Text only: a GiNaC power of the negated sum would
+// be evaluated back into the original.
+std::string factor_text(const ex& f, bool* sign) {
+  if (is_a<add>(f)) {
+    const bool negative = leading_term_negative(f);
+    if (negative) *sign = !*sign;
+    return "\\left(" + tex(negative ? negated_sum(f) : f) + "\\right)";
+  }
+  if (is_a<power>(f) && is_a<add>(f.op(0)) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_integer()) {
+    const bool negative = leading_term_negative(f.op(0));
+    if (negative && ex_to<numeric>(f.op(1)).is_odd()) *sign = !*sign;
+    return "\\left(" + tex(negative ? negated_sum(f.op(0)) : f.op(0)) + "\\right)^{" + tex(f.op(1)) + "}";
+  }
+  return tex_operand(f, false);
+}
+
+// A product: its number first, then the factors sorted by their text; factors with
+// negative exponents go below a fraction bar.
+std::string tex_mul(const ex& e) {
+  numeric coefficient = 1;
+  std::vector<std::string> above, below;
+  bool flipped = false;
+  for (const auto& f : e) {
+    if (is_a<numeric>(f)) {
+      coefficient *= ex_to<numeric>(f);
+    } else if (is_a<power>(f) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_negative()) {
+      below.push_back(factor_text(pow(f.op(0), -f.op(1)), &flipped));
+    } else {
+      above.push_back(factor_text(f, &flipped));
+    }
+  }
+  std::sort(above.begin(), above.end());
+  std::sort(below.begin(), below.end());
+  const auto join = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : " ") + x;
+    return s.empty() ? std::string("1") : s;
+  };
+  if (flipped) coefficient = -coefficient;
+  std::string sign = coefficient.is_negative() ? "-" : "";
+  const numeric c = abs(coefficient);
+  const numeric num = c.numer(), den = c.denom();
+  if (num != 1) above.insert(above.begin(), ginac_tex(num));
+  if (den != 1) below.insert(below.begin(), ginac_tex(den));
+  if (below.empty()) return sign + join(above);
+  return sign + "\\frac{" + join(above) + "}{" + join(below) + "}";
+}
+
+std::string tex_power(const ex& e) {
+  const ex base = e.op(0), exponent = e.op(1);
+  if (exponent.is_equal(numeric(1, 2))) return "\\sqrt{" + tex(base) + "}";
+  if (is_a<numeric>(exponent) && ex_to<numeric>(exponent).is_negative())
+    return "\\frac{1}{" + tex(pow(base, -exponent)) + "}";
+  return tex_operand(base, true) + "^{" + tex(exponent) + "}";
+}
+
+std::string tex_uncached(const ex& e);
+
+// LaTeX of an expression, identical for identical expressions whatever order GiNaC keeps
+// their operands in. Memoised: the canonical sign of a sum looks at its terms' text, and
+// shared subexpressions would otherwise be printed over and over.
+std::string tex(const ex& e) {
+  static std::map<ex, std::string, ex_is_less> cache;
+  if (cache.size() > 200000) cache.clear();
+  const auto it = cache.find(e);
+  if (it != cache.end()) return it->second;
+  std::string text = tex_uncached(e);
+  cache.emplace(e, text);
+  return text;
+}
+
+std::string tex_uncached(const ex& e) {
+  if (is_a<add>(e)) return tex_add(e);
+  if (is_a<mul>(e)) return tex_mul(e);
+  if (is_a<power>(e)) return tex_power(e);
+  if (is_a<function>(e)) {
+    std::string args;
+    const bool even = ex_to<function>(e).get_name() == "abs_value" || ex_to<function>(e).get_name() == "abs";
+    for (const auto& a : e) {
+      const bool flip = even && is_a<add>(a) && leading_term_negative(a);  // |-x| = |x|
+      args += (args.empty() ? "" : ", ") + tex(flip ? negated_sum(a) : a);
+    }
+    const std::string name = ex_to<function>(e).get_name();
+    const bool known = name == "sin" || name == "cos" || name == "tan" || name == "exp" || name == "log";
+    return (known ? "\\" + name : "\\operatorname{" + name + "}") + "\\left(" + args + "\\right)";
+  }
+  return ginac_tex(e);  // symbols and numbers
+}
+
+// Nodes of an expression tree, counted up to `limit` (then limit + 1).
+size_t tree_size(const ex& e, size_t limit) {
+  size_t n = 1;
+  for (size_t i = 0; i < e.nops() && n <= limit; ++i) n += tree_size(e.op(i), limit - n);
+  return n;
 }
 
 std::string tex_matrix(const matrix& m) {
@@ -59,13 +206,13 @@ void section_mass(std::ostringstream& md, const Derivation& d) {
         "integrates the second moment $S = \\int \\xi\\xi^T\\,dm$ exactly over "
         "$[-a/2,a/2]\\times[-b/2,b/2]\\times[-c/2,c/2]$";
   if (!mp.blocks.empty()) {
-    md << "; for block " << output::markdown_code(mp.blocks[0].name) << ":\n\n$$S = " << tex_matrix(mp.blocks[0].local_second_moment)
-       << "$$\n\n";
+    md << "; for block " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nS = " << tex_matrix(mp.blocks[0].local_second_moment)
+       << "\n```\n\n";
   }
   md << "It is rotated and moved into the body frame, $S_b = R S R^T + m\\,c\\,c^T$, and the inertia tensor "
         "about the origin is $J_o = \\operatorname{tr}(S_b) I - S_b$.";
   if (!mp.blocks.empty())
-    md << " For " << output::markdown_code(mp.blocks[0].name) << ":\n\n$$J_o = " << tex_matrix(mp.blocks[0].inertia_origin) << "$$\n\n";
+    md << " For " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nJ_o = " << tex_matrix(mp.blocks[0].inertia_origin) << "\n```\n\n";
   md << "Contributions of every block about the body origin [kg m²] and projected areas [m²]:\n\n"
      << "| block | J_xx | J_yy | J_zz | J_xy | J_xz | J_yz | A_x | A_y | A_z |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& b : mp.blocks) {
@@ -80,9 +227,9 @@ void section_mass(std::ostringstream& md, const Derivation& d) {
      << num(mp.cog_value[2]) << ") m**; exposed areas **(" << num(mp.areas_value[0]) << ", "
      << num(mp.areas_value[1]) << ", " << num(mp.areas_value[2]) << ") m²**.\n\n"
      << "Inertia about the centre of gravity, $J_{cg} = J_o - m(|c|^2 I - c c^T)$ [kg m²]:\n\n"
-     << "$$J_{cg} = \\begin{pmatrix}" << num(Jc[0][0]) << " & " << num(Jc[0][1]) << " & " << num(Jc[0][2])
+     << "```math\nJ_{cg} = \\begin{pmatrix}" << num(Jc[0][0]) << " & " << num(Jc[0][1]) << " & " << num(Jc[0][2])
      << " \\\\ " << num(Jc[1][0]) << " & " << num(Jc[1][1]) << " & " << num(Jc[1][2]) << " \\\\ "
-     << num(Jc[2][0]) << " & " << num(Jc[2][1]) << " & " << num(Jc[2][2]) << "\\end{pmatrix}$$\n\n"
+     << num(Jc[2][0]) << " & " << num(Jc[2][1]) << " & " << num(Jc[2][2]) << "\\end{pmatrix}\n```\n\n"
      << "These stay expressions in the block symbols ($m_i, a_i, b_i, c_i, x_i, y_i, z_i$): a changed "
         "vehicle file re-derives them. They enter the dynamics as parameters `mass`, `cog_*`, `J_*`, `A_*` "
         "with these nominal values, so that a fit may free them.\n\n";
@@ -93,17 +240,24 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
   md << "## 3. Kinematics\n\n"
      << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton). Its rotation "
         "matrix and rate:\n\n"
-     << "$$R(q) = \\begin{pmatrix} 1-2(q_y^2+q_z^2) & 2(q_xq_y-q_wq_z) & 2(q_xq_z+q_wq_y) \\\\ "
+     << "```math\nR(q) = \\begin{pmatrix} 1-2(q_y^2+q_z^2) & 2(q_xq_y-q_wq_z) & 2(q_xq_z+q_wq_y) \\\\ "
         "2(q_xq_y+q_wq_z) & 1-2(q_x^2+q_z^2) & 2(q_yq_z-q_wq_x) \\\\ 2(q_xq_z-q_wq_y) & 2(q_yq_z+q_wq_x) & "
-        "1-2(q_x^2+q_y^2)\\end{pmatrix},\\qquad \\dot q = \\tfrac12\\, q \\otimes (0, \\omega)$$\n\n"
+        "1-2(q_x^2+q_y^2)\\end{pmatrix},\\qquad \\dot q = \\tfrac12\\, q \\otimes (0, \\omega)\n```\n\n"
      << "For reports, Z-Y-X Euler angles give $R = R_z(\\psi) R_y(\\theta) R_x(\\phi)$; the audit shows both "
         "forms agree.\n\n";
   md << "## 4. Forces and torques\n\n";
+  constexpr size_t kReadable = 1500;  // nodes: beyond this an equation is not read but searched
   for (const auto& [name, e] : m.intermediates) {
-    md << "$$" << name << " = ";
+    const size_t size = tree_size(e, kReadable);
+    if (size > kReadable) {
+      md << "$" << name << "$: more than " << kReadable << " terms and factors, too long to read here; the generated "
+         << "code holds it in full.\n\n";
+      continue;
+    }
+    md << "```math\n" << name << " = ";
     if (is_a<matrix>(e)) md << tex_matrix(ex_to<matrix>(e));
     else md << tex(e);
-    md << "$$\n\n";
+    md << "\n```\n\n";
   }
   md << "Thrust acts along body $+z$ at each rotor; a counter-clockwise rotor (seen from above) pushes "
         "the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$. Drag acts at the centre "
@@ -111,15 +265,16 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
   md << "## 5. Equations of motion\n\n"
      << "Translation (D'Alembert: the inertial force balances the applied forces) for the centre of "
         "gravity, expressed for the body origin that the logs record:\n\n"
-     << "$$\\dot v = R\\left(\\frac{F_{body}}{m} - \\dot\\omega\\times c - \\omega\\times(\\omega\\times c)\\right) - "
-        "g\\,e_z$$\n\n"
+     << "```math\n\\dot v = R\\left(\\frac{F_{body}}{m} - \\dot\\omega\\times c - \\omega\\times(\\omega\\times c)\\right) - "
+        "g\\,e_z\n```\n\n"
      << "Rotation (angular-momentum balance about the centre of gravity, body axes):\n\n"
-     << "$$J\\dot\\omega = \\tau - \\omega \\times J\\omega$$\n\n"
+     << "```math\nJ\\dot\\omega = \\tau - \\omega \\times J\\omega\n```\n\n"
      << "Right-hand side rows short enough to read (the others are these vector equations written out; "
         "the generated code holds them in full):\n\n";
   for (size_t i = 0; i < m.states.size(); ++i) {
+    if (tree_size(m.f(i, 0), 400) > 400) continue;  // far beyond a readable row
     const std::string t = tex(m.f(i, 0));
-    if (t.size() < 600) md << "$$\\dot{" << tex(m.states[i].sym) << "} = " << t << "$$\n\n";
+    if (t.size() < 600) md << "```math\n\\dot{" << tex(m.states[i].sym) << "} = " << t << "\n```\n\n";
   }
   md << "Measured outputs: position and the logged attitude quaternion";
   if (std::find(m.effects.begin(), m.effects.end(), "attitude_bias") != m.effects.end())

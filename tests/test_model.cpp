@@ -8,6 +8,7 @@
 
 #include "audit.hpp"
 #include "effects.hpp"
+#include "report.hpp"
 #include "test_helpers.hpp"
 #include "thesis_reference.hpp"
 
@@ -252,6 +253,32 @@ TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
   for (const auto& p : all.params) names.push_back(p.name);
   EXPECT_EQ(reference_parameters(names), std::vector<std::string>{"motor_gain.A"});
   EXPECT_THROW(find_effect("tether"), std::invalid_argument);
+}
+
+// A reviewer diffs derivation.md after a vehicle change: it must not depend on the order
+// GiNaC happens to keep operands in (symbol serial numbers, i.e. the process). The same
+// model derived after other symbols were created prints byte for byte the same, in math
+// blocks that GitHub renders.
+TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
+  const Vehicle v = test::finken3();
+  const auto markdown = [&] {
+    const MassProperties mp = derive_mass_properties(v);
+    DeriveOptions o;
+    o.effects = parse_effect_list("all");
+    const SymbolicModel m = derive_model(v, mp, o);
+    const AuditResult no_audit;
+    const std::vector<ThesisItem> no_thesis;
+    return derivation_markdown({v, mp, m, no_audit, no_thesis});
+  };
+  const std::string first = markdown();
+  std::vector<symbol> noise;
+  for (const char* n : {"u_D", "u_C", "qz", "qy", "qx", "qw", "vz", "vy", "vx", "c_t", "rho", "mass", "m_upper_body"})
+    noise.emplace_back(n);
+  ex junk = 0;
+  for (auto& s : noise) junk += s * s;
+  EXPECT_EQ(markdown(), first);
+  EXPECT_EQ(first.find("$$"), std::string::npos);
+  EXPECT_NE(first.find("```math\nF_A = "), std::string::npos);
 }
 
 TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
