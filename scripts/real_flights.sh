@@ -2,6 +2,8 @@
 # Diagnoses every NanoBench flight of the one Crazyflie (CF_01) and checks the rules of
 # what diagnose may name (README "Real flights"):
 #   scripts/real_flights.sh [OUT_DIR]
+# With JOINT=1 it also diagnoses the five usable flights jointly (B6 saturates its PWM; see
+# docs/crazyflie_evidence.md) with --max-effects 5: one set of airframe parameters for all.
 # For each flight: named findings with their intervals and held-out fold gain, suspected
 # candidates with the test they failed, look-alike groups, and the open-loop prediction
 # error before/after. A finding with an open interval, an interval containing "off", or
@@ -20,4 +22,13 @@ for f in "$data"/*.csv; do
       > "$out/$name.log" 2>&1 || echo "  failed: see $out/$name.log" >&2
   fi
 done
+if [ "${JOINT:-0}" = 1 ] && [ ! -f "$out/joint_5_flights/diagnosis.json" ]; then
+  echo "diagnosing the five usable flights jointly ..." >&2
+  logs=()
+  for f in "$data"/*.csv; do
+    case "$(basename "$f")" in B6_*) ;; *) logs+=("$f") ;; esac
+  done
+  "$q" diagnose vehicles/crazyflie21.yaml "${logs[@]}" --mapping data/mappings/nanobench.yaml --max-effects 5 \
+    --out "$out/joint_5_flights" > "$out/joint_5_flights.log" 2>&1 || echo "  failed: see $out/joint_5_flights.log" >&2
+fi
 python3 scripts/real_flights_table.py "$out"
