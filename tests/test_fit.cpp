@@ -34,6 +34,35 @@ std::vector<MotorStep> synthetic_steps(const std::vector<MotorStep>& layout, con
   return out;
 }
 
+// 300 samples of equation-error data from a model: random states and commands in
+// [0.3, 0.5], the model's accelerations plus Gaussian noise (0.05). At rest with equal
+// commands, velocities and rates are zero and all four rotors get the same command.
+Flight synthetic_flight(const runtime::DynamicModel& model, std::mt19937& rng, bool at_rest_equal_commands) {
+  std::normal_distribution<double> noise(0, 0.05);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  Flight flight;
+  flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
+  for (int k = 0; k < 300; ++k) {
+    FlightSample s;
+    s.t = 0.01 * k;
+    s.x = test::random_state(rng);
+    if (at_rest_equal_commands) {
+      for (int i : {3, 4, 5, 10, 11, 12}) s.x[i] = 0;
+      s.u.assign(4, cmd(rng));
+    } else {
+      for (int i = 0; i < 4; ++i) s.u.push_back(cmd(rng));
+    }
+    std::vector<double> f(13);
+    model.rhs(s.x.data(), s.u.data(), f.data(), nullptr, nullptr, nullptr);
+    for (int i = 0; i < 3; ++i) {
+      s.acc_world[i] = f[3 + i] + noise(rng);
+      s.rate_dot[i] = f[10 + i] + noise(rng);
+    }
+    flight.samples.push_back(s);
+  }
+  return flight;
+}
+
 }  // namespace
 
 TEST(Fit, MotorStepModelJacobianMatchesFiniteDifferences) {
@@ -92,25 +121,7 @@ TEST(Fit, MassAndThrustCoefficientAreStructurallyNonIdentifiable) {
   // see c_t and mass only as c_t / mass, so freeing both must be flagged.
   runtime::CompiledModel<quadgen_generated::finken3::Model> model;
   std::mt19937 rng(5);
-  std::normal_distribution<double> noise(0, 0.05);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  Flight flight;
-  flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
-  for (int k = 0; k < 300; ++k) {
-    FlightSample s;
-    s.t = 0.01 * k;
-    s.x = test::random_state(rng);
-    for (int i : {3, 4, 5, 10, 11, 12}) s.x[i] = 0;
-    const double u = cmd(rng);
-    for (int i = 0; i < 4; ++i) s.u.push_back(u);
-    std::vector<double> f(13);
-    model.rhs(s.x.data(), s.u.data(), f.data(), nullptr, nullptr, nullptr);
-    for (int i = 0; i < 3; ++i) {
-      s.acc_world[i] = f[3 + i] + noise(rng);
-      s.rate_dot[i] = f[10 + i] + noise(rng);
-    }
-    flight.samples.push_back(s);
-  }
+  const Flight flight = synthetic_flight(model, rng, /*at_rest_equal_commands=*/true);
   const std::vector<double> truth = model.params();  // the fit below moves the model's own
   EquationErrorModel m(model, flight, false, {"ax", "ay", "az"}, EquationErrorModel::Derivatives::kPointwise);
   std::vector<FitParameter> ps;
@@ -293,23 +304,7 @@ TEST(Fit, OnBoundSeesBothBoundsAndNothingInside) {
 TEST(Fit, ParallelProfilesEqualSequentialOnes) {
   runtime::CompiledModel<quadgen_generated::finken3::Model> model;
   std::mt19937 rng(11);
-  std::normal_distribution<double> noise(0, 0.05);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  Flight flight;
-  flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
-  for (int k = 0; k < 300; ++k) {
-    FlightSample s;
-    s.t = 0.01 * k;
-    s.x = test::random_state(rng);
-    for (int i = 0; i < 4; ++i) s.u.push_back(cmd(rng));
-    std::vector<double> f(13);
-    model.rhs(s.x.data(), s.u.data(), f.data(), nullptr, nullptr, nullptr);
-    for (int i = 0; i < 3; ++i) {
-      s.acc_world[i] = f[3 + i] + noise(rng);
-      s.rate_dot[i] = f[10 + i] + noise(rng);
-    }
-    flight.samples.push_back(s);
-  }
+  const Flight flight = synthetic_flight(model, rng, /*at_rest_equal_commands=*/false);
   const std::vector<double> truth = model.params();
   EquationErrorModel m(model, flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
   ASSERT_NE(m.clone(), nullptr);
