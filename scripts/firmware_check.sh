@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Compiles the checked-in generated models for a Cortex-M4F (the Crazyflie's STM32F405 class:
+# single-precision FPU) the way firmware would use them (examples/firmware/model_unit.cpp,
+# float, -O2, no exceptions, no RTTI) and reports, per model and entry point, the code size,
+# what the object still needs from outside, and whether any double-precision arithmetic is
+# left (soft-float calls on this FPU). Fails if the object needs the heap, exceptions or RTTI.
+#   scripts/firmware_check.sh
+# Installs the Debian cross compiler (gcc-arm-none-eabi) if it is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! command -v arm-none-eabi-g++ > /dev/null; then
+  echo "installing gcc-arm-none-eabi (Debian) ..." >&2
+  sudo_cmd=""; [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get install -y -q gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib > /dev/null
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+flags=(-std=c++17 -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -ffunction-sections
+       -fno-exceptions -fno-rtti -Wall -Wdouble-promotion -Werror=double-promotion -Wno-unused-variable)
+status=0
+echo "| model | rhs, f only [B] | rhs, f + Jacobians [B] | precompute [B] | precomputed values in RAM [B] | external symbols | double-precision calls |"
+echo "|---|---|---|---|---|---|---|"
+for dir in generated/*/; do
+  name=$(basename "$dir")
+  obj="$tmp/$name.o"
+  if ! arm-none-eabi-g++ "${flags[@]}" -DMODEL_HEADER="\"$PWD/${dir}model.hpp\"" \
+       -DMODEL_NAMESPACE="quadgen_generated::$name" -c examples/firmware/model_unit.cpp -o "$obj" 2> "$tmp/$name.err"; then
+    echo "| $name | does not compile: $(head -c 300 "$tmp/$name.err" | tr '\n' ' ') |"
+    status=1
+    continue
+  fi
+  size_of() {  # bytes of the symbols whose demangled line matches $1 (nm's sizes are hexadecimal)
+    local total=0 hex
+    for hex in $(arm-none-eabi-nm -S -C "$obj" | grep -E "$1" | awk '{ print $2 }'); do total=$((total + 16#$hex)); done
+    echo "$total"
+  }
+  # The two instantiations of rhs<float>: f only (5 arguments) and with the Jacobians (8).
+  f_only=$(size_of 'rhs<float>\(([^,]*,){4}[^,]*\)$')
+  f_jac=$(size_of 'rhs<float>\(([^,]*,){7}[^,]*\)$')
+  undefined=$(arm-none-eabi-nm -u "$obj" | awk '{print $2}' | sort -u)
+  doubles=$(echo "$undefined" | grep -c '^__aeabi_d' || true)
+  forbidden=$(echo "$undefined" | grep -E '^(malloc|free|_Znw|_Zdl|_Zna|_Zda|__cxa_|__gxx_personality|_Unwind)' || true)
+  [ -n "$forbidden" ] && status=1
+  echo "| $name | $f_only | $f_jac | $(size_of ' quadgen_precompute$') | $(size_of ' quadgen_pre$') | $(echo ${undefined:-none} | tr ' ' ',')${forbidden:+ — FORBIDDEN: $forbidden} | $doubles |"
+done
+exit $status
