@@ -11,6 +11,7 @@ struct DeriveArgs {
   std::string vehicle;
   std::string out;
   std::string effects;
+  std::string params;  // fitted_parameters.yaml from diagnose: its effects and values
 };
 
 void add_derive(CLI::App& app, DeriveArgs& args);

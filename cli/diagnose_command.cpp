@@ -50,7 +50,7 @@ namespace {
 
 std::string fitted_parameters_yaml(const Vehicle& v, const diagnose::Diagnosis& d) {
   std::ostringstream y;
-  y.precision(10);
+  y.precision(17);  // round-trips: derive --params regenerates the same values
   y << "# Parameters of " << output::printable(v.name) << " fitted by quadgen diagnose; effects: ";
   for (const auto& e : d.search.selected) y << e << " ";
   y << "\neffects: [";

@@ -398,6 +398,19 @@ TEST(MultiFlight, OneCauseAcrossTwoFlightsIsNamedOnce) {
   std::ifstream h(dir / "out" / "extended_model.hpp");
   const std::string header((std::istreambuf_iterator<char>(h)), {});
   EXPECT_NE(header.find("Parameter values (kNominalParams): fitted by quadgen diagnose to"), std::string::npos);
+  // and derive regenerates the same fitted values from the vehicle file and fitted_parameters.yaml
+  ASSERT_EQ(run(std::string(QUADGEN_BINARY) + " derive " + vehicle_file(a) + " --params " +
+                (dir / "out" / "fitted_parameters.yaml").string() + " --out " + (dir / "regenerated").string() +
+                " > /dev/null 2>&1"),
+            "");
+  std::ifstream r(dir / "regenerated" / "model.hpp");
+  const std::string regenerated((std::istreambuf_iterator<char>(r)), {});
+  const auto nominal = [](const std::string& text) {
+    const auto at = text.find("kNominalParams[kNumParams] = ");
+    return at == std::string::npos ? std::string() : text.substr(at, text.find('\n', at) - at);
+  };
+  EXPECT_FALSE(nominal(header).empty());
+  EXPECT_EQ(nominal(regenerated), nominal(header));
 }
 
 }  // namespace

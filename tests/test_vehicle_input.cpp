@@ -180,3 +180,42 @@ TEST(Cli, DeriveWritesModelJsonAndReport) {
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << "left a temporary: " << e.path();
 }
+
+// derive --params: a fitted_parameters.yaml is applied only when every value names a
+// parameter of the model, in its unit and within its bounds; otherwise one line with the
+// file and line of the value.
+#include "fitted_parameters.hpp"
+TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_parameters";
+  fs::create_directories(dir);
+  const auto file = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const Vehicle v = test::finken3();
+  DeriveOptions o;
+  o.effects = {"motor_gain"};
+  const std::string head = "effects: [motor_gain]\nparameters:\n  c_t: {value: 0.15, unit: \"1\"}\n";
+  SymbolicModel m = derive_model(v, derive_mass_properties(v), o);
+  apply_fitted_parameters(m, load_fitted_parameters(file("good.yaml", head + "  motor_gain.C: {value: -0.08, unit: \"1\"}\n")));
+  EXPECT_EQ(m.params[m.param_index("motor_gain.C")].nominal, -0.08);
+  EXPECT_EQ(m.params[m.param_index("c_t")].nominal, 0.15);
+  const std::pair<std::string, std::string> bad[] = {
+      {head + "  wind.x: {value: 1, unit: \"m/s\"}\n", ":4: no parameter 'wind.x'"},
+      {head + "  kappa: {value: 0.01, unit: \"1\"}\n", ":4: kappa is in m, the file says 1"},
+      {head + "  motor_gain.C: {value: -0.9, unit: \"1\"}\n", ":4: motor_gain.C = -0.9 is outside its bounds"},
+      {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
+      {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: the value of c_w is not finite"},
+  };
+  int k = 0;
+  for (const auto& [text, want] : bad) {
+    const std::string path = file("bad" + std::to_string(k++) + ".yaml", text);
+    try {
+      SymbolicModel copy = m;
+      apply_fitted_parameters(copy, load_fitted_parameters(path));
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const VehicleError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + want), std::string::npos) << e.what();
+    }
+  }
+}
