@@ -79,6 +79,9 @@ CandidateSearch::CandidateSearch(const SymbolicModel& all, runtime::DynamicModel
       throw fit::FitError("candidate effect '" + e + "' is not in the model");
     for (const auto& name : effect_parameters(all, e)) effect_params_[e].push_back(model.param_index(name));
   }
+  std::vector<std::string> names;
+  for (const auto& p : all.params) names.push_back(p.name);
+  for (const auto& ref : reference_parameters(names)) reference_params_.push_back(model.param_index(ref));
 }
 
 std::vector<FitParameter> CandidateSearch::initial_parameters() const {
@@ -101,11 +104,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
     if (!on) ps[i].value = neutral_value(all_.params[i]);
   }
   // Only ratios are identifiable for some effects beside c_t: their reference is held.
-  std::vector<std::string> names;
-  for (const auto& p : ps) names.push_back(p.name);
-  for (const auto& ref : reference_parameters(names))
-    for (auto& p : ps)
-      if (p.name == ref) p.free = false;
+  for (int i : reference_params_) ps[i].free = false;
   fit::FitOptions fo;
   fo.max_iterations = 100;
   fo.function_tolerance = 1e-10;

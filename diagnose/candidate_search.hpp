@@ -160,6 +160,7 @@ class CandidateSearch {
   std::vector<double> weights_;
   std::vector<std::string> candidates_;
   std::map<std::string, std::vector<int>> effect_params_;  // indices into the parameter vector
+  std::vector<int> reference_params_;  // held at off in every fit (reference_parameters)
 
   std::vector<fit::FitParameter> initial_parameters() const;
   // base_ss: the step's base model's residual sum of squares per channel (computed once

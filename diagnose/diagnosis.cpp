@@ -69,6 +69,27 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all) {
   return "";
 }
 
+// Three significant digits, as the reasons print numbers.
+std::string short_number(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+// A candidate the held-out equation-error cost speaks against: suspected with that cost
+// before and after it as its gain.
+Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& evidence, double cost_without,
+                           double cost_with, const std::string& why) {
+  Finding f;
+  f.effect = effect;
+  f.evidence = evidence;
+  f.metric = "validation equation-error cost (weighted)";
+  f.before = cost_without;
+  f.after = cost_with;
+  return {f, why};
+}
+
 }  // namespace
 
 Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
@@ -177,35 +198,21 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::
     search.remove_effects(d.search, drop);
   }
   // Significant on the training data but no held-out gain in the search itself: suspected.
-  for (const auto& ev : d.search.training_only) {
-    Finding f;
-    f.effect = ev.effect;
-    f.evidence = ev;
-    f.metric = "validation equation-error cost (weighted)";
-    f.before = ev.validation_cost_before;
-    f.after = ev.validation_cost_after;
-    std::ostringstream why;
-    why.precision(3);
-    why << "improves the training data (p = " << ev.p_value << ") but not the held-out part (its equation-error cost "
-        << "rises by " << -ev.validation_gain_percent << " %)";
-    d.suspected.push_back({f, why.str()});
-  }
+  for (const auto& ev : d.search.training_only)
+    d.suspected.push_back(held_out_suspect(ev.effect, ev, ev.validation_cost_before, ev.validation_cost_after,
+                                           "improves the training data (p = " + short_number(ev.p_value) +
+                                               ") but not the held-out part (its equation-error cost rises by " +
+                                               short_number(-ev.validation_gain_percent) + " %)"));
   // Taken out by the backward pass because the held-out part is better without it, while
   // the training data still want it: suspected too.
-  for (const auto& rm : d.search.removed) {
-    if (!rm.held_out_failure) continue;
-    Finding f;
-    f.effect = rm.effect;
-    f.metric = "validation equation-error cost (weighted)";
-    f.before = rm.validation_cost_without;
-    f.after = rm.validation_cost_with;
-    std::ostringstream why;
-    why.precision(3);
-    why << "significant on the training data in the final model (p = " << rm.p_value
-        << "), but the held-out part is better without it (its equation-error cost rises by "
-        << -rm.validation_gain_percent << " %); removed by the backward pass";
-    d.suspected.push_back({f, why.str()});
-  }
+  for (const auto& rm : d.search.removed)
+    if (rm.held_out_failure)
+      d.suspected.push_back(held_out_suspect(rm.effect, {}, rm.validation_cost_without, rm.validation_cost_with,
+                                             "significant on the training data in the final model (p = " +
+                                                 short_number(rm.p_value) +
+                                                 "), but the held-out part is better without it (its equation-error "
+                                                 "cost rises by " + short_number(-rm.validation_gain_percent) +
+                                                 " %); removed by the backward pass"));
   const SearchResult& s = d.search;
   // What is wrong, before and after, over the whole flight.
   fit::Flight used = flight;  // the samples with residuals (full derivative windows)
