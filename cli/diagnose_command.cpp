@@ -2,6 +2,7 @@
 // Fits the base model, shows what it gets wrong, names the cause from the effect catalogue,
 // regenerates the model with it and measures the gain on the held-out end of the flight
 // (of each flight, when several flights of the vehicle are diagnosed jointly).
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
@@ -53,10 +54,14 @@ std::string fitted_parameters_yaml(const Vehicle& v, const diagnose::Diagnosis& 
   y.precision(17);  // round-trips: derive --params regenerates the same values
   y << "# Parameters of " << output::printable(v.name) << " fitted by quadgen diagnose; effects: ";
   for (const auto& e : d.search.selected) y << e << " ";
+  for (const auto& e : d.per_flight_effects)
+    if (std::find(d.search.selected.begin(), d.search.selected.end(), e) != d.search.selected.end())
+      y << "\n# " << e << ": one value per flight in diagnosis.json; here their mean over the " << d.flights.size()
+        << " flights";
   y << "\neffects: [";
   for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
   y << "]\nparameters:\n";
-  for (const auto& p : d.search.final_fit)
+  for (const auto& p : d.airframe_fit)
     if (p.free) y << "  " << p.name << ": {value: " << p.value << ", unit: \"" << p.unit << "\"}\n";
   return y.str();
 }
@@ -107,7 +112,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   ext_opt.effects = d.search.selected;
   SymbolicModel ext = derive_model(v, mp, ext_opt);
   // The extended header is the fitted model: its nominal values are the estimates.
-  for (const auto& p : d.search.final_fit)
+  for (const auto& p : d.airframe_fit)
     if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
   emission::EmitOptions eo;
   eo.vehicle_file = a.vehicle;

@@ -134,6 +134,9 @@ std::vector<Effect> build_catalogue() {
   {
     Effect& e = add("motor_gain", "thrust of each rotor scaled by (1 + value)", motor_gain);
     e.first_parameter_is_reference = true;
+    // The NanoBench flights of one Crazyflie trim their motors differently on every flight
+    // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).
+    e.per_flight = true;
     e.look_alikes = {{"cog_offset",
                       "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
                       "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)"}};
@@ -150,7 +153,7 @@ std::vector<Effect> build_catalogue() {
   add("cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset);
   // wind first among the airspeed effects: rotor_drag and blade_flapping act on the
   // air-relative velocity it changes.
-  add("wind", "steady air velocity in the world frame, through the drag terms", wind);
+  add("wind", "steady air velocity in the world frame, through the drag terms", wind).per_flight = true;
   add("rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag).look_alikes = {
       {"blade_flapping", "straight legs at several constant speeds: rotor drag slows the vehicle (a horizontal force), "
                          "flapping only tilts it (a moment the attitude loop must hold)"}};

@@ -35,6 +35,10 @@ struct Effect {
   // Beside c_t only ratios between the parameters are identifiable: the first is the
   // reference, held at off.
   bool first_parameter_is_reference = false;
+  // A property of the flight rather than of the airframe (a motor trim that changes when a
+  // motor or the battery is re-seated, the wind of the day): when several flights are
+  // diagnosed together, each flight has its own values (runtime::PerFlightModel).
+  bool per_flight = false;
   std::vector<LookAlike> look_alikes;
 };
 

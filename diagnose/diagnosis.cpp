@@ -4,8 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <set>
+#include <memory>
 #include <sstream>
+
+#include "effects.hpp"
+#include "per_flight_model.hpp"
 
 namespace quadgen::diagnose {
 
@@ -90,9 +95,55 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   return {f, why};
 }
 
+// In a joint diagnosis, the parameters that take one value per flight: those of the
+// per-flight effects among the candidates, except a reference held at off.
+std::vector<std::string> per_flight_parameters(const SymbolicModel& all, const std::vector<std::string>& candidates) {
+  std::vector<std::string> names, out;
+  for (const auto& p : all.params) names.push_back(p.name);
+  const auto references = reference_parameters(names);
+  for (const auto& e : candidates) {
+    if (!find_effect(e).per_flight) continue;
+    for (const auto& n : effect_parameters(all, e))
+      if (std::find(references.begin(), references.end(), n) == references.end()) out.push_back(n);
+  }
+  return out;
+}
+
+// The full-catalogue model's variables with the per-flight model's copies appended, in its
+// order; a copy has the unit, bounds and meaning of the parameter it copies.
+SymbolicModel with_per_flight_copies(const SymbolicModel& all, const runtime::PerFlightModel& m) {
+  SymbolicModel out = all;
+  for (size_t i = all.params.size(); i < m.param_names().size(); ++i) {
+    Variable v = all.params[all.param_index(runtime::shared_name(m.param_names()[i]))];
+    v.name = m.param_names()[i];
+    v.sym = GiNaC::symbol(v.name);
+    out.params.push_back(v);
+  }
+  return out;
+}
+
+// The airframe's values: a per-flight parameter at its mean over the flights, the copies
+// dropped (the next flight's trim or wind is unknown; the mean is the best guess).
+std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParameter>& ps) {
+  std::map<std::string, std::pair<double, int>> sums;
+  for (const auto& p : ps) {
+    auto& [sum, count] = sums[runtime::shared_name(p.name)];
+    sum += p.value;
+    ++count;
+  }
+  std::vector<fit::FitParameter> out;
+  for (auto p : ps) {
+    if (p.name.find('@') != std::string::npos) continue;
+    const auto& [sum, count] = sums[p.name];
+    p.value = sum / count;
+    out.push_back(p);
+  }
+  return out;
+}
+
 }  // namespace
 
-Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::DynamicModel& model,
+Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {
   const auto clock0 = std::chrono::steady_clock::now();
@@ -102,7 +153,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::
   // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
   std::vector<fit::Flight> flights;
   for (const auto& f : flights_in) {
-    flights.push_back(predict::fill_missing_signals(f, all.params[all.param_index("vbat_ref")].nominal));
+    flights.push_back(predict::fill_missing_signals(f, all_in.params[all_in.param_index("vbat_ref")].nominal));
     d.flights.push_back(f.source);
   }
   const bool joint = flights.size() > 1;
@@ -116,6 +167,20 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::
     if (c.empty()) c = applicable_effects(flight);
     c.erase(std::remove(c.begin(), c.end(), "thrust_decay"), c.end());
   }
+  // Joint: the flight's own quantities (motor trim, wind) get one value per flight; the rest
+  // of the pipeline sees one model with more parameters.
+  std::unique_ptr<runtime::PerFlightModel> per_flight_model;
+  SymbolicModel per_flight_all;
+  if (joint) {
+    const auto starts = fit::joined_start_times(flights);
+    per_flight_model = std::make_unique<runtime::PerFlightModel>(
+        model_in, std::vector<double>(starts.begin() + 1, starts.end()), per_flight_parameters(all_in, opt.search.candidates));
+    per_flight_all = with_per_flight_copies(all_in, *per_flight_model);
+    for (const auto& e : opt.search.candidates)
+      if (find_effect(e).per_flight) d.per_flight_effects.push_back(e);
+  }
+  const SymbolicModel& all = joint ? per_flight_all : all_in;
+  runtime::DynamicModel& model = joint ? *per_flight_model : model_in;
   bool accel = opt.translational == "accelerometer" || (opt.translational == "auto" && !flight.has_pose);
   if (opt.translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
   d.formulation = accel ? "equation error: accelerometer specific force (body) and gyro derivative"
@@ -253,6 +318,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all, runtime::
       const bool lower = std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper);
       d.at_bounds.push_back(p.name + " = " + std::to_string(p.value) + (lower ? " (lower bound)" : " (upper bound)"));
     }
+  d.airframe_fit = airframe_values(s.final_fit);
   d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return d;
 }

@@ -60,6 +60,9 @@ struct ChannelGain {
 struct Diagnosis {
   std::string vehicle, formulation;
   std::vector<std::string> flights;  // the source of each flight diagnosed
+  // Jointly diagnosed flights: effects with one value per flight ("motor_gain.M2" is the
+  // first flight's, "motor_gain.M2@2" the second's; runtime::PerFlightModel).
+  std::vector<std::string> per_flight_effects;
   std::vector<std::string> channel_names, channel_units;
   size_t train_samples = 0, valid_samples = 0;
   double t_split = 0;
@@ -74,6 +77,9 @@ struct Diagnosis {
   // Free parameters of the final model that ended on a bound: the model is strained there,
   // and a finding may stand in for physics the catalogue lacks.
   std::vector<std::string> at_bounds;
+  // The final fit as the airframe's parameters: per-flight values averaged over the flights
+  // (what the extended header and fitted_parameters.yaml carry). One flight: the final fit.
+  std::vector<fit::FitParameter> airframe_fit;
   std::string metric;
   double metric_before = 0, metric_after = 0;
   WindowedSimulation sim_before, sim_after;  // validation part

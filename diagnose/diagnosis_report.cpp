@@ -106,6 +106,8 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["vehicle"] = d.vehicle;
   j["log"] = log_path;
   j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
+  // Effects with one value per flight: "name" is the first flight's, "name@k" the k-th's.
+  j["per_flight_effects"] = d.per_flight_effects;
   j["formulation"] = d.formulation;
   j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
   json findings = json::array();
@@ -341,6 +343,14 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
   h << "<h2>Findings</h2>\n";
   if (d.findings.empty()) h << "<p>None.</p>\n";
+  if (!d.per_flight_effects.empty()) {
+    h << "<p>One value per flight for ";
+    for (size_t i = 0; i < d.per_flight_effects.size(); ++i) h << (i ? ", " : "") << esc(d.per_flight_effects[i]);
+    h << " (a property of the flight, not of the airframe): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
+         "<i>k</i>'s. Flights:</p>\n<ol>\n";
+    for (const auto& f : d.flights) h << "<li>" << esc(f) << "</li>\n";
+    h << "</ol>\n";
+  }
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << "</h3>\n<table><tr><th>parameter</th><th>value</th><th>95 % profile interval</th><th>unit</th><th>identifiability</th></tr>\n";
     for (const auto& p : f.parameters)

@@ -370,6 +370,13 @@ Flight join_flights(const std::vector<Flight>& flights, double gap) {
   return out;
 }
 
+std::vector<double> joined_start_times(const std::vector<Flight>& flights, double gap) {
+  const auto offsets = join_offsets(flights, gap);
+  std::vector<double> starts;
+  for (size_t i = 0; i < flights.size(); ++i) starts.push_back(flights[i].samples.front().t + offsets[i]);
+  return starts;
+}
+
 std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights, double train_fraction, double gap) {
   const auto offsets = join_offsets(flights, gap);
   Flight train = empty_join(flights), valid = empty_join(flights);

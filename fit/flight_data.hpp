@@ -82,6 +82,8 @@ std::pair<Flight, Flight> split_by_time(const Flight& f, double train_fraction);
 Flight join_flights(const std::vector<Flight>& flights, double gap = 1.0);
 std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights, double train_fraction,
                                              double gap = 1.0);
+// Where each flight begins on that joined clock.
+std::vector<double> joined_start_times(const std::vector<Flight>& flights, double gap = 1.0);
 
 // Derivative at each sample by a local quadratic least-squares fit over +-window seconds
 // (a Savitzky–Golay filter that also works for uneven sampling).

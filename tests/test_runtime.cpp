@@ -14,6 +14,7 @@
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
 #include "integrator.hpp"
+#include "per_flight_model.hpp"
 #include "tape_builder.hpp"
 #include "test_helpers.hpp"
 
@@ -118,6 +119,72 @@ TEST(Runtime, RestrictedParameterJacobianKeepsRequestedColumns) {
   tape.restrict_param_jacobian({});
   tape.rhs(x.data(), u.data(), f.data(), nullptr, part.data(), nullptr);
   EXPECT_EQ(part, full);
+}
+
+// Per-flight parameters: the wrapped model evaluates each flight with that flight's values,
+// and df/dp of a per-flight parameter lands in the column of the flight evaluated.
+TEST(PerFlightModel, EachFlightSeesItsOwnValuesAndColumns) {
+  CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
+  const int n = inner.num_states(), np = inner.num_params(), nu = inner.num_inputs();
+  PerFlightModel joint(inner, {10.0, 20.0}, {"motor_gain.C", "wind.x"});
+  ASSERT_EQ(joint.num_params(), np + 4);
+  EXPECT_EQ(joint.param_names()[np], "motor_gain.C@2");
+  EXPECT_EQ(joint.param_names()[np + 3], "wind.x@3");
+  EXPECT_EQ(shared_name("wind.x@3"), "wind.x");
+  EXPECT_EQ(flight_of_name("wind.x@3"), 3);
+  EXPECT_EQ(flight_of_name("wind.x"), 1);
+  EXPECT_EQ(joint.flight_at(9.99), 0);
+  EXPECT_EQ(joint.flight_at(10.0), 1);
+  EXPECT_EQ(joint.flight_at(25.0), 2);
+  std::vector<double> p = joint.params();
+  const int gain = inner.param_index("motor_gain.C"), wind = inner.param_index("wind.x");
+  const double gains[3] = {0.05, -0.1, 0.2}, winds[3] = {0.5, -1.0, 2.0};
+  p[gain] = gains[0];
+  p[wind] = winds[0];
+  p[np] = gains[1], p[np + 1] = winds[1], p[np + 2] = gains[2], p[np + 3] = winds[2];
+  joint.set_params(p);
+  const auto copy = joint.clone();
+  std::mt19937 rng(5);
+  std::vector<double> x = test::random_state(rng);
+  x[2] = 1.0;
+  x.resize(n, 900.0);
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> u{0.3, 0.4, 0.5, 0.6, 5.0 + 10.0 * k, 3.9};
+    ASSERT_EQ(static_cast<int>(u.size()), nu);
+    std::vector<double> pk(inner.params());
+    pk[gain] = gains[k];
+    pk[wind] = winds[k];
+    inner.set_params(pk);
+    std::vector<double> f1(n), f2(n), f3(n), B1(n * np), B2(n * (np + 4)), B3(n * (np + 4));
+    inner.rhs(x.data(), u.data(), f1.data(), nullptr, B1.data(), nullptr);
+    joint.rhs(x.data(), u.data(), f2.data(), nullptr, B2.data(), nullptr);
+    copy->rhs(x.data(), u.data(), f3.data(), nullptr, B3.data(), nullptr);
+    EXPECT_EQ(f1, f2) << "flight " << k + 1;
+    EXPECT_EQ(f2, f3);
+    EXPECT_EQ(B2, B3);
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < np; ++j) {
+        const bool moved = k > 0 && (j == gain || j == wind);
+        EXPECT_EQ(B2[i * (np + 4) + j], moved ? 0.0 : B1[i * np + j]) << k << " " << i << " " << j;
+      }
+      for (int c = 0; c < 4; ++c) {
+        const int j = c % 2 == 0 ? gain : wind;
+        const bool mine = k > 0 && c / 2 == k - 1;
+        EXPECT_EQ(B2[i * (np + 4) + np + c], mine ? B1[i * np + j] : 0.0) << k << " " << i << " " << c;
+      }
+    }
+  }
+  // a column kept by restriction is kept for every flight that has it
+  joint.restrict_param_jacobian({np + 2});
+  std::vector<double> f(n), B(n * (np + 4));
+  const std::vector<double> u3{0.3, 0.4, 0.5, 0.6, 25.0, 3.9};
+  joint.rhs(x.data(), u3.data(), f.data(), nullptr, B.data(), nullptr);
+  bool any = false;
+  for (int i = 0; i < n; ++i) any = any || B[i * (np + 4) + np + 2] != 0.0;
+  EXPECT_TRUE(any);
+  EXPECT_THROW(PerFlightModel(inner, {10.0}, {"motor_gain.Q"}), std::invalid_argument);
+  CompiledModel<quadgen_generated::finken3::Model> no_time;  // no input "t"
+  EXPECT_THROW(PerFlightModel(no_time, {10.0}, {}), std::invalid_argument);
 }
 
 TEST(Runtime, Rk4ConvergesWithFourthOrder) {

@@ -1,0 +1,97 @@
+#include "per_flight_model.hpp"
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+namespace quadgen::runtime {
+
+std::string per_flight_name(const std::string& parameter, int flight) {
+  return flight <= 1 ? parameter : parameter + "@" + std::to_string(flight);
+}
+
+std::string shared_name(const std::string& name) { return name.substr(0, name.find('@')); }
+
+int flight_of_name(const std::string& name) {
+  const auto at = name.find('@');
+  return at == std::string::npos ? 1 : std::stoi(name.substr(at + 1));
+}
+
+PerFlightModel::PerFlightModel(const DynamicModel& inner, std::vector<double> flight_starts,
+                               const std::vector<std::string>& per_flight)
+    : starts_(std::move(flight_starts)), t_input_(inner.input_index("t")), names_(inner.param_names()),
+      p_(inner.params()) {
+  if (t_input_ < 0) throw std::invalid_argument("per-flight parameters need the model's time input 't'");
+  if (!std::is_sorted(starts_.begin(), starts_.end()))
+    throw std::invalid_argument("per-flight parameters: the flights' start times must increase");
+  const int np = inner.num_params();
+  std::vector<int> shared;
+  for (const auto& n : std::set<std::string>(per_flight.begin(), per_flight.end())) {
+    const int j = inner.param_index(n);
+    if (j < 0) throw std::invalid_argument("per-flight parameter '" + n + "' is not a parameter of the model");
+    shared.push_back(j);
+  }
+  std::sort(shared.begin(), shared.end());
+  for (size_t k = 0; k <= starts_.size(); ++k) {
+    std::unique_ptr<DynamicModel> copy = inner.clone();
+    if (!copy) throw std::invalid_argument("per-flight parameters need a model that can be copied");
+    flights_.push_back(std::move(copy));
+    std::vector<int> column(np);
+    for (int j = 0; j < np; ++j) column[j] = j;
+    if (k > 0)
+      for (int j : shared) {
+        column[j] = static_cast<int>(names_.size());
+        names_.push_back(per_flight_name(inner.param_names()[j], static_cast<int>(k) + 1));
+        p_.push_back(inner.params()[j]);
+      }
+    column_.push_back(std::move(column));
+  }
+}
+
+PerFlightModel::PerFlightModel(const PerFlightModel& o)
+    : DynamicModel(o), starts_(o.starts_), t_input_(o.t_input_), names_(o.names_), p_(o.p_), column_(o.column_) {
+  for (const auto& m : o.flights_) flights_.push_back(m->clone());
+}
+
+int PerFlightModel::flight_at(double t) const {
+  return static_cast<int>(std::upper_bound(starts_.begin(), starts_.end(), t) - starts_.begin());
+}
+
+void PerFlightModel::set_params(const std::vector<double>& p) {
+  if (p.size() != names_.size()) throw std::invalid_argument("per-flight model: wrong number of parameters");
+  p_ = p;
+  for (size_t k = 0; k < flights_.size(); ++k) {
+    std::vector<double> inner(column_[k].size());
+    for (size_t j = 0; j < inner.size(); ++j) inner[j] = p_[column_[k][j]];
+    flights_[k]->set_params(inner);
+  }
+}
+
+void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const {
+  const int k = flight_at(u[t_input_]);
+  const DynamicModel& m = *flights_[k];
+  const int n = m.num_states(), np_inner = m.num_params(), np = num_params();
+  if (B) inner_B_.resize(static_cast<size_t>(n) * np_inner);
+  m.rhs(x, u, f, A, B ? inner_B_.data() : nullptr, Bu);
+  if (!B) return;
+  std::fill(B, B + static_cast<size_t>(n) * np, 0.0);
+  const auto& column = column_[k];
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < np_inner; ++j) B[i * np + column[j]] = inner_B_[i * np_inner + j];
+}
+
+void PerFlightModel::restrict_param_jacobian(const std::vector<int>& columns) {
+  // An inner column is needed when any flight's copy of it is.
+  std::set<int> wanted(columns.begin(), columns.end());
+  std::vector<int> inner;
+  for (size_t j = 0; j < column_[0].size(); ++j)
+    for (const auto& column : column_)
+      if (wanted.count(column[j])) {
+        inner.push_back(static_cast<int>(j));
+        break;
+      }
+  if (columns.empty()) inner.clear();
+  for (auto& m : flights_) m->restrict_param_jacobian(inner);
+}
+
+}  // namespace quadgen::runtime
