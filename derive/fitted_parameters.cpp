@@ -1,66 +1,38 @@
 #include "fitted_parameters.hpp"
 
-#include <cmath>
-#include <fstream>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
-
 #include "effects.hpp"
-#include "vehicle.hpp"
+#include "sinks.hpp"
+#include "yaml_reader.hpp"
 
 namespace quadgen {
 
-namespace {
-
-[[noreturn]] void fail(const std::string& path, const YAML::Node& at, const std::string& what) {
-  const int line = at.Mark().line >= 0 ? at.Mark().line + 1 : 1;
-  throw VehicleError(path + ":" + std::to_string(line) + ": " + what);
-}
-
-}  // namespace
-
 FittedParameters load_fitted_parameters(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw VehicleError(path + ": cannot open fitted parameters");
-  std::ostringstream text;
-  text << in.rdbuf();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw VehicleError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
-  }
+  const YamlReader r{path};
+  const YAML::Node root = r.parse(r.read_file("fitted parameters"));
+  if (!root.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
+  r.only_keys(root, {"effects", "parameters"}, "fitted parameters");
   FittedParameters out;
   out.path = path;
-  if (!root.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>("");
-    if (key != "effects" && key != "parameters") fail(path, kv.first, "unknown key '" + key + "' (expected effects, parameters)");
-  }
   const YAML::Node effects = root["effects"], params = root["parameters"];
-  if (!effects || !effects.IsSequence()) fail(path, root, "expected a list 'effects' (may be empty: [])");
-  try {
-    for (const auto& e : effects) out.effects.push_back(find_effect(e.as<std::string>()).name);
-  } catch (const std::invalid_argument& e) {
-    fail(path, effects, e.what());
-  } catch (const YAML::Exception&) {
-    fail(path, effects, "expected effect names");
-  }
-  if (!params || !params.IsMap()) fail(path, root, "expected a map 'parameters' of name: {value, unit}");
+  if (!effects || !effects.IsSequence()) r.fail(root, "expected a list 'effects' (may be empty: [])");
+  for (const auto& e : effects) try {
+      out.effects.push_back(find_effect(r.text(e, "an effect name")).name);
+    } catch (const std::invalid_argument& x) {
+      r.fail(e, x.what());
+    }
+  if (!params || !params.IsMap()) r.fail(root, "expected a map 'parameters' of name: {value, unit}");
+  r.unique_keys(params, "parameters");
   for (const auto& kv : params) {
     FittedValue v;
-    v.name = kv.first.as<std::string>("");
+    v.name = r.text(kv.first, "a parameter name");
     v.line = kv.first.Mark().line + 1;
     const YAML::Node& p = kv.second;
-    if (!p.IsMap() || !p["value"] || !p["unit"]) fail(path, kv.first, "expected {value: NUMBER, unit: \"UNIT\"} for " + v.name);
-    try {
-      v.value = p["value"].as<double>();
-      v.unit = p["unit"].as<std::string>();
-    } catch (const YAML::Exception&) {
-      fail(path, p, "expected {value: NUMBER, unit: \"UNIT\"} for " + v.name);
-    }
-    if (!std::isfinite(v.value)) fail(path, p, "the value of " + v.name + " is not finite");
+    if (!p.IsMap()) r.fail(kv.first, "expected {value: NUMBER, unit: \"UNIT\"} for " + output::printable(v.name));
+    r.only_keys(p, {"value", "unit"}, "parameter " + output::printable(v.name));
+    v.value = r.number(r.need(p, "value", "parameter " + output::printable(v.name)), v.name);
+    v.unit = r.text(r.need(p, "unit", "parameter " + output::printable(v.name)), "the unit of " + v.name);
     out.values.push_back(v);
   }
   return out;

@@ -8,68 +8,15 @@
 #include <yaml-cpp/yaml.h>
 
 #include "names.hpp"
+#include "yaml_reader.hpp"
 #include "sinks.hpp"
 
 namespace quadgen {
 namespace {
 
-// Parsing context: builds "file:line: message" errors.
-struct Reader {
-  std::string path;
-
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
-    std::ostringstream os;
-    os << path;
-    if (at.IsDefined() && at.Mark().line >= 0) os << ':' << at.Mark().line + 1;
-    os << ": " << what;
-    throw VehicleError(os.str());
-  }
-  [[noreturn]] void fail_at(const YAML::Mark& m, const std::string& what) const {
-    std::ostringstream os;
-    os << path << ':' << m.line + 1 << ": " << what;
-    throw VehicleError(os.str());
-  }
-
-  void require_map(const YAML::Node& n, const std::string& what) const {
-    if (!n.IsMap()) fail(n, "expected " + what + " (a mapping of keys)");
-  }
-
-  // Rejects keys not in `allowed`, so that a typo never silently drops a number.
-  // Rejects keys not in `allowed`, and keys given twice (yaml-cpp keeps the first silently).
-  void only_keys(const YAML::Node& n, const std::set<std::string>& allowed,
-                 const std::string& where) const {
-    std::set<std::string> seen;
-    for (const auto& kv : n) {
-      if (!kv.first.IsScalar()) fail(kv.first, "expected a plain key in " + where + " (found a list or mapping as a key)");
-      const std::string key = kv.first.Scalar();
-      if (!seen.insert(key).second) fail(kv.first, "key '" + output::printable(key) + "' given twice in " + where);
-      if (!allowed.count(key)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " + list + ")");
-      }
-    }
-  }
-
-  const YAML::Node need(const YAML::Node& parent, const std::string& key,
-                        const std::string& where) const {
-    const YAML::Node n = parent[key];
-    if (!n) fail(parent, "missing key '" + key + "' in " + where);
-    return n;
-  }
-
-  double number(const YAML::Node& n, const std::string& what) const {
-    if (!n.IsScalar()) fail(n, "expected a number for " + what);
-    double v;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(n, "expected a number for " + what + ", got '" + n.Scalar() + "'");
-    }
-    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + n.Scalar() + "'");
-    return v;
-  }
-
+// Parsing context: the generic reader (file:line errors, keys, numbers, text) and what
+// only a vehicle file has.
+struct Reader : YamlReader {
   double positive(const YAML::Node& n, const std::string& what) const {
     double v = number(n, what);
     if (!(v > 0)) fail(n, "expected a positive number for " + what + ", got " + n.Scalar());
@@ -82,15 +29,6 @@ struct Reader {
     for (int i = 0; i < 3; ++i)
       v[i] = must_be_positive ? positive(n[i], what) : number(n[i], what);
     return v;
-  }
-
-  // Free text (a description): any printable characters and line breaks, no other control
-  // characters (escape sequences would reach terminals and reports).
-  std::string text(const YAML::Node& n, const std::string& what) const {
-    if (!n.IsScalar()) fail(n, "expected text for " + what);
-    for (unsigned char c : n.Scalar())
-      if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) fail(n, "control character in " + what);
-    return n.Scalar();
   }
 
   // A name that becomes a C++ identifier, a CSV column, a plot label and report text: one
@@ -233,13 +171,8 @@ Vehicle parse_vehicle(const std::string& content, const std::string& path) {
 
 namespace {
 Vehicle parse_vehicle_checked(const std::string& content, const std::string& path) {
-  Reader r{path};
-  YAML::Node root;
-  try {
-    root = YAML::Load(content);
-  } catch (const YAML::ParserException& e) {
-    r.fail_at(e.mark, "malformed YAML: " + e.msg);
-  }
+  const Reader r{{path}};
+  const YAML::Node root = r.parse(content);
   if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
   r.require_map(root, "a vehicle description");
   r.only_keys(root, {"name", "description", "environment", "frame", "rotor_model", "motor_map",
@@ -313,13 +246,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
 }
 }  // namespace
 
-Vehicle load_vehicle(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw VehicleError(path + ": cannot open vehicle file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_vehicle(ss.str(), path);
-}
+Vehicle load_vehicle(const std::string& path) { return parse_vehicle(YamlReader{path}.read_file("vehicle file"), path); }
 
 const Parameter& param(const Vehicle& v, const std::string& name) {
   auto it = v.params.find(name);

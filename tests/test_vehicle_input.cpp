@@ -205,7 +205,10 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {head + "  kappa: {value: 0.01, unit: \"1\"}\n", ":4: kappa is in m, the file says 1"},
       {head + "  motor_gain.C: {value: -0.9, unit: \"1\"}\n", ":4: motor_gain.C = -0.9 is outside its bounds"},
       {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
-      {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: the value of c_w is not finite"},
+      {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: expected a finite number for c_w"},
+      {head + "  c_t: {value: 0.2, unit: \"1\"}\n", ":4: key 'c_t' given twice in parameters"},
+      {head + "  c_w: {value: 1, unit: \"1\", bounds: [0, 2]}\n", ":4: unknown key 'bounds' in parameter c_w"},
+      {"effects: [motor_gain]\neffects: []\nparameters: {}\n", ":2: key 'effects' given twice"},
   };
   int k = 0;
   for (const auto& [text, want] : bad) {

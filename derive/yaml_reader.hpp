@@ -1,0 +1,107 @@
+// Reading the project's YAML inputs (vehicle files, fitted parameters) with "file:line: what
+// was expected" errors: the generic half of the vehicle reader, shared so that every input
+// refuses unknown and repeated keys the same way (yaml-cpp keeps the first of two equal keys
+// silently).
+#pragma once
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+#include "sinks.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen {
+
+struct YamlReader {
+  std::string path;
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    std::ostringstream os;
+    os << path;
+    if (at.IsDefined() && at.Mark().line >= 0) os << ':' << at.Mark().line + 1;
+    os << ": " << what;
+    throw VehicleError(os.str());
+  }
+  [[noreturn]] void fail_at(const YAML::Mark& m, const std::string& what) const {
+    std::ostringstream os;
+    os << path << ':' << m.line + 1 << ": " << what;
+    throw VehicleError(os.str());
+  }
+
+  // The file's text; `what` names it in the error ("vehicle file").
+  std::string read_file(const std::string& what) const {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw VehicleError(path + ": cannot open " + what);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
+  YAML::Node parse(const std::string& content) const {
+    try {
+      return YAML::Load(content);
+    } catch (const YAML::ParserException& e) {
+      fail_at(e.mark, "malformed YAML: " + e.msg);
+    }
+  }
+
+  void require_map(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsMap()) fail(n, "expected " + what + " (a mapping of keys)");
+  }
+
+  // Plain keys, each once.
+  void unique_keys(const YAML::Node& n, const std::string& where) const {
+    std::set<std::string> seen;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) fail(kv.first, "expected a plain key in " + where + " (found a list or mapping as a key)");
+      if (!seen.insert(kv.first.Scalar()).second)
+        fail(kv.first, "key '" + output::printable(kv.first.Scalar()) + "' given twice in " + where);
+    }
+  }
+
+  // Rejects keys not in `allowed`, so that a typo never silently drops a number, and keys
+  // given twice.
+  void only_keys(const YAML::Node& n, const std::set<std::string>& allowed, const std::string& where) const {
+    unique_keys(n, where);
+    for (const auto& kv : n) {
+      const std::string key = kv.first.Scalar();
+      if (allowed.count(key)) continue;
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " + list + ")");
+    }
+  }
+
+  const YAML::Node need(const YAML::Node& parent, const std::string& key, const std::string& where) const {
+    const YAML::Node n = parent[key];
+    if (!n) fail(parent, "missing key '" + key + "' in " + where);
+    return n;
+  }
+
+  double number(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected a number for " + what);
+    double v;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(n, "expected a number for " + what + ", got '" + n.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + n.Scalar() + "'");
+    return v;
+  }
+
+  // Free text (a description, a unit): any printable characters and line breaks, no other
+  // control characters (escape sequences would reach terminals and reports).
+  std::string text(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected text for " + what);
+    for (unsigned char c : n.Scalar())
+      if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) fail(n, "control character in " + what);
+    return n.Scalar();
+  }
+};
+
+}  // namespace quadgen
