@@ -54,6 +54,7 @@ struct DiagnoseArgs {
   std::string vehicle, out, mapping, candidates;
   std::vector<std::string> logs;  // one flight, or several of the same vehicle (diagnosed jointly)
   std::string translational = "auto";
+  std::string environment;  // "": the mapping's, else unknown
   double resample = 0, validation = 0.3, alpha = 0.01, window = 1.0;
   int max_effects = 3;
 };

@@ -44,6 +44,10 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);
   c->add_option("--translational", a.translational, "translational channels: auto, pose or accelerometer")
       ->check(CLI::IsMember({"auto", "pose", "accelerometer"}));
+  c->add_option("--environment", a.environment,
+                 "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
+                 "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
+      ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_option("--window", a.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
 }
 
@@ -73,9 +77,10 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   std::vector<fit::Flight> flights;
+  const fit::ColumnMapping mapping = a.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(a.mapping);
   for (const auto& path : a.logs) {
     runtime::CsvTable log = runtime::read_csv(path);
-    if (!a.mapping.empty()) log = fit::apply_mapping(log, fit::load_mapping(a.mapping));
+    if (!a.mapping.empty()) log = fit::apply_mapping(log, mapping);
     if (a.resample > 0) log = fit::resample(log, a.resample);
     flights.push_back(fit::load_flight(log, rotors, {}));
   }
@@ -102,6 +107,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   o.validation_fraction = a.validation;
   o.window = a.window;
   o.translational = a.translational;
+  o.environment = parse_environment(a.environment.empty() ? mapping.environment : a.environment);
   o.search.alpha = a.alpha;
   o.search.max_effects = a.max_effects;
   fit::Flight valid;

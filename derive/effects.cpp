@@ -131,12 +131,16 @@ std::vector<Effect> build_catalogue() {
     list.push_back({std::move(name), std::move(meaning), std::move(apply)});
     return list.back();
   };
+  using Scale = PlausibleRange::Scale;
   {
     Effect& e = add("motor_gain", "thrust of each rotor scaled by (1 + value)", motor_gain);
     e.first_parameter_is_reference = true;
     // The NanoBench flights of one Crazyflie trim their motors differently on every flight
     // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).
     e.per_flight = true;
+    e.plausible = {{"", -0.35, 0.35, Scale::kSI, Environment::kUnknown,
+                    "motors of one type differ by up to ~20 % in thrust at one command, worn brushed motors by ~30 % "
+                    "(the NanoBench trims reach a duty ratio of 1.2); beyond, a motor is broken or something else acts"}};
     e.look_alikes = {{"cog_offset",
                       "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
                       "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)"}};
@@ -145,29 +149,61 @@ std::vector<Effect> build_catalogue() {
     Effect& e = add("motor_lag", "first-order lag from commanded to actual rotor speed", motor_lag);
     e.typical_start = {{"motor_lag.tau", 0.03}};
     e.off_at_lower_bound = true;
+    e.plausible = {{"motor_lag.tau", 0.0, 0.25, Scale::kSI, Environment::kUnknown,
+                    "small electric motors respond in 20-100 ms (Crazyflie: 0.072 s, ARPL log authors)"}};
     e.look_alikes = {{"input_delay", "fast throttle steps or chirps (1-10 Hz): a lag rounds and attenuates the response, a "
                                      "delay shifts it without changing its shape"}};
   }
-  add("input_delay", "pure time shift between logged commands and their effect", input_delay).typical_start = {
-      {"input_delay.seconds", 0.015}};
-  add("cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset);
+  {
+    Effect& e = add("input_delay", "pure time shift between logged commands and their effect", input_delay);
+    e.typical_start = {{"input_delay.seconds", 0.015}};
+    e.plausible = {{"input_delay.seconds", 0.0, 0.1, Scale::kSI, Environment::kUnknown,
+                    "logging and radio latencies are one to a few control periods (10-50 ms)"}};
+  }
+  add("cog_offset", "centre of gravity displaced from the body origin in x, y", cog_offset).plausible = {
+      {"", -0.2, 0.2, Scale::kRotorArm, Environment::kUnknown,
+       "a centre of gravity a fifth of the rotor arm off centre needs one motor at ~1.5x its opposite's thrust to "
+       "hover level: visible at a glance"}};
   // wind first among the airspeed effects: rotor_drag and blade_flapping act on the
   // air-relative velocity it changes.
-  add("wind", "steady air velocity in the world frame, through the drag terms", wind).per_flight = true;
+  {
+    Effect& e = add("wind", "steady air velocity in the world frame, through the drag terms", wind);
+    e.per_flight = true;
+    e.plausible = {{"", -0.5, 0.5, Scale::kSI, Environment::kIndoor,
+                    "indoors the air is still but for ventilation drafts of a few dm/s"},
+                   {"", -15.0, 15.0, Scale::kSI, Environment::kUnknown,
+                    "small multirotors are not flown beyond about Beaufort 6-7 (11-15 m/s)"}};
+  }
   add("rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", rotor_drag).look_alikes = {
       {"blade_flapping", "straight legs at several constant speeds: rotor drag slows the vehicle (a horizontal force), "
                          "flapping only tilts it (a moment the attitude loop must hold)"}};
   add("blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", blade_flapping);
-  add("attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias).look_alikes = {
-      {"wind", "hover while turning through a full yaw circle: an attitude bias turns with the body, a steady wind "
-               "stays fixed in the world"}};
-  add("thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay).look_alikes = {
-      {"battery_sag", "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)"}};
-  add("battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag).needs = EffectNeeds::kBatteryVoltage;
+  {
+    Effect& e = add("attitude_bias", "logged attitude = true attitude rotated by roll and pitch", attitude_bias);
+    e.plausible = {{"", -0.052, 0.052, Scale::kSI, Environment::kUnknown,
+                    "an IMU or marker frame misaligned by more than ~3 degrees is visible by eye and corrected"}};
+    e.look_alikes = {{"wind", "hover while turning through a full yaw circle: an attitude bias turns with the body, a "
+                              "steady wind stays fixed in the world"}};
+  }
+  {
+    Effect& e = add("thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay);
+    e.plausible = {{"thrust_decay.rate", -1e-4, 2e-3, Scale::kSI, Environment::kUnknown,
+                    "a LiPo from full to the end of a flight loses 15-25 % of thrust over minutes, under 0.2 %/s"}};
+    e.look_alikes = {{"battery_sag", "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)"}};
+  }
+  {
+    Effect& e = add("battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", battery_sag);
+    e.needs = EffectNeeds::kBatteryVoltage;
+    e.plausible = {{"battery_sag.exponent", 0.0, 3.0, Scale::kSI, Environment::kUnknown,
+                    "at a fixed duty cycle rotor speed grows about with voltage and thrust with its square: ~2"}};
+  }
   {
     Effect& e = add("ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", ground_effect);
     e.needs = EffectNeeds::kPose;
     e.typical_start = {{"ground_effect.radius", 0.05}};
+    e.plausible = {{"ground_effect.radius", 0.0, 3.0, Scale::kRotorRadius, Environment::kUnknown,
+                    "the Cheeseman-Bennett law's R is the rotor radius; several rotors side by side act like a "
+                    "somewhat larger one"}};
   }
   return list;
 }
@@ -204,6 +240,36 @@ std::vector<std::string> reference_parameters(const std::vector<std::string>& na
 double off_value(const Variable& p) {
   const std::string e = effect_of_parameter(p.name);
   return !e.empty() && find_effect(e).off_at_lower_bound ? p.lower : p.nominal;
+}
+
+Environment parse_environment(const std::string& text) {
+  if (text == "indoor") return Environment::kIndoor;
+  if (text == "outdoor") return Environment::kOutdoor;
+  if (text == "unknown" || text.empty()) return Environment::kUnknown;
+  throw std::invalid_argument("unknown environment '" + text + "' (expected indoor, outdoor or unknown)");
+}
+
+std::string environment_name(Environment e) {
+  return e == Environment::kIndoor ? "indoor" : e == Environment::kOutdoor ? "outdoor" : "unknown";
+}
+
+bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
+                     double* upper, std::string* why) {
+  const std::string effect = effect_of_parameter(parameter);
+  if (effect.empty()) return false;
+  const PlausibleRange* found = nullptr;
+  for (const auto& r : find_effect(effect).plausible) {
+    if (!r.parameter.empty() && r.parameter != parameter) continue;
+    if (r.only_in == where || (r.only_in == Environment::kUnknown && !found)) found = &r;
+  }
+  if (!found) return false;
+  const double unit = found->scale == PlausibleRange::Scale::kRotorArm      ? scales.rotor_arm
+                      : found->scale == PlausibleRange::Scale::kRotorRadius ? scales.rotor_radius
+                                                                            : 1.0;
+  *lower = found->lower * unit;
+  *upper = found->upper * unit;
+  *why = found->why;
+  return true;
 }
 
 std::vector<std::string> parse_effect_list(const std::string& text) {

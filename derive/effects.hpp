@@ -19,6 +19,24 @@ struct LookAlike {
   std::string effect, separating_manoeuvre;
 };
 
+// Where a flight was flown, as a log or the command line declares it: what is plausible
+// depends on it (a steady wind indoors is not).
+enum class Environment { kUnknown, kIndoor, kOutdoor };
+Environment parse_environment(const std::string& text);  // "unknown", "indoor", "outdoor"
+std::string environment_name(Environment e);
+
+// The values of a parameter that the effect's physics can produce. A fitted value beyond
+// them is the effect standing in for something the model lacks, not the effect itself.
+struct PlausibleRange {
+  std::string parameter;
+  double lower = 0, upper = 0;
+  // What lower and upper are in: SI, or fractions of the vehicle's rotor arm (the largest
+  // distance of a rotor from the body z axis) or of its rotor radius.
+  enum class Scale { kSI, kRotorArm, kRotorRadius } scale = Scale::kSI;
+  Environment only_in = Environment::kUnknown;  // kUnknown: wherever no other range applies
+  std::string why;  // the physical argument, with its source
+};
+
 // One home per effect: its symbolic change, and what fits and the diagnosis need to know
 // about it.
 struct Effect {
@@ -39,6 +57,8 @@ struct Effect {
   // motor or the battery is re-seated, the wind of the day): when several flights are
   // diagnosed together, each flight has its own values (runtime::PerFlightModel).
   bool per_flight = false;
+  // Plausible values of its parameters (none for a parameter: any value in its bounds).
+  std::vector<PlausibleRange> plausible;
   std::vector<LookAlike> look_alikes;
 };
 
@@ -61,6 +81,14 @@ std::vector<std::string> reference_parameters(const std::vector<std::string>& pa
 // for effects off there); a base-model parameter's nominal value.
 double off_value(const Variable& parameter);
 
+// The vehicle lengths plausible ranges may be relative to.
+struct VehicleScales {
+  double rotor_arm = 0, rotor_radius = 0;  // m
+};
+// The plausible range of a parameter in this environment, in SI (lower, upper, why); false
+// when its effect declares none.
+bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
+                     double* upper, std::string* why);
 // Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
 std::vector<std::string> parse_effect_list(const std::string& text);
 

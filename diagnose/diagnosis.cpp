@@ -28,11 +28,21 @@ std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vec
   return rms;
 }
 
+// The lengths plausible ranges may be relative to: the largest distance of a rotor from the
+// body z axis, and the largest rotor radius.
+VehicleScales vehicle_scales(const Vehicle& v) {
+  VehicleScales s;
+  for (const auto& r : v.rotors) {
+    s.rotor_arm = std::max(s.rotor_arm, std::hypot(r.position[0], r.position[1]));
+    s.rotor_radius = std::max(s.rotor_radius, r.radius);
+  }
+  return s;
+}
+
 // m g arm / J: the angular acceleration the vehicle's weight gives at its rotor arm, the scale
 // against which a moment is negligible.
 double rotation_scale(const Vehicle& v, const SymbolicModel& all) {
-  double arm = 0;
-  for (const auto& r : v.rotors) arm = std::max(arm, std::hypot(r.position[0], r.position[1]));
+  const double arm = vehicle_scales(v).rotor_arm;
   const auto nominal = [&](const char* n) { return all.params[all.param_index(n)].nominal; };
   const double J = std::max(nominal("J_xx"), nominal("J_yy"));
   return J > 0 ? nominal("mass") * nominal("g") * arm / J : 0.0;
@@ -93,6 +103,26 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   f.before = cost_without;
   f.after = cost_with;
   return {f, why};
+}
+
+// The first parameter of a finding outside its plausible range in this environment; false
+// when every value is plausible.
+bool implausible_parameter(const Finding& f, Environment where, const VehicleScales& scales, StandIn* out) {
+  for (const auto& p : f.parameters) {
+    double lo = 0, hi = 0;
+    std::string why;
+    if (!plausible_range(runtime::shared_name(p.name), where, scales, &lo, &hi, &why)) continue;
+    if (p.value >= lo && p.value <= hi) continue;
+    out->candidate = f;
+    out->parameter = p.name;
+    out->value = p.value;
+    out->unit = p.unit;
+    out->plausible_lower = lo;
+    out->plausible_upper = hi;
+    out->why = why;
+    return true;
+  }
+  return false;
 }
 
 // In a joint diagnosis, the parameters that take one value per flight: those of the
@@ -261,6 +291,27 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       break;
     }
     search.remove_effects(d.search, drop);
+  }
+  // Accepted, but beyond what the effect's physics can produce here: a stand-in for missing
+  // physics. It stays in the model (carried, like the stronger of a look-alike pair) and is
+  // reported with the residual it absorbs, not named.
+  d.environment = environment_name(opt.environment);
+  for (auto it = d.findings.begin(); it != d.findings.end();) {
+    StandIn st;
+    if (!implausible_parameter(*it, opt.environment, vehicle_scales(v), &st)) {
+      ++it;
+      continue;
+    }
+    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
+    others.erase(it->effect);
+    double c = 0;
+    const auto without = search.fit_with(others, d.search.final_fit, &c);
+    st.channels = d.channel_names;
+    st.rms_without = channel_rms(train_ee, without);
+    st.rms_with = channel_rms(train_ee, d.search.final_fit);
+    d.search.carried.push_back(it->effect);
+    d.stand_ins.push_back(st);
+    it = d.findings.erase(it);
   }
   // Significant on the training data but no held-out gain in the search itself: suspected.
   for (const auto& ev : d.search.training_only)

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "candidate_search.hpp"
+#include "effects.hpp"
 #include "flight_data.hpp"
 #include "prediction.hpp"
 #include "residual_analysis.hpp"
@@ -21,6 +22,8 @@ struct DiagnoseOptions {
   // "accelerometer" (specific force, body frame) or "auto" (pose when logged).
   std::string translational = "auto";
   SearchOptions search;
+  // Where the flights were flown: what is plausible depends on it (a steady wind indoors).
+  Environment environment = Environment::kUnknown;
   // Unexplained discrepancy: slow residual structure beyond this many times what the noise
   // gives, at this significance, after the selected effects.
   double unexplained_ratio = 3.0, unexplained_p = 1e-6;
@@ -42,6 +45,19 @@ struct Finding {
 struct Suspected {
   Finding candidate;
   std::string failed;
+};
+
+// A finding whose value lies outside what its effect's physics can produce (a steady wind
+// indoors, a 5 degree IMU misalignment): it stands in for something the model lacks. It
+// stays in the extended model, since what it absorbs is real, but is never named.
+struct StandIn {
+  Finding candidate;
+  std::string parameter, why;  // the parameter out of its range, and the physical argument
+  double value = 0, plausible_lower = 0, plausible_upper = 0;
+  std::string unit;
+  // Training equation-error RMS per channel: the final model without it -> with it.
+  std::vector<std::string> channels;
+  std::vector<double> rms_without, rms_with;
 };
 
 struct Unexplained {
@@ -72,6 +88,8 @@ struct Diagnosis {
   std::vector<double> t, residual_before, residual_after;  // ns x 6, for plots
   std::vector<Finding> findings;
   std::vector<Suspected> suspected;
+  std::string environment;  // as declared: indoor, outdoor, unknown
+  std::vector<StandIn> stand_ins;
   std::vector<Unexplained> unexplained;
   std::vector<ChannelGain> channel_gain;
   // Free parameters of the final model that ended on a bound: the model is strained there,

@@ -120,6 +120,26 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     suspected.push_back(sj);
   }
   j["suspected"] = suspected;
+  j["environment"] = d.environment;
+  json stand_ins = json::array();
+  for (const auto& st : d.stand_ins) {
+    json absorbs = json::array();
+    for (size_t c = 0; c < st.channels.size(); ++c)
+      absorbs.push_back({{"channel", st.channels[c]},
+                         {"training_rms_without", st.rms_without[c]},
+                         {"training_rms_with", st.rms_with[c]}});
+    json sj = finding_json(st.candidate);
+    sj["parameter"] = st.parameter;
+    sj["value"] = st.value;
+    sj["unit"] = st.unit;
+    sj["plausible"] = {st.plausible_lower, st.plausible_upper};
+    sj["why"] = st.why;
+    sj["absorbs"] = absorbs;
+    stand_ins.push_back(sj);
+  }
+  // Accepted by every statistical test but outside what the effect's physics can produce:
+  // in the extended model (carried), never named.
+  j["stand_ins"] = stand_ins;
   json removed = json::array();
   for (const auto& r : d.search.removed)
     removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value},
@@ -310,6 +330,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
        << "); to separate them: " << a.manoeuvre << "\n";
+  for (const auto& st : d.stand_ins)
+    os << "stands in for missing physics, not named: " << st.candidate.effect << " (" << st.parameter << " = "
+       << num(st.value) << " " << st.unit << " lies outside [" << num(st.plausible_lower) << ", "
+       << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
+       << ": " << st.why << ")\n";
   for (const auto& x : d.suspected)
     os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
@@ -360,6 +385,22 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ", validation cost " << num(f.evidence.validation_gain_percent, 3) << " % lower; " << esc(f.metric) << " "
       << num(f.before) << " &rarr; " << num(f.after) << ".</p>\n";
+  }
+  if (!d.stand_ins.empty()) {
+    h << "<h2>Stand-ins for missing physics</h2>\n<p>Each passed every statistical test, but its value lies outside "
+         "what its physics can produce here: it absorbs an error of something the model lacks. It stays in the "
+         "extended model and is not named.</p>\n<table><tr><th>effect</th><th>value</th><th>plausible</th><th>why</th>"
+         "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
+    for (const auto& st : d.stand_ins) {
+      h << "<tr><td>" << esc(st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
+        << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
+        << esc(st.why) << "</td><td>";
+      for (size_t c = 0; c < st.channels.size(); ++c)
+        h << (c ? "; " : "") << esc(st.channels[c]) << " " << num(st.rms_without[c], 3) << " &rarr; "
+          << num(st.rms_with[c], 3);
+      h << "</td></tr>\n";
+    }
+    h << "</table>\n";
   }
   if (!d.search.unresolved.empty()) {
     h << "<h2>Ambiguous</h2>\n";

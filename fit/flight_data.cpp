@@ -26,6 +26,7 @@ runtime::CsvTable read_measurement_csv(const std::string& path) {
 // Column mappings (e.g. data/mappings/nanobench.yaml):
 //
 //   name: TEXT                       optional, names the mapping in messages
+//   environment: indoor|outdoor      optional, where the logs were flown (what is plausible)
 //   columns:
 //     CANONICAL: {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}
 //
@@ -151,10 +152,15 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
   try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
-    const auto top = checked_keys(path, root, "mapping", {"name", "columns"});
+    const auto top = checked_keys(path, root, "mapping", {"name", "columns", "environment"});
     if (!top.count("columns") || !top.at("columns").IsMap())
       throw FitError(path + ":1: expected a 'columns' mapping (canonical column: {source, scale, offset, unit})");
     m.name = top.count("name") ? scalar_text(path, top.at("name"), "name") : path;
+    if (top.count("environment")) {
+      m.environment = scalar_text(path, top.at("environment"), "environment");
+      if (m.environment != "indoor" && m.environment != "outdoor" && m.environment != "unknown")
+        mapping_error(path, top.at("environment"), "environment: expected indoor, outdoor or unknown");
+    }
     std::set<std::string> targets;
     for (const auto& kv : top.at("columns")) {
       ColumnMapping::Entry e = parse_entry(path, kv.first, kv.second);

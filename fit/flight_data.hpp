@@ -14,6 +14,8 @@ namespace quadgen::fit {
 // the canonical column's SI unit (see load_mapping in flight_data.cpp for the rules).
 struct ColumnMapping {
   std::string name;
+  // Where the logs were flown, when the mapping says: "indoor", "outdoor" ("" if not said).
+  std::string environment;
   struct Entry {
     std::string target, source, unit;
     double scale = 1, offset = 0;

@@ -222,6 +222,30 @@ TEST(Model, JacobiansAreDerivativesOfF) {
 
 // Each effect's facts live in its catalogue entry; they must refer to what the effect
 // actually declares, or a search would start a parameter that does not exist.
+// What is plausible depends on where a vehicle flies and on its size.
+TEST(Effects, PlausibleRangesDependOnWhereAndOnTheVehicle) {
+  const VehicleScales cf{0.046, 0.0225};
+  double lo = 0, hi = 0;
+  std::string why;
+  ASSERT_TRUE(plausible_range("wind.x", Environment::kIndoor, cf, &lo, &hi, &why));
+  EXPECT_EQ(hi, 0.5);
+  EXPECT_NE(why.find("indoors"), std::string::npos);
+  for (Environment e : {Environment::kUnknown, Environment::kOutdoor}) {
+    ASSERT_TRUE(plausible_range("wind.y", e, cf, &lo, &hi, &why));
+    EXPECT_EQ(lo, -15.0);
+  }
+  ASSERT_TRUE(plausible_range("cog_offset.x", Environment::kIndoor, cf, &lo, &hi, &why));
+  EXPECT_DOUBLE_EQ(hi, 0.2 * 0.046);
+  ASSERT_TRUE(plausible_range("ground_effect.radius", Environment::kUnknown, cf, &lo, &hi, &why));
+  EXPECT_DOUBLE_EQ(hi, 3 * 0.0225);
+  ASSERT_TRUE(plausible_range("motor_gain.M2", Environment::kUnknown, cf, &lo, &hi, &why));
+  EXPECT_EQ(hi, 0.35);
+  EXPECT_FALSE(plausible_range("blade_flapping.k", Environment::kUnknown, cf, &lo, &hi, &why));
+  EXPECT_FALSE(plausible_range("c_t", Environment::kUnknown, cf, &lo, &hi, &why));
+  EXPECT_EQ(parse_environment("indoor"), Environment::kIndoor);
+  EXPECT_THROW(parse_environment("cave"), std::invalid_argument);
+}
+
 TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
   const SymbolicModel all = derive(test::finken3(), parse_effect_list("all"));
   std::set<std::string> params, effects(all.effects.begin(), all.effects.end());
@@ -233,6 +257,14 @@ TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
       const auto& p = *std::find_if(all.params.begin(), all.params.end(), [&](const auto& q) { return q.name == name; });
       EXPECT_GT(value, p.lower) << name;
       EXPECT_LT(value, p.upper) << name;
+    }
+    // A plausible range names a parameter of its effect (or all of them), contains "off"
+    // and says why.
+    for (const auto& r : e.plausible) {
+      if (!r.parameter.empty()) EXPECT_TRUE(params.count(r.parameter)) << e.name << ": " << r.parameter;
+      EXPECT_LE(r.lower, 0.0) << e.name;
+      EXPECT_GE(r.upper, 0.0) << e.name;
+      EXPECT_FALSE(r.why.empty()) << e.name;
     }
     for (const auto& l : e.look_alikes) {
       EXPECT_TRUE(effects.count(l.effect)) << e.name << " -> " << l.effect;
