@@ -26,12 +26,12 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   const int lag = model.param_index("motor_lag.tau");
   if (lag >= 0 && sim_params[lag] < 1e-3) sim_params[lag] = 1e-3;
   model.set_params(sim_params);
-  auto param = [&](const char* n) {
+  // The data-side values in effect at time t (one per flight in a per-flight model).
+  auto param = [&](const char* n, double t) {
     const int i = model.param_index(n);
-    return i >= 0 ? sim_params[i] : 0.0;
+    return i >= 0 ? sim_params[model.param_column(i, t)] : 0.0;
   };
-  const double delay = param("input_delay.seconds"), roll = param("attitude_bias.roll"),
-               pitch = param("attitude_bias.pitch"), tau = param("motor_lag.tau");
+  double delay = 0, roll = 0, pitch = 0, tau = 0;
   const int n = model.num_states(), nu = model.num_inputs();
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
   const size_t nr = f.samples.front().u.size();
@@ -50,6 +50,9 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   const auto& S = f.samples;
   std::vector<double> u(nu), fx(n);
   for (size_t k0 = 0; k0 + 1 < S.size();) {
+    const double t0 = S[k0].t;
+    delay = param("input_delay.seconds", t0), roll = param("attitude_bias.roll", t0);
+    pitch = param("attitude_bias.pitch", t0), tau = param("motor_lag.tau", t0);
     std::vector<double> x(n, 0.0);
     std::copy(S[k0].x.begin(), S[k0].x.end(), x.begin());
     runtime::unbias_attitude(&S[k0].x[6], roll, pitch, &x[6]);

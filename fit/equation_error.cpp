@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <Eigen/Dense>
 
@@ -24,6 +25,11 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   delay_ = model.param_index("input_delay.seconds");
   roll_ = model.param_index("attitude_bias.roll");
   pitch_ = model.param_index("attitude_bias.pitch");
+  std::set<int> columns;
+  for (int c : {lag_, delay_, roll_, pitch_})
+    if (c >= 0)
+      for (const auto& s : flight_.samples) columns.insert(model.param_column(c, s.t));
+  data_side_columns_.assign(columns.begin(), columns.end());
   for (int i = 13; i < model.num_states(); ++i) {
     const std::string& s = model.state_names()[i];
     if (lag_ < 0 || s.rfind("w_", 0) != 0)
@@ -150,10 +156,11 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   X.assign(ns * n, 0.0);
   U.assign(ns * nu, 0.0);
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
-  const double delay = delay_ >= 0 ? p[delay_] : 0.0;
-  const double roll = roll_ >= 0 ? p[roll_] : 0.0, pitch = pitch_ >= 0 ? p[pitch_] : 0.0;
+  // The data-side values in effect at time t (one per flight in a per-flight model).
+  const auto at = [&](int index, double t) { return index >= 0 ? p[model_->param_column(index, t)] : 0.0; };
   for (size_t k = 0; k < ns; ++k) {
     const FlightSample& s = flight_.samples[k];
+    const double delay = at(delay_, s.t), roll = at(roll_, s.t), pitch = at(pitch_, s.t);
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
@@ -169,12 +176,12 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // first-order lag, started in steady state; the commands are held between samples, for
   // which the discretisation is exact. The mean over each interval (what its mid-interval
   // acceleration sees) goes to mean_speed_; as tau -> 0 it is the held command's speed.
-  const double tau = p[lag_];
   const size_t nr = speed_states_.size();
   mean_speed_.assign(ns * nr, 0.0);
   std::vector<double> f(n), c(nr);
   for (size_t k = 0; k < ns; ++k) {
     double* x = &X[k * n];
+    const double tau = at(lag_, flight_.samples[k].t);
     if (k > 0) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
       const double a = std::exp(-h / tau);
@@ -201,8 +208,8 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const 
   if (!J) return;
   // Columns of the parameters applied to the data: central differences.
   std::vector<double> pp(p, p + np), rp(rows_.size() * 6), rm(rp.size());
-  for (int c : {lag_, delay_, roll_, pitch_}) {
-    if (c < 0 || (!free_.empty() && !free_[c])) continue;
+  for (int c : data_side_columns_) {
+    if (!free_.empty() && !free_[c]) continue;
     const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
     pp[c] = p[c] + h;
     residuals(pp.data(), rp.data(), nullptr);

@@ -64,6 +64,8 @@ class EquationErrorModel : public ResidualModel {
   // Parameters applied to the data (-1 when the model lacks the effect).
   int lag_ = -1, delay_ = -1, roll_ = -1, pitch_ = -1;
   std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
+  // Every column those parameters take over the flight (several when they differ by flight).
+  std::vector<int> data_side_columns_;
   Derivatives derivatives_;
   std::vector<size_t> rows_;
   // kFiltered: for each row, the first sample of its window, the weights of the model's

@@ -46,10 +46,11 @@ struct DataSideEffects {
   double delay = 0, roll = 0, pitch = 0, tau = 0;
 };
 
-DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<double>& p) {
+// Their values in effect at time t (one per flight in a per-flight model).
+DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<double>& p, double t) {
   auto get = [&](const char* n) {
     const int i = model.param_index(n);
-    return i >= 0 ? p[i] : 0.0;
+    return i >= 0 ? p[model.param_column(i, t)] : 0.0;
   };
   return {get("input_delay.seconds"), get("attitude_bias.roll"), get("attitude_bias.pitch"), get("motor_lag.tau")};
 }
@@ -58,12 +59,15 @@ DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<
 // model's input delay), and optionally the log's attitude and body rates imposed.
 class Rollout {
  public:
-  Rollout(runtime::DynamicModel& model, const fit::Flight& f, const DataSideEffects& e, double step)
-      : m_(model), f_(f), e_(e), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
+  Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step)
+      : m_(model), f_(f), p_(p), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
         k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
     t_in_ = model.input_index("t");
     v_in_ = model.input_index("vbat");
   }
+
+  // The data-side effects in force from sample k on (a rollout stays within one flight).
+  const DataSideEffects& start_at(size_t k) { return e_ = data_side(m_, p_, f_.samples[k].t); }
 
   // The measured state at sample k (attitude unbiased), rotor speeds in steady state.
   std::vector<double> initial_state(size_t k) {
@@ -150,6 +154,7 @@ class Rollout {
 
   runtime::DynamicModel& m_;
   const fit::Flight& f_;
+  const std::vector<double>& p_;
   DataSideEffects e_;
   double step_;
   int n_, t_in_ = -1, v_in_ = -1;
@@ -189,8 +194,8 @@ double median_spacing(const fit::Flight& f) {
 
 // Rollouts from start points every `stride` seconds; the error at each horizon is taken at
 // the first sample at or after start + horizon (within a quarter of a sample spacing).
-std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const DataSideEffects& e,
-                                    const PredictionOptions& o, bool replay, size_t* starts) {
+std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, bool replay,
+                                    size_t* starts) {
   std::vector<HorizonErrors> rows;
   for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
   const auto& S = f.samples;
@@ -201,6 +206,7 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const D
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
     ++*starts;
+    const DataSideEffects& e = roll.start_at(k0);
     std::vector<double> x = roll.initial_state(k0);
     if (replay) roll.impose_attitude(S[k0].t, k0, x);
     size_t next = 0;  // the next horizon to score
@@ -221,8 +227,7 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const D
 
 // One-step residuals of the equation error (the fit's own formulation: lag, delay and bias
 // applied to the data), rotated into body and world axes.
-OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f,
-                       const DataSideEffects& e) {
+OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f) {
   OneStepErrors out;
   const bool accel = f.has_accelerometer;
   out.source = accel ? "accelerometer (specific force) and differentiated gyro"
@@ -233,6 +238,7 @@ OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& 
     ee.all_channels(p.data(), r6);
     for (size_t row = 0; row < ee.rows().size(); ++row) {
       const auto& s = f.samples[ee.rows()[row]];
+      const DataSideEffects e = data_side(model, p, s.t);
       double q[4];
       runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
       const runtime::Rotation R = runtime::rotation_matrix(q);
@@ -274,14 +280,13 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   std::vector<double> p = params;
   const int lag = model.param_index("motor_lag.tau");
   if (lag >= 0 && p[lag] < 1e-3) p[lag] = 1e-3;
-  const DataSideEffects e = data_side(model, p);
-  out.one_step = one_step(model, params, f, e);
+  out.one_step = one_step(model, params, f);
   model.set_params(p);
   if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with
-  Rollout roll(model, f, e, o.step);
+  Rollout roll(model, f, p, o.step);
   size_t starts = 0;
-  out.open_loop = rollouts(roll, f, e, o, false, &out.start_points);
-  out.attitude_replayed = rollouts(roll, f, e, o, true, &starts);
+  out.open_loop = rollouts(roll, f, o, false, &out.start_points);
+  out.attitude_replayed = rollouts(roll, f, o, true, &starts);
   return out;
 }
 

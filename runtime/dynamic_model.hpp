@@ -30,6 +30,11 @@ class DynamicModel {
   // holds its parameters and scratch space, so one instance serves one thread. nullptr:
   // this model cannot be copied, and its users stay on one thread.
   virtual std::unique_ptr<DynamicModel> clone() const { return nullptr; }
+  // Where parameter `index`'s value for time t (the input "t") sits in the parameter vector:
+  // `index` itself, except in a model whose parameters differ by flight (PerFlightModel).
+  // Effects applied to the data rather than the dynamics (attitude bias, input delay, motor
+  // lag) read their values through it.
+  virtual int param_column(int index, double /*t*/) const { return index; }
 
   int state_index(const std::string& name) const;
   int input_index(const std::string& name) const;

@@ -57,6 +57,11 @@ int PerFlightModel::flight_at(double t) const {
   return static_cast<int>(std::upper_bound(starts_.begin(), starts_.end(), t) - starts_.begin());
 }
 
+int PerFlightModel::param_column(int index, double t) const {
+  const auto& column = column_[flight_at(t)];
+  return index >= 0 && index < static_cast<int>(column.size()) ? column[index] : index;
+}
+
 void PerFlightModel::set_params(const std::vector<double>& p) {
   if (p.size() != names_.size()) throw std::invalid_argument("per-flight model: wrong number of parameters");
   p_ = p;

@@ -47,6 +47,7 @@ class PerFlightModel : public DynamicModel {
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<PerFlightModel>(*this); }
+  int param_column(int index, double t) const override;
 
  private:
   std::vector<std::unique_ptr<DynamicModel>> flights_;  // the inner model, one copy per flight

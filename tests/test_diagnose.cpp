@@ -426,7 +426,7 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
   const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
   ASSERT_EQ(j["flights"].size(), 2u) << j["flights"].dump();
   ASSERT_EQ(named(j), std::vector<std::string>{"motor_gain"}) << j["findings"].dump(1) << j["suspected"].dump(1);
-  EXPECT_EQ(j["per_flight_effects"], json({"motor_gain", "wind"}));
+  EXPECT_EQ(j["per_flight_effects"], json({"motor_gain", "wind", "attitude_bias"}));
   const json& ps = j["findings"][0]["parameters"];
   for (const auto& [name, truth] : std::vector<std::pair<std::string, double>>{
            {"motor_gain.C", -0.08}, {"motor_gain.B", 0.0}, {"motor_gain.C@2", 0.0}, {"motor_gain.B@2", 0.06}}) {

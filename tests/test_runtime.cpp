@@ -136,6 +136,11 @@ TEST(PerFlightModel, EachFlightSeesItsOwnValuesAndColumns) {
   EXPECT_EQ(joint.flight_at(9.99), 0);
   EXPECT_EQ(joint.flight_at(10.0), 1);
   EXPECT_EQ(joint.flight_at(25.0), 2);
+  // effects applied to the data read each flight's value through param_column
+  EXPECT_EQ(joint.param_column(inner.param_index("motor_gain.C"), 5.0), inner.param_index("motor_gain.C"));
+  EXPECT_EQ(joint.param_column(inner.param_index("motor_gain.C"), 15.0), np);
+  EXPECT_EQ(joint.param_column(inner.param_index("wind.x"), 25.0), np + 3);
+  EXPECT_EQ(joint.param_column(inner.param_index("c_t"), 25.0), inner.param_index("c_t"));
   std::vector<double> p = joint.params();
   const int gain = inner.param_index("motor_gain.C"), wind = inner.param_index("wind.x");
   const double gains[3] = {0.05, -0.1, 0.2}, winds[3] = {0.5, -1.0, 2.0};
