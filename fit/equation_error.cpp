@@ -40,6 +40,7 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     throw FitError("more rotor-speed states than logged commands");
   if (accel_ && !flight_.has_accelerometer) throw FitError(flight_.source + ": no accelerometer columns ax, ay, az");
   if (!accel_ && !flight_.has_pose) throw FitError(flight_.source + ": no pose to differentiate");
+  mark_contiguous_intervals();
   if (derivatives_ == Derivatives::kPointwise) {
     for (size_t k = 0; k < flight_.samples.size(); ++k) rows_.push_back(k);
   } else {
@@ -52,7 +53,9 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
 // of the interval accelerations that give the same derivative of a signal whose rate is
 // those accelerations: y_i - y_k is the sum of (t_{j+1} - t_j) a_{j+1/2} over the
 // intervals in between, so interval j carries (t_{j+1} - t_j) * sum_{i > j} c_i.
-void EquationErrorModel::build_filter(double window) {
+// An interval longer than 1.5 median sample spacings is a gap (trimmed ground contact, the
+// second of several joined flights): nothing is integrated or differentiated across it.
+void EquationErrorModel::mark_contiguous_intervals() {
   const auto& S = flight_.samples;
   const size_t ns = S.size();
   std::vector<double> dts;
@@ -60,9 +63,16 @@ void EquationErrorModel::build_filter(double window) {
   if (dts.empty()) return;
   std::vector<double> sorted = dts;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double gap = 1.5 * sorted[sorted.size() / 2];
+  gap_ = 1.5 * sorted[sorted.size() / 2];
   interval_ok_.assign(ns, false);
-  for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap;
+  for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap_;
+}
+
+void EquationErrorModel::build_filter(double window) {
+  const auto& S = flight_.samples;
+  const size_t ns = S.size();
+  if (interval_ok_.empty()) return;
+  const double gap = gap_;
   for (size_t k = 0; k < ns; ++k) {
     size_t lo = k, hi = k;
     while (lo > 0 && interval_ok_[lo - 1] && S[k].t - S[lo - 1].t <= window + 1e-9) --lo;
@@ -182,7 +192,9 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   for (size_t k = 0; k < ns; ++k) {
     double* x = &X[k * n];
     const double tau = at(lag_, flight_.samples[k].t);
-    if (k > 0) {
+    // After a gap the rotors restart in steady state with the commands, as at the start.
+    const bool restart = k == 0 || !interval_ok_[k - 1];
+    if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
       const double a = std::exp(-h / tau);
       for (size_t i = 0; i < nr; ++i) {
@@ -197,7 +209,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     model_->rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
     for (size_t i = 0; i < nr; ++i) {
       c[i] = tau * f[speed_states_[i]];
-      x[speed_states_[i]] = k == 0 ? c[i] : w_now[i];
+      x[speed_states_[i]] = restart ? c[i] : w_now[i];
     }
   }
 }

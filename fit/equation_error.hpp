@@ -74,6 +74,8 @@ class EquationErrorModel : public ResidualModel {
   std::vector<std::vector<double>> interval_weights_;
   std::vector<std::array<double, 6>> measured_;
   std::vector<bool> interval_ok_;  // interval k -> k+1 lies inside a contiguous stretch
+  double gap_ = 0;  // s: a longer sample interval is a gap
+  void mark_contiguous_intervals();
   void build_filter(double window);
   mutable std::vector<bool> free_;
   mutable Quadrature quadrature_ = Quadrature::kMidpoint;

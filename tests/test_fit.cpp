@@ -10,7 +10,10 @@
 
 #include "dynamic_model.hpp"
 #include "equation_error.hpp"
+#include "attitude.hpp"
 #include "generated/finken3/model.hpp"
+#include "generated/finken3_all_effects/model.hpp"
+#include "per_flight_model.hpp"
 #include "least_squares.hpp"
 #include "motor_steps.hpp"
 #include "profile_likelihood.hpp"
@@ -444,4 +447,81 @@ TEST(FitCli, MotorGainReferenceIsHeld) {
   EXPECT_FALSE(j["estimates"]["motor_gain.A"]["fitted"].get<bool>());
   EXPECT_TRUE(j["estimates"]["motor_gain.C"]["fitted"].get<bool>());
   EXPECT_NEAR(j["estimates"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.01);
+}
+
+// Per-flight data-side parameters: two flights logged with different attitude biases (a
+// marker frame fitted per session). Joined and fitted through a PerFlightModel, each
+// flight's bias comes back; the equation error reads each sample's bias from its flight.
+TEST(Fit, EachFlightKeepsItsOwnAttitudeBias) {
+  runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
+  const double roll[2] = {0.03, -0.02}, pitch[2] = {-0.01, 0.025};
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  std::normal_distribution<double> noise(0, 0.01);
+  Flight joined;
+  joined.has_pose = joined.has_gyro = true;
+  const int n = inner.num_states();
+  const double tau = inner.params()[inner.param_index("motor_lag.tau")];
+  for (int flight = 0; flight < 2; ++flight) {
+    // Commands constant over a flight: the rotor speeds are then the commanded ones,
+    // whatever the lag (the equation error filters the commands into them).
+    std::vector<double> commands;
+    for (int i = 0; i < 4; ++i) commands.push_back(cmd(rng));
+    for (int k = 0; k < 300; ++k) {
+      FlightSample s;
+      s.t = 10.0 * flight + 0.01 * k;
+      s.x = test::random_state(rng);
+      s.u = commands;
+      s.vbat = 3.9;
+      std::vector<double> u = s.u, f(n), x = s.x;
+      u.push_back(s.t);
+      u.push_back(s.vbat);
+      x.resize(n, 0.0);
+      inner.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt at w = 0: w_cmd / tau
+      for (int i = 13; i < n; ++i) x[i] = tau * f[i];
+      inner.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);
+      for (int i = 0; i < 3; ++i) {
+        s.acc_world[i] = f[3 + i] + noise(rng);
+        s.rate_dot[i] = f[10 + i] + noise(rng);
+      }
+      // logged attitude q_log = q (x) q_bias, q_bias = q_y(pitch) (x) q_x(roll)
+      const double qp[4] = {std::cos(pitch[flight] / 2), 0, std::sin(pitch[flight] / 2), 0};
+      const double qr[4] = {std::cos(roll[flight] / 2), std::sin(roll[flight] / 2), 0, 0};
+      double qb[4], q_log[4];
+      runtime::quaternion_product(qp, qr, qb);
+      runtime::quaternion_product(&s.x[6], qb, q_log);
+      std::copy(q_log, q_log + 4, s.x.begin() + 6);
+      joined.samples.push_back(s);
+    }
+  }
+  runtime::PerFlightModel model(inner, {10.0}, {"attitude_bias.roll", "attitude_bias.pitch"});
+  EquationErrorModel m(model, joined, false, {}, EquationErrorModel::Derivatives::kPointwise);
+  std::vector<FitParameter> ps;
+  for (int i = 0; i < model.num_params(); ++i) {
+    const std::string n = model.param_names()[i];
+    const bool free = n.rfind("attitude_bias.", 0) == 0;
+    const double v = model.params()[i];
+    ps.push_back({n, "", v, free ? -0.2 : v, free ? 0.2 : v, free});
+  }
+  FitOptions fo;
+  fo.account_autocorrelation = false;
+  {  // the residuals at the true values
+    std::vector<double> p0 = parameter_values(ps), r0(m.num_residuals());
+    p0[model.param_index("attitude_bias.roll")] = roll[0];
+    p0[model.param_index("attitude_bias.pitch")] = pitch[0];
+    p0[model.param_index("attitude_bias.roll@2")] = roll[1];
+    p0[model.param_index("attitude_bias.pitch@2")] = pitch[1];
+    m.evaluate(p0.data(), r0.data(), nullptr);
+    // At the truth only the noise is left, at the first samples of the second flight too
+    // (its rotors start from its own commands, not from the first flight's).
+    double largest = 0;
+    for (double v : r0) largest = std::max(largest, std::fabs(v));
+    EXPECT_LT(largest, 0.06);
+  }
+  const FitResult best = fit_least_squares(m, ps, fo);
+  const auto value = [&](const std::string& n) { return best.parameters[model.param_index(n)].value; };
+  EXPECT_NEAR(value("attitude_bias.roll"), roll[0], 1e-3);
+  EXPECT_NEAR(value("attitude_bias.pitch"), pitch[0], 1e-3);
+  EXPECT_NEAR(value("attitude_bias.roll@2"), roll[1], 1e-3);
+  EXPECT_NEAR(value("attitude_bias.pitch@2"), pitch[1], 1e-3);
 }
