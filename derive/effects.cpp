@@ -190,8 +190,9 @@ std::vector<Effect> build_catalogue() {
   }
   {
     Effect& e = add("thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", thrust_decay);
-    e.plausible = {{"thrust_decay.rate", -1e-4, 2e-3, Scale::kSI, Environment::kUnknown,
-                    "a LiPo from full to the end of a flight loses 15-25 % of thrust over minutes, under 0.2 %/s"}};
+    e.plausible = {{"thrust_decay.rate", -1e-4, 5e-3, Scale::kSI, Environment::kUnknown,
+                    "a LiPo from full to the end of a flight loses 15-30 % of thrust over minutes; half the thrust "
+                    "in 100 s (0.5 %/s) is beyond any battery that still flies"}};
     e.look_alikes = {{"battery_sag", "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)"}};
   }
   {

@@ -1,0 +1,83 @@
+// PX4 ULog flight logs (the "ULog File Format" specification of docs.px4.io): every logged
+// topic as a table of doubles, the parameters and the information messages.
+//
+// Logs come from users, so the reader trusts no length or offset in them. Policies:
+// - A message cut off by the end of the file is dropped and everything before it kept
+//   (logging stops mid-message on power loss; the spec asks for exactly this). The same
+//   holds at the start of appended data ('B' message, DATA_APPENDED). Ulog::truncated says
+//   that this happened and where.
+// - Anything else that does not fit the spec throws LogError "path: byte N: cause", N the
+//   offset of the message at fault. There is no resynchronisation on 'S' messages: a
+//   corrupt log is reported, not silently shortened.
+// - Message types this reader does not use ('M', 'Q', 'L', 'C', 'S') and unknown ones are
+//   skipped by their size (forward compatibility); unknown incompatible flag bits are refused.
+// - Formats are checked when they are subscribed: an unused format naming an unknown type
+//   is no error. A subscribed format must not be recursive, nest deeper than
+//   kUlogMaxNesting, have arrays longer than kUlogMaxArray (or of length 0) or exceed
+//   kUlogMaxFormatBytes (no data message can be larger), and needs a `uint64_t timestamp`.
+// - Names longer than kUlogMaxName are refused, and the column layouts of all subscribed
+//   topics together may take at most about kUlogMaxLayoutBytes, so a few bytes of formats
+//   and subscriptions cannot demand gigabytes. Otherwise memory grows with the file: rows
+//   take at most about 8 times the bytes of their data messages.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "flight_log.hpp"  // LogError
+
+namespace quadgen::runtime {
+
+constexpr int kUlogMaxNesting = 16;
+constexpr std::uint64_t kUlogMaxArray = 65535;
+constexpr std::uint64_t kUlogMaxFormatBytes = 65535;
+constexpr std::size_t kUlogMaxName = 255;
+constexpr std::uint64_t kUlogMaxLayoutBytes = 64ULL << 20;
+
+// The data messages of one topic instance (a format name and its multi_id), one row each.
+// Columns are the flattened fields, `timestamp` (microseconds) first wherever the format has
+// it, the others in message order: arrays as `q[0]`.., nested types as `sub.field` and
+// `sub[1].field`; `_padding*` fields are left out. Every value is converted to double (char
+// and bool as their byte value, 64-bit integers rounded beyond 2^53). Values are as logged:
+// PX4 logs NaN for unset floats and nothing is range-checked here.
+struct UlogTopic {
+  std::string name;
+  int multi_id = 0;
+  std::vector<std::string> fields;
+  std::vector<std::vector<double>> rows;
+  int column(const std::string& field) const;  // -1 if absent
+};
+
+// A parameter set while logging ('P' message in the Data section).
+struct UlogParameterChange {
+  double timestamp = 0;  // latest data timestamp before it (microseconds), 0 if none yet
+  std::string name;
+  double value = 0;
+};
+
+struct Ulog {
+  std::string path;
+  int version = 0;                // file format version (header byte 7)
+  std::uint64_t start_time = 0;   // header timestamp, microseconds
+  std::vector<UlogTopic> topics;  // in order of first subscription
+  // Values when logging started ('P' messages of the Definitions section), int32_t and float.
+  std::map<std::string, double> parameters;
+  std::vector<UlogParameterChange> parameter_changes;
+  // 'I' messages as "name=value" in file order: char arrays as text (control characters as
+  // '?'), numbers in decimal, arrays comma-separated, other types as "<N bytes of TYPE>".
+  std::vector<std::string> info;
+  int dropouts = 0;  // 'O' messages and their total duration
+  double dropout_ms = 0;
+  bool truncated = false;                                                  // a cut-off message was dropped (see above)
+  std::uint64_t truncated_at = 0;                                          // the byte offset of the first one
+  const UlogTopic* find(const std::string& name, int multi_id = 0) const;  // nullptr if absent
+};
+
+// A regular file of at most max_input_bytes(), read into memory as a whole.
+Ulog read_ulog(const std::string& path);
+// `name` is the file name used in error messages.
+Ulog parse_ulog(const std::string& bytes, const std::string& name);
+
+}  // namespace quadgen::runtime
