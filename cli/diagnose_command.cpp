@@ -15,6 +15,7 @@
 #include "geometry.hpp"
 #include "header_writer.hpp"
 #include "json_document.hpp"
+#include "log_reader.hpp"
 #include "options.hpp"
 #include "output_set.hpp"
 #include "sinks.hpp"
@@ -78,12 +79,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   std::vector<fit::Flight> flights;
   const fit::ColumnMapping mapping = a.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(a.mapping);
-  for (const auto& path : a.logs) {
-    runtime::CsvTable log = runtime::read_csv(path);
-    if (!a.mapping.empty()) log = fit::apply_mapping(log, mapping);
-    if (a.resample > 0) log = fit::resample(log, a.resample);
-    flights.push_back(fit::load_flight(log, rotors, {}));
-  }
+  for (const auto& path : a.logs) flights.push_back(fit::load_flight(fit::read_log(path, a.mapping, a.resample), rotors, {}));
   std::string logs_label;  // what the outputs say was diagnosed
   for (const auto& path : a.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
   size_t samples = 0;

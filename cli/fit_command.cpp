@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "log_reader.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
@@ -203,9 +204,8 @@ std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitPar
   return ss;
 }
 
-int fit_flight(const FitArgs& a, const Vehicle& v, const runtime::CsvTable& raw, output::OutputDirectory& out) {
-  runtime::CsvTable log = a.mapping.empty() ? raw : apply_mapping(raw, load_mapping(a.mapping));
-  if (a.resample > 0) log = resample(log, a.resample);
+int fit_flight(const FitArgs& a, const Vehicle& v, output::OutputDirectory& out) {
+  const runtime::CsvTable log = read_log(a.log, a.mapping, a.resample);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const Flight flight = load_flight(log, rotors, {});
@@ -420,7 +420,8 @@ void check_flight_options(const FitArgs& a) {
 
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
-  const runtime::CsvTable head = runtime::read_csv(a.log);
+  // A ULog is a flight; a CSV is sniffed for the motor-step and thrust-stand layouts.
+  const runtime::CsvTable head = is_ulog(a.log) ? runtime::CsvTable{} : runtime::read_csv(a.log);
   output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});  // refused before the work, not after
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) {
     refuse_options(a, "a motor-step log", {"--out", "--robust", "--profiles", "--threads"});
@@ -431,7 +432,7 @@ int run_fit(const FitArgs& a) {
     return fit_thrust_stand(a, v, out);
   }
   check_flight_options(a);
-  return fit_flight(a, v, head, out);
+  return fit_flight(a, v, out);
 }
 
 }  // namespace quadgen::cli

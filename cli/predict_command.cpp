@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "log_reader.hpp"
 #include "commands.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
@@ -63,9 +64,7 @@ std::vector<double> read_params(const std::string& path, const runtime::DynamicM
 
 fit::Flight held_out_flight(const PredictArgs& a, const std::string& log_path, const std::vector<std::string>& rotors,
                             double vbat_ref) {
-  runtime::CsvTable log = runtime::read_csv(log_path);
-  if (!a.mapping.empty()) log = fit::apply_mapping(log, fit::load_mapping(a.mapping));
-  if (a.resample > 0) log = fit::resample(log, a.resample);
+  const runtime::CsvTable log = fit::read_log(log_path, a.mapping, a.resample);
   const fit::Flight flight = predict::fill_missing_signals(fit::load_flight(log, rotors, {}), vbat_ref);
   if (!flight.has_pose)
     std::cerr << output::printable(log_path) << ": no pose logged: one-step errors only (rollouts need a measured state)\n";

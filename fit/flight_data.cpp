@@ -27,6 +27,7 @@ runtime::CsvTable read_measurement_csv(const std::string& path) {
 //
 //   name: TEXT                       optional, names the mapping in messages
 //   environment: indoor|outdoor      optional, where the logs were flown (what is plausible)
+//   frame: enu_flu|ned_frd           optional, the axes of the source columns (default enu_flu)
 //   columns:
 //     CANONICAL: {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}
 //
@@ -152,10 +153,15 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
   try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
-    const auto top = checked_keys(path, root, "mapping", {"name", "columns", "environment"});
+    const auto top = checked_keys(path, root, "mapping", {"name", "columns", "environment", "frame"});
     if (!top.count("columns") || !top.at("columns").IsMap())
       throw FitError(path + ":1: expected a 'columns' mapping (canonical column: {source, scale, offset, unit})");
     m.name = top.count("name") ? scalar_text(path, top.at("name"), "name") : path;
+    if (top.count("frame")) {
+      m.frame = scalar_text(path, top.at("frame"), "frame");
+      if (m.frame != "enu_flu" && m.frame != "ned_frd")
+        mapping_error(path, top.at("frame"), "frame: expected enu_flu (the model's axes) or ned_frd (PX4's)");
+    }
     if (top.count("environment")) {
       m.environment = scalar_text(path, top.at("environment"), "environment");
       if (m.environment != "indoor" && m.environment != "outdoor" && m.environment != "unknown")
@@ -174,6 +180,48 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   }
   return m;
 }
+
+namespace {
+
+// North-east-down world / forward-right-down body columns to east-north-up / forward-left-up:
+// world vectors (y, x, -z); body vectors (x, -y, -z); the attitude q_enu<-flu =
+// q_enu<-ned (x) q_ned<-frd (x) q_frd<-flu, with q_enu<-ned = (0, 1/sqrt2, 1/sqrt2, 0) and
+// q_frd<-flu = (0, 1, 0, 0).
+void ned_frd_to_enu_flu(runtime::CsvTable& t, const std::string& mapping_name) {
+  const auto col = [&](const char* n) { return t.column(n); };
+  for (const char* euler : {"phi", "theta", "psi"})
+    if (col(euler) >= 0)
+      throw FitError(mapping_name + ": frame ned_frd converts a quaternion attitude (qw..qz), not Euler angles ('" +
+                     std::string(euler) + "')");
+  const auto world = [&](const char* a, const char* b, const char* c) {
+    const int x = col(a), y = col(b), z = col(c);
+    if ((x < 0) != (y < 0))
+      throw FitError(mapping_name + ": frame ned_frd needs both '" + a + "' and '" + b + "' to swap them");
+    for (auto& r : t.rows) {
+      if (x >= 0) std::swap(r[x], r[y]);
+      if (z >= 0) r[z] = -r[z];
+    }
+  };
+  world("x", "y", "z");
+  world("vx", "vy", "vz");
+  for (const char* body : {"q", "r", "ay", "az"})
+    if (col(body) >= 0)
+      for (auto& r : t.rows) r[col(body)] = -r[col(body)];
+  const int qw = col("qw"), qx = col("qx"), qy = col("qy"), qz = col("qz");
+  if (qw < 0 || qx < 0 || qy < 0 || qz < 0) return;
+  const double h = std::sqrt(0.5);
+  for (auto& r : t.rows) {
+    const double w = r[qw], x = r[qx], y = r[qy], z = r[qz];
+    // (0, h, h, 0) (x) q (x) (0, 1, 0, 0) multiplied out, sign flipped (q and -q are one
+    // attitude) so that the identity becomes +90 degrees of yaw with w > 0
+    r[qw] = h * (w + z);
+    r[qx] = h * (x + y);
+    r[qy] = h * (x - y);
+    r[qz] = h * (w - z);
+  }
+}
+
+}  // namespace
 
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m) {
   runtime::CsvTable out;
@@ -197,6 +245,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
     }
     out.rows.push_back(std::move(r));
   }
+  if (m.frame == "ned_frd") ned_frd_to_enu_flu(out, m.name);
   return out;
 }
 

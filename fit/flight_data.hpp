@@ -16,6 +16,9 @@ struct ColumnMapping {
   std::string name;
   // Where the logs were flown, when the mapping says: "indoor", "outdoor" ("" if not said).
   std::string environment;
+  // The axes of the mapped columns: "enu_flu" (the model's: east-north-up world, forward-
+  // left-up body) or "ned_frd" (PX4's north-east-down, forward-right-down), converted.
+  std::string frame = "enu_flu";
   struct Entry {
     std::string target, source, unit;
     double scale = 1, offset = 0;

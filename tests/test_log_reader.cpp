@@ -1,0 +1,164 @@
+// Logs read through a mapping into the canonical layout: a PX4 ULog in north-east-down /
+// forward-right-down axes, topics at different rates, becomes the model's east-north-up /
+// forward-left-up flight. The axes are checked against rotation matrices built here, not
+// against the converter's own formula.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "attitude.hpp"
+#include "least_squares.hpp"
+#include "log_reader.hpp"
+#include "ulog_writer.hpp"
+
+using namespace quadgen;
+using namespace quadgen::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string write_file(const std::string& name, const std::string& bytes) {
+  const fs::path p = fs::temp_directory_path() / name;
+  std::ofstream(p, std::ios::binary) << bytes;
+  return p.string();
+}
+
+// A PX4-like log: position and velocity at 50 Hz, attitude at 100 Hz, IMU at 200 Hz,
+// motor outputs at 100 Hz, over 2 s. Position and velocity are linear in time (exact under
+// linear interpolation); attitude and IMU constant.
+const double kQned[4] = {0.8031189202104505, 0.2, -0.3, 0.4743416490252569};  // |q| = 1
+const double kGyroFrd[3] = {0.1, 0.2, 0.3}, kAccFrd[3] = {0.5, -0.4, -9.7};
+
+std::string px4_log() {
+  Writer w;
+  w.flag_bits()
+      .format("vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;")
+      .format("vehicle_attitude:uint64_t timestamp;float[4] q;")
+      .format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;float[3] accelerometer_m_s2;")
+      .format("actuator_outputs:uint64_t timestamp;float[4] output;")
+      .add(0, 0, "vehicle_local_position")
+      .add(0, 1, "vehicle_attitude")
+      .add(0, 2, "sensor_combined")
+      .add(0, 3, "actuator_outputs");
+  const std::uint64_t t0 = 5000000;  // 5 s after boot
+  for (int k = 0; k <= 400; ++k) {
+    const std::uint64_t t = t0 + 5000 * k;  // 200 Hz
+    const double s = (t - t0) * 1e-6;
+    std::string imu = le(t, 8);
+    for (double g : kGyroFrd) imu += f32(static_cast<float>(g));
+    for (double a : kAccFrd) imu += f32(static_cast<float>(a));
+    w.data(2, imu);
+    if (k % 2 == 0) {
+      std::string att = le(t, 8), out = le(t, 8);
+      for (double q : kQned) att += f32(static_cast<float>(q));
+      for (int i = 0; i < 4; ++i) out += f32(static_cast<float>(1100 + 100 * i + 200 * s));
+      w.data(1, att);
+      w.data(3, out);
+    }
+    if (k % 4 == 0)  // north 1 + 2s, east 3 - s, down -1 - 0.5s (climbing)
+      w.data(0, le(t, 8) + f32(static_cast<float>(1 + 2 * s)) + f32(static_cast<float>(3 - s)) +
+                    f32(static_cast<float>(-1 - 0.5 * s)) + f32(2.0f) + f32(-1.0f) + f32(-0.5f));
+  }
+  return w.bytes();
+}
+
+const char* const kMapping = R"(name: px4_test
+frame: ned_frd
+columns:
+  t:    {source: t, unit: s}
+  x:    {source: vehicle_local_position.x, unit: m}
+  y:    {source: vehicle_local_position.y, unit: m}
+  z:    {source: vehicle_local_position.z, unit: m}
+  vx:   {source: vehicle_local_position.vx, unit: m/s}
+  vy:   {source: vehicle_local_position.vy, unit: m/s}
+  vz:   {source: vehicle_local_position.vz, unit: m/s}
+  qw:   {source: "vehicle_attitude.q[0]"}
+  qx:   {source: "vehicle_attitude.q[1]"}
+  qy:   {source: "vehicle_attitude.q[2]"}
+  qz:   {source: "vehicle_attitude.q[3]"}
+  p:    {source: "sensor_combined.gyro_rad[0]", unit: rad/s}
+  q:    {source: "sensor_combined.gyro_rad[1]", unit: rad/s}
+  r:    {source: "sensor_combined.gyro_rad[2]", unit: rad/s}
+  ax:   {source: "sensor_combined.accelerometer_m_s2[0]", unit: m/s^2}
+  ay:   {source: "sensor_combined.accelerometer_m_s2[1]", unit: m/s^2}
+  az:   {source: "sensor_combined.accelerometer_m_s2[2]", unit: m/s^2}
+  u_M1: {source: "actuator_outputs.output[0]", scale: 0.001, offset: -1}
+)";
+
+}  // namespace
+
+TEST(LogReader, Px4UlogInNedFrdBecomesTheCanonicalFlight) {
+  const std::string log = write_file("quadgen_px4.ulg", px4_log());
+  const std::string mapping = write_file("quadgen_px4_mapping.yaml", kMapping);
+  ASSERT_TRUE(fit::is_ulog(log));
+  const runtime::CsvTable t = fit::read_log(log, mapping, 100.0);
+  // the span all topics cover (the 50 Hz topic ends last at 2 s), on a 100 Hz grid from 0
+  ASSERT_EQ(t.rows.size(), 201u);
+  const auto at = [&](size_t row, const char* c) { return t.rows[row][t.column(c)]; };
+  // NED world -> ENU: (east, north, up)
+  for (size_t k : {0u, 37u, 200u}) {
+    const double s = 0.01 * static_cast<double>(k);
+    EXPECT_NEAR(at(k, "t"), s, 1e-9);
+    EXPECT_NEAR(at(k, "x"), 3 - s, 1e-5);
+    EXPECT_NEAR(at(k, "y"), 1 + 2 * s, 1e-5);
+    EXPECT_NEAR(at(k, "z"), 1 + 0.5 * s, 1e-5);
+    EXPECT_NEAR(at(k, "vx"), -1.0, 1e-6);
+    EXPECT_NEAR(at(k, "vy"), 2.0, 1e-6);
+    EXPECT_NEAR(at(k, "vz"), 0.5, 1e-6);
+    EXPECT_NEAR(at(k, "u_M1"), 0.1 + 0.2 * s, 1e-5);
+  }
+  // FRD body -> FLU: (x, -y, -z)
+  EXPECT_NEAR(at(50, "p"), 0.1, 1e-6);
+  EXPECT_NEAR(at(50, "q"), -0.2, 1e-6);
+  EXPECT_NEAR(at(50, "r"), -0.3, 1e-6);
+  EXPECT_NEAR(at(50, "az"), 9.7, 1e-5);
+  EXPECT_NEAR(at(50, "ay"), 0.4, 1e-6);
+  // attitude: R_enu<-flu = M R_ned<-frd F, M = [[0,1,0],[1,0,0],[0,0,-1]], F = diag(1,-1,-1)
+  const double q[4] = {at(50, "qw"), at(50, "qx"), at(50, "qy"), at(50, "qz")};
+  const runtime::Rotation got = runtime::rotation_matrix(q), ned = runtime::rotation_matrix(kQned);
+  const double M[3][3] = {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, F[3] = {1, -1, -1};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double want = 0;
+      for (int k = 0; k < 3; ++k) want += M[i][k] * ned.m[k][j] * F[j];
+      EXPECT_NEAR(got.m[i][j], want, 1e-6) << i << "," << j;
+    }
+  EXPECT_GT(q[0], 0.0);
+}
+
+TEST(LogReader, MissingTopicsAndFieldsAreNamedWithWhatTheLogHas) {
+  const std::string log = write_file("quadgen_px4_missing.ulg", px4_log());
+  const auto error = [&](const std::string& mapping_text) {
+    try {
+      fit::read_log(log, write_file("quadgen_px4_bad.yaml", mapping_text), 100.0);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string head = "name: bad\ncolumns:\n  t: {source: t, unit: s}\n";
+  EXPECT_NE(error(head + "  x: {source: vehicle_gps_position.lat}\n").find("no topic 'vehicle_gps_position'"),
+            std::string::npos);
+  EXPECT_NE(error(head + "  x: {source: vehicle_gps_position.lat}\n").find("vehicle_attitude"), std::string::npos);
+  EXPECT_NE(error(head + "  x: {source: vehicle_attitude.w}\n").find("fields: timestamp, q[0]"), std::string::npos);
+  EXPECT_NE(error("name: bad\nframe: nwu\ncolumns:\n  t: {source: t}\n").find("frame: expected enu_flu"),
+            std::string::npos);
+  // the bundled PX4 mapping reads, converts axes, and names what this small log lacks
+  const std::string px4 = std::string(QUADGEN_SOURCE_DIR) + "/data/mappings/px4.yaml";
+  EXPECT_EQ(fit::load_mapping(px4).frame, "ned_frd");
+  try {
+    fit::read_log(log, px4, 100.0);
+    ADD_FAILURE() << "a log without battery_status was accepted";
+  } catch (const fit::FitError& e) {
+    EXPECT_NE(std::string(e.what()).find("no topic 'battery_status'"), std::string::npos) << e.what();
+  }
+  // a ULog needs a mapping
+  try {
+    fit::read_log(log, "", 0);
+    ADD_FAILURE() << "a ULog without a mapping was accepted";
+  } catch (const fit::FitError& e) {
+    EXPECT_NE(std::string(e.what()).find("needs --mapping"), std::string::npos);
+  }
+}
