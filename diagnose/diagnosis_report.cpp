@@ -1,9 +1,12 @@
 #include "diagnosis_report.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "effects.hpp"
+#include "per_flight_model.hpp"
 #include "fit_report.hpp"
 #include "plot.hpp"
 #include "sinks.hpp"
@@ -347,6 +350,35 @@ std::string diagnosis_summary(const Diagnosis& d) {
   return os.str();
 }
 
+namespace {
+
+// A per-flight finding at a glance: one row per parameter, one column per flight, each cell
+// the value and its 95 % interval.
+void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
+  std::map<std::string, std::vector<const EffectEstimate*>> rows;
+  std::map<std::string, std::string> units;
+  for (const auto& p : f.parameters) {
+    auto& row = rows[runtime::shared_name(p.name)];
+    row.resize(flights, nullptr);
+    const size_t k = static_cast<size_t>(runtime::flight_of_name(p.name)) - 1;
+    if (k < flights) row[k] = &p;
+    units[runtime::shared_name(p.name)] = p.unit;
+  }
+  h << "<table><tr><th>parameter [unit]</th>";
+  for (size_t k = 0; k < flights; ++k) h << "<th>flight " << k + 1 << "</th>";
+  h << "</tr>\n";
+  for (const auto& [name, row] : rows) {
+    h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
+    for (const auto* p : row)
+      if (p) h << "<td>" << num(p->value, 3) << " [" << num(p->lower, 3) << ", " << num(p->upper, 3) << "]</td>";
+      else h << "<td>–</td>";
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+}
+
+}  // namespace
+
 std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
                            const std::vector<std::pair<std::string, std::string>>& plots) {
   std::ostringstream h;
@@ -377,11 +409,18 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "</ol>\n";
   }
   for (const auto& f : d.findings) {
-    h << "<h3>" << esc(f.effect) << "</h3>\n<table><tr><th>parameter</th><th>value</th><th>95 % profile interval</th><th>unit</th><th>identifiability</th></tr>\n";
-    for (const auto& p : f.parameters)
-      h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>[" << num(p.lower) << ", " << num(p.upper)
-        << "]</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
-    h << "</table>\n<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
+    h << "<h3>" << esc(f.effect) << "</h3>\n";
+    const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
+                                                              f.effect) != d.per_flight_effects.end();
+    if (per_flight) per_flight_table(h, f, d.flights.size());
+    else {
+      h << "<table><tr><th>parameter</th><th>value</th><th>95 % profile interval</th><th>unit</th><th>identifiability</th></tr>\n";
+      for (const auto& p : f.parameters)
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>[" << num(p.lower) << ", "
+          << num(p.upper) << "]</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+      h << "</table>\n";
+    }
+    h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ", validation cost " << num(f.evidence.validation_gain_percent, 3) << " % lower; " << esc(f.metric) << " "
       << num(f.before) << " &rarr; " << num(f.after) << ".</p>\n";

@@ -435,6 +435,13 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
     EXPECT_LE(ps[name]["ci95"][0].get<double>(), truth + 0.002) << name;
     EXPECT_GE(ps[name]["ci95"][1].get<double>(), truth - 0.002) << name;
   }
+  {  // the report shows each flight's trim side by side: one row per rotor, one column per flight
+    std::ifstream in(dir / "out" / "report.html");
+    const std::string html((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(html.find("<th>flight 2</th>"), std::string::npos);
+    EXPECT_NE(html.find("<td>motor_gain.B [1]</td>"), std::string::npos);
+    EXPECT_EQ(html.find("<td>motor_gain.B@2"), std::string::npos);  // no copy names in the table
+  }
   for (const auto& e : j["candidates_considered"]) EXPECT_NE(e, "thrust_decay");  // a per-flight state
   // about 30 % of each flight held out, both flights in the validation part
   const double train = j["samples"]["training"], valid = j["samples"]["validation"];
