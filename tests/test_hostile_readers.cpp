@@ -215,7 +215,7 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
        "columns: duplicate key 'p'"},
       {"dup_top.yaml", "name: a\ncolumns:\n  p: {source: gyro}\nname: b\n", 4, "mapping: duplicate key 'name'"},
       {"top_key.yaml", "name: a\ncolumn:\n  p: {source: gyro}\n", 2,
-       "mapping: unknown key 'column' (allowed: name, columns, environment)"},
+       "mapping: unknown key 'column' (allowed: name, columns, environment, frame)"},
       {"dimension.yaml", "columns:\n  p: {source: gyro, unit: m/s}\n", 2,
        "unit 'm/s' has dimension m s^-1, but 'p' is in rad/s (dimension s^-1)"},
       {"target.yaml", "columns:\n  vbatt: {source: gyro, unit: V}\n", 2, "'vbatt' is not a canonical column"},
