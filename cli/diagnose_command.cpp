@@ -79,7 +79,8 @@ int run_diagnose(const DiagnoseArgs& a) {
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   std::vector<fit::Flight> flights;
   const fit::ColumnMapping mapping = a.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(a.mapping);
-  for (const auto& path : a.logs) flights.push_back(fit::load_flight(fit::read_log(path, a.mapping, a.resample), rotors, {}));
+  for (const auto& path : a.logs)
+    flights.push_back(fit::load_flight(fit::read_log(path, a.mapping.empty() ? nullptr : &mapping, a.resample), rotors, {}));
   std::string logs_label;  // what the outputs say was diagnosed
   for (const auto& path : a.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
   size_t samples = 0;

@@ -261,10 +261,15 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
                      double* upper, std::string* why) {
   const std::string effect = effect_of_parameter(parameter);
   if (effect.empty()) return false;
+  // The best match: a range for this environment over one for any, then one for this
+  // parameter over one for all of the effect's.
   const PlausibleRange* found = nullptr;
+  int best = -1;
   for (const auto& r : find_effect(effect).plausible) {
     if (!r.parameter.empty() && r.parameter != parameter) continue;
-    if (r.only_in == where || (r.only_in == Environment::kUnknown && !found)) found = &r;
+    if (r.only_in != Environment::kUnknown && r.only_in != where) continue;
+    const int rank = (r.only_in == where && where != Environment::kUnknown ? 2 : 0) + (r.parameter.empty() ? 0 : 1);
+    if (rank > best) best = rank, found = &r;
   }
   if (!found) return false;
   const double unit = found->scale == PlausibleRange::Scale::kRotorArm      ? scales.rotor_arm

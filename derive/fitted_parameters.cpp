@@ -1,5 +1,6 @@
 #include "fitted_parameters.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "effects.hpp"
@@ -17,11 +18,17 @@ FittedParameters load_fitted_parameters(const std::string& path) {
   out.path = path;
   const YAML::Node effects = root["effects"], params = root["parameters"];
   if (!effects || !effects.IsSequence()) r.fail(root, "expected a list 'effects' (may be empty: [])");
-  for (const auto& e : effects) try {
-      out.effects.push_back(find_effect(r.text(e, "an effect name")).name);
+  for (const auto& e : effects) {
+    std::string name;
+    try {
+      name = find_effect(r.text(e, "an effect name")).name;
     } catch (const std::invalid_argument& x) {
       r.fail(e, x.what());
     }
+    if (std::find(out.effects.begin(), out.effects.end(), name) != out.effects.end())
+      r.fail(e, "effect '" + name + "' listed twice");
+    out.effects.push_back(name);
+  }
   if (!params || !params.IsMap()) r.fail(root, "expected a map 'parameters' of name: {value, unit}");
   r.unique_keys(params, "parameters");
   for (const auto& kv : params) {

@@ -88,9 +88,9 @@ struct YamlReader {
     try {
       v = n.as<double>();
     } catch (const YAML::Exception&) {
-      fail(n, "expected a number for " + what + ", got '" + n.Scalar() + "'");
+      fail(n, "expected a number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
     }
-    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + n.Scalar() + "'");
+    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
     return v;
   }
 

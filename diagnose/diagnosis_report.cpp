@@ -49,6 +49,22 @@ json parameters_json(const std::vector<fit::FitParameter>& ps) {
   return j;
 }
 
+// Effects the extended model carries without naming them: the stronger of a look-alike pair,
+// and stand-ins for missing physics (kept apart in the outputs).
+std::vector<std::string> stand_in_effects(const Diagnosis& d) {
+  std::vector<std::string> out;
+  for (const auto& st : d.stand_ins) out.push_back(st.candidate.effect);
+  return out;
+}
+
+std::vector<std::string> carried_look_alikes(const Diagnosis& d) {
+  const auto stand_ins = stand_in_effects(d);
+  std::vector<std::string> out;
+  for (const auto& e : d.search.carried)
+    if (std::find(stand_ins.begin(), stand_ins.end(), e) == stand_ins.end()) out.push_back(e);
+  return out;
+}
+
 // A finding (or a suspected one): its parameters, the one gain figure (the final model
 // without it -> with it, on held-out data, with its spread over validation folds), evidence.
 json finding_json(const Finding& f) {
@@ -209,7 +225,8 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["final_fit"] = parameters_json(d.search.final_fit);
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
   j["extended_model"] = {{"effects", d.search.selected},
-                         {"carried_look_alikes", d.search.carried},
+                         {"carried_look_alikes", carried_look_alikes(d)},
+                         {"carried_stand_ins", stand_in_effects(d)},
                          {"header", "extended_model.hpp"},
                          {"model_json", "extended_model.json"},
                          {"fitted_parameters", "fitted_parameters.yaml"}};
@@ -353,7 +370,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
 namespace {
 
 // A per-flight finding at a glance: one row per parameter, one column per flight, each cell
-// the value and its 95 % interval.
+// the value and its 95 % interval (and the verdict when it is not "identifiable").
 void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   std::map<std::string, std::vector<const EffectEstimate*>> rows;
   std::map<std::string, std::string> units;
@@ -370,7 +387,9 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   for (const auto& [name, row] : rows) {
     h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
     for (const auto* p : row)
-      if (p) h << "<td>" << num(p->value, 3) << " [" << num(p->lower, 3) << ", " << num(p->upper, 3) << "]</td>";
+      if (p)
+        h << "<td>" << num(p->value, 3) << " [" << num(p->lower, 3) << ", " << num(p->upper, 3) << "]"
+          << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
       else h << "<td>–</td>";
     h << "</tr>\n";
   }

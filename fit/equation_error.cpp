@@ -49,10 +49,6 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   }
 }
 
-// Savitzky-Golay derivative weights c_i (local quadratic over +-window), and the weights
-// of the interval accelerations that give the same derivative of a signal whose rate is
-// those accelerations: y_i - y_k is the sum of (t_{j+1} - t_j) a_{j+1/2} over the
-// intervals in between, so interval j carries (t_{j+1} - t_j) * sum_{i > j} c_i.
 // An interval longer than 1.5 median sample spacings is a gap (trimmed ground contact, the
 // second of several joined flights): nothing is integrated or differentiated across it.
 void EquationErrorModel::mark_contiguous_intervals() {
@@ -68,6 +64,10 @@ void EquationErrorModel::mark_contiguous_intervals() {
   for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap_;
 }
 
+// Savitzky-Golay derivative weights c_i (local quadratic over +-window), and the weights
+// of the interval accelerations that give the same derivative of a signal whose rate is
+// those accelerations: y_i - y_k is the sum of (t_{j+1} - t_j) a_{j+1/2} over the
+// intervals in between, so interval j carries (t_{j+1} - t_j) * sum_{i > j} c_i.
 void EquationErrorModel::build_filter(double window) {
   const auto& S = flight_.samples;
   const size_t ns = S.size();

@@ -1,8 +1,11 @@
 #include "log_reader.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 #include "least_squares.hpp"  // FitError
@@ -10,53 +13,95 @@
 namespace quadgen::fit {
 
 bool is_ulog(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  // O_NONBLOCK: a FIFO must not block here; only a regular file can be a ULog (read_csv then
+  // refuses anything else with its own message).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
   char magic[7] = {};
-  return in.read(magic, 7) && std::string(magic, 7) == std::string("ULog\x01\x12\x35", 7);
+  const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::read(fd, magic, 7) == 7;
+  ::close(fd);
+  return ok && std::string(magic, 7) == std::string("ULog\x01\x12\x35", 7);
 }
 
 namespace {
 
-// One mapped signal: its topic's timestamps (s) and values.
+// One mapped signal: its topic's timestamps (s) and finite values, and the longest interval
+// between them that still counts as continuous.
 struct Signal {
-  std::string source;
+  std::string source, target;
   std::vector<double> t, v;
+  double gap = 0;
 };
 
-Signal find_signal(const runtime::Ulog& log, const std::string& source) {
-  const auto dot = source.find('.');
-  const std::string topic = dot == std::string::npos ? source : source.substr(0, dot);
-  const runtime::UlogTopic* tp = log.find(topic);
-  if (!tp) {
-    std::string have;
-    for (const auto& t : log.topics) have += (have.empty() ? "" : ", ") + t.name;
-    throw FitError(log.path + ": no topic '" + topic + "' for '" + source + "' (the log has: " + have + ")");
-  }
-  const int c = dot == std::string::npos ? -1 : tp->column(source.substr(dot + 1));
+const runtime::UlogTopic& find_topic(const runtime::Ulog& log, const std::string& topic, const std::string& source) {
+  if (const runtime::UlogTopic* tp = log.find(topic)) return *tp;
+  std::string have;
+  for (const auto& t : log.topics) have += (have.empty() ? "" : ", ") + t.name;
+  throw FitError(log.path + ": no topic '" + topic + "' for '" + source + "' (the log has: " + have + ")");
+}
+
+// PX4 logs NaN for values not set yet: such samples are left out, not interpolated over.
+Signal find_signal(const runtime::Ulog& log, const ColumnMapping::Entry& e) {
+  const auto dot = e.source.find('.');
+  const std::string topic = e.source.substr(0, dot);
+  const runtime::UlogTopic& tp = find_topic(log, topic, e.source);
+  const int c = dot == std::string::npos ? -1 : tp.column(e.source.substr(dot + 1));
   if (c < 0) {
     std::string have;
-    for (const auto& f : tp->fields) have += (have.empty() ? "" : ", ") + f;
-    throw FitError(log.path + ": topic '" + topic + "' has no field for '" + source + "' (fields: " + have + ")");
+    for (const auto& f : tp.fields) have += (have.empty() ? "" : ", ") + f;
+    throw FitError(log.path + ": topic '" + topic + "' has no field for '" + e.source + "' (fields: " + have + ")");
   }
-  Signal s{source, {}, {}};
-  for (const auto& row : tp->rows) {
+  Signal s{e.source, e.target, {}, {}, 0};
+  for (const auto& row : tp.rows) {
     const double t = row[0] * 1e-6;
-    if (!s.t.empty() && t <= s.t.back()) continue;  // repeated or out-of-order timestamps
+    if (!std::isfinite(row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
     s.t.push_back(t);
     s.v.push_back(row[c]);
   }
-  if (s.t.size() < 2) throw FitError(log.path + ": topic '" + topic + "' has fewer than two samples");
+  if (s.t.size() < 2) throw FitError(log.path + ": '" + e.source + "' has fewer than two finite samples");
+  std::vector<double> dt;
+  for (size_t k = 1; k < s.t.size(); ++k) dt.push_back(s.t[k] - s.t[k - 1]);
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  s.gap = std::max(3 * dt[dt.size() / 2], 0.1);  // a dropout or a paused topic beyond this
   return s;
 }
 
-double interpolate(const Signal& s, double t) {
-  const auto it = std::upper_bound(s.t.begin(), s.t.end(), t);
-  if (it == s.t.begin()) return s.v.front();
-  if (it == s.t.end()) return s.v.back();
-  const size_t k = static_cast<size_t>(it - s.t.begin());
-  const double w = (t - s.t[k - 1]) / (s.t[k] - s.t[k - 1]);
-  return s.v[k - 1] + w * (s.v[k] - s.v[k - 1]);
+// The four quaternion components from one topic: q and -q are one attitude, so a component
+// interpolated across a sign flip would pass through zero. Consecutive samples are aligned.
+void align_quaternion_signs(std::vector<Signal>& signals) {
+  Signal* q[4] = {};
+  const char* names[4] = {"qw", "qx", "qy", "qz"};
+  for (auto& s : signals)
+    for (int i = 0; i < 4; ++i)
+      if (s.target == names[i]) q[i] = &s;
+  for (int i = 0; i < 4; ++i)
+    if (!q[i] || q[i]->t != q[0]->t) return;  // not four components on one clock
+  for (size_t k = 1; k < q[0]->t.size(); ++k) {
+    double dot = 0;
+    for (int i = 0; i < 4; ++i) dot += q[i]->v[k] * q[i]->v[k - 1];
+    if (dot < 0)
+      for (int i = 0; i < 4; ++i) q[i]->v[k] = -q[i]->v[k];
+  }
 }
+
+// The value at t, or false when t falls in a gap of the signal (or outside it).
+bool interpolate(const Signal& s, double t, double* v) {
+  const auto it = std::upper_bound(s.t.begin(), s.t.end(), t);
+  if (it == s.t.end()) {
+    *v = s.v.back();
+    return t - s.t.back() <= 1e-9;
+  }
+  if (it == s.t.begin()) return false;
+  const size_t k = static_cast<size_t>(it - s.t.begin());
+  if (s.t[k] - s.t[k - 1] > s.gap) return false;
+  const double w = (t - s.t[k - 1]) / (s.t[k] - s.t[k - 1]);
+  *v = s.v[k - 1] + w * (s.v[k] - s.v[k - 1]);
+  return true;
+}
+
+// A cap on the table a few bytes of timestamps could ask for: 2^28 cells (2 GiB of doubles).
+constexpr double kMaxCells = 268435456.0;
 
 }  // namespace
 
@@ -66,39 +111,54 @@ runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, d
   double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
   for (const auto& e : m.entries) {
     if (e.source == "t") continue;  // the time base this function makes
-    signals.push_back(find_signal(log, e.source));
+    signals.push_back(find_signal(log, e));
     t0 = std::max(t0, signals.back().t.front());
     t1 = std::min(t1, signals.back().t.back());
   }
   if (signals.empty()) throw FitError(m.name + ": maps no ULog signal (sources are topic.field)");
   if (!(t1 > t0)) throw FitError(log.path + ": the mapped topics do not overlap in time");
-  const double step = 1.0 / rate_hz;
-  const double rows = std::floor((t1 - t0) / step) + 1;
-  if (rows > 5e7) throw FitError(log.path + ": " + std::to_string(rows) + " rows at this rate is too many");
+  align_quaternion_signs(signals);
+  const double step = 1.0 / rate_hz, rows = std::floor((t1 - t0) / step) + 1;
+  if (rows * static_cast<double>(signals.size() + 1) > kMaxCells)
+    throw FitError(log.path + ": " + std::to_string(static_cast<long long>(rows)) + " rows of " +
+                   std::to_string(signals.size() + 1) + " columns at " + std::to_string(rate_hz) +
+                   " Hz over the logged span is more than quadgen holds; lower --resample");
   runtime::CsvTable out;
   out.path = log.path;
   out.columns.push_back("t");
   for (const auto& s : signals) out.columns.push_back(s.source);
+  // Grid points inside a gap of any signal are left out: the table then has a gap there too,
+  // which fits and simulations treat as the end of a contiguous stretch.
   for (size_t k = 0; k < static_cast<size_t>(rows); ++k) {
     const double t = t0 + static_cast<double>(k) * step;
     std::vector<double> row{t - t0};
-    for (const auto& s : signals) row.push_back(interpolate(s, t));
-    out.rows.push_back(std::move(row));
+    bool inside = true;
+    for (const auto& s : signals) {
+      double v = 0;
+      inside = inside && interpolate(s, t, &v);
+      row.push_back(v);
+    }
+    if (inside) out.rows.push_back(std::move(row));
   }
+  if (out.rows.size() < 2) throw FitError(log.path + ": fewer than two samples where every mapped signal is logged");
   return out;
 }
 
-runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz) {
+runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz) {
   if (is_ulog(path)) {
-    if (mapping_path.empty())
-      throw FitError(path + ": a ULog log needs --mapping naming its signals as topic.field (docs/formats.md)");
-    const ColumnMapping m = load_mapping(mapping_path);
-    return apply_mapping(ulog_table(runtime::read_ulog(path), m, resample_hz > 0 ? resample_hz : 100.0), m);
+    if (!mapping) throw FitError(path + ": a ULog log needs --mapping naming its signals as topic.field (docs/formats.md)");
+    return apply_mapping(ulog_table(runtime::read_ulog(path), *mapping, resample_hz > 0 ? resample_hz : 100.0), *mapping);
   }
   runtime::CsvTable log = runtime::read_csv(path);
-  if (!mapping_path.empty()) log = apply_mapping(log, load_mapping(mapping_path));
+  if (mapping) log = apply_mapping(log, *mapping);
   if (resample_hz > 0) log = resample(log, resample_hz);
   return log;
+}
+
+runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz) {
+  if (mapping_path.empty()) return read_log(path, static_cast<const ColumnMapping*>(nullptr), resample_hz);
+  const ColumnMapping m = load_mapping(mapping_path);
+  return read_log(path, &m, resample_hz);
 }
 
 }  // namespace quadgen::fit

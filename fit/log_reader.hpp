@@ -3,7 +3,10 @@
 //  - PX4 ULog (runtime/ulog.hpp). The mapping names a ULog signal as "topic.field" (array
 //    elements "topic.field[i]"; instance 0 of a topic). Every topic keeps its own rate: the
 //    signals the mapping uses are interpolated linearly onto one uniform time base (column
-//    "t", seconds) over the span all of them cover.
+//    "t", seconds) over the span all of them cover. Samples a topic logs as NaN (not set yet)
+//    are left out; where any signal has a gap (a dropout, a paused topic: longer than three
+//    of its median intervals and 0.1 s) the table has a gap too, rather than a line drawn
+//    across it. Quaternion components are sign-aligned sample to sample first.
 // A mapping's `frame: ned_frd` then turns PX4's north-east-down world and forward-right-down
 // body axes into the model's east-north-up world and forward-left-up body axes.
 #pragma once
@@ -23,8 +26,9 @@ bool is_ulog(const std::string& path);
 runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, double rate_hz);
 
 // Reads a log (CSV or ULog) and returns it in the canonical layout. `mapping_path` may be
-// empty for a canonical CSV; a ULog needs one. `resample_hz` > 0 resamples the result (a
-// ULog is always sampled at that rate, 100 Hz when 0).
+// empty (`mapping` null) for a canonical CSV; a ULog needs one. `resample_hz` > 0 resamples
+// the result (a ULog is always sampled at that rate, 100 Hz when 0).
 runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz);
+runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz);
 
 }  // namespace quadgen::fit

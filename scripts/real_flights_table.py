@@ -38,9 +38,10 @@ def violations(f):
     return out
 
 
-# The plausible ranges in SI the catalogue declares (docs/effects.md), written down again here
-# so that this check does not rely on the code it checks: a named finding beyond them breaks
-# the rule that stand-ins for missing physics are not named.
+# The symmetric SI plausible ranges of the catalogue (docs/effects.md; motor_lag and
+# input_delay are one-sided, their bounds keep them >= 0), written down again here so that
+# this check does not rely on the code it checks: a named finding beyond them breaks the
+# rule that stand-ins for missing physics are not named.
 PLAUSIBLE = {"wind": {"indoor": 0.5, "unknown": 15.0, "outdoor": 15.0}, "attitude_bias": 0.052, "motor_gain": 0.35,
              "input_delay": 0.1, "motor_lag": 0.25}
 

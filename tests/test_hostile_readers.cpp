@@ -16,6 +16,7 @@
 
 #include "flight_data.hpp"
 #include "flight_log.hpp"
+#include "log_reader.hpp"
 #include "least_squares.hpp"
 #include "motor_steps.hpp"
 #include "thrust_stand.hpp"
@@ -291,6 +292,9 @@ TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
   const std::string fifo = (dir_ / "log.fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(fifo); }).find(fifo + ": a FIFO, not a regular file"),
+            std::string::npos);
+  // the log entry point looks for the ULog magic bytes first: that must not block either
+  EXPECT_NE(message_of<runtime::LogError>([&] { fit::read_log(fifo, "", 0); }).find(fifo + ": a FIFO, not a regular file"),
             std::string::npos);
   EXPECT_NE(
       message_of<runtime::LogError>([&] { runtime::read_csv("/dev/zero"); }).find("/dev/zero: a character device"),

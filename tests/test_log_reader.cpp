@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 
@@ -126,6 +127,42 @@ TEST(LogReader, Px4UlogInNedFrdBecomesTheCanonicalFlight) {
       EXPECT_NEAR(got.m[i][j], want, 1e-6) << i << "," << j;
     }
   EXPECT_GT(q[0], 0.0);
+}
+
+// PX4 logs NaN for values not set yet, and topics pause (dropouts): unset samples are left
+// out, and a pause stays a gap in the table instead of a line drawn across it. A quaternion
+// logged with a sign flip is interpolated as one attitude.
+TEST(LogReader, UnsetValuesAreSkippedGapsStayGapsQuaternionSignsAligned) {
+  Writer w;
+  w.flag_bits().format("a:uint64_t timestamp;float v;").format("q:uint64_t timestamp;float[4] q;");
+  w.add(0, 0, "a").add(0, 1, "q");
+  for (int k = 0; k <= 200; ++k) {
+    const double s = 0.01 * k;
+    if (s > 1.0 + 1e-9 && s < 1.5 - 1e-9) continue;  // a 0.5 s pause of both topics
+    const std::uint64_t t = 1000000 + 10000 * static_cast<std::uint64_t>(k);
+    const float v = (k >= 20 && k < 23) ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(s);
+    w.data(0, le(t, 8) + f32(v));
+    const float sign = k % 2 ? -1.0f : 1.0f;  // q and -q alternate
+    w.data(1, le(t, 8) + f32(sign * 0.6f) + f32(sign * 0.8f) + f32(0) + f32(0));
+  }
+  const std::string log = write_file("quadgen_gaps.ulg", w.bytes());
+  const std::string mapping = write_file("quadgen_gaps.yaml",
+                                         "name: gaps\ncolumns:\n  t: {source: t}\n  vbat: {source: a.v}\n"
+                                         "  qw: {source: \"q.q[0]\"}\n  qx: {source: \"q.q[1]\"}\n"
+                                         "  qy: {source: \"q.q[2]\"}\n  qz: {source: \"q.q[3]\"}\n");
+  const runtime::CsvTable t = fit::read_log(log, mapping, 200.0);
+  bool gap = false;
+  for (size_t k = 0; k < t.rows.size(); ++k) {
+    const double s = t.rows[k][0], v = t.rows[k][t.column("vbat")];
+    EXPECT_TRUE(std::isfinite(v)) << s;
+    EXPECT_NEAR(v, s, 1e-5) << s;  // the NaN samples are bridged by their neighbours
+    EXPECT_FALSE(s > 1.0 + 1e-9 && s < 1.5 - 1e-9) << "a row inside the pause at " << s;
+    if (k > 0) gap = gap || s - t.rows[k - 1][0] > 0.4;
+    // between a sample and its sign-flipped neighbour: still (0.6, 0.8) up to a common sign
+    const double qw = t.rows[k][t.column("qw")], qx = t.rows[k][t.column("qx")];
+    EXPECT_NEAR(std::hypot(qw, qx), 1.0, 1e-6) << s;
+  }
+  EXPECT_TRUE(gap);
 }
 
 TEST(LogReader, MissingTopicsAndFieldsAreNamedWithWhatTheLogHas) {

@@ -209,6 +209,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {head + "  c_t: {value: 0.2, unit: \"1\"}\n", ":4: key 'c_t' given twice in parameters"},
       {head + "  c_w: {value: 1, unit: \"1\", bounds: [0, 2]}\n", ":4: unknown key 'bounds' in parameter c_w"},
       {"effects: [motor_gain]\neffects: []\nparameters: {}\n", ":2: key 'effects' given twice"},
+      {"effects: [wind, wind]\nparameters: {}\n", ":1: effect 'wind' listed twice"},
   };
   int k = 0;
   for (const auto& [text, want] : bad) {
