@@ -296,9 +296,10 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // physics. It stays in the model (carried, like the stronger of a look-alike pair) and is
   // reported with the residual it absorbs, not named.
   d.environment = environment_name(opt.environment);
+  const VehicleScales scales = vehicle_scales(v);
   for (auto it = d.findings.begin(); it != d.findings.end();) {
     StandIn st;
-    if (!implausible_parameter(*it, opt.environment, vehicle_scales(v), &st)) {
+    if (!implausible_parameter(*it, opt.environment, scales, &st)) {
       ++it;
       continue;
     }
