@@ -4,7 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
+#include <map>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -25,11 +26,6 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   delay_ = model.param_index("input_delay.seconds");
   roll_ = model.param_index("attitude_bias.roll");
   pitch_ = model.param_index("attitude_bias.pitch");
-  std::set<int> columns;
-  for (int c : {lag_, delay_, roll_, pitch_})
-    if (c >= 0)
-      for (const auto& s : flight_.samples) columns.insert(model.param_column(c, s.t));
-  data_side_columns_.assign(columns.begin(), columns.end());
   for (int i = 13; i < model.num_states(); ++i) {
     const std::string& s = model.state_names()[i];
     if (lag_ < 0 || s.rfind("w_", 0) != 0)
@@ -41,6 +37,7 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   if (accel_ && !flight_.has_accelerometer) throw FitError(flight_.source + ": no accelerometer columns ax, ay, az");
   if (!accel_ && !flight_.has_pose) throw FitError(flight_.source + ": no pose to differentiate");
   mark_contiguous_intervals();
+  find_data_side_columns();
   if (derivatives_ == Derivatives::kPointwise) {
     for (size_t k = 0; k < flight_.samples.size(); ++k) rows_.push_back(k);
   } else {
@@ -62,6 +59,28 @@ void EquationErrorModel::mark_contiguous_intervals() {
   gap_ = 1.5 * sorted[sorted.size() / 2];
   interval_ok_.assign(ns, false);
   for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap_;
+}
+
+// Each column of a data-side parameter, and the stretches of the log it acts on: from its
+// first to its last sample, widened to whole contiguous stretches (the rotor speeds are
+// filtered along a stretch, and no derivative window crosses a gap).
+void EquationErrorModel::find_data_side_columns() {
+  const auto& S = flight_.samples;
+  std::map<int, SampleSpan> spans;
+  for (int index : {lag_, delay_, roll_, pitch_}) {
+    if (index < 0) continue;
+    for (size_t k = 0; k < S.size(); ++k) {
+      const int c = model_->param_column(index, S[k].t);
+      auto [it, fresh] = spans.try_emplace(c, SampleSpan{k, k + 1});
+      if (!fresh) it->second.lo = std::min(it->second.lo, k), it->second.hi = std::max(it->second.hi, k + 1);
+    }
+  }
+  for (auto [c, span] : spans) {
+    while (span.lo > 0 && !interval_ok_.empty() && interval_ok_[span.lo - 1]) --span.lo;
+    while (span.hi < S.size() && !interval_ok_.empty() && interval_ok_[span.hi - 1]) ++span.hi;
+    data_side_columns_.push_back(c);
+    data_side_spans_.push_back(span);
+  }
 }
 
 // Savitzky-Golay derivative weights c_i (local quadratic over +-window), and the weights
@@ -155,12 +174,21 @@ void EquationErrorModel::commands_at(double t, double* u) const {
     std::copy(s.u.begin(), s.u.end(), u);
     return;
   }
+  // A delayed lookup that falls into a gap (before the start of the sample's stretch, the
+  // previous joined flight's end) holds the stretch's first command instead of blending in
+  // commands from across the gap.
+  const size_t after = static_cast<size_t>(it - S.begin());
+  if (!interval_ok_.empty() && !interval_ok_[after - 1]) {
+    std::copy(it->u.begin(), it->u.end(), u);
+    return;
+  }
   const FlightSample &b = *it, &a = *(it - 1);
   const double w = (t - a.t) / (b.t - a.t);
   for (size_t i = 0; i < a.u.size(); ++i) u[i] = a.u[i] + w * (b.u[i] - a.u[i]);
 }
 
-void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::vector<double>& U) const {
+void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::vector<double>& U,
+                                 SampleSpan span) const {
   const int n = model_->num_states(), nu = model_->num_inputs();
   const size_t ns = flight_.samples.size();
   X.assign(ns * n, 0.0);
@@ -168,7 +196,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   // The data-side values in effect at time t (one per flight in a per-flight model).
   const auto at = [&](int index, double t) { return index >= 0 ? p[model_->param_column(index, t)] : 0.0; };
-  for (size_t k = 0; k < ns; ++k) {
+  for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const double delay = at(delay_, s.t), roll = at(roll_, s.t), pitch = at(pitch_, s.t);
     double* x = &X[k * n];
@@ -189,11 +217,12 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   const size_t nr = speed_states_.size();
   mean_speed_.assign(ns * nr, 0.0);
   std::vector<double> f(n), c(nr);
-  for (size_t k = 0; k < ns; ++k) {
+  for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
     const double tau = at(lag_, flight_.samples[k].t);
-    // After a gap the rotors restart in steady state with the commands, as at the start.
-    const bool restart = k == 0 || !interval_ok_[k - 1];
+    // After a gap the rotors restart in steady state with the commands, as at the start
+    // (a span starts at a gap or at the log's start).
+    const bool restart = k == span.lo || !interval_ok_[k - 1];
     if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
       const double a = std::exp(-h / tau);
@@ -216,27 +245,40 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
 
 void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const {
   const int np = model_->num_params();
-  residuals(p, r, J);
+  residuals(p, r, J, all_samples());
   if (!J) return;
-  // Columns of the parameters applied to the data: central differences.
-  std::vector<double> pp(p, p + np), rp(rows_.size() * 6), rm(rp.size());
-  for (int c : data_side_columns_) {
+  // Columns of the parameters applied to the data: central differences over the rows each
+  // column can change (zero elsewhere).
+  std::vector<double> pp(p, p + np), rp, rm;
+  for (size_t d = 0; d < data_side_columns_.size(); ++d) {
+    const int c = data_side_columns_[d];
     if (!free_.empty() && !free_[c]) continue;
+    const auto [row_lo, row_hi] = rows_in(data_side_spans_[d]);
+    rp.resize((row_hi - row_lo) * 6);
+    rm.resize(rp.size());
     const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
     pp[c] = p[c] + h;
-    residuals(pp.data(), rp.data(), nullptr);
+    residuals(pp.data(), rp.data(), nullptr, data_side_spans_[d]);
     pp[c] = p[c] - h;
-    residuals(pp.data(), rm.data(), nullptr);
+    residuals(pp.data(), rm.data(), nullptr, data_side_spans_[d]);
     pp[c] = p[c];
-    for (size_t i = 0; i < rp.size(); ++i) J[i * np + c] = (rp[i] - rm[i]) / (2 * h);
+    for (size_t i = 0; i < rows_.size() * 6; ++i) J[i * np + c] = 0.0;
+    for (size_t i = 0; i < rp.size(); ++i) J[(row_lo * 6 + i) * np + c] = (rp[i] - rm[i]) / (2 * h);
   }
   model_->set_params(pp);
+}
+
+std::pair<size_t, size_t> EquationErrorModel::rows_in(SampleSpan span) const {
+  const auto lo = std::lower_bound(rows_.begin(), rows_.end(), span.lo);
+  const auto hi = std::lower_bound(lo, rows_.end(), span.hi);
+  return {static_cast<size_t>(lo - rows_.begin()), static_cast<size_t>(hi - rows_.begin())};
 }
 
 // Model accelerations (rows 3..5 and 10..12 of f, and of df/dp) at the middle of every
 // interval k -> k+1: state averaged, the commands of t_k held over it.
 void EquationErrorModel::interval_accelerations(const std::vector<double>& X, const std::vector<double>& U,
-                                                std::vector<double>& F, std::vector<double>* Bm) const {
+                                                std::vector<double>& F, std::vector<double>* Bm,
+                                                SampleSpan span) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   const size_t ns = flight_.samples.size();
@@ -244,7 +286,7 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
   if (Bm) Bm->assign(ns * 6 * np, 0.0);
   std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
   static const int kRows[6] = {3, 4, 5, 10, 11, 12};
-  for (size_t k = 0; k + 1 < ns; ++k) {
+  for (size_t k = span.lo; k + 1 < span.hi; ++k) {
     if (!interval_ok_[k]) continue;
     for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
     const double qn = std::sqrt(xm[6] * xm[6] + xm[7] * xm[7] + xm[8] * xm[8] + xm[9] * xm[9]);
@@ -276,19 +318,20 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
   }
 }
 
-void EquationErrorModel::residuals(const double* p, double* r, double* J) const {
+void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
   model_->set_params(std::vector<double>(p, p + np));
   std::vector<double> X, U;
-  prepare(p, X, U);
+  prepare(p, X, U, span);
   const bool filtered = derivatives_ == Derivatives::kFiltered;
   std::vector<double> F, Bm;
-  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr);
+  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr, span);
   const bool pointwise_needed = !filtered || accel_;
   std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
   // Model accelerations seen by the measurement at this row: the six rows of f (and of B).
   std::vector<double> a6(6), Ba6(J ? 6 * np : 0);
-  for (size_t row = 0; row < rows_.size(); ++row) {
+  const auto [row_lo, row_hi] = rows_in(span);
+  for (size_t row = row_lo; row < row_hi; ++row) {
     const size_t k = rows_[row];
     const FlightSample& s = flight_.samples[k];
     const double* xk = &X[k * n];
@@ -316,7 +359,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
           for (int q = 0; q < np; ++q) Ba6[c * np + q] = B[(3 + c) * np + q], Ba6[(3 + c) * np + q] = B[(10 + c) * np + q];
       }
     }
-    double* rk = r + 6 * row;
+    double* rk = r + 6 * (row - row_lo);
     // Body -> world rotation of the (true) attitude.
     const runtime::Rotation rotation = runtime::rotation_matrix(xk + 6);
     const auto& R = rotation.m;
@@ -332,7 +375,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J) const 
       rk[3 + i] = a6[3 + i] - meas[3 + i];
     }
     if (!J) continue;
-    double* Jk = J + static_cast<size_t>(6 * row) * np;
+    double* Jk = J + static_cast<size_t>(6 * (row - row_lo)) * np;
     for (int c = 0; c < np; ++c) {
       for (int i = 0; i < 3; ++i) {
         double d;

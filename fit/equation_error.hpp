@@ -64,8 +64,15 @@ class EquationErrorModel : public ResidualModel {
   // Parameters applied to the data (-1 when the model lacks the effect).
   int lag_ = -1, delay_ = -1, roll_ = -1, pitch_ = -1;
   std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
-  // Every column those parameters take over the flight (several when they differ by flight).
+  // Samples [lo, hi) of the log: a range of whole contiguous stretches.
+  struct SampleSpan {
+    size_t lo = 0, hi = 0;
+  };
+  // Every column those parameters take over the flight (several when they differ by flight),
+  // with the stretches whose residuals it can change: a per-flight copy changes its own
+  // flight's only, so its difference quotient re-evaluates that flight, not the joined log.
   std::vector<int> data_side_columns_;
+  std::vector<SampleSpan> data_side_spans_;
   Derivatives derivatives_;
   std::vector<size_t> rows_;
   // kFiltered: for each row, the first sample of its window, the weights of the model's
@@ -76,6 +83,7 @@ class EquationErrorModel : public ResidualModel {
   std::vector<bool> interval_ok_;  // interval k -> k+1 lies inside a contiguous stretch
   double gap_ = 0;  // s: a longer sample interval is a gap
   void mark_contiguous_intervals();
+  void find_data_side_columns();
   void build_filter(double window);
   mutable std::vector<bool> free_;
   mutable Quadrature quadrature_ = Quadrature::kMidpoint;
@@ -83,11 +91,16 @@ class EquationErrorModel : public ResidualModel {
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
-  void prepare(const double* p, std::vector<double>& X, std::vector<double>& U) const;
+  // Only the samples in `span` are filled (the others stay zero).
+  void prepare(const double* p, std::vector<double>& X, std::vector<double>& U, SampleSpan span) const;
   void commands_at(double t, double* u) const;  // rotor commands interpolated at t
-  void residuals(const double* p, double* r, double* J) const;
+  SampleSpan all_samples() const { return {0, flight_.samples.size()}; }
+  // First and one-past-last residual row whose sample lies in `span`.
+  std::pair<size_t, size_t> rows_in(SampleSpan span) const;
+  // Residuals (and df/dp columns) of the rows in `span`: row i of that range at r + 6 i.
+  void residuals(const double* p, double* r, double* J, SampleSpan span) const;
   void interval_accelerations(const std::vector<double>& X, const std::vector<double>& U, std::vector<double>& F,
-                              std::vector<double>* Bm) const;
+                              std::vector<double>* Bm, SampleSpan span) const;
 };
 
 

@@ -525,3 +525,78 @@ TEST(Fit, EachFlightKeepsItsOwnAttitudeBias) {
   EXPECT_NEAR(value("attitude_bias.roll@2"), roll[1], 1e-3);
   EXPECT_NEAR(value("attitude_bias.pitch@2"), pitch[1], 1e-3);
 }
+
+// The data-side Jacobian columns of a per-flight copy are differenced over its own flight
+// only. Checked against central differences of the whole joined residual vector (which
+// also shows that a flight's bias, delay and lag leave the other flight's rows alone), on
+// commands that vary so that delay and lag matter, with filtered derivatives and the gap
+// between the flights.
+TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
+  runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  Flight joined;
+  joined.has_pose = joined.has_gyro = true;
+  for (int flight = 0; flight < 2; ++flight)
+    for (int k = 0; k < 200; ++k) {
+      FlightSample s;
+      s.t = 10.0 * flight + 0.01 * k;
+      s.x = test::random_state(rng);
+      s.u = {cmd(rng), cmd(rng), cmd(rng), cmd(rng)};
+      s.vbat = 3.9;
+      joined.samples.push_back(s);
+    }
+  const std::vector<std::string> data_side = {"attitude_bias.roll", "attitude_bias.pitch", "input_delay.seconds",
+                                              "motor_lag.tau"};
+  runtime::PerFlightModel model(inner, {10.0}, data_side);
+  EquationErrorModel m(model, joined, false);
+  std::vector<double> p = model.params();
+  p[model.param_index("attitude_bias.roll")] = 0.02;
+  p[model.param_index("attitude_bias.pitch@2")] = -0.03;
+  p[model.param_index("input_delay.seconds")] = 0.013;
+  p[model.param_index("input_delay.seconds@2")] = 0.027;
+  p[model.param_index("motor_lag.tau")] = 0.03;
+  p[model.param_index("motor_lag.tau@2")] = 0.05;
+  const int np = model.num_params(), nr = m.num_residuals();
+  std::vector<double> r(nr), J(static_cast<size_t>(nr) * np);
+  m.evaluate(p.data(), r.data(), J.data());
+  std::vector<double> rp(nr), rm(nr);
+  int checked = 0;
+  for (const auto& name : data_side)
+    for (const std::string copy : {name, name + "@2"}) {
+      const int c = model.param_index(copy);
+      ASSERT_GE(c, 0) << copy;
+      std::vector<double> q = p;
+      const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
+      q[c] = p[c] + h;
+      m.evaluate(q.data(), rp.data(), nullptr);
+      q[c] = p[c] - h;
+      m.evaluate(q.data(), rm.data(), nullptr);
+      double scale = 0, worst = 0;
+      for (int i = 0; i < nr; ++i) {
+        const double fd = (rp[i] - rm[i]) / (2 * h);
+        scale = std::max(scale, std::abs(fd));
+        worst = std::max(worst, std::abs(fd - J[static_cast<size_t>(i) * np + c]));
+      }
+      EXPECT_GT(scale, 1e-3) << copy << " does not act on the residuals";
+      EXPECT_LE(worst, 1e-6 * scale) << copy;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 8);
+  // A delayed command lookup at the second flight's start does not reach across the gap:
+  // other commands in the first flight leave the second flight's residuals as they were.
+  Flight changed = joined;
+  for (auto& s : changed.samples)
+    if (s.t < 10.0) s.u = {0.45, 0.31, 0.44, 0.33};
+  EquationErrorModel m2(model, changed, false);
+  std::vector<double> r2(nr);
+  m2.evaluate(p.data(), r2.data(), nullptr);
+  const auto& rows = m.rows();
+  int second = 0;
+  for (size_t row = 0; row < rows.size(); ++row) {
+    if (joined.samples[rows[row]].t < 10.0) continue;
+    ++second;
+    for (int c = 0; c < 6; ++c) EXPECT_EQ(r[row * 6 + c], r2[row * 6 + c]) << "row " << row;
+  }
+  EXPECT_GT(second, 100);
+}
