@@ -5,7 +5,9 @@
 #include <limits>
 
 #include "attitude.hpp"
+#include "data_side_effects.hpp"
 #include "integrator.hpp"
+#include "per_flight_model.hpp"
 
 namespace quadgen::diagnose {
 
@@ -23,20 +25,16 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   // A rotor lag below 1 ms (the equation error's "no lag") would make RK4 at 1 ms steps
   // unstable; over 1 s windows 1 ms of lag is invisible, so it is simulated as 1 ms.
   std::vector<double> sim_params = params;
-  const int lag = model.param_index("motor_lag.tau");
-  if (lag >= 0 && sim_params[lag] < 1e-3) sim_params[lag] = 1e-3;
+  for (int i = 0; i < model.num_params(); ++i)  // every flight's copy of the lag
+    if (runtime::shared_name(model.param_names()[i]) == "motor_lag.tau") sim_params[i] = std::max(sim_params[i], 1e-3);
   model.set_params(sim_params);
-  // The data-side values in effect at time t (one per flight in a per-flight model).
-  auto param = [&](const char* n, double t) {
-    const int i = model.param_index(n);
-    return i >= 0 ? sim_params[model.param_column(i, t)] : 0.0;
-  };
-  double delay = 0, roll = 0, pitch = 0, tau = 0;
+  const runtime::DataSideParams data_side(model);
+  runtime::DataSideEffects e;  // in effect over the current window
   const int n = model.num_states(), nu = model.num_inputs();
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
   const size_t nr = f.samples.front().u.size();
   auto inputs = [&](double t, double* u) {
-    const auto& s = f.samples[held_index(f, t - delay)];
+    const auto& s = f.samples[held_index(f, t - e.delay)];
     for (size_t i = 0; i < nr; ++i) u[i] = s.u[i];
     if (t_in >= 0) u[t_in] = t;
     if (v_in >= 0) u[v_in] = f.samples[held_index(f, t)].vbat;
@@ -51,15 +49,14 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   std::vector<double> u(nu), fx(n);
   for (size_t k0 = 0; k0 + 1 < S.size();) {
     const double t0 = S[k0].t;
-    delay = param("input_delay.seconds", t0), roll = param("attitude_bias.roll", t0);
-    pitch = param("attitude_bias.pitch", t0), tau = param("motor_lag.tau", t0);
+    e = data_side.at(model, sim_params.data(), t0);
     std::vector<double> x(n, 0.0);
     std::copy(S[k0].x.begin(), S[k0].x.end(), x.begin());
-    runtime::unbias_attitude(&S[k0].x[6], roll, pitch, &x[6]);
+    runtime::unbias_attitude(&S[k0].x[6], e.roll, e.pitch, &x[6]);
     if (n > 13) {  // rotor speeds in steady state with the commands (model's dw/dt at w = 0, times tau)
       inputs(S[k0].t, u.data());
       model.rhs(x.data(), u.data(), fx.data(), nullptr, nullptr, nullptr);
-      for (int i = 13; i < n; ++i) x[i] = tau * fx[i];
+      for (int i = 13; i < n; ++i) x[i] = e.tau * fx[i];
     }
     size_t k = k0;
     bool lost = false;
@@ -80,7 +77,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       }
       // Attitude error: angle of q_sim^-1 ⊗ q_true(logged, unbiased).
       double qt[4];
-      runtime::unbias_attitude(&m[6], roll, pitch, qt);
+      runtime::unbias_attitude(&m[6], e.roll, e.pitch, qt);
       const double dot = std::abs(x[6] * qt[0] + x[7] * qt[1] + x[8] * qt[2] + x[9] * qt[3]);
       const double angle = 2 * std::acos(std::min(1.0, dot));
       se += e2;

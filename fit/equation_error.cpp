@@ -14,7 +14,7 @@ namespace quadgen::fit {
 EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flight, bool use_accelerometer,
                                        std::vector<std::string> use, Derivatives d, double window)
     : model_(&model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
-      derivatives_(d) {
+      data_side_(model), derivatives_(d) {
   const auto names = all_names();
   if (use.empty()) use = names;
   for (const auto& u : use) {
@@ -22,13 +22,9 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     if (c < 0) throw FitError("unknown residual channel '" + u + "'");
     used_.push_back(c);
   }
-  lag_ = model.param_index("motor_lag.tau");
-  delay_ = model.param_index("input_delay.seconds");
-  roll_ = model.param_index("attitude_bias.roll");
-  pitch_ = model.param_index("attitude_bias.pitch");
   for (int i = 13; i < model.num_states(); ++i) {
     const std::string& s = model.state_names()[i];
-    if (lag_ < 0 || s.rfind("w_", 0) != 0)
+    if (data_side_.tau < 0 || s.rfind("w_", 0) != 0)
       throw FitError("equation error needs every state measured or filtered from the commands; this model has state " + s);
     speed_states_.push_back(i);
   }
@@ -67,7 +63,7 @@ void EquationErrorModel::mark_contiguous_intervals() {
 void EquationErrorModel::find_data_side_columns() {
   const auto& S = flight_.samples;
   std::map<int, SampleSpan> spans;
-  for (int index : {lag_, delay_, roll_, pitch_}) {
+  for (int index : data_side_.indices()) {
     if (index < 0) continue;
     for (size_t k = 0; k < S.size(); ++k) {
       const int c = model_->param_column(index, S[k].t);
@@ -195,17 +191,16 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   U.assign(ns * nu, 0.0);
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   // The data-side values in effect at time t (one per flight in a per-flight model).
-  const auto at = [&](int index, double t) { return index >= 0 ? p[model_->param_column(index, t)] : 0.0; };
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
-    const double delay = at(delay_, s.t), roll = at(roll_, s.t), pitch = at(pitch_, s.t);
+    const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
-    runtime::unbias_attitude(&s.x[6], roll, pitch, x + 6);
+    runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, x + 6);
     // The commands logged at t_k - d act now (held until the next sample; between
     // samples the linear interpolation is their average over the interval).
-    commands_at(s.t - delay, u);
+    commands_at(s.t - e.delay, u);
     if (t_in >= 0) u[t_in] = s.t;
     if (v_in >= 0) u[v_in] = s.vbat;
   }
@@ -219,7 +214,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   std::vector<double> f(n), c(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
-    const double tau = at(lag_, flight_.samples[k].t);
+    const double tau = data_side_.at(*model_, p, flight_.samples[k].t).tau;
     // After a gap the rotors restart in steady state with the commands, as at the start
     // (a span starts at a gap or at the log's start).
     const bool restart = k == span.lo || !interval_ok_[k - 1];

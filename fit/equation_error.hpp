@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "data_side_effects.hpp"
 #include "dynamic_model.hpp"
 #include "flight_data.hpp"
 #include "least_squares.hpp"
@@ -61,8 +62,7 @@ class EquationErrorModel : public ResidualModel {
   bool accel_;
   int g_index_;
   std::vector<int> used_;  // indices into the six channels
-  // Parameters applied to the data (-1 when the model lacks the effect).
-  int lag_ = -1, delay_ = -1, roll_ = -1, pitch_ = -1;
+  runtime::DataSideParams data_side_;  // parameters applied to the data
   std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
   // Samples [lo, hi) of the log: a range of whole contiguous stretches.
   struct SampleSpan {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "attitude.hpp"
+#include "data_side_effects.hpp"
 #include "equation_error.hpp"
 
 namespace quadgen::predict {
@@ -41,18 +42,11 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The effects that act outside the ODE, read from the parameter vector by name.
-struct DataSideEffects {
-  double delay = 0, roll = 0, pitch = 0, tau = 0;
-};
+using runtime::DataSideEffects;
 
-// Their values in effect at time t (one per flight in a per-flight model).
+// The data-side values in effect at time t (one per flight in a per-flight model).
 DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<double>& p, double t) {
-  auto get = [&](const char* n) {
-    const int i = model.param_index(n);
-    return i >= 0 ? p[model.param_column(i, t)] : 0.0;
-  };
-  return {get("input_delay.seconds"), get("attitude_bias.roll"), get("attitude_bias.pitch"), get("motor_lag.tau")};
+  return runtime::DataSideParams(model).at(model, p.data(), t);
 }
 
 // One rollout integrator over a flight: commands held at the log's samples (delayed by the
