@@ -65,6 +65,7 @@ struct PredictArgs {
   std::string vehicle, out, mapping, params;
   std::vector<std::string> logs;
   double validation = 0.3, resample = 0, stride = 0.05;
+  bool calibrate = false;
 };
 void add_predict(CLI::App& app, PredictArgs& args);
 int run_predict(const PredictArgs& args);

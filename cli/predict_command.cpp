@@ -3,6 +3,7 @@
 // models report it (predict/prediction.hpp): prediction.json, prediction.csv, prediction.svg.
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "log_reader.hpp"
 #include "commands.hpp"
@@ -13,6 +14,7 @@
 #include "model_registry.hpp"
 #include "options.hpp"
 #include "output_set.hpp"
+#include "parameter_source.hpp"
 #include "prediction.hpp"
 #include "sinks.hpp"
 #include "vehicle.hpp"
@@ -32,48 +34,36 @@ void add_predict(CLI::App& app, PredictArgs& a) {
       ->check(finite_range(0.05, 1.0));
   c->add_option("--resample", a.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(0.1, 1e5));
+  c->add_flag("--calibrate", a.calibrate,
+              "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (motor trims, "
+              "marker frame, wind) on the part before the evaluated one, the airframe's held");
   c->add_option("--stride", a.stride, "seconds between rollout start points (default 0.05)")->check(finite_range(0.001, 10));
 }
 
 namespace {
 
-// Parameter values by name from quadgen's own outputs: diagnosis.json (final_fit) or
-// fit.json (estimates). Every name must be a parameter of the model.
-std::vector<double> read_params(const std::string& path, const runtime::DynamicModel& m) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path + ": cannot open the parameter file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw std::invalid_argument(path + ": not JSON (" + e.what() + ")");
-  }
-  const char* key = j.contains("final_fit") ? "final_fit" : j.contains("estimates") ? "estimates" : nullptr;
-  if (!key || !j[key].is_object())
-    throw std::invalid_argument(path + ": expected a diagnosis.json (final_fit) or fit.json (estimates)");
-  std::vector<double> p = m.params();
-  for (const auto& [name, entry] : j[key].items()) {
-    const int i = m.param_index(name);
-    if (i < 0) throw std::invalid_argument(path + ": parameter '" + output::printable(name) + "' is not in the model");
-    if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
-      throw std::invalid_argument(path + ": " + key + "." + output::printable(name) + " has no numeric value");
-    p[static_cast<size_t>(i)] = entry["value"].get<double>();
-  }
-  return p;
-}
-
-fit::Flight held_out_flight(const PredictArgs& a, const std::string& log_path, const std::vector<std::string>& rotors,
-                            double vbat_ref) {
+fit::Flight load(const PredictArgs& a, const std::string& log_path, const std::vector<std::string>& rotors,
+                 double vbat_ref) {
   const runtime::CsvTable log = fit::read_log(log_path, a.mapping, a.resample);
   const fit::Flight flight = predict::fill_missing_signals(fit::load_flight(log, rotors, {}), vbat_ref);
   if (!flight.has_pose)
     std::cerr << output::printable(log_path) << ": no pose logged: one-step errors only (rollouts need a measured state)\n";
-  return a.validation >= 1.0 ? flight : fit::split_by_time(flight, 1.0 - a.validation).second;
+  return flight;
+}
+
+// Name, unit and bounds of every parameter, for calibration.
+std::vector<fit::FitParameter> parameter_bounds(const SymbolicModel& model) {
+  std::vector<fit::FitParameter> out;
+  for (const auto& p : model.params) out.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, false});
+  return out;
 }
 
 }  // namespace
 
 int run_predict(const PredictArgs& a) {
+  if (a.calibrate && a.params.empty()) throw std::invalid_argument("--calibrate needs --params (a diagnosis.json)");
+  if (a.calibrate && a.validation >= 1.0)
+    throw std::invalid_argument("--calibrate needs a part before the evaluated one: --validation below 1");
   const Vehicle v = load_vehicle(a.vehicle);
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.mapping, a.params});
@@ -83,7 +73,8 @@ int run_predict(const PredictArgs& a) {
   const SymbolicModel model = derive_model(v, derive_mass_properties(v), all);
   bool compiled = false;
   const auto m = make_model(model, &compiled);
-  const std::vector<double> params = a.params.empty() ? m->params() : read_params(a.params, *m);
+  std::optional<predict::ParameterSource> source;
+  if (!a.params.empty()) source.emplace(a.params);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const double vbat_ref = param(v, "vbat_ref").value;
@@ -94,10 +85,27 @@ int run_predict(const PredictArgs& a) {
   for (size_t i = 0; i < a.logs.size(); ++i) {
     std::cerr << "[" << i + 1 << "/" << a.logs.size() << "] " << output::printable(a.logs[i]) << " ("
               << (compiled ? "compiled model" : "interpreted model") << ")\n";
-    const fit::Flight f = held_out_flight(a, a.logs[i], rotors, vbat_ref);
+    const fit::Flight whole = load(a, a.logs[i], rotors, vbat_ref);
+    const auto [before, f] = a.validation >= 1.0 ? std::pair<fit::Flight, fit::Flight>{{}, whole}
+                                                 : fit::split_by_time(whole, 1.0 - a.validation);
+    predict::ParameterSource::ForLog values;
+    values.values = m->params();
+    values.origin = "vehicle file (nominal)";
+    if (source) values = source->for_log(*m, a.logs[i]);
+    nlohmann::ordered_json calibrated = nlohmann::ordered_json::object();
+    if (a.calibrate && values.flight == 0 && !values.flight_params.empty()) {
+      std::cerr << "  calibrating " << values.flight_params.size() << " flight parameters on the first "
+                << 100 * (1.0 - a.validation) << " %\n";
+      values.values = predict::calibrate(*m, values.values, values.flight_params, parameter_bounds(model), before);
+      for (int k : values.flight_params) calibrated[m->param_names()[k]] = values.values[k];
+      values.origin += ", flight parameters calibrated on the part before";
+    }
+    const std::vector<double>& params = values.values;
     const predict::Prediction p = predict::evaluate_prediction(*m, params, f, o);
     auto j = predict::prediction_json(p);
     j["log"] = a.logs[i];
+    j["parameters_from"] = values.origin;
+    if (!calibrated.empty()) j["calibrated"] = calibrated;
     j["evaluated_from_s"] = f.samples.empty() ? 0.0 : f.samples.front().t;
     flights.push_back(j);
     pooled.merge(p);

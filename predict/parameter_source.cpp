@@ -1,0 +1,114 @@
+#include "parameter_source.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "equation_error.hpp"
+#include "per_flight_model.hpp"
+#include "sinks.hpp"
+
+namespace quadgen::predict {
+
+namespace {
+
+// Logs are matched by their canonical path (as given to diagnose, from the same directory).
+std::string canonical(const std::string& path) {
+  std::error_code ec;
+  const auto c = std::filesystem::weakly_canonical(path, ec);
+  return ec ? path : c.string();
+}
+
+}  // namespace
+
+ParameterSource::ParameterSource(const std::string& path) : path_(path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(path + ": cannot open the parameter file");
+  try {
+    json_ = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(path + ": not JSON (" + e.what() + ")");
+  }
+  if (!json_.is_object()) throw std::invalid_argument(path + ": expected a diagnosis.json or fit.json object");
+  key_ = json_.contains("final_fit") ? "final_fit" : json_.contains("estimates") ? "estimates" : nullptr;
+  if (!key_ || !json_[key_].is_object())
+    throw std::invalid_argument(path + ": expected a diagnosis.json (final_fit) or fit.json (estimates)");
+  const auto strings = [&](const char* key) {
+    std::vector<std::string> out;
+    if (!json_.contains(key)) return out;
+    if (!json_[key].is_array()) throw std::invalid_argument(path + ": " + key + " is not a list");
+    for (const auto& s : json_[key]) {
+      if (!s.is_string()) throw std::invalid_argument(path + ": " + key + " holds a non-text entry");
+      out.push_back(s.get<std::string>());
+    }
+    return out;
+  };
+  for (const auto& f : strings("flights")) flights_.push_back(canonical(f));
+  flight_params_ = strings("flight_parameters");
+  if (json_.contains("airframe_fit") && !json_["airframe_fit"].is_object())
+    throw std::invalid_argument(path + ": airframe_fit is not an object");
+}
+
+void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::json& entries, const char* key,
+                          std::vector<double>& p) const {
+  for (const auto& [name, entry] : entries.items()) {
+    if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
+      throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " has no numeric value");
+    const int i = model.param_index(name);
+    if (i >= 0) {
+      p[static_cast<size_t>(i)] = entry["value"].get<double>();
+      continue;
+    }
+    // Another flight's copy (name@k) of a per-flight parameter: applied by for_log.
+    const std::string shared = runtime::shared_name(name);
+    if (shared == name || model.param_index(shared) < 0)
+      throw std::invalid_argument(path_ + ": parameter '" + output::printable(name) + "' is not in the model");
+  }
+}
+
+ParameterSource::ForLog ParameterSource::for_log(const runtime::DynamicModel& model, const std::string& log) const {
+  ForLog out;
+  out.values = model.params();
+  const auto it = std::find(flights_.begin(), flights_.end(), canonical(log));
+  out.flight = it == flights_.end() ? 0 : static_cast<int>(it - flights_.begin()) + 1;
+  const bool airframe = out.flight == 0 && json_.contains("airframe_fit");
+  const char* key = airframe ? "airframe_fit" : key_;
+  set(model, json_[key], key, out.values);
+  if (out.flight > 1)  // this flight's own copies replace flight 1's (the plain names)
+    for (const auto& [name, entry] : json_[key].items())
+      if (runtime::flight_of_name(name) == out.flight)
+        out.values[static_cast<size_t>(model.param_index(runtime::shared_name(name)))] = entry["value"].get<double>();
+  for (const auto& n : flight_params_) {
+    const int i = model.param_index(n);
+    if (i < 0) throw std::invalid_argument(path_ + ": flight parameter '" + output::printable(n) + "' is not in the model");
+    out.flight_params.push_back(i);
+  }
+  if (flights_.empty() && key_ == std::string("estimates"))
+    out.origin = path_ + " (fit estimates)";
+  else if (out.flight > 0)
+    out.origin = path_ + " (flight " + std::to_string(out.flight) + " of " + std::to_string(flights_.size()) + ")";
+  else
+    out.origin = path_ + (airframe ? " (airframe values: a log it was not fitted to)" : " (a log it was not fitted to)");
+  return out;
+}
+
+std::vector<double> calibrate(runtime::DynamicModel& model, const std::vector<double>& start,
+                              const std::vector<int>& free, const std::vector<fit::FitParameter>& bounds,
+                              const fit::Flight& part) {
+  if (bounds.size() != start.size()) throw std::invalid_argument("calibrate: one bound per parameter expected");
+  std::vector<fit::FitParameter> ps = bounds;
+  for (size_t i = 0; i < ps.size(); ++i) {
+    ps[i].value = std::clamp(start[i], ps[i].lower, ps[i].upper);
+    ps[i].free = std::find(free.begin(), free.end(), static_cast<int>(i)) != free.end();
+    if (!ps[i].free) ps[i].lower = ps[i].upper = ps[i].value = start[i];
+  }
+  model.set_params(start);
+  const fit::EquationErrorModel residuals(model, part, !part.has_pose);
+  fit::FitOptions o;
+  o.max_iterations = 100;
+  const fit::FitResult r = fit::fit_least_squares(residuals, ps, o);
+  return fit::parameter_values(r.parameters);
+}
+
+}  // namespace quadgen::predict
