@@ -127,13 +127,13 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   return out;
 }
 
-// With thrust (c_t = 0), gravity (g = 0), the rotor drag (whose hub forces have a moment)
-// and the flapping moment removed there are no torques; the model's rotational rows must
+// With thrust (c_t = 0), gravity (g = 0) and the flapping moment removed there are no
+// torques (rotor drag is a force at the CoG); the model's rotational rows must
 // then conserve 1/2 ω·Jω and |Jω|^2.
 std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
   lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
   for (const auto& p : m.params)
-    if (p.name == "rotor_drag.k" || p.name == "blade_flapping.k") off.append(p.sym == 0);
+    if (p.name == "blade_flapping.k") off.append(p.sym == 0);
   matrix w(3, 1), wdot(3, 1);
   for (int i = 0; i < 3; ++i) {
     w(i, 0) = m.states[10 + i].sym;
@@ -149,7 +149,7 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
     dL += Jw(i, 0) * Jwdot(i, 0);
   }
   return {make("energy", "rotational kinetic energy conserved", normal(dE).is_zero(),
-               "d/dt (1/2 ω^T J ω) = ω^T J dω/dt of the model's rows with c_t = g = 0 (and rotor_drag.k = blade_flapping.k = 0) normalises to 0 "
+               "d/dt (1/2 ω^T J ω) = ω^T J dω/dt of the model's rows with c_t = g = 0 (and blade_flapping.k = 0) normalises to 0 "
                "for a general symmetric J"),
           make("energy", "angular momentum magnitude conserved", normal(dL).is_zero(),
                "d/dt |Jω|^2 / 2 = (Jω)^T J dω/dt normalises to 0")};

@@ -87,7 +87,6 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   c.air_velocity_world = c.velocity;
   c.extra_body_force = vec3(0, 0, 0);
   c.extra_body_torque = vec3(0, 0, 0);
-  c.rotor_hub_force.assign(c.vehicle.rotors.size(), vec3(0, 0, 0));
 
   for (const Rotor& r : c.vehicle.rotors)
     c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
@@ -175,9 +174,6 @@ void assemble(ModelContext& c) {
                                  c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z"));
     const matrix arm = position.sub(c.cog);
     torque = torque.add(cross(arm, vec3(0, 0, thrust)));
-    // Forces effects put at the hub (rotor drag): their moment about the CoG too.
-    force_body = force_body.add(c.rotor_hub_force[i]);
-    torque = torque.add(cross(arm, c.rotor_hub_force[i]));
     // Reaction torque opposes the spin: a ccw rotor (seen from above) pushes the body along -z.
     const int reaction = (r.spin == Spin::ccw) ? -1 : 1;
     torque = torque.add(vec3(0, 0, reaction * c.p("kappa") * thrust));

@@ -24,7 +24,6 @@ struct ModelContext {
   GiNaC::matrix air_velocity_world{3, 1};
   GiNaC::matrix extra_body_force{3, 1};
   GiNaC::matrix extra_body_torque{3, 1};  // body-frame moment about the CoG from effects
-  std::vector<GiNaC::matrix> rotor_hub_force{};  // body-frame force acting at each rotor's hub
   std::vector<GiNaC::ex> rotor_speed;   // rad/s, per rotor
   std::vector<GiNaC::ex> thrust_scale;  // multiplies each rotor's thrust
   std::vector<GiNaC::ex> commanded_speed;  // motor map of the command, per rotor

@@ -50,25 +50,28 @@ void cog_offset(ModelContext& c) {
   c.cog = c.cog.add(vec3(dx, dy, 0));
 }
 
-// Horizontal body force −k (Σ w_i) v_air,body,xy (blade flapping / induced drag), each
-// rotor's share −k w_i v acting at its hub, so that a hub above or below the CoG also
-// feels the moment (the pitch-up of a multirotor flying forward).
+// Horizontal body force −k (Σ w_i) v_air,body,xy (rotor drag / induced drag, linear in
+// airspeed and rotor speed), acting at the CoG: a pure force. The moment a multirotor feels
+// in forward flight is blade_flapping's, with its own coefficient. Putting each rotor's share
+// at its hub would tie the moment to the hub's height above the CoG, which the blocks give
+// only roughly (8 mm on the Crazyflie file): fitted to real flights, the force then stood in
+// for the flapping moment through that lever, or was rejected because the moment it forced
+// conflicted with the gyro. With force and moment apart, their ratio is the effective point
+// of action, estimated rather than assumed.
 void rotor_drag(ModelContext& c) {
   const ex k = c.add_param("rotor_drag.k", "N s^2/m", 0.0, 0.0, 1e-3, true,
                            "rotor drag per rotor speed sum");
   const matrix vb = c.R.transpose().mul(c.air_velocity_world);
-  for (size_t i = 0; i < c.rotor_speed.size(); ++i) {
-    const ex w = c.rotor_speed[i];
-    c.rotor_hub_force[i] = c.rotor_hub_force[i].add(vec3(-k * w * vb(0, 0), -k * w * vb(1, 0), 0));
-  }
+  ex speed_sum = 0;
+  for (const ex& w : c.rotor_speed) speed_sum += w;
+  c.extra_body_force = c.extra_body_force.add(vec3(-k * speed_sum * vb(0, 0), -k * speed_sum * vb(1, 0), 0));
 }
 
 // Moment from blade flapping: flying through the air tilts each rotor disc away from the
 // relative wind, and the stiff hub of a small propeller passes the tilt to the body as a
 // moment proportional to rotor speed and airspeed (blade flapping, as in Mahony, Kumar and
 // Corke, "Multirotor Aerial Vehicles", IEEE Robotics & Automation Magazine 19(3), 2012).
-// With its own coefficient rather than through an assumed hub height (rotor_drag's moment
-// depends on where the CoG sits, which the blocks give only roughly):
+// With its own coefficient rather than through an assumed hub height (see rotor_drag):
 //   tau_body = k (sum of rotor speeds) (v_y, -v_x, 0), body-frame air velocity;
 // k > 0 pitches the nose up when flying forward. Typical size: the NanoBench Crazyflie's
 // residuals give 2-2.7e-4 N m per m/s at a rotor speed sum near 9,000 rad/s, k ~ 3e-8 N s^2
