@@ -123,11 +123,19 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
 
   c.cog = vec3(c.p("cog_x"), c.p("cog_y"), c.p("cog_z"));
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
+    const Rotor& r = c.vehicle.rotors[i];
+    const std::string n = r.name;
+    c.rotor_disc_area.push_back(c.add_constant(n + ".A_p", "m^2", r.disc_area, "disc area of rotor " + n));
+    c.rotor_radius.push_back(c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n));
+    c.rotor_position.push_back(vec3(c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x"),
+                                    c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
+                                    c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z")));
     const ex u = c.model.inputs[i].sym;
     const ex w = c.p("motor_a0") + c.p("motor_a1") * u + c.p("motor_a2") * u * u;
     c.commanded_speed.push_back(w);
     c.rotor_speed.push_back(w);
     c.thrust_scale.push_back(1);
+    c.thrust_speed_loss.push_back(0);
   }
 }
 
@@ -163,16 +171,11 @@ void assemble(ModelContext& c) {
   for (size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];
     const ex w = c.rotor_speed[i];
-    const std::string n = r.name;
-    const ex A_p = c.add_constant(n + ".A_p", "m^2", r.disc_area, "disc area of rotor " + n);
-    const ex r_p = c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n);
-    const ex thrust = c.thrust_scale[i] * c.p("c_t") * c.p("rho") * A_p * pow(r_p, 2) * w * w;
+    const ex thrust = c.thrust_scale[i] * c.p("c_t") * c.p("rho") * c.rotor_disc_area[i] * pow(c.rotor_radius[i], 2) *
+                      w * (w - c.thrust_speed_loss[i]);
     m.intermediates.push_back({"F_" + r.name, thrust});
     total_thrust += thrust;
-    const matrix position = vec3(c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x"),
-                                 c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
-                                 c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z"));
-    const matrix arm = position.sub(c.cog);
+    const matrix arm = c.rotor_position[i].sub(c.cog);
     torque = torque.add(cross(arm, vec3(0, 0, thrust)));
     // Reaction torque opposes the spin: a ccw rotor (seen from above) pushes the body along -z.
     const int reaction = (r.spin == Spin::ccw) ? -1 : 1;

@@ -26,6 +26,12 @@ struct ModelContext {
   GiNaC::matrix extra_body_torque{3, 1};  // body-frame moment about the CoG from effects
   std::vector<GiNaC::ex> rotor_speed;   // rad/s, per rotor
   std::vector<GiNaC::ex> thrust_scale;  // multiplies each rotor's thrust
+  // Each rotor's thrust is thrust_scale c_t rho A_p r_p^2 w (w - thrust_speed_loss): an
+  // effect that lowers the thrust in proportion to w (inflow) sets the loss [rad/s].
+  std::vector<GiNaC::ex> thrust_speed_loss;
+  std::vector<GiNaC::matrix> rotor_position;  // m, body frame, each rotor's hub (named constants)
+  std::vector<GiNaC::ex> rotor_radius;        // m, r_p
+  std::vector<GiNaC::ex> rotor_disc_area;     // m^2, A_p
   std::vector<GiNaC::ex> commanded_speed;  // motor map of the command, per rotor
   GiNaC::matrix measured_q{4, 1};       // attitude as logged
 

@@ -130,6 +130,8 @@ std::vector<HiddenCase> single_effects() {
       {"battery_sag", "battery_sag", {{"battery_sag.exponent", 1.5}}, {{"battery_sag.exponent", 0.2}}, ""},
       {"ground_effect", "ground_effect", {{"ground_effect.radius", 0.0635}}, {{"ground_effect.radius", 0.02}},
        "--height 0.2 --height-amplitude 0.1"},  // low and varied enough for the held-out prediction to gain
+      // The size blade-element theory gives a small rotor (derive/effects.cpp).
+      {"inflow", "inflow", {{"inflow.k", 3.0}}, {{"inflow.k", 0.6}}, ""},
   };
   std::vector<HiddenCase> all;
   for (unsigned seed : {1u, 2u})

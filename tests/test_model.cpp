@@ -123,11 +123,12 @@ TEST(Model, EffectsChangeTheModelAwayFromNominal) {
   // Guard against an effect that is silently a no-op: move its parameters and f must change.
   const Vehicle v = test::finken3();
   for (const char* name : {"motor_gain", "cog_offset", "rotor_drag", "blade_flapping", "wind", "thrust_decay",
-                           "battery_sag", "ground_effect"}) {
+                           "battery_sag", "ground_effect", "inflow"}) {
     SymbolicModel m = derive(v, {name});
     std::vector<double> x(13, 0.0);
     x[2] = 0.05;
     x[3] = 1.0;
+    x[5] = 0.5;
     x[6] = 1;
     std::vector<double> u{0.4, 0.4, 0.4, 0.4};
     for (size_t i = 4; i < m.inputs.size(); ++i) u.push_back(m.inputs[i].name == "t" ? 2.0 : 3.7);
@@ -170,6 +171,50 @@ TEST(Model, BladeFlappingMomentMatchesItsClosedForm) {
     EXPECT_NEAR(f1[10 + a] - f0[10 + a], expected[a], 1e-9 * (1 + std::fabs(expected[a]))) << "rate row " << a;
   }
   EXPECT_GT(std::fabs(expected[1]), 0.1);  // a moment worth checking: rad/s^2
+}
+
+// The inflow thrust loss against its closed form, computed here from the vehicle file:
+// level attitude, climbing at 1 m/s while rolling and pitching. Each rotor's hub climbs at
+// v_i = v_z + p (y_i - c_y) - q (x_i - c_x) and loses dF_i = -c_t rho A r^2 w_i k v_i / r of
+// its thrust; the body force changes by sum dF_i along z, the moment by arm_i x dF_i plus
+// the reaction +-kappa dF_i, and the origin's acceleration by dF/m - (dw x c).
+TEST(Model, InflowThrustLossMatchesItsClosedForm) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {"inflow"});
+  std::vector<double> x(13, 0.0);
+  x[2] = 1.0;
+  x[5] = 1.0;   // climbing, world = body z at level attitude
+  x[6] = 1;
+  x[10] = 2.0;  // p
+  x[11] = -1.5; // q
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  const auto f0 = test::eval_f(m, x, u);
+  const double k = 3.0;
+  m.params[m.param_index("inflow.k")].nominal = k;
+  const auto f1 = test::eval_f(m, x, u);
+  auto nom = [&](const char* n) { return m.params[m.param_index(n)].nominal; };
+  const Eigen::Vector3d cog(nom("cog_x"), nom("cog_y"), nom("cog_z"));
+  Eigen::Vector3d dforce = Eigen::Vector3d::Zero(), dtorque = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < v.rotors.size(); ++i) {
+    const Rotor& r = v.rotors[i];
+    const double w = nom("motor_a0") + nom("motor_a1") * u[i] + nom("motor_a2") * u[i] * u[i];
+    const Eigen::Vector3d arm = Eigen::Vector3d(r.position[0], r.position[1], r.position[2]) - cog;
+    const double climb = x[5] + x[10] * arm.y() - x[11] * arm.x();
+    const double dF = -nom("c_t") * nom("rho") * r.disc_area * r.radius * r.radius * w * k * climb / r.radius;
+    dforce.z() += dF;
+    dtorque += arm.cross(Eigen::Vector3d(0, 0, dF));
+    dtorque.z() += (r.spin == Spin::ccw ? -1 : 1) * nom("kappa") * dF;
+  }
+  Eigen::Matrix3d J;
+  J << nom("J_xx"), nom("J_xy"), nom("J_xz"), nom("J_xy"), nom("J_yy"), nom("J_yz"), nom("J_xz"), nom("J_yz"), nom("J_zz");
+  const Eigen::Vector3d dw = J.inverse() * dtorque;
+  const Eigen::Vector3d dv = dforce / nom("mass") - dw.cross(cog);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(f1[3 + a] - f0[3 + a], dv[a], 1e-9 * (1 + std::fabs(dv[a]))) << "velocity row " << a;
+    EXPECT_NEAR(f1[10 + a] - f0[10 + a], dw[a], 1e-9 * (1 + std::fabs(dw[a]))) << "rate row " << a;
+  }
+  EXPECT_LT(dv.z(), -0.1);  // climbing costs thrust: m/s^2
+  EXPECT_GT(std::fabs(dw.x()) + std::fabs(dw.y()), 1.0);  // and rolling and pitching are damped: rad/s^2
 }
 
 TEST(Model, AttitudeBiasChangesOnlyTheMeasurement) {
