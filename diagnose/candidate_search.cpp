@@ -11,6 +11,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 
 #include "effects.hpp"
+#include "per_flight_model.hpp"
 #include "residual_analysis.hpp"
 
 namespace quadgen::diagnose {
@@ -445,22 +446,46 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   const Eigen::MatrixXd C = H.completeOrthogonalDecomposition().pseudoInverse();
   best.standard_errors.assign(np, std::numeric_limits<double>::quiet_NaN());
   for (size_t a = 0; a < cols.size(); ++a) best.standard_errors[cols[a]] = std::sqrt(std::max(0.0, C(a, a)));
+  // Profiles for the airframe's parameters, on every core; a flight's own copies of a
+  // per-flight parameter (one per flight in a joint diagnosis) get Wald intervals from the
+  // joint covariance, which includes the airframe's uncertainty.
+  std::vector<int> profiled, wald;
+  for (const auto& e : r.selected)
+    for (int i : effect_params_.at(e)) {
+      if (!r.final_fit[i].free) continue;
+      const std::string shared = runtime::shared_name(r.final_fit[i].name);
+      const bool per_flight = model_.param_index(runtime::per_flight_name(shared, 2)) >= 0;
+      (per_flight ? wald : profiled).push_back(i);
+    }
   fit::FitOptions fo;
   fo.max_iterations = 50;
   fit::ProfileOptions po;
   po.max_steps_each_side = 12;
-  for (const auto& e : r.selected)
-    for (int i : effect_params_.at(e)) {
-      if (!r.final_fit[i].free) continue;
-      if (opt_.verbose_progress && isatty(2))
-        std::cerr << "\r[diagnose] profile of " << r.final_fit[i].name << "        " << std::flush;
-      fit::Profile pr = fit::profile_parameter(train_, best, i, fo, po);
-      EffectEstimate est{r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
-                         pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
-                         pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict};
-      r.estimates.push_back(est);
-      r.profiles.push_back(std::move(pr));
-    }
+  po.threads = 0;
+  if (opt_.verbose_progress)
+    po.progress = [](const std::string& name, int done, int count, double seconds) {
+      std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profile " << done << "/" << count << " (" << name << ", "
+                << static_cast<int>(seconds) << " s)        " << (isatty(2) ? "" : "\n") << std::flush;
+    };
+  std::vector<fit::Profile> profiles = fit::profile_all(train_, best, fo, po, profiled);
+  for (auto& pr : profiles) {
+    const int i = pr.index;
+    r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
+                           pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
+                           pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict});
+    r.profiles.push_back(std::move(pr));
+  }
+  for (int i : wald) {
+    const double se = best.standard_errors[i], nan = std::numeric_limits<double>::quiet_NaN();
+    const bool finite = std::isfinite(se) && se > 0;
+    const double v = r.final_fit[i].value, z = 1.959963984540054;
+    r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, se, finite ? v - z * se : nan,
+                           finite ? v + z * se : nan, 0.0,
+                           finite ? "identifiable" : "structurally non-identifiable", "wald"});
+  }
+  std::stable_sort(r.estimates.begin(), r.estimates.end(), [&](const EffectEstimate& a, const EffectEstimate& b) {
+    return model_.param_index(a.name) < model_.param_index(b.name);
+  });
   // Discretisation allowance: refit with the other quadrature rule.
   std::set<std::string> sel(r.selected.begin(), r.selected.end());
   train_.set_quadrature(fit::EquationErrorModel::Quadrature::kTrapezoid);
@@ -474,7 +499,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
     if (!std::isnan(e.upper)) e.upper += e.numerical_allowance;
   }
   if (opt_.verbose_progress)
-    std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profiles of " << r.profiles.size() << " parameters done        \n";
+    std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] intervals of " << r.estimates.size() << " parameters done ("
+              << r.profiles.size() << " profiles)        \n";
 }
 
 }  // namespace quadgen::diagnose

@@ -54,6 +54,10 @@ struct EffectEstimate {
   // accelerations use the trapezoid instead of the midpoint rule.
   double numerical_allowance = 0;
   std::string verdict;  // from the profile likelihood
+  // How the interval was found: "profile" (profile likelihood), or "wald" (value +- 1.96
+  // standard errors of the joint fit) for a flight's own copy of a per-flight parameter in
+  // a joint diagnosis, where profiling every flight's copy would take hours.
+  std::string interval = "profile";
 };
 
 struct CandidateEvidence {

@@ -80,7 +80,8 @@ json finding_json(const Finding& f) {
                   {"unit", e.unit},
                   {"standard_error", number_or_null(e.standard_error)},
                   {"numerical_allowance", e.numerical_allowance},
-                  {"identifiability", e.verdict}};
+                  {"identifiability", e.verdict},
+                  {"interval_method", e.interval}};
   json fj = {{"effect", f.effect},
              {"parameters", ps},
              {"gain", {{"metric", f.metric},
@@ -440,9 +441,14 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "<h3>" << esc(f.effect) << "</h3>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
-    if (per_flight) per_flight_table(h, f, d.flights.size());
+    if (per_flight) {
+      per_flight_table(h, f, d.flights.size());
+      h << "<p>Intervals: each flight's value &plusmn; 1.96 standard errors of the joint fit (Wald), which includes "
+           "the uncertainty of the airframe's parameters; the airframe's parameters have profile-likelihood "
+           "intervals.</p>\n";
+    }
     else {
-      h << "<table><tr><th>parameter</th><th>value</th><th>95 % profile interval</th><th>unit</th><th>identifiability</th></tr>\n";
+      h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
       for (const auto& p : f.parameters)
         h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>[" << num(p.lower) << ", "
           << num(p.upper) << "]</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
