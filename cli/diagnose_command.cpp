@@ -127,7 +127,8 @@ int run_diagnose(const DiagnoseArgs& a) {
   const std::vector<ThesisItem> no_thesis;
   const Derivation der{v, mp, ext, ext_audit, no_thesis};
   std::string err;
-  const auto plots = diagnose::diagnosis_plots(d, valid, &err);
+  std::vector<std::pair<std::string, std::string>> plot_data;
+  const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
   if (plots.empty()) std::cerr << "no plots: " << err << "\n";
   out.add("diagnosis.json", output::json_document(diagnose::diagnosis_json(d, logs_label)));
   out.add("report.html", diagnose::diagnosis_html(d, logs_label, plots));
@@ -136,6 +137,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   out.add("extended_derivation.md", derivation_markdown(der));
   out.add("fitted_parameters.yaml", fitted_parameters_yaml(v, d));
   for (const auto& [name, svg] : plots) out.add(name, svg);
+  for (const auto& [name, csv] : plot_data) out.add(name, csv);  // every plotted series, for Python or MATLAB
   out.commit();
   std::cout << diagnose::diagnosis_summary(d) << "diagnosed in " << d.seconds << " s; wrote " << a.out << "/report.html\n";
   return 0;

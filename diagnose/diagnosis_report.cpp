@@ -259,10 +259,12 @@ runtime::Series series(const std::string& label, const std::vector<double>& x, c
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis& d, const fit::Flight& valid,
-                                                                 std::string* error) {
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(
+    const Diagnosis& d, const fit::Flight& valid, std::string* error,
+    std::vector<std::pair<std::string, std::string>>* data) {
   std::vector<std::pair<std::string, std::string>> out;
   auto render = [&](const std::string& name, const std::string& title, const std::vector<runtime::Panel>& panels) {
+    if (data) data->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
     std::string svg;
     if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
   };
@@ -539,7 +541,10 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   if (plots.empty()) h << "<p>No plots (gnuplot unavailable).</p>\n";
   for (const auto& [name, svg] : plots) {
     const size_t at = svg.find("<svg");
-    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name) << "</figcaption></figure>\n";
+    const std::string stem = name.substr(0, name.rfind('.'));
+    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name);
+    if (stem != "profiles") h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
+    h << "</figcaption></figure>\n";
   }
   h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
        "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "

@@ -15,8 +15,10 @@ namespace quadgen::diagnose {
 nlohmann::ordered_json diagnosis_json(const Diagnosis& d, const std::string& log_path);
 
 // Plots as (file name, SVG text); empty when gnuplot is unavailable (`error` says why).
-std::vector<std::pair<std::string, std::string>> diagnosis_plots(const Diagnosis& d, const fit::Flight& validation,
-                                                                 std::string* error);
+// `data`, when given, receives each plot's series as (name.csv, CSV text), gnuplot or not.
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(
+    const Diagnosis& d, const fit::Flight& validation, std::string* error,
+    std::vector<std::pair<std::string, std::string>>* data = nullptr);
 
 std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
                            const std::vector<std::pair<std::string, std::string>>& plots);

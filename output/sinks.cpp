@@ -97,6 +97,17 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
   return s;
 }
 
+std::string csv_field(const std::string& s) {
+  std::string out = "\"";
+  if (!s.empty() && (s[0] == '=' || s[0] == '+' || s[0] == '-' || s[0] == '@')) out += '\'';
+  for_each_char(s, [&](const std::string& c) {
+    if (c == "\"") out += "\"\"";
+    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
+    else out += c;
+  });
+  return out + "\"";
+}
+
 std::string gnuplot_string(const std::string& s) {
   std::string out = "'";
   for_each_char(s, [&](const std::string& c) {

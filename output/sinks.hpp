@@ -43,4 +43,9 @@ std::string markdown_code(const std::string& s);
 // Text inside LaTeX \text{...} or prose: the ten special characters replaced by their commands.
 std::string latex_text(const std::string& s);
 
+// A CSV field (RFC 4180), quotes included: '"' doubled, control characters (a line break would
+// start a new record) as spaces, invalid UTF-8 as '?'; a field that a spreadsheet would run as
+// a formula (leading = + - @) gets a leading apostrophe.
+std::string csv_field(const std::string& s);
+
 }  // namespace quadgen::output

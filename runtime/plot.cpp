@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <tuple>
@@ -182,6 +183,26 @@ bool render_svg(const std::string& title, const std::vector<Panel>& panels, std:
   }
   *svg = run.out;
   return true;
+}
+
+std::string panels_csv(const std::string& title, const std::vector<Panel>& panels) {
+  std::string out = "plot,panel,x_label,y_label,series,x,y\n";
+  char number[32];
+  const auto field = [&](double v) {
+    if (!std::isfinite(v)) return std::string();
+    std::snprintf(number, sizeof number, "%.17g", v);
+    return std::string(number);
+  };
+  const std::string plot = output::csv_field(title);
+  for (const auto& p : panels) {
+    const std::string prefix = plot + "," + output::csv_field(p.title) + "," + output::csv_field(p.xlabel) + "," +
+                               output::csv_field(p.ylabel) + ",";
+    for (const auto& s : p.series) {
+      const std::string lead = prefix + output::csv_field(s.label) + ",";
+      for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) out += lead + field(s.x[i]) + "," + field(s.y[i]) + "\n";
+    }
+  }
+  return out;
 }
 
 }  // namespace quadgen::runtime

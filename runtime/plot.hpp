@@ -32,6 +32,11 @@ bool render_svg(const std::string& title, const std::vector<Panel>& panels, std:
 // The gnuplot script render_svg sends (exposed for tests and the fuzz target).
 std::string gnuplot_script(const std::string& title, const std::vector<Panel>& panels);
 
+// Every point of every series, as one CSV table for Python, MATLAB or a spreadsheet (long
+// format, one row per point: plot,panel,x_label,y_label,series,x,y; a non-finite value is an
+// empty field). Unthinned; text fields through output::csv_field.
+std::string panels_csv(const std::string& title, const std::vector<Panel>& panels);
+
 // `s` thinned to at most kMaxPlotPointsPerSeries points (bucket minimum and maximum, in order).
 Series decimated(const Series& s);
 

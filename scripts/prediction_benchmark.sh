@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Prediction error on real flights, the way published models report it, for the nominal
-# Crazyflie model and for the model `quadgen diagnose` fits and extends (base fit and
+# Crazyflie model and for the models `quadgen diagnose` fits and extends (base fit and
 # extended model, on each flight's held-out last 30 %). Prints one table with the published
 # numbers beside ours (scripts/prediction_table.py). Not part of CI: about 2-5 minutes per
 # flight on 2 cores, most of it the diagnoses.
 #   scripts/prediction_benchmark.sh [OUT_DIR]        (default out/prediction_benchmark)
+# DIAGNOSES=DIR reuses the diagnoses of scripts/real_flights.sh DIR instead of running them;
+# when DIR holds its joint diagnosis (JOINT=1), each flight is also predicted with the joint
+# fit's values for that flight ("joint fit").
 # Needs the build (./setup.sh --no-run), ../shared/data beside the clone, and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,11 +15,21 @@ out="${1:-out/prediction_benchmark}"
 data=../shared/data/crazyflie
 command -v python3 > /dev/null || { echo "python3 is needed for the table (apt-get install python3)"; exit 1; }
 vehicle=vehicles/crazyflie21.yaml
+reuse="${DIAGNOSES:-}"
 run() {  # name log mapping [extra diagnose flags...]
   local name=$1 log=$2 mapping=$3; shift 3
   echo "== $name" >&2
+  mkdir -p "$out/$name"
   build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/nominal" > /dev/null
-  build/quadgen diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
+  if [ -n "$reuse" ] && [ -f "$reuse/$name/diagnosis.json" ]; then
+    ln -sfn "$(cd "$reuse/$name" && pwd)" "$out/$name/diagnosis"
+  else
+    build/quadgen diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
+  fi
+  if [ -n "$reuse" ] && [ -f "$reuse/joint_5_flights/diagnosis.json" ] && [ "$name" != arpl_log10 ]; then
+    build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$reuse/joint_5_flights/diagnosis.json" \
+      --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
+  fi
 }
 for log in "$data"/nanobench/*.csv; do
   run "$(basename "$log" .csv)" "$log" data/mappings/nanobench.yaml

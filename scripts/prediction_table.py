@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Prints the prediction benchmark's table (scripts/prediction_benchmark.sh) as Markdown:
-per flight, the nominal model, the diagnosis' base fit and its extended model, with the
-issue's targets and the published anchors. Usage: prediction_table.py OUT_DIR"""
+per flight, the nominal model, the diagnosis' base fit and its extended model, and any
+further model in a folder of its own beside them, with the targets and the published anchors. Usage: prediction_table.py OUT_DIR"""
 import json
 import math
 import sys
@@ -52,6 +52,11 @@ def main(out):
             if "prediction" in d:
                 effects = ", ".join(d["extended_model"]["effects"]) or "nothing found"
                 models += [("base fit", d["prediction"]["before"]), (f"extended ({effects})", d["prediction"]["after"])]
+        # Further models, one folder each (named by what they are): a joint fit's values, an
+        # unseen flight predicted with the airframe's values, calibrated or not.
+        for sub in sorted(p for p in flight.iterdir() if p.name not in ("nominal", "diagnosis") and p.is_dir()):
+            if (sub / "prediction.json").exists():
+                models.append((sub.name, json.loads((sub / "prediction.json").read_text())))
         for name, pred in models:
             print(f"| {flight.name} | {name} | " + " | ".join(value(pred, *c[1:]) for c in COLUMNS) + " |")
 

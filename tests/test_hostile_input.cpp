@@ -251,6 +251,53 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
   EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
 }
 
+// A plot's series as CSV: read back with an RFC 4180 reader written here, every hostile label
+// is one field of one record (no extra row or column), unchanged but for control characters
+// and a formula guard, and the numbers come back exactly.
+namespace {
+std::vector<std::vector<std::string>> read_rfc4180(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1, std::vector<std::string>(1));
+  bool quoted = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') rows.back().back() += '"', ++i;
+      else if (c == '"') quoted = false;
+      else rows.back().back() += c;
+    } else if (c == '"') quoted = true;
+    else if (c == ',') rows.back().emplace_back();
+    else if (c == '\n') rows.emplace_back(1);
+    else rows.back().back() += c;
+  }
+  if (rows.back().size() == 1 && rows.back()[0].empty()) rows.pop_back();
+  return rows;
+}
+}  // namespace
+
+TEST(Sinks, PlotDataCsvKeepsEveryLabelInItsField) {
+  for (const auto& s : hostile_strings()) {
+    quadgen::runtime::Panel p{s, s, s, {{s, {0, 1, 2}, {1.25, -0.5, 1e-300}}}};
+    const auto rows = read_rfc4180(quadgen::runtime::panels_csv(s, {p}));
+    ASSERT_EQ(rows.size(), 4u) << out::printable(s);
+    for (const auto& r : rows) ASSERT_EQ(r.size(), 7u) << out::printable(s);
+    const bool formula = !s.empty() && std::string("=+-@").find(s[0]) != std::string::npos;
+    for (int f = 0; f < 5; ++f) {
+      const std::string& label = rows[1][f];
+      if (formula) EXPECT_EQ(label.substr(0, 1), "'") << out::printable(s);
+      // Text that needs no repair (no control character, valid UTF-8) comes back as it was.
+      if (out::printable(s) == s) EXPECT_EQ(formula ? label.substr(1) : label, s);
+    }
+    EXPECT_EQ(std::stod(rows[2][5]), 1.0);
+    EXPECT_EQ(std::stod(rows[2][6]), -0.5);
+    EXPECT_EQ(std::stod(rows[3][6]), 1e-300);
+  }
+  const auto rows = read_rfc4180(quadgen::runtime::panels_csv("t", {{"a,b", "t [s]", "m", {{"say \"hi\"", {1}, {2}}}}}));
+  EXPECT_EQ(rows[1][1], "a,b");
+  EXPECT_EQ(rows[1][4], "say \"hi\"");
+  EXPECT_EQ(read_rfc4180(out::csv_field("=HYPERLINK(1)"))[0][0], "'=HYPERLINK(1)");
+  EXPECT_EQ(read_rfc4180(out::csv_field("a\nb"))[0][0], "a b");
+}
+
 TEST(Sinks, HtmlReportQuotesNoMarkup) {
   quadgen::diagnose::Diagnosis d;
   for (const auto& s : hostile_strings()) {

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Fit on some flights, predict another: diagnoses four NanoBench flights of the one Crazyflie
+# jointly (figure-8s and the circle), then predicts the helix (B5), which no fit has seen, on
+# its last 30 %: with the nominal model, with the airframe's values from the joint fit, and
+# with those plus the helix's own flight parameters (motor trims, marker frame) calibrated
+# on its first 70 % (quadgen predict --calibrate). The four training flights are predicted
+# on their held-out ends with their own values. Prints the table of prediction_table.py.
+#   scripts/cross_flight.sh [OUT_DIR]       (default /tmp/quadgen_cross_flight; ~20 min)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-/tmp/quadgen_cross_flight}
+q=${QUADGEN:-build/quadgen}
+data=${QUADGEN_NANOBENCH:-../shared/data/crazyflie/nanobench}
+vehicle=vehicles/crazyflie21.yaml
+mapping=data/mappings/nanobench.yaml
+train=(B2_circle_medium_rep1 B3_figure8_medium_rep1 B3_figure8_medium_rep2 B3_figure8_slow_rep1)
+unseen=B5_helix_slow_rep1
+mkdir -p "$out/table"
+if [ ! -f "$out/joint_4_flights/diagnosis.json" ]; then
+  logs=()
+  for n in "${train[@]}"; do logs+=("$data/$n.csv"); done
+  echo "diagnosing ${train[*]} jointly ..." >&2
+  "$q" diagnose "$vehicle" "${logs[@]}" --mapping "$mapping" --max-effects 5 --out "$out/joint_4_flights" \
+    > "$out/joint_4_flights.log" 2>&1 || { echo "failed: see $out/joint_4_flights.log" >&2; exit 1; }
+fi
+params="$out/joint_4_flights/diagnosis.json"
+predict() {  # flight folder-name [flags...]
+  local n=$1 name=$2; shift 2
+  rm -rf "$out/table/$n/$name"
+  mkdir -p "$out/table/$n"
+  "$q" predict "$vehicle" "$data/$n.csv" --mapping "$mapping" "$@" --out "$out/table/$n/$name" > /dev/null 2>&1 ||
+    echo "predict $n $name failed" >&2
+}
+for n in "${train[@]}"; do predict "$n" joint_fit_own_values --params "$params"; done
+predict "$unseen" nominal
+predict "$unseen" unseen_airframe_values --params "$params"
+predict "$unseen" unseen_calibrated_first_70pct --params "$params" --calibrate
+python3 scripts/prediction_table.py "$out/table"
