@@ -1,5 +1,7 @@
 #include "flight_log.hpp"
 
+#include "log_file.hpp"
+
 #include "attitude.hpp"
 
 #include <fcntl.h>
@@ -169,20 +171,6 @@ class FdLines {
   size_t pos_ = 0, len_ = 0;
 };
 
-struct FdCloser {
-  int fd;
-  ~FdCloser() { ::close(fd); }
-};
-
-const char* file_kind(mode_t m) {
-  if (S_ISDIR(m)) return "a directory";
-  if (S_ISFIFO(m)) return "a FIFO";
-  if (S_ISCHR(m)) return "a character device";
-  if (S_ISBLK(m)) return "a block device";
-  if (S_ISSOCK(m)) return "a socket";
-  return "not a regular file";
-}
-
 }  // namespace
 
 unsigned long long max_input_bytes() {
@@ -204,22 +192,10 @@ CsvTable parse_csv(const std::string& text, const std::string& path) {
 }
 
 CsvTable read_csv(const std::string& path) {
-  // O_NONBLOCK so that opening a FIFO cannot block; the checks then use fstat on what was
-  // opened, not a second look-up of the path.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
-  const FdCloser closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw LogError(path + ": cannot stat log: " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode))
-    throw LogError(path + ": " + file_kind(st.st_mode) + ", not a regular file (expected a CSV log)");
-  const unsigned long long size = static_cast<unsigned long long>(st.st_size), limit = max_input_bytes();
-  if (size > limit)
-    throw LogError(path + ": " + std::to_string(size) + " bytes, above the limit of " + std::to_string(limit) +
-                   " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
-  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
-  FdLines lines(fd, path, limit);
-  return parse_lines(lines, path, size);
+  const LogFile file(path, "a CSV log");
+  file.set_blocking();
+  FdLines lines(file.fd(), path, file.limit());
+  return parse_lines(lines, path, file.size());
 }
 
 void check_values(const CsvTable& log) {

@@ -1,5 +1,7 @@
 #include "ulog.hpp"
 
+#include "log_file.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -536,11 +538,6 @@ void Parser::timestamp_first(Layout& l, const std::string& fmt, std::uint64_t at
   std::rotate(l.leaves.begin(), l.leaves.begin() + i, l.leaves.begin() + i + 1);
 }
 
-struct FdCloser {
-  int fd;
-  ~FdCloser() { ::close(fd); }
-};
-
 std::string read_all(int fd, const std::string& path, unsigned long long expected, unsigned long long limit) {
   std::string bytes;
   bytes.reserve(expected);
@@ -562,19 +559,8 @@ std::string read_all(int fd, const std::string& path, unsigned long long expecte
 Ulog parse_ulog(const std::string& bytes, const std::string& name) { return Parser(bytes, name).run(); }
 
 Ulog read_ulog(const std::string& path) {
-  // O_NONBLOCK: opening a FIFO must not block; it is then refused as not a regular file.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
-  const FdCloser closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw LogError(path + ": cannot stat log: " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) throw LogError(path + ": not a regular file (expected a ULog file)");
-  const auto size = static_cast<unsigned long long>(st.st_size);
-  const unsigned long long limit = max_input_bytes();
-  if (size > limit)
-    throw LogError(path + ": " + std::to_string(size) + " bytes, above the limit of " + std::to_string(limit) +
-                   " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
-  return parse_ulog(read_all(fd, path, size, limit), path);
+  const LogFile file(path, "a ULog file");
+  return parse_ulog(read_all(file.fd(), path, file.size(), file.limit()), path);
 }
 
 }  // namespace quadgen::runtime

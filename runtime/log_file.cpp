@@ -1,0 +1,50 @@
+#include "log_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "flight_log.hpp"
+
+namespace quadgen::runtime {
+
+namespace {
+
+const char* file_kind(mode_t m) {
+  if (S_ISDIR(m)) return "a directory";
+  if (S_ISFIFO(m)) return "a FIFO";
+  if (S_ISCHR(m)) return "a character device";
+  if (S_ISBLK(m)) return "a block device";
+  if (S_ISSOCK(m)) return "a socket";
+  return "not a regular file";
+}
+
+}  // namespace
+
+LogFile::LogFile(const std::string& path, const std::string& expected) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd_ < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
+  try {
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) throw LogError(path + ": cannot stat log: " + std::strerror(errno));
+    if (!S_ISREG(st.st_mode))
+      throw LogError(path + ": " + file_kind(st.st_mode) + ", not a regular file (expected " + expected + ")");
+    size_ = static_cast<unsigned long long>(st.st_size);
+    limit_ = max_input_bytes();
+    if (size_ > limit_)
+      throw LogError(path + ": " + std::to_string(size_) + " bytes, above the limit of " + std::to_string(limit_) +
+                     " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
+}
+
+LogFile::~LogFile() { ::close(fd_); }
+
+void LogFile::set_blocking() const { ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) & ~O_NONBLOCK); }
+
+}  // namespace quadgen::runtime

@@ -1,0 +1,28 @@
+// A log file opened for reading, the one way every log reader opens its input: without
+// blocking (a FIFO is refused at once, not waited on), checked on what was opened (fstat, not a
+// second look-up of the path), a regular file of at most max_input_bytes(). Errors are
+// LogError with the path and what was expected ("a CSV log", "a ULog file").
+#pragma once
+#include <string>
+
+namespace quadgen::runtime {
+
+class LogFile {
+ public:
+  LogFile(const std::string& path, const std::string& expected);
+  ~LogFile();
+  LogFile(const LogFile&) = delete;
+  LogFile& operator=(const LogFile&) = delete;
+
+  int fd() const { return fd_; }
+  unsigned long long size() const { return size_; }    // bytes when opened
+  unsigned long long limit() const { return limit_; }  // max_input_bytes()
+  // Reads may block from here on (a regular file's reads do not wait for writers anyway).
+  void set_blocking() const;
+
+ private:
+  int fd_ = -1;
+  unsigned long long size_ = 0, limit_ = 0;
+};
+
+}  // namespace quadgen::runtime
