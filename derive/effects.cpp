@@ -1,5 +1,7 @@
 #include "effects.hpp"
 
+#include <cmath>
+#include <iomanip>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -149,6 +151,109 @@ void inflow(ModelContext& c) {
 
 namespace {
 
+// A number for a sentence: two significant digits (three at 100 and above), no exponent
+// between 0.01 and 10,000.
+std::string words(double v) {
+  std::ostringstream os;
+  const double a = std::fabs(v);
+  if (a != 0 && (a < 0.01 || a >= 1e4)) os << std::setprecision(2) << v;
+  else os << std::fixed << std::setprecision(a >= 100 ? 0 : a >= 10 ? 1 : a >= 1 ? 1 : 2) << v;
+  return os.str();
+}
+
+double value_of(const std::map<std::string, double>& v, const std::string& name) {
+  const auto it = v.find(name);
+  return it == v.end() ? 0.0 : it->second;
+}
+
+std::string after_dot(const std::string& name) { return name.substr(name.find('.') + 1); }
+
+// "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more."
+std::string motor_gain_headline(const std::map<std::string, double>& v, const std::string& reference) {
+  std::ostringstream os;
+  bool first = true;
+  for (const auto& [name, g] : v) {
+    os << (first ? "Motor " : "; motor ") << after_dot(name) << (first ? " gives " : " ") << words(100 * std::fabs(g))
+       << " % " << (g < 0 ? "less" : "more") << (first ? " thrust" : "");
+    if (first && !reference.empty()) os << " than motor " << after_dot(reference);
+    first = false;
+  }
+  return os.str() + ".";
+}
+
+// Each effect's sentence in words, with the units a reader expects (ms, degrees, mm, %).
+void set_headlines(std::vector<Effect>& list) {
+  using Values = std::map<std::string, double>;
+  const double deg = 180.0 / 3.14159265358979323846;
+  const std::map<std::string, std::function<std::string(const Values&, const std::string&)>> sentences = {
+      {"motor_gain", motor_gain_headline},
+      {"motor_lag",
+       [](const Values& v, const std::string&) {
+         return "The rotors follow a new command with a time constant of " + words(1e3 * value_of(v, "motor_lag.tau")) +
+                " ms.";
+       }},
+      {"input_delay",
+       [](const Values& v, const std::string&) {
+         return "Commands act " + words(1e3 * value_of(v, "input_delay.seconds")) + " ms after they are logged.";
+       }},
+      {"cog_offset",
+       [](const Values& v, const std::string&) {
+         const double x = 1e3 * value_of(v, "cog_offset.x"), y = 1e3 * value_of(v, "cog_offset.y");
+         return "The centre of gravity sits " + words(std::fabs(x)) + " mm " + (x < 0 ? "behind" : "ahead of") +
+                " and " + words(std::fabs(y)) + " mm " + (y < 0 ? "right" : "left") + " of where the blocks put it.";
+       }},
+      {"wind",
+       [](const Values& v, const std::string&) {
+         const double x = value_of(v, "wind.x"), y = value_of(v, "wind.y");
+         return "A steady wind of " + words(std::hypot(x, y)) + " m/s (x " + words(x) + ", y " + words(y) +
+                " m/s, world frame).";
+       }},
+      {"rotor_drag",
+       [](const Values& v, const std::string&) {
+         return "The rotors drag the vehicle back against its airspeed (k = " + words(value_of(v, "rotor_drag.k")) +
+                " N s²/m per rad/s of summed rotor speed).";
+       }},
+      {"blade_flapping",
+       [](const Values& v, const std::string&) {
+         const double k = value_of(v, "blade_flapping.k");
+         return std::string("Flying through the air ") + (k > 0 ? "pitches the nose up" : "pitches the nose down") +
+                " (flapping moment k = " + words(k) + " N s² per rad/s of summed rotor speed and m/s of airspeed).";
+       }},
+      {"attitude_bias",
+       [deg](const Values& v, const std::string&) {
+         return "The logged attitude is off by " + words(deg * value_of(v, "attitude_bias.roll")) + "° in roll and " +
+                words(deg * value_of(v, "attitude_bias.pitch")) + "° in pitch.";
+       }},
+      {"thrust_decay",
+       [](const Values& v, const std::string&) {
+         const double r = value_of(v, "thrust_decay.rate");
+         return "Thrust " + std::string(r >= 0 ? "falls" : "rises") + " by " + words(100 * std::fabs(r)) +
+                " % per second of flight (" + words(6000 * std::fabs(r)) + " % per minute).";
+       }},
+      {"battery_sag",
+       [](const Values& v, const std::string&) {
+         return "Thrust follows the battery voltage to the power " + words(value_of(v, "battery_sag.exponent")) + ".";
+       }},
+      {"ground_effect",
+       [](const Values& v, const std::string&) {
+         return "Near the ground thrust rises as for a rotor of radius " +
+                words(1e3 * value_of(v, "ground_effect.radius")) + " mm.";
+       }},
+      {"inflow",
+       [](const Values& v, const std::string&) {
+         const double k = value_of(v, "inflow.k");
+         return "Climbing costs thrust: each rotor loses " + words(k) +
+                " times its climb-to-tip-speed ratio (a 1 m/s climb at a 40 m/s tip speed: " + words(100 * k / 40) +
+                " %), which also damps roll and pitch.";
+       }},
+  };
+  for (Effect& e : list) {
+    const auto it = sentences.find(e.name);
+    if (it == sentences.end()) throw std::logic_error("effect '" + e.name + "' has no headline");
+    e.headline = it->second;
+  }
+}
+
 // The catalogue, built one entry at a time so that each effect's facts sit together.
 std::vector<Effect> build_catalogue() {
   std::vector<Effect> list;
@@ -242,6 +347,7 @@ std::vector<Effect> build_catalogue() {
     e.look_alikes = {{"thrust_decay", "climbs and descents at several speeds at one battery state: inflow follows the "
                                       "climb rate, a decay follows the clock"}};
   }
+  set_headlines(list);
   return list;
 }
 

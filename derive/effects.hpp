@@ -3,6 +3,7 @@
 // quantities of the model context. At their nominal values the model is unchanged.
 #pragma once
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,10 @@ struct Effect {
   // Plausible values of its parameters (none for a parameter: any value in its bounds).
   std::vector<PlausibleRange> plausible;
   std::vector<LookAlike> look_alikes;
+  // One sentence in words for a person reading a report ("Motor C gives 8 % less thrust than
+  // motor A"), from the fitted values by parameter name; `reference` is the parameter held at
+  // off (first_parameter_is_reference), or empty.
+  std::function<std::string(const std::map<std::string, double>& values, const std::string& reference)> headline;
 };
 
 // All effects in canonical order (the order they are applied in, whatever the user wrote).

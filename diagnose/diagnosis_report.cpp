@@ -67,6 +67,30 @@ std::vector<std::string> carried_look_alikes(const Diagnosis& d) {
 
 // A finding (or a suspected one): its parameters, the one gain figure (the final model
 // without it -> with it, on held-out data, with its spread over validation folds), evidence.
+// The finding in one sentence (the effect's own words), from its values: a per-flight
+// parameter at its mean over the flights.
+std::string headline(const Finding& f) {
+  const Effect& e = find_effect(f.effect);
+  std::map<std::string, std::pair<double, int>> sums;
+  for (const auto& p : f.parameters) {
+    auto& [sum, n] = sums[runtime::shared_name(p.name)];
+    sum += p.value;
+    ++n;
+  }
+  std::map<std::string, double> values;
+  for (const auto& [name, sn] : sums) values[name] = sn.first / sn.second;
+  std::string reference;
+  if (e.first_parameter_is_reference)
+    for (const auto& p : f.evidence.parameters)
+      if (effect_of_parameter(p.name) == f.effect && !p.free && p.name.find('@') == std::string::npos) {
+        reference = p.name;
+        break;
+      }
+  std::string s = e.headline(values, reference);
+  if (sums.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
+  return s;
+}
+
 json finding_json(const Finding& f) {
   json ps = json::object();
   const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
@@ -83,6 +107,7 @@ json finding_json(const Finding& f) {
                   {"identifiability", e.verdict},
                   {"interval_method", e.interval}};
   json fj = {{"effect", f.effect},
+             {"headline", headline(f)},
              {"parameters", ps},
              {"gain", {{"metric", f.metric},
                        {"before", number_or_null(f.before)},
@@ -357,7 +382,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " [" << num(p.lower) << ", " << num(p.upper) << "]";
-    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n";
+    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n  " << headline(f) << "\n";
   }
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
@@ -417,7 +442,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
-       "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em}</style></head><body>\n";
+       "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
+       ".headline{font-size:1.1em}</style></head><body>\n";
   h << "<h1>Diagnosis of " << esc(log_path) << " (" << esc(d.vehicle) << ")</h1>\n";
   h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples;
   if (d.flights.size() > 1)
@@ -426,7 +452,14 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   else
     h << " validation samples from t = " << num(d.t_split, 4) << " s";
   h << "; " << num(d.seconds, 3) << " s.</p>\n";
-  h << "<h2>Verdict</h2>\n<pre>" << esc(diagnosis_summary(d)) << "</pre>\n";
+  h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
+  if (d.findings.empty()) h << "<li>No cause named.</li>\n";
+  for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";
+  if (!d.findings.empty())
+    h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
+      << num(reduction(d.metric_before, d.metric_after), 2) << " % better (" << esc(d.metric) << " "
+      << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
+  h << "</ul>\n<h2>Verdict</h2>\n<pre>" << esc(diagnosis_summary(d)) << "</pre>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
   h << "<h2>Findings</h2>\n";
@@ -440,7 +473,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "</ol>\n";
   }
   for (const auto& f : d.findings) {
-    h << "<h3>" << esc(f.effect) << "</h3>\n";
+    h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
+      << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
+      << num(reduction(f.before, f.after), 3) << " % lower).</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
     if (per_flight) {
@@ -458,8 +493,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     }
     h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
-      << ", validation cost " << num(f.evidence.validation_gain_percent, 3) << " % lower; " << esc(f.metric) << " "
-      << num(f.before) << " &rarr; " << num(f.after) << ".</p>\n";
+      << ".</p>\n";
   }
   if (!d.stand_ins.empty()) {
     h << "<h2>Stand-ins for missing physics</h2>\n<p>Each passed every statistical test, but its value lies outside "

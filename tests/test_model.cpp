@@ -378,3 +378,28 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   realsymbol a("a"), b("b"), c("c");
   EXPECT_TRUE(reduce_trig(thesis_transformation(a, b, c).determinant() + 1, {a, b, c}).is_zero());
 }
+
+// Every effect says what it found in a sentence with the units a reader expects; spot checks
+// of the numbers against the values (written here) for a few.
+TEST(Effects, EachFindingReadsAsASentence) {
+  for (const auto& e : effect_catalogue()) {
+    ASSERT_TRUE(e.headline) << e.name;
+    std::map<std::string, double> values;
+    const SymbolicModel m = derive(test::finken3(), {e.name});
+    for (const auto& p : m.params)
+      if (effect_of_parameter(p.name) == e.name) values[p.name] = 0.5 * (p.lower + p.upper) + 0.1 * (p.upper - p.lower);
+    const std::string s = e.headline(values, "");
+    EXPECT_GT(s.size(), 20u) << e.name;
+    EXPECT_EQ(s.back(), '.') << e.name << ": " << s;
+    EXPECT_EQ(s.find("nan"), std::string::npos) << s;
+    EXPECT_EQ(s.find("inf"), std::string::npos) << s;
+  }
+  EXPECT_EQ(find_effect("motor_gain").headline({{"motor_gain.C", -0.08}, {"motor_gain.D", 0.031}}, "motor_gain.A"),
+            "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more.");
+  EXPECT_EQ(find_effect("input_delay").headline({{"input_delay.seconds", 0.045}}, ""),
+            "Commands act 45.0 ms after they are logged.");
+  EXPECT_EQ(find_effect("attitude_bias").headline({{"attitude_bias.roll", 0.03}, {"attitude_bias.pitch", -0.02}}, ""),
+            "The logged attitude is off by 1.7° in roll and -1.1° in pitch.");
+  EXPECT_EQ(find_effect("cog_offset").headline({{"cog_offset.x", 0.01}, {"cog_offset.y", -0.005}}, ""),
+            "The centre of gravity sits 10.0 mm ahead of and 5.0 mm right of where the blocks put it.");
+}
