@@ -227,6 +227,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.train_samples = train.samples.size();
   d.valid_samples = valid.samples.size();
   d.t_split = valid.samples.front().t;
+  for (size_t k = 0; k < valid.samples.size(); ++k)  // a held-out part starts after a gap of > 0.5 s
+    if (k == 0 || valid.samples[k].t - valid.samples[k - 1].t > 0.5) d.validation_starts.push_back(valid.samples[k].t);
   *validation_out = valid;
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
       all_ee(model, flight, accel);

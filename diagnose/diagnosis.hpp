@@ -82,6 +82,8 @@ struct Diagnosis {
   std::vector<std::string> channel_names, channel_units;
   size_t train_samples = 0, valid_samples = 0;
   double t_split = 0;
+  // Where each held-out stretch begins on the (joined) clock: one per flight, for the plots.
+  std::vector<double> validation_starts;
   std::vector<std::string> candidates;
   SearchResult search;
   ResidualAnalysis before, after;  // whole flight, base fit and final model

@@ -288,7 +288,16 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     const Diagnosis& d, const fit::Flight& valid, std::string* error,
     std::vector<std::pair<std::string, std::string>>* data) {
   std::vector<std::pair<std::string, std::string>> out;
-  auto render = [&](const std::string& name, const std::string& title, const std::vector<runtime::Panel>& panels) {
+  // One colour per model in every plot: measured black, base model red, extended model blue.
+  const std::map<std::string, std::string> colours = {{"measured", "#000000"},
+                                                       {"base model", "#d62728"},
+                                                       {"extended model", "#1f77b4"},
+                                                       {"95 % white-noise band", "#7f7f7f"},
+                                                       {"", "#7f7f7f"}};
+  auto render = [&](const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
+    for (auto& p : panels)
+      for (auto& s : p.series)
+        if (const auto it = colours.find(s.label); it != colours.end()) s.color = it->second;
     if (data) data->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
     std::string svg;
     if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
@@ -329,8 +338,9 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   for (int c = 0; c < 6; ++c) {
     std::vector<double> rb, ra;
     for (size_t k = 0; k < d.t.size(); ++k) rb.push_back(d.residual_before[k * 6 + c]), ra.push_back(d.residual_after[k * 6 + c]);
-    res.push_back({d.channel_names[c] + " residual (model - measured)", "t [s]", d.channel_units[c],
-                   {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)}});
+    res.push_back({d.channel_names[c] + " residual (model - measured; dashed: held-out part starts)", "t [s]",
+                   d.channel_units[c], {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)},
+                   d.validation_starts});
   }
   render("residuals.svg",
          d.vehicle + ": equation-error residuals (" +

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -134,6 +135,16 @@ Series decimated(const Series& s) {
   return d;
 }
 
+namespace {
+// "#rrggbb" and nothing else reaches the script as a colour.
+bool is_rgb(const std::string& c) {
+  if (c.size() != 7 || c[0] != '#') return false;
+  for (size_t i = 1; i < 7; ++i)
+    if (!std::isxdigit(static_cast<unsigned char>(c[i]))) return false;
+  return true;
+}
+}  // namespace
+
 std::string gnuplot_script(const std::string& title, const std::vector<Panel>& panels) {
   std::ostringstream script;
   script.precision(10);
@@ -161,8 +172,19 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
       }
       script << "EOD\n";
       plot << (plot.tellp() > 0 ? ", " : "") << name << " using 1:2 with "
-           << (s.points ? "points pt 7 ps 0.5" : "lines lw 1.5") << " title " << gnuplot_string(s.label) << " noenhanced";
+           << (s.points ? "points pt 7 ps 0.5" : "lines lw 1.5");
+      if (is_rgb(s.color)) plot << " lc rgb '" << s.color << "'";
+      plot << " title " << gnuplot_string(s.label) << " noenhanced";
     }
+    script << "unset arrow\n";
+    for (double m : p.marks)
+      if (std::isfinite(m)) {
+        script << "set arrow from ";
+        write_number(script, m);
+        script << ", graph 0 to ";
+        write_number(script, m);
+        script << ", graph 1 nohead dt 2 lw 1.5 lc rgb '#555555'\n";
+      }
     // A panel without data still gets its axes, so the layout of the figure stays the same.
     script << "plot " << (plot.tellp() > 0 ? plot.str() : "[0:1][0:1] -1 notitle") << "\n";
   }

@@ -12,11 +12,13 @@ struct Series {
   std::string label;
   std::vector<double> x, y;
   bool points = false;  // markers instead of a line (measurements)
+  std::string color = {};  // "#rrggbb", so that one model has one colour in every plot; empty: gnuplot's
 };
 
 struct Panel {
   std::string title, xlabel, ylabel;
   std::vector<Series> series;
+  std::vector<double> marks = {};  // x values marked by a dashed vertical line (e.g. where validation starts)
 };
 
 // At most this many points of one series reach gnuplot; longer series are thinned to the

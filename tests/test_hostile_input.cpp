@@ -497,3 +497,20 @@ TEST(Options, ReplayLongerThanTheLogIsRefused) {
   expect_one_line_error(r, "holds 0.5", "long replay");
   EXPECT_FALSE(fs::exists(tmp / "r.csv"));
 }
+
+// Colours reach the script only as #rrggbb (anything else is left to gnuplot's default), and
+// a panel's marks become dashed vertical lines that do not carry over to the next panel.
+TEST(Sinks, PlotColoursAndMarksAreDataNotScript) {
+  using quadgen::runtime::Panel;
+  using quadgen::runtime::Series;
+  Series base{"base model", {0, 1}, {0, 1}, false, "#d62728"};
+  Series bad{"x", {0, 1}, {0, 1}, false, "#00'; system 'touch PWNED"};
+  const std::string script =
+      quadgen::runtime::gnuplot_script("t", {Panel{"a", "t", "m", {base, bad}, {0.5}}, Panel{"b", "t", "m", {base}}});
+  EXPECT_NE(script.find("lc rgb '#d62728'"), std::string::npos);
+  EXPECT_EQ(script.find("system"), std::string::npos);
+  EXPECT_EQ(script.find("PWNED"), std::string::npos);
+  const size_t arrow = script.find("set arrow from 0.5");
+  ASSERT_NE(arrow, std::string::npos);
+  EXPECT_NE(script.find("unset arrow", arrow), std::string::npos);  // cleared before the second panel
+}
