@@ -125,11 +125,13 @@ bool implausible_parameter(const Finding& f, Environment where, const VehicleSca
   return false;
 }
 
-// In a joint diagnosis, the parameters that take one value per flight: those of the
-// per-flight effects among the candidates, except a reference held at off.
+// In a joint diagnosis, the parameters that take one value per flight: c_t when fitted, and
+// those of the per-flight effects among the candidates, except a reference held at off.
 std::vector<std::string> per_flight_parameters(const SymbolicModel& all, const std::vector<std::string>& candidates) {
   std::vector<std::string> names, out;
   for (const auto& p : all.params) names.push_back(p.name);
+  for (const auto& p : all.params)
+    if (p.fit && effect_of_parameter(p.name).empty() && belongs_to_flight(p.name)) out.push_back(p.name);
   const auto references = reference_parameters(names);
   for (const auto& e : candidates) {
     if (!find_effect(e).per_flight) continue;
@@ -375,6 +377,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.airframe_fit = airframe_values(s.final_fit);
   d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return d;
+}
+
+bool belongs_to_flight(const std::string& parameter) {
+  const std::string name = runtime::shared_name(parameter);
+  if (name == "c_t") return true;
+  const std::string e = effect_of_parameter(name);
+  return !e.empty() && find_effect(e).per_flight;
 }
 
 }  // namespace quadgen::diagnose

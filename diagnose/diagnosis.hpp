@@ -110,6 +110,13 @@ struct Diagnosis {
   double seconds = 0;
 };
 
+// Whether a parameter describes the flight rather than the airframe: those of per-flight
+// effects (motor trims, wind, the marker frame) and the thrust constant c_t, which takes up
+// the battery's state of charge (thrust per command differs from flight to flight; the
+// within-flight decay is thrust_decay's or battery_sag's). In a joint diagnosis each flight
+// gets its own value; quadgen predict --calibrate refits them on an unseen flight.
+bool belongs_to_flight(const std::string& parameter);
+
 // Runs the whole diagnosis. `all` is the full-catalogue symbolic model of the vehicle and
 // `model` its runtime form. Several flights of one vehicle are diagnosed jointly: one set
 // of parameters for all, the end of each flight held out, the flights joined on one clock

@@ -250,12 +250,12 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["base_fit"] = parameters_json(d.search.base_fit);
   j["final_fit"] = parameters_json(d.search.final_fit);
   // For predicting other flights (quadgen predict): the airframe's values, and which fitted
-  // parameters belong to a flight rather than to the airframe (its trims, marker frame, wind).
+  // parameters belong to a flight rather than to the airframe (battery state in c_t, trims,
+  // marker frame, wind).
   j["airframe_fit"] = parameters_json(d.airframe_fit.empty() ? d.search.final_fit : d.airframe_fit);
   json own = json::array();
   for (const auto& p : d.search.final_fit)
-    if (p.free && p.name.find('@') == std::string::npos && p.name.find('.') != std::string::npos &&
-        find_effect(effect_of_parameter(p.name)).per_flight)
+    if (p.free && p.name.find('@') == std::string::npos && belongs_to_flight(p.name))
       own.push_back(p.name);
   j["flight_parameters"] = own;
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
