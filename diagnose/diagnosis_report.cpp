@@ -17,7 +17,7 @@ using json = nlohmann::ordered_json;
 
 namespace {
 
-json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+using fit::number_or_null;
 
 double reduction(double before, double after) {
   return before > 0 && std::isfinite(before) && std::isfinite(after) ? 100 * (before - after) / before : 0.0;

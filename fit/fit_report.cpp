@@ -6,11 +6,9 @@
 
 namespace quadgen::fit {
 
-namespace {
 nlohmann::ordered_json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
-}  // namespace
 
 nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles) {
   using J = nlohmann::ordered_json;

@@ -11,6 +11,9 @@
 
 namespace quadgen::fit {
 
+// A number in JSON, or null for NaN and infinities (an open interval side, a missing value).
+nlohmann::ordered_json number_or_null(double v);
+
 nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles);
 
 // One panel per profile: delta chi2 against the parameter, with both thresholds.
