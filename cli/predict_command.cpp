@@ -73,6 +73,7 @@ int run_predict(const PredictArgs& a) {
   const SymbolicModel model = derive_model(v, derive_mass_properties(v), all);
   bool compiled = false;
   const auto m = make_model(model, &compiled);
+  const std::vector<double> nominal = m->params();  // before any calibration moves the model's
   std::optional<predict::ParameterSource> source;
   if (!a.params.empty()) source.emplace(a.params);
   std::vector<std::string> rotors;
@@ -89,7 +90,7 @@ int run_predict(const PredictArgs& a) {
     const auto [before, f] = a.validation >= 1.0 ? std::pair<fit::Flight, fit::Flight>{{}, whole}
                                                  : fit::split_by_time(whole, 1.0 - a.validation);
     predict::ParameterSource::ForLog values;
-    values.values = m->params();
+    values.values = nominal;
     values.origin = "vehicle file (nominal)";
     if (source) values = source->for_log(*m, a.logs[i]);
     nlohmann::ordered_json calibrated = nlohmann::ordered_json::object();

@@ -467,7 +467,9 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profile " << done << "/" << count << " (" << name << ", "
                 << static_cast<int>(seconds) << " s)        " << (isatty(2) ? "" : "\n") << std::flush;
     };
-  std::vector<fit::Profile> profiles = fit::profile_all(train_, best, fo, po, profiled);
+  // (profile_all profiles every free parameter when given none: only call it with some.)
+  std::vector<fit::Profile> profiles =
+      profiled.empty() ? std::vector<fit::Profile>{} : fit::profile_all(train_, best, fo, po, profiled);
   for (auto& pr : profiles) {
     const int i = pr.index;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
@@ -475,8 +477,20 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
                            pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict});
     r.profiles.push_back(std::move(pr));
   }
+  // A per-flight copy that the data cannot separate from other parameters (a direction of
+  // J^T W J with a near-zero eigenvalue) has no Wald interval: the pseudo-inverse would give
+  // it a finite, too small one.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  std::vector<bool> confounded(cols.size(), false);
+  const double largest = eig.eigenvalues().size() ? eig.eigenvalues().maxCoeff() : 0.0;
+  for (Eigen::Index k = 0; k < eig.eigenvalues().size(); ++k)
+    if (eig.eigenvalues()(k) <= 1e-10 * largest)
+      for (size_t a = 0; a < cols.size(); ++a)
+        if (std::abs(eig.eigenvectors()(static_cast<Eigen::Index>(a), k)) > 0.1) confounded[a] = true;
   for (int i : wald) {
-    const double se = best.standard_errors[i], nan = std::numeric_limits<double>::quiet_NaN();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const size_t a = static_cast<size_t>(std::find(cols.begin(), cols.end(), i) - cols.begin());
+    const double se = a < cols.size() && confounded[a] ? nan : best.standard_errors[i];
     const bool finite = std::isfinite(se) && se > 0;
     const double v = r.final_fit[i].value, z = 1.959963984540054;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, se, finite ? v - z * se : nan,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -151,6 +152,14 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["vehicle"] = d.vehicle;
   j["log"] = log_path;
   j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
+  // The same logs as absolute paths, so that quadgen predict matches them from any directory.
+  json paths = json::array();
+  for (const auto& f : d.flights) {
+    std::error_code ec;
+    const auto c = std::filesystem::weakly_canonical(std::filesystem::absolute(f, ec), ec);
+    paths.push_back(ec ? f : c.string());
+  }
+  j["flight_paths"] = paths;
   // Effects with one value per flight: "name" is the first flight's, "name@k" the k-th's.
   j["per_flight_effects"] = d.per_flight_effects;
   j["formulation"] = d.formulation;

@@ -30,11 +30,16 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   model.set_params(sim_params);
   const runtime::DataSideParams data_side(model);
   runtime::DataSideEffects e;  // in effect over the current window
+  // Delayed commands are not read from before the window's stretch (a previous joined flight).
+  std::vector<double> times;
+  for (const auto& s : f.samples) times.push_back(s.t);
+  const std::vector<size_t> stretch = runtime::stretch_starts(times, 0.1);
+  size_t first_command = 0;
   const int n = model.num_states(), nu = model.num_inputs();
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
   const size_t nr = f.samples.front().u.size();
   auto inputs = [&](double t, double* u) {
-    const auto& s = f.samples[held_index(f, t - e.delay)];
+    const auto& s = f.samples[std::max(held_index(f, t - e.delay), first_command)];
     for (size_t i = 0; i < nr; ++i) u[i] = s.u[i];
     if (t_in >= 0) u[t_in] = t;
     if (v_in >= 0) u[v_in] = f.samples[held_index(f, t)].vbat;
@@ -50,6 +55,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   for (size_t k0 = 0; k0 + 1 < S.size();) {
     const double t0 = S[k0].t;
     e = data_side.at(model, sim_params.data(), t0);
+    first_command = stretch[k0];
     std::vector<double> x(n, 0.0);
     std::copy(S[k0].x.begin(), S[k0].x.end(), x.begin());
     runtime::unbias_attitude(&S[k0].x[6], e.roll, e.pitch, &x[6]);

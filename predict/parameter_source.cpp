@@ -44,7 +44,9 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
     }
     return out;
   };
-  for (const auto& f : strings("flights")) flights_.push_back(canonical(f));
+  // flight_paths (absolute) where the diagnosis wrote them; flights as given otherwise.
+  for (const auto& f : strings(json_.contains("flight_paths") ? "flight_paths" : "flights"))
+    flights_.push_back(canonical(f));
   flight_params_ = strings("flight_parameters");
   if (json_.contains("airframe_fit") && !json_["airframe_fit"].is_object())
     throw std::invalid_argument(path + ": airframe_fit is not an object");
@@ -60,10 +62,18 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
       p[static_cast<size_t>(i)] = entry["value"].get<double>();
       continue;
     }
-    // Another flight's copy (name@k) of a per-flight parameter: applied by for_log.
-    const std::string shared = runtime::shared_name(name);
-    if (shared == name || model.param_index(shared) < 0)
+    // Another flight's copy (name@k, k = 2 .. the number of flights) of a per-flight
+    // parameter: applied by for_log.
+    const auto at = name.rfind('@');
+    const std::string suffix = at == std::string::npos ? "" : name.substr(at + 1);
+    const bool digits = !suffix.empty() && suffix.size() <= 6 &&
+                        std::all_of(suffix.begin(), suffix.end(), [](char c) { return c >= '0' && c <= '9'; });
+    const int k = digits ? std::stoi(suffix) : 0;
+    if (at == std::string::npos || model.param_index(name.substr(0, at)) < 0)
       throw std::invalid_argument(path_ + ": parameter '" + output::printable(name) + "' is not in the model");
+    if (k < 2 || (!flights_.empty() && k > static_cast<int>(flights_.size())))
+      throw std::invalid_argument(path_ + ": '" + output::printable(name) + "': a flight's copy is name@k with k from 2 to " +
+                                  std::to_string(flights_.size()) + ", the number of flights");
   }
 }
 
@@ -103,11 +113,13 @@ std::vector<double> calibrate(runtime::DynamicModel& model, const std::vector<do
     ps[i].free = std::find(free.begin(), free.end(), static_cast<int>(i)) != free.end();
     if (!ps[i].free) ps[i].lower = ps[i].upper = ps[i].value = start[i];
   }
+  const std::vector<double> entry = model.params();  // restored after: the fit leaves its last trial
   model.set_params(start);
   const fit::EquationErrorModel residuals(model, part, !part.has_pose);
   fit::FitOptions o;
   o.max_iterations = 100;
   const fit::FitResult r = fit::fit_least_squares(residuals, ps, o);
+  model.set_params(entry);
   return fit::parameter_values(r.parameters);
 }
 

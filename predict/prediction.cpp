@@ -58,10 +58,16 @@ class Rollout {
         k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
     t_in_ = model.input_index("t");
     v_in_ = model.input_index("vbat");
+    std::vector<double> times;
+    for (const auto& s : f.samples) times.push_back(s.t);
+    stretch_ = runtime::stretch_starts(times, 0.1);
   }
 
   // The data-side effects in force from sample k on (a rollout stays within one flight).
-  const DataSideEffects& start_at(size_t k) { return e_ = data_side(m_, p_, f_.samples[k].t); }
+  const DataSideEffects& start_at(size_t k) {
+    first_command_ = stretch_[k];
+    return e_ = data_side(m_, p_, f_.samples[k].t);
+  }
 
   // The measured state at sample k (attitude unbiased), rotor speeds in steady state.
   std::vector<double> initial_state(size_t k) {
@@ -122,7 +128,7 @@ class Rollout {
     return it == S.begin() ? 0 : static_cast<size_t>(it - S.begin()) - 1;
   }
   void inputs(double t, double* u) const {
-    const auto& s = f_.samples[held_index(t - e_.delay)];
+    const auto& s = f_.samples[std::max(held_index(t - e_.delay), first_command_)];
     std::copy(s.u.begin(), s.u.end(), u);
     if (t_in_ >= 0) u[t_in_] = t;
     if (v_in_ >= 0) u[v_in_] = f_.samples[held_index(t)].vbat;
@@ -150,6 +156,8 @@ class Rollout {
   const fit::Flight& f_;
   const std::vector<double>& p_;
   DataSideEffects e_;
+  std::vector<size_t> stretch_;  // first sample of each sample's contiguous stretch
+  size_t first_command_ = 0;     // the rollout's stretch: delayed commands are not read before it
   double step_;
   int n_, t_in_ = -1, v_in_ = -1;
   std::vector<double> u_, k1_, k2_, k3_, k4_, tmp_, forced_;

@@ -8,6 +8,8 @@
 // are read through DynamicModel::param_column at the sample's time.
 #pragma once
 #include <array>
+#include <cstddef>
+#include <vector>
 
 #include "dynamic_model.hpp"
 
@@ -39,5 +41,14 @@ struct DataSideParams {
     return {value(delay), value(roll), value(pitch), value(tau)};
   }
 };
+
+// For each sample time, the index of the first sample of its contiguous stretch (an interval
+// longer than `gap` seconds starts a new one): a delayed command lookup is clamped there, so
+// it never reaches across a gap into a previous joined flight or trimmed ground contact.
+inline std::vector<size_t> stretch_starts(const std::vector<double>& times, double gap) {
+  std::vector<size_t> out(times.size(), 0);
+  for (size_t k = 1; k < times.size(); ++k) out[k] = times[k] - times[k - 1] > gap ? k : out[k - 1];
+  return out;
+}
 
 }  // namespace quadgen::runtime

@@ -121,7 +121,9 @@ TEST(PredictParameters, EachLogGetsItsFlightsValuesOrTheAirframes) {
     EXPECT_EQ(f->flight_params, std::vector<int>{gain});
   }
   EXPECT_EQ(a.values[m.param_index("g")], m.params()[m.param_index("g")]);  // not in the file: nominal
-  for (const char* bad : {R"({"thrust": {"value": 1}})", R"({"thrust@2": {"value": 1}})", R"({"c_t": {"value": "x"}})"}) {
+  for (const char* bad : {R"({"thrust": {"value": 1}})", R"({"thrust@2": {"value": 1}})", R"({"c_t": {"value": "x"}})",
+                          R"({"motor_gain.C@x": {"value": 1}})", R"({"motor_gain.C@3": {"value": 1}})",
+                          R"({"motor_gain.C@0": {"value": 1}})"}) {
     try {
       quadgen::predict::ParameterSource(write(bad)).for_log(m, (dir / "a.csv").string());
       ADD_FAILURE() << bad << " accepted";
