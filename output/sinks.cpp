@@ -99,7 +99,10 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 
 std::string csv_field(const std::string& s) {
   std::string out = "\"";
-  if (!s.empty() && (s[0] == '=' || s[0] == '+' || s[0] == '-' || s[0] == '@')) out += '\'';
+  // The first character a spreadsheet sees once leading blanks and control characters are
+  // skipped (a tab or a space before '=' still starts a formula in some of them).
+  const size_t first = s.find_first_not_of(std::string(" \t\r\n\v\f", 6));
+  if (first != std::string::npos && std::string("=+-@").find(s[first]) != std::string::npos) out += '\'';
   for_each_char(s, [&](const std::string& c) {
     if (c == "\"") out += "\"\"";
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';

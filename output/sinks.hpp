@@ -45,7 +45,7 @@ std::string latex_text(const std::string& s);
 
 // A CSV field (RFC 4180), quotes included: '"' doubled, control characters (a line break would
 // start a new record) as spaces, invalid UTF-8 as '?'; a field that a spreadsheet would run as
-// a formula (leading = + - @) gets a leading apostrophe.
+// a formula (= + - @ first, after any blanks) gets a leading apostrophe.
 std::string csv_field(const std::string& s);
 
 }  // namespace quadgen::output

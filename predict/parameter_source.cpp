@@ -1,11 +1,16 @@
 #include "parameter_source.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
 #include "equation_error.hpp"
+#include "flight_log.hpp"
+#include "log_file.hpp"
 #include "per_flight_model.hpp"
 #include "sinks.hpp"
 
@@ -23,10 +28,23 @@ std::string canonical(const std::string& path) {
 }  // namespace
 
 ParameterSource::ParameterSource(const std::string& path) : path_(path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path + ": cannot open the parameter file");
+  std::string text;
+  try {  // opened as a log is: a FIFO or a device is refused, not waited on; size-limited
+    const runtime::LogFile file(path, "a diagnosis.json or fit.json");
+    text.resize(static_cast<size_t>(file.size()));
+    size_t got = 0;
+    while (got < text.size()) {
+      const ssize_t n = ::read(file.fd(), &text[got], text.size() - got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += static_cast<size_t>(n);
+    }
+    text.resize(got);
+  } catch (const runtime::LogError& e) {
+    throw std::invalid_argument(e.what());
+  }
   try {
-    json_ = nlohmann::json::parse(in);
+    json_ = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw std::invalid_argument(path + ": not JSON (" + e.what() + ")");
   }
@@ -99,7 +117,9 @@ ParameterSource::ForLog ParameterSource::for_log(const runtime::DynamicModel& mo
   else if (out.flight > 0)
     out.origin = path_ + " (flight " + std::to_string(out.flight) + " of " + std::to_string(flights_.size()) + ")";
   else
-    out.origin = path_ + (airframe ? " (airframe values: a log it was not fitted to)" : " (a log it was not fitted to)");
+    out.origin = path_ + (airframe ? " (airframe values: a log it was not fitted to)"
+                          : flights_.size() > 1 ? " (a log it was not fitted to; no airframe_fit in the file: flight 1's values)"
+                                                : " (a log it was not fitted to)");
   return out;
 }
 

@@ -296,6 +296,8 @@ TEST(Sinks, PlotDataCsvKeepsEveryLabelInItsField) {
   EXPECT_EQ(rows[1][4], "say \"hi\"");
   EXPECT_EQ(read_rfc4180(out::csv_field("=HYPERLINK(1)"))[0][0], "'=HYPERLINK(1)");
   EXPECT_EQ(read_rfc4180(out::csv_field("a\nb"))[0][0], "a b");
+  EXPECT_EQ(read_rfc4180(out::csv_field(" \t=1+1"))[0][0], "'  =1+1");  // blanks do not hide a formula
+  EXPECT_EQ(read_rfc4180(out::csv_field("a=1"))[0][0], "a=1");
 }
 
 TEST(Sinks, HtmlReportQuotesNoMarkup) {

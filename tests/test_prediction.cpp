@@ -4,6 +4,7 @@
 // acceleration is 5 % of the thrust per mass along body z, so the position error at horizon
 // h is about 0.5 * 0.05 * (T/m) * h^2, and the one-step vertical residual about 0.05 * T/m.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -130,6 +131,15 @@ TEST(PredictParameters, EachLogGetsItsFlightsValuesOrTheAirframes) {
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find("diagnosis.json"), std::string::npos) << e.what();
     }
+  }
+  // A FIFO as the parameter file is refused at once, not waited on.
+  const std::string fifo = (dir / "params.fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    quadgen::predict::ParameterSource{fifo};
+    ADD_FAILURE() << "FIFO accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("a FIFO, not a regular file"), std::string::npos) << e.what();
   }
   fs::remove_all(dir);
 }
