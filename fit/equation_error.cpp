@@ -190,10 +190,13 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   X.assign(ns * n, 0.0);
   U.assign(ns * nu, 0.0);
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
-  // The data-side values in effect at time t (one per flight in a per-flight model).
+  // The data-side values in effect at each sample (one per flight in a per-flight model);
+  // the lags are kept for the rotor-speed filter below.
+  std::vector<double> tau(ns, 0.0);
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
+    tau[k] = e.tau;
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
@@ -214,17 +217,16 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   std::vector<double> f(n), c(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
-    const double tau = data_side_.at(*model_, p, flight_.samples[k].t).tau;
     // After a gap the rotors restart in steady state with the commands, as at the start
     // (a span starts at a gap or at the log's start).
     const bool restart = k == span.lo || !interval_ok_[k - 1];
     if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
-      const double a = std::exp(-h / tau);
+      const double a = std::exp(-h / tau[k]);
       for (size_t i = 0; i < nr; ++i) {
         const double w0 = X[(k - 1) * n + speed_states_[i]];
         x[speed_states_[i]] = a * w0 + (1 - a) * c[i];
-        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * tau / h * (1 - a);
+        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * tau[k] / h * (1 - a);
       }
     }
     // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
@@ -232,7 +234,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     for (size_t i = 0; i < nr; ++i) w_now[i] = x[speed_states_[i]], x[speed_states_[i]] = 0;
     model_->rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
     for (size_t i = 0; i < nr; ++i) {
-      c[i] = tau * f[speed_states_[i]];
+      c[i] = tau[k] * f[speed_states_[i]];
       x[speed_states_[i]] = restart ? c[i] : w_now[i];
     }
   }

@@ -44,17 +44,12 @@ constexpr double kPi = 3.14159265358979323846;
 
 using runtime::DataSideEffects;
 
-// The data-side values in effect at time t (one per flight in a per-flight model).
-DataSideEffects data_side(const runtime::DynamicModel& model, const std::vector<double>& p, double t) {
-  return runtime::DataSideParams(model).at(model, p.data(), t);
-}
-
 // One rollout integrator over a flight: commands held at the log's samples (delayed by the
 // model's input delay), and optionally the log's attitude and body rates imposed.
 class Rollout {
  public:
   Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step)
-      : m_(model), f_(f), p_(p), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
+      : m_(model), f_(f), p_(p), data_side_(model), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
         k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
     t_in_ = model.input_index("t");
     v_in_ = model.input_index("vbat");
@@ -66,7 +61,7 @@ class Rollout {
   // The data-side effects in force from sample k on (a rollout stays within one flight).
   const DataSideEffects& start_at(size_t k) {
     first_command_ = stretch_[k];
-    return e_ = data_side(m_, p_, f_.samples[k].t);
+    return e_ = data_side_.at(m_, p_.data(), f_.samples[k].t);
   }
 
   // The measured state at sample k (attitude unbiased), rotor speeds in steady state.
@@ -155,6 +150,7 @@ class Rollout {
   runtime::DynamicModel& m_;
   const fit::Flight& f_;
   const std::vector<double>& p_;
+  const runtime::DataSideParams data_side_;  // where the data-side effects sit in p_
   DataSideEffects e_;
   std::vector<size_t> stretch_;  // first sample of each sample's contiguous stretch
   size_t first_command_ = 0;     // the rollout's stretch: delayed commands are not read before it
@@ -238,9 +234,10 @@ OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& 
   try {
     const fit::EquationErrorModel ee(model, f, accel);
     ee.all_channels(p.data(), r6);
+    const runtime::DataSideParams data_side(model);
     for (size_t row = 0; row < ee.rows().size(); ++row) {
       const auto& s = f.samples[ee.rows()[row]];
-      const DataSideEffects e = data_side(model, p, s.t);
+      const DataSideEffects e = data_side.at(model, p.data(), s.t);
       double q[4];
       runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
       const runtime::Rotation R = runtime::rotation_matrix(q);
