@@ -1,9 +1,6 @@
 #include "parameter_source.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -30,16 +27,7 @@ std::string canonical(const std::string& path) {
 ParameterSource::ParameterSource(const std::string& path) : path_(path) {
   std::string text;
   try {  // opened as a log is: a FIFO or a device is refused, not waited on; size-limited
-    const runtime::LogFile file(path, "a diagnosis.json or fit.json");
-    text.resize(static_cast<size_t>(file.size()));
-    size_t got = 0;
-    while (got < text.size()) {
-      const ssize_t n = ::read(file.fd(), &text[got], text.size() - got);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      got += static_cast<size_t>(n);
-    }
-    text.resize(got);
+    text = runtime::LogFile(path, "a diagnosis.json or fit.json").read_all();
   } catch (const runtime::LogError& e) {
     throw std::invalid_argument(e.what());
   }

@@ -24,7 +24,7 @@ const char* file_kind(mode_t m) {
 
 }  // namespace
 
-LogFile::LogFile(const std::string& path, const std::string& expected) {
+LogFile::LogFile(const std::string& path, const std::string& expected) : path_(path) {
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
   try {
@@ -44,6 +44,21 @@ LogFile::LogFile(const std::string& path, const std::string& expected) {
 }
 
 LogFile::~LogFile() { ::close(fd_); }
+
+std::string LogFile::read_all() const {
+  std::string bytes;
+  bytes.reserve(size_);
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd_, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw LogError(path_ + ": cannot read log: " + std::strerror(errno));
+    if (n == 0) return bytes;
+    bytes.append(buf, static_cast<std::size_t>(n));
+    if (bytes.size() > limit_)  // it grew while being read
+      throw LogError(path_ + ": more than " + std::to_string(limit_) + " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+  }
+}
 
 void LogFile::set_blocking() const { ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) & ~O_NONBLOCK); }
 

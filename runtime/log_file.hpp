@@ -17,10 +17,13 @@ class LogFile {
   int fd() const { return fd_; }
   unsigned long long size() const { return size_; }    // bytes when opened
   unsigned long long limit() const { return limit_; }  // max_input_bytes()
+  // The whole file, at most limit() bytes even if it grows while being read.
+  std::string read_all() const;
   // Reads may block from here on (a regular file's reads do not wait for writers anyway).
   void set_blocking() const;
 
  private:
+  std::string path_;
   int fd_ = -1;
   unsigned long long size_ = 0, limit_ = 0;
 };

@@ -538,29 +538,13 @@ void Parser::timestamp_first(Layout& l, const std::string& fmt, std::uint64_t at
   std::rotate(l.leaves.begin(), l.leaves.begin() + i, l.leaves.begin() + i + 1);
 }
 
-std::string read_all(int fd, const std::string& path, unsigned long long expected, unsigned long long limit) {
-  std::string bytes;
-  bytes.reserve(expected);
-  char buf[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw LogError(path + ": cannot read log: " + std::strerror(errno));
-    if (n == 0) return bytes;
-    bytes.append(buf, static_cast<std::size_t>(n));
-    if (bytes.size() > limit)  // it grew while being read
-      throw LogError(path + ": more than " + std::to_string(limit) +
-                     " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
-  }
-}
-
 }  // namespace
 
 Ulog parse_ulog(const std::string& bytes, const std::string& name) { return Parser(bytes, name).run(); }
 
 Ulog read_ulog(const std::string& path) {
   const LogFile file(path, "a ULog file");
-  return parse_ulog(read_all(file.fd(), path, file.size(), file.limit()), path);
+  return parse_ulog(file.read_all(), path);
 }
 
 }  // namespace quadgen::runtime
