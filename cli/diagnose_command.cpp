@@ -6,21 +6,19 @@
 #include <iostream>
 #include <sstream>
 
-#include "audit.hpp"
 #include "commands.hpp"
 #include "diagnosis.hpp"
 #include "diagnosis_report.hpp"
 #include "dynamics.hpp"
 #include "effects.hpp"
 #include "geometry.hpp"
-#include "header_writer.hpp"
+#include "extended_model.hpp"
 #include "json_document.hpp"
 #include "log_reader.hpp"
 #include "options.hpp"
 #include "output_set.hpp"
 #include "sinks.hpp"
 #include "model_registry.hpp"
-#include "report.hpp"
 #include "vehicle.hpp"
 
 namespace quadgen::cli {
@@ -51,27 +49,6 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
       ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_option("--window", a.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
 }
-
-namespace {
-
-std::string fitted_parameters_yaml(const Vehicle& v, const diagnose::Diagnosis& d) {
-  std::ostringstream y;
-  y.precision(17);  // round-trips: derive --params regenerates the same values
-  y << "# Parameters of " << output::printable(v.name) << " fitted by quadgen diagnose; effects: ";
-  for (const auto& e : d.search.selected) y << e << " ";
-  for (const auto& e : d.per_flight_effects)
-    if (std::find(d.search.selected.begin(), d.search.selected.end(), e) != d.search.selected.end())
-      y << "\n# " << e << ": one value per flight in diagnosis.json; here their mean over the " << d.flights.size()
-        << " flights";
-  y << "\neffects: [";
-  for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
-  y << "]\nparameters:\n";
-  for (const auto& p : d.airframe_fit)
-    if (p.free) y << "  " << p.name << ": {value: " << p.value << ", unit: \"" << p.unit << "\"}\n";
-  return y.str();
-}
-
-}  // namespace
 
 int run_diagnose(const DiagnoseArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
@@ -109,33 +86,18 @@ int run_diagnose(const DiagnoseArgs& a) {
   o.search.max_effects = a.max_effects;
   fit::Flight valid;
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
-  // The extended model, regenerated with exactly the effects found.
   std::cerr << "[diagnose] generating the extended model\n";
-  DeriveOptions ext_opt;
-  ext_opt.effects = d.search.selected;
-  SymbolicModel ext = derive_model(v, mp, ext_opt);
-  // The extended header is the fitted model: its nominal values are the estimates.
-  for (const auto& p : d.airframe_fit)
-    if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
-  emission::EmitOptions eo;
-  eo.vehicle_file = a.vehicle;
-  eo.effects_flag = ext.effects.empty() ? "" : " --effects " + ext.effect_list();
-  eo.parameter_source = "fitted by quadgen diagnose to " + logs_label +
-                        " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
-  const auto header = emission::generate_header(ext, eo);
-  const AuditResult ext_audit = audit(ext, mp);
-  const std::vector<ThesisItem> no_thesis;
-  const Derivation der{v, mp, ext, ext_audit, no_thesis};
+  const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, a.vehicle, logs_label);
   std::string err;
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
   if (plots.empty()) std::cerr << "no plots: " << err << "\n";
   out.add("diagnosis.json", output::json_document(diagnose::diagnosis_json(d, logs_label)));
   out.add("report.html", diagnose::diagnosis_html(d, logs_label, plots));
-  out.add("extended_model.hpp", header.content);
-  out.add("extended_model.json", model_json(der));
-  out.add("extended_derivation.md", derivation_markdown(der));
-  out.add("fitted_parameters.yaml", fitted_parameters_yaml(v, d));
+  out.add("extended_model.hpp", ext.header);
+  out.add("extended_model.json", ext.model_json);
+  out.add("extended_derivation.md", ext.derivation_markdown);
+  out.add("fitted_parameters.yaml", ext.fitted_parameters_yaml);
   for (const auto& [name, svg] : plots) out.add(name, svg);
   for (const auto& [name, csv] : plot_data) out.add(name, csv);  // every plotted series, for Python or MATLAB
   out.commit();

@@ -82,9 +82,9 @@ std::vector<FitParameter> MotorStepModel::parameters() const {
 double MotorStepModel::predict(const double* p, size_t k, double t) const {
   const MotorStep& s = steps_[k];
   auto ss = [&](double u) { return u == 0 ? 0.0 : p[0] + p[1] * u + p[2] * u * u; };
-  const double ts = s.t_before + p[4 + k];
+  const double ts = s.t_before + p[kFirstStepTime + k];
   if (t < ts) return ss(s.u_old);
-  return ss(s.u_new) + (ss(s.u_old) - ss(s.u_new)) * std::exp(-(t - ts) / p[3]);
+  return ss(s.u_new) + (ss(s.u_old) - ss(s.u_new)) * std::exp(-(t - ts) / p[kTau]);
 }
 
 void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
@@ -94,7 +94,7 @@ void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
     const MotorStep& s = steps_[k];
     const double uo = s.u_old, un = s.u_new, on = uo == 0 ? 0.0 : 1.0;
     const double ss_old = on * (p[0] + p[1] * uo + p[2] * uo * uo), ss_new = p[0] + p[1] * un + p[2] * un * un;
-    const double ts = s.t_before + p[4 + k], tau = p[3];
+    const double ts = s.t_before + p[kFirstStepTime + k], tau = p[kTau];
     for (size_t i = 0; i < s.t.size(); ++i, ++row) {
       const double t = s.t[i];
       const double e = t < ts ? 1.0 : std::exp(-(t - ts) / tau);

@@ -29,6 +29,8 @@ class MotorStepModel : public ResidualModel {
   std::vector<std::string> channels() const override { return {"rpm"}; }
   // a0, a1, a2 [rpm], tau [s], step_1..step_n [s after t_before]; nominal starting values.
   std::vector<FitParameter> parameters() const;
+  static constexpr int kTau = 3;           // index of tau in parameters()
+  static constexpr int kFirstStepTime = 4;  // index of step_1; step k is kFirstStepTime + k
   const std::vector<MotorStep>& steps() const { return steps_; }
   // Model rpm at time t within step k, for plots.
   double predict(const double* p, size_t k, double t) const;

@@ -17,10 +17,11 @@
 namespace quadgen::fit {
 
 struct StandSample {
+  static constexpr int kMotors = 4;  // the Crazyflie stand logs four rotors
   double thrust = 0;  // N, all four rotors
   double u = 0;       // PWM / 65535
   double vbat = 0;    // V
-  double w[4] = {0, 0, 0, 0};  // rad/s
+  double w[kMotors] = {0, 0, 0, 0};  // rad/s
 };
 
 std::vector<StandSample> read_thrust_stand(const std::string& path);  // rows with PWM > 0

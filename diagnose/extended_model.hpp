@@ -1,0 +1,25 @@
+// The diagnosis' last step: the model regenerated with exactly the effects it found, its
+// nominal values set to the estimates, so the header a user compiles is the fitted model.
+// Written beside the report as extended_model.hpp, its derivation and fitted_parameters.yaml
+// (which `quadgen derive --params` reads back).
+#pragma once
+#include <string>
+
+#include "diagnosis.hpp"
+#include "geometry.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen::diagnose {
+
+struct ExtendedModelFiles {
+  std::string header;                   // extended_model.hpp
+  std::string model_json;               // extended_model.json
+  std::string derivation_markdown;      // extended_derivation.md
+  std::string fitted_parameters_yaml;   // fitted_parameters.yaml
+};
+
+// `vehicle_file` and `logs_label` say in the header where the model and its values came from.
+ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
+                                  const std::string& vehicle_file, const std::string& logs_label);
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,398 @@
+#include "fit_pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "dynamic_model.hpp"
+#include "effects.hpp"
+#include "equation_error.hpp"
+#include "fit_report.hpp"
+#include "log_reader.hpp"
+#include "motor_steps.hpp"
+#include "multiple_shooting.hpp"
+#include "plot.hpp"
+#include "sinks.hpp"
+#include "thrust_stand.hpp"
+
+namespace quadgen::fit {
+
+namespace {
+
+// The thesis' motor time constant, read off one normalised step at 63 % (2.3.4, Figure 24).
+constexpr double kThesisMotorTau = 0.128;
+
+// Published Crazyflie 2.x values the stand results are compared with.
+nlohmann::ordered_json published_crazyflie() {
+  return {{"thrust_coefficient_N_s2",
+           {{"2.2e-8", "crazyflie_mhmp simulation model of the Crazyflie 2.0 (k = 2.2e-8 N s^2)"},
+            {"2.3e-8", "UPenn MEAM 620 flightsim crazyflie_params.py, inferred from 14.5 g at 2500 rad/s"}}},
+          {"torque_to_thrust_m", {{"0.005964552", "Förster 2015 (ETH Zürich), as used in Crazyflie firmware ports"}}}};
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Profiles take minutes: say as each one is done.
+ProfileOptions profile_options(const FitJobOptions& o) {
+  ProfileOptions po;
+  po.threads = o.threads;
+  auto progress = o.progress;
+  po.progress = [progress](const std::string& name, int i, int n, double seconds) {
+    std::ostringstream line;
+    line << "  profile " << i << "/" << n << " done: " << output::printable(name) << " (" << std::round(seconds * 10) / 10
+         << " s)";
+    progress(line.str());
+  };
+  return po;
+}
+
+// Which free parameters to profile (indices into best.parameters); a name that is not a
+// free parameter of this fit is refused, not skipped.
+std::vector<int> profile_selection(const FitJobOptions& o, const FitResult& best) {
+  std::vector<int> which;
+  if (o.profiles.empty()) {
+    if (o.profile_all_free)
+      for (size_t k = 0; k < best.parameters.size(); ++k)
+        if (best.parameters[k].free) which.push_back(static_cast<int>(k));
+    return which;
+  }
+  for (const auto& name : o.profiles) {
+    const auto it = std::find_if(best.parameters.begin(), best.parameters.end(), [&](const auto& p) { return p.name == name; });
+    if (it == best.parameters.end())
+      throw std::invalid_argument("--profiles: no parameter '" + output::printable(name) + "' in this fit");
+    if (!it->free) throw std::invalid_argument("--profiles: '" + output::printable(name) + "' is not a free parameter of this fit");
+    which.push_back(static_cast<int>(it - best.parameters.begin()));
+  }
+  return which;
+}
+
+std::vector<Profile> run_profiles(const FitJobOptions& o, const ResidualModel& m, const FitResult& best, const FitOptions& fo) {
+  const auto which = profile_selection(o, best);
+  if (which.empty()) return {};
+  return profile_all(m, best, fo, profile_options(o), which);
+}
+
+// An interval side the profile never crossed is open, not a number.
+std::string side(double v, bool open) {
+  if (open) return "open";
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+nlohmann::ordered_json side_or_null(double v, bool open) { return open ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v); }
+
+// A plot joins the outputs when gnuplot can draw it; without one the fit still counts.
+void add_plot(FitOutputs& out, const std::string& file, const std::string& title, const std::vector<runtime::Panel>& panels) {
+  std::string svg, err;
+  if (runtime::render_svg(title, panels, &svg, &err)) out.plots.emplace_back(file, svg);
+  else out.plot_errors.push_back(file + ": " + err);
+}
+
+void add_profile_plot(FitOutputs& out, const std::string& title, const std::vector<Profile>& profiles) {
+  std::string svg, err;
+  if (plot_profiles(title, profiles, &svg, &err)) out.plots.emplace_back("profiles.svg", svg);
+  else out.plot_errors.push_back("profiles.svg: " + err);
+}
+
+FitOptions fit_options(const FitJobOptions& o) {
+  FitOptions fo;
+  fo.robust = o.robust;
+  return fo;
+}
+
+// Like the thesis' Figure 24: every step normalised to 0..1 and aligned at its fitted step
+// instant; a first-order lag is then one curve, 1 - exp(-t / tau).
+std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const std::vector<double>& p) {
+  runtime::Series meas{"Table 2, normalised", {}, {}, true}, fitted{"fitted tau", {}, {}},
+      thesis{"thesis tau = 0.128 s", {}, {}};
+  const double tau = p[MotorStepModel::kTau];
+  for (size_t k = 0; k < model.steps().size(); ++k) {
+    const auto& s = model.steps()[k];
+    const double t0 = s.t_before + p[MotorStepModel::kFirstStepTime + k];
+    const double y0 = model.predict(p.data(), k, s.t_before), y1 = model.predict(p.data(), k, s.t_before + 100);
+    for (size_t i = 0; i < s.t.size(); ++i) {
+      if (s.t[i] - t0 > 0.5) continue;  // the steady samples seconds later stay off the plot
+      meas.x.push_back(s.t[i] - t0);
+      meas.y.push_back((s.rpm[i] - y0) / (y1 - y0));
+    }
+  }
+  for (int i = 0; i <= 100; ++i) {
+    const double t = 0.5 * i / 100.0;
+    fitted.x.push_back(t);
+    fitted.y.push_back(1 - std::exp(-t / tau));
+    thesis.x.push_back(t);
+    thesis.y.push_back(1 - std::exp(-t / kThesisMotorTau));
+  }
+  return {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", {meas, fitted, thesis}}};
+}
+
+}  // namespace
+
+LogKind log_kind(const std::string& path) {
+  if (is_ulog(path)) return LogKind::kFlight;
+  const runtime::CsvTable head = runtime::read_csv(path);
+  if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return LogKind::kMotorSteps;
+  if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) return LogKind::kThrustStand;
+  return LogKind::kFlight;
+}
+
+std::vector<FitParameter> fit_parameters(const SymbolicModel& model) {
+  std::vector<FitParameter> out;
+  for (const auto& p : model.params) out.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, p.fit});
+  return out;
+}
+
+FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
+  MotorStepModel model(read_motor_steps(path));
+  const FitOptions fo = fit_options(o);
+  o.progress("[1/2] fitting motor map and lag to " + std::to_string(model.steps().size()) + " steps (" +
+             std::to_string(model.num_residuals()) + " samples)");
+  const FitResult best = fit_least_squares(model, model.parameters(), fo);
+  o.progress("[2/2] profile likelihood");
+  const auto profiles = run_profiles(o, model, best, fo);
+  const Profile* tau = nullptr;
+  for (const auto& p : profiles)
+    if (p.parameter == "tau") tau = &p;
+  const double tau_s = best.parameters[MotorStepModel::kTau].value;
+  FitOutputs out;
+  auto& j = out.json = fit_json(best, profiles);
+  j["kind"] = "motor_steps";
+  j["vehicle"] = v.name;
+  j["log"] = path;
+  j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
+                     {"thesis_method", "read off one normalised step at 63 % (thesis 2.3.4, Figure 24)"},
+                     {"tau_s", tau_s},
+                     {"tau_ci95", {tau ? side_or_null(tau->lower, tau->lower_open) : nullptr,
+                                   tau ? side_or_null(tau->upper, tau->upper_open) : nullptr}},
+                     {"tau_verdict", tau ? tau->verdict : ""}};
+  add_profile_plot(out, v.name + ": motor step profiles", profiles);
+  add_plot(out, "fit.svg", v.name + ": motor steps (thesis Table 2)", normalised_steps(model, parameter_values(best.parameters)));
+  std::ostringstream s;
+  s << "tau = " << tau_s << " s";
+  if (tau)
+    s << ", 95 % profile interval [" << side(tau->lower, tau->lower_open) << ", " << side(tau->upper, tau->upper_open) << "] ("
+      << tau->verdict << ")";
+  s << "; thesis: " << kThesisMotorTau << " s\n";
+  out.summary = s.str();
+  return out;
+}
+
+namespace {
+
+// RMS of each channel of a residual model at the given parameters.
+std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps) {
+  const std::vector<double> p = parameter_values(ps);
+  std::vector<double> r(m.num_residuals());
+  m.evaluate(p.data(), r.data(), nullptr);
+  const size_t nc = m.channels().size();
+  std::vector<double> ss(nc, 0.0);
+  std::vector<int> n(nc, 0);
+  for (int i = 0; i < m.num_residuals(); ++i) {
+    ss[m.channel_of(i)] += r[i] * r[i];
+    ++n[m.channel_of(i)];
+  }
+  for (size_t c = 0; c < nc; ++c) ss[c] = std::sqrt(ss[c] / std::max(1, n[c]));
+  return ss;
+}
+
+// The model's parameters with --free applied, or else the vehicle's fit flags less the
+// reference parameters (beside c_t only ratios to them are identifiable).
+std::vector<FitParameter> starting_parameters(const SymbolicModel& sm, const FitJobOptions& o) {
+  std::vector<FitParameter> params = fit_parameters(sm);
+  for (const auto& name : o.free)
+    if (std::none_of(params.begin(), params.end(), [&](const auto& p) { return p.name == name; }))
+      throw std::invalid_argument("--free: no parameter '" + output::printable(name) + "' in the model");
+  if (!o.free.empty()) {
+    for (auto& p : params) p.free = std::find(o.free.begin(), o.free.end(), p.name) != o.free.end();
+    return params;
+  }
+  std::vector<std::string> names;
+  for (const auto& p : params) names.push_back(p.name);
+  for (const auto& ref : reference_parameters(names))
+    for (auto& p : params)
+      if (p.name == ref && p.free) {
+        p.free = false;
+        o.progress("holding " + output::printable(ref) + " at 0: beside c_t only ratios to it are identifiable (--free overrides)");
+      }
+  return params;
+}
+
+// Measured and modelled vertical specific force and roll acceleration over the flight.
+std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Flight& flight, const std::vector<double>& p) {
+  const bool accel = flight.has_accelerometer;
+  EquationErrorModel all(model, flight, accel);
+  std::vector<double> r;
+  all.all_channels(p.data(), r);
+  runtime::Series meas{"measured", {}, {}, true}, fitted{"model (fitted)", {}, {}}, pm{"measured", {}, {}, true},
+      pf{"model (fitted)", {}, {}};
+  constexpr size_t kAz = 2, kPdot = 3, kChannels = 6;  // all_channels: ax ay az pdot qdot rdot per row
+  for (size_t row = 0; row < all.rows().size(); ++row) {
+    const auto& s = flight.samples[all.rows()[row]];
+    const double mz = accel ? s.specific_force[2] : s.acc_world[2];
+    meas.x.push_back(s.t);
+    meas.y.push_back(mz);
+    fitted.x.push_back(s.t);
+    fitted.y.push_back(mz + r[kChannels * row + kAz]);
+    pm.x.push_back(s.t);
+    pm.y.push_back(s.rate_dot[0]);
+    pf.x.push_back(s.t);
+    pf.y.push_back(s.rate_dot[0] + r[kChannels * row + kPdot]);
+  }
+  return {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
+          {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}};
+}
+
+}  // namespace
+
+FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, const SymbolicModel& sm, runtime::DynamicModel& model,
+                          const FitJobOptions& o) {
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
+  const std::vector<FitParameter> params = starting_parameters(sm, o);
+  const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
+  const bool accel = flight.has_accelerometer;
+  const bool shooting = o.formulation == "multiple_shooting";
+  std::unique_ptr<ResidualModel> train_m, valid_m;
+  if (shooting) {
+    train_m = std::make_unique<MultipleShootingModel>(model, train, o.window);
+    valid_m = std::make_unique<MultipleShootingModel>(model, valid, o.window);
+  } else {
+    train_m = std::make_unique<EquationErrorModel>(model, train, accel, o.channels);
+    valid_m = std::make_unique<EquationErrorModel>(model, valid, accel);
+  }
+  const FitOptions fo = fit_options(o);
+  o.progress("[1/3] " + o.formulation + " fit on " + std::to_string(train.samples.size()) + " samples (" +
+             std::to_string(train_m->num_residuals()) + " residuals), " +
+             std::to_string(std::count_if(params.begin(), params.end(), [](auto& p) { return p.free; })) + " free parameters");
+  auto clock0 = std::chrono::steady_clock::now();
+  const FitResult best = fit_least_squares(*train_m, params, fo);
+  const double fit_seconds = seconds_since(clock0);
+  o.progress("[2/3] profile likelihood (fit took " + std::to_string(fit_seconds) + " s)");
+  clock0 = std::chrono::steady_clock::now();
+  const auto profiles = run_profiles(o, *train_m, best, fo);
+  const double profile_seconds = seconds_since(clock0);
+  o.progress("[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples");
+  const auto before = channel_rms(*valid_m, params), after = channel_rms(*valid_m, best.parameters);
+  FitOutputs out;
+  auto& j = out.json = fit_json(best, profiles);
+  j["kind"] = shooting ? "flight_multiple_shooting" : "flight_equation_error";
+  j["vehicle"] = v.name;
+  j["log"] = path;
+  j["mapping"] = o.mapping;
+  j["formulation"] = shooting ? "multiple shooting: " + std::to_string(o.window) + " s windows from measured states, pose residuals"
+                     : accel  ? "equation error: accelerometer specific force and gyro derivative"
+                              : "equation error: differentiated velocity and gyro derivative";
+  nlohmann::ordered_json val = nlohmann::ordered_json::array();
+  const auto ch = valid_m->channels();
+  for (size_t c = 0; c < ch.size(); ++c)
+    val.push_back({{"channel", ch[c]}, {"rms_nominal", before[c]}, {"rms_fitted", after[c]},
+                   {"reduction_percent", before[c] > 0 ? 100 * (before[c] - after[c]) / before[c] : 0.0}});
+  j["validation"] = {{"fraction", o.validation}, {"samples", valid.samples.size()}, {"channels", val}};
+  j["fitted_channels"] = train_m->channels();
+  j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
+  add_profile_plot(out, v.name + ": profile likelihood", profiles);
+  const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
+  add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
+           flight_panels(model, flight, parameter_values(best.parameters)));
+  std::ostringstream s;
+  for (const auto& pr : profiles)
+    s << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
+      << side(pr.upper, pr.upper_open) << "] " << pr.verdict << "\n";
+  out.summary = s.str();
+  return out;
+}
+
+namespace {
+
+nlohmann::ordered_json per_motor_attempt(const StandFit& f) {  // verdicts only: no value at a bound is an estimate
+  nlohmann::ordered_json attempt = nlohmann::ordered_json::object();
+  for (const auto& pr : f.per_motor_profiles)
+    attempt[pr.parameter] = {{"verdict", pr.verdict},
+                             {"at_bound", std::count(f.per_motor.at_bound.begin(), f.per_motor.at_bound.end(), pr.parameter) > 0}};
+  return attempt;
+}
+
+// Measured thrust and the fitted law against the mean rotor speed.
+std::vector<runtime::Panel> stand_panels(const std::vector<StandSample>& samples, const StandFit& f, bool shared) {
+  runtime::Series meas{"measured (all motors)", {}, {}, true},
+      model{shared ? "k sum w_i^2 + tare" : "sum k_i w_i^2 + tare", {}, {}, true};
+  const ThrustVsSpeed thrust(samples, f.coefficients);
+  const std::vector<double> pv = parameter_values(f.thrust.parameters);
+  std::vector<double> r(thrust.num_residuals());
+  thrust.evaluate(pv.data(), r.data(), nullptr);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const double wm = (samples[i].w[0] + samples[i].w[1] + samples[i].w[2] + samples[i].w[3]) / 4;
+    meas.x.push_back(wm);
+    meas.y.push_back(samples[i].thrust);
+    model.x.push_back(wm);
+    model.y.push_back(samples[i].thrust + r[i]);
+  }
+  return {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}};
+}
+
+}  // namespace
+
+FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
+  const auto samples = read_thrust_stand(path);
+  o.progress("thrust vs rotor speed and rotor speed vs command, " + std::to_string(samples.size()) + " samples");
+  const double vref = param(v, "vbat_ref").value;
+  const StandFit f = fit_stand(samples, vref, fit_options(o), profile_options(o));
+  const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
+  const int n_k = shared ? 1 : static_cast<int>(StandSample::kMotors);
+  double k = 0;
+  for (int i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / n_k;
+  const Rotor& r0 = v.rotors.front();
+  const double ct = k / (param(v, "rho").value * r0.disc_area * r0.radius * r0.radius);  // k = c_t rho A r^2
+  FitOutputs out;
+  auto& j = out.json;
+  j["kind"] = "thrust_stand";
+  j["vehicle"] = v.name;
+  j["log"] = path;
+  j["thrust_vs_speed"] = fit_json(f.thrust, f.thrust_profiles);
+  j["thrust_vs_speed"]["coefficients"] = shared ? "shared" : "per_motor";
+  j["thrust_vs_speed"]["motor_speed_ratio_variation_rms"] = f.ratio_variation;
+  if (shared) {
+    j["thrust_vs_speed"]["why"] = f.coefficients_reason;
+    j["thrust_vs_speed"]["per_motor_attempt"] = per_motor_attempt(f);
+  }
+  j["speed_vs_command"] = fit_json(f.speed, f.speed_profiles);
+  if (!f.voltage_exponent_identified) j["speed_vs_command"]["why"] = f.voltage_reason;
+  const Profile* kp = shared ? &f.thrust_profiles.front() : nullptr;
+  j["summary"] = {{"k_mean_N_s2", k},
+                  {"k_ci95_N_s2", kp ? nlohmann::ordered_json{side_or_null(kp->lower, kp->lower_open), side_or_null(kp->upper, kp->upper_open)}
+                                     : nlohmann::ordered_json(nullptr)},
+                  {"coefficients", shared ? "one shared by all motors" : "mean of the per-motor coefficients"},
+                  {"c_t", ct},
+                  {"c_t_in_vehicle_file", param(v, "c_t").value},
+                  {"battery_sag_exponent_implied", f.voltage_exponent_identified ? nlohmann::ordered_json(2 * f.speed.parameters[3].value)
+                                                                                : nlohmann::ordered_json(nullptr)},
+                  {"vbat_ref_V", vref}};
+  j["published"] = published_crazyflie();
+  std::vector<Profile> all = f.thrust_profiles;
+  all.insert(all.end(), f.speed_profiles.begin(), f.speed_profiles.end());
+  add_profile_plot(out, v.name + ": thrust stand profiles", all);
+  add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
+  std::ostringstream s;
+  if (shared) {
+    s << "k = " << k << " N s^2 [" << side(kp->lower, kp->lower_open) << ", " << side(kp->upper, kp->upper_open) << "] ("
+      << kp->verdict << "), shared by all motors: " << f.coefficients_reason << "\n";
+  } else {
+    s << "k per motor:";
+    for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << f.thrust_profiles[i].verdict << ")";
+    s << "; mean " << k << " N s^2\n";
+  }
+  s << "c_t = " << ct << "; ";
+  if (f.voltage_exponent_identified) s << "speed ~ vbat^" << f.speed.parameters[3].value << "\n";
+  else s << f.voltage_reason << "\n";
+  out.summary = s.str();
+  return out;
+}
+
+}  // namespace quadgen::fit

@@ -1,0 +1,65 @@
+// The three fits `quadgen fit` runs, each from a log to what it writes (fit.json, plots and
+// a summary line), kept apart from the command line that chooses one. The kind of fit
+// follows the log's layout: a flight (ULog, or a CSV of poses, IMU and motor commands), the
+// thesis' motor step tests (time_ms, throttle_percent, rpm: motor map and lag) or a thrust
+// stand (weight[g], rpm1..4: thrust and speed laws).
+#pragma once
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "flight_data.hpp"
+#include "least_squares.hpp"
+#include "profile_likelihood.hpp"
+#include "symbolic_model.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen::runtime {
+class DynamicModel;
+}
+
+namespace quadgen::fit {
+
+enum class LogKind { kFlight, kMotorSteps, kThrustStand };
+
+// A ULog is a flight; a CSV is told apart by its columns.
+LogKind log_kind(const std::string& path);
+
+struct FitJobOptions {
+  bool robust = false;                 // Huber loss instead of squares
+  std::vector<std::string> profiles;   // names to profile; empty with profile_all: every free one
+  bool profile_all_free = true;        // false with an empty list: estimates and standard errors only
+  int threads = 0;                     // profile threads (0: one per core)
+  std::string mapping;                 // flights: column mapping (YAML) for logs not in the canonical layout
+  double resample = 0;                 // flights: resample onto a uniform grid at this rate [Hz] (0: no)
+  double validation = 0.3;             // flights: fraction at the end held out
+  std::string formulation = "equation_error";  // flights: or multiple_shooting
+  double window = 0.5;                 // multiple shooting: window length [s]
+  std::vector<std::string> channels;   // equation error: residual channels fitted (empty: all)
+  std::vector<std::string> free;       // parameters fitted, overriding the vehicle file's flags
+  std::function<void(const std::string&)> progress = [](const std::string&) {};  // one line per step
+};
+
+// What a fit writes: fit.json, rendered plots (file name, SVG), plots that could not be
+// drawn (gnuplot missing: the fit still counts) and the lines the command prints.
+struct FitOutputs {
+  nlohmann::ordered_json json;
+  std::vector<std::pair<std::string, std::string>> plots;
+  std::vector<std::string> plot_errors;
+  std::string summary;
+};
+
+// Every parameter of a derived model as a fit parameter, starting at its nominal value,
+// free as the vehicle file's fit flags say.
+std::vector<FitParameter> fit_parameters(const SymbolicModel& model);
+
+FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o);
+FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o);
+// `model` evaluates `symbolic` (compiled or interpreted).
+FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, const SymbolicModel& symbolic,
+                          runtime::DynamicModel& model, const FitJobOptions& o);
+
+}  // namespace quadgen::fit

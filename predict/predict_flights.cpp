@@ -1,0 +1,76 @@
+#include "predict_flights.hpp"
+
+#include <optional>
+#include <sstream>
+#include <utility>
+
+#include "log_reader.hpp"
+#include "parameter_source.hpp"
+#include "sinks.hpp"
+
+namespace quadgen::predict {
+
+namespace {
+
+fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlightsOptions& o) {
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const runtime::CsvTable log = fit::read_log(path, o.mapping, o.resample);
+  const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").value);
+  if (!flight.has_pose) o.progress(output::printable(path) + ": no pose logged: one-step errors only (rollouts need a measured state)");
+  return flight;
+}
+
+std::string percent(double fraction) {
+  std::ostringstream s;
+  s << 100 * fraction;
+  return s.str();
+}
+
+}  // namespace
+
+PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model, const std::vector<fit::FitParameter>& bounds,
+                                 const std::vector<std::string>& logs, const PredictFlightsOptions& o) {
+  if (o.calibrate && o.params.empty()) throw std::invalid_argument("--calibrate needs --params (a diagnosis.json)");
+  if (o.calibrate && o.validation >= 1.0)
+    throw std::invalid_argument("--calibrate needs a part before the evaluated one: --validation below 1");
+  const std::vector<double> nominal = model.params();  // before any calibration moves the model's
+  std::optional<ParameterSource> source;
+  if (!o.params.empty()) source.emplace(o.params);
+  PredictedFlights out;
+  nlohmann::ordered_json flights = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < logs.size(); ++i) {
+    o.progress("[" + std::to_string(i + 1) + "/" + std::to_string(logs.size()) + "] " + output::printable(logs[i]));
+    const fit::Flight whole = load(logs[i], v, o);
+    const auto [before, evaluated] = o.validation >= 1.0 ? std::pair<fit::Flight, fit::Flight>{{}, whole}
+                                                         : fit::split_by_time(whole, 1.0 - o.validation);
+    ParameterSource::ForLog values;
+    values.values = nominal;
+    values.origin = "vehicle file (nominal)";
+    if (source) values = source->for_log(model, logs[i]);
+    nlohmann::ordered_json calibrated = nlohmann::ordered_json::object();
+    if (o.calibrate && values.flight == 0 && !values.flight_params.empty()) {
+      o.progress("  calibrating " + std::to_string(values.flight_params.size()) + " flight parameters on the first " +
+                 percent(1.0 - o.validation) + " %");
+      values.values = calibrate(model, values.values, values.flight_params, bounds, before);
+      for (int k : values.flight_params) calibrated[model.param_names()[k]] = values.values[k];
+      values.origin += ", flight parameters calibrated on the part before";
+    }
+    const Prediction p = evaluate_prediction(model, values.values, evaluated, o.prediction);
+    auto j = prediction_json(p);
+    j["log"] = logs[i];
+    j["parameters_from"] = values.origin;
+    if (!calibrated.empty()) j["calibrated"] = calibrated;
+    j["evaluated_from_s"] = evaluated.samples.empty() ? 0.0 : evaluated.samples.front().t;
+    flights.push_back(j);
+    out.pooled.merge(p);
+  }
+  out.json = prediction_json(out.pooled);
+  out.json["vehicle"] = v.name;
+  out.json["parameters_from"] = o.params.empty() ? "vehicle file (nominal)" : o.params;
+  out.json["evaluated_fraction"] = o.validation;
+  out.json["flights"] = flights;
+  return out;
+}
+
+}  // namespace quadgen::predict

@@ -1,0 +1,40 @@
+// `quadgen predict` as a pipeline: logs in, prediction errors out (per flight and pooled),
+// with the parameter values each log is predicted with (predict/parameter_source.hpp) and,
+// for a log the diagnosis has not seen, its own parameters calibrated on the part before
+// the evaluated one. The command line only turns flags into PredictFlightsOptions.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dynamic_model.hpp"
+#include "least_squares.hpp"
+#include "prediction.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen::predict {
+
+struct PredictFlightsOptions {
+  std::string mapping;   // column mapping (YAML) for logs not in the canonical layout
+  double resample = 0;   // resample each log onto a uniform grid at this rate [Hz] first (0: no)
+  double validation = 0.3;  // fraction of each flight (at its end) evaluated; 1: all of it
+  std::string params;    // a fit.json or diagnosis.json; empty: the vehicle file's nominal values
+  bool calibrate = false;   // fit an unseen log's own parameters on the part before (needs params)
+  PredictionOptions prediction;
+  std::function<void(const std::string&)> progress = [](const std::string&) {};
+};
+
+struct PredictedFlights {
+  Prediction pooled;             // every flight's errors together
+  nlohmann::ordered_json json;   // prediction.json: pooled errors and one entry per flight
+};
+
+// `bounds`: every parameter of `model` with its name, unit and bounds (for calibration).
+// Throws std::invalid_argument for options that contradict each other.
+PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
+                                 const std::vector<fit::FitParameter>& bounds, const std::vector<std::string>& logs,
+                                 const PredictFlightsOptions& o);
+
+}  // namespace quadgen::predict
