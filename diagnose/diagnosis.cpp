@@ -125,6 +125,18 @@ bool implausible_parameter(const Finding& f, Environment where, const VehicleSca
   return false;
 }
 
+// Where each flight's held-out part begins: its first held-out sample on the (joined) clock.
+std::vector<double> held_out_starts(const fit::Flight& valid, const std::vector<double>& flight_starts) {
+  std::vector<double> out;
+  for (size_t i = 0; i < flight_starts.size(); ++i) {
+    const double begin = i == 0 ? -INFINITY : flight_starts[i], end = i + 1 < flight_starts.size() ? flight_starts[i + 1] : INFINITY;
+    const auto it = std::find_if(valid.samples.begin(), valid.samples.end(),
+                                 [&](const fit::FlightSample& s) { return s.t >= begin && s.t < end; });
+    if (it != valid.samples.end()) out.push_back(it->t);
+  }
+  return out;
+}
+
 // In a joint diagnosis, the parameters that take one value per flight: c_t when fitted, and
 // those of the per-flight effects among the candidates, except a reference held at off.
 std::vector<std::string> per_flight_parameters(const SymbolicModel& all, const std::vector<std::string>& candidates) {
@@ -229,8 +241,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.train_samples = train.samples.size();
   d.valid_samples = valid.samples.size();
   d.t_split = valid.samples.front().t;
-  for (size_t k = 0; k < valid.samples.size(); ++k)  // a held-out part starts after a gap of > 0.5 s
-    if (k == 0 || valid.samples[k].t - valid.samples[k - 1].t > 0.5) d.validation_starts.push_back(valid.samples[k].t);
+  d.validation_starts = held_out_starts(valid, joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
   *validation_out = valid;
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
       all_ee(model, flight, accel);

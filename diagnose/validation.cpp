@@ -33,7 +33,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   // Delayed commands are not read from before the window's stretch (a previous joined flight).
   std::vector<double> times;
   for (const auto& s : f.samples) times.push_back(s.t);
-  const std::vector<size_t> stretch = runtime::stretch_starts(times, 0.1);
+  const std::vector<size_t> stretch = runtime::stretch_starts(times);
   size_t first_command = 0;
   const int n = model.num_states(), nu = model.num_inputs();
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");

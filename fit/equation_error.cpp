@@ -47,14 +47,16 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
 void EquationErrorModel::mark_contiguous_intervals() {
   const auto& S = flight_.samples;
   const size_t ns = S.size();
-  std::vector<double> dts;
-  for (size_t k = 1; k < ns; ++k) dts.push_back(S[k].t - S[k - 1].t);
-  if (dts.empty()) return;
-  std::vector<double> sorted = dts;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  gap_ = 1.5 * sorted[sorted.size() / 2];
+  if (ns < 2) return;
+  std::vector<double> times;
+  for (const auto& s : S) times.push_back(s.t);
+  gap_ = runtime::gap_threshold(times);
   interval_ok_.assign(ns, false);
-  for (size_t k = 0; k + 1 < ns; ++k) interval_ok_[k] = dts[k] <= gap_;
+  rotors_restart_.assign(ns, true);
+  for (size_t k = 0; k + 1 < ns; ++k) {
+    interval_ok_[k] = S[k + 1].t - S[k].t <= gap_;
+    rotors_restart_[k] = S[k + 1].t - S[k].t > kRotorRestartGap;
+  }
 }
 
 // Each column of a data-side parameter, and the stretches of the log it acts on: from its
@@ -72,8 +74,8 @@ void EquationErrorModel::find_data_side_columns() {
     }
   }
   for (auto [c, span] : spans) {
-    while (span.lo > 0 && !interval_ok_.empty() && interval_ok_[span.lo - 1]) --span.lo;
-    while (span.hi < S.size() && !interval_ok_.empty() && interval_ok_[span.hi - 1]) ++span.hi;
+    while (span.lo > 0 && !rotors_restart_.empty() && !rotors_restart_[span.lo - 1]) --span.lo;
+    while (span.hi < S.size() && !rotors_restart_.empty() && !rotors_restart_[span.hi - 1]) ++span.hi;
     data_side_columns_.push_back(c);
     data_side_spans_.push_back(span);
   }
@@ -217,9 +219,10 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   std::vector<double> f(n), c(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
-    // After a gap the rotors restart in steady state with the commands, as at the start
-    // (a span starts at a gap or at the log's start).
-    const bool restart = k == span.lo || !interval_ok_[k - 1];
+    // After a long gap the rotors restart in steady state with the commands, as at the start
+    // (a span starts at such a gap or at the log's start); across a short one they are
+    // carried with the last command held (see kRotorRestartGap).
+    const bool restart = k == span.lo || !rotors_continue(k);
     if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
       const double a = std::exp(-h / tau[k]);

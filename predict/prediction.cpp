@@ -55,7 +55,7 @@ class Rollout {
     v_in_ = model.input_index("vbat");
     std::vector<double> times;
     for (const auto& s : f.samples) times.push_back(s.t);
-    stretch_ = runtime::stretch_starts(times, 0.1);
+    stretch_ = runtime::stretch_starts(times);
   }
 
   // The data-side effects in force from sample k on (a rollout stays within one flight).

@@ -7,6 +7,7 @@
 // validation windows, the prediction rollouts); their values may differ by flight, so they
 // are read through DynamicModel::param_column at the sample's time.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -42,10 +43,23 @@ struct DataSideParams {
   }
 };
 
-// For each sample time, the index of the first sample of its contiguous stretch (an interval
-// longer than `gap` seconds starts a new one): a delayed command lookup is clamped there, so
-// it never reaches across a gap into a previous joined flight or trimmed ground contact.
-inline std::vector<size_t> stretch_starts(const std::vector<double>& times, double gap) {
+// The one gap rule of the pipeline: a sample interval longer than 1.5 times the log's median
+// interval is a gap (a joined flight's boundary, trimmed ground contact, a dropped sample).
+// No derivative, rotor-speed filter or delayed command lookup reaches across one. Relative
+// to the median so that it holds at any logging rate; 1.5 lets sampling jitter through.
+inline double gap_threshold(const std::vector<double>& times) {
+  std::vector<double> dts;
+  for (size_t k = 1; k < times.size(); ++k) dts.push_back(times[k] - times[k - 1]);
+  if (dts.empty()) return 0.0;
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  return 1.5 * dts[dts.size() / 2];
+}
+
+// For each sample time, the index of the first sample of its contiguous stretch (gaps as
+// gap_threshold says): a delayed command lookup is clamped there, so it never reaches across
+// a gap into a previous joined flight or trimmed ground contact.
+inline std::vector<size_t> stretch_starts(const std::vector<double>& times) {
+  const double gap = gap_threshold(times);
   std::vector<size_t> out(times.size(), 0);
   for (size_t k = 1; k < times.size(); ++k) out[k] = times[k] - times[k - 1] > gap ? k : out[k - 1];
   return out;
