@@ -600,3 +600,69 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
   }
   EXPECT_GT(second, 100);
 }
+
+// Across a short gap (an in-flight motor dip trimmed as not airborne, a dropped sample) the
+// rotors keep spinning: the equation error carries their speeds over it. A flight with a
+// 60 ms motor lag and three such gaps (0.1-0.3 s, the command held over each, so carrying is
+// exact): at the true lag only the noise is left, and the fitted lag is the true one.
+// Restarting the rotors in steady state after each gap (the ARPL regression) fails both.
+TEST(Fit, RotorSpeedsAreCarriedAcrossShortGaps) {
+  runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> model;
+  const int lag = model.param_index("motor_lag.tau"), n = model.num_states();
+  std::vector<double> truth = model.params();
+  truth[lag] = 0.06;
+  model.set_params(truth);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  std::normal_distribution<double> noise(0, 0.01);
+  const auto in_gap = [](double t) { return (t >= 1.0 && t < 1.2) || (t >= 2.5 && t < 2.8) || (t >= 4.0 && t < 4.1); };
+  Flight flight;
+  flight.has_pose = flight.has_gyro = true;
+  const int nr = n - 13;
+  std::vector<double> commands(4), w(nr), c_before(nr), c_now(nr), f(n);
+  const double a = std::exp(-0.01 / truth[lag]);  // the lag over one sample interval, commands held
+  for (int k = 0; k < 600; ++k) {
+    const double t = 0.01 * k;
+    if (k % 10 == 0 && !in_gap(t))  // new commands every 0.1 s, held through a gap
+      for (auto& v : commands) v = cmd(rng);
+    std::vector<double> u = commands, x = test::random_state(rng);
+    u.push_back(t);
+    u.push_back(3.9);
+    x.resize(n, 0.0);
+    model.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt at w = 0: w_cmd / tau
+    for (int i = 0; i < nr; ++i) {
+      c_now[i] = truth[lag] * f[13 + i];
+      w[i] = k == 0 ? c_now[i] : a * w[i] + (1 - a) * c_before[i];
+      x[13 + i] = w[i];
+    }
+    c_before = c_now;
+    if (in_gap(t)) continue;  // trimmed: the rotors spin on
+    model.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);
+    FlightSample s;
+    s.t = t;
+    s.x.assign(x.begin(), x.begin() + 13);
+    s.u = commands;
+    s.vbat = 3.9;
+    for (int i = 0; i < 3; ++i) {
+      s.acc_world[i] = f[3 + i] + noise(rng);
+      s.rate_dot[i] = f[10 + i] + noise(rng);
+    }
+    flight.samples.push_back(s);
+  }
+  EquationErrorModel m(model, flight, false, {}, EquationErrorModel::Derivatives::kPointwise);
+  {  // at the truth only the noise is left, at the first samples after each gap too
+    std::vector<double> r(m.num_residuals());
+    m.evaluate(truth.data(), r.data(), nullptr);
+    double largest = 0;
+    for (double v : r) largest = std::max(largest, std::fabs(v));
+    EXPECT_LT(largest, 0.06);
+  }
+  std::vector<FitParameter> ps;
+  for (int i = 0; i < model.num_params(); ++i)
+    ps.push_back({model.param_names()[i], "", i == lag ? 0.03 : truth[i], i == lag ? 1e-3 : truth[i],
+                  i == lag ? 0.25 : truth[i], i == lag});
+  FitOptions fo;
+  fo.account_autocorrelation = false;
+  const FitResult best = fit_least_squares(m, ps, fo);
+  EXPECT_NEAR(best.parameters[lag].value, truth[lag], 1e-3);
+}
