@@ -169,17 +169,13 @@ SymbolicModel with_per_flight_copies(const SymbolicModel& all, const runtime::Pe
 // The airframe's values: a per-flight parameter at its mean over the flights, the copies
 // dropped (the next flight's trim or wind is unknown; the mean is the best guess).
 std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParameter>& ps) {
-  std::map<std::string, std::pair<double, int>> sums;
-  for (const auto& p : ps) {
-    auto& [sum, count] = sums[runtime::shared_name(p.name)];
-    sum += p.value;
-    ++count;
-  }
+  std::vector<std::pair<std::string, double>> values;
+  for (const auto& p : ps) values.emplace_back(p.name, p.value);
+  const auto means = runtime::mean_over_flights(values);
   std::vector<fit::FitParameter> out;
   for (auto p : ps) {
     if (p.name.find('@') != std::string::npos) continue;
-    const auto& [sum, count] = sums[p.name];
-    p.value = sum / count;
+    p.value = means.at(p.name);
     out.push_back(p);
   }
   return out;

@@ -72,14 +72,9 @@ std::vector<std::string> carried_look_alikes(const Diagnosis& d) {
 // parameter at its mean over the flights.
 std::string headline(const Finding& f) {
   const Effect& e = find_effect(f.effect);
-  std::map<std::string, std::pair<double, int>> sums;
-  for (const auto& p : f.parameters) {
-    auto& [sum, n] = sums[runtime::shared_name(p.name)];
-    sum += p.value;
-    ++n;
-  }
-  std::map<std::string, double> values;
-  for (const auto& [name, sn] : sums) values[name] = sn.first / sn.second;
+  std::vector<std::pair<std::string, double>> named;
+  for (const auto& p : f.parameters) named.emplace_back(p.name, p.value);
+  const std::map<std::string, double> values = runtime::mean_over_flights(named);
   std::string reference;
   if (e.first_parameter_is_reference)
     for (const auto& p : f.evidence.parameters)
@@ -88,7 +83,7 @@ std::string headline(const Finding& f) {
         break;
       }
   std::string s = e.headline(values, reference);
-  if (sums.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
+  if (values.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
   return s;
 }
 

@@ -12,6 +12,18 @@ std::string per_flight_name(const std::string& parameter, int flight) {
 
 std::string shared_name(const std::string& name) { return name.substr(0, name.find('@')); }
 
+std::map<std::string, double> mean_over_flights(const std::vector<std::pair<std::string, double>>& values) {
+  std::map<std::string, std::pair<double, int>> sums;
+  for (const auto& [name, value] : values) {
+    auto& [sum, count] = sums[shared_name(name)];
+    sum += value;
+    ++count;
+  }
+  std::map<std::string, double> means;
+  for (const auto& [name, sum_count] : sums) means[name] = sum_count.first / sum_count.second;
+  return means;
+}
+
 int flight_of_name(const std::string& name) {
   const auto at = name.find('@');
   return at == std::string::npos ? 1 : std::stoi(name.substr(at + 1));

@@ -12,6 +12,8 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "dynamic_model.hpp"
@@ -24,6 +26,9 @@ std::string per_flight_name(const std::string& parameter, int flight);
 // (1 for a plain name).
 std::string shared_name(const std::string& name);
 int flight_of_name(const std::string& name);
+// Each parameter's mean over its flights' copies (name, name@2, ...), by shared name: the
+// airframe's value of a per-flight parameter; a parameter without copies keeps its value.
+std::map<std::string, double> mean_over_flights(const std::vector<std::pair<std::string, double>>& values);
 
 class PerFlightModel : public DynamicModel {
  public:
