@@ -16,10 +16,23 @@ namespace quadgen::diagnose {
 
 namespace {
 
-std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
+// The samples of a flight that have equation-error residuals (full derivative windows).
+fit::Flight rows_of(const fit::Flight& f, const fit::EquationErrorModel& m) {
+  fit::Flight out = f;
+  out.samples.clear();
+  for (size_t k : m.rows()) out.samples.push_back(f.samples[k]);
+  return out;
+}
+
+std::vector<double> residuals_of(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
   const auto p = fit::parameter_values(ps);
   std::vector<double> r6;
   m.all_channels(p.data(), r6);
+  return r6;
+}
+
+std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
+  const std::vector<double> r6 = residuals_of(m, ps);
   std::vector<double> rms(6, 0.0);
   const size_t ns = r6.size() / 6;
   for (size_t k = 0; k < ns; ++k)
@@ -343,13 +356,10 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
                                                  " %); removed by the backward pass"));
   const SearchResult& s = d.search;
   // What is wrong, before and after, over the whole flight.
-  fit::Flight used = flight;  // the samples with residuals (full derivative windows)
-  used.samples.clear();
-  for (size_t k : all_ee.rows()) used.samples.push_back(flight.samples[k]);
+  const fit::Flight used = rows_of(flight, all_ee);
   for (const auto& smp : used.samples) d.t.push_back(smp.t);
-  const auto pb = fit::parameter_values(s.base_fit), pa = fit::parameter_values(s.final_fit);
-  all_ee.all_channels(pb.data(), d.residual_before);
-  all_ee.all_channels(pa.data(), d.residual_after);
+  d.residual_before = residuals_of(all_ee, s.base_fit);
+  d.residual_after = residuals_of(all_ee, s.final_fit);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const SignalSet signals = physical_signals(used, rotors);
@@ -376,6 +386,10 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     d.unexplained.push_back(u);
   }
+  std::cerr << "[diagnose] beyond the catalogue: sparse regression on what the final model leaves\n";
+  d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
+                                residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,
+                                joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) {
       const bool lower = std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper);

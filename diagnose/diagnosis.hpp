@@ -10,6 +10,7 @@
 #include "flight_data.hpp"
 #include "prediction.hpp"
 #include "residual_analysis.hpp"
+#include "term_discovery.hpp"
 #include "validation.hpp"
 #include "vehicle.hpp"
 
@@ -93,6 +94,9 @@ struct Diagnosis {
   std::string environment;  // as declared: indoor, outdoor, unknown
   std::vector<StandIn> stand_ins;
   std::vector<Unexplained> unexplained;
+  // Beyond the catalogue: per channel, the term sparse regression proposes for what the
+  // final model still gets wrong on the training part, with its held-out gain (or why none).
+  std::vector<DiscoveredTerm> discovered;
   std::vector<ChannelGain> channel_gain;
   // Free parameters of the final model that ended on a bound: the model is strained there,
   // and a finding may stand in for physics the catalogue lacks.

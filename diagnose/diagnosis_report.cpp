@@ -66,6 +66,13 @@ std::vector<std::string> carried_look_alikes(const Diagnosis& d) {
   return out;
 }
 
+// The unit of a residual channel, as the diagnosis names its channels.
+std::string channel_unit(const Diagnosis& d, const std::string& channel) {
+  for (size_t c = 0; c < d.channel_names.size() && c < d.channel_units.size(); ++c)
+    if (d.channel_names[c] == channel) return d.channel_units[c];
+  return "";
+}
+
 // A finding (or a suspected one): its parameters, the one gain figure (the final model
 // without it -> with it, on held-out data, with its spread over validation folds), evidence.
 // The finding in one sentence (the effect's own words), from its values: a per-flight
@@ -215,6 +222,28 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});
   j["unexplained"] = un;
+  // Beyond the catalogue: one entry per channel, proposed or not (and why).
+  json disc = json::array();
+  for (const auto& t : d.discovered) {
+    json cs = json::array();
+    for (const auto& c : t.coefficients)
+      cs.push_back({{"regressor", c.regressor}, {"unit", c.unit}, {"value", number_or_null(c.value)},
+                    {"ci95", {number_or_null(c.lower), number_or_null(c.upper)}}});
+    disc.push_back({{"channel", t.channel},
+                    {"unit", t.unit},
+                    {"proposed", t.proposed},
+                    {"expression", t.expression()},
+                    {"coefficients", cs},
+                    {"sparsity_threshold", t.threshold},
+                    {"cross_validation", t.cross_validation},
+                    {"training_rms", {number_or_null(t.train_rms_before), number_or_null(t.train_rms_after)}},
+                    {"held_out_rms", {number_or_null(t.valid_rms_before), number_or_null(t.valid_rms_after)}},
+                    {"held_out_gain", {{"mean", number_or_null(t.gain_mean)},
+                                       {"standard_error", number_or_null(t.gain_standard_error)},
+                                       {"per_block", t.fold_gains}}},
+                    {"verdict", t.verdict}});
+  }
+  j["discovered_terms"] = disc;
   j["parameters_at_bounds"] = d.at_bounds;
   j["gain"] = {{"metric", d.metric},
                {"before", number_or_null(d.metric_before)},
@@ -415,10 +444,39 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
+  for (const auto& t : d.discovered)
+    if (t.proposed)
+      os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
+         << t.verdict << "\n";
   return os.str();
 }
 
 namespace {
+
+// Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
+// for which none is proposed.
+void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
+  if (d.discovered.empty()) return;
+  h << "<h2>Beyond the catalogue: proposed terms</h2>\n<p>Sparse regression (sequentially thresholded least "
+       "squares) of what the final model still gets wrong on the training part, over the constant, body velocity, "
+       "body rates, mean command U, battery voltage and their pairwise products; sparsity chosen by "
+       "cross-validation, a term kept only if significant after correction for the regressors searched, and "
+       "proposed only if it predicts the held-out part better. What a term means physically is for you to "
+       "decide; it is not a named cause.</p>\n<table><tr><th>channel</th><th>term added to the model</th>"
+       "<th>coefficients (95 % interval)</th><th>held-out RMS</th><th>verdict</th></tr>\n";
+  for (const auto& t : d.discovered) {
+    h << "<tr><td>" << esc(t.channel) << "</td><td>" << (t.coefficients.empty() ? "&mdash;" : esc(t.expression()))
+      << "</td><td>";
+    for (size_t i = 0; i < t.coefficients.size(); ++i) {
+      const auto& c = t.coefficients[i];
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, 3) << " [" << num(c.lower, 3) << ", "
+        << num(c.upper, 3) << "] " << esc(c.unit);
+    }
+    h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
+      << "</td><td>" << (t.proposed ? "<b>proposed</b>" : "not proposed") << ": " << esc(t.verdict) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
 
 // A per-flight finding at a glance: one row per parameter, one column per flight, each cell
 // the value and its 95 % interval (and the verdict when it is not "identifiable").
@@ -473,7 +531,10 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
       << num(reduction(d.metric_before, d.metric_after), 2) << " % better (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
-  h << "</ul>\n<h2>Verdict</h2>\n<pre>" << esc(diagnosis_summary(d)) << "</pre>\n";
+  // The command's own printout, for a reader who compares it with a terminal; the sections
+  // below say the same in tables.
+  h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << esc(diagnosis_summary(d))
+    << "</pre></details>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
   h << "<h2>Findings</h2>\n";
@@ -541,9 +602,13 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << "</td></tr>\n";
     h << "</table>\n";
   }
+  discovered_terms_html(h, d);
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.
-    h << "<h2>Prediction on the validation part</h2>\n<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
+    h << "<h2>Prediction on the validation part</h2>\n";
+    if (d.prediction_after.open_loop.empty())
+      h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state); one-step errors only.</p>\n";
+    h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
          "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
          "<th>position, attitude replayed [m]</th></tr>\n";
     const auto& b = d.prediction_before;
@@ -560,14 +625,16 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(a.one_step.angular_acceleration[2].rms(), 3) << " rad/s², world vertical acceleration "
       << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
   }
-  h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>RMS base</th><th>RMS extended</th><th>reduction %</th></tr>\n";
+  h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
+       "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
-    h << "<tr><td>" << esc(c.channel) << "</td><td>" << num(c.before) << "</td><td>" << num(c.after) << "</td><td>"
-      << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
-  h << "</table>\n<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>RMS</th><th>bias</th><th>corr. time [samples]</th>"
-       "<th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
+    h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
+      << "</td><td>" << num(c.after) << "</td><td>" << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
+  h << "</table>\n<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
+       "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
   for (const auto& c : d.before.channels) {
-    h << "<tr><td>" << esc(c.name) << "</td><td>" << num(c.rms) << "</td><td>" << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
+    h << "<tr><td>" << esc(c.name) << "</td><td>" << esc(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
+      << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
       << "</td><td>" << num(c.slow_ratio, 3) << "</td><td>";
     for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)
       h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << num(c.correlations[i].r, 2) << ")";

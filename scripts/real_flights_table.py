@@ -72,6 +72,9 @@ def main(root):
         groups = [" or ".join(a["effects"]) for a in j.get("ambiguous", [])]
         stand_ins = [f"{s['effect']} ({s['parameter']} = {s['value']:.3g} {s['unit']})" for s in j.get("stand_ins", [])]
         removed = [r["effect"] for r in j.get("removed_by_backward_pass", [])]
+        # Beyond the catalogue: proposed terms with their held-out RMS before -> after.
+        proposed = [f"{t['expression']} ({fmt(t['held_out_rms'][0])} → {fmt(t['held_out_rms'][1])} {t['unit']})"
+                    for t in j.get("discovered_terms", []) if t.get("proposed")]
         pb, pa = j.get("prediction", {}).get("before", {}), j.get("prediction", {}).get("after", {})
 
         def at(p, h):  # mean position error at horizon h of the open-loop view
@@ -81,11 +84,11 @@ def main(root):
             return None
         pred = f"{fmt(at(pb, 0.5))} → {fmt(at(pa, 0.5))}"
         rows.append((d.name, "<br>".join(named) or "—", ", ".join(stand_ins) or "—", ", ".join(suspected) or "—",
-                     ", ".join(groups) or "—", pred,
+                     ", ".join(groups) or "—", "<br>".join(proposed) or "—", pred,
                      f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
     print("| flight | named (95 % interval) | stand-ins (not named) | suspected (failed) | look-alike groups | "
           "0.5 s open-loop error before → after [m] | s |")
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for r in rows:
         print("| " + " | ".join(r) + " |")
     print(f"\n{bad} rule violations in {len(rows)} diagnoses")
