@@ -98,6 +98,11 @@ int run_diagnose(const DiagnoseArgs& a) {
   out.add("extended_model.json", ext.model_json);
   out.add("extended_derivation.md", ext.derivation_markdown);
   out.add("fitted_parameters.yaml", ext.fitted_parameters_yaml);
+  if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
+    const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, a.vehicle, logs_label, true);
+    out.add("discovered_model.hpp", disc.header);
+    out.add("discovered_derivation.md", disc.derivation_markdown);
+  }
   for (const auto& [name, svg] : plots) out.add(name, svg);
   for (const auto& [name, csv] : plot_data) out.add(name, csv);  // every plotted series, for Python or MATLAB
   out.commit();

@@ -127,13 +127,14 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   return out;
 }
 
-// With thrust (c_t = 0), gravity (g = 0) and the flapping moment removed there are no
-// torques (rotor drag is a force at the CoG); the model's rotational rows must
-// then conserve 1/2 ω·Jω and |Jω|^2.
+// With thrust (c_t = 0), gravity (g = 0), the flapping moment and any term added beyond the
+// catalogue (term_*: an external force or moment found in data) removed there are no
+// torques (rotor drag is a force at the CoG); the model's rotational rows must then conserve
+// 1/2 ω·Jω and |Jω|^2.
 std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
   lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
   for (const auto& p : m.params)
-    if (p.name == "blade_flapping.k") off.append(p.sym == 0);
+    if (p.name == "blade_flapping.k" || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
   matrix w(3, 1), wdot(3, 1);
   for (int i = 0; i < 3; ++i) {
     w(i, 0) = m.states[10 + i].sym;

@@ -317,6 +317,7 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
     wanted.erase(e.name);
   }
   if (!wanted.empty()) throw std::invalid_argument("unknown effect '" + *wanted.begin() + "'");
+  add_terms(c, opt.terms);
   assemble(c);
   differentiate(m);
   return m;

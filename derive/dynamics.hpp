@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "added_terms.hpp"
 #include "geometry.hpp"
 #include "symbolic_model.hpp"
 #include "vehicle.hpp"
@@ -46,6 +47,7 @@ struct ModelContext {
 
 struct DeriveOptions {
   std::vector<std::string> effects;  // any order; duplicates rejected
+  std::vector<AddedTerm> terms;      // beyond the catalogue, applied after the effects
 };
 
 SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt);

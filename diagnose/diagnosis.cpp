@@ -10,7 +10,10 @@
 #include <sstream>
 
 #include "effects.hpp"
+#include "geometry.hpp"
 #include "per_flight_model.hpp"
+#include "tape.hpp"
+#include "tape_builder.hpp"
 
 namespace quadgen::diagnose {
 
@@ -103,6 +106,53 @@ std::string short_number(double v) {
   os.precision(3);
   os << v;
   return os.str();
+}
+
+// What the proposed terms buy in a simulation, like an effect: the full-catalogue model with
+// the terms added is derived and taped, and the held-out folds are simulated with the final
+// fit's values and the terms' coefficients, then with the coefficients at zero. No folds (no
+// pose): not measured.
+Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, const std::vector<AddedTerm>& terms,
+                                const std::vector<double>& later_starts, const std::vector<std::string>& per_flight,
+                                const std::vector<fit::FitParameter>& final_fit, const std::vector<fit::Flight>& folds,
+                                double window) {
+  Diagnosis::TermsGain g;
+  if (folds.empty()) {
+    g.note = "no pose logged: no open-loop rollouts; the gain is the channel's held-out equation-error RMS";
+    return g;
+  }
+  DeriveOptions o;
+  o.effects = all.effects;
+  o.terms = terms;
+  const SymbolicModel with_terms = derive_model(v, derive_mass_properties(v), o);
+  runtime::TapeModel tape(emission::build_tape(with_terms));
+  std::unique_ptr<runtime::DynamicModel> model;
+  if (later_starts.empty()) model = tape.clone();
+  else model = std::make_unique<runtime::PerFlightModel>(tape, later_starts, per_flight);
+  std::map<std::string, double> fitted;
+  for (const auto& p : final_fit) fitted[p.name] = p.value;
+  auto values = [&](bool on) {
+    std::vector<double> p;
+    for (const auto& n : model->param_names()) {
+      if (fitted.count(n)) p.push_back(fitted.at(n));
+      else if (n.rfind("term_", 0) == 0) p.push_back(on ? with_terms.params[with_terms.param_index(n)].nominal : 0.0);
+      else p.push_back(with_terms.params[with_terms.param_index(runtime::shared_name(n))].nominal);
+    }
+    return p;
+  };
+  const auto without = values(false), with = values(true);
+  g.measured = true;
+  g.metric = "position RMSE of " + short_number(window) + " s open-loop windows on the held-out part [m]";
+  double sum_before = 0, sum_after = 0;
+  for (const auto& f : folds) {
+    const double b = simulate_windows(*model, without, f, window).position_rmse;
+    const double a = simulate_windows(*model, with, f, window).position_rmse;
+    sum_before += b / static_cast<double>(folds.size()), sum_after += a / static_cast<double>(folds.size());
+    g.fold_gains.push_back(b - a);
+  }
+  g.before = sum_before, g.after = sum_after;
+  mean_and_standard_error(g.fold_gains, &g.gain_mean, &g.gain_standard_error);
+  return g;
 }
 
 // A candidate the held-out equation-error cost speaks against: suspected with that cost
@@ -224,10 +274,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // of the pipeline sees one model with more parameters.
   std::unique_ptr<runtime::PerFlightModel> per_flight_model;
   SymbolicModel per_flight_all;
+  std::vector<double> later_starts;  // where flights 2..K begin on the joined clock
+  std::vector<std::string> per_flight_names;
   if (joint) {
     const auto starts = fit::joined_start_times(flights);
-    per_flight_model = std::make_unique<runtime::PerFlightModel>(
-        model_in, std::vector<double>(starts.begin() + 1, starts.end()), per_flight_parameters(all_in, opt.search.candidates));
+    later_starts.assign(starts.begin() + 1, starts.end());
+    per_flight_names = per_flight_parameters(all_in, opt.search.candidates);
+    per_flight_model = std::make_unique<runtime::PerFlightModel>(model_in, later_starts, per_flight_names);
     per_flight_all = with_per_flight_copies(all_in, *per_flight_model);
     for (const auto& e : opt.search.candidates)
       if (find_effect(e).per_flight) d.per_flight_effects.push_back(e);
@@ -390,6 +443,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
                                 residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,
                                 joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
+  if (!proposed_terms(d.discovered).empty()) {
+    std::cerr << "[diagnose] the proposed terms regenerated into the model and simulated on the held-out part\n";
+    d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
+                              pose ? folds : std::vector<fit::Flight>{}, opt.window);
+  }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) {
       const bool lower = std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper);

@@ -97,6 +97,15 @@ struct Diagnosis {
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).
   std::vector<DiscoveredTerm> discovered;
+  // The proposed terms regenerated into the final model and simulated like an effect: the
+  // held-out metric without -> with them, per validation fold (measured only with a pose).
+  struct TermsGain {
+    bool measured = false;
+    std::string metric, note;
+    double before = 0, after = 0;
+    std::vector<double> fold_gains;
+    double gain_mean = 0, gain_standard_error = 0;
+  } terms_gain;
   std::vector<ChannelGain> channel_gain;
   // Free parameters of the final model that ended on a bound: the model is strained there,
   // and a finding may stand in for physics the catalogue lacks.

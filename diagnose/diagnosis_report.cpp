@@ -244,6 +244,15 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                     {"verdict", t.verdict}});
   }
   j["discovered_terms"] = disc;
+  const auto& tg = d.terms_gain;
+  j["discovered_terms_gain"] = {{"measured", tg.measured},
+                                {"metric", tg.metric},
+                                {"before", number_or_null(tg.before)},
+                                {"after", number_or_null(tg.after)},
+                                {"per_fold", tg.fold_gains},
+                                {"mean", number_or_null(tg.gain_mean)},
+                                {"standard_error", number_or_null(tg.gain_standard_error)},
+                                {"note", tg.note}};
   j["parameters_at_bounds"] = d.at_bounds;
   j["gain"] = {{"metric", d.metric},
                {"before", number_or_null(d.metric_before)},
@@ -448,6 +457,10 @@ std::string diagnosis_summary(const Diagnosis& d) {
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
          << t.verdict << "\n";
+  if (d.terms_gain.measured)
+    os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
+       << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
+       << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")\n";
   return os.str();
 }
 
@@ -476,6 +489,14 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       << "</td><td>" << (t.proposed ? "<b>proposed</b>" : "not proposed") << ": " << esc(t.verdict) << "</td></tr>\n";
   }
   h << "</table>\n";
+  const auto& g = d.terms_gain;
+  if (g.measured)
+    h << "<p>With the proposed terms regenerated into the model (<code>discovered_model.hpp</code>) and simulated like an "
+         "effect: "
+      << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per validation fold "
+      << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ").</p>\n";
+  else if (!g.note.empty())
+    h << "<p>" << esc(g.note) << ".</p>\n";
 }
 
 // A per-flight finding at a glance: one row per parameter, one column per flight, each cell

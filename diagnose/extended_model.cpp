@@ -38,9 +38,11 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
 }  // namespace
 
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
-                                  const std::string& vehicle_file, const std::string& logs_label) {
+                                  const std::string& vehicle_file, const std::string& logs_label,
+                                  bool with_proposed_terms) {
   DeriveOptions options;
   options.effects = d.search.selected;
+  if (with_proposed_terms) options.terms = proposed_terms(d.discovered);
   SymbolicModel ext = derive_model(v, mass, options);
   for (const auto& p : d.airframe_fit)  // the header's nominal values are the estimates
     if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
@@ -49,6 +51,9 @@ ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, 
   eo.effects_flag = ext.effects.empty() ? "" : " --effects " + ext.effect_list();
   eo.parameter_source = "fitted by quadgen diagnose to " + logs_label +
                         " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
+  if (with_proposed_terms)
+    eo.parameter_source += "; term_* parameters: terms proposed beyond the catalogue (diagnosis.json discovered_terms), "
+                           "not named causes";
   const std::vector<ThesisItem> no_thesis;  // the thesis comparison belongs to the FINken 3 derivation
   const AuditResult ext_audit = audit(ext, mass);
   const Derivation der{v, mass, ext, ext_audit, no_thesis};

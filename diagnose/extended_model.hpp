@@ -19,7 +19,10 @@ struct ExtendedModelFiles {
 };
 
 // `vehicle_file` and `logs_label` say in the header where the model and its values came from.
+// With `with_proposed_terms`, the terms proposed beyond the catalogue are added too (written
+// as discovered_model.hpp: a lead, not the named causes' model).
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
-                                  const std::string& vehicle_file, const std::string& logs_label);
+                                  const std::string& vehicle_file, const std::string& logs_label,
+                                  bool with_proposed_terms = false);
 
 }  // namespace quadgen::diagnose

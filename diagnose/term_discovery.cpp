@@ -370,4 +370,17 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
   return out;
 }
 
+std::vector<AddedTerm> proposed_terms(const std::vector<DiscoveredTerm>& terms) {
+  std::vector<AddedTerm> out;
+  for (const auto& t : terms) {
+    if (!t.proposed) continue;
+    AddedTerm a;
+    a.channel = t.channel;
+    a.centres = t.centres;
+    for (const auto& c : t.coefficients) a.coefficients.emplace_back(c.regressor, c.value);
+    out.push_back(a);
+  }
+  return out;
+}
+
 }  // namespace quadgen::diagnose

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "added_terms.hpp"
 #include "flight_data.hpp"
 
 namespace quadgen::diagnose {
@@ -69,5 +70,12 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
                                            const std::vector<std::string>& channels,
                                            const std::vector<std::string>& units,
                                            const std::vector<double>& flight_starts, const DiscoveryOptions& opt = {});
+
+}  // namespace quadgen::diagnose
+
+namespace quadgen::diagnose {
+
+// The proposed terms in the form the symbolic model takes them (derive's AddedTerm).
+std::vector<AddedTerm> proposed_terms(const std::vector<DiscoveredTerm>& terms);
 
 }  // namespace quadgen::diagnose

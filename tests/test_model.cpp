@@ -11,6 +11,7 @@
 #include "report.hpp"
 #include "test_helpers.hpp"
 #include "thesis_reference.hpp"
+#include "units.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;
@@ -402,4 +403,59 @@ TEST(Effects, EachFindingReadsAsASentence) {
             "The logged attitude is off by 1.7° in roll and -1.1° in pitch.");
   EXPECT_EQ(find_effect("cog_offset").headline({{"cog_offset.x", 0.01}, {"cog_offset.y", -0.005}}, ""),
             "The centre of gravity sits 10.0 mm ahead of and 5.0 mm right of where the blocks put it.");
+}
+
+// A term found beyond the catalogue changes its channel by exactly the term: an angular
+// acceleration through the moment J a, a world acceleration through the body force m R^T a,
+// a specific force through m a; its coefficients are parameters with units the audit accepts.
+TEST(Model, AddedTermsChangeTheirChannelByExactlyTheTerm) {
+  const Vehicle v = test::finken3();
+  const SymbolicModel base = derive(v);
+  AddedTerm moment{"qdot", {{"v_bx", -1.5}, {"v_bx*dU", 2.0}}, {{"dU", 0.5}}};
+  AddedTerm world{"az_world", {{"1", 0.3}, {"dvbat", 2.0}}, {{"dvbat", 3.9}}};
+  AddedTerm body{"ax", {{"p*q", 0.7}}, {}};
+  DeriveOptions o;
+  o.terms = {moment};
+  const SymbolicModel with_moment = derive_model(v, derive_mass_properties(v), o);
+  o.terms = {world, body};
+  const SymbolicModel with_forces = derive_model(v, derive_mass_properties(v), o);
+  ASSERT_EQ(with_moment.params.size(), base.params.size() + 2);
+  // rad/s^2 per (m/s), and m/s^2 per volt
+  EXPECT_EQ(parse_unit(with_moment.params[with_moment.param_index("term_qdot_2")].unit).dim,
+            parse_unit("rad/s^2").dim / parse_unit("m/s").dim);
+  EXPECT_EQ(parse_unit(with_forces.params[with_forces.param_index("term_az_world_2")].unit).dim,
+            (parse_unit("m/s^2").dim / parse_unit("V").dim));
+  ASSERT_EQ(with_forces.inputs.size(), base.inputs.size() + 1);  // the battery voltage
+  EXPECT_EQ(with_forces.inputs.back().name, "vbat");
+  for (const auto* m : {&with_moment, &with_forces})
+    for (const auto& c : audit(*m, derive_mass_properties(v)).checks)
+      EXPECT_TRUE(c.passed) << c.group << " " << c.name << ": " << c.detail;
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto x = test::random_state(rng);
+    const std::vector<double> u = {0.4, 0.55, 0.6, 0.7};
+    const double U = (0.4 + 0.55 + 0.6 + 0.7) / 4, vbat = 3.7;
+    // Body velocity v_b = R^T v; R from the quaternion (w, x, y, z).
+    const double qw = x[6], qx = x[7], qy = x[8], qz = x[9];
+    const double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz), 2 * (qx * qz + qw * qy)},
+                            {2 * (qx * qy + qw * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qw * qx)},
+                            {2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx), 1 - 2 * (qx * qx + qy * qy)}};
+    const double vbx = R[0][0] * x[3] + R[1][0] * x[4] + R[2][0] * x[5];
+    const auto f0 = test::eval_f(base, x, u), f1 = test::eval_f(with_moment, x, u);
+    auto u_vbat = u;
+    u_vbat.push_back(vbat);
+    const auto f2 = test::eval_f(with_forces, x, u_vbat);
+    EXPECT_NEAR(f1[11] - f0[11], -1.5 * vbx + 2.0 * vbx * (U - 0.5), 1e-9);
+    EXPECT_NEAR(f1[10] - f0[10], 0.0, 1e-9);
+    EXPECT_NEAR(f1[12] - f0[12], 0.0, 1e-9);
+    // World acceleration: + (0, 0, 0.3 + 2 (vbat - 3.9)) + R (0.7 p q, 0, 0).
+    const double fx = 0.7 * x[10] * x[11];
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(f2[3 + i] - f0[3 + i], R[i][0] * fx + (i == 2 ? 0.3 + 2.0 * (vbat - 3.9) : 0.0), 1e-9) << i;
+    for (int i = 10; i < 13; ++i) EXPECT_NEAR(f2[i] - f0[i], 0.0, 1e-9);
+  }
+  EXPECT_THROW(derive_model(v, derive_mass_properties(v), DeriveOptions{{}, {{"pdot", {{"w", 1.0}}, {}}}}),
+               std::invalid_argument);
+  EXPECT_THROW(derive_model(v, derive_mass_properties(v), DeriveOptions{{}, {{"yaw", {{"1", 1.0}}, {}}}}),
+               std::invalid_argument);
 }
