@@ -29,7 +29,8 @@ struct SimulateArgs {
   unsigned seed = 1;
   std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters
   double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
-  double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0;
+  double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0,
+         yaw_per_speed = 0;
   bool no_size_limit = false;
 };
 

@@ -53,6 +53,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
       ->check(finite_range(0.0, 5.0))->needs(cl);
   c->add_option("--tether", a.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
       ->check(finite_range(0.0, 100.0))->needs(cl);
+  c->add_option("--yaw-per-speed", a.yaw_per_speed,
+                "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)")
+      ->check(finite_range(-50.0, 50.0))->needs(cl);
   c->add_option("--duration", a.duration, "simulated time [s]")
       ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
@@ -152,6 +155,7 @@ int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const Symboli
   o.yaw_amplitude = a.yaw_amplitude;
   o.excitation = a.excitation;
   o.tether_stiffness = a.tether;
+  o.yaw_per_forward_speed = a.yaw_per_speed;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
   out.set(0, flight.csv());

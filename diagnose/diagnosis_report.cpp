@@ -235,6 +235,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                     {"expression", t.expression()},
                     {"coefficients", cs},
                     {"sparsity_threshold", t.threshold},
+                    {"cv_mean_squared_error", t.cv_error},  // per sparsity level tried, "no term" last
                     {"cross_validation", t.cross_validation},
                     {"training_rms", {number_or_null(t.train_rms_before), number_or_null(t.train_rms_after)}},
                     {"held_out_rms", {number_or_null(t.valid_rms_before), number_or_null(t.valid_rms_after)}},

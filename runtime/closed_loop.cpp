@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "attitude.hpp"
 #include "integrator.hpp"
 
 namespace quadgen::runtime {
@@ -245,6 +246,11 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
         ref.at(0, a, start);
         x[3 + a] -= o.tether_stiffness * (x[a] - start[0]) / b.mass * dt;
       }
+    }
+    if (o.yaw_per_forward_speed != 0) {  // impulse of the yaw moment over the period
+      const Rotation R = rotation_matrix(&x[6]);
+      const double forward = R.m[0][0] * x[3] + R.m[1][0] * x[4] + R.m[2][0] * x[5];  // (R^T v)_x
+      x[12] += o.yaw_per_forward_speed * forward * dt;
     }
     if (x[2] < -5 || (p - V3(rx[0], ry[0], rz[0])).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");

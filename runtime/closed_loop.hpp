@@ -42,6 +42,9 @@ struct ClosedLoopOptions {
   // as unexplained instead of naming a wrong cause): a horizontal tether pulling the
   // vehicle back to the start point with this stiffness [N/m].
   double tether_stiffness = 0;
+  // Another, within the vocabulary of diagnose's term discovery: a yaw acceleration in
+  // proportion to the forward body speed (a bent part acting as a rudder) [rad/s^2 per m/s].
+  double yaw_per_forward_speed = 0;
   int command_levels = 65535;  // quantisation of logged/applied commands (16-bit PWM)
   double vbat_start = 4.15, vbat_end = 3.75;  // V, open-circuit sag over the flight (logged)
   double vbat_load_drop = 0.15;  // V, extra drop per unit of relative load above hover (internal resistance)
