@@ -135,7 +135,7 @@ std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const 
 }  // namespace
 
 LogKind log_kind(const std::string& path) {
-  if (is_ulog(path)) return LogKind::kFlight;
+  if (is_topic_log(path)) return LogKind::kFlight;
   const runtime::CsvTable head = runtime::read_csv(path);
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return LogKind::kMotorSteps;
   if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) return LogKind::kThrustStand;

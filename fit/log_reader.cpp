@@ -24,6 +24,8 @@ bool is_ulog(const std::string& path) {
   return ok && std::string(magic, 7) == std::string("ULog\x01\x12\x35", 7);
 }
 
+bool is_topic_log(const std::string& path) { return is_ulog(path) || runtime::is_usd_log(path); }
+
 namespace {
 
 // One mapped signal: its topic's timestamps (s) and finite values, and the longest interval
@@ -34,18 +36,18 @@ struct Signal {
   double gap = 0;
 };
 
-const runtime::UlogTopic& find_topic(const runtime::Ulog& log, const std::string& topic, const std::string& source) {
-  if (const runtime::UlogTopic* tp = log.find(topic)) return *tp;
+const runtime::LogTopic& find_topic(const runtime::TopicLog& log, const std::string& topic, const std::string& source) {
+  if (const runtime::LogTopic* tp = log.find(topic)) return *tp;
   std::string have;
   for (const auto& t : log.topics) have += (have.empty() ? "" : ", ") + t.name;
   throw FitError(log.path + ": no topic '" + topic + "' for '" + source + "' (the log has: " + have + ")");
 }
 
 // PX4 logs NaN for values not set yet: such samples are left out, not interpolated over.
-Signal find_signal(const runtime::Ulog& log, const ColumnMapping::Entry& e) {
+Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
   const std::string topic = e.source.substr(0, dot);
-  const runtime::UlogTopic& tp = find_topic(log, topic, e.source);
+  const runtime::LogTopic& tp = find_topic(log, topic, e.source);
   const int c = dot == std::string::npos ? -1 : tp.column(e.source.substr(dot + 1));
   if (c < 0) {
     std::string have;
@@ -105,7 +107,7 @@ constexpr double kMaxCells = 268435456.0;
 
 }  // namespace
 
-runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, double rate_hz) {
+runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz) {
   if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw FitError(log.path + ": sampling rate must be positive");
   std::vector<Signal> signals;
   double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
@@ -115,7 +117,7 @@ runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, d
     t0 = std::max(t0, signals.back().t.front());
     t1 = std::min(t1, signals.back().t.back());
   }
-  if (signals.empty()) throw FitError(m.name + ": maps no ULog signal (sources are topic.field)");
+  if (signals.empty()) throw FitError(m.name + ": maps no signal of the log's topics (sources are topic.field)");
   if (!(t1 > t0)) throw FitError(log.path + ": the mapped topics do not overlap in time");
   align_quaternion_signs(signals);
   const double step = 1.0 / rate_hz, rows = std::floor((t1 - t0) / step) + 1;
@@ -145,9 +147,15 @@ runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, d
 }
 
 runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz) {
-  if (is_ulog(path)) {
-    if (!mapping) throw FitError(path + ": a ULog log needs --mapping naming its signals as topic.field (docs/formats.md)");
-    return apply_mapping(ulog_table(runtime::read_ulog(path), *mapping, resample_hz > 0 ? resample_hz : 100.0), *mapping);
+  if (is_topic_log(path)) {
+    const bool ulog = is_ulog(path);
+    if (!mapping)
+      throw FitError(path + (ulog ? ": a ULog log" : ": a Crazyflie uSD log") +
+                     " needs --mapping naming its signals as topic.field (docs/formats.md)");
+    const double rate = resample_hz > 0 ? resample_hz : 100.0;
+    const runtime::CsvTable table = ulog ? topic_table(runtime::read_ulog(path), *mapping, rate)
+                                         : topic_table(runtime::read_usd_log(path), *mapping, rate);
+    return apply_mapping(table, *mapping);
   }
   runtime::CsvTable log = runtime::read_csv(path);
   if (mapping) log = apply_mapping(log, *mapping);

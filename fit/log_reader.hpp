@@ -1,7 +1,9 @@
 // One entry point for the flight logs quadgen reads, in the canonical layout (docs/formats.md):
 //  - CSV, canonical or through a column mapping;
-//  - PX4 ULog (runtime/ulog.hpp). The mapping names a ULog signal as "topic.field" (array
-//    elements "topic.field[i]"; instance 0 of a topic). Every topic keeps its own rate: the
+//  - PX4 ULog (runtime/ulog.hpp) and Crazyflie uSD card logs (runtime/usd_log.hpp), both logs
+//    of several topics. The mapping names a signal as "topic.field" (ULog array elements
+//    "topic.field[i]", instance 0 of a topic; uSD "fixedFrequency.acc.x", the event type's
+//    name and the log variable). Every topic keeps its own rate: the
 //    signals the mapping uses are interpolated linearly onto one uniform time base (column
 //    "t", seconds) over the span all of them cover. Samples a topic logs as NaN (not set yet)
 //    are left out; where any signal has a gap (a dropout, a paused topic: longer than three
@@ -15,19 +17,22 @@
 #include "flight_data.hpp"
 #include "flight_log.hpp"
 #include "ulog.hpp"
+#include "usd_log.hpp"
 
 namespace quadgen::fit {
 
 // Whether the file starts with the ULog magic bytes.
 bool is_ulog(const std::string& path);
+// Whether it is a log of several topics (ULog or uSD), which needs a mapping.
+bool is_topic_log(const std::string& path);
 
-// The signals a mapping uses, from a ULog, on a uniform grid at `rate_hz`: "t" and one column
-// per source. Throws FitError naming a missing topic or field and what the log has.
-runtime::CsvTable ulog_table(const runtime::Ulog& log, const ColumnMapping& m, double rate_hz);
+// The signals a mapping uses, from a log of topics, on a uniform grid at `rate_hz`: "t" and one
+// column per source. Throws FitError naming a missing topic or field and what the log has.
+runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz);
 
-// Reads a log (CSV or ULog) and returns it in the canonical layout. `mapping_path` may be
-// empty (`mapping` null) for a canonical CSV; a ULog needs one. `resample_hz` > 0 resamples
-// the result (a ULog is always sampled at that rate, 100 Hz when 0).
+// Reads a log (CSV, ULog or uSD) and returns it in the canonical layout. `mapping_path` may be
+// empty (`mapping` null) for a canonical CSV; a log of topics needs one. `resample_hz` > 0
+// resamples the result (a log of topics is always sampled at that rate, 100 Hz when 0).
 runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz);
 runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz);
 

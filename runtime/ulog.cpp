@@ -17,14 +17,6 @@
 
 namespace quadgen::runtime {
 
-int UlogTopic::column(const std::string& field) const { return index_in(fields, field); }
-
-const UlogTopic* Ulog::find(const std::string& name, int multi_id) const {
-  for (const auto& t : topics)
-    if (t.name == name && t.multi_id == multi_id) return &t;
-  return nullptr;
-}
-
 namespace {
 
 constexpr std::size_t kHeaderBytes = 16, kMsgHeaderBytes = 3;
@@ -459,7 +451,7 @@ void Parser::data(const Msg& m) {
   const auto s = subs_.find(msg_id);
   if (s == subs_.end()) fail(m.at, "data message for unknown msg_id " + std::to_string(msg_id));
   const Layout& l = *s->second.layout;
-  UlogTopic& topic = out_.topics[s->second.topic];
+  LogTopic& topic = out_.topics[s->second.topic];
   const std::string_view d = m.body.substr(2);
   if (d.size() < l.min_size || d.size() > l.size)
     fail(m.at, "data message for " + shown(topic.name) + " has " + std::to_string(d.size()) + " bytes, expected " +

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "flight_log.hpp"  // LogError
+#include "topic_log.hpp"
 
 namespace quadgen::runtime {
 
@@ -36,19 +37,12 @@ constexpr std::uint64_t kUlogMaxFormatBytes = 65535;
 constexpr std::size_t kUlogMaxName = 255;
 constexpr std::uint64_t kUlogMaxLayoutBytes = 64ULL << 20;
 
-// The data messages of one topic instance (a format name and its multi_id), one row each.
-// Columns are the flattened fields, `timestamp` (microseconds) first wherever the format has
-// it, the others in message order: arrays as `q[0]`.., nested types as `sub.field` and
-// `sub[1].field`; `_padding*` fields are left out. Every value is converted to double (char
-// and bool as their byte value, 64-bit integers rounded beyond 2^53). Values are as logged:
-// PX4 logs NaN for unset floats and nothing is range-checked here.
-struct UlogTopic {
-  std::string name;
-  int multi_id = 0;
-  std::vector<std::string> fields;
-  std::vector<std::vector<double>> rows;
-  int column(const std::string& field) const;  // -1 if absent
-};
+// Each topic instance (a format name and its multi_id) is a LogTopic: its columns are the
+// flattened fields, `timestamp` (microseconds) first wherever the format has it, the others in
+// message order: arrays as `q[0]`.., nested types as `sub.field` and `sub[1].field`;
+// `_padding*` fields are left out. Every value is converted to double (char and bool as their
+// byte value, 64-bit integers rounded beyond 2^53). Values are as logged: PX4 logs NaN for
+// unset floats and nothing is range-checked here.
 
 // A parameter set while logging ('P' message in the Data section).
 struct UlogParameterChange {
@@ -57,11 +51,9 @@ struct UlogParameterChange {
   double value = 0;
 };
 
-struct Ulog {
-  std::string path;
+struct Ulog : TopicLog {  // path, topics (in order of first subscription), find()
   int version = 0;                // file format version (header byte 7)
   std::uint64_t start_time = 0;   // header timestamp, microseconds
-  std::vector<UlogTopic> topics;  // in order of first subscription
   // Values when logging started ('P' messages of the Definitions section), int32_t and float.
   std::map<std::string, double> parameters;
   std::vector<UlogParameterChange> parameter_changes;
@@ -72,7 +64,6 @@ struct Ulog {
   double dropout_ms = 0;
   bool truncated = false;                                                  // a cut-off message was dropped (see above)
   std::uint64_t truncated_at = 0;                                          // the byte offset of the first one
-  const UlogTopic* find(const std::string& name, int multi_id = 0) const;  // nullptr if absent
 };
 
 // A regular file of at most max_input_bytes(), read into memory as a whole.

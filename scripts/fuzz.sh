@@ -13,7 +13,7 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
 cmake --build build-fuzz -j"$(nproc)" > /dev/null
 mkdir -p fuzz/crashes
 status=0
-for t in vehicle flight_log template mapping ulog; do
+for t in vehicle flight_log template mapping ulog usd; do
   work=$(mktemp -d)
   cp -r "fuzz/corpus/$t/." "$work/"
   echo "fuzzing $t for $seconds s"

@@ -110,7 +110,7 @@ Writer fixture() {
 
 bool same(double a, double b) { return a == b ? std::signbit(a) == std::signbit(b) : std::isnan(a) && std::isnan(b); }
 
-void expect_rows(const UlogTopic& t, const std::vector<std::vector<double>>& rows) {
+void expect_rows(const LogTopic& t, const std::vector<std::vector<double>>& rows) {
   ASSERT_EQ(t.rows.size(), rows.size()) << t.name;
   for (std::size_t r = 0; r < rows.size(); ++r) {
     ASSERT_EQ(t.rows[r].size(), rows[r].size()) << t.name << " row " << r;
@@ -153,19 +153,19 @@ TEST(Ulog, ReadsEveryValueOfTheFixture) {
   EXPECT_FALSE(log.truncated);
   ASSERT_EQ(log.topics.size(), 3u);
 
-  const UlogTopic& a = log.topics[0];
+  const LogTopic& a = log.topics[0];
   EXPECT_EQ(a.name, "probe");
   EXPECT_EQ(a.multi_id, 0);
   EXPECT_EQ(a.fields, kProbeFields);
   expect_rows(a, {probe_row(p0), probe_row(p1), probe_row(p2)});
 
-  const UlogTopic& b = log.topics[1];
+  const LogTopic& b = log.topics[1];
   EXPECT_EQ(b.name, "probe");
   EXPECT_EQ(b.multi_id, 1);
   EXPECT_EQ(b.fields, kProbeFields);
   expect_rows(b, {probe_row(p3)});
 
-  const UlogTopic& c = log.topics[2];
+  const LogTopic& c = log.topics[2];
   EXPECT_EQ(c.name, "late");
   EXPECT_EQ(c.fields, (std::vector<std::string>{"timestamp", "v"}));
   expect_rows(c, {{1800, -2.5}});
