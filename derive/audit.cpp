@@ -22,10 +22,26 @@ AuditCheck make(const std::string& group, const std::string& name, bool ok, cons
   return AuditCheck{group, name, ok, detail};
 }
 
+// sin(x)^2 -> 1 - cos(x)^2 until no sine is squared: GiNaC evaluates sin and cos of multiples
+// of Pi/4 and Pi/6 to radicals but keeps cos(1/8 Pi) as a function, and normal() treats
+// sin(x) and cos(x) as independent, so an identity that needs sin^2 + cos^2 = 1 (a rotated
+// block of an octocopter's 22.5 deg arm) would not normalise to 0. Reduced to degree <= 1 in
+// each sine, a polynomial in sines and cosines of the same angles is zero iff it vanishes.
+ex reduce_trigonometry(const ex& e) {
+  const ex sin2 = pow(sin(wild(0)), 2) == 1 - pow(cos(wild(0)), 2);
+  ex r = expand(e);
+  for (int pass = 0; pass < 8; ++pass) {
+    const ex next = expand(r.subs(sin2, subs_options::algebraic));
+    if (next.is_equal(r)) break;
+    r = next;
+  }
+  return r;
+}
+
 bool is_zero_matrix(const matrix& m) {
   for (unsigned i = 0; i < m.rows(); ++i)
     for (unsigned j = 0; j < m.cols(); ++j)
-      if (!normal(m(i, j)).is_zero()) return false;
+      if (!normal(reduce_trigonometry(m(i, j))).is_zero()) return false;
   return true;
 }
 

@@ -37,6 +37,27 @@ TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
   }
 }
 
+// Blocks turned by angles whose sine and cosine GiNaC keeps as functions (22.5 deg, an
+// octocopter's arm; 30/20/10 deg about all three axes): the closed-form inertia check needs
+// sin^2 + cos^2 = 1 and must still pass, and still catch a wrong tensor.
+TEST(Model, InertiaAuditHoldsForBlocksAtAnyAngle) {
+  Vehicle v = test::finken3();
+  v.blocks[0].yaw_pitch_roll_deg = {22.5, 0, 0};
+  v.blocks[1].yaw_pitch_roll_deg = {30, 20, 10};
+  MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive_model(v, mp, DeriveOptions{});
+  auto closed_form_ok = [&](const MassProperties& props) {
+    for (const auto& c : audit(m, props).checks)
+      if (c.name == "integrals match closed form + parallel axis") return c.passed;
+    ADD_FAILURE() << "no closed-form check";
+    return false;
+  };
+  EXPECT_TRUE(closed_form_ok(mp));
+  // A tensor off by a part in a million of one product of inertia is caught.
+  mp.blocks[1].inertia_origin(0, 1) = mp.blocks[1].inertia_origin(0, 1) * GiNaC::numeric(1000001, 1000000);
+  EXPECT_FALSE(closed_form_ok(mp));
+}
+
 TEST(Model, UnitCheckerRejectsInconsistentEquation) {
   SymbolicModel m = derive(test::finken3());
   // Add a velocity [m/s] to an acceleration [m/s^2]: a typical slip in hand derivations.
