@@ -294,11 +294,13 @@ void differentiate(SymbolicModel& m) {
       for (size_t j = 0; j < vars.size(); ++j) J(i, j) = f(i, 0).diff(vars[j].sym);
     return J;
   };
-  m.dfdx = jac(m.f, m.states);
-  m.dfdu = jac(m.f, m.inputs);
-  m.dfdp = jac(m.f, m.params);
-  m.dhdx = jac(m.h, m.states);
-  m.dhdp = jac(m.h, m.params);
+  const lst constants = m.constant_substitution();
+  const matrix f = ex_to<matrix>(ex(m.f).subs(constants)), h = ex_to<matrix>(ex(m.h).subs(constants));
+  m.dfdx = jac(f, m.states);
+  m.dfdu = jac(f, m.inputs);
+  m.dfdp = jac(f, m.params);
+  m.dhdx = jac(h, m.states);
+  m.dhdp = jac(h, m.params);
 }
 
 SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt) {

@@ -37,6 +37,10 @@ struct SymbolicModel {
   std::vector<Variable> outputs;  // what is measured (pose), names and units
   GiNaC::matrix h;  // outputs.size() x 1, depends on x and p
 
+  // The Jacobians of f and h with the constants already replaced by their values, as the
+  // generated code has them: differentiated after the substitution, the rotor geometry folds
+  // into numeric coefficients and the trees to differentiate shrink (an octocopter's f by
+  // about half), which is most of the time a derive takes.
   GiNaC::matrix dfdx, dfdu, dfdp, dhdx, dhdp;
 
   // Set when the input_delay effect is on: the runtime feeds u(t - delay) and uses

@@ -109,10 +109,12 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   ExpressionGraph g;
   declare_model_variables(g, m);
   const lst constants = m.constant_substitution();
-  auto nodes = [&](const std::string& target, const std::vector<ex>& values) {
+  // f and h carry the constants as symbols (for the unit audit and the report); the
+  // Jacobians have them substituted already (SymbolicModel).
+  auto nodes = [&](const std::string& target, const std::vector<ex>& values, bool substitute) {
     std::vector<Output> out;
     for (size_t i = 0; i < values.size(); ++i)
-      out.push_back({target + "[" + std::to_string(i) + "]", g.add(values[i].subs(constants))});
+      out.push_back({target + "[" + std::to_string(i) + "]", g.add(substitute ? values[i].subs(constants) : values[i])});
     return out;
   };
   std::vector<ex> f, h;
@@ -120,12 +122,13 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   for (unsigned i = 0; i < m.h.rows(); ++i) h.push_back(m.h(i, 0));
   const Sparse fx = nonzeros(m.dfdx), fu = nonzeros(m.dfdu), fp = nonzeros(m.dfdp);
   const Sparse hx = nonzeros(m.dhdx), hp = nonzeros(m.dhdp);
-  const std::vector<OutputGroup> rhs = {{"", nodes("f", f)},
-                                        {"dfdx", nodes("dfdx", fx.values)},
-                                        {"dfdu", nodes("dfdu", fu.values)},
-                                        {"dfdp", nodes("dfdp", fp.values)}};
-  const std::vector<OutputGroup> meas = {
-      {"", nodes("h", h)}, {"dhdx", nodes("dhdx", hx.values)}, {"dhdp", nodes("dhdp", hp.values)}};
+  const std::vector<OutputGroup> rhs = {{"", nodes("f", f, true)},
+                                        {"dfdx", nodes("dfdx", fx.values, false)},
+                                        {"dfdu", nodes("dfdu", fu.values, false)},
+                                        {"dfdp", nodes("dfdp", fp.values, false)}};
+  const std::vector<OutputGroup> meas = {{"", nodes("h", h, true)},
+                                         {"dhdx", nodes("dhdx", hx.values, false)},
+                                         {"dhdp", nodes("dhdp", hp.values, false)}};
   CppEmitter em(g);
   std::vector<OutputGroup> all = rhs;
   all.insert(all.end(), meas.begin(), meas.end());

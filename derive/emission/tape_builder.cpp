@@ -115,7 +115,7 @@ runtime::Tape build_tape(const SymbolicModel& m) {
         if (!(*j.J)(r, c).is_zero()) {
           j.out->row.push_back(static_cast<int>(r));
           j.out->col.push_back(static_cast<int>(c));
-          j.nodes.push_back(g.add((*j.J)(r, c).subs(constants)));
+          j.nodes.push_back(g.add((*j.J)(r, c)));  // constants substituted already
         }
   Builder b{g, t, std::vector<int>(g.size(), -1), t.nx + t.nu + t.np};
   for (int id : f_nodes) {
