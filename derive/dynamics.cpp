@@ -216,6 +216,14 @@ void assemble(ModelContext& c) {
   for (int i = 0; i < 4; ++i) m.f(6 + i, 0) = q_dot(i, 0);
   for (size_t i = 0; i < c.extra_rates.size(); ++i) m.f(13 + i, 0) = c.extra_rates[i];
 
+  m.omega_dot = {symbol("omegadot_x"), symbol("omegadot_y"), symbol("omegadot_z")};
+  const matrix w_dot = vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]);
+  const matrix transport_split = cross(w_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
+  const matrix accel_split =
+      c.R.mul(force_body.mul_scalar(1 / c.p("mass")).sub(transport_split)).sub(vec3(0, 0, c.p("g")));
+  m.f_split = m.f;
+  for (int i = 0; i < 3; ++i) m.f_split(3 + i, 0) = accel_split(i, 0);
+
   const char* out[][3] = {{"x", "m", "position x"}, {"y", "m", "position y"}, {"z", "m", "position z"},
                           {"qw", "1", "logged attitude w"}, {"qx", "1", "logged attitude x"},
                           {"qy", "1", "logged attitude y"}, {"qz", "1", "logged attitude z"}};
@@ -287,20 +295,42 @@ lst SymbolicModel::constant_substitution() const {
   return l;
 }
 
+// df/dv = ∂f_split/∂v + Σ_k ∂f_split/∂ω̇_k · dω̇_k/dv, with dω̇_k/dv the Jacobian's own rows
+// 10-12 (computed first: those rows do not contain ω̇), and ω̇ put back into the small
+// partial derivatives only.
 void differentiate(SymbolicModel& m) {
-  auto jac = [](const matrix& f, const std::vector<Variable>& vars) {
+  const lst constants = m.constant_substitution();
+  const matrix f = ex_to<matrix>(ex(m.f_split).subs(constants)), h = ex_to<matrix>(ex(m.h).subs(constants));
+  exmap omega_dot_value;
+  for (int k = 0; k < 3; ++k) omega_dot_value[m.omega_dot[k]] = f(10 + k, 0);
+  matrix dfdw(f.rows(), 3);  // ∂f_i/∂ω̇_k, ω̇ put back
+  for (unsigned i = 0; i < f.rows(); ++i)
+    for (int k = 0; k < 3; ++k) dfdw(i, k) = f(i, 0).diff(m.omega_dot[k]).subs(omega_dot_value);
+  auto jac = [&](const std::vector<Variable>& vars) {
     matrix J(f.rows(), vars.size());
-    for (unsigned i = 0; i < f.rows(); ++i)
-      for (size_t j = 0; j < vars.size(); ++j) J(i, j) = f(i, 0).diff(vars[j].sym);
+    for (size_t j = 0; j < vars.size(); ++j) {
+      for (unsigned i = 10; i < 13; ++i) J(i, j) = f(i, 0).diff(vars[j].sym);
+      for (unsigned i = 0; i < f.rows(); ++i) {
+        if (i >= 10 && i < 13) continue;
+        ex d = f(i, 0).diff(vars[j].sym).subs(omega_dot_value);
+        for (unsigned k = 0; k < 3; ++k)
+          if (!dfdw(i, k).is_zero()) d += dfdw(i, k) * J(10 + k, j);
+        J(i, j) = d;
+      }
+    }
     return J;
   };
-  const lst constants = m.constant_substitution();
-  const matrix f = ex_to<matrix>(ex(m.f).subs(constants)), h = ex_to<matrix>(ex(m.h).subs(constants));
-  m.dfdx = jac(f, m.states);
-  m.dfdu = jac(f, m.inputs);
-  m.dfdp = jac(f, m.params);
-  m.dhdx = jac(h, m.states);
-  m.dhdp = jac(h, m.params);
+  auto plain_jac = [](const matrix& g, const std::vector<Variable>& vars) {
+    matrix J(g.rows(), vars.size());
+    for (unsigned i = 0; i < g.rows(); ++i)
+      for (size_t j = 0; j < vars.size(); ++j) J(i, j) = g(i, 0).diff(vars[j].sym);
+    return J;
+  };
+  m.dfdx = jac(m.states);
+  m.dfdu = jac(m.inputs);
+  m.dfdp = jac(m.params);
+  m.dhdx = plain_jac(h, m.states);
+  m.dhdp = plain_jac(h, m.params);
 }
 
 SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt) {

@@ -42,6 +42,12 @@ struct SymbolicModel {
   // into numeric coefficients and the trees to differentiate shrink (an octocopter's f by
   // about half), which is most of the time a derive takes.
   GiNaC::matrix dfdx, dfdu, dfdp, dhdx, dhdp;
+  // f once more, with dω/dt in the translation rows (the origin's transport acceleration)
+  // kept as the symbols `omega_dot`: the chain rule then differentiates dω/dt once, in rows
+  // 10-12, instead of once for each of its copies in rows 3-5 (derive time; see
+  // differentiate()). Equal to f once omega_dot is replaced by rows 10-12.
+  GiNaC::matrix f_split;
+  std::vector<GiNaC::symbol> omega_dot;
 
   // Set when the input_delay effect is on: the runtime feeds u(t - delay) and uses
   // dfdu * du/dt for the delay's sensitivity (a pure delay is not an ODE term).

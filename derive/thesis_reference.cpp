@@ -228,14 +228,13 @@ double climb_height(const Numbers& n, double force, double seconds) {
   return z;
 }
 
-// The derived model integrated (RK4, 1 ms) for constant per-rotor thrusts from rest:
-// returns x, y, z and roll, pitch [deg] after `seconds`.
+// The derived model (`m`, its tape, built once for all flights) integrated (RK4, 1 ms) for
+// per-rotor thrusts from rest: returns x, y, z and roll, pitch [deg] after `seconds`.
 struct Flight {
   double x, y, z, roll_deg, pitch_deg, yaw_deg, vz;
 };
 using ThrustProfile = std::function<std::vector<double>(double t)>;
-Flight fly(const SymbolicModel& model, const ThrustProfile& thrust, double seconds) {
-  runtime::TapeModel m(emission::build_tape(model));
+Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfile& thrust, double seconds) {
   auto P = [&](const char* n) { return m.params()[m.param_index(n)]; };
   std::vector<runtime::ThrustLaw> laws;
   for (int i = 0; i < 4; ++i) {
@@ -268,8 +267,9 @@ std::string describe(const Flight& f) {
 }
 
 void simulated_items(std::vector<ThesisItem>& out, const SymbolicModel& model) {
-  const Flight right = fly(model, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
-  const Flight forward = fly(model, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
+  runtime::TapeModel tape(emission::build_tape(model));
+  const Flight right = fly(tape, model, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
+  const Flight forward = fly(tape, model, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
   // The scenarios of `quadgen simulate`, 3 s each.
   const std::vector<std::string> rotors{"A", "B", "C", "D"};
   double hover = 0;
@@ -279,7 +279,7 @@ void simulated_items(std::vector<ThesisItem>& out, const SymbolicModel& model) {
     if (p.name == "g") hover *= p.nominal / 9.81;
   auto scenario = [&](const char* name) {
     const runtime::Scenario& s = runtime::find_scenario(name);
-    return fly(model, [&](double t) { return s.thrust(t, hover, rotors); }, 3.0);
+    return fly(tape, model, [&](double t) { return s.thrust(t, hover, rotors); }, 3.0);
   };
   const Flight s_right = scenario("right"), s_forward = scenario("forward"), s_yaw = scenario("yaw"),
                s_height = scenario("new_height");

@@ -3,7 +3,8 @@
 # single-precision FPU) the way firmware would use them (examples/firmware/model_unit.cpp,
 # float, -O2, no exceptions, no RTTI) and reports, per model and entry point, the code size,
 # what the object still needs from outside, and whether any double-precision arithmetic is
-# left (soft-float calls on this FPU). Fails if the object needs the heap, exceptions or RTTI.
+# left (soft-float calls on this FPU, or .f64 instructions). Fails on any of these, or if the
+# object needs the heap, exceptions or RTTI.
 #   scripts/firmware_check.sh
 # Installs the Debian cross compiler (gcc-arm-none-eabi) if it is missing.
 set -euo pipefail
@@ -38,7 +39,10 @@ for dir in generated/*/; do
   f_only=$(size_of 'rhs<float>\(([^,]*,){4}[^,]*\)$')
   f_jac=$(size_of 'rhs<float>\(([^,]*,){7}[^,]*\)$')
   undefined=$(arm-none-eabi-nm -u "$obj" | awk '{print $2}' | sort -u)
-  doubles=$(echo "$undefined" | grep -c '^__aeabi_d' || true)
+  # Double precision either as soft-float calls (this FPU has none for doubles) or as .f64
+  # instructions in the disassembly (there should be neither).
+  doubles=$(( $(echo "$undefined" | grep -c '^__aeabi_d' || true) + $(arm-none-eabi-objdump -d "$obj" | grep -c '\.f64' || true) ))
+  [ "$doubles" -gt 0 ] && status=1
   forbidden=$(echo "$undefined" | grep -E '^(malloc|free|_Znw|_Zdl|_Zna|_Zda|__cxa_|__gxx_personality|_Unwind)' || true)
   [ -n "$forbidden" ] && status=1
   echo "| $name | $f_only | $f_jac | $(size_of ' quadgen_precompute$') | $(size_of ' quadgen_pre$') | $(echo ${undefined:-none} | tr ' ' ',')${forbidden:+ — FORBIDDEN: $forbidden} | $doubles |"

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""The FINken 3 base model written independently in SymPy, for a side-by-side comparison
+"""A quadgen model (any vehicle, base or with effects) written independently in SymPy, for a side-by-side comparison
 with quadgen's generated header (scripts/sympy_compare.sh drives it).
 
-The physics is written here from the vehicle file (rotor layout, radius, disc area, spin)
-and the parameter list of the model.json that `quadgen derive` writes (names, order and
-nominal values); nothing is taken from quadgen's generated expressions. f and all
+The physics is written here from the vehicle file (rotor layout, radius, disc area, spin),
+the effect formulas of docs/effects.md and the variable lists of the model.json that
+`quadgen derive` writes (names and order of states, inputs and parameters, the effects);
+nothing is taken from quadgen's generated expressions. f and all
 Jacobians (df/dx, df/du, df/dp) go through sympy.cse jointly and are printed as C++ with
 integer powers written as products.
 
@@ -37,11 +38,12 @@ def build_model(vehicle_path, model_json_path):
     state_names = [s["name"] for s in mj["states"]]
     input_names = [s["name"] for s in mj["inputs"]]
     param_names = [s["name"] for s in mj["parameters"]]
-    assert mj["effects"] == [], "the comparison is for the base model (no effects)"
+    effects = set(mj["effects"])
     X = sp.symbols(" ".join("x_" + n for n in state_names), real=True)
-    U = sp.symbols(" ".join(input_names), real=True)
+    U = sp.symbols(" ".join("u_" + n for n in input_names), real=True)
     P = sp.symbols(" ".join("p_" + n for n in param_names), real=True)
     S = dict(zip(state_names, X))
+    In = dict(zip(input_names, U))
     Pm = dict(zip(param_names, P))
 
     qw, qx, qy, qz = S["qw"], S["qx"], S["qy"], S["qz"]
@@ -53,21 +55,55 @@ def build_model(vehicle_path, model_json_path):
                    [2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx), 1 - 2 * (qx**2 + qy**2)]])
     c = sp.Matrix([Pm["cog_x"], Pm["cog_y"], Pm["cog_z"]])
     rho, c_t, c_w, kappa = Pm["rho"], Pm["c_t"], Pm["c_w"], Pm["kappa"]
+    # The effects (docs/effects.md), each written here from its formula there.
+    if "cog_offset" in effects:
+        c = c + sp.Matrix([Pm["cog_offset.x"], Pm["cog_offset.y"], 0])
+    v_air = v - sp.Matrix([Pm["wind.x"], Pm["wind.y"], 0]) if "wind" in effects else v
+    vb = R.T * v_air  # body-frame air velocity
 
     force = sp.zeros(3, 1)
     torque = sp.zeros(3, 1)
+    extra_rates = []
+    speeds = []
     for i, rot in enumerate(veh["rotors"]):
-        u = U[i]
-        speed = Pm["motor_a0"] + Pm["motor_a1"] * u + Pm["motor_a2"] * u**2  # rad/s
-        thrust = c_t * rho * exact(rot["disc_area"]) * exact(rot["radius"]) ** 2 * speed**2
+        u = In["u_" + rot["name"]]
+        commanded = Pm["motor_a0"] + Pm["motor_a1"] * u + Pm["motor_a2"] * u**2  # rad/s
+        if "motor_lag" in effects:  # first-order lag: the rotor speed is a state
+            speed = S["w_" + rot["name"]]
+            extra_rates.append((commanded - speed) / Pm["motor_lag.tau"])
+        else:
+            speed = commanded
+        speeds.append(speed)
+    speed_sum = sum(speeds)
+    for i, rot in enumerate(veh["rotors"]):
+        speed = speeds[i]
+        radius = exact(rot["radius"])
         pos = sp.Matrix([exact(a) for a in rot["position"]])
+        arm = pos - c
+        scale = 1
+        if "motor_gain" in effects:
+            scale *= 1 + Pm["motor_gain." + rot["name"]]
+        if "thrust_decay" in effects:
+            scale *= 1 - Pm["thrust_decay.rate"] * In["t"]
+        if "battery_sag" in effects:
+            scale *= (In["vbat"] / Pm["vbat_ref"]) ** Pm["battery_sag.exponent"]
+        if "ground_effect" in effects:
+            scale /= 1 - (Pm["ground_effect.radius"] / (4 * S["z"])) ** 2
+        loss = 0  # thrust loss with the rotor's climb speed through the air
+        if "inflow" in effects:
+            climb = vb[2] + w.cross(arm)[2]
+            loss = Pm["inflow.k"] * climb / radius
+        thrust = scale * c_t * rho * exact(rot["disc_area"]) * radius**2 * speed * (speed - loss)
         F = sp.Matrix([0, 0, thrust])
-        torque += (pos - c).cross(F)
+        torque += arm.cross(F)
         spin = 1 if rot["spin"] == "ccw" else -1  # reaction torque opposes the rotor's spin
         torque[2] -= spin * kappa * thrust
         force += F
+    if "rotor_drag" in effects:  # a horizontal force at the CoG
+        force += sp.Matrix([-Pm["rotor_drag.k"] * speed_sum * vb[0], -Pm["rotor_drag.k"] * speed_sum * vb[1], 0])
+    if "blade_flapping" in effects:  # a moment on the body-frame airspeed
+        torque += sp.Matrix([Pm["blade_flapping.k"] * speed_sum * vb[1], -Pm["blade_flapping.k"] * speed_sum * vb[0], 0])
     areas = [Pm["A_x"], Pm["A_y"], Pm["A_z"]]
-    vb = R.T * v
     for k in range(3):
         force[k] -= sp.Rational(1, 2) * c_w * rho * areas[k] * vb[k] * sp.Abs(vb[k])
     J = sp.Matrix([[Pm["J_xx"], Pm["J_xy"], Pm["J_xz"]],
@@ -92,7 +128,8 @@ def build_model(vehicle_path, model_json_path):
          sp.Rational(1, 2) * (qw * w[0] + qy * w[2] - qz * w[1]),
          sp.Rational(1, 2) * (qw * w[1] - qx * w[2] + qz * w[0]),
          sp.Rational(1, 2) * (qw * w[2] + qx * w[1] - qy * w[0]),
-         wdot[0], wdot[1], wdot[2]]
+         wdot[0], wdot[1], wdot[2]] + extra_rates
+    assert len(f) == len(X), "states beyond the ones written here: %s" % state_names
     return X, U, P, f
 
 

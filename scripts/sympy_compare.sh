@@ -5,7 +5,9 @@
 # text) and ns per call of both, compiled in one translation unit with the same flags.
 # Not part of CI; installs python3-sympy (and python3-yaml) with apt-get when missing.
 #
-#   scripts/sympy_compare.sh            # uses build/quadgen-derive (builds it if missing)
+#   scripts/sympy_compare.sh            # FINken 3; uses build/quadgen-derive (builds it if missing)
+#   scripts/sympy_compare.sh VEHICLE.yaml [EFFECTS]   # any vehicle, e.g. an octocopter written
+#       by scripts/multirotor_vehicle.py 8 17 octo.yaml; EFFECTS as for derive --effects (all)
 #   BUILD=build-codegen scripts/sympy_compare.sh
 #   CXXFLAGS="-O3 -march=native" scripts/sympy_compare.sh
 set -euo pipefail
@@ -23,8 +25,13 @@ fi
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-"$BUILD/quadgen-derive" derive vehicles/finken3.yaml --out "$tmp/quadgen" > /dev/null 2>&1
-python3 scripts/sympy_compare.py emit vehicles/finken3.yaml "$tmp/quadgen/model.json" "$tmp"
+VEHICLE=${1:-vehicles/finken3.yaml}
+derive_args=(derive "$VEHICLE" --out "$tmp/quadgen")
+[ -n "${2:-}" ] && derive_args+=(--effects "$2")
+"$BUILD/quadgen-derive" "${derive_args[@]}" > /dev/null 2>&1
+name=$(sed -n '/^namespace quadgen_generated {/{n;s/^namespace \([A-Za-z0-9_]*\) {$/\1/p;q}' "$tmp/quadgen/model.hpp")
+echo "vehicle: $VEHICLE ($name), effects: ${2:-none}"
+python3 scripts/sympy_compare.py emit "$VEHICLE" "$tmp/quadgen/model.json" "$tmp"
 python3 scripts/sympy_compare.py count "$tmp/quadgen/model.hpp" "$tmp/sympy_model.hpp"
 
 cat > "$tmp/harness.cpp" << 'EOF'
@@ -37,7 +44,7 @@ cat > "$tmp/harness.cpp" << 'EOF'
 #include "quadgen/model.hpp"
 #include "sympy_model.hpp"
 
-namespace q = quadgen_generated::finken3;
+namespace q = quadgen_generated::MODEL_NAME;
 namespace s = sympy_model;
 constexpr int NX = q::kNumStates, NU = q::kNumInputs, NP = q::kNumParams;
 
@@ -115,7 +122,8 @@ int main() {
   }
 
   double x[NX] = {0.1, -0.2, 1.2, 0.5, -0.3, 0.1, 0.98, 0.1, -0.1, 0.1, 0.4, -0.2, 0.3};
-  double u[NU] = {0.4, 0.45, 0.5, 0.42}, p[NP];
+  double u[NU], p[NP];
+  for (int i = 0; i < NU; ++i) u[i] = 0.4 + 0.03 * (i % 4);
   for (int i = 0; i < NP; ++i) p[i] = q::kNominalParams[i];
   q::Precomputed<double> pre;
   q::precompute(p, &pre);
@@ -136,5 +144,5 @@ int main() {
 EOF
 echo "compiling both with: $CXX -std=c++17 $CXXFLAGS"
 # shellcheck disable=SC2086
-$CXX -std=c++17 $CXXFLAGS -I"$tmp" "$tmp/harness.cpp" -o "$tmp/harness"
+$CXX -std=c++17 $CXXFLAGS -DMODEL_NAME="$name" -I"$tmp" "$tmp/harness.cpp" -o "$tmp/harness"
 "$tmp/harness"
