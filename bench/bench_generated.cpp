@@ -6,6 +6,9 @@
 #include <ceres/jet.h>
 
 #include <cstdio>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -150,15 +153,40 @@ BENCHMARK(BM_CeresAutodiffJacobians);
 BENCHMARK(BM_CentralDifferences);
 BENCHMARK(BM_DeriveAndEmitFinken3AllEffects)->Unit(benchmark::kMillisecond)->Iterations(3);
 
-// Collects times to print the ratios the issue asks for.
+// Collects each benchmark's times (ns) to print the ratios: the median over repetitions, from
+// the individual runs or, with --benchmark_report_aggregates_only, from the "median"
+// aggregate. A benchmark a filter left out has no time, and its ratios are not printed.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
-  std::map<std::string, double> ns;
   void ReportRuns(const std::vector<Run>& runs) override {
-    for (const auto& r : runs) ns[r.benchmark_name()] = r.GetAdjustedRealTime() * (r.time_unit == benchmark::kMillisecond ? 1e6 : 1.0);
+    for (const auto& r : runs) {
+      const double ns = r.GetAdjustedRealTime() * (r.time_unit == benchmark::kMillisecond ? 1e6 : 1.0);
+      if (r.run_type == Run::RT_Iteration) samples_[r.run_name.str()].push_back(ns);
+      else if (r.aggregate_name == "median") medians_[r.run_name.str()] = ns;
+    }
     ConsoleReporter::ReportRuns(runs);
   }
+  // NaN when the benchmark did not run.
+  double median_ns(const std::string& name) const {
+    if (auto it = samples_.find(name); it != samples_.end()) {
+      std::vector<double> v = it->second;
+      std::sort(v.begin(), v.end());
+      const size_t n = v.size();
+      return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    }
+    if (auto it = medians_.find(name); it != medians_.end()) return it->second;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+
+ private:
+  std::map<std::string, std::vector<double>> samples_;
+  std::map<std::string, double> medians_;
 };
+
+void print_ratio(const char* what, double numerator, double denominator, const char* format) {
+  if (std::isnan(numerator) || std::isnan(denominator)) std::printf("  %s   (not run)\n", what);
+  else std::printf(format, what, numerator / denominator);
+}
 
 }  // namespace
 
@@ -166,13 +194,17 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   RatioReporter rep;
   benchmark::RunSpecifiedBenchmarks(&rep);
-  auto t = [&](const char* n) { return rep.ns[n]; };
-  const double gen_all = t("BM_GeneratedFAndJacobians");
-  std::printf("\nFINken 3 base model, same process (ratios, higher = generated code faster):\n");
-  std::printf("  Ceres autodiff (hand-written functor) / generated f+Jacobians: %6.1fx\n", t("BM_CeresAutodiffJacobians") / gen_all);
-  std::printf("  central differences (generated f)     / generated f+Jacobians: %6.1fx\n", t("BM_CentralDifferences") / gen_all);
-  std::printf("  hand-written f                        / generated f:           %6.2fx\n", t("BM_HandWrittenF") / t("BM_GeneratedF"));
-  std::printf("  generated f+Jacobians                 / generated f:           %6.1fx\n", gen_all / t("BM_GeneratedF"));
-  std::printf("  derive + emit, FINken 3 with all effects: %.0f ms\n", t("BM_DeriveAndEmitFinken3AllEffects/iterations:3") / 1e6);
+  auto t = [&](const char* n) { return rep.median_ns(n); };
+  const double gen_all = t("BM_GeneratedFAndJacobians"), gen_f = t("BM_GeneratedF");
+  std::printf("\nFINken 3 base model, same process (ratios of medians, higher = generated code faster):\n");
+  print_ratio("Ceres autodiff (hand-written functor) / generated f+Jacobians:", t("BM_CeresAutodiffJacobians"), gen_all,
+              "  %s %6.1fx\n");
+  print_ratio("central differences (generated f)     / generated f+Jacobians:", t("BM_CentralDifferences"), gen_all,
+              "  %s %6.1fx\n");
+  print_ratio("hand-written f                        / generated f:          ", t("BM_HandWrittenF"), gen_f,
+              "  %s %6.2fx\n");
+  print_ratio("generated f+Jacobians                 / generated f:          ", gen_all, gen_f, "  %s %6.1fx\n");
+  print_ratio("derive + emit, FINken 3 with all effects [ms]:", t("BM_DeriveAndEmitFinken3AllEffects/iterations:3"), 1e6,
+              "  %s %.0f\n");
   return 0;
 }
