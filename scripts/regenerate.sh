@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Regenerates the checked-in generated/ headers (the golden files tests/test_generated.cpp
-# compares byte for byte). Run after changing the generator, templates or vehicle files:
+# Regenerates the checked-in generated/ headers and their derivation reports (the golden
+# files tests/test_generated.cpp compares byte for byte: a reviewer diffs derivation.md after
+# a change to a vehicle or to the generator). Run after changing the generator, templates or vehicle files:
 #   scripts/regenerate.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,7 +14,8 @@ regen() {  # vehicle-file folder-name [effects]
   build/quadgen-derive "${args[@]}" > /dev/null 2>&1
   mkdir -p "generated/$2"
   cp "$tmp/$2/model.hpp" "generated/$2/model.hpp"
-  echo "generated/$2/model.hpp"
+  cp "$tmp/$2/derivation.md" "generated/$2/derivation.md"
+  echo "generated/$2/model.hpp generated/$2/derivation.md"
 }
 regen vehicles/finken3.yaml finken3
 regen vehicles/finken3.yaml finken3_all_effects all

@@ -188,7 +188,8 @@ TEST(Generated, FOnlyEntryPointGivesTheSameF) {
   }
 }
 
-// The checked-in generated/ is what the generator produces now (update: scripts/regenerate.sh).
+// The checked-in generated/ is what the generator produces now, headers and derivation
+// reports (update: scripts/regenerate.sh).
 TEST(Generated, CheckedInHeadersAreUpToDate) {
   const fs::path tmp = fs::temp_directory_path() / "quadgen_golden";
   fs::remove_all(tmp);
@@ -206,11 +207,13 @@ TEST(Generated, CheckedInHeadersAreUpToDate) {
                       (tmp / c.name).string() + (std::string(c.effects).empty() ? "" : std::string(" --effects ") + c.effects) +
                       " > /dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    const std::string now = read(tmp / c.name / "model.hpp");
-    const std::string checked_in = read(fs::path(src) / "generated" / c.name / "model.hpp");
-    ASSERT_FALSE(now.empty());
-    EXPECT_TRUE(now == checked_in) << "generated/" << c.name
-                                   << "/model.hpp is stale or was edited; run scripts/regenerate.sh";
+    for (const char* file : {"model.hpp", "derivation.md"}) {
+      const std::string now = read(tmp / c.name / file);
+      const std::string checked_in = read(fs::path(src) / "generated" / c.name / file);
+      ASSERT_FALSE(now.empty());
+      EXPECT_TRUE(now == checked_in) << "generated/" << c.name << "/" << file
+                                     << " is stale or was edited; run scripts/regenerate.sh";
+    }
   }
 }
 
