@@ -17,7 +17,7 @@ struct RotorLayout {
   double disc_area[4], radius[4];
 };
 
-// FINken 3: A (-l,-l) ccw, B (+l,-l) cw, C (+l,+l) ccw, D (-l,+l) cw (contracts.md §1).
+// FINken 3: A (-l,-l) ccw, B (+l,-l) cw, C (+l,+l) ccw, D (-l,+l) cw (docs/formats.md "Conventions").
 inline RotorLayout finken3_layout() {
   const double l = 0.07465;
   return RotorLayout{{-l, l, l, -l}, {-l, -l, l, l}, {0, 0, 0, 0}, {1, -1, 1, -1},

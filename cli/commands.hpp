@@ -1,4 +1,4 @@
-// Subcommands of the quadgen executable (contracts.md §4).
+// Subcommands of the quadgen executable (README "What each command writes").
 #pragma once
 #include <set>
 #include <string>

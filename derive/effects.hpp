@@ -1,4 +1,4 @@
-// Model extensions (contracts.md §3). Each effect is a self-contained symbolic change:
+// Model extensions (docs/effects.md). Each effect is a self-contained symbolic change:
 // it declares its parameters (and states or inputs) and rewrites the intermediate
 // quantities of the model context. At their nominal values the model is unchanged.
 #pragma once

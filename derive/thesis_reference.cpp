@@ -17,20 +17,14 @@ using namespace GiNaC;
 
 namespace {
 
-std::string fmt(const char* f, double a) {
-  char b[128];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
-}
-std::string fmt(const char* f, double a, double c) {
-  char b[160];
-  std::snprintf(b, sizeof b, f, a, c);
-  return b;
-}
-std::string fmt(const char* f, double a, double c, double d) {
-  char b[200];
-  std::snprintf(b, sizeof b, f, a, c, d);
-  return b;
+// printf of numbers (every one as a double) into a string of the length needed: a fixed
+// buffer once cut a comparison cell short.
+template <class... Numbers>
+std::string fmt(const char* f, Numbers... numbers) {
+  const int n = std::snprintf(nullptr, 0, f, static_cast<double>(numbers)...);
+  std::string s(n > 0 ? static_cast<size_t>(n) : 0, '\0');
+  std::snprintf(s.data(), s.size() + 1, f, static_cast<double>(numbers)...);
+  return s;
 }
 double pct(double ours, double theirs) { return 100.0 * (theirs - ours) / ours; }
 

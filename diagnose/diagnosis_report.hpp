@@ -1,6 +1,6 @@
-// diagnosis.json (contracts.md §5 plus the evidence behind every finding) and the report a
-// person reads: one self-contained HTML page with its plots inlined as SVG, so it renders
-// in a browser without network access.
+// diagnosis.json (the fields of docs/formats.md "diagnosis.json", with the evidence behind
+// every finding) and the report a person reads: one self-contained HTML page with its plots
+// inlined as SVG, so it renders in a browser without network access.
 #pragma once
 #include <string>
 #include <utility>

@@ -35,7 +35,7 @@ ColumnMapping load_mapping(const std::string& path);  // throws FitError with fi
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);
 
-// The SI unit of a canonical column (contracts.md §2): "s", "m", "m/s", "rad/s", "m/s^2",
+// The SI unit of a canonical column (docs/formats.md "Flight log"): "s", "m", "m/s", "rad/s", "m/s^2",
 // "1", "rad", "V"; empty for a name that is no canonical column.
 std::string canonical_unit(const std::string& column);
 

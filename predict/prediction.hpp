@@ -77,7 +77,7 @@ fit::Flight fill_missing_signals(fit::Flight f, double vbat_ref);
 Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<double>& params,
                                const fit::Flight& flight, const PredictionOptions& options);
 
-// The layout of contracts §6: open_loop, attitude_replayed, one_step.
+// The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed, one_step.
 nlohmann::ordered_json prediction_json(const Prediction& p);
 
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.

@@ -1,5 +1,5 @@
 // Z-Y-X Euler angles (roll phi, pitch theta, yaw psi) of a unit quaternion body -> world,
-// for logs, plots and reports (contracts.md §1: R = Rz(psi) Ry(theta) Rx(phi)).
+// for logs, plots and reports (docs/formats.md "Conventions": R = Rz(psi) Ry(theta) Rx(phi)).
 #pragma once
 #include <array>
 #include <cmath>
@@ -31,7 +31,7 @@ inline void quaternion_product(const double* a, const double* b, double* q) {
   q[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
 }
 
-// True attitude from a logged one under attitude_bias (contracts.md §3: q_log = q ⊗ q_bias,
+// True attitude from a logged one under attitude_bias (docs/effects.md: q_log = q ⊗ q_bias,
 // q_bias = q_y(pitch) ⊗ q_x(roll)): q = q_log ⊗ conj(q_bias).
 inline void unbias_attitude(const double* q_log, double roll, double pitch, double* q) {
   const double qp[4] = {std::cos(pitch / 2), 0, std::sin(pitch / 2), 0};

@@ -1,5 +1,5 @@
 // Flight logs as CSV: reading with line-exact errors, the canonical layout of
-// contracts.md §2 (validation against a model's rotor names), and writing trajectories.
+// docs/formats.md "Flight log" (validation against a model's rotor names), and writing trajectories.
 #pragma once
 #include <stdexcept>
 #include <string>

@@ -358,7 +358,7 @@ TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n").find("too few samples"), std::string::npos);
 }
 
-// contracts.md §4 / issue: `quadgen simulate vehicles/finken3.yaml --scenario climb
+// The README's command line: `quadgen simulate vehicles/finken3.yaml --scenario climb
 // --duration 1 --out traj.csv` reproduces thesis (63)-(64).
 TEST(Simulate, ClimbReproducesThesis63And64) {
   const std::string dir = testing::TempDir() + "quadgen_sim";
