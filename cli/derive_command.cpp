@@ -3,17 +3,11 @@
 #include <iostream>
 #include <set>
 
-#include "audit.hpp"
 #include "commands.hpp"
-#include "dynamics.hpp"
+#include "derive_pipeline.hpp"
 #include "effects.hpp"
 #include "fitted_parameters.hpp"
-#include "geometry.hpp"
-#include "header_writer.hpp"
 #include "output_set.hpp"
-#include "report.hpp"
-#include "thesis_reference.hpp"
-#include "vehicle.hpp"
 
 namespace quadgen::cli {
 
@@ -33,47 +27,41 @@ int run_derive(const DeriveArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Vehicle vehicle = load_vehicle(args.vehicle);
   output::OutputDirectory out(args.out, {args.vehicle, args.params});  // refused before the work, not after
-  DeriveOptions opt;
-  opt.effects = parse_effect_list(args.effects);
-  FittedParameters fitted;
+  DeriveRequest request;
+  request.derive.effects = parse_effect_list(args.effects);
+  request.emit.vehicle_file = args.vehicle;
+  request.emit.effects_flag = args.effects.empty() ? "" : " --effects " + args.effects;
   if (!args.params.empty()) {
-    fitted = load_fitted_parameters(args.params);
-    if (args.effects.empty()) opt.effects = fitted.effects;
-    else if (std::set<std::string>(opt.effects.begin(), opt.effects.end()) !=
+    const FittedParameters fitted = load_fitted_parameters(args.params);
+    if (args.effects.empty()) request.derive.effects = fitted.effects;
+    else if (std::set<std::string>(request.derive.effects.begin(), request.derive.effects.end()) !=
              std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
       throw std::invalid_argument("--effects differs from the effects " + args.params + " was fitted with; leave it out");
+    request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
+    request.emit.effects_flag = " --params " + args.params;
+    request.emit.parameter_source = "fitted values from " + args.params;
   }
   std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
   const MassProperties mp = derive_mass_properties(vehicle);
-  std::cerr << "[2/5] equations of motion and Jacobians\n";
-  SymbolicModel model = derive_model(vehicle, mp, opt);
-  if (!args.params.empty()) apply_fitted_parameters(model, fitted);
-  std::cerr << "[3/5] audit\n";
-  const AuditResult result = audit(model, mp);
-  std::vector<ThesisItem> thesis;
-  if (vehicle.name == "finken3") thesis = compare_with_thesis(model, mp);
-  std::cerr << "[4/5] generating C++\n";
-  emission::EmitOptions eo;
-  eo.vehicle_file = args.vehicle;
-  eo.effects_flag = args.params.empty() ? (args.effects.empty() ? "" : " --effects " + args.effects)
-                                        : " --params " + args.params;
-  if (!args.params.empty()) eo.parameter_source = "fitted values from " + args.params;
-  const emission::GeneratedHeader header = emission::generate_header(model, eo);
+  int step = 1;
+  request.progress = [&](const std::string& what) { std::cerr << "[" << ++step << "/5] " << what << "\n"; };
+  const DerivedModel d = run_derive_pipeline(vehicle, mp, request);
   std::cerr << "[5/5] writing " << args.out << "\n";
-  const Derivation d{vehicle, mp, model, result, thesis};
-  out.add("model.json", model_json(d));
-  out.add("derivation.md", derivation_markdown(d));
-  out.add("model.hpp", header.content);
+  out.add("model.json", d.model_json);
+  out.add("derivation.md", d.derivation_md);
+  out.add("model.hpp", d.header.content);
   out.commit();
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const SymbolicModel& model = d.model;
+  const emission::GeneratedHeader& header = d.header;
   std::cout << "derived " << vehicle.name << ": " << model.states.size() << " states, " << model.inputs.size()
             << " inputs, " << model.params.size() << " parameters; audit "
-            << (result.all_passed() ? "passed" : "FAILED") << " (" << result.checks.size() << " checks); "
-            << secs << " s\n"
+            << (d.audit.all_passed() ? "passed" : "FAILED") << " (" << d.audit.checks.size() << " checks); " << secs
+            << " s\n"
             << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
             << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
             << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n";
-  return result.all_passed() ? 0 : 3;
+  return d.audit.all_passed() ? 0 : 3;
 }
 
 }  // namespace quadgen::cli

@@ -99,7 +99,7 @@ void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, co
   auto P = [&](const char* s) { return model.params[model.param_index(s)].sym; };
   lst at_origin{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
   bool torque_agrees = true;
-  if (model.vehicle_name == "finken3" && model.effects.empty()) {
+  if (is_thesis_vehicle(model) && model.effects.empty()) {
     ex F[4];
     for (int i = 0; i < 4; ++i)
       for (const auto& [name, e] : model.intermediates)
@@ -355,7 +355,10 @@ matrix thesis_transformation(const ex& phi, const ex& theta, const ex& psi) {
                     st, -ct * sf, ct * cf});
 }
 
+bool is_thesis_vehicle(const SymbolicModel& m) { return m.vehicle_name == "finken3"; }
+
 std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp) {
+  if (!is_thesis_vehicle(m)) return {};
   std::vector<ThesisItem> out;
   const Numbers n = nominal(m, mp);
   transformation_items(out);
@@ -364,7 +367,7 @@ std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassPr
   inertia_items(out, mp, n);
   geometry_items(out, mp, n);
   evaluation_items(out, n);
-  if (m.effects.empty() && m.vehicle_name == "finken3") simulated_items(out, m);
+  if (m.effects.empty()) simulated_items(out, m);
   return out;
 }
 

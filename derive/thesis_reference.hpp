@@ -20,6 +20,11 @@ struct ThesisItem {
   std::string size;     // how large the difference is numerically
 };
 
+// Whether a model is of the thesis' vehicle, the FINken 3 (vehicles/finken3.yaml, name
+// "finken3"): the one place that decides it.
+bool is_thesis_vehicle(const SymbolicModel& m);
+
+// The comparison, item by item; empty for any other vehicle.
 std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp);
 
 // The thesis' transformation matrix (3)/(81), as printed.

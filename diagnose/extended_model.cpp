@@ -4,10 +4,7 @@
 #include <sstream>
 #include <vector>
 
-#include "audit.hpp"
-#include "dynamics.hpp"
-#include "header_writer.hpp"
-#include "report.hpp"
+#include "derive_pipeline.hpp"
 #include "sinks.hpp"
 
 namespace quadgen::diagnose {
@@ -40,24 +37,23 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
                                   const std::string& vehicle_file, const std::string& logs_label,
                                   bool with_proposed_terms) {
-  DeriveOptions options;
-  options.effects = d.search.selected;
-  if (with_proposed_terms) options.terms = proposed_terms(d.discovered);
-  SymbolicModel ext = derive_model(v, mass, options);
-  for (const auto& p : d.airframe_fit)  // the header's nominal values are the estimates
-    if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
-  emission::EmitOptions eo;
-  eo.vehicle_file = vehicle_file;
-  eo.effects_flag = ext.effects.empty() ? "" : " --effects " + ext.effect_list();
-  eo.parameter_source = "fitted by quadgen diagnose to " + logs_label +
-                        " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
+  DeriveRequest request;
+  request.derive.effects = d.search.selected;
+  if (with_proposed_terms) request.derive.terms = proposed_terms(d.discovered);
+  request.set_nominal = [&](SymbolicModel& ext) {  // the header's nominal values are the estimates
+    for (const auto& p : d.airframe_fit)
+      if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
+  };
+  request.thesis_comparison = false;  // the thesis comparison belongs to the FINken 3's own derivation
+  request.emit.vehicle_file = vehicle_file;
+  request.effects_flag_from_model = true;
+  request.emit.parameter_source = "fitted by quadgen diagnose to " + logs_label +
+                                  " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
   if (with_proposed_terms)
-    eo.parameter_source += "; term_* parameters: terms proposed beyond the catalogue (diagnosis.json discovered_terms), "
-                           "not named causes";
-  const std::vector<ThesisItem> no_thesis;  // the thesis comparison belongs to the FINken 3 derivation
-  const AuditResult ext_audit = audit(ext, mass);
-  const Derivation der{v, mass, ext, ext_audit, no_thesis};
-  return {emission::generate_header(ext, eo).content, model_json(der), derivation_markdown(der), fitted_parameters_yaml(v, d)};
+    request.emit.parameter_source +=
+        "; term_* parameters: terms proposed beyond the catalogue (diagnosis.json discovered_terms), not named causes";
+  const DerivedModel ext = run_derive_pipeline(v, mass, request);
+  return {ext.header.content, ext.model_json, ext.derivation_md, fitted_parameters_yaml(v, d)};
 }
 
 }  // namespace quadgen::diagnose

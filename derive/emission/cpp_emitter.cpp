@@ -13,18 +13,6 @@ namespace quadgen::emission {
 
 namespace {
 
-// Shortest decimal that reads back as the same double.
-std::string double_literal(double v) {
-  char buf[40];
-  for (int prec = 1; prec <= 17; ++prec) {
-    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  std::string s(buf);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
-}
-
 double power_of(double c, int k) {
   double r = 1;
   for (int i = 0; i < std::abs(k); ++i) r *= c;

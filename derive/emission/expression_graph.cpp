@@ -29,18 +29,6 @@ uint64_t mix(uint64_t h, const std::string& s) {
   return mix(h, s.size());
 }
 
-// Shortest decimal that reads back as the same double.
-std::string double_literal(double v) {
-  char buf[40];
-  for (int prec = 1; prec <= 17; ++prec) {
-    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  std::string s(buf);
-  if (s.find_first_of(".e") == std::string::npos) s += ".0";
-  return s;
-}
-
 }  // namespace
 
 void ExpressionGraph::declare(VarKind kind, const std::vector<std::pair<symbol, std::string>>& vars) {
@@ -215,6 +203,19 @@ double ExpressionGraph::tree_ops(int id) {
   for (int a : n.args) ops += tree_ops(a);
   tree_ops_[id] = ops;
   return ops;
+}
+
+// Shortest decimal that reads back as the same double; ".0" appended to an integer, so that
+// C++ reads it as a double (not to "inf" or "nan").
+std::string double_literal(double v) {
+  char buf[40];
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  std::string s(buf);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
 }
 
 }  // namespace quadgen::emission

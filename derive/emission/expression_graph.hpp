@@ -63,4 +63,8 @@ class ExpressionGraph {
 // A graph with the model's states, inputs and parameters declared.
 void declare_model_variables(ExpressionGraph& g, const SymbolicModel& m);
 
+// The text of a constant in generated code and in the graph's keys: the shortest decimal
+// that reads back as the same double.
+std::string double_literal(double v);
+
 }  // namespace quadgen::emission

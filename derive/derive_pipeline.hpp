@@ -1,0 +1,44 @@
+// The derive pipeline, written once: a vehicle and its mass properties -> the symbolic model
+// -> the audit (and, for the thesis' vehicle, the comparison with the thesis) -> the
+// generated header, model.json and derivation.md. `quadgen derive` and diagnose's extended
+// model both run it; what differs between them is in DeriveRequest.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "audit.hpp"
+#include "dynamics.hpp"
+#include "emission/header_writer.hpp"
+#include "geometry.hpp"
+#include "symbolic_model.hpp"
+#include "thesis_reference.hpp"
+#include "vehicle.hpp"
+
+namespace quadgen {
+
+struct DeriveRequest {
+  DeriveOptions derive;       // effects and added terms
+  emission::EmitOptions emit;  // the header's provenance
+  // The header's regenerate command names the model's effects in canonical order
+  // ("--effects motor_gain,wind") rather than emit.effects_flag.
+  bool effects_flag_from_model = false;
+  // Sets nominal values other than the vehicle file's (fitted ones) before the audit and the
+  // emission; none when empty.
+  std::function<void(SymbolicModel&)> set_nominal;
+  bool thesis_comparison = true;  // for the thesis' vehicle only (thesis_reference.hpp)
+  // Called before each step with its description ("audit", "generating C++").
+  std::function<void(const std::string&)> progress;
+};
+
+struct DerivedModel {
+  SymbolicModel model;
+  AuditResult audit;
+  std::vector<ThesisItem> thesis;
+  emission::GeneratedHeader header;
+  std::string model_json, derivation_md;
+};
+
+DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request);
+
+}  // namespace quadgen
