@@ -27,8 +27,9 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   CLI::App* c = app.add_subcommand("diagnose", "find what the model gets wrong in a flight, name the cause, extend the model");
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
   c->add_option("logs", a.logs,
-                "flight log(s) (CSV): several flights of the same vehicle are diagnosed jointly, with one set of "
-                "vehicle parameters and the end of each flight held out")
+                std::string("flight log(s): ") + kLogFormats +
+                    ". Several flights of the same vehicle are diagnosed jointly, with one set of vehicle parameters "
+                    "and the end of each flight held out")
       ->required();
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");

@@ -22,7 +22,9 @@ using namespace quadgen::fit;
 void add_fit(CLI::App& app, FitArgs& a) {
   CLI::App* c = app.add_subcommand("fit", "estimate parameters from measured data, with profile likelihood");
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
-  c->add_option("log", a.log, "measurements (CSV)")->required();
+  c->add_option("log", a.log, std::string("measurements: a flight log (") + kLogFormats +
+                                  "), motor steps or a thrust stand (CSV)")
+      ->required();
   c->add_option("--out", a.out, "output directory")->required();
   c->add_flag("--robust", a.robust, "Huber loss instead of squares");
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
@@ -37,10 +39,12 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(0.1, 1e5));
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
-  c->add_option("--free", a.free, "parameters to fit (comma-separated), overriding the vehicle file's fit flags");
+  c->add_option("--free", a.free,
+                std::string("parameters to fit (comma-separated), overriding the vehicle file's fit flags: ") +
+                    kParameterNames);
   c->add_option("--profiles", a.profiles,
                 "profile likelihood of: all free parameters, none (estimates and standard errors only), or "
-                "comma-separated names")
+                "comma-separated names (as for --free)")
       ->capture_default_str();
   c->add_option("--threads", a.threads, "threads for the profiles (0: one per core)")
       ->check(CLI::Range(0, 256))

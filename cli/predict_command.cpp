@@ -23,7 +23,7 @@ namespace quadgen::cli {
 void add_predict(CLI::App& app, PredictArgs& a) {
   CLI::App* c = app.add_subcommand("predict", "measure how well a model predicts flights (error at horizons, one step)");
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
-  c->add_option("logs", a.logs, "flight logs (CSV), one or more")->required()->default_str("");
+  c->add_option("logs", a.logs, std::string("flight logs, one or more: ") + kLogFormats)->required()->default_str("");
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--params", a.params,

@@ -34,7 +34,10 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   cl->excludes(sc)->excludes(in);
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
   c->add_option("--seed", a.seed, "closed loop: random trajectory and noise seed")->needs(cl);
-  c->add_option("--set", a.set, "closed loop: NAME=VALUE for a parameter of the true model (repeatable)")->needs(cl);
+  c->add_option("--set", a.set,
+                std::string("closed loop: NAME=VALUE for a parameter of the true model (repeatable); names: ") +
+                    kParameterNames)
+      ->needs(cl);
   c->add_option("--pose-noise", a.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
   c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);

@@ -1,6 +1,10 @@
 // The assembled model: units audit, effects at nominal values, physics spot checks.
 #include <gtest/gtest.h>
 
+#include <regex>
+
+#include "cli/options.hpp"
+
 #include <algorithm>
 #include <set>
 
@@ -56,6 +60,24 @@ TEST(Model, InertiaAuditHoldsForBlocksAtAnyAngle) {
   // A tensor off by a part in a million of one product of inertia is caught.
   mp.blocks[1].inertia_origin(0, 1) = mp.blocks[1].inertia_origin(0, 1) * GiNaC::numeric(1000001, 1000000);
   EXPECT_FALSE(closed_form_ok(mp));
+}
+
+// The parameter names --help lists (cli/options.hpp) are every name of the full-catalogue
+// model, ranges and the rotor written as patterns: a new effect must be added there too.
+TEST(Model, HelpListsEveryParameterName) {
+  const SymbolicModel m = derive(test::finken3(), parse_effect_list("all"));
+  const std::string help = quadgen::cli::kParameterNames;
+  const std::vector<std::pair<std::regex, std::string>> patterns = {
+      {std::regex("motor_gain\\..*"), "motor_gain.<rotor>"}, {std::regex("motor_a[0-2]"), "motor_a0..motor_a2"},
+      {std::regex("cog_[xyz]"), "cog_x..cog_z"},              {std::regex("J_[xyz][xyz]"), "J_xx..J_yz"},
+      {std::regex("A_[xyz]"), "A_x..A_z"},                    {std::regex("(cog_offset|wind)\\.[xy]"), "$1.x/y"},
+      {std::regex("attitude_bias\\..*"), "attitude_bias.roll/pitch"}};
+  for (const auto& p : m.params) {
+    std::string shown = p.name;
+    for (const auto& [re, as] : patterns)
+      if (std::regex_match(p.name, re)) shown = std::regex_replace(p.name, re, as);
+    EXPECT_NE(help.find(shown), std::string::npos) << p.name << " (as " << shown << ") is not in --help";
+  }
 }
 
 TEST(Model, UnitCheckerRejectsInconsistentEquation) {
