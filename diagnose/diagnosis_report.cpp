@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "effects.hpp"
@@ -92,6 +94,49 @@ std::string headline(const Finding& f) {
   std::string s = e.headline(values, reference);
   if (values.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
   return s;
+}
+
+// Where the rotor drag force acts, when the diagnosis names both halves of it: the force
+// (rotor_drag, at the CoG) and its forward-flight moment (blade_flapping) have coefficients of
+// their own, and a force at height h above the CoG gives exactly blade_flapping.k =
+// h rotor_drag.k (r x F with r = (0, 0, h)). Their ratio is that height, estimated rather than
+// assumed from the blocks. The interval is the delta method on the two standard errors with
+// their covariance neglected: a rough one, said so in diagnosis.json.
+struct PointOfAction {
+  double height = 0, lower = NAN, upper = NAN;
+};
+
+std::optional<PointOfAction> point_of_action(const Diagnosis& d) {
+  const EffectEstimate *drag = nullptr, *flap = nullptr;
+  for (const auto& f : d.findings)
+    for (const auto& p : f.parameters) {
+      if (p.name == "rotor_drag.k") drag = &p;
+      if (p.name == "blade_flapping.k") flap = &p;
+    }
+  if (!drag || !flap || !(std::fabs(drag->value) > 0)) return std::nullopt;
+  PointOfAction out;
+  out.height = flap->value / drag->value;
+  const double rel_f = flap->standard_error / flap->value, rel_d = drag->standard_error / drag->value;
+  const double se = std::fabs(out.height) * std::sqrt(rel_f * rel_f + rel_d * rel_d);
+  if (std::isfinite(se) && se > 0) out.lower = out.height - 1.96 * se, out.upper = out.height + 1.96 * se;
+  return out;
+}
+
+std::string point_of_action_headline(const PointOfAction& p) {
+  std::ostringstream os;
+  os << "The rotor drag force acts " << std::fixed << std::setprecision(0) << std::fabs(1000 * p.height) << " mm "
+     << (p.height >= 0 ? "above" : "below") << " the centre of gravity (blade_flapping.k / rotor_drag.k)";
+  return os.str();
+}
+
+json point_of_action_json(const Diagnosis& d) {
+  const auto p = point_of_action(d);
+  if (!p) return nullptr;
+  return {{"height_above_cog_m", p->height},
+          {"ci95", {number_or_null(p->lower), number_or_null(p->upper)}},
+          {"from", "blade_flapping.k / rotor_drag.k"},
+          {"interval_method", "delta method on the two standard errors, their covariance neglected"},
+          {"headline", point_of_action_headline(*p)}};
 }
 
 json finding_json(const Finding& f) {
@@ -210,6 +255,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                    {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
                    {"separating_manoeuvre", a.manoeuvre}});
   j["ambiguous"] = amb;
+  j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
   json un = json::array();
   for (const auto& u : d.unexplained)
     un.push_back({{"channel", u.channel},
@@ -549,6 +595,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";
+  if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
   if (!d.findings.empty())
     h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
       << num(reduction(d.metric_before, d.metric_after), 2) << " % better (" << esc(d.metric) << " "

@@ -197,6 +197,39 @@ TEST(LookAlikes, AmbiguousPairDoesNotHideADistinctEffect) {
   EXPECT_TRUE(outcome_ambiguous) << j["selection"].dump(1).substr(0, 2000);
 }
 
+// A pure input delay in a flight without rate excitation: a lag of the rotors looks the same
+// there, so the two are reported as look-alikes with the manoeuvre that separates them, and
+// the model carries one of them - never delay plus a small lag (issue 14, item 6).
+TEST(LookAlikes, PureDelayWithoutExcitationIsNotDelayPlusLag) {
+  const json j = diagnose({"delay_no_excitation", "input_delay", {{"input_delay.seconds", 0.025}}, {}, "", 1});
+  EXPECT_TRUE(ambiguous_between(j, "input_delay", "motor_lag") || named(j) == std::vector<std::string>{"input_delay"})
+      << j["ambiguous"].dump(1) << j["findings"].dump(1);
+  for (const auto& f : j["findings"]) EXPECT_NE(f["effect"], "motor_lag") << j["findings"].dump(1);
+  const auto carried = j["extended_model"]["effects"].get<std::vector<std::string>>();
+  EXPECT_FALSE(std::count(carried.begin(), carried.end(), "input_delay") &&
+               std::count(carried.begin(), carried.end(), "motor_lag"))
+      << j["extended_model"].dump(1);
+}
+
+// Rotor drag acting at the hubs, 50 mm above the CoG: a force and the moment of that force.
+// Both halves are named, with their own coefficients, and their ratio - the point of action -
+// comes out as the hub height instead of the force being dropped for conflicting with the gyro.
+TEST(LookAlikes, RotorDragAboveTheCogIsForceAndMomentWithItsPointOfAction) {
+  const double k = 2e-5, height = 0.05;
+  const json j = diagnose({"drag_at_hub", "rotor_drag,blade_flapping",
+                           {{"rotor_drag.k", k}, {"blade_flapping.k", k * height}}, {}, "", 1});
+  auto sorted = named(j);
+  std::sort(sorted.begin(), sorted.end());
+  ASSERT_EQ(sorted, (std::vector<std::string>{"blade_flapping", "rotor_drag"})) << j["findings"].dump(1);
+  const json& p = j["point_of_action"];
+  ASSERT_TRUE(p.is_object()) << j.dump(1).substr(0, 1000);
+  EXPECT_NEAR(p["height_above_cog_m"].get<double>(), height, 0.01) << p.dump(1);
+  ASSERT_TRUE(p["ci95"][0].is_number() && p["ci95"][1].is_number()) << p.dump(1);
+  EXPECT_LE(p["ci95"][0].get<double>(), height) << p.dump(1);
+  EXPECT_GE(p["ci95"][1].get<double>(), height) << p.dump(1);
+  EXPECT_NE(p["headline"].get<std::string>().find("50 mm above"), std::string::npos) << p.dump(1);
+}
+
 // Negligible is relative to the vehicle: rotor drag of a 30 g Crazyflie at its published
 // size (linear drag ~1e-2 N s/m for the airframe, i.e. k ~ 1.1e-6 per rad/s of summed rotor
 // speed near 9,000 rad/s) is a real force for it, and is named.
