@@ -1,9 +1,13 @@
 #include "candidate_search.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <iostream>
 #include <limits>
+#include <mutex>
+#include <thread>
 
 #include <unistd.h>
 
@@ -96,6 +100,12 @@ std::vector<FitParameter> CandidateSearch::initial_parameters() const {
 
 std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>& effects,
                                                     const std::vector<FitParameter>& start, double* cost) const {
+  return fit_with(effects, start, cost, own_workspace());
+}
+
+std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>& effects,
+                                                    const std::vector<FitParameter>& start, double* cost,
+                                                    const Workspace& ws) const {
   std::vector<FitParameter> ps = start;
   for (size_t i = 0; i < ps.size(); ++i) {
     const std::string e = effect_of_parameter(ps[i].name);
@@ -110,7 +120,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
   fo.max_iterations = 100;
   fo.function_tolerance = 1e-10;
   fo.parameter_tolerance = 1e-10;
-  *cost = fit::solve_weighted(train_, ps, weights_, fo);
+  *cost = fit::solve_weighted(*ws.train, ps, weights_, fo);
   return ps;
 }
 
@@ -166,14 +176,14 @@ std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>&
 
 CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std::set<std::string>& base,
                                             const std::vector<FitParameter>& base_fit, const std::vector<double>& base_ss,
-                                            double base_valid_cost) const {
+                                            double base_valid_cost, const Workspace& ws) const {
   CandidateEvidence ev;
   ev.effect = effect;
   std::set<std::string> with = base;
   with.insert(effect);
   ev.model_effects.assign(with.begin(), with.end());
   double c = 0;
-  ev.parameters = fit_with(with, base_fit, &c);
+  ev.parameters = fit_with(with, base_fit, &c, ws);
   // Second start away from a flat neutral value.
   std::vector<FitParameter> start = base_fit;
   bool other_start = false;
@@ -183,11 +193,11 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   }
   if (other_start) {
     double c2 = 0;
-    auto ps2 = fit_with(with, start, &c2);
+    auto ps2 = fit_with(with, start, &c2, ws);
     if (c2 < c) ev.parameters = ps2, c = c2;
   }
   ev.cost = c;
-  const ChannelNoise large = channel_noise(train_, ev.parameters);
+  const ChannelNoise large = channel_noise(*ws.train, ev.parameters);
   ev.statistic = lr_statistic(base_ss, large);
   for (int i : effect_params_.at(effect)) ev.dof += ev.parameters[i].free ? 1 : 0;
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
@@ -197,9 +207,9 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.delta_bic = -ev.statistic + ev.dof * std::log(large.n_eff);
   ev.delta_aic = -ev.statistic + 2.0 * ev.dof;
   ev.validation_cost_before = base_valid_cost;
-  ev.validation_cost_after = cost(valid_, ev.parameters);
+  ev.validation_cost_after = cost(*ws.valid, ev.parameters);
   ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
-  effect_size(effect, ev.parameters, ev);
+  effect_size(effect, ev.parameters, ev, ws);
   const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
   if (!(ev.p_value < ev.level))
     ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
@@ -222,11 +232,11 @@ double CandidateSearch::p_value_of(const std::string& effect, double statistic, 
 }
 
 void CandidateSearch::effect_size(const std::string& effect, const std::vector<FitParameter>& ps,
-                                  CandidateEvidence& ev) const {
+                                  CandidateEvidence& ev, const Workspace& ws) const {
   std::vector<double> on = fit::parameter_values(ps), off = on, r_on, r_off;
   for (int i : effect_params_.at(effect)) off[i] = neutral_value(all_.params[i]);
-  train_.all_channels(on.data(), r_on);
-  train_.all_channels(off.data(), r_off);
+  ws.train->all_channels(on.data(), r_on);
+  ws.train->all_channels(off.data(), r_off);
   double trans = 0, rot = 0;
   const size_t rows = r_on.size() / 6;
   for (size_t k = 0; k < rows; ++k)
@@ -269,6 +279,61 @@ std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& s
   return out;
 }
 
+CandidateSearch::Workspace CandidateSearch::own_workspace() const { return {&train_, &valid_}; }
+
+// The candidates of one step are independent fits from the same base: they run on every core,
+// each worker on its own clones of the two problems (a fit sets its problem's free mask and
+// scratch state, and each clone has its own dynamic model). Results keep the candidates'
+// order, so the outcome does not depend on which worker fitted what.
+std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<std::string>& todo,
+                                                             const std::set<std::string>& base,
+                                                             const std::vector<FitParameter>& base_fit,
+                                                             const std::vector<double>& base_ss, double base_valid,
+                                                             int round) const {
+  std::vector<CandidateEvidence> out(todo.size());
+  std::vector<Workspace> workers{own_workspace()};
+  std::vector<std::unique_ptr<fit::ResidualModel>> clones;
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), todo.size());
+  while (workers.size() < threads) {
+    auto train = train_.clone(), valid = valid_.clone();
+    const auto* t = dynamic_cast<const fit::EquationErrorModel*>(train.get());
+    const auto* v = dynamic_cast<const fit::EquationErrorModel*>(valid.get());
+    if (!t || !v) break;  // a model that cannot be copied: fewer workers
+    workers.push_back({t, v});
+    clones.push_back(std::move(train));
+    clones.push_back(std::move(valid));
+  }
+  std::atomic<size_t> next{0}, done{0};
+  std::mutex progress;
+  std::exception_ptr failure;
+  auto work = [&](const Workspace& ws) {
+    for (size_t i; (i = next++) < todo.size();) {
+      try {
+        out[i] = evaluate(todo[i], base, base_fit, base_ss, base_valid, ws);
+      } catch (const fit::FitError& err) {  // a candidate the solver cannot fit is no candidate
+        out[i].effect = todo[i];
+        out[i].why_not = std::string("the fit failed: ") + err.what();
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(progress);
+        if (!failure) failure = std::current_exception();
+        next = todo.size();
+        return;
+      }
+      if (opt_.verbose_progress && isatty(2)) {
+        const std::lock_guard<std::mutex> lock(progress);
+        std::cerr << "\r[diagnose] step " << round + 1 << ": " << ++done << "/" << todo.size() << " candidates ("
+                  << todo[i] << ")                    " << std::flush;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers.size(); ++w) pool.emplace_back(work, std::cref(workers[w]));
+  work(workers[0]);
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  return out;
+}
+
 SearchResult CandidateSearch::run() {
   SearchResult res;
   std::set<std::string> base;
@@ -290,22 +355,10 @@ SearchResult CandidateSearch::run() {
     step.base_effects.assign(base.begin(), base.end());
     const double base_valid = cost(valid_, current);
     const std::vector<double> base_ss = channel_noise(train_, current).ss;
-    int k = 0;
-    for (const auto& e : candidates_) {
-      ++k;
-      if (base.count(e)) continue;
-      if (opt_.verbose_progress && isatty(2))
-        std::cerr << "\r[diagnose] step " << round + 1 << ": candidate " << k << "/" << candidates_.size() << " "
-                  << e << "                    " << std::flush;
-      try {
-        step.candidates.push_back(evaluate(e, base, current, base_ss, base_valid));
-      } catch (const fit::FitError& err) {  // a candidate the solver cannot fit is no candidate
-        CandidateEvidence failed;
-        failed.effect = e;
-        failed.why_not = std::string("the fit failed: ") + err.what();
-        step.candidates.push_back(failed);
-      }
-    }
+    std::vector<std::string> todo;
+    for (const auto& e : candidates_)
+      if (!base.count(e)) todo.push_back(e);
+    step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
                 << " candidates fitted                              \n";

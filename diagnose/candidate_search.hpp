@@ -166,16 +166,31 @@ class CandidateSearch {
   std::map<std::string, std::vector<int>> effect_params_;  // indices into the parameter vector
   std::vector<int> reference_params_;  // held at off in every fit (reference_parameters)
 
+  // The two problems a fit works on: the search's own, or a worker thread's clones of them.
+  struct Workspace {
+    const fit::EquationErrorModel* train;
+    const fit::EquationErrorModel* valid;
+  };
+  Workspace own_workspace() const;
+  std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
+                                          const std::vector<fit::FitParameter>& start, double* cost,
+                                          const Workspace& ws) const;
+
   std::vector<fit::FitParameter> initial_parameters() const;
   // base_ss: the step's base model's residual sum of squares per channel (computed once
   // per step, not once per candidate).
   CandidateEvidence evaluate(const std::string& effect, const std::set<std::string>& base,
                              const std::vector<fit::FitParameter>& base_fit, const std::vector<double>& base_ss,
-                             double base_valid_cost) const;
+                             double base_valid_cost, const Workspace& ws) const;
+  // Every candidate of a step, on all cores, in `todo`'s order.
+  std::vector<CandidateEvidence> evaluate_all(const std::vector<std::string>& todo, const std::set<std::string>& base,
+                                              const std::vector<fit::FitParameter>& base_fit,
+                                              const std::vector<double>& base_ss, double base_valid, int round) const;
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
-  void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev) const;
+  void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,
+                   const Workspace& ws) const;
   double p_value_of(const std::string& effect, double statistic, int dof) const;
   void estimate_intervals(SearchResult& r) const;
 };
