@@ -452,10 +452,8 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   if (d.has_prediction)
     render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
            predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
-  std::string svg;
-  if (!d.search.profiles.empty() &&
-      fit::plot_profiles(d.vehicle + ": profile likelihood of the found parameters", d.search.profiles, &svg, error))
-    out.emplace_back("profiles.svg", svg);
+  if (!d.search.profiles.empty())
+    render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", fit::profile_panels(d.search.profiles));
   return out;
 }
 

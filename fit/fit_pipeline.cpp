@@ -87,17 +87,17 @@ std::string side(double v, bool open) {
 
 nlohmann::ordered_json side_or_null(double v, bool open) { return open ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v); }
 
-// A plot joins the outputs when gnuplot can draw it; without one the fit still counts.
+// A plot's data always joins the outputs as CSV beside it (fit.csv for fit.svg); the plot
+// itself when gnuplot can draw it, and without one the fit still counts.
 void add_plot(FitOutputs& out, const std::string& file, const std::string& title, const std::vector<runtime::Panel>& panels) {
+  out.plots.emplace_back(file.substr(0, file.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
   std::string svg, err;
   if (runtime::render_svg(title, panels, &svg, &err)) out.plots.emplace_back(file, svg);
   else out.plot_errors.push_back(file + ": " + err);
 }
 
 void add_profile_plot(FitOutputs& out, const std::string& title, const std::vector<Profile>& profiles) {
-  std::string svg, err;
-  if (plot_profiles(title, profiles, &svg, &err)) out.plots.emplace_back("profiles.svg", svg);
-  else out.plot_errors.push_back("profiles.svg: " + err);
+  if (!profiles.empty()) add_plot(out, "profiles.svg", title, profile_panels(profiles));
 }
 
 FitOptions fit_options(const FitJobOptions& o) {

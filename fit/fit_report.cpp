@@ -56,8 +56,7 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
   return j;
 }
 
-bool plot_profiles(const std::string& title, const std::vector<Profile>& profiles, std::string* svg,
-                   std::string* error) {
+std::vector<runtime::Panel> profile_panels(const std::vector<Profile>& profiles) {
   std::vector<runtime::Panel> panels;
   for (const auto& pr : profiles) {
     runtime::Panel p{pr.parameter + " (" + pr.verdict + ")", pr.parameter, "delta chi2", {}};
@@ -72,7 +71,7 @@ bool plot_profiles(const std::string& title, const std::vector<Profile>& profile
     p.series.push_back({"simultaneous 95 %", {a, b}, {pr.threshold_simultaneous, pr.threshold_simultaneous}});
     panels.push_back(p);
   }
-  return runtime::render_svg(title, panels, svg, error);
+  return panels;
 }
 
 }  // namespace quadgen::fit

@@ -1,6 +1,7 @@
 // fit.json (estimates, standard errors, profile-likelihood intervals, verdicts, noise per
 // channel) and the profile plots.
 #pragma once
+#include "plot.hpp"
 #include <string>
 #include <vector>
 
@@ -16,9 +17,8 @@ nlohmann::ordered_json number_or_null(double v);
 
 nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles);
 
-// One panel per profile: delta chi2 against the parameter, with both thresholds.
-// Returns false with a reason when plotting is impossible (no gnuplot).
-bool plot_profiles(const std::string& title, const std::vector<Profile>& profiles, std::string* svg,
-                   std::string* error);
+// One panel per profile: delta chi2 against the parameter, with both thresholds (for
+// runtime::render_svg, and runtime::panels_csv for the data beside the plot).
+std::vector<runtime::Panel> profile_panels(const std::vector<Profile>& profiles);
 
 }  // namespace quadgen::fit

@@ -215,6 +215,14 @@ TEST(FitCli, MotorStepsOfTheThesis) {
   EXPECT_EQ(j["estimates"]["tau"]["verdict"], "identifiable");
   // The motor map fitted with the lag stays close to the steady-state least squares.
   EXPECT_NEAR(j["estimates"]["a1"]["value"].get<double>(), 21224.5, 0.15 * 21224.5);
+  // Every plot's data beside it: the profile of tau as rows (text fields quoted)
+  // "title","tau (verdict)","tau","delta chi2","profile",value,delta_chi2.
+  for (const char* f : {"fit.csv", "profiles.csv"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  std::ifstream csv(out / "profiles.csv");
+  std::string line;
+  int tau_rows = 0;
+  while (std::getline(csv, line)) tau_rows += line.find(R"(,"tau","delta chi2","profile",)") != std::string::npos;
+  EXPECT_EQ(tau_rows, static_cast<int>(j["profiles"]["tau"].size()));
 }
 
 // Multiple shooting recovers the thrust coefficient and yaw-torque coefficient from the
