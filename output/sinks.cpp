@@ -55,10 +55,25 @@ void for_each_char(const std::string& s, Emit emit) {
 
 }  // namespace
 
+// A character a terminal acts on instead of showing, beyond the C0 controls: the C1 controls
+// U+0080..U+009F (a UTF-8 encoded U+009B is CSI to terminals that honour C1 in UTF-8), and
+// the bidirectional overrides and isolates (U+202A..U+202E, U+2066..U+2069), which reorder
+// what a reader sees ("Trojan Source").
+bool invisible_control(const std::string& c) {
+  const auto b = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
+  if (c.size() == 2) return b(0) == 0xC2 && b(1) >= 0x80 && b(1) <= 0x9F;
+  if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x80) return b(2) >= 0xAA && b(2) <= 0xAE;
+  if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x81) return b(2) >= 0xA6 && b(2) <= 0xA9;
+  return false;
+}
+
 std::string printable(const std::string& s) {
   std::string out;
   for_each_char(s, [&](const std::string& c) {
-    out += c.size() == 1 && control(static_cast<unsigned char>(c[0])) ? hex_byte(static_cast<unsigned char>(c[0]), "\\x") : c;
+    if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += hex_byte(static_cast<unsigned char>(c[0]), "\\x");
+    else if (invisible_control(c))
+      for (unsigned char byte : c) out += hex_byte(byte, "\\x");
+    else out += c;
   });
   return out;
 }

@@ -8,8 +8,9 @@
 
 namespace quadgen::output {
 
-// One line for a terminal or a log: control characters (newline, escape sequences) become
-// \xNN, invalid UTF-8 becomes '?'.
+// One line for a terminal or a log: control characters (newline, escape sequences; the C1
+// controls and the bidirectional overrides in their UTF-8 form too) become \xNN, invalid
+// UTF-8 becomes '?'.
 std::string printable(const std::string& s);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a

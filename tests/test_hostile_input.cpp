@@ -55,6 +55,8 @@ const std::vector<std::string>& hostile_strings() {
       std::string("nul\0byte", 8),
       "\x1b[31mred\x1b[0m",
       "\xff\xfe invalid utf-8",
+      "c1 \xc2\x9b" "31m csi in utf-8",               // U+009B, CSI where C1 controls are honoured
+      "bidi \xe2\x80\xae" "desrever \xe2\x81\xa6x",  // U+202E right-to-left override, U+2066 isolate
   };
   return s;
 }
@@ -157,6 +159,29 @@ TEST(NameRule, AcceptsIdentifiersAndRefusesEverythingElse) {
     EXPECT_TRUE(out::name_problem(bad)) << bad;
   EXPECT_TRUE(out::name_problem(std::string(65, 'a')));
   for (const auto& s : hostile_strings()) EXPECT_TRUE(out::name_problem(s)) << out::printable(s);
+}
+
+// Terminal output (every error message goes through output::printable): nothing a terminal
+// acts on survives - C0 controls, DEL, the C1 controls in their UTF-8 form, bidirectional
+// overrides and isolates - and ordinary UTF-8 text is kept as it is.
+TEST(Sinks, TerminalTextShowsControlsAsEscapes) {
+  auto acts_on = [](const std::string& t) {
+    for (size_t i = 0; i < t.size(); ++i) {
+      const auto c = static_cast<unsigned char>(t[i]);
+      if (c < 0x20 || c == 0x7f) return true;
+      if (c == 0xC2 && i + 1 < t.size() && static_cast<unsigned char>(t[i + 1]) >= 0x80 &&
+          static_cast<unsigned char>(t[i + 1]) <= 0x9F)
+        return true;
+      if (c == 0xE2 && i + 2 < t.size()) {
+        const auto b1 = static_cast<unsigned char>(t[i + 1]), b2 = static_cast<unsigned char>(t[i + 2]);
+        if ((b1 == 0x80 && b2 >= 0xAA && b2 <= 0xAE) || (b1 == 0x81 && b2 >= 0xA6 && b2 <= 0xA9)) return true;
+      }
+    }
+    return false;
+  };
+  for (const auto& s : hostile_strings()) EXPECT_FALSE(acts_on(out::printable(s))) << out::printable(s);
+  EXPECT_EQ(out::printable("F\xc3\xb6rster \xe2\x80\x94 \xce\xbc"), "F\xc3\xb6rster \xe2\x80\x94 \xce\xbc");
+  EXPECT_EQ(out::printable("a\xc2\x9b" "b"), "a\\xC2\\x9Bb");
 }
 
 TEST(NameRule, VehicleParserRefusesHostileNamesWithFileAndLine) {
