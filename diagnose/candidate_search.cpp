@@ -469,6 +469,31 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
   estimate_intervals(r);
 }
 
+NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
+  // Scaled to unit diagonal first (the correlation form): the parameters' scales differ by
+  // many orders of magnitude (blade_flapping.k ~ 1e-8 N s^2 beside a wind of 1 m/s), and on
+  // the raw matrix every well-determined direction of a small-scale parameter made the
+  // eigenvalues of all the others look near zero beside it - a joint diagnosis then found
+  // every flight's wind and motor gains "confounded" and named nothing.
+  const Eigen::Index n = H.rows();
+  NormalMatrixAnalysis out;
+  out.covariance = Eigen::MatrixXd::Zero(n, n);
+  out.confounded.assign(static_cast<size_t>(n), false);
+  if (n == 0) return out;
+  Eigen::VectorXd scale(n);
+  for (Eigen::Index a = 0; a < n; ++a) scale(a) = H(a, a) > 0 ? 1 / std::sqrt(H(a, a)) : 0.0;
+  const Eigen::MatrixXd Hs = scale.asDiagonal() * H * scale.asDiagonal();
+  out.covariance = scale.asDiagonal() * Hs.completeOrthogonalDecomposition().pseudoInverse() * scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Hs);
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (eig.eigenvalues()(k) <= 1e-10 * std::max(1.0, eig.eigenvalues().maxCoeff()))
+      for (Eigen::Index a = 0; a < n; ++a)
+        if (std::abs(eig.eigenvectors()(a, k)) > 0.1) out.confounded[static_cast<size_t>(a)] = true;
+  for (Eigen::Index a = 0; a < n; ++a)
+    if (scale(a) == 0) out.confounded[static_cast<size_t>(a)] = true;  // a parameter the data do not touch
+  return out;
+}
+
 // Intervals for the selected effects' parameters: profile likelihood with the final
 // model's noise and correlation time in the weights, so the chi2 thresholds hold.
 void CandidateSearch::estimate_intervals(SearchResult& r) const {
@@ -496,9 +521,10 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
       for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
   }
   H = H.selfadjointView<Eigen::Lower>();
-  const Eigen::MatrixXd C = H.completeOrthogonalDecomposition().pseudoInverse();
+  const NormalMatrixAnalysis normal = analyse_normal_matrix(H);
   best.standard_errors.assign(np, std::numeric_limits<double>::quiet_NaN());
-  for (size_t a = 0; a < cols.size(); ++a) best.standard_errors[cols[a]] = std::sqrt(std::max(0.0, C(a, a)));
+  for (size_t a = 0; a < cols.size(); ++a)
+    best.standard_errors[cols[a]] = std::sqrt(std::max(0.0, normal.covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a))));
   // Profiles for the airframe's parameters, on every core; a flight's own copies of a
   // per-flight parameter (one per flight in a joint diagnosis) get Wald intervals from the
   // joint covariance, which includes the airframe's uncertainty.
@@ -530,16 +556,9 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
                            pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict});
     r.profiles.push_back(std::move(pr));
   }
-  // A per-flight copy that the data cannot separate from other parameters (a direction of
-  // J^T W J with a near-zero eigenvalue) has no Wald interval: the pseudo-inverse would give
-  // it a finite, too small one.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
-  std::vector<bool> confounded(cols.size(), false);
-  const double largest = eig.eigenvalues().size() ? eig.eigenvalues().maxCoeff() : 0.0;
-  for (Eigen::Index k = 0; k < eig.eigenvalues().size(); ++k)
-    if (eig.eigenvalues()(k) <= 1e-10 * largest)
-      for (size_t a = 0; a < cols.size(); ++a)
-        if (std::abs(eig.eigenvectors()(static_cast<Eigen::Index>(a), k)) > 0.1) confounded[a] = true;
+  // A per-flight copy that the data cannot separate from other parameters has no Wald
+  // interval: the pseudo-inverse would give it a finite, too small one.
+  const std::vector<bool>& confounded = normal.confounded;
   for (int i : wald) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const size_t a = static_cast<size_t>(std::find(cols.begin(), cols.end(), i) - cols.begin());

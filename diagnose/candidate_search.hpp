@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "dynamic_model.hpp"
 #include "equation_error.hpp"
 #include "least_squares.hpp"
@@ -136,6 +138,16 @@ std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::
 
 // What would separate two look-alike effects.
 std::string separating_manoeuvre(const std::string& a, const std::string& b);
+
+// The Gauss-Newton normal matrix J^T W J of a fit's free parameters: its pseudo-inverse (the
+// covariance, for standard errors) and which parameters lie along a direction the data cannot
+// determine (an eigenvalue of the unit-diagonal form near zero), computed on the matrix scaled
+// to unit diagonal so that parameters of very different size do not hide one another.
+struct NormalMatrixAnalysis {
+  Eigen::MatrixXd covariance;
+  std::vector<bool> confounded;
+};
+NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H);
 
 class CandidateSearch {
  public:
