@@ -1,27 +1,16 @@
 #include "log_reader.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "least_squares.hpp"  // FitError
+#include "log_file.hpp"
 
 namespace quadgen::fit {
 
 bool is_ulog(const std::string& path) {
-  // O_NONBLOCK: a FIFO must not block here; only a regular file can be a ULog (read_csv then
-  // refuses anything else with its own message).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return false;
-  struct stat st {};
-  char magic[7] = {};
-  const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::read(fd, magic, 7) == 7;
-  ::close(fd);
-  return ok && std::string(magic, 7) == std::string("ULog\x01\x12\x35", 7);
+  return runtime::read_head(path, 7) == std::string("ULog\x01\x12\x35", 7);
 }
 
 bool is_topic_log(const std::string& path) { return is_ulog(path) || runtime::is_usd_log(path); }

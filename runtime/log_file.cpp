@@ -45,6 +45,18 @@ LogFile::LogFile(const std::string& path, const std::string& expected) : path_(p
 
 LogFile::~LogFile() { ::close(fd_); }
 
+std::string read_head(const std::string& path, std::size_t n) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return {};
+  struct stat st {};
+  std::string head(n, '\0');
+  ssize_t got = 0;
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) got = ::read(fd, head.data(), n);
+  ::close(fd);
+  head.resize(got > 0 ? static_cast<std::size_t>(got) : 0);
+  return head;
+}
+
 std::string LogFile::read_all() const {
   std::string bytes;
   bytes.reserve(size_);

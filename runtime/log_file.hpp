@@ -3,9 +3,15 @@
 // second look-up of the path), a regular file of at most max_input_bytes(). Errors are
 // LogError with the path and what was expected ("a CSV log", "a ULog file").
 #pragma once
+#include <cstddef>
 #include <string>
 
 namespace quadgen::runtime {
+
+// The first `n` bytes of a regular file, for recognising a format by its magic bytes; fewer
+// (possibly none) when it is shorter, cannot be opened or is no regular file. Opened without
+// blocking, so that a FIFO is not waited on.
+std::string read_head(const std::string& path, std::size_t n);
 
 class LogFile {
  public:

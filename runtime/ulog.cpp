@@ -1,5 +1,6 @@
 #include "ulog.hpp"
 
+#include "log_bytes.hpp"
 #include "log_file.hpp"
 
 #include <fcntl.h>
@@ -41,41 +42,35 @@ const BaseType* base_type(std::string_view name) {
   return nullptr;
 }
 
-// Little-endian whatever the host: the spec fixes the byte order.
-std::uint64_t le(const char* p, unsigned n) {
-  std::uint64_t v = 0;
-  for (unsigned i = n; i-- > 0;) v = (v << 8) | static_cast<unsigned char>(p[i]);
-  return v;
-}
 
 double decode(Base b, const char* p) {
   switch (b) {
     case Base::i8:
-      return static_cast<std::int8_t>(le(p, 1));
+      return static_cast<std::int8_t>(little_endian(p, 1));
     case Base::i16:
-      return static_cast<std::int16_t>(le(p, 2));
+      return static_cast<std::int16_t>(little_endian(p, 2));
     case Base::i32:
-      return static_cast<std::int32_t>(le(p, 4));
+      return static_cast<std::int32_t>(little_endian(p, 4));
     case Base::i64:
-      return static_cast<double>(static_cast<std::int64_t>(le(p, 8)));
+      return static_cast<double>(static_cast<std::int64_t>(little_endian(p, 8)));
     case Base::u8:
     case Base::boolean:
     case Base::chr:
-      return static_cast<double>(le(p, 1));
+      return static_cast<double>(little_endian(p, 1));
     case Base::u16:
-      return static_cast<double>(le(p, 2));
+      return static_cast<double>(little_endian(p, 2));
     case Base::u32:
-      return static_cast<double>(le(p, 4));
+      return static_cast<double>(little_endian(p, 4));
     case Base::u64:
-      return static_cast<double>(le(p, 8));
+      return static_cast<double>(little_endian(p, 8));
     case Base::f32: {
-      const auto bits = static_cast<std::uint32_t>(le(p, 4));
+      const auto bits = static_cast<std::uint32_t>(little_endian(p, 4));
       float f;
       std::memcpy(&f, &bits, sizeof f);
       return f;
     }
     case Base::f64: {
-      const std::uint64_t bits = le(p, 8);
+      const std::uint64_t bits = little_endian(p, 8);
       double d;
       std::memcpy(&d, &bits, sizeof d);
       return d;
@@ -86,22 +81,14 @@ double decode(Base b, const char* p) {
 
 std::string number_text(Base b, const char* p) {
   // Through double, 64-bit integers would lose digits.
-  if (b == Base::u64) return std::to_string(le(p, 8));
-  if (b == Base::i64) return std::to_string(static_cast<std::int64_t>(le(p, 8)));
+  if (b == Base::u64) return std::to_string(little_endian(p, 8));
+  if (b == Base::i64) return std::to_string(static_cast<std::int64_t>(little_endian(p, 8)));
   std::ostringstream os;
   os.precision(b == Base::f32 ? 9 : 17);
   os << decode(b, p);
   return os.str();
 }
 
-// Text from the file in a one-line message: control characters as '?', long text cut short.
-std::string printable(std::string_view s, std::size_t max) {
-  std::string out;
-  for (char c : s.substr(0, max)) out += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
-  return s.size() > max ? out + "..." : out;
-}
-
-std::string shown(std::string_view s) { return "'" + printable(s, 40) + "'"; }
 
 // Plain ASCII tests: std::isalnum on a negative char is undefined.
 bool name_char(char c, bool message_name) {
@@ -125,16 +112,16 @@ struct TypeRef {
 std::string parse_type(std::string_view s, TypeRef& t) {
   const auto open = s.find('[');
   t.name = std::string(s.substr(0, open));
-  if (!is_name(t.name, true)) return "type " + shown(t.name) + " is not a valid type name";
+  if (!is_name(t.name, true)) return "type " + quoted_from_log(t.name) + " is not a valid type name";
   if (open == std::string_view::npos) return "";
   const std::string_view digits = s.substr(open + 1, s.size() - open - 2);
   if (s.back() != ']' || digits.empty() ||
       !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    return "type " + shown(s) + " is not type[length]";
+    return "type " + quoted_from_log(s) + " is not type[length]";
   t.array = true;
   t.count = digits.size() > 6 ? kUlogMaxArray + 1 : std::stoull(std::string(digits));
   if (t.count == 0 || t.count > kUlogMaxArray)
-    return "array length " + printable(digits, 20) + " in " + shown(s) + " (expected 1.." +
+    return "array length " + text_from_log(digits, 20) + " in " + quoted_from_log(s) + " (expected 1.." +
            std::to_string(kUlogMaxArray) + ")";
   return "";
 }
@@ -244,13 +231,13 @@ void Parser::read_header() {
     fail(0, "not a ULog file (expected the magic \"ULog\" 01 12 35)");
   if (b_.size() < kHeaderBytes) fail(b_.size(), "the file ends inside the 16-byte ULog header");
   out_.version = static_cast<unsigned char>(b_[7]);
-  out_.start_time = le(b_.data() + 8, 8);
+  out_.start_time = little_endian(b_.data() + 8, 8);
 }
 
 // The message at pos if it ends by `end`, else nothing (a cut-off or absent message).
 std::optional<Msg> Parser::message_at(std::size_t pos, std::size_t end) const {
   if (end - pos < kMsgHeaderBytes) return std::nullopt;
-  const std::size_t size = le(b_.data() + pos, 2);
+  const std::size_t size = little_endian(b_.data() + pos, 2);
   if (end - pos - kMsgHeaderBytes < size) return std::nullopt;
   return Msg{b_[pos + 2], pos, std::string_view(b_).substr(pos + kMsgHeaderBytes, size)};
 }
@@ -268,7 +255,7 @@ std::vector<std::size_t> Parser::flag_bits(const Msg& m) const {
   std::vector<std::size_t> ends;
   const std::uint64_t start = m.at + kMsgHeaderBytes + m.body.size();
   for (int i = 0; i < 3 && (p[8] & 1); ++i) {
-    const std::uint64_t offset = le(p + 16 + 8 * i, 8), from = ends.empty() ? start : ends.back();
+    const std::uint64_t offset = little_endian(p + 16 + 8 * i, 8), from = ends.empty() ? start : ends.back();
     if (offset == 0) continue;
     if (offset < from || offset > b_.size())
       fail(m.at, "appended_offsets[" + std::to_string(i) + "] = " + std::to_string(offset) +
@@ -318,12 +305,12 @@ void Parser::handle(const Msg& m) {
       return data(m);
     case 'R':
       require(m, 2, "msg_id");
-      subs_.erase(static_cast<std::uint16_t>(le(m.body.data(), 2)));
+      subs_.erase(static_cast<std::uint16_t>(little_endian(m.body.data(), 2)));
       return;
     case 'O':
       require(m, 2, "duration");
       ++out_.dropouts;
-      out_.dropout_ms += static_cast<double>(le(m.body.data(), 2));
+      out_.dropout_ms += static_cast<double>(little_endian(m.body.data(), 2));
       return;
     case 'L':
     case 'C':
@@ -340,10 +327,10 @@ void Parser::format(const Msg& m) {
   const std::string_view text = m.body;
   const auto colon = text.find(':');
   if (colon == std::string_view::npos)
-    fail(m.at, "format " + shown(text) + " has no ':' (expected \"name:type field;...\")");
+    fail(m.at, "format " + quoted_from_log(text) + " has no ':' (expected \"name:type field;...\")");
   const std::string name(text.substr(0, colon));
   if (!is_name(name, true) || base_type(name))
-    fail(m.at, "format name " + shown(name) + " is not a valid message name");
+    fail(m.at, "format name " + quoted_from_log(name) + " is not a valid message name");
   FormatDef def{{}, std::string(text), m.at};
   std::set<std::string> seen;
   for (std::string_view list = text.substr(colon + 1); !list.empty();) {
@@ -354,25 +341,25 @@ void Parser::format(const Msg& m) {
     def.fields.push_back(parse_field(item, m.at, name));
     const FieldDef& f = def.fields.back();
     if (!f.padding && !seen.insert(f.name).second)
-      fail(m.at, "format " + shown(name) + " has field " + shown(f.name) + " twice");
+      fail(m.at, "format " + quoted_from_log(name) + " has field " + quoted_from_log(f.name) + " twice");
   }
-  if (def.fields.empty()) fail(m.at, "format " + shown(name) + " has no fields");
+  if (def.fields.empty()) fail(m.at, "format " + quoted_from_log(name) + " has no fields");
   const auto [it, added] = formats_.emplace(name, std::move(def));
   // Formats cannot change once data may have been read with them.
   if (!added && it->second.text != text)
     fail(m.at,
-         "format " + shown(name) + " defined again, differently (first at byte " + std::to_string(it->second.at) + ")");
+         "format " + quoted_from_log(name) + " defined again, differently (first at byte " + std::to_string(it->second.at) + ")");
 }
 
 FieldDef Parser::parse_field(std::string_view item, std::uint64_t at, const std::string& fmt) const {
   const auto space = item.find(' ');
   if (space == std::string_view::npos || item.find(' ', space + 1) != std::string_view::npos)
-    fail(at, "format " + shown(fmt) + ": field " + shown(item) + " is not \"type name\"");
+    fail(at, "format " + quoted_from_log(fmt) + ": field " + quoted_from_log(item) + " is not \"type name\"");
   FieldDef f;
   if (const std::string why = parse_type(item.substr(0, space), f.type); !why.empty())
-    fail(at, "format " + shown(fmt) + ": " + why);
+    fail(at, "format " + quoted_from_log(fmt) + ": " + why);
   f.name = std::string(item.substr(space + 1));
-  if (!is_name(f.name, false)) fail(at, "format " + shown(fmt) + ": " + shown(f.name) + " is not a valid field name");
+  if (!is_name(f.name, false)) fail(at, "format " + quoted_from_log(fmt) + ": " + quoted_from_log(f.name) + " is not a valid field name");
   f.padding = f.name.rfind("_padding", 0) == 0;
   return f;
 }
@@ -388,9 +375,9 @@ KeyValue Parser::key_value(const Msg& m) const {
   std::string why = space == std::string_view::npos ? "no space" : parse_type(key.substr(0, space), kv.type);
   if (why.empty()) {
     kv.name = std::string(key.substr(space + 1));
-    if (!is_name(kv.name, true)) why = shown(kv.name) + " is not a valid name";
+    if (!is_name(kv.name, true)) why = quoted_from_log(kv.name) + " is not a valid name";
   }
-  if (!why.empty()) fail(m.at, std::string("'") + m.type + "' key " + shown(key) + " is not \"type name\": " + why);
+  if (!why.empty()) fail(m.at, std::string("'") + m.type + "' key " + quoted_from_log(key) + " is not \"type name\": " + why);
   kv.value = m.body.substr(1 + key_len);
   return kv;
 }
@@ -404,10 +391,10 @@ void Parser::info(const Msg& m) {
   } else if (t->base == Base::chr) {
     const auto used = kv.value.find_last_not_of('\0');  // some writers keep C terminators
     const std::string_view value = kv.value.substr(0, used == std::string_view::npos ? 0 : used + 1);
-    text = printable(value, value.size());
+    text = text_from_log(value, value.size());
   } else {
     if (kv.value.size() != t->size * kv.type.count)
-      fail(m.at, "info " + shown(kv.name) + ": value of " + std::to_string(kv.value.size()) + " bytes, expected " +
+      fail(m.at, "info " + quoted_from_log(kv.name) + ": value of " + std::to_string(kv.value.size()) + " bytes, expected " +
                      std::to_string(t->size * kv.type.count));
     for (std::size_t i = 0; i < kv.type.count; ++i)
       text += (i ? "," : "") + number_text(t->base, kv.value.data() + i * t->size);
@@ -419,7 +406,7 @@ void Parser::parameter(const Msg& m) {
   const KeyValue kv = key_value(m);
   const BaseType* t = base_type(kv.type.name);
   if (!t || kv.type.array || t->base == Base::chr || kv.value.size() != t->size)
-    fail(m.at, "parameter " + shown(kv.name) + ": expected a number (int32_t or float), got " + shown(kv.type.name) +
+    fail(m.at, "parameter " + quoted_from_log(kv.name) + ": expected a number (int32_t or float), got " + quoted_from_log(kv.type.name) +
                    (kv.type.array ? "[]" : "") + " with " + std::to_string(kv.value.size()) + " bytes");
   const double v = decode(t->base, kv.value.data());
   if (in_data_)
@@ -431,10 +418,10 @@ void Parser::parameter(const Msg& m) {
 void Parser::subscribe(const Msg& m) {
   require(m, 4, "multi_id, msg_id, message name");
   const int multi_id = static_cast<unsigned char>(m.body[0]);
-  const auto msg_id = static_cast<std::uint16_t>(le(m.body.data() + 1, 2));
+  const auto msg_id = static_cast<std::uint16_t>(little_endian(m.body.data() + 1, 2));
   const std::string name(m.body.substr(3));
-  if (!is_name(name, true)) fail(m.at, "subscription to " + shown(name) + ", not a valid message name");
-  if (!formats_.count(name)) fail(m.at, "subscription to undefined format " + shown(name));
+  if (!is_name(name, true)) fail(m.at, "subscription to " + quoted_from_log(name) + ", not a valid message name");
+  if (!formats_.count(name)) fail(m.at, "subscription to undefined format " + quoted_from_log(name));
   if (subs_.count(msg_id)) fail(m.at, "msg_id " + std::to_string(msg_id) + " subscribed twice");
   const Layout& l = layout(name, m.at);
   const auto [it, added] = topic_of_.emplace(std::make_pair(name, multi_id), out_.topics.size());
@@ -447,14 +434,14 @@ void Parser::subscribe(const Msg& m) {
 
 void Parser::data(const Msg& m) {
   require(m, 2, "msg_id");
-  const auto msg_id = static_cast<std::uint16_t>(le(m.body.data(), 2));
+  const auto msg_id = static_cast<std::uint16_t>(little_endian(m.body.data(), 2));
   const auto s = subs_.find(msg_id);
   if (s == subs_.end()) fail(m.at, "data message for unknown msg_id " + std::to_string(msg_id));
   const Layout& l = *s->second.layout;
   LogTopic& topic = out_.topics[s->second.topic];
   const std::string_view d = m.body.substr(2);
   if (d.size() < l.min_size || d.size() > l.size)
-    fail(m.at, "data message for " + shown(topic.name) + " has " + std::to_string(d.size()) + " bytes, expected " +
+    fail(m.at, "data message for " + quoted_from_log(topic.name) + " has " + std::to_string(d.size()) + " bytes, expected " +
                    (l.min_size == l.size ? "" : std::to_string(l.min_size) + "..") + std::to_string(l.size));
   std::vector<double> row(l.leaves.size());
   for (std::size_t i = 0; i < row.size(); ++i) row[i] = decode(l.leaves[i].type, d.data() + l.leaves[i].offset);
@@ -477,14 +464,14 @@ const Layout& Parser::layout(const std::string& fmt, std::uint64_t at) {
 
 std::uint64_t Parser::format_size(const std::string& fmt, int depth, std::set<std::string>& open, std::uint64_t at) {
   if (const auto it = sizes_.find(fmt); it != sizes_.end()) return it->second;
-  if (!open.insert(fmt).second) fail(at, "format " + shown(fmt) + " contains itself (recursive formats are refused)");
+  if (!open.insert(fmt).second) fail(at, "format " + quoted_from_log(fmt) + " contains itself (recursive formats are refused)");
   if (depth > kUlogMaxNesting)
-    fail(at, "format " + shown(fmt) + " is nested deeper than " + std::to_string(kUlogMaxNesting) + " levels");
+    fail(at, "format " + quoted_from_log(fmt) + " is nested deeper than " + std::to_string(kUlogMaxNesting) + " levels");
   std::uint64_t total = 0;
   for (const auto& f : formats_.at(fmt).fields) {
     total += element_size(f.type, fmt, depth, open, at) * f.type.count;  // both <= 65535: no overflow
     if (total > kUlogMaxFormatBytes)
-      fail(at, "format " + shown(fmt) + " is larger than " + std::to_string(kUlogMaxFormatBytes) +
+      fail(at, "format " + quoted_from_log(fmt) + " is larger than " + std::to_string(kUlogMaxFormatBytes) +
                    " bytes (no data message can hold it)");
   }
   open.erase(fmt);
@@ -494,7 +481,7 @@ std::uint64_t Parser::format_size(const std::string& fmt, int depth, std::set<st
 std::uint64_t Parser::element_size(const TypeRef& t, const std::string& fmt, int depth, std::set<std::string>& open,
                                    std::uint64_t at) {
   if (const BaseType* b = base_type(t.name)) return b->size;
-  if (!formats_.count(t.name)) fail(at, "format " + shown(fmt) + ": unknown type " + shown(t.name));
+  if (!formats_.count(t.name)) fail(at, "format " + quoted_from_log(fmt) + ": unknown type " + quoted_from_log(t.name));
   return format_size(t.name, depth + 1, open, at);
 }
 
@@ -525,7 +512,7 @@ void Parser::timestamp_first(Layout& l, const std::string& fmt, std::uint64_t at
   const auto it = std::find(l.names.begin(), l.names.end(), "timestamp");
   const auto i = it - l.names.begin();
   if (it == l.names.end() || l.leaves[i].type != Base::u64)
-    fail(at, "format " + shown(fmt) + " has no field 'uint64_t timestamp' (every subscribed format needs one)");
+    fail(at, "format " + quoted_from_log(fmt) + " has no field 'uint64_t timestamp' (every subscribed format needs one)");
   std::rotate(l.names.begin(), it, it + 1);
   std::rotate(l.leaves.begin(), l.leaves.begin() + i, l.leaves.begin() + i + 1);
 }

@@ -1,15 +1,12 @@
 #include "usd_log.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <set>
 #include <string_view>
 
+#include "log_bytes.hpp"
 #include "log_file.hpp"
 
 namespace quadgen::runtime {
@@ -38,12 +35,6 @@ const TypeCode* type_code(char c) {
   return nullptr;
 }
 
-// Little-endian whatever the host: the firmware writes the STM32's memory images.
-std::uint64_t le(const char* p, unsigned n) {
-  std::uint64_t v = 0;
-  for (unsigned i = n; i-- > 0;) v = (v << 8) | static_cast<unsigned char>(p[i]);
-  return v;
-}
 
 // IEEE 754 half precision: 1 sign, 5 exponent (bias 15), 10 mantissa bits.
 double half_to_double(std::uint16_t h) {
@@ -56,21 +47,21 @@ double half_to_double(std::uint16_t h) {
 double decode(char code, const char* p) {
   switch (code) {
     case 'B':
-      return static_cast<double>(le(p, 1));
+      return static_cast<double>(little_endian(p, 1));
     case 'b':
-      return static_cast<std::int8_t>(le(p, 1));
+      return static_cast<std::int8_t>(little_endian(p, 1));
     case 'H':
-      return static_cast<double>(le(p, 2));
+      return static_cast<double>(little_endian(p, 2));
     case 'h':
-      return static_cast<std::int16_t>(le(p, 2));
+      return static_cast<std::int16_t>(little_endian(p, 2));
     case 'I':
-      return static_cast<double>(le(p, 4));
+      return static_cast<double>(little_endian(p, 4));
     case 'i':
-      return static_cast<std::int32_t>(le(p, 4));
+      return static_cast<std::int32_t>(little_endian(p, 4));
     case 'e':
-      return half_to_double(static_cast<std::uint16_t>(le(p, 2)));
+      return half_to_double(static_cast<std::uint16_t>(little_endian(p, 2)));
     default: {  // 'f'
-      const auto bits = static_cast<std::uint32_t>(le(p, 4));
+      const auto bits = static_cast<std::uint32_t>(little_endian(p, 4));
       float v;
       std::memcpy(&v, &bits, sizeof v);
       return v;
@@ -78,12 +69,6 @@ double decode(char code, const char* p) {
   }
 }
 
-// Text from the file in a one-line message: control characters as '?', long text cut short.
-std::string shown(std::string_view s) {
-  std::string out = "'";
-  for (char c : s.substr(0, 40)) out += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
-  return out + (s.size() > 40 ? "...'" : "'");
-}
 
 // Event and log-variable names: a-zA-Z0-9_ and '.' between group and name (plain ASCII tests:
 // std::isalnum on a negative char is undefined).
@@ -125,7 +110,7 @@ class Parser {
 
 std::uint64_t Parser::take(unsigned n, const char* what) {
   if (b_.size() - pos_ < n) fail(pos_, std::string("the header ends inside ") + what);
-  const std::uint64_t v = le(b_.data() + pos_, n);
+  const std::uint64_t v = little_endian(b_.data() + pos_, n);
   pos_ += n;
   return v;
 }
@@ -143,13 +128,13 @@ void Parser::read_event_type() {
   EventType e{static_cast<unsigned>(take(2, "an event id")), out_.topics.size(), "", 2 + timestamp_bytes_};
   LogTopic topic;
   topic.name = take_text("an event name");
-  if (!is_log_name(topic.name)) fail(at + 2, "event name " + shown(topic.name) + " is no log name (a-zA-Z0-9_.)");
+  if (!is_log_name(topic.name)) fail(at + 2, "event name " + quoted_from_log(topic.name) + " is no log name (a-zA-Z0-9_.)");
   for (const auto& t : types_)
     if (t.id == e.id || out_.topics[t.topic].name == topic.name)
-      fail(at, "event type " + std::to_string(e.id) + " " + shown(topic.name) + " is defined twice");
+      fail(at, "event type " + std::to_string(e.id) + " " + quoted_from_log(topic.name) + " is defined twice");
   const auto count = static_cast<unsigned>(take(2, "a variable count"));
   if (count > kUsdMaxVariables)
-    fail(pos_ - 2, std::to_string(count) + " variables in event " + shown(topic.name) + " (at most " +
+    fail(pos_ - 2, std::to_string(count) + " variables in event " + quoted_from_log(topic.name) + " (at most " +
                        std::to_string(kUsdMaxVariables) + ")");
   topic.fields.push_back("timestamp");
   std::set<std::string> seen;
@@ -160,10 +145,10 @@ void Parser::read_event_type() {
     const TypeCode* type = def.size() >= 4 && def[def.size() - 3] == '(' && def.back() == ')'
                                ? type_code(def[def.size() - 2])
                                : nullptr;
-    if (!type) fail(var_at, "variable " + shown(def) + " is not name(T) with T one of B b H h I i f e");
+    if (!type) fail(var_at, "variable " + quoted_from_log(def) + " is not name(T) with T one of B b H h I i f e");
     const std::string name = def.substr(0, def.size() - 3);
-    if (!is_log_name(name)) fail(var_at, "variable name " + shown(name) + " is no log name (a-zA-Z0-9_.)");
-    if (!seen.insert(name).second) fail(var_at, "variable " + shown(name) + " appears twice in one event");
+    if (!is_log_name(name)) fail(var_at, "variable name " + quoted_from_log(name) + " is no log name (a-zA-Z0-9_.)");
+    if (!seen.insert(name).second) fail(var_at, "variable " + quoted_from_log(name) + " appears twice in one event");
     topic.fields.push_back(name);
     e.codes += type->code;
     e.record_bytes += type->size;
@@ -182,7 +167,7 @@ void Parser::read_records(std::size_t end) {
       out_.truncated = true, out_.truncated_at = at;
       return;
     }
-    const auto id = static_cast<unsigned>(le(b_.data() + pos_, 2));
+    const auto id = static_cast<unsigned>(little_endian(b_.data() + pos_, 2));
     const EventType* e = nullptr;
     for (const auto& t : types_)
       if (t.id == id) e = &t;
@@ -193,7 +178,7 @@ void Parser::read_records(std::size_t end) {
       return;
     }
     const char* p = b_.data() + pos_ + 2;
-    const std::uint64_t stamp = le(p, timestamp_bytes_);
+    const std::uint64_t stamp = little_endian(p, timestamp_bytes_);
     std::vector<double> row;
     row.reserve(1 + e->codes.size());
     // Microseconds on both versions: version 1 counts milliseconds (the 1 kHz system tick).
@@ -220,7 +205,7 @@ UsdLog Parser::run() {
   if (types == 0) fail(3, "the header defines no event type");
   for (unsigned k = 0; k < types; ++k) read_event_type();
   // The CRC, when logging stopped cleanly: the last four bytes, over everything before them.
-  out_.crc_valid = b_.size() >= pos_ + 4 && le(b_.data() + b_.size() - 4, 4) == crc32(b_, b_.size() - 4);
+  out_.crc_valid = b_.size() >= pos_ + 4 && little_endian(b_.data() + b_.size() - 4, 4) == crc32(b_, b_.size() - 4);
   read_records(out_.crc_valid ? b_.size() - 4 : b_.size());
   return std::move(out_);
 }
@@ -228,14 +213,8 @@ UsdLog Parser::run() {
 }  // namespace
 
 bool is_usd_log(const std::string& path) {
-  // O_NONBLOCK: a FIFO must not block here; only a regular file can be a uSD log.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return false;
-  struct stat st {};
-  unsigned char head[3] = {};
-  const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::read(fd, head, 3) == 3;
-  ::close(fd);
-  return ok && head[0] == 0xBC && (head[1] == 1 || head[1] == 2) && head[2] == 0;
+  const std::string head = read_head(path, 3);
+  return head.size() == 3 && head[0] == '\xBC' && (head[1] == 1 || head[1] == 2) && head[2] == 0;
 }
 
 UsdLog parse_usd_log(const std::string& bytes, const std::string& name) { return Parser(bytes, name).run(); }
