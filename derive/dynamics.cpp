@@ -201,9 +201,12 @@ void assemble(ModelContext& c) {
   const matrix omega_dot = Jinv.mul(torque.sub(cross(c.omega, J.mul(c.omega))));
   // Translation: the CoG obeys m a_cg = R F_b − m g e_z; the origin is offset from it
   // by −c, so a_o = a_cg − R(ω̇ × c + ω × (ω × c)).
-  const matrix transport = cross(omega_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
-  const matrix accel_body = force_body.mul_scalar(1 / c.p("mass")).sub(transport);
-  const matrix accel_world = c.R.mul(accel_body).sub(vec3(0, 0, c.p("g")));
+  auto accel_world_for = [&](const matrix& w_dot) {
+    const matrix transport = cross(w_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
+    const matrix accel_body = force_body.mul_scalar(1 / c.p("mass")).sub(transport);
+    return c.R.mul(accel_body).sub(vec3(0, 0, c.p("g")));
+  };
+  const matrix accel_world = accel_world_for(omega_dot);
   const matrix q_dot = quaternion_rate(c.q, c.omega);
 
   const size_t n = m.states.size();
@@ -217,10 +220,7 @@ void assemble(ModelContext& c) {
   for (size_t i = 0; i < c.extra_rates.size(); ++i) m.f(13 + i, 0) = c.extra_rates[i];
 
   m.omega_dot = {symbol("omegadot_x"), symbol("omegadot_y"), symbol("omegadot_z")};
-  const matrix w_dot = vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]);
-  const matrix transport_split = cross(w_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
-  const matrix accel_split =
-      c.R.mul(force_body.mul_scalar(1 / c.p("mass")).sub(transport_split)).sub(vec3(0, 0, c.p("g")));
+  const matrix accel_split = accel_world_for(vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]));
   m.f_split = m.f;
   for (int i = 0; i < 3; ++i) m.f_split(3 + i, 0) = accel_split(i, 0);
 
