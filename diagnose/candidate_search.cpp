@@ -553,7 +553,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
     const int i = pr.index;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
                            pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
-                           pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict});
+                           pr.upper_open ? std::numeric_limits<double>::quiet_NaN() : pr.upper, 0.0, pr.verdict,
+                           "profile", fit::on_bound(r.final_fit[i])});
     r.profiles.push_back(std::move(pr));
   }
   // A per-flight copy that the data cannot separate from other parameters has no Wald
@@ -567,7 +568,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
     const double v = r.final_fit[i].value, z = 1.959963984540054;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, se, finite ? v - z * se : nan,
                            finite ? v + z * se : nan, 0.0,
-                           finite ? "identifiable" : "structurally non-identifiable", "wald"});
+                           finite ? "identifiable" : "structurally non-identifiable", "wald",
+                           fit::on_bound(r.final_fit[i])});
   }
   std::stable_sort(r.estimates.begin(), r.estimates.end(), [&](const EffectEstimate& a, const EffectEstimate& b) {
     return model_.param_index(a.name) < model_.param_index(b.name);

@@ -60,6 +60,7 @@ struct EffectEstimate {
   // standard errors of the joint fit) for a flight's own copy of a per-flight parameter in
   // a joint diagnosis, where profiling every flight's copy would take hours.
   std::string interval = "profile";
+  bool at_bound = false;  // ended on a bound of the final fit
 };
 
 struct CandidateEvidence {

@@ -449,10 +449,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
                               pose ? folds : std::vector<fit::Flight>{}, opt.window);
   }
   for (const auto& p : s.final_fit)
-    if (p.free && fit::on_bound(p)) {
-      const bool lower = std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper);
-      d.at_bounds.push_back(p.name + " = " + std::to_string(p.value) + (lower ? " (lower bound)" : " (upper bound)"));
-    }
+    if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
   d.airframe_fit = airframe_values(s.final_fit);
   d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return d;

@@ -109,7 +109,7 @@ struct Diagnosis {
   std::vector<ChannelGain> channel_gain;
   // Free parameters of the final model that ended on a bound: the model is strained there,
   // and a finding may stand in for physics the catalogue lacks.
-  std::vector<std::string> at_bounds;
+  std::vector<fit::FitParameter> at_bounds;
   // The final fit as the airframe's parameters: per-flight values averaged over the flights
   // (what the extended header and fitted_parameters.yaml carry). One flight: the final fit.
   std::vector<fit::FitParameter> airframe_fit;

@@ -10,6 +10,7 @@
 
 #include "effects.hpp"
 #include "per_flight_model.hpp"
+#include "estimate.hpp"
 #include "fit_report.hpp"
 #include "plot.hpp"
 #include "sinks.hpp"
@@ -20,7 +21,7 @@ using json = nlohmann::ordered_json;
 
 namespace {
 
-using fit::number_or_null;
+using output::number_or_null;
 
 double reduction(double before, double after) {
   return before > 0 && std::isfinite(before) && std::isfinite(after) ? 100 * (before - after) / before : 0.0;
@@ -45,10 +46,12 @@ json evidence_json(const CandidateEvidence& e) {
           {"why_not", e.why_not}};
 }
 
+// The free parameters of a fit, each in the one estimate shape: intervals are only computed
+// for the named effects' parameters (findings), so here they stay null.
 json parameters_json(const std::vector<fit::FitParameter>& ps) {
   json j = json::object();
   for (const auto& p : ps)
-    if (p.free) j[p.name] = {{"value", p.value}, {"unit", p.unit}};
+    if (p.free) j[p.name] = output::estimate_json({p.value, p.unit, NAN, NAN, "", fit::on_bound(p)});
   return j;
 }
 
@@ -132,8 +135,7 @@ std::string point_of_action_headline(const PointOfAction& p) {
 json point_of_action_json(const Diagnosis& d) {
   const auto p = point_of_action(d);
   if (!p) return nullptr;
-  return {{"height_above_cog_m", p->height},
-          {"ci95", {number_or_null(p->lower), number_or_null(p->upper)}},
+  return {{"height_above_cog", output::estimate_json({p->height, "m", p->lower, p->upper, "", false})},
           {"from", "blade_flapping.k / rotor_drag.k"},
           {"interval_method", "delta method on the two standard errors, their covariance neglected"},
           {"headline", point_of_action_headline(*p)}};
@@ -144,16 +146,17 @@ json finding_json(const Finding& f) {
   const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
   if (has_reference)
     for (const auto& p : f.evidence.parameters)
-      if (effect_of_parameter(p.name) == f.effect && !p.free)
-        ps[p.name] = {{"value", 0.0}, {"ci95", {0.0, 0.0}}, {"unit", "1"}, {"reference", true}};
-  for (const auto& e : f.parameters)
-    ps[e.name] = {{"value", e.value},
-                  {"ci95", {number_or_null(e.lower), number_or_null(e.upper)}},
-                  {"unit", e.unit},
-                  {"standard_error", number_or_null(e.standard_error)},
-                  {"numerical_allowance", e.numerical_allowance},
-                  {"identifiability", e.verdict},
-                  {"interval_method", e.interval}};
+      if (effect_of_parameter(p.name) == f.effect && !p.free) {
+        ps[p.name] = output::estimate_json({0.0, p.unit, 0.0, 0.0, "reference (held at 0)", false});
+        ps[p.name]["reference"] = true;
+      }
+  for (const auto& e : f.parameters) {
+    json pj = output::estimate_json({e.value, e.unit, e.lower, e.upper, e.verdict, e.at_bound});
+    pj["standard_error"] = number_or_null(e.standard_error);
+    pj["numerical_allowance"] = e.numerical_allowance;
+    pj["interval_method"] = e.interval;
+    ps[e.name] = pj;
+  }
   json fj = {{"effect", f.effect},
              {"headline", headline(f)},
              {"parameters", ps},
@@ -273,8 +276,11 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   for (const auto& t : d.discovered) {
     json cs = json::array();
     for (const auto& c : t.coefficients)
-      cs.push_back({{"regressor", c.regressor}, {"unit", c.unit}, {"value", number_or_null(c.value)},
-                    {"ci95", {number_or_null(c.lower), number_or_null(c.upper)}}});
+    {
+      json cj = {{"regressor", c.regressor}};
+      cj.update(output::estimate_json({c.value, c.unit, c.lower, c.upper, "", false}));
+      cs.push_back(cj);
+    }
     disc.push_back({{"channel", t.channel},
                     {"unit", t.unit},
                     {"proposed", t.proposed},
@@ -300,7 +306,9 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                                 {"mean", number_or_null(tg.gain_mean)},
                                 {"standard_error", number_or_null(tg.gain_standard_error)},
                                 {"note", tg.note}};
-  j["parameters_at_bounds"] = d.at_bounds;
+  json at_bounds = json::array();
+  for (const auto& p : d.at_bounds) at_bounds.push_back(p.name);
+  j["parameters_at_bounds"] = at_bounds;
   j["gain"] = {{"metric", d.metric},
                {"before", number_or_null(d.metric_before)},
                {"after", number_or_null(d.metric_after)},
@@ -492,8 +500,9 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& x : d.suspected)
     os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
-  for (const auto& b : d.at_bounds)
-    os << "caution: " << b << " — the model is strained there; a finding may stand in for missing physics\n";
+  for (const auto& p : d.at_bounds)
+    os << "caution: " << p.name << " = " << num(p.value) << " " << p.unit
+       << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "

@@ -85,8 +85,6 @@ std::string side(double v, bool open) {
   return os.str();
 }
 
-nlohmann::ordered_json side_or_null(double v, bool open) { return open ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v); }
-
 // A plot's data always joins the outputs as CSV beside it (fit.csv for fit.svg); the plot
 // itself when gnuplot can draw it, and without one the fit still counts.
 void add_plot(FitOutputs& out, const std::string& file, const std::string& title, const std::vector<runtime::Panel>& panels) {
@@ -167,10 +165,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   j["log"] = path;
   j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
                      {"thesis_method", "read off one normalised step at 63 % (thesis 2.3.4, Figure 24)"},
-                     {"tau_s", tau_s},
-                     {"tau_ci95", {tau ? side_or_null(tau->lower, tau->lower_open) : nullptr,
-                                   tau ? side_or_null(tau->upper, tau->upper_open) : nullptr}},
-                     {"tau_verdict", tau ? tau->verdict : ""}};
+                     {"tau", j["estimates"]["tau"]}};
   add_profile_plot(out, v.name + ": motor step profiles", profiles);
   add_plot(out, "fit.svg", v.name + ": motor steps (thesis Table 2)", normalised_steps(model, parameter_values(best.parameters)));
   std::ostringstream s;
@@ -314,7 +309,7 @@ namespace {
 nlohmann::ordered_json per_motor_attempt(const StandFit& f) {  // verdicts only: no value at a bound is an estimate
   nlohmann::ordered_json attempt = nlohmann::ordered_json::object();
   for (const auto& pr : f.per_motor_profiles)
-    attempt[pr.parameter] = {{"verdict", pr.verdict},
+    attempt[pr.parameter] = {{"identifiability", pr.verdict},
                              {"at_bound", std::count(f.per_motor.at_bound.begin(), f.per_motor.at_bound.end(), pr.parameter) > 0}};
   return attempt;
 }
@@ -365,9 +360,13 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   j["speed_vs_command"] = fit_json(f.speed, f.speed_profiles);
   if (!f.voltage_exponent_identified) j["speed_vs_command"]["why"] = f.voltage_reason;
   const Profile* kp = shared ? &f.thrust_profiles.front() : nullptr;
-  j["summary"] = {{"k_mean_N_s2", k},
-                  {"k_ci95_N_s2", kp ? nlohmann::ordered_json{side_or_null(kp->lower, kp->lower_open), side_or_null(kp->upper, kp->upper_open)}
-                                     : nlohmann::ordered_json(nullptr)},
+  // k as an estimate: with its profile when one coefficient is shared, else the plain mean.
+  output::Estimate k_estimate{k, "N s^2", NAN, NAN, "", false};
+  if (kp) {
+    const FitParameter& shared_k = f.thrust.parameters.front();
+    k_estimate = estimate_of(shared_k, kp, std::count(f.thrust.at_bound.begin(), f.thrust.at_bound.end(), shared_k.name) > 0);
+  }
+  j["summary"] = {{"k", output::estimate_json(k_estimate)},
                   {"coefficients", shared ? "one shared by all motors" : "mean of the per-motor coefficients"},
                   {"c_t", ct},
                   {"c_t_in_vehicle_file", param(v, "c_t").value},

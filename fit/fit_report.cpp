@@ -1,13 +1,18 @@
 #include "fit_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "plot.hpp"
 
 namespace quadgen::fit {
 
-nlohmann::ordered_json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+using output::number_or_null;
+
+output::Estimate estimate_of(const FitParameter& p, const Profile* profile, bool at_bound) {
+  output::Estimate e{p.value, p.unit, NAN, NAN, "", at_bound};
+  if (profile) e.lower = profile->lower, e.upper = profile->upper, e.identifiability = profile->verdict;
+  return e;
 }
 
 nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles) {
@@ -16,19 +21,18 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
   J est = J::object();
   for (size_t i = 0; i < r.parameters.size(); ++i) {
     const auto& p = r.parameters[i];
-    J e;
-    e["value"] = p.value;
-    e["unit"] = p.unit;
+    const Profile* profile = nullptr;
+    for (const auto& pr : profiles)
+      if (pr.index == static_cast<int>(i)) profile = &pr;
+    const bool at_bound = std::find(r.at_bound.begin(), r.at_bound.end(), p.name) != r.at_bound.end();
+    J e = output::estimate_json(estimate_of(p, profile, at_bound));
     e["fitted"] = p.free;
     e["standard_error"] = number_or_null(r.standard_errors[i]);
     e["bounds"] = {p.lower, p.upper};
-    for (const auto& pr : profiles)
-      if (pr.index == static_cast<int>(i)) {
-        e["profile_ci95"] = {number_or_null(pr.lower), number_or_null(pr.upper)};
-        e["verdict"] = pr.verdict;
-        if (!pr.compensated_by.empty()) e["compensated_by"] = pr.compensated_by;
-      }
-    e["at_bound"] = std::find(r.at_bound.begin(), r.at_bound.end(), p.name) != r.at_bound.end();
+    if (profile) {
+      e["interval_method"] = "profile likelihood";
+      if (!profile->compensated_by.empty()) e["compensated_by"] = profile->compensated_by;
+    }
     est[p.name] = e;
   }
   j["estimates"] = est;

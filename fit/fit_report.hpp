@@ -7,13 +7,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "estimate.hpp"
 #include "least_squares.hpp"
 #include "profile_likelihood.hpp"
 
 namespace quadgen::fit {
 
-// A number in JSON, or null for NaN and infinities (an open interval side, a missing value).
-nlohmann::ordered_json number_or_null(double v);
+// A fitted parameter as output::Estimate: its profile's interval and verdict when it was
+// profiled (nullptr: not profiled, the interval stays null).
+output::Estimate estimate_of(const FitParameter& p, const Profile* profile, bool at_bound);
 
 nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& profiles);
 

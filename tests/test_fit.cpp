@@ -17,6 +17,7 @@
 #include "least_squares.hpp"
 #include "motor_steps.hpp"
 #include "profile_likelihood.hpp"
+#include "estimate_shape.hpp"
 #include "test_helpers.hpp"
 
 using namespace quadgen;
@@ -212,7 +213,9 @@ TEST(FitCli, MotorStepsOfTheThesis) {
   const double tau = j["estimates"]["tau"]["value"];
   EXPECT_GT(tau, 0.02);
   EXPECT_LT(tau, 0.3);
-  EXPECT_EQ(j["estimates"]["tau"]["verdict"], "identifiable");
+  EXPECT_EQ(j["estimates"]["tau"]["identifiability"], "identifiable");
+  for (const auto& [name, e] : j["estimates"].items()) EXPECT_TRUE(test::has_estimate_shape(e)) << name;
+  EXPECT_TRUE(test::has_estimate_shape(j["comparison"]["tau"]));
   // The motor map fitted with the lag stays close to the steady-state least squares.
   EXPECT_NEAR(j["estimates"]["a1"]["value"].get<double>(), 21224.5, 0.15 * 21224.5);
   // Every plot's data beside it: the profile of tau as rows (text fields quoted)
@@ -423,13 +426,14 @@ TEST(FitCli, ProfilesOnDemand) {
   auto j = nlohmann::json::parse(std::ifstream(out / "fit.json"));
   EXPECT_EQ(j["profiles"].size(), 1u);
   EXPECT_TRUE(j["profiles"].contains("tau"));
-  EXPECT_EQ(j["estimates"]["tau"]["verdict"], "identifiable");
-  EXPECT_FALSE(j["estimates"]["a1"].contains("verdict"));
+  EXPECT_EQ(j["estimates"]["tau"]["identifiability"], "identifiable");
+  EXPECT_TRUE(j["estimates"]["a1"]["identifiability"].is_null());  // not profiled
+  EXPECT_TRUE(j["estimates"]["a1"]["ci95"][0].is_null());
   r = run_fit(v, log, out.string(), "--profiles none");
   ASSERT_EQ(r.rc, 0) << r.err;
   j = nlohmann::json::parse(std::ifstream(out / "fit.json"));
   EXPECT_TRUE(j["profiles"].empty());
-  EXPECT_TRUE(j["comparison"]["tau_ci95"][0].is_null());
+  EXPECT_TRUE(j["comparison"]["tau"]["ci95"][0].is_null());
   const fs::path bad = fs::temp_directory_path() / "quadgen_fit_profiles_bad";
   fs::remove_all(bad);
   r = run_fit(v, log, bad.string(), "--profiles nope");
