@@ -510,10 +510,9 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   }
   best.num_free = static_cast<int>(cols.size());
   // Standard errors from the Gauss-Newton approximation J^T W J.
-  train_.set_free(free);
   const int np = static_cast<int>(r.final_fit.size()), nr = train_.num_residuals();
   std::vector<double> p = fit::parameter_values(r.final_fit), res(nr), J(static_cast<size_t>(nr) * np);
-  train_.evaluate(p.data(), res.data(), J.data());
+  train_.evaluate_free(p.data(), res.data(), J.data(), free);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
   for (int i = 0; i < nr; ++i) {
     const double w2 = std::pow(r.final_weights[train_.channel_of(i)], 2);
@@ -574,12 +573,13 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   std::stable_sort(r.estimates.begin(), r.estimates.end(), [&](const EffectEstimate& a, const EffectEstimate& b) {
     return model_.param_index(a.name) < model_.param_index(b.name);
   });
-  // Discretisation allowance: refit with the other quadrature rule.
+  // Discretisation allowance: refit with the other quadrature rule, on a copy of the
+  // training problem (it shares the dynamic model, and runs on this thread).
   std::set<std::string> sel(r.selected.begin(), r.selected.end());
-  train_.set_quadrature(fit::EquationErrorModel::Quadrature::kTrapezoid);
+  fit::EquationErrorModel trapezoid(train_);
+  trapezoid.set_quadrature(fit::EquationErrorModel::Quadrature::kTrapezoid);
   double c = 0;
-  const auto alt = fit_with(sel, r.final_fit, &c);
-  train_.set_quadrature(fit::EquationErrorModel::Quadrature::kMidpoint);
+  const auto alt = fit_with(sel, r.final_fit, &c, Workspace{&trapezoid, &valid_});
   for (auto& e : r.estimates) {
     const int i = model_.param_index(e.name);
     e.numerical_allowance = std::abs(alt[i].value - e.value);

@@ -129,14 +129,6 @@ std::vector<std::string> EquationErrorModel::all_names() const {
   return {"ax", "ay", "az", "pdot", "qdot", "rdot"};  // world-frame accelerations when no accelerometer
 }
 
-void EquationErrorModel::set_free(const std::vector<bool>& free) const {
-  free_ = free;
-  std::vector<int> cols;
-  for (size_t j = 0; j < free.size(); ++j)
-    if (free[j]) cols.push_back(static_cast<int>(j));
-  model_->restrict_param_jacobian(cols);
-}
-
 std::vector<std::string> EquationErrorModel::channels() const {
   const auto names = all_names();
   std::vector<std::string> out;
@@ -144,12 +136,13 @@ std::vector<std::string> EquationErrorModel::channels() const {
   return out;
 }
 
-void EquationErrorModel::evaluate(const double* p, double* r, double* J) const {
-  if (used_.size() == 6) return evaluate6(p, r, J);
+void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
+  if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
+  if (used_.size() == 6) return evaluate6(p, r, J, free);
   const int np = model_->num_params();
   const size_t ns = rows_.size();
   std::vector<double> r6(ns * 6), J6(J ? ns * 6 * np : 0);
-  evaluate6(p, r6.data(), J ? J6.data() : nullptr);
+  evaluate6(p, r6.data(), J ? J6.data() : nullptr, free);
   const size_t nu = used_.size();
   for (size_t k = 0; k < ns; ++k)
     for (size_t c = 0; c < nu; ++c) {
@@ -161,7 +154,7 @@ void EquationErrorModel::evaluate(const double* p, double* r, double* J) const {
 
 void EquationErrorModel::all_channels(const double* p, std::vector<double>& r6) const {
   r6.resize(rows_.size() * 6);
-  evaluate6(p, r6.data(), nullptr);
+  evaluate6(p, r6.data(), nullptr, {});
 }
 
 void EquationErrorModel::commands_at(double t, double* u) const {
@@ -243,7 +236,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   }
 }
 
-void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const {
+void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const {
   const int np = model_->num_params();
   residuals(p, r, J, all_samples());
   if (!J) return;
@@ -252,7 +245,7 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J) const 
   std::vector<double> pp(p, p + np), rp, rm;
   for (size_t d = 0; d < data_side_columns_.size(); ++d) {
     const int c = data_side_columns_[d];
-    if (!free_.empty() && !free_[c]) continue;
+    if (!free.empty() && !free[c]) continue;
     const auto [row_lo, row_hi] = rows_in(data_side_spans_[d]);
     rp.resize((row_hi - row_lo) * 6);
     rm.resize(rp.size());

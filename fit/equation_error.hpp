@@ -43,13 +43,13 @@ class EquationErrorModel : public ResidualModel {
   // (state averaged), or as the mean of its ends. Their difference bounds the
   // discretisation error of estimates (diagnose adds it to intervals).
   enum class Quadrature { kMidpoint, kTrapezoid };
-  void set_quadrature(Quadrature q) const { quadrature_ = q; }
+  void set_quadrature(Quadrature q) { quadrature_ = q; }
   // Sample (index into flight().samples) of each residual row.
   const std::vector<size_t>& rows() const { return rows_; }
-  void evaluate(const double* p, double* r, double* J) const override;
+  void evaluate(const double* p, double* r, double* J) const override { evaluate_free(p, r, J, {}); }
+  void evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const override;
   int channel_of(int i) const override { return i % static_cast<int>(used_.size()); }
   std::vector<std::string> channels() const override;
-  void set_free(const std::vector<bool>& free) const override;
   std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
   // Residuals of all six channels of every row (rows() x 6), at these parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
@@ -93,11 +93,12 @@ class EquationErrorModel : public ResidualModel {
   void mark_contiguous_intervals();
   void find_data_side_columns();
   void build_filter(double window);
-  mutable std::vector<bool> free_;
-  mutable Quadrature quadrature_ = Quadrature::kMidpoint;
-  mutable std::vector<double> mean_speed_;  // rotor speeds averaged over each interval (motor_lag)
+  Quadrature quadrature_ = Quadrature::kMidpoint;
+  // Scratch of one evaluation, not state: rotor speeds averaged over each interval
+  // (motor_lag), kept to reuse the allocation (one instance serves one thread; clone()).
+  mutable std::vector<double> mean_speed_;
   std::vector<std::string> all_names() const;
-  void evaluate6(const double* p, double* r, double* J) const;
+  void evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
   // Only the samples in `span` are filled (the others stay zero).
   void prepare(const double* p, std::vector<double>& X, std::vector<double>& U, SampleSpan span) const;

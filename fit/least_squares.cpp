@@ -16,7 +16,7 @@ namespace {
 // scaled by its channel's weight.
 // A point whose residuals or (free) Jacobian columns are not finite is reported as not
 // evaluable: Ceres then rejects the step, or fails at the start (solve_weighted throws).
-// Fixed columns are not looked at: a model may leave them unwritten (set_free).
+// Fixed columns are not looked at: a model may leave them unwritten (evaluate_free).
 class WeightedCost : public ceres::CostFunction {
  public:
   WeightedCost(const ResidualModel& m, int n_params, const std::vector<double>& w, std::vector<bool> free)
@@ -27,7 +27,7 @@ class WeightedCost : public ceres::CostFunction {
   bool Evaluate(double const* const* p, double* r, double** J) const override {
     const int nr = m_.num_residuals();
     if (J && J[0]) {
-      m_.evaluate(p[0], r, J[0]);
+      m_.evaluate_free(p[0], r, J[0], free_);
     } else {
       m_.evaluate(p[0], r, nullptr);
     }
@@ -86,7 +86,6 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   const int n = static_cast<int>(params.size());
   std::vector<double> x = parameter_values(params);
   const std::vector<bool> free = free_mask(params);
-  model.set_free(free);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);

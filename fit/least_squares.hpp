@@ -26,9 +26,13 @@ class ResidualModel {
   // Channel of each residual (e.g. "rpm", "ax"): noise and autocorrelation are per channel.
   virtual int channel_of(int residual) const = 0;
   virtual std::vector<std::string> channels() const = 0;
-  // Which parameters are free in the next solve: a model may skip Jacobian columns of
-  // fixed parameters (they are then left zero).
-  virtual void set_free(const std::vector<bool>& /*free*/) const {}
+  // r(p) and the Jacobian columns of the free parameters only (free[j]; empty: all): a
+  // model may skip the work for the others and leave their columns unwritten. The mask is
+  // an argument of each call, never state of the model, so what one solve fixed cannot
+  // leak into the next evaluation.
+  virtual void evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& /*free*/) const {
+    evaluate(p, r, J);
+  }
   // An independent copy for another thread (a model may keep scratch state between
   // evaluations, so one instance serves one thread). nullptr: work on it stays sequential.
   virtual std::unique_ptr<ResidualModel> clone() const { return nullptr; }

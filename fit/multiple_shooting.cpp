@@ -27,17 +27,14 @@ MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Fligh
   if (windows_.empty()) throw FitError(flight_.source + ": flight shorter than one window");
 }
 
-void MultipleShootingModel::set_free(const std::vector<bool>& free) const {
-  free_.clear();
-  for (size_t j = 0; j < free.size(); ++j)
-    if (free[j]) free_.push_back(static_cast<int>(j));
-  model_->restrict_param_jacobian(free_);
-}
-
-void MultipleShootingModel::evaluate(const double* p, double* r, double* J) const {
+void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
   const int n = 13, np = model_->num_params(), nu = model_->num_inputs();
-  if (free_.empty() && J) {  // no set_free yet: all columns
-    for (int j = 0; j < np; ++j) free_.push_back(j);
+  // The parameter columns to propagate through the sensitivities: the free ones, or all.
+  std::vector<int> free_;
+  if (J) {
+    model_->restrict_param_jacobian(runtime::free_columns(free));
+    for (int j = 0; j < np; ++j)
+      if (free.empty() || free[j]) free_.push_back(j);
   }
   const int nf = static_cast<int>(free_.size()), cols = n + nf;
   model_->set_params(std::vector<double>(p, p + np));

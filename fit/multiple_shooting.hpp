@@ -20,11 +20,11 @@ class MultipleShootingModel : public ResidualModel {
  public:
   MultipleShootingModel(runtime::DynamicModel& model, Flight flight, double window_seconds);
   int num_residuals() const override { return num_residuals_; }
-  void evaluate(const double* p, double* r, double* J) const override;
+  void evaluate(const double* p, double* r, double* J) const override { evaluate_free(p, r, J, {}); }
+  void evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const override;
   int channel_of(int i) const override { return i % 6; }
   std::vector<std::string> channels() const override { return {"x", "y", "z", "roll_err", "pitch_err", "yaw_err"}; }
   size_t num_windows() const { return windows_.size(); }
-  void set_free(const std::vector<bool>& free) const override;
   std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
 
  private:
@@ -33,7 +33,6 @@ class MultipleShootingModel : public ResidualModel {
   Flight flight_;
   std::vector<std::pair<size_t, size_t>> windows_;  // [first, last] sample indices
   int num_residuals_ = 0;
-  mutable std::vector<int> free_;  // parameter columns to propagate
 };
 
 }  // namespace quadgen::fit

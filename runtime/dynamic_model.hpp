@@ -24,7 +24,8 @@ class DynamicModel {
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
   // A fit with few free parameters needs only their columns of B; a model may then skip
-  // the others (left zero). Empty: all columns.
+  // the others (left zero). Empty: all columns. Cheap when the columns are those of the
+  // last call (residual models pass their free columns at every evaluation).
   virtual void restrict_param_jacobian(const std::vector<int>& /*columns*/) {}
   // An independent copy (parameters, caches and all), for work on another thread: a model
   // holds its parameters and scratch space, so one instance serves one thread. nullptr:
@@ -90,5 +91,14 @@ class CompiledModel : public DynamicModel {
   typename M::template Precomputed<double> pre_;
   std::vector<std::string> states_, inputs_, param_names_;
 };
+
+// The indices of the true entries of a free-parameter mask (empty mask: none, which
+// restrict_param_jacobian reads as all).
+inline std::vector<int> free_columns(const std::vector<bool>& free) {
+  std::vector<int> cols;
+  for (size_t j = 0; j < free.size(); ++j)
+    if (free[j]) cols.push_back(static_cast<int>(j));
+  return cols;
+}
 
 }  // namespace quadgen::runtime

@@ -98,6 +98,8 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
 }
 
 void PerFlightModel::restrict_param_jacobian(const std::vector<int>& columns) {
+  if (columns == restricted_to_) return;  // a cache: the same columns as the last call
+  restricted_to_ = columns;
   // An inner column is needed when any flight's copy of it is.
   std::set<int> wanted(columns.begin(), columns.end());
   std::vector<int> inner;

@@ -63,6 +63,7 @@ class PerFlightModel : public DynamicModel {
   // column_[k][j]: the column of inner parameter j for flight k in this model's parameters.
   std::vector<std::vector<int>> column_;
   mutable std::vector<double> inner_B_;
+  std::vector<int> restricted_to_;  // the columns of the last restrict_param_jacobian (empty: all)
 };
 
 }  // namespace quadgen::runtime

@@ -42,6 +42,8 @@ TapeModel::TapeModel(Tape t) : tape_(std::move(t)), reg_(tape_.num_registers, 0.
 }
 
 void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
+  if (columns == restricted_to_) return;  // a cache: the same columns as the last call
+  restricted_to_ = columns;
   if (columns.empty()) {
     dfdp_code_ = tape_.dfdp_code;
     dfdp_ = tape_.dfdp;

@@ -61,6 +61,7 @@ class TapeModel : public DynamicModel {
   // dfdp code and outputs pruned to the requested columns (backward liveness).
   std::vector<Instruction> dfdp_code_;
   SparseOutputs dfdp_;
+  std::vector<int> restricted_to_;  // the columns dfdp_code_ computes (empty: all)
   mutable std::vector<double> reg_;
 };
 

@@ -613,6 +613,47 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
   EXPECT_GT(second, 100);
 }
 
+// Which parameters a solve held fixed is an argument of each evaluation, not state of the
+// residual model: after an evaluation with one column free (a candidate's fit), the full
+// Jacobian is the one a fresh model gives, data-side columns included. (With set_free the
+// mask stayed behind and the next evaluation left those columns unwritten.)
+TEST(Fit, AFreeMaskDoesNotOutliveItsEvaluation) {
+  runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> model;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  Flight flight;
+  flight.has_pose = flight.has_gyro = true;
+  for (int k = 0; k < 200; ++k) {
+    FlightSample s;
+    s.t = 0.01 * k;
+    s.x = test::random_state(rng);
+    s.u = {cmd(rng), cmd(rng), cmd(rng), cmd(rng)};
+    s.vbat = 3.9;
+    flight.samples.push_back(s);
+  }
+  std::vector<double> p = model.params();
+  p[model.param_index("attitude_bias.roll")] = 0.02;
+  p[model.param_index("motor_lag.tau")] = 0.03;
+  EquationErrorModel m(model, flight, false);
+  const int np = model.num_params(), nr = m.num_residuals();
+  std::vector<double> r(nr), fresh(static_cast<size_t>(nr) * np), masked(fresh.size(), 0.0), after(fresh.size());
+  m.evaluate(p.data(), r.data(), fresh.data());
+  std::vector<bool> free(np, false);
+  const int mass = model.param_index("mass");
+  free[mass] = true;
+  m.evaluate_free(p.data(), r.data(), masked.data(), free);
+  for (int i = 0; i < nr; ++i)
+    ASSERT_EQ(masked[static_cast<size_t>(i) * np + mass], fresh[static_cast<size_t>(i) * np + mass]) << "row " << i;
+  m.evaluate(p.data(), r.data(), after.data());
+  EXPECT_EQ(after, fresh);
+  int data_side_nonzero = 0;
+  for (const char* name : {"attitude_bias.roll", "motor_lag.tau"}) {
+    const int c = model.param_index(name);
+    for (int i = 0; i < nr; ++i) data_side_nonzero += after[static_cast<size_t>(i) * np + c] != 0.0;
+  }
+  EXPECT_GT(data_side_nonzero, nr / 2);
+}
+
 // Across a short gap (an in-flight motor dip trimmed as not airborne, a dropped sample) the
 // rotors keep spinning: the equation error carries their speeds over it. A flight with a
 // 60 ms motor lag and three such gaps (0.1-0.3 s, the command held over each, so carrying is
