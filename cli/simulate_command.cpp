@@ -208,7 +208,7 @@ int run_simulate(const SimulateArgs& a) {
   const double vbat_ref = param(vehicle, "vbat_ref").value;
   check_hover_reachable(vehicle, laws, m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr));
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m, out);
-  const int delay = model.input_delay_param ? static_cast<int>(*model.input_delay_param) : -1;
+  const int delay = m.input_delay_param();
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
 

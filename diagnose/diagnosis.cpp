@@ -34,14 +34,9 @@ std::vector<double> residuals_of(const fit::EquationErrorModel& m, const std::ve
   return r6;
 }
 
-std::vector<double> channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  const std::vector<double> r6 = residuals_of(m, ps);
-  std::vector<double> rms(6, 0.0);
-  const size_t ns = r6.size() / 6;
-  for (size_t k = 0; k < ns; ++k)
-    for (int c = 0; c < 6; ++c) rms[c] += r6[k * 6 + c] * r6[k * 6 + c];
-  for (double& v : rms) v = std::sqrt(v / static_cast<double>(std::max<size_t>(1, ns)));
-  return rms;
+// All six channels, whichever the fit used.
+std::vector<double> six_channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
+  return fit::rms_by_channel(residuals_of(m, ps), 6, [](size_t i) { return i % 6; });
 }
 
 // The lengths plausible ranges may be relative to: the largest distance of a rotor from the
@@ -385,8 +380,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     double c = 0;
     const auto without = search.fit_with(others, d.search.final_fit, &c);
     st.channels = d.channel_names;
-    st.rms_without = channel_rms(train_ee, without);
-    st.rms_with = channel_rms(train_ee, d.search.final_fit);
+    st.rms_without = six_channel_rms(train_ee, without);
+    st.rms_with = six_channel_rms(train_ee, d.search.final_fit);
     d.search.carried.push_back(it->effect);
     d.stand_ins.push_back(st);
     it = d.findings.erase(it);
@@ -427,7 +422,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.has_prediction = true;
   d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
   d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
-  const auto rb = channel_rms(valid_ee, s.base_fit), ra = channel_rms(valid_ee, s.final_fit);
+  const auto rb = six_channel_rms(valid_ee, s.base_fit), ra = six_channel_rms(valid_ee, s.final_fit);
   for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
   // Left over: slow structure the noise cannot explain. The final model carries the stronger
   // of each look-alike pair (either explains the discrepancy; only the name is open).

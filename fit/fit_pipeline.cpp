@@ -180,22 +180,6 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
 
 namespace {
 
-// RMS of each channel of a residual model at the given parameters.
-std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps) {
-  const std::vector<double> p = parameter_values(ps);
-  std::vector<double> r(m.num_residuals());
-  m.evaluate(p.data(), r.data(), nullptr);
-  const size_t nc = m.channels().size();
-  std::vector<double> ss(nc, 0.0);
-  std::vector<int> n(nc, 0);
-  for (int i = 0; i < m.num_residuals(); ++i) {
-    ss[m.channel_of(i)] += r[i] * r[i];
-    ++n[m.channel_of(i)];
-  }
-  for (size_t c = 0; c < nc; ++c) ss[c] = std::sqrt(ss[c] / std::max(1, n[c]));
-  return ss;
-}
-
 // The model's parameters with --free applied, or else the vehicle's fit flags less the
 // reference parameters (beside c_t only ratios to them are identifiable).
 std::vector<FitParameter> starting_parameters(const SymbolicModel& sm, const FitJobOptions& o) {

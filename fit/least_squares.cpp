@@ -251,6 +251,13 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   return res;
 }
 
+std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps) {
+  const std::vector<double> p = parameter_values(ps);
+  std::vector<double> r(m.num_residuals());
+  m.evaluate(p.data(), r.data(), nullptr);
+  return rms_by_channel(r, m.channels().size(), [&](size_t i) { return m.channel_of(static_cast<int>(i)); });
+}
+
 bool on_bound(const FitParameter& p) {
   const double tol = 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
   return std::fabs(p.value - p.lower) < tol || std::fabs(p.value - p.upper) < tol;

@@ -4,6 +4,8 @@
 // and the covariance of the free parameters. The problem (ResidualModel) is kept apart
 // from the solver (fit_least_squares) and its options (FitOptions).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -75,6 +77,24 @@ struct FitResult {
 
 // The parameters' current values, in order (what ResidualModel::evaluate takes).
 std::vector<double> parameter_values(const std::vector<FitParameter>& ps);
+
+// RMS of each of `nc` channels of residuals r, residual i belonging to channel_of(i) (the
+// one home of this sum: validation tables of fit and diagnose).
+template <class ChannelOf>
+std::vector<double> rms_by_channel(const std::vector<double>& r, size_t nc, ChannelOf channel_of) {
+  std::vector<double> ss(nc, 0.0);
+  std::vector<size_t> n(nc, 0);
+  for (size_t i = 0; i < r.size(); ++i) {
+    const size_t c = static_cast<size_t>(channel_of(i));
+    ss[c] += r[i] * r[i];
+    ++n[c];
+  }
+  for (size_t c = 0; c < nc; ++c) ss[c] = std::sqrt(ss[c] / static_cast<double>(std::max<size_t>(1, n[c])));
+  return ss;
+}
+
+// RMS of each channel of a residual model at the given parameters.
+std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps);
 
 // Whether p's value sits on its lower or upper bound (to 1e-9 of the bounds' span).
 bool on_bound(const FitParameter& p);

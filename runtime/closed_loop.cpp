@@ -124,17 +124,13 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   const long steps = std::lround(o.duration * o.log_rate);
   V3 int_pos = V3::Zero(), int_rate = V3::Zero();
   const V3 gyro_bias(o.gyro_bias, -o.gyro_bias, 0.5 * o.gyro_bias), acc_bias(o.accel_bias, -o.accel_bias, 0);
-  // Effects outside the ODE, taken from the true model's parameters: the attitude the
-  // autopilot estimates and logs is q ⊗ q_bias (it flies on that estimate), and the motors
-  // act on the commands of `delay` seconds ago.
-  auto truth_param = [&](const char* name) {
-    const int i = truth.param_index(name);
-    return i >= 0 ? truth.params()[i] : 0.0;
-  };
-  const Eigen::Quaterniond q_bias =
-      Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.pitch"), V3::UnitY())) *
-      Eigen::Quaterniond(Eigen::AngleAxisd(truth_param("attitude_bias.roll"), V3::UnitX()));
-  const double delay = truth_param("input_delay.seconds");
+  // Effects outside the ODE, from the true model: the attitude the autopilot estimates and
+  // logs is the model's measurement h(x) (q ⊗ q_bias under attitude_bias; it flies on that
+  // estimate), and the motors act on the commands of `delay` seconds ago.
+  const int delay_param = truth.input_delay_param();
+  const double delay = delay_param >= 0 ? truth.params()[delay_param] : 0.0;
+  std::vector<double> logged(truth.num_outputs());
+  const int logged_q = truth.num_outputs() - 4;  // h = (position, quaternion)
   // Whole control periods of delay, and the rest (below 1 us counts as none: 0.03 / 0.01
   // is 2.9999999999999996 in floating point).
   const long delay_steps = static_cast<long>(std::floor(delay / dt + 1e-6));
@@ -164,7 +160,9 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     int_pos += e_p * dt;
     const V3 a_cmd = V3(rx[2], ry[2], rz[2]) + o.kp_pos * e_p + o.kd_pos * e_v + o.ki_pos * int_pos + V3(0, 0, b.g);
     const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[6], x[7], x[8], x[9]).normalized();
-    const Eigen::Quaterniond q_est = q_true * q_bias;
+    truth.measurement(x.data(), t, logged.data(), nullptr, nullptr);
+    const Eigen::Quaterniond q_est =
+        Eigen::Quaterniond(logged[logged_q], logged[logged_q + 1], logged[logged_q + 2], logged[logged_q + 3]).normalized();
     const M3 R = q_est.toRotationMatrix(), R_true = q_true.toRotationMatrix();
     const double thrust = b.mass * a_cmd.dot(R.col(2));
     const V3 b3 = a_cmd.normalized();

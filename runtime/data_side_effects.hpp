@@ -29,7 +29,7 @@ struct DataSideParams {
   int delay = -1, roll = -1, pitch = -1, tau = -1;
 
   explicit DataSideParams(const DynamicModel& model)
-      : delay(model.param_index("input_delay.seconds")),
+      : delay(model.input_delay_param()),
         roll(model.param_index("attitude_bias.roll")),
         pitch(model.param_index("attitude_bias.pitch")),
         tau(model.param_index("motor_lag.tau")) {}

@@ -23,6 +23,16 @@ class DynamicModel {
   // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
+  // What a flight log records, h(x, p) (the generated measurement function): position, and
+  // the attitude quaternion as the autopilot logs it (q ⊗ q_bias under attitude_bias). H =
+  // dh/dx (num_outputs x n) and Hp = dh/dp (num_outputs x np), dense row-major, from the
+  // generated analytic Jacobians; either may be nullptr. `t` is the log time: it picks a
+  // per-flight parameter's copy (PerFlightModel), other models ignore it.
+  virtual int num_outputs() const = 0;
+  virtual void measurement(const double* x, double t, double* h, double* H, double* Hp) const = 0;
+  // The input_delay parameter (the runtime feeds the commands of t - delay), or -1. Its value
+  // for a time t sits at param_column(input_delay_param(), t).
+  virtual int input_delay_param() const = 0;
   // A fit with few free parameters needs only their columns of B; a model may then skip
   // the others (left zero). Empty: all columns. Cheap when the columns are those of the
   // last call (residual models pass their free columns at every evaluation).
@@ -80,11 +90,20 @@ class CompiledModel : public DynamicModel {
     if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
   }
+  int num_outputs() const override { return M::kNumOutputs; }
+  void measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const override {
+    double sx[M::kDhdxNnz + 1], sp[M::kDhdpNnz + 1];
+    M::measurement(x, p_.data(), pre_, h, H ? sx : nullptr, Hp ? sp : nullptr);
+    if (H) scatter(H, M::kNumStates, sx, M::kDhdxNnz, M::kDhdxRow, M::kDhdxCol, M::kNumOutputs);
+    if (Hp) scatter(Hp, M::kNumParams, sp, M::kDhdpNnz, M::kDhdpRow, M::kDhdpCol, M::kNumOutputs);
+  }
+  int input_delay_param() const override { return M::kInputDelayParam; }
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<CompiledModel>(*this); }
 
  private:
-  static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col) {
-    for (int i = 0; i < M::kNumStates * cols; ++i) dense[i] = 0;
+  static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col,
+                      int rows = M::kNumStates) {
+    for (int i = 0; i < rows * cols; ++i) dense[i] = 0;
     for (int k = 0; k < nnz; ++k) dense[row[k] * cols + col[k]] = v[k];
   }
   std::vector<double> p_;

@@ -97,6 +97,19 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
     for (int j = 0; j < np_inner; ++j) B[i * np + column[j]] = inner_B_[i * np_inner + j];
 }
 
+void PerFlightModel::measurement(const double* x, double t, double* h, double* H, double* Hp) const {
+  const int k = flight_at(t);
+  const DynamicModel& m = *flights_[k];
+  const int ny = m.num_outputs(), np_inner = m.num_params(), np = num_params();
+  std::vector<double> inner_Hp(Hp ? static_cast<size_t>(ny) * np_inner : 0);
+  m.measurement(x, t, h, H, Hp ? inner_Hp.data() : nullptr);
+  if (!Hp) return;
+  std::fill(Hp, Hp + static_cast<size_t>(ny) * np, 0.0);
+  const auto& column = column_[k];
+  for (int i = 0; i < ny; ++i)
+    for (int j = 0; j < np_inner; ++j) Hp[i * np + column[j]] = inner_Hp[i * np_inner + j];
+}
+
 void PerFlightModel::restrict_param_jacobian(const std::vector<int>& columns) {
   if (columns == restricted_to_) return;  // a cache: the same columns as the last call
   restricted_to_ = columns;

@@ -51,6 +51,9 @@ class PerFlightModel : public DynamicModel {
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
+  int num_outputs() const override { return flights_[0]->num_outputs(); }
+  void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
+  int input_delay_param() const override { return flights_[0]->input_delay_param(); }  // flight 1's copy
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<PerFlightModel>(*this); }
   int param_column(int index, double t) const override;
 

@@ -77,6 +77,15 @@ void TapeModel::set_params(const std::vector<double>& p) {
   run(tape_.precompute, reg_.data());
 }
 
+void TapeModel::measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const {
+  double* r = reg_.data();
+  for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];
+  run(tape_.h_code, r);
+  for (int i = 0; i < tape_.ny; ++i) h[i] = r[tape_.h_out[i]];
+  if (H) scatter(H, tape_.ny, tape_.nx, tape_.dhdx, r);
+  if (Hp) scatter(Hp, tape_.ny, tape_.np, tape_.dhdp, r);
+}
+
 void TapeModel::rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const {
   double* r = reg_.data();
   for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];

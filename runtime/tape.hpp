@@ -30,6 +30,11 @@ struct Tape {
   std::vector<Instruction> dfdx_code, dfdp_code, dfdu_code;  // the rest, per Jacobian
   std::vector<int> f_out;
   SparseOutputs dfdx, dfdp, dfdu;
+  // The measurement h(x, p) and its Jacobians, in one piece of code after f's.
+  int ny = 0;
+  std::vector<Instruction> h_code;
+  std::vector<int> h_out;
+  SparseOutputs dhdx, dhdp;
   std::vector<std::string> state_names, input_names, param_names;
   std::vector<double> nominal;
   int input_delay_param = -1;
@@ -53,7 +58,9 @@ class TapeModel : public DynamicModel {
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<TapeModel>(*this); }
-  int input_delay_param() const { return tape_.input_delay_param; }
+  int num_outputs() const override { return tape_.ny; }
+  void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
+  int input_delay_param() const override { return tape_.input_delay_param; }
 
  private:
   Tape tape_;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "attitude.hpp"
 #include "dynamic_model.hpp"
 #include "effects.hpp"
 #include "flight_log.hpp"
@@ -98,6 +99,77 @@ TEST(Runtime, AllEffectsTapeMatchesCompiledHeaderAwayFromNeutral) {
     for (int i = 0; i < n * np; ++i)
       EXPECT_NEAR(B1[i], B2[i], 1e-7 * (1 + std::fabs(B1[i]))) << "dfdp " << i / np << "," << compiled.param_names()[i % np];
   }
+}
+
+// The generated measurement h(x, p) through DynamicModel: compiled and interpreted agree,
+// its analytic Jacobians match central differences, it logs q ⊗ q_bias (so that
+// unbias_attitude, which the equation error applies to logged attitudes, undoes it), a
+// joint model measures each flight with that flight's bias, and every model names its
+// input-delay parameter the same way.
+TEST(Runtime, MeasurementIsTheLoggedPoseWithAnalyticJacobians) {
+  TapeModel tape = finken3_tape(parse_effect_list("all"));
+  CompiledModel<quadgen_generated::finken3_all_effects::Model> compiled;
+  const int n = compiled.num_states(), np = compiled.num_params(), ny = compiled.num_outputs();
+  ASSERT_EQ(ny, 7);
+  ASSERT_EQ(tape.num_outputs(), ny);
+  const int roll = compiled.param_index("attitude_bias.roll"), pitch = compiled.param_index("attitude_bias.pitch");
+  std::vector<double> p = compiled.params();
+  p[roll] = 0.03;
+  p[pitch] = -0.05;
+  tape.set_params(p);
+  compiled.set_params(p);
+  EXPECT_EQ(compiled.input_delay_param(), compiled.param_index("input_delay.seconds"));
+  EXPECT_EQ(tape.input_delay_param(), compiled.input_delay_param());
+  EXPECT_EQ(CompiledModel<quadgen_generated::finken3::Model>().input_delay_param(), -1);
+  std::mt19937 rng(4);
+  std::vector<double> x = test::random_state(rng);
+  x.resize(n, 900.0);
+  std::vector<double> h1(ny), h2(ny), H1(ny * n), H2(ny * n), Hp1(ny * np), Hp2(ny * np);
+  tape.measurement(x.data(), 0.0, h1.data(), H1.data(), Hp1.data());
+  compiled.measurement(x.data(), 0.0, h2.data(), H2.data(), Hp2.data());
+  EXPECT_LT(max_diff(h1, h2), 1e-12);
+  EXPECT_LT(max_diff(H1, H2), 1e-12);
+  EXPECT_LT(max_diff(Hp1, Hp2), 1e-12);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(h2[i], x[i]);
+  double q_true[4];
+  unbias_attitude(&h2[3], p[roll], p[pitch], q_true);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(q_true[i], x[6 + i], 1e-14) << i;
+  // dh/dx and dh/dp against central differences
+  std::vector<double> hp(ny), hm(ny);
+  for (int j = 0; j < n; ++j) {
+    std::vector<double> xp = x, xm = x;
+    xp[j] += 1e-6, xm[j] -= 1e-6;
+    compiled.measurement(xp.data(), 0.0, hp.data(), nullptr, nullptr);
+    compiled.measurement(xm.data(), 0.0, hm.data(), nullptr, nullptr);
+    for (int i = 0; i < ny; ++i) EXPECT_NEAR(H2[i * n + j], (hp[i] - hm[i]) / 2e-6, 1e-8) << i << " " << j;
+  }
+  for (int j = 0; j < np; ++j) {
+    std::vector<double> pp = p, pm = p;
+    pp[j] += 1e-6, pm[j] -= 1e-6;
+    compiled.set_params(pp);
+    compiled.measurement(x.data(), 0.0, hp.data(), nullptr, nullptr);
+    compiled.set_params(pm);
+    compiled.measurement(x.data(), 0.0, hm.data(), nullptr, nullptr);
+    for (int i = 0; i < ny; ++i)
+      EXPECT_NEAR(Hp2[i * np + j], (hp[i] - hm[i]) / 2e-6, 1e-8) << i << " " << compiled.param_names()[j];
+  }
+  int bias_entries = 0;
+  for (int i = 3; i < ny; ++i) bias_entries += (Hp2[i * np + roll] != 0) + (Hp2[i * np + pitch] != 0);
+  EXPECT_EQ(bias_entries, 8);
+  // a joint model: flight 2's bias, in flight 2's column
+  compiled.set_params(p);
+  PerFlightModel joint(compiled, {10.0}, {"attitude_bias.roll"});
+  std::vector<double> pj = joint.params();
+  pj[np] = -0.02;  // attitude_bias.roll@2
+  joint.set_params(pj);
+  EXPECT_EQ(joint.input_delay_param(), compiled.input_delay_param());
+  std::vector<double> hj(ny), Hpj(ny * (np + 1));
+  joint.measurement(x.data(), 15.0, hj.data(), nullptr, Hpj.data());
+  unbias_attitude(&hj[3], -0.02, p[pitch], q_true);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(q_true[i], x[6 + i], 1e-14) << i;
+  for (int i = 0; i < ny; ++i) EXPECT_EQ(Hpj[i * (np + 1) + roll], 0.0) << i;
+  joint.measurement(x.data(), 5.0, hj.data(), nullptr, nullptr);
+  EXPECT_LT(max_diff(hj, h2), 1e-15);
 }
 
 TEST(Runtime, RestrictedParameterJacobianKeepsRequestedColumns) {

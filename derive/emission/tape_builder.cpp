@@ -117,6 +117,17 @@ runtime::Tape build_tape(const SymbolicModel& m) {
           j.out->col.push_back(static_cast<int>(c));
           j.nodes.push_back(g.add((*j.J)(r, c)));  // constants substituted already
         }
+  std::vector<int> h_nodes;
+  for (unsigned i = 0; i < m.h.rows(); ++i) h_nodes.push_back(g.add(m.h(i, 0).subs(constants)));
+  std::vector<Jac> hjacs = {{&m.dhdx, &t.dhdx, &t.h_code, {}}, {&m.dhdp, &t.dhdp, &t.h_code, {}}};
+  for (auto& j : hjacs)
+    for (unsigned r = 0; r < j.J->rows(); ++r)
+      for (unsigned c = 0; c < j.J->cols(); ++c)
+        if (!(*j.J)(r, c).is_zero()) {
+          j.out->row.push_back(static_cast<int>(r));
+          j.out->col.push_back(static_cast<int>(c));
+          j.nodes.push_back(g.add((*j.J)(r, c)));
+        }
   Builder b{g, t, std::vector<int>(g.size(), -1), t.nx + t.nu + t.np};
   for (int id : f_nodes) {
     b.emit_split(id, t.f_code);
@@ -135,6 +146,21 @@ runtime::Tape build_tape(const SymbolicModel& m) {
       j.out->reg.push_back(b.reg[id]);
     }
   }
+  // The measurement and its Jacobians: one piece of code, from the registers after f.
+  t.ny = static_cast<int>(m.h.rows());
+  std::vector<int> own = after_f;
+  for (size_t k = 0; k < own.size(); ++k)
+    if (b.reg[k] >= 0 && !g.node(static_cast<int>(k)).dynamic) own[k] = b.reg[k];
+  b.reg = own;
+  for (int id : h_nodes) {
+    b.emit_split(id, t.h_code);
+    t.h_out.push_back(b.reg[id]);
+  }
+  for (auto& j : hjacs)
+    for (int id : j.nodes) {
+      b.emit_split(id, t.h_code);
+      j.out->reg.push_back(b.reg[id]);
+    }
   t.num_registers = b.next;
   return t;
 }
