@@ -116,11 +116,15 @@ int run_fit(const FitArgs& a) {
     check_flight_options(a);
     DeriveOptions derive;
     derive.effects = parse_effect_list(a.effects);
-    const SymbolicModel symbolic = derive_model(v, derive_mass_properties(v), derive);
-    bool compiled = false;
-    const auto model = make_model(symbolic, &compiled);
-    std::cerr << "model: " << (compiled ? "compiled header from generated/" : "interpreted (no matching generated header)") << "\n";
-    result = fit_flight_log(a.log, v, symbolic, *model, o);
+    // A matching compiled header carries everything a fit needs: no symbolic derivation.
+    std::unique_ptr<runtime::DynamicModel> model = compiled_model_for(v, derive.effects);
+    if (model) {
+      std::cerr << "model: compiled header from generated/ (no derivation needed)\n";
+    } else {
+      model = make_model(derive_model(v, derive_mass_properties(v), derive));
+      std::cerr << "model: interpreted (no matching generated header)\n";
+    }
+    result = fit_flight_log(a.log, v, *model, o);
   }
   out.add("fit.json", output::json_document(result.json));
   for (const auto& [file, svg] : result.plots) out.add(file, svg);

@@ -4,28 +4,36 @@
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
+#include "effects.hpp"
 #include "tape_builder.hpp"
 
 namespace quadgen::cli {
 
 namespace {
 template <class M>
-bool matches(const SymbolicModel& m) {
-  return m.vehicle_hash == M::kVehicleHash && m.effect_list() == M::kEffects;
+std::unique_ptr<runtime::DynamicModel> compiled_if(const std::string& vehicle_hash, const std::string& effects) {
+  if (vehicle_hash != M::kVehicleHash || effects != M::kEffects) return nullptr;
+  return std::make_unique<runtime::CompiledModel<M>>();
+}
+
+// The header generated from this vehicle file hash and canonical effect list, if any.
+std::unique_ptr<runtime::DynamicModel> find_compiled(const std::string& hash, const std::string& effects) {
+  namespace g = quadgen_generated;
+  for (auto make : {compiled_if<g::finken3::Model>, compiled_if<g::finken3_all_effects::Model>,
+                    compiled_if<g::crazyflie21::Model>, compiled_if<g::crazyflie21_all_effects::Model>})
+    if (auto m = make(hash, effects)) return m;
+  return nullptr;
 }
 }  // namespace
 
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled) {
-  namespace g = quadgen_generated;
-  if (compiled) *compiled = true;
-  if (matches<g::finken3::Model>(m)) return std::make_unique<runtime::CompiledModel<g::finken3::Model>>();
-  if (matches<g::finken3_all_effects::Model>(m))
-    return std::make_unique<runtime::CompiledModel<g::finken3_all_effects::Model>>();
-  if (matches<g::crazyflie21::Model>(m)) return std::make_unique<runtime::CompiledModel<g::crazyflie21::Model>>();
-  if (matches<g::crazyflie21_all_effects::Model>(m))
-    return std::make_unique<runtime::CompiledModel<g::crazyflie21_all_effects::Model>>();
-  if (compiled) *compiled = false;
-  return std::make_unique<runtime::TapeModel>(emission::build_tape(m));
+  auto model = find_compiled(m.vehicle_hash, m.effect_list());
+  if (compiled) *compiled = model != nullptr;
+  return model ? std::move(model) : std::make_unique<runtime::TapeModel>(emission::build_tape(m));
+}
+
+std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, const std::vector<std::string>& effects) {
+  return find_compiled(v.content_hash, canonical_effect_list(effects));
 }
 
 }  // namespace quadgen::cli

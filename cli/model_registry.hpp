@@ -5,7 +5,12 @@
 
 #include "dynamic_model.hpp"
 #include "symbolic_model.hpp"
+#include "vehicle.hpp"
 
 namespace quadgen::cli {
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled = nullptr);
+// The compiled header generated from this vehicle file (its bytes' hash) with these effects,
+// found without deriving; nullptr when generated/ has none. Its parameters carry units,
+// bounds and fit flags, so fit and predict then need no symbolic derivation.
+std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, const std::vector<std::string>& effects);
 }

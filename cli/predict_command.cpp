@@ -46,10 +46,10 @@ int run_predict(const PredictArgs& a) {
   output::OutputDirectory out(a.out, inputs);  // refused before the work, not after
   DeriveOptions all;
   all.effects = parse_effect_list("all");  // effects at neutral values unless --params sets them
-  const SymbolicModel symbolic = derive_model(v, derive_mass_properties(v), all);
-  bool compiled = false;
-  const auto model = make_model(symbolic, &compiled);
-  std::cerr << "model: " << (compiled ? "compiled header from generated/" : "interpreted tape") << "\n";
+  // A matching compiled header carries everything prediction needs: no symbolic derivation.
+  std::unique_ptr<runtime::DynamicModel> model = compiled_model_for(v, all.effects);
+  std::cerr << "model: " << (model ? "compiled header from generated/ (no derivation needed)" : "interpreted tape") << "\n";
+  if (!model) model = make_model(derive_model(v, derive_mass_properties(v), all));
   predict::PredictFlightsOptions o;
   o.mapping = a.mapping;
   o.resample = a.resample;
@@ -58,7 +58,7 @@ int run_predict(const PredictArgs& a) {
   o.calibrate = a.calibrate;
   o.prediction.start_stride = a.stride;
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
-  const predict::PredictedFlights p = predict::predict_flights(v, *model, fit::fit_parameters(symbolic), a.logs, o);
+  const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), a.logs, o);
   out.add("prediction.json", output::json_document(p.json));
   out.add("prediction.csv", predict::prediction_csv(p.pooled));
   std::string svg, err;

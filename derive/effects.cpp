@@ -443,4 +443,11 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
   return out;
 }
 
+std::string canonical_effect_list(const std::vector<std::string>& effects) {
+  std::string out;
+  for (const auto& e : effect_catalogue())
+    if (std::find(effects.begin(), effects.end(), e.name) != effects.end()) out += (out.empty() ? "" : ",") + e.name;
+  return out;
+}
+
 }  // namespace quadgen

@@ -96,5 +96,8 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
                      double* upper, std::string* why);
 // Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
 std::vector<std::string> parse_effect_list(const std::string& text);
+// These effects in canonical order joined by commas: SymbolicModel::effect_list() of the model
+// derived with them, and a generated header's kEffects, known before deriving.
+std::string canonical_effect_list(const std::vector<std::string>& effects);
 
 }  // namespace quadgen

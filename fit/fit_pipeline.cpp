@@ -140,12 +140,6 @@ LogKind log_kind(const std::string& path) {
   return LogKind::kFlight;
 }
 
-std::vector<FitParameter> fit_parameters(const SymbolicModel& model) {
-  std::vector<FitParameter> out;
-  for (const auto& p : model.params) out.push_back({p.name, p.unit, p.nominal, p.lower, p.upper, p.fit});
-  return out;
-}
-
 FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
   MotorStepModel model(read_motor_steps(path));
   const FitOptions fo = fit_options(o);
@@ -182,8 +176,8 @@ namespace {
 
 // The model's parameters with --free applied, or else the vehicle's fit flags less the
 // reference parameters (beside c_t only ratios to them are identifiable).
-std::vector<FitParameter> starting_parameters(const SymbolicModel& sm, const FitJobOptions& o) {
-  std::vector<FitParameter> params = fit_parameters(sm);
+std::vector<FitParameter> starting_parameters(const runtime::DynamicModel& model, const FitJobOptions& o) {
+  std::vector<FitParameter> params = model.parameters();
   for (const auto& name : o.free)
     if (std::none_of(params.begin(), params.end(), [&](const auto& p) { return p.name == name; }))
       throw std::invalid_argument("--free: no parameter '" + output::printable(name) + "' in the model");
@@ -229,12 +223,11 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
 
 }  // namespace
 
-FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, const SymbolicModel& sm, runtime::DynamicModel& model,
-                          const FitJobOptions& o) {
+FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
-  const std::vector<FitParameter> params = starting_parameters(sm, o);
+  const std::vector<FitParameter> params = starting_parameters(model, o);
   const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
   const bool accel = flight.has_accelerometer;
   const bool shooting = o.formulation == "multiple_shooting";

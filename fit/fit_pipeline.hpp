@@ -14,7 +14,6 @@
 #include "flight_data.hpp"
 #include "least_squares.hpp"
 #include "profile_likelihood.hpp"
-#include "symbolic_model.hpp"
 #include "vehicle.hpp"
 
 namespace quadgen::runtime {
@@ -52,14 +51,10 @@ struct FitOutputs {
   std::string summary;
 };
 
-// Every parameter of a derived model as a fit parameter, starting at its nominal value,
-// free as the vehicle file's fit flags say.
-std::vector<FitParameter> fit_parameters(const SymbolicModel& model);
-
 FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o);
 FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o);
-// `model` evaluates `symbolic` (compiled or interpreted).
-FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, const SymbolicModel& symbolic,
-                          runtime::DynamicModel& model, const FitJobOptions& o);
+// `model` (compiled or interpreted) starts at its parameters' current values, free as their
+// fit flags say; it needs no symbolic model.
+FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o);
 
 }  // namespace quadgen::fit

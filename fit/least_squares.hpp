@@ -11,13 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "parameter.hpp"
+
 namespace quadgen::fit {
 
-struct FitParameter {
-  std::string name, unit;
-  double value = 0, lower = 0, upper = 0;
-  bool free = true;
-};
+// The model's parameter record (runtime/parameter.hpp): `free` marks the ones this solve fits.
+using FitParameter = runtime::Parameter;
 
 // r(p) and dr/dp over all parameters (row-major, num_residuals x num_params).
 class ResidualModel {

@@ -17,7 +17,8 @@ const std::set<std::string>& generated_header_names() {
       "std", "quadgen_generated", "Model", "Scalar", "State", "Input", "Param", "Precomputed",
       "abs_value", "sign_of", "precompute", "rhs", "measurement", "kNumStates", "kNumInputs",
       "kNumParams", "kNumOutputs", "kNumPrecomputed", "kVehicleHash", "kEffects", "kStateNames",
-      "kInputNames", "kParamNames", "kOutputNames", "kNominalParams", "kInputDelayParam"};
+      "kInputNames", "kParamNames", "kOutputNames", "kNominalParams", "kInputDelayParam", "kParamUnits", "kParamLower",
+      "kParamUpper", "kParamFit"};
   return names;
 }
 

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "parameter.hpp"
+
 namespace quadgen::runtime {
 
 class DynamicModel {
@@ -20,6 +22,8 @@ class DynamicModel {
   virtual const std::vector<std::string>& param_names() const = 0;
   virtual const std::vector<double>& params() const = 0;
   virtual void set_params(const std::vector<double>& p) = 0;  // reruns the precompute step
+  // Every parameter at its current value, with its unit, bounds and default fit flag.
+  virtual std::vector<Parameter> parameters() const = 0;
   // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
@@ -89,6 +93,12 @@ class CompiledModel : public DynamicModel {
     if (A) scatter(A, n, sx, M::kDfdxNnz, M::kDfdxRow, M::kDfdxCol);
     if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
+  }
+  std::vector<Parameter> parameters() const override {
+    std::vector<Parameter> out;
+    for (int i = 0; i < M::kNumParams; ++i)
+      out.push_back({M::kParamNames[i], M::kParamUnits[i], p_[i], M::kParamLower[i], M::kParamUpper[i], M::kParamFit[i]});
+    return out;
   }
   int num_outputs() const override { return M::kNumOutputs; }
   void measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const override {

@@ -97,6 +97,19 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
     for (int j = 0; j < np_inner; ++j) B[i * np + column[j]] = inner_B_[i * np_inner + j];
 }
 
+std::vector<Parameter> PerFlightModel::parameters() const {
+  const std::vector<Parameter> inner = flights_[0]->parameters();
+  std::vector<Parameter> out(names_.size());
+  for (size_t k = 0; k < column_.size(); ++k)
+    for (size_t j = 0; j < inner.size(); ++j) {
+      Parameter& p = out[column_[k][j]];
+      p = inner[j];
+      p.name = names_[column_[k][j]];
+      p.value = p_[column_[k][j]];
+    }
+  return out;
+}
+
 void PerFlightModel::measurement(const double* x, double t, double* h, double* H, double* Hp) const {
   const int k = flight_at(t);
   const DynamicModel& m = *flights_[k];

@@ -51,6 +51,7 @@ class PerFlightModel : public DynamicModel {
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
+  std::vector<Parameter> parameters() const override;  // a flight's copy as flight 1's, renamed
   int num_outputs() const override { return flights_[0]->num_outputs(); }
   void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
   int input_delay_param() const override { return flights_[0]->input_delay_param(); }  // flight 1's copy

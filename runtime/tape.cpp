@@ -77,6 +77,14 @@ void TapeModel::set_params(const std::vector<double>& p) {
   run(tape_.precompute, reg_.data());
 }
 
+std::vector<Parameter> TapeModel::parameters() const {
+  std::vector<Parameter> out;
+  for (int i = 0; i < tape_.np; ++i)
+    out.push_back({tape_.param_names[i], tape_.param_units[i], p_[i], tape_.param_lower[i], tape_.param_upper[i],
+                   tape_.param_fit[i] != 0});
+  return out;
+}
+
 void TapeModel::measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const {
   double* r = reg_.data();
   for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];

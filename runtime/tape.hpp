@@ -37,6 +37,9 @@ struct Tape {
   SparseOutputs dhdx, dhdp;
   std::vector<std::string> state_names, input_names, param_names;
   std::vector<double> nominal;
+  std::vector<std::string> param_units;
+  std::vector<double> param_lower, param_upper;
+  std::vector<char> param_fit;
   int input_delay_param = -1;
   // Registers 0..nx-1 are x, then u, then p, then constants and nodes.
   int x_reg(int i) const { return i; }
@@ -58,6 +61,7 @@ class TapeModel : public DynamicModel {
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<TapeModel>(*this); }
+  std::vector<Parameter> parameters() const override;
   int num_outputs() const override { return tape_.ny; }
   void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
   int input_delay_param() const override { return tape_.input_delay_param; }

@@ -461,6 +461,45 @@ TEST(FitCli, MotorGainReferenceIsHeld) {
   EXPECT_NEAR(j["estimates"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.01);
 }
 
+// A generated header carries each parameter's unit, bounds and fit flag, so a fit with a
+// matching compiled header derives nothing; the same vehicle with one comment more (another
+// hash: no header matches) is derived and interpreted. Both give the same fit.
+TEST(FitCli, CompiledHeaderNeedsNoDerivationAndFitsTheSame) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fit_compiled";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string v = test::source_path("vehicles/finken3.yaml"), log = (dir / "flight.csv").string();
+  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + v + " --closed-loop --duration 8 --out " + log +
+                         " > /dev/null 2>&1").c_str()),
+            0);
+  const fs::path copy = dir / "finken3_copy.yaml";
+  {
+    std::ifstream in(v);
+    std::ofstream out(copy);
+    out << in.rdbuf() << "# a copy: another hash, so no generated header matches\n";
+  }
+  const CliRun compiled = run_fit(v, log, (dir / "compiled").string(), "--profiles none");
+  const CliRun derived = run_fit(copy.string(), log, (dir / "derived").string(), "--profiles none");
+  ASSERT_EQ(compiled.rc, 0) << compiled.err;
+  ASSERT_EQ(derived.rc, 0) << derived.err;
+  EXPECT_NE(compiled.err.find("no derivation needed"), std::string::npos) << compiled.err;
+  EXPECT_NE(derived.err.find("interpreted"), std::string::npos) << derived.err;
+  const auto a = nlohmann::json::parse(std::ifstream(dir / "compiled" / "fit.json"))["estimates"];
+  const auto b = nlohmann::json::parse(std::ifstream(dir / "derived" / "fit.json"))["estimates"];
+  ASSERT_EQ(a.size(), b.size());
+  int fitted = 0;
+  for (const auto& [name, e] : a.items()) {
+    ASSERT_TRUE(b.contains(name)) << name;
+    EXPECT_EQ(e["unit"], b[name]["unit"]) << name;
+    EXPECT_EQ(e["bounds"], b[name]["bounds"]) << name;
+    EXPECT_EQ(e["fitted"], b[name]["fitted"]) << name;
+    const double x = e["value"].get<double>(), y = b[name]["value"].get<double>();
+    EXPECT_NEAR(x, y, 1e-6 * (1e-12 + std::fabs(y))) << name;
+    fitted += e["fitted"].get<bool>();
+  }
+  EXPECT_GE(fitted, 2);
+}
+
 // Per-flight data-side parameters: two flights logged with different attitude biases (a
 // marker frame fitted per session). Joined and fitted through a PerFlightModel, each
 // flight's bias comes back; the equation error reads each sample's bias from its flight.

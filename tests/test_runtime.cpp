@@ -172,6 +172,43 @@ TEST(Runtime, MeasurementIsTheLoggedPoseWithAnalyticJacobians) {
   EXPECT_LT(max_diff(hj, h2), 1e-15);
 }
 
+// The parameter record a generated header carries (unit, bounds, fit flag) is the derived
+// model's: compiled and interpreted models list the same records, effect parameters included;
+// a joint model copies flight 1's record under each flight's name.
+TEST(Runtime, HeadersCarryEachParametersUnitBoundsAndFitFlag) {
+  TapeModel tape = finken3_tape(parse_effect_list("all"));
+  CompiledModel<quadgen_generated::finken3_all_effects::Model> compiled;
+  const std::vector<runtime::Parameter> a = compiled.parameters(), b = tape.parameters();
+  ASSERT_EQ(a.size(), b.size());
+  int fitted = 0, bounded = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].name, b[i].name);
+    EXPECT_EQ(a[i].unit, b[i].unit) << a[i].name;
+    EXPECT_EQ(a[i].value, b[i].value) << a[i].name;
+    EXPECT_EQ(a[i].lower, b[i].lower) << a[i].name;
+    EXPECT_EQ(a[i].upper, b[i].upper) << a[i].name;
+    EXPECT_EQ(a[i].free, b[i].free) << a[i].name;
+    EXPECT_LE(a[i].lower, a[i].value) << a[i].name;
+    EXPECT_GE(a[i].upper, a[i].value) << a[i].name;
+    fitted += a[i].free;
+    bounded += a[i].lower < a[i].upper;
+  }
+  EXPECT_EQ(a[compiled.param_index("mass")].unit, "kg");
+  EXPECT_EQ(a[compiled.param_index("input_delay.seconds")].unit, "s");
+  EXPECT_GE(fitted, 2);
+  EXPECT_GT(bounded, 10);  // the vehicle's fitted parameters and every effect's
+  PerFlightModel joint(compiled, {10.0}, {"wind.x"});
+  std::vector<double> p = joint.params();
+  p.back() = 1.5;
+  joint.set_params(p);
+  const std::vector<runtime::Parameter> j = joint.parameters();
+  ASSERT_EQ(j.size(), a.size() + 1);
+  EXPECT_EQ(j.back().name, "wind.x@2");
+  EXPECT_EQ(j.back().unit, a[compiled.param_index("wind.x")].unit);
+  EXPECT_EQ(j.back().upper, a[compiled.param_index("wind.x")].upper);
+  EXPECT_EQ(j.back().value, 1.5);
+}
+
 TEST(Runtime, RestrictedParameterJacobianKeepsRequestedColumns) {
   TapeModel tape = finken3_tape({"motor_gain"});
   std::mt19937 rng(8);

@@ -43,6 +43,12 @@ std::string number(double v) {
   return buf;
 }
 
+// A bound as a C++ constant: an infinite one (no bound) is HUGE_VAL from <cmath>.
+std::string bound(double v) {
+  if (std::isinf(v)) return v > 0 ? "HUGE_VAL" : "-HUGE_VAL";
+  return number(v);
+}
+
 data variables(const std::vector<Variable>& vs) {
   list l;
   for (size_t i = 0; i < vs.size(); ++i) {
@@ -177,6 +183,19 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   std::string nominal = "{";
   for (size_t i = 0; i < m.params.size(); ++i) nominal += (i ? ", " : "") + number(m.params[i].nominal);
   d.set("nominal_params", nominal + "}");
+  std::string units = "{", lower = "{", upper = "{", fit = "{";
+  for (size_t i = 0; i < m.params.size(); ++i) {
+    const Variable& v = m.params[i];
+    const std::string sep = i ? ", " : "";
+    units += sep + output::cpp_string_literal(v.unit);
+    lower += sep + bound(v.lower);
+    upper += sep + bound(v.upper);
+    fit += sep + (v.fit ? "true" : "false");
+  }
+  d.set("param_units", units + "}");
+  d.set("param_lower", lower + "}");
+  d.set("param_upper", upper + "}");
+  d.set("param_fit", fit + "}");
   d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
   list sparsity;
   const std::pair<const char*, const Sparse*> sp[] = {{"Dfdx", &fx}, {"Dfdu", &fu}, {"Dfdp", &fp}, {"Dhdx", &hx}, {"Dhdp", &hp}};

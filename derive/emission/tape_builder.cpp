@@ -92,6 +92,10 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   for (const auto& v : m.params) {
     t.param_names.push_back(v.name);
     t.nominal.push_back(v.nominal);
+    t.param_units.push_back(v.unit);
+    t.param_lower.push_back(v.lower);
+    t.param_upper.push_back(v.upper);
+    t.param_fit.push_back(v.fit ? 1 : 0);
   }
   t.input_delay_param = m.input_delay_param ? static_cast<int>(*m.input_delay_param) : -1;
 

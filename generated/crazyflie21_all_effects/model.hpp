@@ -110,6 +110,12 @@ inline constexpr const char* kParamNames[kNumParams] = {"g", "rho", "c_w", "c_t"
 inline constexpr const char* kOutputNames[kNumOutputs] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 // Nominal parameter values (SI) from the vehicle file and the block geometry.
 inline constexpr double kNominalParams[kNumParams] = {9.81, 1.2041, 1, 0.01963, 0.006, 325.5391611478327, 2752.5064034426973, -651.6762720973987, 0.0271, 0, 0, -0.0005107011070110702, 1.4324029146678967e-05, 1.4738195813345634e-05, 2.8252337333333335e-05, 0, 0, 0, 0.001080536045127715, 0.001185536045127715, 0.002957, 0, 0, 0, 0, 0.001, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3.15, 0, 0};
+// Their units (SI), the bounds a fit keeps them in, and whether a fit frees them by default
+// (the vehicle file's `fit`; an effect's parameters are freed by the effect search).
+inline constexpr const char* kParamUnits[kNumParams] = {"m/s^2", "kg/m^3", "1", "1", "m", "rad/s", "rad/s", "rad/s", "kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "m^2", "m^2", "m^2", "1", "1", "1", "1", "s", "s", "m", "m", "m/s", "m/s", "N s^2/m", "N s^2", "rad", "rad", "1/s", "1", "V", "m", "1"};
+inline constexpr double kParamLower[kNumParams] = {9.81, 1.2041, 0.05, 0.002, 0.0001, 325.5391611478327, 2752.5064034426973, -651.6762720973987, 0.015, 0, 0, -0.0005107011070110702, 1.4324029146678967e-05, 1.4738195813345634e-05, 2.8252337333333335e-05, 0, 0, 0, 0.001080536045127715, 0.001185536045127715, 0.002957, -0.5, -0.5, -0.5, -0.5, 1e-06, 0, -0.05, -0.05, -1e+01, -1e+01, 0, -0.0001, -0.2, -0.2, -0.05, -1, 3.15, 0, -5};
+inline constexpr double kParamUpper[kNumParams] = {9.81, 1.2041, 3, 0.2, 0.05, 325.5391611478327, 2752.5064034426973, -651.6762720973987, 0.05, 0, 0, -0.0005107011070110702, 1.4324029146678967e-05, 1.4738195813345634e-05, 2.8252337333333335e-05, 0, 0, 0, 0.001080536045127715, 0.001185536045127715, 0.002957, 0.5, 0.5, 0.5, 0.5, 1, 0.2, 0.05, 0.05, 1e+01, 1e+01, 0.001, 0.0001, 0.2, 0.2, 0.05, 4, 3.15, 0.5, 2e+01};
+inline constexpr bool kParamFit[kNumParams] = {false, false, true, true, true, false, false, false, false, false, false, false, false, false, false, false, false, false, false, false, false, true, true, true, true, true, true, true, true, true, true, true, true, true, true, true, true, false, true, true};
 // Index of the input_delay parameter, or -1: the runtime feeds u(t - delay).
 inline constexpr int kInputDelayParam = 26;
 
@@ -2023,6 +2029,10 @@ struct Model {
   static constexpr const char* const* kParamNames = crazyflie21_all_effects::kParamNames;
   static constexpr const char* const* kOutputNames = crazyflie21_all_effects::kOutputNames;
   static constexpr const double* kNominalParams = crazyflie21_all_effects::kNominalParams;
+  static constexpr const char* const* kParamUnits = crazyflie21_all_effects::kParamUnits;
+  static constexpr const double* kParamLower = crazyflie21_all_effects::kParamLower;
+  static constexpr const double* kParamUpper = crazyflie21_all_effects::kParamUpper;
+  static constexpr const bool* kParamFit = crazyflie21_all_effects::kParamFit;
   static constexpr const char* kVehicleHash = crazyflie21_all_effects::kVehicleHash;
   static constexpr const char* kEffects = crazyflie21_all_effects::kEffects;
   template <typename Scalar>

@@ -110,6 +110,12 @@ inline constexpr const char* kParamNames[kNumParams] = {"g", "rho", "c_w", "c_t"
 inline constexpr const char* kOutputNames[kNumOutputs] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 // Nominal parameter values (SI) from the vehicle file and the block geometry.
 inline constexpr double kNominalParams[kNumParams] = {9.81, 1.2041, 0.7, 0.14175, 0.01, 175.30087007031045, 2222.6292025260404, -309.3992764898563, 0.387, 0, 0, 0.004764857881136951, 0.0008776430048017434, 0.0008644430048017434, 0.0012437846721357866, 0, 0, 0, 0.010766540947084818, 0.010356540947084818, 0.015815, 0, 0, 0, 0, 0.001, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4, 0, 0};
+// Their units (SI), the bounds a fit keeps them in, and whether a fit frees them by default
+// (the vehicle file's `fit`; an effect's parameters are freed by the effect search).
+inline constexpr const char* kParamUnits[kNumParams] = {"m/s^2", "kg/m^3", "1", "1", "m", "rad/s", "rad/s", "rad/s", "kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "m^2", "m^2", "m^2", "1", "1", "1", "1", "s", "s", "m", "m", "m/s", "m/s", "N s^2/m", "N s^2", "rad", "rad", "1/s", "1", "V", "m", "1"};
+inline constexpr double kParamLower[kNumParams] = {9.81, 1.2041, 0.1, 0.01, 0.0001, 175.30087007031045, 2222.6292025260404, -309.3992764898563, 0.2, 0, 0, 0.004764857881136951, 0.0008776430048017434, 0.0008644430048017434, 0.0012437846721357866, 0, 0, 0, 0.010766540947084818, 0.010356540947084818, 0.015815, -0.5, -0.5, -0.5, -0.5, 1e-06, 0, -0.05, -0.05, -1e+01, -1e+01, 0, -0.0001, -0.2, -0.2, -0.05, -1, 4, 0, -5};
+inline constexpr double kParamUpper[kNumParams] = {9.81, 1.2041, 2.5, 1, 0.1, 175.30087007031045, 2222.6292025260404, -309.3992764898563, 0.8, 0, 0, 0.004764857881136951, 0.0008776430048017434, 0.0008644430048017434, 0.0012437846721357866, 0, 0, 0, 0.010766540947084818, 0.010356540947084818, 0.015815, 0.5, 0.5, 0.5, 0.5, 1, 0.2, 0.05, 0.05, 1e+01, 1e+01, 0.001, 0.0001, 0.2, 0.2, 0.05, 4, 4, 0.5, 2e+01};
+inline constexpr bool kParamFit[kNumParams] = {false, false, false, true, true, false, false, false, false, false, false, false, false, false, false, false, false, false, false, false, false, true, true, true, true, true, true, true, true, true, true, true, true, true, true, true, true, false, true, true};
 // Index of the input_delay parameter, or -1: the runtime feeds u(t - delay).
 inline constexpr int kInputDelayParam = 26;
 
@@ -2023,6 +2029,10 @@ struct Model {
   static constexpr const char* const* kParamNames = finken3_all_effects::kParamNames;
   static constexpr const char* const* kOutputNames = finken3_all_effects::kOutputNames;
   static constexpr const double* kNominalParams = finken3_all_effects::kNominalParams;
+  static constexpr const char* const* kParamUnits = finken3_all_effects::kParamUnits;
+  static constexpr const double* kParamLower = finken3_all_effects::kParamLower;
+  static constexpr const double* kParamUpper = finken3_all_effects::kParamUpper;
+  static constexpr const bool* kParamFit = finken3_all_effects::kParamFit;
   static constexpr const char* kVehicleHash = finken3_all_effects::kVehicleHash;
   static constexpr const char* kEffects = finken3_all_effects::kEffects;
   template <typename Scalar>
