@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Diagnoses every NanoBench flight of the one Crazyflie (CF_01) and checks the rules of
-# what diagnose may name (README "Real flights"):
+# what diagnose may name (docs/validation.md, "Real data"):
 #   scripts/real_flights.sh [OUT_DIR]
 # With JOINT=1 it also diagnoses the five usable flights jointly (B6 saturates its PWM; see
 # docs/crazyflie_evidence.md) with --max-effects 5: one set of airframe parameters for all.

@@ -5,7 +5,7 @@
 // the flight cannot separate them, find two effects at once, and report an effect outside
 // the catalogue as unexplained instead of naming a wrong cause.
 //
-// Magnitudes (README "Hidden-effect suite" cites where they come from): 8 % thrust loss on
+// Magnitudes (docs/validation.md "Hidden-effect suite" cites where they come from): 8 % thrust loss on
 // one rotor, 50 ms rotor lag, 25 ms delay, 1 cm CoG offset, rotor drag 2e-5, 1.8 m/s wind,
 // blade flapping 2e-6 N s^2 (about 2 rad/s^2 of pitch per m/s), 1.7 deg attitude offset,
 // 12 % thrust decay per minute, exponent 1.5 battery sag, ground effect with the true
