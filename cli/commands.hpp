@@ -5,17 +5,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "derive_command.hpp"
+#include "diagnose_job.hpp"
+
 namespace quadgen::cli {
-
-struct DeriveArgs {
-  std::string vehicle;
-  std::string out;
-  std::string effects;
-  std::string params;  // fitted_parameters.yaml from diagnose: its effects and values
-};
-
-void add_derive(CLI::App& app, DeriveArgs& args);
-int run_derive(const DeriveArgs& args);
 
 struct SimulateArgs {
   std::string vehicle, scenario, inputs, out, effects;
@@ -52,12 +45,8 @@ void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);
 
 struct DiagnoseArgs {
-  std::string vehicle, out, mapping, candidates;
-  std::vector<std::string> logs;  // one flight, or several of the same vehicle (diagnosed jointly)
-  std::string translational = "auto";
-  std::string environment;  // "": the mapping's, else unknown
-  double resample = 0, validation = 0.3, alpha = 0.01, window = 1.0;
-  int max_effects = 3;
+  app::DiagnoseJob job;  // the flags land here; defaults are the library's
+  std::string out;
 };
 void add_diagnose(CLI::App& app, DiagnoseArgs& args);
 int run_diagnose(const DiagnoseArgs& args);

@@ -3,7 +3,7 @@
 #include <iostream>
 #include <set>
 
-#include "commands.hpp"
+#include "derive_command.hpp"
 #include "derive_pipeline.hpp"
 #include "effects.hpp"
 #include "fitted_parameters.hpp"

@@ -117,11 +117,11 @@ int run_fit(const FitArgs& a) {
     DeriveOptions derive;
     derive.effects = parse_effect_list(a.effects);
     // A matching compiled header carries everything a fit needs: no symbolic derivation.
-    std::unique_ptr<runtime::DynamicModel> model = compiled_model_for(v, derive.effects);
+    std::unique_ptr<runtime::DynamicModel> model = app::compiled_model_for(v, derive.effects);
     if (model) {
       std::cerr << "model: compiled header from generated/ (no derivation needed)\n";
     } else {
-      model = make_model(derive_model(v, derive_mass_properties(v), derive));
+      model = app::make_model(derive_model(v, derive_mass_properties(v), derive));
       std::cerr << "model: interpreted (no matching generated header)\n";
     }
     result = fit_flight_log(a.log, v, *model, o);

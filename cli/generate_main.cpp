@@ -3,7 +3,7 @@
 #include <iostream>
 #include <string>
 
-#include "commands.hpp"
+#include "derive_command.hpp"
 #include "sinks.hpp"
 
 int main(int argc, char** argv) {

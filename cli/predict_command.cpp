@@ -47,9 +47,9 @@ int run_predict(const PredictArgs& a) {
   DeriveOptions all;
   all.effects = parse_effect_list("all");  // effects at neutral values unless --params sets them
   // A matching compiled header carries everything prediction needs: no symbolic derivation.
-  std::unique_ptr<runtime::DynamicModel> model = compiled_model_for(v, all.effects);
+  std::unique_ptr<runtime::DynamicModel> model = app::compiled_model_for(v, all.effects);
   std::cerr << "model: " << (model ? "compiled header from generated/ (no derivation needed)" : "interpreted tape") << "\n";
-  if (!model) model = make_model(derive_model(v, derive_mass_properties(v), all));
+  if (!model) model = app::make_model(derive_model(v, derive_mass_properties(v), all));
   predict::PredictFlightsOptions o;
   o.mapping = a.mapping;
   o.resample = a.resample;

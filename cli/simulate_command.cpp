@@ -201,7 +201,7 @@ int run_simulate(const SimulateArgs& a) {
   DeriveOptions opt;
   opt.effects = parse_effect_list(a.effects);
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
-  const auto model_ptr = make_model(model);
+  const auto model_ptr = app::make_model(model);
   DynamicModel& m = *model_ptr;
   const size_t nr = vehicle.rotors.size();
   const auto laws = nominal_thrust_laws(vehicle, model);

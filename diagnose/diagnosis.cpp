@@ -241,6 +241,22 @@ std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParamet
 
 }  // namespace
 
+bool DiagnoseOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!(validation_fraction >= 0.1 && validation_fraction <= 0.6)) return fail("validation fraction: 0.1 to 0.6");
+  if (!(window >= 0.1 && window <= 10)) return fail("validation window: 0.1 to 10 s");
+  if (translational != "auto" && translational != "pose" && translational != "accelerometer")
+    return fail("translational channels: auto, pose or accelerometer");
+  if (!(search.alpha > 0 && search.alpha <= 0.2)) return fail("alpha: above 0, at most 0.2");
+  if (search.max_effects < 1 || search.max_effects > 10) return fail("max effects: 1 to 10");
+  if (!(unexplained_ratio > 1) || !(unexplained_p > 0 && unexplained_p < 1))
+    return fail("unexplained: a ratio above 1 and a p-value in (0, 1)");
+  return true;
+}
+
 Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {

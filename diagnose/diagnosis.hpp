@@ -28,6 +28,9 @@ struct DiagnoseOptions {
   // Unexplained discrepancy: slow residual structure beyond this many times what the noise
   // gives, at this significance, after the selected effects.
   double unexplained_ratio = 3.0, unexplained_p = 1e-6;
+
+  // Ceres-style: false with a reason for a value no diagnosis can use.
+  bool IsValid(std::string* error) const;
 };
 
 struct Finding {

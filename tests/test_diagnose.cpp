@@ -24,6 +24,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "diagnose_job.hpp"
 #include "estimate_shape.hpp"
 
 namespace {
@@ -540,3 +541,26 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
 }
 
 }  // namespace
+
+// The diagnosis as a library call checks its options itself (Ceres-style IsValid), so a
+// caller that is not the command line gets the same refusals, with the reason.
+TEST(DiagnoseJob, RefusesOptionsNoDiagnosisCanUse) {
+  quadgen::app::DiagnoseJob job;
+  std::string why;
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_NE(why.find("vehicle"), std::string::npos) << why;
+  job.vehicle = "vehicles/finken3.yaml";
+  job.logs = {"flight.csv"};
+  EXPECT_TRUE(job.IsValid(&why)) << why;  // the library's defaults are valid
+  job.options.validation_fraction = 0.9;
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_NE(why.find("validation"), std::string::npos) << why;
+  job.options.validation_fraction = 0.3;
+  job.options.search.alpha = std::nan("");
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_NE(why.find("alpha"), std::string::npos) << why;
+  job.options.search.alpha = 0.01;
+  job.environment = "orbit";
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_THROW(quadgen::app::run_diagnose_job(job), std::invalid_argument);  // refused before reading any file
+}

@@ -7,7 +7,7 @@
 #include "symbolic_model.hpp"
 #include "vehicle.hpp"
 
-namespace quadgen::cli {
+namespace quadgen::app {
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled = nullptr);
 // The compiled header generated from this vehicle file (its bytes' hash) with these effects,
 // found without deriving; nullptr when generated/ has none. Its parameters carry units,

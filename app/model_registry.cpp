@@ -7,7 +7,7 @@
 #include "effects.hpp"
 #include "tape_builder.hpp"
 
-namespace quadgen::cli {
+namespace quadgen::app {
 
 namespace {
 template <class M>
@@ -36,4 +36,4 @@ std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, cons
   return find_compiled(v.content_hash, canonical_effect_list(effects));
 }
 
-}  // namespace quadgen::cli
+}  // namespace quadgen::app

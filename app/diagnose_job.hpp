@@ -1,0 +1,36 @@
+// `quadgen diagnose` as a library call: the logs of one vehicle in; out, in memory, every
+// file the command writes (diagnosis.json, report.html, the extended model and its
+// derivation, fitted_parameters.yaml, the plots and their data). The caller decides where
+// they go: the command line writes them as one output set, all or nothing.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnosis.hpp"
+
+namespace quadgen::app {
+
+struct DiagnoseJob {
+  std::string vehicle;            // vehicle file (YAML)
+  std::vector<std::string> logs;  // one flight, or several of the vehicle (diagnosed jointly)
+  std::string mapping;            // column mapping (YAML); "": the canonical layout
+  double resample = 0;            // Hz; 0: the samples as logged
+  std::string environment;        // indoor, outdoor or unknown; "": the mapping's, else unknown
+  std::string candidates;         // comma-separated effects; "": all that the logs support
+  diagnose::DiagnoseOptions options;
+
+  // Ceres-style: false with a reason for a value no diagnosis can use.
+  bool IsValid(std::string* error) const;
+};
+
+struct DiagnoseJobResult {
+  std::vector<std::pair<std::string, std::string>> files;  // name, contents
+  std::string summary;                                     // what the command prints
+};
+
+// Throws std::invalid_argument for an invalid job, and the layers' own errors (a bad vehicle
+// file or log, with file and line) unchanged.
+DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job);
+
+}  // namespace quadgen::app
