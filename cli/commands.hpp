@@ -7,6 +7,8 @@
 
 #include "derive_command.hpp"
 #include "diagnose_job.hpp"
+#include "fit_pipeline.hpp"
+#include "predict_flights.hpp"
 
 namespace quadgen::cli {
 
@@ -31,15 +33,10 @@ void add_simulate(CLI::App& app, SimulateArgs& args);
 int run_simulate(const SimulateArgs& args);
 
 struct FitArgs {
-  std::string vehicle, log, out, mapping, effects, free, channels;
-  bool robust = false;
-  double validation = 0.3;
-  std::string formulation = "equation_error";
-  double window = 0.5;
-  double resample = 0;
+  std::string vehicle, log, out, effects, free, channels;
   std::string profiles = "all";  // all | none | comma-separated parameter names
-  int threads = 0;               // profile threads; 0: one per core
-  std::set<std::string> given;  // options on the command line (each fit kind refuses those it does not use)
+  fit::FitJobOptions options;    // the other flags land here; defaults are the library's
+  std::set<std::string> given;   // options on the command line (each fit kind refuses those it does not use)
 };
 void add_fit(CLI::App& app, FitArgs& args);
 int run_fit(const FitArgs& args);
@@ -52,10 +49,9 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& args);
 int run_diagnose(const DiagnoseArgs& args);
 
 struct PredictArgs {
-  std::string vehicle, out, mapping, params;
+  std::string vehicle, out;
   std::vector<std::string> logs;
-  double validation = 0.3, resample = 0, stride = 0.05;
-  bool calibrate = false;
+  predict::PredictFlightsOptions options;  // the flags land here; defaults are the library's
 };
 void add_predict(CLI::App& app, PredictArgs& args);
 int run_predict(const PredictArgs& args);

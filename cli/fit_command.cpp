@@ -26,17 +26,17 @@ void add_fit(CLI::App& app, FitArgs& a) {
                                   "), motor steps or a thrust stand (CSV)")
       ->required();
   c->add_option("--out", a.out, "output directory")->required();
-  c->add_flag("--robust", a.robust, "Huber loss instead of squares");
-  c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
+  c->add_flag("--robust", a.options.robust, "Huber loss instead of squares");
+  c->add_option("--mapping", a.options.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
   std::string effect_names;  // the catalogue, so --help lists what --effects accepts
   for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
-  c->add_option("--validation", a.validation, "fraction of the flight (at its end) held out for validation")
+  c->add_option("--validation", a.options.validation, "fraction of the flight (at its end) held out for validation")
       ->check(finite_range(0.0, 0.9));
-  c->add_option("--formulation", a.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
+  c->add_option("--formulation", a.options.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
       ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
-  c->add_option("--window", a.window, "multiple shooting: window length [s]")->check(finite_range(0.01, 100));
-  c->add_option("--resample", a.resample, "resample the log onto a uniform grid at this rate [Hz] first")
+  c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(0.01, 100));
+  c->add_option("--resample", a.options.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(0.1, 1e5));
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free,
@@ -46,7 +46,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
                 "profile likelihood of: all free parameters, none (estimates and standard errors only), or "
                 "comma-separated names (as for --free)")
       ->capture_default_str();
-  c->add_option("--threads", a.threads, "threads for the profiles (0: one per core)")
+  c->add_option("--threads", a.options.threads, "threads for the profiles (0: one per core)")
       ->check(CLI::Range(0, 256))
       ->capture_default_str();
 }
@@ -63,16 +63,9 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 FitJobOptions job_options(const FitArgs& a) {
-  FitJobOptions o;
-  o.robust = a.robust;
+  FitJobOptions o = a.options;
   o.profile_all_free = a.profiles != "none";
   if (a.profiles != "all" && a.profiles != "none") o.profiles = split_list(a.profiles);
-  o.threads = a.threads;
-  o.mapping = a.mapping;
-  o.resample = a.resample;
-  o.validation = a.validation;
-  o.formulation = a.formulation;
-  o.window = a.window;
   o.channels = split_list(a.channels);
   o.free = split_list(a.free);
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
@@ -92,7 +85,7 @@ void refuse_options(const FitArgs& a, const std::string& kind, const std::set<st
 }
 
 void check_flight_options(const FitArgs& a) {
-  const bool shooting = a.formulation == "multiple_shooting";
+  const bool shooting = a.options.formulation == "multiple_shooting";
   if (a.given.count("--window") && !shooting) throw std::invalid_argument("--window: only with --formulation multiple_shooting");
   if (a.given.count("--channels") && shooting)
     throw std::invalid_argument("--channels: only with --formulation equation_error (multiple shooting fits the pose)");
@@ -103,7 +96,7 @@ void check_flight_options(const FitArgs& a) {
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   const LogKind kind = log_kind(a.log);
-  output::OutputDirectory out(a.out, {a.vehicle, a.log, a.mapping});  // refused before the work, not after
+  output::OutputDirectory out(a.out, {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
   const FitJobOptions o = job_options(a);
   FitOutputs result;
   if (kind == LogKind::kMotorSteps) {

@@ -25,24 +25,24 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
   c->add_option("logs", a.logs, std::string("flight logs, one or more: ") + kLogFormats)->required()->default_str("");
   c->add_option("--out", a.out, "output directory")->required();
-  c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");
-  c->add_option("--params", a.params,
+  c->add_option("--mapping", a.options.mapping, "column mapping (YAML) for logs not in the canonical layout");
+  c->add_option("--params", a.options.params,
                 "parameter values from a fit.json or diagnosis.json (default: the vehicle file's nominal values)");
-  c->add_option("--validation", a.validation,
-                "fraction of each flight (at its end) evaluated; 1 for flights no fit has seen (default 0.3)")
+  c->add_option("--validation", a.options.validation,
+                "fraction of each flight (at its end) evaluated; 1 for flights no fit has seen")
       ->check(finite_range(0.05, 1.0));
-  c->add_option("--resample", a.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
+  c->add_option("--resample", a.options.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(0.1, 1e5));
-  c->add_flag("--calibrate", a.calibrate,
+  c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");
-  c->add_option("--stride", a.stride, "seconds between rollout start points (default 0.05)")->check(finite_range(0.001, 10));
+  c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(0.001, 10));
 }
 
 int run_predict(const PredictArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   std::vector<std::string> inputs = a.logs;
-  inputs.insert(inputs.end(), {a.vehicle, a.mapping, a.params});
+  inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, inputs);  // refused before the work, not after
   DeriveOptions all;
   all.effects = parse_effect_list("all");  // effects at neutral values unless --params sets them
@@ -50,13 +50,7 @@ int run_predict(const PredictArgs& a) {
   std::unique_ptr<runtime::DynamicModel> model = app::compiled_model_for(v, all.effects);
   std::cerr << "model: " << (model ? "compiled header from generated/ (no derivation needed)" : "interpreted tape") << "\n";
   if (!model) model = app::make_model(derive_model(v, derive_mass_properties(v), all));
-  predict::PredictFlightsOptions o;
-  o.mapping = a.mapping;
-  o.resample = a.resample;
-  o.validation = a.validation;
-  o.params = a.params;
-  o.calibrate = a.calibrate;
-  o.prediction.start_stride = a.stride;
+  predict::PredictFlightsOptions o = a.options;
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), a.logs, o);
   out.add("prediction.json", output::json_document(p.json));

@@ -132,6 +132,20 @@ std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const 
 
 }  // namespace
 
+bool FitJobOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (threads < 0) return fail("threads: 0 (one per core) or more");
+  if (!(resample == 0 || (resample >= 0.1 && resample <= 1e5))) return fail("resample: 0 or 0.1 to 1e5 Hz");
+  if (!(validation >= 0 && validation <= 0.9)) return fail("validation fraction: 0 to 0.9");
+  if (formulation != "equation_error" && formulation != "multiple_shooting")
+    return fail("formulation: equation_error or multiple_shooting");
+  if (!(window >= 0.01 && window <= 100)) return fail("window: 0.01 to 100 s");
+  return true;
+}
+
 LogKind log_kind(const std::string& path) {
   if (is_topic_log(path)) return LogKind::kFlight;
   const runtime::CsvTable head = runtime::read_csv(path);
@@ -224,6 +238,8 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
 }  // namespace
 
 FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
+  std::string error;
+  if (!o.IsValid(&error)) throw std::invalid_argument("fit: " + error);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});

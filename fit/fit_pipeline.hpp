@@ -40,6 +40,9 @@ struct FitJobOptions {
   std::vector<std::string> channels;   // equation error: residual channels fitted (empty: all)
   std::vector<std::string> free;       // parameters fitted, overriding the vehicle file's flags
   std::function<void(const std::string&)> progress = [](const std::string&) {};  // one line per step
+
+  // Ceres-style: false with a reason for a value no fit can use.
+  bool IsValid(std::string* error) const;
 };
 
 // What a fit writes: fit.json, rendered plots (file name, SVG), plots that could not be
