@@ -36,15 +36,6 @@ Variable make_variable(const std::string& name, const std::string& unit, const s
   return v;
 }
 
-// A bound as the file wrote it: the shortest text that reads back as the same double.
-std::string exact_text(double x) {
-  char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
 
 // A value outside [lower, upper] to 6 digits, or to more where 6 would read as inside.
 std::string outside_text(double x, double lower, double upper) {
@@ -64,7 +55,7 @@ void check_derived_bounds(const Vehicle& v, const std::string& name, const std::
   const std::string where = declared.line > 0 ? ":" + std::to_string(declared.line) : "";
   throw VehicleError(v.source_path + where + ": derived quantity " + name + ": the blocks give " +
                      outside_text(value, declared.lower, declared.upper) + " " + unit +
-                     ", outside its bounds [" + exact_text(declared.lower) + ", " + exact_text(declared.upper) +
+                     ", outside its bounds [" + shortest_text(declared.lower) + ", " + shortest_text(declared.upper) +
                      "]");
 }
 

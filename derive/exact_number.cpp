@@ -29,4 +29,13 @@ GiNaC::numeric exact(double v) {
   return negative ? -result : result;
 }
 
+std::string shortest_text(double v) {
+  char buf[40];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
 }  // namespace quadgen

@@ -5,6 +5,7 @@
 #include <kainjow/mustache.hpp>
 
 #include "cpp_emitter.hpp"
+#include "exact_number.hpp"
 #include "names.hpp"
 #include "sinks.hpp"
 #include "effects.hpp"
@@ -34,14 +35,7 @@ std::string quoted_list(const std::vector<Variable>& vs) {
   return s + "}";
 }
 
-std::string number(double v) {
-  char buf[40];
-  for (int prec = 1; prec <= 17; ++prec) {
-    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
+std::string number(double v) { return shortest_text(v); }
 
 // A bound as a C++ constant: an infinite one (no bound) is HUGE_VAL from <cmath>.
 std::string bound(double v) {

@@ -110,28 +110,25 @@ runtime::Tape build_tape(const SymbolicModel& m) {
     std::vector<Instruction>* code;
     std::vector<int> nodes;
   };
+  // Each Jacobian's structural non-zeros (constants substituted already), row-major.
+  const auto add_nonzeros = [&](std::vector<Jac>& group) {
+    for (auto& j : group)
+      for (unsigned r = 0; r < j.J->rows(); ++r)
+        for (unsigned c = 0; c < j.J->cols(); ++c)
+          if (!(*j.J)(r, c).is_zero()) {
+            j.out->row.push_back(static_cast<int>(r));
+            j.out->col.push_back(static_cast<int>(c));
+            j.nodes.push_back(g.add((*j.J)(r, c)));
+          }
+  };
   std::vector<Jac> jacs = {{&m.dfdx, &t.dfdx, &t.dfdx_code, {}},
                            {&m.dfdp, &t.dfdp, &t.dfdp_code, {}},
                            {&m.dfdu, &t.dfdu, &t.dfdu_code, {}}};
-  for (auto& j : jacs)
-    for (unsigned r = 0; r < j.J->rows(); ++r)
-      for (unsigned c = 0; c < j.J->cols(); ++c)
-        if (!(*j.J)(r, c).is_zero()) {
-          j.out->row.push_back(static_cast<int>(r));
-          j.out->col.push_back(static_cast<int>(c));
-          j.nodes.push_back(g.add((*j.J)(r, c)));  // constants substituted already
-        }
+  add_nonzeros(jacs);
   std::vector<int> h_nodes;
   for (unsigned i = 0; i < m.h.rows(); ++i) h_nodes.push_back(g.add(m.h(i, 0).subs(constants)));
   std::vector<Jac> hjacs = {{&m.dhdx, &t.dhdx, &t.h_code, {}}, {&m.dhdp, &t.dhdp, &t.h_code, {}}};
-  for (auto& j : hjacs)
-    for (unsigned r = 0; r < j.J->rows(); ++r)
-      for (unsigned c = 0; c < j.J->cols(); ++c)
-        if (!(*j.J)(r, c).is_zero()) {
-          j.out->row.push_back(static_cast<int>(r));
-          j.out->col.push_back(static_cast<int>(c));
-          j.nodes.push_back(g.add((*j.J)(r, c)));
-        }
+  add_nonzeros(hjacs);
   Builder b{g, t, std::vector<int>(g.size(), -1), t.nx + t.nu + t.np};
   for (int id : f_nodes) {
     b.emit_split(id, t.f_code);
