@@ -164,7 +164,7 @@ void assemble(ModelContext& c) {
     const ex w = c.rotor_speed[i];
     const ex thrust = c.thrust_scale[i] * c.p("c_t") * c.p("rho") * c.rotor_disc_area[i] * pow(c.rotor_radius[i], 2) *
                       w * (w - c.thrust_speed_loss[i]);
-    m.intermediates.push_back({"F_" + r.name, thrust});
+    m.intermediates.push_back({rotor_thrust_name(r.name), thrust});
     total_thrust += thrust;
     const matrix arm = c.rotor_position[i].sub(c.cog);
     torque = torque.add(cross(arm, vec3(0, 0, thrust)));
@@ -344,6 +344,10 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
   assemble(c);
   differentiate(m);
   return m;
+}
+
+std::string rotor_thrust_name(const std::string& rotor) {
+  return "F_{\\mathrm{" + output::latex_text(rotor) + "}}";  // a rotor called front_left stays one subscript
 }
 
 }  // namespace quadgen

@@ -55,4 +55,7 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
 // Computes dfdx, dfdu, dfdp, dhdx, dhdp from f and h.
 void differentiate(SymbolicModel& m);
 
+// The TeX name of rotor `rotor`'s thrust among SymbolicModel::intermediates ("F_{\mathrm{A}}").
+std::string rotor_thrust_name(const std::string& rotor);
+
 }  // namespace quadgen

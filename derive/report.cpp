@@ -247,6 +247,17 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
         "forms agree.\n\n";
   md << "## 4. Forces and torques\n\n";
   constexpr size_t kReadable = 1500;  // nodes: beyond this an equation is not read but searched
+  // MathJax (GitHub's renderer too) takes at most 5 KB of TeX in one formula and shows a longer
+  // one as raw text: a vector beyond that is written one component per formula, a component
+  // beyond it is named only (scripts/render_derivation.sh checks the result in a browser).
+  constexpr size_t kMathJaxLimit = 4800;  // characters, with room for the left-hand side
+  const auto equation = [&](const std::string& lhs, const std::string& rhs) {
+    if (rhs.size() > kMathJaxLimit)
+      md << "$" << lhs << "$: " << rhs.size() << " characters of TeX, more than MathJax renders in one formula; the "
+         << "generated code holds it in full.\n\n";
+    else
+      md << "```math\n" << lhs << " = " << rhs << "\n```\n\n";
+  };
   for (const auto& [name, e] : m.intermediates) {
     const size_t size = tree_size(e, kReadable);
     if (size > kReadable) {
@@ -254,10 +265,17 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
          << "code holds it in full.\n\n";
       continue;
     }
-    md << "```math\n" << name << " = ";
-    if (is_a<matrix>(e)) md << tex_matrix(ex_to<matrix>(e));
-    else md << tex(e);
-    md << "\n```\n\n";
+    if (!is_a<matrix>(e)) {
+      equation(name, tex(e));
+      continue;
+    }
+    const matrix& v = ex_to<matrix>(e);
+    const std::string whole = tex_matrix(v);
+    if (whole.size() <= kMathJaxLimit || v.cols() != 1 || v.rows() != 3) {
+      equation(name, whole);
+      continue;
+    }
+    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + name + "\\right)_" + "xyz"[i], tex(v(i, 0)));
   }
   md << "Thrust acts along body $+z$ at each rotor; a counter-clockwise rotor (seen from above) pushes "
         "the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$. Drag acts at the centre "

@@ -7,6 +7,7 @@
 
 #include "attitude.hpp"
 #include "audit.hpp"
+#include "dynamics.hpp"
 #include "integrator.hpp"
 #include "kinematics.hpp"
 #include "scenarios.hpp"
@@ -103,7 +104,7 @@ void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, co
     ex F[4];
     for (int i = 0; i < 4; ++i)
       for (const auto& [name, e] : model.intermediates)
-        if (name == std::string("F_") + "ABCD"[i]) F[i] = e;
+        if (name == rotor_thrust_name(std::string(1, "ABCD"[i]))) F[i] = e;
     const ex kappa = P("kappa");
     ex l;
     for (const auto& c : model.constants)

@@ -53,7 +53,9 @@ dom, blocks, md = open(sys.argv[1], encoding="utf-8").read(), int(sys.argv[2]), 
 problems = []
 if 'data-typeset="done"' not in dom:
     problems.append("MathJax did not finish")
-errors = len(re.findall(r'class="[^"]*\b(merror|MathJax_Error|mjx-merror)\b', dom))
+# A TeX error shows as merror, or with MathJax's noErrors extension as the raw TeX in a box
+# (mjx-noError: e.g. a formula beyond MathJax's 5 KB input buffer, GitHub's limit too).
+errors = len(re.findall(r'class="[^"]*\b(merror|MathJax_Error|mjx-merror|mjx-noError)\b', dom))
 # An undefined control sequence (MathJax's noUndefined) is shown in red, not as an merror.
 errors += len(re.findall(r'class="mjx-mtext[^"]*" style="color: red;', dom))
 if errors:

@@ -399,7 +399,7 @@ TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
   for (auto& s : noise) junk += s * s;
   EXPECT_EQ(markdown(), first);
   EXPECT_EQ(first.find("$$"), std::string::npos);
-  EXPECT_NE(first.find("```math\nF_A = "), std::string::npos);
+  EXPECT_NE(first.find("```math\nF_{\\mathrm{A}} = "), std::string::npos);
 }
 
 TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
