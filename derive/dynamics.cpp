@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "thrust_law.hpp"
 #include "effects.hpp"
 #include "exact_number.hpp"
 #include "kinematics.hpp"
@@ -162,8 +163,8 @@ void assemble(ModelContext& c) {
   for (size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];
     const ex w = c.rotor_speed[i];
-    const ex thrust = c.thrust_scale[i] * c.p("c_t") * c.p("rho") * c.rotor_disc_area[i] * pow(c.rotor_radius[i], 2) *
-                      w * (w - c.thrust_speed_loss[i]);
+    const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
+    const ex thrust = c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
     m.intermediates.push_back({rotor_thrust_name(r.name), thrust});
     total_thrust += thrust;
     const matrix arm = c.rotor_position[i].sub(c.cog);

@@ -8,10 +8,9 @@ double nominal(const SymbolicModel& m, const char* name) { return m.params[m.par
 
 std::vector<runtime::ThrustLaw> nominal_thrust_laws(const Vehicle& v, const SymbolicModel& m) {
   std::vector<runtime::ThrustLaw> laws;
-  const double k = nominal(m, "c_t") * nominal(m, "rho");
   for (const Rotor& r : v.rotors)
-    laws.push_back({k * r.disc_area * r.radius * r.radius, nominal(m, "motor_a0"), nominal(m, "motor_a1"),
-                    nominal(m, "motor_a2")});
+    laws.push_back({runtime::rotor_thrust_coefficient(nominal(m, "c_t"), nominal(m, "rho"), r.disc_area, r.radius),
+                    nominal(m, "motor_a0"), nominal(m, "motor_a1"), nominal(m, "motor_a2")});
   return laws;
 }
 

@@ -239,7 +239,7 @@ Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfil
       if (c.name == r + ".A_p") Ap = c.nominal;
       if (c.name == r + ".r_p") rp = c.nominal;
     }
-    laws.push_back({P("c_t") * P("rho") * Ap * rp * rp, P("motor_a0"), P("motor_a1"), P("motor_a2")});
+    laws.push_back({runtime::rotor_thrust_coefficient(P("c_t"), P("rho"), Ap, rp), P("motor_a0"), P("motor_a1"), P("motor_a2")});
   }
   auto inputs = [&](double t, double* uu) {
     const auto F = thrust(t);

@@ -6,6 +6,7 @@
 #include <memory>
 #include <sstream>
 
+#include "thrust_law.hpp"
 #include "dynamic_model.hpp"
 #include "effects.hpp"
 #include "equation_error.hpp"
@@ -337,7 +338,7 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   double k = 0;
   for (int i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / n_k;
   const Rotor& r0 = v.rotors.front();
-  const double ct = k / (param(v, "rho").value * r0.disc_area * r0.radius * r0.radius);  // k = c_t rho A r^2
+  const double ct = runtime::thrust_coefficient_c_t(k, param(v, "rho").value, r0.disc_area, r0.radius);
   FitOutputs out;
   auto& j = out.json;
   j["kind"] = "thrust_stand";

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "thrust_law.hpp"
+
 namespace quadgen::runtime {
 
 // What it takes to turn a thrust into a command for one rotor:
