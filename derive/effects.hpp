@@ -76,6 +76,8 @@ const Effect& find_effect(const std::string& name);
 // The effect a parameter belongs to ("motor_gain.A" -> "motor_gain"); "" for a parameter of
 // the base model.
 std::string effect_of_parameter(const std::string& parameter);
+// Whether a parameter belongs to an effect rather than to the vehicle file.
+inline bool is_effect_parameter(const std::string& parameter) { return !effect_of_parameter(parameter).empty(); }
 
 // Of these parameter names (in model order), those held at off whatever the fit flags
 // say: the first parameter of each effect identifiable only as ratios (motor_gain's first

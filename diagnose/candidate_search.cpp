@@ -92,7 +92,7 @@ CandidateSearch::CandidateSearch(const SymbolicModel& all, runtime::DynamicModel
 std::vector<FitParameter> CandidateSearch::initial_parameters() const {
   std::vector<FitParameter> ps;
   for (const auto& p : all_.params) {
-    const bool effect_param = p.name.find('.') != std::string::npos;
+    const bool effect_param = is_effect_parameter(p.name);
     ps.push_back({p.name, p.unit, neutral_value(p), p.lower, p.upper, p.fit && !effect_param});
   }
   return ps;
@@ -109,7 +109,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
   std::vector<FitParameter> ps = start;
   for (size_t i = 0; i < ps.size(); ++i) {
     const std::string e = effect_of_parameter(ps[i].name);
-    if (ps[i].name.find('.') == std::string::npos) continue;
+    if (!is_effect_parameter(ps[i].name)) continue;
     const bool on = effects.count(e) > 0 && all_.params[i].fit;
     ps[i].free = on;
     if (!on) ps[i].value = neutral_value(all_.params[i]);

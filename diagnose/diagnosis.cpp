@@ -232,7 +232,7 @@ std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParamet
   const auto means = runtime::mean_over_flights(values);
   std::vector<fit::FitParameter> out;
   for (auto p : ps) {
-    if (p.name.find('@') != std::string::npos) continue;
+    if (runtime::flight_of_name(p.name) != 1) continue;
     p.value = means.at(p.name);
     out.push_back(p);
   }

@@ -90,7 +90,7 @@ std::string headline(const Finding& f) {
   std::string reference;
   if (e.first_parameter_is_reference)
     for (const auto& p : f.evidence.parameters)
-      if (effect_of_parameter(p.name) == f.effect && !p.free && p.name.find('@') == std::string::npos) {
+      if (effect_of_parameter(p.name) == f.effect && !p.free && runtime::flight_of_name(p.name) == 1) {
         reference = p.name;
         break;
       }
@@ -352,7 +352,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["airframe_fit"] = parameters_json(d.airframe_fit.empty() ? d.search.final_fit : d.airframe_fit);
   json own = json::array();
   for (const auto& p : d.search.final_fit)
-    if (p.free && p.name.find('@') == std::string::npos && belongs_to_flight(p.name))
+    if (p.free && runtime::flight_of_name(p.name) == 1 && belongs_to_flight(p.name))
       own.push_back(p.name);
   j["flight_parameters"] = own;
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
