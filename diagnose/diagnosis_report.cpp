@@ -501,7 +501,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
   for (const auto& p : d.at_bounds)
-    os << "caution: " << p.name << " = " << num(p.value) << " " << p.unit
+    os << "caution: " << p.name << " = " << num(p.value) << (p.unit == "1" ? "" : " " + p.unit)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
