@@ -46,6 +46,15 @@ json evidence_json(const CandidateEvidence& e) {
           {"why_not", e.why_not}};
 }
 
+// A discovered term's verdict for the report: "proposed" in bold, said once (the verdict
+// text may already begin with it).
+std::string verdict_cell(const DiscoveredTerm& t) {
+  const std::string said = t.proposed ? "proposed" : "not proposed";
+  const bool begins = t.verdict.rfind(said, 0) == 0;
+  const std::string rest = begins ? t.verdict.substr(said.size()) : ": " + t.verdict;
+  return (t.proposed ? "<b>proposed</b>" : said) + output::html_text(rest);
+}
+
 // The free parameters of a fit, each in the one estimate shape: intervals are only computed
 // for the named effects' parameters (findings), so here they stay null.
 json parameters_json(const std::vector<fit::FitParameter>& ps) {
@@ -540,7 +549,7 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
         << num(c.upper, 3) << "] " << esc(c.unit);
     }
     h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
-      << "</td><td>" << (t.proposed ? "<b>proposed</b>" : "not proposed") << ": " << esc(t.verdict) << "</td></tr>\n";
+      << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
   }
   h << "</table>\n";
   const auto& g = d.terms_gain;
