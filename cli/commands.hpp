@@ -9,24 +9,14 @@
 #include "diagnose_job.hpp"
 #include "fit_pipeline.hpp"
 #include "predict_flights.hpp"
+#include "simulate_job.hpp"
 
 namespace quadgen::cli {
 
 struct SimulateArgs {
-  std::string vehicle, scenario, inputs, out, effects;
-  double duration = 0;
-  std::string integrator = "rk4";
-  double step = 1e-3;
-  double rate = 100;
-  std::string interpolation = "hold";
-  // Closed-loop flight generator.
-  bool closed_loop = false;
-  unsigned seed = 1;
-  std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters
-  double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
-  double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0,
-         yaw_per_speed = 0;
-  bool no_size_limit = false;
+  app::SimulateJob job;          // the flags land here
+  std::string out;
+  std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters, parsed into job.set
 };
 
 void add_simulate(CLI::App& app, SimulateArgs& args);

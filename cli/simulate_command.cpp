@@ -17,7 +17,7 @@
 #include "integrator.hpp"
 #include "plot.hpp"
 #include "scenarios.hpp"
-#include "model_registry.hpp"
+#include "simulate_job.hpp"
 
 namespace quadgen::cli {
 
@@ -25,54 +25,54 @@ using namespace quadgen::runtime;
 
 void add_simulate(CLI::App& app, SimulateArgs& a) {
   CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
-  c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
-  auto* sc = c->add_option("--scenario", a.scenario, "hover, climb, right, forward, yaw, new_height");
-  auto* in = c->add_option("--inputs", a.inputs, "replay the motor commands of a canonical flight log (CSV)");
-  auto* cl = c->add_flag("--closed-loop", a.closed_loop,
+  c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
+  auto* sc = c->add_option("--scenario", a.job.scenario, "hover, climb, right, forward, yaw, new_height");
+  auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a canonical flight log (CSV)");
+  auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
                          "fly a smooth random trajectory under a cascaded controller (test flights)");
   sc->excludes(in);
   cl->excludes(sc)->excludes(in);
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
-  c->add_option("--seed", a.seed, "closed loop: random trajectory and noise seed")->needs(cl);
+  c->add_option("--seed", a.job.seed, "closed loop: random trajectory and noise seed")->needs(cl);
   c->add_option("--set", a.set,
                 std::string("closed loop: NAME=VALUE for a parameter of the true model (repeatable); names: ") +
                     kParameterNames)
       ->needs(cl);
-  c->add_option("--pose-noise", a.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
-  c->add_option("--gyro-noise", a.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
-  c->add_option("--gyro-bias", a.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
-  c->add_option("--accel-noise", a.accel_noise, "closed loop: accelerometer noise [m/s^2]")
+  c->add_option("--pose-noise", a.job.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
+  c->add_option("--gyro-noise", a.job.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
+  c->add_option("--gyro-bias", a.job.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
+  c->add_option("--accel-noise", a.job.accel_noise, "closed loop: accelerometer noise [m/s^2]")
       ->check(finite_range(0, 100))->needs(cl);
-  c->add_option("--accel-bias", a.accel_bias, "closed loop: accelerometer bias [m/s^2]")
+  c->add_option("--accel-bias", a.job.accel_bias, "closed loop: accelerometer bias [m/s^2]")
       ->check(finite_range(-100, 100))->needs(cl);
-  c->add_option("--amplitude", a.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
+  c->add_option("--amplitude", a.job.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
       ->check(finite_range(0.0, 20.0))->needs(cl);
-  c->add_option("--height", a.height, "closed loop: mean height [m]")->check(finite_range(0.05, 100.0))->needs(cl);
-  c->add_option("--height-amplitude", a.height_amplitude, "closed loop: height excursions [m]")
+  c->add_option("--height", a.job.height, "closed loop: mean height [m]")->check(finite_range(0.05, 100.0))->needs(cl);
+  c->add_option("--height-amplitude", a.job.height_amplitude, "closed loop: height excursions [m]")
       ->check(finite_range(0.0, 10.0))->needs(cl);
-  c->add_option("--yaw-amplitude", a.yaw_amplitude, "closed loop: heading excursions [rad]")
+  c->add_option("--yaw-amplitude", a.job.yaw_amplitude, "closed loop: heading excursions [rad]")
       ->check(finite_range(0.0, 10.0))->needs(cl);
-  c->add_option("--excitation", a.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
+  c->add_option("--excitation", a.job.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
       ->check(finite_range(0.0, 5.0))->needs(cl);
-  c->add_option("--tether", a.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
+  c->add_option("--tether", a.job.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
       ->check(finite_range(0.0, 100.0))->needs(cl);
-  c->add_option("--yaw-per-speed", a.yaw_per_speed,
+  c->add_option("--yaw-per-speed", a.job.yaw_per_speed,
                 "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)")
       ->check(finite_range(-50.0, 50.0))->needs(cl);
-  c->add_option("--duration", a.duration, "simulated time [s]")
+  c->add_option("--duration", a.job.duration, "simulated time [s]")
       ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
   std::string effect_names;  // the catalogue, so --help lists what --effects accepts
   for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
-  c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
-  c->add_option("--integrator", a.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
+  c->add_option("--effects", a.job.effects, "comma-separated effects to add, or 'all': " + effect_names);
+  c->add_option("--integrator", a.job.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
       ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);
-  c->add_option("--step", a.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
-  c->add_option("--rate", a.rate, "output rate [Hz]")->check(finite_range(1e-3, 1e6))->excludes(cl);
-  c->add_option("--interpolation", a.interpolation, "inputs between samples: hold or linear")
+  c->add_option("--step", a.job.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
+  c->add_option("--rate", a.job.rate, "output rate [Hz]")->check(finite_range(1e-3, 1e6))->excludes(cl);
+  c->add_option("--interpolation", a.job.interpolation, "inputs between samples: hold or linear")
       ->check(CLI::IsMember({"hold", "linear"}))->needs(in);
-  c->add_flag("--no-size-limit", a.no_size_limit,
+  c->add_flag("--no-size-limit", a.job.no_size_limit,
               "run even when the estimated work exceeds the limits (1e7 integration steps or output rows)");
 }
 
@@ -85,28 +85,7 @@ std::string plot_path(const std::string& out) { return std::filesystem::path(out
 output::OutputFiles output_for(const SimulateArgs& a) {
   if (std::filesystem::path(a.out).extension() == ".svg")
     throw std::invalid_argument("--out " + output::printable(a.out) + ": the plot goes to the .svg beside the trajectory; name the trajectory .csv");
-  return output::OutputFiles({a.out, plot_path(a.out)}, {a.vehicle, a.inputs});
-}
-
-// The plot as the output set's second file, when gnuplot can draw it.
-void set_plot(output::OutputFiles& out, const std::string& title, const std::vector<Panel>& panels) {
-  std::string svg, err;
-  if (render_svg(title, panels, &svg, &err)) out.set(1, svg);
-  else std::cerr << "no plot: " << err << "\n";
-}
-
-// Work beyond these sizes is refused before it starts unless --no-size-limit is given: each
-// stored sample costs ~0.2 kB, so 1e7 of them is about 2 GB.
-constexpr double kMaxSteps = 1e7, kMaxRows = 1e7;
-
-void check_size(const SimulateArgs& a, double steps, double rows) {
-  if (a.no_size_limit) return;
-  std::ostringstream os;
-  if (steps > kMaxSteps) os << "about " << steps << " integration steps (limit " << kMaxSteps << ")";
-  else if (rows > kMaxRows) os << "about " << rows << " output rows (limit " << kMaxRows << ")";
-  else return;
-  throw std::invalid_argument("--duration " + std::to_string(a.duration) + ": " + os.str() +
-                              "; shorten it, raise --step or lower --rate, or pass --no-size-limit");
+  return output::OutputFiles({a.out, plot_path(a.out)}, {a.job.vehicle, a.job.inputs});
 }
 
 // NAME=VALUE of --set; the value a finite number.
@@ -119,213 +98,19 @@ std::pair<std::string, double> parse_setting(const std::string& kv) {
   return {kv.substr(0, eq), value};
 }
 
-// Fills the inputs that effects add (t, vbat) after the rotor commands.
-void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) {
-  for (int i = 0; i < m.num_inputs(); ++i) {
-    if (m.input_names()[i] == "t") u[i] = t;
-    if (m.input_names()[i] == "vbat") u[i] = vbat;
-  }
-}
-
 }  // namespace
 
-// A closed-loop test flight: the true model (effects and --set values) flown by a
-// controller that believes the nominal base model.
-int run_closed_loop(const SimulateArgs& a, const Vehicle& vehicle, const SymbolicModel& model, DynamicModel& truth,
-                    output::OutputFiles& out) {
-  std::vector<double> p = truth.params();
-  for (const std::string& kv : a.set) {
-    const auto [name, value] = parse_setting(kv);
-    const int i = truth.param_index(name);
-    if (i < 0) throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model (add its effect with --effects)");
-    p[i] = value;
-  }
-  truth.set_params(p);
-  const ControllerModel belief = nominal_controller_belief(vehicle, model);
-  std::vector<std::string> rotors;
-  for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
-  ClosedLoopOptions o;
-  o.duration = a.duration;
-  o.seed = a.seed;
-  o.pose_noise = a.pose_noise;
-  o.gyro_noise = a.gyro_noise;
-  o.gyro_bias = a.gyro_bias;
-  o.accel_noise = a.accel_noise;
-  o.accel_bias = a.accel_bias;
-  o.amplitude = a.amplitude;
-  o.height = a.height;
-  o.height_amplitude = a.height_amplitude;
-  o.yaw_amplitude = a.yaw_amplitude;
-  o.excitation = a.excitation;
-  o.tether_stiffness = a.tether;
-  o.yaw_per_forward_speed = a.yaw_per_speed;
-  std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
-  const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
-  out.set(0, flight.csv());
-  // Plot: position against reference, commands.
-  auto col = [&](const std::string& n) {
-    std::vector<double> v;
-    const int c = index_in(flight.columns, n);
-    for (const auto& r : flight.rows) v.push_back(r[c]);
-    return v;
-  };
-  const auto t = col("t");
-  Panel pos{"position and its reference", "t [s]", "m", {}};
-  for (const char* n : {"x", "y", "z", "x_ref", "y_ref", "z_ref"}) pos.series.push_back({n, t, col(n)});
-  Panel cmd{"motor commands", "t [s]", "1", {}};
-  for (const auto& r : rotors) cmd.series.push_back({"u_" + r, t, col("u_" + r)});
-  set_plot(out, vehicle.name + ": closed-loop test flight", {pos, cmd});
-  out.commit();
-  std::cout << "flew " << a.duration << " s closed loop; wrote " << a.out << "\n";
-  return 0;
-}
-
-// Hover must be within reach of every rotor's motor map, or no manoeuvre can be flown; said
-// once, naming the vehicle file, instead of failing somewhere inside the flight.
-void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws, double hover_thrust) {
-  for (size_t i = 0; i < laws.size(); ++i) try {
-      laws[i].command_for(hover_thrust);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: " + e.what() +
-                                  "; check c_t (rotor_model) and a0, a1, a2 (motor_map)");
-    }
-}
-
 int run_simulate(const SimulateArgs& a) {
-  if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
-    throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
-  const Vehicle vehicle = load_vehicle(a.vehicle);
-  if (a.closed_loop) check_size(a, 0, a.duration * ClosedLoopOptions{}.log_rate);
-  else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
+  app::SimulateJob job = a.job;
+  for (const std::string& kv : a.set) job.set.push_back(parse_setting(kv));
   output::OutputFiles out = output_for(a);  // refused before the work, not after
-  DeriveOptions opt;
-  opt.effects = parse_effect_list(a.effects);
-  const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
-  const auto model_ptr = app::make_model(model);
-  DynamicModel& m = *model_ptr;
-  const size_t nr = vehicle.rotors.size();
-  const auto laws = nominal_thrust_laws(vehicle, model);
-  const double vbat_ref = param(vehicle, "vbat_ref").value;
-  check_hover_reachable(vehicle, laws, m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr));
-  if (a.closed_loop) return run_closed_loop(a, vehicle, model, m, out);
-  const int delay = m.input_delay_param();
-  std::vector<std::string> rotors;
-  for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
-
-  std::vector<double> x0(m.num_states(), 0.0);
-  x0[6] = 1.0;
-  InputFunction inputs;
-  std::unique_ptr<InputSignal> signal;
-  if (!a.scenario.empty()) {
-    const Scenario& s = find_scenario(a.scenario);
-    const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
-    inputs = [&, s, hover](double t, double* u) {
-      const double td = delay >= 0 ? t - m.params()[delay] : t;
-      const auto F = s.thrust(td, hover, rotors);
-      for (size_t i = 0; i < nr; ++i) u[i] = laws[i].command_for(F[i]);
-      fill_extra_inputs(m, t, vbat_ref, u);
-    };
-  } else {
-    const CsvTable log = read_csv(a.inputs);
-    validate_canonical(log, rotors);
-    std::vector<double> t = log.values("t");
-    if (a.duration > t.back() - t.front() + 1e-9)
-      throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
-                                  std::to_string(t.back() - t.front()) +
-                                  " s of commands; a longer replay would hold the last command for the rest");
-    std::vector<std::vector<double>> u(t.size(), std::vector<double>(nr));
-    for (size_t r = 0; r < nr; ++r) {
-      const auto col = log.values("u_" + rotors[r]);
-      for (size_t k = 0; k < t.size(); ++k) u[k][r] = col[k];
-    }
-    signal = std::make_unique<InputSignal>(t, u, a.interpolation == "linear" ? Interpolation::linear : Interpolation::hold);
-    const double t0 = t.front();
-    const bool has_vbat = log.column("vbat") >= 0;
-    if (m.input_index("vbat") >= 0 && !has_vbat)
-      throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
-    std::shared_ptr<InputSignal> vbat_signal;
-    if (has_vbat) {
-      const auto v = log.values("vbat");
-      std::vector<std::vector<double>> rows;
-      for (double x : v) rows.push_back({x});
-      vbat_signal = std::make_shared<InputSignal>(t, rows, Interpolation::linear);
-    }
-    // Start from the logged pose where the log has one.
-    const char* pose[] = {"x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r"};
-    for (int i = 0; i < 13; ++i)
-      if (log.column(pose[i]) >= 0) x0[i] = log.rows.front()[log.column(pose[i])];
-    const InputSignal* sig = signal.get();
-    inputs = [&, sig, t0, vbat_signal](double tt, double* uu) {
-      sig->at(t0 + tt, uu, delay >= 0 ? m.params()[delay] : 0.0);
-      double vb_now = vbat_ref;
-      if (vbat_signal) vbat_signal->at(t0 + tt, &vb_now);
-      fill_extra_inputs(m, tt, vb_now, uu);
-    };
-  }
-  // Rotor-speed states (motor_lag) start at their commanded steady state.
-  {
-    std::vector<double> u0(m.num_inputs());
-    inputs(0.0, u0.data());
-    for (size_t i = 0; i < nr; ++i) {
-      const int w = m.state_index("w_" + rotors[i]);
-      if (w >= 0) x0[w] = laws[i].a0 + laws[i].a1 * u0[i] + laws[i].a2 * u0[i] * u0[i];
-    }
-  }
-
-  IntegratorOptions io;
-  io.step = a.step;
-  std::vector<double> out_times;
-  const long n_out = std::lround(a.duration * a.rate);
-  for (long k = 0; k <= n_out; ++k) out_times.push_back(a.duration * static_cast<double>(k) / static_cast<double>(n_out));
-  Stats stats;
-  std::cerr << "simulating " << a.duration << " s of " << vehicle.name << " with " << a.integrator << "\n";
-  Trajectory tr;
-  if (a.integrator == "dopri5") {
-    tr = integrate_dopri5(m, x0, inputs, out_times, io, &stats);
-  } else {
-    const Trajectory full = integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
-    const long every = std::max(1L, std::lround(1.0 / (a.rate * io.step)));
-    for (size_t k = 0; k < full.t.size(); k += every) {
-      tr.t.push_back(full.t[k]);
-      tr.x.push_back(full.x[k]);
-    }
-  }
-
-  out.set(0, trajectory_csv(m, tr, inputs, rotors));
-  // Plot like the thesis' figures: translation, rotation, thrust per rotor.
-  Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{"thrust per rotor", "t [s]", "N", {}};
-  const char* pos[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    Series s{pos[i], tr.t, {}};
-    for (const auto& x : tr.x) s.y.push_back(x[i]);
-    trans.series.push_back(s);
-  }
-  Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
-  for (const auto& x : tr.x) {
-    const auto e = euler_zyx(x[6], x[7], x[8], x[9]);
-    phi.y.push_back(e[0] * 180 / M_PI);
-    theta.y.push_back(e[1] * 180 / M_PI);
-    psi.y.push_back(e[2] * 180 / M_PI);
-  }
-  rot.series = {phi, theta, psi};
-  std::vector<double> ub(m.num_inputs());
-  for (size_t r = 0; r < nr; ++r) {
-    Series s{"F_" + rotors[r], tr.t, {}};
-    const int w = m.state_index("w_" + rotors[r]);
-    for (size_t k = 0; k < tr.t.size(); ++k) {
-      inputs(tr.t[k], ub.data());
-      const auto& L = laws[r];
-      const double speed = w >= 0 ? tr.x[k][w] : L.a0 + L.a1 * ub[r] + L.a2 * ub[r] * ub[r];
-      s.y.push_back(L.k * speed * speed);
-    }
-    thrust.series.push_back(s);
-  }
-  const std::string what = a.scenario.empty() ? "replay of " + a.inputs : "scenario " + a.scenario;
-  set_plot(out, vehicle.name + ": " + what, {trans, rot, thrust});
+  const app::SimulateJobResult r = app::run_simulate_job(job);
+  out.set(0, r.csv);
+  std::string svg, err;  // the plot, when gnuplot can draw it
+  if (render_svg(r.plot_title, r.plot, &svg, &err)) out.set(1, svg);
+  else std::cerr << "no plot: " << err << "\n";
   out.commit();
-  const auto& xe = tr.x.back();
-  std::cout << "simulated " << a.duration << " s (" << stats.rhs_evaluations << " rhs evaluations): final position ("
-            << xe[0] << ", " << xe[1] << ", " << xe[2] << ") m; wrote " << a.out << "\n";
+  std::cout << r.summary << "; wrote " << output::printable(a.out) << "\n";
   return 0;
 }
 

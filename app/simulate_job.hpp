@@ -1,0 +1,46 @@
+// `quadgen simulate` as a library call: a scenario of the thesis, a replay of logged motor
+// commands, or a closed-loop test flight of the true model (effects and parameter overrides)
+// flown by a controller that believes the nominal base model. Returns the trajectory in the
+// canonical flight-log layout and the plot's panels; the caller writes them.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plot.hpp"
+
+namespace quadgen::app {
+
+struct SimulateJob {
+  std::string vehicle;      // vehicle file (YAML)
+  std::string scenario;     // one of the thesis' manoeuvres, or
+  std::string inputs;       // a canonical log whose motor commands are replayed, or
+  bool closed_loop = false;  // a closed-loop test flight
+  std::string effects;      // comma-separated effects of the simulated (true) model
+  double duration = 0;      // s
+  std::string integrator = "rk4";  // or dopri5
+  double step = 1e-3;       // s, RK4
+  double rate = 100;        // Hz, output rows
+  std::string interpolation = "hold";  // replayed commands between samples: hold or linear
+  // Closed loop: the flight generator's trajectory, noise and disturbances
+  // (runtime::ClosedLoopOptions says what each does).
+  unsigned seed = 1;
+  std::vector<std::pair<std::string, double>> set;  // the true model's parameter overrides
+  double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
+  double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0,
+         yaw_per_speed = 0;
+  bool no_size_limit = false;  // refuse runs beyond ~1e7 steps or rows unless set
+};
+
+struct SimulateJobResult {
+  std::string csv;                     // the trajectory, canonical flight-log layout
+  std::string plot_title;
+  std::vector<runtime::Panel> plot;    // translation, rotation, thrust; or position and commands
+  std::string summary;                 // what the command prints
+};
+
+// Throws std::invalid_argument for contradicting or oversized requests before any work, and
+// the layers' own errors (vehicle file, log) unchanged.
+SimulateJobResult run_simulate_job(const SimulateJob& job);
+
+}  // namespace quadgen::app
