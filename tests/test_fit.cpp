@@ -67,6 +67,24 @@ Flight synthetic_flight(const runtime::DynamicModel& model, std::mt19937& rng, b
   return flight;
 }
 
+// `flights` stretches of 200 samples each (flight k from t = 10 k s, so a joined log has a gap
+// between them) of random states and commands in [0.3, 0.5], vbat 3.9 V, pose and gyro logged.
+Flight random_command_flights(std::mt19937& rng, int flights) {
+  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  Flight out;
+  out.has_pose = out.has_gyro = true;
+  for (int flight = 0; flight < flights; ++flight)
+    for (int k = 0; k < 200; ++k) {
+      FlightSample s;
+      s.t = 10.0 * flight + 0.01 * k;
+      s.x = test::random_state(rng);
+      s.u = {cmd(rng), cmd(rng), cmd(rng), cmd(rng)};
+      s.vbat = 3.9;
+      out.samples.push_back(s);
+    }
+  return out;
+}
+
 }  // namespace
 
 TEST(Fit, MotorStepModelJacobianMatchesFiniteDifferences) {
@@ -585,18 +603,7 @@ TEST(Fit, EachFlightKeepsItsOwnAttitudeBias) {
 TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
   runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  Flight joined;
-  joined.has_pose = joined.has_gyro = true;
-  for (int flight = 0; flight < 2; ++flight)
-    for (int k = 0; k < 200; ++k) {
-      FlightSample s;
-      s.t = 10.0 * flight + 0.01 * k;
-      s.x = test::random_state(rng);
-      s.u = {cmd(rng), cmd(rng), cmd(rng), cmd(rng)};
-      s.vbat = 3.9;
-      joined.samples.push_back(s);
-    }
+  const Flight joined = random_command_flights(rng, 2);
   const std::vector<std::string> data_side = {"attitude_bias.roll", "attitude_bias.pitch", "input_delay.seconds",
                                               "motor_lag.tau"};
   runtime::PerFlightModel model(inner, {10.0}, data_side);
@@ -659,17 +666,7 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
 TEST(Fit, AFreeMaskDoesNotOutliveItsEvaluation) {
   runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> model;
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  Flight flight;
-  flight.has_pose = flight.has_gyro = true;
-  for (int k = 0; k < 200; ++k) {
-    FlightSample s;
-    s.t = 0.01 * k;
-    s.x = test::random_state(rng);
-    s.u = {cmd(rng), cmd(rng), cmd(rng), cmd(rng)};
-    s.vbat = 3.9;
-    flight.samples.push_back(s);
-  }
+  const Flight flight = random_command_flights(rng, 1);
   std::vector<double> p = model.params();
   p[model.param_index("attitude_bias.roll")] = 0.02;
   p[model.param_index("motor_lag.tau")] = 0.03;
