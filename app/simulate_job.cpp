@@ -22,14 +22,6 @@ namespace quadgen::app {
 using namespace quadgen::runtime;
 
 namespace {
-std::string shortest(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-}  // namespace
-
-namespace {
 
 // Work beyond these sizes is refused before it starts unless --no-size-limit is given: each
 // stored sample costs ~0.2 kB, so 1e7 of them is about 2 GB.
@@ -53,8 +45,6 @@ void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) 
   }
 }
 
-}  // namespace
-
 // A closed-loop test flight: the true model (effects and --set values) flown by a
 // controller that believes the nominal base model.
 SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, const SymbolicModel& model,
@@ -70,22 +60,9 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   const ControllerModel belief = nominal_controller_belief(vehicle, model);
   std::vector<std::string> rotors;
   for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
-  ClosedLoopOptions o;
+  ClosedLoopOptions o = a.flight;
   o.duration = a.duration;
-  o.seed = a.seed;
-  o.pose_noise = a.pose_noise;
-  o.gyro_noise = a.gyro_noise;
-  o.gyro_bias = a.gyro_bias;
-  o.accel_noise = a.accel_noise;
-  o.accel_bias = a.accel_bias;
-  o.amplitude = a.amplitude;
-  o.height = a.height;
-  o.height_amplitude = a.height_amplitude;
-  o.yaw_amplitude = a.yaw_amplitude;
-  o.excitation = a.excitation;
-  o.tether_stiffness = a.tether;
-  o.yaw_per_forward_speed = a.yaw_per_speed;
-  std::cerr << "flying " << a.duration << " s closed loop (seed " << a.seed << ")\n";
+  std::cerr << "flying " << a.duration << " s closed loop (seed " << o.seed << ")\n";
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
   result.csv = flight.csv();
   // Plot: position against reference, commands.
@@ -102,7 +79,9 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   for (const auto& r : rotors) cmd.series.push_back({"u_" + r, t, col("u_" + r)});
   result.plot_title = vehicle.name + ": closed-loop test flight";
   result.plot = {pos, cmd};
-  result.summary = "flew " + shortest(a.duration) + " s closed loop";
+  std::ostringstream summary;
+  summary << "flew " << a.duration << " s closed loop";
+  result.summary = summary.str();
   return result;
 }
 
@@ -117,11 +96,13 @@ void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws,
     }
 }
 
+}  // namespace
+
 SimulateJobResult run_simulate_job(const SimulateJob& a) {
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   const Vehicle vehicle = load_vehicle(a.vehicle);
-  if (a.closed_loop) check_size(a, 0, a.duration * ClosedLoopOptions{}.log_rate);
+  if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
   else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
   DeriveOptions opt;
   opt.effects = parse_effect_list(a.effects);
@@ -131,7 +112,8 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const size_t nr = vehicle.rotors.size();
   const auto laws = nominal_thrust_laws(vehicle, model);
   const double vbat_ref = param(vehicle, "vbat_ref").value;
-  check_hover_reachable(vehicle, laws, m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr));
+  const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
+  check_hover_reachable(vehicle, laws, hover);
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
   SimulateJobResult result;
   const int delay = m.input_delay_param();
@@ -144,7 +126,6 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   std::unique_ptr<InputSignal> signal;
   if (!a.scenario.empty()) {
     const Scenario& s = find_scenario(a.scenario);
-    const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
     inputs = [&, s, hover](double t, double* u) {
       const double td = delay >= 0 ? t - m.params()[delay] : t;
       const auto F = s.thrust(td, hover, rotors);

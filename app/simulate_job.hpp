@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "closed_loop.hpp"
 #include "plot.hpp"
 
 namespace quadgen::app {
@@ -22,13 +23,11 @@ struct SimulateJob {
   double step = 1e-3;       // s, RK4
   double rate = 100;        // Hz, output rows
   std::string interpolation = "hold";  // replayed commands between samples: hold or linear
-  // Closed loop: the flight generator's trajectory, noise and disturbances
-  // (runtime::ClosedLoopOptions says what each does).
-  unsigned seed = 1;
-  std::vector<std::pair<std::string, double>> set;  // the true model's parameter overrides
-  double pose_noise = 1e-3, gyro_noise = 0, gyro_bias = 0, accel_noise = 0, accel_bias = 0;
-  double amplitude = 0.8, height = 1.0, height_amplitude = 0.3, yaw_amplitude = 0.8, excitation = 0, tether = 0,
-         yaw_per_speed = 0;
+  // Closed loop: the flight generator's seed, trajectory, noise and disturbances, with its
+  // defaults (its own duration is replaced by `duration`), and the true model's parameter
+  // overrides.
+  runtime::ClosedLoopOptions flight;
+  std::vector<std::pair<std::string, double>> set;
   bool no_size_limit = false;  // refuse runs beyond ~1e7 steps or rows unless set
 };
 

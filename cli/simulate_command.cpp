@@ -33,30 +33,30 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   sc->excludes(in);
   cl->excludes(sc)->excludes(in);
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
-  c->add_option("--seed", a.job.seed, "closed loop: random trajectory and noise seed")->needs(cl);
+  c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
   c->add_option("--set", a.set,
                 std::string("closed loop: NAME=VALUE for a parameter of the true model (repeatable); names: ") +
                     kParameterNames)
       ->needs(cl);
-  c->add_option("--pose-noise", a.job.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
-  c->add_option("--gyro-noise", a.job.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
-  c->add_option("--gyro-bias", a.job.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
-  c->add_option("--accel-noise", a.job.accel_noise, "closed loop: accelerometer noise [m/s^2]")
+  c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
+  c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
+  c->add_option("--gyro-bias", a.job.flight.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
+  c->add_option("--accel-noise", a.job.flight.accel_noise, "closed loop: accelerometer noise [m/s^2]")
       ->check(finite_range(0, 100))->needs(cl);
-  c->add_option("--accel-bias", a.job.accel_bias, "closed loop: accelerometer bias [m/s^2]")
+  c->add_option("--accel-bias", a.job.flight.accel_bias, "closed loop: accelerometer bias [m/s^2]")
       ->check(finite_range(-100, 100))->needs(cl);
-  c->add_option("--amplitude", a.job.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
+  c->add_option("--amplitude", a.job.flight.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
       ->check(finite_range(0.0, 20.0))->needs(cl);
-  c->add_option("--height", a.job.height, "closed loop: mean height [m]")->check(finite_range(0.05, 100.0))->needs(cl);
-  c->add_option("--height-amplitude", a.job.height_amplitude, "closed loop: height excursions [m]")
+  c->add_option("--height", a.job.flight.height, "closed loop: mean height [m]")->check(finite_range(0.05, 100.0))->needs(cl);
+  c->add_option("--height-amplitude", a.job.flight.height_amplitude, "closed loop: height excursions [m]")
       ->check(finite_range(0.0, 10.0))->needs(cl);
-  c->add_option("--yaw-amplitude", a.job.yaw_amplitude, "closed loop: heading excursions [rad]")
+  c->add_option("--yaw-amplitude", a.job.flight.yaw_amplitude, "closed loop: heading excursions [rad]")
       ->check(finite_range(0.0, 10.0))->needs(cl);
-  c->add_option("--excitation", a.job.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
+  c->add_option("--excitation", a.job.flight.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
       ->check(finite_range(0.0, 5.0))->needs(cl);
-  c->add_option("--tether", a.job.tether, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
+  c->add_option("--tether", a.job.flight.tether_stiffness, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
       ->check(finite_range(0.0, 100.0))->needs(cl);
-  c->add_option("--yaw-per-speed", a.job.yaw_per_speed,
+  c->add_option("--yaw-per-speed", a.job.flight.yaw_per_forward_speed,
                 "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)")
       ->check(finite_range(-50.0, 50.0))->needs(cl);
   c->add_option("--duration", a.job.duration, "simulated time [s]")
