@@ -23,7 +23,7 @@ bool DiagnoseJob::IsValid(std::string* error) const {
   };
   if (vehicle.empty()) return fail("no vehicle file");
   if (logs.empty()) return fail("no flight log");
-  if (!(resample == 0 || (resample >= 0.1 && resample <= 1e5))) return fail("resample: 0 or 0.1 to 1e5 Hz");
+  if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
   if (!environment.empty() && environment != "indoor" && environment != "outdoor" && environment != "unknown")
     return fail("environment: indoor, outdoor or unknown");
   return options.IsValid(error);

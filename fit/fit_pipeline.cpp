@@ -139,7 +139,7 @@ bool FitJobOptions::IsValid(std::string* error) const {
     return false;
   };
   if (threads < 0) return fail("threads: 0 (one per core) or more");
-  if (!(resample == 0 || (resample >= 0.1 && resample <= 1e5))) return fail("resample: 0 or 0.1 to 1e5 Hz");
+  if (!valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
   if (!(validation >= 0 && validation <= 0.9)) return fail("validation fraction: 0 to 0.9");
   if (formulation != "equation_error" && formulation != "multiple_shooting")
     return fail("formulation: equation_error or multiple_shooting");
