@@ -137,11 +137,14 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   // Registers of f (and of precomputed nodes) are shared; each Jacobian gets its own code
   // for the rest, starting from the state after f.
   const std::vector<int> after_f = b.reg;
-  for (auto& j : jacs) {
+  const auto start_after_f = [&] {
     std::vector<int> own = after_f;
     for (size_t k = 0; k < own.size(); ++k)  // precompute nodes emitted meanwhile stay shared
       if (b.reg[k] >= 0 && !g.node(static_cast<int>(k)).dynamic) own[k] = b.reg[k];
     b.reg = own;
+  };
+  for (auto& j : jacs) {
+    start_after_f();
     for (int id : j.nodes) {
       b.emit_split(id, *j.code);
       j.out->reg.push_back(b.reg[id]);
@@ -149,10 +152,7 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   }
   // The measurement and its Jacobians: one piece of code, from the registers after f.
   t.ny = static_cast<int>(m.h.rows());
-  std::vector<int> own = after_f;
-  for (size_t k = 0; k < own.size(); ++k)
-    if (b.reg[k] >= 0 && !g.node(static_cast<int>(k)).dynamic) own[k] = b.reg[k];
-  b.reg = own;
+  start_after_f();
   for (int id : h_nodes) {
     b.emit_split(id, t.h_code);
     t.h_out.push_back(b.reg[id]);
