@@ -6,7 +6,7 @@
 
 #include "diagnosis_report.hpp"
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "extended_model.hpp"
 #include "geometry.hpp"
 #include "json_document.hpp"

@@ -4,7 +4,7 @@
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "tape_builder.hpp"
 
 namespace quadgen::app {
@@ -29,7 +29,7 @@ std::unique_ptr<runtime::DynamicModel> find_compiled(const std::string& hash, co
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled) {
   auto model = find_compiled(m.vehicle_hash, m.effect_list());
   if (compiled) *compiled = model != nullptr;
-  return model ? std::move(model) : std::make_unique<runtime::TapeModel>(emission::build_tape(m));
+  return model ? std::move(model) : std::make_unique<runtime::TapeModel>(codegen::build_tape(m));
 }
 
 std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, const std::vector<std::string>& effects) {

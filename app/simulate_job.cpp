@@ -8,7 +8,7 @@
 
 #include "attitude.hpp"
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "flight_log.hpp"
 #include "geometry.hpp"
 #include "integrator.hpp"

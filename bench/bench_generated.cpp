@@ -13,7 +13,7 @@
 #include <string>
 
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "header_writer.hpp"
 #include "reference_model.hpp"
 
@@ -139,7 +139,7 @@ void BM_DeriveAndEmitFinken3AllEffects(benchmark::State& st) {
   o.effects = quadgen::parse_effect_list("all");
   for (auto _ : st) {
     const auto m = quadgen::derive_model(v, quadgen::derive_mass_properties(v), o);
-    auto h = quadgen::emission::generate_header(m, {"vehicles/finken3.yaml", " --effects all"});
+    auto h = quadgen::codegen::generate_header(m, {"vehicles/finken3.yaml", " --effects all"});
     benchmark::DoNotOptimize(h.content);
   }
 }

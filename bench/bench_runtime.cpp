@@ -19,7 +19,7 @@ namespace {
 std::unique_ptr<DynamicModel> make(bool compiled) {
   if (compiled) return std::make_unique<CompiledModel<quadgen_generated::finken3::Model>>();
   const Vehicle v = load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml");
-  return std::make_unique<TapeModel>(emission::build_tape(derive_model(v, derive_mass_properties(v), {})));
+  return std::make_unique<TapeModel>(codegen::build_tape(derive_model(v, derive_mass_properties(v), {})));
 }
 
 // Slightly unequal constant commands: a rotating, accelerating 10 s flight.

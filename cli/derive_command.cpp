@@ -5,7 +5,7 @@
 
 #include "derive_command.hpp"
 #include "derive_pipeline.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "fitted_parameters.hpp"
 #include "output_set.hpp"
 
@@ -53,7 +53,7 @@ int run_derive(const DeriveArgs& args) {
   out.commit();
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const SymbolicModel& model = d.model;
-  const emission::GeneratedHeader& header = d.header;
+  const codegen::GeneratedHeader& header = d.header;
   std::cout << "derived " << vehicle.name << ": " << model.states.size() << " states, " << model.inputs.size()
             << " inputs, " << model.params.size() << " parameters; audit "
             << (d.audit.all_passed() ? "passed" : "FAILED") << " (" << d.audit.checks.size() << " checks); " << secs

@@ -5,7 +5,7 @@
 
 #include "commands.hpp"
 #include "diagnose_job.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "options.hpp"
 #include "output_set.hpp"
 #include "sinks.hpp"

@@ -6,7 +6,7 @@
 
 #include "commands.hpp"
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "fit_pipeline.hpp"
 #include "geometry.hpp"
 #include "json_document.hpp"

@@ -6,7 +6,7 @@
 
 #include "commands.hpp"
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "geometry.hpp"
 #include "json_document.hpp"
 #include "model_registry.hpp"

@@ -11,7 +11,7 @@
 #include "output_set.hpp"
 #include "sinks.hpp"
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "flight_log.hpp"
 #include "geometry.hpp"
 #include "integrator.hpp"

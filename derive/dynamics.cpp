@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "thrust_law.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "exact_number.hpp"
 #include "kinematics.hpp"
 #include "sinks.hpp"

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "sinks.hpp"
 #include "yaml_reader.hpp"
 

@@ -14,7 +14,7 @@
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "per_flight_model.hpp"
 #include "residual_analysis.hpp"
 
@@ -494,6 +494,36 @@ NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
   return out;
 }
 
+StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const std::vector<FitParameter>& ps,
+                                            const std::vector<double>& weights) {
+  std::vector<bool> free;
+  std::vector<int> cols;
+  for (size_t i = 0; i < ps.size(); ++i) {
+    free.push_back(ps[i].free);
+    if (ps[i].free) cols.push_back(static_cast<int>(i));
+  }
+  const int np = static_cast<int>(ps.size()), nr = m.num_residuals();
+  std::vector<double> p = fit::parameter_values(ps), res(nr), J(static_cast<size_t>(nr) * np);
+  m.evaluate_free(p.data(), res.data(), J.data(), free);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
+  for (int i = 0; i < nr; ++i) {
+    const double w2 = std::pow(weights[m.channel_of(i)], 2);
+    for (size_t a = 0; a < cols.size(); ++a)
+      for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
+  }
+  H = H.selfadjointView<Eigen::Lower>();
+  const NormalMatrixAnalysis normal = analyse_normal_matrix(H);
+  StandardErrors out;
+  out.value.assign(ps.size(), std::numeric_limits<double>::quiet_NaN());
+  out.confounded.assign(ps.size(), false);
+  for (size_t a = 0; a < cols.size(); ++a) {
+    const auto k = static_cast<Eigen::Index>(a);
+    out.value[cols[a]] = std::sqrt(std::max(0.0, normal.covariance(k, k)));
+    out.confounded[cols[a]] = normal.confounded[a];
+  }
+  return out;
+}
+
 // Intervals for the selected effects' parameters: profile likelihood with the final
 // model's noise and correlation time in the weights, so the chi2 thresholds hold.
 void CandidateSearch::estimate_intervals(SearchResult& r) const {
@@ -502,28 +532,10 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   best.parameters = r.final_fit;
   best.weights = r.final_weights;
   best.chi2 = cost(train_, r.final_fit);
-  std::vector<bool> free;
-  std::vector<int> cols;
-  for (size_t i = 0; i < r.final_fit.size(); ++i) {
-    free.push_back(r.final_fit[i].free);
-    if (r.final_fit[i].free) cols.push_back(static_cast<int>(i));
-  }
-  best.num_free = static_cast<int>(cols.size());
-  // Standard errors from the Gauss-Newton approximation J^T W J.
-  const int np = static_cast<int>(r.final_fit.size()), nr = train_.num_residuals();
-  std::vector<double> p = fit::parameter_values(r.final_fit), res(nr), J(static_cast<size_t>(nr) * np);
-  train_.evaluate_free(p.data(), res.data(), J.data(), free);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
-  for (int i = 0; i < nr; ++i) {
-    const double w2 = std::pow(r.final_weights[train_.channel_of(i)], 2);
-    for (size_t a = 0; a < cols.size(); ++a)
-      for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
-  }
-  H = H.selfadjointView<Eigen::Lower>();
-  const NormalMatrixAnalysis normal = analyse_normal_matrix(H);
-  best.standard_errors.assign(np, std::numeric_limits<double>::quiet_NaN());
-  for (size_t a = 0; a < cols.size(); ++a)
-    best.standard_errors[cols[a]] = std::sqrt(std::max(0.0, normal.covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a))));
+  const StandardErrors se = gauss_newton_standard_errors(train_, r.final_fit, r.final_weights);
+  best.standard_errors = se.value;
+  best.num_free = static_cast<int>(std::count_if(r.final_fit.begin(), r.final_fit.end(),
+                                                 [](const FitParameter& q) { return q.free; }));
   // Profiles for the airframe's parameters, on every core; a flight's own copies of a
   // per-flight parameter (one per flight in a joint diagnosis) get Wald intervals from the
   // joint covariance, which includes the airframe's uncertainty.
@@ -558,15 +570,13 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
   }
   // A per-flight copy that the data cannot separate from other parameters has no Wald
   // interval: the pseudo-inverse would give it a finite, too small one.
-  const std::vector<bool>& confounded = normal.confounded;
   for (int i : wald) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    const size_t a = static_cast<size_t>(std::find(cols.begin(), cols.end(), i) - cols.begin());
-    const double se = a < cols.size() && confounded[a] ? nan : best.standard_errors[i];
-    const bool finite = std::isfinite(se) && se > 0;
+    const double sd = se.confounded[i] ? nan : se.value[i];
+    const bool finite = std::isfinite(sd) && sd > 0;
     const double v = r.final_fit[i].value, z = 1.959963984540054;
-    r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, se, finite ? v - z * se : nan,
-                           finite ? v + z * se : nan, 0.0,
+    r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, sd, finite ? v - z * sd : nan,
+                           finite ? v + z * sd : nan, 0.0,
                            finite ? "identifiable" : "structurally non-identifiable", "wald",
                            fit::on_bound(r.final_fit[i])});
   }

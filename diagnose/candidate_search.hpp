@@ -150,6 +150,17 @@ struct NormalMatrixAnalysis {
 };
 NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H);
 
+// Standard errors of the free parameters at `ps` from the Gauss-Newton normal matrix of a
+// weighted fit (weights per channel, as the search uses them); NaN for fixed parameters.
+// `confounded`: along a direction the data cannot determine (analyse_normal_matrix), where
+// the pseudo-inverse gives a finite, too small error.
+struct StandardErrors {
+  std::vector<double> value;
+  std::vector<bool> confounded;
+};
+StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const std::vector<fit::FitParameter>& ps,
+                                            const std::vector<double>& weights);
+
 class CandidateSearch {
  public:
   // `all` is the full-catalogue symbolic model and `model` its runtime form; train and

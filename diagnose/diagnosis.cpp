@@ -9,7 +9,9 @@
 #include <memory>
 #include <sstream>
 
-#include "effects.hpp"
+#include "agreement.hpp"
+#include "dynamics.hpp"
+#include "effect_catalogue.hpp"
 #include "geometry.hpp"
 #include "per_flight_model.hpp"
 #include "tape.hpp"
@@ -120,7 +122,7 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   o.effects = all.effects;
   o.terms = terms;
   const SymbolicModel with_terms = derive_model(v, derive_mass_properties(v), o);
-  runtime::TapeModel tape(emission::build_tape(with_terms));
+  runtime::TapeModel tape(codegen::build_tape(with_terms));
   std::unique_ptr<runtime::DynamicModel> model;
   if (later_starts.empty()) model = tape.clone();
   else model = std::make_unique<runtime::PerFlightModel>(tape, later_starts, per_flight);
@@ -401,6 +403,34 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     d.search.carried.push_back(it->effect);
     d.stand_ins.push_back(st);
     it = d.findings.erase(it);
+  }
+  // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
+  if (joint) {
+    std::cerr << "[diagnose] agreement: each named airframe effect refitted on each flight alone\n";
+    AgreementInputs in;
+    in.model = &model_in;
+    for (const auto& f : flights) in.training_parts.push_back(fit::split_by_time(f, 1.0 - opt.validation_fraction).first);
+    in.use_accelerometer = accel;
+    in.joint_fit = d.search.final_fit;
+    in.weights = d.search.final_weights;
+    const auto check = [&](const Finding& f, bool named) {
+      if (find_effect(f.effect).per_flight) return;
+      AgreementInputs::Effect e{f.effect, named, {}, {}, {}};
+      for (const auto& name : effect_parameters(all_in, f.effect)) {
+        const auto est = std::find_if(f.parameters.begin(), f.parameters.end(),
+                                      [&](const EffectEstimate& x) { return x.name == name; });
+        if (est == f.parameters.end()) return;  // no estimate to start from (held at its reference)
+        e.parameters.push_back(name);
+        e.off.push_back(neutral_value(all_in.params[all_in.param_index(name)]));
+        e.start.push_back(est->value);
+      }
+      in.effects.push_back(e);
+    };
+    for (const auto& f : d.findings) check(f, true);
+    // Candidates the acceptance tests turned down, while they still hold their estimates: a
+    // value that differs between the flights is often why the joint fit gains nothing.
+    for (const auto& x : d.suspected) check(x.candidate, false);
+    d.agreement = per_flight_agreement(in);
   }
   // Significant on the training data but no held-out gain in the search itself: suspected.
   for (const auto& ev : d.search.training_only)

@@ -5,8 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "agreement.hpp"
 #include "candidate_search.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "flight_data.hpp"
 #include "prediction.hpp"
 #include "residual_analysis.hpp"
@@ -96,6 +97,9 @@ struct Diagnosis {
   std::vector<Suspected> suspected;
   std::string environment;  // as declared: indoor, outdoor, unknown
   std::vector<StandIn> stand_ins;
+  // Jointly diagnosed flights: each named airframe parameter refitted on each flight alone,
+  // and whether the flights agree (agreement.hpp).
+  std::vector<ParameterAgreement> agreement;
   std::vector<Unexplained> unexplained;
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).

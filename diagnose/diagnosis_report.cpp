@@ -8,7 +8,7 @@
 #include <optional>
 #include <sstream>
 
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "per_flight_model.hpp"
 #include "estimate.hpp"
 #include "fit_report.hpp"
@@ -182,6 +182,34 @@ json finding_json(const Finding& f) {
   return fj;
 }
 
+// Jointly diagnosed flights: each named airframe parameter per flight, and whether they agree.
+json agreement_json(const Diagnosis& d) {
+  json out = json::array();
+  for (const auto& a : d.agreement) {
+    json flights = json::array();
+    for (size_t k = 0; k < a.flights.size(); ++k) {
+      const FlightEstimate& f = a.flights[k];
+      flights.push_back({{"flight", k < d.flights.size() ? d.flights[k] : std::string()},
+                         {"value", number_or_null(f.value)},
+                         {"ci95", {number_or_null(f.lower), number_or_null(f.upper)}},
+                         {"standard_error", number_or_null(f.standard_error)},
+                         {"alone", {{"statistic", f.statistic}, {"p_value", f.p_value}}}});
+    }
+    out.push_back({{"parameter", a.parameter},
+                   {"effect", a.effect},
+                   {"named", a.named},
+                   {"unit", a.unit},
+                   {"joint_value", a.joint_value},
+                   {"pooled", a.pooled},
+                   {"spread", number_or_null(a.spread)},
+                   {"cochran_q", a.q},
+                   {"q_p_value", a.q_p_value},
+                   {"agree", a.agree},
+                   {"flights", flights}});
+  }
+  return out;
+}
+
 json channels_json(const ResidualAnalysis& a) {
   json arr = json::array();
   for (const auto& c : a.channels) {
@@ -267,6 +295,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                    {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
                    {"separating_manoeuvre", a.manoeuvre}});
   j["ambiguous"] = amb;
+  j["agreement"] = agreement_json(d);
   j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
   json un = json::array();
   for (const auto& u : d.unexplained)
@@ -498,6 +527,14 @@ std::string diagnosis_summary(const Diagnosis& d) {
       os << " " << p.name << " = " << num(p.value) << " [" << num(p.lower) << ", " << num(p.upper) << "]";
     os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n  " << headline(f) << "\n";
   }
+  for (const auto& a : d.agreement) {
+    os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+       << " %, Cochran's Q p = " << num(a.q_p_value, 2) << "):";
+    for (size_t k = 0; k < a.flights.size(); ++k)
+      os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " [" << num(a.flights[k].lower, 3) << ", "
+         << num(a.flights[k].upper, 3) << "]";
+    os << "\n";
+  }
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
        << "); to separate them: " << a.manoeuvre << "\n";
@@ -589,6 +626,46 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   h << "</table>\n";
 }
 
+// Each named airframe parameter per flight as a forest plot in the table: the flight's 95 %
+// interval as a bar, its value as a dot, the joint value as a vertical line; agreeing
+// flights' bars all cross the line.
+void agreement_html(std::ostringstream& h, const Diagnosis& d) {
+  if (d.agreement.empty()) return;
+  h << "<h2>Do the flights agree?</h2>\n<p>Each named airframe effect refitted on each flight's training part alone "
+       "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
+       "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
+       "joint estimate). \"Alone\": the effect's "
+       "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
+       "value and the spread (largest &minus; smallest over the joint value) is below 30 %.</p>\n";
+  for (const auto& a : d.agreement) {
+    double lo = a.joint_value, hi = a.joint_value;
+    for (const auto& f : a.flights)
+      for (double v : {f.value, f.lower, f.upper})
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    const double pad = 0.05 * (hi - lo) + 1e-300;
+    lo -= pad, hi += pad;
+    const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
+    h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
+      << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>Joint " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
+      << num(100 * a.spread, 3) << " %, Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
+      << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
+         "<th style=\"width:40%\">at a glance</th></tr>\n";
+    for (size_t k = 0; k < a.flights.size(); ++k) {
+      const FlightEstimate& f = a.flights[k];
+      h << "<tr><td>" << k + 1 << ". " << esc(k < d.flights.size() ? d.flights[k] : std::string()) << "</td><td>"
+        << num(f.value, 3) << "</td><td>[" << num(f.lower, 3) << ", " << num(f.upper, 3) << "]</td><td>"
+        << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
+        << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
+      if (std::isfinite(f.lower) && std::isfinite(f.upper))
+        h << "<div style=\"position:absolute;left:" << at(f.lower) << ";width:calc(" << at(f.upper) << " - " << at(f.lower)
+          << ");top:5px;height:4px;background:#357\"></div>";
+      h << "<div style=\"position:absolute;left:calc(" << at(f.value) << " - 4px);top:3px;width:8px;height:8px;"
+        << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
+    }
+    h << "</table>\n";
+  }
+}
+
 }  // namespace
 
 std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
@@ -655,6 +732,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ".</p>\n";
   }
+  agreement_html(h, d);
   if (!d.stand_ins.empty()) {
     h << "<h2>Stand-ins for missing physics</h2>\n<p>Each passed every statistical test, but its value lies outside "
          "what its physics can produce here: it absorbs an error of something the model lacks. It stays in the "

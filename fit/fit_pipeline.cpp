@@ -8,7 +8,7 @@
 
 #include "thrust_law.hpp"
 #include "dynamic_model.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "equation_error.hpp"
 #include "fit_report.hpp"
 #include "log_reader.hpp"

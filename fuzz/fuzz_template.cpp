@@ -28,7 +28,7 @@ size_t count(const std::string& s, char c) {
 std::string header_with(const std::string& s) {
   static const kainjow::mustache::mustache tmpl{std::string(kModelHeaderTemplate)};
   kainjow::mustache::data d;
-  quadgen::emission::set_provenance_fields(d, {s, s, s, s, s, s});
+  quadgen::codegen::set_provenance_fields(d, {s, s, s, s, s, s});
   d.set("namespace", "fuzz_model");
   kainjow::mustache::data var;
   var.set("ident", "v");

@@ -137,7 +137,7 @@ std::vector<HiddenCase> single_effects() {
       {"battery_sag", "battery_sag", {{"battery_sag.exponent", 1.5}}, {{"battery_sag.exponent", 0.2}}, ""},
       {"ground_effect", "ground_effect", {{"ground_effect.radius", 0.0635}}, {{"ground_effect.radius", 0.02}},
        "--height 0.2 --height-amplitude 0.1"},  // low and varied enough for the held-out prediction to gain
-      // The size blade-element theory gives a small rotor (derive/effects.cpp).
+      // The size blade-element theory gives a small rotor (derive/effects/inflow.cpp).
       {"inflow", "inflow", {{"inflow.k", 3.0}}, {{"inflow.k", 0.6}}, ""},
   };
   std::vector<HiddenCase> all;
@@ -538,6 +538,54 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
   };
   EXPECT_FALSE(nominal(header).empty());
   EXPECT_EQ(nominal(regenerated), nominal(header));
+}
+
+// Two flights of one airframe: each flight alone must show the named airframe effect with the
+// value the joint fit gives (agreement), and a value that differs between the flights must be
+// reported as disagreement - the check that keeps a flight-to-flight stand-in from passing as a
+// property of the airframe.
+json rotor_drag_on_two_flights(const std::string& name, double k_a, double k_b) {
+  const fs::path dir = fresh_directory(name);
+  const HiddenCase a{"a", "rotor_drag,motor_gain", {{"rotor_drag.k", k_a}, {"motor_gain.C", -0.05}}, {}, "", 1};
+  const HiddenCase b{"b", "rotor_drag,motor_gain", {{"rotor_drag.k", k_b}, {"motor_gain.B", 0.04}}, {}, "", 2};
+  const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
+  return diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
+}
+
+const json* agreement_of(const json& j, const std::string& parameter) {
+  for (const auto& a : j["agreement"])
+    if (a["parameter"] == parameter) return &a;
+  return nullptr;
+}
+
+TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
+  const double truth = 2e-5;
+  const json j = rotor_drag_on_two_flights("quadgen_agree", truth, truth);
+  const auto n = named(j);
+  ASSERT_NE(std::find(n.begin(), n.end(), "rotor_drag"), n.end()) << j["findings"].dump(1);
+  const json* a = agreement_of(j, "rotor_drag.k");
+  ASSERT_NE(a, nullptr) << j["agreement"].dump(1);
+  EXPECT_TRUE((*a)["agree"].get<bool>()) << a->dump(1);
+  ASSERT_EQ((*a)["flights"].size(), 2u);
+  for (const auto& f : (*a)["flights"]) {
+    // each flight's own estimate within 4 of its standard errors of the truth, and the effect
+    // significant on each flight by itself
+    const double v = f["value"], se = f["standard_error"];
+    EXPECT_LT(std::fabs(v - truth), 4 * se + 1e-7) << f.dump();
+    EXPECT_LT(f["alone"]["p_value"].get<double>(), 1e-3) << f.dump();
+  }
+  EXPECT_LT((*a)["spread"].get<double>(), 0.3);
+}
+
+TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
+  const json j = rotor_drag_on_two_flights("quadgen_disagree", 1e-5, 4e-5);
+  // One joint value fits neither flight: named or suspected, it is checked flight by flight.
+  const json* a = agreement_of(j, "rotor_drag.k");
+  ASSERT_NE(a, nullptr) << j["findings"].dump(1) << j["suspected"].dump(1) << j["agreement"].dump(1);
+  EXPECT_FALSE((*a)["agree"].get<bool>()) << a->dump(1);
+  EXPECT_LT((*a)["q_p_value"].get<double>(), 0.01) << a->dump(1);
+  const double v1 = (*a)["flights"][0]["value"], v2 = (*a)["flights"][1]["value"];
+  EXPECT_GT(v2, 2 * v1) << a->dump(1);  // each flight shows its own value
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "dynamics.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "generated_models.hpp"
 #include "header_writer.hpp"
 #include "test_helpers.hpp"
@@ -229,10 +229,10 @@ TEST(Generated, IndependentOfSymbolCreationOrder) {
   quadgen::DeriveOptions o;
   o.effects = quadgen::parse_effect_list("all");
   const quadgen::SymbolicModel m = quadgen::derive_model(v, quadgen::derive_mass_properties(v), o);
-  quadgen::emission::EmitOptions eo;
+  quadgen::codegen::EmitOptions eo;
   eo.vehicle_file = "vehicles/finken3.yaml";
   eo.effects_flag = " --effects all";
-  const std::string text = quadgen::emission::generate_header(m, eo).content;
+  const std::string text = quadgen::codegen::generate_header(m, eo).content;
   EXPECT_TRUE(text == read(fs::path(QUADGEN_SOURCE_DIR) / "generated/finken3_all_effects/model.hpp"));
 }
 

@@ -229,14 +229,14 @@ TEST(Sinks, CppCommentAndLiteralCannotEndEarly) {
 TEST(Sinks, GeneratedHeaderChangesOnlyInItsCommentWhatEverThePath) {
   const quadgen::Vehicle v = quadgen::test::finken3();
   const auto model = quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
-  quadgen::emission::EmitOptions plain;
+  quadgen::codegen::EmitOptions plain;
   plain.vehicle_file = "vehicles/finken3.yaml";
-  const std::string reference = quadgen::emission::generate_header(model, plain).content;
+  const std::string reference = quadgen::codegen::generate_header(model, plain).content;
   for (const auto& s : hostile_strings()) {
-    quadgen::emission::EmitOptions o = plain;
+    quadgen::codegen::EmitOptions o = plain;
     o.vehicle_file = s;
     o.effects_flag = s;
-    const std::string h = quadgen::emission::generate_header(model, o).content;
+    const std::string h = quadgen::codegen::generate_header(model, o).content;
     // Line 2 (the regenerate command) is the only one that may differ, and stays one line.
     const auto line2 = [](const std::string& x) {
       const size_t a = x.find('\n') + 1;
@@ -251,9 +251,9 @@ TEST(Sinks, GeneratedHeaderChangesOnlyInItsCommentWhatEverThePath) {
   // A name that got past the parser is refused by the generator, never emitted.
   auto bad = model;
   bad.vehicle_name = "finken3\n#define Scalar(v) (2*(v))\n//";
-  EXPECT_THROW(quadgen::emission::generate_header(bad, plain), std::invalid_argument);
+  EXPECT_THROW(quadgen::codegen::generate_header(bad, plain), std::invalid_argument);
   bad.vehicle_name = "class";
-  EXPECT_THROW(quadgen::emission::generate_header(bad, plain), std::invalid_argument);
+  EXPECT_THROW(quadgen::codegen::generate_header(bad, plain), std::invalid_argument);
 }
 
 TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {

@@ -11,7 +11,7 @@
 #include <Eigen/Dense>
 
 #include "audit.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "report.hpp"
 #include "test_helpers.hpp"
 #include "thesis_reference.hpp"

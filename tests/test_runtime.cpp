@@ -10,7 +10,7 @@
 
 #include "attitude.hpp"
 #include "dynamic_model.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "flight_log.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
@@ -28,7 +28,7 @@ TapeModel finken3_tape(std::vector<std::string> effects = {}) {
   const Vehicle v = test::finken3();
   DeriveOptions o;
   o.effects = std::move(effects);
-  return TapeModel(emission::build_tape(derive_model(v, derive_mass_properties(v), o)));
+  return TapeModel(codegen::build_tape(derive_model(v, derive_mass_properties(v), o)));
 }
 
 std::vector<double> at_rest() {
@@ -517,7 +517,7 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   DeriveOptions o;
   o.effects = {"motor_gain"};
   const SymbolicModel sm = derive_model(v, mp, o);
-  TapeModel truth(emission::build_tape(sm));
+  TapeModel truth(codegen::build_tape(sm));
   const ControllerModel belief = nominal_controller_belief(v, derive_model(v, mp, {}));
   ClosedLoopOptions co;
   co.duration = 20;

@@ -8,7 +8,7 @@
 
 #include <Eigen/Dense>
 
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "test_helpers.hpp"
 
 using namespace quadgen;

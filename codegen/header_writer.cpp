@@ -8,12 +8,12 @@
 #include "exact_number.hpp"
 #include "names.hpp"
 #include "sinks.hpp"
-#include "effects.hpp"
+#include "effect_catalogue.hpp"
 #include "vehicle.hpp"
 
 extern const char* const kModelHeaderTemplate;  // templates/model.hpp.mustache, embedded by CMake
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 using namespace GiNaC;
 using kainjow::mustache::data;
 using kainjow::mustache::list;
@@ -213,4 +213,4 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   return out;
 }
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

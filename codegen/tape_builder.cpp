@@ -5,7 +5,7 @@
 
 #include "expression_graph.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 using namespace GiNaC;
 using runtime::Instruction;
 using runtime::TapeOp;
@@ -166,4 +166,4 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   return t;
 }
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

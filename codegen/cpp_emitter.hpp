@@ -22,7 +22,7 @@
 
 #include "expression_graph.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 
 struct Output {
   std::string target;  // e.g. "f[3]", "dfdx[17]"
@@ -108,4 +108,4 @@ class CppEmitter {
   std::vector<int> pre_order_;
 };
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

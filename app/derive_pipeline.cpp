@@ -16,10 +16,10 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   out.audit = audit(out.model, mass);
   if (request.thesis_comparison) out.thesis = compare_with_thesis(out.model, mass);
   progress("generating C++");
-  emission::EmitOptions emit = request.emit;
+  codegen::EmitOptions emit = request.emit;
   if (request.effects_flag_from_model)
     emit.effects_flag = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
-  out.header = emission::generate_header(out.model, emit);
+  out.header = codegen::generate_header(out.model, emit);
   const Derivation d{vehicle, mass, out.model, out.audit, out.thesis};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);

@@ -9,7 +9,7 @@
 
 #include "audit.hpp"
 #include "dynamics.hpp"
-#include "emission/header_writer.hpp"
+#include "header_writer.hpp"
 #include "geometry.hpp"
 #include "symbolic_model.hpp"
 #include "thesis_reference.hpp"
@@ -19,7 +19,7 @@ namespace quadgen {
 
 struct DeriveRequest {
   DeriveOptions derive;       // effects and added terms
-  emission::EmitOptions emit;  // the header's provenance
+  codegen::EmitOptions emit;  // the header's provenance
   // The header's regenerate command names the model's effects in canonical order
   // ("--effects motor_gain,wind") rather than emit.effects_flag.
   bool effects_flag_from_model = false;
@@ -35,7 +35,7 @@ struct DerivedModel {
   SymbolicModel model;
   AuditResult audit;
   std::vector<ThesisItem> thesis;
-  emission::GeneratedHeader header;
+  codegen::GeneratedHeader header;
   std::string model_json, derivation_md;
 };
 

@@ -326,7 +326,7 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
 void section_thesis(std::ostringstream& md, const Derivation& d) {
   if (d.thesis.empty()) return;
   md << "## 8. Comparison with the thesis\n\n"
-     << "The thesis' equations and numbers are encoded in `derive/thesis_reference.cpp`; each row compares "
+     << "The thesis' equations and numbers are encoded in `audit/thesis_reference.cpp`; each row compares "
         "them with the derived model at its nominal parameters.\n\n"
      << "| ref | topic | thesis | derived | verdict | cause | size |\n|---|---|---|---|---|---|---|\n";
   for (const auto& t : d.thesis)

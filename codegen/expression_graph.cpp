@@ -8,7 +8,7 @@
 
 #include "symbolic_functions.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 using namespace GiNaC;
 
 namespace {
@@ -218,4 +218,4 @@ std::string double_literal(double v) {
   return s;
 }
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

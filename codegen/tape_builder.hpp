@@ -4,6 +4,6 @@
 #include "symbolic_model.hpp"
 #include "tape.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 runtime::Tape build_tape(const SymbolicModel& m);
 }

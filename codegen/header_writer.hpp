@@ -6,7 +6,7 @@
 
 #include "symbolic_model.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 
 struct EmitOptions {
   std::string vehicle_file;  // as named on the command line, for the regenerate comment
@@ -39,4 +39,4 @@ void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p);
 // The model's name: vehicle, plus effects.
 std::string model_name(const SymbolicModel& m);
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

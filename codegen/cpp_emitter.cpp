@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 
 namespace {
 
@@ -681,4 +681,4 @@ EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups
   return out;
 }
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

@@ -13,7 +13,7 @@
 
 #include "symbolic_model.hpp"
 
-namespace quadgen::emission {
+namespace quadgen::codegen {
 
 enum class Op { constant, state, input, param, add, mul, div, ipow, pow, sin, cos, log, abs, sign };
 
@@ -67,4 +67,4 @@ void declare_model_variables(ExpressionGraph& g, const SymbolicModel& m);
 // that reads back as the same double.
 std::string double_literal(double v);
 
-}  // namespace quadgen::emission
+}  // namespace quadgen::codegen

@@ -262,7 +262,7 @@ std::string describe(const Flight& f) {
 }
 
 void simulated_items(std::vector<ThesisItem>& out, const SymbolicModel& model) {
-  runtime::TapeModel tape(emission::build_tape(model));
+  runtime::TapeModel tape(codegen::build_tape(model));
   const Flight right = fly(tape, model, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
   const Flight forward = fly(tape, model, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
   // The scenarios of `quadgen simulate`, 3 s each.

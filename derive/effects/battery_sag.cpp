@@ -1,0 +1,34 @@
+// battery_sag: thrust scaled by (vbat / vbat_ref)^exponent, when the log holds the battery
+// voltage.
+#include "definitions.hpp"
+#include "dynamics.hpp"
+#include "headline_words.hpp"
+
+namespace quadgen::effects {
+using namespace GiNaC;
+
+namespace {
+
+void terms(ModelContext& c) {
+  const ex e = c.add_param("battery_sag.exponent", "1", 0.0, -1.0, 4.0, true, "thrust ~ (vbat/vbat_ref)^exponent");
+  const Parameter& ref = param(c.vehicle, "vbat_ref");
+  const ex vref = c.add_param("vbat_ref", "V", ref.value, ref.value, ref.value, false, ref.doc);
+  const ex vbat = c.add_input("vbat", "V", "battery voltage");
+  for (ex& s : c.thrust_scale) s = s * pow(vbat / vref, e);
+}
+
+}  // namespace
+
+Effect battery_sag() {
+  Effect e{"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", terms};
+  e.needs = EffectNeeds::kBatteryVoltage;
+  e.plausible = {{"battery_sag.exponent", 0.0, 3.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
+                  "at a fixed duty cycle rotor speed grows about with voltage and thrust with its square: ~2"}};
+  e.headline = [](const std::map<std::string, double>& v, const std::string&) {
+    return "Thrust follows the battery voltage to the power " +
+           headline::words(headline::value_of(v, "battery_sag.exponent")) + ".";
+  };
+  return e;
+}
+
+}  // namespace quadgen::effects

@@ -1,0 +1,133 @@
+#include "effect_catalogue.hpp"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "definitions.hpp"
+
+namespace quadgen {
+
+namespace {
+
+// Canonical order: the order effects are applied in. wind comes before the airspeed
+// effects (rotor_drag, blade_flapping, inflow) because they act on the air-relative velocity
+// it changes; thrust scalings commute, so their order only fixes the parameter order.
+std::vector<Effect> build_catalogue() {
+  std::vector<Effect> list = {effects::motor_gain(),    effects::motor_lag(),      effects::input_delay(),
+                              effects::cog_offset(),    effects::wind(),           effects::rotor_drag(),
+                              effects::blade_flapping(), effects::attitude_bias(), effects::thrust_decay(),
+                              effects::battery_sag(),   effects::ground_effect(),  effects::inflow()};
+  std::set<std::string> names;
+  for (const Effect& e : list) {
+    if (e.name.empty() || !e.apply || !e.headline || e.meaning.empty())
+      throw std::logic_error("effect '" + e.name + "' lacks a name, terms, a meaning or a headline");
+    if (!names.insert(e.name).second) throw std::logic_error("effect '" + e.name + "' listed twice");
+  }
+  for (const Effect& e : list)
+    for (const LookAlike& l : e.look_alikes)
+      if (!names.count(l.effect)) throw std::logic_error("effect '" + e.name + "' names an unknown look-alike");
+  return list;
+}
+
+}  // namespace
+
+const std::vector<Effect>& effect_catalogue() {
+  static const std::vector<Effect> list = build_catalogue();
+  return list;
+}
+
+const Effect& find_effect(const std::string& name) {
+  for (const auto& e : effect_catalogue())
+    if (e.name == name) return e;
+  throw std::invalid_argument("unknown effect '" + name + "'");
+}
+
+std::string effect_of_parameter(const std::string& parameter) {
+  const auto dot = parameter.find('.');
+  return dot == std::string::npos ? std::string() : parameter.substr(0, dot);
+}
+
+std::vector<std::string> reference_parameters(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (const auto& n : names) {
+    const std::string e = effect_of_parameter(n);
+    if (e.empty() || !seen.insert(e).second) continue;
+    if (find_effect(e).first_parameter_is_reference) out.push_back(n);
+  }
+  return out;
+}
+
+double off_value(const std::string& parameter, double nominal, double lower) {
+  const std::string e = effect_of_parameter(parameter);
+  return !e.empty() && find_effect(e).off_at_lower_bound ? lower : nominal;
+}
+
+Environment parse_environment(const std::string& text) {
+  if (text == "indoor") return Environment::kIndoor;
+  if (text == "outdoor") return Environment::kOutdoor;
+  if (text == "unknown" || text.empty()) return Environment::kUnknown;
+  throw std::invalid_argument("unknown environment '" + text + "' (expected indoor, outdoor or unknown)");
+}
+
+std::string environment_name(Environment e) {
+  return e == Environment::kIndoor ? "indoor" : e == Environment::kOutdoor ? "outdoor" : "unknown";
+}
+
+bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
+                     double* upper, std::string* why) {
+  const std::string effect = effect_of_parameter(parameter);
+  if (effect.empty()) return false;
+  // The best match: a range for this environment over one for any, then one for this
+  // parameter over one for all of the effect's.
+  const PlausibleRange* found = nullptr;
+  int best = -1;
+  for (const auto& r : find_effect(effect).plausible) {
+    if (!r.parameter.empty() && r.parameter != parameter) continue;
+    if (r.only_in != Environment::kUnknown && r.only_in != where) continue;
+    const int rank = (r.only_in == where && where != Environment::kUnknown ? 2 : 0) + (r.parameter.empty() ? 0 : 1);
+    if (rank > best) best = rank, found = &r;
+  }
+  if (!found) return false;
+  const double unit = found->scale == PlausibleRange::Scale::kRotorArm      ? scales.rotor_arm
+                      : found->scale == PlausibleRange::Scale::kRotorRadius ? scales.rotor_radius
+                                                                            : 1.0;
+  *lower = found->lower * unit;
+  *upper = found->upper * unit;
+  *why = found->why;
+  return true;
+}
+
+std::vector<std::string> parse_effect_list(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  if (text == "all") {
+    for (const auto& e : effect_catalogue()) out.push_back(e.name);
+    return out;
+  }
+  std::set<std::string> known, seen;
+  for (const auto& e : effect_catalogue()) known.insert(e.name);
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!known.count(item)) {
+      std::string list;
+      for (const auto& e : effect_catalogue()) list += (list.empty() ? "" : ", ") + e.name;
+      throw std::invalid_argument("unknown effect '" + item + "' (known: " + list + ", or all)");
+    }
+    if (!seen.insert(item).second) throw std::invalid_argument("effect '" + item + "' named twice");
+    out.push_back(item);
+  }
+  return out;
+}
+
+std::string canonical_effect_list(const std::vector<std::string>& effects) {
+  std::string out;
+  for (const auto& e : effect_catalogue())
+    if (std::find(effects.begin(), effects.end(), e.name) != effects.end()) out += (out.empty() ? "" : ",") + e.name;
+  return out;
+}
+
+}  // namespace quadgen

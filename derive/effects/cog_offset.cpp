@@ -1,0 +1,38 @@
+// cog_offset: the centre of gravity displaced in x and y from where the blocks put it.
+#include <cmath>
+
+#include "definitions.hpp"
+#include "dynamics.hpp"
+#include "headline_words.hpp"
+#include "kinematics.hpp"
+
+namespace quadgen::effects {
+using namespace GiNaC;
+
+namespace {
+
+void terms(ModelContext& c) {
+  const ex dx = c.add_param("cog_offset.x", "m", 0.0, -0.05, 0.05, true, "CoG displacement x");
+  const ex dy = c.add_param("cog_offset.y", "m", 0.0, -0.05, 0.05, true, "CoG displacement y");
+  c.cog = c.cog.add(vec3(dx, dy, 0));
+}
+
+std::string headline(const std::map<std::string, double>& v, const std::string&) {
+  using headline::words;
+  const double x = 1e3 * headline::value_of(v, "cog_offset.x"), y = 1e3 * headline::value_of(v, "cog_offset.y");
+  return "The centre of gravity sits " + words(std::fabs(x)) + " mm " + (x < 0 ? "behind" : "ahead of") + " and " +
+         words(std::fabs(y)) + " mm " + (y < 0 ? "right" : "left") + " of where the blocks put it.";
+}
+
+}  // namespace
+
+Effect cog_offset() {
+  Effect e{"cog_offset", "centre of gravity displaced from the body origin in x, y", terms};
+  e.plausible = {{"", -0.2, 0.2, PlausibleRange::Scale::kRotorArm, Environment::kUnknown,
+                  "a centre of gravity a fifth of the rotor arm off centre needs one motor at ~1.5x its opposite's "
+                  "thrust to hover level: visible at a glance"}};
+  e.headline = headline;
+  return e;
+}
+
+}  // namespace quadgen::effects

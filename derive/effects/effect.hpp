@@ -1,0 +1,74 @@
+// What an effect is, without its algebra: the record the fit, the diagnosis, the flight
+// generator and the reports iterate over. Each effect fills one in its own file in this
+// folder (motor_gain.cpp, ..., with its symbolic terms beside it); catalogue.cpp lists them
+// in canonical order. The header has no GiNaC: code that only needs the facts (plausible
+// ranges, look-alikes, headlines) does not see the symbolic layer.
+#pragma once
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace quadgen {
+
+struct ModelContext;  // derive/dynamics.hpp: the intermediate quantities an effect rewrites
+
+// What a log must hold for an effect to be estimated from it.
+enum class EffectNeeds { kNothing, kBatteryVoltage, kPose };
+
+// Another effect that a flight can mistake for this one, and the manoeuvre that tells
+// the two apart.
+struct LookAlike {
+  std::string effect, separating_manoeuvre;
+};
+
+// Where a flight was flown, as a log or the command line declares it: what is plausible
+// depends on it (a steady wind indoors is not).
+enum class Environment { kUnknown, kIndoor, kOutdoor };
+
+// The values of a parameter that the effect's physics can produce. A fitted value beyond
+// them is the effect standing in for something the model lacks, not the effect itself.
+struct PlausibleRange {
+  std::string parameter;  // empty: every parameter of the effect
+  double lower = 0, upper = 0;
+  // What lower and upper are in: SI, or fractions of the vehicle's rotor arm (the largest
+  // distance of a rotor from the body z axis) or of its rotor radius.
+  enum class Scale { kSI, kRotorArm, kRotorRadius } scale = Scale::kSI;
+  Environment only_in = Environment::kUnknown;  // kUnknown: wherever no other range applies
+  std::string why;  // the physical argument, with its source
+};
+
+// One sentence in words for a person reading a report ("Motor C gives 8 % less thrust than
+// motor A"), from the fitted values by parameter name; `reference` is the parameter held at
+// off (first_parameter_is_reference), or empty.
+using Headline = std::function<std::string(const std::map<std::string, double>& values, const std::string& reference)>;
+
+// One home per effect: its symbolic change, and what fits and the diagnosis need to know
+// about it.
+struct Effect {
+  std::string name;
+  std::string meaning;
+  // Declares the effect's parameters (states, inputs) on the context and rewrites its
+  // intermediate quantities; at the parameters' off values the model is unchanged.
+  std::function<void(ModelContext&)> apply;
+  EffectNeeds needs = EffectNeeds::kNothing;
+  // Where the cost is flat at "off" (a lag or a delay of zero, a radius of zero), fits
+  // also start here: parameter -> value.
+  std::vector<std::pair<std::string, double>> typical_start;
+  // "Off" is the parameters' lower bound, not their nominal value (a nominal rotor lag of
+  // 1 ms keeps simulations non-stiff; equation error has no such limit).
+  bool off_at_lower_bound = false;
+  // Beside c_t only ratios between the parameters are identifiable: the first is the
+  // reference, held at off.
+  bool first_parameter_is_reference = false;
+  // A property of the flight rather than of the airframe (a motor trim that changes when a
+  // motor or the battery is re-seated, the wind of the day): when several flights are
+  // diagnosed together, each flight has its own values (runtime::PerFlightModel).
+  bool per_flight = false;
+  // Plausible values of its parameters (none for a parameter: any value in its bounds).
+  std::vector<PlausibleRange> plausible;
+  std::vector<LookAlike> look_alikes;
+  Headline headline;
+};
+
+}  // namespace quadgen

@@ -1,0 +1,55 @@
+// The catalogue of effects (docs/effects.md) and the questions asked of it. Each effect is a
+// self-contained change of the model, described in its own file of this folder (effect.hpp
+// says what such a description holds); at its parameters' off values the model is unchanged.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "effect.hpp"
+
+namespace quadgen {
+
+// All effects in canonical order (the order they are applied in, whatever the user wrote).
+const std::vector<Effect>& effect_catalogue();
+
+// The catalogue entry of this name; std::invalid_argument if there is none.
+const Effect& find_effect(const std::string& name);
+
+// The effect a parameter belongs to ("motor_gain.A" -> "motor_gain"); "" for a parameter of
+// the base model.
+std::string effect_of_parameter(const std::string& parameter);
+// Whether a parameter belongs to an effect rather than to the vehicle file.
+inline bool is_effect_parameter(const std::string& parameter) { return !effect_of_parameter(parameter).empty(); }
+
+// Of these parameter names (in model order), those held at off whatever the fit flags
+// say: the first parameter of each effect identifiable only as ratios (motor_gain's first
+// rotor, when c_t is fitted beside the gains).
+std::vector<std::string> reference_parameters(const std::vector<std::string>& parameter_names);
+
+// The value at which a parameter means "off": an effect parameter's nominal value, or its
+// lower bound for effects off there; a base-model parameter's nominal value.
+double off_value(const std::string& parameter, double nominal, double lower);
+// The same for any parameter record with name, nominal and lower (a symbolic Variable).
+template <class Record>
+double off_value(const Record& p) {
+  return off_value(p.name, p.nominal, p.lower);
+}
+
+Environment parse_environment(const std::string& text);  // "unknown", "indoor", "outdoor"
+std::string environment_name(Environment e);
+
+// The vehicle lengths plausible ranges may be relative to.
+struct VehicleScales {
+  double rotor_arm = 0, rotor_radius = 0;  // m
+};
+// The plausible range of a parameter in this environment, in SI (lower, upper, why); false
+// when its effect declares none.
+bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
+                     double* upper, std::string* why);
+// Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
+std::vector<std::string> parse_effect_list(const std::string& text);
+// These effects in canonical order joined by commas: SymbolicModel::effect_list() of the model
+// derived with them, and a generated header's kEffects, known before deriving.
+std::string canonical_effect_list(const std::vector<std::string>& effects);
+
+}  // namespace quadgen

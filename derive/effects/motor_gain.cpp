@@ -1,0 +1,56 @@
+// motor_gain: the thrust of each rotor scaled by (1 + gain). Beside c_t only the ratios
+// between rotors are identifiable, so the first rotor is the reference.
+#include <cmath>
+#include <sstream>
+
+#include "definitions.hpp"
+#include "dynamics.hpp"
+#include "headline_words.hpp"
+
+namespace quadgen::effects {
+using namespace GiNaC;
+
+namespace {
+
+void terms(ModelContext& c) {
+  for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
+    const std::string n = c.vehicle.rotors[i].name;
+    const ex g = c.add_param("motor_gain." + n, "1", 0.0, -0.5, 0.5, true, "relative thrust error of rotor " + n);
+    c.thrust_scale[i] = c.thrust_scale[i] * (1 + g);
+  }
+}
+
+// "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more."
+std::string headline(const std::map<std::string, double>& v, const std::string& reference) {
+  using headline::after_dot;
+  using headline::words;
+  std::ostringstream os;
+  bool first = true;
+  for (const auto& [name, g] : v) {
+    os << (first ? "Motor " : "; motor ") << after_dot(name) << (first ? " gives " : " ") << words(100 * std::fabs(g))
+       << " % " << (g < 0 ? "less" : "more") << (first ? " thrust" : "");
+    if (first && !reference.empty()) os << " than motor " << after_dot(reference);
+    first = false;
+  }
+  return os.str() + ".";
+}
+
+}  // namespace
+
+Effect motor_gain() {
+  Effect e{"motor_gain", "thrust of each rotor scaled by (1 + value)", terms};
+  e.first_parameter_is_reference = true;
+  // The NanoBench flights of one Crazyflie trim their motors differently on every flight
+  // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).
+  e.per_flight = true;
+  e.plausible = {{"", -0.35, 0.35, PlausibleRange::Scale::kSI, Environment::kUnknown,
+                  "motors of one type differ by up to ~20 % in thrust at one command, worn brushed motors by ~30 % "
+                  "(the NanoBench trims reach a duty ratio of 1.2); beyond, a motor is broken or something else acts"}};
+  e.look_alikes = {{"cog_offset",
+                    "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
+                    "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)"}};
+  e.headline = headline;
+  return e;
+}
+
+}  // namespace quadgen::effects

@@ -1,0 +1,136 @@
+#include "agreement.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include <boost/math/distributions/chi_squared.hpp>
+
+#include "candidate_search.hpp"
+#include "equation_error.hpp"
+#include "per_flight_model.hpp"
+
+namespace quadgen::diagnose {
+
+namespace {
+
+constexpr double kZ95 = 1.959963984540054;
+
+double chi2_upper_tail(double x, double dof) {
+  if (!(dof > 0)) return 1.0;
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), std::max(0.0, x)));
+}
+
+// Flight k's (1-based) parameters under the single-flight model's names: its own copy of a
+// per-flight parameter, the airframe's value of every other; free are the named effects'
+// parameters and the flight's own parameters that the joint fit freed.
+std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, const std::vector<std::string>& named) {
+  std::map<std::string, double> start;
+  for (const auto& e : in.effects)
+    for (size_t j = 0; j < e.parameters.size(); ++j) start[e.parameters[j]] = e.start[j];
+  std::map<std::string, const fit::FitParameter*> joint;
+  for (const auto& p : in.joint_fit) joint[p.name] = &p;
+  std::vector<fit::FitParameter> ps;
+  for (const auto& n : in.model->param_names()) {
+    const bool per_flight = joint.count(runtime::per_flight_name(n, 2)) > 0;
+    const auto it = joint.find(per_flight ? runtime::per_flight_name(n, k) : n);
+    if (it == joint.end()) throw fit::FitError("agreement: no joint value for " + n);
+    fit::FitParameter p = *it->second;
+    p.name = n;
+    const bool of_effect = std::find(named.begin(), named.end(), n) != named.end();
+    p.free = of_effect || (per_flight && p.free);
+    if (of_effect) p.value = std::clamp(start.at(n), p.lower, p.upper);
+    ps.push_back(p);
+  }
+  return ps;
+}
+
+// One flight: its estimates of every named parameter and, per effect, the LR test against off.
+std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, int k, const std::vector<std::string>& named) {
+  const fit::EquationErrorModel ee(*in.model, in.training_parts[static_cast<size_t>(k - 1)], in.use_accelerometer);
+  fit::FitOptions fo;
+  fo.max_iterations = 100;
+  fo.function_tolerance = 1e-10;
+  fo.parameter_tolerance = 1e-10;
+  std::vector<fit::FitParameter> on = flight_start(in, k, named);
+  const double cost_on = fit::solve_weighted(ee, on, in.weights, fo);
+  const StandardErrors se = gauss_newton_standard_errors(ee, on, in.weights);
+  std::map<std::string, FlightEstimate> out;
+  for (const auto& e : in.effects) {
+    std::vector<fit::FitParameter> off = on;
+    for (size_t j = 0; j < e.parameters.size(); ++j) {
+      const int i = in.model->param_index(e.parameters[j]);
+      off[i].value = e.off[j];
+      off[i].free = false;
+    }
+    const double cost_off = fit::solve_weighted(ee, off, in.weights, fo);
+    const double statistic = std::max(0.0, cost_off - cost_on);
+    for (const auto& name : e.parameters) {
+      const int i = in.model->param_index(name);
+      FlightEstimate f;
+      f.value = on[i].value;
+      const bool known = !se.confounded[i] && std::isfinite(se.value[i]) && se.value[i] > 0;
+      f.standard_error = known ? se.value[i] : std::numeric_limits<double>::quiet_NaN();
+      f.lower = f.value - kZ95 * f.standard_error;
+      f.upper = f.value + kZ95 * f.standard_error;
+      f.statistic = statistic;
+      f.p_value = chi2_upper_tail(statistic, static_cast<double>(e.parameters.size()));
+      out[name] = f;
+    }
+  }
+  return out;
+}
+
+// Pooled value, Cochran's Q, spread and the verdict from the flights' estimates.
+void summarise(ParameterAgreement& a) {
+  double sw = 0, swk = 0, lo = INFINITY, hi = -INFINITY;
+  for (const auto& f : a.flights) {
+    lo = std::min(lo, f.value), hi = std::max(hi, f.value);
+    if (!(f.standard_error > 0)) continue;
+    const double w = 1 / (f.standard_error * f.standard_error);
+    sw += w, swk += w * f.value;
+  }
+  a.pooled = sw > 0 ? swk / sw : a.joint_value;
+  int counted = 0;
+  bool within = true;
+  for (const auto& f : a.flights) {
+    if (!(f.standard_error > 0)) {
+      within = false;  // a flight that cannot say: no agreement claimed
+      continue;
+    }
+    a.q += std::pow((f.value - a.pooled) / f.standard_error, 2);
+    ++counted;
+    within = within && a.pooled >= f.lower && a.pooled <= f.upper;
+  }
+  a.q_p_value = chi2_upper_tail(a.q, counted - 1.0);
+  a.spread = a.joint_value != 0 ? (hi - lo) / std::abs(a.joint_value) : INFINITY;
+  a.agree = within && a.spread < 0.3;
+}
+
+}  // namespace
+
+std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) {
+  std::vector<std::string> named;
+  for (const auto& e : in.effects) named.insert(named.end(), e.parameters.begin(), e.parameters.end());
+  std::vector<ParameterAgreement> out;
+  if (named.empty() || in.training_parts.size() < 2) return out;
+  std::vector<std::map<std::string, FlightEstimate>> per_flight;
+  for (size_t k = 1; k <= in.training_parts.size(); ++k) per_flight.push_back(fit_one_flight(in, static_cast<int>(k), named));
+  for (const auto& e : in.effects)
+    for (const auto& name : e.parameters) {
+      ParameterAgreement a;
+      a.parameter = name;
+      a.effect = e.name;
+      a.named = e.named;
+      for (const auto& p : in.joint_fit)
+        if (p.name == name) a.unit = p.unit;
+      a.joint_value = e.start[static_cast<size_t>(&name - e.parameters.data())];
+      for (const auto& f : per_flight) a.flights.push_back(f.at(name));
+      summarise(a);
+      out.push_back(a);
+    }
+  return out;
+}
+
+}  // namespace quadgen::diagnose

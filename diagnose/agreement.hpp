@@ -1,0 +1,62 @@
+// Do the flights agree? A joint diagnosis names an airframe effect once, from all flights
+// together; that says nothing yet about whether every flight shows the same value. Here each
+// named airframe parameter is refitted on each flight's training part alone: the other
+// airframe values held at the joint fit, the flight's own parameters (its thrust constant,
+// trims, marker frame) free with it. Beside each flight's estimate and its interval stand
+//  - whether the effect is significant on that flight alone (a likelihood-ratio test against
+//    the same fit with the effect off), and
+//  - the heterogeneity of the estimates: Cochran's Q = sum (k_i - k_pooled)^2 / se_i^2
+//    against chi2 with (flights - 1) degrees of freedom (inverse-variance pooling, as in a
+//    meta-analysis), and the spread (largest - smallest) / |joint value|.
+// A property of the airframe should give agreeing estimates; a value that changes from
+// flight to flight is the model's error absorbed, not a cause.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "dynamic_model.hpp"
+#include "flight_data.hpp"
+#include "least_squares.hpp"
+
+namespace quadgen::diagnose {
+
+struct FlightEstimate {
+  double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
+  double statistic = 0, p_value = 1;  // the effect on this flight alone: LR test against "off"
+};
+
+struct ParameterAgreement {
+  std::string parameter, effect, unit;
+  bool named = false;  // the effect is a finding (else a suspected candidate, checked the same way)
+  double joint_value = 0;
+  std::vector<FlightEstimate> flights;  // in the order the flights were given
+  double q = 0, q_p_value = 1;          // Cochran's heterogeneity statistic and its p-value
+  double pooled = 0;                    // inverse-variance weighted mean of the flights' values
+  double spread = 0;                    // (largest - smallest) / |joint value|
+  // Every flight's interval contains the pooled value or the heterogeneity test does not
+  // reject at 1 %; and the spread is below 30 %.
+  bool agree = false;
+};
+
+struct AgreementInputs {
+  runtime::DynamicModel* model = nullptr;   // the single-flight model (shared parameter names)
+  std::vector<fit::Flight> training_parts;  // each flight's training part, in order
+  bool use_accelerometer = false;
+  // The joint final fit, with per-flight copies named as runtime::PerFlightModel names them.
+  std::vector<fit::FitParameter> joint_fit;
+  std::vector<double> weights;  // per channel, the joint search's final weights
+  // Per airframe effect to check: its parameters (shared names), their values at "off" and
+  // where each flight's fit starts (the joint estimate; for a suspected candidate, which the
+  // joint fit no longer holds, its own).
+  struct Effect {
+    std::string name;
+    bool named = false;
+    std::vector<std::string> parameters;
+    std::vector<double> off, start;
+  };
+  std::vector<Effect> effects;
+};
+
+std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
+
+}  // namespace quadgen::diagnose
