@@ -277,6 +277,19 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
     }
     for (unsigned i = 0; i < 3; ++i) equation("\\left(" + name + "\\right)_" + "xyz"[i], tex(v(i, 0)));
   }
+  if (!m.effect_formulas.empty()) {
+    md << "### What each effect adds\n\nEach effect applied alone to the base model, in body axes ($R = I$; "
+          "$v_a$ is the air velocity, in body axes unless said), with the quantity it changes: a rotor's thrust is "
+          "$s\\,c_t \\rho A_p r_p^2\\,\\omega(\\omega - \\omega_{\\mathrm{loss}})$, $\\Delta c$ moves the centre of "
+          "gravity, $\\Delta F_{body}$ and $\\Delta\\tau$ add to the body force and the moment about the centre of "
+          "gravity.\n\n";
+    for (const auto& f : m.effect_formulas) {
+      md << "**" << output::markdown_text(f.effect) << "**" << (f.note.empty() ? "" : " (" + output::markdown_text(f.note) + ")")
+         << (f.lines.empty() ? "\n\n" : ":\n\n");
+      for (const auto& [lhs, value] : f.lines)
+        equation(lhs, is_a<matrix>(value) ? tex_matrix(ex_to<matrix>(value)) : tex(value));
+    }
+  }
   md << "Thrust acts along body $+z$ at each rotor; a counter-clockwise rotor (seen from above) pushes "
         "the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$. Drag acts at the centre "
         "of gravity on the air-relative velocity in body axes.\n\n";

@@ -325,6 +325,66 @@ void differentiate(SymbolicModel& m) {
   m.dhdp = plain_jac(h, m.params);
 }
 
+// An effect's own formula: the effect applied alone to a fresh base model, each intermediate
+// quantity it changes written as an equation. Shown in body axes: R is the identity and the
+// air velocity the symbols v_a (so a drag term reads -k (sum of w) v_a,x, not a page of
+// quaternion products). Per-rotor quantities are shown for the first rotor; the others are alike.
+SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperties& mp, const Effect& e) {
+  SymbolicModel scratch;
+  ModelContext c{v, scratch};
+  declare_base(c, mp);
+  c.R = matrix(3, 3, lst{1, 0, 0, 0, 1, 0, 0, 0, 1});
+  c.air_velocity_world = vec3(symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}"));
+  // Rotor speeds as symbols rather than the motor map, and a level vehicle (q = 1), so that
+  // an attitude bias shows as the rotation it applies.
+  for (size_t i = 0; i < v.rotors.size(); ++i) {
+    const std::string n = output::latex_text(v.rotors[i].name);
+    c.rotor_speed[i] = symbol("omega_" + v.rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
+    c.commanded_speed[i] = symbol("wcmd_" + v.rotors[i].name, "\\omega_{\\mathrm{cmd},\\mathrm{" + n + "}}");
+  }
+  c.measured_q = quaternion(1, 0, 0, 0);
+  const ModelContext before = c;
+  const size_t rates_before = c.extra_rates.size();
+  e.apply(c);
+  SymbolicModel::EffectFormula f{e.name, {}, ""};
+  const auto changed = [](const matrix& a, const matrix& b) { return !(a.sub(b)).is_zero_matrix(); };
+  const std::string r0 = v.rotors.empty() ? std::string() : output::latex_text(v.rotors[0].name);
+  // "\omega" -> "\omega_{\mathrm{M1}}", with a subscript already there ("loss") joined to it.
+  const auto rotor = [&](const std::string& base, const std::string& sub = "") {
+    return base + "_{" + (sub.empty() ? "" : sub + ",") + "\\mathrm{" + r0 + "}}";
+  };
+  if (!v.rotors.empty()) {
+    if (!(c.thrust_scale[0] - before.thrust_scale[0]).is_zero())
+      f.lines.push_back({"\\text{thrust factor } " + rotor("s"), c.thrust_scale[0]});
+    if (!(c.thrust_speed_loss[0] - before.thrust_speed_loss[0]).is_zero())
+      f.lines.push_back({"\\text{thrust speed loss } " + rotor("\\omega", "\\mathrm{loss}"), c.thrust_speed_loss[0]});
+    if (!(c.rotor_speed[0] - before.rotor_speed[0]).is_zero())
+      f.lines.push_back({"\\text{rotor speed } " + rotor("\\omega"), c.rotor_speed[0]});
+  }
+  if (c.extra_rates.size() > rates_before)
+    f.lines.push_back({"\\frac{d}{dt}" + tex_of(scratch.states[scratch.states.size() - (c.extra_rates.size() - rates_before)].name),
+                       c.extra_rates[rates_before]});
+  if (changed(c.cog, before.cog)) f.lines.push_back({"\\Delta c", c.cog.sub(before.cog)});
+  if (changed(c.air_velocity_world, before.air_velocity_world))
+    f.lines.push_back({"\\Delta v_{a}\\ \\text{(world axes)}", c.air_velocity_world.sub(before.air_velocity_world)});
+  if (changed(c.extra_body_force, before.extra_body_force))
+    f.lines.push_back({"\\Delta F_{body}", c.extra_body_force.sub(before.extra_body_force)});
+  if (changed(c.extra_body_torque, before.extra_body_torque))
+    f.lines.push_back({"\\Delta \\tau", c.extra_body_torque.sub(before.extra_body_torque)});
+  if (changed(c.measured_q, before.measured_q)) {
+    f.lines.push_back({"q_{\\mathrm{logged}}", c.measured_q});
+    f.note = "for a level vehicle, q = 1; in general q_logged = q * that quaternion";
+  }
+  if (scratch.input_delay_param)
+    f.note = "no term of f: the runtime feeds the commands delayed, u(t - " +
+             scratch.params[*scratch.input_delay_param].name + ")";
+  else if (v.rotors.size() > 1 && (!(c.thrust_scale[0] - before.thrust_scale[0]).is_zero() ||
+                                   !(c.rotor_speed[0] - before.rotor_speed[0]).is_zero() ||
+                                   !(c.thrust_speed_loss[0] - before.thrust_speed_loss[0]).is_zero()))
+    f.note = "shown for rotor " + v.rotors[0].name + "; every rotor alike";
+  return f;
+}
+
 SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const DeriveOptions& opt) {
   SymbolicModel m;
   m.vehicle_name = v.name;
@@ -338,6 +398,7 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
     if (!wanted.count(e.name)) continue;
     e.apply(c);
     m.effects.push_back(e.name);
+    m.effect_formulas.push_back(effect_formula(v, mp, e));
     wanted.erase(e.name);
   }
   if (!wanted.empty()) throw std::invalid_argument("unknown effect '" + *wanted.begin() + "'");

@@ -56,6 +56,15 @@ struct SymbolicModel {
   // Named intermediate expressions for the report (forces, torques, thrusts).
   std::vector<std::pair<std::string, GiNaC::ex>> intermediates;
 
+  // Each effect's own formula for the report: what it does to the model's intermediate
+  // quantities, derived by applying it alone to the base model (TeX left-hand side, value).
+  struct EffectFormula {
+    std::string effect;
+    std::vector<std::pair<std::string, GiNaC::ex>> lines;
+    std::string note;  // what the lines leave out (a delay is no ODE term; the other rotors)
+  };
+  std::vector<EffectFormula> effect_formulas;
+
   size_t state_index(const std::string& name) const;
   size_t param_index(const std::string& name) const;
   size_t input_index(const std::string& name) const;

@@ -87,12 +87,34 @@ def main(root):
                      ", ".join(groups) or "—", "<br>".join(proposed) or "—", pred,
                      f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
     print("| flight | named (95 % interval) | stand-ins (not named) | suspected (failed) | look-alike groups | "
-          "0.5 s open-loop error before → after [m] | s |")
+          "proposed terms (held-out RMS before → after) | 0.5 s open-loop error before → after [m] | s |")
     print("|---|---|---|---|---|---|---|---|")
     for r in rows:
         print("| " + " | ".join(r) + " |")
     print(f"\n{bad} rule violations in {len(rows)} diagnoses")
+    agreement_tables(root)
     return 1 if bad else 0
+
+
+def agreement_tables(root):
+    """Joint diagnoses: each airframe effect refitted on each flight alone (diagnosis.json
+    `agreement`), one row per flight, so agreement or disagreement shows at a glance."""
+    for d in sorted(pathlib.Path(root).iterdir()):
+        j_path = d / "diagnosis.json"
+        if not j_path.is_file():
+            continue
+        for a in json.loads(j_path.read_text()).get("agreement", []):
+            state = "agree" if a["agree"] else "disagree"
+            named = "named" if a["named"] else "suspected"
+            print(f"\n{d.name}: **{a['parameter']}** [{a['unit']}] ({named}) — flights {state}: joint "
+                  f"{fmt(a['joint_value'])}, pooled {fmt(a['pooled'])}, spread {fmt(100 * a['spread'] if a['spread'] is not None else None)} %, "
+                  f"Cochran's Q {fmt(a['cochran_q'])} (p = {fmt(a['q_p_value'], 2)})\n")
+            print("| flight | value | 95 % interval | alone: LR statistic | alone: p |")
+            print("|---|---|---|---|---|")
+            for f in a["flights"]:
+                lo, hi = f["ci95"]
+                print(f"| {pathlib.Path(f['flight']).stem} | {fmt(f['value'])} | [{fmt(lo)}, {fmt(hi)}] | "
+                      f"{fmt(f['alone']['statistic'])} | {fmt(f['alone']['p_value'], 2)} |")
 
 
 if __name__ == "__main__":

@@ -502,3 +502,61 @@ TEST(Model, AddedTermsChangeTheirChannelByExactlyTheTerm) {
   EXPECT_THROW(derive_model(v, derive_mass_properties(v), DeriveOptions{{}, {{"yaw", {{"1", 1.0}}, {}}}}),
                std::invalid_argument);
 }
+
+namespace {
+// e with every symbol replaced by the value of its name in `values` (an unknown name: 0.5).
+double evaluate_by_name(const ex& e, const std::map<std::string, double>& values) {
+  exmap subs;
+  for (const_preorder_iterator it = e.preorder_begin(); it != e.preorder_end(); ++it)
+    if (is_a<symbol>(*it)) {
+      const auto v = values.find(ex_to<symbol>(*it).get_name());
+      subs[*it] = v == values.end() ? 0.5 : v->second;
+    }
+  return ex_to<numeric>(evalf(e.subs(subs))).to_double();
+}
+
+const SymbolicModel::EffectFormula& formula_of(const SymbolicModel& m, const std::string& effect) {
+  for (const auto& f : m.effect_formulas)
+    if (f.effect == effect) return f;
+  throw std::runtime_error("no formula for " + effect);
+}
+}  // namespace
+
+// Each effect's own formula in the derivation report (what it adds, applied alone in body
+// axes) against the physics written out here: rotor drag -k (sum of w) v_a,xy, the flapping
+// moment k (sum of w) (v_a,y, -v_a,x), the gain factor 1 + g, the lag's rate (w_cmd - w) / tau.
+TEST(Report, EachEffectHasItsOwnFormula) {
+  const Vehicle v = test::finken3();
+  const SymbolicModel m = derive(v, parse_effect_list("all"));
+  ASSERT_EQ(m.effect_formulas.size(), effect_catalogue().size());
+  for (const auto& f : m.effect_formulas)
+    if (f.effect != "input_delay") EXPECT_FALSE(f.lines.empty()) << f.effect;
+  EXPECT_NE(formula_of(m, "input_delay").note.find("delayed"), std::string::npos);
+  const std::map<std::string, double> at = {{"rotor_drag.k", 3.0}, {"blade_flapping.k", 5.0}, {"omega_A", 1.0}, {"omega_B", 2.0},
+                                            {"omega_C", 4.0}, {"omega_D", 8.0}, {"w_A", 1.5}, {"v_ax", 0.25}, {"v_ay", -0.75},
+                                            {"motor_gain.A", 0.1}, {"motor_lag.tau", 0.05}, {"wcmd_A", 7.0}};
+  const double sum_w = 15.0;
+  {
+    const auto& line = formula_of(m, "rotor_drag").lines.at(0);
+    const matrix& F = ex_to<matrix>(line.second);
+    EXPECT_DOUBLE_EQ(evaluate_by_name(F(0, 0), at), -3.0 * sum_w * 0.25);
+    EXPECT_DOUBLE_EQ(evaluate_by_name(F(1, 0), at), -3.0 * sum_w * -0.75);
+    EXPECT_DOUBLE_EQ(evaluate_by_name(F(2, 0), at), 0.0);
+  }
+  {
+    const matrix& T = ex_to<matrix>(formula_of(m, "blade_flapping").lines.at(0).second);
+    EXPECT_DOUBLE_EQ(evaluate_by_name(T(0, 0), at), 5.0 * sum_w * -0.75);
+    EXPECT_DOUBLE_EQ(evaluate_by_name(T(1, 0), at), -5.0 * sum_w * 0.25);
+  }
+  EXPECT_DOUBLE_EQ(evaluate_by_name(formula_of(m, "motor_gain").lines.at(0).second, at), 1.1);
+  const auto& lag = formula_of(m, "motor_lag").lines;
+  ASSERT_EQ(lag.size(), 2u);
+  EXPECT_DOUBLE_EQ(evaluate_by_name(lag[1].second, at), (7.0 - 1.5) / 0.05);  // w_A: the rotor speed state
+  // and the report prints them, one block per effect
+  const MassProperties mp = derive_mass_properties(v);
+  const AuditResult checks = audit(m, mp);
+  const std::vector<ThesisItem> no_thesis;
+  const std::string md = derivation_markdown({v, mp, m, checks, no_thesis});
+  EXPECT_NE(md.find("### What each effect adds"), std::string::npos);
+  EXPECT_NE(md.find("**blade\\_flapping**"), std::string::npos);
+}
