@@ -7,6 +7,7 @@
 #include <iostream>
 #include <limits>
 #include <mutex>
+#include <chrono>
 #include <thread>
 
 #include <unistd.h>
@@ -358,10 +359,13 @@ SearchResult CandidateSearch::run() {
     std::vector<std::string> todo;
     for (const auto& e : candidates_)
       if (!base.count(e)) todo.push_back(e);
+    const auto step_start = std::chrono::steady_clock::now();
     step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
-                << " candidates fitted                              \n";
+                << " candidates fitted ("
+                << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count())
+                << " s)                              \n";
     for (const auto& ev : step.candidates) note_training_only(res, ev);
     std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) {
       if (a.significant != b.significant) return a.significant;
@@ -396,7 +400,7 @@ SearchResult CandidateSearch::run() {
                           res.training_only.end());
   res.final_fit = current;
   res.final_weights = weights_;
-  estimate_intervals(res);
+  estimate_intervals(res, !opt_.wald_until_accepted);
   return res;
 }
 
@@ -466,7 +470,7 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
   }
   r.estimates.clear();
   r.profiles.clear();
-  estimate_intervals(r);
+  estimate_intervals(r, !opt_.wald_until_accepted);
 }
 
 NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
@@ -526,7 +530,11 @@ StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const s
 
 // Intervals for the selected effects' parameters: profile likelihood with the final
 // model's noise and correlation time in the weights, so the chi2 thresholds hold.
-void CandidateSearch::estimate_intervals(SearchResult& r) const {
+void CandidateSearch::profile_intervals(SearchResult& r) const { estimate_intervals(r, true); }
+
+void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) const {
+  r.estimates.clear();
+  r.profiles.clear();
   if (r.selected.empty()) return;
   fit::FitResult best;
   best.parameters = r.final_fit;
@@ -545,7 +553,7 @@ void CandidateSearch::estimate_intervals(SearchResult& r) const {
       if (!r.final_fit[i].free) continue;
       const std::string shared = runtime::shared_name(r.final_fit[i].name);
       const bool per_flight = model_.param_index(runtime::per_flight_name(shared, 2)) >= 0;
-      (per_flight ? wald : profiled).push_back(i);
+      (per_flight || !with_profiles ? wald : profiled).push_back(i);
     }
   fit::FitOptions fo;
   fo.max_iterations = 50;

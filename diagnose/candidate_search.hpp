@@ -47,6 +47,11 @@ struct SearchOptions {
   // physically negligible, however significant statistically.
   double negligible_fraction = 2e-4;
   double rotation_scale = 0;  // rad/s^2, m g arm / J; 0: translation alone decides
+  // Intervals of the selected effects as Wald intervals (+-1.96 standard errors) until the
+  // caller has decided what to name, then profiles for those alone (profile_intervals): a
+  // profile costs tens of seconds a parameter in a joint diagnosis, and candidates that the
+  // acceptance tests turn down no longer pay for one.
+  bool wald_until_accepted = false;
 };
 
 struct EffectEstimate {
@@ -171,6 +176,9 @@ class CandidateSearch {
   // Takes `effects` out of the result's final model (refit, new intervals): for candidates
   // that a later test (held-out prediction, interval) does not stand behind.
   void remove_effects(SearchResult& r, const std::vector<std::string>& effects) const;
+  // Profile-likelihood intervals for the effects in r's final model (with
+  // wald_until_accepted, once what to name is decided).
+  void profile_intervals(SearchResult& r) const;
 
   // Fits the model with these effects active (others neutral) from `start`.
   std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
@@ -216,7 +224,8 @@ class CandidateSearch {
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,
                    const Workspace& ws) const;
   double p_value_of(const std::string& effect, double statistic, int dof) const;
-  void estimate_intervals(SearchResult& r) const;
+  // with_profiles: profile likelihood for the airframe's parameters; else Wald for all.
+  void estimate_intervals(SearchResult& r, bool with_profiles) const;
 };
 
 }  // namespace quadgen::diagnose

@@ -322,6 +322,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       all_ee(model, flight, accel);
   SearchOptions so = opt.search;
   so.rotation_scale = rotation_scale(v, all);
+  so.wald_until_accepted = true;
   CandidateSearch search(all, model, train_ee, valid_ee, so);
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
   d.search = search.run();
@@ -343,14 +344,20 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (sim) *sim = w;
     return w.position_rmse;
   };
+  // The estimates of an effect's parameters in the search's current final model.
+  auto parameters_of = [&](const std::string& e) {
+    std::vector<EffectEstimate> out;
+    for (const auto& est : d.search.estimates)
+      if (est.name.rfind(e + ".", 0) == 0) out.push_back(est);
+    return out;
+  };
   // Each named effect against the final model without it: what it buys on held-out data.
   auto finding_for = [&](const std::string& e) {
     Finding f;
     f.effect = e;
     for (const auto& step : d.search.steps)
       if (step.selected == e) f.evidence = step.candidates.front();
-    for (const auto& est : d.search.estimates)
-      if (est.name.rfind(e + ".", 0) == 0) f.parameters.push_back(est);
+    f.parameters = parameters_of(e);
     std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
     others.erase(e);
     double c = 0;
@@ -366,21 +373,34 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   std::cerr << "[diagnose] acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
   // Until nothing more fails: taking a suspected cause out refits the model (the extended
   // model keeps only what is named, and carried look-alikes), which changes the others'
-  // gains and intervals, so they are tested again against what the report will show.
+  // gains and intervals, so they are tested again against what the report will show. The
+  // search gives Wald intervals; once nothing fails with them, the survivors get profiles and
+  // are tested once more (a profile may be open where the Wald interval is not).
+  bool profiled = !so.wald_until_accepted;
+  std::map<std::string, Finding> held_out;  // per effect, in the current final model
   for (;;) {
     std::vector<Finding> accepted;
     std::vector<std::string> drop;
     for (const auto& e : d.search.named()) {
-      Finding f = finding_for(e);
+      if (!held_out.count(e)) held_out[e] = finding_for(e);
+      Finding f = held_out.at(e);
+      f.parameters = parameters_of(e);
       const std::string failed = acceptance_failure(f, all);
       if (failed.empty()) accepted.push_back(f);
       else d.suspected.push_back({f, failed}), drop.push_back(e);
+    }
+    if (drop.empty() && !profiled) {
+      search.profile_intervals(d.search);
+      profiled = true;
+      continue;
     }
     if (drop.empty()) {
       d.findings = accepted;
       break;
     }
     search.remove_effects(d.search, drop);
+    held_out.clear();
+    profiled = !so.wald_until_accepted;
   }
   // Accepted, but beyond what the effect's physics can produce here: a stand-in for missing
   // physics. It stays in the model (carried, like the stronger of a look-alike pair) and is
@@ -430,7 +450,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     // Candidates the acceptance tests turned down, while they still hold their estimates: a
     // value that differs between the flights is often why the joint fit gains nothing.
     for (const auto& x : d.suspected) check(x.candidate, false);
+    const auto agreement_start = std::chrono::steady_clock::now();
     d.agreement = per_flight_agreement(in);
+    std::cerr << "[diagnose] agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
+              << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - agreement_start).count())
+              << " s)\n";
   }
   // Significant on the training data but no held-out gain in the search itself: suspected.
   for (const auto& ev : d.search.training_only)
