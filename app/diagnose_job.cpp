@@ -1,8 +1,13 @@
 #include "diagnose_job.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+
+#include <nlohmann/json.hpp>
 
 #include "diagnosis_report.hpp"
 #include "dynamics.hpp"
@@ -10,6 +15,7 @@
 #include "extended_model.hpp"
 #include "geometry.hpp"
 #include "json_document.hpp"
+#include "sinks.hpp"
 #include "log_reader.hpp"
 #include "model_registry.hpp"
 #include "vehicle.hpp"
@@ -24,6 +30,8 @@ bool DiagnoseJob::IsValid(std::string* error) const {
   if (vehicle.empty()) return fail("no vehicle file");
   if (logs.empty()) return fail("no flight log");
   if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
+  if (!airframe.empty() && logs.size() != 1)
+    return fail("airframe: checks one flight against an airframe; several logs are diagnosed jointly instead");
   if (!environment.empty() && environment != "indoor" && environment != "outdoor" && environment != "unknown")
     return fail("environment: indoor, outdoor or unknown");
   return options.IsValid(error);
@@ -38,6 +46,72 @@ std::vector<fit::Flight> load_flights(const DiagnoseJob& job, const Vehicle& v, 
   for (const auto& path : job.logs)
     flights.push_back(fit::load_flight(fit::read_log(path, job.mapping.empty() ? nullptr : &mapping, job.resample), rotors, {}));
   return flights;
+}
+
+std::runtime_error airframe_error(const std::string& path, const std::string& what) {
+  return std::runtime_error(output::printable(path) + ": " + what);
+}
+
+// The airframe an earlier diagnosis found, from its diagnosis.json: its fitted values
+// (airframe_fit; parameters it did not fit at the model's nominal or "off" values), the
+// parameters each flight has its own value of, and its named airframe effects with their
+// values and standard errors. Every name must be a parameter of `all` (the same vehicle).
+diagnose::AirframeReference load_airframe(const std::string& path, const SymbolicModel& all) {
+  std::ifstream in(path);
+  if (!in) throw airframe_error(path, "cannot read the airframe's diagnosis");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    throw airframe_error(path, std::string("not JSON: ") + e.what());
+  }
+  if (!j.is_object() || !j.contains("airframe_fit") || !j.contains("findings") || !j.contains("flight_parameters"))
+    throw airframe_error(path, "not a diagnosis.json of quadgen (expected airframe_fit, findings, flight_parameters)");
+  const auto known = [&](const std::string& name) {
+    for (const auto& p : all.params)
+      if (p.name == name) return;
+    throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model");
+  };
+  const auto number = [&](const nlohmann::json& v, const std::string& what) {
+    if (!v.is_number()) throw airframe_error(path, what + ": expected a number");
+    return v.get<double>();
+  };
+  diagnose::AirframeReference ref;
+  ref.source = path;
+  for (const auto& p : all.params)
+    ref.values.push_back({p.name, p.unit, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, p.lower,
+                          p.upper, false});
+  for (const auto& [name, e] : j["airframe_fit"].items()) {
+    known(name);
+    for (auto& p : ref.values)
+      if (p.name == name) p.value = std::clamp(number(e.value("value", nlohmann::json()), name), p.lower, p.upper);
+  }
+  for (const auto& n : j["flight_parameters"]) {
+    if (!n.is_string()) throw airframe_error(path, "flight_parameters: expected names");
+    known(n.get<std::string>());
+    ref.flight_parameters.push_back(n.get<std::string>());
+  }
+  for (const auto& f : j["findings"]) {
+    const std::string effect = f.value("effect", "");
+    if (effect.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
+    if (find_effect(effect).per_flight) continue;  // a flight's state, freed above
+    diagnose::AirframeReference::Effect e{effect, {}, {}, {}, {}};
+    for (const auto& [name, p] : f["parameters"].items()) {
+      if (p.value("reference", false)) continue;
+      known(name);
+      const double v = number(p.value("value", nlohmann::json()), name);
+      double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
+      if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
+          p["ci95"][1].is_number())
+        se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * 1.959963984540054);
+      e.parameters.push_back(name);
+      e.value.push_back(v);
+      e.standard_error.push_back(se > 0 ? se : 0.0);
+      e.off.push_back(diagnose::neutral_value(all.params[all.param_index(name)]));
+    }
+    if (!e.parameters.empty()) ref.effects.push_back(e);
+  }
+  return ref;
 }
 
 }  // namespace
@@ -62,6 +136,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
   const SymbolicModel all = derive_model(v, mp, all_opt);
+  if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
   bool compiled = false;
   const auto model = make_model(all, &compiled);
   std::cerr << "[diagnose] model: " << (compiled ? "compiled header from generated/" : "interpreted tape") << "\n";

@@ -18,6 +18,9 @@ struct DiagnoseJob {
   double resample = 0;            // Hz; 0: the samples as logged
   std::string environment;        // indoor, outdoor or unknown; "": the mapping's, else unknown
   std::string candidates;         // comma-separated effects; "": all that the logs support
+  // diagnosis.json of an earlier (joint) diagnosis of this vehicle: one flight is also checked
+  // against the airframe it found (diagnose::check_against_airframe); "": no check.
+  std::string airframe;
   diagnose::DiagnoseOptions options;
 
   // Ceres-style: false with a reason for a value no diagnosis can use.

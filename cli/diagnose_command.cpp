@@ -42,6 +42,9 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
       ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
+  c->add_option("--airframe", j.airframe,
+                "diagnosis.json of a joint diagnosis of this vehicle: also refit its named effects on this one flight "
+                "and say whether the flight agrees with it");
 }
 
 int run_diagnose(const DiagnoseArgs& a) {
@@ -52,6 +55,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   std::vector<std::string> inputs = j.logs;
   inputs.push_back(j.vehicle);
   inputs.push_back(j.mapping);
+  inputs.push_back(j.airframe);
   output::OutputDirectory out(a.out, inputs);
   const app::DiagnoseJobResult r = app::run_diagnose_job(j);
   for (const auto& [name, contents] : r.files) out.add(name, contents);

@@ -33,7 +33,7 @@ std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, co
   for (const auto& p : in.joint_fit) joint[p.name] = &p;
   std::vector<fit::FitParameter> ps;
   for (const auto& n : in.model->param_names()) {
-    const bool per_flight = joint.count(runtime::per_flight_name(n, 2)) > 0;
+    const bool per_flight = std::find(in.per_flight.begin(), in.per_flight.end(), n) != in.per_flight.end();
     const auto it = joint.find(per_flight ? runtime::per_flight_name(n, k) : n);
     if (it == joint.end()) throw fit::FitError("agreement: no joint value for " + n);
     fit::FitParameter p = *it->second;
@@ -128,6 +128,49 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) 
       a.joint_value = e.start[static_cast<size_t>(&name - e.parameters.data())];
       for (const auto& f : per_flight) a.flights.push_back(f.at(name));
       summarise(a);
+      out.push_back(a);
+    }
+  return out;
+}
+
+std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& model, const fit::Flight& training_part,
+                                                       bool use_accelerometer, const std::vector<double>& weights,
+                                                       const AirframeReference& airframe) {
+  AgreementInputs in;
+  in.model = &model;
+  in.training_parts = {training_part};
+  in.use_accelerometer = use_accelerometer;
+  in.joint_fit = airframe.values;
+  for (auto& p : in.joint_fit) p.free = false;
+  for (const auto& n : airframe.flight_parameters)
+    for (auto& p : in.joint_fit)
+      if (p.name == n) p.free = true;
+  in.per_flight = airframe.flight_parameters;
+  in.weights = weights;
+  std::vector<std::string> named;
+  for (const auto& e : airframe.effects) {
+    in.effects.push_back({e.name, true, e.parameters, e.off, e.value});
+    named.insert(named.end(), e.parameters.begin(), e.parameters.end());
+  }
+  std::vector<ParameterAgreement> out;
+  if (named.empty()) return out;
+  const auto here = fit_one_flight(in, 1, named);
+  for (const auto& e : airframe.effects)
+    for (size_t j = 0; j < e.parameters.size(); ++j) {
+      ParameterAgreement a;
+      a.parameter = e.parameters[j];
+      a.effect = e.name;
+      a.named = true;
+      for (const auto& p : airframe.values)
+        if (p.name == a.parameter) a.unit = p.unit;
+      a.joint_value = a.pooled = e.value[j];
+      const FlightEstimate& f = here.at(a.parameter);
+      a.flights = {f};
+      const double se = std::hypot(f.standard_error, e.standard_error[j]);
+      a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
+      a.q_p_value = chi2_upper_tail(a.q, 1.0);
+      a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
+      a.agree = a.q < kZ95 * kZ95 && a.spread < 0.3;
       out.push_back(a);
     }
   return out;

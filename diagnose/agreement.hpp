@@ -44,6 +44,9 @@ struct AgreementInputs {
   bool use_accelerometer = false;
   // The joint final fit, with per-flight copies named as runtime::PerFlightModel names them.
   std::vector<fit::FitParameter> joint_fit;
+  // The parameters each flight has its own value of (shared names: c_t, the trims); freed on
+  // each flight where the joint fit freed them.
+  std::vector<std::string> per_flight;
   std::vector<double> weights;  // per channel, the joint search's final weights
   // Per airframe effect to check: its parameters (shared names), their values at "off" and
   // where each flight's fit starts (the joint estimate; for a suspected candidate, which the
@@ -58,5 +61,27 @@ struct AgreementInputs {
 };
 
 std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
+
+// The airframe a joint diagnosis found, as a flight it was not fitted to is checked against
+// it (quadgen diagnose LOG --airframe DIAGNOSIS.json).
+struct AirframeReference {
+  std::string source;                       // the diagnosis.json it came from
+  std::vector<fit::FitParameter> values;    // its airframe_fit: the model's parameters
+  std::vector<std::string> flight_parameters;  // its own on every flight (c_t, the trims): freed here
+  struct Effect {
+    std::string name;
+    std::vector<std::string> parameters;
+    std::vector<double> value, standard_error, off;
+  };
+  std::vector<Effect> effects;  // the airframe's named effects (not the per-flight ones)
+};
+
+// The airframe's named effects refitted on this flight's training part (the airframe's other
+// values held, this flight's own parameters free), each against the airframe's value: the
+// flight agrees when |z| = |k - k_airframe| / sqrt(se^2 + se_airframe^2) < 1.96 and the two
+// differ by less than 30 %. One entry per parameter, its `flights` this one flight.
+std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& model, const fit::Flight& training_part,
+                                                       bool use_accelerometer, const std::vector<double>& weights,
+                                                       const AirframeReference& airframe);
 
 }  // namespace quadgen::diagnose

@@ -263,6 +263,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {
   const auto clock0 = std::chrono::steady_clock::now();
+  // "[diagnose] 212 s: " - where a long diagnosis spends its time.
+  const auto progress = [&]() {
+    std::ostringstream os;
+    os << "[diagnose] " << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count())
+       << " s: ";
+    return os.str();
+  };
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
@@ -370,7 +377,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
     return f;
   };
-  std::cerr << "[diagnose] acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
+  std::cerr << progress() << "acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
   // Until nothing more fails: taking a suspected cause out refits the model (the extended
   // model keeps only what is named, and carried look-alikes), which changes the others'
   // gains and intervals, so they are tested again against what the report will show. The
@@ -426,12 +433,12 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   }
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {
-    std::cerr << "[diagnose] agreement: each named airframe effect refitted on each flight alone\n";
     AgreementInputs in;
     in.model = &model_in;
     for (const auto& f : flights) in.training_parts.push_back(fit::split_by_time(f, 1.0 - opt.validation_fraction).first);
     in.use_accelerometer = accel;
     in.joint_fit = d.search.final_fit;
+    in.per_flight = per_flight_names;
     in.weights = d.search.final_weights;
     const auto check = [&](const Finding& f, bool named) {
       if (find_effect(f.effect).per_flight) return;
@@ -452,8 +459,18 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     for (const auto& x : d.suspected) check(x.candidate, false);
     const auto agreement_start = std::chrono::steady_clock::now();
     d.agreement = per_flight_agreement(in);
-    std::cerr << "[diagnose] agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
+    std::cerr << progress() << "agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
               << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - agreement_start).count())
+              << " s)\n";
+  }
+  // One flight of an airframe diagnosed before: does it show the airframe's effects?
+  if (!joint && opt.airframe) {
+    const auto start = std::chrono::steady_clock::now();
+    d.airframe_source = opt.airframe->source;
+    d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
+    std::cerr << progress() << "against the airframe of " << opt.airframe->source << ": " << d.airframe_check.size()
+              << " parameters ("
+              << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
               << " s)\n";
   }
   // Significant on the training data but no held-out gain in the search itself: suspected.
@@ -484,11 +501,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
   d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
   // The gain on the validation part.
-  std::cerr << "[diagnose] validation of the base and the extended model\n";
+  std::cerr << progress() << "validation of the base and the extended model\n";
   d.metric_before = metric(s.base_fit, &d.sim_before);
   d.metric_after = metric(s.final_fit, &d.sim_after);
   // Without a pose only the one-step view can be measured.
-  std::cerr << "[diagnose] prediction error at horizons, before and after\n";
+  std::cerr << progress() << "prediction error at horizons, before and after\n";
   d.has_prediction = true;
   d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
   d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
@@ -504,12 +521,12 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     d.unexplained.push_back(u);
   }
-  std::cerr << "[diagnose] beyond the catalogue: sparse regression on what the final model leaves\n";
+  std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
   d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
                                 residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,
                                 joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
   if (!proposed_terms(d.discovered).empty()) {
-    std::cerr << "[diagnose] the proposed terms regenerated into the model and simulated on the held-out part\n";
+    std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
                               pose ? folds : std::vector<fit::Flight>{}, opt.window);
   }

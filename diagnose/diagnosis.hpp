@@ -2,6 +2,7 @@
 // extend the model, measure the gain): flight in, Diagnosis out. Writing files and the
 // report is diagnosis_report's job; the command line is cli/diagnose_command.cpp.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct DiagnoseOptions {
   // Unexplained discrepancy: slow residual structure beyond this many times what the noise
   // gives, at this significance, after the selected effects.
   double unexplained_ratio = 3.0, unexplained_p = 1e-6;
+  // One flight checked against an airframe diagnosed before (its named effects refitted on
+  // this flight, compared with the airframe's values); none: no check.
+  std::optional<AirframeReference> airframe;
 
   // Ceres-style: false with a reason for a value no diagnosis can use.
   bool IsValid(std::string* error) const;
@@ -100,6 +104,9 @@ struct Diagnosis {
   // Jointly diagnosed flights: each named airframe parameter refitted on each flight alone,
   // and whether the flights agree (agreement.hpp).
   std::vector<ParameterAgreement> agreement;
+  // One flight diagnosed with an airframe: its named effects on this flight against it.
+  std::string airframe_source;
+  std::vector<ParameterAgreement> airframe_check;
   std::vector<Unexplained> unexplained;
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).

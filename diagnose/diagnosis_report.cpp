@@ -182,18 +182,18 @@ json finding_json(const Finding& f) {
   return fj;
 }
 
-// Jointly diagnosed flights: each named airframe parameter per flight, and whether they agree.
-json agreement_json(const Diagnosis& d) {
+// Each airframe parameter per flight (flight names: `flights`), and whether they agree.
+json agreement_json(const std::vector<ParameterAgreement>& list, const std::vector<std::string>& flights) {
   json out = json::array();
-  for (const auto& a : d.agreement) {
-    json flights = json::array();
+  for (const auto& a : list) {
+    json per_flight = json::array();
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
-      flights.push_back({{"flight", k < d.flights.size() ? d.flights[k] : std::string()},
-                         {"value", number_or_null(f.value)},
-                         {"ci95", {number_or_null(f.lower), number_or_null(f.upper)}},
-                         {"standard_error", number_or_null(f.standard_error)},
-                         {"alone", {{"statistic", f.statistic}, {"p_value", f.p_value}}}});
+      per_flight.push_back({{"flight", k < flights.size() ? flights[k] : std::string()},
+                            {"value", number_or_null(f.value)},
+                            {"ci95", {number_or_null(f.lower), number_or_null(f.upper)}},
+                            {"standard_error", number_or_null(f.standard_error)},
+                            {"alone", {{"statistic", f.statistic}, {"p_value", f.p_value}}}});
     }
     out.push_back({{"parameter", a.parameter},
                    {"effect", a.effect},
@@ -202,10 +202,10 @@ json agreement_json(const Diagnosis& d) {
                    {"joint_value", a.joint_value},
                    {"pooled", a.pooled},
                    {"spread", number_or_null(a.spread)},
-                   {"cochran_q", a.q},
+                   {"cochran_q", number_or_null(a.q)},
                    {"q_p_value", a.q_p_value},
                    {"agree", a.agree},
-                   {"flights", flights}});
+                   {"flights", per_flight}});
   }
   return out;
 }
@@ -295,7 +295,13 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                    {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
                    {"separating_manoeuvre", a.manoeuvre}});
   j["ambiguous"] = amb;
-  j["agreement"] = agreement_json(d);
+  j["agreement"] = agreement_json(d.agreement, d.flights);
+  // One flight against an airframe diagnosed before: joint_value is the airframe's, cochran_q
+  // the squared z of the difference.
+  j["airframe_check"] = d.airframe_source.empty()
+                            ? json(nullptr)
+                            : json({{"airframe", d.airframe_source},
+                                    {"parameters", agreement_json(d.airframe_check, d.flights)}});
   j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
   json un = json::array();
   for (const auto& u : d.unexplained)
@@ -535,6 +541,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
          << num(a.flights[k].upper, 3) << "]";
     os << "\n";
   }
+  for (const auto& a : d.airframe_check)
+    os << "this flight " << (a.agree ? "agrees" : "disagrees") << " with the airframe on " << a.parameter << ": "
+       << num(a.flights.front().value, 3) << " [" << num(a.flights.front().lower, 3) << ", " << num(a.flights.front().upper, 3)
+       << "] against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
+       << ")\n";
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
        << "); to separate them: " << a.manoeuvre << "\n";
@@ -629,15 +640,9 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
 // Each named airframe parameter per flight as a forest plot in the table: the flight's 95 %
 // interval as a bar, its value as a dot, the joint value as a vertical line; agreeing
 // flights' bars all cross the line.
-void agreement_html(std::ostringstream& h, const Diagnosis& d) {
-  if (d.agreement.empty()) return;
-  h << "<h2>Do the flights agree?</h2>\n<p>Each named airframe effect refitted on each flight's training part alone "
-       "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
-       "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
-       "joint estimate). \"Alone\": the effect's "
-       "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
-       "value and the spread (largest &minus; smallest over the joint value) is below 30 %.</p>\n";
-  for (const auto& a : d.agreement) {
+void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgreement>& list,
+                          const std::vector<std::string>& flights, const std::string& reference_name) {
+  for (const auto& a : list) {
     double lo = a.joint_value, hi = a.joint_value;
     for (const auto& f : a.flights)
       for (double v : {f.value, f.lower, f.upper})
@@ -646,13 +651,14 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
-      << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>Joint " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
+      << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>"
+      << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
       << num(100 * a.spread, 3) << " %, Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
          "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
-      h << "<tr><td>" << k + 1 << ". " << esc(k < d.flights.size() ? d.flights[k] : std::string()) << "</td><td>"
+      h << "<tr><td>" << k + 1 << ". " << esc(k < flights.size() ? flights[k] : std::string()) << "</td><td>"
         << num(f.value, 3) << "</td><td>[" << num(f.lower, 3) << ", " << num(f.upper, 3) << "]</td><td>"
         << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
         << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
@@ -665,6 +671,25 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
     h << "</table>\n";
   }
 }
+
+void agreement_html(std::ostringstream& h, const Diagnosis& d) {
+  if (!d.airframe_check.empty()) {
+    h << "<h2>Against the airframe</h2>\n<p>The named effects of the airframe in " << esc(d.airframe_source)
+      << " refitted on this flight's training part (the airframe's other values held, this flight's own thrust "
+         "constant and trims free). The flight agrees with the airframe when the difference is within 1.96 of its "
+         "standard error (both estimates' errors) and below 30 %. Line: the airframe's value.</p>\n";
+    agreement_table_html(h, d.airframe_check, d.flights, "airframe");
+  }
+  if (d.agreement.empty()) return;
+  h << "<h2>Do the flights agree?</h2>\n<p>Each named airframe effect refitted on each flight's training part alone "
+       "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
+       "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
+       "joint estimate). \"Alone\": the effect's "
+       "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
+       "value and the spread (largest &minus; smallest over the joint value) is below 30 %.</p>\n";
+  agreement_table_html(h, d.agreement, d.flights, "joint");
+}
+
 
 }  // namespace
 

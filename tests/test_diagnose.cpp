@@ -325,6 +325,18 @@ TEST(DiagnoseInput, BadInputAndInterruptedWrite) {
   one_line_error(veh + " " + (dir / "short.csv").string() + " --out " + out);
   one_line_error(veh + " " + flight + " --out " + out + " --candidates motor_gain,nonsense");
   one_line_error(veh + " " + flight + " --out /proc/quadgen_cannot_write_here");
+  // --airframe: a missing file, not JSON, JSON that is no diagnosis, a parameter the
+  // vehicle's model lacks (with a hostile name), and several logs at once.
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const std::string bad_names = write("names.json", R"({"airframe_fit": {"x\u001b[31m</td>": {"value": 1}},
+                                                         "findings": [], "flight_parameters": []})");
+  for (const std::string& airframe : {(dir / "none.json").string(), write("text.json", "not json"),
+                                      write("other.json", R"({"findings": []})"), bad_names})
+    one_line_error(veh + " " + flight + " --airframe " + airframe + " --out " + out);
+  one_line_error(veh + " " + flight + " " + flight + " --airframe " + bad_names + " --out " + out);
   EXPECT_FALSE(fs::exists(out));
   // A complete run, then one killed between writing and renaming.
   ASSERT_EQ(run(bin + " diagnose " + veh + " " + flight + " --out " + out + " > /dev/null 2>&1"), "");
@@ -575,6 +587,35 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
     EXPECT_LT(f["alone"]["p_value"].get<double>(), 1e-3) << f.dump();
   }
   EXPECT_LT((*a)["spread"].get<double>(), 0.3);
+
+  // Flights no fit saw, checked against that airframe (diagnose LOG --airframe): one with the
+  // same rotor drag and a trim of its own agrees, one with 2.5 times the drag does not.
+  const fs::path dir = fs::temp_directory_path() / "quadgen_agree";
+  const fs::path airframe = dir / "out" / "diagnosis.json";
+  const auto check = [&](const std::string& name, double k, unsigned seed) {
+    const HiddenCase c{name, "rotor_drag,motor_gain", {{"rotor_drag.k", k}, {"motor_gain.D", -0.06}}, {}, "", seed};
+    const fs::path sub = fresh_directory("quadgen_agree_" + name);
+    const fs::path log = fly(c, sub, "flight.csv", 40);
+    EXPECT_EQ(run(std::string(QUADGEN_BINARY) + " diagnose " + vehicle_file(c) + " " + log.string() + " --airframe " +
+                  airframe.string() + " --out " + (sub / "out").string() + " > " + (sub / "diagnose.log").string() + " 2>&1"),
+              "");
+    std::ifstream in(sub / "out" / "diagnosis.json");
+    json j;
+    if (in.good()) in >> j;
+    return j;
+  };
+  const json same = check("same", truth, 3), other = check("other", 2.5 * truth, 4);
+  for (const json* j : {&same, &other}) {
+    ASSERT_TRUE(j->contains("airframe_check") && (*j)["airframe_check"].is_object()) << j->dump(1).substr(0, 2000);
+    ASSERT_EQ((*j)["airframe_check"]["parameters"].size(), 1u) << (*j)["airframe_check"].dump(1);
+  }
+  const json& s = same["airframe_check"]["parameters"][0];
+  const json& o = other["airframe_check"]["parameters"][0];
+  EXPECT_EQ(s["parameter"], "rotor_drag.k");
+  EXPECT_TRUE(s["agree"].get<bool>()) << s.dump(1);
+  EXPECT_FALSE(o["agree"].get<bool>()) << o.dump(1);
+  EXPECT_NEAR(o["flights"][0]["value"].get<double>(), 2.5 * truth, 0.2 * truth) << o.dump(1);
+  EXPECT_LT(o["q_p_value"].get<double>(), 1e-3) << o.dump(1);
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
