@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 
+#include "dimension_checker.hpp"
 #include "kinematics.hpp"
 
 namespace quadgen {

@@ -33,7 +33,7 @@ runtime::CsvTable read_measurement_csv(const std::string& path) {
 //
 // canonical value = (source * scale + offset) converted from `unit` to the canonical
 // column's SI unit: `unit` is the unit of (source * scale + offset), parsed by the same
-// unit module as the vehicle files (derive/units.hpp, parse_unit), and its dimension must
+// unit module as the vehicle files (model/units.hpp, parse_unit), and its dimension must
 // be the canonical column's (t: s; x, y, z: m; vx, vy, vz: m/s; p, q, r: rad/s;
 // ax, ay, az: m/s^2; qw..qz, u_*: 1; phi, theta, psi: rad; w_*: rad/s; vbat: V). So
 // "deg/s" for p converts to rad/s by itself, and "m/s" for p is an error. Without `unit`

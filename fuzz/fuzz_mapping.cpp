@@ -1,7 +1,7 @@
 // Fuzz target: a column mapping (YAML) applied to a raw log (CSV), the result validated,
 // prepared for fitting and turned into equation-error residuals of the FINken 3 model.
 // Input: the mapping, a line "%%", the CSV. Only LogError / FitError may come out.
-// The mapping's `unit:` entries go through parse_unit (derive/units.cpp) and are checked
+// The mapping's `unit:` entries go through parse_unit (model/units.cpp) and are checked
 // against the canonical columns' dimensions; whatever a unit parses to, its conversion
 // factor must be a finite positive number (exponents are bounded), else the target traps.
 #include <cmath>

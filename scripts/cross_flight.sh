@@ -5,6 +5,9 @@
 # with those plus the helix's own flight parameters (motor trims, marker frame) calibrated
 # on its first 70 % (quadgen predict --calibrate). The four training flights are predicted
 # on their held-out ends with their own values. Prints the table of prediction_table.py.
+# Then diagnoses the helix and the linear ramps (B6, in no joint fit) against the four
+# flights' airframe (quadgen diagnose --airframe): do its named effects hold there, with
+# the airframe's values?
 #   scripts/cross_flight.sh [OUT_DIR]       (default /tmp/quadgen_cross_flight; ~20 min)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,3 +39,12 @@ predict "$unseen" nominal
 predict "$unseen" unseen_airframe_values --params "$params"
 predict "$unseen" unseen_calibrated_first_70pct --params "$params" --calibrate
 python3 scripts/prediction_table.py "$out/table"
+for n in "$unseen" B6_linear_ramp_rep1; do
+  if [ ! -f "$out/check_$n/diagnosis.json" ]; then
+    echo "checking $n against the airframe ..." >&2
+    "$q" diagnose "$vehicle" "$data/$n.csv" --mapping "$mapping" --airframe "$params" --out "$out/check_$n" \
+      > "$out/check_$n.log" 2>&1 || echo "check of $n failed: see $out/check_$n.log" >&2
+  fi
+  echo; echo "$n against the airframe of the four flights:"
+  grep -E '^(this flight|found|suspected)' "$out/check_$n.log" | cut -c1-300 || true
+done

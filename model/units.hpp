@@ -1,12 +1,11 @@
-// Physical units: parsing unit strings into a scale to SI and a dimension vector,
-// and dimensional analysis of GiNaC expressions.
+// Physical units: parsing unit strings into a scale to SI and a dimension vector (no
+// GiNaC: the vehicle file and the log mappings read units; audit/dimension_checker.hpp
+// checks the dimensions of expressions).
 #pragma once
 #include <array>
 #include <map>
 #include <stdexcept>
 #include <string>
-
-#include <ginac/ginac.h>
 
 namespace quadgen {
 
@@ -45,18 +44,5 @@ constexpr int kMaxUnitExponent = 12;
 // and whichever were chosen, a value written with the other meaning in mind would pass
 // the dimension check and be off by 2 pi. Exponents beyond kMaxUnitExponent are refused.
 Unit parse_unit(const std::string& text);
-
-// Dimensional analysis: maps every symbol to its dimension and infers the dimension
-// of an expression, requiring every term of a sum to agree and every function
-// argument and symbolic exponent to be dimensionless.
-class DimensionChecker {
- public:
-  void declare(const GiNaC::symbol& s, const Dimension& d);
-  // Returns the dimension or throws UnitError naming the offending sub-expression.
-  Dimension infer(const GiNaC::ex& e) const;
-
- private:
-  std::map<GiNaC::ex, Dimension, GiNaC::ex_is_less> dims_;
-};
 
 }  // namespace quadgen
