@@ -286,15 +286,11 @@ CandidateSearch::Workspace CandidateSearch::own_workspace() const { return {&tra
 // each worker on its own clones of the two problems (a fit sets its problem's free mask and
 // scratch state, and each clone has its own dynamic model). Results keep the candidates'
 // order, so the outcome does not depend on which worker fitted what.
-std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<std::string>& todo,
-                                                             const std::set<std::string>& base,
-                                                             const std::vector<FitParameter>& base_fit,
-                                                             const std::vector<double>& base_ss, double base_valid,
-                                                             int round) const {
-  std::vector<CandidateEvidence> out(todo.size());
+template <class Work>
+void CandidateSearch::on_every_core(size_t count, Work work) const {
   std::vector<Workspace> workers{own_workspace()};
   std::vector<std::unique_ptr<fit::ResidualModel>> clones;
-  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), todo.size());
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), count);
   while (workers.size() < threads) {
     auto train = train_.clone(), valid = valid_.clone();
     const auto* t = dynamic_cast<const fit::EquationErrorModel*>(train.get());
@@ -304,34 +300,49 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
     clones.push_back(std::move(train));
     clones.push_back(std::move(valid));
   }
-  std::atomic<size_t> next{0}, done{0};
-  std::mutex progress;
+  std::atomic<size_t> next{0};
+  std::mutex failing;
   std::exception_ptr failure;
-  auto work = [&](const Workspace& ws) {
-    for (size_t i; (i = next++) < todo.size();) {
+  auto run = [&](const Workspace& ws) {
+    for (size_t i; (i = next++) < count;) {
       try {
-        out[i] = evaluate(todo[i], base, base_fit, base_ss, base_valid, ws);
-      } catch (const fit::FitError& err) {  // a candidate the solver cannot fit is no candidate
-        out[i].effect = todo[i];
-        out[i].why_not = std::string("the fit failed: ") + err.what();
+        work(i, ws);
       } catch (...) {
-        const std::lock_guard<std::mutex> lock(progress);
+        const std::lock_guard<std::mutex> lock(failing);
         if (!failure) failure = std::current_exception();
-        next = todo.size();
+        next = count;
         return;
-      }
-      if (opt_.verbose_progress && isatty(2)) {
-        const std::lock_guard<std::mutex> lock(progress);
-        std::cerr << "\r[diagnose] step " << round + 1 << ": " << ++done << "/" << todo.size() << " candidates ("
-                  << todo[i] << ")                    " << std::flush;
       }
     }
   };
   std::vector<std::thread> pool;
-  for (size_t w = 1; w < workers.size(); ++w) pool.emplace_back(work, std::cref(workers[w]));
-  work(workers[0]);
+  for (size_t w = 1; w < workers.size(); ++w) pool.emplace_back(run, std::cref(workers[w]));
+  run(workers[0]);
   for (auto& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);
+}
+
+std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<std::string>& todo,
+                                                             const std::set<std::string>& base,
+                                                             const std::vector<FitParameter>& base_fit,
+                                                             const std::vector<double>& base_ss, double base_valid,
+                                                             int round) const {
+  std::vector<CandidateEvidence> out(todo.size());
+  std::atomic<size_t> done{0};
+  std::mutex progress;
+  on_every_core(todo.size(), [&](size_t i, const Workspace& ws) {
+    try {
+      out[i] = evaluate(todo[i], base, base_fit, base_ss, base_valid, ws);
+    } catch (const fit::FitError& err) {  // a candidate the solver cannot fit is no candidate
+      out[i].effect = todo[i];
+      out[i].why_not = std::string("the fit failed: ") + err.what();
+    }
+    if (opt_.verbose_progress && isatty(2)) {
+      const std::lock_guard<std::mutex> lock(progress);
+      std::cerr << "\r[diagnose] step " << round + 1 << ": " << ++done << "/" << todo.size() << " candidates ("
+                << todo[i] << ")                    " << std::flush;
+    }
+  });
   return out;
 }
 
@@ -418,11 +429,20 @@ void CandidateSearch::note_training_only(SearchResult& r, const CandidateEvidenc
 void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<FitParameter>& current) {
   for (bool removed = true; removed;) {
     removed = false;
-    for (const auto& e : r.named()) {
+    // The final model without each named effect in turn: independent fits, on every core.
+    const std::vector<std::string> named = r.named();
+    std::vector<std::vector<FitParameter>> without_each(named.size());
+    on_every_core(named.size(), [&](size_t k, const Workspace& ws) {
+      std::set<std::string> without = base;
+      without.erase(named[k]);
+      double c = 0;
+      without_each[k] = fit_with(without, current, &c, ws);
+    });
+    for (size_t k = 0; k < named.size(); ++k) {
+      const std::string& e = named[k];
       std::set<std::string> without = base;
       without.erase(e);
-      double c = 0;
-      const auto smaller = fit_with(without, current, &c);
+      const std::vector<FitParameter>& smaller = without_each[k];
       const ChannelNoise full = channel_noise(train_, current);
       const double statistic = lr_statistic(channel_noise(train_, smaller).ss, full);
       int dof = 0;
@@ -438,6 +458,7 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       r.removed.push_back({e, reason, p, gain, p < level, vb, va});
       r.selected.erase(std::find(r.selected.begin(), r.selected.end(), e));
       base = without;
+      double c = 0;
       if (base.empty()) {  // back to the base model, fitted as it was
         current = r.base_fit;
         weights_ = r.base_weights;

@@ -214,6 +214,10 @@ class CandidateSearch {
   CandidateEvidence evaluate(const std::string& effect, const std::set<std::string>& base,
                              const std::vector<fit::FitParameter>& base_fit, const std::vector<double>& base_ss,
                              double base_valid_cost, const Workspace& ws) const;
+  // work(i, workspace) for i in [0, count), on every core: each worker thread on its own
+  // clones of the two problems; the first exception is rethrown once all have stopped.
+  template <class Work>
+  void on_every_core(size_t count, Work work) const;
   // Every candidate of a step, on all cores, in `todo`'s order.
   std::vector<CandidateEvidence> evaluate_all(const std::vector<std::string>& todo, const std::set<std::string>& base,
                                               const std::vector<fit::FitParameter>& base_fit,
