@@ -156,6 +156,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
              {"extended_model.json", ext.model_json},
              {"extended_derivation.md", ext.derivation_markdown},
              {"fitted_parameters.yaml", ext.fitted_parameters_yaml}};
+  if (!ext.fitted_vehicle_yaml.empty()) r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
   if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
     const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, logs_label, true);
     r.files.push_back({"discovered_model.hpp", disc.header});

@@ -1,8 +1,12 @@
 #include "extended_model.hpp"
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 #include "derive_pipeline.hpp"
 #include "sinks.hpp"
@@ -32,6 +36,29 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
   return y.str();
 }
 
+// The vehicle file as the user wrote it (comments kept), with the fitted values appended as
+// its `fitted:` section: `quadgen derive` on it builds the fitted model. Empty when the file
+// has a `fitted:` section already, or is not a block map a key can be appended to.
+std::string fitted_vehicle_yaml(const Vehicle& v, const std::string& fitted_parameters) {
+  if (v.fitted_line > 0) return "";
+  std::ifstream in(v.source_path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  if (!in.good() && !in.eof()) return "";
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  std::ostringstream y;
+  y << text << "\n# Written by quadgen diagnose: the effects it named and the values it fitted. `quadgen derive`\n"
+    << "# on this file builds the fitted model (the same as extended_model.hpp).\nfitted:\n";
+  std::istringstream lines(fitted_parameters);
+  for (std::string line; std::getline(lines, line);) y << "  " << line << "\n";
+  try {  // a flow-style top level ({name: ...}) cannot take a block key after it
+    const YAML::Node node = YAML::Load(y.str());
+    if (!node.IsMap() || !node["fitted"] || !node["fitted"]["parameters"]) return "";
+  } catch (const YAML::Exception&) {
+    return "";
+  }
+  return y.str();
+}
+
 }  // namespace
 
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
@@ -53,7 +80,8 @@ ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, 
     request.emit.parameter_source +=
         "; term_* parameters: terms proposed beyond the catalogue (diagnosis.json discovered_terms), not named causes";
   const DerivedModel ext = run_derive_pipeline(v, mass, request);
-  return {ext.header.content, ext.model_json, ext.derivation_md, fitted_parameters_yaml(v, d)};
+  const std::string fitted = fitted_parameters_yaml(v, d);
+  return {ext.header.content, ext.model_json, ext.derivation_md, fitted, fitted_vehicle_yaml(v, fitted)};
 }
 
 }  // namespace quadgen::diagnose

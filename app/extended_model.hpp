@@ -16,6 +16,7 @@ struct ExtendedModelFiles {
   std::string model_json;               // extended_model.json
   std::string derivation_markdown;      // extended_derivation.md
   std::string fitted_parameters_yaml;   // fitted_parameters.yaml
+  std::string fitted_vehicle_yaml;      // fitted_vehicle.yaml: the vehicle file plus `fitted:` ("": not written)
 };
 
 // `vehicle_file` and `logs_label` say in the header where the model and its values came from.

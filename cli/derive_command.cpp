@@ -31,15 +31,19 @@ int run_derive(const DeriveArgs& args) {
   request.derive.effects = parse_effect_list(args.effects);
   request.emit.vehicle_file = args.vehicle;
   request.emit.effects_flag = args.effects.empty() ? "" : " --effects " + args.effects;
-  if (!args.params.empty()) {
-    const FittedParameters fitted = load_fitted_parameters(args.params);
+  // The fitted values: --params, or the vehicle file's own `fitted:` section.
+  if (vehicle.fitted_line > 0 && !args.params.empty())
+    throw std::invalid_argument(args.vehicle + " carries fitted values already (its 'fitted:' section); leave --params out");
+  const std::string params = vehicle.fitted_line > 0 ? args.vehicle : args.params;
+  if (!params.empty()) {
+    const FittedParameters fitted = load_fitted_parameters(params);
     if (args.effects.empty()) request.derive.effects = fitted.effects;
     else if (std::set<std::string>(request.derive.effects.begin(), request.derive.effects.end()) !=
              std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
-      throw std::invalid_argument("--effects differs from the effects " + args.params + " was fitted with; leave it out");
+      throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
     request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
-    request.emit.effects_flag = " --params " + args.params;
-    request.emit.parameter_source = "fitted values from " + args.params;
+    request.emit.effects_flag = params == args.vehicle ? "" : " --params " + params;
+    request.emit.parameter_source = "fitted values from " + params;
   }
   std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
   const MassProperties mp = derive_mass_properties(vehicle);

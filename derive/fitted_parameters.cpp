@@ -11,8 +11,12 @@ namespace quadgen {
 
 FittedParameters load_fitted_parameters(const std::string& path) {
   const YamlReader r{path};
-  const YAML::Node root = r.parse(r.read_file("fitted parameters"));
-  if (!root.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
+  const YAML::Node file = r.parse(r.read_file("fitted parameters"));
+  if (!file.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
+  // A vehicle file with a `fitted:` section (fitted_vehicle.yaml) holds the same map there.
+  const bool in_vehicle = file["fitted"] && file["name"];
+  const YAML::Node root = in_vehicle ? file["fitted"] : file;
+  if (in_vehicle && !root.IsMap()) r.fail(root, "expected 'fitted' to hold 'effects' and 'parameters'");
   r.only_keys(root, {"effects", "parameters"}, "fitted parameters");
   FittedParameters out;
   out.path = path;

@@ -21,8 +21,9 @@ struct FittedParameters {
   std::vector<FittedValue> values;
 };
 
-// Reads the file; a malformed file, an unknown effect or a non-finite value is a
-// VehicleError "path:line: ...".
+// Reads the file: a fitted_parameters.yaml, or a vehicle file's `fitted:` section (the same
+// map); a malformed file, an unknown effect or a non-finite value is a VehicleError
+// "path:line: ...".
 FittedParameters load_fitted_parameters(const std::string& path);
 
 // Sets the model's nominal values to the fitted ones. Each must name a parameter of the

@@ -176,9 +176,10 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
   r.require_map(root, "a vehicle description");
   r.only_keys(root, {"name", "description", "environment", "frame", "rotor_model", "motor_map",
-                     "battery", "blocks", "rotors", "derived"},
+                     "battery", "blocks", "rotors", "derived", "fitted"},
               "the vehicle file");
   Vehicle v;
+  if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
   v.source_path = path;
   v.content_hash = fnv1a_hex(content);
   v.name = r.name(r.need(root, "name", "the vehicle file"), "vehicle name");

@@ -60,6 +60,10 @@ struct Vehicle {
   std::map<std::string, Parameter> params;
   // Fit flags and bounds for quantities derived from the blocks (mass, J_xx, ...).
   std::map<std::string, Parameter> derived_overrides;
+  // The file carries a `fitted:` section (effects and fitted values, as fitted_parameters.yaml
+  // holds them, written by quadgen diagnose into fitted_vehicle.yaml): `quadgen derive` then
+  // builds the fitted model. Read by derive's load_fitted_parameters, at this line.
+  int fitted_line = 0;
 };
 
 struct VehicleError : std::runtime_error {

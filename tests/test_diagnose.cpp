@@ -550,6 +550,17 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
   };
   EXPECT_FALSE(nominal(header).empty());
   EXPECT_EQ(nominal(regenerated), nominal(header));
+  // fitted_vehicle.yaml: the vehicle file with the fitted values in it; derive alone builds
+  // the same fitted model, and refuses a second source of fitted values
+  ASSERT_EQ(run(std::string(QUADGEN_BINARY) + " derive " + (dir / "out" / "fitted_vehicle.yaml").string() + " --out " +
+                (dir / "from_vehicle").string() + " > /dev/null 2>&1"),
+            "");
+  std::ifstream fv(dir / "from_vehicle" / "model.hpp");
+  EXPECT_EQ(nominal(std::string((std::istreambuf_iterator<char>(fv)), {})), nominal(header));
+  EXPECT_NE(run(std::string(QUADGEN_BINARY) + " derive " + (dir / "out" / "fitted_vehicle.yaml").string() + " --params " +
+                (dir / "out" / "fitted_parameters.yaml").string() + " --out " + (dir / "both").string() +
+                " > /dev/null 2>&1"),
+            "");
 }
 
 // Two flights of one airframe: each flight alone must show the named airframe effect with the
