@@ -118,15 +118,15 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) 
   std::vector<std::map<std::string, FlightEstimate>> per_flight;
   for (size_t k = 1; k <= in.training_parts.size(); ++k) per_flight.push_back(fit_one_flight(in, static_cast<int>(k), named));
   for (const auto& e : in.effects)
-    for (const auto& name : e.parameters) {
+    for (size_t j = 0; j < e.parameters.size(); ++j) {
       ParameterAgreement a;
-      a.parameter = name;
+      a.parameter = e.parameters[j];
       a.effect = e.name;
       a.named = e.named;
       for (const auto& p : in.joint_fit)
-        if (p.name == name) a.unit = p.unit;
-      a.joint_value = e.start[static_cast<size_t>(&name - e.parameters.data())];
-      for (const auto& f : per_flight) a.flights.push_back(f.at(name));
+        if (p.name == a.parameter) a.unit = p.unit;
+      a.joint_value = e.start[j];
+      for (const auto& f : per_flight) a.flights.push_back(f.at(a.parameter));
       summarise(a);
       out.push_back(a);
     }
