@@ -83,9 +83,13 @@ void mean_and_standard_error(const std::vector<double>& x, double* mean, double*
 // What a named cause must show beyond significance on training data (issue: what diagnose
 // may name): a closed 95 % interval for every parameter, at least one excluding "off", and
 // a held-out gain larger than its own uncertainty across the validation folds. Empty: passed.
-std::string acceptance_failure(const Finding& f, const SymbolicModel& all) {
-  bool excludes_off = false;
+// `check_intervals`: false while the intervals are only Wald intervals (the rule is about
+// profile-likelihood intervals; a Wald interval around a bound or a skewed likelihood would
+// turn down what the profile accepts), so only the held-out gain is tested then.
+std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool check_intervals) {
+  bool excludes_off = !check_intervals;
   for (const auto& p : f.parameters) {
+    if (!check_intervals) break;
     if (std::isnan(p.lower) || std::isnan(p.upper)) return "the 95 % interval of " + p.name + " is open";
     const double off = neutral_value(all.params[all.param_index(p.name)]);
     excludes_off = excludes_off || off < p.lower || off > p.upper;
@@ -381,8 +385,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // Until nothing more fails: taking a suspected cause out refits the model (the extended
   // model keeps only what is named, and carried look-alikes), which changes the others'
   // gains and intervals, so they are tested again against what the report will show. The
-  // search gives Wald intervals; once nothing fails with them, the survivors get profiles and
-  // are tested once more (a profile may be open where the Wald interval is not).
+  // search gives Wald intervals: first only the held-out gains are tested; once nothing fails
+  // that, the survivors get profiles and are tested in full (intervals too).
   bool profiled = !so.wald_until_accepted;
   std::map<std::string, Finding> held_out;  // per effect, in the current final model
   for (;;) {
@@ -392,7 +396,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       if (!held_out.count(e)) held_out[e] = finding_for(e);
       Finding f = held_out.at(e);
       f.parameters = parameters_of(e);
-      const std::string failed = acceptance_failure(f, all);
+      const std::string failed = acceptance_failure(f, all, profiled);
       if (failed.empty()) accepted.push_back(f);
       else d.suspected.push_back({f, failed}), drop.push_back(e);
     }
