@@ -5,8 +5,6 @@
 #include <limits>
 #include <map>
 
-#include <boost/math/distributions/chi_squared.hpp>
-
 #include "candidate_search.hpp"
 #include "equation_error.hpp"
 #include "per_flight_model.hpp"
@@ -16,11 +14,6 @@ namespace quadgen::diagnose {
 namespace {
 
 constexpr double kZ95 = 1.959963984540054;
-
-double chi2_upper_tail(double x, double dof) {
-  if (!(dof > 0)) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), std::max(0.0, x)));
-}
 
 // Flight k's (1-based) parameters under the single-flight model's names: its own copy of a
 // per-flight parameter, the airframe's value of every other; free are the named effects'
@@ -75,7 +68,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
       f.lower = f.value - kZ95 * f.standard_error;
       f.upper = f.value + kZ95 * f.standard_error;
       f.statistic = statistic;
-      f.p_value = chi2_upper_tail(statistic, static_cast<double>(e.parameters.size()));
+      f.p_value = chi2_upper(statistic, static_cast<double>(e.parameters.size()));
       out[name] = f;
     }
   }
@@ -103,7 +96,7 @@ void summarise(ParameterAgreement& a) {
     ++counted;
     within = within && a.pooled >= f.lower && a.pooled <= f.upper;
   }
-  a.q_p_value = chi2_upper_tail(a.q, counted - 1.0);
+  a.q_p_value = chi2_upper(a.q, counted - 1.0);
   a.spread = a.joint_value != 0 ? (hi - lo) / std::abs(a.joint_value) : INFINITY;
   a.agree = within && a.spread < 0.3;
 }
@@ -168,7 +161,7 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
       a.flights = {f};
       const double se = std::hypot(f.standard_error, e.standard_error[j]);
       a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
-      a.q_p_value = chi2_upper_tail(a.q, 1.0);
+      a.q_p_value = chi2_upper(a.q, 1.0);
       a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
       a.agree = a.q < kZ95 * kZ95 && a.spread < 0.3;
       out.push_back(a);

@@ -35,10 +35,7 @@ double typical_start(const std::string& param) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-double chi2_upper(double x, double dof) {
-  if (x <= 0) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
-}
+
 
 }  // namespace
 
@@ -517,6 +514,11 @@ NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
   for (Eigen::Index a = 0; a < n; ++a)
     if (scale(a) == 0) out.confounded[static_cast<size_t>(a)] = true;  // a parameter the data do not touch
   return out;
+}
+
+double chi2_upper(double x, double dof) {
+  if (x <= 0 || !(dof > 0)) return 1.0;  // no evidence, or nothing to test (one flight)
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
 }
 
 StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const std::vector<FitParameter>& ps,

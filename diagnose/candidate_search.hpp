@@ -159,6 +159,10 @@ NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H);
 // weighted fit (weights per channel, as the search uses them); NaN for fixed parameters.
 // `confounded`: along a direction the data cannot determine (analyse_normal_matrix), where
 // the pseudo-inverse gives a finite, too small error.
+// P(chi2_dof > x): the p-value of a likelihood-ratio or heterogeneity statistic; 1 for x <= 0
+// or dof <= 0.
+double chi2_upper(double x, double dof);
+
 struct StandardErrors {
   std::vector<double> value;
   std::vector<bool> confounded;
