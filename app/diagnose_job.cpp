@@ -103,7 +103,7 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
       double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
       if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
           p["ci95"][1].is_number())
-        se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * 1.959963984540054);
+        se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * fit::kZ95);
       e.parameters.push_back(name);
       e.value.push_back(v);
       e.standard_error.push_back(se > 0 ? se : 0.0);

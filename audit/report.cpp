@@ -153,8 +153,10 @@ std::string tex_uncached(const ex& e) {
       args += (args.empty() ? "" : ", ") + tex(flip ? negated_sum(a) : a);
     }
     const std::string name = ex_to<function>(e).get_name();
+    if (even) return "\\left|" + args + "\\right|";
+    if (name == "sign_of") return "\\operatorname{sgn}\\left(" + args + "\\right)";
     const bool known = name == "sin" || name == "cos" || name == "tan" || name == "exp" || name == "log";
-    return (known ? "\\" + name : "\\operatorname{" + name + "}") + "\\left(" + args + "\\right)";
+    return (known ? "\\" + name : "\\operatorname{" + output::latex_text(name) + "}") + "\\left(" + args + "\\right)";
   }
   return ginac_tex(e);  // symbols and numbers
 }
@@ -258,25 +260,39 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
     else
       md << "```math\n" << lhs << " = " << rhs << "\n```\n\n";
   };
-  for (const auto& [name, e] : m.intermediates) {
-    const size_t size = tree_size(e, kReadable);
-    if (size > kReadable) {
-      md << "$" << name << "$: more than " << kReadable << " terms and factors, too long to read here; the generated "
+  md << "Each rotor's speed $\\omega_i$ and thrust $F_i$ (along body $+z$ at its hub), the moment $\\tau_i$ of "
+        "that thrust about the centre of gravity with the reaction moment of the spin (a counter-clockwise rotor, "
+        "seen from above, turns the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$), "
+        "the air velocity in body axes $v_a = R^T (v - v_{wind})$, and the frame's drag on it, acting at the "
+        "centre of gravity. Each quantity is written with the ones before it as symbols; the generated code "
+        "holds them substituted.\n\n";
+  bool effect_terms = false;
+  for (const auto& eq : m.named_equations) {
+    if (!eq.rhs_tex.empty()) {
+      effect_terms = effect_terms || eq.rhs_tex.find("\\Delta") != std::string::npos;
+      md << "```math\n" << eq.lhs << " = " << eq.rhs_tex << "\n```\n\n";
+      continue;
+    }
+    const ex& e = eq.rhs;
+    if (tree_size(e, kReadable) > kReadable) {
+      md << "$" << eq.lhs << "$: more than " << kReadable << " terms and factors, too long to read here; the generated "
          << "code holds it in full.\n\n";
       continue;
     }
     if (!is_a<matrix>(e)) {
-      equation(name, tex(e));
+      equation(eq.lhs, tex(e));
       continue;
     }
     const matrix& v = ex_to<matrix>(e);
     const std::string whole = tex_matrix(v);
     if (whole.size() <= kMathJaxLimit || v.cols() != 1 || v.rows() != 3) {
-      equation(name, whole);
+      equation(eq.lhs, whole);
       continue;
     }
-    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + name + "\\right)_" + "xyz"[i], tex(v(i, 0)));
+    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + eq.lhs + "\\right)_" + "xyz"[i], tex(v(i, 0)));
   }
+  if (effect_terms)
+    md << "$\\Delta F_{body}$ and $\\Delta \\tau$ are the sums of what the effects add below.\n\n";
   if (!m.effect_formulas.empty()) {
     md << "### What each effect adds\n\nEach effect applied alone to the base model, in body axes ($R = I$; "
           "$v_a$ is the air velocity, in body axes unless said), with the quantity it changes: a rotor's thrust is "
@@ -290,9 +306,6 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
         equation(lhs, is_a<matrix>(value) ? tex_matrix(ex_to<matrix>(value)) : tex(value));
     }
   }
-  md << "Thrust acts along body $+z$ at each rotor; a counter-clockwise rotor (seen from above) pushes "
-        "the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$. Drag acts at the centre "
-        "of gravity on the air-relative velocity in body axes.\n\n";
   md << "## 5. Equations of motion\n\n"
      << "Translation (D'Alembert: the inertial force balances the applied forces) for the centre of "
         "gravity, expressed for the body origin that the logs record:\n\n"

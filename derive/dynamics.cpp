@@ -153,6 +153,43 @@ matrix inertia_matrix(const ModelContext& c) {
   return matrix(3, 3, lst{xx, xy, xz, xy, yy, yz, xz, yz, zz});
 }
 
+// The report's equations (SymbolicModel::named_equations): the same physics as assemble()
+// below, built once more with each earlier quantity as a named symbol. The symbols' names
+// are those of the effect formulas (omega_<rotor>, v_ax), so both read alike.
+void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
+  auto& out = c.model.named_equations;
+  const auto& rotors = c.vehicle.rotors;
+  const symbol va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
+  // Effects that depend on the air velocity (inflow, rotor drag) built it the same way:
+  // their terms read with v_a instead of the rotation written out.
+  const lst named_air{v_air_body(0, 0) == va[0], v_air_body(1, 0) == va[1], v_air_body(2, 0) == va[2]};
+  std::vector<ex> thrust;
+  for (size_t i = 0; i < rotors.size(); ++i) {
+    const std::string n = output::latex_text(rotors[i].name);
+    const symbol w("omega_" + rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
+    out.push_back({"\\omega_{\\mathrm{" + n + "}}", c.rotor_speed[i], ""});
+    const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
+    const ex named = c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
+    out.push_back({rotor_thrust_name(rotors[i].name), named.subs(named_air), ""});
+    thrust.push_back(symbol("F_" + rotors[i].name, rotor_thrust_name(rotors[i].name)));
+  }
+  for (size_t i = 0; i < rotors.size(); ++i) {
+    const int reaction = (rotors[i].spin == Spin::ccw) ? -1 : 1;  // as in assemble()
+    const matrix arm = c.rotor_position[i].sub(c.cog);
+    const matrix tau = cross(arm, vec3(0, 0, thrust[i])).add(vec3(0, 0, reaction * c.p("kappa") * thrust[i]));
+    out.push_back({"\\tau_{\\mathrm{" + output::latex_text(rotors[i].name) + "}}", tau, ""});
+  }
+  out.push_back({"v_a", v_air_body, ""});
+  const char* areas[] = {"A_x", "A_y", "A_z"};
+  matrix drag(3, 1);
+  for (int k = 0; k < 3; ++k)
+    drag(k, 0) = -numeric(1, 2) * c.p("c_w") * c.p("rho") * c.p(areas[k]) * va[k] * abs_value(va[k]);
+  out.push_back({"F_{drag}", drag, ""});
+  const bool extra_force = !c.extra_body_force.is_zero_matrix(), extra_torque = !c.extra_body_torque.is_zero_matrix();
+  out.push_back({"F_{body}", 0, "e_z \\sum_i F_i + F_{drag}" + std::string(extra_force ? " + \\Delta F_{body}" : "")});
+  out.push_back({"\\tau", 0, "\\sum_i \\tau_i" + std::string(extra_torque ? " + \\Delta \\tau" : "")});
+}
+
 // Closes the equations once every effect has had its say.
 void assemble(ModelContext& c) {
   SymbolicModel& m = c.model;
@@ -186,6 +223,7 @@ void assemble(ModelContext& c) {
   m.intermediates.push_back({"F_{drag}", drag});
   m.intermediates.push_back({"F_{body}", force_body});
   m.intermediates.push_back({"\\tau", torque});
+  write_named_equations(c, v_air_body);
 
   // Rotation about the centre of gravity: J dω/dt = τ − ω × Jω.
   const matrix J = inertia_matrix(c);

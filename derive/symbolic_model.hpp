@@ -53,8 +53,21 @@ struct SymbolicModel {
   // dfdu * du/dt for the delay's sensitivity (a pure delay is not an ODE term).
   std::optional<size_t> input_delay_param;
 
-  // Named intermediate expressions for the report (forces, torques, thrusts).
+  // Intermediate quantities written out in full (thrust of each rotor, drag, body force,
+  // torque), for checks that compare them with other derivations (the thesis comparison).
   std::vector<std::pair<std::string, GiNaC::ex>> intermediates;
+
+  // The same quantities as the report prints them, in reading order, each written with the
+  // ones before it as named symbols: rotor speed ω_i, thrust F_i and moment τ_i of each rotor,
+  // the air velocity v_a in body axes, drag, then F_body and τ as sums of those. A reviewer
+  // checks one small step at a time instead of one expanded tree. When `rhs_tex` is set it is
+  // the right-hand side (a sum over rotors, written as such) and `rhs` is unused.
+  struct NamedEquation {
+    std::string lhs;  // TeX
+    GiNaC::ex rhs;
+    std::string rhs_tex;
+  };
+  std::vector<NamedEquation> named_equations;
 
   // Each effect's own formula for the report: what it does to the model's intermediate
   // quantities, derived by applying it alone to the base model (TeX left-hand side, value).

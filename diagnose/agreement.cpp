@@ -13,7 +13,7 @@ namespace quadgen::diagnose {
 
 namespace {
 
-constexpr double kZ95 = 1.959963984540054;
+using fit::kZ95;
 
 // Flight k's (1-based) parameters under the single-flight model's names: its own copy of a
 // per-flight parameter, the airframe's value of every other; free are the named effects'
@@ -42,10 +42,7 @@ std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, co
 // One flight: its estimates of every named parameter and, per effect, the LR test against off.
 std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, int k, const std::vector<std::string>& named) {
   const fit::EquationErrorModel ee(*in.model, in.training_parts[static_cast<size_t>(k - 1)], in.use_accelerometer);
-  fit::FitOptions fo;
-  fo.max_iterations = 100;
-  fo.function_tolerance = 1e-10;
-  fo.parameter_tolerance = 1e-10;
+  const fit::FitOptions fo = refit_options();
   std::vector<fit::FitParameter> on = flight_start(in, k, named);
   const double cost_on = fit::solve_weighted(ee, on, in.weights, fo);
   const StandardErrors se = gauss_newton_standard_errors(ee, on, in.weights);

@@ -114,11 +114,7 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
   }
   // Only ratios are identifiable for some effects beside c_t: their reference is held.
   for (int i : reference_params_) ps[i].free = false;
-  fit::FitOptions fo;
-  fo.max_iterations = 100;
-  fo.function_tolerance = 1e-10;
-  fo.parameter_tolerance = 1e-10;
-  *cost = fit::solve_weighted(*ws.train, ps, weights_, fo);
+  *cost = fit::solve_weighted(*ws.train, ps, weights_, refit_options());
   return ps;
 }
 
@@ -516,6 +512,14 @@ NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
   return out;
 }
 
+fit::FitOptions refit_options() {
+  fit::FitOptions fo;
+  fo.max_iterations = 100;
+  fo.function_tolerance = 1e-10;
+  fo.parameter_tolerance = 1e-10;
+  return fo;
+}
+
 double chi2_upper(double x, double dof) {
   if (x <= 0 || !(dof > 0)) return 1.0;  // no evidence, or nothing to test (one flight)
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
@@ -605,7 +609,7 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double sd = se.confounded[i] ? nan : se.value[i];
     const bool finite = std::isfinite(sd) && sd > 0;
-    const double v = r.final_fit[i].value, z = 1.959963984540054;
+    const double v = r.final_fit[i].value, z = fit::kZ95;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, sd, finite ? v - z * sd : nan,
                            finite ? v + z * sd : nan, 0.0,
                            finite ? "identifiable" : "structurally non-identifiable", "wald",

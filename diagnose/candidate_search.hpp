@@ -155,14 +155,18 @@ struct NormalMatrixAnalysis {
 };
 NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H);
 
-// Standard errors of the free parameters at `ps` from the Gauss-Newton normal matrix of a
-// weighted fit (weights per channel, as the search uses them); NaN for fixed parameters.
-// `confounded`: along a direction the data cannot determine (analyse_normal_matrix), where
-// the pseudo-inverse gives a finite, too small error.
 // P(chi2_dof > x): the p-value of a likelihood-ratio or heterogeneity statistic; 1 for x <= 0
 // or dof <= 0.
 double chi2_upper(double x, double dof);
 
+// The solver settings of every refit a diagnosis makes (each step of the search, each flight
+// alone in the agreement check), so that their costs compare.
+fit::FitOptions refit_options();
+
+// Standard errors of the free parameters at `ps` from the Gauss-Newton normal matrix of a
+// weighted fit (weights per channel, as the search uses them); NaN for fixed parameters.
+// `confounded`: along a direction the data cannot determine (analyse_normal_matrix), where
+// the pseudo-inverse gives a finite, too small error.
 struct StandardErrors {
   std::vector<double> value;
   std::vector<bool> confounded;

@@ -130,7 +130,7 @@ std::optional<PointOfAction> point_of_action(const Diagnosis& d) {
   out.height = flap->value / drag->value;
   const double rel_f = flap->standard_error / flap->value, rel_d = drag->standard_error / drag->value;
   const double se = std::fabs(out.height) * std::sqrt(rel_f * rel_f + rel_d * rel_d);
-  if (std::isfinite(se) && se > 0) out.lower = out.height - 1.96 * se, out.upper = out.height + 1.96 * se;
+  if (std::isfinite(se) && se > 0) out.lower = out.height - fit::kZ95 * se, out.upper = out.height + fit::kZ95 * se;
   return out;
 }
 

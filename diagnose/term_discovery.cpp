@@ -8,6 +8,7 @@
 #include <boost/math/distributions/normal.hpp>
 
 #include "attitude.hpp"
+#include "least_squares.hpp"
 #include "residual_analysis.hpp"
 
 namespace quadgen::diagnose {
@@ -334,7 +335,7 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
       const double s = scale[static_cast<size_t>(j)];
       const std::string& ru = lt.units[col];
       d.coefficients.push_back({lt.names[col], ru.empty() || ru == "1" ? units[ch] : units[ch] + "/(" + ru + ")",
-                                xi(j) / s, (xi(j) - 1.96 * se(j)) / s, (xi(j) + 1.96 * se(j)) / s});
+                                xi(j) / s, (xi(j) - fit::kZ95 * se(j)) / s, (xi(j) + fit::kZ95 * se(j)) / s});
     }
     if (d.coefficients.empty()) {
       d.verdict = "no term: no selected coefficient is significant once corrected for the " + std::to_string(k) + " regressors searched";

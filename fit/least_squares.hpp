@@ -43,6 +43,10 @@ struct FitError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The 97.5 % quantile of the standard normal: a 95 % Wald interval is value ± kZ95 standard
+// errors. One constant for every interval and z test of a fit or diagnosis.
+constexpr double kZ95 = 1.959963984540054;
+
 struct FitOptions {
   int max_iterations = 200;
   double function_tolerance = 1e-12;

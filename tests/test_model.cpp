@@ -560,3 +560,81 @@ TEST(Report, EachEffectHasItsOwnFormula) {
   EXPECT_NE(md.find("### What each effect adds"), std::string::npos);
   EXPECT_NE(md.find("**blade\\_flapping**"), std::string::npos);
 }
+
+namespace {
+// Every symbol of the model's expressions given a value by name, deterministic and away from
+// 0 and 1 so that no term vanishes by accident (quaternion not unit: both sides use the
+// same expressions, the identity holds for any numbers).
+std::map<std::string, double> values_by_name(const SymbolicModel& m) {
+  std::map<std::string, double> at;
+  double x = 0.37;
+  const auto fill = [&](const std::vector<Variable>& vars) {
+    for (const auto& v : vars) at[v.name] = (x = std::fmod(x * 7.13 + 0.29, 1.9) - 0.45);
+  };
+  fill(m.states), fill(m.inputs), fill(m.params), fill(m.constants);
+  return at;
+}
+
+const SymbolicModel::NamedEquation& named(const SymbolicModel& m, const std::string& lhs) {
+  for (const auto& e : m.named_equations)
+    if (e.lhs == lhs) return e;
+  throw std::runtime_error("no named equation " + lhs);
+}
+
+const ex& intermediate(const SymbolicModel& m, const std::string& name) {
+  for (const auto& [n, e] : m.intermediates)
+    if (n == name) return e;
+  throw std::runtime_error("no intermediate " + name);
+}
+
+// The report's chain of named quantities (rotor speed, thrust, moment per rotor, v_a, drag)
+// composed step by step equals the forces and torque the generated code is built from.
+void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
+  std::map<std::string, double> at = values_by_name(m);
+  const matrix& va = ex_to<matrix>(named(m, "v_a").rhs);
+  const char* axes = "xyz";
+  for (int k = 0; k < 3; ++k) at[std::string("v_a") + axes[k]] = evaluate_by_name(va(k, 0), at);
+  matrix tau_sum(3, 1);
+  double thrust_sum = 0;
+  for (const auto& r : {"A", "B", "C", "D"}) {
+    const std::string tex_name = "\\mathrm{" + std::string(r) + "}}";
+    at[std::string("omega_") + r] = evaluate_by_name(named(m, "\\omega_{" + tex_name).rhs, at);
+    const double thrust = evaluate_by_name(named(m, "F_{" + tex_name).rhs, at);
+    EXPECT_NEAR(thrust, evaluate_by_name(intermediate(m, "F_{" + tex_name), at), 1e-12 * std::fabs(thrust)) << r;
+    at[std::string("F_") + r] = thrust;
+    thrust_sum += thrust;
+    const matrix& tau_r = ex_to<matrix>(named(m, "\\tau_{" + tex_name).rhs);
+    for (int k = 0; k < 3; ++k) tau_sum(k, 0) = tau_sum(k, 0) + evaluate_by_name(tau_r(k, 0), at);
+  }
+  const matrix& drag_named = ex_to<matrix>(named(m, "F_{drag}").rhs);
+  const matrix& drag = ex_to<matrix>(intermediate(m, "F_{drag}"));
+  const matrix& force = ex_to<matrix>(intermediate(m, "F_{body}"));
+  const matrix& tau = ex_to<matrix>(intermediate(m, "\\tau"));
+  for (int k = 0; k < 3; ++k) {
+    const double d = evaluate_by_name(drag_named(k, 0), at);
+    EXPECT_NEAR(d, evaluate_by_name(drag(k, 0), at), 1e-12 * (1 + std::fabs(d))) << axes[k];
+    if (!no_effect_terms) continue;
+    const double f = d + (k == 2 ? thrust_sum : 0.0);
+    EXPECT_NEAR(f, evaluate_by_name(force(k, 0), at), 1e-12 * (1 + std::fabs(f))) << axes[k];
+    const double t = ex_to<numeric>(tau_sum(k, 0)).to_double();
+    EXPECT_NEAR(t, evaluate_by_name(tau(k, 0), at), 1e-12 * (1 + std::fabs(t))) << axes[k];
+  }
+  EXPECT_EQ(named(m, "F_{body}").rhs_tex.find("\\Delta") == std::string::npos, no_effect_terms);
+}
+}  // namespace
+
+// derivation.md writes each quantity with the ones before it as symbols (#16: body velocity,
+// thrust and moment per rotor as their own equations). Composed back, the chain must give the
+// expanded forces and torque that the equations of motion and the generated code use.
+TEST(Report, NamedEquationsComposeToTheModelsForcesAndTorque) {
+  const Vehicle v = test::finken3();
+  expect_named_chain_composes(derive(v), true);
+  expect_named_chain_composes(derive(v, parse_effect_list("all")), false);
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive(v);
+  const std::string md = derivation_markdown({v, mp, m, audit(m, mp), {}});
+  EXPECT_NE(md.find("```math\nv_a = "), std::string::npos);
+  EXPECT_NE(md.find("```math\n\\tau_{\\mathrm{A}} = "), std::string::npos);
+  EXPECT_NE(md.find("```math\n\\tau = \\sum_i \\tau_i\n```"), std::string::npos);
+  EXPECT_EQ(md.find("abs_value"), std::string::npos);  // |x|, not an operator name with an underscore
+}
