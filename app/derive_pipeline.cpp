@@ -1,6 +1,6 @@
-#include "derive_pipeline.hpp"
+#include "app/derive_pipeline.hpp"
 
-#include "report.hpp"
+#include "audit/report.hpp"
 
 namespace quadgen {
 

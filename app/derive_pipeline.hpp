@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "audit.hpp"
-#include "dynamics.hpp"
-#include "header_writer.hpp"
-#include "geometry.hpp"
-#include "symbolic_model.hpp"
-#include "thesis_reference.hpp"
-#include "vehicle.hpp"
+#include "audit/audit.hpp"
+#include "derive/dynamics.hpp"
+#include "codegen/header_writer.hpp"
+#include "derive/geometry.hpp"
+#include "derive/symbolic_model.hpp"
+#include "audit/thesis_reference.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 

@@ -1,4 +1,4 @@
-#include "diagnose_job.hpp"
+#include "app/diagnose_job.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,16 +9,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diagnosis_report.hpp"
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "extended_model.hpp"
-#include "geometry.hpp"
-#include "json_document.hpp"
-#include "sinks.hpp"
-#include "log_reader.hpp"
-#include "model_registry.hpp"
-#include "vehicle.hpp"
+#include "diagnose/diagnosis_report.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "app/extended_model.hpp"
+#include "derive/geometry.hpp"
+#include "output/json_document.hpp"
+#include "output/sinks.hpp"
+#include "fit/log_reader.hpp"
+#include "app/model_registry.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::app {
 

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis.hpp"
+#include "diagnose/diagnosis.hpp"
 
 namespace quadgen::app {
 

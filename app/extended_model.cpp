@@ -1,4 +1,4 @@
-#include "extended_model.hpp"
+#include "app/extended_model.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -8,8 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "derive_pipeline.hpp"
-#include "sinks.hpp"
+#include "app/derive_pipeline.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::diagnose {
 

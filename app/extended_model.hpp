@@ -5,9 +5,9 @@
 #pragma once
 #include <string>
 
-#include "diagnosis.hpp"
-#include "geometry.hpp"
-#include "vehicle.hpp"
+#include "diagnose/diagnosis.hpp"
+#include "derive/geometry.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::diagnose {
 

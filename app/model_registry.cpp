@@ -1,11 +1,11 @@
-#include "model_registry.hpp"
+#include "app/model_registry.hpp"
 
 #include "generated/crazyflie21/model.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
-#include "effect_catalogue.hpp"
-#include "tape_builder.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "codegen/tape_builder.hpp"
 
 namespace quadgen::app {
 

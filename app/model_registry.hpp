@@ -3,9 +3,9 @@
 #pragma once
 #include <memory>
 
-#include "dynamic_model.hpp"
-#include "symbolic_model.hpp"
-#include "vehicle.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "derive/symbolic_model.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::app {
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled = nullptr);

@@ -1,4 +1,4 @@
-#include "simulate_job.hpp"
+#include "app/simulate_job.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -6,16 +6,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "attitude.hpp"
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "flight_log.hpp"
-#include "geometry.hpp"
-#include "integrator.hpp"
-#include "model_registry.hpp"
-#include "runtime_bridge.hpp"
-#include "scenarios.hpp"
-#include "sinks.hpp"
+#include "runtime/attitude.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "runtime/flight_log.hpp"
+#include "derive/geometry.hpp"
+#include "runtime/integrator.hpp"
+#include "app/model_registry.hpp"
+#include "codegen/runtime_bridge.hpp"
+#include "runtime/scenarios.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::app {
 

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "closed_loop.hpp"
-#include "plot.hpp"
+#include "runtime/closed_loop.hpp"
+#include "runtime/plot.hpp"
 
 namespace quadgen::app {
 

@@ -1,12 +1,12 @@
-#include "audit.hpp"
+#include "audit/audit.hpp"
 
 #include <cmath>
 #include <sstream>
 
 #include <Eigen/Dense>
 
-#include "dimension_checker.hpp"
-#include "kinematics.hpp"
+#include "audit/dimension_checker.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

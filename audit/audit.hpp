@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry.hpp"
-#include "symbolic_model.hpp"
+#include "derive/geometry.hpp"
+#include "derive/symbolic_model.hpp"
 
 namespace quadgen {
 

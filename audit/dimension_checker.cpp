@@ -1,8 +1,8 @@
-#include "dimension_checker.hpp"
+#include "audit/dimension_checker.hpp"
 
 #include <sstream>
 
-#include "symbolic_functions.hpp"
+#include "derive/symbolic_functions.hpp"
 
 namespace quadgen {
 

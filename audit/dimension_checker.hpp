@@ -4,7 +4,7 @@
 
 #include <ginac/ginac.h>
 
-#include "units.hpp"
+#include "model/units.hpp"
 
 namespace quadgen {
 

@@ -1,4 +1,4 @@
-#include "report.hpp"
+#include "audit/report.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "json_document.hpp"
-#include "sinks.hpp"
+#include "output/json_document.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

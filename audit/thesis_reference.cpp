@@ -1,17 +1,17 @@
-#include "thesis_reference.hpp"
+#include "audit/thesis_reference.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <sstream>
 
-#include "attitude.hpp"
-#include "audit.hpp"
-#include "dynamics.hpp"
-#include "integrator.hpp"
-#include "kinematics.hpp"
-#include "scenarios.hpp"
-#include "tape_builder.hpp"
+#include "runtime/attitude.hpp"
+#include "audit/audit.hpp"
+#include "derive/dynamics.hpp"
+#include "runtime/integrator.hpp"
+#include "derive/kinematics.hpp"
+#include "runtime/scenarios.hpp"
+#include "codegen/tape_builder.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

@@ -6,12 +6,12 @@
 
 #include <random>
 
-#include "dynamic_model.hpp"
-#include "equation_error.hpp"
-#include "integrator.hpp"
-#include "multiple_shooting.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/equation_error.hpp"
+#include "runtime/integrator.hpp"
+#include "fit/multiple_shooting.hpp"
 #include "generated/finken3/model.hpp"
-#include "profile_likelihood.hpp"
+#include "fit/profile_likelihood.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;

@@ -12,10 +12,10 @@
 #include <map>
 #include <string>
 
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "header_writer.hpp"
-#include "reference_model.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "codegen/header_writer.hpp"
+#include "bench/reference_model.hpp"
 
 namespace gen = quadgen_generated::finken3;
 using quadgen::reference::reference_rhs;

@@ -8,8 +8,8 @@
 
 #include <string>
 
-#include "geometry.hpp"
-#include "vehicle.hpp"
+#include "derive/geometry.hpp"
+#include "model/vehicle.hpp"
 
 using namespace quadgen;
 

@@ -5,11 +5,11 @@
 
 #include <string>
 
-#include "dynamic_model.hpp"
-#include "dynamics.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "derive/dynamics.hpp"
 #include "generated/finken3/model.hpp"
-#include "integrator.hpp"
-#include "tape_builder.hpp"
+#include "runtime/integrator.hpp"
+#include "codegen/tape_builder.hpp"
 
 using namespace quadgen;
 using namespace quadgen::runtime;

@@ -5,11 +5,11 @@
 
 #include <CLI/CLI.hpp>
 
-#include "derive_command.hpp"
-#include "diagnose_job.hpp"
-#include "fit_pipeline.hpp"
-#include "predict_flights.hpp"
-#include "simulate_job.hpp"
+#include "cli/derive_command.hpp"
+#include "app/diagnose_job.hpp"
+#include "fit/fit_pipeline.hpp"
+#include "predict/predict_flights.hpp"
+#include "app/simulate_job.hpp"
 
 namespace quadgen::cli {
 

@@ -3,11 +3,11 @@
 #include <iostream>
 #include <set>
 
-#include "derive_command.hpp"
-#include "derive_pipeline.hpp"
-#include "effect_catalogue.hpp"
-#include "fitted_parameters.hpp"
-#include "output_set.hpp"
+#include "cli/derive_command.hpp"
+#include "app/derive_pipeline.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "derive/fitted_parameters.hpp"
+#include "output/output_set.hpp"
 
 namespace quadgen::cli {
 

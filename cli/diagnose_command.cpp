@@ -3,12 +3,12 @@
 // The pipeline itself: app/diagnose_job.cpp.
 #include <iostream>
 
-#include "commands.hpp"
-#include "diagnose_job.hpp"
-#include "effect_catalogue.hpp"
-#include "options.hpp"
-#include "output_set.hpp"
-#include "sinks.hpp"
+#include "cli/commands.hpp"
+#include "app/diagnose_job.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "cli/options.hpp"
+#include "output/output_set.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::cli {
 

@@ -3,8 +3,8 @@
 #include <iostream>
 #include <string>
 
-#include "derive_command.hpp"
-#include "sinks.hpp"
+#include "cli/derive_command.hpp"
+#include "output/sinks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"quadgen-derive: derive, audit and emit a flight model (bootstrap for generated/)"};

@@ -4,19 +4,19 @@
 #include <fstream>
 #include <iostream>
 
-#include "commands.hpp"
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "geometry.hpp"
-#include "json_document.hpp"
-#include "model_registry.hpp"
-#include "options.hpp"
-#include "output_set.hpp"
-#include "fit_pipeline.hpp"
-#include "predict_flights.hpp"
-#include "prediction.hpp"
-#include "sinks.hpp"
-#include "vehicle.hpp"
+#include "cli/commands.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "derive/geometry.hpp"
+#include "output/json_document.hpp"
+#include "app/model_registry.hpp"
+#include "cli/options.hpp"
+#include "output/output_set.hpp"
+#include "fit/fit_pipeline.hpp"
+#include "predict/predict_flights.hpp"
+#include "predict/prediction.hpp"
+#include "output/sinks.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::cli {
 

@@ -3,9 +3,9 @@
 #include <new>
 #include <string>
 
-#include "commands.hpp"
-#include "options.hpp"
-#include "sinks.hpp"
+#include "cli/commands.hpp"
+#include "cli/options.hpp"
+#include "output/sinks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};

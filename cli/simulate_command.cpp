@@ -3,21 +3,21 @@
 #include <filesystem>
 #include <iostream>
 
-#include "closed_loop.hpp"
-#include "runtime_bridge.hpp"
-#include "attitude.hpp"
-#include "commands.hpp"
-#include "options.hpp"
-#include "output_set.hpp"
-#include "sinks.hpp"
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "flight_log.hpp"
-#include "geometry.hpp"
-#include "integrator.hpp"
-#include "plot.hpp"
-#include "scenarios.hpp"
-#include "simulate_job.hpp"
+#include "runtime/closed_loop.hpp"
+#include "codegen/runtime_bridge.hpp"
+#include "runtime/attitude.hpp"
+#include "cli/commands.hpp"
+#include "cli/options.hpp"
+#include "output/output_set.hpp"
+#include "output/sinks.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "runtime/flight_log.hpp"
+#include "derive/geometry.hpp"
+#include "runtime/integrator.hpp"
+#include "runtime/plot.hpp"
+#include "runtime/scenarios.hpp"
+#include "app/simulate_job.hpp"
 
 namespace quadgen::cli {
 

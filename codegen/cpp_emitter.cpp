@@ -1,4 +1,4 @@
-#include "cpp_emitter.hpp"
+#include "codegen/cpp_emitter.hpp"
 
 #include <algorithm>
 #include <cmath>

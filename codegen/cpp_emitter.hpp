@@ -20,7 +20,7 @@
 #include <tuple>
 #include <vector>
 
-#include "expression_graph.hpp"
+#include "codegen/expression_graph.hpp"
 
 namespace quadgen::codegen {
 

@@ -1,4 +1,4 @@
-#include "expression_graph.hpp"
+#include "codegen/expression_graph.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "symbolic_functions.hpp"
+#include "derive/symbolic_functions.hpp"
 
 namespace quadgen::codegen {
 using namespace GiNaC;

@@ -11,7 +11,7 @@
 
 #include <ginac/ginac.h>
 
-#include "symbolic_model.hpp"
+#include "derive/symbolic_model.hpp"
 
 namespace quadgen::codegen {
 

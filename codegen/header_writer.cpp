@@ -1,15 +1,15 @@
-#include "header_writer.hpp"
+#include "codegen/header_writer.hpp"
 
 #include <cmath>
 
 #include <kainjow/mustache.hpp>
 
-#include "cpp_emitter.hpp"
-#include "exact_number.hpp"
-#include "names.hpp"
-#include "sinks.hpp"
-#include "effect_catalogue.hpp"
-#include "vehicle.hpp"
+#include "codegen/cpp_emitter.hpp"
+#include "derive/exact_number.hpp"
+#include "output/names.hpp"
+#include "output/sinks.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "model/vehicle.hpp"
 
 extern const char* const kModelHeaderTemplate;  // templates/model.hpp.mustache, embedded by CMake
 

@@ -4,7 +4,7 @@
 
 #include <kainjow/mustache.hpp>
 
-#include "symbolic_model.hpp"
+#include "derive/symbolic_model.hpp"
 
 namespace quadgen::codegen {
 

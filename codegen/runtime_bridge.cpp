@@ -1,4 +1,4 @@
-#include "runtime_bridge.hpp"
+#include "codegen/runtime_bridge.hpp"
 
 namespace quadgen {
 

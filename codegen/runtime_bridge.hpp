@@ -4,10 +4,10 @@
 #pragma once
 #include <vector>
 
-#include "closed_loop.hpp"
-#include "scenarios.hpp"
-#include "symbolic_model.hpp"
-#include "vehicle.hpp"
+#include "runtime/closed_loop.hpp"
+#include "runtime/scenarios.hpp"
+#include "derive/symbolic_model.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 

@@ -1,9 +1,9 @@
-#include "tape_builder.hpp"
+#include "codegen/tape_builder.hpp"
 
 #include <cstdlib>
 #include <functional>
 
-#include "expression_graph.hpp"
+#include "codegen/expression_graph.hpp"
 
 namespace quadgen::codegen {
 using namespace GiNaC;

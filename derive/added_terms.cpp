@@ -1,9 +1,9 @@
-#include "added_terms.hpp"
+#include "derive/added_terms.hpp"
 
 #include <stdexcept>
 
-#include "dynamics.hpp"
-#include "units.hpp"
+#include "derive/dynamics.hpp"
+#include "model/units.hpp"
 
 namespace quadgen {
 

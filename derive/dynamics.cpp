@@ -1,16 +1,16 @@
-#include "dynamics.hpp"
+#include "derive/dynamics.hpp"
 
 #include <cstdio>
 #include <cstdlib>
 #include <set>
 #include <stdexcept>
 
-#include "thrust_law.hpp"
-#include "effect_catalogue.hpp"
-#include "exact_number.hpp"
-#include "kinematics.hpp"
-#include "sinks.hpp"
-#include "symbolic_functions.hpp"
+#include "runtime/thrust_law.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "derive/exact_number.hpp"
+#include "derive/kinematics.hpp"
+#include "output/sinks.hpp"
+#include "derive/symbolic_functions.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

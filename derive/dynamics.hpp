@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "added_terms.hpp"
-#include "geometry.hpp"
-#include "symbolic_model.hpp"
-#include "vehicle.hpp"
+#include "derive/added_terms.hpp"
+#include "derive/geometry.hpp"
+#include "derive/symbolic_model.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 

@@ -1,4 +1,4 @@
-#include "exact_number.hpp"
+#include "derive/exact_number.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -1,11 +1,11 @@
-#include "fitted_parameters.hpp"
+#include "derive/fitted_parameters.hpp"
 
 #include <algorithm>
 #include <sstream>
 
-#include "effect_catalogue.hpp"
-#include "sinks.hpp"
-#include "yaml_reader.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "output/sinks.hpp"
+#include "model/yaml_reader.hpp"
 
 namespace quadgen {
 

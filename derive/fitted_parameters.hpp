@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "symbolic_model.hpp"
+#include "derive/symbolic_model.hpp"
 
 namespace quadgen {
 

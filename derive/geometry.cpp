@@ -1,12 +1,12 @@
-#include "geometry.hpp"
+#include "derive/geometry.hpp"
 
 #include <array>
 #include <cmath>
 #include <map>
 #include <utility>
 
-#include "exact_number.hpp"
-#include "kinematics.hpp"
+#include "derive/exact_number.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

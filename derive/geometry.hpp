@@ -10,7 +10,7 @@
 
 #include <ginac/ginac.h>
 
-#include "vehicle.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 

@@ -1,4 +1,4 @@
-#include "kinematics.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

@@ -1,4 +1,4 @@
-#include "symbolic_functions.hpp"
+#include "derive/symbolic_functions.hpp"
 
 namespace quadgen {
 using namespace GiNaC;

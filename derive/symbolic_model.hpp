@@ -9,7 +9,7 @@
 
 #include <ginac/ginac.h>
 
-#include "units.hpp"
+#include "model/units.hpp"
 
 namespace quadgen {
 

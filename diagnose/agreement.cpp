@@ -1,13 +1,13 @@
-#include "agreement.hpp"
+#include "diagnose/agreement.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 
-#include "candidate_search.hpp"
-#include "equation_error.hpp"
-#include "per_flight_model.hpp"
+#include "diagnose/candidate_search.hpp"
+#include "fit/equation_error.hpp"
+#include "runtime/per_flight_model.hpp"
 
 namespace quadgen::diagnose {
 

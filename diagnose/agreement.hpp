@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
-#include "least_squares.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
+#include "fit/least_squares.hpp"
 
 namespace quadgen::diagnose {
 

@@ -1,4 +1,4 @@
-#include "candidate_search.hpp"
+#include "diagnose/candidate_search.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -15,9 +15,9 @@
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "effect_catalogue.hpp"
-#include "per_flight_model.hpp"
-#include "residual_analysis.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "diagnose/residual_analysis.hpp"
 
 namespace quadgen::diagnose {
 

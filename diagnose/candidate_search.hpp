@@ -29,11 +29,11 @@
 
 #include <Eigen/Core>
 
-#include "dynamic_model.hpp"
-#include "equation_error.hpp"
-#include "least_squares.hpp"
-#include "profile_likelihood.hpp"
-#include "symbolic_model.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/equation_error.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/profile_likelihood.hpp"
+#include "derive/symbolic_model.hpp"
 
 namespace quadgen::diagnose {
 

@@ -1,4 +1,4 @@
-#include "diagnosis.hpp"
+#include "diagnose/diagnosis.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,13 +9,13 @@
 #include <memory>
 #include <sstream>
 
-#include "agreement.hpp"
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "geometry.hpp"
-#include "per_flight_model.hpp"
-#include "tape.hpp"
-#include "tape_builder.hpp"
+#include "diagnose/agreement.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "derive/geometry.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "runtime/tape.hpp"
+#include "codegen/tape_builder.hpp"
 
 namespace quadgen::diagnose {
 

@@ -6,15 +6,15 @@
 #include <string>
 #include <vector>
 
-#include "agreement.hpp"
-#include "candidate_search.hpp"
-#include "effect_catalogue.hpp"
-#include "flight_data.hpp"
-#include "prediction.hpp"
-#include "residual_analysis.hpp"
-#include "term_discovery.hpp"
-#include "validation.hpp"
-#include "vehicle.hpp"
+#include "diagnose/agreement.hpp"
+#include "diagnose/candidate_search.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "fit/flight_data.hpp"
+#include "predict/prediction.hpp"
+#include "diagnose/residual_analysis.hpp"
+#include "diagnose/term_discovery.hpp"
+#include "diagnose/validation.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::diagnose {
 

@@ -1,4 +1,4 @@
-#include "diagnosis_report.hpp"
+#include "diagnose/diagnosis_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <optional>
 #include <sstream>
 
-#include "effect_catalogue.hpp"
-#include "per_flight_model.hpp"
-#include "estimate.hpp"
-#include "fit_report.hpp"
-#include "plot.hpp"
-#include "sinks.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "output/estimate.hpp"
+#include "fit/fit_report.hpp"
+#include "runtime/plot.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::diagnose {
 

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diagnosis.hpp"
+#include "diagnose/diagnosis.hpp"
 
 namespace quadgen::diagnose {
 

@@ -1,4 +1,4 @@
-#include "residual_analysis.hpp"
+#include "diagnose/residual_analysis.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
-#include "attitude.hpp"
+#include "runtime/attitude.hpp"
 
 namespace quadgen::diagnose {
 

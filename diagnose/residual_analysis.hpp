@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "flight_data.hpp"
+#include "fit/flight_data.hpp"
 
 namespace quadgen::diagnose {
 

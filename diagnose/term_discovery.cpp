@@ -1,4 +1,4 @@
-#include "term_discovery.hpp"
+#include "diagnose/term_discovery.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <Eigen/Dense>
 #include <boost/math/distributions/normal.hpp>
 
-#include "attitude.hpp"
-#include "least_squares.hpp"
-#include "residual_analysis.hpp"
+#include "runtime/attitude.hpp"
+#include "fit/least_squares.hpp"
+#include "diagnose/residual_analysis.hpp"
 
 namespace quadgen::diagnose {
 

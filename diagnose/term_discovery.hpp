@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "added_terms.hpp"
-#include "flight_data.hpp"
+#include "derive/added_terms.hpp"
+#include "fit/flight_data.hpp"
 
 namespace quadgen::diagnose {
 

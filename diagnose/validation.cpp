@@ -1,13 +1,13 @@
-#include "validation.hpp"
+#include "diagnose/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "attitude.hpp"
-#include "data_side_effects.hpp"
-#include "integrator.hpp"
-#include "per_flight_model.hpp"
+#include "runtime/attitude.hpp"
+#include "runtime/data_side_effects.hpp"
+#include "runtime/integrator.hpp"
+#include "runtime/per_flight_model.hpp"
 
 namespace quadgen::diagnose {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
 
 namespace quadgen::diagnose {
 

@@ -1,6 +1,6 @@
-#include "equation_error.hpp"
+#include "fit/equation_error.hpp"
 
-#include "attitude.hpp"
+#include "runtime/attitude.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "data_side_effects.hpp"
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
-#include "least_squares.hpp"
+#include "runtime/data_side_effects.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
+#include "fit/least_squares.hpp"
 
 namespace quadgen::fit {
 

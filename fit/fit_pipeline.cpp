@@ -1,4 +1,4 @@
-#include "fit_pipeline.hpp"
+#include "fit/fit_pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,17 +6,17 @@
 #include <memory>
 #include <sstream>
 
-#include "thrust_law.hpp"
-#include "dynamic_model.hpp"
-#include "effect_catalogue.hpp"
-#include "equation_error.hpp"
-#include "fit_report.hpp"
-#include "log_reader.hpp"
-#include "motor_steps.hpp"
-#include "multiple_shooting.hpp"
-#include "plot.hpp"
-#include "sinks.hpp"
-#include "thrust_stand.hpp"
+#include "runtime/thrust_law.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "fit/equation_error.hpp"
+#include "fit/fit_report.hpp"
+#include "fit/log_reader.hpp"
+#include "fit/motor_steps.hpp"
+#include "fit/multiple_shooting.hpp"
+#include "runtime/plot.hpp"
+#include "output/sinks.hpp"
+#include "fit/thrust_stand.hpp"
 
 namespace quadgen::fit {
 

@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "flight_data.hpp"
-#include "least_squares.hpp"
-#include "profile_likelihood.hpp"
-#include "vehicle.hpp"
+#include "fit/flight_data.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/profile_likelihood.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::runtime {
 class DynamicModel;

@@ -1,9 +1,9 @@
-#include "fit_report.hpp"
+#include "fit/fit_report.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "plot.hpp"
+#include "runtime/plot.hpp"
 
 namespace quadgen::fit {
 

@@ -1,15 +1,15 @@
 // fit.json (estimates, standard errors, profile-likelihood intervals, verdicts, noise per
 // channel) and the profile plots.
 #pragma once
-#include "plot.hpp"
+#include "runtime/plot.hpp"
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "estimate.hpp"
-#include "least_squares.hpp"
-#include "profile_likelihood.hpp"
+#include "output/estimate.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/profile_likelihood.hpp"
 
 namespace quadgen::fit {
 

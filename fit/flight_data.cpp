@@ -1,4 +1,4 @@
-#include "flight_data.hpp"
+#include "fit/flight_data.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <Eigen/Dense>
 #include <yaml-cpp/yaml.h>
 
-#include "least_squares.hpp"
-#include "units.hpp"
+#include "fit/least_squares.hpp"
+#include "model/units.hpp"
 
 namespace quadgen::fit {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "flight_log.hpp"
+#include "runtime/flight_log.hpp"
 
 namespace quadgen::fit {
 

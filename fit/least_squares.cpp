@@ -1,4 +1,4 @@
-#include "least_squares.hpp"
+#include "fit/least_squares.hpp"
 
 #include <cmath>
 #include <limits>

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "parameter.hpp"
+#include "runtime/parameter.hpp"
 
 namespace quadgen::fit {
 

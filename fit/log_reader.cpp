@@ -1,11 +1,11 @@
-#include "log_reader.hpp"
+#include "fit/log_reader.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "least_squares.hpp"  // FitError
-#include "log_file.hpp"
+#include "fit/least_squares.hpp"  // FitError
+#include "runtime/log_file.hpp"
 
 namespace quadgen::fit {
 

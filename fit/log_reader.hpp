@@ -14,10 +14,10 @@
 #pragma once
 #include <string>
 
-#include "flight_data.hpp"
-#include "flight_log.hpp"
-#include "ulog.hpp"
-#include "usd_log.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
+#include "runtime/ulog.hpp"
+#include "runtime/usd_log.hpp"
 
 namespace quadgen::fit {
 

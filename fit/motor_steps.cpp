@@ -1,10 +1,10 @@
-#include "motor_steps.hpp"
+#include "fit/motor_steps.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "flight_data.hpp"
-#include "flight_log.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
 
 namespace quadgen::fit {
 

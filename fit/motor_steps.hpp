@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "least_squares.hpp"
+#include "fit/least_squares.hpp"
 
 namespace quadgen::fit {
 

@@ -1,8 +1,8 @@
-#include "multiple_shooting.hpp"
+#include "fit/multiple_shooting.hpp"
 
 #include <cmath>
 
-#include "integrator.hpp"
+#include "runtime/integrator.hpp"
 
 namespace quadgen::fit {
 

@@ -1,4 +1,4 @@
-#include "profile_likelihood.hpp"
+#include "fit/profile_likelihood.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -1,11 +1,11 @@
-#include "thrust_stand.hpp"
+#include "fit/thrust_stand.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "flight_data.hpp"
-#include "flight_log.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
 
 namespace quadgen::fit {
 

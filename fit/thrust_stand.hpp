@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "least_squares.hpp"
-#include "profile_likelihood.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/profile_likelihood.hpp"
 
 namespace quadgen::fit {
 

@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <string>
 
-#include "flight_data.hpp"
-#include "flight_log.hpp"
-#include "least_squares.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
+#include "fit/least_squares.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

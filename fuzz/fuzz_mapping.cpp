@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "equation_error.hpp"
-#include "flight_data.hpp"
-#include "flight_log.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/equation_error.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
 #include "generated/finken3/model.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -10,10 +10,10 @@
 
 #include <kainjow/mustache.hpp>
 
-#include "header_writer.hpp"
-#include "names.hpp"
-#include "plot.hpp"
-#include "sinks.hpp"
+#include "codegen/header_writer.hpp"
+#include "output/names.hpp"
+#include "runtime/plot.hpp"
+#include "output/sinks.hpp"
 
 extern const char* const kModelHeaderTemplate;
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "ulog.hpp"
+#include "runtime/ulog.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

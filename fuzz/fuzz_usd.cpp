@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "usd_log.hpp"
+#include "runtime/usd_log.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

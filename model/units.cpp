@@ -1,4 +1,4 @@
-#include "units.hpp"
+#include "model/units.hpp"
 
 #include <cmath>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "vehicle.hpp"
+#include "model/vehicle.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -7,9 +7,9 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "names.hpp"
-#include "yaml_reader.hpp"
-#include "sinks.hpp"
+#include "output/names.hpp"
+#include "model/yaml_reader.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen {
 namespace {

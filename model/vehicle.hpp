@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "fnv1a.hpp"
-#include "units.hpp"
+#include "output/fnv1a.hpp"
+#include "model/units.hpp"
 
 namespace quadgen {
 

@@ -11,8 +11,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "sinks.hpp"
-#include "vehicle.hpp"
+#include "output/sinks.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 

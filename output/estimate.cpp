@@ -1,4 +1,4 @@
-#include "estimate.hpp"
+#include "output/estimate.hpp"
 
 namespace quadgen::output {
 

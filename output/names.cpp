@@ -1,4 +1,4 @@
-#include "names.hpp"
+#include "output/names.hpp"
 
 #include <algorithm>
 #include <set>

@@ -1,4 +1,4 @@
-#include "output_set.hpp"
+#include "output/output_set.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -16,8 +16,8 @@
 #include <set>
 #include <sstream>
 
-#include "fnv1a.hpp"
-#include "sinks.hpp"
+#include "output/fnv1a.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::output {
 namespace fs = std::filesystem;

@@ -1,9 +1,9 @@
-#include "sinks.hpp"
+#include "output/sinks.hpp"
 
 #include <cstdio>
 #include <stdexcept>
 
-#include "names.hpp"
+#include "output/names.hpp"
 
 namespace quadgen::output {
 namespace {

@@ -1,15 +1,15 @@
-#include "parameter_source.hpp"
+#include "predict/parameter_source.hpp"
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
-#include "equation_error.hpp"
-#include "flight_log.hpp"
-#include "log_file.hpp"
-#include "per_flight_model.hpp"
-#include "sinks.hpp"
+#include "fit/equation_error.hpp"
+#include "runtime/flight_log.hpp"
+#include "runtime/log_file.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::predict {
 

@@ -11,9 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
-#include "least_squares.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
+#include "fit/least_squares.hpp"
 
 namespace quadgen::predict {
 

@@ -1,12 +1,12 @@
-#include "predict_flights.hpp"
+#include "predict/predict_flights.hpp"
 
 #include <optional>
 #include <sstream>
 #include <utility>
 
-#include "log_reader.hpp"
-#include "parameter_source.hpp"
-#include "sinks.hpp"
+#include "fit/log_reader.hpp"
+#include "predict/parameter_source.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::predict {
 

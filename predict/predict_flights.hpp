@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynamic_model.hpp"
-#include "least_squares.hpp"
-#include "prediction.hpp"
-#include "vehicle.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/least_squares.hpp"
+#include "predict/prediction.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::predict {
 

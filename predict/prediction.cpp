@@ -1,13 +1,13 @@
-#include "prediction.hpp"
+#include "predict/prediction.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include "attitude.hpp"
-#include "data_side_effects.hpp"
-#include "equation_error.hpp"
+#include "runtime/attitude.hpp"
+#include "runtime/data_side_effects.hpp"
+#include "fit/equation_error.hpp"
 
 namespace quadgen::predict {
 

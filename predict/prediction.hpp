@@ -16,9 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
-#include "plot.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/plot.hpp"
 
 namespace quadgen::predict {
 

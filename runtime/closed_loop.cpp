@@ -1,4 +1,4 @@
-#include "closed_loop.hpp"
+#include "runtime/closed_loop.hpp"
 
 #include <cmath>
 #include <random>
@@ -6,8 +6,8 @@
 
 #include <Eigen/Dense>
 
-#include "attitude.hpp"
-#include "integrator.hpp"
+#include "runtime/attitude.hpp"
+#include "runtime/integrator.hpp"
 
 namespace quadgen::runtime {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "scenarios.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "runtime/scenarios.hpp"
 
 namespace quadgen::runtime {
 

@@ -12,7 +12,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "dynamic_model.hpp"
+#include "runtime/dynamic_model.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,8 +1,8 @@
-#include "flight_log.hpp"
+#include "runtime/flight_log.hpp"
 
-#include "log_file.hpp"
+#include "runtime/log_file.hpp"
 
-#include "attitude.hpp"
+#include "runtime/attitude.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

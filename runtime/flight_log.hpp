@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "integrator.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "runtime/integrator.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,4 +1,4 @@
-#include "integrator.hpp"
+#include "runtime/integrator.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
-#include "input_signal.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "runtime/input_signal.hpp"
 
 namespace quadgen::runtime {
 

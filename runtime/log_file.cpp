@@ -1,4 +1,4 @@
-#include "log_file.hpp"
+#include "runtime/log_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "flight_log.hpp"
+#include "runtime/flight_log.hpp"
 
 namespace quadgen::runtime {
 

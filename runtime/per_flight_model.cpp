@@ -1,4 +1,4 @@
-#include "per_flight_model.hpp"
+#include "runtime/per_flight_model.hpp"
 
 #include <algorithm>
 #include <set>

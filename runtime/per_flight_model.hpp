@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "dynamic_model.hpp"
+#include "runtime/dynamic_model.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,4 +1,4 @@
-#include "plot.hpp"
+#include "runtime/plot.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -16,7 +16,7 @@
 #include <sstream>
 #include <tuple>
 
-#include "sinks.hpp"
+#include "output/sinks.hpp"
 
 extern char** environ;
 

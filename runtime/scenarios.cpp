@@ -1,4 +1,4 @@
-#include "scenarios.hpp"
+#include "runtime/scenarios.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "thrust_law.hpp"
+#include "runtime/thrust_law.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,4 +1,4 @@
-#include "tape.hpp"
+#include "runtime/tape.hpp"
 
 #include <cmath>
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_model.hpp"
+#include "runtime/dynamic_model.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,6 +1,6 @@
-#include "topic_log.hpp"
+#include "runtime/topic_log.hpp"
 
-#include "dynamic_model.hpp"  // index_in
+#include "runtime/dynamic_model.hpp"  // index_in
 
 namespace quadgen::runtime {
 

@@ -1,7 +1,7 @@
-#include "ulog.hpp"
+#include "runtime/ulog.hpp"
 
-#include "log_bytes.hpp"
-#include "log_file.hpp"
+#include "runtime/log_bytes.hpp"
+#include "runtime/log_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "flight_log.hpp"  // LogError
-#include "topic_log.hpp"
+#include "runtime/flight_log.hpp"  // LogError
+#include "runtime/topic_log.hpp"
 
 namespace quadgen::runtime {
 

@@ -1,4 +1,4 @@
-#include "usd_log.hpp"
+#include "runtime/usd_log.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -6,8 +6,8 @@
 #include <set>
 #include <string_view>
 
-#include "log_bytes.hpp"
-#include "log_file.hpp"
+#include "runtime/log_bytes.hpp"
+#include "runtime/log_file.hpp"
 
 namespace quadgen::runtime {
 

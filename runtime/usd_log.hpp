@@ -29,8 +29,8 @@
 #include <cstdint>
 #include <string>
 
-#include "flight_log.hpp"  // LogError
-#include "topic_log.hpp"
+#include "runtime/flight_log.hpp"  // LogError
+#include "runtime/topic_log.hpp"
 
 namespace quadgen::runtime {
 

@@ -24,8 +24,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "diagnose_job.hpp"
-#include "estimate_shape.hpp"
+#include "app/diagnose_job.hpp"
+#include "tests/estimate_shape.hpp"
 
 namespace {
 

@@ -8,17 +8,17 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynamic_model.hpp"
-#include "equation_error.hpp"
-#include "attitude.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/equation_error.hpp"
+#include "runtime/attitude.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
-#include "per_flight_model.hpp"
-#include "least_squares.hpp"
-#include "motor_steps.hpp"
-#include "profile_likelihood.hpp"
-#include "estimate_shape.hpp"
-#include "test_helpers.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/motor_steps.hpp"
+#include "fit/profile_likelihood.hpp"
+#include "tests/estimate_shape.hpp"
+#include "tests/test_helpers.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;
@@ -248,8 +248,8 @@ TEST(FitCli, MotorStepsOfTheThesis) {
 
 // Multiple shooting recovers the thrust coefficient and yaw-torque coefficient from the
 // pose alone: a simulated 4 s flight with wobbling commands, mocap-like pose noise.
-#include "integrator.hpp"
-#include "multiple_shooting.hpp"
+#include "runtime/integrator.hpp"
+#include "fit/multiple_shooting.hpp"
 TEST(Fit, MultipleShootingRecoversParametersFromPose) {
   runtime::CompiledModel<quadgen_generated::finken3::Model> model;
   const std::vector<double> truth = model.params();
@@ -377,7 +377,7 @@ TEST(Fit, ParallelProfilesEqualSequentialOnes) {
   EXPECT_THROW(profile_all(m, best, fo, two, {model.param_index("mass")}), FitError);  // not free
 }
 
-#include "thrust_stand.hpp"
+#include "fit/thrust_stand.hpp"
 namespace {
 // A synthetic stand run: thrust sum k w_i^2 + tare with noise; each motor's speed is the
 // common speed times its own factor, varied per sample by `independent`; the battery

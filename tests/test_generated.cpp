@@ -9,11 +9,11 @@
 #include <fstream>
 #include <random>
 
-#include "dynamics.hpp"
-#include "effect_catalogue.hpp"
-#include "generated_models.hpp"
-#include "header_writer.hpp"
-#include "test_helpers.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "tests/generated_models.hpp"
+#include "codegen/header_writer.hpp"
+#include "tests/test_helpers.hpp"
 
 namespace fs = std::filesystem;
 
@@ -239,7 +239,7 @@ TEST(Generated, IndependentOfSymbolCreationOrder) {
 // The hand-written reference (bench/reference_model.hpp) is an independent writing of the
 // same physics; it must agree with the generated f everywhere, products of inertia and
 // CoG offsets included.
-#include "reference_model.hpp"
+#include "bench/reference_model.hpp"
 TEST(Generated, AgreesWithHandWrittenReferenceModel) {
   std::mt19937 rng(21);
   const auto layout = quadgen::reference::finken3_layout();

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "generated_models.hpp"
+#include "tests/generated_models.hpp"
 
 // Forward-mode automatic differentiation of the generated f: exact to rounding, so the
 // analytic Jacobians must agree to 1e-8 relative. The derivative directions are seeded

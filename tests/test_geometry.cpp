@@ -12,7 +12,7 @@
 
 #include <Eigen/Dense>
 
-#include "test_helpers.hpp"
+#include "tests/test_helpers.hpp"
 
 using namespace quadgen;
 

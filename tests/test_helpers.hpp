@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "dynamics.hpp"
-#include "geometry.hpp"
-#include "vehicle.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/geometry.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen::test {
 

@@ -16,18 +16,18 @@
 #include <string>
 #include <thread>
 
-#include "diagnosis_report.hpp"
-#include "dynamics.hpp"
-#include "geometry.hpp"
-#include "json_document.hpp"
-#include "header_writer.hpp"
-#include "names.hpp"
-#include "output_set.hpp"
-#include "plot.hpp"
-#include "report.hpp"
-#include "sinks.hpp"
-#include "test_helpers.hpp"
-#include "vehicle.hpp"
+#include "diagnose/diagnosis_report.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/geometry.hpp"
+#include "output/json_document.hpp"
+#include "codegen/header_writer.hpp"
+#include "output/names.hpp"
+#include "output/output_set.hpp"
+#include "runtime/plot.hpp"
+#include "audit/report.hpp"
+#include "output/sinks.hpp"
+#include "tests/test_helpers.hpp"
+#include "model/vehicle.hpp"
 
 namespace fs = std::filesystem;
 using quadgen::test::source_path;

@@ -14,12 +14,12 @@
 #include <limits>
 #include <string>
 
-#include "flight_data.hpp"
-#include "flight_log.hpp"
-#include "log_reader.hpp"
-#include "least_squares.hpp"
-#include "motor_steps.hpp"
-#include "thrust_stand.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
+#include "fit/log_reader.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/motor_steps.hpp"
+#include "fit/thrust_stand.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;

@@ -3,9 +3,9 @@
 
 #include <Eigen/Geometry>
 
-#include "audit.hpp"
-#include "kinematics.hpp"
-#include "test_helpers.hpp"
+#include "audit/audit.hpp"
+#include "derive/kinematics.hpp"
+#include "tests/test_helpers.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;

@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "attitude.hpp"
-#include "least_squares.hpp"
-#include "log_reader.hpp"
-#include "ulog_writer.hpp"
+#include "runtime/attitude.hpp"
+#include "fit/least_squares.hpp"
+#include "fit/log_reader.hpp"
+#include "tests/ulog_writer.hpp"
 
 using namespace quadgen;
 using namespace quadgen::test;

@@ -10,12 +10,12 @@
 
 #include <Eigen/Dense>
 
-#include "audit.hpp"
-#include "effect_catalogue.hpp"
-#include "report.hpp"
-#include "test_helpers.hpp"
-#include "thesis_reference.hpp"
-#include "units.hpp"
+#include "audit/audit.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "audit/report.hpp"
+#include "tests/test_helpers.hpp"
+#include "audit/thesis_reference.hpp"
+#include "model/units.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;

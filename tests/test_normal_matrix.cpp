@@ -4,7 +4,7 @@
 
 #include <Eigen/Dense>
 
-#include "candidate_search.hpp"
+#include "diagnose/candidate_search.hpp"
 
 using quadgen::diagnose::analyse_normal_matrix;
 

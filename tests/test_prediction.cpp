@@ -13,12 +13,12 @@
 #include <string>
 
 #include "generated/finken3_all_effects/model.hpp"
-#include "dynamic_model.hpp"
-#include "flight_data.hpp"
-#include "flight_log.hpp"
-#include "parameter_source.hpp"
-#include "prediction.hpp"
-#include "test_helpers.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/flight_log.hpp"
+#include "predict/parameter_source.hpp"
+#include "predict/prediction.hpp"
+#include "tests/test_helpers.hpp"
 
 namespace fs = std::filesystem;
 using quadgen::test::source_path;

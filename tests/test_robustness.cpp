@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "test_helpers.hpp"
+#include "tests/test_helpers.hpp"
 
 namespace fs = std::filesystem;
 using quadgen::test::source_path;

@@ -8,16 +8,16 @@
 #include <filesystem>
 #include <fstream>
 
-#include "attitude.hpp"
-#include "dynamic_model.hpp"
-#include "effect_catalogue.hpp"
-#include "flight_log.hpp"
+#include "runtime/attitude.hpp"
+#include "runtime/dynamic_model.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "runtime/flight_log.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
-#include "integrator.hpp"
-#include "per_flight_model.hpp"
-#include "tape_builder.hpp"
-#include "test_helpers.hpp"
+#include "runtime/integrator.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "codegen/tape_builder.hpp"
+#include "tests/test_helpers.hpp"
 
 using namespace quadgen;
 using namespace quadgen::runtime;
@@ -500,8 +500,8 @@ TEST(Simulate, BadReplayLogFailsWithOneLineAndNoOutput) {
 // The closed-loop generator: tracks its reference, is reproducible by seed, and its
 // integrators compensate a weak motor with a larger command (what the thesis saw as
 // motor signals offset from each other).
-#include "closed_loop.hpp"
-#include "runtime_bridge.hpp"
+#include "runtime/closed_loop.hpp"
+#include "codegen/runtime_bridge.hpp"
 namespace {
 double column_mean(const GeneratedFlight& f, const std::string& name, size_t from) {
   const int c = index_in(f.columns, name);

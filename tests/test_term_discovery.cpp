@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "term_discovery.hpp"
+#include "diagnose/term_discovery.hpp"
 
 using namespace quadgen;
 using namespace quadgen::diagnose;

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "ulog.hpp"
-#include "ulog_writer.hpp"
+#include "runtime/ulog.hpp"
+#include "tests/ulog_writer.hpp"
 
 using namespace quadgen::runtime;
 using namespace quadgen::test;

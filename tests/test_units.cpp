@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "units.hpp"
+#include "model/units.hpp"
 
 using namespace quadgen;
 

@@ -10,10 +10,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "least_squares.hpp"  // FitError
-#include "log_reader.hpp"
-#include "usd_log.hpp"
-#include "usd_log_writer.hpp"
+#include "fit/least_squares.hpp"  // FitError
+#include "fit/log_reader.hpp"
+#include "runtime/usd_log.hpp"
+#include "tests/usd_log_writer.hpp"
 
 using namespace quadgen;
 using namespace quadgen::runtime;

@@ -8,8 +8,8 @@
 
 #include <Eigen/Dense>
 
-#include "effect_catalogue.hpp"
-#include "test_helpers.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "tests/test_helpers.hpp"
 
 using namespace quadgen;
 namespace fs = std::filesystem;
@@ -184,7 +184,7 @@ TEST(Cli, DeriveWritesModelJsonAndReport) {
 // derive --params: a fitted_parameters.yaml is applied only when every value names a
 // parameter of the model, in its unit and within its bounds; otherwise one line with the
 // file and line of the value.
-#include "fitted_parameters.hpp"
+#include "derive/fitted_parameters.hpp"
 TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
   const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_parameters";
   fs::create_directories(dir);

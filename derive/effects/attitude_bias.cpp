@@ -1,10 +1,10 @@
 // attitude_bias: the logged attitude is the true one rotated by a fixed roll and pitch,
 // q_log = q ⊗ q_bias (an IMU or a marker frame mounted askew). It acts in the measurement
 // h(x), not in the equations of motion.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
-#include "kinematics.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

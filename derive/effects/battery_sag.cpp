@@ -1,8 +1,8 @@
 // battery_sag: thrust scaled by (vbat / vbat_ref)^exponent, when the log holds the battery
 // voltage.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -7,10 +7,10 @@
 // k > 0 pitches the nose up when flying forward. Typical size: the NanoBench Crazyflie's
 // residuals give 2-2.7e-4 N m per m/s at a rotor speed sum near 9,000 rad/s, k ~ 3e-8 N s^2
 // (docs/crazyflie_evidence.md); no published Crazyflie value was found.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
-#include "kinematics.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -1,11 +1,11 @@
-#include "effect_catalogue.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 
 #include <algorithm>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
-#include "definitions.hpp"
+#include "derive/effects/definitions.hpp"
 
 namespace quadgen {
 

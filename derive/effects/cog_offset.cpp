@@ -1,10 +1,10 @@
 // cog_offset: the centre of gravity displaced in x and y from where the blocks put it.
 #include <cmath>
 
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
-#include "kinematics.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -1,7 +1,7 @@
 // Each effect's descriptor, built in its own file of this folder. catalogue.cpp calls them
 // in canonical order; a new effect adds its file, a line here and a line there.
 #pragma once
-#include "effect.hpp"
+#include "model/effect.hpp"
 
 namespace quadgen::effects {
 

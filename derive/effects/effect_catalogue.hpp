@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "effect.hpp"
+#include "model/effect.hpp"
 
 namespace quadgen {
 

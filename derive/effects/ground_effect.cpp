@@ -1,8 +1,8 @@
 // ground_effect: thrust near the ground scaled by 1 / (1 - (R / 4z)^2) (Cheeseman & Bennett,
 // "The effect of the ground on a helicopter rotor in forward flight", ARC R&M 3021, 1955).
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -1,4 +1,4 @@
-#include "headline_words.hpp"
+#include "derive/effects/headline_words.hpp"
 
 #include <cmath>
 #include <iomanip>

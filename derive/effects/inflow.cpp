@@ -10,9 +10,9 @@
 // dC_T/C_T per unit climb ratio = 1 / (lambda_h + 16 lambda_h^2 / (sigma a)), lambda_h =
 // sqrt(C_T / 2); for the Crazyflie (C_T ~ 0.02, solidity sigma ~ 0.1-0.15, lift slope
 // a ~ 5.7 /rad, both assumed) k ~ 2.5-3.5: a 1 m/s climb at a 40 m/s tip speed costs ~7 %.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -1,7 +1,7 @@
 // input_delay: a pure time shift between the logged commands and their effect.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 

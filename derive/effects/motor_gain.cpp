@@ -3,9 +3,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -1,7 +1,7 @@
 // motor_lag: a first-order lag from commanded to actual rotor speed, tau dw/dt = w_cmd - w.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

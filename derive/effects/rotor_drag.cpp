@@ -7,10 +7,10 @@
 // real flights, the force then stood in for the flapping moment through that lever, or was
 // rejected because the moment it forced conflicted with the gyro. With force and moment apart,
 // their ratio is the effective point of action, estimated rather than assumed.
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
-#include "kinematics.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

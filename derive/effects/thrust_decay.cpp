@@ -2,9 +2,9 @@
 // the battery running down when no voltage is logged.
 #include <cmath>
 
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

@@ -3,10 +3,10 @@
 // blade_flapping, inflow), which is why it comes before them in the catalogue.
 #include <cmath>
 
-#include "definitions.hpp"
-#include "dynamics.hpp"
-#include "headline_words.hpp"
-#include "kinematics.hpp"
+#include "derive/effects/definitions.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/headline_words.hpp"
+#include "derive/kinematics.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;

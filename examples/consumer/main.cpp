@@ -4,7 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model.hpp"  // generated from vehicles/finken3.yaml
+#include "model.hpp"                   // generated from vehicles/finken3.yaml
+#include "runtime/dynamic_model.hpp"  // installed with quadgen: the runtime's interface to a model
 
 namespace m = quadgen_generated::finken3;
 
@@ -56,6 +57,23 @@ double hover_command(const Simulation<double>& sim) {
   return (lo + hi) / 2;
 }
 
+// The same model through the runtime's interface (quadgen::runtime::CompiledModel, from the
+// installed runtime/dynamic_model.hpp): f at a state must be the header's own, bit for bit.
+int adapter_mismatches(const Simulation<double>& sim, double u_hover) {
+  const quadgen::runtime::CompiledModel<m::Model> model;
+  double x[m::kNumStates], u[m::kNumInputs], direct[m::kNumStates], adapted[m::kNumStates];
+  hover_state(x);
+  x[m::State::vx] = 0.3, x[m::State::p] = 0.1;  // moving, so that every term is exercised
+  for (double& ui : u) ui = u_hover;
+  m::rhs(x, u, sim.p, sim.pre, direct);
+  model.rhs(x, u, adapted, nullptr, nullptr, nullptr);
+  int bad = 0;
+  for (int i = 0; i < m::kNumStates; ++i) bad += direct[i] == adapted[i] ? 0 : 1;
+  std::printf("runtime adapter (%d states, %d parameters): %d mismatches with the header\n", model.num_states(),
+              model.num_params(), bad);
+  return bad;
+}
+
 int main() {
   const Simulation<double> sd;
   const Simulation<float> sf;
@@ -90,5 +108,6 @@ int main() {
   }
   std::printf("finken3: hover command %.6f, %d RK4 steps of %g s; float vs double: %d mismatches\n", u_hover,
               steps, h, bad);
+  bad += adapter_mismatches(sd, u_hover);
   return bad == 0 ? 0 : 1;
 }
