@@ -277,9 +277,22 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
+  // Several flights: one whose commands sit at their limit is left out (it would bend the
+  // airframe to explain motors that cannot give what was asked), unless none is usable.
+  size_t usable = 0;
+  for (const auto& f : flights_in) {
+    d.screening.push_back(screen_flight(f));
+    usable += d.screening.back().usable ? 1 : 0;
+  }
+  const bool leave_out = flights_in.size() > 1 && usable > 0;
   // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
   std::vector<fit::Flight> flights;
-  for (const auto& f : flights_in) {
+  for (size_t k = 0; k < flights_in.size(); ++k) {
+    if (leave_out && !d.screening[k].usable) {
+      std::cerr << "[diagnose] left out " << flights_in[k].source << ": " << d.screening[k].reason << "\n";
+      continue;
+    }
+    const fit::Flight& f = flights_in[k];
     flights.push_back(predict::fill_missing_signals(f, all_in.params[all_in.param_index("vbat_ref")].nominal));
     d.flights.push_back(f.source);
   }

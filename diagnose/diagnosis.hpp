@@ -8,6 +8,7 @@
 
 #include "diagnose/agreement.hpp"
 #include "diagnose/candidate_search.hpp"
+#include "diagnose/flight_screening.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/flight_data.hpp"
 #include "predict/prediction.hpp"
@@ -85,6 +86,9 @@ struct ChannelGain {
 struct Diagnosis {
   std::string vehicle, formulation;
   std::vector<std::string> flights;  // the source of each flight diagnosed
+  // Every flight given, screened (flight_screening.hpp); in a joint diagnosis the unusable
+  // ones are not in `flights`.
+  std::vector<FlightScreening> screening;
   // Jointly diagnosed flights: effects with one value per flight ("motor_gain.M2" is the
   // first flight's, "motor_gain.M2@2" the second's; runtime::PerFlightModel).
   std::vector<std::string> per_flight_effects;

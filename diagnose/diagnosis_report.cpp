@@ -234,11 +234,43 @@ json channels_json(const ResidualAnalysis& a) {
 
 }  // namespace
 
+namespace {
+
+// Each flight given: the share of its samples with a command at its limit, whether it could
+// inform the diagnosis, and whether it was left out of this one.
+json screening_json(const Diagnosis& d) {
+  json out = json::array();
+  for (const auto& s : d.screening) {
+    const bool diagnosed = std::find(d.flights.begin(), d.flights.end(), s.source) != d.flights.end();
+    out.push_back({{"flight", s.source}, {"commands_at_limit_share", s.saturated_share}, {"usable", s.usable},
+                   {"left_out", !diagnosed}, {"reason", s.reason}});
+  }
+  return out;
+}
+
+// What the screening says in words: flights left out, or a caution on an unusable flight
+// diagnosed anyway (alone, or when no flight given was usable).
+std::vector<std::string> screening_notes(const Diagnosis& d) {
+  std::vector<std::string> out;
+  for (const auto& s : d.screening) {
+    if (s.usable) continue;
+    const bool diagnosed = std::find(d.flights.begin(), d.flights.end(), s.source) != d.flights.end();
+    out.push_back(diagnosed ? "caution: " + s.source + ": " + s.reason +
+                                  "; the commands there do not tell the thrust, and what is found may stand in for that"
+                            : "left out: " + s.source + ": " + s.reason +
+                                  "; it would bend the airframe to explain motors that cannot give what was asked");
+  }
+  return out;
+}
+
+}  // namespace
+
 json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   json j;
   j["vehicle"] = d.vehicle;
   j["log"] = log_path;
   j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
+  j["flight_screening"] = screening_json(d);
   // The same logs as absolute paths, so that quadgen predict matches them from any directory.
   json paths = json::array();
   for (const auto& f : d.flights) {
@@ -525,6 +557,7 @@ std::string num(double v, int prec = 4) {
 
 std::string diagnosis_summary(const Diagnosis& d) {
   std::ostringstream os;
+  for (const auto& note : screening_notes(d)) os << note << "\n";
   if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
     os << "no significant discrepancy: the base model explains the flight\n";
   for (const auto& f : d.findings) {
@@ -710,6 +743,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   else
     h << " validation samples from t = " << num(d.t_split, 4) << " s";
   h << "; " << num(d.seconds, 3) << " s.</p>\n";
+  for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";

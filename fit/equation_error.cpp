@@ -238,7 +238,10 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
 
 void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const {
   const int np = model_->num_params();
-  residuals(p, r, J, all_samples());
+  std::vector<int> columns = runtime::free_columns(free);
+  if (columns.empty())
+    for (int c = 0; c < np; ++c) columns.push_back(c);
+  residuals(p, r, J, all_samples(), columns);
   if (!J) return;
   // Columns of the parameters applied to the data: central differences over the rows each
   // column can change (zero elsewhere).
@@ -251,9 +254,9 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const 
     rm.resize(rp.size());
     const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
     pp[c] = p[c] + h;
-    residuals(pp.data(), rp.data(), nullptr, data_side_spans_[d]);
+    residuals(pp.data(), rp.data(), nullptr, data_side_spans_[d], {});
     pp[c] = p[c] - h;
-    residuals(pp.data(), rm.data(), nullptr, data_side_spans_[d]);
+    residuals(pp.data(), rm.data(), nullptr, data_side_spans_[d], {});
     pp[c] = p[c];
     for (size_t i = 0; i < rows_.size() * 6; ++i) J[i * np + c] = 0.0;
     for (size_t i = 0; i < rp.size(); ++i) J[(row_lo * 6 + i) * np + c] = (rp[i] - rm[i]) / (2 * h);
@@ -271,7 +274,7 @@ std::pair<size_t, size_t> EquationErrorModel::rows_in(SampleSpan span) const {
 // interval k -> k+1: state averaged, the commands of t_k held over it.
 void EquationErrorModel::interval_accelerations(const std::vector<double>& X, const std::vector<double>& U,
                                                 std::vector<double>& F, std::vector<double>* Bm,
-                                                SampleSpan span) const {
+                                                SampleSpan span, const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   const size_t ns = flight_.samples.size();
@@ -305,20 +308,21 @@ void EquationErrorModel::interval_accelerations(const std::vector<double>& X, co
       for (int c = 0; c < 6; ++c) {
         F[k * 6 + c] += 0.5 * f[kRows[c]];
         if (Bm)
-          for (int q = 0; q < np; ++q) (*Bm)[(k * 6 + c) * np + q] += 0.5 * B[kRows[c] * np + q];
+          for (int q : columns) (*Bm)[(k * 6 + c) * np + q] += 0.5 * B[kRows[c] * np + q];
       }
     }
   }
 }
 
-void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span) const {
+void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span,
+                                   const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
   model_->set_params(std::vector<double>(p, p + np));
   std::vector<double> X, U;
   prepare(p, X, U, span);
   const bool filtered = derivatives_ == Derivatives::kFiltered;
   std::vector<double> F, Bm;
-  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr, span);
+  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr, span, columns);
   const bool pointwise_needed = !filtered || accel_;
   std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
   // Model accelerations seen by the measurement at this row: the six rows of f (and of B).
@@ -339,7 +343,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
         for (int c = 0; c < 6; ++c) {
           a6[c] += W[j] * F[(lo + j) * 6 + c];
           if (J)
-            for (int q = 0; q < np; ++q) Ba6[c * np + q] += W[j] * Bm[((lo + j) * 6 + c) * np + q];
+            for (int q : columns) Ba6[c * np + q] += W[j] * Bm[((lo + j) * 6 + c) * np + q];
         }
       for (int c = 0; c < 6; ++c) meas[c] = measured_[row][c];
     } else {
@@ -349,7 +353,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
         meas[c] = s.acc_world[c];
         meas[3 + c] = s.rate_dot[c];
         if (J)
-          for (int q = 0; q < np; ++q) Ba6[c * np + q] = B[(3 + c) * np + q], Ba6[(3 + c) * np + q] = B[(10 + c) * np + q];
+          for (int q : columns) Ba6[c * np + q] = B[(3 + c) * np + q], Ba6[(3 + c) * np + q] = B[(10 + c) * np + q];
       }
     }
     double* rk = r + 6 * (row - row_lo);
@@ -369,7 +373,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
     }
     if (!J) continue;
     double* Jk = J + static_cast<size_t>(6 * (row - row_lo)) * np;
-    for (int c = 0; c < np; ++c) {
+    for (int c : columns) {
       for (int i = 0; i < 3; ++i) {
         double d;
         if (accel_) {

@@ -106,10 +106,12 @@ class EquationErrorModel : public ResidualModel {
   SampleSpan all_samples() const { return {0, flight_.samples.size()}; }
   // First and one-past-last residual row whose sample lies in `span`.
   std::pair<size_t, size_t> rows_in(SampleSpan span) const;
-  // Residuals (and df/dp columns) of the rows in `span`: row i of that range at r + 6 i.
-  void residuals(const double* p, double* r, double* J, SampleSpan span) const;
+  // Residuals (and the df/dp columns in `columns`, the others left unwritten) of the rows in
+  // `span`: row i of that range at r + 6 i. A search step frees a few of the 30-80
+  // parameters of a per-flight model; the Jacobian work follows the free ones.
+  void residuals(const double* p, double* r, double* J, SampleSpan span, const std::vector<int>& columns) const;
   void interval_accelerations(const std::vector<double>& X, const std::vector<double>& U, std::vector<double>& F,
-                              std::vector<double>* Bm, SampleSpan span) const;
+                              std::vector<double>* Bm, SampleSpan span, const std::vector<int>& columns) const;
 };
 
 

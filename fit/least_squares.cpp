@@ -37,9 +37,9 @@ class WeightedCost : public ceres::CostFunction {
       if (!std::isfinite(r[i])) return false;
       if (!(J && J[0])) continue;
       double* row = J[0] + static_cast<size_t>(i) * n_;
-      for (int j = 0; j < n_; ++j) {
-        row[j] *= w;
-        if (free_[j] && !std::isfinite(row[j])) return false;
+      for (int j = 0; j < n_; ++j) {  // a held parameter's column may be left unwritten by the model
+        row[j] = free_[j] ? row[j] * w : 0.0;
+        if (!std::isfinite(row[j])) return false;
       }
     }
     return true;
@@ -50,6 +50,74 @@ class WeightedCost : public ceres::CostFunction {
   int n_;
   std::vector<double> w_;
   std::vector<bool> free_;
+};
+
+// The same weighted residuals with only the free parameters as Ceres' parameter block: the
+// fixed ones are held inside. Ceres' SubsetManifold over all parameters would multiply every
+// Jacobian row by the n x n_free plus-Jacobian, and check and clear all n columns, which was
+// the largest single cost of a diagnosis (a per-flight model has 28 and more parameters, of
+// which a search step frees few). Selecting columns is exact.
+//
+// A second block of one number, the norm of the fixed values, which no residual depends on
+// (its Jacobian column is zero, so no step moves it): Ceres stops when a step is below
+// parameter_tolerance * (|x| + parameter_tolerance), and with it |x| is the norm of all the
+// parameters, as when they were one block. The stopping rule, and so every fit, stays as it was.
+class FreeSubsetCost : public ceres::CostFunction {
+ public:
+  FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, std::vector<bool> free)
+      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)) {
+    for (size_t j = 0; j < free_.size(); ++j)
+      if (free_[j]) columns_.push_back(static_cast<int>(j));
+    set_num_residuals(m.num_residuals());
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(columns_.size()));
+    mutable_parameter_block_sizes()->push_back(1);
+  }
+  // The norm of the fixed values: the second block's value.
+  double fixed_norm() const {
+    double ss = 0;
+    for (size_t j = 0; j < all_.size(); ++j)
+      if (!free_[j]) ss += all_[j] * all_[j];
+    return std::sqrt(ss);
+  }
+  // All parameter values with the free ones taken from the block.
+  std::vector<double> expand(const double* free_values) const {
+    std::vector<double> p = all_;
+    for (size_t k = 0; k < columns_.size(); ++k) p[columns_[k]] = free_values[k];
+    return p;
+  }
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    const std::vector<double> p = expand(x[0]);
+    const int nr = m_.num_residuals(), n = static_cast<int>(all_.size()), nf = static_cast<int>(columns_.size());
+    const bool jacobian = J && J[0];
+    if (J && J[1]) std::fill(J[1], J[1] + nr, 0.0);
+    if (jacobian) {
+      full_.resize(static_cast<size_t>(nr) * n);
+      m_.evaluate_free(p.data(), r, full_.data(), free_);
+    } else {
+      m_.evaluate(p.data(), r, nullptr);
+    }
+    for (int i = 0; i < nr; ++i) {
+      const double w = w_[m_.channel_of(i)];
+      r[i] *= w;
+      if (!std::isfinite(r[i])) return false;
+      if (!jacobian) continue;
+      const double* in = full_.data() + static_cast<size_t>(i) * n;
+      double* out = J[0] + static_cast<size_t>(i) * nf;
+      for (int k = 0; k < nf; ++k) {
+        out[k] = in[columns_[k]] * w;
+        if (!std::isfinite(out[k])) return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const ResidualModel& m_;
+  std::vector<double> all_;
+  std::vector<double> w_;
+  std::vector<bool> free_;
+  std::vector<int> columns_;
+  mutable std::vector<double> full_;  // the model's Jacobian over all parameters, reused
 };
 
 std::vector<bool> free_mask(const std::vector<FitParameter>& ps) {
@@ -84,38 +152,46 @@ void require_finite_information(const Eigen::MatrixXd& Jf, const std::vector<Fit
 double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
-  std::vector<double> x = parameter_values(params);
+  const std::vector<double> x = parameter_values(params);
   const std::vector<bool> free = free_mask(params);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
-  problem.AddResidualBlock(new WeightedCost(model, n, w, free), loss, x.data());
-  std::vector<int> fixed;
-  for (int i = 0; i < n; ++i) {
-    if (!params[i].free) {
-      fixed.push_back(i);
-      continue;
-    }
-    if (params[i].lower < params[i].upper) {
-      problem.SetParameterLowerBound(x.data(), i, params[i].lower);
-      problem.SetParameterUpperBound(x.data(), i, params[i].upper);
-    }
-  }
-  if (static_cast<int>(fixed.size()) == n) {
+  std::vector<double> xf;  // the free values: Ceres' parameter block
+  for (int i = 0; i < n; ++i)
+    if (free[i]) xf.push_back(x[i]);
+  if (xf.empty()) {
+    std::vector<double> all = x;
+    problem.AddResidualBlock(new WeightedCost(model, n, w, free), loss, all.data());
     double cost = 0;
     if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr) || !std::isfinite(cost))
       throw FitError("least squares: a residual is not finite at " + values_text(params));
     if (converged) *converged = true;
     return 2 * cost;
   }
-  if (!fixed.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(n, fixed));
+  auto* cost_function = new FreeSubsetCost(model, x, w, free);
+  double fixed_norm = cost_function->fixed_norm();
+  problem.AddResidualBlock(cost_function, loss, xf.data(), &fixed_norm);
+  for (int i = 0, k = 0; i < n; ++i) {
+    if (!free[i]) continue;
+    if (params[i].lower < params[i].upper) {
+      problem.SetParameterLowerBound(xf.data(), k, params[i].lower);
+      problem.SetParameterUpperBound(xf.data(), k, params[i].upper);
+    }
+    ++k;
+  }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = opt.function_tolerance;
   so.parameter_tolerance = opt.parameter_tolerance;
   so.gradient_tolerance = 1e-14;
+  // With bounds, every trust-region step is followed by a projected line search. Cubic
+  // interpolation asks for the gradient, i.e. a whole Jacobian, at each trial point: three
+  // quarters of a diagnosis' Jacobians were line-search trials (docs/benchmarks.md).
+  // Quadratic interpolation needs only the cost there, about a tenth of the work.
+  so.line_search_interpolation_type = ceres::QUADRATIC;
   so.minimizer_progress_to_stdout = opt.verbose;
   so.num_threads = 1;
   ceres::Solver::Summary summary;
@@ -125,7 +201,8 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.initial_cost) || !std::isfinite(summary.final_cost))
     throw FitError("least squares failed (" + summary.message + ") starting from " + values_text(params) +
                    ": a residual or Jacobian entry is not finite there");
-  for (int i = 0; i < n; ++i) params[i].value = x[i];
+  const std::vector<double> solved = cost_function->expand(xf.data());
+  for (int i = 0; i < n; ++i) params[i].value = solved[i];
   if (converged) *converged = summary.termination_type == ceres::CONVERGENCE;
   if (report) *report = summary.BriefReport();
   return 2 * summary.final_cost;

@@ -505,13 +505,41 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
 // A motor trim belongs to the flight (docs/crazyflie_evidence.md): flight a flies with motor
 // C 8 % weak, flight b with motor B 6 % strong. One cause, named once, with each flight's
 // own values (motor_gain is per flight in a joint diagnosis).
+// A copy of a canonical log with every motor command at its limit, as in a flight whose
+// battery could no longer give what the controller asked (NanoBench B6).
+fs::path saturated_copy(const fs::path& log, const fs::path& out) {
+  std::ifstream in(log);
+  std::ofstream o(out);
+  std::string line;
+  std::getline(in, line);
+  o << line << "\n";
+  std::vector<bool> command;
+  std::stringstream header(line);
+  for (std::string c; std::getline(header, c, ',');) command.push_back(c.rfind("u_", 0) == 0);
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    size_t k = 0;
+    for (std::string v; std::getline(row, v, ','); ++k) o << (k ? "," : "") << (k < command.size() && command[k] ? "1" : v);
+    o << "\n";
+  }
+  return out;
+}
+
+// Two flights with each its own trim, and a third whose commands sit at their limit: the third
+// is left out (and said so), and the two give what they give alone.
 TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
   const fs::path dir = fresh_directory("quadgen_two_flights");
   const HiddenCase a{"a", "motor_gain", {{"motor_gain.C", -0.08}}, {}, "", 1};
   HiddenCase b{"b", "motor_gain", {{"motor_gain.B", 0.06}}, {}, "", 2};
   const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
-  const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
+  const fs::path fc = saturated_copy(fa, dir / "c_saturated.csv");
+  const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string() + " " + fc.string()), dir);
   ASSERT_EQ(j["flights"].size(), 2u) << j["flights"].dump();
+  ASSERT_EQ(j["flight_screening"].size(), 3u) << j["flight_screening"].dump(1);
+  EXPECT_FALSE(j["flight_screening"][0]["left_out"].get<bool>());
+  EXPECT_TRUE(j["flight_screening"][2]["left_out"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["flight_screening"][2]["commands_at_limit_share"].get<double>(), 1.0);
+  EXPECT_LT(j["flight_screening"][0]["commands_at_limit_share"].get<double>(), 0.5);
   ASSERT_EQ(named(j), std::vector<std::string>{"motor_gain"}) << j["findings"].dump(1) << j["suspected"].dump(1);
   EXPECT_EQ(j["per_flight_effects"], json({"motor_gain", "wind", "attitude_bias"}));
   const json& ps = j["findings"][0]["parameters"];
@@ -525,6 +553,7 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
   {  // the report shows each flight's trim side by side: one row per rotor, one column per flight
     std::ifstream in(dir / "out" / "report.html");
     const std::string html((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(html.find("left out: "), std::string::npos);  // and says which flight it left out, and why
     EXPECT_NE(html.find("<th>flight 2</th>"), std::string::npos);
     EXPECT_NE(html.find("<td>motor_gain.B [1]</td>"), std::string::npos);
     EXPECT_EQ(html.find("<td>motor_gain.B@2"), std::string::npos);  // no copy names in the table

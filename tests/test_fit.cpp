@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 
+#include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
 #include "runtime/dynamic_model.hpp"
@@ -754,4 +755,64 @@ TEST(Fit, RotorSpeedsAreCarriedAcrossShortGaps) {
   fo.account_autocorrelation = false;
   const FitResult best = fit_least_squares(m, ps, fo);
   EXPECT_NEAR(best.parameters[lag].value, truth[lag], 1e-3);
+}
+
+namespace {
+// r = w_c (A p - b), two channels: a linear model whose weighted least-squares solution with
+// some parameters held is known in closed form.
+class LinearModel : public ResidualModel {
+ public:
+  LinearModel() {
+    std::mt19937 rng(7);
+    std::normal_distribution<double> n(0.0, 1.0);
+    A_ = Eigen::MatrixXd(40, 4);
+    b_ = Eigen::VectorXd(40);
+    for (int i = 0; i < 40; ++i) {
+      for (int j = 0; j < 4; ++j) A_(i, j) = n(rng);
+      b_(i) = n(rng);
+    }
+  }
+  int num_residuals() const override { return 40; }
+  void evaluate(const double* p, double* r, double* J) const override {
+    const Eigen::Map<const Eigen::Vector4d> x(p);
+    Eigen::Map<Eigen::VectorXd>(r, 40) = A_ * x - b_;
+    if (J) Eigen::Map<Eigen::Matrix<double, 40, 4, Eigen::RowMajor>>{J} = A_;
+  }
+  int channel_of(int residual) const override { return residual < 25 ? 0 : 1; }
+  std::vector<std::string> channels() const override { return {"a", "b"}; }
+  Eigen::MatrixXd A_;
+  Eigen::VectorXd b_;
+};
+}  // namespace
+
+// A fit that holds some parameters: the held ones keep their values exactly, the free ones
+// are the weighted least-squares solution given the held ones (normal equations, here), and
+// a bound that binds holds the parameter on it. Ceres sees only the free parameters.
+TEST(Fit, HeldParametersStayAndTheFreeOnesSolveTheRest) {
+  const LinearModel m;
+  const std::vector<double> w = {2.0, 0.5};
+  std::vector<FitParameter> ps = {{"a", "1", 0.1, -10, 10, true},
+                                  {"b", "1", 0.3, -10, 10, false},
+                                  {"c", "1", -0.2, -10, 10, true},
+                                  {"d", "1", 0.7, -10, 10, false}};
+  FitOptions fo;
+  fo.function_tolerance = fo.parameter_tolerance = 1e-15;
+  solve_weighted(m, ps, w, fo);
+  EXPECT_EQ(ps[1].value, 0.3);
+  EXPECT_EQ(ps[3].value, 0.7);
+  Eigen::VectorXd W(40);
+  for (int i = 0; i < 40; ++i) W(i) = w[m.channel_of(i)];
+  Eigen::MatrixXd Af(40, 2);
+  Af << m.A_.col(0), m.A_.col(2);
+  const Eigen::VectorXd rhs = m.b_ - m.A_.col(1) * 0.3 - m.A_.col(3) * 0.7;
+  const Eigen::VectorXd x = (W.asDiagonal() * Af).colPivHouseholderQr().solve(W.asDiagonal() * rhs);
+  EXPECT_NEAR(ps[0].value, x(0), 1e-7);  // to the solver's tolerances
+  EXPECT_NEAR(ps[2].value, x(1), 1e-7);
+  // A bound that cuts the free solution off: the parameter ends on it.
+  std::vector<FitParameter> bounded = ps;
+  bounded[0].value = x(0) > 0 ? -0.5 : 0.5;
+  (x(0) > 0 ? bounded[0].upper : bounded[0].lower) = x(0) / 2;
+  solve_weighted(m, bounded, w, fo);
+  EXPECT_NEAR(bounded[0].value, x(0) / 2, 1e-12);
+  EXPECT_EQ(bounded[1].value, 0.3);
 }
