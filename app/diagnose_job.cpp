@@ -131,7 +131,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   o.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
 
   std::cerr << "[diagnose] " << samples << " airborne samples in " << flights.size()
-            << (flights.size() > 1 ? " flights (diagnosed jointly)" : " flight") << "; deriving the full-catalogue model\n";
+            << (flights.size() > 1 ? " logs (diagnosed jointly)" : " log") << "; deriving the full-catalogue model\n";
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
@@ -144,7 +144,9 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
 
   std::cerr << "[diagnose] generating the extended model\n";
-  const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, logs_label);
+  std::string fitted_to;  // the flights the extended model was fitted to: a left-out log is not one
+  for (const auto& f : d.flights) fitted_to += (fitted_to.empty() ? "" : ", ") + f;
+  const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to);
   std::string err;
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
@@ -158,7 +160,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
              {"fitted_parameters.yaml", ext.fitted_parameters_yaml}};
   if (!ext.fitted_vehicle_yaml.empty()) r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
   if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
-    const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, logs_label, true);
+    const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to, true);
     r.files.push_back({"discovered_model.hpp", disc.header});
     r.files.push_back({"discovered_derivation.md", disc.derivation_markdown});
   }

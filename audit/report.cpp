@@ -260,12 +260,12 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
     else
       md << "```math\n" << lhs << " = " << rhs << "\n```\n\n";
   };
-  md << "Each rotor's speed $\\omega_i$ and thrust $F_i$ (along body $+z$ at its hub), the moment $\\tau_i$ of "
-        "that thrust about the centre of gravity with the reaction moment of the spin (a counter-clockwise rotor, "
-        "seen from above, turns the body with $-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$), "
-        "the air velocity in body axes $v_a = R^T (v - v_{wind})$, and the frame's drag on it, acting at the "
-        "centre of gravity. Each quantity is written with the ones before it as symbols; the generated code "
-        "holds them substituted.\n\n";
+  md << "The air velocity in body axes $v_a = R^T (v - v_{wind})$; each rotor's speed $\\omega_i$ and thrust "
+        "$F_i$ (along body $+z$ at its hub); the moment $\\tau_i$ of that thrust about the centre of gravity with "
+        "the reaction moment of the spin (a counter-clockwise rotor, seen from above, turns the body with "
+        "$-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$); and the frame's drag on $v_a$, acting at "
+        "the centre of gravity. Each quantity is written with the ones before it as symbols (an effect's factor "
+        "of a thrust is written out); the generated code holds them substituted.\n\n";
   bool effect_terms = false;
   for (const auto& eq : m.named_equations) {
     if (!eq.rhs_tex.empty()) {

@@ -159,18 +159,16 @@ matrix inertia_matrix(const ModelContext& c) {
 void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
   auto& out = c.model.named_equations;
   const auto& rotors = c.vehicle.rotors;
-  const symbol va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
-  // Effects that depend on the air velocity (inflow, rotor drag) built it the same way:
-  // their terms read with v_a instead of the rotation written out.
-  const lst named_air{v_air_body(0, 0) == va[0], v_air_body(1, 0) == va[1], v_air_body(2, 0) == va[2]};
+  out.push_back({"v_a", v_air_body, ""});
+  // An effect's factor of a thrust (inflow's climb rate through the disc, ground effect) stays
+  // written out: GiNaC multiplies a number into the sum v_a is, so it cannot be found again there.
   std::vector<ex> thrust;
   for (size_t i = 0; i < rotors.size(); ++i) {
     const std::string n = output::latex_text(rotors[i].name);
     const symbol w("omega_" + rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
     out.push_back({"\\omega_{\\mathrm{" + n + "}}", c.rotor_speed[i], ""});
     const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
-    const ex named = c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
-    out.push_back({rotor_thrust_name(rotors[i].name), named.subs(named_air), ""});
+    out.push_back({rotor_thrust_name(rotors[i].name), c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]), ""});
     thrust.push_back(symbol("F_" + rotors[i].name, rotor_thrust_name(rotors[i].name)));
   }
   for (size_t i = 0; i < rotors.size(); ++i) {
@@ -179,7 +177,7 @@ void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
     const matrix tau = cross(arm, vec3(0, 0, thrust[i])).add(vec3(0, 0, reaction * c.p("kappa") * thrust[i]));
     out.push_back({"\\tau_{\\mathrm{" + output::latex_text(rotors[i].name) + "}}", tau, ""});
   }
-  out.push_back({"v_a", v_air_body, ""});
+  const symbol va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
   const char* areas[] = {"A_x", "A_y", "A_z"};
   matrix drag(3, 1);
   for (int k = 0; k < 3; ++k)

@@ -1,4 +1,5 @@
 #include "diagnose/diagnosis.hpp"
+#include "output/sinks.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -289,7 +290,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   std::vector<fit::Flight> flights;
   for (size_t k = 0; k < flights_in.size(); ++k) {
     if (leave_out && !d.screening[k].usable) {
-      std::cerr << "[diagnose] left out " << flights_in[k].source << ": " << d.screening[k].reason << "\n";
+      d.screening[k].left_out = true;
+      std::cerr << "[diagnose] left out " << output::printable(flights_in[k].source) << ": " << d.screening[k].reason << "\n";
       continue;
     }
     const fit::Flight& f = flights_in[k];

@@ -240,11 +240,9 @@ namespace {
 // inform the diagnosis, and whether it was left out of this one.
 json screening_json(const Diagnosis& d) {
   json out = json::array();
-  for (const auto& s : d.screening) {
-    const bool diagnosed = std::find(d.flights.begin(), d.flights.end(), s.source) != d.flights.end();
+  for (const auto& s : d.screening)
     out.push_back({{"flight", s.source}, {"commands_at_limit_share", s.saturated_share}, {"usable", s.usable},
-                   {"left_out", !diagnosed}, {"reason", s.reason}});
-  }
+                   {"left_out", s.left_out}, {"reason", s.reason}});
   return out;
 }
 
@@ -254,11 +252,11 @@ std::vector<std::string> screening_notes(const Diagnosis& d) {
   std::vector<std::string> out;
   for (const auto& s : d.screening) {
     if (s.usable) continue;
-    const bool diagnosed = std::find(d.flights.begin(), d.flights.end(), s.source) != d.flights.end();
-    out.push_back(diagnosed ? "caution: " + s.source + ": " + s.reason +
-                                  "; the commands there do not tell the thrust, and what is found may stand in for that"
-                            : "left out: " + s.source + ": " + s.reason +
-                                  "; it would bend the airframe to explain motors that cannot give what was asked");
+    const std::string source = output::printable(s.source);  // printed to a terminal too
+    out.push_back(s.left_out ? "left out: " + source + ": " + s.reason +
+                                   "; it would bend the airframe to explain motors that cannot give what was asked"
+                             : "caution: " + source + ": " + s.reason +
+                                   "; the commands there do not tell the thrust, and what is found may stand in for that");
   }
   return out;
 }

@@ -20,7 +20,8 @@ struct FlightScreening {
   std::string source;
   double saturated_share = 0;  // samples with some command at its limit
   bool usable = true;
-  std::string reason;  // why not, in words; "" when usable
+  std::string reason;    // why not, in words; "" when usable
+  bool left_out = false;  // not diagnosed: unusable, among several flights of which some are usable
 };
 
 FlightScreening screen_flight(const fit::Flight& f);

@@ -16,7 +16,9 @@ namespace {
 // scaled by its channel's weight.
 // A point whose residuals or (free) Jacobian columns are not finite is reported as not
 // evaluable: Ceres then rejects the step, or fails at the start (solve_weighted throws).
-// Fixed columns are not looked at: a model may leave them unwritten (evaluate_free).
+// Fixed columns are set to zero: a model may leave them unwritten (evaluate_free), and Ceres
+// reads every entry of the block (the SubsetManifold product, its finiteness check). Used
+// where all parameters must be one block: the covariance, and a cost with nothing free.
 class WeightedCost : public ceres::CostFunction {
  public:
   WeightedCost(const ResidualModel& m, int n_params, const std::vector<double>& w, std::vector<bool> free)

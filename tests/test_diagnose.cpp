@@ -25,6 +25,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/diagnose_job.hpp"
+#include "diagnose/diagnosis_report.hpp"
+#include "diagnose/flight_screening.hpp"
 #include "tests/estimate_shape.hpp"
 
 namespace {
@@ -692,4 +694,34 @@ TEST(DiagnoseJob, RefusesOptionsNoDiagnosisCanUse) {
   job.environment = "orbit";
   EXPECT_FALSE(job.IsValid(&why));
   EXPECT_THROW(quadgen::app::run_diagnose_job(job), std::invalid_argument);  // refused before reading any file
+}
+
+// A flight with a motor command at its limit in more than half of its samples is unusable;
+// the printout says so, with the path made printable (a log's name is hostile input).
+TEST(FlightScreening, CommandsAtTheirLimitMakeAFlightUnusable) {
+  const auto flight = [](int at_limit, const std::string& source) {
+    quadgen::fit::Flight f;
+    f.source = source;
+    for (int k = 0; k < 10; ++k) {
+      quadgen::fit::FlightSample s;
+      s.u = {0.5, 0.6, 0.55, k < at_limit ? 1.0 : 0.7};
+      f.samples.push_back(s);
+    }
+    return f;
+  };
+  const quadgen::diagnose::FlightScreening ok = quadgen::diagnose::screen_flight(flight(4, "a.csv"));
+  EXPECT_TRUE(ok.usable);
+  EXPECT_DOUBLE_EQ(ok.saturated_share, 0.4);
+  quadgen::diagnose::Diagnosis d;
+  d.screening.push_back(quadgen::diagnose::screen_flight(flight(6, "b\x1b[2J.csv")));
+  EXPECT_FALSE(d.screening[0].usable);
+  EXPECT_DOUBLE_EQ(d.screening[0].saturated_share, 0.6);
+  EXPECT_NE(d.screening[0].reason.find("60 %"), std::string::npos) << d.screening[0].reason;
+  std::string text = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(text.find("caution: b"), std::string::npos) << text;  // diagnosed alone: a caution
+  EXPECT_EQ(text.find('\x1b'), std::string::npos);
+  d.screening[0].left_out = true;
+  text = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(text.find("left out: b"), std::string::npos) << text;
+  EXPECT_EQ(quadgen::diagnose::diagnosis_json(d, "b.csv")["flight_screening"][0]["left_out"], true);
 }

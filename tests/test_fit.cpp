@@ -815,4 +815,11 @@ TEST(Fit, HeldParametersStayAndTheFreeOnesSolveTheRest) {
   solve_weighted(m, bounded, w, fo);
   EXPECT_NEAR(bounded[0].value, x(0) / 2, 1e-12);
   EXPECT_EQ(bounded[1].value, 0.3);
+  // the same with the second free parameter (c, the block's second entry) bounded
+  std::vector<FitParameter> second = ps;
+  second[2].value = x(1) > 0 ? -0.5 : 0.5;
+  (x(1) > 0 ? second[2].upper : second[2].lower) = x(1) / 2;
+  solve_weighted(m, second, w, fo);
+  EXPECT_NEAR(second[2].value, x(1) / 2, 1e-12);
+  EXPECT_EQ(second[3].value, 0.7);
 }
