@@ -1,4 +1,5 @@
 #include "fit/least_squares.hpp"
+#include "runtime/dynamic_model.hpp"  // free_columns
 
 #include <cmath>
 #include <limits>
@@ -67,9 +68,7 @@ class WeightedCost : public ceres::CostFunction {
 class FreeSubsetCost : public ceres::CostFunction {
  public:
   FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, std::vector<bool> free)
-      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)) {
-    for (size_t j = 0; j < free_.size(); ++j)
-      if (free_[j]) columns_.push_back(static_cast<int>(j));
+      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)), columns_(runtime::free_columns(free_)) {
     set_num_residuals(m.num_residuals());
     mutable_parameter_block_sizes()->push_back(static_cast<int>(columns_.size()));
     mutable_parameter_block_sizes()->push_back(1);

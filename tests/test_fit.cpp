@@ -808,18 +808,17 @@ TEST(Fit, HeldParametersStayAndTheFreeOnesSolveTheRest) {
   const Eigen::VectorXd x = (W.asDiagonal() * Af).colPivHouseholderQr().solve(W.asDiagonal() * rhs);
   EXPECT_NEAR(ps[0].value, x(0), 1e-7);  // to the solver's tolerances
   EXPECT_NEAR(ps[2].value, x(1), 1e-7);
-  // A bound that cuts the free solution off: the parameter ends on it.
-  std::vector<FitParameter> bounded = ps;
-  bounded[0].value = x(0) > 0 ? -0.5 : 0.5;
-  (x(0) > 0 ? bounded[0].upper : bounded[0].lower) = x(0) / 2;
-  solve_weighted(m, bounded, w, fo);
-  EXPECT_NEAR(bounded[0].value, x(0) / 2, 1e-12);
-  EXPECT_EQ(bounded[1].value, 0.3);
-  // the same with the second free parameter (c, the block's second entry) bounded
-  std::vector<FitParameter> second = ps;
-  second[2].value = x(1) > 0 ? -0.5 : 0.5;
-  (x(1) > 0 ? second[2].upper : second[2].lower) = x(1) / 2;
-  solve_weighted(m, second, w, fo);
-  EXPECT_NEAR(second[2].value, x(1) / 2, 1e-12);
-  EXPECT_EQ(second[3].value, 0.7);
+  // A bound that cuts the free solution off: the parameter ends on it, for the block's first
+  // entry (a) and its second (c), and the held ones stay.
+  const auto bound_at_half = [&](size_t i, double free_solution) {
+    std::vector<FitParameter> bounded = ps;
+    bounded[i].value = free_solution > 0 ? -0.5 : 0.5;
+    (free_solution > 0 ? bounded[i].upper : bounded[i].lower) = free_solution / 2;
+    solve_weighted(m, bounded, w, fo);
+    EXPECT_NEAR(bounded[i].value, free_solution / 2, 1e-12) << ps[i].name;
+    EXPECT_EQ(bounded[1].value, 0.3);
+    EXPECT_EQ(bounded[3].value, 0.7);
+  };
+  bound_at_half(0, x(0));
+  bound_at_half(2, x(1));
 }
