@@ -1,13 +1,16 @@
 // Integration speed for the FINken 3: right-hand-side evaluations per second and simulated
 // seconds per wall-clock second, RK4 at 1 kHz and DOPRI5 at 1e-8, for the compiled header
-// and the interpreted tape `quadgen simulate` uses.
+// and the interpreted tape `quadgen simulate` uses. And the fits' and diagnoses' hot path:
+// f with all three Jacobians of the Crazyflie with every effect, every effect switched on.
 #include <benchmark/benchmark.h>
 
 #include <string>
 
 #include "runtime/dynamic_model.hpp"
 #include "derive/dynamics.hpp"
+#include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "runtime/integrator.hpp"
 #include "codegen/tape_builder.hpp"
 
@@ -55,6 +58,38 @@ void BM_Rk4_1kHz_Tape(benchmark::State& st) { run(st, false, false); }
 void BM_Dopri5_1e8_Compiled(benchmark::State& st) { run(st, true, true); }
 void BM_Dopri5_1e8_Tape(benchmark::State& st) { run(st, false, true); }
 
+// Every effect away from its neutral value, a hover-like state with some motion.
+void jacobians(benchmark::State& st, bool compiled) {
+  using Crazyflie = CompiledModel<quadgen_generated::crazyflie21_all_effects::Model>;
+  std::unique_ptr<DynamicModel> m;
+  if (compiled) {
+    m = std::make_unique<Crazyflie>();
+  } else {
+    const Vehicle v = load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/crazyflie21.yaml");
+    DeriveOptions o;
+    o.effects = parse_effect_list("all");
+    m = std::make_unique<TapeModel>(codegen::build_tape(derive_model(v, derive_mass_properties(v), o)));
+  }
+  std::vector<double> p = m->params();
+  for (int i = 0; i < m->num_params(); ++i)
+    if (m->param_names()[i].find('.') != std::string::npos && p[i] == 0) p[i] = 1e-3;
+  m->set_params(p);
+  const int n = m->num_states(), nu = m->num_inputs(), np = m->num_params();
+  std::vector<double> x(n, 0.0), u(nu, 0.5), f(n), A(n * n), B(n * np), Bu(n * nu);
+  x[2] = 0.5;
+  x[3] = 0.3;
+  x[6] = 1;
+  for (int i = 13; i < n; ++i) x[i] = 1500;
+  for (auto _ : st) {
+    m->rhs(x.data(), u.data(), f.data(), A.data(), B.data(), Bu.data());
+    benchmark::DoNotOptimize(B.data());
+  }
+}
+void BM_Jacobians_CrazyflieAllEffects_Compiled(benchmark::State& st) { jacobians(st, true); }
+void BM_Jacobians_CrazyflieAllEffects_Tape(benchmark::State& st) { jacobians(st, false); }
+
+BENCHMARK(BM_Jacobians_CrazyflieAllEffects_Compiled)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Jacobians_CrazyflieAllEffects_Tape)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Rk4_1kHz_Compiled)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Rk4_1kHz_Tape)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Dopri5_1e8_Compiled)->Unit(benchmark::kMillisecond);

@@ -4,7 +4,8 @@
 
 #include <kainjow/mustache.hpp>
 
-#include "codegen/cpp_emitter.hpp"
+#include "codegen/cpp_printer.hpp"
+#include "codegen/lowered_model.hpp"
 #include "derive/exact_number.hpp"
 #include "output/names.hpp"
 #include "output/sinks.hpp"
@@ -57,23 +58,6 @@ data variables(const std::vector<Variable>& vs) {
   return data{l};
 }
 
-// Jacobian entries that are not structurally zero, row-major.
-struct Sparse {
-  std::vector<int> rows, cols;
-  std::vector<ex> values;
-};
-Sparse nonzeros(const matrix& J) {
-  Sparse s;
-  for (unsigned i = 0; i < J.rows(); ++i)
-    for (unsigned j = 0; j < J.cols(); ++j)
-      if (!J(i, j).is_zero()) {
-        s.rows.push_back(static_cast<int>(i));
-        s.cols.push_back(static_cast<int>(j));
-        s.values.push_back(J(i, j));
-      }
-  return s;
-}
-
 std::string int_list(const std::vector<int>& v) {
   std::string s = "{";
   for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
@@ -106,37 +90,11 @@ std::string model_name(const SymbolicModel& m) {
 }
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
-  ExpressionGraph g;
-  declare_model_variables(g, m);
-  const lst constants = m.constant_substitution();
-  // f and h carry the constants as symbols (for the unit audit and the report); the
-  // Jacobians have them substituted already (SymbolicModel).
-  auto nodes = [&](const std::string& target, const std::vector<ex>& values, bool substitute) {
-    std::vector<Output> out;
-    for (size_t i = 0; i < values.size(); ++i)
-      out.push_back({target + "[" + std::to_string(i) + "]", g.add(substitute ? values[i].subs(constants) : values[i])});
-    return out;
-  };
-  std::vector<ex> f, h;
-  for (unsigned i = 0; i < m.f.rows(); ++i) f.push_back(m.f(i, 0));
-  for (unsigned i = 0; i < m.h.rows(); ++i) h.push_back(m.h(i, 0));
-  const Sparse fx = nonzeros(m.dfdx), fu = nonzeros(m.dfdu), fp = nonzeros(m.dfdp);
-  const Sparse hx = nonzeros(m.dhdx), hp = nonzeros(m.dhdp);
-  const std::vector<OutputGroup> rhs = {{"", nodes("f", f, true)},
-                                        {"dfdx", nodes("dfdx", fx.values, false)},
-                                        {"dfdu", nodes("dfdu", fu.values, false)},
-                                        {"dfdp", nodes("dfdp", fp.values, false)}};
-  const std::vector<OutputGroup> meas = {{"", nodes("h", h, true)},
-                                         {"dhdx", nodes("dhdx", hx.values, false)},
-                                         {"dhdp", nodes("dhdp", hp.values, false)}};
-  CppEmitter em(g);
-  std::vector<OutputGroup> all = rhs;
-  all.insert(all.end(), meas.begin(), meas.end());
-  em.plan_precompute(all);
-  const EmittedPrecompute pre = em.emit_precompute();
-  const EmittedFunction f_only = em.emit_function({rhs[0]});
-  const EmittedFunction rhs_code = em.emit_function(rhs);
-  const EmittedFunction meas_code = em.emit_function(meas);
+  const LoweredModel lm = lower_model(m);
+  const PrintedFunction pre = print_cpp(*lm.plan, lm.precompute);
+  const PrintedFunction f_only = print_cpp(*lm.plan, lm.rhs_f);
+  const PrintedFunction rhs_code = print_cpp(*lm.plan, lm.rhs);
+  const PrintedFunction meas_code = print_cpp(*lm.plan, lm.measurement);
 
   GeneratedHeader out;
   out.name = model_name(m);
@@ -144,8 +102,8 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   out.ops_after = rhs_code.ops_after;
   out.ops_f_before = f_only.ops_before;
   out.ops_f_after = f_only.ops_after;
-  out.pre_ops = pre.ops;
-  out.pre_count = pre.count;
+  out.pre_ops = pre.ops_after;
+  out.pre_count = lm.plan->precompute_count();
 
   data d;
   d.set("namespace", out.name);
@@ -192,7 +150,8 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("param_fit", fit + "}");
   d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
   list sparsity;
-  const std::pair<const char*, const Sparse*> sp[] = {{"Dfdx", &fx}, {"Dfdu", &fu}, {"Dfdp", &fp}, {"Dhdx", &hx}, {"Dhdp", &hp}};
+  const std::pair<const char*, const SparsePattern*> sp[] = {
+      {"Dfdx", &lm.dfdx}, {"Dfdu", &lm.dfdu}, {"Dfdp", &lm.dfdp}, {"Dhdx", &lm.dhdx}, {"Dhdp", &lm.dhdp}};
   for (const auto& [name, s] : sp) {
     data e;
     e.set("name", name);

@@ -1,84 +1,162 @@
 #include "codegen/tape_builder.hpp"
 
-#include <cstdlib>
-#include <functional>
+#include <map>
+#include <stdexcept>
 
-#include "codegen/expression_graph.hpp"
+#include "codegen/lowered_model.hpp"
 
 namespace quadgen::codegen {
-using namespace GiNaC;
 using runtime::Instruction;
 using runtime::TapeOp;
 
 namespace {
 
-struct Builder {
-  ExpressionGraph& g;
+using Kind = LoweredPlan::Kind;
+using Leaf = LoweredPlan::Leaf;
+using Function = LoweredPlan::Function;
+
+// Registers shared by all functions of one tape: x, u, p, constants, precomputed values.
+struct Registers {
   runtime::Tape& t;
-  std::vector<int> reg;  // node -> register, -1 until emitted
-  int next = 0;
+  int next;
+  std::map<double, int> constant;  // keyed by value: +0 and -0 compare equal, see below
+  std::vector<int> pre_slot;       // precompute slot -> register
 
   int fresh() { return next++; }
-
-  void emit(int id, std::vector<Instruction>& code) {
-    if (reg[id] >= 0) return;
-    const Node& n = g.node(id);
-    switch (n.op) {
-      case Op::state: reg[id] = t.x_reg(n.index); return;
-      case Op::input: reg[id] = t.u_reg(n.index); return;
-      case Op::param: reg[id] = t.p_reg(n.index); return;
-      case Op::constant:
-        reg[id] = fresh();
-        t.constants.push_back({reg[id], std::strtod(n.literal.c_str(), nullptr)});
-        return;
-      default: break;
-    }
-    for (int a : n.args) emit(a, code);
-    auto binary_chain = [&](TapeOp op) {
-      int acc = reg[n.args[0]];
-      for (size_t i = 1; i < n.args.size(); ++i) {
-        const int dst = fresh();
-        code.push_back({op, dst, acc, reg[n.args[i]], 0});
-        acc = dst;
-      }
-      return acc;
-    };
-    const int a = reg[n.args[0]];
-    const int b = n.args.size() > 1 ? reg[n.args[1]] : 0;
-    auto unary = [&](TapeOp op, long k = 0) {
-      const int dst = fresh();
-      code.push_back({op, dst, a, b, k});
-      return dst;
-    };
-    switch (n.op) {
-      case Op::add: reg[id] = binary_chain(TapeOp::add); break;
-      case Op::mul: reg[id] = binary_chain(TapeOp::mul); break;
-      case Op::div: reg[id] = unary(TapeOp::div); break;
-      case Op::ipow: reg[id] = unary(TapeOp::ipow, n.exponent); break;
-      case Op::pow: reg[id] = unary(TapeOp::pow); break;
-      case Op::sin: reg[id] = unary(TapeOp::sin); break;
-      case Op::cos: reg[id] = unary(TapeOp::cos); break;
-      case Op::log: reg[id] = unary(TapeOp::log); break;
-      case Op::abs: reg[id] = unary(TapeOp::abs); break;
-      case Op::sign: reg[id] = unary(TapeOp::sign); break;
-      default: break;
-    }
-  }
-
-  // Parameter-only sub-DAGs first (precompute), then the dynamic nodes into `code`.
-  void emit_split(int id, std::vector<Instruction>& code) {
-    std::function<void(int)> pre = [&](int k) {
-      const Node& n = g.node(k);
-      if (!n.dynamic) {
-        emit(k, t.precompute);
-        return;
-      }
-      for (int a : n.args) pre(a);
-    };
-    pre(id);
-    emit(id, code);
+  int of_constant(double v) {
+    // -0.0 == 0.0 as map keys; the plan's constants are magnitudes (signs are
+    // subtractions), so a negative zero never reaches here.
+    auto it = constant.find(v);
+    if (it != constant.end()) return it->second;
+    const int r = fresh();
+    t.constants.push_back({r, v});
+    constant[v] = r;
+    return r;
   }
 };
+
+// One function of the plan as instructions, following the C++ printer's reading of the
+// same plan operation for operation (cpp_printer.cpp): what the printer writes inline the
+// lowering computes in place, what it names the lowering keeps in a register.
+class FunctionLowering {
+ public:
+  FunctionLowering(const LoweredPlan& plan, const Function& fn, Registers& regs, std::vector<Instruction>& code)
+      : plan_(plan), fn_(fn), regs_(regs), code_(code), temp_reg_(fn.num_temps, -1) {}
+
+  // Runs every step; returns the registers of each group's outputs, in order.
+  std::vector<std::vector<int>> lower() {
+    std::vector<std::vector<int>> outputs(fn_.groups.size());
+    for (size_t g = 0; g < fn_.groups.size(); ++g) outputs[g].assign(fn_.groups[g].outputs.size(), -1);
+    for (const auto& s : fn_.steps) {
+      switch (s.kind) {
+        case Function::StepKind::define: temp_reg_[s.temp] = body(s.node); break;
+        case Function::StepKind::store: regs_.pre_slot[s.slot] = value(s.node); break;
+        case Function::StepKind::assign: outputs[s.group][s.output] = assignment(s.node, s.sign); break;
+        default: break;  // guards: the tape prunes per request instead (TapeModel)
+      }
+    }
+    return outputs;
+  }
+
+ private:
+  int emit(TapeOp op, int a, int b = 0) {
+    const int dst = regs_.fresh();
+    code_.push_back({op, dst, a, b});
+    return dst;
+  }
+
+  int assignment(int id, int sign) {
+    const auto& n = plan_.node(id);
+    if (sign > 0) return value(id);
+    if (n.kind == Kind::sum && n.dynamic && fn_.temp[id] < 0) return sum(id, -1);
+    return emit(TapeOp::neg, value(id));  // -x*y is (-x)*y in C++: the same number
+  }
+
+  int value(int id) {
+    const auto& n = plan_.node(id);
+    switch (n.leaf) {
+      case Leaf::state: return regs_.t.x_reg(n.index);
+      case Leaf::input: return regs_.t.u_reg(n.index);
+      case Leaf::param: return regs_.t.p_reg(n.index);
+      case Leaf::constant: return regs_.of_constant(n.value);
+      case Leaf::none: break;
+    }
+    if (fn_.temp[id] >= 0) return temp_reg_[fn_.temp[id]];
+    if (!fn_.precompute && !n.dynamic) return regs_.pre_slot.at(plan_.precompute_slot(id));
+    return body(id);
+  }
+
+  int sum(int id, int outer) {
+    const auto& n = plan_.node(id);
+    int acc = -1;
+    for (size_t i : LoweredPlan::sum_order(n, outer)) {
+      const bool plus = n.sign[i] * outer > 0;
+      const int term = value(n.args[i]);
+      if (acc < 0) acc = plus ? term : emit(TapeOp::neg, term);
+      else acc = emit(plus ? TapeOp::add : TapeOp::sub, acc, term);
+    }
+    return acc;
+  }
+
+  int body(int id) {
+    const auto& n = plan_.node(id);
+    switch (n.kind) {
+      case Kind::sum: return sum(id, 1);
+      case Kind::prod: {  // the factors multiplied left to right, then the divisions
+        int acc = -1;
+        std::vector<int> divisors;
+        for (int a : n.args) {
+          if (plan_.is_inline_division(fn_, a)) {
+            divisors.push_back(value(plan_.node(a).args[0]));
+          } else {
+            const int r = value(a);
+            acc = acc < 0 ? r : emit(TapeOp::mul, acc, r);
+          }
+        }
+        if (acc < 0) acc = regs_.of_constant(1.0);
+        for (int d : divisors) acc = emit(TapeOp::div, acc, d);
+        return acc;
+      }
+      case Kind::recip: return emit(TapeOp::div, regs_.of_constant(1.0), value(n.args[0]));
+      case Kind::call: return call(n);
+      case Kind::leaf: break;
+    }
+    throw std::logic_error("tape_builder: a leaf has no body");
+  }
+
+  int call(const LoweredPlan::Node& n) {
+    if (n.text == "pow") return emit(TapeOp::pow, value(n.args[0]), value(n.args[1]));
+    static const std::map<std::string, TapeOp> unary = {{"sin", TapeOp::sin},       {"cos", TapeOp::cos},
+                                                        {"log", TapeOp::log},       {"abs_value", TapeOp::abs},
+                                                        {"sign_of", TapeOp::sign}};
+    const auto it = unary.find(n.text);
+    if (it == unary.end()) throw std::logic_error("tape_builder: no instruction for " + n.text);
+    return emit(it->second, value(n.args[0]));
+  }
+
+  const LoweredPlan& plan_;
+  const Function& fn_;
+  Registers& regs_;
+  std::vector<Instruction>& code_;
+  std::vector<int> temp_reg_;
+};
+
+// Group 0 (f or h) as a column; the Jacobians in their sparse pattern.
+runtime::TapeFunction lower_function(const LoweredPlan& plan, const Function& fn, Registers& regs,
+                                     const std::vector<const SparsePattern*>& patterns) {
+  runtime::TapeFunction out;
+  const auto regs_of = FunctionLowering(plan, fn, regs, out.code).lower();
+  for (size_t g = 0; g < regs_of.size(); ++g) {
+    runtime::SparseOutputs s;
+    for (size_t k = 0; k < regs_of[g].size(); ++k) {
+      s.row.push_back(g == 0 ? static_cast<int>(k) : patterns[g - 1]->rows[k]);
+      s.col.push_back(g == 0 ? 0 : patterns[g - 1]->cols[k]);
+      s.reg.push_back(regs_of[g][k]);
+    }
+    out.groups.push_back(std::move(s));
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -87,6 +165,7 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   t.nx = static_cast<int>(m.states.size());
   t.nu = static_cast<int>(m.inputs.size());
   t.np = static_cast<int>(m.params.size());
+  t.ny = static_cast<int>(m.h.rows());
   for (const auto& v : m.states) t.state_names.push_back(v.name);
   for (const auto& v : m.inputs) t.input_names.push_back(v.name);
   for (const auto& v : m.params) {
@@ -99,70 +178,12 @@ runtime::Tape build_tape(const SymbolicModel& m) {
   }
   t.input_delay_param = m.input_delay_param ? static_cast<int>(*m.input_delay_param) : -1;
 
-  ExpressionGraph g;
-  declare_model_variables(g, m);
-  const lst constants = m.constant_substitution();
-  std::vector<int> f_nodes;
-  for (unsigned i = 0; i < m.f.rows(); ++i) f_nodes.push_back(g.add(m.f(i, 0).subs(constants)));
-  struct Jac {
-    const matrix* J;
-    runtime::SparseOutputs* out;
-    std::vector<Instruction>* code;
-    std::vector<int> nodes;
-  };
-  // Each Jacobian's structural non-zeros (constants substituted already), row-major.
-  const auto add_nonzeros = [&](std::vector<Jac>& group) {
-    for (auto& j : group)
-      for (unsigned r = 0; r < j.J->rows(); ++r)
-        for (unsigned c = 0; c < j.J->cols(); ++c)
-          if (!(*j.J)(r, c).is_zero()) {
-            j.out->row.push_back(static_cast<int>(r));
-            j.out->col.push_back(static_cast<int>(c));
-            j.nodes.push_back(g.add((*j.J)(r, c)));
-          }
-  };
-  std::vector<Jac> jacs = {{&m.dfdx, &t.dfdx, &t.dfdx_code, {}},
-                           {&m.dfdp, &t.dfdp, &t.dfdp_code, {}},
-                           {&m.dfdu, &t.dfdu, &t.dfdu_code, {}}};
-  add_nonzeros(jacs);
-  std::vector<int> h_nodes;
-  for (unsigned i = 0; i < m.h.rows(); ++i) h_nodes.push_back(g.add(m.h(i, 0).subs(constants)));
-  std::vector<Jac> hjacs = {{&m.dhdx, &t.dhdx, &t.h_code, {}}, {&m.dhdp, &t.dhdp, &t.h_code, {}}};
-  add_nonzeros(hjacs);
-  Builder b{g, t, std::vector<int>(g.size(), -1), t.nx + t.nu + t.np};
-  for (int id : f_nodes) {
-    b.emit_split(id, t.f_code);
-    t.f_out.push_back(b.reg[id]);
-  }
-  // Registers of f (and of precomputed nodes) are shared; each Jacobian gets its own code
-  // for the rest, starting from the state after f.
-  const std::vector<int> after_f = b.reg;
-  const auto start_after_f = [&] {
-    std::vector<int> own = after_f;
-    for (size_t k = 0; k < own.size(); ++k)  // precompute nodes emitted meanwhile stay shared
-      if (b.reg[k] >= 0 && !g.node(static_cast<int>(k)).dynamic) own[k] = b.reg[k];
-    b.reg = own;
-  };
-  for (auto& j : jacs) {
-    start_after_f();
-    for (int id : j.nodes) {
-      b.emit_split(id, *j.code);
-      j.out->reg.push_back(b.reg[id]);
-    }
-  }
-  // The measurement and its Jacobians: one piece of code, from the registers after f.
-  t.ny = static_cast<int>(m.h.rows());
-  start_after_f();
-  for (int id : h_nodes) {
-    b.emit_split(id, t.h_code);
-    t.h_out.push_back(b.reg[id]);
-  }
-  for (auto& j : hjacs)
-    for (int id : j.nodes) {
-      b.emit_split(id, t.h_code);
-      j.out->reg.push_back(b.reg[id]);
-    }
-  t.num_registers = b.next;
+  const LoweredModel lm = lower_model(m);
+  Registers regs{t, t.nx + t.nu + t.np, {}, std::vector<int>(lm.plan->precompute_count(), -1)};
+  FunctionLowering(*lm.plan, lm.precompute, regs, t.precompute).lower();
+  t.rhs = lower_function(*lm.plan, lm.rhs, regs, {&lm.dfdx, &lm.dfdu, &lm.dfdp});
+  t.measurement = lower_function(*lm.plan, lm.measurement, regs, {&lm.dhdx, &lm.dhdp});
+  t.num_registers = regs.next;
   return t;
 }
 

@@ -1,5 +1,5 @@
-// Builds the runtime's interpreted model (runtime/tape.hpp) from a symbolic model, through
-// the same canonical expression DAG the C++ emitter uses.
+// Builds the runtime's interpreted model (runtime/tape.hpp) from a symbolic model by
+// lowering the same plan (lowered_model) that header_writer prints as C++.
 #pragma once
 #include "derive/symbolic_model.hpp"
 #include "runtime/tape.hpp"

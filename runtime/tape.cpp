@@ -5,115 +5,135 @@
 namespace quadgen::runtime {
 
 namespace {
+
 void run(const std::vector<Instruction>& code, double* r) {
   for (const Instruction& in : code) {
     const double a = r[in.a];
     double v = 0;
     switch (in.op) {
       case TapeOp::add: v = a + r[in.b]; break;
+      case TapeOp::sub: v = a - r[in.b]; break;
       case TapeOp::mul: v = a * r[in.b]; break;
       case TapeOp::div: v = a / r[in.b]; break;
-      case TapeOp::ipow: {
-        v = 1;
-        for (long i = 0; i < in.k; ++i) v *= a;
-        break;
-      }
+      case TapeOp::neg: v = -a; break;
       case TapeOp::pow: v = std::pow(a, r[in.b]); break;
       case TapeOp::sin: v = std::sin(a); break;
       case TapeOp::cos: v = std::cos(a); break;
       case TapeOp::log: v = std::log(a); break;
-      case TapeOp::abs: v = std::fabs(a); break;
+      case TapeOp::abs: v = a < 0 ? -a : a; break;
       case TapeOp::sign: v = a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); break;
     }
     r[in.dst] = v;
   }
 }
+
+bool is_binary(TapeOp op) {
+  return op == TapeOp::add || op == TapeOp::sub || op == TapeOp::mul || op == TapeOp::div || op == TapeOp::pow;
+}
+
 void scatter(double* dense, int rows, int cols, const SparseOutputs& s, const double* r) {
   for (int i = 0; i < rows * cols; ++i) dense[i] = 0;
   for (size_t k = 0; k < s.reg.size(); ++k) dense[s.row[k] * cols + s.col[k]] = r[s.reg[k]];
 }
-}  // namespace
 
-TapeModel::TapeModel(Tape t) : tape_(std::move(t)), reg_(tape_.num_registers, 0.0) {
-  for (const auto& [r, v] : tape_.constants) reg_[r] = v;
-  dfdp_code_ = tape_.dfdp_code;
-  dfdp_ = tape_.dfdp;
-  set_params(tape_.nominal);
-}
-
-void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
-  if (columns == restricted_to_) return;  // a cache: the same columns as the last call
-  restricted_to_ = columns;
-  if (columns.empty()) {
-    dfdp_code_ = tape_.dfdp_code;
-    dfdp_ = tape_.dfdp;
-    return;
-  }
-  std::vector<char> want_col(tape_.np, 0), live(tape_.num_registers, 0);
-  for (int c : columns) want_col[c] = 1;
-  dfdp_ = SparseOutputs{};
-  for (size_t k = 0; k < tape_.dfdp.reg.size(); ++k)
-    if (want_col[tape_.dfdp.col[k]]) {
-      dfdp_.row.push_back(tape_.dfdp.row[k]);
-      dfdp_.col.push_back(tape_.dfdp.col[k]);
-      dfdp_.reg.push_back(tape_.dfdp.reg[k]);
-      live[tape_.dfdp.reg[k]] = 1;
+// The function with only the groups in `mask` (bit g-1 for group g; group 0 always), group
+// `restricted` cut to the columns `want_col` (empty: all), and only the instructions they
+// need: walking backwards, an instruction is needed when its result is, and then so are
+// its operands (each register is written once).
+TapeFunction pruned(const TapeFunction& fn, unsigned mask, int restricted, const std::vector<char>& want_col,
+                    int num_registers) {
+  TapeFunction out;
+  std::vector<char> live(num_registers, 0);
+  for (size_t g = 0; g < fn.groups.size(); ++g) {
+    SparseOutputs kept;
+    if (g == 0 || (mask >> (g - 1)) & 1u) {
+      const SparseOutputs& all = fn.groups[g];
+      for (size_t k = 0; k < all.reg.size(); ++k) {
+        if (static_cast<int>(g) == restricted && !want_col.empty() && !want_col[all.col[k]]) continue;
+        kept.row.push_back(all.row[k]);
+        kept.col.push_back(all.col[k]);
+        kept.reg.push_back(all.reg[k]);
+        live[all.reg[k]] = 1;
+      }
     }
-  // Each register is written once in this straight-line code: walking backwards, an
-  // instruction is needed when its result is, and then so are its operands.
+    out.groups.push_back(std::move(kept));
+  }
   std::vector<Instruction> kept;
-  for (auto it = tape_.dfdp_code.rbegin(); it != tape_.dfdp_code.rend(); ++it) {
+  for (auto it = fn.code.rbegin(); it != fn.code.rend(); ++it) {
     if (!live[it->dst]) continue;
     kept.push_back(*it);
     live[it->a] = 1;
-    if (it->op == TapeOp::add || it->op == TapeOp::mul || it->op == TapeOp::div || it->op == TapeOp::pow) live[it->b] = 1;
+    if (is_binary(it->op)) live[it->b] = 1;
   }
-  dfdp_code_.assign(kept.rbegin(), kept.rend());
+  out.code.assign(kept.rbegin(), kept.rend());
+  return out;
+}
+
+constexpr int kDfdpGroup = 3;  // rhs groups: f, dfdx, dfdu, dfdp
+
+}  // namespace
+
+TapeModel::TapeModel(Tape t)
+    : tape_(std::make_shared<const Tape>(std::move(t))), reg_(tape_->num_registers, 0.0) {
+  for (const auto& [r, v] : tape_->constants) reg_[r] = v;
+  programs_ = programs_for(*tape_, {});
+  set_params(tape_->nominal);
+}
+
+std::shared_ptr<const TapeModel::Programs> TapeModel::programs_for(const Tape& t, const std::vector<int>& dfdp_columns) {
+  auto p = std::make_shared<Programs>();
+  p->dfdp_columns = dfdp_columns;
+  std::vector<char> want_col;
+  if (!dfdp_columns.empty()) {
+    want_col.assign(t.np, 0);
+    for (int c : dfdp_columns) want_col[c] = 1;
+  }
+  for (unsigned mask = 0; mask < p->rhs_for.size(); ++mask)
+    p->rhs_for[mask] = pruned(t.rhs, mask, kDfdpGroup, want_col, t.num_registers);
+  for (unsigned mask = 0; mask < p->measurement_for.size(); ++mask)
+    p->measurement_for[mask] = pruned(t.measurement, mask, -1, {}, t.num_registers);
+  return p;
+}
+
+void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
+  if (columns == programs_->dfdp_columns) return;  // a cache: the same columns as the last call
+  programs_ = programs_for(*tape_, columns);
 }
 
 void TapeModel::set_params(const std::vector<double>& p) {
   p_ = p;
-  for (int i = 0; i < tape_.np; ++i) reg_[tape_.p_reg(i)] = p[i];
-  run(tape_.precompute, reg_.data());
+  for (int i = 0; i < tape_->np; ++i) reg_[tape_->p_reg(i)] = p[i];
+  run(tape_->precompute, reg_.data());
 }
 
 std::vector<Parameter> TapeModel::parameters() const {
   std::vector<Parameter> out;
-  for (int i = 0; i < tape_.np; ++i)
-    out.push_back({tape_.param_names[i], tape_.param_units[i], p_[i], tape_.param_lower[i], tape_.param_upper[i],
-                   tape_.param_fit[i] != 0});
+  for (int i = 0; i < tape_->np; ++i)
+    out.push_back({tape_->param_names[i], tape_->param_units[i], p_[i], tape_->param_lower[i], tape_->param_upper[i],
+                   tape_->param_fit[i] != 0});
   return out;
 }
 
 void TapeModel::measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const {
   double* r = reg_.data();
-  for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];
-  run(tape_.h_code, r);
-  for (int i = 0; i < tape_.ny; ++i) h[i] = r[tape_.h_out[i]];
-  if (H) scatter(H, tape_.ny, tape_.nx, tape_.dhdx, r);
-  if (Hp) scatter(Hp, tape_.ny, tape_.np, tape_.dhdp, r);
+  for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
+  const TapeFunction& fn = programs_->measurement_for[(H ? 1u : 0u) | (Hp ? 2u : 0u)];
+  run(fn.code, r);
+  for (int i = 0; i < tape_->ny; ++i) h[i] = r[fn.groups[0].reg[i]];
+  if (H) scatter(H, tape_->ny, tape_->nx, fn.groups[1], r);
+  if (Hp) scatter(Hp, tape_->ny, tape_->np, fn.groups[2], r);
 }
 
 void TapeModel::rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const {
   double* r = reg_.data();
-  for (int i = 0; i < tape_.nx; ++i) r[i] = x[i];
-  for (int i = 0; i < tape_.nu; ++i) r[tape_.nx + i] = u[i];
-  run(tape_.f_code, r);
-  for (int i = 0; i < tape_.nx; ++i) f[i] = r[tape_.f_out[i]];
-  // Each Jacobian's code computes only what it needs beyond f; nodes shared between
-  // Jacobians are recomputed, which is cheaper than computing Jacobians nobody asked for.
-  if (A) {
-    run(tape_.dfdx_code, r);
-    scatter(A, tape_.nx, tape_.nx, tape_.dfdx, r);
-  }
-  if (B) {
-    run(dfdp_code_, r);
-    scatter(B, tape_.nx, tape_.np, dfdp_, r);
-  }
-  if (Bu) {
-    run(tape_.dfdu_code, r);
-    scatter(Bu, tape_.nx, tape_.nu, tape_.dfdu, r);
-  }
+  for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
+  for (int i = 0; i < tape_->nu; ++i) r[tape_->u_reg(i)] = u[i];
+  const TapeFunction& fn = programs_->rhs_for[(A ? 1u : 0u) | (Bu ? 2u : 0u) | (B ? 4u : 0u)];
+  run(fn.code, r);
+  for (int i = 0; i < tape_->nx; ++i) f[i] = r[fn.groups[0].reg[i]];
+  if (A) scatter(A, tape_->nx, tape_->nx, fn.groups[1], r);
+  if (Bu) scatter(Bu, tape_->nx, tape_->nu, fn.groups[2], r);
+  if (B) scatter(B, tape_->nx, tape_->np, fn.groups[kDfdpGroup], r);
 }
 
 }  // namespace quadgen::runtime

@@ -1,7 +1,11 @@
-// A straight-line program over registers that evaluates a model's expression DAG at run
-// time: the interpreted twin of a generated header (same DAG, same operations).
+// A straight-line program over registers that evaluates a model at run time: the
+// interpreted twin of a generated header. It is lowered from the same plan as the header
+// (codegen/lowered_plan), so it performs the header's operations in the header's order and
+// its results are the header's, bit for bit.
 #pragma once
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -9,32 +13,32 @@
 
 namespace quadgen::runtime {
 
-enum class TapeOp : uint8_t { add, mul, div, ipow, pow, sin, cos, log, abs, sign };
+// abs: v < 0 ? -v : v, and sign: -1, 0 or 1, as the header's abs_value and sign_of.
+enum class TapeOp : uint8_t { add, sub, mul, div, neg, pow, sin, cos, log, abs, sign };
 
 struct Instruction {
   TapeOp op;
   int dst, a, b;  // registers; b unused for unary ops
-  long k = 0;     // ipow exponent
 };
 
 struct SparseOutputs {
   std::vector<int> row, col, reg;
 };
 
+// One function of the header (rhs or measurement) as instructions. Group 0 is the value
+// (f, or h; col 0), then its Jacobians in the header's sparse layout: rhs: dfdx, dfdu,
+// dfdp; measurement: dhdx, dhdp. Every register is written once.
+struct TapeFunction {
+  std::vector<Instruction> code;
+  std::vector<SparseOutputs> groups;
+};
+
 struct Tape {
-  int nx = 0, nu = 0, np = 0;
+  int nx = 0, nu = 0, np = 0, ny = 0;
   int num_registers = 0;
   std::vector<std::pair<int, double>> constants;  // register, value
   std::vector<Instruction> precompute;  // parameters only: run on set_params
-  std::vector<Instruction> f_code;      // enough for f
-  std::vector<Instruction> dfdx_code, dfdp_code, dfdu_code;  // the rest, per Jacobian
-  std::vector<int> f_out;
-  SparseOutputs dfdx, dfdp, dfdu;
-  // The measurement h(x, p) and its Jacobians, in one piece of code after f's.
-  int ny = 0;
-  std::vector<Instruction> h_code;
-  std::vector<int> h_out;
-  SparseOutputs dhdx, dhdp;
+  TapeFunction rhs, measurement;
   std::vector<std::string> state_names, input_names, param_names;
   std::vector<double> nominal;
   std::vector<std::string> param_units;
@@ -50,30 +54,38 @@ struct Tape {
 class TapeModel : public DynamicModel {
  public:
   explicit TapeModel(Tape t);
-  int num_states() const override { return tape_.nx; }
-  int num_inputs() const override { return tape_.nu; }
-  int num_params() const override { return tape_.np; }
-  const std::vector<std::string>& state_names() const override { return tape_.state_names; }
-  const std::vector<std::string>& input_names() const override { return tape_.input_names; }
-  const std::vector<std::string>& param_names() const override { return tape_.param_names; }
+  int num_states() const override { return tape_->nx; }
+  int num_inputs() const override { return tape_->nu; }
+  int num_params() const override { return tape_->np; }
+  const std::vector<std::string>& state_names() const override { return tape_->state_names; }
+  const std::vector<std::string>& input_names() const override { return tape_->input_names; }
+  const std::vector<std::string>& param_names() const override { return tape_->param_names; }
   const std::vector<double>& params() const override { return p_; }
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<TapeModel>(*this); }
   std::vector<Parameter> parameters() const override;
-  int num_outputs() const override { return tape_.ny; }
+  int num_outputs() const override { return tape_->ny; }
   void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
-  int input_delay_param() const override { return tape_.input_delay_param; }
+  int input_delay_param() const override { return tape_->input_delay_param; }
 
  private:
-  Tape tape_;
+  // The functions pruned (backward liveness) to the outputs asked for, one per
+  // combination: rhs bit 0 dfdx, bit 1 dfdu, bit 2 dfdp (cut to the restricted columns);
+  // measurement bit 0 dhdx, bit 1 dhdp.
+  struct Programs {
+    std::vector<int> dfdp_columns;  // empty: all
+    std::array<TapeFunction, 8> rhs_for;
+    std::array<TapeFunction, 4> measurement_for;
+  };
+  static std::shared_ptr<const Programs> programs_for(const Tape& t, const std::vector<int>& dfdp_columns);
+
+  // Immutable, so shared by clones: a clone costs its registers and parameters only.
+  std::shared_ptr<const Tape> tape_;
+  std::shared_ptr<const Programs> programs_;
   std::vector<double> p_;
-  // dfdp code and outputs pruned to the requested columns (backward liveness).
-  std::vector<Instruction> dfdp_code_;
-  SparseOutputs dfdp_;
-  std::vector<int> restricted_to_;  // the columns dfdp_code_ computes (empty: all)
-  mutable std::vector<double> reg_;
+  mutable std::vector<double> reg_;  // scratch of rhs() and measurement()
 };
 
 }  // namespace quadgen::runtime

@@ -1,4 +1,4 @@
-#include "codegen/cpp_emitter.hpp"
+#include "codegen/lowered_plan.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -24,7 +24,7 @@ double power_of(double c, int k) {
 // ---------------------------------------------------------------------------------------
 // Emission-form nodes, hash-consed.
 
-int CppEmitter::intern(INode n) {
+int LoweredPlan::intern(Node n) {
   if (n.kind != Kind::leaf) {
     n.dynamic = false;
     for (int a : n.args) n.dynamic = n.dynamic || ir_[a].dynamic;
@@ -37,22 +37,28 @@ int CppEmitter::intern(INode n) {
   return static_cast<int>(ir_.size() - 1);
 }
 
-int CppEmitter::leaf(const std::string& text, bool dynamic) { return intern(INode{Kind::leaf, {}, {}, text, dynamic}); }
+int LoweredPlan::leaf(Leaf kind, int index, const std::string& text, bool dynamic) {
+  Node n{Kind::leaf, {}, {}, text, dynamic};
+  n.leaf = kind;
+  n.index = index;
+  if (kind == Leaf::constant) n.value = std::strtod(text.c_str() + 7, nullptr);  // "Scalar(" ...
+  return intern(n);
+}
 
-int CppEmitter::constant(double v) { return leaf("Scalar(" + double_literal(v) + ")", false); }
+int LoweredPlan::constant(double v) { return leaf(Leaf::constant, -1, "Scalar(" + double_literal(v) + ")", false); }
 
-int CppEmitter::prod(std::vector<int> factors) {
+int LoweredPlan::prod(std::vector<int> factors) {
   if (factors.empty()) return constant(1);
   if (factors.size() == 1) return factors[0];
   std::sort(factors.begin(), factors.end());
-  return intern(INode{Kind::prod, factors, {}, "", false});
+  return intern(Node{Kind::prod, factors, {}, "", false});
 }
 
-int CppEmitter::sum(std::vector<std::pair<int, int>> terms) {
+int LoweredPlan::sum(std::vector<std::pair<int, int>> terms) {
   std::sort(terms.begin(), terms.end());
   if (terms.size() == 1 && terms[0].second > 0) return terms[0].first;
   if (terms.size() == 1) return negate(terms[0].first);
-  INode n{Kind::sum, {}, {}, "", false};
+  Node n{Kind::sum, {}, {}, "", false};
   for (const auto& [id, s] : terms) {
     n.args.push_back(id);
     n.sign.push_back(static_cast<signed char>(s));
@@ -60,16 +66,16 @@ int CppEmitter::sum(std::vector<std::pair<int, int>> terms) {
   return intern(n);
 }
 
-int CppEmitter::negate(int id) {
-  const INode& n = ir_[id];
+int LoweredPlan::negate(int id) {
+  const Node& n = ir_[id];
   if (n.kind == Kind::sum && n.args.size() == 1 && n.sign[0] < 0) return n.args[0];
-  return intern(INode{Kind::sum, {id}, {-1}, "", false});
+  return intern(Node{Kind::sum, {id}, {-1}, "", false});
 }
 
-int CppEmitter::recip(int id) { return intern(INode{Kind::recip, {id}, {}, "", false}); }
+int LoweredPlan::recip(int id) { return intern(Node{Kind::recip, {id}, {}, "", false}); }
 
-int CppEmitter::call(const std::string& name, std::vector<int> args) {
-  return intern(INode{Kind::call, std::move(args), {}, name, false});
+int LoweredPlan::call(const std::string& name, std::vector<int> args) {
+  return intern(Node{Kind::call, std::move(args), {}, name, false});
 }
 
 // ---------------------------------------------------------------------------------------
@@ -93,10 +99,10 @@ Factors merge(const Factors& a, const Factors& b, int scale_b = 1) {
 }
 }  // namespace
 
-CppEmitter::Mono CppEmitter::convert(int gid) {
+LoweredPlan::Mono LoweredPlan::convert(int gid) {
   auto it = memo_.find(gid);
   if (it != memo_.end()) return it->second;
-  const Node& n = g_.node(gid);
+  const codegen::Node& n = g_.node(gid);  // the graph's node
   Mono m;
   auto single = [&](int id) {
     Mono r;
@@ -111,9 +117,9 @@ CppEmitter::Mono CppEmitter::convert(int gid) {
   };
   switch (n.op) {
     case Op::constant: m.coeff = std::strtod(n.literal.c_str(), nullptr); break;
-    case Op::state: m = single(leaf("x[" + std::to_string(n.index) + "]", true)); break;
-    case Op::input: m = single(leaf("u[" + std::to_string(n.index) + "]", true)); break;
-    case Op::param: m = single(leaf("p[" + std::to_string(n.index) + "]", false)); break;
+    case Op::state: m = single(leaf(Leaf::state, n.index, "x[" + std::to_string(n.index) + "]", true)); break;
+    case Op::input: m = single(leaf(Leaf::input, n.index, "u[" + std::to_string(n.index) + "]", true)); break;
+    case Op::param: m = single(leaf(Leaf::param, n.index, "p[" + std::to_string(n.index) + "]", false)); break;
     case Op::mul:
       for (int a : n.args) m = times(m, convert(a));
       break;
@@ -141,7 +147,7 @@ CppEmitter::Mono CppEmitter::convert(int gid) {
 // A sum of monomials: like terms combined, factors common to every term (and a common
 // coefficient magnitude) taken out, parameter-only terms combined into one (precomputed)
 // term, the sign normalised so that the term with the lowest id is added.
-CppEmitter::Mono CppEmitter::make_sum(std::vector<Mono> in) {
+LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
   std::map<Factors, double> like;
   std::vector<Factors> order;
   for (const auto& t : in) {
@@ -259,7 +265,7 @@ CppEmitter::Mono CppEmitter::make_sum(std::vector<Mono> in) {
 
 // A monomial as sign * node: constants and parameter-only factors are one factor (a
 // precompute candidate), dynamic denominators one reciprocal.
-CppEmitter::Signed CppEmitter::materialize(const Mono& m) {
+LoweredPlan::Signed LoweredPlan::materialize(const Mono& m) {
   if (m.coeff == 0) return {1, constant(0)};
   const int sign = m.coeff < 0 ? -1 : 1;
   const double a = std::fabs(m.coeff);
@@ -285,7 +291,7 @@ CppEmitter::Signed CppEmitter::materialize(const Mono& m) {
   return {sign, prod(dnum)};
 }
 
-int CppEmitter::materialize_positive(const Mono& m) {
+int LoweredPlan::materialize_positive(const Mono& m) {
   const Signed s = materialize(m);
   return s.sign < 0 ? negate(s.id) : s.id;
 }
@@ -293,13 +299,13 @@ int CppEmitter::materialize_positive(const Mono& m) {
 // ---------------------------------------------------------------------------------------
 // Greedy pair extraction.
 
-std::vector<int> CppEmitter::reachable(Kind kind) const {
+std::vector<int> LoweredPlan::reachable(Kind kind) const {
   std::vector<char> seen(ir_.size(), 0);
   std::vector<int> out;
   std::function<void(int)> visit = [&](int id) {
     if (seen[id]) return;
     seen[id] = 1;
-    const INode& n = ir_[id];
+    const Node& n = ir_[id];
     if (!n.dynamic) return;
     for (int a : n.args) visit(a);
     if (n.kind == kind && n.args.size() >= 2) out.push_back(id);
@@ -309,7 +315,7 @@ std::vector<int> CppEmitter::reachable(Kind kind) const {
   return out;
 }
 
-void CppEmitter::extract_pairs(Kind kind) {
+void LoweredPlan::extract_pairs(Kind kind) {
   const bool is_sum = kind == Kind::sum;
   const std::vector<int> nodes = reachable(kind);
   std::vector<std::vector<int>> args(ir_.size());
@@ -400,11 +406,11 @@ void CppEmitter::extract_pairs(Kind kind) {
   for (auto& [gid, s] : out_) s.id = rebuild(s.id, final_args, final_sign, memo);
 }
 
-int CppEmitter::rebuild(int id, const std::vector<std::vector<int>>& args,
+int LoweredPlan::rebuild(int id, const std::vector<std::vector<int>>& args,
                         const std::vector<std::vector<signed char>>& sign, std::vector<int>& memo) {
   if (static_cast<size_t>(id) < memo.size() && memo[id] >= 0) return memo[id];
   const bool mod = static_cast<size_t>(id) < args.size() && !args[id].empty();
-  const INode n = ir_[id];
+  const Node n = ir_[id];
   std::vector<int> a = mod ? args[id] : n.args;
   const std::vector<signed char> s = mod ? sign[id] : n.sign;
   for (int& x : a) x = rebuild(x, args, sign, memo);
@@ -429,13 +435,13 @@ int CppEmitter::rebuild(int id, const std::vector<std::vector<int>>& args,
 // ---------------------------------------------------------------------------------------
 // Planning: emission form of every output, pair extraction, precompute slots.
 
-void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
+LoweredPlan::LoweredPlan(ExpressionGraph& g, const std::vector<OutputGroup>& all_groups) : g_(g) {
   for (const auto& grp : all_groups)
     for (const auto& o : grp.outputs) {
       if (out_.count(o.node)) continue;
       Signed s = materialize(convert(o.node));
       if (!ir_[s.id].dynamic && s.sign < 0) {
-        const INode& n = ir_[s.id];
+        const Node& n = ir_[s.id];
         if (n.kind == Kind::leaf && n.text.rfind("Scalar(", 0) == 0)
           s.id = constant(-std::strtod(n.text.c_str() + 7, nullptr));
         else
@@ -451,10 +457,16 @@ void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
     extract_pairs(Kind::prod);
     extract_pairs(Kind::sum);
   }
+  plan_precompute_slots(all_groups);
+}
+
+// Every parameter-only, non-leaf operand of a dynamic node (and every parameter-only
+// output) gets a slot of precompute(), in first-use order.
+void LoweredPlan::plan_precompute_slots(const std::vector<OutputGroup>& all_groups) {
   pre_slot_.assign(ir_.size(), -1);
   std::vector<char> seen(ir_.size(), 0);
   auto slot = [&](int id) {
-    const INode& c = ir_[id];
+    const Node& c = ir_[id];
     if (!c.dynamic && c.kind != Kind::leaf && pre_slot_[id] < 0) {
       pre_slot_[id] = static_cast<int>(pre_order_.size());
       pre_order_.push_back(id);
@@ -463,7 +475,7 @@ void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
   std::function<void(int)> visit = [&](int id) {
     if (seen[id]) return;
     seen[id] = 1;
-    const INode& n = ir_[id];
+    const Node& n = ir_[id];
     if (!n.dynamic) return;
     for (int a : n.args) {
       visit(a);
@@ -478,13 +490,11 @@ void CppEmitter::plan_precompute(const std::vector<OutputGroup>& all_groups) {
     }
 }
 
-// ---------------------------------------------------------------------------------------
-// Rendering. `uses` decides what is inlined: a node is a temporary (temp[id] >= 0) when
-// used more than once; a reciprocal used once by a product becomes a division there.
 
-std::string CppEmitter::render_sum(int id, int outer, const std::vector<int>& temp, const std::vector<int>& uses,
-                                   bool pre_region, double& ops) const {
-  const INode& n = ir_[id];
+// ---------------------------------------------------------------------------------------
+// Function plans: which nodes are temporaries, in which order statements come.
+
+std::vector<size_t> LoweredPlan::sum_order(const Node& n, int outer) {
   std::vector<size_t> order;
   for (size_t i = 0; i < n.args.size(); ++i)
     if (n.sign[i] * outer > 0) {
@@ -493,73 +503,23 @@ std::string CppEmitter::render_sum(int id, int outer, const std::vector<int>& te
     }
   for (size_t i = 0; i < n.args.size(); ++i)
     if (order.empty() || i != order[0]) order.push_back(i);
-  std::string s;
-  for (size_t k = 0; k < order.size(); ++k) {
-    const size_t i = order[k];
-    const bool plus = n.sign[i] * outer > 0;
-    const std::string term = render(n.args[i], temp, uses, pre_region, ops, true);
-    if (k == 0) s += plus ? term : "-" + term;
-    else s += (plus ? " + " : " - ") + term;
-    if (k > 0 || !plus) ops += 1;
-  }
-  return s;
+  return order;
 }
 
-std::string CppEmitter::render(int id, const std::vector<int>& temp, const std::vector<int>& uses, bool pre_region,
-                               double& ops, bool as_operand) const {
-  const INode& n = ir_[id];
-  if (n.kind == Kind::leaf) return n.text;
-  if (temp[id] >= 0) return "t" + std::to_string(temp[id]);
-  if (!pre_region && !n.dynamic) return "pre.c[" + std::to_string(pre_slot_[id]) + "]";
-  auto operand = [&](int a) { return render(a, temp, uses, pre_region, ops, true); };
-  auto paren = [&](int a) {  // sums parenthesise themselves as operands
-    const std::string s = operand(a);
-    const INode& c = ir_[a];
-    const bool inline_node = c.kind != Kind::leaf && temp[a] < 0 && (pre_region || c.dynamic);
-    return inline_node && (c.kind == Kind::prod || c.kind == Kind::recip) ? "(" + s + ")" : s;
-  };
-  switch (n.kind) {
-    case Kind::sum: {
-      const std::string s = render_sum(id, 1, temp, uses, pre_region, ops);
-      return as_operand ? "(" + s + ")" : s;
-    }
-    case Kind::prod: {
-      std::string num, den;
-      int nn = 0;
-      for (int a : n.args) {
-        const INode& c = ir_[a];
-        if (c.kind == Kind::recip && temp[a] < 0 && uses[a] == 1 && (pre_region || c.dynamic)) {
-          den += "/" + paren(c.args[0]);
-          ops += 1;
-        } else {
-          num += (nn ? "*" : "") + paren(a);
-          if (nn) ops += 1;
-          ++nn;
-        }
-      }
-      if (nn == 0) num = "Scalar(1.0)";
-      return num + den;
-    }
-    case Kind::recip:
-      ops += 1;
-      return "Scalar(1.0)/" + paren(n.args[0]);
-    case Kind::call: {
-      ops += 1;
-      std::string s = n.text + "(";
-      for (size_t i = 0; i < n.args.size(); ++i) s += (i ? ", " : "") + render(n.args[i], temp, uses, pre_region, ops, false);
-      return s + ")";
-    }
-    case Kind::leaf: break;
-  }
-  return "";
+bool LoweredPlan::is_inline_division(const Function& fn, int id) const {
+  const Node& c = ir_[id];
+  return c.kind == Kind::recip && fn.temp[id] < 0 && fn.uses[id] == 1 && (fn.precompute || c.dynamic);
 }
 
-EmittedPrecompute CppEmitter::emit_precompute() {
-  std::vector<int> uses(ir_.size(), 0), temp(ir_.size(), -1);
+LoweredPlan::Function LoweredPlan::precompute_function() const {
+  Function fn;
+  fn.precompute = true;
+  fn.uses.assign(ir_.size(), 0);
+  fn.temp.assign(ir_.size(), -1);
   std::vector<char> seen(ir_.size(), 0);
   std::function<void(int)> count = [&](int id) {
     for (int a : ir_[id].args) {
-      uses[a]++;
+      fn.uses[a]++;
       if (!seen[a]) {
         seen[a] = 1;
         count(a);
@@ -567,44 +527,43 @@ EmittedPrecompute CppEmitter::emit_precompute() {
     }
   };
   for (int id : pre_order_) {
-    uses[id] += 2;  // stored: always named
+    fn.uses[id] += 2;  // stored: always named
     if (!seen[id]) {
       seen[id] = 1;
       count(id);
     }
   }
-  EmittedPrecompute out;
-  std::ostringstream os;
-  int next = 0;
   std::vector<char> done(ir_.size(), 0);
-  std::function<void(int)> emit = [&](int id) {
+  std::function<void(int)> define = [&](int id) {
     if (done[id] || ir_[id].kind == Kind::leaf) return;
     done[id] = 1;
-    for (int a : ir_[id].args) emit(a);
-    if (uses[id] > 1) {
-      const std::string expr = render(id, temp, uses, true, out.ops, false);
-      temp[id] = next++;
-      os << "  const Scalar t" << temp[id] << " = " << expr << ";\n";
+    for (int a : ir_[id].args) define(a);
+    if (fn.uses[id] > 1) {
+      fn.temp[id] = fn.num_temps++;
+      fn.steps.push_back({Function::StepKind::define, id, fn.temp[id]});
     }
   };
   for (int id : pre_order_) {
-    emit(id);
-    os << "  pre->c[" << pre_slot_[id] << "] = t" << temp[id] << ";\n";
+    define(id);
+    Function::Step store{Function::StepKind::store, id};
+    store.slot = pre_slot_[id];
+    fn.steps.push_back(store);
   }
-  out.body = os.str();
-  out.count = static_cast<int>(pre_order_.size());
-  return out;
+  return fn;
 }
 
-EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups) {
-  std::vector<int> uses(ir_.size(), 0), temp(ir_.size(), -1);
+LoweredPlan::Function LoweredPlan::function(const std::vector<OutputGroup>& groups) const {
+  using StepKind = Function::StepKind;
+  Function fn;
+  fn.groups = groups;
+  fn.uses.assign(ir_.size(), 0);
+  fn.temp.assign(ir_.size(), -1);
   std::vector<char> seen(ir_.size(), 0);
-  EmittedFunction out;
   std::function<void(int)> count = [&](int id) {
-    const INode& n = ir_[id];
+    const Node& n = ir_[id];
     if (!n.dynamic) return;
     for (int a : n.args) {
-      uses[a]++;
+      fn.uses[a]++;
       if (!seen[a]) {
         seen[a] = 1;
         count(a);
@@ -613,72 +572,57 @@ EmittedFunction CppEmitter::emit_function(const std::vector<OutputGroup>& groups
   };
   for (const auto& grp : groups)
     for (const auto& o : grp.outputs) {
-      out.ops_before += g_.tree_ops(o.node);
+      fn.ops_before += g_.tree_ops(o.node);
       const int id = out_.at(o.node).id;
-      uses[id]++;
+      fn.uses[id]++;
       if (!seen[id]) {
         seen[id] = 1;
         count(id);
       }
     }
-  std::ostringstream os;
-  int next = 0;
   std::vector<char> done(ir_.size(), 0);
-  std::string indent = "  ";
-  std::function<void(int)> emit = [&](int id) {
-    const INode& n = ir_[id];
+  std::function<void(int)> define = [&](int id) {
+    const Node& n = ir_[id];
     if (done[id] || n.kind == Kind::leaf || !n.dynamic) return;
     done[id] = 1;
-    for (int a : n.args) emit(a);
-    if (uses[id] > 1) {
-      const std::string expr = render(id, temp, uses, false, out.ops_after, false);
-      temp[id] = next++;
-      os << indent << "const Scalar t" << temp[id] << " = " << expr << ";\n";
+    for (int a : n.args) define(a);
+    if (fn.uses[id] > 1) {
+      fn.temp[id] = fn.num_temps++;
+      fn.steps.push_back({StepKind::define, id, fn.temp[id]});
     }
   };
-  auto assign = [&](const Output& o, const std::string& ind) {
-    const Signed s = out_.at(o.node);
-    std::string expr;
-    const INode& n = ir_[s.id];
-    if (s.sign > 0) {
-      expr = render(s.id, temp, uses, false, out.ops_after, false);
-    } else if (n.kind == Kind::sum && n.dynamic && temp[s.id] < 0) {
-      expr = render_sum(s.id, -1, temp, uses, false, out.ops_after);
-    } else {
-      expr = "-" + render(s.id, temp, uses, false, out.ops_after, true);
-      out.ops_after += 1;
-    }
-    os << ind << o.target << " = " << expr << ";\n";
+  auto assign = [&](int g, int k) {
+    const Signed o = out_.at(groups[g].outputs[k].node);
+    Function::Step step{StepKind::assign, o.id, -1, g, k};
+    step.sign = o.sign;
+    fn.steps.push_back(step);
   };
   // Unguarded groups (f) first; guarded groups (Jacobians) share one outer block in
   // which all their temporaries are computed, each group then written under its guard.
-  std::string outer;
-  for (const auto& grp : groups) {
-    if (grp.guard.empty()) {
-      for (const auto& o : grp.outputs) {
-        emit(out_.at(o.node).id);
-        assign(o, indent);
-      }
-    } else {
-      outer += (outer.empty() ? "" : " || ") + grp.guard;
+  bool any_guarded = false;
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+    if (!groups[g].guard.empty()) {
+      any_guarded = true;
+      continue;
+    }
+    for (int k = 0; k < static_cast<int>(groups[g].outputs.size()); ++k) {
+      define(out_.at(groups[g].outputs[k].node).id);
+      assign(g, k);
     }
   }
-  if (!outer.empty()) {
-    os << "  if (" << outer << ") {\n";
-    indent = "    ";
-    for (const auto& grp : groups)
-      if (!grp.guard.empty())
-        for (const auto& o : grp.outputs) emit(out_.at(o.node).id);
-    for (const auto& grp : groups) {
-      if (grp.guard.empty()) continue;
-      os << "    if (" << grp.guard << ") {\n";
-      for (const auto& o : grp.outputs) assign(o, "      ");
-      os << "    }\n";
-    }
-    os << "  }\n";
+  if (!any_guarded) return fn;
+  fn.steps.push_back({StepKind::open_any});
+  for (const auto& grp : groups)
+    if (!grp.guard.empty())
+      for (const auto& o : grp.outputs) define(out_.at(o.node).id);
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+    if (groups[g].guard.empty()) continue;
+    fn.steps.push_back({StepKind::open_group, -1, -1, g});
+    for (int k = 0; k < static_cast<int>(groups[g].outputs.size()); ++k) assign(g, k);
+    fn.steps.push_back({StepKind::close});
   }
-  out.body = os.str();
-  return out;
+  fn.steps.push_back({StepKind::close});
+  return fn;
 }
 
 }  // namespace quadgen::codegen
