@@ -61,36 +61,31 @@ class WeightedCost : public ceres::CostFunction {
 // the largest single cost of a diagnosis (a per-flight model has 28 and more parameters, of
 // which a search step frees few). Selecting columns is exact.
 //
-// A second block of one number, the norm of the fixed values, which no residual depends on
-// (its Jacobian column is zero, so no step moves it): Ceres stops when a step is below
-// parameter_tolerance * (|x| + parameter_tolerance), and with it |x| is the norm of all the
-// parameters, as when they were one block. The stopping rule, and so every fit, stays as it was.
+// Each free parameter is solved for in units of its own scale (block value = value / scale).
+// Ceres stops when a step is below parameter_tolerance * (|x| + parameter_tolerance): over
+// raw values, |x| was dominated by the motor map (~1e3 rad/s), so a step of 1e-7 counted as
+// converged, while a rotor drag or blade flapping coefficient (~1e-6, ~3e-8) could still
+// be moving by several times its size. In scaled units every parameter has to settle to the
+// same relative precision. (The trust region is scaled per column already: Jacobi scaling.)
 class FreeSubsetCost : public ceres::CostFunction {
  public:
-  FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, std::vector<bool> free)
-      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)), columns_(runtime::free_columns(free_)) {
+  FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, std::vector<bool> free,
+                 std::vector<double> scale)
+      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)), columns_(runtime::free_columns(free_)),
+        scale_(std::move(scale)) {
     set_num_residuals(m.num_residuals());
     mutable_parameter_block_sizes()->push_back(static_cast<int>(columns_.size()));
-    mutable_parameter_block_sizes()->push_back(1);
   }
-  // The norm of the fixed values: the second block's value.
-  double fixed_norm() const {
-    double ss = 0;
-    for (size_t j = 0; j < all_.size(); ++j)
-      if (!free_[j]) ss += all_[j] * all_[j];
-    return std::sqrt(ss);
-  }
-  // All parameter values with the free ones taken from the block.
+  // All parameter values with the free ones taken from the (scaled) block.
   std::vector<double> expand(const double* free_values) const {
     std::vector<double> p = all_;
-    for (size_t k = 0; k < columns_.size(); ++k) p[columns_[k]] = free_values[k];
+    for (size_t k = 0; k < columns_.size(); ++k) p[columns_[k]] = free_values[k] * scale_[k];
     return p;
   }
   bool Evaluate(double const* const* x, double* r, double** J) const override {
     const std::vector<double> p = expand(x[0]);
     const int nr = m_.num_residuals(), n = static_cast<int>(all_.size()), nf = static_cast<int>(columns_.size());
     const bool jacobian = J && J[0];
-    if (J && J[1]) std::fill(J[1], J[1] + nr, 0.0);
     if (jacobian) {
       full_.resize(static_cast<size_t>(nr) * n);
       m_.evaluate_free(p.data(), r, full_.data(), free_);
@@ -105,7 +100,7 @@ class FreeSubsetCost : public ceres::CostFunction {
       const double* in = full_.data() + static_cast<size_t>(i) * n;
       double* out = J[0] + static_cast<size_t>(i) * nf;
       for (int k = 0; k < nf; ++k) {
-        out[k] = in[columns_[k]] * w;
+        out[k] = in[columns_[k]] * w * scale_[k];
         if (!std::isfinite(out[k])) return false;
       }
     }
@@ -118,6 +113,7 @@ class FreeSubsetCost : public ceres::CostFunction {
   std::vector<double> w_;
   std::vector<bool> free_;
   std::vector<int> columns_;
+  std::vector<double> scale_;  // per free column
   mutable std::vector<double> full_;  // the model's Jacobian over all parameters, reused
 };
 
@@ -148,6 +144,15 @@ void require_finite_information(const Eigen::MatrixXd& Jf, const std::vector<Fit
 }
 
 
+// A free parameter's unit for the solver: its starting magnitude, or for one that starts at
+// zero (an effect at its neutral value) half its bound interval. Positive scales keep the
+// bounds' order.
+double solve_scale(const FitParameter& p) {
+  if (p.value != 0 && std::isfinite(p.value)) return std::fabs(p.value);
+  const double half_width = 0.5 * (p.upper - p.lower);
+  return std::isfinite(half_width) && half_width > 0 ? half_width : 1.0;
+}
+
 }  // namespace
 
 double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
@@ -159,9 +164,12 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
-  std::vector<double> xf;  // the free values: Ceres' parameter block
+  std::vector<double> xf, scale;  // the free values in units of their scale: Ceres' parameter block
   for (int i = 0; i < n; ++i)
-    if (free[i]) xf.push_back(x[i]);
+    if (free[i]) {
+      scale.push_back(solve_scale(params[i]));
+      xf.push_back(x[i] / scale.back());
+    }
   if (xf.empty()) {
     std::vector<double> all = x;
     problem.AddResidualBlock(new WeightedCost(model, n, w, free), loss, all.data());
@@ -171,14 +179,13 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
     if (converged) *converged = true;
     return 2 * cost;
   }
-  auto* cost_function = new FreeSubsetCost(model, x, w, free);
-  double fixed_norm = cost_function->fixed_norm();
-  problem.AddResidualBlock(cost_function, loss, xf.data(), &fixed_norm);
+  auto* cost_function = new FreeSubsetCost(model, x, w, free, scale);
+  problem.AddResidualBlock(cost_function, loss, xf.data());
   for (int i = 0, k = 0; i < n; ++i) {
     if (!free[i]) continue;
     if (params[i].lower < params[i].upper) {
-      problem.SetParameterLowerBound(xf.data(), k, params[i].lower);
-      problem.SetParameterUpperBound(xf.data(), k, params[i].upper);
+      problem.SetParameterLowerBound(xf.data(), k, params[i].lower / scale[k]);
+      problem.SetParameterUpperBound(xf.data(), k, params[i].upper / scale[k]);
     }
     ++k;
   }

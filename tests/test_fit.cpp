@@ -822,3 +822,40 @@ TEST(Fit, HeldParametersStayAndTheFreeOnesSolveTheRest) {
   bound_at_half(0, x(0));
   bound_at_half(2, x(1));
 }
+
+namespace {
+// r_i = b + exp(k * 1e8 * t_i) - y_i: an offset of size 1e3 (a motor map's size) beside a
+// coefficient of size 1e-8 (a blade-flapping coefficient's), the data made with b = 1000,
+// k = 3e-8.
+class MixedScaleModel : public ResidualModel {
+ public:
+  int num_residuals() const override { return 50; }
+  void evaluate(const double* p, double* r, double* J) const override {
+    for (int i = 0; i < 50; ++i) {
+      const double t = i / 49.0, e = std::exp(p[1] * 1e8 * t);
+      r[i] = p[0] + e - (1000 + std::exp(3.0 * t));
+      if (J) J[i * 2] = 1, J[i * 2 + 1] = e * 1e8 * t;
+    }
+  }
+  int channel_of(int) const override { return 0; }
+  std::vector<std::string> channels() const override { return {"y"}; }
+};
+}  // namespace
+
+// Every parameter converges to the same relative precision, whatever its size. Ceres stops
+// when a step is below parameter_tolerance * |x|; over raw values |x| is the offset's 1e3, so
+// a step in k of 1e-8 (a third of k) counted as converged and the fit stopped with k far
+// from its solution. The solver works in units of each parameter's scale instead.
+TEST(Fit, SmallParametersConvergeBesideLargeOnes) {
+  const MixedScaleModel m;
+  FitOptions fo;  // the diagnosis' tolerances
+  fo.function_tolerance = fo.parameter_tolerance = 1e-10;
+  for (const bool b_free : {false, true}) {  // the offset held (as a search step holds the airframe), or free
+    std::vector<FitParameter> ps = {{"b", "1", b_free ? 999.0 : 1000.0, 0, 2000, b_free}, {"k", "1", 1e-8, 0, 1e-6, true}};
+    bool converged = false;
+    solve_weighted(m, ps, {1.0}, fo, &converged);
+    EXPECT_TRUE(converged);
+    EXPECT_NEAR(ps[0].value, 1000, 1e-6);
+    EXPECT_NEAR(ps[1].value, 3e-8, 1e-14) << (b_free ? "b free" : "b held");
+  }
+}
