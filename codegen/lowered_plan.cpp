@@ -511,40 +511,43 @@ bool LoweredPlan::is_inline_division(const Function& fn, int id) const {
   return c.kind == Kind::recip && fn.temp[id] < 0 && fn.uses[id] == 1 && (fn.precompute || c.dynamic);
 }
 
+// A function's region: precompute() computes parameter-only nodes; the other functions stop
+// at them (they read them from pre.c).
+bool LoweredPlan::inside(const Function& fn, int id) const { return fn.precompute || ir_[id].dynamic; }
+
+// One use of `id`, and the first time it is seen one use of each of its operands.
+void LoweredPlan::count_use(Function& fn, int id, std::vector<char>& seen) const {
+  fn.uses[id]++;
+  if (seen[id]) return;
+  seen[id] = 1;
+  if (!inside(fn, id)) return;
+  for (int a : ir_[id].args) count_use(fn, a, seen);
+}
+
+// Post-order: a node used more than once becomes the next temporary, after its operands.
+void LoweredPlan::define_temporaries(Function& fn, int id, std::vector<char>& done) const {
+  const Node& n = ir_[id];
+  if (done[id] || n.kind == Kind::leaf || !inside(fn, id)) return;
+  done[id] = 1;
+  for (int a : n.args) define_temporaries(fn, a, done);
+  if (fn.uses[id] > 1) {
+    fn.temp[id] = fn.num_temps++;
+    fn.steps.push_back({Function::StepKind::define, id, fn.temp[id]});
+  }
+}
+
 LoweredPlan::Function LoweredPlan::precompute_function() const {
   Function fn;
   fn.precompute = true;
   fn.uses.assign(ir_.size(), 0);
   fn.temp.assign(ir_.size(), -1);
-  std::vector<char> seen(ir_.size(), 0);
-  std::function<void(int)> count = [&](int id) {
-    for (int a : ir_[id].args) {
-      fn.uses[a]++;
-      if (!seen[a]) {
-        seen[a] = 1;
-        count(a);
-      }
-    }
-  };
+  std::vector<char> seen(ir_.size(), 0), done(ir_.size(), 0);
   for (int id : pre_order_) {
-    fn.uses[id] += 2;  // stored: always named
-    if (!seen[id]) {
-      seen[id] = 1;
-      count(id);
-    }
+    fn.uses[id]++;  // stored: always named
+    count_use(fn, id, seen);
   }
-  std::vector<char> done(ir_.size(), 0);
-  std::function<void(int)> define = [&](int id) {
-    if (done[id] || ir_[id].kind == Kind::leaf) return;
-    done[id] = 1;
-    for (int a : ir_[id].args) define(a);
-    if (fn.uses[id] > 1) {
-      fn.temp[id] = fn.num_temps++;
-      fn.steps.push_back({Function::StepKind::define, id, fn.temp[id]});
-    }
-  };
   for (int id : pre_order_) {
-    define(id);
+    define_temporaries(fn, id, done);
     Function::Step store{Function::StepKind::store, id};
     store.slot = pre_slot_[id];
     fn.steps.push_back(store);
@@ -558,39 +561,12 @@ LoweredPlan::Function LoweredPlan::function(const std::vector<OutputGroup>& grou
   fn.groups = groups;
   fn.uses.assign(ir_.size(), 0);
   fn.temp.assign(ir_.size(), -1);
-  std::vector<char> seen(ir_.size(), 0);
-  std::function<void(int)> count = [&](int id) {
-    const Node& n = ir_[id];
-    if (!n.dynamic) return;
-    for (int a : n.args) {
-      fn.uses[a]++;
-      if (!seen[a]) {
-        seen[a] = 1;
-        count(a);
-      }
-    }
-  };
+  std::vector<char> seen(ir_.size(), 0), done(ir_.size(), 0);
   for (const auto& grp : groups)
     for (const auto& o : grp.outputs) {
       fn.ops_before += g_.tree_ops(o.node);
-      const int id = out_.at(o.node).id;
-      fn.uses[id]++;
-      if (!seen[id]) {
-        seen[id] = 1;
-        count(id);
-      }
+      count_use(fn, out_.at(o.node).id, seen);
     }
-  std::vector<char> done(ir_.size(), 0);
-  std::function<void(int)> define = [&](int id) {
-    const Node& n = ir_[id];
-    if (done[id] || n.kind == Kind::leaf || !n.dynamic) return;
-    done[id] = 1;
-    for (int a : n.args) define(a);
-    if (fn.uses[id] > 1) {
-      fn.temp[id] = fn.num_temps++;
-      fn.steps.push_back({StepKind::define, id, fn.temp[id]});
-    }
-  };
   auto assign = [&](int g, int k) {
     const Signed o = out_.at(groups[g].outputs[k].node);
     Function::Step step{StepKind::assign, o.id, -1, g, k};
@@ -606,7 +582,7 @@ LoweredPlan::Function LoweredPlan::function(const std::vector<OutputGroup>& grou
       continue;
     }
     for (int k = 0; k < static_cast<int>(groups[g].outputs.size()); ++k) {
-      define(out_.at(groups[g].outputs[k].node).id);
+      define_temporaries(fn, out_.at(groups[g].outputs[k].node).id, done);
       assign(g, k);
     }
   }
@@ -614,7 +590,7 @@ LoweredPlan::Function LoweredPlan::function(const std::vector<OutputGroup>& grou
   fn.steps.push_back({StepKind::open_any});
   for (const auto& grp : groups)
     if (!grp.guard.empty())
-      for (const auto& o : grp.outputs) define(out_.at(o.node).id);
+      for (const auto& o : grp.outputs) define_temporaries(fn, out_.at(o.node).id, done);
   for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
     if (groups[g].guard.empty()) continue;
     fn.steps.push_back({StepKind::open_group, -1, -1, g});

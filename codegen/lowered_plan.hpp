@@ -128,6 +128,9 @@ class LoweredPlan {
               std::vector<int>& memo);
   std::vector<int> reachable(Kind kind) const;
   void plan_precompute_slots(const std::vector<OutputGroup>& all_groups);
+  bool inside(const Function& fn, int id) const;
+  void count_use(Function& fn, int id, std::vector<char>& seen) const;
+  void define_temporaries(Function& fn, int id, std::vector<char>& done) const;
 
   ExpressionGraph& g_;
   std::vector<Node> ir_;
