@@ -111,7 +111,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   DynamicModel& m = *model_ptr;
   const size_t nr = vehicle.rotors.size();
   const auto laws = nominal_thrust_laws(vehicle, model);
-  const double vbat_ref = param(vehicle, "vbat_ref").value;
+  const double vbat_ref = param(vehicle, "vbat_ref").nominal;
   const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
   check_hover_reachable(vehicle, laws, hover);
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);

@@ -84,9 +84,9 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
     c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
 
   for (const char* n : {"g", "rho", "c_w", "c_t", "kappa", "a0", "a1", "a2"}) {
-    const Parameter& vp = param(c.vehicle, n);
-    const std::string name = (n[0] == 'a' && n[1] != 0 && isdigit(n[1])) ? std::string("motor_") + n : n;
-    c.add_param(name, vp.unit, vp.value, vp.lower, vp.upper, vp.fit, vp.doc);
+    ParameterSpec spec = param(c.vehicle, n);  // the record without its file line
+    if (n[0] == 'a' && n[1] != 0 && isdigit(n[1])) spec.name = std::string("motor_") + n;
+    c.add_param(spec);
   }
   // Mass properties derived from the blocks become parameters with those nominal values,
   // so that a fit may free them and the generated code precomputes J^-1 once.
@@ -264,15 +264,16 @@ void assemble(ModelContext& c) {
 
 }  // namespace
 
-symbol ModelContext::add_param(const std::string& name, const std::string& unit, double nominal,
-                               double lower, double upper, bool fit, const std::string& doc) {
-  Variable v = make_variable(name, unit, doc);
-  v.nominal = nominal;
-  v.lower = lower;
-  v.upper = upper;
-  v.fit = fit;
+symbol ModelContext::add_param(const ParameterSpec& spec) {
+  Variable v;
+  static_cast<ParameterSpec&>(v) = spec;
+  v.sym = symbol(spec.name, tex_of(spec.name));
   model.params.push_back(v);
   return v.sym;
+}
+symbol ModelContext::add_param(const std::string& name, const std::string& unit, double nominal,
+                               double lower, double upper, bool fit, const std::string& doc) {
+  return add_param(ParameterSpec{name, unit, parse_unit(unit).dim, nominal, lower, upper, fit, doc});
 }
 symbol ModelContext::add_state(const std::string& name, const std::string& unit, const std::string& doc) {
   model.states.push_back(make_variable(name, unit, doc));

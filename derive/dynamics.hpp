@@ -36,6 +36,8 @@ struct ModelContext {
   std::vector<GiNaC::ex> commanded_speed;  // motor map of the command, per rotor
   GiNaC::matrix measured_q{4, 1};       // attitude as logged
 
+  // A parameter as its record says (a vehicle file's, with its name as the model calls it).
+  GiNaC::symbol add_param(const ParameterSpec& spec);
   GiNaC::symbol add_param(const std::string& name, const std::string& unit, double nominal,
                           double lower, double upper, bool fit, const std::string& doc);
   GiNaC::symbol add_state(const std::string& name, const std::string& unit, const std::string& doc);

@@ -9,19 +9,15 @@
 
 #include <ginac/ginac.h>
 
+#include "model/parameter_spec.hpp"
 #include "model/units.hpp"
 
 namespace quadgen {
 
-struct Variable {
-  std::string name;  // e.g. "vx", "u_A", "motor_gain.A"
+// A state, input, output, constant or parameter of the symbolic model: its record (for
+// states and inputs only name, unit, dimension and doc mean anything) and its symbol.
+struct Variable : ParameterSpec {
   GiNaC::symbol sym;
-  std::string unit;  // SI
-  Dimension dim;
-  double nominal = 0;
-  double lower = 0, upper = 0;
-  bool fit = false;
-  std::string doc;
 };
 
 struct SymbolicModel {

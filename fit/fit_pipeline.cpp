@@ -331,14 +331,14 @@ std::vector<runtime::Panel> stand_panels(const std::vector<StandSample>& samples
 FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
   const auto samples = read_thrust_stand(path);
   o.progress("thrust vs rotor speed and rotor speed vs command, " + std::to_string(samples.size()) + " samples");
-  const double vref = param(v, "vbat_ref").value;
+  const double vref = param(v, "vbat_ref").nominal;
   const StandFit f = fit_stand(samples, vref, fit_options(o), profile_options(o));
   const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
   const int n_k = shared ? 1 : static_cast<int>(StandSample::kMotors);
   double k = 0;
   for (int i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / n_k;
   const Rotor& r0 = v.rotors.front();
-  const double ct = runtime::thrust_coefficient_c_t(k, param(v, "rho").value, r0.disc_area, r0.radius);
+  const double ct = runtime::thrust_coefficient_c_t(k, param(v, "rho").nominal, r0.disc_area, r0.radius);
   FitOutputs out;
   auto& j = out.json;
   j["kind"] = "thrust_stand";
@@ -363,7 +363,7 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   j["summary"] = {{"k", output::estimate_json(k_estimate)},
                   {"coefficients", shared ? "one shared by all motors" : "mean of the per-motor coefficients"},
                   {"c_t", ct},
-                  {"c_t_in_vehicle_file", param(v, "c_t").value},
+                  {"c_t_in_vehicle_file", param(v, "c_t").nominal},
                   {"battery_sag_exponent_implied", f.voltage_exponent_identified ? nlohmann::ordered_json(2 * f.speed.parameters[3].value)
                                                                                 : nlohmann::ordered_json(nullptr)},
                   {"vbat_ref_V", vref}};

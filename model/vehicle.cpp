@@ -54,7 +54,7 @@ struct Reader : YamlReader {
     p.dim = si.dim;
     double scale = 1.0;
     if (n.IsScalar()) {
-      p.value = number(n, name);
+      p.nominal = number(n, name);
     } else {
       require_map(n, "parameter " + name);
       only_keys(n, {"value", "unit", "bounds", "fit", "source"}, "parameter " + name);
@@ -69,14 +69,14 @@ struct Reader : YamlReader {
           fail(n["unit"], "unit of " + name + " must have dimension " + si.dim.str() + ", got " + u.dim.str());
         scale = u.scale / si.scale;
       }
-      p.value = number(need(n, "value", "parameter " + name), name) * scale;
+      p.nominal = number(need(n, "value", "parameter " + name), name) * scale;
       if (n["bounds"]) {
         const YAML::Node b = n["bounds"];
         if (!b.IsSequence() || b.size() != 2) fail(b, "expected bounds [lower, upper] for " + name);
         p.lower = number(b[0], "lower bound of " + name) * scale;
         p.upper = number(b[1], "upper bound of " + name) * scale;
         if (!(p.lower < p.upper)) fail(b, "expected lower < upper in bounds of " + name);
-        if (p.value < p.lower || p.value > p.upper)
+        if (p.nominal < p.lower || p.nominal > p.upper)
           fail(b, "nominal value of " + name + " lies outside its bounds");
       }
       if (n["fit"]) {
@@ -89,7 +89,7 @@ struct Reader : YamlReader {
       if (p.fit && !n["bounds"]) fail(n, "parameter " + name + " is to be fitted but has no bounds");
     }
     if (p.lower == 0 && p.upper == 0) {  // no bounds given: the nominal value only
-      p.lower = p.upper = p.value;
+      p.lower = p.upper = p.nominal;
     }
     return p;
   }
@@ -198,8 +198,8 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (root["battery"])
     read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});
   else
-    v.params["vbat_ref"] = Parameter{"vbat_ref", 4.0, "V", parse_unit("V").dim, 4.0, 4.0, false,
-                                     "reference battery voltage"};
+    v.params["vbat_ref"] = Parameter{{"vbat_ref", "V", parse_unit("V").dim, 4.0, 4.0, 4.0, false,
+                                      "reference battery voltage"}};
 
   const YAML::Node blocks = r.need(root, "blocks", "the vehicle file");
   if (!blocks.IsSequence() || blocks.size() == 0) r.fail(blocks, "expected a non-empty list of blocks");

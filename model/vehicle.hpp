@@ -9,22 +9,16 @@
 #include <vector>
 
 #include "output/fnv1a.hpp"
+#include "model/parameter_spec.hpp"
 #include "model/units.hpp"
 
 namespace quadgen {
 
 using Vec3 = std::array<double, 3>;
 
-// A scalar the model treats as a parameter: nominal value (SI), unit, bounds, fit flag.
-struct Parameter {
-  std::string name;
-  double value = 0;
-  std::string unit;  // SI unit text, e.g. "m/s^2"
-  Dimension dim;
-  double lower = 0, upper = 0;  // bounds in SI
-  bool fit = false;
-  std::string doc;  // what it is
-  int line = 0;     // where the vehicle file gives it (0: not from a file), for error messages
+// A scalar the model treats as a parameter, as the vehicle file gives it.
+struct Parameter : ParameterSpec {
+  int line = 0;  // where the vehicle file gives it (0: not from a file), for error messages
 };
 
 // A cuboid of constant density, given in its own frame (edges along its axes, centred),

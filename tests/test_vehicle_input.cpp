@@ -140,9 +140,9 @@ TEST(VehicleFiles, Finken3MotorMapIsTheTable2Fit) {
   const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(b);
   const Vehicle v = test::finken3();
   const double rpm_to_rad = 2 * M_PI / 60;
-  EXPECT_NEAR(param(v, "a0").value, coef(0) * rpm_to_rad, 1e-6);
-  EXPECT_NEAR(param(v, "a1").value, coef(1) * rpm_to_rad, 1e-6);
-  EXPECT_NEAR(param(v, "a2").value, coef(2) * rpm_to_rad, 1e-6);
+  EXPECT_NEAR(param(v, "a0").nominal, coef(0) * rpm_to_rad, 1e-6);
+  EXPECT_NEAR(param(v, "a1").nominal, coef(1) * rpm_to_rad, 1e-6);
+  EXPECT_NEAR(param(v, "a2").nominal, coef(2) * rpm_to_rad, 1e-6);
 }
 
 // The command line: bad input exits non-zero with one line and leaves no files.

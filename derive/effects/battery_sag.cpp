@@ -11,8 +11,10 @@ namespace {
 
 void terms(ModelContext& c) {
   const ex e = c.add_param("battery_sag.exponent", "1", 0.0, -1.0, 4.0, true, "thrust ~ (vbat/vbat_ref)^exponent");
-  const Parameter& ref = param(c.vehicle, "vbat_ref");
-  const ex vref = c.add_param("vbat_ref", "V", ref.value, ref.value, ref.value, false, ref.doc);
+  ParameterSpec ref = param(c.vehicle, "vbat_ref");  // a constant of this effect: held
+  ref.lower = ref.upper = ref.nominal;
+  ref.fit = false;
+  const ex vref = c.add_param(ref);
   const ex vbat = c.add_input("vbat", "V", "battery voltage");
   for (ex& s : c.thrust_scale) s = s * pow(vbat / vref, e);
 }

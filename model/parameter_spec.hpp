@@ -1,0 +1,23 @@
+// What a model parameter is, one record from the vehicle file through the symbolic model to
+// the generated header (kParamUnits, kParamLower, kParamUpper, kParamFit): the vehicle's
+// Parameter adds the file line, the symbolic model's Variable adds the GiNaC symbol. At run
+// time a parameter is a value with its bounds and fit flag (runtime::Parameter, which the
+// installed runtime headers carry without this project's model library).
+#pragma once
+#include <string>
+
+#include "model/units.hpp"
+
+namespace quadgen {
+
+struct ParameterSpec {
+  std::string name;
+  std::string unit;  // SI unit text, e.g. "m/s^2"
+  Dimension dim;
+  double nominal = 0;           // SI
+  double lower = 0, upper = 0;  // bounds in SI; equal: held at the nominal value
+  bool fit = false;
+  std::string doc;  // what it is
+};
+
+}  // namespace quadgen
