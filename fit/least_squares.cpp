@@ -1,6 +1,7 @@
 #include "fit/least_squares.hpp"
 #include "runtime/dynamic_model.hpp"  // free_columns
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -145,12 +146,16 @@ void require_finite_information(const Eigen::MatrixXd& Jf, const std::vector<Fit
 
 
 // A free parameter's unit for the solver: its starting magnitude, or for one that starts at
-// zero (an effect at its neutral value) half its bound interval. Positive scales keep the
-// bounds' order.
+// zero (an effect at its neutral value) half its bound interval. A start far below that
+// (a leftover 1e-12 of an earlier fit) is not its size: the scale is at least a thousandth
+// of the half interval. Half intervals beyond 1 (in SI units) count as 1: bounds of
+// +-1e300 say "unbounded", not "of size 1e300", and would scale the Jacobian to overflow.
+// Positive scales keep the bounds' order.
 double solve_scale(const FitParameter& p) {
-  if (p.value != 0 && std::isfinite(p.value)) return std::fabs(p.value);
   const double half_width = 0.5 * (p.upper - p.lower);
-  return std::isfinite(half_width) && half_width > 0 ? half_width : 1.0;
+  const double size = std::isfinite(half_width) && half_width > 0 ? std::min(half_width, 1.0) : 1.0;
+  if (p.value == 0 || !std::isfinite(p.value)) return size;
+  return std::max(std::fabs(p.value), 1e-3 * size);
 }
 
 }  // namespace
@@ -209,8 +214,13 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.initial_cost) || !std::isfinite(summary.final_cost))
     throw FitError("least squares failed (" + summary.message + ") starting from " + values_text(params) +
                    ": a residual or Jacobian entry is not finite there");
+  // Back in the parameters' units: a value Ceres left on a bound (bound / scale) times the
+  // scale can miss the bound by an ulp, outside it, where the next fit could not start.
   const std::vector<double> solved = cost_function->expand(xf.data());
-  for (int i = 0; i < n; ++i) params[i].value = solved[i];
+  for (int i = 0; i < n; ++i)
+    params[i].value = free[i] && params[i].lower < params[i].upper
+                          ? std::clamp(solved[i], params[i].lower, params[i].upper)
+                          : solved[i];
   if (converged) *converged = summary.termination_type == ceres::CONVERGENCE;
   if (report) *report = summary.BriefReport();
   return 2 * summary.final_cost;

@@ -76,11 +76,12 @@ constexpr int kDfdpGroup = 3;  // rhs groups: f, dfdx, dfdu, dfdp
 TapeModel::TapeModel(Tape t)
     : tape_(std::make_shared<const Tape>(std::move(t))), reg_(tape_->num_registers, 0.0) {
   for (const auto& [r, v] : tape_->constants) reg_[r] = v;
-  programs_ = programs_for(*tape_, {});
+  programs_ = programs_for(*tape_, {}, nullptr);
   set_params(tape_->nominal);
 }
 
-std::shared_ptr<const TapeModel::Programs> TapeModel::programs_for(const Tape& t, const std::vector<int>& dfdp_columns) {
+std::shared_ptr<const TapeModel::Programs> TapeModel::programs_for(const Tape& t, const std::vector<int>& dfdp_columns,
+                                                                    const Programs* unrestricted_parts) {
   auto p = std::make_shared<Programs>();
   p->dfdp_columns = dfdp_columns;
   std::vector<char> want_col;
@@ -88,16 +89,20 @@ std::shared_ptr<const TapeModel::Programs> TapeModel::programs_for(const Tape& t
     want_col.assign(t.np, 0);
     for (int c : dfdp_columns) want_col[c] = 1;
   }
+  constexpr unsigned kDfdpBit = 4;
   for (unsigned mask = 0; mask < p->rhs_for.size(); ++mask)
-    p->rhs_for[mask] = pruned(t.rhs, mask, kDfdpGroup, want_col, t.num_registers);
+    p->rhs_for[mask] = unrestricted_parts && !(mask & kDfdpBit)
+                           ? unrestricted_parts->rhs_for[mask]
+                           : pruned(t.rhs, mask, kDfdpGroup, want_col, t.num_registers);
   for (unsigned mask = 0; mask < p->measurement_for.size(); ++mask)
-    p->measurement_for[mask] = pruned(t.measurement, mask, -1, {}, t.num_registers);
+    p->measurement_for[mask] = unrestricted_parts ? unrestricted_parts->measurement_for[mask]
+                                                  : pruned(t.measurement, mask, -1, {}, t.num_registers);
   return p;
 }
 
 void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
   if (columns == programs_->dfdp_columns) return;  // a cache: the same columns as the last call
-  programs_ = programs_for(*tape_, columns);
+  programs_ = programs_for(*tape_, columns, programs_.get());
 }
 
 void TapeModel::set_params(const std::vector<double>& p) {

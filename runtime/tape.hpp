@@ -79,7 +79,9 @@ class TapeModel : public DynamicModel {
     std::array<TapeFunction, 8> rhs_for;
     std::array<TapeFunction, 4> measurement_for;
   };
-  static std::shared_ptr<const Programs> programs_for(const Tape& t, const std::vector<int>& dfdp_columns);
+  // Restricting dfdp re-prunes only the four rhs programs that compute it.
+  static std::shared_ptr<const Programs> programs_for(const Tape& t, const std::vector<int>& dfdp_columns,
+                                                      const Programs* unrestricted_parts);
 
   // Immutable, so shared by clones: a clone costs its registers and parameters only.
   std::shared_ptr<const Tape> tape_;

@@ -858,4 +858,11 @@ TEST(Fit, SmallParametersConvergeBesideLargeOnes) {
     EXPECT_NEAR(ps[0].value, 1000, 1e-6);
     EXPECT_NEAR(ps[1].value, 3e-8, 1e-14) << (b_free ? "b free" : "b held");
   }
+  // The solution beyond a bound: k ends on it, not an ulp outside (bound / scale * scale).
+  for (const double start : {7e-9, 9.2e-9, 1.84e-8, 1.99e-8}) {  // the last three: (2e-8 / start) * start > 2e-8
+    std::vector<FitParameter> ps = {{"b", "1", 1000.0, 0, 2000, false}, {"k", "1", start, 0, 2e-8, true}};
+    solve_weighted(m, ps, {1.0}, fo);
+    EXPECT_LE(ps[1].value, 2e-8) << start;
+    EXPECT_NEAR(ps[1].value, 2e-8, 1e-22) << start;
+  }
 }
