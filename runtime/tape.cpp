@@ -1,6 +1,8 @@
 #include "runtime/tape.hpp"
 
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 
 namespace quadgen::runtime {
 
@@ -36,7 +38,19 @@ void scatter(double* dense, int rows, int cols, const SparseOutputs& s, const do
   for (size_t k = 0; k < s.reg.size(); ++k) dense[s.row[k] * cols + s.col[k]] = r[s.reg[k]];
 }
 
-// The function with only the groups in `mask` (bit g-1 for group g; group 0 always), group
+// Group g of a function (g >= 1: a Jacobian) is wanted when bit g-1 of a request mask is set;
+// group 0, the value, always is. rhs groups: f, dfdx, dfdu, dfdp; measurement: h, dhdx, dhdp.
+constexpr unsigned group_bit(int group) { return 1u << (group - 1); }
+constexpr int kDfdxGroup = 1, kDfduGroup = 2, kDfdpGroup = 3, kDhdxGroup = 1, kDhdpGroup = 2;
+
+unsigned request(std::initializer_list<std::pair<const double*, int>> outputs) {
+  unsigned mask = 0;
+  for (const auto& [out, group] : outputs)
+    if (out) mask |= group_bit(group);
+  return mask;
+}
+
+// The function with only the groups in `mask` (group_bit; group 0 always), group
 // `restricted` cut to the columns `want_col` (empty: all), and only the instructions they
 // need: walking backwards, an instruction is needed when its result is, and then so are
 // its operands (each register is written once).
@@ -46,7 +60,7 @@ TapeFunction pruned(const TapeFunction& fn, unsigned mask, int restricted, const
   std::vector<char> live(num_registers, 0);
   for (size_t g = 0; g < fn.groups.size(); ++g) {
     SparseOutputs kept;
-    if (g == 0 || (mask >> (g - 1)) & 1u) {
+    if (g == 0 || (mask & group_bit(static_cast<int>(g)))) {
       const SparseOutputs& all = fn.groups[g];
       for (size_t k = 0; k < all.reg.size(); ++k) {
         if (static_cast<int>(g) == restricted && !want_col.empty() && !want_col[all.col[k]]) continue;
@@ -69,8 +83,6 @@ TapeFunction pruned(const TapeFunction& fn, unsigned mask, int restricted, const
   return out;
 }
 
-constexpr int kDfdpGroup = 3;  // rhs groups: f, dfdx, dfdu, dfdp
-
 }  // namespace
 
 TapeModel::TapeModel(Tape t)
@@ -89,9 +101,8 @@ std::shared_ptr<const TapeModel::Programs> TapeModel::programs_for(const Tape& t
     want_col.assign(t.np, 0);
     for (int c : dfdp_columns) want_col[c] = 1;
   }
-  constexpr unsigned kDfdpBit = 4;
   for (unsigned mask = 0; mask < p->rhs_for.size(); ++mask)
-    p->rhs_for[mask] = unrestricted_parts && !(mask & kDfdpBit)
+    p->rhs_for[mask] = unrestricted_parts && !(mask & group_bit(kDfdpGroup))
                            ? unrestricted_parts->rhs_for[mask]
                            : pruned(t.rhs, mask, kDfdpGroup, want_col, t.num_registers);
   for (unsigned mask = 0; mask < p->measurement_for.size(); ++mask)
@@ -122,22 +133,22 @@ std::vector<Parameter> TapeModel::parameters() const {
 void TapeModel::measurement(const double* x, double /*t*/, double* h, double* H, double* Hp) const {
   double* r = reg_.data();
   for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
-  const TapeFunction& fn = programs_->measurement_for[(H ? 1u : 0u) | (Hp ? 2u : 0u)];
+  const TapeFunction& fn = programs_->measurement_for[request({{H, kDhdxGroup}, {Hp, kDhdpGroup}})];
   run(fn.code, r);
   for (int i = 0; i < tape_->ny; ++i) h[i] = r[fn.groups[0].reg[i]];
-  if (H) scatter(H, tape_->ny, tape_->nx, fn.groups[1], r);
-  if (Hp) scatter(Hp, tape_->ny, tape_->np, fn.groups[2], r);
+  if (H) scatter(H, tape_->ny, tape_->nx, fn.groups[kDhdxGroup], r);
+  if (Hp) scatter(Hp, tape_->ny, tape_->np, fn.groups[kDhdpGroup], r);
 }
 
 void TapeModel::rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const {
   double* r = reg_.data();
   for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
   for (int i = 0; i < tape_->nu; ++i) r[tape_->u_reg(i)] = u[i];
-  const TapeFunction& fn = programs_->rhs_for[(A ? 1u : 0u) | (Bu ? 2u : 0u) | (B ? 4u : 0u)];
+  const TapeFunction& fn = programs_->rhs_for[request({{A, kDfdxGroup}, {Bu, kDfduGroup}, {B, kDfdpGroup}})];
   run(fn.code, r);
   for (int i = 0; i < tape_->nx; ++i) f[i] = r[fn.groups[0].reg[i]];
-  if (A) scatter(A, tape_->nx, tape_->nx, fn.groups[1], r);
-  if (Bu) scatter(Bu, tape_->nx, tape_->nu, fn.groups[2], r);
+  if (A) scatter(A, tape_->nx, tape_->nx, fn.groups[kDfdxGroup], r);
+  if (Bu) scatter(Bu, tape_->nx, tape_->nu, fn.groups[kDfduGroup], r);
   if (B) scatter(B, tape_->nx, tape_->np, fn.groups[kDfdpGroup], r);
 }
 

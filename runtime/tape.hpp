@@ -71,9 +71,9 @@ class TapeModel : public DynamicModel {
   int input_delay_param() const override { return tape_->input_delay_param; }
 
  private:
-  // The functions pruned (backward liveness) to the outputs asked for, one per
-  // combination: rhs bit 0 dfdx, bit 1 dfdu, bit 2 dfdp (cut to the restricted columns);
-  // measurement bit 0 dhdx, bit 1 dhdp.
+  // The functions pruned (backward liveness) to the outputs asked for, one per combination
+  // of requested Jacobians (a mask with bit g-1 for group g: rhs dfdx, dfdu, dfdp, the last
+  // cut to the restricted columns; measurement dhdx, dhdp).
   struct Programs {
     std::vector<int> dfdp_columns;  // empty: all
     std::array<TapeFunction, 8> rhs_for;
