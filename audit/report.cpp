@@ -219,7 +219,7 @@ void section_mass(std::ostringstream& md, const Derivation& d) {
      << "| block | J_xx | J_yy | J_zz | J_xy | J_xz | J_yz | A_x | A_y | A_z |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& b : mp.blocks) {
     const auto& J = b.inertia_origin_value;
-    md << "| " << b.name << " | " << num(J[0][0]) << " | " << num(J[1][1]) << " | " << num(J[2][2]) << " | "
+    md << "| " << output::markdown_text(b.name) << " | " << num(J[0][0]) << " | " << num(J[1][1]) << " | " << num(J[2][2]) << " | "
        << num(J[0][1]) << " | " << num(J[0][2]) << " | " << num(J[1][2]) << " | " << num(b.areas_value[0])
        << " | " << num(b.areas_value[1]) << " | " << num(b.areas_value[2]) << " |\n";
   }
@@ -332,11 +332,11 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
   else md << "| # | name | unit | meaning |\n|---|---|---|---|\n";
   for (size_t i = 0; i < vars.size(); ++i) {
     const auto& v = vars[i];
-    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << v.unit << " | ";
+    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(v.unit) << " | ";
     if (params)
       md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
          << " | " << (v.fit ? "yes" : "no") << " | ";
-    md << v.doc << " |\n";
+    md << output::markdown_text(v.doc) << " |\n";
   }
   md << "\n";
 }
@@ -345,7 +345,8 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   md << "## 7. Audit\n\n**" << (d.audit.all_passed() ? "All checks passed." : "SOME CHECKS FAILED.") << "**\n\n"
      << "| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
-    md << "| " << c.group << " | " << c.name << " | " << (c.passed ? "pass" : "**FAIL**") << " | " << c.detail << " |\n";
+    md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | " << (c.passed ? "pass" : "**FAIL**")
+       << " | " << output::markdown_text(c.detail) << " |\n";
   md << "\n";
 }
 
@@ -356,8 +357,9 @@ void section_thesis(std::ostringstream& md, const Derivation& d) {
         "them with the derived model at its nominal parameters.\n\n"
      << "| ref | topic | thesis | derived | verdict | cause | size |\n|---|---|---|---|---|---|---|\n";
   for (const auto& t : d.thesis)
-    md << "| " << t.ref << " | " << t.topic << " | " << t.thesis << " | " << t.derived << " | "
-       << (t.agrees ? "agrees" : "**differs**") << " | " << t.cause << " | " << t.size << " |\n";
+    md << "| " << output::markdown_text(t.ref) << " | " << output::markdown_text(t.topic) << " | " << output::markdown_text(t.thesis)
+       << " | " << output::markdown_text(t.derived) << " | " << (t.agrees ? "agrees" : "**differs**") << " | "
+       << output::markdown_text(t.cause) << " | " << output::markdown_text(t.size) << " |\n";
   md << "\n";
 }
 

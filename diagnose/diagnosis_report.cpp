@@ -189,11 +189,12 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
     json per_flight = json::array();
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
-      per_flight.push_back({{"flight", k < flights.size() ? flights[k] : std::string()},
-                            {"value", number_or_null(f.value)},
-                            {"ci95", {number_or_null(f.lower), number_or_null(f.upper)}},
-                            {"standard_error", number_or_null(f.standard_error)},
-                            {"alone", {{"statistic", f.statistic}, {"p_value", f.p_value}}}});
+      // The one estimate shape (output/estimate.hpp), then what belongs to agreement.
+      json entry = output::estimate_json({f.value, a.unit, f.lower, f.upper, "", false});
+      entry["flight"] = k < flights.size() ? flights[k] : std::string();
+      entry["standard_error"] = number_or_null(f.standard_error);
+      entry["alone"] = {{"statistic", f.statistic}, {"p_value", f.p_value}};
+      per_flight.push_back(std::move(entry));
     }
     out.push_back({{"parameter", a.parameter},
                    {"effect", a.effect},
@@ -468,7 +469,8 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   auto render = [&](const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
     for (auto& p : panels)
       for (auto& s : p.series)
-        if (const auto it = colours.find(s.label); it != colours.end()) s.color = it->second;
+        for (const auto& [model, colour] : colours)  // "base model, tilt" is the base model's too
+          if (!model.empty() && (s.label == model || s.label.rfind(model + ",", 0) == 0)) s.color = colour;
     if (data) data->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
     std::string svg;
     if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
@@ -551,6 +553,12 @@ std::string num(double v, int prec = 4) {
   return os.str();
 }
 
+// A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
+std::string interval(double lower, double upper, int prec = 4) {
+  const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
+  return "[" + side(lower) + ", " + side(upper) + "]";
+}
+
 }  // namespace
 
 std::string diagnosis_summary(const Diagnosis& d) {
@@ -561,21 +569,20 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& f : d.findings) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
-      os << " " << p.name << " = " << num(p.value) << " [" << num(p.lower) << ", " << num(p.upper) << "]";
+      os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n  " << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %, Cochran's Q p = " << num(a.q_p_value, 2) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
-      os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " [" << num(a.flights[k].lower, 3) << ", "
-         << num(a.flights[k].upper, 3) << "]";
+      os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
     os << "\n";
   }
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : "disagrees") << " with the airframe on " << a.parameter << ": "
-       << num(a.flights.front().value, 3) << " [" << num(a.flights.front().lower, 3) << ", " << num(a.flights.front().upper, 3)
-       << "] against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
+       << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
+       << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
        << ")\n";
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
@@ -624,8 +631,7 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       << "</td><td>";
     for (size_t i = 0; i < t.coefficients.size(); ++i) {
       const auto& c = t.coefficients[i];
-      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, 3) << " [" << num(c.lower, 3) << ", "
-        << num(c.upper, 3) << "] " << esc(c.unit);
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, 3) << " " << interval(c.lower, c.upper, 3) << " " << esc(c.unit);
     }
     h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
       << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
@@ -660,7 +666,7 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
     h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
     for (const auto* p : row)
       if (p)
-        h << "<td>" << num(p->value, 3) << " [" << num(p->lower, 3) << ", " << num(p->upper, 3) << "]"
+        h << "<td>" << num(p->value, 3) << " " << interval(p->lower, p->upper, 3)
           << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
       else h << "<td>–</td>";
     h << "</tr>\n";
@@ -690,7 +696,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       h << "<tr><td>" << k + 1 << ". " << esc(k < flights.size() ? flights[k] : std::string()) << "</td><td>"
-        << num(f.value, 3) << "</td><td>[" << num(f.lower, 3) << ", " << num(f.upper, 3) << "]</td><td>"
+        << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
         << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
         << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
       if (std::isfinite(f.lower) && std::isfinite(f.upper))
@@ -781,8 +787,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     else {
       h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
       for (const auto& p : f.parameters)
-        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>[" << num(p.lower) << ", "
-          << num(p.upper) << "]</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>" << interval(p.lower, p.upper)
+          << "</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
       h << "</table>\n";
     }
     h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "

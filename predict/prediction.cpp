@@ -8,6 +8,7 @@
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "fit/equation_error.hpp"
+#include "output/estimate.hpp"
 
 namespace quadgen::predict {
 
@@ -292,8 +293,8 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
 namespace {
 
 nlohmann::ordered_json stats_json(const ErrorStats& s) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
-  return {{"mean", num(s.mean())}, {"rms", num(s.rms())}, {"count", s.count}};
+  using output::number_or_null;
+  return {{"mean", number_or_null(s.mean())}, {"rms", number_or_null(s.rms())}, {"count", s.count}};
 }
 
 double rms_of(const ErrorStats& s) { return s.rms(); }
@@ -316,7 +317,7 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
                         {"position_m", stats_json(h.position)},
                         {"velocity_m_s", stats_json(h.velocity)},
                         {"diverged", h.diverged}});
-  auto num = [](double v) { return std::isfinite(v) ? J(v) : J(nullptr); };
+  const auto num = output::number_or_null;
   const auto& o = p.one_step;
   J one = {{"specific_force_m_s2",
             {{"x", num(rms_of(o.specific_force[0]))}, {"y", num(rms_of(o.specific_force[1]))}, {"z", num(rms_of(o.specific_force[2]))}}},
@@ -383,7 +384,8 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   runtime::Panel replay{"attitude replayed (force model alone): mean position error", "horizon [s]", "m", {}};
   runtime::Panel tilt{"open loop: mean tilt and heading error", "horizon [s]", "rad", {}};
   for (const auto& [label, p] : predictions) {
-    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}};
+    // Heading as markers, so that it keeps its model's colour beside the tilt's line.
+    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true};
     for (const auto& h : p->open_loop) {
       so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
       st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());

@@ -725,3 +725,22 @@ TEST(FlightScreening, CommandsAtTheirLimitMakeAFlightUnusable) {
   EXPECT_NE(text.find("left out: b"), std::string::npos) << text;
   EXPECT_EQ(quadgen::diagnose::diagnosis_json(d, "b.csv")["flight_screening"][0]["left_out"], true);
 }
+
+// An interval side the profile never closed is printed as "open", in the terminal summary
+// and in the report, never as a number or a bare dash (#16).
+TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
+  quadgen::diagnose::Diagnosis d;
+  quadgen::diagnose::Finding f;
+  f.effect = "motor_lag";
+  quadgen::diagnose::EffectEstimate tau;
+  tau.name = "motor_lag.tau", tau.unit = "s", tau.value = 0.05, tau.lower = 0.03, tau.upper = NAN;
+  tau.verdict = "practically non-identifiable";
+  f.parameters.push_back(tau);
+  f.metric = "position RMSE [m]", f.before = 0.2, f.after = 0.1;
+  d.findings.push_back(f);
+  const std::string text = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(text.find("motor_lag.tau = 0.05 [0.03, open]"), std::string::npos) << text;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
+  EXPECT_NE(html.find("[0.03, open]"), std::string::npos);
+  EXPECT_EQ(html.find("nan"), std::string::npos);
+}

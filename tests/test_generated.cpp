@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -214,6 +215,34 @@ TEST(Generated, CheckedInHeadersAreUpToDate) {
       EXPECT_TRUE(now == checked_in) << "generated/" << c.name << "/" << file
                                      << " is stale or was edited; run scripts/regenerate.sh";
     }
+  }
+}
+
+// Every table row of the derivation reports has as many cells as its header: a bare `|` in a
+// cell's text (an audit detail "modulo |q|^2", a vehicle file's doc) splits the cell and shifts
+// the verdict into the wrong column when Markdown renders it.
+TEST(Generated, DerivationTablesHaveAsManyCellsAsTheirHeader) {
+  const auto cells = [](const std::string& row) {
+    int pipes = 0;
+    for (size_t i = 0; i < row.size(); ++i)
+      if (row[i] == '\\') ++i;  // an escaped character, \| included
+      else if (row[i] == '|') ++pipes;
+    return pipes - 1;
+  };
+  for (const char* name : {"finken3", "finken3_all_effects", "crazyflie21", "crazyflie21_all_effects"}) {
+    std::istringstream in(read(fs::path(QUADGEN_SOURCE_DIR) / "generated" / name / "derivation.md"));
+    std::string line;
+    int header = -1, rows = 0;
+    for (int number = 1; std::getline(in, line); ++number) {
+      if (line.empty() || line[0] != '|') {
+        header = -1;
+        continue;
+      }
+      if (header < 0) header = cells(line);
+      ++rows;
+      EXPECT_EQ(cells(line), header) << name << "/derivation.md:" << number << ": " << line;
+    }
+    EXPECT_GT(rows, 40) << name;
   }
 }
 

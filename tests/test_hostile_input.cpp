@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -115,6 +116,17 @@ CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd,
   CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read(err)};
   fs::remove(err);
   return r;
+}
+
+// `quadgen --version` prints the project's version on stdout and exits 0.
+TEST(Cli, VersionPrintsTheProjectVersion) {
+  FILE* p = ::popen((std::string(QUADGEN_BINARY) + " --version 2>&1").c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string out;
+  char buf[256];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  EXPECT_EQ(::pclose(p), 0);
+  EXPECT_EQ(out, std::string("quadgen ") + QUADGEN_VERSION + "\n");
 }
 
 // The error line: "quadgen: error: ..." as the last line, alone.

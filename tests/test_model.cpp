@@ -606,6 +606,17 @@ void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
     const matrix& tau_r = ex_to<matrix>(named(m, "\\tau_{" + tex_name).rhs);
     for (int k = 0; k < 3; ++k) tau_sum(k, 0) = tau_sum(k, 0) + evaluate_by_name(tau_r(k, 0), at);
   }
+  // What the effects add, as their own formulas write it (body axes, v_a and omega_i as
+  // symbols): summed over the effects and evaluated on the chain, it must be what the model's
+  // F_body and tau hold beyond thrust, drag and the rotor moments. An effect applied in a way
+  // its formula does not show (another frame, another rotor speed) breaks this.
+  double delta_force[3] = {0, 0, 0}, delta_torque[3] = {0, 0, 0};
+  for (const auto& f : m.effect_formulas)
+    for (const auto& [lhs, rhs] : f.lines) {
+      double* sum = lhs == "\\Delta F_{body}" ? delta_force : lhs == "\\Delta \\tau" ? delta_torque : nullptr;
+      if (!sum) continue;
+      for (int k = 0; k < 3; ++k) sum[k] += evaluate_by_name(ex_to<matrix>(rhs)(k, 0), at);
+    }
   const matrix& drag_named = ex_to<matrix>(named(m, "F_{drag}").rhs);
   const matrix& drag = ex_to<matrix>(intermediate(m, "F_{drag}"));
   const matrix& force = ex_to<matrix>(intermediate(m, "F_{body}"));
@@ -613,12 +624,15 @@ void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
   for (int k = 0; k < 3; ++k) {
     const double d = evaluate_by_name(drag_named(k, 0), at);
     EXPECT_NEAR(d, evaluate_by_name(drag(k, 0), at), 1e-12 * (1 + std::fabs(d))) << axes[k];
-    if (!no_effect_terms) continue;
-    const double f = d + (k == 2 ? thrust_sum : 0.0);
+    const double f = d + (k == 2 ? thrust_sum : 0.0) + delta_force[k];
     EXPECT_NEAR(f, evaluate_by_name(force(k, 0), at), 1e-12 * (1 + std::fabs(f))) << axes[k];
-    const double t = ex_to<numeric>(tau_sum(k, 0)).to_double();
+    const double t = ex_to<numeric>(tau_sum(k, 0)).to_double() + delta_torque[k];
     EXPECT_NEAR(t, evaluate_by_name(tau(k, 0), at), 1e-12 * (1 + std::fabs(t))) << axes[k];
   }
+  // The all-effects model has such terms, and they are not negligible at the chosen state.
+  const double delta_size = std::hypot(delta_force[0], delta_force[1], delta_force[2]) +
+                            std::hypot(delta_torque[0], delta_torque[1], delta_torque[2]);
+  EXPECT_EQ(delta_size > 1e-9, !no_effect_terms) << delta_size;
   EXPECT_EQ(named(m, "F_{body}").rhs_tex.find("\\Delta") == std::string::npos, no_effect_terms);
 }
 }  // namespace
