@@ -200,7 +200,11 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
 
   result.csv = trajectory_csv(m, tr, inputs, rotors);
   // Plot like the thesis' figures: translation, rotation, thrust per rotor.
-  Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{"thrust per rotor", "t [s]", "N", {}};
+  // The thrust law on the rotor speed; with effects (a gain, inflow, ground effect) the model's
+  // thrust differs from it, and the title says so rather than showing the law as the model's.
+  const std::string thrust_title =
+      a.effects.empty() ? "thrust per rotor" : "thrust per rotor by the nominal law c_t rho A r^2 w^2 (effects not included)";
+  Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{thrust_title, "t [s]", "N", {}};
   const char* pos[] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
     Series s{pos[i], tr.t, {}};

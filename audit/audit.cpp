@@ -1,11 +1,13 @@
 #include "audit/audit.hpp"
 
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Dense>
 
 #include "audit/dimension_checker.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "derive/kinematics.hpp"
 
 namespace quadgen {
@@ -144,14 +146,18 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   return out;
 }
 
-// With thrust (c_t = 0), gravity (g = 0), the flapping moment and any term added beyond the
-// catalogue (term_*: an external force or moment found in data) removed there are no
-// torques (rotor drag is a force at the CoG); the model's rotational rows must then conserve
-// 1/2 ω·Jω and |Jω|^2.
+// With thrust (c_t = 0), gravity (g = 0), every effect whose own formula adds a moment
+// (Δτ: the flapping moment) and any term added beyond the catalogue (term_*: an external
+// force or moment found in data) removed there are no torques (rotor drag is a force at the
+// CoG); the model's rotational rows must then conserve 1/2 ω·Jω and |Jω|^2.
 std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
   lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
+  std::set<std::string> adds_moment;
+  for (const auto& f : m.effect_formulas)
+    for (const auto& line : f.lines)
+      if (line.first == "\\Delta \\tau") adds_moment.insert(f.effect);
   for (const auto& p : m.params)
-    if (p.name == "blade_flapping.k" || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
+    if (adds_moment.count(effect_of_parameter(p.name)) || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
   matrix w(3, 1), wdot(3, 1);
   for (int i = 0; i < 3; ++i) {
     w(i, 0) = m.states[10 + i].sym;

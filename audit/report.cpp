@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "derive/effects/effect_catalogue.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 
@@ -321,8 +322,8 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
     if (t.size() < 600) md << "```math\n\\dot{" << tex(m.states[i].sym) << "} = " << t << "\n```\n\n";
   }
   md << "Measured outputs: position and the logged attitude quaternion";
-  if (std::find(m.effects.begin(), m.effects.end(), "attitude_bias") != m.effects.end())
-    md << " $q_{log} = q \\otimes q_{bias}$";
+  for (const std::string& e : m.effects)  // what acts on them, as its formula below shows
+    if (find_effect(e).acts_on == Effect::ActsOn::kMeasurement) md << "; " << output::markdown_code(e) << " acts on them";
   md << ".\n\n";
 }
 

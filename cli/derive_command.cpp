@@ -15,8 +15,7 @@ void add_derive(CLI::App& app, DeriveArgs& args) {
   CLI::App* c = app.add_subcommand("derive", "derive, audit and emit the flight model of a vehicle");
   c->add_option("vehicle", args.vehicle, "vehicle description (YAML)")->required();
   c->add_option("--out", args.out, "output directory")->required();
-  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
-  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--effects", args.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--params", args.params,
                 "fitted_parameters.yaml written by diagnose: the model gets its effects and its fitted values as "
@@ -46,10 +45,10 @@ int run_derive(const DeriveArgs& args) {
     request.emit.parameter_source = "fitted values from " + params;
   }
   std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
-  const MassProperties mp = derive_mass_properties(vehicle);
+  const MassProperties mass_properties = derive_mass_properties(vehicle);
   int step = 1;
   request.progress = [&](const std::string& what) { std::cerr << "[" << ++step << "/5] " << what << "\n"; };
-  const DerivedModel d = run_derive_pipeline(vehicle, mp, request);
+  const DerivedModel d = run_derive_pipeline(vehicle, mass_properties, request);
   std::cerr << "[5/5] writing " << args.out << "\n";
   out.add("model.json", d.model_json);
   out.add("derivation.md", d.derivation_md);

@@ -31,8 +31,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
       ->check(finite_range(1e-9, 0.2));
   c->add_option("--max-effects", o.search.max_effects, "stop after this many effects")->check(CLI::Range(1, 10));
-  std::string effect_names;  // the catalogue, so --help lists what --candidates accepts
-  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);
   c->add_option("--translational", o.translational, "translational channels: auto, pose or accelerometer")

@@ -28,8 +28,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--out", a.out, "output directory")->required();
   c->add_flag("--robust", a.options.robust, "Huber loss instead of squares");
   c->add_option("--mapping", a.options.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
-  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
-  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--validation", a.options.validation, "fraction of the flight (at its end) held out for validation")
       ->check(finite_range(0.0, 0.9));

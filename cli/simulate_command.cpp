@@ -63,8 +63,7 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
       ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
-  std::string effect_names;  // the catalogue, so --help lists what --effects accepts
-  for (const Effect& e : effect_catalogue()) effect_names += (effect_names.empty() ? "" : ", ") + e.name;
+  const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--effects", a.job.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--integrator", a.job.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
       ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);

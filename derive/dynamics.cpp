@@ -153,6 +153,13 @@ matrix inertia_matrix(const ModelContext& c) {
   return matrix(3, 3, lst{xx, xy, xz, xy, yy, yz, xz, yz, zz});
 }
 
+// Rotor i's thrust at rotor speed w: the thrust law (runtime/thrust_law.hpp) with what the
+// effects did to it, a factor (a motor gain, ground effect) and a speed lost to inflow.
+ex rotor_thrust(const ModelContext& c, size_t i, const ex& w) {
+  const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
+  return c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
+}
+
 // The report's equations (SymbolicModel::named_equations): the same physics as assemble()
 // below, built once more with each earlier quantity as a named symbol. The symbols' names
 // are those of the effect formulas (omega_<rotor>, v_ax), so both read alike.
@@ -167,8 +174,7 @@ void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
     const std::string n = output::latex_text(rotors[i].name);
     const symbol w("omega_" + rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
     out.push_back({"\\omega_{\\mathrm{" + n + "}}", c.rotor_speed[i], ""});
-    const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
-    out.push_back({rotor_thrust_name(rotors[i].name), c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]), ""});
+    out.push_back({rotor_thrust_name(rotors[i].name), rotor_thrust(c, i, w), ""});
     thrust.push_back(symbol("F_" + rotors[i].name, rotor_thrust_name(rotors[i].name)));
   }
   for (size_t i = 0; i < rotors.size(); ++i) {
@@ -197,9 +203,7 @@ void assemble(ModelContext& c) {
   ex total_thrust = 0;
   for (size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];
-    const ex w = c.rotor_speed[i];
-    const ex k = runtime::rotor_thrust_coefficient<ex>(c.p("c_t"), c.p("rho"), c.rotor_disc_area[i], c.rotor_radius[i]);
-    const ex thrust = c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
+    const ex thrust = rotor_thrust(c, i, c.rotor_speed[i]);
     m.intermediates.push_back({rotor_thrust_name(r.name), thrust});
     total_thrust += thrust;
     const matrix arm = c.rotor_position[i].sub(c.cog);

@@ -303,11 +303,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   DiagnoseOptions opt = opt_in;
   if (joint) {
     auto& c = opt.search.candidates;
-    if (std::find(c.begin(), c.end(), "thrust_decay") != c.end())
-      throw fit::FitError("thrust_decay: runs on the time since each log's start, a per-flight battery state; it is no "
-                          "candidate when several flights are diagnosed together");
+    const auto not_joint = [](const std::string& name) { return !find_effect(name).not_in_joint_diagnosis.empty(); };
+    for (const std::string& name : c)
+      if (not_joint(name))
+        throw fit::FitError(name + " is no candidate when several flights are diagnosed together: " +
+                            find_effect(name).not_in_joint_diagnosis);
     if (c.empty()) c = applicable_effects(flight);
-    c.erase(std::remove(c.begin(), c.end(), "thrust_decay"), c.end());
+    c.erase(std::remove_if(c.begin(), c.end(), not_joint), c.end());
   }
   // Joint: the flight's own quantities (motor trim, wind) get one value per flight; the rest
   // of the pipeline sees one model with more parameters.

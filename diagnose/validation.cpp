@@ -22,11 +22,7 @@ size_t held_index(const fit::Flight& f, double t) {
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window) {
-  // A rotor lag below 1 ms (the equation error's "no lag") would make RK4 at 1 ms steps
-  // unstable; over 1 s windows 1 ms of lag is invisible, so it is simulated as 1 ms.
-  std::vector<double> sim_params = params;
-  for (int i = 0; i < model.num_params(); ++i)  // every flight's copy of the lag
-    if (runtime::shared_name(model.param_names()[i]) == "motor_lag.tau") sim_params[i] = std::max(sim_params[i], 1e-3);
+  const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
   const runtime::DataSideParams data_side(model);
   runtime::DataSideEffects e;  // in effect over the current window

@@ -65,6 +65,12 @@ struct Effect {
   // motor or the battery is re-seated, the wind of the day): when several flights are
   // diagnosed together, each flight has its own values (runtime::PerFlightModel).
   bool per_flight = false;
+  // Where it acts: in the equations of motion, on the logged commands before they reach them
+  // (a delay), or on what the log measures (a misaligned IMU). The last two have no term of f:
+  // the runtime applies them to the log (runtime/data_side_effects.hpp).
+  enum class ActsOn { kDynamics, kCommands, kMeasurement } acts_on = ActsOn::kDynamics;
+  // Why it is no candidate when several flights are diagnosed together; empty: it is one.
+  std::string not_in_joint_diagnosis;
   // Plausible values of its parameters (none for a parameter: any value in its bounds).
   std::vector<PlausibleRange> plausible;
   std::vector<LookAlike> look_alikes;

@@ -129,14 +129,14 @@ Rotor read_rotor(const Reader& r, const YAML::Node& n) {
 
 // One parameter a section may hold. A struct, not a row of strings: a row with an item
 // missing once put c_t's doc text in the "required" slot, so a file without c_t parsed.
-struct ParameterSpec {
+struct SectionKey {  // one key a vehicle section may hold
   std::string key, unit;  // unit: SI, what the value is converted to
   bool required;
   std::string doc;
 };
 
 void read_section(const Reader& r, const YAML::Node& root, Vehicle& v, const std::string& section,
-                  const std::vector<ParameterSpec>& specs) {
+                  const std::vector<SectionKey>& specs) {
   const YAML::Node s = root[section];
   if (!s) r.fail(root, "missing section '" + section + "'");
   r.require_map(s, "section '" + section + "'");

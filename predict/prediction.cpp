@@ -275,11 +275,7 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   Prediction out;
   if (f.samples.size() < 2) return out;
   out.seconds_of_data = f.samples.back().t - f.samples.front().t;
-  // A rotor lag below 1 ms (the equation error's "no lag") would make RK4 at 1 ms steps
-  // unstable; over a second 1 ms of lag is invisible, so it is simulated as 1 ms.
-  std::vector<double> p = params;
-  const int lag = model.param_index("motor_lag.tau");
-  if (lag >= 0 && p[lag] < 1e-3) p[lag] = 1e-3;
+  const std::vector<double> p = runtime::simulation_params(model, params);
   out.one_step = one_step(model, params, f);
   model.set_params(p);
   if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "runtime/dynamic_model.hpp"
+#include "runtime/per_flight_model.hpp"
 
 namespace quadgen::runtime {
 
@@ -42,6 +43,16 @@ struct DataSideParams {
     return {value(delay), value(roll), value(pitch), value(tau)};
   }
 };
+
+// The parameters a simulation of `model` runs with: every flight's copy of the motor lag at
+// least 1 ms. A lag below that (the equation error's "no lag") would make RK4 at 1 ms steps
+// unstable; over a second, 1 ms of lag is invisible.
+inline std::vector<double> simulation_params(const DynamicModel& model, std::vector<double> p) {
+  constexpr double kShortestSimulatedLag = 1e-3;  // s
+  for (int i = 0; i < model.num_params(); ++i)
+    if (shared_name(model.param_names()[i]) == "motor_lag.tau") p[i] = std::max(p[i], kShortestSimulatedLag);
+  return p;
+}
 
 // The one gap rule of the pipeline: a sample interval longer than 1.5 times the log's median
 // interval is a gap (a joined flight's boundary, trimmed ground contact, a dropped sample).

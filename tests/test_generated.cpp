@@ -116,7 +116,7 @@ void check_f_against_symbolic_model(const char* vehicle_file, int trials, unsign
     Point<M> pt = random_point<M>(rng);
     for (int i = 0; i < M::kNumParams; ++i) {
       const quadgen::Variable& par = m.params[i];
-      if (par.name.find('.') == std::string::npos) continue;  // not an effect parameter
+      if (!quadgen::is_effect_parameter(par.name)) continue;
       const bool up = par.upper > par.nominal, down = par.lower < par.nominal;
       ASSERT_TRUE(up || down) << par.name << " cannot move off its neutral value";
       const double bound = up && down ? (unit(rng) < 0.5 ? par.lower : par.upper) : up ? par.upper : par.lower;

@@ -178,7 +178,7 @@ TEST(Model, EffectsChangeTheModelAwayFromNominal) {
     for (size_t i = 4; i < m.inputs.size(); ++i) u.push_back(m.inputs[i].name == "t" ? 2.0 : 3.7);
     const auto f0 = test::eval_f(m, x, u);
     for (auto& p : m.params)
-      if (p.name.find('.') != std::string::npos) p.nominal = 0.5 * p.upper + 0.25 * p.lower + 1e-3;
+      if (is_effect_parameter(p.name)) p.nominal = 0.5 * p.upper + 0.25 * p.lower + 1e-3;
     const auto f1 = test::eval_f(m, x, u);
     double diff = 0;
     for (size_t i = 0; i < f0.size(); ++i) diff += std::fabs(f1[i] - f0[i]);
@@ -529,8 +529,18 @@ TEST(Report, EachEffectHasItsOwnFormula) {
   const Vehicle v = test::finken3();
   const SymbolicModel m = derive(v, parse_effect_list("all"));
   ASSERT_EQ(m.effect_formulas.size(), effect_catalogue().size());
-  for (const auto& f : m.effect_formulas)
-    if (f.effect != "input_delay") EXPECT_FALSE(f.lines.empty()) << f.effect;
+  // Where each descriptor says its effect acts is what its algebra does: on the commands, no
+  // line at all (the runtime delays them); on the measurement, the logged attitude alone;
+  // in the dynamics, at least one line and none about the logged attitude.
+  for (const auto& f : m.effect_formulas) {
+    bool measurement_only = !f.lines.empty();
+    for (const auto& line : f.lines) measurement_only &= line.first == "q_{\\mathrm{logged}}";
+    switch (find_effect(f.effect).acts_on) {
+      case Effect::ActsOn::kCommands: EXPECT_TRUE(f.lines.empty()) << f.effect; break;
+      case Effect::ActsOn::kMeasurement: EXPECT_TRUE(measurement_only) << f.effect; break;
+      case Effect::ActsOn::kDynamics: EXPECT_FALSE(f.lines.empty() || measurement_only) << f.effect; break;
+    }
+  }
   EXPECT_NE(formula_of(m, "input_delay").note.find("delayed"), std::string::npos);
   const std::map<std::string, double> at = {{"rotor_drag.k", 3.0}, {"blade_flapping.k", 5.0}, {"omega_A", 1.0}, {"omega_B", 2.0},
                                             {"omega_C", 4.0}, {"omega_D", 8.0}, {"w_A", 1.5}, {"v_ax", 0.25}, {"v_ay", -0.75},

@@ -113,7 +113,7 @@ TEST(Runtime, AllEffectsTapeIsTheCompiledHeaderBitForBitAwayFromNeutral) {
   std::vector<double> p = compiled.params();
   for (int i = 0; i < compiled.num_params(); ++i) {
     const std::string& n = compiled.param_names()[i];
-    if (n.find('.') == std::string::npos) continue;
+    if (!is_effect_parameter(n)) continue;
     p[i] = n == "motor_lag.tau" ? 0.02 : n == "ground_effect.radius" ? 0.06 : n == "blade_flapping.k" ? 2e-6
          : n == "rotor_drag.k" ? 2e-5 : 0.01;
   }

@@ -38,6 +38,12 @@ const std::vector<Effect>& effect_catalogue() {
   return list;
 }
 
+std::string catalogue_names() {
+  std::string out;
+  for (const Effect& e : effect_catalogue()) out += (out.empty() ? "" : ", ") + e.name;
+  return out;
+}
+
 const Effect& find_effect(const std::string& name) {
   for (const auto& e : effect_catalogue())
     if (e.name == name) return e;

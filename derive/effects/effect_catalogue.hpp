@@ -12,6 +12,9 @@ namespace quadgen {
 // All effects in canonical order (the order they are applied in, whatever the user wrote).
 const std::vector<Effect>& effect_catalogue();
 
+// Their names in canonical order, joined by ", " (what --help says --effects accepts).
+std::string catalogue_names();
+
 // The catalogue entry of this name; std::invalid_argument if there is none.
 const Effect& find_effect(const std::string& name);
 

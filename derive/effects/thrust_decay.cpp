@@ -24,6 +24,9 @@ Effect thrust_decay() {
   e.plausible = {{"thrust_decay.rate", -1e-4, 5e-3, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "a LiPo from full to the end of a flight loses 15-30 % of thrust over minutes; half the thrust "
                   "in 100 s (0.5 %/s) is beyond any battery that still flies"}};
+  e.not_in_joint_diagnosis =
+      "it runs on the time since each log's start, a per-flight battery state; diagnose flights with a battery log "
+      "jointly with battery_sag instead";
   e.look_alikes = {{"battery_sag", "a flight whose battery voltage does not fall linearly in time (e.g. throttle bursts)"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
     using headline::words;
