@@ -1,8 +1,28 @@
 #include "app/derive_pipeline.hpp"
 
+#include <set>
+#include <stdexcept>
+
 #include "audit/report.hpp"
+#include "derive/fitted_parameters.hpp"
 
 namespace quadgen {
+
+void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,
+                       const std::string& params_path, bool effects_given) {
+  if (vehicle.fitted_line > 0 && !params_path.empty())
+    throw std::invalid_argument(vehicle_path + " carries fitted values already (its 'fitted:' section); leave --params out");
+  const std::string params = vehicle.fitted_line > 0 ? vehicle_path : params_path;
+  if (params.empty()) return;
+  const FittedParameters fitted = load_fitted_parameters(params);
+  const auto& wanted = request.derive.effects;
+  if (!effects_given) request.derive.effects = fitted.effects;
+  else if (std::set<std::string>(wanted.begin(), wanted.end()) != std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
+    throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
+  request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
+  request.emit.effects_flag = params == vehicle_path ? "" : " --params " + params;
+  request.emit.parameter_source = "fitted values from " + params;
+}
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
   auto progress = [&](const char* step) {

@@ -4,7 +4,9 @@
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
+#include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "derive/geometry.hpp"
 #include "codegen/tape_builder.hpp"
 
 namespace quadgen::app {
@@ -34,6 +36,18 @@ std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* 
 
 std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, const std::vector<std::string>& effects) {
   return find_compiled(v.content_hash, canonical_effect_list(effects));
+}
+
+std::unique_ptr<runtime::DynamicModel> model_for(const Vehicle& v, const std::vector<std::string>& effects,
+                                                 std::string* how) {
+  if (auto compiled = compiled_model_for(v, effects)) {
+    if (how) *how = "compiled header from generated/ (no derivation needed)";
+    return compiled;
+  }
+  DeriveOptions o;
+  o.effects = effects;
+  if (how) *how = "interpreted tape (no matching generated header)";
+  return make_model(derive_model(v, derive_mass_properties(v), o));
 }
 
 }  // namespace quadgen::app

@@ -1,12 +1,10 @@
 // quadgen derive VEHICLE.yaml --out DIR [--effects e1,e2|all] [--params fitted_parameters.yaml]
 #include <chrono>
 #include <iostream>
-#include <set>
 
 #include "cli/derive_command.hpp"
 #include "app/derive_pipeline.hpp"
 #include "derive/effects/effect_catalogue.hpp"
-#include "derive/fitted_parameters.hpp"
 #include "output/output_set.hpp"
 
 namespace quadgen::cli {
@@ -31,19 +29,7 @@ int run_derive(const DeriveArgs& args) {
   request.emit.vehicle_file = args.vehicle;
   request.emit.effects_flag = args.effects.empty() ? "" : " --effects " + args.effects;
   // The fitted values: --params, or the vehicle file's own `fitted:` section.
-  if (vehicle.fitted_line > 0 && !args.params.empty())
-    throw std::invalid_argument(args.vehicle + " carries fitted values already (its 'fitted:' section); leave --params out");
-  const std::string params = vehicle.fitted_line > 0 ? args.vehicle : args.params;
-  if (!params.empty()) {
-    const FittedParameters fitted = load_fitted_parameters(params);
-    if (args.effects.empty()) request.derive.effects = fitted.effects;
-    else if (std::set<std::string>(request.derive.effects.begin(), request.derive.effects.end()) !=
-             std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
-      throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
-    request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
-    request.emit.effects_flag = params == args.vehicle ? "" : " --params " + params;
-    request.emit.parameter_source = "fitted values from " + params;
-  }
+  use_fitted_values(request, vehicle, args.vehicle, args.params, !args.effects.empty());
   std::cerr << "[1/5] mass properties of " << vehicle.blocks.size() << " blocks\n";
   const MassProperties mass_properties = derive_mass_properties(vehicle);
   int step = 1;

@@ -106,16 +106,9 @@ int run_fit(const FitArgs& a) {
     result = fit_thrust_stand_log(a.log, v, o);
   } else {
     check_flight_options(a);
-    DeriveOptions derive;
-    derive.effects = parse_effect_list(a.effects);
-    // A matching compiled header carries everything a fit needs: no symbolic derivation.
-    std::unique_ptr<runtime::DynamicModel> model = app::compiled_model_for(v, derive.effects);
-    if (model) {
-      std::cerr << "model: compiled header from generated/ (no derivation needed)\n";
-    } else {
-      model = app::make_model(derive_model(v, derive_mass_properties(v), derive));
-      std::cerr << "model: interpreted (no matching generated header)\n";
-    }
+    std::string how;
+    const std::unique_ptr<runtime::DynamicModel> model = app::model_for(v, parse_effect_list(a.effects), &how);
+    std::cerr << "model: " << how << "\n";
     result = fit_flight_log(a.log, v, *model, o);
   }
   out.add("fit.json", output::json_document(result.json));

@@ -44,12 +44,10 @@ int run_predict(const PredictArgs& a) {
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, inputs);  // refused before the work, not after
-  DeriveOptions all;
-  all.effects = parse_effect_list("all");  // effects at neutral values unless --params sets them
-  // A matching compiled header carries everything prediction needs: no symbolic derivation.
-  std::unique_ptr<runtime::DynamicModel> model = app::compiled_model_for(v, all.effects);
-  std::cerr << "model: " << (model ? "compiled header from generated/ (no derivation needed)" : "interpreted tape") << "\n";
-  if (!model) model = app::make_model(derive_model(v, derive_mass_properties(v), all));
+  // Every effect, at its neutral value unless --params sets it.
+  std::string how;
+  const std::unique_ptr<runtime::DynamicModel> model = app::model_for(v, parse_effect_list("all"), &how);
+  std::cerr << "model: " << how << "\n";
   predict::PredictFlightsOptions o = a.options;
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), a.logs, o);
