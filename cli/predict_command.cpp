@@ -36,6 +36,9 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");
+  c->add_flag("--linear-correction", a.options.linear_correction,
+              "also the one-step errors after a linear correction fitted on the part before the evaluated one (on "
+              "the nominal model: a linear-regression baseline on the same split)");
   c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(0.001, 10));
 }
 

@@ -34,6 +34,8 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   if (o.calibrate && o.params.empty()) throw std::invalid_argument("--calibrate needs --params (a diagnosis.json)");
   if (o.calibrate && o.validation >= 1.0)
     throw std::invalid_argument("--calibrate needs a part before the evaluated one: --validation below 1");
+  if (o.linear_correction && o.validation >= 1.0)
+    throw std::invalid_argument("--linear-correction needs a part before the evaluated one to fit on: --validation below 1");
   const std::vector<double> nominal = model.params();  // before any calibration moves the model's
   std::optional<ParameterSource> source;
   if (!o.params.empty()) source.emplace(o.params);
@@ -56,7 +58,8 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
       for (int k : values.flight_params) calibrated[model.param_names()[k]] = values.values[k];
       values.origin += ", flight parameters calibrated on the part before";
     }
-    const Prediction p = evaluate_prediction(model, values.values, evaluated, o.prediction);
+    Prediction p = evaluate_prediction(model, values.values, evaluated, o.prediction);
+    if (o.linear_correction) p.one_step_corrected = linearly_corrected_one_step(model, values.values, before, evaluated);
     auto j = prediction_json(p);
     j["log"] = logs[i];
     j["parameters_from"] = values.origin;

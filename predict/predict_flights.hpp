@@ -22,6 +22,9 @@ struct PredictFlightsOptions {
   double validation = 0.3;  // fraction of each flight (at its end) evaluated; 1: all of it
   std::string params;    // a fit.json or diagnosis.json; empty: the vehicle file's nominal values
   bool calibrate = false;   // fit an unseen log's own parameters on the part before (needs params)
+  // Also the one-step errors left after a linear correction fitted on the part before
+  // (linearly_corrected_one_step; needs validation below 1).
+  bool linear_correction = false;
   PredictionOptions prediction;
   std::function<void(const std::string&)> progress = [](const std::string&) {};
 };

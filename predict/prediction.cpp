@@ -1,9 +1,13 @@
 #include "predict/prediction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
 
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
@@ -33,6 +37,15 @@ void Prediction::merge(const Prediction& o) {
     one_step.angular_acceleration[a].merge(o.one_step.angular_acceleration[a]);
   }
   one_step.vertical_acceleration_world.merge(o.one_step.vertical_acceleration_world);
+  if (o.one_step_corrected) {
+    if (!one_step_corrected) one_step_corrected = OneStepErrors{};
+    for (int a = 0; a < 3; ++a) {
+      one_step_corrected->specific_force[a].merge(o.one_step_corrected->specific_force[a]);
+      one_step_corrected->angular_acceleration[a].merge(o.one_step_corrected->angular_acceleration[a]);
+    }
+    one_step_corrected->vertical_acceleration_world.merge(o.one_step_corrected->vertical_acceleration_world);
+    one_step_corrected->source = o.one_step_corrected->source;
+  }
   if (one_step.source.empty()) one_step.source = o.one_step.source;
   else if (!o.one_step.source.empty() && o.one_step.source != one_step.source) one_step.source = "mixed";
   start_points += o.start_points;
@@ -224,10 +237,35 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
   return rows;
 }
 
-// One-step residuals of the equation error (the fit's own formulation: lag, delay and bias
-// applied to the data), rotated into body and world axes.
-OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f) {
-  OneStepErrors out;
+// One-step residuals (model - measured) of every usable sample of `f`: body specific force
+// (x y z), body angular acceleration (x y z) and world vertical acceleration, from the
+// equation error (the fit's own formulation: lag, delay and bias applied to the data),
+// rotated into body and world axes; with the regressors of the linear correction beside them.
+struct OneStepRows {
+  std::vector<std::array<double, 7>> residual;
+  std::vector<std::vector<double>> regressors;
+  std::string source;
+};
+
+// 1, u_i and u_i^2 per rotor, body rates; with a pose, body velocity and body velocity times
+// the mean u^2 (rotor drag and flapping grow with both); with a battery log, the voltage
+// times the mean u^2 (thrust per command follows the voltage).
+std::vector<double> correction_regressors(const fit::FlightSample& s, const runtime::Rotation& R, const fit::Flight& f) {
+  std::vector<double> x = {1.0};
+  double mean_u2 = 0;
+  for (double u : s.u) x.push_back(u), x.push_back(u * u), mean_u2 += u * u / static_cast<double>(s.u.size());
+  for (int a = 0; a < 3; ++a) x.push_back(s.x[10 + a]);
+  if (f.has_pose)
+    for (int a = 0; a < 3; ++a) {
+      const double v_body = R.m[0][a] * s.x[3] + R.m[1][a] * s.x[4] + R.m[2][a] * s.x[5];
+      x.push_back(v_body), x.push_back(v_body * mean_u2);
+    }
+  if (f.has_vbat) x.push_back(s.vbat * mean_u2);
+  return x;
+}
+
+OneStepRows one_step_rows(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f) {
+  OneStepRows out;
   const bool accel = f.has_accelerometer;
   out.source = accel ? "accelerometer (specific force) and differentiated gyro"
                      : "differentiated velocity and differentiated gyro";
@@ -243,21 +281,39 @@ OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& 
       runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
       const runtime::Rotation R = runtime::rotation_matrix(q);
       const double* r = &r6[row * 6];
-      double body[3], world[3];
+      std::array<double, 7> res;
       for (int a = 0; a < 3; ++a) {
-        body[a] = accel ? r[a] : R.m[0][a] * r[0] + R.m[1][a] * r[1] + R.m[2][a] * r[2];
-        world[a] = accel ? R.m[a][0] * r[0] + R.m[a][1] * r[1] + R.m[a][2] * r[2] : r[a];
+        res[a] = accel ? r[a] : R.m[0][a] * r[0] + R.m[1][a] * r[1] + R.m[2][a] * r[2];
+        res[3 + a] = r[3 + a];
       }
-      for (int a = 0; a < 3; ++a) {
-        out.specific_force[a].add(body[a]);
-        out.angular_acceleration[a].add(r[3 + a]);
-      }
-      out.vertical_acceleration_world.add(world[2]);
+      res[6] = accel ? R.m[2][0] * r[0] + R.m[2][1] * r[1] + R.m[2][2] * r[2] : r[2];
+      out.residual.push_back(res);
+      out.regressors.push_back(correction_regressors(s, R, f));
     }
   } catch (const fit::FitError&) {
     out.source = "not available: too few samples for the derivative filter";
   }
   return out;
+}
+
+// The statistics of these rows, each residual minus its correction (none: uncorrected).
+OneStepErrors one_step_errors(const OneStepRows& rows, const std::vector<Eigen::VectorXd>* correction = nullptr) {
+  OneStepErrors out;
+  out.source = rows.source;
+  for (size_t k = 0; k < rows.residual.size(); ++k) {
+    std::array<double, 7> r = rows.residual[k];
+    if (correction) {
+      const Eigen::Map<const Eigen::VectorXd> x(rows.regressors[k].data(), static_cast<Eigen::Index>(rows.regressors[k].size()));
+      for (int c = 0; c < 7; ++c) r[c] -= x.dot((*correction)[c]);
+    }
+    for (int a = 0; a < 3; ++a) out.specific_force[a].add(r[a]), out.angular_acceleration[a].add(r[3 + a]);
+    out.vertical_acceleration_world.add(r[6]);
+  }
+  return out;
+}
+
+OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& p, const fit::Flight& f) {
+  return one_step_errors(one_step_rows(model, p, f));
 }
 
 }  // namespace
@@ -286,6 +342,27 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   return out;
 }
 
+OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const std::vector<double>& params,
+                                          const fit::Flight& train, const fit::Flight& evaluated) {
+  const OneStepRows fit_rows = one_step_rows(model, params, train), rows = one_step_rows(model, params, evaluated);
+  if (fit_rows.residual.empty() || rows.residual.empty()) return one_step_errors(rows);
+  const Eigen::Index n = static_cast<Eigen::Index>(fit_rows.residual.size()),
+                     m = static_cast<Eigen::Index>(fit_rows.regressors.front().size());
+  if (n < 10 * m) throw std::invalid_argument("linear correction: fewer than 10 training samples per regressor");
+  Eigen::MatrixXd X(n, m), Y(n, 7);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    for (Eigen::Index j = 0; j < m; ++j) X(k, j) = fit_rows.regressors[k][j];
+    for (int c = 0; c < 7; ++c) Y(k, c) = fit_rows.residual[k][c];
+  }
+  // Columns scaled to unit RMS so that rank decisions do not depend on units (u^2 ~ 0.3,
+  // velocity ~ 1, voltage times u^2 ~ 1.5); a column the data leave constant drops out.
+  const Eigen::VectorXd scale = (X.colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt().cwiseMax(1e-12);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X * scale.cwiseInverse().asDiagonal());
+  std::vector<Eigen::VectorXd> correction;
+  for (int c = 0; c < 7; ++c) correction.push_back(scale.cwiseInverse().asDiagonal() * qr.solve(Y.col(c)));
+  return one_step_errors(rows, &correction);
+}
+
 namespace {
 
 nlohmann::ordered_json stats_json(const ErrorStats& s) {
@@ -294,6 +371,20 @@ nlohmann::ordered_json stats_json(const ErrorStats& s) {
 }
 
 double rms_of(const ErrorStats& s) { return s.rms(); }
+
+nlohmann::ordered_json one_step_json(const OneStepErrors& o) {
+  const auto num = output::number_or_null;
+  return {{"specific_force_m_s2",
+           {{"x", num(rms_of(o.specific_force[0]))}, {"y", num(rms_of(o.specific_force[1]))}, {"z", num(rms_of(o.specific_force[2]))}}},
+          {"angular_acceleration_rad_s2",
+           {{"x", num(rms_of(o.angular_acceleration[0]))},
+            {"y", num(rms_of(o.angular_acceleration[1]))},
+            {"z", num(rms_of(o.angular_acceleration[2]))}}},
+          {"vertical_acceleration_world_m_s2", num(rms_of(o.vertical_acceleration_world))},
+          {"samples", o.vertical_acceleration_world.count},
+          {"measured_from", o.source},
+          {"statistic", "RMS of model - measured over samples"}};
+}
 
 }  // namespace
 
@@ -313,26 +404,20 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
                         {"position_m", stats_json(h.position)},
                         {"velocity_m_s", stats_json(h.velocity)},
                         {"diverged", h.diverged}});
-  const auto num = output::number_or_null;
-  const auto& o = p.one_step;
-  J one = {{"specific_force_m_s2",
-            {{"x", num(rms_of(o.specific_force[0]))}, {"y", num(rms_of(o.specific_force[1]))}, {"z", num(rms_of(o.specific_force[2]))}}},
-           {"angular_acceleration_rad_s2",
-            {{"x", num(rms_of(o.angular_acceleration[0]))},
-             {"y", num(rms_of(o.angular_acceleration[1]))},
-             {"z", num(rms_of(o.angular_acceleration[2]))}}},
-           {"vertical_acceleration_world_m_s2", num(rms_of(o.vertical_acceleration_world))},
-           {"samples", o.vertical_acceleration_world.count},
-           {"measured_from", o.source},
-           {"statistic", "RMS of model - measured over samples"}};
-  return {{"open_loop", open},
+  J out = {{"open_loop", open},
           {"attitude_replayed", replayed},
-          {"one_step", one},
+          {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
           {"definition",
            "error at each horizon after a start from the measured state, averaged over start points; "
            "tilt = angle between body z axes, heading = yaw difference"}};
+  if (p.one_step_corrected) {
+    out["one_step_linear_correction"] = one_step_json(*p.one_step_corrected);
+    out["one_step_linear_correction"]["statistic"] =
+        "RMS of model - linear correction (fitted on the part before) - measured over samples";
+  }
+  return out;
 }
 
 std::string prediction_csv(const Prediction& p) {

@@ -11,6 +11,7 @@
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
 // gets the one-step view alone.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,8 @@ struct OneStepErrors {
 struct Prediction {
   std::vector<HorizonErrors> open_loop, attitude_replayed;
   OneStepErrors one_step;
+  // With a linear correction fitted on the part before (linearly_corrected_one_step).
+  std::optional<OneStepErrors> one_step_corrected;
   size_t start_points = 0;
   double seconds_of_data = 0;
   void merge(const Prediction& o);  // pools another flight's errors (same horizons)
@@ -76,6 +79,16 @@ fit::Flight fill_missing_signals(fit::Flight f, double vbat_ref);
 // `model` with `params` (a full parameter vector of it) on `flight`.
 Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<double>& params,
                                const fit::Flight& flight, const PredictionOptions& options);
+
+// The one-step errors on `evaluated` left after a linear correction, fitted on `train` by
+// least squares per channel, is subtracted from the model's accelerations. Regressors: 1,
+// u_i and u_i^2 per rotor, body rates; with a pose body velocity and body velocity times the
+// mean u^2; with a battery log the voltage times the mean u^2. On the nominal model this is a
+// linear-regression baseline on the same split and the same measured accelerations
+// (NanoBench's Task 1 reports linear regression as its best baseline); on a fitted model it
+// shows how much of what the model still gets wrong a linear model of these signals explains.
+OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const std::vector<double>& params,
+                                          const fit::Flight& train, const fit::Flight& evaluated);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed, one_step.
 nlohmann::ordered_json prediction_json(const Prediction& p);

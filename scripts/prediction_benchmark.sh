@@ -7,7 +7,10 @@
 #   scripts/prediction_benchmark.sh [OUT_DIR]        (default out/prediction_benchmark)
 # DIAGNOSES=DIR reuses the diagnoses of scripts/real_flights.sh DIR instead of running them;
 # when DIR holds its joint diagnosis (JOINT=1), each flight is also predicted with the joint
-# fit's values for that flight ("joint fit").
+# fit's values for that flight ("joint fit"). The nominal model and the joint fit are also
+# scored with a linear correction fitted on the first 70 % (`predict --linear-correction`): on
+# the nominal model a linear-regression baseline on the same split, on the joint fit what a
+# linear model of the same signals would still explain.
 # Needs the build (./setup.sh --no-run), ../shared/data beside the clone, and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +23,7 @@ run() {  # name log mapping [extra diagnose flags...]
   local name=$1 log=$2 mapping=$3; shift 3
   echo "== $name" >&2
   mkdir -p "$out/$name"
-  build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/nominal" > /dev/null
+  build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --linear-correction --out "$out/$name/nominal" > /dev/null
   if [ -n "$reuse" ] && [ -f "$reuse/$name/diagnosis.json" ]; then
     ln -sfn "$(cd "$reuse/$name" && pwd)" "$out/$name/diagnosis"
   else
@@ -28,7 +31,7 @@ run() {  # name log mapping [extra diagnose flags...]
   fi
   if [ -n "$reuse" ] && [ -f "$reuse/joint_5_flights/diagnosis.json" ] && [ "$name" != arpl_log10 ]; then
     build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$reuse/joint_5_flights/diagnosis.json" \
-      --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
+      --linear-correction --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
   fi
 }
 for log in "$data"/nanobench/*.csv; do

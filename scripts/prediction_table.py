@@ -59,6 +59,10 @@ def main(out):
                 models.append((sub.name, json.loads((sub / "prediction.json").read_text())))
         for name, pred in models:
             print(f"| {flight.name} | {name} | " + " | ".join(value(pred, *c[1:]) for c in COLUMNS) + " |")
+            if "one_step_linear_correction" in pred:  # one-step columns only
+                corrected = {"one_step": pred["one_step_linear_correction"]}
+                print(f"| {flight.name} | {name} + linear correction (fitted on the first 70 %) | " +
+                      " | ".join(value(corrected, *c[1:]) for c in COLUMNS) + " |")
 
 
 if __name__ == "__main__":
