@@ -75,6 +75,14 @@ json diagnose_log(const std::string& vehicle, const fs::path& log, const fs::pat
   if (in.good()) in >> j;
   for (const char* f : {"report.html", "extended_model.hpp", "fitted_parameters.yaml"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  // Every plotted series is also data a Python or MATLAB user can load: a CSV beside each plot.
+  int tables = 0;
+  for (const auto& e : fs::directory_iterator(dir / "out")) {
+    if (e.path().extension() == ".csv") ++tables;
+    if (e.path().extension() == ".svg")
+      EXPECT_TRUE(fs::exists(fs::path(e.path()).replace_extension(".csv"))) << e.path() << " has no CSV beside it";
+  }
+  EXPECT_GE(tables, 3);
   return j;
 }
 
