@@ -30,7 +30,9 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
       ->check(finite_range(0.1, 0.6));
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
       ->check(finite_range(1e-9, 0.2));
-  c->add_option("--max-effects", o.search.max_effects, "stop after this many effects")->check(CLI::Range(1, 10));
+  c->add_option("--max-effects", o.search.max_effects,
+                "forward-selection steps at most (each adds one effect; later tests may turn it down)")
+      ->check(CLI::Range(1, 10));
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);

@@ -3,7 +3,7 @@
 # what diagnose may name (docs/validation.md, "Real data"):
 #   scripts/real_flights.sh [OUT_DIR]
 # With JOINT=1 it also diagnoses the five usable flights jointly (B6 saturates its PWM; see
-# docs/crazyflie_evidence.md) with --max-effects 5: one set of airframe parameters for all.
+# docs/crazyflie_evidence.md): one set of airframe parameters for all.
 # For each flight: named findings with their intervals and held-out fold gain, suspected
 # candidates with the test they failed, look-alike groups, and the open-loop prediction
 # error before/after. A finding with an open interval, an interval containing "off", or
@@ -28,7 +28,7 @@ if [ "${JOINT:-0}" = 1 ] && [ ! -f "$out/joint_5_flights/diagnosis.json" ]; then
   for f in "$data"/*.csv; do
     case "$(basename "$f")" in B6_*) ;; *) logs+=("$f") ;; esac
   done
-  "$q" diagnose vehicles/crazyflie21.yaml "${logs[@]}" --mapping data/mappings/nanobench.yaml --max-effects 5 \
+  "$q" diagnose vehicles/crazyflie21.yaml "${logs[@]}" --mapping data/mappings/nanobench.yaml \
     --out "$out/joint_5_flights" > "$out/joint_5_flights.log" 2>&1 || echo "  failed: see $out/joint_5_flights.log" >&2
 fi
 python3 scripts/real_flights_table.py "$out"
