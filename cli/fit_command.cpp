@@ -40,7 +40,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--free", a.free,
                 std::string("parameters to fit (comma-separated), overriding the vehicle file's fit flags: ") +
-                    kParameterNames);
+                    parameter_names_help());
   c->add_option("--profiles", a.profiles,
                 "profile likelihood of: all free parameters, none (estimates and standard errors only), or "
                 "comma-separated names (as for --free)")

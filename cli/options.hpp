@@ -10,17 +10,19 @@
 
 #include <CLI/CLI.hpp>
 
+#include "derive/effects/effect_catalogue.hpp"
+
 namespace quadgen::cli {
 
 // What --help says a log may be, and which parameter names the options that take names
 // accept (the effects' names depend on the vehicle's rotors, so they are given as patterns).
 inline const char* const kLogFormats =
     "CSV in the canonical layout, or any CSV, PX4 ULog or Crazyflie uSD log through --mapping";
-inline const char* const kParameterNames =
-    "the vehicle's (g, rho, c_w, c_t, kappa, motor_a0..motor_a2, mass, cog_x..cog_z, J_xx..J_yz, A_x..A_z, vbat_ref; "
-    "model.json lists them) and the effects' (motor_gain.<rotor>, motor_lag.tau, input_delay.seconds, "
-    "cog_offset.x/y, wind.x/y, rotor_drag.k, blade_flapping.k, attitude_bias.roll/pitch, thrust_decay.rate, "
-    "battery_sag.exponent, ground_effect.radius, inflow.k)";
+// The base parameters' names come from the vehicle schema, the effects' from their descriptors.
+inline std::string parameter_names_help() {
+  return "the vehicle's (g, rho, c_w, c_t, kappa, motor_a0..motor_a2, mass, cog_x..cog_z, J_xx..J_yz, A_x..A_z, vbat_ref; "
+         "model.json lists them) and the effects' (" + catalogue_parameter_names() + ")";
+}
 
 // A finite number of the whole text, or nothing.
 inline bool parse_finite(const std::string& text, double* value) {

@@ -36,7 +36,7 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
   c->add_option("--set", a.set,
                 std::string("closed loop: NAME=VALUE for a parameter of the true model (repeatable); names: ") +
-                    kParameterNames)
+                    parameter_names_help())
       ->needs(cl);
   c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);

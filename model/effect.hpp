@@ -51,6 +51,9 @@ struct Effect {
   // Declares the effect's parameters (states, inputs) on the context and rewrites its
   // intermediate quantities; at the parameters' off values the model is unchanged.
   std::function<void(ModelContext&)> apply;
+  // Its parameters' names as a person reads them in --help ("motor_gain.<rotor>", "wind.x/y");
+  // the test Model.HelpListsEveryParameterName checks them against the derived model.
+  std::string parameter_names;
   EffectNeeds needs = EffectNeeds::kNothing;
   // Where the cost is flat at "off" (a lag or a delay of zero, a radius of zero), fits
   // also start here: parameter -> value.

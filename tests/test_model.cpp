@@ -66,7 +66,7 @@ TEST(Model, InertiaAuditHoldsForBlocksAtAnyAngle) {
 // model, ranges and the rotor written as patterns: a new effect must be added there too.
 TEST(Model, HelpListsEveryParameterName) {
   const SymbolicModel m = derive(test::finken3(), parse_effect_list("all"));
-  const std::string help = quadgen::cli::kParameterNames;
+  const std::string help = quadgen::cli::parameter_names_help();
   const std::vector<std::pair<std::regex, std::string>> patterns = {
       {std::regex("motor_gain\\..*"), "motor_gain.<rotor>"}, {std::regex("motor_a[0-2]"), "motor_a0..motor_a2"},
       {std::regex("cog_[xyz]"), "cog_x..cog_z"},              {std::regex("J_[xyz][xyz]"), "J_xx..J_yz"},

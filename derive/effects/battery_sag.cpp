@@ -23,6 +23,7 @@ void terms(ModelContext& c) {
 
 Effect battery_sag() {
   Effect e{"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", terms};
+  e.parameter_names = "battery_sag.exponent";  // as --help lists them
   e.needs = EffectNeeds::kBatteryVoltage;
   e.plausible = {{"battery_sag.exponent", 0.0, 3.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "at a fixed duty cycle rotor speed grows about with voltage and thrust with its square: ~2"}};

@@ -30,6 +30,7 @@ void terms(ModelContext& c) {
 
 Effect blade_flapping() {
   Effect e{"blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", terms};
+  e.parameter_names = "blade_flapping.k";  // as --help lists them
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
     const double k = headline::value_of(v, "blade_flapping.k");
     return std::string("Flying through the air ") + (k > 0 ? "pitches the nose up" : "pitches the nose down") +

@@ -44,6 +44,12 @@ std::string catalogue_names() {
   return out;
 }
 
+std::string catalogue_parameter_names() {
+  std::string out;
+  for (const Effect& e : effect_catalogue()) out += (out.empty() ? "" : ", ") + e.parameter_names;
+  return out;
+}
+
 const Effect& find_effect(const std::string& name) {
   for (const auto& e : effect_catalogue())
     if (e.name == name) return e;

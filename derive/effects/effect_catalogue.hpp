@@ -15,6 +15,9 @@ const std::vector<Effect>& effect_catalogue();
 // Their names in canonical order, joined by ", " (what --help says --effects accepts).
 std::string catalogue_names();
 
+// Every effect's parameter names as --help lists them, joined by ", ".
+std::string catalogue_parameter_names();
+
 // The catalogue entry of this name; std::invalid_argument if there is none.
 const Effect& find_effect(const std::string& name);
 

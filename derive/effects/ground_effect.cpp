@@ -19,6 +19,7 @@ void terms(ModelContext& c) {
 
 Effect ground_effect() {
   Effect e{"ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", terms};
+  e.parameter_names = "ground_effect.radius";  // as --help lists them
   e.needs = EffectNeeds::kPose;
   e.typical_start = {{"ground_effect.radius", 0.05}};
   e.plausible = {{"ground_effect.radius", 0.0, 3.0, PlausibleRange::Scale::kRotorRadius, Environment::kUnknown,

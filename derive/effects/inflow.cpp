@@ -33,6 +33,7 @@ void terms(ModelContext& c) {
 
 Effect inflow() {
   Effect e{"inflow", "thrust lowered by k (climb speed of each rotor through the air) / (tip speed)", terms};
+  e.parameter_names = "inflow.k";  // as --help lists them
   e.plausible = {{"inflow.k", 0.0, 8.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "blade-element theory with momentum inflow gives 1 / (lambda_h + 16 lambda_h^2 / (sigma a)): "
                   "about 1-6 for small rotors; negative would mean thrust grows with climb"}};

@@ -18,6 +18,7 @@ void terms(ModelContext& c) {
 
 Effect input_delay() {
   Effect e{"input_delay", "pure time shift between logged commands and their effect", terms};
+  e.parameter_names = "input_delay.seconds";  // as --help lists them
   e.acts_on = Effect::ActsOn::kCommands;
   e.typical_start = {{"input_delay.seconds", 0.015}};
   e.plausible = {{"input_delay.seconds", 0.0, 0.1, PlausibleRange::Scale::kSI, Environment::kUnknown,

@@ -39,6 +39,7 @@ std::string headline(const std::map<std::string, double>& v, const std::string& 
 
 Effect motor_gain() {
   Effect e{"motor_gain", "thrust of each rotor scaled by (1 + value)", terms};
+  e.parameter_names = "motor_gain.<rotor>";  // as --help lists them
   e.first_parameter_is_reference = true;
   // The NanoBench flights of one Crazyflie trim their motors differently on every flight
   // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).

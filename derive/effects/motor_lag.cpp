@@ -25,6 +25,7 @@ void terms(ModelContext& c) {
 
 Effect motor_lag() {
   Effect e{"motor_lag", "first-order lag from commanded to actual rotor speed", terms};
+  e.parameter_names = "motor_lag.tau";  // as --help lists them
   e.typical_start = {{"motor_lag.tau", 0.03}};
   e.off_at_lower_bound = true;
   e.plausible = {{"motor_lag.tau", 0.0, 0.25, PlausibleRange::Scale::kSI, Environment::kUnknown,

@@ -29,6 +29,7 @@ std::string headline(const std::map<std::string, double>& v, const std::string&)
 
 Effect wind() {
   Effect e{"wind", "steady air velocity in the world frame, through the drag terms", terms};
+  e.parameter_names = "wind.x/y";  // as --help lists them
   e.per_flight = true;
   e.plausible = {{"", -0.5, 0.5, PlausibleRange::Scale::kSI, Environment::kIndoor,
                   "indoors the air is still but for ventilation drafts of a few dm/s"},
