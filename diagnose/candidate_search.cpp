@@ -8,6 +8,7 @@
 #include <limits>
 #include <mutex>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 #include <unistd.h>
@@ -18,6 +19,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "diagnose/residual_analysis.hpp"
+#include "fit/evaluation_threads.hpp"
 
 namespace quadgen::diagnose {
 
@@ -297,6 +299,9 @@ void CandidateSearch::on_every_core(size_t count, Work work) const {
   std::mutex failing;
   std::exception_ptr failure;
   auto run = [&](const Workspace& ws) {
+    // One fit per core: each fit's evaluations stay on their thread (one fit alone splits).
+    std::optional<fit::OneCorePerFit> one_core;
+    if (workers.size() > 1) one_core.emplace();
     for (size_t i; (i = next++) < count;) {
       try {
         work(i, ws);
@@ -340,6 +345,15 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
 }
 
 SearchResult CandidateSearch::run() {
+  // "[diagnose] base model fitted (12 s)": the serial parts between the parallel steps.
+  auto phase_start = std::chrono::steady_clock::now();
+  const auto phase_done = [&](const std::string& what) {
+    const auto now = std::chrono::steady_clock::now();
+    if (opt_.verbose_progress)
+      std::cerr << "[diagnose] " << what << " ("
+                << static_cast<int>(std::chrono::duration<double>(now - phase_start).count()) << " s)\n";
+    phase_start = now;
+  };
   SearchResult res;
   std::set<std::string> base;
   std::vector<FitParameter> current = initial_parameters();
@@ -355,6 +369,7 @@ SearchResult CandidateSearch::run() {
   current = fit_with(base, current, &c);
   res.base_fit = current;
   res.base_weights = weights_;
+  phase_done("base model fitted");
   for (int round = 0; round < opt_.max_effects; ++round) {
     SelectionStep step;
     step.base_effects.assign(base.begin(), base.end());
@@ -365,6 +380,7 @@ SearchResult CandidateSearch::run() {
       if (!base.count(e)) todo.push_back(e);
     const auto step_start = std::chrono::steady_clock::now();
     step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
+    phase_start = std::chrono::steady_clock::now();
     if (opt_.verbose_progress)
       std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
                 << " candidates fitted ("
@@ -395,8 +411,11 @@ SearchResult CandidateSearch::run() {
     weights_ = weights_at(current);
     current = fit_with(base, current, &c);
     res.steps.push_back(step);
+    phase_done("step " + std::to_string(round + 1) + ": " + step.selected + " refitted" +
+               (step.ambiguities.empty() ? "" : ", look-alikes checked"));
   }
   backward_pass(res, base, current);
+  phase_done("backward elimination");
   const auto in_model = [&](const CandidateEvidence& ev) {
     return std::find(res.selected.begin(), res.selected.end(), ev.effect) != res.selected.end();
   };
@@ -405,6 +424,7 @@ SearchResult CandidateSearch::run() {
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res, !opt_.wald_until_accepted);
+  phase_done("intervals");
   return res;
 }
 

@@ -1,10 +1,13 @@
 #include "fit/equation_error.hpp"
 
+#include "fit/evaluation_threads.hpp"
 #include "runtime/attitude.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <map>
+#include <thread>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -137,7 +140,10 @@ std::vector<std::string> EquationErrorModel::channels() const {
 }
 
 void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
-  if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
+  if (J) {
+    restricted_columns_ = runtime::free_columns(free);
+    model_->restrict_param_jacobian(restricted_columns_);
+  }
   if (used_.size() == 6) return evaluate6(p, r, J, free);
   const int np = model_->num_params();
   const size_t ns = rows_.size();
@@ -270,48 +276,93 @@ std::pair<size_t, size_t> EquationErrorModel::rows_in(SampleSpan span) const {
   return {static_cast<size_t>(lo - rows_.begin()), static_cast<size_t>(hi - rows_.begin())};
 }
 
+template <class Part>
+void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p, bool jacobian,
+                                          const Part& part) const {
+  const size_t parts = hi > lo ? evaluation_parts(hi - lo) : 1;
+  while (helpers_.models.size() + 1 < parts) {
+    auto copy = model_->clone();
+    if (!copy) break;  // a model that cannot be copied stays on one thread
+    helpers_.models.push_back(std::move(copy));
+  }
+  const size_t n = std::min(parts, helpers_.models.size() + 1);
+  if (n <= 1) return part(*model_, lo, hi);
+  const std::vector<double> params(p, p + model_->num_params());
+  std::vector<std::thread> threads;
+  std::vector<std::exception_ptr> failures(n);
+  const auto bound = [&](size_t i) { return lo + (hi - lo) * i / n; };
+  for (size_t i = 1; i < n; ++i) {
+    runtime::DynamicModel& m = *helpers_.models[i - 1];
+    m.set_params(params);
+    if (jacobian) m.restrict_param_jacobian(restricted_columns_);
+    threads.emplace_back([&, i, mp = &m] {
+      try {
+        part(*mp, bound(i), bound(i + 1));
+      } catch (...) {
+        failures[i] = std::current_exception();
+      }
+    });
+  }
+  try {
+    part(*model_, bound(0), bound(1));
+  } catch (...) {
+    failures[0] = std::current_exception();
+  }
+  for (auto& t : threads) t.join();
+  for (const auto& f : failures)
+    if (f) std::rethrow_exception(f);
+}
+
 // Model accelerations (rows 3..5 and 10..12 of f, and of df/dp) at the middle of every
 // interval k -> k+1: state averaged, the commands of t_k held over it.
-void EquationErrorModel::interval_accelerations(const std::vector<double>& X, const std::vector<double>& U,
-                                                std::vector<double>& F, std::vector<double>* Bm,
-                                                SampleSpan span, const std::vector<int>& columns) const {
+void EquationErrorModel::interval_accelerations(const double* p, const std::vector<double>& X,
+                                                const std::vector<double>& U, std::vector<double>& F,
+                                                std::vector<double>* Bm, SampleSpan span,
+                                                const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
   const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
-  const size_t ns = flight_.samples.size();
+  const size_t ns = flight_.samples.size(), nc = columns.size();
   F.assign(ns * 6, 0.0);
-  if (Bm) Bm->assign(ns * 6 * np, 0.0);
-  std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
+  // Only the columns asked for, packed: a search step frees a few of a per-flight model's
+  // 28 and more parameters, and the window sums in residuals() then run over contiguous memory.
+  if (Bm) Bm->assign(ns * 6 * nc, 0.0);
   static const int kRows[6] = {3, 4, 5, 10, 11, 12};
-  for (size_t k = span.lo; k + 1 < span.hi; ++k) {
-    if (!interval_ok_[k]) continue;
-    for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
-    const double qn = std::sqrt(xm[6] * xm[6] + xm[7] * xm[7] + xm[8] * xm[8] + xm[9] * xm[9]);
-    for (int i = 6; i < 10; ++i) xm[i] /= qn;
-    for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = mean_speed_[k * speed_states_.size() + i];
-    std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
-    if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
-    if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
-    if (quadrature_ == Quadrature::kMidpoint) {
-      model_->rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
-      for (int c = 0; c < 6; ++c) {
-        F[k * 6 + c] = f[kRows[c]];
-        if (Bm) std::copy(&B[kRows[c] * np], &B[kRows[c] * np] + np, &(*Bm)[(k * 6 + c) * np]);
+  // Intervals k_lo .. k_hi - 1; each writes its own rows of F and Bm only.
+  const auto part = [&](const runtime::DynamicModel& model, size_t k_lo, size_t k_hi) {
+    std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
+    for (size_t k = k_lo; k < k_hi; ++k) {
+      if (!interval_ok_[k]) continue;
+      for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
+      const double qn = std::sqrt(xm[6] * xm[6] + xm[7] * xm[7] + xm[8] * xm[8] + xm[9] * xm[9]);
+      for (int i = 6; i < 10; ++i) xm[i] /= qn;
+      for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = mean_speed_[k * speed_states_.size() + i];
+      std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
+      if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
+      if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
+      if (quadrature_ == Quadrature::kMidpoint) {
+        model.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+        for (int c = 0; c < 6; ++c) {
+          F[k * 6 + c] = f[kRows[c]];
+          if (Bm)
+            for (size_t qi = 0; qi < nc; ++qi) (*Bm)[(k * 6 + c) * nc + qi] = B[kRows[c] * np + columns[qi]];
+        }
+        continue;
       }
-      continue;
-    }
-    // Trapezoid: the rigid-body state at both ends, the held command and the interval's
-    // mean rotor speeds (a rotor speed at the switching instant belongs to neither side).
-    for (size_t end = k; end <= k + 1; ++end) {
-      std::vector<double> xe(&X[end * n], &X[end * n] + n);
-      for (size_t i = 0; i < speed_states_.size(); ++i) xe[speed_states_[i]] = xm[speed_states_[i]];
-      model_->rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
-      for (int c = 0; c < 6; ++c) {
-        F[k * 6 + c] += 0.5 * f[kRows[c]];
-        if (Bm)
-          for (int q : columns) (*Bm)[(k * 6 + c) * np + q] += 0.5 * B[kRows[c] * np + q];
+      // Trapezoid: the rigid-body state at both ends, the held command and the interval's
+      // mean rotor speeds (a rotor speed at the switching instant belongs to neither side).
+      for (size_t end = k; end <= k + 1; ++end) {
+        std::vector<double> xe(&X[end * n], &X[end * n] + n);
+        for (size_t i = 0; i < speed_states_.size(); ++i) xe[speed_states_[i]] = xm[speed_states_[i]];
+        model.rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+        for (int c = 0; c < 6; ++c) {
+          F[k * 6 + c] += 0.5 * f[kRows[c]];
+          if (Bm)
+            for (size_t qi = 0; qi < nc; ++qi) (*Bm)[(k * 6 + c) * nc + qi] += 0.5 * B[kRows[c] * np + columns[qi]];
+        }
       }
     }
-  }
+  };
+  if (span.hi > span.lo + 1) split_over_cores(span.lo, span.hi - 1, p, Bm != nullptr, part);
 }
 
 void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span,
@@ -322,71 +373,82 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
   prepare(p, X, U, span);
   const bool filtered = derivatives_ == Derivatives::kFiltered;
   std::vector<double> F, Bm;
-  if (filtered) interval_accelerations(X, U, F, J ? &Bm : nullptr, span, columns);
+  if (filtered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
   const bool pointwise_needed = !filtered || accel_;
-  std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
-  // Model accelerations seen by the measurement at this row: the six rows of f (and of B).
-  std::vector<double> a6(6), Ba6(J ? 6 * np : 0);
-  const auto [row_lo, row_hi] = rows_in(span);
-  for (size_t row = row_lo; row < row_hi; ++row) {
-    const size_t k = rows_[row];
-    const FlightSample& s = flight_.samples[k];
-    const double* xk = &X[k * n];
-    if (pointwise_needed) model_->rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
-    double meas[6];
-    if (filtered) {
-      std::fill(a6.begin(), a6.end(), 0.0);
-      if (J) std::fill(Ba6.begin(), Ba6.end(), 0.0);
-      const auto& W = interval_weights_[row];
-      const size_t lo = window_start_[row];
-      for (size_t j = 0; j < W.size(); ++j)
-        for (int c = 0; c < 6; ++c) {
-          a6[c] += W[j] * F[(lo + j) * 6 + c];
-          if (J)
-            for (int q : columns) Ba6[c * np + q] += W[j] * Bm[((lo + j) * 6 + c) * np + q];
-        }
-      for (int c = 0; c < 6; ++c) meas[c] = measured_[row][c];
-    } else {
-      for (int c = 0; c < 3; ++c) {
-        a6[c] = f[3 + c];
-        a6[3 + c] = f[10 + c];
-        meas[c] = s.acc_world[c];
-        meas[3 + c] = s.rate_dot[c];
-        if (J)
-          for (int q : columns) Ba6[c * np + q] = B[(3 + c) * np + q], Ba6[(3 + c) * np + q] = B[(10 + c) * np + q];
-      }
-    }
-    double* rk = r + 6 * (row - row_lo);
-    // Body -> world rotation of the (true) attitude.
-    const runtime::Rotation rotation = runtime::rotation_matrix(xk + 6);
-    const auto& R = rotation.m;
-    const double g = p[g_index_];
-    for (int i = 0; i < 3; ++i) {
-      if (accel_) {  // specific force in body axes at the sample: R^T (a + g e_z)
-        double sf = 0;
-        for (int j = 0; j < 3; ++j) sf += R[j][i] * (f[3 + j] + (j == 2 ? g : 0.0));
-        rk[i] = sf - s.specific_force[i];
+  const size_t nc = columns.size();
+  const auto rows = rows_in(span);
+  const size_t row_lo = rows.first, row_hi = rows.second;
+  // Rows from_row .. to_row - 1; each writes its own rows of r and J only.
+  const auto part = [&](const runtime::DynamicModel& model, size_t from_row, size_t to_row) {
+    std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
+    // Model accelerations seen by the measurement at this row: the six rows of f (and of B,
+    // packed to the columns asked for).
+    std::vector<double> a6(6), Ba6(J ? 6 * nc : 0);
+    for (size_t row = from_row; row < to_row; ++row) {
+      const size_t k = rows_[row];
+      const FlightSample& s = flight_.samples[k];
+      const double* xk = &X[k * n];
+      if (pointwise_needed) model.rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
+      double meas[6];
+      if (filtered) {
+        std::fill(a6.begin(), a6.end(), 0.0);
+        if (J) std::fill(Ba6.begin(), Ba6.end(), 0.0);
+        const auto& W = interval_weights_[row];
+        const size_t lo = window_start_[row];
+        for (size_t j = 0; j < W.size(); ++j)
+          for (int c = 0; c < 6; ++c) {
+            a6[c] += W[j] * F[(lo + j) * 6 + c];
+            if (!J) continue;
+            const double* from = &Bm[((lo + j) * 6 + c) * nc];
+            double* to = &Ba6[c * nc];
+            for (size_t qi = 0; qi < nc; ++qi) to[qi] += W[j] * from[qi];
+          }
+        for (int c = 0; c < 6; ++c) meas[c] = measured_[row][c];
       } else {
-        rk[i] = a6[i] - meas[i];
-      }
-      rk[3 + i] = a6[3 + i] - meas[3 + i];
-    }
-    if (!J) continue;
-    double* Jk = J + static_cast<size_t>(6 * (row - row_lo)) * np;
-    for (int c : columns) {
-      for (int i = 0; i < 3; ++i) {
-        double d;
-        if (accel_) {
-          d = 0;
-          for (int j = 0; j < 3; ++j) d += R[j][i] * (B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
-        } else {
-          d = Ba6[i * np + c];
+        for (int c = 0; c < 3; ++c) {
+          a6[c] = f[3 + c];
+          a6[3 + c] = f[10 + c];
+          meas[c] = s.acc_world[c];
+          meas[3 + c] = s.rate_dot[c];
+          if (J)
+            for (size_t qi = 0; qi < nc; ++qi)
+              Ba6[c * nc + qi] = B[(3 + c) * np + columns[qi]], Ba6[(3 + c) * nc + qi] = B[(10 + c) * np + columns[qi]];
         }
-        Jk[i * np + c] = d;
-        Jk[(3 + i) * np + c] = Ba6[(3 + i) * np + c];
+      }
+      double* rk = r + 6 * (row - row_lo);
+      // Body -> world rotation of the (true) attitude.
+      const runtime::Rotation rotation = runtime::rotation_matrix(xk + 6);
+      const auto& R = rotation.m;
+      const double g = p[g_index_];
+      for (int i = 0; i < 3; ++i) {
+        if (accel_) {  // specific force in body axes at the sample: R^T (a + g e_z)
+          double sf = 0;
+          for (int j = 0; j < 3; ++j) sf += R[j][i] * (f[3 + j] + (j == 2 ? g : 0.0));
+          rk[i] = sf - s.specific_force[i];
+        } else {
+          rk[i] = a6[i] - meas[i];
+        }
+        rk[3 + i] = a6[3 + i] - meas[3 + i];
+      }
+      if (!J) continue;
+      double* Jk = J + static_cast<size_t>(6 * (row - row_lo)) * np;
+      for (size_t qi = 0; qi < nc; ++qi) {
+        const int c = columns[qi];
+        for (int i = 0; i < 3; ++i) {
+          double d;
+          if (accel_) {
+            d = 0;
+            for (int j = 0; j < 3; ++j) d += R[j][i] * (B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
+          } else {
+            d = Ba6[i * nc + qi];
+          }
+          Jk[i * np + c] = d;
+          Jk[(3 + i) * np + c] = Ba6[(3 + i) * nc + qi];
+        }
       }
     }
-  }
+  };
+  split_over_cores(row_lo, row_hi, p, J != nullptr, part);
 }
 
 }  // namespace quadgen::fit

@@ -97,6 +97,24 @@ class EquationErrorModel : public ResidualModel {
   // Scratch of one evaluation, not state: rotor speeds averaged over each interval
   // (motor_lag), kept to reuse the allocation (one instance serves one thread; clone()).
   mutable std::vector<double> mean_speed_;
+  // Copies of the dynamic model for the helper threads of a split evaluation
+  // (evaluation_threads.hpp), made when first needed. Not copied with the instance: a
+  // clone() makes its own.
+  struct HelperModels {
+    std::vector<std::unique_ptr<runtime::DynamicModel>> models;
+    HelperModels() = default;
+    HelperModels(const HelperModels&) {}
+    HelperModels& operator=(const HelperModels&) {
+      models.clear();
+      return *this;
+    }
+  };
+  mutable HelperModels helpers_;
+  mutable std::vector<int> restricted_columns_;  // what model_ was last restricted to
+  // Runs part(model, lo, hi) over [lo, hi), split between this thread (model_) and helper
+  // threads (each with its own copy of the model at parameters p) when that pays.
+  template <class Part>
+  void split_over_cores(size_t lo, size_t hi, const double* p, bool jacobian, const Part& part) const;
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
@@ -110,7 +128,8 @@ class EquationErrorModel : public ResidualModel {
   // `span`: row i of that range at r + 6 i. A search step frees a few of the 30-80
   // parameters of a per-flight model; the Jacobian work follows the free ones.
   void residuals(const double* p, double* r, double* J, SampleSpan span, const std::vector<int>& columns) const;
-  void interval_accelerations(const std::vector<double>& X, const std::vector<double>& U, std::vector<double>& F,
+  void interval_accelerations(const double* p, const std::vector<double>& X, const std::vector<double>& U,
+                              std::vector<double>& F,
                               std::vector<double>* Bm, SampleSpan span, const std::vector<int>& columns) const;
 };
 

@@ -1,4 +1,5 @@
 #include "fit/profile_likelihood.hpp"
+#include "fit/evaluation_threads.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <optional>
 #include <thread>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -199,6 +201,9 @@ std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& be
   std::exception_ptr first_error;
   int profiles_done = 0;
   const auto worker = [&](const ResidualModel& m) {
+    // One profile side per core: its evaluations stay on its thread (a lone one splits).
+    std::optional<OneCorePerFit> one_core;
+    if (threads > 1) one_core.emplace();
     for (size_t j; (j = next_job++) < jobs;) {
       const size_t i = j / 2;
       {

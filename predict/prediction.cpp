@@ -19,6 +19,16 @@ namespace quadgen::predict {
 double ErrorStats::mean() const { return count ? sum / static_cast<double>(count) : std::nan(""); }
 double ErrorStats::rms() const { return count ? std::sqrt(sum_sq / static_cast<double>(count)) : std::nan(""); }
 
+void OneStepErrors::merge(const OneStepErrors& o) {
+  for (int a = 0; a < 3; ++a) {
+    specific_force[a].merge(o.specific_force[a]);
+    angular_acceleration[a].merge(o.angular_acceleration[a]);
+  }
+  vertical_acceleration_world.merge(o.vertical_acceleration_world);
+  if (source.empty()) source = o.source;
+  else if (!o.source.empty() && o.source != source) source = "mixed";
+}
+
 void Prediction::merge(const Prediction& o) {
   auto merge_rows = [](std::vector<HorizonErrors>& a, const std::vector<HorizonErrors>& b) {
     if (a.empty()) a = b;
@@ -32,22 +42,11 @@ void Prediction::merge(const Prediction& o) {
   };
   merge_rows(open_loop, o.open_loop);
   merge_rows(attitude_replayed, o.attitude_replayed);
-  for (int a = 0; a < 3; ++a) {
-    one_step.specific_force[a].merge(o.one_step.specific_force[a]);
-    one_step.angular_acceleration[a].merge(o.one_step.angular_acceleration[a]);
-  }
-  one_step.vertical_acceleration_world.merge(o.one_step.vertical_acceleration_world);
+  one_step.merge(o.one_step);
   if (o.one_step_corrected) {
     if (!one_step_corrected) one_step_corrected = OneStepErrors{};
-    for (int a = 0; a < 3; ++a) {
-      one_step_corrected->specific_force[a].merge(o.one_step_corrected->specific_force[a]);
-      one_step_corrected->angular_acceleration[a].merge(o.one_step_corrected->angular_acceleration[a]);
-    }
-    one_step_corrected->vertical_acceleration_world.merge(o.one_step_corrected->vertical_acceleration_world);
-    one_step_corrected->source = o.one_step_corrected->source;
+    one_step_corrected->merge(*o.one_step_corrected);
   }
-  if (one_step.source.empty()) one_step.source = o.one_step.source;
-  else if (!o.one_step.source.empty() && o.one_step.source != one_step.source) one_step.source = "mixed";
   start_points += o.start_points;
   seconds_of_data += o.seconds_of_data;
 }

@@ -60,6 +60,9 @@ struct OneStepErrors {
   ErrorStats angular_acceleration[3];  // rad/s^2, body x y z
   ErrorStats vertical_acceleration_world;
   std::string source;  // where the measured accelerations come from
+
+  // Adds another flight's errors; a source that differs between them becomes "mixed".
+  void merge(const OneStepErrors& o);
 };
 
 struct Prediction {

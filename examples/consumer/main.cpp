@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "model.hpp"                   // generated from vehicles/finken3.yaml
+#include "rk4.hpp"
 #include "runtime/dynamic_model.hpp"  // installed with quadgen: the runtime's interface to a model
 
 namespace m = quadgen_generated::finken3;
@@ -20,15 +21,8 @@ struct Simulation {
   }
   // One classical Runge-Kutta step of dx/dt = f(x, u, p), attitude quaternion renormalised.
   void rk4_step(S* x, const S* u, S h) const {
-    S k1[m::kNumStates], k2[m::kNumStates], k3[m::kNumStates], k4[m::kNumStates], xt[m::kNumStates];
-    m::rhs(x, u, p, pre, k1);  // f only; rhs(x, u, p, pre, f, dfdx, dfdu, dfdp) adds Jacobians
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h / 2 * k1[i];
-    m::rhs(xt, u, p, pre, k2);
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h / 2 * k2[i];
-    m::rhs(xt, u, p, pre, k3);
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h * k3[i];
-    m::rhs(xt, u, p, pre, k4);
-    for (int i = 0; i < m::kNumStates; ++i) x[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    // f only; rhs(x, u, p, pre, f, dfdx, dfdu, dfdp) adds Jacobians
+    ::rk4_step<m::kNumStates>(x, h, [&](const S* xs, S* f) { m::rhs(xs, u, p, pre, f); });
     using std::sqrt;
     const S n = sqrt(x[m::State::qw] * x[m::State::qw] + x[m::State::qx] * x[m::State::qx] +
                      x[m::State::qy] * x[m::State::qy] + x[m::State::qz] * x[m::State::qz]);

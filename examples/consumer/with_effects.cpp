@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "model.hpp"  // generated from vehicles/finken3.yaml with motor_gain,motor_lag
+#include "rk4.hpp"
 
 namespace m = quadgen_generated::finken3_with_motor_gain_motor_lag;
 
@@ -25,15 +26,7 @@ int main() {
   const double h = 1e-4;
   int bad = 0;
   for (int k = 1; k <= 1500; ++k) {  // to 3 tau
-    double k1[m::kNumStates], k2[m::kNumStates], k3[m::kNumStates], k4[m::kNumStates], xt[m::kNumStates];
-    m::rhs(x, u, p, pre, k1);
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h / 2 * k1[i];
-    m::rhs(xt, u, p, pre, k2);
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h / 2 * k2[i];
-    m::rhs(xt, u, p, pre, k3);
-    for (int i = 0; i < m::kNumStates; ++i) xt[i] = x[i] + h * k3[i];
-    m::rhs(xt, u, p, pre, k4);
-    for (int i = 0; i < m::kNumStates; ++i) x[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    rk4_step<m::kNumStates>(x, h, [&](const double* xs, double* dxdt) { m::rhs(xs, u, p, pre, dxdt); });
     if (k == 500 || k == 1500) {
       const double t = k * h, expected = w_cmd * (1 - std::exp(-t / tau)), got = x[m::State::w_A];
       const bool ok = std::isfinite(got) && std::fabs(got - expected) <= 1e-6 * w_cmd;

@@ -1,0 +1,34 @@
+// Whether one residual evaluation may be split over the machine's cores. A diagnosis fits
+// most candidates side by side, one fit per core (CandidateSearch, profiles); there, splitting
+// each evaluation again would only make the threads fight for the same cores. The fits that
+// run alone (the base fit, the refit after each selection, the intervals) are a third of a
+// joint diagnosis' time, and they use every core only if their evaluations split.
+#pragma once
+#include <cstddef>
+
+namespace quadgen::fit {
+
+// While one lives, evaluations on this thread are split into exactly `parts` parts
+// (1: they stay on this thread, as in a pool that runs one fit per core).
+class EvaluationParts {
+ public:
+  explicit EvaluationParts(size_t parts);
+  ~EvaluationParts();
+  EvaluationParts(const EvaluationParts&) = delete;
+  EvaluationParts& operator=(const EvaluationParts&) = delete;
+
+ private:
+  size_t previous_;
+};
+
+// A thread of a pool that runs one fit per core.
+class OneCorePerFit : public EvaluationParts {
+ public:
+  OneCorePerFit() : EvaluationParts(1) {}
+};
+
+// How many parts an evaluation over `items` independent items should be split into on this
+// thread: what an EvaluationParts in scope says; else one per core (at most 8) for long work.
+size_t evaluation_parts(size_t items);
+
+}  // namespace quadgen::fit
