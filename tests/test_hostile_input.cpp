@@ -47,7 +47,7 @@ const std::vector<std::string>& hostile_strings() {
       "@PWNED",
       "finken3\n#define Scalar(v) (2*(v))\n//",
       "trailing backslash \\",
-      "trigraph ??/",
+      "trigraph ?\?/",  // the characters ? ? /, written so that no compiler reads a trigraph
       "end */ of comment /*",
       "</script><script>alert(1)</script>",
       "</svg><img src=x onerror=alert(1)>",

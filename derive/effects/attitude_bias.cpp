@@ -21,7 +21,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect attitude_bias() {
-  Effect e{"attitude_bias", "logged attitude = true attitude rotated by roll and pitch", terms};
+  Effect e;
+  e.name = "attitude_bias";
+  e.meaning = "logged attitude = true attitude rotated by roll and pitch";
+  e.apply = terms;
   e.parameter_names = "attitude_bias.roll/pitch";  // as --help lists them
   // Vicon attitude and IMU differ by 0.5-2.3 degrees in roll and pitch, by flight (the
   // marker frame is fitted per session; docs/crazyflie_evidence.md).

@@ -22,7 +22,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect battery_sag() {
-  Effect e{"battery_sag", "thrust scaled by (vbat / vbat_ref)^exponent", terms};
+  Effect e;
+  e.name = "battery_sag";
+  e.meaning = "thrust scaled by (vbat / vbat_ref)^exponent";
+  e.apply = terms;
   e.parameter_names = "battery_sag.exponent";  // as --help lists them
   e.needs = EffectNeeds::kBatteryVoltage;
   e.plausible = {{"battery_sag.exponent", 0.0, 3.0, PlausibleRange::Scale::kSI, Environment::kUnknown,

@@ -29,7 +29,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect blade_flapping() {
-  Effect e{"blade_flapping", "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed", terms};
+  Effect e;
+  e.name = "blade_flapping";
+  e.meaning = "body moment k (sum of rotor speeds) (v_y, -v_x, 0) on the body-frame airspeed";
+  e.apply = terms;
   e.parameter_names = "blade_flapping.k";  // as --help lists them
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
     const double k = headline::value_of(v, "blade_flapping.k");

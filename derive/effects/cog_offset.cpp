@@ -27,7 +27,10 @@ std::string headline(const std::map<std::string, double>& v, const std::string&)
 }  // namespace
 
 Effect cog_offset() {
-  Effect e{"cog_offset", "centre of gravity displaced from the body origin in x, y", terms};
+  Effect e;
+  e.name = "cog_offset";
+  e.meaning = "centre of gravity displaced from the body origin in x, y";
+  e.apply = terms;
   e.parameter_names = "cog_offset.x/y";  // as --help lists them
   e.plausible = {{"", -0.2, 0.2, PlausibleRange::Scale::kRotorArm, Environment::kUnknown,
                   "a centre of gravity a fifth of the rotor arm off centre needs one motor at ~1.5x its opposite's "

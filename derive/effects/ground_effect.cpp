@@ -18,7 +18,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect ground_effect() {
-  Effect e{"ground_effect", "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground", terms};
+  Effect e;
+  e.name = "ground_effect";
+  e.meaning = "thrust scaled by 1 / (1 - (R / 4 z)^2) near the ground";
+  e.apply = terms;
   e.parameter_names = "ground_effect.radius";  // as --help lists them
   e.needs = EffectNeeds::kPose;
   e.typical_start = {{"ground_effect.radius", 0.05}};

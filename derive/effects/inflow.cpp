@@ -32,7 +32,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect inflow() {
-  Effect e{"inflow", "thrust lowered by k (climb speed of each rotor through the air) / (tip speed)", terms};
+  Effect e;
+  e.name = "inflow";
+  e.meaning = "thrust lowered by k (climb speed of each rotor through the air) / (tip speed)";
+  e.apply = terms;
   e.parameter_names = "inflow.k";  // as --help lists them
   e.plausible = {{"inflow.k", 0.0, 8.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "blade-element theory with momentum inflow gives 1 / (lambda_h + 16 lambda_h^2 / (sigma a)): "

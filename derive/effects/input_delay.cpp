@@ -17,7 +17,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect input_delay() {
-  Effect e{"input_delay", "pure time shift between logged commands and their effect", terms};
+  Effect e;
+  e.name = "input_delay";
+  e.meaning = "pure time shift between logged commands and their effect";
+  e.apply = terms;
   e.parameter_names = "input_delay.seconds";  // as --help lists them
   e.acts_on = Effect::ActsOn::kCommands;
   e.typical_start = {{"input_delay.seconds", 0.015}};

@@ -38,7 +38,10 @@ std::string headline(const std::map<std::string, double>& v, const std::string& 
 }  // namespace
 
 Effect motor_gain() {
-  Effect e{"motor_gain", "thrust of each rotor scaled by (1 + value)", terms};
+  Effect e;
+  e.name = "motor_gain";
+  e.meaning = "thrust of each rotor scaled by (1 + value)";
+  e.apply = terms;
   e.parameter_names = "motor_gain.<rotor>";  // as --help lists them
   e.first_parameter_is_reference = true;
   // The NanoBench flights of one Crazyflie trim their motors differently on every flight

@@ -24,7 +24,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect motor_lag() {
-  Effect e{"motor_lag", "first-order lag from commanded to actual rotor speed", terms};
+  Effect e;
+  e.name = "motor_lag";
+  e.meaning = "first-order lag from commanded to actual rotor speed";
+  e.apply = terms;
   e.parameter_names = "motor_lag.tau";  // as --help lists them
   e.typical_start = {{"motor_lag.tau", 0.03}};
   e.off_at_lower_bound = true;

@@ -28,7 +28,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect rotor_drag() {
-  Effect e{"rotor_drag", "horizontal body force -k (sum of rotor speeds) v_body,xy", terms};
+  Effect e;
+  e.name = "rotor_drag";
+  e.meaning = "horizontal body force -k (sum of rotor speeds) v_body,xy";
+  e.apply = terms;
   e.parameter_names = "rotor_drag.k";  // as --help lists them
   e.look_alikes = {{"blade_flapping", "straight legs at several constant speeds: rotor drag slows the vehicle (a "
                                       "horizontal force), flapping only tilts it (a moment the attitude loop must hold)"}};

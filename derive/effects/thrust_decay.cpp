@@ -20,7 +20,10 @@ void terms(ModelContext& c) {
 }  // namespace
 
 Effect thrust_decay() {
-  Effect e{"thrust_decay", "all thrust scaled by (1 - rate (t - t_start))", terms};
+  Effect e;
+  e.name = "thrust_decay";
+  e.meaning = "all thrust scaled by (1 - rate (t - t_start))";
+  e.apply = terms;
   e.parameter_names = "thrust_decay.rate";  // as --help lists them
   e.plausible = {{"thrust_decay.rate", -1e-4, 5e-3, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "a LiPo from full to the end of a flight loses 15-30 % of thrust over minutes; half the thrust "

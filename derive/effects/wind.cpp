@@ -28,7 +28,10 @@ std::string headline(const std::map<std::string, double>& v, const std::string&)
 }  // namespace
 
 Effect wind() {
-  Effect e{"wind", "steady air velocity in the world frame, through the drag terms", terms};
+  Effect e;
+  e.name = "wind";
+  e.meaning = "steady air velocity in the world frame, through the drag terms";
+  e.apply = terms;
   e.parameter_names = "wind.x/y";  // as --help lists them
   e.per_flight = true;
   e.plausible = {{"", -0.5, 0.5, PlausibleRange::Scale::kSI, Environment::kIndoor,
