@@ -280,34 +280,40 @@ template <class Part>
 void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p, bool jacobian,
                                           const Part& part) const {
   const size_t parts = hi > lo ? evaluation_parts(hi - lo) : 1;
-  while (helpers_.models.size() + 1 < parts) {
+  auto& h = helpers_;
+  while (h.models.size() + 1 < parts) {
     auto copy = model_->clone();
     if (!copy) break;  // a model that cannot be copied stays on one thread
-    helpers_.models.push_back(std::move(copy));
+    h.models.push_back(std::move(copy));
+    h.params.emplace_back();
+    h.columns.push_back({-1});  // no restriction passed yet
   }
-  const size_t n = std::min(parts, helpers_.models.size() + 1);
+  const size_t n = std::min(parts, h.models.size() + 1);
   if (n <= 1) return part(*model_, lo, hi);
   const std::vector<double> params(p, p + model_->num_params());
-  std::vector<std::thread> threads;
+  for (size_t i = 0; i + 1 < n; ++i) {  // before any thread starts: these may throw
+    if (h.params[i] != params) h.models[i]->set_params(params), h.params[i] = params;
+    if (jacobian && h.columns[i] != restricted_columns_)
+      h.models[i]->restrict_param_jacobian(restricted_columns_), h.columns[i] = restricted_columns_;
+  }
   std::vector<std::exception_ptr> failures(n);
   const auto bound = [&](size_t i) { return lo + (hi - lo) * i / n; };
+  const auto run = [&](size_t i, const runtime::DynamicModel& m) {
+    try {
+      part(m, bound(i), bound(i + 1));
+    } catch (...) {
+      failures[i] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
   for (size_t i = 1; i < n; ++i) {
-    runtime::DynamicModel& m = *helpers_.models[i - 1];
-    m.set_params(params);
-    if (jacobian) m.restrict_param_jacobian(restricted_columns_);
-    threads.emplace_back([&, i, mp = &m] {
-      try {
-        part(*mp, bound(i), bound(i + 1));
-      } catch (...) {
-        failures[i] = std::current_exception();
-      }
-    });
+    try {
+      threads.emplace_back(run, i, std::cref(*h.models[i - 1]));
+    } catch (...) {  // no thread to be had: this part runs here
+      run(i, *h.models[i - 1]);
+    }
   }
-  try {
-    part(*model_, bound(0), bound(1));
-  } catch (...) {
-    failures[0] = std::current_exception();
-  }
+  run(0, *model_);
   for (auto& t : threads) t.join();
   for (const auto& f : failures)
     if (f) std::rethrow_exception(f);

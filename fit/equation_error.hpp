@@ -100,12 +100,16 @@ class EquationErrorModel : public ResidualModel {
   // Copies of the dynamic model for the helper threads of a split evaluation
   // (evaluation_threads.hpp), made when first needed. Not copied with the instance: a
   // clone() makes its own.
+  // Each remembers the parameters and columns it was last given: a residuals() call splits
+  // twice, and setting parameters reruns the model's precompute step.
   struct HelperModels {
     std::vector<std::unique_ptr<runtime::DynamicModel>> models;
+    std::vector<std::vector<double>> params;
+    std::vector<std::vector<int>> columns;
     HelperModels() = default;
     HelperModels(const HelperModels&) {}
     HelperModels& operator=(const HelperModels&) {
-      models.clear();
+      models.clear(), params.clear(), columns.clear();
       return *this;
     }
   };

@@ -61,7 +61,8 @@ PerFlightModel::PerFlightModel(const DynamicModel& inner, std::vector<double> fl
 }
 
 PerFlightModel::PerFlightModel(const PerFlightModel& o)
-    : DynamicModel(o), starts_(o.starts_), t_input_(o.t_input_), names_(o.names_), p_(o.p_), column_(o.column_) {
+    : DynamicModel(o), starts_(o.starts_), t_input_(o.t_input_), names_(o.names_), p_(o.p_), column_(o.column_),
+      restricted_to_(o.restricted_to_) {  // the inner copies keep their restriction: so does the record of it
   for (const auto& m : o.flights_) flights_.push_back(m->clone());
 }
 

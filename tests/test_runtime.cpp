@@ -259,6 +259,32 @@ TEST(Runtime, RestrictedParameterJacobianKeepsRequestedColumns) {
   EXPECT_EQ(part, full);
 }
 
+// A copy of a per-flight model remembers which columns it computes: its inner copies (tapes,
+// which really skip columns) keep the restriction, so asking the copy for all columns again
+// must reach them. (The copy used to forget it, take "all" for what it already had, and
+// leave the other columns zero: the helper threads of a split evaluation are such copies.)
+TEST(PerFlightModel, ACopyKeepsItsColumnRestriction) {
+  const TapeModel inner = finken3_tape(parse_effect_list("all"));
+  const int n = inner.num_states(), nu = inner.num_inputs();
+  PerFlightModel joint(inner, {10.0}, {"motor_gain.C"});
+  const int np = joint.num_params();
+  std::mt19937 rng(9);
+  std::vector<double> x = test::random_state(rng);
+  x.resize(n, 900.0);
+  std::vector<double> u(nu, 0.4);
+  u[inner.input_index("t")] = 15.0;
+  u[inner.input_index("vbat")] = 3.9;
+  std::vector<double> f(n), full(n * np), restricted(n * np), again(n * np);
+  joint.rhs(x.data(), u.data(), f.data(), nullptr, full.data(), nullptr);
+  joint.restrict_param_jacobian({np - 1});
+  joint.rhs(x.data(), u.data(), f.data(), nullptr, restricted.data(), nullptr);
+  EXPECT_NE(restricted, full);
+  const auto copy = joint.clone();
+  copy->restrict_param_jacobian({});
+  copy->rhs(x.data(), u.data(), f.data(), nullptr, again.data(), nullptr);
+  EXPECT_EQ(again, full);
+}
+
 // Per-flight parameters: the wrapped model evaluates each flight with that flight's values,
 // and df/dp of a per-flight parameter lands in the column of the flight evaluated.
 TEST(PerFlightModel, EachFlightSeesItsOwnValuesAndColumns) {
