@@ -493,7 +493,16 @@ TEST(Options, EveryNumberIsCheckedAndNothingIsSilentlyIgnored) {
   Scratch tmp;
   const std::string f3 = source_path("vehicles/finken3.yaml");
   const std::string steps = source_path("data/finken3_motor_steps.csv");
-  const std::string stand = source_path("../shared/data/crazyflie/thrust-stand/cf21_stock2.csv");
+  // A thrust-stand log (the columns of Bitcraze's stand, as in the shared data): its own few
+  // rows, so that the test needs nothing outside the repository.
+  const std::string stand = tmp / "stand.csv";
+  {
+    std::ofstream out(stand);
+    out << "weight[g],pwm,vbat[V],rpm1,rpm2,rpm3,rpm4,v[V],i[A],p[W]\n"
+           "0.0,0,3.874,0,0,0,0,3.903,0.189,0.657\n"
+           "10.2,20000,3.85,9000,9100,8950,9050,3.88,1.1,4.2\n"
+           "25.1,40000,3.80,15000,15100,14900,15050,3.83,2.9,11.1\n";
+  }
   const std::string traj = tmp / "t.csv";
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"simulate", f3, "--scenario", "hover", "--duration", "nan", "--out", traj}, "--duration"},
