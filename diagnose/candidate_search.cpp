@@ -8,7 +8,6 @@
 #include <limits>
 #include <mutex>
 #include <chrono>
-#include <optional>
 #include <thread>
 
 #include <unistd.h>
@@ -300,8 +299,7 @@ void CandidateSearch::on_every_core(size_t count, Work work) const {
   std::exception_ptr failure;
   auto run = [&](const Workspace& ws) {
     // One fit per core: each fit's evaluations stay on their thread (one fit alone splits).
-    std::optional<fit::OneCorePerFit> one_core;
-    if (workers.size() > 1) one_core.emplace();
+    const fit::OneCorePerFit one_core(workers.size() > 1);
     for (size_t i; (i = next++) < count;) {
       try {
         work(i, ws);

@@ -140,10 +140,7 @@ std::vector<std::string> EquationErrorModel::channels() const {
 }
 
 void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
-  if (J) {
-    restricted_columns_ = runtime::free_columns(free);
-    model_->restrict_param_jacobian(restricted_columns_);
-  }
+  if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
   if (used_.size() == 6) return evaluate6(p, r, J, free);
   const int np = model_->num_params();
   const size_t ns = rows_.size();
@@ -277,24 +274,23 @@ std::pair<size_t, size_t> EquationErrorModel::rows_in(SampleSpan span) const {
 }
 
 template <class Part>
-void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p, bool jacobian,
+void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p, const std::vector<int>* columns,
                                           const Part& part) const {
   const size_t parts = hi > lo ? evaluation_parts(hi - lo) : 1;
-  auto& h = helpers_;
-  while (h.models.size() + 1 < parts) {
-    auto copy = model_->clone();
-    if (!copy) break;  // a model that cannot be copied stays on one thread
-    h.models.push_back(std::move(copy));
-    h.params.emplace_back();
-    h.columns.push_back({-1});  // no restriction passed yet
+  auto& helpers = helpers_.list;
+  while (helpers.size() + 1 < parts) {
+    Helper h;
+    h.model = model_->clone();
+    if (!h.model) break;  // a model that cannot be copied stays on one thread
+    helpers.push_back(std::move(h));
   }
-  const size_t n = std::min(parts, h.models.size() + 1);
+  const size_t n = std::min(parts, helpers.size() + 1);
   if (n <= 1) return part(*model_, lo, hi);
   const std::vector<double> params(p, p + model_->num_params());
   for (size_t i = 0; i + 1 < n; ++i) {  // before any thread starts: these may throw
-    if (h.params[i] != params) h.models[i]->set_params(params), h.params[i] = params;
-    if (jacobian && h.columns[i] != restricted_columns_)
-      h.models[i]->restrict_param_jacobian(restricted_columns_), h.columns[i] = restricted_columns_;
+    Helper& h = helpers[i];
+    if (h.params != params) h.model->set_params(params), h.params = params;
+    if (columns && h.columns != *columns) h.model->restrict_param_jacobian(*columns), h.columns = *columns;
   }
   std::vector<std::exception_ptr> failures(n);
   const auto bound = [&](size_t i) { return lo + (hi - lo) * i / n; };
@@ -308,9 +304,9 @@ void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p,
   std::vector<std::thread> threads;
   for (size_t i = 1; i < n; ++i) {
     try {
-      threads.emplace_back(run, i, std::cref(*h.models[i - 1]));
+      threads.emplace_back(run, i, std::cref(*helpers[i - 1].model));
     } catch (...) {  // no thread to be had: this part runs here
-      run(i, *h.models[i - 1]);
+      run(i, *helpers[i - 1].model);
     }
   }
   run(0, *model_);
@@ -368,7 +364,7 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
       }
     }
   };
-  if (span.hi > span.lo + 1) split_over_cores(span.lo, span.hi - 1, p, Bm != nullptr, part);
+  if (span.hi > span.lo + 1) split_over_cores(span.lo, span.hi - 1, p, Bm ? &columns : nullptr, part);
 }
 
 void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span,
@@ -454,7 +450,7 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
       }
     }
   };
-  split_over_cores(row_lo, row_hi, p, J != nullptr, part);
+  split_over_cores(row_lo, row_hi, p, J ? &columns : nullptr, part);
 }
 
 }  // namespace quadgen::fit

@@ -98,27 +98,31 @@ class EquationErrorModel : public ResidualModel {
   // (motor_lag), kept to reuse the allocation (one instance serves one thread; clone()).
   mutable std::vector<double> mean_speed_;
   // Copies of the dynamic model for the helper threads of a split evaluation
-  // (evaluation_threads.hpp), made when first needed. Not copied with the instance: a
-  // clone() makes its own.
-  // Each remembers the parameters and columns it was last given: a residuals() call splits
-  // twice, and setting parameters reruns the model's precompute step.
-  struct HelperModels {
-    std::vector<std::unique_ptr<runtime::DynamicModel>> models;
-    std::vector<std::vector<double>> params;
-    std::vector<std::vector<int>> columns;
-    HelperModels() = default;
-    HelperModels(const HelperModels&) {}
-    HelperModels& operator=(const HelperModels&) {
-      models.clear(), params.clear(), columns.clear();
+  // (evaluation_threads.hpp), made when first needed; each remembers the parameters and
+  // Jacobian columns it was last given (a residuals() call splits twice, and setting
+  // parameters reruns the model's precompute step). Not copied with the instance: a clone()
+  // makes its own.
+  struct Helper {
+    std::unique_ptr<runtime::DynamicModel> model;
+    std::vector<double> params;
+    std::vector<int> columns = {-1};  // none passed yet
+  };
+  struct Helpers {
+    std::vector<Helper> list;
+    Helpers() = default;
+    Helpers(const Helpers&) {}
+    Helpers& operator=(const Helpers&) {
+      list.clear();
       return *this;
     }
   };
-  mutable HelperModels helpers_;
-  mutable std::vector<int> restricted_columns_;  // what model_ was last restricted to
+  mutable Helpers helpers_;
   // Runs part(model, lo, hi) over [lo, hi), split between this thread (model_) and helper
-  // threads (each with its own copy of the model at parameters p) when that pays.
+  // threads, each with its own copy of the model at parameters p and, when `columns` is
+  // given, computing those Jacobian columns.
   template <class Part>
-  void split_over_cores(size_t lo, size_t hi, const double* p, bool jacobian, const Part& part) const;
+  void split_over_cores(size_t lo, size_t hi, const double* p, const std::vector<int>* columns,
+                        const Part& part) const;
   std::vector<std::string> all_names() const;
   void evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
@@ -133,8 +137,8 @@ class EquationErrorModel : public ResidualModel {
   // parameters of a per-flight model; the Jacobian work follows the free ones.
   void residuals(const double* p, double* r, double* J, SampleSpan span, const std::vector<int>& columns) const;
   void interval_accelerations(const double* p, const std::vector<double>& X, const std::vector<double>& U,
-                              std::vector<double>& F,
-                              std::vector<double>* Bm, SampleSpan span, const std::vector<int>& columns) const;
+                              std::vector<double>& F, std::vector<double>* Bm, SampleSpan span,
+                              const std::vector<int>& columns) const;
 };
 
 

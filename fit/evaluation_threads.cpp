@@ -12,7 +12,9 @@ thread_local size_t parts_in_scope = 0;  // 0: none set, decide by the work's si
 constexpr size_t kMinItemsPerPart = 1000;
 }  // namespace
 
-EvaluationParts::EvaluationParts(size_t parts) : previous_(parts_in_scope) { parts_in_scope = std::max<size_t>(1, parts); }
+EvaluationParts::EvaluationParts(size_t parts) : previous_(parts_in_scope) {
+  if (parts > 0) parts_in_scope = parts;
+}
 EvaluationParts::~EvaluationParts() { parts_in_scope = previous_; }
 
 size_t evaluation_parts(size_t items) {

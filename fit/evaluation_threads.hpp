@@ -9,7 +9,7 @@
 namespace quadgen::fit {
 
 // While one lives, evaluations on this thread are split into exactly `parts` parts
-// (1: they stay on this thread, as in a pool that runs one fit per core).
+// (1: they stay on this thread, as in a pool that runs one fit per core; 0: as before it).
 class EvaluationParts {
  public:
   explicit EvaluationParts(size_t parts);
@@ -21,10 +21,11 @@ class EvaluationParts {
   size_t previous_;
 };
 
-// A thread of a pool that runs one fit per core.
+// A thread of a pool that runs one fit per core; `in_pool` false: a pool of one thread,
+// whose fit may split its evaluations.
 class OneCorePerFit : public EvaluationParts {
  public:
-  OneCorePerFit() : EvaluationParts(1) {}
+  explicit OneCorePerFit(bool in_pool = true) : EvaluationParts(in_pool ? 1 : 0) {}
 };
 
 // How many parts an evaluation over `items` independent items should be split into on this

@@ -9,7 +9,6 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
-#include <optional>
 #include <thread>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -202,8 +201,7 @@ std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& be
   int profiles_done = 0;
   const auto worker = [&](const ResidualModel& m) {
     // One profile side per core: its evaluations stay on its thread (a lone one splits).
-    std::optional<OneCorePerFit> one_core;
-    if (threads > 1) one_core.emplace();
+    const OneCorePerFit one_core(threads > 1);
     for (size_t j; (j = next_job++) < jobs;) {
       const size_t i = j / 2;
       {
