@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "audit/tex_writer.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
@@ -16,168 +17,11 @@ using namespace GiNaC;
 
 namespace {
 
-// GiNaC's own printing, for leaves only (a symbol's TeX name, a number): deterministic.
-std::string ginac_tex(const ex& e) {
-  std::ostringstream os;
-  os << latex << e;
-  return os.str();
-}
-
-std::string tex(const ex& e);
-
-// Wrapped in parentheses when it would otherwise bind wrongly as a factor or a base.
-std::string tex_operand(const ex& e, bool as_base) {
-  const bool wrap = is_a<add>(e) || (as_base && (is_a<mul>(e) || is_a<power>(e))) ||
-                    (is_a<numeric>(e) && (ex_to<numeric>(e).is_negative() || !ex_to<numeric>(e).is_integer()));
-  return wrap ? "\\left(" + tex(e) + "\\right)" : tex(e);
-}
-
-// Terms of a sum sorted by their text, a sign in front of each: the order GiNaC keeps
-// depends on symbol serial numbers, i.e. on the process, and a reviewer diffs reports.
-std::string tex_add(const ex& e) {
-  std::vector<std::pair<std::string, bool>> terms;  // text without sign, negative
-  for (const auto& t : e) {
-    const std::string text = tex(t);  // a term's sign is what its own canonical text shows
-    const bool negative = !text.empty() && text[0] == '-';
-    terms.push_back({negative ? text.substr(1) : text, negative});
-  }
-  std::sort(terms.begin(), terms.end());
-  std::string out;
-  for (size_t i = 0; i < terms.size(); ++i)
-    out += (terms[i].second ? (i ? " - " : "-") : (i ? " + " : "")) + terms[i].first;
-  return out;
-}
-
-// GiNaC may keep -(a - b) c as (b - a) c, depending on the process: a sum that is a factor
-// is written with its first term (in text order) positive, the sign moved to the product.
-bool leading_term_negative(const ex& sum) {
-  std::string first;
-  bool negative = false;
-  for (const auto& t : sum) {
-    const std::string text = tex(t);
-    const bool neg = !text.empty() && text[0] == '-';
-    const std::string unsigned_text = neg ? text.substr(1) : text;
-    if (first.empty() || unsigned_text < first) first = unsigned_text, negative = neg;
-  }
-  return negative;
-}
-
-// The sum with every term negated, built term by term (-sum may come back as the product
-// (-1) sum, which would be turned around again without end).
-ex negated_sum(const ex& sum) {
-  exvector terms;
-  for (const auto& t : sum) terms.push_back(-t);
-  return add(terms);
-}
-
-// The text of a factor of a product with any sum in it in its canonical sign; flips *sign
-// when that text is the factor's negative. Text only: a GiNaC power of the negated sum would
-// be evaluated back into the original.
-std::string factor_text(const ex& f, bool* sign) {
-  if (is_a<add>(f)) {
-    const bool negative = leading_term_negative(f);
-    if (negative) *sign = !*sign;
-    return "\\left(" + tex(negative ? negated_sum(f) : f) + "\\right)";
-  }
-  if (is_a<power>(f) && is_a<add>(f.op(0)) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_integer()) {
-    const bool negative = leading_term_negative(f.op(0));
-    if (negative && ex_to<numeric>(f.op(1)).is_odd()) *sign = !*sign;
-    return "\\left(" + tex(negative ? negated_sum(f.op(0)) : f.op(0)) + "\\right)^{" + tex(f.op(1)) + "}";
-  }
-  return tex_operand(f, false);
-}
-
-// A product: its number first, then the factors sorted by their text; factors with
-// negative exponents go below a fraction bar.
-std::string tex_mul(const ex& e) {
-  numeric coefficient = 1;
-  std::vector<std::string> above, below;
-  bool flipped = false;
-  for (const auto& f : e) {
-    if (is_a<numeric>(f)) {
-      coefficient *= ex_to<numeric>(f);
-    } else if (is_a<power>(f) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_negative()) {
-      below.push_back(factor_text(pow(f.op(0), -f.op(1)), &flipped));
-    } else {
-      above.push_back(factor_text(f, &flipped));
-    }
-  }
-  std::sort(above.begin(), above.end());
-  std::sort(below.begin(), below.end());
-  const auto join = [](const std::vector<std::string>& v) {
-    std::string s;
-    for (const auto& x : v) s += (s.empty() ? "" : " ") + x;
-    return s.empty() ? std::string("1") : s;
-  };
-  if (flipped) coefficient = -coefficient;
-  std::string sign = coefficient.is_negative() ? "-" : "";
-  const numeric c = abs(coefficient);
-  const numeric num = c.numer(), den = c.denom();
-  if (num != 1) above.insert(above.begin(), ginac_tex(num));
-  if (den != 1) below.insert(below.begin(), ginac_tex(den));
-  if (below.empty()) return sign + join(above);
-  return sign + "\\frac{" + join(above) + "}{" + join(below) + "}";
-}
-
-std::string tex_power(const ex& e) {
-  const ex base = e.op(0), exponent = e.op(1);
-  if (exponent.is_equal(numeric(1, 2))) return "\\sqrt{" + tex(base) + "}";
-  if (is_a<numeric>(exponent) && ex_to<numeric>(exponent).is_negative())
-    return "\\frac{1}{" + tex(pow(base, -exponent)) + "}";
-  return tex_operand(base, true) + "^{" + tex(exponent) + "}";
-}
-
-std::string tex_uncached(const ex& e);
-
-// LaTeX of an expression, identical for identical expressions whatever order GiNaC keeps
-// their operands in. Memoised: the canonical sign of a sum looks at its terms' text, and
-// shared subexpressions would otherwise be printed over and over.
-std::string tex(const ex& e) {
-  static std::map<ex, std::string, ex_is_less> cache;
-  if (cache.size() > 200000) cache.clear();
-  const auto it = cache.find(e);
-  if (it != cache.end()) return it->second;
-  std::string text = tex_uncached(e);
-  cache.emplace(e, text);
-  return text;
-}
-
-std::string tex_uncached(const ex& e) {
-  if (is_a<add>(e)) return tex_add(e);
-  if (is_a<mul>(e)) return tex_mul(e);
-  if (is_a<power>(e)) return tex_power(e);
-  if (is_a<function>(e)) {
-    std::string args;
-    const bool even = ex_to<function>(e).get_name() == "abs_value" || ex_to<function>(e).get_name() == "abs";
-    for (const auto& a : e) {
-      const bool flip = even && is_a<add>(a) && leading_term_negative(a);  // |-x| = |x|
-      args += (args.empty() ? "" : ", ") + tex(flip ? negated_sum(a) : a);
-    }
-    const std::string name = ex_to<function>(e).get_name();
-    if (even) return "\\left|" + args + "\\right|";
-    if (name == "sign_of") return "\\operatorname{sgn}\\left(" + args + "\\right)";
-    const bool known = name == "sin" || name == "cos" || name == "tan" || name == "exp" || name == "log";
-    return (known ? "\\" + name : "\\operatorname{" + output::latex_text(name) + "}") + "\\left(" + args + "\\right)";
-  }
-  return ginac_tex(e);  // symbols and numbers
-}
-
 // Nodes of an expression tree, counted up to `limit` (then limit + 1).
 size_t tree_size(const ex& e, size_t limit) {
   size_t n = 1;
   for (size_t i = 0; i < e.nops() && n <= limit; ++i) n += tree_size(e.op(i), limit - n);
   return n;
-}
-
-std::string tex_matrix(const matrix& m) {
-  std::ostringstream os;
-  os << "\\begin{pmatrix}";
-  for (unsigned i = 0; i < m.rows(); ++i) {
-    for (unsigned j = 0; j < m.cols(); ++j) os << (j ? " & " : "") << tex(m(i, j));
-    os << (i + 1 < m.rows() ? " \\\\ " : "");
-  }
-  os << "\\end{pmatrix}";
-  return os.str();
 }
 
 std::string num(double v) {
@@ -202,20 +46,20 @@ void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "\n";
 }
 
-void section_mass(std::ostringstream& md, const Derivation& d) {
+void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
   const MassProperties& mp = d.mass;
   md << "## 2. Mass properties by exact integration\n\n"
      << "Each block is a cuboid of constant density $\\rho = m/(abc)$. In its own frame GiNaC "
         "integrates the second moment $S = \\int \\xi\\xi^T\\,dm$ exactly over "
         "$[-a/2,a/2]\\times[-b/2,b/2]\\times[-c/2,c/2]$";
   if (!mp.blocks.empty()) {
-    md << "; for block " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nS = " << tex_matrix(mp.blocks[0].local_second_moment)
+    md << "; for block " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nS = " << tex.matrix(mp.blocks[0].local_second_moment)
        << "\n```\n\n";
   }
   md << "It is rotated and moved into the body frame, $S_b = R S R^T + m\\,c\\,c^T$, and the inertia tensor "
         "about the origin is $J_o = \\operatorname{tr}(S_b) I - S_b$.";
   if (!mp.blocks.empty())
-    md << " For " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nJ_o = " << tex_matrix(mp.blocks[0].inertia_origin) << "\n```\n\n";
+    md << " For " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nJ_o = " << tex.matrix(mp.blocks[0].inertia_origin) << "\n```\n\n";
   md << "Contributions of every block about the body origin [kg m²] and projected areas [m²]:\n\n"
      << "| block | J_xx | J_yy | J_zz | J_xy | J_xz | J_yz | A_x | A_y | A_z |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& b : mp.blocks) {
@@ -225,7 +69,7 @@ void section_mass(std::ostringstream& md, const Derivation& d) {
        << " | " << num(b.areas_value[1]) << " | " << num(b.areas_value[2]) << " |\n";
   }
   const auto& Jc = mp.inertia_cog_value;
-  md << "\nTotals: $m = " << tex(mp.mass) << "$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
+  md << "\nTotals: $m = " << tex.tex(mp.mass) << "$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
      << "$c = \\frac{1}{m}\\sum m_i c_i$ = **(" << num(mp.cog_value[0]) << ", " << num(mp.cog_value[1]) << ", "
      << num(mp.cog_value[2]) << ") m**; exposed areas **(" << num(mp.areas_value[0]) << ", "
      << num(mp.areas_value[1]) << ", " << num(mp.areas_value[2]) << ") m²**.\n\n"
@@ -238,7 +82,7 @@ void section_mass(std::ostringstream& md, const Derivation& d) {
         "with these nominal values, so that a fit may free them.\n\n";
 }
 
-void section_equations(std::ostringstream& md, const Derivation& d) {
+void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
   const SymbolicModel& m = d.model;
   md << "## 3. Kinematics\n\n"
      << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton). Its rotation "
@@ -281,16 +125,16 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
       continue;
     }
     if (!is_a<matrix>(e)) {
-      equation(eq.lhs, tex(e));
+      equation(eq.lhs, tex.tex(e));
       continue;
     }
     const matrix& v = ex_to<matrix>(e);
-    const std::string whole = tex_matrix(v);
+    const std::string whole = tex.matrix(v);
     if (whole.size() <= kMathJaxLimit || v.cols() != 1 || v.rows() != 3) {
       equation(eq.lhs, whole);
       continue;
     }
-    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + eq.lhs + "\\right)_" + "xyz"[i], tex(v(i, 0)));
+    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + eq.lhs + "\\right)_" + "xyz"[i], tex.tex(v(i, 0)));
   }
   if (effect_terms)
     md << "$\\Delta F_{body}$ and $\\Delta \\tau$ are the sums of what the effects add below.\n\n";
@@ -304,7 +148,7 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
       md << "**" << output::markdown_text(f.effect) << "**" << (f.note.empty() ? "" : " (" + output::markdown_text(f.note) + ")")
          << (f.lines.empty() ? "\n\n" : ":\n\n");
       for (const auto& [lhs, value] : f.lines)
-        equation(lhs, is_a<matrix>(value) ? tex_matrix(ex_to<matrix>(value)) : tex(value));
+        equation(lhs, is_a<matrix>(value) ? tex.matrix(ex_to<matrix>(value)) : tex.tex(value));
     }
   }
   md << "## 5. Equations of motion\n\n"
@@ -318,8 +162,8 @@ void section_equations(std::ostringstream& md, const Derivation& d) {
         "the generated code holds them in full):\n\n";
   for (size_t i = 0; i < m.states.size(); ++i) {
     if (tree_size(m.f(i, 0), 400) > 400) continue;  // far beyond a readable row
-    const std::string t = tex(m.f(i, 0));
-    if (t.size() < 600) md << "```math\n\\dot{" << tex(m.states[i].sym) << "} = " << t << "\n```\n\n";
+    const std::string t = tex.tex(m.f(i, 0));
+    if (t.size() < 600) md << "```math\n\\dot{" << tex.tex(m.states[i].sym) << "} = " << t << "\n```\n\n";
   }
   md << "Measured outputs: position and the logged attitude quaternion";
   for (const std::string& e : m.effects)  // what acts on them, as its formula below shows
@@ -378,8 +222,9 @@ std::string derivation_markdown(const Derivation& d) {
         }())
      << ".\n\n";
   section_vehicle(md, d);
-  section_mass(md, d);
-  section_equations(md, d);
+  TexWriter tex(d.model);
+  section_mass(md, d, tex);
+  section_equations(md, d, tex);
   md << "## 6. Variables\n\n";
   variable_table(md, "States x", d.model.states, false);
   variable_table(md, "Inputs u", d.model.inputs, false);

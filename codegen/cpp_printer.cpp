@@ -82,7 +82,7 @@ class Printer {
     const auto& n = plan_.node(id);
     std::string s;
     bool first = true;
-    for (size_t i : LoweredPlan::sum_order(n, outer)) {
+    for (size_t i : plan_.sum_order(id, outer)) {
       const bool plus = n.sign[i] * outer > 0;
       const std::string term = expr(n.args[i], true);
       if (first) s += plus ? term : "-" + term;
@@ -103,7 +103,8 @@ class Printer {
       case Kind::prod: {
         std::string num, den;
         int nn = 0;
-        for (int a : n.args) {
+        for (size_t i : plan_.operand_order(id)) {
+          const int a = n.args[i];
           if (plan_.is_inline_division(fn_, a)) {
             den += "/" + factor(plan_.node(a).args[0]);
             out_.ops_after += 1;

@@ -458,6 +458,30 @@ LoweredPlan::LoweredPlan(ExpressionGraph& g, const std::vector<OutputGroup>& all
     extract_pairs(Kind::sum);
   }
   plan_precompute_slots(all_groups);
+  find_supports();
+}
+
+// The support of every node an output reaches: its variables at their places in reading
+// order. Operands have lower ids than their users, so one pass in id order suffices.
+void LoweredPlan::find_supports() {
+  std::vector<char> reached(ir_.size(), 0);
+  for (const auto& r : roots_) reached[r.id] = 1;
+  for (int id = static_cast<int>(ir_.size()) - 1; id >= 0; --id)
+    if (reached[id])
+      for (int a : ir_[id].args) reached[a] = 1;
+  support_.assign(ir_.size(), {});
+  for (size_t id = 0; id < ir_.size(); ++id) {
+    if (!reached[id]) continue;
+    const Node& n = ir_[id];
+    using term_order::Group;
+    switch (n.leaf) {
+      case Leaf::param: support_[id] = {{Group::parameter, n.index, ""}}; break;
+      case Leaf::input: support_[id] = {{Group::input, n.index, ""}}; break;
+      case Leaf::state: support_[id] = {{Group::state, n.index, ""}}; break;
+      case Leaf::constant: case Leaf::none: break;
+    }
+    for (int a : n.args) support_[id] = term_order::merged(support_[id], support_[a]);
+  }
 }
 
 // Every parameter-only, non-leaf operand of a dynamic node (and every parameter-only
@@ -494,15 +518,25 @@ void LoweredPlan::plan_precompute_slots(const std::vector<OutputGroup>& all_grou
 // ---------------------------------------------------------------------------------------
 // Function plans: which nodes are temporaries, in which order statements come.
 
-std::vector<size_t> LoweredPlan::sum_order(const Node& n, int outer) {
-  std::vector<size_t> order;
-  for (size_t i = 0; i < n.args.size(); ++i)
-    if (n.sign[i] * outer > 0) {
-      order.push_back(i);
-      break;
-    }
-  for (size_t i = 0; i < n.args.size(); ++i)
-    if (order.empty() || i != order[0]) order.push_back(i);
+std::vector<size_t> LoweredPlan::operand_order(int id) const {
+  const Node& n = ir_[id];
+  std::vector<size_t> order(n.args.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) {
+    const auto& a = support_[n.args[i]];
+    const auto& b = support_[n.args[j]];
+    if (term_order::before(a, b)) return true;
+    if (term_order::before(b, a)) return false;
+    return n.args[i] < n.args[j];
+  });
+  return order;
+}
+
+std::vector<size_t> LoweredPlan::sum_order(int id, int outer) const {
+  const Node& n = ir_[id];
+  std::vector<size_t> order = operand_order(id);
+  const auto added = std::find_if(order.begin(), order.end(), [&](size_t i) { return n.sign[i] * outer > 0; });
+  if (added != order.end()) std::rotate(order.begin(), added, added + 1);
   return order;
 }
 

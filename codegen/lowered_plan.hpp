@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "codegen/expression_graph.hpp"
+#include "derive/term_order.hpp"
 
 namespace quadgen::codegen {
 
@@ -93,10 +94,12 @@ class LoweredPlan {
   Function function(const std::vector<OutputGroup>& groups) const;
 
   // Rules both back ends follow to the letter, so that they compute the same operations:
-  // a sum is written starting with its first term that is added (sign * outer > 0), then
-  // the others in order; a reciprocal used once by a product, and not a temporary, is a
-  // division in that product.
-  static std::vector<size_t> sum_order(const Node& n, int outer);
+  // the operands of a sum or product are written in the shared reading order
+  // (derive/term_order.hpp: by the variables they depend on, then by node id); a sum starts
+  // with its first term that is added (sign * outer > 0), then the others in that order; a
+  // reciprocal used once by a product, and not a temporary, is a division in that product.
+  std::vector<size_t> operand_order(int id) const;
+  std::vector<size_t> sum_order(int id, int outer) const;
   bool is_inline_division(const Function& fn, int id) const;
 
   const Node& node(int id) const { return ir_[id]; }
@@ -128,6 +131,7 @@ class LoweredPlan {
               std::vector<int>& memo);
   std::vector<int> reachable(Kind kind) const;
   void plan_precompute_slots(const std::vector<OutputGroup>& all_groups);
+  void find_supports();
   bool inside(const Function& fn, int id) const;
   void count_use(Function& fn, int id, std::vector<char>& seen) const;
   void define_temporaries(Function& fn, int id, std::vector<char>& done) const;
@@ -140,6 +144,7 @@ class LoweredPlan {
   std::vector<Signed> roots_;                // every output, in order
   std::vector<int> pre_slot_;                // emission node -> precompute slot, or -1
   std::vector<int> pre_order_;
+  std::vector<term_order::Support> support_;  // emission node -> what it depends on (reachable nodes)
 };
 
 }  // namespace quadgen::codegen

@@ -89,7 +89,7 @@ class FunctionLowering {
   int sum(int id, int outer) {
     const auto& n = plan_.node(id);
     int acc = -1;
-    for (size_t i : LoweredPlan::sum_order(n, outer)) {
+    for (size_t i : plan_.sum_order(id, outer)) {
       const bool plus = n.sign[i] * outer > 0;
       const int term = value(n.args[i]);
       if (acc < 0) acc = plus ? term : emit(TapeOp::neg, term);
@@ -105,7 +105,8 @@ class FunctionLowering {
       case Kind::prod: {  // the factors multiplied left to right, then the divisions
         int acc = -1;
         std::vector<int> divisors;
-        for (int a : n.args) {
+        for (size_t i : plan_.operand_order(id)) {
+          const int a = n.args[i];
           if (plan_.is_inline_division(fn_, a)) {
             divisors.push_back(value(plan_.node(a).args[0]));
           } else {

@@ -6,6 +6,7 @@
 #include "cli/options.hpp"
 
 #include <algorithm>
+#include <map>
 #include <set>
 
 #include <Eigen/Dense>
@@ -13,6 +14,8 @@
 #include "audit/audit.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "audit/report.hpp"
+#include "audit/tex_writer.hpp"
+#include "codegen/cpp_printer.hpp"
 #include "tests/test_helpers.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/units.hpp"
@@ -650,6 +653,79 @@ void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
 // derivation.md writes each quantity with the ones before it as symbols (#16: body velocity,
 // thrust and moment per rotor as their own equations). Composed back, the chain must give the
 // expanded forces and torque that the equations of motion and the generated code use.
+namespace {
+
+// The model's variable names as they appear, left to right, in generated C++ (p[i], u[i],
+// x[i]) or in the report's TeX (each symbol's TeX name is its name here); a power written
+// as repeated factors (u*u) or as u^{2} counts once.
+std::vector<std::string> names_in_order(const std::string& text, const SymbolicModel& m, bool cpp) {
+  std::vector<std::string> all;
+  for (const auto* vs : {&m.params, &m.inputs, &m.states})
+    for (const auto& v : *vs) all.push_back(v.name);
+  const std::regex token(cpp ? R"(([pux])\[(\d+)\])" : R"([a-zA-Z]+)");
+  std::vector<std::string> out;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), token); it != std::sregex_iterator(); ++it) {
+    std::string name = (*it)[0];
+    if (cpp) {
+      const auto& vs = (*it)[1] == "p" ? m.params : (*it)[1] == "u" ? m.inputs : m.states;
+      name = vs[std::stoul((*it)[2])].name;
+    }
+    if (std::find(all.begin(), all.end(), name) == all.end()) continue;  // \left, Scalar, ...
+    if (out.empty() || out.back() != name) out.push_back(name);
+  }
+  return out;
+}
+
+// The generated right-hand side of output 0, with each precomputed value written inline.
+std::string generated_rhs(const SymbolicModel& m, const ex& e) {
+  codegen::ExpressionGraph g;
+  codegen::declare_model_variables(g, m);
+  const std::vector<codegen::OutputGroup> groups{{"", {{"f[0]", g.add(e)}}}};
+  const codegen::LoweredPlan plan(g, groups);
+  std::string body = codegen::print_cpp(plan, plan.function(groups)).body;
+  const std::string pre = codegen::print_cpp(plan, plan.precompute_function()).body;
+  const std::regex slot(R"(pre->c\[(\d+)\] = (.*);)");
+  for (auto it = std::sregex_iterator(pre.begin(), pre.end(), slot); it != std::sregex_iterator(); ++it) {
+    const std::string use = "pre.c[" + std::string((*it)[1]) + "]";
+    for (size_t at; (at = body.find(use)) != std::string::npos;) body.replace(at, use.size(), "(" + std::string((*it)[2]) + ")");
+  }
+  return body;
+}
+
+}  // namespace
+
+// One order for the report and the generated code (derive/term_order.hpp): parameters before
+// inputs before states, each in declaration order, a coefficient before what it multiplies,
+// a polynomial by rising powers. The variables are declared in an order unlike their names'
+// and unlike their creation, so neither alphabetical nor GiNaC's own order would pass.
+TEST(Report, SumsAndProductsReadInTheOrderOfTheGeneratedCode) {
+  std::map<std::string, Variable> made;  // symbols created in alphabetical order
+  for (const char* name : {"a", "b", "c", "k", "thr", "vx", "vy"}) {
+    made[name].name = name;
+    made[name].sym = symbol(name, name);
+  }
+  SymbolicModel m;
+  for (const char* n : {"k", "c", "b", "a"}) m.params.push_back(made[n]);
+  m.inputs.push_back(made["thr"]);
+  for (const char* n : {"vy", "vx"}) m.states.push_back(made[n]);
+  const auto s = [&](const char* name) { return ex(made.at(name).sym); };
+  // Expressions the code generator writes as they are (no factor shared by two terms, no
+  // pair shared by two products, which it would take out).
+  const std::vector<std::pair<ex, std::vector<std::string>>> cases = {
+      {s("vx") * s("a") * s("thr"), {"a", "thr", "vx"}},
+      {s("a") * s("vx") + s("c") + s("b") * s("thr"), {"c", "b", "thr", "a", "vx"}},
+      {s("vx") * (s("a") + s("vy")) * s("k") * (s("b") * s("thr") + s("c")), {"k", "c", "b", "thr", "a", "vy", "vx"}},
+      {s("vx") * s("thr") - s("a") * s("vy"), {"thr", "vx", "a", "vy"}},  // the first added term first
+  };
+  for (const auto& [e, expected] : cases) {
+    const std::string cpp = generated_rhs(m, e);
+    TexWriter tex(m);
+    const std::string report = tex.tex(e);
+    EXPECT_EQ(names_in_order(cpp, m, true), expected) << cpp;
+    EXPECT_EQ(names_in_order(report, m, false), expected) << report;
+  }
+}
+
 TEST(Report, NamedEquationsComposeToTheModelsForcesAndTorque) {
   const Vehicle v = test::finken3();
   expect_named_chain_composes(derive(v), true);
