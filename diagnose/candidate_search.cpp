@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <exception>
 #include <iostream>
 #include <limits>
 #include <mutex>
@@ -295,27 +294,11 @@ void CandidateSearch::on_every_core(size_t count, Work work) const {
     clones.push_back(std::move(valid));
   }
   std::atomic<size_t> next{0};
-  std::mutex failing;
-  std::exception_ptr failure;
-  auto run = [&](const Workspace& ws) {
+  fit::run_workers(workers.size(), [&](size_t w, const std::atomic<bool>& stopped) {
     // One fit per core: each fit's evaluations stay on their thread (one fit alone splits).
     const fit::OneCorePerFit one_core(workers.size() > 1);
-    for (size_t i; (i = next++) < count;) {
-      try {
-        work(i, ws);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(failing);
-        if (!failure) failure = std::current_exception();
-        next = count;
-        return;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (size_t w = 1; w < workers.size(); ++w) pool.emplace_back(run, std::cref(workers[w]));
-  run(workers[0]);
-  for (auto& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
+    for (size_t i; !stopped && (i = next++) < count;) work(i, workers[w]);
+  });
 }
 
 std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<std::string>& todo,

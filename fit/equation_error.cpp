@@ -5,9 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <map>
-#include <thread>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -292,27 +290,10 @@ void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p,
     if (h.params != params) h.model->set_params(params), h.params = params;
     if (columns && h.columns != *columns) h.model->restrict_param_jacobian(*columns), h.columns = *columns;
   }
-  std::vector<std::exception_ptr> failures(n);
   const auto bound = [&](size_t i) { return lo + (hi - lo) * i / n; };
-  const auto run = [&](size_t i, const runtime::DynamicModel& m) {
-    try {
-      part(m, bound(i), bound(i + 1));
-    } catch (...) {
-      failures[i] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> threads;
-  for (size_t i = 1; i < n; ++i) {
-    try {
-      threads.emplace_back(run, i, std::cref(*helpers[i - 1].model));
-    } catch (...) {  // no thread to be had: this part runs here
-      run(i, *helpers[i - 1].model);
-    }
-  }
-  run(0, *model_);
-  for (auto& t : threads) t.join();
-  for (const auto& f : failures)
-    if (f) std::rethrow_exception(f);
+  run_workers(n, [&](size_t i, const std::atomic<bool>&) {
+    part(i == 0 ? *model_ : *helpers[i - 1].model, bound(i), bound(i + 1));
+  });
 }
 
 // Model accelerations (rows 3..5 and 10..12 of f, and of df/dp) at the middle of every
@@ -369,88 +350,103 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
 
 void EquationErrorModel::residuals(const double* p, double* r, double* J, SampleSpan span,
                                    const std::vector<int>& columns) const {
-  const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
+  const int n = model_->num_states(), np = model_->num_params();
   model_->set_params(std::vector<double>(p, p + np));
   std::vector<double> X, U;
   prepare(p, X, U, span);
-  const bool filtered = derivatives_ == Derivatives::kFiltered;
   std::vector<double> F, Bm;
-  if (filtered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
-  const bool pointwise_needed = !filtered || accel_;
-  const size_t nc = columns.size();
-  const auto rows = rows_in(span);
-  const size_t row_lo = rows.first, row_hi = rows.second;
+  if (derivatives_ == Derivatives::kFiltered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
+  const Evaluation e{p, X, U, F, Bm, columns, J != nullptr};
+  const auto [row_lo, row_hi] = rows_in(span);
   // Rows from_row .. to_row - 1; each writes its own rows of r and J only.
   const auto part = [&](const runtime::DynamicModel& model, size_t from_row, size_t to_row) {
-    std::vector<double> f(n, 0.0), B(J ? n * np : 0, 0.0);
-    // Model accelerations seen by the measurement at this row: the six rows of f (and of B,
-    // packed to the columns asked for).
-    std::vector<double> a6(6), Ba6(J ? 6 * nc : 0);
+    RowScratch s;
+    s.f.assign(n, 0.0);
+    s.B.assign(J ? n * np : 0, 0.0);
+    s.a6.assign(6, 0.0);
+    s.Ba6.assign(J ? 6 * columns.size() : 0, 0.0);
     for (size_t row = from_row; row < to_row; ++row) {
-      const size_t k = rows_[row];
-      const FlightSample& s = flight_.samples[k];
-      const double* xk = &X[k * n];
-      if (pointwise_needed) model.rhs(xk, &U[k * nu], f.data(), nullptr, J ? B.data() : nullptr, nullptr);
-      double meas[6];
-      if (filtered) {
-        std::fill(a6.begin(), a6.end(), 0.0);
-        if (J) std::fill(Ba6.begin(), Ba6.end(), 0.0);
-        const auto& W = interval_weights_[row];
-        const size_t lo = window_start_[row];
-        for (size_t j = 0; j < W.size(); ++j)
-          for (int c = 0; c < 6; ++c) {
-            a6[c] += W[j] * F[(lo + j) * 6 + c];
-            if (!J) continue;
-            const double* from = &Bm[((lo + j) * 6 + c) * nc];
-            double* to = &Ba6[c * nc];
-            for (size_t qi = 0; qi < nc; ++qi) to[qi] += W[j] * from[qi];
-          }
-        for (int c = 0; c < 6; ++c) meas[c] = measured_[row][c];
-      } else {
-        for (int c = 0; c < 3; ++c) {
-          a6[c] = f[3 + c];
-          a6[3 + c] = f[10 + c];
-          meas[c] = s.acc_world[c];
-          meas[3 + c] = s.rate_dot[c];
-          if (J)
-            for (size_t qi = 0; qi < nc; ++qi)
-              Ba6[c * nc + qi] = B[(3 + c) * np + columns[qi]], Ba6[(3 + c) * nc + qi] = B[(10 + c) * np + columns[qi]];
-        }
-      }
-      double* rk = r + 6 * (row - row_lo);
-      // Body -> world rotation of the (true) attitude.
-      const runtime::Rotation rotation = runtime::rotation_matrix(xk + 6);
-      const auto& R = rotation.m;
-      const double g = p[g_index_];
-      for (int i = 0; i < 3; ++i) {
-        if (accel_) {  // specific force in body axes at the sample: R^T (a + g e_z)
-          double sf = 0;
-          for (int j = 0; j < 3; ++j) sf += R[j][i] * (f[3 + j] + (j == 2 ? g : 0.0));
-          rk[i] = sf - s.specific_force[i];
-        } else {
-          rk[i] = a6[i] - meas[i];
-        }
-        rk[3 + i] = a6[3 + i] - meas[3 + i];
-      }
-      if (!J) continue;
-      double* Jk = J + static_cast<size_t>(6 * (row - row_lo)) * np;
-      for (size_t qi = 0; qi < nc; ++qi) {
-        const int c = columns[qi];
-        for (int i = 0; i < 3; ++i) {
-          double d;
-          if (accel_) {
-            d = 0;
-            for (int j = 0; j < 3; ++j) d += R[j][i] * (B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
-          } else {
-            d = Ba6[i * nc + qi];
-          }
-          Jk[i * np + c] = d;
-          Jk[(3 + i) * np + c] = Ba6[(3 + i) * nc + qi];
-        }
-      }
+      row_accelerations(model, e, row, s);
+      row_residuals(e, row, s, r + 6 * (row - row_lo), J ? J + 6 * (row - row_lo) * np : nullptr);
     }
   };
   split_over_cores(row_lo, row_hi, p, J ? &columns : nullptr, part);
+}
+
+// The model's six accelerations seen by the measurement at this row (and their df/dp
+// columns): the filtered derivatives' window sums of the interval accelerations, or the rows
+// of f at the sample itself; the measured ones beside them.
+void EquationErrorModel::row_accelerations(const runtime::DynamicModel& model, const Evaluation& e, size_t row,
+                                           RowScratch& s) const {
+  const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
+  const size_t k = rows_[row], nc = e.columns.size();
+  const bool filtered = derivatives_ == Derivatives::kFiltered;
+  if (!filtered || accel_)  // the specific force needs f at the sample itself
+    model.rhs(&e.X[k * n], &e.U[k * nu], s.f.data(), nullptr, e.jacobian ? s.B.data() : nullptr, nullptr);
+  if (filtered) {
+    std::fill(s.a6.begin(), s.a6.end(), 0.0);
+    std::fill(s.Ba6.begin(), s.Ba6.end(), 0.0);
+    const auto& W = interval_weights_[row];
+    const size_t lo = window_start_[row];
+    for (size_t j = 0; j < W.size(); ++j)
+      for (int c = 0; c < 6; ++c) {
+        s.a6[c] += W[j] * e.F[(lo + j) * 6 + c];
+        if (!e.jacobian) continue;
+        const double* from = &e.Bm[((lo + j) * 6 + c) * nc];
+        double* to = &s.Ba6[c * nc];
+        for (size_t qi = 0; qi < nc; ++qi) to[qi] += W[j] * from[qi];
+      }
+    for (int c = 0; c < 6; ++c) s.measured[c] = measured_[row][c];
+    return;
+  }
+  const FlightSample& sample = flight_.samples[k];
+  for (int c = 0; c < 3; ++c) {
+    s.a6[c] = s.f[3 + c];
+    s.a6[3 + c] = s.f[10 + c];
+    s.measured[c] = sample.acc_world[c];
+    s.measured[3 + c] = sample.rate_dot[c];
+    if (!e.jacobian) continue;
+    for (size_t qi = 0; qi < nc; ++qi) {
+      s.Ba6[c * nc + qi] = s.B[(3 + c) * np + e.columns[qi]];
+      s.Ba6[(3 + c) * nc + qi] = s.B[(10 + c) * np + e.columns[qi]];
+    }
+  }
+}
+
+// The row's six residuals at rk (model minus measurement) and, when Jk is given, their
+// derivatives in the columns asked for. With an accelerometer the translation residual is
+// the specific force in body axes at the sample, R^T (a + g e_z), against the measured one.
+void EquationErrorModel::row_residuals(const Evaluation& e, size_t row, const RowScratch& s, double* rk,
+                                       double* Jk) const {
+  const int n = model_->num_states(), np = model_->num_params();
+  const size_t k = rows_[row];
+  const runtime::Rotation rotation = runtime::rotation_matrix(&e.X[k * n] + 6);  // body -> world, true attitude
+  const auto& R = rotation.m;
+  const double g = e.p[g_index_];
+  for (int i = 0; i < 3; ++i) {
+    if (accel_) {
+      double sf = 0;
+      for (int j = 0; j < 3; ++j) sf += R[j][i] * (s.f[3 + j] + (j == 2 ? g : 0.0));
+      rk[i] = sf - flight_.samples[k].specific_force[i];
+    } else {
+      rk[i] = s.a6[i] - s.measured[i];
+    }
+    rk[3 + i] = s.a6[3 + i] - s.measured[3 + i];
+  }
+  if (!Jk) return;
+  const size_t nc = e.columns.size();
+  for (size_t qi = 0; qi < nc; ++qi) {
+    const int c = e.columns[qi];
+    for (int i = 0; i < 3; ++i) {
+      double d = s.Ba6[i * nc + qi];
+      if (accel_) {
+        d = 0;
+        for (int j = 0; j < 3; ++j) d += R[j][i] * (s.B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
+      }
+      Jk[i * np + c] = d;
+      Jk[(3 + i) * np + c] = s.Ba6[(3 + i) * nc + qi];
+    }
+  }
 }
 
 }  // namespace quadgen::fit

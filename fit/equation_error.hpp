@@ -139,6 +139,24 @@ class EquationErrorModel : public ResidualModel {
   void interval_accelerations(const double* p, const std::vector<double>& X, const std::vector<double>& U,
                               std::vector<double>& F, std::vector<double>* Bm, SampleSpan span,
                               const std::vector<int>& columns) const;
+  // What the rows of one residuals() call share (read only) and what each part of it keeps
+  // per row (its own scratch).
+  struct Evaluation {
+    const double* p;
+    const std::vector<double>& X;  // prepare()
+    const std::vector<double>& U;
+    const std::vector<double>& F;   // interval accelerations (filtered derivatives)
+    const std::vector<double>& Bm;  // and their df/dp columns
+    const std::vector<int>& columns;
+    bool jacobian;
+  };
+  struct RowScratch {
+    std::vector<double> f, B;  // the model's f and df/dp at the row's sample
+    std::vector<double> a6, Ba6;  // the six accelerations the row compares (B packed to `columns`)
+    double measured[6];
+  };
+  void row_accelerations(const runtime::DynamicModel& model, const Evaluation& e, size_t row, RowScratch& s) const;
+  void row_residuals(const Evaluation& e, size_t row, const RowScratch& s, double* rk, double* Jk) const;
 };
 
 

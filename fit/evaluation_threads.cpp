@@ -1,7 +1,10 @@
 #include "fit/evaluation_threads.hpp"
 
 #include <algorithm>
+#include <exception>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 namespace quadgen::fit {
 
@@ -21,6 +24,34 @@ size_t evaluation_parts(size_t items) {
   if (parts_in_scope > 0) return std::min(parts_in_scope, std::max<size_t>(1, items));
   const size_t cores = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 8);
   return std::max<size_t>(1, std::min(cores, items / kMinItemsPerPart));
+}
+
+void run_workers(size_t workers, const std::function<void(size_t, const std::atomic<bool>&)>& body) {
+  std::atomic<bool> stopped{false};
+  std::mutex failing;
+  std::exception_ptr failure;
+  const auto run = [&](size_t w) {
+    try {
+      body(w, stopped);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failing);
+      if (!failure) failure = std::current_exception();
+      stopped = true;
+    }
+  };
+  std::vector<std::thread> threads;
+  std::vector<size_t> here;  // workers without a thread of their own
+  for (size_t w = 1; w < workers; ++w) {
+    try {
+      threads.emplace_back(run, w);
+    } catch (...) {
+      here.push_back(w);
+    }
+  }
+  run(0);
+  for (size_t w : here) run(w);
+  for (auto& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace quadgen::fit

@@ -196,38 +196,26 @@ std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& be
   std::vector<int> sides_done(params.size(), 0);
   std::vector<std::chrono::steady_clock::time_point> started(params.size());
   std::atomic<size_t> next_job{0};
-  std::mutex mutex;  // guards sides_done, started, first_error and the progress callback
-  std::exception_ptr first_error;
+  std::mutex mutex;  // guards sides_done, started and the progress callback
   int profiles_done = 0;
-  const auto worker = [&](const ResidualModel& m) {
+  run_workers(threads, [&](size_t w, const std::atomic<bool>& stopped) {
+    const ResidualModel& m = w == 0 ? model : *copies[w - 1];
     // One profile side per core: its evaluations stay on its thread (a lone one splits).
     const OneCorePerFit one_core(threads > 1);
-    for (size_t j; (j = next_job++) < jobs;) {
+    for (size_t j; !stopped && (j = next_job++) < jobs;) {
       const size_t i = j / 2;
-      {
+      if (j % 2 == 0) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (first_error) return;
-        if (j % 2 == 0) started[i] = std::chrono::steady_clock::now();
+        started[i] = std::chrono::steady_clock::now();
       }
-      try {
-        sides[j] = walk(m, best, params[i], j % 2 == 0 ? -1.0 : 1.0, fo, po, stop);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!first_error) first_error = std::current_exception();
-        return;
-      }
+      sides[j] = walk(m, best, params[i], j % 2 == 0 ? -1.0 : 1.0, fo, po, stop);
       std::lock_guard<std::mutex> lock(mutex);
       if (++sides_done[i] == 2 && po.progress) {
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[i]).count();
         po.progress(best.parameters[params[i]].name, ++profiles_done, static_cast<int>(params.size()), s);
       }
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker, std::cref(*copies[t - 1]));
-  worker(model);
-  for (auto& t : pool) t.join();
-  if (first_error) std::rethrow_exception(first_error);
+  });
   std::vector<Profile> out;
   for (size_t i = 0; i < params.size(); ++i) out.push_back(assemble(best, params[i], po, sides[2 * i], sides[2 * i + 1]));
   return out;

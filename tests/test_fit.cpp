@@ -666,6 +666,26 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
 // from the same prepared states. A joined two-flight log on a per-flight model with the
 // data-side effects at work, both quadratures, all columns and a free subset, and a part
 // boundary inside each flight (3 parts over 400 samples), after an evaluation elsewhere.
+// The one thread helper of the split evaluation, the candidate pool and the profiles: every
+// worker runs once, a failure reaches the caller after all threads are joined, and the other
+// workers see `stopped` and stop taking jobs from their queue.
+TEST(Threads, EveryWorkerRunsOnceAndTheFirstFailureReachesTheCaller) {
+  std::vector<std::atomic<int>> runs(5);
+  fit::run_workers(5, [&](size_t w, const std::atomic<bool>&) { ++runs[w]; });
+  for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
+
+  std::atomic<size_t> next{0}, taken{0};
+  const size_t jobs = 100000;
+  EXPECT_THROW(fit::run_workers(3, [&](size_t w, const std::atomic<bool>& stopped) {
+                 for (size_t j; !stopped && (j = next++) < jobs;) {
+                   ++taken;
+                   if (w == 1 || j == 10) throw std::runtime_error("job " + std::to_string(j));
+                 }
+               }),
+               std::runtime_error);
+  EXPECT_LT(taken.load(), jobs);  // the queue was left when one failed
+}
+
 TEST(Fit, ASplitEvaluationEqualsOneThread) {
   runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
   std::mt19937 rng(17);
