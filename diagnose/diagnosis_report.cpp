@@ -884,7 +884,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     const size_t at = svg.find("<svg");
     const std::string stem = name.substr(0, name.rfind('.'));
     h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name);
-    if (stem != "profiles") h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
+    h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
     h << "</figcaption></figure>\n";
   }
   h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
