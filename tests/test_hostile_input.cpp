@@ -3,6 +3,9 @@
 // code, a one-line reason naming the file or option, that no output was created or changed,
 // and that no input was changed.
 #include <gtest/gtest.h>
+
+#include <regex>
+#include <sstream>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -127,6 +130,30 @@ TEST(Cli, VersionPrintsTheProjectVersion) {
   while (std::fgets(buf, sizeof buf, p)) out += buf;
   EXPECT_EQ(::pclose(p), 0);
   EXPECT_EQ(out, std::string("quadgen ") + QUADGEN_VERSION + "\n");
+}
+
+// Every number a subcommand takes shows its default in --help ("--window FLOAT:...=0.5"),
+// and the effect names are listed where --effects is offered.
+TEST(Cli, HelpShowsTheDefaultOfEveryNumberAndTheEffectNames) {
+  for (const char* command : {"derive", "simulate", "fit", "diagnose", "predict"}) {
+    FILE* p = ::popen((std::string(QUADGEN_BINARY) + " " + command + " --help 2>&1").c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string out;
+    char buf[1024];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    EXPECT_EQ(::pclose(p), 0) << command;
+    std::istringstream lines(out);
+    int numbers = 0;
+    for (std::string line; std::getline(lines, line);) {
+      static const std::regex number_option(R"(^\s+(--[a-z-]+) (FLOAT|INT|UINT)\b)");
+      std::smatch m;
+      if (!std::regex_search(line, m, number_option) || line.find("REQUIRED") != std::string::npos) continue;
+      ++numbers;
+      EXPECT_NE(line.find('='), std::string::npos) << command << " " << m[1] << ": no default in '" << line << "'";
+    }
+    if (std::string(command) != "derive") EXPECT_GT(numbers, 0) << command;  // derive takes no number
+    if (out.find("--effects") != std::string::npos) EXPECT_NE(out.find("blade_flapping"), std::string::npos) << command;
+  }
 }
 
 // The error line: "quadgen: error: ..." as the last line, alone.
