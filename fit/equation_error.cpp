@@ -357,7 +357,8 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
   std::vector<double> F, Bm;
   if (derivatives_ == Derivatives::kFiltered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
   const Evaluation e{p, X, U, F, Bm, columns, J != nullptr};
-  const auto [row_lo, row_hi] = rows_in(span);
+  const auto rows = rows_in(span);  // not a structured binding: C++17 lambdas cannot capture one
+  const size_t row_lo = rows.first, row_hi = rows.second;
   // Rows from_row .. to_row - 1; each writes its own rows of r and J only.
   const auto part = [&](const runtime::DynamicModel& model, size_t from_row, size_t to_row) {
     RowScratch s;

@@ -16,7 +16,9 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
 targets=(vehicle flight_log template mapping ulog usd)
 # Only the fuzz targets and what they link: the diagnosis, prediction and app libraries are
 # not fuzzed, and building them instrumented took about 3 of the stage's minutes.
-cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" > /dev/null
+if ! cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" > build-fuzz/build.log 2>&1; then
+  echo "fuzz build FAILED (build-fuzz/build.log):"; grep -E -A5 "error|FAILED" build-fuzz/build.log | head -60; exit 1
+fi
 mkdir -p fuzz/crashes
 status=0
 for t in "${targets[@]}"; do
