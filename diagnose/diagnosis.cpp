@@ -62,13 +62,17 @@ double rotation_scale(const Vehicle& v, const SymbolicModel& all) {
   return J > 0 ? nominal("mass") * nominal("g") * arm / J : 0.0;
 }
 
-// The validation part cut into `k` consecutive blocks of equal duration.
+// The validation part cut into `k` consecutive blocks of equal duration. Joined flights hold
+// their validation parts apart in time (each flight's training part lies between): a block
+// that holds no window to simulate is dropped.
 std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
   std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
   for (auto& f : folds) f.samples.clear();
   const double t0 = valid.samples.front().t, span = valid.samples.back().t - t0 + 1e-9;
   for (const auto& s : valid.samples)
     folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>((s.t - t0) / span * k))].samples.push_back(s);
+  folds.erase(std::remove_if(folds.begin(), folds.end(), [](const fit::Flight& f) { return f.samples.size() < 2; }),
+              folds.end());
   return folds;
 }
 

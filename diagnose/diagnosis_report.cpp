@@ -739,7 +739,17 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
        ".headline{font-size:1.1em}</style></head><body>\n";
-  h << "<h1>Diagnosis of " << esc(log_path) << " (" << esc(d.vehicle) << ")</h1>\n";
+  // Several flights: their count in the title (their paths, a wall of text there, numbered
+  // below it: the per-flight values refer to these numbers).
+  const std::string subject = d.flights.size() > 1    ? std::to_string(d.flights.size()) + " flights"
+                              : d.flights.size() == 1 ? d.flights[0]  // the others left out, said below
+                                                      : log_path;
+  h << "<h1>Diagnosis of " << esc(subject) << " (" << esc(d.vehicle) << ")</h1>\n";
+  if (d.flights.size() > 1) {
+    h << "<ol>\n";
+    for (const auto& f : d.flights) h << "<li>" << esc(f) << "</li>\n";
+    h << "</ol>\n";
+  }
   h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples;
   if (d.flights.size() > 1)
     h << " validation samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
@@ -768,9 +778,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "<p>One value per flight for ";
     for (size_t i = 0; i < d.per_flight_effects.size(); ++i) h << (i ? ", " : "") << esc(d.per_flight_effects[i]);
     h << " (a property of the flight, not of the airframe): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
-         "<i>k</i>'s. Flights:</p>\n<ol>\n";
-    for (const auto& f : d.flights) h << "<li>" << esc(f) << "</li>\n";
-    h << "</ol>\n";
+         "<i>k</i>'s (flights numbered as under the title).</p>\n";
   }
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "

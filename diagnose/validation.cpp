@@ -22,6 +22,7 @@ size_t held_index(const fit::Flight& f, double t) {
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window) {
+  if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
   const runtime::DataSideParams data_side(model);

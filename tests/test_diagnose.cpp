@@ -27,6 +27,9 @@
 #include "app/diagnose_job.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "diagnose/flight_screening.hpp"
+#include "diagnose/validation.hpp"
+#include "generated/finken3/model.hpp"
+#include "runtime/dynamic_model.hpp"
 #include "tests/estimate_shape.hpp"
 
 namespace {
@@ -751,4 +754,16 @@ TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
   EXPECT_NE(html.find("[0.03, open]"), std::string::npos);
   EXPECT_EQ(html.find("nan"), std::string::npos);
+}
+
+// Joined flights hold their held-out parts apart in time, so a block of equal duration may
+// hold no sample; simulating such a flight gives no windows (it read the first sample of an
+// empty flight, and a two-flight diagnosis crashed).
+TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
+  quadgen::runtime::CompiledModel<quadgen_generated::finken3::Model> model;
+  const std::vector<double> p = model.params();
+  const quadgen::fit::Flight empty;
+  const auto w = quadgen::diagnose::simulate_windows(model, p, empty, 1.0);
+  EXPECT_TRUE(w.t.empty());
+  EXPECT_EQ(w.position_rmse, 0.0);
 }
