@@ -69,18 +69,23 @@ std::string TexWriter::operand(const ex& e, bool as_base) {
   return wrap ? "\\left(" + tex(e) + "\\right)" : tex(e);
 }
 
-// Terms in the shared order, starting with the first one that is added (as the generated
-// code writes a sum), a sign in front of each.
-std::string TexWriter::sum(const ex& e) {
+// A sum's terms in the shared order, each as its text without sign and its sign.
+std::vector<TexWriter::Written> TexWriter::sorted_terms(const ex& sum) {
   std::vector<Written> terms;
-  for (const auto& t : e) {
+  for (const auto& t : sum) {
     const std::string text = tex(t);  // a term's sign is what its own canonical text shows
     const bool negative = !text.empty() && text[0] == '-';
     terms.push_back({places_.support(t), negative ? text.substr(1) : text, negative});
   }
   sort(terms);
-  const auto added = std::find_if(terms.begin(), terms.end(), [](const Written& w) { return !w.negative; });
-  if (added != terms.end()) std::rotate(terms.begin(), added, added + 1);
+  return terms;
+}
+
+// Terms in the shared order, starting with the first one that is added (as the generated
+// code writes a sum), a sign in front of each.
+std::string TexWriter::sum(const ex& e) {
+  std::vector<Written> terms = sorted_terms(e);
+  term_order::first_added_first(terms.begin(), terms.end(), [](const Written& w) { return !w.negative; });
   std::string out;
   for (size_t i = 0; i < terms.size(); ++i)
     out += (terms[i].negative ? (i ? " - " : "-") : (i ? " + " : "")) + terms[i].text;
@@ -90,13 +95,7 @@ std::string TexWriter::sum(const ex& e) {
 // GiNaC may keep -(a - b) c as (b - a) c, depending on the process: a sum that is a factor
 // is written with its first term (in the shared order) positive, the sign moved to the product.
 bool TexWriter::leading_term_negative(const ex& sum) {
-  std::vector<Written> terms;
-  for (const auto& t : sum) {
-    const std::string text = tex(t);
-    const bool negative = !text.empty() && text[0] == '-';
-    terms.push_back({places_.support(t), negative ? text.substr(1) : text, negative});
-  }
-  sort(terms);
+  const std::vector<Written> terms = sorted_terms(sum);
   return !terms.empty() && terms.front().negative;
 }
 

@@ -35,6 +35,7 @@ class TexWriter {
     bool negative = false;
   };
   static void sort(std::vector<Written>& v);
+  std::vector<Written> sorted_terms(const GiNaC::ex& sum);
 
   term_order::SymbolPlaces places_;
   std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> cache_;

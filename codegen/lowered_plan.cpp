@@ -535,8 +535,7 @@ std::vector<size_t> LoweredPlan::operand_order(int id) const {
 std::vector<size_t> LoweredPlan::sum_order(int id, int outer) const {
   const Node& n = ir_[id];
   std::vector<size_t> order = operand_order(id);
-  const auto added = std::find_if(order.begin(), order.end(), [&](size_t i) { return n.sign[i] * outer > 0; });
-  if (added != order.end()) std::rotate(order.begin(), added, added + 1);
+  term_order::first_added_first(order.begin(), order.end(), [&](size_t i) { return n.sign[i] * outer > 0; });
   return order;
 }
 

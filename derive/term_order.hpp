@@ -16,6 +16,7 @@
 // products are also grouped for speed (common factors, shared pairs), so the order holds
 // within each sum and product as emitted.
 #pragma once
+#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -42,6 +43,15 @@ using Support = std::vector<Place>;  // sorted, without repeats
 Support merged(const Support& a, const Support& b);
 // True when an operand with support a is written before one with support b.
 bool before(const Support& a, const Support& b);
+
+// A sum is written from its first added term (no leading minus where the sum has a plus),
+// the others after it in the order above: moves the first element of [begin, end) for which
+// added(element) holds to the front, keeping the order of the rest.
+template <class It, class Added>
+void first_added_first(It begin, It end, Added added) {
+  const It first = std::find_if(begin, end, added);
+  if (first != end) std::rotate(begin, first, first + 1);
+}
 
 // The supports of a symbolic model's expressions (memoised per subexpression).
 class SymbolPlaces {
