@@ -48,6 +48,26 @@ struct Finding {
   // Held-out gain per validation fold (before - after), its mean and standard error.
   std::vector<double> fold_gains;
   double gain_mean = 0, gain_standard_error = 0;
+  // The same folds judged one step at a time: the held-out equation-error cost (weighted,
+  // the fit's own measure), its reduction per fold in per cent. Open-loop rollouts of an
+  // unstable vehicle are dominated by the attitude drift no catalogue effect removes, so an
+  // effect that sharpens every one-step prediction (a motor lag) can leave them unchanged;
+  // empty without a pose (then `fold_gains` already are equation-error costs).
+  // A gain bought by making one kind of channel worse (a wind that trades the horizontal
+  // force for the moments) is no gain: the translational and the rotational channels are
+  // also judged apart, each by its sum of squares per fold.
+  struct OneStep {
+    std::vector<double> fold_gains;  // per cent of the fold's cost without the effect
+    double gain_mean = 0, gain_standard_error = 0;
+    std::vector<double> translation_fold_gains, rotation_fold_gains;  // per cent, unweighted
+    double translation_gain_mean = 0, translation_gain_standard_error = 0;
+    double rotation_gain_mean = 0, rotation_gain_standard_error = 0;
+  } one_step;
+  // Which held-out test stood behind it: kByOpenLoopPosition, or kByOneStep (the rollouts
+  // neither better nor worse beyond their spread); empty when none did.
+  static constexpr const char* kByOpenLoopPosition = "open-loop position";
+  static constexpr const char* kByOneStep = "one-step equation error";
+  std::string accepted_by;
 };
 
 // A candidate significant on the training data that a later test does not stand behind:
@@ -146,6 +166,14 @@ struct Diagnosis {
 // the battery's state of charge (thrust per command differs from flight to flight; the
 // within-flight decay is thrust_decay's or battery_sag's). In a joint diagnosis each flight
 // gets its own value; quadgen predict --calibrate refits them on an unseen flight.
+// The held-out test a finding passes (Finding::kByOpenLoopPosition or kByOneStep), "" for
+// none: its open-loop position gain above its spread over the validation folds; or else its
+// one-step equation-error gain above its spread with the rollouts, the translational and the
+// rotational channels each no worse beyond their spread (a gain the rollouts cannot see, not
+// one they refute or one channel pays for). The one-step route is for the airframe's
+// effects only: a flight's own quantities (per-flight effects) need the rollouts.
+std::string held_out_test(const Finding& f);
+
 bool belongs_to_flight(const std::string& parameter);
 
 // Runs the whole diagnosis. `all` is the full-catalogue symbolic model of the vehicle and

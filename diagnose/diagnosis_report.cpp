@@ -176,6 +176,17 @@ json finding_json(const Finding& f) {
                        {"fold_gains", f.fold_gains},
                        {"gain_mean", number_or_null(f.gain_mean)},
                        {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
+             {"one_step_gain", {{"metric", "held-out equation-error cost (weighted), reduction per validation fold [%]"},
+                                {"fold_gains", f.one_step.fold_gains},
+                                {"gain_mean", number_or_null(f.one_step.gain_mean)},
+                                {"gain_standard_error", number_or_null(f.one_step.gain_standard_error)},
+                                {"translation", {{"fold_gains", f.one_step.translation_fold_gains},
+                                                 {"gain_mean", number_or_null(f.one_step.translation_gain_mean)},
+                                                 {"gain_standard_error", number_or_null(f.one_step.translation_gain_standard_error)}}},
+                                {"rotation", {{"fold_gains", f.one_step.rotation_fold_gains},
+                                              {"gain_mean", number_or_null(f.one_step.rotation_gain_mean)},
+                                              {"gain_standard_error", number_or_null(f.one_step.rotation_gain_standard_error)}}}}},
+             {"accepted_by", f.accepted_by},
              {"evidence", evidence_json(f.evidence)}};
   if (has_reference)
     fj["note"] = "c_t is fitted with these parameters, so only their ratios are identifiable: the first is the reference, held at 0";
@@ -553,6 +564,14 @@ std::string num(double v, int prec = 4) {
   return os.str();
 }
 
+// Where the one-step test, not the rollouts, stood behind a finding: say so beside the
+// rollouts' numbers, which then show no gain.
+std::string one_step_text(const Finding& f) {
+  if (f.accepted_by != Finding::kByOneStep || f.one_step.fold_gains.empty()) return "";
+  return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.gain_mean, 3) +
+         " % +- " + num(f.one_step.gain_standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
+}
+
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
 std::string interval(double lower, double upper, int prec = 4) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
@@ -570,7 +589,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
-    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << "\n  " << headline(f) << "\n";
+    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << one_step_text(f) << "\n  "
+       << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
@@ -783,7 +803,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
-      << num(reduction(f.before, f.after), 3) << " % lower).</p>\n";
+      << num(reduction(f.before, f.after), 3) << " % lower)" << esc(one_step_text(f)) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
     if (per_flight) {
