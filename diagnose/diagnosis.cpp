@@ -79,8 +79,7 @@ std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
 
 // Sums of squares of the translational (first three) and the rotational channels.
 std::array<double, 2> channel_group_squares(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  std::vector<double> r;
-  m.all_channels(fit::parameter_values(ps).data(), r);
+  const std::vector<double> r = residuals_of(m, ps);
   std::array<double, 2> ss{0, 0};
   for (size_t i = 0; i < r.size(); ++i) ss[(i % 6) / 3] += r[i] * r[i];
   return ss;
@@ -100,6 +99,13 @@ std::string one_step_summary(const Finding& f) {
   std::ostringstream os;
   os.precision(3);
   os << "; one step: " << f.one_step.gain_mean << " % +- " << f.one_step.gain_standard_error << " %";
+  const auto& o = f.one_step;
+  if (find_effect(f.effect).per_flight) os << ", which does not count for a flight's own quantity";
+  else if (o.gain_mean > 0 && o.gain_mean > o.gain_standard_error) {
+    if (f.gain_mean < -f.gain_standard_error) os << ", but the rollouts are worse beyond their spread";
+    else if (o.translation_gain_mean < -o.translation_gain_standard_error) os << ", bought with worse translational channels";
+    else if (o.rotation_gain_mean < -o.rotation_gain_standard_error) os << ", bought with worse rotational channels";
+  }
   return os.str();
 }
 
@@ -388,7 +394,10 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   std::vector<std::unique_ptr<fit::EquationErrorModel>> fold_ee;
   if (pose)
     for (const auto& f : folds)
-      if (f.samples.size() >= 3) fold_ee.push_back(std::make_unique<fit::EquationErrorModel>(model, f, accel));
+      try {  // a fold of short stretches between gaps has no row to differentiate: skipped
+        fold_ee.push_back(std::make_unique<fit::EquationErrorModel>(model, f, accel));
+      } catch (const fit::FitError&) {
+      }
   auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
     std::vector<double> m;
     if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};

@@ -25,6 +25,10 @@ def finding_text(f):
     return f"**{f['effect']}**{how} " + "; ".join(parts)
 
 
+# The catalogue's per-flight effects (docs/effects.md), written down again like PLAUSIBLE below.
+PER_FLIGHT = {"motor_gain", "wind", "attitude_bias"}
+
+
 def above_spread(g, floor=0.0):
     m, se = g.get("gain_mean"), g.get("gain_standard_error")
     return m is not None and se is not None and m > floor and m > se
@@ -37,6 +41,8 @@ def held_out_gain(f):
     g, o = f["gain"], f.get("one_step_gain") or {}
     if above_spread(g):
         return True
+    if f["effect"] in PER_FLIGHT:  # a flight's own quantity: only the rollouts may stand behind it
+        return False
 
     def not_worse(x):
         m, se = x.get("gain_mean"), x.get("gain_standard_error")
