@@ -390,12 +390,22 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
                   : "validation equation-error cost (weighted, no pose logged)";
   // The held-out metric the report prints, per fold of the validation part.
   const std::vector<fit::Flight> folds = validation_folds(valid, 4);
-  // The folds' one-step problems (with a pose; without one the metric already is one-step).
-  std::vector<std::unique_ptr<fit::EquationErrorModel>> fold_ee;
+  // The folds' one-step problems (with a pose; without one the metric already is one-step):
+  // the fit's own, and the accelerometer's where one is logged and the fit differentiates the
+  // pose instead — the translational guard then judges the force by a sensor the fit did not
+  // use (a per-flight wind once improved the differentiated pose and made the accelerometer's
+  // horizontal force 5x worse).
+  struct FoldProblems {
+    std::unique_ptr<fit::EquationErrorModel> fit, accelerometer;  // accelerometer: may be null
+    const fit::EquationErrorModel& translation() const { return accelerometer ? *accelerometer : *fit; }
+  };
+  std::vector<FoldProblems> fold_ee;
   if (pose)
     for (const auto& f : folds)
       try {  // a fold of short stretches between gaps has no row to differentiate: skipped
-        fold_ee.push_back(std::make_unique<fit::EquationErrorModel>(model, f, accel));
+        FoldProblems p{std::make_unique<fit::EquationErrorModel>(model, f, accel), nullptr};
+        if (!accel && f.has_accelerometer) p.accelerometer = std::make_unique<fit::EquationErrorModel>(model, f, true);
+        fold_ee.push_back(std::move(p));
       } catch (const fit::FitError&) {
       }
   auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
@@ -436,11 +446,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
     auto& o = f.one_step;
     for (const auto& fold : fold_ee) {
-      const double b = search.cost(*fold, without), a = search.cost(*fold, d.search.final_fit);
+      const double b = search.cost(*fold.fit, without), a = search.cost(*fold.fit, d.search.final_fit);
       o.fold_gains.push_back(100 * (b - a) / std::max(1e-300, b));
-      const auto gb = channel_group_squares(*fold, without), ga = channel_group_squares(*fold, d.search.final_fit);
-      o.translation_fold_gains.push_back(100 * (gb[0] - ga[0]) / std::max(1e-300, gb[0]));
+      const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, d.search.final_fit);
       o.rotation_fold_gains.push_back(100 * (gb[1] - ga[1]) / std::max(1e-300, gb[1]));
+      const auto tb = channel_group_squares(fold.translation(), without),
+                 ta = channel_group_squares(fold.translation(), d.search.final_fit);
+      o.translation_fold_gains.push_back(100 * (tb[0] - ta[0]) / std::max(1e-300, tb[0]));
     }
     mean_and_standard_error(o.fold_gains, &o.gain_mean, &o.gain_standard_error);
     mean_and_standard_error(o.translation_fold_gains, &o.translation_gain_mean, &o.translation_gain_standard_error);

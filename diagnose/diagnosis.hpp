@@ -54,8 +54,9 @@ struct Finding {
   // effect that sharpens every one-step prediction (a motor lag) can leave them unchanged;
   // empty without a pose (then `fold_gains` already are equation-error costs).
   // A gain bought by making one kind of channel worse is no gain: the translational and the
-  // rotational channels are also judged apart, each by its sum of squares per fold, in the
-  // formulation the fit uses (with a pose: the differentiated pose, not the accelerometer).
+  // rotational channels are also judged apart, each by its sum of squares per fold; the
+  // translational ones by the accelerometer where one is logged (a sensor the fit did not
+  // use when it differentiates the pose), else as the fit measures them.
   struct OneStep {
     std::vector<double> fold_gains;  // per cent of the fold's cost without the effect
     double gain_mean = 0, gain_standard_error = 0;
