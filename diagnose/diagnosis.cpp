@@ -94,18 +94,30 @@ void mean_and_standard_error(const std::vector<double>& x, double* mean, double*
   *se = x.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
 }
 
+// A gain larger than its own uncertainty; a change no worse than minus its uncertainty.
+bool beyond_spread(double mean, double standard_error) { return mean > 0 && mean > standard_error; }
+bool not_worse_beyond_spread(double mean, double standard_error) { return mean >= -standard_error; }
+
+// Why the one-step route does not stand behind a finding whose one-step gain is beyond its
+// spread ("" when it does, or when that gain is not: then there is nothing to explain).
+std::string one_step_refusal(const Finding& f) {
+  const auto& o = f.one_step;
+  if (o.cost.per_fold.empty() || !beyond_spread(o.cost.mean, o.cost.standard_error)) return "";
+  if (f.effect.empty() || find_effect(f.effect).per_flight) return "which does not count for a flight's own quantity";
+  if (!not_worse_beyond_spread(f.gain_mean, f.gain_standard_error)) return "but the rollouts are worse beyond their spread";
+  if (!not_worse_beyond_spread(o.translation.mean, o.translation.standard_error))
+    return "bought with worse translational channels";
+  if (!not_worse_beyond_spread(o.rotation.mean, o.rotation.standard_error)) return "bought with worse rotational channels";
+  return "";
+}
+
 std::string one_step_summary(const Finding& f) {
-  if (f.one_step.fold_gains.empty()) return "";
+  if (f.one_step.cost.per_fold.empty()) return "";
   std::ostringstream os;
   os.precision(3);
-  os << "; one step: " << f.one_step.gain_mean << " % +- " << f.one_step.gain_standard_error << " %";
-  const auto& o = f.one_step;
-  if (find_effect(f.effect).per_flight) os << ", which does not count for a flight's own quantity";
-  else if (o.gain_mean > 0 && o.gain_mean > o.gain_standard_error) {
-    if (f.gain_mean < -f.gain_standard_error) os << ", but the rollouts are worse beyond their spread";
-    else if (o.translation_gain_mean < -o.translation_gain_standard_error) os << ", bought with worse translational channels";
-    else if (o.rotation_gain_mean < -o.rotation_gain_standard_error) os << ", bought with worse rotational channels";
-  }
+  os << "; one step: " << f.one_step.cost.mean << " % +- " << f.one_step.cost.standard_error << " %";
+  const std::string refusal = one_step_refusal(f);
+  if (!refusal.empty()) os << ", " << refusal;
   return os.str();
 }
 
@@ -397,7 +409,6 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // horizontal force 5x worse).
   struct FoldProblems {
     std::unique_ptr<fit::EquationErrorModel> fit, accelerometer;  // accelerometer: may be null
-    const fit::EquationErrorModel& translation() const { return accelerometer ? *accelerometer : *fit; }
   };
   std::vector<FoldProblems> fold_ee;
   if (pose)
@@ -445,18 +456,17 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
     mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
     auto& o = f.one_step;
+    const auto percent_lower = [](double before, double after) { return 100 * (before - after) / std::max(1e-300, before); };
     for (const auto& fold : fold_ee) {
-      const double b = search.cost(*fold.fit, without), a = search.cost(*fold.fit, d.search.final_fit);
-      o.fold_gains.push_back(100 * (b - a) / std::max(1e-300, b));
+      o.cost.per_fold.push_back(percent_lower(search.cost(*fold.fit, without), search.cost(*fold.fit, d.search.final_fit)));
       const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, d.search.final_fit);
-      o.rotation_fold_gains.push_back(100 * (gb[1] - ga[1]) / std::max(1e-300, gb[1]));
-      const auto tb = channel_group_squares(fold.translation(), without),
-                 ta = channel_group_squares(fold.translation(), d.search.final_fit);
-      o.translation_fold_gains.push_back(100 * (tb[0] - ta[0]) / std::max(1e-300, tb[0]));
+      o.rotation.per_fold.push_back(percent_lower(gb[1], ga[1]));
+      const bool own = fold.accelerometer == nullptr;  // the translational channels as the fit measures them
+      const auto tb = own ? gb : channel_group_squares(*fold.accelerometer, without),
+                 ta = own ? ga : channel_group_squares(*fold.accelerometer, d.search.final_fit);
+      o.translation.per_fold.push_back(percent_lower(tb[0], ta[0]));
     }
-    mean_and_standard_error(o.fold_gains, &o.gain_mean, &o.gain_standard_error);
-    mean_and_standard_error(o.translation_fold_gains, &o.translation_gain_mean, &o.translation_gain_standard_error);
-    mean_and_standard_error(o.rotation_fold_gains, &o.rotation_gain_mean, &o.rotation_gain_standard_error);
+    for (auto* g : {&o.cost, &o.translation, &o.rotation}) mean_and_standard_error(g->per_fold, &g->mean, &g->standard_error);
     f.accepted_by = held_out_test(f);
     // Without a pose the report's metric itself is the held-out equation-error cost.
     if (!pose && f.accepted_by == Finding::kByOpenLoopPosition) f.accepted_by = Finding::kByOneStep;
@@ -622,17 +632,15 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   return d;
 }
 
+// A flight's own quantities (its trims, a wind) are judged by the rollouts alone: their
+// one-step gain on the end of the same flight they were fitted to shows the flight's state
+// absorbing error as well as a cause (a per-flight wind passed it by trading the
+// accelerometer's horizontal force, 5x worse, for the moments). `one_step_refusal` holds the
+// guards.
 std::string held_out_test(const Finding& f) {
-  if (f.gain_mean > 0 && f.gain_mean > f.gain_standard_error) return Finding::kByOpenLoopPosition;
-  // A flight's own quantities (its trims, a wind) are judged by the rollouts alone: their
-  // one-step gain on the end of the same flight they were fitted to shows the flight's state
-  // absorbing error as well as a cause (a per-flight wind passed it by trading the
-  // accelerometer's horizontal force, 5x worse, for the moments).
-  if (f.effect.empty() || find_effect(f.effect).per_flight) return "";
+  if (beyond_spread(f.gain_mean, f.gain_standard_error)) return Finding::kByOpenLoopPosition;
   const auto& o = f.one_step;
-  if (!o.fold_gains.empty() && o.gain_mean > 0 && o.gain_mean > o.gain_standard_error &&
-      f.gain_mean >= -f.gain_standard_error && o.translation_gain_mean >= -o.translation_gain_standard_error &&
-      o.rotation_gain_mean >= -o.rotation_gain_standard_error)
+  if (!o.cost.per_fold.empty() && beyond_spread(o.cost.mean, o.cost.standard_error) && one_step_refusal(f).empty())
     return Finding::kByOneStep;
   return "";
 }

@@ -57,12 +57,14 @@ struct Finding {
   // rotational channels are also judged apart, each by its sum of squares per fold; the
   // translational ones by the accelerometer where one is logged (a sensor the fit did not
   // use when it differentiates the pose), else as the fit measures them.
+  // Each a reduction per fold in per cent of the fold's value without the effect.
+  struct FoldGains {
+    std::vector<double> per_fold;
+    double mean = 0, standard_error = 0;
+  };
   struct OneStep {
-    std::vector<double> fold_gains;  // per cent of the fold's cost without the effect
-    double gain_mean = 0, gain_standard_error = 0;
-    std::vector<double> translation_fold_gains, rotation_fold_gains;  // per cent, unweighted
-    double translation_gain_mean = 0, translation_gain_standard_error = 0;
-    double rotation_gain_mean = 0, rotation_gain_standard_error = 0;
+    FoldGains cost;                  // the weighted equation-error cost
+    FoldGains translation, rotation;  // unweighted sums of squares of each channel group
   } one_step;
   // Which held-out test stood behind it: kByOpenLoopPosition, or kByOneStep (the rollouts
   // neither better nor worse beyond their spread); empty when none did.

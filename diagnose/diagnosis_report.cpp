@@ -150,6 +150,20 @@ json point_of_action_json(const Diagnosis& d) {
           {"headline", point_of_action_headline(*p)}};
 }
 
+json fold_gains_json(const Finding::FoldGains& g) {
+  return {{"fold_gains", g.per_fold},
+          {"gain_mean", number_or_null(g.mean)},
+          {"gain_standard_error", number_or_null(g.standard_error)}};
+}
+
+json one_step_json(const Finding::OneStep& o) {
+  json j = {{"metric", "held-out equation-error cost (weighted), reduction per validation fold [%]"}};
+  j.update(fold_gains_json(o.cost));
+  j["translation"] = fold_gains_json(o.translation);
+  j["rotation"] = fold_gains_json(o.rotation);
+  return j;
+}
+
 json finding_json(const Finding& f) {
   json ps = json::object();
   const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
@@ -176,16 +190,7 @@ json finding_json(const Finding& f) {
                        {"fold_gains", f.fold_gains},
                        {"gain_mean", number_or_null(f.gain_mean)},
                        {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
-             {"one_step_gain", {{"metric", "held-out equation-error cost (weighted), reduction per validation fold [%]"},
-                                {"fold_gains", f.one_step.fold_gains},
-                                {"gain_mean", number_or_null(f.one_step.gain_mean)},
-                                {"gain_standard_error", number_or_null(f.one_step.gain_standard_error)},
-                                {"translation", {{"fold_gains", f.one_step.translation_fold_gains},
-                                                 {"gain_mean", number_or_null(f.one_step.translation_gain_mean)},
-                                                 {"gain_standard_error", number_or_null(f.one_step.translation_gain_standard_error)}}},
-                                {"rotation", {{"fold_gains", f.one_step.rotation_fold_gains},
-                                              {"gain_mean", number_or_null(f.one_step.rotation_gain_mean)},
-                                              {"gain_standard_error", number_or_null(f.one_step.rotation_gain_standard_error)}}}}},
+             {"one_step_gain", one_step_json(f.one_step)},
              {"accepted_by", f.accepted_by},
              {"evidence", evidence_json(f.evidence)}};
   if (has_reference)
@@ -567,9 +572,9 @@ std::string num(double v, int prec = 4) {
 // Where the one-step test, not the rollouts, stood behind a finding: say so beside the
 // rollouts' numbers, which then show no gain.
 std::string one_step_text(const Finding& f) {
-  if (f.accepted_by != Finding::kByOneStep || f.one_step.fold_gains.empty()) return "";
-  return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.gain_mean, 3) +
-         " % +- " + num(f.one_step.gain_standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
+  if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
+  return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
+         " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
 }
 
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.

@@ -780,24 +780,24 @@ TEST(Acceptance, AOneStepGainCountsOnlyWhereTheRolloutsDoNotSpeakAgainstIt) {
   EXPECT_EQ(held_out_test(f), Finding::kByOpenLoopPosition);
   f.gain_mean = -0.001, f.gain_standard_error = 0.004;  // the rollouts unchanged within their spread
   EXPECT_EQ(held_out_test(f), "") << "no one-step folds: nothing stands behind it";
-  f.one_step.fold_gains = {6, 8, 7, 9};
-  f.one_step.gain_mean = 7.5, f.one_step.gain_standard_error = 0.6;
+  f.one_step.cost.per_fold = {6, 8, 7, 9};
+  f.one_step.cost.mean = 7.5, f.one_step.cost.standard_error = 0.6;
   EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
   f.effect = "wind";  // a flight's own quantity: only the rollouts may stand behind it
   EXPECT_EQ(held_out_test(f), "");
   f.effect = "motor_lag";
-  f.one_step.translation_gain_mean = -12, f.one_step.translation_gain_standard_error = 3;
+  f.one_step.translation.mean = -12, f.one_step.translation.standard_error = 3;
   EXPECT_EQ(held_out_test(f), "") << "the moments bought with a worse force";
-  f.one_step.translation_gain_mean = -1;  // within its spread
+  f.one_step.translation.mean = -1;  // within its spread
   EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
-  f.one_step.rotation_gain_mean = -12, f.one_step.rotation_gain_standard_error = 3;
+  f.one_step.rotation.mean = -12, f.one_step.rotation.standard_error = 3;
   EXPECT_EQ(held_out_test(f), "") << "the force bought with worse moments";
-  f.one_step.rotation_gain_mean = 20;
+  f.one_step.rotation.mean = 20;
   f.gain_mean = -0.02;  // the rollouts worse beyond their spread: they refute it
   EXPECT_EQ(held_out_test(f), "");
   f.gain_mean = -0.001;
-  f.one_step.gain_mean = 0.5, f.one_step.gain_standard_error = 2;  // one step within its spread
+  f.one_step.cost.mean = 0.5, f.one_step.cost.standard_error = 2;  // one step within its spread
   EXPECT_EQ(held_out_test(f), "");
-  f.one_step.gain_mean = -3, f.one_step.gain_standard_error = 0.5;  // one step worse
+  f.one_step.cost.mean = -3, f.one_step.cost.standard_error = 0.5;  // one step worse
   EXPECT_EQ(held_out_test(f), "");
 }
