@@ -17,6 +17,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "diagnose/residual_analysis.hpp"
+#include "diagnose/validation.hpp"
 #include "fit/evaluation_threads.hpp"
 
 namespace quadgen::diagnose {
@@ -202,7 +203,7 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.delta_aic = -ev.statistic + 2.0 * ev.dof;
   ev.validation_cost_before = base_valid_cost;
   ev.validation_cost_after = cost(*ws.valid, ev.parameters);
-  ev.validation_gain_percent = 100 * (base_valid_cost - ev.validation_cost_after) / std::max(1e-300, base_valid_cost);
+  ev.validation_gain_percent = percent_lower(base_valid_cost, ev.validation_cost_after);
   effect_size(effect, ev.parameters, ev, ws);
   const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
   if (!(ev.p_value < ev.level))
@@ -443,7 +444,7 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       for (int i : effect_params_.at(e)) dof += current[i].free ? 1 : 0;
       const double p = p_value_of(e, statistic, dof), level = opt_.alpha / static_cast<double>(candidates_.size());
       const double vb = cost(valid_, smaller), va = cost(valid_, current);
-      const double gain = 100 * (vb - va) / std::max(1e-300, vb);
+      const double gain = percent_lower(vb, va);
       const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
       std::string reason;
       if (!(p < level)) reason = "no longer significant" + beside + " (p = " + std::to_string(p) + ")";

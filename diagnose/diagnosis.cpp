@@ -456,7 +456,6 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
     mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
     auto& o = f.one_step;
-    const auto percent_lower = [](double before, double after) { return 100 * (before - after) / std::max(1e-300, before); };
     for (const auto& fold : fold_ee) {
       o.cost.per_fold.push_back(percent_lower(search.cost(*fold.fit, without), search.cost(*fold.fit, d.search.final_fit)));
       const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, d.search.final_fit);

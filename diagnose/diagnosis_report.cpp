@@ -23,8 +23,9 @@ namespace {
 
 using output::number_or_null;
 
+// A reduction to show: 0 where it is undefined (a diverged simulation, nothing before).
 double reduction(double before, double after) {
-  return before > 0 && std::isfinite(before) && std::isfinite(after) ? 100 * (before - after) / before : 0.0;
+  return before > 0 && std::isfinite(before) && std::isfinite(after) ? percent_lower(before, after) : 0.0;
 }
 
 json evidence_json(const CandidateEvidence& e) {

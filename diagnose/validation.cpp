@@ -8,6 +8,7 @@
 #include "runtime/data_side_effects.hpp"
 #include "runtime/integrator.hpp"
 #include "runtime/per_flight_model.hpp"
+#include "predict/start_state.hpp"
 
 namespace quadgen::diagnose {
 
@@ -25,14 +26,13 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
-  const runtime::DataSideParams data_side(model);
+  const predict::StartStates start(model, sim_params, f);  // each window's first state
   runtime::DataSideEffects e;  // in effect over the current window
   // Delayed commands are not read from before the window's stretch (a previous joined flight).
   std::vector<double> times;
   for (const auto& s : f.samples) times.push_back(s.t);
   const std::vector<size_t> stretch = runtime::stretch_starts(times);
   size_t first_command = 0;
-  const int n = model.num_states(), nu = model.num_inputs();
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
   const size_t nr = f.samples.front().u.size();
   auto inputs = [&](double t, double* u) {
@@ -48,19 +48,10 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   double se = 0, sv = 0, sa = 0, sw = 0;
   size_t count = 0;
   const auto& S = f.samples;
-  std::vector<double> u(nu), fx(n);
   for (size_t k0 = 0; k0 + 1 < S.size();) {
-    const double t0 = S[k0].t;
-    e = data_side.at(model, sim_params.data(), t0);
+    e = start.effects_at(k0);
     first_command = stretch[k0];
-    std::vector<double> x(n, 0.0);
-    std::copy(S[k0].x.begin(), S[k0].x.end(), x.begin());
-    runtime::unbias_attitude(&S[k0].x[6], e.roll, e.pitch, &x[6]);
-    if (n > 13) {  // rotor speeds in steady state with the commands (model's dw/dt at w = 0, times tau)
-      inputs(S[k0].t, u.data());
-      model.rhs(x.data(), u.data(), fx.data(), nullptr, nullptr, nullptr);
-      for (int i = 13; i < n; ++i) x[i] = e.tau * fx[i];
-    }
+    std::vector<double> x = start.at(k0);
     size_t k = k0;
     bool lost = false;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {

@@ -3,6 +3,7 @@
 // the measured state at its start with the logged commands (open loop: a whole flight would
 // drift off, as the thesis' did) and compared with the measured positions.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,12 @@
 #include "fit/flight_data.hpp"
 
 namespace quadgen::diagnose {
+
+// How much lower `after` is than `before`, in percent of `before`: the one formula of every
+// gain the diagnosis reports (held-out cost, position error, a channel group's sum of squares).
+inline double percent_lower(double before, double after) {
+  return 100 * (before - after) / std::max(1e-300, before);
+}
 
 struct WindowedSimulation {
   double position_rmse = 0;  // m, over every sample of every window

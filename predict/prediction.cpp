@@ -12,6 +12,7 @@
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "fit/equation_error.hpp"
+#include "predict/start_state.hpp"
 #include "output/estimate.hpp"
 
 namespace quadgen::predict {
@@ -58,11 +59,12 @@ constexpr double kPi = 3.14159265358979323846;
 using runtime::DataSideEffects;
 
 // One rollout integrator over a flight: commands held at the log's samples (delayed by the
-// model's input delay), and optionally the log's attitude and body rates imposed.
+// model's input delay), and optionally the log's attitude and body rates imposed. The model's
+// parameters must be set to p.
 class Rollout {
  public:
   Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step)
-      : m_(model), f_(f), p_(p), data_side_(model), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
+      : m_(model), f_(f), start_(model, p, f), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
         k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
     t_in_ = model.input_index("t");
     v_in_ = model.input_index("vbat");
@@ -74,23 +76,11 @@ class Rollout {
   // The data-side effects in force from sample k on (a rollout stays within one flight).
   const DataSideEffects& start_at(size_t k) {
     first_command_ = stretch_[k];
-    return e_ = data_side_.at(m_, p_.data(), f_.samples[k].t);
+    return e_ = start_.effects_at(k);
   }
 
-  // The measured state at sample k (attitude unbiased), rotor speeds in steady state.
-  std::vector<double> initial_state(size_t k) {
-    std::vector<double> x(n_, 0.0);
-    const auto& s = f_.samples[k];
-    std::copy(s.x.begin(), s.x.end(), x.begin());
-    runtime::unbias_attitude(&s.x[6], e_.roll, e_.pitch, &x[6]);
-    if (n_ > 13) {  // the model's dw/dt at w = 0, times tau, is the commanded speed
-      std::vector<double> f(n_);
-      inputs(s.t, u_.data());
-      m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
-      for (int i = 13; i < n_; ++i) x[i] = e_.tau * f[i];
-    }
-    return x;
-  }
+  // The measured state at sample k (attitude unbiased), rotor speeds as the lag carried them.
+  std::vector<double> initial_state(size_t k) const { return start_.at(k); }
 
   // Integrates x from sample k to sample k + 1; false if it left the finite numbers.
   bool advance(std::vector<double>& x, size_t k, bool replay_attitude) {
@@ -162,8 +152,7 @@ class Rollout {
 
   runtime::DynamicModel& m_;
   const fit::Flight& f_;
-  const std::vector<double>& p_;
-  const runtime::DataSideParams data_side_;  // where the data-side effects sit in p_
+  const StartStates start_;  // the state each rollout starts from
   DataSideEffects e_;
   std::vector<size_t> stretch_;  // first sample of each sample's contiguous stretch
   size_t first_command_ = 0;     // the rollout's stretch: delayed commands are not read before it
