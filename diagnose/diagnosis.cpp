@@ -159,7 +159,7 @@ std::string short_number(double v) {
 Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, const std::vector<AddedTerm>& terms,
                                 const std::vector<double>& later_starts, const std::vector<std::string>& per_flight,
                                 const std::vector<fit::FitParameter>& final_fit, const std::vector<fit::Flight>& folds,
-                                double window) {
+                                double window, double window_stride) {
   Diagnosis::TermsGain g;
   if (folds.empty()) {
     g.note = "no pose logged: no open-loop rollouts; the gain is the channel's held-out equation-error RMS";
@@ -186,11 +186,13 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   };
   const auto without = values(false), with = values(true);
   g.measured = true;
-  g.metric = "position RMSE of " + short_number(window) + " s open-loop windows on the held-out part [m]";
+  g.metric = "position RMSE of " + short_number(window) + " s open-loop windows on the held-out part" +
+             (window_stride > 0 && window_stride < window ? ", started every " + short_number(window_stride) + " s" : "") +
+             " [m]";
   double sum_before = 0, sum_after = 0;
   for (const auto& f : folds) {
-    const double b = simulate_windows(*model, without, f, window).position_rmse;
-    const double a = simulate_windows(*model, with, f, window).position_rmse;
+    const double b = simulate_windows(*model, without, f, window, window_stride).position_rmse;
+    const double a = simulate_windows(*model, with, f, window, window_stride).position_rmse;
     sum_before += b / static_cast<double>(folds.size()), sum_after += a / static_cast<double>(folds.size());
     g.fold_gains.push_back(b - a);
   }
@@ -398,7 +400,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.search = search.run();
   const bool pose = flight.has_pose;
   d.metric = pose ? "validation position RMSE (" + std::to_string(opt.window).substr(0, 3) +
-                        " s open-loop windows from measured states) [m]"
+                        " s open-loop windows from measured states" +
+                        (opt.window_stride > 0 && opt.window_stride < opt.window
+                             ? ", started every " + short_number(opt.window_stride) + " s"
+                             : "") +
+                        ") [m]"
                   : "validation equation-error cost (weighted, no pose logged)";
   // The held-out metric the report prints, per fold of the validation part.
   const std::vector<fit::Flight> folds = validation_folds(valid, 4);
@@ -422,12 +428,12 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
     std::vector<double> m;
     if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};
-    for (const auto& f : folds) m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window).position_rmse);
+    for (const auto& f : folds) m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride).position_rmse);
     return m;
   };
   auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
     if (!pose) return search.cost(valid_ee, ps);
-    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window);
+    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window, opt.window_stride);
     if (sim) *sim = w;
     return w.position_rmse;
   };
@@ -622,7 +628,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (!proposed_terms(d.discovered).empty()) {
     std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
-                              pose ? folds : std::vector<fit::Flight>{}, opt.window);
+                              pose ? folds : std::vector<fit::Flight>{}, opt.window, opt.window_stride);
   }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);

@@ -22,7 +22,7 @@ size_t held_index(const fit::Flight& f, double t) {
 }  // namespace
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& f, double window) {
+                                    const fit::Flight& f, double window, double start_stride) {
   if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
@@ -45,22 +45,26 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   io.step = 1e-3;  // well inside RK4's stability limit for rotor lags down to 0.4 ms
   io.divergence_bound = 1e6;
   WindowedSimulation out;
-  double se = 0, sv = 0, sa = 0, sw = 0;
-  size_t count = 0;
   const auto& S = f.samples;
-  for (size_t k0 = 0; k0 + 1 < S.size();) {
+  // Sums of squared errors over every scored sample.
+  struct Sums {
+    double pos = 0, vel = 0, att = 0, rate = 0;
+    size_t count = 0;
+  };
+  // One window from sample k0: integrates until `window` seconds or a gap, scores each
+  // sample into `sums` and, with `trace`, appends it to the plotted trace. Returns the
+  // window's last sample, or S.size() if the simulation left the finite numbers.
+  auto run_window = [&](size_t k0, Sums& sums, bool trace) {
     e = start.effects_at(k0);
     first_command = stretch[k0];
     std::vector<double> x = start.at(k0);
     size_t k = k0;
-    bool lost = false;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
       if (S[k + 1].t - S[k].t > 0.1) break;  // a gap (trimmed ground contact): new window
       try {
         x = runtime::integrate_rk4(model, x, inputs, S[k].t, S[k + 1].t, io).x.back();
       } catch (const std::exception&) {
-        lost = true;
-        break;
+        return S.size();
       }
       const auto& m = S[k + 1].x;
       double e2 = 0, v2 = 0, w2 = 0;
@@ -74,11 +78,9 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       runtime::unbias_attitude(&m[6], e.roll, e.pitch, qt);
       const double dot = std::abs(x[6] * qt[0] + x[7] * qt[1] + x[8] * qt[2] + x[9] * qt[3]);
       const double angle = 2 * std::acos(std::min(1.0, dot));
-      se += e2;
-      sv += v2;
-      sa += angle * angle;
-      sw += w2;
-      ++count;
+      sums.pos += e2, sums.vel += v2, sums.att += angle * angle, sums.rate += w2;
+      ++sums.count;
+      if (!trace) continue;
       out.t.push_back(S[k + 1].t);
       out.x.push_back(x[0]);
       out.y.push_back(x[1]);
@@ -88,21 +90,40 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       out.e_att.push_back(angle);
       out.e_rate.push_back(std::sqrt(w2));
     }
-    if (lost) {  // diverged: no error measure is meaningful (diagnosis.json shows null)
-      const double inf = std::numeric_limits<double>::infinity();
-      out.position_rmse = out.velocity_rmse = out.attitude_rmse = out.rate_rmse = inf;
-      return out;
-    }
+    return k;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  auto diverged = [&] {  // no error measure is meaningful (diagnosis.json shows null)
+    out.position_rmse = out.velocity_rmse = out.attitude_rmse = out.rate_rmse = inf;
+    return out;
+  };
+  // The plotted trace: consecutive windows, NaN between them.
+  Sums consecutive;
+  for (size_t k0 = 0; k0 + 1 < S.size();) {
+    const size_t k = run_window(k0, consecutive, true);
+    if (k == S.size()) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     out.t.push_back(S[k].t);
     for (auto* v : {&out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->push_back(nan);
     k0 = std::max(k, k0 + 1);
   }
-  const double samples = static_cast<double>(std::max<size_t>(count, 1));
-  out.position_rmse = std::sqrt(se / samples);
-  out.velocity_rmse = std::sqrt(sv / samples);
-  out.attitude_rmse = std::sqrt(sa / samples);
-  out.rate_rmse = std::sqrt(sw / samples);
+  // The scores: from the consecutive windows, or from windows started every `start_stride`
+  // seconds (overlapping; each sample is scored at several horizons).
+  Sums scored = consecutive;
+  if (start_stride > 0 && start_stride < window) {
+    scored = {};
+    double next_start = S.front().t;
+    for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
+      if (S[k0].t + 1e-9 < next_start) continue;
+      next_start = S[k0].t + start_stride;
+      if (run_window(k0, scored, false) == S.size()) return diverged();
+    }
+  }
+  const double samples = static_cast<double>(std::max<size_t>(scored.count, 1));
+  out.position_rmse = std::sqrt(scored.pos / samples);
+  out.velocity_rmse = std::sqrt(scored.vel / samples);
+  out.attitude_rmse = std::sqrt(scored.att / samples);
+  out.rate_rmse = std::sqrt(scored.rate / samples);
   return out;
 }
 

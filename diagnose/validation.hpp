@@ -29,7 +29,9 @@ struct WindowedSimulation {
 };
 
 // `model` must be the full-catalogue model with `params` (effects off at their neutral values).
+// The RMSEs come from windows started every `start_stride` seconds (overlapping), or, with
+// 0, from the consecutive windows of the plotted trace.
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& flight, double window_seconds);
+                                    const fit::Flight& flight, double window_seconds, double start_stride = 0);
 
 }  // namespace quadgen::diagnose
