@@ -12,15 +12,6 @@
 
 namespace quadgen::diagnose {
 
-namespace {
-// Index of the last sample at or before t (commands are held between samples).
-size_t held_index(const fit::Flight& f, double t) {
-  const auto& S = f.samples;
-  const auto it = std::upper_bound(S.begin(), S.end(), t, [](double v, const fit::FlightSample& s) { return v < s.t; });
-  return it == S.begin() ? 0 : static_cast<size_t>(it - S.begin()) - 1;
-}
-}  // namespace
-
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window, double start_stride) {
   if (f.samples.size() < 2) return {};  // no window to simulate
@@ -29,17 +20,15 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   const predict::StartStates start(model, sim_params, f);  // each window's first state
   runtime::DataSideEffects e;  // in effect over the current window
   // Delayed commands are not read from before the window's stretch (a previous joined flight).
-  std::vector<double> times;
-  for (const auto& s : f.samples) times.push_back(s.t);
-  const std::vector<size_t> stretch = runtime::stretch_starts(times);
+  const std::vector<size_t>& stretch = start.stretch_starts();
   size_t first_command = 0;
   const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
   const size_t nr = f.samples.front().u.size();
   auto inputs = [&](double t, double* u) {
-    const auto& s = f.samples[std::max(held_index(f, t - e.delay), first_command)];
+    const auto& s = f.samples[predict::command_sample(f, t, e.delay, first_command)];
     for (size_t i = 0; i < nr; ++i) u[i] = s.u[i];
     if (t_in >= 0) u[t_in] = t;
-    if (v_in >= 0) u[v_in] = f.samples[held_index(f, t)].vbat;
+    if (v_in >= 0) u[v_in] = f.samples[predict::held_sample(f, t)].vbat;
   };
   runtime::IntegratorOptions io;
   io.step = 1e-3;  // well inside RK4's stability limit for rotor lags down to 0.4 ms
@@ -97,9 +86,14 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     out.position_rmse = out.velocity_rmse = out.attitude_rmse = out.rate_rmse = inf;
     return out;
   };
-  // The plotted trace: consecutive windows, NaN between them.
+  // The plotted trace: consecutive windows, NaN between them. A window starts only where the
+  // rotor speeds are known (StartStates::settled: not in the first 0.3 s of the part).
   Sums consecutive;
   for (size_t k0 = 0; k0 + 1 < S.size();) {
+    if (!start.settled(k0)) {
+      ++k0;
+      continue;
+    }
     const size_t k = run_window(k0, consecutive, true);
     if (k == S.size()) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -114,7 +108,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     scored = {};
     double next_start = S.front().t;
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
-      if (S[k0].t + 1e-9 < next_start) continue;
+      if (S[k0].t + 1e-9 < next_start || !start.settled(k0)) continue;
       next_start = S[k0].t + start_stride;
       if (run_window(k0, scored, false) == S.size()) return diverged();
     }

@@ -56,7 +56,7 @@ void EquationErrorModel::mark_contiguous_intervals() {
   rotors_restart_.assign(ns, true);
   for (size_t k = 0; k + 1 < ns; ++k) {
     interval_ok_[k] = S[k + 1].t - S[k].t <= gap_;
-    rotors_restart_[k] = S[k + 1].t - S[k].t > kRotorRestartGap;
+    rotors_restart_[k] = S[k + 1].t - S[k].t > runtime::kRotorRestartGap;
   }
 }
 
@@ -215,7 +215,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     double* x = &X[k * n];
     // After a long gap the rotors restart in steady state with the commands, as at the start
     // (a span starts at such a gap or at the log's start); across a short one they are
-    // carried with the last command held (see kRotorRestartGap).
+    // carried with the last command held (see runtime::kRotorRestartGap).
     const bool restart = k == span.lo || !rotors_continue(k);
     if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;

@@ -81,12 +81,8 @@ class EquationErrorModel : public ResidualModel {
   std::vector<std::vector<double>> interval_weights_;
   std::vector<std::array<double, 6>> measured_;
   std::vector<bool> interval_ok_;  // interval k -> k+1 lies inside a contiguous stretch
-  // Across a gap up to this long (a dropped sample; an in-flight motor dip trimmed as not
-  // airborne, up to 0.3 s in the ARPL log) the rotors kept spinning: their speeds are carried
-  // with the last command held. After a longer one (ground contact, a joined flight's start
-  // 1 s on) they restart in steady state with the commands.
-  static constexpr double kRotorRestartGap = 0.5;  // s
-  // Interval k -> k+1 is long enough (> kRotorRestartGap) that the rotors restart after it.
+  // Interval k -> k+1 is long enough (> runtime::kRotorRestartGap) that the rotors restart
+  // after it.
   std::vector<bool> rotors_restart_;
   bool rotors_continue(size_t k) const { return !rotors_restart_[k - 1]; }
   double gap_ = 0;  // s: a longer sample interval is a gap

@@ -68,14 +68,14 @@ class Rollout {
         k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
     t_in_ = model.input_index("t");
     v_in_ = model.input_index("vbat");
-    std::vector<double> times;
-    for (const auto& s : f.samples) times.push_back(s.t);
-    stretch_ = runtime::stretch_starts(times);
   }
+
+  // Whether a rollout may start at sample k (its rotor speeds known: StartStates::settled).
+  bool may_start_at(size_t k) const { return start_.settled(k); }
 
   // The data-side effects in force from sample k on (a rollout stays within one flight).
   const DataSideEffects& start_at(size_t k) {
-    first_command_ = stretch_[k];
+    first_command_ = start_.stretch_starts()[k];
     return e_ = start_.effects_at(k);
   }
 
@@ -120,16 +120,11 @@ class Rollout {
   }
 
  private:
-  size_t held_index(double t) const {
-    const auto& S = f_.samples;
-    const auto it = std::upper_bound(S.begin(), S.end(), t, [](double v, const fit::FlightSample& s) { return v < s.t; });
-    return it == S.begin() ? 0 : static_cast<size_t>(it - S.begin()) - 1;
-  }
   void inputs(double t, double* u) const {
-    const auto& s = f_.samples[std::max(held_index(t - e_.delay), first_command_)];
+    const auto& s = f_.samples[command_sample(f_, t, e_.delay, first_command_)];
     std::copy(s.u.begin(), s.u.end(), u);
     if (t_in_ >= 0) u[t_in_] = t;
-    if (v_in_ >= 0) u[v_in_] = f_.samples[held_index(t)].vbat;
+    if (v_in_ >= 0) u[v_in_] = f_.samples[held_sample(f_, t)].vbat;
   }
   void deriv(double t, const std::vector<double>& x, size_t k, bool replay, std::vector<double>& f) {
     const std::vector<double>* state = &x;
@@ -154,7 +149,6 @@ class Rollout {
   const fit::Flight& f_;
   const StartStates start_;  // the state each rollout starts from
   DataSideEffects e_;
-  std::vector<size_t> stretch_;  // first sample of each sample's contiguous stretch
   size_t first_command_ = 0;     // the rollout's stretch: delayed commands are not read before it
   double step_;
   int n_, t_in_ = -1, v_in_ = -1;
@@ -202,7 +196,7 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
   const double dt = median_spacing(f), longest = *std::max_element(o.horizons.begin(), o.horizons.end());
   double next_start = S.empty() ? 0 : S.front().t;
   for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
-    if (S[k0].t + 1e-9 < next_start) continue;
+    if (S[k0].t + 1e-9 < next_start || !roll.may_start_at(k0)) continue;
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
     ++*starts;

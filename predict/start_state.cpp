@@ -7,46 +7,52 @@
 
 namespace quadgen::predict {
 
-namespace {
-// Index of the last sample at or before t (commands are held between samples).
-size_t held_index(const fit::Flight& f, double t) {
+size_t held_sample(const fit::Flight& f, double t) {
   const auto& S = f.samples;
   const auto it = std::upper_bound(S.begin(), S.end(), t, [](double v, const fit::FlightSample& s) { return v < s.t; });
   return it == S.begin() ? 0 : static_cast<size_t>(it - S.begin()) - 1;
 }
-}  // namespace
 
-StartStates::StartStates(runtime::DynamicModel& model, const std::vector<double>& params, const fit::Flight& flight)
-    : model_(model), params_(params), flight_(flight), data_side_(model) {
+size_t command_sample(const fit::Flight& f, double t, double delay, size_t first) {
+  return std::max(held_sample(f, t - delay + 1e-12), first);
+}
+
+StartStates::StartStates(runtime::DynamicModel& model, std::vector<double> params, const fit::Flight& flight)
+    : model_(model), params_(std::move(params)), flight_(flight), data_side_(model) {
   const auto& S = flight_.samples;
   std::vector<double> times;
   for (const auto& s : S) times.push_back(s.t);
   stretch_ = runtime::stretch_starts(times);
-  if (model_.num_states() <= 13 || S.empty()) return;
-  rotors_ = static_cast<size_t>(model_.num_states() - 13);
+  settled_.assign(S.size(), false);
+  if (model_.num_states() > 13) rotors_ = static_cast<size_t>(model_.num_states() - 13);
   speeds_.assign(S.size() * rotors_, 0.0);
   std::vector<double> c(rotors_);
+  double restarted = 0;  // s, time of the last restart
   for (size_t k = 0; k < S.size(); ++k) {
     const runtime::DataSideEffects e = effects_at(k);
-    double* w = &speeds_[k * rotors_];
-    if (k == 0 || S[k].t - S[k - 1].t > kRotorRestartGap) {  // steady state with the commands
-      commanded_speeds(S[k].t, e.delay, stretch_[k], e.tau, c);
-      std::copy(c.begin(), c.end(), w);
-      continue;
+    double* w = rotors_ ? &speeds_[k * rotors_] : nullptr;
+    if (k == 0 || S[k].t - S[k - 1].t > runtime::kRotorRestartGap) {  // steady state with the commands
+      restarted = S[k].t;
+      if (rotors_) {
+        commanded_speeds(S[k].t, e.delay, stretch_[k], e.tau, c);
+        std::copy(c.begin(), c.end(), w);
+      }
+    } else if (rotors_) {
+      // From the previous sample's speeds through the lag, one piece per held command: the
+      // delayed command changes where a logged sample's time plus the delay falls inside.
+      std::copy(&speeds_[(k - 1) * rotors_], &speeds_[k * rotors_], w);
+      double t = S[k - 1].t;
+      while (t < S[k].t) {
+        const size_t j = command_sample(flight_, t, e.delay, 0);  // command in force from t on
+        const double next_change = j + 1 < S.size() ? S[j + 1].t + e.delay : S[k].t;
+        const double t_end = std::min(S[k].t, std::max(next_change, t + 1e-9));
+        commanded_speeds(t, e.delay, stretch_[k - 1], e.tau, c);
+        const double a = e.tau > 0 ? std::exp(-(t_end - t) / e.tau) : 0.0;
+        for (size_t i = 0; i < rotors_; ++i) w[i] = c[i] + (w[i] - c[i]) * a;
+        t = t_end;
+      }
     }
-    // From the previous sample's speeds through the lag, one piece per held command: the
-    // delayed command changes where a logged sample's time plus the delay falls inside.
-    std::copy(&speeds_[(k - 1) * rotors_], &speeds_[k * rotors_], w);
-    double t = S[k - 1].t;
-    while (t < S[k].t) {
-      const size_t j = held_index(flight_, t - e.delay + 1e-12);  // command in force from t on
-      const double next_change = j + 1 < S.size() ? S[j + 1].t + e.delay : S[k].t;
-      const double t_end = std::min(S[k].t, std::max(next_change, t + 1e-9));
-      commanded_speeds(t, e.delay, stretch_[k - 1], e.tau, c);
-      const double a = e.tau > 0 ? std::exp(-(t_end - t) / e.tau) : 0.0;
-      for (size_t i = 0; i < rotors_; ++i) w[i] = c[i] + (w[i] - c[i]) * a;
-      t = t_end;
-    }
+    settled_[k] = S[k].t - restarted >= kSettle - 1e-9;
   }
 }
 
@@ -57,11 +63,9 @@ runtime::DataSideEffects StartStates::effects_at(size_t k) const {
 void StartStates::commanded_speeds(double t, double delay, size_t first, double tau, std::vector<double>& c) const {
   const int n = model_.num_states();
   std::vector<double> x(n, 0.0), u(model_.num_inputs(), 0.0), f(n);
-  const auto& s = flight_.samples[held_index(flight_, t)];
+  const auto& s = flight_.samples[held_sample(flight_, t)];
   std::copy(s.x.begin(), s.x.end(), x.begin());
-  // The small tolerance keeps a command's own switching time (a sample's time plus the
-  // delay, computed in floating point) on the new command.
-  const auto& cmd = flight_.samples[std::max(held_index(flight_, t - delay + 1e-12), first)].u;
+  const auto& cmd = flight_.samples[command_sample(flight_, t, delay, first)].u;
   std::copy(cmd.begin(), cmd.end(), u.begin());
   const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
   if (t_in >= 0) u[t_in] = t;

@@ -66,6 +66,12 @@ inline double gap_threshold(const std::vector<double>& times) {
   return 1.5 * dts[dts.size() / 2];
 }
 
+// Across a gap up to this long (a dropped sample; an in-flight motor dip trimmed as not
+// airborne, up to 0.3 s in the ARPL log) the rotors kept spinning: a rotor-speed filter
+// carries their speeds with the last command held. After a longer one (ground contact, a
+// joined flight's start 1 s on) they restart in steady state with the commands.
+constexpr double kRotorRestartGap = 0.5;  // s
+
 // For each sample time, the index of the first sample of its contiguous stretch (gaps as
 // gap_threshold says): a delayed command lookup is clamped there, so it never reaches across
 // a gap into a previous joined flight or trimmed ground contact.

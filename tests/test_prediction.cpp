@@ -18,6 +18,7 @@
 #include "runtime/flight_log.hpp"
 #include "predict/parameter_source.hpp"
 #include "predict/prediction.hpp"
+#include "diagnose/validation.hpp"
 #include "tests/test_helpers.hpp"
 
 namespace fs = std::filesystem;
@@ -91,6 +92,29 @@ TEST(Prediction, LaggedRotorsStartWhereTheLagCarriedThem) {
     EXPECT_LT(h.body_rates.mean(), 0.03) << h.horizon;
     EXPECT_LT(h.tilt.mean(), 0.01) << h.horizon;
     EXPECT_LT(h.position.mean(), 0.03 * h.horizon) << h.horizon;
+  }
+}
+
+// The same with an input delay that is not a whole number of sample periods (15 ms: each
+// command starts acting inside a sample interval), through both kinds of rollout: the
+// prediction's, and the diagnosis' validation windows, consecutive and started every 0.1 s.
+TEST(Prediction, LaggedAndDelayedRotorsStartWhereTheyWereInEveryRollout) {
+  const GeneratedFlight g = generate_flight(
+      "--effects motor_lag,input_delay --set motor_lag.tau=0.05 --set input_delay.seconds=0.015 --excitation 0.1");
+  ASSERT_GT(g.flight.samples.size(), 1150u);
+  Model m;
+  std::vector<double> params = m.params();
+  params[m.param_index("motor_lag.tau")] = 0.05;
+  params[m.param_index("input_delay.seconds")] = 0.015;
+  const auto p = quadgen::predict::evaluate_prediction(m, params, g.flight, {});
+  for (const auto& h : p.open_loop) {
+    EXPECT_LT(h.body_rates.mean(), 0.03) << h.horizon;
+    EXPECT_LT(h.position.mean(), 0.03 * h.horizon) << h.horizon;
+  }
+  for (double stride : {0.0, 0.1}) {
+    const auto w = quadgen::diagnose::simulate_windows(m, params, g.flight, 1.0, stride);
+    EXPECT_LT(w.rate_rmse, 0.03) << stride;
+    EXPECT_LT(w.position_rmse, 0.02) << stride;
   }
 }
 
