@@ -152,6 +152,12 @@ std::string short_number(double v) {
   return os.str();
 }
 
+// What a held-out position metric's name says about its windows: ", started every 0.1 s"
+// when they overlap, nothing when they are consecutive.
+std::string stride_clause(double window, double start_stride) {
+  return overlapping_windows(window, start_stride) ? ", started every " + short_number(start_stride) + " s" : "";
+}
+
 // What the proposed terms buy in a simulation, like an effect: the full-catalogue model with
 // the terms added is derived and taped, and the held-out folds are simulated with the final
 // fit's values and the terms' coefficients, then with the coefficients at zero. No folds (no
@@ -187,8 +193,7 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   const auto without = values(false), with = values(true);
   g.measured = true;
   g.metric = "position RMSE of " + short_number(window) + " s open-loop windows on the held-out part" +
-             (window_stride > 0 && window_stride < window ? ", started every " + short_number(window_stride) + " s" : "") +
-             " [m]";
+             stride_clause(window, window_stride) + " [m]";
   double sum_before = 0, sum_after = 0;
   for (const auto& f : folds) {
     const double b = simulate_windows(*model, without, f, window, window_stride).position_rmse;
@@ -401,10 +406,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   const bool pose = flight.has_pose;
   d.metric = pose ? "validation position RMSE (" + std::to_string(opt.window).substr(0, 3) +
                         " s open-loop windows from measured states" +
-                        (opt.window_stride > 0 && opt.window_stride < opt.window
-                             ? ", started every " + short_number(opt.window_stride) + " s"
-                             : "") +
-                        ") [m]"
+                        stride_clause(opt.window, opt.window_stride) + ") [m]"
                   : "validation equation-error cost (weighted, no pose logged)";
   // The held-out metric the report prints, per fold of the validation part.
   const std::vector<fit::Flight> folds = validation_folds(valid, 4);

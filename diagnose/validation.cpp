@@ -104,7 +104,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   // The scores: from the consecutive windows, or from windows started every `start_stride`
   // seconds (overlapping; each sample is scored at several horizons).
   Sums scored = consecutive;
-  if (start_stride > 0 && start_stride < window) {
+  if (overlapping_windows(window, start_stride)) {
     scored = {};
     double next_start = S.front().t;
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {

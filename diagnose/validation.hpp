@@ -29,8 +29,11 @@ struct WindowedSimulation {
 };
 
 // `model` must be the full-catalogue model with `params` (effects off at their neutral values).
-// The RMSEs come from windows started every `start_stride` seconds (overlapping), or, with
-// 0, from the consecutive windows of the plotted trace.
+// The RMSEs come from windows started every `start_stride` seconds (overlapping: see
+// overlapping_windows), or else from the consecutive windows of the plotted trace.
+// Whether simulate_windows scores overlapping windows for this stride.
+inline bool overlapping_windows(double window, double start_stride) { return start_stride > 0 && start_stride < window; }
+
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& flight, double window_seconds, double start_stride = 0);
 

@@ -3,8 +3,7 @@
 //  - open loop: from many start points (every sample, or a dense stride), the model is
 //    integrated from the measured state (rotor speeds as the lag carried them; no start in
 //    the first 0.3 s of the data: predict/start_state.hpp) with the logged commands; the
-//    error AT a horizon
-//    (0.1, 0.25, 0.5, 1 s) is averaged over the start points (IDSIA nano-drone benchmark,
+//    error AT a horizon (0.1, 0.25, 0.5, 1 s) is averaged over the start points (IDSIA nano-drone benchmark,
 //    NanoBench rollouts). Tilt (angle between body z axes) and heading are reported apart.
 //  - attitude replayed: the same with attitude and body rates taken from the log at every
 //    step, integrating only translation (and rotor speeds): the force model alone.
