@@ -42,6 +42,14 @@ double typical_start(const std::string& param) {
 
 double neutral_value(const Variable& p) { return off_value(p); }
 
+void rank_candidates(std::vector<CandidateEvidence>& candidates) {
+  std::stable_sort(candidates.begin(), candidates.end(), [](const CandidateEvidence& a, const CandidateEvidence& b) {
+    if (a.significant != b.significant) return a.significant;
+    if (a.significant && a.implausible.empty() != b.implausible.empty()) return a.implausible.empty();
+    return a.statistic > b.statistic;
+  });
+}
+
 std::vector<std::string> SearchResult::named() const {
   std::vector<std::string> out;
   for (const auto& e : selected)
@@ -216,7 +224,22 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
     ev.why_not = "physically negligible size";
   ev.significant = ev.why_not.empty();
   ev.training_only = ev.why_not == "no gain on the validation part" && relevant;
+  ev.implausible = implausible_estimate(effect, ev.parameters);
   return ev;
+}
+
+std::string CandidateSearch::implausible_estimate(const std::string& effect, const std::vector<FitParameter>& ps) const {
+  for (int i : effect_params_.at(effect)) {
+    const FitParameter& p = ps[static_cast<size_t>(i)];
+    double lo = 0, hi = 0;
+    std::string why;
+    if (!p.free || !plausible_range(runtime::shared_name(p.name), opt_.environment, opt_.scales, &lo, &hi, &why))
+      continue;
+    if (p.value >= lo && p.value <= hi) continue;
+    return p.name + " = " + short_number(p.value) + " " + p.unit + " outside [" + short_number(lo) + ", " +
+           short_number(hi) + "]";
+  }
+  return "";
 }
 
 // A parameter whose neutral value is its bound has a chi-bar-square null (Self & Liang 1987).
@@ -251,6 +274,9 @@ std::vector<Ambiguity> CandidateSearch::check_look_alikes(const SelectionStep& s
   for (size_t k = 1; k < step.candidates.size() && k < 3; ++k) {
     const CandidateEvidence& b = step.candidates[k];
     if (!b.significant || b.statistic < opt_.ambiguity_ratio * a.statistic) continue;
+    // A look-alike whose estimate is implausible here does not make a plausible winner
+    // ambiguous: what the physics rules out is no alternative.
+    if (!b.implausible.empty() && a.implausible.empty()) continue;
     std::set<std::string> both = base;
     both.insert(a.effect);
     both.insert(b.effect);
@@ -369,10 +395,7 @@ SearchResult CandidateSearch::run() {
                 << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count())
                 << " s)                              \n";
     for (const auto& ev : step.candidates) note_training_only(res, ev);
-    std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) {
-      if (a.significant != b.significant) return a.significant;
-      return a.statistic > b.statistic;
-    });
+    rank_candidates(step.candidates);
     if (step.candidates.empty() || !step.candidates.front().significant) {
       step.outcome = "nothing significant";
       res.steps.push_back(step);

@@ -33,6 +33,7 @@
 #include "fit/equation_error.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/profile_likelihood.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "derive/symbolic_model.hpp"
 
 namespace quadgen::diagnose {
@@ -57,6 +58,11 @@ struct SearchOptions {
   // profile costs tens of seconds a parameter in a joint diagnosis, and candidates that the
   // acceptance tests turn down no longer pay for one.
   bool wald_until_accepted = false;
+  // Where the flights were flown and the vehicle's lengths, for the plausible ranges: a
+  // candidate whose estimate lies outside its range there is selected only at a step where
+  // no plausible candidate is significant (rank_candidates).
+  Environment environment = Environment::kUnknown;
+  VehicleScales scales;
 };
 
 struct EffectEstimate {
@@ -89,6 +95,9 @@ struct CandidateEvidence {
   double size_translation = 0, size_rotation = 0;
   bool significant = false;
   std::string why_not;  // when not significant: which gate it failed
+  // The first parameter whose estimate lies outside its plausible range in the flights'
+  // environment ("wind.x = -1.98 m/s outside [-0.5, 0.5]"); empty when all are plausible.
+  std::string implausible;
   // Significant on the training data, of a relevant size, but no gain on the held-out
   // part: reported as suspected, never selected.
   bool training_only = false;
@@ -140,6 +149,12 @@ struct SearchResult {
 // neutral except the rotor lag, whose nominal 1 ms keeps simulations non-stiff; equation
 // error has no such limit, so "no lag" is its lower bound (1 us).
 double neutral_value(const Variable& p);
+
+// The order in which a step considers its candidates: significant ones first; among those,
+// plausible before implausible, so that a stand-in for missing physics (a steady wind
+// indoors) cannot take a step that a plausible cause would also take and then push that
+// cause out by absorbing its residual; then by statistic, strongest first.
+void rank_candidates(std::vector<CandidateEvidence>& candidates);
 
 // Effects the log can speak to (battery_sag needs vbat; ground_effect a height).
 std::vector<std::string> applicable_effects(const fit::Flight& flight);
@@ -238,6 +253,8 @@ class CandidateSearch {
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
+  // CandidateEvidence::implausible of this effect's estimates in `ps`.
+  std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,
                    const Workspace& ws) const;
   double p_value_of(const std::string& effect, double statistic, int dof) const;

@@ -144,14 +144,6 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
   return "";
 }
 
-// Three significant digits, as the reasons print numbers.
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
-}
-
 // What a held-out position metric's name says about its windows: ", started every 0.1 s"
 // when they overlap, nothing when they are consecutive.
 std::string stride_clause(double window, double start_stride) {
@@ -400,6 +392,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   SearchOptions so = opt.search;
   so.rotation_scale = rotation_scale(v, all);
   so.wald_until_accepted = true;
+  so.environment = opt.environment;
+  so.scales = vehicle_scales(v);
   CandidateSearch search(all, model, train_ee, valid_ee, so);
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
   d.search = search.run();

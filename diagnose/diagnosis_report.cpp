@@ -44,7 +44,8 @@ json evidence_json(const CandidateEvidence& e) {
           {"size_fraction_of_g", e.size_translation},
           {"size_fraction_of_rotation_scale", e.size_rotation},
           {"significant", e.significant},
-          {"why_not", e.why_not}};
+          {"why_not", e.why_not},
+          {"implausible", e.implausible}};
 }
 
 // A discovered term's verdict for the report: "proposed" in bold, said once (the verdict
@@ -909,7 +910,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     for (const auto& c : st.candidates)
       h << "<tr><td>" << esc(c.effect) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
-        << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not)) << "</td></tr>\n";
+        << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not))
+        << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
     h << "</table>\n";
   }
   h << "<h2>Plots</h2>\n";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
@@ -11,6 +12,13 @@
 #include "predict/start_state.hpp"
 
 namespace quadgen::diagnose {
+
+std::string short_number(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window, double start_stride) {
