@@ -128,7 +128,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   for (const auto& f : flights) samples += f.samples.size();
   diagnose::DiagnoseOptions o = job.options;
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);
-  o.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
+  o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
 
   std::cerr << "[diagnose] " << samples << " airborne samples in " << flights.size()
             << (flights.size() > 1 ? " logs (diagnosed jointly)" : " log") << "; deriving the full-catalogue model\n";

@@ -43,6 +43,10 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
       ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
+  c->add_option("--window-stride", o.window_stride,
+                "time between the starts of the validation windows the held-out position error is taken over [s]; "
+                "0: consecutive windows")
+      ->check(finite_range(0.0, 10.0));
   c->add_option("--airframe", j.airframe,
                 "diagnosis.json of a joint diagnosis of this vehicle: also refit its named effects on this one flight "
                 "and say whether the flight agrees with it");

@@ -14,7 +14,6 @@
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "derive/effects/effect_catalogue.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
@@ -233,11 +232,11 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
     const FitParameter& p = ps[static_cast<size_t>(i)];
     double lo = 0, hi = 0;
     std::string why;
-    if (!p.free || !plausible_range(runtime::shared_name(p.name), opt_.environment, opt_.scales, &lo, &hi, &why))
+    if (!p.free ||
+        !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
-    if (p.value >= lo && p.value <= hi) continue;
-    return p.name + " = " + short_number(p.value) + " " + p.unit + " outside [" + short_number(lo) + ", " +
-           short_number(hi) + "]";
+    const std::string unit = p.unit.empty() || p.unit == "1" ? "" : " " + p.unit;
+    return p.name + " = " + short_number(p.value) + unit + " outside [" + short_number(lo) + ", " + short_number(hi) + "]";
   }
   return "";
 }

@@ -8,7 +8,9 @@
 //   - a Bonferroni level over the candidates of a step, the change of BIC, and
 //   - the change of the cost on the held-out validation part.
 // Forward selection adds the best significant candidate and searches again, so two
-// simultaneous effects are found; it stops when nothing more is significant. A runner-up
+// simultaneous effects are found; it stops when nothing more is significant. A candidate
+// whose estimate is implausible where the flights were flown comes after every plausible
+// significant one (rank_candidates): a stand-in takes a step only when no cause can. A runner-up
 // that explains almost as much is fitted together with the winner: if neither adds
 // anything significant to the other, the data cannot tell them apart: the step reports the
 // pair as a group with the manoeuvre that would separate them, the model carries the
@@ -60,7 +62,8 @@ struct SearchOptions {
   bool wald_until_accepted = false;
   // Where the flights were flown and the vehicle's lengths, for the plausible ranges: a
   // candidate whose estimate lies outside its range there is selected only at a step where
-  // no plausible candidate is significant (rank_candidates).
+  // no plausible candidate is significant (rank_candidates). Ranges relative to a length
+  // left at 0 are not applied.
   Environment environment = Environment::kUnknown;
   VehicleScales scales;
 };
@@ -112,7 +115,7 @@ struct Ambiguity {
 
 struct SelectionStep {
   std::vector<std::string> base_effects;
-  std::vector<CandidateEvidence> candidates;  // strongest first
+  std::vector<CandidateEvidence> candidates;  // in rank_candidates' order: the selected one first
   std::string selected;                       // the effect added to the model (empty: stop)
   std::string outcome;  // "selected", "ambiguous" (the stronger look-alike carried, not named), "nothing significant"
   std::vector<Ambiguity> ambiguities;

@@ -217,8 +217,7 @@ bool implausible_parameter(const Finding& f, Environment where, const VehicleSca
   for (const auto& p : f.parameters) {
     double lo = 0, hi = 0;
     std::string why;
-    if (!plausible_range(runtime::shared_name(p.name), where, scales, &lo, &hi, &why)) continue;
-    if (p.value >= lo && p.value <= hi) continue;
+    if (!outside_plausible_range(runtime::shared_name(p.name), p.value, where, scales, &lo, &hi, &why)) continue;
     out->candidate = f;
     out->parameter = p.name;
     out->value = p.value;
@@ -296,6 +295,9 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   };
   if (!(validation_fraction >= 0.1 && validation_fraction <= 0.6)) return fail("validation fraction: 0.1 to 0.6");
   if (!(window >= 0.1 && window <= 10)) return fail("validation window: 0.1 to 10 s");
+  // Below 10 ms the starts would outnumber the samples of a 100 Hz log.
+  if (!(window_stride == 0 || (window_stride >= 0.01 && window_stride <= 10)))
+    return fail("window stride: 0 (consecutive windows) or 0.01 to 10 s");
   if (translational != "auto" && translational != "pose" && translational != "accelerometer")
     return fail("translational channels: auto, pose or accelerometer");
   if (!(search.alpha > 0 && search.alpha <= 0.2)) return fail("alpha: above 0, at most 0.2");
@@ -392,7 +394,6 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   SearchOptions so = opt.search;
   so.rotation_scale = rotation_scale(v, all);
   so.wald_until_accepted = true;
-  so.environment = opt.environment;
   so.scales = vehicle_scales(v);
   CandidateSearch search(all, model, train_ee, valid_ee, so);
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
@@ -508,11 +509,10 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // Accepted, but beyond what the effect's physics can produce here: a stand-in for missing
   // physics. It stays in the model (carried, like the stronger of a look-alike pair) and is
   // reported with the residual it absorbs, not named.
-  d.environment = environment_name(opt.environment);
-  const VehicleScales scales = vehicle_scales(v);
+  d.environment = environment_name(so.environment);
   for (auto it = d.findings.begin(); it != d.findings.end();) {
     StandIn st;
-    if (!implausible_parameter(*it, opt.environment, scales, &st)) {
+    if (!implausible_parameter(*it, so.environment, so.scales, &st)) {
       ++it;
       continue;
     }

@@ -33,9 +33,9 @@ struct DiagnoseOptions {
   // Translational channels: "pose" (differentiated mocap velocity, world frame),
   // "accelerometer" (specific force, body frame) or "auto" (pose when logged).
   std::string translational = "auto";
+  // The search's options; its `environment` is where the flights were flown, on which what
+  // is plausible depends (a steady wind indoors). Its `scales` are the vehicle's, set here.
   SearchOptions search;
-  // Where the flights were flown: what is plausible depends on it (a steady wind indoors).
-  Environment environment = Environment::kUnknown;
   // Unexplained discrepancy: slow residual structure beyond this many times what the noise
   // gives, at this significance, after the selected effects.
   double unexplained_ratio = 3.0, unexplained_p = 1e-6;

@@ -495,6 +495,12 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
     json j;
     in >> j;
     EXPECT_EQ(j["environment"], where);
+    // The search saw the environment: the wind's evidence says it is implausible indoors only.
+    ASSERT_FALSE(j["selection"].empty());
+    const auto& first = j["selection"][0]["candidates"];
+    const auto wind = std::find_if(first.begin(), first.end(), [](const json& c) { return c["effect"] == "wind"; });
+    ASSERT_NE(wind, first.end());
+    EXPECT_EQ((*wind)["implausible"].get<std::string>().empty(), where == "outdoor") << wind->dump(1);
     if (where == "outdoor") {
       EXPECT_EQ(named(j), std::vector<std::string>{"wind"}) << j["stand_ins"].dump(1);
       EXPECT_TRUE(j["stand_ins"].empty());
@@ -514,6 +520,40 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
     const auto& model = j["extended_model"]["effects"];
     EXPECT_NE(std::find(model.begin(), model.end(), "wind"), model.end());  // kept in the model
   }
+}
+
+// A stand-in for missing physics (a steady wind indoors) may explain more of a flight than the
+// plausible cause does, and once in the model it absorbs that cause's residual: on the
+// NanoBench helix a 2 m/s "wind" took the first step and blade flapping then failed its
+// held-out test. A step takes the strongest plausible significant candidate; a stand-in only
+// when nothing plausible is significant (then it is carried and reported, as before).
+TEST(Plausibility, APlausibleCauseTakesTheStepBeforeAStrongerStandIn) {
+  using quadgen::diagnose::CandidateEvidence;
+  const auto candidate = [](const std::string& effect, double statistic, bool significant, const std::string& implausible) {
+    CandidateEvidence e;
+    e.effect = effect, e.statistic = statistic, e.significant = significant, e.implausible = implausible;
+    return e;
+  };
+  const auto order = [](const std::vector<CandidateEvidence>& cs) {
+    std::vector<std::string> out;
+    for (const auto& c : cs) out.push_back(c.effect);
+    return out;
+  };
+  std::vector<CandidateEvidence> step{candidate("motor_lag", 1000, false, ""),
+                                      candidate("wind", 900, true, "wind.x = -1.98 m/s outside [-0.5, 0.5]"),
+                                      candidate("thrust_decay", 100, true, ""),
+                                      candidate("blade_flapping", 600, true, ""),
+                                      candidate("cog_offset", 50, false, "cog_offset.x = 0.02 m outside [-0.0092, 0.0092]")};
+  quadgen::diagnose::rank_candidates(step);
+  EXPECT_EQ(order(step),
+            (std::vector<std::string>{"blade_flapping", "thrust_decay", "wind", "motor_lag", "cog_offset"}));
+  // Nothing plausible significant: the stand-in takes the step; among candidates that are
+  // not significant plausibility does not matter (the statistic orders them).
+  step = {candidate("blade_flapping", 600, false, ""), candidate("motor_lag", 400, false, ""),
+          candidate("wind", 900, true, "wind.x = -1.98 m/s outside [-0.5, 0.5]"),
+          candidate("cog_offset", 700, false, "cog_offset.x = 0.02 m outside [-0.0092, 0.0092]")};
+  quadgen::diagnose::rank_candidates(step);
+  EXPECT_EQ(order(step), (std::vector<std::string>{"wind", "cog_offset", "blade_flapping", "motor_lag"}));
 }
 
 // A motor trim belongs to the flight (docs/crazyflie_evidence.md): flight a flies with motor
@@ -703,6 +743,11 @@ TEST(DiagnoseJob, RefusesOptionsNoDiagnosisCanUse) {
   EXPECT_FALSE(job.IsValid(&why));
   EXPECT_NE(why.find("alpha"), std::string::npos) << why;
   job.options.search.alpha = 0.01;
+  job.options.window_stride = 0.001;  // a hundred thousand windows in a 100 s held-out part
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_NE(why.find("window stride"), std::string::npos) << why;
+  job.options.window_stride = 0;  // consecutive windows
+  EXPECT_TRUE(job.IsValid(&why)) << why;
   job.environment = "orbit";
   EXPECT_FALSE(job.IsValid(&why));
   EXPECT_THROW(quadgen::app::run_diagnose_job(job), std::invalid_argument);  // refused before reading any file
@@ -767,37 +812,6 @@ TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
   const auto w = quadgen::diagnose::simulate_windows(model, p, empty, 1.0);
   EXPECT_TRUE(w.t.empty());
   EXPECT_EQ(w.position_rmse, 0.0);
-}
-
-// A stand-in for missing physics (a steady wind indoors) may explain more of a flight than the
-// plausible cause does, and once in the model it absorbs that cause's residual: on the
-// NanoBench helix a 2 m/s "wind" took the first step and blade flapping then failed its
-// held-out test. A step takes the strongest plausible significant candidate; a stand-in only
-// when nothing plausible is significant (then it is carried and reported, as before).
-TEST(Plausibility, APlausibleCauseTakesTheStepBeforeAStrongerStandIn) {
-  using quadgen::diagnose::CandidateEvidence;
-  const auto candidate = [](const std::string& effect, double statistic, bool significant, const std::string& implausible) {
-    CandidateEvidence e;
-    e.effect = effect, e.statistic = statistic, e.significant = significant, e.implausible = implausible;
-    return e;
-  };
-  const auto order = [](const std::vector<CandidateEvidence>& cs) {
-    std::vector<std::string> out;
-    for (const auto& c : cs) out.push_back(c.effect);
-    return out;
-  };
-  std::vector<CandidateEvidence> step{candidate("motor_lag", 1000, false, ""),
-                                      candidate("wind", 900, true, "wind.x = -1.98 m/s outside [-0.5, 0.5]"),
-                                      candidate("thrust_decay", 100, true, ""),
-                                      candidate("blade_flapping", 600, true, ""),
-                                      candidate("cog_offset", 50, false, "cog_offset.x = 0.02 m outside [-0.0092, 0.0092]")};
-  quadgen::diagnose::rank_candidates(step);
-  EXPECT_EQ(order(step),
-            (std::vector<std::string>{"blade_flapping", "thrust_decay", "wind", "motor_lag", "cog_offset"}));
-  // Nothing plausible significant: the stand-in takes the step.
-  step = {candidate("blade_flapping", 600, false, ""), candidate("wind", 900, true, "wind.x = -1.98 m/s outside [-0.5, 0.5]")};
-  quadgen::diagnose::rank_candidates(step);
-  EXPECT_EQ(order(step), (std::vector<std::string>{"wind", "blade_flapping"}));
 }
 
 // A motor lag sharpens every one-step prediction while open-loop rollouts, dominated by an

@@ -334,6 +334,12 @@ TEST(Effects, PlausibleRangesDependOnWhereAndOnTheVehicle) {
   EXPECT_EQ(hi, 0.35);
   EXPECT_FALSE(plausible_range("blade_flapping.k", Environment::kUnknown, cf, &lo, &hi, &why));
   EXPECT_FALSE(plausible_range("c_t", Environment::kUnknown, cf, &lo, &hi, &why));
+  // A range relative to a length the caller did not give is no range (not [0, 0]).
+  EXPECT_FALSE(plausible_range("cog_offset.x", Environment::kIndoor, VehicleScales{}, &lo, &hi, &why));
+  EXPECT_TRUE(outside_plausible_range("wind.x", -1.98, Environment::kIndoor, cf, &lo, &hi, &why));
+  EXPECT_FALSE(outside_plausible_range("wind.x", -1.98, Environment::kOutdoor, cf, &lo, &hi, &why));
+  EXPECT_FALSE(outside_plausible_range("wind.x", 0.5, Environment::kIndoor, cf, &lo, &hi, &why));  // on the bound
+  EXPECT_FALSE(outside_plausible_range("blade_flapping.k", 1.0, Environment::kIndoor, cf, &lo, &hi, &why));  // none
   EXPECT_EQ(parse_environment("indoor"), Environment::kIndoor);
   EXPECT_THROW(parse_environment("cave"), std::invalid_argument);
 }

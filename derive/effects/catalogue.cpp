@@ -106,10 +106,16 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
   const double unit = found->scale == PlausibleRange::Scale::kRotorArm      ? scales.rotor_arm
                       : found->scale == PlausibleRange::Scale::kRotorRadius ? scales.rotor_radius
                                                                             : 1.0;
+  if (!(unit > 0)) return false;  // relative to a length the caller did not give
   *lower = found->lower * unit;
   *upper = found->upper * unit;
   *why = found->why;
   return true;
+}
+
+bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,
+                             double* lower, double* upper, std::string* why) {
+  return plausible_range(parameter, where, scales, lower, upper, why) && !(value >= *lower && value <= *upper);
 }
 
 std::vector<std::string> parse_effect_list(const std::string& text) {

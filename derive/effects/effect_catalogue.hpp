@@ -49,9 +49,14 @@ struct VehicleScales {
   double rotor_arm = 0, rotor_radius = 0;  // m
 };
 // The plausible range of a parameter in this environment, in SI (lower, upper, why); false
-// when its effect declares none.
+// when its effect declares none, or declares it relative to a length `scales` does not give.
 bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
                      double* upper, std::string* why);
+// Whether `value` lies outside the plausible range of `parameter` here (the range and why it
+// is plausible in lower, upper, why): the one test behind the search's ranking and the
+// stand-ins. False inside the range or without one.
+bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,
+                             double* lower, double* upper, std::string* why);
 // Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
 std::vector<std::string> parse_effect_list(const std::string& text);
 // These effects in canonical order joined by commas: SymbolicModel::effect_list() of the model
