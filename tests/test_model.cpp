@@ -349,7 +349,10 @@ TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
   std::set<std::string> params, effects(all.effects.begin(), all.effects.end());
   for (const auto& p : all.params) params.insert(p.name);
   for (const auto& e : effect_catalogue()) {
-    for (const auto& [name, value] : e.typical_start) {
+    for (const auto& start : e.typical_start) {
+      // Named copies: clang refuses a lambda capture of a structured binding in C++17.
+      const std::string& name = start.first;
+      const double value = start.second;
       ASSERT_TRUE(params.count(name)) << e.name << ": " << name;
       EXPECT_EQ(effect_of_parameter(name), e.name);
       const auto& p = *std::find_if(all.params.begin(), all.params.end(), [&](const auto& q) { return q.name == name; });
