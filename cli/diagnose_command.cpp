@@ -44,8 +44,8 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
       ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
   c->add_option("--window-stride", o.window_stride,
-                "time between the starts of the validation windows the held-out position error is taken over [s]; "
-                "0: consecutive windows")
+                "time between the starts of the validation windows the held-out position error is taken over [s]: "
+                "0 (consecutive windows) or from 0.01 to below --window")
       ->check(finite_range(0.0, 10.0));
   c->add_option("--airframe", j.airframe,
                 "diagnosis.json of a joint diagnosis of this vehicle: also refit its named effects on this one flight "

@@ -295,9 +295,10 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   };
   if (!(validation_fraction >= 0.1 && validation_fraction <= 0.6)) return fail("validation fraction: 0.1 to 0.6");
   if (!(window >= 0.1 && window <= 10)) return fail("validation window: 0.1 to 10 s");
-  // Below 10 ms the starts would outnumber the samples of a 100 Hz log.
-  if (!(window_stride == 0 || (window_stride >= 0.01 && window_stride <= 10)))
-    return fail("window stride: 0 (consecutive windows) or 0.01 to 10 s");
+  // Below 10 ms the starts would outnumber the samples of a 100 Hz log; from the window's
+  // length on, the windows would not overlap (consecutive windows are stride 0).
+  if (!(window_stride == 0 || (window_stride >= 0.01 && window_stride < window)))
+    return fail("window stride: 0 (consecutive windows) or from 0.01 s to below the window's length");
   if (translational != "auto" && translational != "pose" && translational != "accelerometer")
     return fail("translational channels: auto, pose or accelerometer");
   if (!(search.alpha > 0 && search.alpha <= 0.2)) return fail("alpha: above 0, at most 0.2");

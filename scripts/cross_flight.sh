@@ -8,7 +8,7 @@
 # Then diagnoses the helix and the linear ramps (B6, in no joint fit) against the four
 # flights' airframe (quadgen diagnose --airframe): do its named effects hold there, with
 # the airframe's values?
-#   scripts/cross_flight.sh [OUT_DIR]       (default /tmp/quadgen_cross_flight; ~20 min)
+#   scripts/cross_flight.sh [OUT_DIR]       (default /tmp/quadgen_cross_flight; ~4 min)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_cross_flight}

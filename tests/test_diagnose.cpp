@@ -746,6 +746,8 @@ TEST(DiagnoseJob, RefusesOptionsNoDiagnosisCanUse) {
   job.options.window_stride = 0.001;  // a hundred thousand windows in a 100 s held-out part
   EXPECT_FALSE(job.IsValid(&why));
   EXPECT_NE(why.find("window stride"), std::string::npos) << why;
+  job.options.window_stride = 1.0;  // as long as the window: no overlap, say 0 for that
+  EXPECT_FALSE(job.IsValid(&why));
   job.options.window_stride = 0;  // consecutive windows
   EXPECT_TRUE(job.IsValid(&why)) << why;
   job.environment = "orbit";
