@@ -10,6 +10,7 @@
 #include "runtime/attitude.hpp"
 #include "fit/least_squares.hpp"
 #include "diagnose/residual_analysis.hpp"
+#include "diagnose/validation.hpp"
 
 namespace quadgen::diagnose {
 
@@ -157,13 +158,6 @@ std::vector<std::vector<size_t>> cv_folds(const fit::Flight& train, const std::v
   return blocks;
 }
 
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
-}
-
 // Covariance of least-squares coefficients when the residuals are autocorrelated (a smoothed
 // derivative's noise is): Newey & West's estimator (Econometrica 55(3), 1987) with Bartlett
 // weights out to five times the residual's integrated autocorrelation time.
@@ -238,7 +232,7 @@ std::string DiscoveredTerm::expression() const {
   if (coefficients.empty()) os << " 0";
   for (size_t i = 0; i < coefficients.size(); ++i) {
     const double v = coefficients[i].value;
-    os << (i == 0 ? (v < 0 ? " -" : " ") : (v < 0 ? " - " : " + ")) << number(std::abs(v));
+    os << (i == 0 ? (v < 0 ? " -" : " ") : (v < 0 ? " - " : " + ")) << short_number(std::abs(v));
     if (coefficients[i].regressor != "1") os << " " << coefficients[i].regressor;
   }
   return os.str();
@@ -361,8 +355,8 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
     double ss = 0;
     for (double g : d.fold_gains) ss += (g - d.gain_mean) * (g - d.gain_mean);
     d.gain_standard_error = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
-    const std::string held = "held-out RMS " + number(d.valid_rms_before) + " -> " + number(d.valid_rms_after) + " " +
-                             d.unit + " (gain " + number(d.gain_mean) + " +- " + number(d.gain_standard_error) +
+    const std::string held = "held-out RMS " + short_number(d.valid_rms_before) + " -> " + short_number(d.valid_rms_after) + " " +
+                             d.unit + " (gain " + short_number(d.gain_mean) + " +- " + short_number(d.gain_standard_error) +
                              " over " + std::to_string(d.fold_gains.size()) + " blocks)";
     d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
     d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;

@@ -31,12 +31,12 @@ struct WindowedSimulation {
   std::vector<double> e_pos, e_vel, e_att, e_rate;
 };
 
-// `model` must be the full-catalogue model with `params` (effects off at their neutral values).
-// The RMSEs come from windows started every `start_stride` seconds (overlapping: see
-// overlapping_windows), or else from the consecutive windows of the plotted trace.
 // Whether simulate_windows scores overlapping windows for this stride.
 inline bool overlapping_windows(double window, double start_stride) { return start_stride > 0 && start_stride < window; }
 
+// `model` must be the full-catalogue model with `params` (effects off at their neutral values).
+// The RMSEs come from windows started every `start_stride` seconds (overlapping: see
+// overlapping_windows), or else from the consecutive windows of the plotted trace.
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& flight, double window_seconds, double start_stride = 0);
 
