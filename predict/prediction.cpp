@@ -43,6 +43,7 @@ void Prediction::merge(const Prediction& o) {
   };
   merge_rows(open_loop, o.open_loop);
   merge_rows(attitude_replayed, o.attitude_replayed);
+  merge_rows(translation_replayed, o.translation_replayed);
   one_step.merge(o.one_step);
   if (o.one_step_corrected) {
     if (!one_step_corrected) one_step_corrected = OneStepErrors{};
@@ -58,8 +59,14 @@ constexpr double kPi = 3.14159265358979323846;
 
 using runtime::DataSideEffects;
 
+// What a rollout takes from the log at every RK4 stage instead of integrating it: nothing
+// (open loop), the attitude and body rates (the force model alone), or the position and
+// velocity (the moment model alone: the attitude it drifts to through its own moments, with
+// the airspeed terms read at the measured velocity).
+enum class Replay { kNothing, kAttitude, kTranslation };
+
 // One rollout integrator over a flight: commands held at the log's samples (delayed by the
-// model's input delay), and optionally the log's attitude and body rates imposed. The model's
+// model's input delay), and optionally part of the state imposed from the log. The model's
 // parameters must be set to p.
 class Rollout {
  public:
@@ -83,26 +90,40 @@ class Rollout {
   std::vector<double> initial_state(size_t k) const { return start_.at(k); }
 
   // Integrates x from sample k to sample k + 1; false if it left the finite numbers.
-  bool advance(std::vector<double>& x, size_t k, bool replay_attitude) {
+  bool advance(std::vector<double>& x, size_t k, Replay replay) {
     const double t0 = f_.samples[k].t, t1 = f_.samples[k + 1].t;
     const int steps = std::max(1, static_cast<int>(std::ceil((t1 - t0) / step_ - 1e-9)));
     const double h = (t1 - t0) / steps;
     for (int i = 0; i < steps; ++i) {
       const double t = t0 + i * h;
-      deriv(t, x, k, replay_attitude, k1_);
+      deriv(t, x, k, replay, k1_);
       stage(x, k1_, h / 2);
-      deriv(t + h / 2, tmp_, k, replay_attitude, k2_);
+      deriv(t + h / 2, tmp_, k, replay, k2_);
       stage(x, k2_, h / 2);
-      deriv(t + h / 2, tmp_, k, replay_attitude, k3_);
+      deriv(t + h / 2, tmp_, k, replay, k3_);
       stage(x, k3_, h);
-      deriv(t + h, tmp_, k, replay_attitude, k4_);
+      deriv(t + h, tmp_, k, replay, k4_);
       for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
-      if (replay_attitude) impose_attitude(t + h, k, x);
-      else normalise_quaternion(x);
+      impose(replay, t + h, k, x);
     }
     for (double v : x)
       if (!std::isfinite(v) || std::fabs(v) > 1e6) return false;
     return true;
+  }
+
+  // What `replay` takes from the log at time t in [t_k, t_k+1]; the quaternion normalised.
+  void impose(Replay replay, double t, size_t k, std::vector<double>& x) const {
+    if (replay == Replay::kAttitude) impose_attitude(t, k, x);
+    if (replay == Replay::kTranslation) impose_translation(t, k, x);
+    normalise_quaternion(x);
+  }
+
+  // The logged position and velocity at time t in [t_k, t_k+1], interpolated.
+  void impose_translation(double t, size_t k, std::vector<double>& x) const {
+    const auto& a = f_.samples[k];
+    const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
+    const double w = b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
+    for (int i = 0; i < 6; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
   }
 
   // The logged attitude (unbiased) and body rates at time t in [t_k, t_k+1], interpolated.
@@ -126,11 +147,11 @@ class Rollout {
     if (t_in_ >= 0) u[t_in_] = t;
     if (v_in_ >= 0) u[v_in_] = f_.samples[held_sample(f_, t)].vbat;
   }
-  void deriv(double t, const std::vector<double>& x, size_t k, bool replay, std::vector<double>& f) {
+  void deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {
     const std::vector<double>* state = &x;
-    if (replay) {
+    if (replay != Replay::kNothing) {
       forced_ = x;
-      impose_attitude(t, k, forced_);
+      impose(replay, t, k, forced_);
       state = &forced_;
     }
     inputs(t, u_.data());
@@ -188,7 +209,7 @@ double median_spacing(const fit::Flight& f) {
 
 // Rollouts from start points every `stride` seconds; the error at each horizon is taken at
 // the first sample at or after start + horizon (within a quarter of a sample spacing).
-std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, bool replay,
+std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, Replay replay,
                                     size_t* starts) {
   std::vector<HorizonErrors> rows;
   for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
@@ -202,7 +223,7 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     ++*starts;
     const DataSideEffects& e = roll.start_at(k0);
     std::vector<double> x = roll.initial_state(k0);
-    if (replay) roll.impose_attitude(S[k0].t, k0, x);
+    roll.impose(replay, S[k0].t, k0, x);
     size_t next = 0;  // the next horizon to score
     for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
       if (S[k + 1].t - S[k].t > o.max_gap) break;
@@ -319,8 +340,10 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with
   Rollout roll(model, f, p, o.step);
   size_t starts = 0;
-  out.open_loop = rollouts(roll, f, o, false, &out.start_points);
-  out.attitude_replayed = rollouts(roll, f, o, true, &starts);
+  out.open_loop = rollouts(roll, f, o, Replay::kNothing, &out.start_points);
+  out.attitude_replayed = rollouts(roll, f, o, Replay::kAttitude, &starts);
+  starts = 0;
+  out.translation_replayed = rollouts(roll, f, o, Replay::kTranslation, &starts);
   return out;
 }
 
@@ -386,8 +409,16 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
                         {"position_m", stats_json(h.position)},
                         {"velocity_m_s", stats_json(h.velocity)},
                         {"diverged", h.diverged}});
+  J moments = J::array();
+  for (const auto& h : p.translation_replayed)
+    moments.push_back({{"horizon_s", h.horizon},
+                       {"tilt_rad", stats_json(h.tilt)},
+                       {"heading_rad", stats_json(h.heading)},
+                       {"body_rates_rad_s", stats_json(h.body_rates)},
+                       {"diverged", h.diverged}});
   J out = {{"open_loop", open},
           {"attitude_replayed", replayed},
+          {"translation_replayed", moments},
           {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
@@ -420,6 +451,11 @@ std::string prediction_csv(const Prediction& p) {
     row("attitude_replayed", h.horizon, "position", "m", h.position);
     row("attitude_replayed", h.horizon, "velocity", "m/s", h.velocity);
   }
+  for (const auto& h : p.translation_replayed) {
+    row("translation_replayed", h.horizon, "tilt", "rad", h.tilt);
+    row("translation_replayed", h.horizon, "heading", "rad", h.heading);
+    row("translation_replayed", h.horizon, "body_rates", "rad/s", h.body_rates);
+  }
   const char* axes[] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
     row("one_step", 0, (std::string("specific_force_") + axes[a]).c_str(), "m/s^2", p.one_step.specific_force[a]);
@@ -446,24 +482,28 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   runtime::Panel open{"open loop: mean position error at a horizon", "horizon [s]", "m", {}};
   runtime::Panel replay{"attitude replayed (force model alone): mean position error", "horizon [s]", "m", {}};
   runtime::Panel tilt{"open loop: mean tilt and heading error", "horizon [s]", "rad", {}};
+  runtime::Panel moments{"translation replayed (moment model alone): mean tilt error", "horizon [s]", "rad", {}};
   for (const auto& [label, p] : predictions) {
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
-    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true};
+    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true},
+        sm{label, {}, {}};
     for (const auto& h : p->open_loop) {
       so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
       st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());
       sh.x.push_back(h.horizon), sh.y.push_back(h.heading.mean());
     }
     for (const auto& h : p->attitude_replayed) sr.x.push_back(h.horizon), sr.y.push_back(h.position.mean());
+    for (const auto& h : p->translation_replayed) sm.x.push_back(h.horizon), sm.y.push_back(h.tilt.mean());
     open.series.push_back(so);
     replay.series.push_back(sr);
     tilt.series.push_back(st);
     tilt.series.push_back(sh);
+    moments.series.push_back(sm);
   }
   runtime::Series published{"published (IDSIA, NanoBench)", {}, {}, true};
   for (const auto& pt : published_position_errors()) published.x.push_back(pt.horizon_s), published.y.push_back(pt.position_m);
   open.series.push_back(published);
-  return {open, replay, tilt};
+  return {open, replay, tilt, moments};
 }
 
 }  // namespace quadgen::predict

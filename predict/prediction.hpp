@@ -7,6 +7,9 @@
 //    NanoBench rollouts). Tilt (angle between body z axes) and heading are reported apart.
 //  - attitude replayed: the same with attitude and body rates taken from the log at every
 //    step, integrating only translation (and rotor speeds): the force model alone.
+//  - translation replayed: position and velocity taken from the log, integrating attitude,
+//    body rates (and rotor speeds): the moment model alone. Its tilt against the open loop's
+//    says how much of the open-loop drift the moments make by themselves.
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
@@ -67,7 +70,7 @@ struct OneStepErrors {
 };
 
 struct Prediction {
-  std::vector<HorizonErrors> open_loop, attitude_replayed;
+  std::vector<HorizonErrors> open_loop, attitude_replayed, translation_replayed;
   OneStepErrors one_step;
   // With a linear correction fitted on the part before (linearly_corrected_one_step).
   std::optional<OneStepErrors> one_step_corrected;
@@ -94,7 +97,8 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
 OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const std::vector<double>& params,
                                           const fit::Flight& train, const fit::Flight& evaluated);
 
-// The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed, one_step.
+// The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
+// translation_replayed, one_step.
 nlohmann::ordered_json prediction_json(const Prediction& p);
 
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.

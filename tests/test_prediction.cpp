@@ -136,6 +136,45 @@ TEST(Prediction, ThrustTooStrongGivesTheClosedFormError) {
   EXPECT_GE(p.open_loop[3].position.mean(), 0.9 * p.attitude_replayed[3].position.mean());
 }
 
+// The moment model alone (translation replayed). With c_t 5 % too strong the model's rotor
+// moments are 1.05 times the true ones, and on this flight (no airspeed term active, small
+// rates) the true rotor moments are what turns the vehicle: the body-rate error at horizon h
+// is 0.05 times the measured change of the body rates over h, a closed form taken from the
+// log alone. Without airspeed terms the moments do not see the translation, so the attitude
+// drifts as in the open loop; with the model's own values there is no drift at all.
+TEST(Prediction, TranslationReplayedIsTheMomentModelAlone) {
+  const auto& S = flight().flight.samples;
+  Model m;
+  std::vector<double> strong = m.params();
+  strong[m.param_index("c_t")] *= 1.05;
+  const auto p = quadgen::predict::evaluate_prediction(m, strong, flight().flight, {});
+  ASSERT_EQ(p.translation_replayed.size(), p.open_loop.size());
+  for (size_t i = 0; i < p.translation_replayed.size(); ++i) {
+    const auto& h = p.translation_replayed[i];
+    // 0.05 |omega(t0 + h) - omega(t0)|, averaged over every start 0.3 s or more into the flight.
+    double sum = 0;
+    size_t n = 0;
+    for (size_t k0 = 0, k1 = 0; k0 < S.size(); ++k0) {
+      if (S[k0].t < S.front().t + 0.3) continue;
+      while (k1 < S.size() && S[k1].t < S[k0].t + h.horizon - 1e-6) ++k1;
+      if (k1 >= S.size()) break;
+      sum += 0.05 * std::hypot(S[k1].x[10] - S[k0].x[10], S[k1].x[11] - S[k0].x[11], S[k1].x[12] - S[k0].x[12]);
+      ++n;
+    }
+    const double expected = sum / static_cast<double>(n);
+    EXPECT_GT(h.body_rates.count, 100u);
+    EXPECT_NEAR(h.body_rates.mean(), expected, 0.2 * expected) << "horizon " << h.horizon;
+    EXPECT_NEAR(h.tilt.mean(), p.open_loop[i].tilt.mean(), 0.05 * p.open_loop[i].tilt.mean() + 1e-4) << h.horizon;
+    if (h.horizon >= 0.5) EXPECT_GT(h.tilt.mean(), 1e-3) << h.horizon;  // a drift to compare
+  }
+  Model truth;  // m's parameters are now the strong ones
+  const auto own = quadgen::predict::evaluate_prediction(truth, truth.params(), flight().flight, {});
+  for (const auto& h : own.translation_replayed) {
+    EXPECT_LT(h.tilt.mean(), 2e-3) << h.horizon;
+    EXPECT_LT(h.body_rates.mean(), 0.02) << h.horizon;
+  }
+}
+
 // The linear correction (the regression baseline of `predict --linear-correction`), fitted on
 // the first 70 % and scored on the rest: a thrust 5 % too strong is 0.05 T/m along body z,
 // nearly linear in the regressors u_i, u_i^2 over a flight's range of commands, so the
