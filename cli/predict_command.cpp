@@ -65,6 +65,7 @@ int run_predict(const PredictArgs& a) {
   for (const auto& h : p.pooled.open_loop)
     std::cout << "open loop, " << h.horizon << " s: position " << h.position.mean() << " m (mean), tilt " << h.tilt.mean()
               << " rad, heading " << h.heading.mean() << " rad\n";
+  if (const std::string limits = predict::what_limits_prediction(p.pooled); !limits.empty()) std::cout << limits << "\n";
   std::cout << "wrote " << output::printable(a.out) << "/prediction.json\n";
   return 0;
 }

@@ -886,6 +886,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(a.one_step.angular_acceleration[0].rms(), 3) << " / " << num(a.one_step.angular_acceleration[1].rms(), 3) << " / "
       << num(a.one_step.angular_acceleration[2].rms(), 3) << " rad/s², world vertical acceleration "
       << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
+    if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
+      h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
   }
   h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
        "<th>reduction %</th></tr>\n";

@@ -370,6 +370,47 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 
 namespace {
 
+std::string three_digits(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+// The row of `rows` whose horizon is nearest to h (rows not empty).
+const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
+  return *std::min_element(rows.begin(), rows.end(), [h](const HorizonErrors& a, const HorizonErrors& b) {
+    return std::fabs(a.horizon - h) < std::fabs(b.horizon - h);
+  });
+}
+
+}  // namespace
+
+std::string what_limits_prediction(const Prediction& p) {
+  if (p.open_loop.empty() || p.attitude_replayed.size() != p.open_loop.size()) return "";
+  const HorizonErrors &open = p.open_loop.back(), &replayed = p.attitude_replayed.back();
+  const double both = open.position.mean(), forces = replayed.position.mean();
+  if (!(both > 0) || !std::isfinite(forces)) return "";
+  std::string s = "At " + three_digits(open.horizon) + " s the open-loop position error is " + three_digits(both) +
+                  " m; with the measured attitude replayed (the force model alone) " + three_digits(forces) + " m";
+  if (forces < both)
+    s += ", so " + std::to_string(static_cast<int>(std::lround(100 * (1 - forces / both)))) +
+         " % of it comes from the attitude.";
+  else
+    s += ": the attitude does not add to it, the force model is what limits it.";
+  if (p.translation_replayed.size() != p.open_loop.size()) return s;
+  const HorizonErrors &tilt_open = nearest(p.open_loop, 0.5), &tilt_moments = nearest(p.translation_replayed, 0.5);
+  const double a = tilt_open.tilt.mean(), m = tilt_moments.tilt.mean();
+  if (!std::isfinite(a) || !std::isfinite(m)) return s;
+  s += " At " + three_digits(tilt_open.horizon) + " s the moment model alone (translation replayed) tilts by " +
+       three_digits(m) + " rad against " + three_digits(a) + " rad open loop: ";
+  s += m >= 0.8 * a ? "the attitude drift is the moment model's own error."
+                    : "the attitude drift grows through the simulated translation (the force model's error turns the vehicle).";
+  return s;
+}
+
+namespace {
+
 nlohmann::ordered_json stats_json(const ErrorStats& s) {
   using output::number_or_null;
   return {{"mean", number_or_null(s.mean())}, {"rms", number_or_null(s.rms())}, {"count", s.count}};

@@ -97,6 +97,13 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
 OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const std::vector<double>& params,
                                           const fit::Flight& train, const fit::Flight& evaluated);
 
+// In words, what limits the open-loop prediction ("" without rollouts): the share of the
+// position error at the longest horizon that the attitude causes (open loop against attitude
+// replayed), and near 0.5 s whether the attitude drift is the moment model's own (translation
+// replayed drifts at least 80 % as far as the open loop) or grows through the simulated
+// translation.
+std::string what_limits_prediction(const Prediction& p);
+
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
 // translation_replayed, one_step.
 nlohmann::ordered_json prediction_json(const Prediction& p);

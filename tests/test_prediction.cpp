@@ -175,6 +175,34 @@ TEST(Prediction, TranslationReplayedIsTheMomentModelAlone) {
   }
 }
 
+// The sentence that says what limits a prediction, on made-up errors: the attitude's share of
+// the position error at the longest horizon, and whose drift it is near 0.5 s.
+TEST(Prediction, WhatLimitsItIsSaidInWords) {
+  using quadgen::predict::HorizonErrors;
+  auto row = [](double horizon, double position, double tilt) {
+    HorizonErrors h;
+    h.horizon = horizon;
+    h.position.add(position);
+    h.tilt.add(tilt);
+    return h;
+  };
+  quadgen::predict::Prediction p;
+  EXPECT_EQ(quadgen::predict::what_limits_prediction(p), "");  // no rollouts (IMU only)
+  p.open_loop = {row(0.5, 0.1, 0.3), row(1.0, 1.0, 1.2)};
+  p.attitude_replayed = {row(0.5, 0.05, 0), row(1.0, 0.2, 0)};
+  p.translation_replayed = {row(0.5, 0, 0.45), row(1.0, 0, 1.5)};
+  std::string s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("At 1 s the open-loop position error is 1 m"), std::string::npos) << s;
+  EXPECT_NE(s.find("80 % of it comes from the attitude"), std::string::npos) << s;
+  EXPECT_NE(s.find("At 0.5 s the moment model alone (translation replayed) tilts by 0.45 rad against 0.3 rad"), std::string::npos) << s;
+  EXPECT_NE(s.find("the moment model's own error"), std::string::npos) << s;
+  p.translation_replayed = {row(0.5, 0, 0.1), row(1.0, 0, 0.2)};
+  p.attitude_replayed = {row(0.5, 0.2, 0), row(1.0, 1.5, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("the force model is what limits it"), std::string::npos) << s;
+  EXPECT_NE(s.find("grows through the simulated translation"), std::string::npos) << s;
+}
+
 // The linear correction (the regression baseline of `predict --linear-correction`), fitted on
 // the first 70 % and scored on the rest: a thrust 5 % too strong is 0.05 T/m along body z,
 // nearly linear in the regressors u_i, u_i^2 over a flight's range of commands, so the
