@@ -188,8 +188,8 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
              stride_clause(window, window_stride) + " [m]";
   double sum_before = 0, sum_after = 0;
   for (const auto& f : folds) {
-    const double b = simulate_windows(*model, without, f, window, window_stride).position_rmse;
-    const double a = simulate_windows(*model, with, f, window, window_stride).position_rmse;
+    const double b = simulate_windows(*model, without, f, window, window_stride, false).position_rmse;
+    const double a = simulate_windows(*model, with, f, window, window_stride, false).position_rmse;
     sum_before += b / static_cast<double>(folds.size()), sum_after += a / static_cast<double>(folds.size());
     g.fold_gains.push_back(b - a);
   }
@@ -426,12 +426,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
     std::vector<double> m;
     if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};
-    for (const auto& f : folds) m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride).position_rmse);
+    for (const auto& f : folds)
+      m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride, false).position_rmse);
     return m;
   };
   auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
     if (!pose) return search.cost(valid_ee, ps);
-    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window, opt.window_stride);
+    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window, opt.window_stride, sim != nullptr);
     if (sim) *sim = w;
     return w.position_rmse;
   };

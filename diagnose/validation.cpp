@@ -21,7 +21,7 @@ std::string short_number(double v) {
 }
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& f, double window, double start_stride) {
+                                    const fit::Flight& f, double window, double start_stride, bool keep_trace) {
   if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
@@ -96,23 +96,26 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   };
   // The plotted trace: consecutive windows, NaN between them. A window starts only where the
   // rotor speeds are known (StartStates::settled: not in the first 0.3 s of the part).
+  const bool overlapping = overlapping_windows(window, start_stride);
   Sums consecutive;
-  for (size_t k0 = 0; k0 + 1 < S.size();) {
+  for (size_t k0 = 0; k0 + 1 < S.size() && (keep_trace || !overlapping);) {
     if (!start.settled(k0)) {
       ++k0;
       continue;
     }
-    const size_t k = run_window(k0, consecutive, true);
+    const size_t k = run_window(k0, consecutive, keep_trace);
     if (k == S.size()) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    out.t.push_back(S[k].t);
-    for (auto* v : {&out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->push_back(nan);
+    if (keep_trace) {
+      out.t.push_back(S[k].t);
+      for (auto* v : {&out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->push_back(nan);
+    }
     k0 = std::max(k, k0 + 1);
   }
   // The scores: from the consecutive windows, or from windows started every `start_stride`
   // seconds (overlapping; each sample is scored at several horizons).
   Sums scored = consecutive;
-  if (overlapping_windows(window, start_stride)) {
+  if (overlapping) {
     scored = {};
     double next_start = S.front().t;
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {

@@ -115,6 +115,13 @@ TEST(Prediction, LaggedAndDelayedRotorsStartWhereTheyWereInEveryRollout) {
     const auto w = quadgen::diagnose::simulate_windows(m, params, g.flight, 1.0, stride);
     EXPECT_LT(w.rate_rmse, 0.03) << stride;
     EXPECT_LT(w.position_rmse, 0.02) << stride;
+    // Without the plotted trace the scores are the same (the trace is not simulated when the
+    // overlapping windows score).
+    const auto scores_only = quadgen::diagnose::simulate_windows(m, params, g.flight, 1.0, stride, false);
+    EXPECT_EQ(scores_only.position_rmse, w.position_rmse) << stride;
+    EXPECT_EQ(scores_only.rate_rmse, w.rate_rmse) << stride;
+    EXPECT_TRUE(scores_only.t.empty() && scores_only.e_pos.empty()) << stride;
+    EXPECT_FALSE(w.t.empty()) << stride;
   }
 }
 
