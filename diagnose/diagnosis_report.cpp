@@ -637,6 +637,9 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
        << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
        << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")\n";
+  if (d.has_prediction)
+    if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
+      os << "prediction of the extended model on the held-out part: " << limits << "\n";
   return os.str();
 }
 
