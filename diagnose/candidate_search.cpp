@@ -18,6 +18,7 @@
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
 #include "fit/evaluation_threads.hpp"
+#include "output/estimate.hpp"
 
 namespace quadgen::diagnose {
 
@@ -236,7 +237,7 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
         !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
     const std::string unit = p.unit.empty() || p.unit == "1" ? "" : " " + p.unit;
-    return p.name + " = " + short_number(p.value) + unit + " outside [" + short_number(lo) + ", " + short_number(hi) + "]";
+    return p.name + " = " + output::short_number(p.value) + unit + " outside [" + output::short_number(lo) + ", " + output::short_number(hi) + "]";
   }
   return "";
 }

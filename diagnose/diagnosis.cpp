@@ -18,6 +18,7 @@
 #include "runtime/per_flight_model.hpp"
 #include "runtime/tape.hpp"
 #include "codegen/tape_builder.hpp"
+#include "output/estimate.hpp"
 
 namespace quadgen::diagnose {
 
@@ -147,7 +148,7 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
 // What a held-out position metric's name says about its windows: ", started every 0.1 s"
 // when they overlap, nothing when they are consecutive.
 std::string stride_clause(double window, double start_stride) {
-  return overlapping_windows(window, start_stride) ? ", started every " + short_number(start_stride) + " s" : "";
+  return overlapping_windows(window, start_stride) ? ", started every " + output::short_number(start_stride) + " s" : "";
 }
 
 // What the proposed terms buy in a simulation, like an effect: the full-catalogue model with
@@ -184,7 +185,7 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   };
   const auto without = values(false), with = values(true);
   g.measured = true;
-  g.metric = "position RMSE of " + short_number(window) + " s open-loop windows on the held-out part" +
+  g.metric = "position RMSE of " + output::short_number(window) + " s open-loop windows on the held-out part" +
              stride_clause(window, window_stride) + " [m]";
   double sum_before = 0, sum_after = 0;
   for (const auto& f : folds) {
@@ -574,18 +575,18 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // Significant on the training data but no held-out gain in the search itself: suspected.
   for (const auto& ev : d.search.training_only)
     d.suspected.push_back(held_out_suspect(ev.effect, ev, ev.validation_cost_before, ev.validation_cost_after,
-                                           "improves the training data (p = " + short_number(ev.p_value) +
+                                           "improves the training data (p = " + output::short_number(ev.p_value) +
                                                ") but not the held-out part (its equation-error cost rises by " +
-                                               short_number(-ev.validation_gain_percent) + " %)"));
+                                               output::short_number(-ev.validation_gain_percent) + " %)"));
   // Taken out by the backward pass because the held-out part is better without it, while
   // the training data still want it: suspected too.
   for (const auto& rm : d.search.removed)
     if (rm.held_out_failure)
       d.suspected.push_back(held_out_suspect(rm.effect, {}, rm.validation_cost_without, rm.validation_cost_with,
                                              "significant on the training data in the final model (p = " +
-                                                 short_number(rm.p_value) +
+                                                 output::short_number(rm.p_value) +
                                                  "), but the held-out part is better without it (its equation-error "
-                                                 "cost rises by " + short_number(-rm.validation_gain_percent) +
+                                                 "cost rises by " + output::short_number(-rm.validation_gain_percent) +
                                                  " %); removed by the backward pass"));
   const SearchResult& s = d.search;
   // What is wrong, before and after, over the whole flight.

@@ -11,6 +11,7 @@
 #include "fit/least_squares.hpp"
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
+#include "output/estimate.hpp"
 
 namespace quadgen::diagnose {
 
@@ -232,7 +233,7 @@ std::string DiscoveredTerm::expression() const {
   if (coefficients.empty()) os << " 0";
   for (size_t i = 0; i < coefficients.size(); ++i) {
     const double v = coefficients[i].value;
-    os << (i == 0 ? (v < 0 ? " -" : " ") : (v < 0 ? " - " : " + ")) << short_number(std::abs(v));
+    os << (i == 0 ? (v < 0 ? " -" : " ") : (v < 0 ? " - " : " + ")) << output::short_number(std::abs(v));
     if (coefficients[i].regressor != "1") os << " " << coefficients[i].regressor;
   }
   return os.str();
@@ -355,8 +356,8 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
     double ss = 0;
     for (double g : d.fold_gains) ss += (g - d.gain_mean) * (g - d.gain_mean);
     d.gain_standard_error = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
-    const std::string held = "held-out RMS " + short_number(d.valid_rms_before) + " -> " + short_number(d.valid_rms_after) + " " +
-                             d.unit + " (gain " + short_number(d.gain_mean) + " +- " + short_number(d.gain_standard_error) +
+    const std::string held = "held-out RMS " + output::short_number(d.valid_rms_before) + " -> " + output::short_number(d.valid_rms_after) + " " +
+                             d.unit + " (gain " + output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) +
                              " over " + std::to_string(d.fold_gains.size()) + " blocks)";
     d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
     d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;

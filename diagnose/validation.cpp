@@ -13,13 +13,6 @@
 
 namespace quadgen::diagnose {
 
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
-}
-
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window, double start_stride, bool keep_trace) {
   if (f.samples.size() < 2) return {};  // no window to simulate
@@ -49,9 +42,12 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     size_t count = 0;
   };
   // One window from sample k0: integrates until `window` seconds or a gap, scores each
-  // sample into `sums` and, with `trace`, appends it to the plotted trace. Returns the
-  // window's last sample, or S.size() if the simulation left the finite numbers.
-  auto run_window = [&](size_t k0, Sums& sums, bool trace) {
+  // sample into `sums` and, with `trace`, appends it to the plotted trace.
+  struct WindowEnd {
+    size_t last;    // the window's last sample scored (k0 if none)
+    bool diverged;  // the simulation left the finite numbers after `last`
+  };
+  auto run_window = [&](size_t k0, Sums& sums, bool trace) -> WindowEnd {
     e = start.effects_at(k0);
     first_command = stretch[k0];
     std::vector<double> x = start.at(k0);
@@ -61,7 +57,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       try {
         x = runtime::integrate_rk4(model, x, inputs, S[k].t, S[k + 1].t, io).x.back();
       } catch (const std::exception&) {
-        return S.size();
+        return {k, true};
       }
       const auto& m = S[k + 1].x;
       double e2 = 0, v2 = 0, w2 = 0;
@@ -87,7 +83,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       out.e_att.push_back(angle);
       out.e_rate.push_back(std::sqrt(w2));
     }
-    return k;
+    return {k, false};
   };
   const double inf = std::numeric_limits<double>::infinity();
   auto diverged = [&] {  // no error measure is meaningful (diagnosis.json shows null)
@@ -96,6 +92,9 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   };
   // The plotted trace: consecutive windows, NaN between them. A window starts only where the
   // rotor speeds are known (StartStates::settled: not in the first 0.3 s of the part).
+  // Divergence is decided by the windows that are scored: when the scores come from the
+  // overlapping windows, a diverging trace window just ends there (so that the scores do not
+  // depend on whether a trace is kept).
   const bool overlapping = overlapping_windows(window, start_stride);
   Sums consecutive;
   for (size_t k0 = 0; k0 + 1 < S.size() && (keep_trace || !overlapping);) {
@@ -103,8 +102,8 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       ++k0;
       continue;
     }
-    const size_t k = run_window(k0, consecutive, keep_trace);
-    if (k == S.size()) return diverged();
+    const auto [k, window_diverged] = run_window(k0, consecutive, keep_trace);
+    if (window_diverged && !overlapping) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     if (keep_trace) {
       out.t.push_back(S[k].t);
@@ -121,7 +120,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
       if (S[k0].t + 1e-9 < next_start || !start.settled(k0)) continue;
       next_start = S[k0].t + start_stride;
-      if (run_window(k0, scored, false) == S.size()) return diverged();
+      if (run_window(k0, scored, false).diverged) return diverged();
     }
   }
   const double samples = static_cast<double>(std::max<size_t>(scored.count, 1));

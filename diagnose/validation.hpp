@@ -18,9 +18,6 @@ inline double percent_lower(double before, double after) {
   return 100 * (before - after) / std::max(1e-300, before);
 }
 
-// Three significant digits, as the diagnosis' reasons print numbers.
-std::string short_number(double v);
-
 struct WindowedSimulation {
   double position_rmse = 0;  // m, over every sample of every window
   double velocity_rmse = 0;  // m/s

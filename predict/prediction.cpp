@@ -104,6 +104,7 @@ class Rollout {
       stage(x, k3_, h);
       deriv(t + h, tmp_, k, replay, k4_);
       for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
+      normalise_quaternion(x);  // after full steps only, in every view alike
       impose(replay, t + h, k, x);
     }
     for (double v : x)
@@ -111,11 +112,11 @@ class Rollout {
     return true;
   }
 
-  // What `replay` takes from the log at time t in [t_k, t_k+1]; the quaternion normalised.
+  // What `replay` takes from the log at time t in [t_k, t_k+1] (an imposed attitude is a unit
+  // quaternion; an integrated one is left as the RK4 stage made it, as in the open loop).
   void impose(Replay replay, double t, size_t k, std::vector<double>& x) const {
     if (replay == Replay::kAttitude) impose_attitude(t, k, x);
     if (replay == Replay::kTranslation) impose_translation(t, k, x);
-    normalise_quaternion(x);
   }
 
   // The logged position and velocity at time t in [t_k, t_k+1], interpolated.
@@ -210,7 +211,7 @@ double median_spacing(const fit::Flight& f) {
 // Rollouts from start points every `stride` seconds; the error at each horizon is taken at
 // the first sample at or after start + horizon (within a quarter of a sample spacing).
 std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, Replay replay,
-                                    size_t* starts) {
+                                    size_t* starts = nullptr) {
   std::vector<HorizonErrors> rows;
   for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
   const auto& S = f.samples;
@@ -220,9 +221,11 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     if (S[k0].t + 1e-9 < next_start || !roll.may_start_at(k0)) continue;
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
-    ++*starts;
+    if (starts) ++*starts;
     const DataSideEffects& e = roll.start_at(k0);
     std::vector<double> x = roll.initial_state(k0);
+    // The measured state already, but the same interpolation as every later step imposes
+    // (attitude: unbiased with this rollout's bias, renormalised).
     roll.impose(replay, S[k0].t, k0, x);
     size_t next = 0;  // the next horizon to score
     for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
@@ -339,11 +342,9 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   model.set_params(p);
   if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with
   Rollout roll(model, f, p, o.step);
-  size_t starts = 0;
   out.open_loop = rollouts(roll, f, o, Replay::kNothing, &out.start_points);
-  out.attitude_replayed = rollouts(roll, f, o, Replay::kAttitude, &starts);
-  starts = 0;
-  out.translation_replayed = rollouts(roll, f, o, Replay::kTranslation, &starts);
+  out.attitude_replayed = rollouts(roll, f, o, Replay::kAttitude);
+  out.translation_replayed = rollouts(roll, f, o, Replay::kTranslation);
   return out;
 }
 
@@ -370,13 +371,6 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 
 namespace {
 
-std::string three_digits(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
-}
-
 // The row of `rows` whose horizon is nearest to h (rows not empty).
 const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
   return *std::min_element(rows.begin(), rows.end(), [h](const HorizonErrors& a, const HorizonErrors& b) {
@@ -388,22 +382,30 @@ const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
 
 std::string what_limits_prediction(const Prediction& p) {
   if (p.open_loop.empty() || p.attitude_replayed.size() != p.open_loop.size()) return "";
-  const HorizonErrors &open = p.open_loop.back(), &replayed = p.attitude_replayed.back();
+  // The views' rows are in the order of PredictionOptions::horizons, which need not be sorted.
+  const auto by_horizon = [](const HorizonErrors& a, const HorizonErrors& b) { return a.horizon < b.horizon; };
+  const size_t longest = static_cast<size_t>(std::max_element(p.open_loop.begin(), p.open_loop.end(), by_horizon) - p.open_loop.begin());
+  const HorizonErrors &open = p.open_loop[longest], &replayed = p.attitude_replayed[longest];
   const double both = open.position.mean(), forces = replayed.position.mean();
   if (!(both > 0) || !std::isfinite(forces)) return "";
-  std::string s = "At " + three_digits(open.horizon) + " s the open-loop position error is " + three_digits(both) +
-                  " m; with the measured attitude replayed (the force model alone) " + three_digits(forces) + " m";
+  std::string s = "At " + output::short_number(open.horizon) + " s the open-loop position error is " + output::short_number(both) +
+                  " m; with the measured attitude replayed (the force model alone) " + output::short_number(forces) + " m";
   if (forces < both)
     s += ", so " + std::to_string(static_cast<int>(std::lround(100 * (1 - forces / both)))) +
          " % of it comes from the attitude.";
   else
     s += ": the attitude does not add to it, the force model is what limits it.";
   if (p.translation_replayed.size() != p.open_loop.size()) return s;
+  // Near 0.5 s: long enough for the tilt to have grown well past the start's (at 0.1 s the
+  // views agree by construction), short enough that the open loop has not yet left the
+  // measured velocity so far that its airspeed terms (flapping) act on another flight. 0.8:
+  // the moments alone drifting at least 80 % as far means the translation adds at most a
+  // fifth (on the real flights they drift 1.2-1.8 times as far: docs/validation.md).
   const HorizonErrors &tilt_open = nearest(p.open_loop, 0.5), &tilt_moments = nearest(p.translation_replayed, 0.5);
   const double a = tilt_open.tilt.mean(), m = tilt_moments.tilt.mean();
   if (!std::isfinite(a) || !std::isfinite(m)) return s;
-  s += " At " + three_digits(tilt_open.horizon) + " s the moment model alone (translation replayed) tilts by " +
-       three_digits(m) + " rad against " + three_digits(a) + " rad open loop: ";
+  s += " At " + output::short_number(tilt_open.horizon) + " s the moment model alone (translation replayed) tilts by " +
+       output::short_number(m) + " rad against " + output::short_number(a) + " rad open loop: ";
   s += m >= 0.8 * a ? "the attitude drift is the moment model's own error."
                     : "the attitude drift grows through the simulated translation (the force model's error turns the vehicle).";
   return s;

@@ -28,7 +28,7 @@
 namespace quadgen::predict {
 
 struct PredictionOptions {
-  std::vector<double> horizons = {0.1, 0.25, 0.5, 1.0};  // s, both rollout views
+  std::vector<double> horizons = {0.1, 0.25, 0.5, 1.0};  // s, every rollout view
   double start_stride = 0.05;  // s between start points (5 samples at 100 Hz)
   double step = 1e-3;          // s, RK4 step
   // A start whose horizon crosses a gap in the log (trimmed ground contact) is not counted.

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """What is left of the roll and pitch moments after a diagnosis, and whether anything simple
 predicts it on the held-out part. Reads a diagnosis folder's residuals.csv (the extended
-model's equation-error residuals, the held-out part starting where its title says) and the
-log it was fitted to (the NanoBench column names), and prints per channel (pdot, qdot):
+model's equation-error residuals; the held-out part starts at diagnosis.json's
+samples.validation_from_s) and the log it was fitted to (the NanoBench column names), and prints per channel (pdot, qdot):
 
   - the held-out mean and RMS of the residual, and the RMS of its 0.25 s running mean: when
     that is close to the RMS, the residual is slow, and an open-loop rollout integrates it
@@ -16,6 +16,7 @@ log it was fitted to (the NanoBench column names), and prints per channel (pdot,
 Usage: slow_moment_residual.py DIAGNOSIS_DIR LOG.csv"""
 import bisect
 import csv
+import json
 import math
 import sys
 
@@ -51,12 +52,28 @@ def rms(values):
     return math.sqrt(sum(v * v for v in values) / len(values))
 
 
+def running_means(points, width):
+    """Means of the values whose times lie in [t, t + width), for a start t every fifth point
+    (residuals.csv may be thinned, so the window is a time span, not a sample count)."""
+    means, end, total = [], 0, 0.0
+    for i, (t, _) in enumerate(points):
+        while end < len(points) and points[end][0] < t + width:
+            total += points[end][1]
+            end += 1
+        if points[-1][0] < t + width:
+            break  # the last window must be full
+        if i % 5 == 0:
+            means.append(total / (end - i))
+        total -= points[i][1]
+    return means
+
+
 def main(diagnosis, log_path):
     log = list(csv.DictReader(open(log_path)))
     t_first = float(log[0]["t"])
     log_t = [float(r["t"]) - t_first for r in log]
     rows = list(csv.DictReader(open(f"{diagnosis}/residuals.csv")))
-    held_out_from = float(rows[0]["plot"].split("t = ")[1].split(" ")[0])
+    held_out_from = json.load(open(f"{diagnosis}/diagnosis.json"))["samples"]["validation_from_s"]
     for channel in ("pdot", "qdot"):
         data = []
         for r in rows:
@@ -66,8 +83,7 @@ def main(diagnosis, log_path):
         train = [d for d in data if d[0] < held_out_from]
         held = [d for d in data if d[0] >= held_out_from]
         y = [v for *_, v in held]
-        window = 25  # samples: 0.25 s at 100 Hz
-        running = [sum(y[i:i + window]) / window for i in range(0, len(y) - window, 5)]
+        running = running_means([(t, v) for t, _, v in held], 0.25)
         line = [f"{channel}: held-out mean {sum(y) / len(y):.2f}, RMS {rms(y):.2f}, 0.25 s running mean RMS {rms(running):.2f};"
                 " after a correction fitted on the training part:"]
         for kind in CORRECTIONS:
