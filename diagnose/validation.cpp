@@ -7,9 +7,8 @@
 
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
-#include "runtime/integrator.hpp"
 #include "runtime/per_flight_model.hpp"
-#include "predict/start_state.hpp"
+#include "predict/rollout.hpp"
 
 namespace quadgen::diagnose {
 
@@ -18,22 +17,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
-  const predict::StartStates start(model, sim_params, f);  // each window's first state
-  runtime::DataSideEffects e;  // in effect over the current window
-  // Delayed commands are not read from before the window's stretch (a previous joined flight).
-  const std::vector<size_t>& stretch = start.stretch_starts();
-  size_t first_command = 0;
-  const int t_in = model.input_index("t"), v_in = model.input_index("vbat");
-  const size_t nr = f.samples.front().u.size();
-  auto inputs = [&](double t, double* u) {
-    const auto& s = f.samples[predict::command_sample(f, t, e.delay, first_command)];
-    for (size_t i = 0; i < nr; ++i) u[i] = s.u[i];
-    if (t_in >= 0) u[t_in] = t;
-    if (v_in >= 0) u[v_in] = f.samples[predict::held_sample(f, t)].vbat;
-  };
-  runtime::IntegratorOptions io;
-  io.step = 1e-3;  // well inside RK4's stability limit for rotor lags down to 0.4 ms
-  io.divergence_bound = 1e6;
+  predict::Rollout roll(model, f, sim_params);  // the prediction's rollout, open loop
   WindowedSimulation out;
   const auto& S = f.samples;
   // Sums of squared errors over every scored sample.
@@ -48,17 +32,12 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     bool diverged;  // the simulation left the finite numbers after `last`
   };
   auto run_window = [&](size_t k0, Sums& sums, bool trace) -> WindowEnd {
-    e = start.effects_at(k0);
-    first_command = stretch[k0];
-    std::vector<double> x = start.at(k0);
+    const runtime::DataSideEffects& e = roll.start_at(k0);
+    std::vector<double> x = roll.initial_state(k0, predict::Replay::kNothing);
     size_t k = k0;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
       if (S[k + 1].t - S[k].t > 0.1) break;  // a gap (trimmed ground contact): new window
-      try {
-        x = runtime::integrate_rk4(model, x, inputs, S[k].t, S[k + 1].t, io).x.back();
-      } catch (const std::exception&) {
-        return {k, true};
-      }
+      if (!roll.advance(x, k, predict::Replay::kNothing)) return {k, true};
       const auto& m = S[k + 1].x;
       double e2 = 0, v2 = 0, w2 = 0;
       for (int a = 0; a < 3; ++a) {
@@ -98,7 +77,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   const bool overlapping = overlapping_windows(window, start_stride);
   Sums consecutive;
   for (size_t k0 = 0; k0 + 1 < S.size() && (keep_trace || !overlapping);) {
-    if (!start.settled(k0)) {
+    if (!roll.may_start_at(k0)) {
       ++k0;
       continue;
     }
@@ -118,7 +97,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     scored = {};
     double next_start = S.front().t;
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
-      if (S[k0].t + 1e-9 < next_start || !start.settled(k0)) continue;
+      if (S[k0].t + 1e-9 < next_start || !roll.may_start_at(k0)) continue;
       next_start = S[k0].t + start_stride;
       if (run_window(k0, scored, false).diverged) return diverged();
     }

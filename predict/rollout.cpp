@@ -1,0 +1,119 @@
+#include "predict/rollout.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "runtime/attitude.hpp"
+
+namespace quadgen::predict {
+
+namespace {
+
+void normalise_quaternion(std::vector<double>& x) {
+  const double n = std::sqrt(x[6] * x[6] + x[7] * x[7] + x[8] * x[8] + x[9] * x[9]);
+  if (n > 0)
+    for (int i = 6; i < 10; ++i) x[i] /= n;
+}
+
+// The weight of sample k + 1 at time t in [t_k, t_k+1] for linear interpolation.
+double weight(const fit::FlightSample& a, const fit::FlightSample& b, double t) {
+  return b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
+}
+
+}  // namespace
+
+Rollout::Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step)
+    : m_(model), f_(f), start_(model, p, f), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
+      k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
+  t_in_ = model.input_index("t");
+  v_in_ = model.input_index("vbat");
+}
+
+const runtime::DataSideEffects& Rollout::start_at(size_t k) {
+  first_command_ = start_.stretch_starts()[k];
+  return e_ = start_.effects_at(k);
+}
+
+std::vector<double> Rollout::initial_state(size_t k, Replay replay) const {
+  std::vector<double> x = start_.at(k);
+  // The measured state already, but imposed the way every later step imposes it (attitude:
+  // unbiased with this rollout's bias, renormalised), so that a replayed view starts exactly
+  // on what it replays.
+  impose(replay, f_.samples[k].t, k, x);
+  return x;
+}
+
+bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
+  const double t0 = f_.samples[k].t, t1 = f_.samples[k + 1].t;
+  const int steps = std::max(1, static_cast<int>(std::ceil((t1 - t0) / step_ - 1e-9)));
+  const double h = (t1 - t0) / steps;
+  for (int i = 0; i < steps; ++i) {
+    const double t = t0 + i * h;
+    deriv(t, x, k, replay, k1_);
+    stage(x, k1_, h / 2);
+    deriv(t + h / 2, tmp_, k, replay, k2_);
+    stage(x, k2_, h / 2);
+    deriv(t + h / 2, tmp_, k, replay, k3_);
+    stage(x, k3_, h);
+    deriv(t + h, tmp_, k, replay, k4_);
+    for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
+    normalise_quaternion(x);  // after full steps only, in every view alike
+    impose(replay, t + h, k, x);
+  }
+  for (double v : x)
+    if (!std::isfinite(v) || std::fabs(v) > 1e6) return false;
+  return true;
+}
+
+// An imposed attitude is a unit quaternion; an integrated one is left as the RK4 stage made
+// it, as in the open loop.
+void Rollout::impose(Replay replay, double t, size_t k, std::vector<double>& x) const {
+  if (replay == Replay::kAttitude) impose_attitude(t, k, x);
+  if (replay == Replay::kTranslation) impose_translation(t, k, x);
+}
+
+// The logged position and velocity at time t in [t_k, t_k+1], interpolated.
+void Rollout::impose_translation(double t, size_t k, std::vector<double>& x) const {
+  const auto& a = f_.samples[k];
+  const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
+  const double w = weight(a, b, t);
+  for (int i = 0; i < 6; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
+}
+
+// The logged attitude (unbiased) and body rates at time t in [t_k, t_k+1], interpolated.
+void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const {
+  const auto& a = f_.samples[k];
+  const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
+  const double w = weight(a, b, t);
+  double qa[4], qb[4];
+  runtime::unbias_attitude(&a.x[6], e_.roll, e_.pitch, qa);
+  runtime::unbias_attitude(&b.x[6], e_.roll, e_.pitch, qb);
+  const double sign = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0 ? -1.0 : 1.0;
+  for (int i = 0; i < 4; ++i) x[6 + i] = (1 - w) * qa[i] + w * sign * qb[i];
+  normalise_quaternion(x);
+  for (int i = 0; i < 3; ++i) x[10 + i] = (1 - w) * a.x[10 + i] + w * b.x[10 + i];
+}
+
+void Rollout::inputs(double t, double* u) const {
+  const auto& s = f_.samples[command_sample(f_, t, e_.delay, first_command_)];
+  std::copy(s.u.begin(), s.u.end(), u);
+  if (t_in_ >= 0) u[t_in_] = t;
+  if (v_in_ >= 0) u[v_in_] = f_.samples[held_sample(f_, t)].vbat;
+}
+
+void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {
+  const std::vector<double>* state = &x;
+  if (replay != Replay::kNothing) {
+    forced_ = x;
+    impose(replay, t, k, forced_);
+    state = &forced_;
+  }
+  inputs(t, u_.data());
+  m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
+}
+
+void Rollout::stage(const std::vector<double>& x, const std::vector<double>& k, double h) {
+  for (int j = 0; j < n_; ++j) tmp_[j] = x[j] + h * k[j];
+}
+
+}  // namespace quadgen::predict
