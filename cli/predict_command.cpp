@@ -40,6 +40,10 @@ void add_predict(CLI::App& app, PredictArgs& a) {
               "also the one-step errors after a linear correction fitted on the part before the evaluated one (on "
               "the nominal model: a linear-regression baseline on the same split)");
   c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(0.001, 10));
+  c->add_option("--disturbance-window", a.options.prediction.disturbance_window,
+                "seconds of log before each start whose mean acceleration residual the open loop with the past "
+                "disturbance holds (0: that view is not run)")
+      ->check(finite_range(0.0, 10));
 }
 
 int run_predict(const PredictArgs& a) {

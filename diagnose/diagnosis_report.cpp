@@ -874,7 +874,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state); one-step errors only.</p>\n";
     h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
          "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
-         "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th></tr>\n";
+         "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
+         "<th>position, past disturbance held [m]</th></tr>\n";
     const auto& b = d.prediction_before;
     const auto& a = d.prediction_after;
     for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
@@ -882,7 +883,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << num(a.open_loop[i].position.mean()) << "</td><td>" << num(a.open_loop[i].tilt.mean()) << "</td><td>"
         << num(a.open_loop[i].heading.mean()) << "</td><td>"
         << (i < a.attitude_replayed.size() ? num(a.attitude_replayed[i].position.mean()) : "–") << "</td><td>"
-        << (i < a.translation_replayed.size() ? num(a.translation_replayed[i].tilt.mean()) : "–") << "</td></tr>\n";
+        << (i < a.translation_replayed.size() ? num(a.translation_replayed[i].tilt.mean()) : "–") << "</td><td>"
+        << (i < a.open_loop_past_disturbance.size() ? num(a.open_loop_past_disturbance[i].position.mean()) : "–")
+        << "</td></tr>\n";
     h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
       << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "
       << num(a.one_step.specific_force[2].rms(), 3) << " m/s², angular acceleration "

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
@@ -32,8 +31,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     bool diverged;  // the simulation left the finite numbers after `last`
   };
   auto run_window = [&](size_t k0, Sums& sums, bool trace) -> WindowEnd {
-    const runtime::DataSideEffects& e = roll.start_at(k0);
-    std::vector<double> x = roll.initial_state(k0, predict::Replay::kNothing);
+    auto [e, x] = roll.start_at(k0, predict::Replay::kNothing);
     size_t k = k0;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
       if (S[k + 1].t - S[k].t > 0.1) break;  // a gap (trimmed ground contact): new window
@@ -81,10 +79,13 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       ++k0;
       continue;
     }
+    const size_t trace_before = out.t.size();
     const auto [k, window_diverged] = run_window(k0, consecutive, keep_trace);
     if (window_diverged && !overlapping) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     if (keep_trace) {
+      if (window_diverged)  // its points up to the bound would only stretch the plot's axes
+        for (auto* v : {&out.t, &out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->resize(trace_before);
       out.t.push_back(S[k].t);
       for (auto* v : {&out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->push_back(nan);
     }

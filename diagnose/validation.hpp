@@ -35,7 +35,10 @@ inline bool overlapping_windows(double window, double start_stride) { return sta
 // The RMSEs come from windows started every `start_stride` seconds (overlapping: see
 // overlapping_windows), or else from the consecutive windows of the plotted trace. Without
 // `keep_trace` the trace is left empty, and with overlapping windows not simulated at all
-// (about a tenth of the work at the default 0.1 s stride of 1 s windows).
+// (about a tenth of the work at the default 0.1 s stride of 1 s windows). A scored window
+// that diverges makes every RMSE infinite; with overlapping windows a diverging window of
+// the trace only ends that window (and is left out of the plot), so that the scores do not
+// depend on keep_trace.
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& flight, double window_seconds, double start_stride = 0,
                                     bool keep_trace = true);

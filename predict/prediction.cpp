@@ -44,11 +44,13 @@ void Prediction::merge(const Prediction& o) {
   merge_rows(open_loop, o.open_loop);
   merge_rows(attitude_replayed, o.attitude_replayed);
   merge_rows(translation_replayed, o.translation_replayed);
+  merge_rows(open_loop_past_disturbance, o.open_loop_past_disturbance);
   one_step.merge(o.one_step);
   if (o.one_step_corrected) {
     if (!one_step_corrected) one_step_corrected = OneStepErrors{};
     one_step_corrected->merge(*o.one_step_corrected);
   }
+  if (disturbance_window == 0) disturbance_window = o.disturbance_window;
   start_points += o.start_points;
   seconds_of_data += o.seconds_of_data;
 }
@@ -93,7 +95,7 @@ double median_spacing(const fit::Flight& f) {
 // Rollouts from start points every `stride` seconds; the error at each horizon is taken at
 // the first sample at or after start + horizon (within a quarter of a sample spacing).
 std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, Replay replay,
-                                    size_t* starts = nullptr) {
+                                    size_t* starts = nullptr, double disturbance_window = 0) {
   std::vector<HorizonErrors> rows;
   for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
   const auto& S = f.samples;
@@ -104,8 +106,8 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
     if (starts) ++*starts;
-    const DataSideEffects& e = roll.start_at(k0);
-    std::vector<double> x = roll.initial_state(k0, replay);
+    roll.hold_disturbance(disturbance_window > 0 ? roll.past_disturbance(k0, disturbance_window) : std::array<double, 6>{});
+    auto [e, x] = roll.start_at(k0, replay);
     size_t next = 0;  // the next horizon to score
     for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
       if (S[k + 1].t - S[k].t > o.max_gap) break;
@@ -224,6 +226,11 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   out.open_loop = rollouts(roll, f, o, Replay::kNothing, &out.start_points);
   out.attitude_replayed = rollouts(roll, f, o, Replay::kAttitude);
   out.translation_replayed = rollouts(roll, f, o, Replay::kTranslation);
+  if (o.disturbance_window > 0) {
+    out.disturbance_window = o.disturbance_window;
+    out.open_loop_past_disturbance = rollouts(roll, f, o, Replay::kNothing, nullptr, o.disturbance_window);
+    roll.hold_disturbance({});
+  }
   return out;
 }
 
@@ -274,6 +281,17 @@ std::string what_limits_prediction(const Prediction& p) {
          " % of it comes from the attitude.";
   else
     s += ": the attitude does not add to it, the force model is what limits it.";
+  if (p.open_loop_past_disturbance.size() == p.open_loop.size()) {
+    const double held = p.open_loop_past_disturbance[longest].position.mean();
+    if (std::isfinite(held))
+      s += " Holding the disturbance of the last " + output::short_number(p.disturbance_window) +
+           " s before each start (the mean acceleration residual) " +
+           (held < both ? "lowers it to " + output::short_number(held) + " m: " +
+                              std::to_string(static_cast<int>(std::lround(100 * (1 - held / both)))) +
+                              " % of it is a disturbance slow enough to persist over the horizon, which the model does "
+                              "not carry."
+                        : "does not lower it (" + output::short_number(held) + " m): the error is not a slow disturbance.");
+  }
   if (p.translation_replayed.size() != p.open_loop.size()) return s;
   // Near 0.5 s: long enough for the tilt to have grown well past the start's (at 0.1 s the
   // views agree by construction), short enough that the open loop has not yet left the
@@ -317,15 +335,19 @@ nlohmann::ordered_json one_step_json(const OneStepErrors& o) {
 
 nlohmann::ordered_json prediction_json(const Prediction& p) {
   using J = nlohmann::ordered_json;
-  J open = J::array(), replayed = J::array();
-  for (const auto& h : p.open_loop)
-    open.push_back({{"horizon_s", h.horizon},
-                    {"position_m", stats_json(h.position)},
-                    {"velocity_m_s", stats_json(h.velocity)},
-                    {"tilt_rad", stats_json(h.tilt)},
-                    {"heading_rad", stats_json(h.heading)},
-                    {"body_rates_rad_s", stats_json(h.body_rates)},
-                    {"diverged", h.diverged}});
+  auto full_rows = [](const std::vector<HorizonErrors>& rows) {  // an open loop: every quantity
+    J out = J::array();
+    for (const auto& h : rows)
+      out.push_back({{"horizon_s", h.horizon},
+                     {"position_m", stats_json(h.position)},
+                     {"velocity_m_s", stats_json(h.velocity)},
+                     {"tilt_rad", stats_json(h.tilt)},
+                     {"heading_rad", stats_json(h.heading)},
+                     {"body_rates_rad_s", stats_json(h.body_rates)},
+                     {"diverged", h.diverged}});
+    return out;
+  };
+  J replayed = J::array();
   for (const auto& h : p.attitude_replayed)
     replayed.push_back({{"horizon_s", h.horizon},
                         {"position_m", stats_json(h.position)},
@@ -338,9 +360,11 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
                        {"heading_rad", stats_json(h.heading)},
                        {"body_rates_rad_s", stats_json(h.body_rates)},
                        {"diverged", h.diverged}});
-  J out = {{"open_loop", open},
+  J out = {{"open_loop", full_rows(p.open_loop)},
           {"attitude_replayed", replayed},
           {"translation_replayed", moments},
+          {"open_loop_past_disturbance", full_rows(p.open_loop_past_disturbance)},
+          {"disturbance_window_s", p.disturbance_window},
           {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
@@ -372,6 +396,13 @@ std::string prediction_csv(const Prediction& p) {
   for (const auto& h : p.attitude_replayed) {
     row("attitude_replayed", h.horizon, "position", "m", h.position);
     row("attitude_replayed", h.horizon, "velocity", "m/s", h.velocity);
+  }
+  for (const auto& h : p.open_loop_past_disturbance) {
+    row("open_loop_past_disturbance", h.horizon, "position", "m", h.position);
+    row("open_loop_past_disturbance", h.horizon, "velocity", "m/s", h.velocity);
+    row("open_loop_past_disturbance", h.horizon, "tilt", "rad", h.tilt);
+    row("open_loop_past_disturbance", h.horizon, "heading", "rad", h.heading);
+    row("open_loop_past_disturbance", h.horizon, "body_rates", "rad/s", h.body_rates);
   }
   for (const auto& h : p.translation_replayed) {
     row("translation_replayed", h.horizon, "tilt", "rad", h.tilt);
@@ -408,7 +439,7 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   for (const auto& [label, p] : predictions) {
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
     runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true},
-        sm{label, {}, {}};
+        sm{label, {}, {}}, sd{label + ", past disturbance held", {}, {}, true};
     for (const auto& h : p->open_loop) {
       so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
       st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());
@@ -416,7 +447,9 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
     }
     for (const auto& h : p->attitude_replayed) sr.x.push_back(h.horizon), sr.y.push_back(h.position.mean());
     for (const auto& h : p->translation_replayed) sm.x.push_back(h.horizon), sm.y.push_back(h.tilt.mean());
+    for (const auto& h : p->open_loop_past_disturbance) sd.x.push_back(h.horizon), sd.y.push_back(h.position.mean());
     open.series.push_back(so);
+    if (!sd.x.empty()) open.series.push_back(sd);
     replay.series.push_back(sr);
     tilt.series.push_back(st);
     tilt.series.push_back(sh);

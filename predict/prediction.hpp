@@ -33,6 +33,9 @@ struct PredictionOptions {
   double step = 1e-3;          // s, RK4 step
   // A start whose horizon crosses a gap in the log (trimmed ground contact) is not counted.
   double max_gap = 0.1;  // s
+  // Seconds of log before each start from which the open loop with the past disturbance
+  // takes the disturbance it holds (Rollout::past_disturbance); 0: that view is not run.
+  double disturbance_window = 0.5;
 };
 
 // Mean and RMS of an error over start points; kept as sums so that flights can be pooled.
@@ -71,6 +74,13 @@ struct OneStepErrors {
 
 struct Prediction {
   std::vector<HorizonErrors> open_loop, attitude_replayed, translation_replayed;
+  // The open loop holding the disturbance the log showed just before each start (the mean
+  // acceleration residual over PredictionOptions::disturbance_window, Rollout::
+  // past_disturbance): a predictor that reads the recent past, as an observer would. Against
+  // the open loop it says how much of the error is a disturbance slow enough to persist
+  // over the horizon, which the model does not carry.
+  std::vector<HorizonErrors> open_loop_past_disturbance;
+  double disturbance_window = 0;  // s
   OneStepErrors one_step;
   // With a linear correction fitted on the part before (linearly_corrected_one_step).
   std::optional<OneStepErrors> one_step_corrected;
@@ -101,7 +111,8 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 // position error at the longest horizon that the attitude causes (open loop against attitude
 // replayed), and near 0.5 s whether the attitude drift is the moment model's own (translation
 // replayed drifts at least 80 % as far as the open loop) or grows through the simulated
-// translation.
+// translation; and how much of the error at the longest horizon holding the past
+// disturbance removes.
 std::string what_limits_prediction(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,

@@ -29,18 +29,15 @@ Rollout::Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::
   v_in_ = model.input_index("vbat");
 }
 
-const runtime::DataSideEffects& Rollout::start_at(size_t k) {
+Rollout::Start Rollout::start_at(size_t k, Replay replay) {
   first_command_ = start_.stretch_starts()[k];
-  return e_ = start_.effects_at(k);
-}
-
-std::vector<double> Rollout::initial_state(size_t k, Replay replay) const {
+  e_ = start_.effects_at(k);
   std::vector<double> x = start_.at(k);
   // The measured state already, but imposed the way every later step imposes it (attitude:
   // unbiased with this rollout's bias, renormalised), so that a replayed view starts exactly
   // on what it replays.
   impose(replay, f_.samples[k].t, k, x);
-  return x;
+  return {e_, x};
 }
 
 bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
@@ -61,7 +58,7 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
     impose(replay, t + h, k, x);
   }
   for (double v : x)
-    if (!std::isfinite(v) || std::fabs(v) > 1e6) return false;
+    if (!std::isfinite(v) || std::fabs(v) > kDivergenceBound) return false;
   return true;
 }
 
@@ -110,6 +107,38 @@ void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay rep
   }
   inputs(t, u_.data());
   m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
+  for (int a = 0; a < 3; ++a) f[3 + a] += held_[a], f[10 + a] += held_[3 + a];
+}
+
+std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
+  const auto& S = f_.samples;
+  if (model_acc_.empty()) {  // once per flight: the model at every logged state
+    const runtime::DataSideEffects saved = e_;
+    const size_t saved_first = first_command_;
+    std::vector<double> f(n_);
+    model_acc_.resize(S.size());
+    for (size_t j = 0; j < S.size(); ++j) {
+      const std::vector<double> x = start_at(j, Replay::kNothing).state;
+      inputs(S[j].t, u_.data());
+      m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
+      for (int a = 0; a < 3; ++a) model_acc_[j][a] = f[3 + a], model_acc_[j][3 + a] = f[10 + a];
+    }
+    e_ = saved, first_command_ = saved_first;
+  }
+  size_t j0 = k;
+  const size_t first = start_.stretch_starts()[k];
+  while (j0 > first && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
+  std::array<double, 6> d{};
+  const double span = S[k].t - S[j0].t;
+  if (j0 == k || !(span > 0)) return d;
+  std::array<double, 6> model_integral{};
+  for (size_t j = j0; j < k; ++j)
+    for (int c = 0; c < 6; ++c) model_integral[c] += 0.5 * (S[j + 1].t - S[j].t) * (model_acc_[j][c] + model_acc_[j + 1][c]);
+  for (int a = 0; a < 3; ++a) {
+    d[a] = (S[k].x[3 + a] - S[j0].x[3 + a] - model_integral[a]) / span;
+    d[3 + a] = (S[k].x[10 + a] - S[j0].x[10 + a] - model_integral[3 + a]) / span;
+  }
+  return d;
 }
 
 void Rollout::stage(const std::vector<double>& x, const std::vector<double>& k, double h) {

@@ -1,13 +1,16 @@
 // One simulation from a logged sample onward, the one home for it: the prediction's rollouts
 // (predict/prediction.hpp) and the diagnosis' validation windows (diagnose/validation.hpp)
-// both integrate with it, so that the two measures of a model cannot drift apart.
+// both integrate with it, so that the two measures start, step and read commands alike.
 //  - It starts from StartStates (the measured state, rotor speeds as the lag carried them).
 //  - Commands are held at the log's samples, delayed by the model's input delay and not read
 //    from before the rollout's stretch; the battery voltage is held likewise.
-//  - RK4 with a fixed step (1 ms by default: well inside its stability limit for rotor lags
-//    down to 0.4 ms), the quaternion normalised after every full step.
+//  - RK4 with steps of at most `step` (1 ms by default; equal steps filling each sample
+//    interval), the quaternion normalised after every full step. 1 ms keeps a rotor lag of
+//    0.4 ms or more inside RK4's stability limit (h / tau < 2.79).
+//  - A rollout diverges when a state leaves the finite numbers or exceeds kDivergenceBound.
 //  - Optionally part of the state is imposed from the log at every RK4 stage (Replay).
 #pragma once
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -29,18 +32,34 @@ class Rollout {
   // `p`: the parameters as the simulation runs with them (runtime::simulation_params), already
   // set in `model`. `model` and `f` must outlive the rollout.
   Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step = 1e-3);
+  Rollout(runtime::DynamicModel&, const fit::Flight&&, const std::vector<double>&, double = 1e-3) = delete;
 
   // Whether a rollout may start at sample k (its rotor speeds known: StartStates::settled).
   bool may_start_at(size_t k) const { return start_.settled(k); }
 
   // Begins a rollout at sample k: the data-side effects in force from there on (a rollout
   // stays within one flight) and its state, with what `replay` takes from the log imposed.
-  const runtime::DataSideEffects& start_at(size_t k);
-  std::vector<double> initial_state(size_t k, Replay replay) const;
+  struct Start {
+    runtime::DataSideEffects effects;
+    std::vector<double> state;
+  };
+  Start start_at(size_t k, Replay replay);
 
-  // Integrates x from sample k to sample k + 1; false if it left the finite numbers (or
-  // |x_i| > 1e6).
+  // Integrates x from sample k to sample k + 1 (of the rollout begun last); false if it
+  // diverged.
   bool advance(std::vector<double>& x, size_t k, Replay replay);
+  static constexpr double kDivergenceBound = 1e6;  // |x_i| beyond this counts as divergence
+
+  // The disturbance the log showed just before sample k: over the `window` seconds before
+  // it (fewer where the stretch began later), the measured mean acceleration minus the
+  // model's, [0..2] world linear (m/s^2), [3..5] body angular (rad/s^2). The measured means
+  // are the changes of the logged velocity and body rates over the window divided by its
+  // length (no differentiation of noisy data); the model's the trapezoid mean of its
+  // right-hand side at the logged states and commands. Only samples at or before k are read:
+  // a predictor may use it. Zero for a window shorter than two samples.
+  std::array<double, 6> past_disturbance(size_t k, double window);
+  // Added to the model's accelerations in every later advance (zero: none).
+  void hold_disturbance(const std::array<double, 6>& d) { held_ = d; }
 
  private:
   void impose(Replay replay, double t, size_t k, std::vector<double>& x) const;
@@ -58,6 +77,10 @@ class Rollout {
   double step_;
   int n_, t_in_ = -1, v_in_ = -1;
   std::vector<double> u_, k1_, k2_, k3_, k4_, tmp_, forced_;
+  std::array<double, 6> held_{};  // hold_disturbance
+  // The model's accelerations (world linear, body angular) at each logged sample, computed on
+  // the first past_disturbance call.
+  std::vector<std::array<double, 6>> model_acc_;
 };
 
 }  // namespace quadgen::predict
