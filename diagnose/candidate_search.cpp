@@ -18,7 +18,7 @@
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
 #include "fit/evaluation_threads.hpp"
-#include "output/estimate.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::diagnose {
 

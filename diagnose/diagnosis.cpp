@@ -18,7 +18,7 @@
 #include "runtime/per_flight_model.hpp"
 #include "runtime/tape.hpp"
 #include "codegen/tape_builder.hpp"
-#include "output/estimate.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::diagnose {
 
@@ -104,7 +104,7 @@ bool not_worse_beyond_spread(double mean, double standard_error) { return mean >
 std::string one_step_refusal(const Finding& f) {
   const auto& o = f.one_step;
   if (o.cost.per_fold.empty() || !beyond_spread(o.cost.mean, o.cost.standard_error)) return "";
-  if (f.effect.empty() || find_effect(f.effect).per_flight) return "which does not count for a flight's own quantity";
+  if (f.effect.empty() || find_effect(f.effect).per_flight) return "which alone does not count for a flight's own quantity";
   if (!not_worse_beyond_spread(f.gain_mean, f.gain_standard_error)) return "but the rollouts are worse beyond their spread";
   if (!not_worse_beyond_spread(o.translation.mean, o.translation.standard_error))
     return "bought with worse translational channels";
@@ -119,6 +119,8 @@ std::string one_step_summary(const Finding& f) {
   os << "; one step: " << f.one_step.cost.mean << " % +- " << f.one_step.cost.standard_error << " %";
   const std::string refusal = one_step_refusal(f);
   if (!refusal.empty()) os << ", " << refusal;
+  if (!f.force_alone.per_fold.empty())
+    os << "; force model alone: " << f.force_alone.mean << " m +- " << f.force_alone.standard_error << " m";
   return os.str();
 }
 
@@ -424,11 +426,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
         fold_ee.push_back(std::move(p));
       } catch (const fit::FitError&) {
       }
-  auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps) {
+  auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps, predict::Replay replay = predict::Replay::kNothing) {
     std::vector<double> m;
     if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};
     for (const auto& f : folds)
-      m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride, false).position_rmse);
+      m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride, false, replay).position_rmse);
     return m;
   };
   auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
@@ -472,6 +474,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       o.translation.per_fold.push_back(percent_lower(tb[0], ta[0]));
     }
     for (auto* g : {&o.cost, &o.translation, &o.rotation}) mean_and_standard_error(g->per_fold, &g->mean, &g->standard_error);
+    if (pose && find_effect(e).per_flight) {
+      const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(d.search.final_fit, predict::Replay::kAttitude);
+      for (size_t k = 0; k < fb.size(); ++k) f.force_alone.per_fold.push_back(fb[k] - fa[k]);
+      mean_and_standard_error(f.force_alone.per_fold, &f.force_alone.mean, &f.force_alone.standard_error);
+    }
     f.accepted_by = held_out_test(f);
     // Without a pose the report's metric itself is the held-out equation-error cost.
     if (!pose && f.accepted_by == Finding::kByOpenLoopPosition) f.accepted_by = Finding::kByOneStep;
@@ -644,8 +651,13 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
 std::string held_out_test(const Finding& f) {
   if (beyond_spread(f.gain_mean, f.gain_standard_error)) return Finding::kByOpenLoopPosition;
   const auto& o = f.one_step;
-  if (!o.cost.per_fold.empty() && beyond_spread(o.cost.mean, o.cost.standard_error) && one_step_refusal(f).empty())
-    return Finding::kByOneStep;
+  const bool one_step_gain = !o.cost.per_fold.empty() && beyond_spread(o.cost.mean, o.cost.standard_error);
+  if (one_step_gain && one_step_refusal(f).empty()) return Finding::kByOneStep;
+  const bool own_quantity = !f.effect.empty() && find_effect(f.effect).per_flight;
+  if (own_quantity && one_step_gain && !f.force_alone.per_fold.empty() &&
+      beyond_spread(f.force_alone.mean, f.force_alone.standard_error) &&
+      not_worse_beyond_spread(o.translation.mean, o.translation.standard_error))
+    return Finding::kByForceModelAlone;
   return "";
 }
 

@@ -11,7 +11,7 @@
 #include "fit/least_squares.hpp"
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
-#include "output/estimate.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::diagnose {
 

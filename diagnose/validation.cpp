@@ -12,11 +12,12 @@
 namespace quadgen::diagnose {
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& f, double window, double start_stride, bool keep_trace) {
+                                    const fit::Flight& f, double window, double start_stride, bool keep_trace,
+                                    predict::Replay replay) {
   if (f.samples.size() < 2) return {};  // no window to simulate
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
-  predict::Rollout roll(model, f, sim_params);  // the prediction's rollout, open loop
+  predict::Rollout roll(model, f, sim_params);  // the prediction's rollout
   WindowedSimulation out;
   const auto& S = f.samples;
   // Sums of squared errors over every scored sample.
@@ -31,11 +32,11 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     bool diverged;  // the simulation left the finite numbers after `last`
   };
   auto run_window = [&](size_t k0, Sums& sums, bool trace) -> WindowEnd {
-    auto [e, x] = roll.start_at(k0, predict::Replay::kNothing);
+    auto [e, x] = roll.start_at(k0, replay);
     size_t k = k0;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
-      if (S[k + 1].t - S[k].t > 0.1) break;  // a gap (trimmed ground contact): new window
-      if (!roll.advance(x, k, predict::Replay::kNothing)) return {k, true};
+      if (S[k + 1].t - S[k].t > predict::Rollout::kMaxGap) break;  // a gap: a new window
+      if (!roll.advance(x, k, replay)) return {k, true};
       const auto& m = S[k + 1].x;
       double e2 = 0, v2 = 0, w2 = 0;
       for (int a = 0; a < 3; ++a) {

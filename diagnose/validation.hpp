@@ -9,6 +9,7 @@
 
 #include "runtime/dynamic_model.hpp"
 #include "fit/flight_data.hpp"
+#include "predict/rollout.hpp"
 
 namespace quadgen::diagnose {
 
@@ -38,9 +39,10 @@ inline bool overlapping_windows(double window, double start_stride) { return sta
 // (about a tenth of the work at the default 0.1 s stride of 1 s windows). A scored window
 // that diverges makes every RMSE infinite; with overlapping windows a diverging window of
 // the trace only ends that window (and is left out of the plot), so that the scores do not
-// depend on keep_trace.
+// depend on keep_trace. With `replay` the windows take that part of the state from the log
+// (predict::Replay::kAttitude: the force model alone).
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& flight, double window_seconds, double start_stride = 0,
-                                    bool keep_trace = true);
+                                    bool keep_trace = true, predict::Replay replay = predict::Replay::kNothing);
 
 }  // namespace quadgen::diagnose

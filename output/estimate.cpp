@@ -1,7 +1,5 @@
 #include "output/estimate.hpp"
 
-#include <sstream>
-
 namespace quadgen::output {
 
 nlohmann::ordered_json number_or_null(double v) {
@@ -15,13 +13,6 @@ nlohmann::ordered_json estimate_json(const Estimate& e) {
            {"ci95", J::array({number_or_null(e.lower), number_or_null(e.upper)})},
            {"identifiability", e.identifiability.empty() ? J(nullptr) : J(e.identifiability)},
            {"at_bound", e.at_bound}};
-}
-
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
 }
 
 }  // namespace quadgen::output

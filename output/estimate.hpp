@@ -24,8 +24,4 @@ nlohmann::ordered_json number_or_null(double v);
 
 nlohmann::ordered_json estimate_json(const Estimate& e);
 
-// Three significant digits, as sentences for people print numbers (the diagnosis' reasons,
-// what limits a prediction).
-std::string short_number(double v);
-
 }  // namespace quadgen::output

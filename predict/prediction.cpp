@@ -14,6 +14,7 @@
 #include "fit/equation_error.hpp"
 #include "predict/rollout.hpp"
 #include "output/estimate.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::predict {
 
@@ -106,8 +107,8 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
     if (starts) ++*starts;
-    roll.hold_disturbance(disturbance_window > 0 ? roll.past_disturbance(k0, disturbance_window) : std::array<double, 6>{});
     auto [e, x] = roll.start_at(k0, replay);
+    if (disturbance_window > 0) roll.hold_disturbance(roll.past_disturbance(k0, disturbance_window));
     size_t next = 0;  // the next horizon to score
     for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
       if (S[k + 1].t - S[k].t > o.max_gap) break;
@@ -229,7 +230,6 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   if (o.disturbance_window > 0) {
     out.disturbance_window = o.disturbance_window;
     out.open_loop_past_disturbance = rollouts(roll, f, o, Replay::kNothing, nullptr, o.disturbance_window);
-    roll.hold_disturbance({});
   }
   return out;
 }
@@ -283,14 +283,14 @@ std::string what_limits_prediction(const Prediction& p) {
     s += ": the attitude does not add to it, the force model is what limits it.";
   if (p.open_loop_past_disturbance.size() == p.open_loop.size()) {
     const double held = p.open_loop_past_disturbance[longest].position.mean();
+    const long lower = std::lround(100 * (1 - held / both));  // per cent
     if (std::isfinite(held))
-      s += " Holding the disturbance of the last " + output::short_number(p.disturbance_window) +
-           " s before each start (the mean acceleration residual) " +
-           (held < both ? "lowers it to " + output::short_number(held) + " m: " +
-                              std::to_string(static_cast<int>(std::lround(100 * (1 - held / both)))) +
-                              " % of it is a disturbance slow enough to persist over the horizon, which the model does "
-                              "not carry."
-                        : "does not lower it (" + output::short_number(held) + " m): the error is not a slow disturbance.");
+      s += " Holding the acceleration residual of the last " + output::short_number(p.disturbance_window) +
+           " s before each start (model bias or disturbance) " +
+           (lower >= 1    ? "lowers it to " + output::short_number(held) + " m: " + std::to_string(lower) +
+                                " % of it is a residual slow enough to persist over the horizon."
+            : lower <= -1 ? "raises it to " + output::short_number(held) + " m: the residual changes within the horizon."
+                          : "leaves it at " + output::short_number(held) + " m: the residual is not slow.");
   }
   if (p.translation_replayed.size() != p.open_loop.size()) return s;
   // Near 0.5 s: long enough for the tilt to have grown well past the start's (at 0.1 s the

@@ -10,6 +10,9 @@
 //  - translation replayed: position and velocity taken from the log, integrating attitude,
 //    body rates (and rotor speeds): the moment model alone. Its tilt against the open loop's
 //    says how much of the open-loop drift the moments make by themselves.
+//  - open loop, past disturbance held: the open loop with the acceleration residual of the
+//    log's last disturbance_window seconds before each start added over the rollout
+//    (Rollout::past_disturbance): how much of the error is slow enough to persist.
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
@@ -32,7 +35,7 @@ struct PredictionOptions {
   double start_stride = 0.05;  // s between start points (5 samples at 100 Hz)
   double step = 1e-3;          // s, RK4 step
   // A start whose horizon crosses a gap in the log (trimmed ground contact) is not counted.
-  double max_gap = 0.1;  // s
+  double max_gap = 0.1;  // s, as Rollout::kMaxGap
   // Seconds of log before each start from which the open loop with the past disturbance
   // takes the disturbance it holds (Rollout::past_disturbance); 0: that view is not run.
   double disturbance_window = 0.5;
@@ -116,7 +119,7 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 std::string what_limits_prediction(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
-// translation_replayed, one_step.
+// translation_replayed, open_loop_past_disturbance, disturbance_window_s, one_step.
 nlohmann::ordered_json prediction_json(const Prediction& p);
 
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.

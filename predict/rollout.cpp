@@ -32,6 +32,7 @@ Rollout::Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::
 Rollout::Start Rollout::start_at(size_t k, Replay replay) {
   first_command_ = start_.stretch_starts()[k];
   e_ = start_.effects_at(k);
+  held_ = {};
   std::vector<double> x = start_.at(k);
   // The measured state already, but imposed the way every later step imposes it (attitude:
   // unbiased with this rollout's bias, renormalised), so that a replayed view starts exactly
@@ -130,7 +131,7 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
   while (j0 > first && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
   std::array<double, 6> d{};
   const double span = S[k].t - S[j0].t;
-  if (j0 == k || !(span > 0)) return d;
+  if (j0 == k || !(span >= 0.5 * window)) return d;
   std::array<double, 6> model_integral{};
   for (size_t j = j0; j < k; ++j)
     for (int c = 0; c < 6; ++c) model_integral[c] += 0.5 * (S[j + 1].t - S[j].t) * (model_acc_[j][c] + model_acc_[j + 1][c]);

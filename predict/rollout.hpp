@@ -39,6 +39,7 @@ class Rollout {
 
   // Begins a rollout at sample k: the data-side effects in force from there on (a rollout
   // stays within one flight) and its state, with what `replay` takes from the log imposed.
+  // It holds no disturbance until hold_disturbance is called.
   struct Start {
     runtime::DataSideEffects effects;
     std::vector<double> state;
@@ -49,16 +50,20 @@ class Rollout {
   // diverged.
   bool advance(std::vector<double>& x, size_t k, Replay replay);
   static constexpr double kDivergenceBound = 1e6;  // |x_i| beyond this counts as divergence
+  // A rollout ends at a gap between samples longer than this (trimmed ground contact).
+  static constexpr double kMaxGap = 0.1;  // s
 
-  // The disturbance the log showed just before sample k: over the `window` seconds before
-  // it (fewer where the stretch began later), the measured mean acceleration minus the
-  // model's, [0..2] world linear (m/s^2), [3..5] body angular (rad/s^2). The measured means
-  // are the changes of the logged velocity and body rates over the window divided by its
-  // length (no differentiation of noisy data); the model's the trapezoid mean of its
-  // right-hand side at the logged states and commands. Only samples at or before k are read:
-  // a predictor may use it. Zero for a window shorter than two samples.
+  // The acceleration residual the log showed just before sample k (model bias or external
+  // disturbance alike): over the `window` seconds before it (fewer where the sample's stretch
+  // began later), the measured mean acceleration minus the model's, [0..2] world linear
+  // (m/s^2), [3..5] body angular (rad/s^2). The measured means are the changes of the logged
+  // velocity and body rates over the window divided by its length (no derivative of noisy
+  // data is taken here); the model's the trapezoid mean of its right-hand side at the logged
+  // states and commands. Only samples at or before k are read (a velocity the log did not
+  // hold is itself a centred derivative of the positions: flight_data.cpp). Zero where less
+  // than half the window lies in the stretch: a difference over a few samples is noise.
   std::array<double, 6> past_disturbance(size_t k, double window);
-  // Added to the model's accelerations in every later advance (zero: none).
+  // Added to the model's accelerations in every advance of the rollout begun last.
   void hold_disturbance(const std::array<double, 6>& d) { held_ = d; }
 
  private:

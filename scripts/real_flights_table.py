@@ -3,7 +3,10 @@
 checks every finding against the naming rules: a closed 95 % interval, not containing the
 parameter's "off" value (for at least one parameter), and a held-out gain above its
 standard error (open-loop position; or one-step equation error with neither the position
-gain nor either channel group's one-step gain below minus its standard error). Exit status 1 on a violation."""
+gain nor either channel group's one-step gain below minus its standard error; or, for a
+flight's own quantity, the force model alone — position with the measured attitude replayed —
+with the one-step gain above and the translational channels not below their spread). Exit
+status 1 on a violation."""
 import json
 import math
 import pathlib
@@ -21,7 +24,8 @@ def finding_text(f):
             continue
         lo, hi = p["ci95"]
         parts.append(f"{name} = {fmt(p['value'])} [{fmt(lo)}, {fmt(hi)}]")
-    how = " (held out: one step)" if f.get("accepted_by") == "one-step equation error" else ""
+    how = {"one-step equation error": " (held out: one step)",
+           "force model alone (attitude replayed)": " (held out: force model alone)"}.get(f.get("accepted_by"), "")
     return f"**{f['effect']}**{how} " + "; ".join(parts)
 
 
@@ -41,12 +45,13 @@ def held_out_gain(f):
     g, o = f["gain"], f.get("one_step_gain") or {}
     if above_spread(g):
         return True
-    if f["effect"] in PER_FLIGHT:  # a flight's own quantity: only the rollouts may stand behind it
-        return False
 
     def not_worse(x):
         m, se = x.get("gain_mean"), x.get("gain_standard_error")
         return m is not None and se is not None and m >= -se
+    if f["effect"] in PER_FLIGHT:  # a flight's own quantity: the rollouts, or the force model alone
+        return (above_spread(f.get("force_alone_gain") or {}) and bool(o.get("fold_gains")) and above_spread(o)
+                and not_worse(o.get("translation", {})))
     return (bool(o.get("fold_gains")) and above_spread(o) and not_worse(g) and not_worse(o.get("translation", {}))
             and not_worse(o.get("rotation", {})))
 

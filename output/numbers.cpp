@@ -1,0 +1,14 @@
+#include "output/numbers.hpp"
+
+#include <sstream>
+
+namespace quadgen::output {
+
+std::string short_number(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+}  // namespace quadgen::output

@@ -1,0 +1,12 @@
+// Numbers in sentences for people (the diagnosis' reasons, what limits a prediction): one
+// format everywhere, so that the same value reads the same in the console, the report and
+// diagnosis.json's reasons.
+#pragma once
+#include <string>
+
+namespace quadgen::output {
+
+// Three significant digits ("0.0524", "1.32e-06", "208").
+std::string short_number(double v);
+
+}  // namespace quadgen::output
