@@ -112,6 +112,23 @@ std::string one_step_refusal(const Finding& f) {
   return "";
 }
 
+// Why the force model alone does not stand behind a flight's own quantity that acts on the
+// force ("" when it does; also "" for other effects and without its folds). Like the one-step
+// route's guards: a gain one kind of channel pays for is no gain.
+bool force_alone_applies(const Finding& f) {
+  return !f.effect.empty() && find_effect(f.effect).judged_by_force_model && !f.force_alone.per_fold.empty();
+}
+
+std::string force_alone_refusal(const Finding& f) {
+  if (!force_alone_applies(f)) return "";
+  const auto& o = f.one_step;
+  if (!beyond_spread(f.force_alone.mean, f.force_alone.standard_error)) return "not better beyond its spread";
+  if (!not_worse_beyond_spread(o.translation.mean, o.translation.standard_error))
+    return "bought with worse translational channels";
+  if (!not_worse_beyond_spread(o.rotation.mean, o.rotation.standard_error)) return "bought with worse rotational channels";
+  return "";
+}
+
 std::string one_step_summary(const Finding& f) {
   if (f.one_step.cost.per_fold.empty()) return "";
   std::ostringstream os;
@@ -119,8 +136,10 @@ std::string one_step_summary(const Finding& f) {
   os << "; one step: " << f.one_step.cost.mean << " % +- " << f.one_step.cost.standard_error << " %";
   const std::string refusal = one_step_refusal(f);
   if (!refusal.empty()) os << ", " << refusal;
-  if (!f.force_alone.per_fold.empty())
-    os << "; force model alone: " << f.force_alone.mean << " m +- " << f.force_alone.standard_error << " m";
+  if (!f.force_alone.per_fold.empty()) {
+    os << "; force model alone: " << f.force_alone.mean << " m +- " << f.force_alone.standard_error << " m lower";
+    if (const std::string why = force_alone_refusal(f); !why.empty()) os << ", " << why;
+  }
   return os.str();
 }
 
@@ -474,7 +493,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       o.translation.per_fold.push_back(percent_lower(tb[0], ta[0]));
     }
     for (auto* g : {&o.cost, &o.translation, &o.rotation}) mean_and_standard_error(g->per_fold, &g->mean, &g->standard_error);
-    if (pose && find_effect(e).per_flight) {
+    if (pose && find_effect(e).judged_by_force_model) {
       const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(d.search.final_fit, predict::Replay::kAttitude);
       for (size_t k = 0; k < fb.size(); ++k) f.force_alone.per_fold.push_back(fb[k] - fa[k]);
       mean_and_standard_error(f.force_alone.per_fold, &f.force_alone.mean, &f.force_alone.standard_error);
@@ -643,21 +662,19 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   return d;
 }
 
-// A flight's own quantities (its trims, a wind) are judged by the rollouts alone: their
-// one-step gain on the end of the same flight they were fitted to shows the flight's state
-// absorbing error as well as a cause (a per-flight wind passed it by trading the
-// accelerometer's horizontal force, 5x worse, for the moments). `one_step_refusal` holds the
+// A flight's own quantities (its trims, a wind, the marker frame) are not judged by their
+// one-step gain alone: on the end of the same flight they were fitted to it shows the
+// flight's state absorbing error as well as a cause (a per-flight wind passed it by trading
+// the accelerometer's horizontal force, 5x worse, for the moments). They need the open-loop
+// rollouts or, for those acting on the force, the force model alone with the one-step gain
+// and neither kind of channel worse. `one_step_refusal` and `force_alone_refusal` hold the
 // guards.
 std::string held_out_test(const Finding& f) {
   if (beyond_spread(f.gain_mean, f.gain_standard_error)) return Finding::kByOpenLoopPosition;
   const auto& o = f.one_step;
   const bool one_step_gain = !o.cost.per_fold.empty() && beyond_spread(o.cost.mean, o.cost.standard_error);
   if (one_step_gain && one_step_refusal(f).empty()) return Finding::kByOneStep;
-  const bool own_quantity = !f.effect.empty() && find_effect(f.effect).per_flight;
-  if (own_quantity && one_step_gain && !f.force_alone.per_fold.empty() &&
-      beyond_spread(f.force_alone.mean, f.force_alone.standard_error) &&
-      not_worse_beyond_spread(o.translation.mean, o.translation.standard_error))
-    return Finding::kByForceModelAlone;
+  if (one_step_gain && force_alone_applies(f) && force_alone_refusal(f).empty()) return Finding::kByForceModelAlone;
   return "";
 }
 

@@ -74,10 +74,10 @@ struct Finding {
     FoldGains cost;                  // the weighted equation-error cost
     FoldGains translation, rotation;  // unweighted sums of squares of each channel group
   } one_step;
-  // A flight's own quantity (per-flight effect, with a pose) also judged by the force model
-  // alone: the same held-out windows with the measured attitude replayed at every step
-  // (predict::Replay::kAttitude), their position RMSE per fold, before - after [m]. Empty
-  // for the airframe's effects.
+  // A flight's own quantity acting on the force (Effect::judged_by_force_model: the marker
+  // frame, a wind; with a pose) also judged by the force model alone: the same held-out
+  // windows with the measured attitude replayed at every step (predict::Replay::kAttitude),
+  // their position RMSE per fold, before - after [m]. Empty for other effects.
   FoldGains force_alone;
   // Which held-out test stood behind it: kByOpenLoopPosition, kByOneStep (the rollouts
   // neither better nor worse beyond their spread), or kByForceModelAlone (a flight's own
@@ -189,11 +189,12 @@ struct Diagnosis {
 // one-step equation-error gain above its spread with the rollouts, the translational and the
 // rotational channels each no worse beyond their spread (a gain the rollouts cannot see, not
 // one they refute or one channel pays for). The one-step route is for the airframe's
-// effects only: a flight's own quantities (per-flight effects) need the rollouts, open loop
-// or, since the open loop over a window is dominated by the moment model's own attitude
-// drift (docs/validation.md), the force model alone: its position gain with the measured
-// attitude replayed above its spread, with the one-step cost lower beyond its spread and the
-// translational channels no worse.
+// effects only: a flight's own quantities (per-flight effects) need the open-loop rollouts,
+// or, for those acting on the force (the marker frame, a wind), since the open loop over a
+// window is dominated by the moment model's own attitude drift (docs/validation.md), the
+// force model alone: its position gain with the measured attitude replayed above its
+// spread, with the one-step cost lower beyond its spread and neither the translational nor
+// the rotational channels worse beyond theirs.
 std::string held_out_test(const Finding& f);
 
 bool belongs_to_flight(const std::string& parameter);

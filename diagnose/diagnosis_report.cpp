@@ -583,7 +583,8 @@ std::string one_step_text(const Finding& f) {
     return "; accepted by the force model alone: with the measured attitude replayed the held-out position RMSE is " +
            num(f.force_alone.mean, 3) + " m +- " + num(f.force_alone.standard_error, 3) +
            " m lower per fold, and the equation-error cost " + num(f.one_step.cost.mean, 3) + " % +- " +
-           num(f.one_step.cost.standard_error, 3) + " % (the open loop is dominated by the moment model's attitude drift)";
+           num(f.one_step.cost.standard_error, 3) +
+           " % lower, neither kind of channel worse (the open loop is dominated by the moment model's attitude drift)";
   if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
   return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
          " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";

@@ -68,6 +68,11 @@ struct Effect {
   // motor or the battery is re-seated, the wind of the day): when several flights are
   // diagnosed together, each flight has its own values (runtime::PerFlightModel).
   bool per_flight = false;
+  // A flight's own quantity that acts on the force (the marker frame's tilt, a wind): its
+  // held-out test may be the force model alone, the rollouts with the measured attitude
+  // replayed (diagnose::held_out_test), since open-loop rollouts are dominated by the moment
+  // model's attitude drift, which it cannot remove.
+  bool judged_by_force_model = false;
   // Where it acts: in the equations of motion, on the logged commands before they reach them
   // (a delay), or on what the log measures (a misaligned IMU). The last two have no term of f:
   // the runtime applies them to the log (runtime/data_side_effects.hpp).

@@ -29,8 +29,10 @@ def finding_text(f):
     return f"**{f['effect']}**{how} " + "; ".join(parts)
 
 
-# The catalogue's per-flight effects (docs/effects.md), written down again like PLAUSIBLE below.
+# The catalogue's per-flight effects (docs/effects.md), written down again like PLAUSIBLE below,
+# and those of them that act on the force (judged by the force model alone).
 PER_FLIGHT = {"motor_gain", "wind", "attitude_bias"}
+ON_THE_FORCE = {"wind", "attitude_bias"}
 
 
 def above_spread(g, floor=0.0):
@@ -41,7 +43,9 @@ def above_spread(g, floor=0.0):
 def held_out_gain(f):
     """The open-loop position gain above its standard error over the folds; or the one-step
     (equation-error) gain above its standard error with the position gain, and the translational and
-    rotational channels' one-step gains, each not below minus its own standard error."""
+    rotational channels' one-step gains, each not below minus its own standard error; or, for a
+    flight's own quantity acting on the force, the force model alone's position gain above its
+    standard error with the one-step gain above and both channel groups not below theirs."""
     g, o = f["gain"], f.get("one_step_gain") or {}
     if above_spread(g):
         return True
@@ -50,8 +54,9 @@ def held_out_gain(f):
         m, se = x.get("gain_mean"), x.get("gain_standard_error")
         return m is not None and se is not None and m >= -se
     if f["effect"] in PER_FLIGHT:  # a flight's own quantity: the rollouts, or the force model alone
-        return (above_spread(f.get("force_alone_gain") or {}) and bool(o.get("fold_gains")) and above_spread(o)
-                and not_worse(o.get("translation", {})))
+        return (f["effect"] in ON_THE_FORCE and above_spread(f.get("force_alone_gain") or {})
+                and bool(o.get("fold_gains")) and above_spread(o)
+                and not_worse(o.get("translation", {})) and not_worse(o.get("rotation", {})))
     return (bool(o.get("fold_gains")) and above_spread(o) and not_worse(g) and not_worse(o.get("translation", {}))
             and not_worse(o.get("rotation", {})))
 

@@ -223,6 +223,29 @@ TEST(Prediction, AHeldAngularAccelerationTurnsTheBody) {
   }
 }
 
+// The force model alone as the diagnosis judges a flight's own quantity on the force: the
+// validation windows with the measured attitude replayed carry no attitude error, and a
+// marker-frame tilt of 0.03 rad that the flight does not have turns the thrust by that angle,
+// so the position error grows as 0.5 (T/m) sin(0.03) t^2, whose RMS over windows' t in (0, 1]
+// is that times 1/sqrt(5); the true model's stays at its integration error.
+TEST(Prediction, ValidationWindowsWithTheAttitudeReplayedAreTheForceModelAlone) {
+  Model m;
+  const auto& f = flight().flight;
+  std::vector<double> tilted = m.params();
+  tilted[m.param_index("attitude_bias.roll")] = 0.03;
+  using quadgen::predict::Replay;
+  const auto own = quadgen::diagnose::simulate_windows(m, m.params(), f, 1.0, 0.1, false, Replay::kAttitude);
+  const auto wrong = quadgen::diagnose::simulate_windows(m, tilted, f, 1.0, 0.1, false, Replay::kAttitude);
+  EXPECT_LT(own.attitude_rmse, 1e-6);
+  EXPECT_LT(wrong.attitude_rmse, 1e-6);
+  EXPECT_LT(own.position_rmse, 3e-3);
+  const double expected = 0.5 * flight().mean_thrust_per_mass * std::sin(0.03) / std::sqrt(5.0);
+  EXPECT_NEAR(wrong.position_rmse, expected, 0.25 * expected);
+  // Open loop the same tilt starts every window tilted and the moments carry it on: not the
+  // same number.
+  EXPECT_NE(quadgen::diagnose::simulate_windows(m, tilted, f, 1.0, 0.1, false).position_rmse, wrong.position_rmse);
+}
+
 TEST(Prediction, ThrustTooStrongGivesTheClosedFormError) {
   Model m;
   std::vector<double> params = m.params();

@@ -29,6 +29,7 @@ Effect attitude_bias() {
   // Vicon attitude and IMU differ by 0.5-2.3 degrees in roll and pitch, by flight (the
   // marker frame is fitted per session; docs/crazyflie_evidence.md).
   e.per_flight = true;
+  e.judged_by_force_model = true;
   e.acts_on = Effect::ActsOn::kMeasurement;
   e.plausible = {{"", -0.052, 0.052, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "an IMU or marker frame misaligned by more than ~3 degrees is visible by eye and corrected"}};

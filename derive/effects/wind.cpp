@@ -34,6 +34,7 @@ Effect wind() {
   e.apply = terms;
   e.parameter_names = "wind.x/y";  // as --help lists them
   e.per_flight = true;
+  e.judged_by_force_model = true;
   e.plausible = {{"", -0.5, 0.5, PlausibleRange::Scale::kSI, Environment::kIndoor,
                   "indoors the air is still but for ventilation drafts of a few dm/s"},
                  {"", -15.0, 15.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
