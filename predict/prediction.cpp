@@ -386,24 +386,21 @@ std::string prediction_csv(const Prediction& p) {
   auto row = [&](const char* view, double h, const char* q, const char* unit, const ErrorStats& s) {
     os << view << ',' << h << ',' << q << ',' << unit << ',' << s.mean() << ',' << s.rms() << ',' << s.count << '\n';
   };
-  for (const auto& h : p.open_loop) {
-    row("open_loop", h.horizon, "position", "m", h.position);
-    row("open_loop", h.horizon, "velocity", "m/s", h.velocity);
-    row("open_loop", h.horizon, "tilt", "rad", h.tilt);
-    row("open_loop", h.horizon, "heading", "rad", h.heading);
-    row("open_loop", h.horizon, "body_rates", "rad/s", h.body_rates);
-  }
+  auto open_loop_rows = [&](const char* view, const std::vector<HorizonErrors>& rows) {  // every quantity
+    for (const auto& h : rows) {
+      row(view, h.horizon, "position", "m", h.position);
+      row(view, h.horizon, "velocity", "m/s", h.velocity);
+      row(view, h.horizon, "tilt", "rad", h.tilt);
+      row(view, h.horizon, "heading", "rad", h.heading);
+      row(view, h.horizon, "body_rates", "rad/s", h.body_rates);
+    }
+  };
+  open_loop_rows("open_loop", p.open_loop);
   for (const auto& h : p.attitude_replayed) {
     row("attitude_replayed", h.horizon, "position", "m", h.position);
     row("attitude_replayed", h.horizon, "velocity", "m/s", h.velocity);
   }
-  for (const auto& h : p.open_loop_past_disturbance) {
-    row("open_loop_past_disturbance", h.horizon, "position", "m", h.position);
-    row("open_loop_past_disturbance", h.horizon, "velocity", "m/s", h.velocity);
-    row("open_loop_past_disturbance", h.horizon, "tilt", "rad", h.tilt);
-    row("open_loop_past_disturbance", h.horizon, "heading", "rad", h.heading);
-    row("open_loop_past_disturbance", h.horizon, "body_rates", "rad/s", h.body_rates);
-  }
+  open_loop_rows("open_loop_past_disturbance", p.open_loop_past_disturbance);
   for (const auto& h : p.translation_replayed) {
     row("translation_replayed", h.horizon, "tilt", "rad", h.tilt);
     row("translation_replayed", h.horizon, "heading", "rad", h.heading);
