@@ -112,13 +112,15 @@ std::string one_step_refusal(const Finding& f) {
   return "";
 }
 
-// Why the force model alone does not stand behind a flight's own quantity that acts on the
-// force ("" when it does; also "" for other effects and without its folds). Like the one-step
-// route's guards: a gain one kind of channel pays for is no gain.
+// Whether the force model alone was measured for this finding: a flight's own quantity that
+// acts on the force, with a pose.
 bool force_alone_applies(const Finding& f) {
   return !f.effect.empty() && find_effect(f.effect).judged_by_force_model && !f.force_alone.per_fold.empty();
 }
 
+// Why the force model alone does not stand behind such a quantity ("" when it does, and
+// where it does not apply). Like the one-step route's guards: a gain one kind of channel
+// pays for is no gain.
 std::string force_alone_refusal(const Finding& f) {
   if (!force_alone_applies(f)) return "";
   const auto& o = f.one_step;

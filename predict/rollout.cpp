@@ -9,12 +9,6 @@ namespace quadgen::predict {
 
 namespace {
 
-void normalise_quaternion(std::vector<double>& x) {
-  const double n = std::sqrt(x[6] * x[6] + x[7] * x[7] + x[8] * x[8] + x[9] * x[9]);
-  if (n > 0)
-    for (int i = 6; i < 10; ++i) x[i] /= n;
-}
-
 // The weight of sample k + 1 at time t in [t_k, t_k+1] for linear interpolation.
 double weight(const fit::FlightSample& a, const fit::FlightSample& b, double t) {
   return b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
@@ -55,7 +49,7 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
     stage(x, k3_, h);
     deriv(t + h, tmp_, k, replay, k4_);
     for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
-    normalise_quaternion(x);  // after full steps only, in every view alike
+    runtime::normalize_quaternion(&x[6]);  // after full steps only, in every view alike
     impose(replay, t + h, k, x);
   }
   for (double v : x)
@@ -88,7 +82,7 @@ void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const 
   runtime::unbias_attitude(&b.x[6], e_.roll, e_.pitch, qb);
   const double sign = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0 ? -1.0 : 1.0;
   for (int i = 0; i < 4; ++i) x[6 + i] = (1 - w) * qa[i] + w * sign * qb[i];
-  normalise_quaternion(x);
+  runtime::normalize_quaternion(&x[6]);
   for (int i = 0; i < 3; ++i) x[10 + i] = (1 - w) * a.x[10 + i] + w * b.x[10 + i];
 }
 

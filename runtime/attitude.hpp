@@ -23,6 +23,14 @@ inline Rotation rotation_matrix(const double* q) {
            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
 }
 
+// Scales the quaternion q[0..3] to unit length (left alone at zero): integrators keep the
+// attitude on the unit sphere with it after every full step.
+inline void normalize_quaternion(double* q) {
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (n > 0)
+    for (int i = 0; i < 4; ++i) q[i] /= n;
+}
+
 // Hamilton product a ⊗ b, scalar first.
 inline void quaternion_product(const double* a, const double* b, double* q) {
   q[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];

@@ -4,17 +4,17 @@
 #include <cmath>
 #include <sstream>
 
+#include "runtime/attitude.hpp"
+
 namespace quadgen::runtime {
 
 namespace {
 
 using Vec = std::vector<double>;
 
-void normalize_quaternion(Vec& x, int q) {
-  if (q < 0) return;
-  const double n = std::sqrt(x[q] * x[q] + x[q + 1] * x[q + 1] + x[q + 2] * x[q + 2] + x[q + 3] * x[q + 3]);
-  if (n > 0)
-    for (int i = 0; i < 4; ++i) x[q + i] /= n;
+// The state's quaternion at offset q (none: q < 0).
+void normalize_quaternion_at(Vec& x, int q) {
+  if (q >= 0) runtime::normalize_quaternion(&x[q]);
 }
 
 struct Rhs {
@@ -70,7 +70,7 @@ Trajectory integrate_rk4(const DynamicModel& m, Vec x, const InputFunction& u, d
   for (long s = 0; s < steps; ++s) {
     const double t = t0 + static_cast<double>(s) * h;
     rk4_step(f, t, x, h);
-    normalize_quaternion(x, opt.quaternion_offset);
+    normalize_quaternion_at(x, opt.quaternion_offset);
     check_finite(m, x, t + h, opt.divergence_bound);
     if (stats) ++stats->accepted_steps;
     tr.t.push_back(t0 + static_cast<double>(s + 1) * h);
@@ -141,14 +141,14 @@ Trajectory integrate_dopri5(const DynamicModel& m, Vec x, const InputFunction& u
           const double r5 = h * (d1 * k1[i] + d3 * k3[i] + d4 * k4[i] + d5 * k5[i] + d6 * k6[i] + d7 * k7[i]);
           xo[i] = r1 + th * (ydiff + th1 * (bspl + th * ((ydiff - h * k7[i] - bspl) + th1 * r5)));
         }
-        normalize_quaternion(xo, opt.quaternion_offset);
+        normalize_quaternion_at(xo, opt.quaternion_offset);
         tr.t.push_back(out_t[next_out]);
         tr.x.push_back(xo);
         ++next_out;
       }
       t += h;
       x = y;
-      normalize_quaternion(x, opt.quaternion_offset);
+      normalize_quaternion_at(x, opt.quaternion_offset);
       check_finite(m, x, t, opt.divergence_bound);
       k1 = k7;
       if (opt.quaternion_offset >= 0) f(t, x, k1);  // x changed by normalisation
