@@ -64,7 +64,12 @@ struct Finding {
   // A gain bought by making one kind of channel worse is no gain: the translational and the
   // rotational channels are also judged apart, each by its sum of squares per fold; the
   // translational ones by the accelerometer where one is logged (a sensor the fit did not
-  // use when it differentiates the pose), else as the fit measures them.
+  // use when it differentiates the pose), else as the fit measures them. The horizontal
+  // force (x, y) is judged once more apart: the vertical residual (z) is the larger, and a
+  // better one would hide a worse horizontal force in their sum; the vertical is reported
+  // but counts in the sum only (worse_channel_group in diagnosis.cpp says why). (x, y, z are
+  // world axes when the pose is differentiated, body axes with the accelerometer; a flying
+  // multirotor tilts by tens of degrees at most, so body z stays near the vertical.)
   // Each a reduction per fold in per cent of the fold's value without the effect.
   struct FoldGains {
     std::vector<double> per_fold;
@@ -73,6 +78,7 @@ struct Finding {
   struct OneStep {
     FoldGains cost;                  // the weighted equation-error cost
     FoldGains translation, rotation;  // unweighted sums of squares of each channel group
+    FoldGains horizontal, vertical;    // the translational ones split: x and y, and z
   } one_step;
   // A flight's own quantity acting on the force (Effect::judged_by_force_model: the marker
   // frame, a wind; with a pose) also judged by the force model alone: the same held-out

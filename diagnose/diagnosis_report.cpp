@@ -163,6 +163,8 @@ json one_step_json(const Finding::OneStep& o) {
   j.update(fold_gains_json(o.cost));
   j["translation"] = fold_gains_json(o.translation);
   j["rotation"] = fold_gains_json(o.rotation);
+  j["horizontal"] = fold_gains_json(o.horizontal);
+  j["vertical"] = fold_gains_json(o.vertical);
   return j;
 }
 

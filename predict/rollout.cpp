@@ -120,9 +120,12 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
     }
     e_ = saved, first_command_ = saved_first;
   }
+  // The window stays within the sample's stretch and after the rotor speeds are known: just
+  // after a restart the states carry the steady-state guess, and the model's accelerations
+  // there would be part of the residual.
   size_t j0 = k;
   const size_t first = start_.stretch_starts()[k];
-  while (j0 > first && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
+  while (j0 > first && start_.settled(j0 - 1) && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
   std::array<double, 6> d{};
   const double span = S[k].t - S[j0].t;
   if (j0 == k || !(span >= 0.5 * window)) return d;

@@ -11,6 +11,7 @@
 # scored with a linear correction fitted on the first 70 % (`predict --linear-correction`): on
 # the nominal model a linear-regression baseline on the same split, on the joint fit what a
 # linear model of the same signals would still explain.
+# QUADGEN=BINARY selects the quadgen binary (default build/quadgen), as in real_flights.sh.
 # Needs the build (./setup.sh --no-run), ../shared/data beside the clone, and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,18 +20,19 @@ data=../shared/data/crazyflie
 command -v python3 > /dev/null || { echo "python3 is needed for the table (apt-get install python3)"; exit 1; }
 vehicle=vehicles/crazyflie21.yaml
 reuse="${DIAGNOSES:-}"
+q="${QUADGEN:-build/quadgen}"
 run() {  # name log mapping [extra diagnose flags...]
   local name=$1 log=$2 mapping=$3; shift 3
   echo "== $name" >&2
   mkdir -p "$out/$name"
-  build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --linear-correction --out "$out/$name/nominal" > /dev/null
+  "$q" predict "$vehicle" "$log" --mapping "$mapping" "$@" --linear-correction --out "$out/$name/nominal" > /dev/null
   if [ -n "$reuse" ] && [ -f "$reuse/$name/diagnosis.json" ]; then
     ln -sfn "$(cd "$reuse/$name" && pwd)" "$out/$name/diagnosis"
   else
-    build/quadgen diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
+    "$q" diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
   fi
   if [ -n "$reuse" ] && [ -f "$reuse/joint_5_flights/diagnosis.json" ] && [ "$name" != arpl_log10 ]; then
-    build/quadgen predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$reuse/joint_5_flights/diagnosis.json" \
+    "$q" predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$reuse/joint_5_flights/diagnosis.json" \
       --linear-correction --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
   fi
 }

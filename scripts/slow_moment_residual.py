@@ -10,7 +10,9 @@ samples.validation_from_s) and the log it was fitted to (the NanoBench column na
   - the held-out RMS after a correction fitted by least squares on the training part and
     applied unchanged to the held-out part: a constant; a linear trend in time; the battery
     voltage; u_i^2 per rotor (motor trims again); u_i^2 and u_i^2 * vbat (per-rotor battery
-    dependence); u_i^2 and u_i^2 * t (per-rotor drift). A correction that lowers the held-out
+    dependence); u_i^2 and u_i^2 * t (per-rotor drift); the position in the arena, linear (a
+    draft in one part of the room; a figure-8 passes the same places in both parts). A
+    correction that lowers the held-out
     RMS predicts part of the slow residual; one that raises it does not.
 
 Usage: slow_moment_residual.py DIAGNOSIS_DIR LOG.csv"""
@@ -20,7 +22,7 @@ import json
 import math
 import sys
 
-CORRECTIONS = ["constant", "time", "vbat", "u2", "u2 vbat", "u2 time"]
+CORRECTIONS = ["constant", "time", "vbat", "u2", "u2 vbat", "u2 time", "position"]
 
 
 def solve(rows, targets):
@@ -44,6 +46,8 @@ def regressors(sample, t, kind):
     u = [float(sample[f"motor_motor_m{i}"]) / 65535 for i in (1, 2, 3, 4)]
     vbat = float(sample["pwr_pm_vbat"])
     u2 = [x * x for x in u]
+    if kind == "position":
+        return [1] + [float(sample[c]) for c in ("px", "py", "pz")]
     return {"constant": [1], "time": [1, t], "vbat": [1, vbat], "u2": [1] + u2,
             "u2 vbat": [1] + u2 + [x * vbat for x in u2], "u2 time": [1] + u2 + [x * t for x in u2]}[kind]
 

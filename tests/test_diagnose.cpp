@@ -838,6 +838,18 @@ TEST(Acceptance, AOneStepGainCountsOnlyWhereTheRolloutsDoNotSpeakAgainstIt) {
   EXPECT_EQ(held_out_test(f), "") << "the moments bought with a worse force";
   f.one_step.translation.mean = -1;  // within its spread
   EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
+  // The vertical residual dominates the sum: a better vertical force can hide a worse
+  // horizontal one in it.
+  f.one_step.translation.mean = 10, f.one_step.vertical.mean = 15, f.one_step.vertical.standard_error = 3;
+  f.one_step.horizontal.mean = -20, f.one_step.horizontal.standard_error = 5;
+  EXPECT_EQ(held_out_test(f), "") << "the sum better, the horizontal force worse";
+  // The vertical force, set by the flight's thrust constant that every refit moves, counts in
+  // the sum only (B2's rotor drag: horizontal 56 % +- 21 % better, vertical 24 % +- 11 % worse).
+  f.one_step.translation.mean = 32, f.one_step.translation.standard_error = 17;
+  f.one_step.horizontal.mean = 56, f.one_step.horizontal.standard_error = 21;
+  f.one_step.vertical.mean = -24, f.one_step.vertical.standard_error = 11;
+  EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
+  f.one_step.translation.mean = -1, f.one_step.translation.standard_error = 3;
   f.one_step.rotation.mean = -12, f.one_step.rotation.standard_error = 3;
   EXPECT_EQ(held_out_test(f), "") << "the force bought with worse moments";
   f.one_step.rotation.mean = 20;
@@ -871,6 +883,9 @@ TEST(Acceptance, AFlightsOwnQuantityMayStandOnTheForceModelAlone) {
   f.one_step.translation.mean = -12, f.one_step.translation.standard_error = 3;
   EXPECT_EQ(held_out_test(f), "") << "bought with worse translational channels";
   f.one_step.translation.mean = 40;
+  f.one_step.horizontal.mean = -30, f.one_step.horizontal.standard_error = 6;
+  EXPECT_EQ(held_out_test(f), "") << "the sum better, the horizontal force worse beyond its spread";
+  f.one_step.horizontal.mean = 60;
   f.one_step.rotation.mean = -28, f.one_step.rotation.standard_error = 8;  // B3 rep 2's moments
   EXPECT_EQ(held_out_test(f), "") << "bought with worse rotational channels";
   f.one_step.rotation.mean = 1, f.one_step.rotation.standard_error = 2;

@@ -189,6 +189,24 @@ TEST(Prediction, HoldingThePastDisturbanceRemovesAConstantOne) {
     EXPECT_EQ(original.past_disturbance(k, 0.5), altered.past_disturbance(k, 0.5));
     EXPECT_NE(original.past_disturbance(k + 10, 0.5), altered.past_disturbance(k + 10, 0.5));
   }
+  {  // Nor what comes before the rotor speeds are known again after a restart: a gap of a second
+     // restarts them; 0.6 s later the window's first 0.1 s would be the 0.3 s that settle them.
+    const std::vector<double> p = quadgen::runtime::simulation_params(m, heavy);
+    m.set_params(p);
+    quadgen::fit::Flight gapped = f;
+    const size_t restart = f.samples.size() / 2;
+    for (size_t j = restart; j < gapped.samples.size(); ++j) gapped.samples[j].t += 1.0;
+    size_t k = restart;
+    while (gapped.samples[k].t - gapped.samples[restart].t < 0.6 - 1e-9) ++k;
+    quadgen::fit::Flight changed = gapped;
+    for (size_t j = restart; gapped.samples[j].t - gapped.samples[restart].t < 0.25; ++j)
+      changed.samples[j].x[3] += 1.0, changed.samples[j].x[10] += 1.0;
+    quadgen::predict::Rollout original(m, gapped, p), altered(m, changed, p);
+    ASSERT_TRUE(original.may_start_at(k));
+    const auto d = original.past_disturbance(k, 0.5);
+    EXPECT_NEAR(d[2], 0.2, 0.01) << "the window after the settling time still sees the disturbance";
+    EXPECT_EQ(d, altered.past_disturbance(k, 0.5));
+  }
   const auto p = quadgen::predict::evaluate_prediction(m, heavy, f, {});
   ASSERT_EQ(p.open_loop_past_disturbance.size(), p.open_loop.size());
   for (size_t i = 0; i < p.open_loop.size(); ++i) {
