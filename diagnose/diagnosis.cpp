@@ -15,8 +15,10 @@
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/geometry.hpp"
+#include "runtime/attitude.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/tape.hpp"
+#include "runtime/thrust_law.hpp"
 #include "codegen/tape_builder.hpp"
 #include "output/numbers.hpp"
 
@@ -152,6 +154,8 @@ std::string force_alone_refusal(const Finding& f) {
   return worse_channel_group(o);
 }
 
+}  // namespace
+
 std::string one_step_summary(const Finding& f) {
   if (f.one_step.cost.per_fold.empty()) return "";
   std::ostringstream os;
@@ -165,6 +169,8 @@ std::string one_step_summary(const Finding& f) {
   }
   return os.str();
 }
+
+namespace {
 
 // What a named cause must show beyond significance on training data (issue: what diagnose
 // may name): a closed 95 % interval for every parameter, at least one excluding "off", and
@@ -187,6 +193,38 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
            std::to_string(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) +
            " validation folds)" + one_step_summary(f);
   return "";
+}
+
+// What the draft check reads from a diagnosis: the final model's residuals over the whole
+// flight, each sample's heading and part, and the coefficients and sizes the ratio needs (by
+// name from the final fit; in a joint diagnosis the first flight's c_t, which only sets the
+// implied draft speed's hover rotor speeds).
+DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight& used, const fit::Flight& valid,
+                                          const Vehicle& v, const std::vector<fit::FitParameter>& final_fit,
+                                          bool force_in_world) {
+  DraftSignatureInput in;
+  in.t = d.t, in.residual = d.residual_after, in.force_in_world = force_in_world;
+  std::vector<double> held_out_times;
+  for (const auto& s : valid.samples) held_out_times.push_back(s.t);
+  for (const auto& s : used.samples) {
+    in.heading.push_back(runtime::euler_zyx(s.x[6], s.x[7], s.x[8], s.x[9])[2]);
+    in.velocity.push_back(s.x[3]), in.velocity.push_back(s.x[4]);
+    in.held_out.push_back(std::binary_search(held_out_times.begin(), held_out_times.end(), s.t));
+  }
+  auto value = [&](const std::string& name) {
+    for (const auto& p : final_fit)
+      if (p.name == name) return p.value;
+    return 0.0;
+  };
+  in.rotor_drag_k = value("rotor_drag.k"), in.blade_flapping_k = value("blade_flapping.k");
+  in.mass = value("mass"), in.J_xx = value("J_xx"), in.J_yy = value("J_yy");
+  if (!v.rotors.empty()) {  // hover: m g = n k_T omega^2 with k_T of the thrust law
+    const auto& r = v.rotors.front();
+    const double k_thrust = runtime::rotor_thrust_coefficient(value("c_t"), value("rho"), r.disc_area, r.radius);
+    const double n = static_cast<double>(v.rotors.size());
+    if (k_thrust > 0) in.hover_speeds_sum = n * std::sqrt(in.mass * value("g") / (n * k_thrust));
+  }
+  return in;
 }
 
 // What a held-out position metric's name says about its windows: ", started every 0.1 s"
@@ -672,6 +710,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     d.unexplained.push_back(u);
   }
+  d.draft = draft_signature(draft_signature_input(d, used, valid, v, s.final_fit, !accel));
   std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
   d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
                                 residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,

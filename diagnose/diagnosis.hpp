@@ -8,6 +8,7 @@
 
 #include "diagnose/agreement.hpp"
 #include "diagnose/candidate_search.hpp"
+#include "diagnose/draft_signature.hpp"
 #include "diagnose/flight_screening.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/flight_data.hpp"
@@ -156,6 +157,9 @@ struct Diagnosis {
   std::string airframe_source;
   std::vector<ParameterAgreement> airframe_check;
   std::vector<Unexplained> unexplained;
+  // Whether the slow roll/pitch residual the final model leaves follows the horizontal force
+  // as a draft through the rotors would (draft_signature.hpp): a lead, never a named cause.
+  DraftSignature draft;
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).
   std::vector<DiscoveredTerm> discovered;
@@ -202,6 +206,12 @@ struct Diagnosis {
 // spread, with the one-step cost lower beyond its spread and neither the translational nor
 // the rotational channels worse beyond theirs.
 std::string held_out_test(const Finding& f);
+
+// The held-out routes' verdicts in words, as a suspect's reason carries them after its
+// open-loop gain: "; one step: 43 % +- 9 %, bought with worse horizontal force and
+// rotational channels; force model alone: ..." ("" without one-step folds). A refusal
+// names every kind of channel that got worse beyond its spread.
+std::string one_step_summary(const Finding& f);
 
 bool belongs_to_flight(const std::string& parameter);
 

@@ -158,6 +158,37 @@ json fold_gains_json(const Finding::FoldGains& g) {
           {"gain_standard_error", number_or_null(g.standard_error)}};
 }
 
+json draft_pair_json(const DraftSignature::Pair& p) {
+  return {{"force", p.force},
+          {"moment", p.moment},
+          {"draft_slope", p.draft_slope},
+          {"r_before_velocity_partialled_out", number_or_null(p.raw_r)},
+          {"r", number_or_null(p.r)},
+          {"effective_n", number_or_null(p.effective_n)},
+          {"p", number_or_null(p.p)},
+          {"slope", number_or_null(p.slope)},
+          {"reverse_slope", number_or_null(p.reverse_slope)},
+          {"shows_draft", p.shows_draft()}};
+}
+
+json draft_signature_json(const DraftSignature& d) {
+  if (!d.measured) return {{"measured", false}, {"why_not", d.why_not}};
+  json parts = json::array();
+  for (const auto& p : d.parts)
+    parts.push_back({{"part", p.name},
+                     {"running_means", p.means},
+                     {"a_y_on_pdot", draft_pair_json(p.y_roll)},
+                     {"a_x_on_qdot", draft_pair_json(p.x_pitch)},
+                     {"implied_draft_at_most_m_s", number_or_null(p.implied_speed)}});
+  return {{"measured", true},
+          {"window_s", DraftSignature::kWindow},
+          {"grid_s", DraftSignature::kGrid},
+          {"level", DraftSignature::kLevel},
+          {"parts", parts},
+          {"axes_showing_it", d.axes_showing_it()},
+          {"note", "a hypothesis of air moving through the rotors (unmeasured), never a named cause"}};
+}
+
 json one_step_json(const Finding::OneStep& o) {
   json j = {{"metric", "held-out equation-error cost (weighted), reduction per validation fold [%]"}};
   j.update(fold_gains_json(o.cost));
@@ -371,6 +402,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});
   j["unexplained"] = un;
+  j["draft_signature"] = draft_signature_json(d.draft);
   // Beyond the catalogue: one entry per channel, proposed or not (and why).
   json disc = json::array();
   for (const auto& t : d.discovered) {
@@ -578,6 +610,25 @@ std::string num(double v, int prec = 4) {
   return os.str();
 }
 
+// One sentence for the printout and the report when an axis shows the draft's signature on
+// both parts ("" otherwise: then there is nothing to say beyond the JSON).
+std::string draft_lead(const DraftSignature& d) {
+  const auto axes = d.axes_showing_it();
+  if (axes.empty()) return "";
+  std::string s = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
+                  "moving through the rotors would, on axis ";
+  for (size_t i = 0; i < axes.size(); ++i) s += (i ? " and " : "") + axes[i];
+  s += " (1 s means, body velocity partialled out, p <= 0.05 on both parts";
+  for (const auto& p : d.parts) {
+    const auto& pair = axes.front() == "y (roll)" ? p.y_roll : p.x_pitch;
+    s += "; " + p.name + " r = " + num(pair.r, 2) + ", p = " + num(pair.p, 2) + ", slope " + num(pair.slope, 3) +
+         " against " + num(pair.draft_slope, 3);
+    if (p.implied_speed > 0) s += ", draft at most " + num(p.implied_speed, 2) + " m/s";
+  }
+  return s + "); no logged signal measures the air";
+}
+
+
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
 // finding: say so beside the rollouts' numbers, which then show no gain (or a loss).
 std::string one_step_text(const Finding& f) {
@@ -642,6 +693,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
+  if (const std::string lead = draft_lead(d.draft); !lead.empty()) os << lead << "\n";
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
@@ -879,6 +931,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << "</td></tr>\n";
     h << "</table>\n";
   }
+  if (const std::string lead = draft_lead(d.draft); !lead.empty()) h << "<p>" << esc(lead) << "</p>\n";
   discovered_terms_html(h, d);
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.

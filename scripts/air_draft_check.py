@@ -12,38 +12,50 @@ so, whatever S and w, the force residual is tied to the moment residual by a fix
 
     a_y = -(k_d J_xx / (k_f m)) pdot        a_x = +(k_d J_yy / (k_f m)) qdot.
 
-A trim, a CoG offset or a mis-fitted coefficient has no reason to keep that sign. This script
-takes the slow part of the residuals (running means over 0.25 s and 1 s, where the moment
-residual lives; docs/validation.md, "Where the open-loop error comes from") on the training
+A trim or a CoG offset has no reason to keep that sign. (The frame's own drag, 1/2 c_w rho A
+v|v| on the air-relative velocity, adds a speed-dependent force to a draft's, so the ratio
+holds only where that is small.) This script takes the slow part of the residuals (running
+means over 1 s, where the moment residual lives; docs/validation.md, "Where the open-loop error comes from") on the training
 and the held-out part and prints the regression of the force residual on the moment residual
 (slope and correlation r) beside the ratio the draft predicts. The force residual is the
 pose-derived world acceleration rotated into the heading frame (the flights tilt little).
 Noise in the moment residual pulls a regression slope towards zero, so the reverse
 regression's slope (1 / slope of pdot on a_y, its bound from the other side) is printed too.
-Slow signals of a repeated trajectory correlate by chance, so as a control the force residual
-is shifted circularly against the moments by every whole 0.5 s from 2 s to half the part's
-length, both ways: printed is the share of shifts whose correlation lies as far in the
-draft's direction as the unshifted one (a permutation-style p; small means the alignment in
-time matters).
+Slow signals correlate by chance far more often than white ones, so the correlation is
+judged with Bartlett's effective sample size for two autocorrelated series,
+n / (1 + 2 sum_k rho_f(k) rho_m(k)), and Student's t with n_eff - 2 degrees of freedom, as
+diagnose's residual analysis does, one-sided in the draft's direction (diagnose's own
+draft check, diagnose/draft_signature.hpp, is the same test on the unthinned residuals). The running means are taken on a uniform 0.1 s grid.
 
-It also prints the draft speed the moment residual implies, |w| from the RMS of the slow
-pdot and qdot, with S the hover's sum of rotor speeds (m g = k_T S^2 / 4, k_T from the
-Crazyflie thrust stand).
+A common scale error of the airspeed terms (k_d and k_f off by one factor, or the rotor
+speeds S off) leaves the same signature with w replaced by a multiple of the body velocity.
+So the force and the moment means are first regressed on the body velocity along the axis
+(and a constant), and the partial correlation of what is left is the one tested.
+
+It also prints the draft speed the moment residual would imply, |w| from the RMS of the
+slow pdot and qdot (mean included: an upper bound for a draft), with S the hover's sum of
+rotor speeds (m g = k_T S^2 / 4, k_T from the Crazyflie thrust stand).
+
+`--self-test` runs the test on synthetic slow series instead: a draft (the signature with
+noise) and independent slow forces, to show the false-alarm rate at the 5 % level.
 
 Reads a diagnosis folder (residuals.csv, diagnosis.json, fitted_parameters.yaml,
 extended_model.json) whose final model has both rotor_drag and blade_flapping, or takes their
 values from --airframe DIR (e.g. a joint diagnosis), and the NanoBench log it was fitted to.
 
-Usage: air_draft_check.py DIAGNOSIS_DIR LOG.csv [--airframe DIR]"""
+Usage: air_draft_check.py DIAGNOSIS_DIR LOG.csv [--airframe DIR]
+       air_draft_check.py --self-test"""
 import bisect
 import csv
 import json
 import math
+import random
 import re
 import sys
 
-WIDTHS = (0.25, 1.0)  # s, running-mean windows
-CONTROL_MIN_SHIFT, CONTROL_STEP = 2.0, 0.5  # s
+WIDTH = 1.0  # s, running means
+GRID = 0.1  # s, where they are taken
+LEVEL = 0.05
 # Thrust per squared rotor speed [N s^2], the Crazyflie thrust stand fitted by this project
 # (README, "How well it works"); only for the draft speed's order of magnitude.
 THRUST_STAND_K = 2.02e-8
@@ -59,53 +71,94 @@ def fitted_values(folder):
     return values
 
 
-def running_means(ts, ys, width):
-    """Mean of the values in [t, t + width) for every sample t whose window is full."""
-    out, total, end = [], 0.0, 0
-    for i, t in enumerate(ts):
-        while end < len(ts) and ts[end] < t + width:
+def grid_means(ts, ys, grid):
+    """Mean of the values in [g, g + WIDTH) for every grid time g (None where it holds none)."""
+    out, start, end, total = [], 0, 0, 0.0
+    for g in grid:
+        while end < len(ts) and ts[end] < g + WIDTH:
             total += ys[end]
             end += 1
-        if ts[-1] < t + width:
-            break
-        out.append(total / (end - i))
-        total -= ys[i]
+        while start < end and ts[start] < g:
+            total -= ys[start]
+            start += 1
+        out.append(total / (end - start) if end > start else None)
     return out
 
 
-def regression(x, y):
-    """Slope of y on x, the reverse regression's slope (1 / slope of x on y) and r."""
-    n = len(x)
-    mx, my = sum(x) / n, sum(y) / n
-    sxx = sum((a - mx) ** 2 for a in x)
-    syy = sum((b - my) ** 2 for b in y)
-    sxy = sum((a - mx) * (b - my) for a, b in zip(x, y))
-    return sxy / sxx, syy / sxy if sxy else math.inf, sxy / math.sqrt(sxx * syy)
+def centred(v):
+    m = sum(v) / len(v)
+    return [x - m for x in v]
 
 
-def residual_channels(folder):
-    channels = {}
-    for r in csv.DictReader(open(f"{folder}/residuals.csv")):
-        if r["series"].startswith("extended"):
-            channels.setdefault(r["panel"].split(" ")[0], []).append((float(r["x"]), float(r["y"])))
-    return channels
+def residual_on(y, x):
+    """y minus its least-squares fit on x and a constant."""
+    xc, yc = centred(x), centred(y)
+    sxx = sum(a * a for a in xc)
+    b = sum(a * c for a, c in zip(xc, yc)) / sxx if sxx > 0 else 0.0
+    return [c - b * a for a, c in zip(xc, yc)]
 
 
-def shift_control(ts, moment, force, draft_sign):
-    """Share of circular shifts of `force` against `moment` whose correlation lies as far in
-    the draft's direction (sign of the draft ratio) as the unshifted one."""
-    r0 = draft_sign * regression(moment, force)[2]
-    span = ts[-1] - ts[0]
-    dt = span / (len(ts) - 1)
-    shifts, s = [], CONTROL_MIN_SHIFT
-    while s <= span / 2:
-        k = int(round(s / dt))
-        shifts += [k, len(ts) - k]
-        s += CONTROL_STEP
-    if not shifts:
-        return math.nan
-    beyond = sum(draft_sign * regression(moment, force[k:] + force[:k])[2] >= r0 for k in shifts)
-    return beyond / len(shifts)
+def acf(v, max_lag):
+    c = centred(v)
+    c0 = sum(x * x for x in c)
+    return [sum(c[i] * c[i + k] for i in range(len(c) - k)) / c0 for k in range(max_lag + 1)]
+
+
+def incomplete_beta(a, b, x):
+    """Regularized incomplete beta I_x(a, b): its continued fraction, evaluated by the
+    modified Lentz method on the side where it converges fast."""
+    if x <= 0 or x >= 1:
+        return 0.0 if x <= 0 else 1.0
+    front = math.exp(math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log(1 - x))
+    if x > (a + 1) / (a + b + 2):
+        return 1 - incomplete_beta(b, a, 1 - x)
+    tiny = 1e-300
+    c, d = 1.0, 1 - (a + b) * x / (a + 1)
+    d = 1 / (d if abs(d) > tiny else tiny)
+    h = d
+    for m in range(1, 300):
+        for num in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
+                    -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
+            d = 1 + num * d
+            d = 1 / (d if abs(d) > tiny else tiny)
+            c = 1 + num / c
+            c = c if abs(c) > tiny else tiny
+            h *= d * c
+        if abs(d * c - 1) < 1e-14:
+            break
+    return front * h / a
+
+
+def student_t_above(t, dof):
+    """P(T > t) for Student's t with `dof` degrees of freedom."""
+    tail = 0.5 * incomplete_beta(dof / 2, 0.5, dof / (dof + t * t))
+    return tail if t > 0 else 1 - tail
+
+
+def correlation_test(x, y, sign):
+    """r of y on x, Bartlett's effective n and the one-sided p in the direction `sign`
+    (Student's t with n_eff - 2 degrees of freedom, as diagnose's residual analysis)."""
+    xc, yc = centred(x), centred(y)
+    sxx, syy = sum(a * a for a in xc), sum(b * b for b in yc)
+    sxy = sum(a * b for a, b in zip(xc, yc))
+    r = sxy / math.sqrt(sxx * syy)
+    lag = len(x) // 4
+    ax, ay = acf(x, lag), acf(y, lag)
+    inflate = 1 + 2 * sum(ax[k] * ay[k] for k in range(1, lag + 1))
+    n_eff = min(len(x), max(3.0, len(x) / max(1.0, inflate)))
+    t = sign * r * math.sqrt((n_eff - 2) / max(1 - r * r, 1e-12))
+    p = student_t_above(t, max(1.0, n_eff - 2))
+    return r, n_eff, p, sxy / sxx, (syy / sxy if sxy else math.inf)
+
+
+def pair_line(name, moment, force, velocity, ratio):
+    sign = math.copysign(1, ratio)
+    r_raw = correlation_test(moment, force, sign)[0]
+    r, n_eff, p, slope, reverse = correlation_test(residual_on(moment, velocity), residual_on(force, velocity), sign)
+    shows = p <= LEVEL
+    return (f"{name}: r {r_raw:+.2f}, with the velocity partialled out {r:+.2f} (n_eff {n_eff:.1f}, p {p:.3f}"
+            f"{', the draft' + chr(39) + 's sign' if shows else ''}), slope {slope:+.4f} (reverse {reverse:+.4f}; "
+            f"draft {ratio:+.4f})"), shows
 
 
 def main(folder, log_path, airframe):
@@ -116,42 +169,74 @@ def main(folder, log_path, airframe):
         sys.exit(f"{airframe or folder}: the final model needs rotor_drag and blade_flapping (use --airframe)")
     kd, kf = values["rotor_drag.k"], values["blade_flapping.k"]
     ratio_y, ratio_x = -kd * jxx / (kf * m), kd * jyy / (kf * m)
-    channels = residual_channels(folder)
+    channels = {}
+    for r in csv.DictReader(open(f"{folder}/residuals.csv")):
+        if r["series"].startswith("extended"):
+            channels.setdefault(r["panel"].split(" ")[0], []).append((float(r["x"]), float(r["y"])))
     log = list(csv.DictReader(open(log_path)))
     t_first = float(log[0]["t"])
     log_t = [float(r["t"]) - t_first for r in log]
     split = json.load(open(f"{folder}/diagnosis.json"))["samples"]["validation_from_s"]
     ts = [t for t, _ in channels["pdot"]]
-    yaw = [float(log[min(bisect.bisect_left(log_t, t), len(log) - 1)]["yaw"]) for t in ts]
-    ax, ay = [v for _, v in channels["ax_world"]], [v for _, v in channels["ay_world"]]
-    heading_x = [math.cos(p) * a + math.sin(p) * b for p, a, b in zip(yaw, ax, ay)]
-    heading_y = [-math.sin(p) * a + math.cos(p) * b for p, a, b in zip(yaw, ax, ay)]
-    pdot, qdot = [v for _, v in channels["pdot"]], [v for _, v in channels["qdot"]]
+    rows = [log[min(bisect.bisect_left(log_t, t), len(log) - 1)] for t in ts]
+    yaw = [float(r["yaw"]) for r in rows]
+
+    def heading_frame(x, y):
+        return ([math.cos(p) * a + math.sin(p) * b for p, a, b in zip(yaw, x, y)],
+                [-math.sin(p) * a + math.cos(p) * b for p, a, b in zip(yaw, x, y)])
+    ax, ay = heading_frame([v for _, v in channels["ax_world"]], [v for _, v in channels["ay_world"]])
+    vx, vy = heading_frame([float(r["vx"]) for r in rows], [float(r["vy"]) for r in rows])
+    series = {"pdot": [v for _, v in channels["pdot"]], "qdot": [v for _, v in channels["qdot"]],
+              "ax": ax, "ay": ay, "vx": vx, "vy": vy}
     speeds_sum = 4 * math.sqrt(m * 9.81 / 4 / THRUST_STAND_K)  # hover: m g = k_T S^2 / 4
     print(f"{folder}: draft ratios a_y/pdot {ratio_y:+.4f}, a_x/qdot {ratio_x:+.4f} "
-          f"(k_d {kd:.3g}, k_f {kf:.3g}, m {m:.4g}, J {jxx:.3g} {jyy:.3g})")
-    for part, inside in (("training", lambda t: t < split), ("held-out", lambda t: t >= split)):
-        idx = [i for i, t in enumerate(ts) if inside(t)]
+          f"(k_d {kd:.3g}, k_f {kf:.3g}, m {m:.4g}, J {jxx:.3g} {jyy:.3g}); {WIDTH:g} s means every {GRID:g} s")
+    for part, lo, hi in (("training", -math.inf, split), ("held-out", split, math.inf)):
+        idx = [i for i, t in enumerate(ts) if lo <= t < hi]
         t_part = [ts[i] for i in idx]
-        for width in WIDTHS:
-            cols = {name: running_means(t_part, [series[i] for i in idx], width)
-                    for name, series in (("pdot", pdot), ("qdot", qdot), ("ax", heading_x), ("ay", heading_y))}
-            n = len(cols["pdot"])
-            t_means = t_part[:n]
-            line = [f"  {part}, {width} s means (n {n}):"]
-            for force, moment, ratio in (("ay", "pdot", ratio_y), ("ax", "qdot", ratio_x)):
-                slope, reverse, r = regression(cols[moment], cols[force])
-                p = shift_control(t_means, cols[moment], cols[force], math.copysign(1, ratio))
-                line.append(f"{force} on {moment}: slope {slope:+.4f} (reverse {reverse:+.4f}; draft {ratio:+.4f}) "
-                            f"r {r:+.2f}, shifts as far {p:.2f}")
-            rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v))
-            w = math.hypot(rms(cols["pdot"]) * jxx, rms(cols["qdot"]) * jyy) / (kf * speeds_sum)
-            line.append(f"draft speed the moments imply {w:.2f} m/s")
-            print(line[0] + " " + "; ".join(line[1:]))
+        grid = [t_part[0] + GRID * k for k in range(int((t_part[-1] - WIDTH - t_part[0]) / GRID) + 1)]
+        means = {k: grid_means(t_part, [v[i] for i in idx], grid) for k, v in series.items()}
+        keep = [g for g in range(len(grid)) if all(means[k][g] is not None for k in means)]
+        cols = {k: [v[g] for g in keep] for k, v in means.items()}
+        y_line, _ = pair_line("a_y on pdot", cols["pdot"], cols["ay"], cols["vy"], ratio_y)
+        x_line, _ = pair_line("a_x on qdot", cols["qdot"], cols["ax"], cols["vx"], ratio_x)
+        rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v))
+        w = math.hypot(rms(cols["pdot"]) * jxx, rms(cols["qdot"]) * jyy) / (kf * speeds_sum)
+        print(f"  {part} ({len(keep)} means): {y_line}; {x_line}; draft speed the moments would imply at most "
+              f"{w:.2f} m/s")
+
+
+def self_test():
+    """The test on synthetic 1 s means (100 Hz noise averaged): a draft, an independent slow
+    force, and its false-alarm rate over many independent pairs."""
+    rng = random.Random(1)
+    ratio = -0.024
+
+    def slow(n):  # AR(1), 2 s time constant at 100 Hz, averaged over 1 s and taken every 0.1 s
+        w, out = 0.0, []
+        raw = []
+        for _ in range(n * 10 + 100):
+            w = 0.995 * w + rng.gauss(0, 0.02)
+            raw.append(w)
+        return [sum(raw[k * 10:k * 10 + 100]) / 100 for k in range(n)]
+    n = 120  # 12 s of means, like a held-out part
+    alarms, tries = 0, 400
+    for _ in range(tries):
+        moment, force = [14.7 * x + rng.gauss(0, 0.3) for x in slow(n)], [0.35 * x for x in slow(n)]
+        alarms += correlation_test(moment, force, -1)[2] <= LEVEL
+    w = slow(n)
+    moment = [14.7 * x + rng.gauss(0, 0.3) for x in w]
+    force = [ratio * y + rng.gauss(0, 0.01) for y in moment]
+    r, n_eff, p, slope, _ = correlation_test(moment, force, -1)
+    print(f"a draft: r {r:+.2f}, n_eff {n_eff:.1f}, p {p:.3g}, slope {slope:+.4f} (true {ratio:+.4f})")
+    print(f"independent slow forces: {alarms} of {tries} pass at the {LEVEL:g} level ({100 * alarms / tries:.1f} %)")
 
 
 if __name__ == "__main__":
     args = sys.argv[1:]
+    if args == ["--self-test"]:
+        self_test()
+        sys.exit(0)
     airframe = None
     if "--airframe" in args:
         i = args.index("--airframe")

@@ -888,6 +888,12 @@ TEST(Acceptance, AFlightsOwnQuantityMayStandOnTheForceModelAlone) {
   f.one_step.horizontal.mean = 60;
   f.one_step.rotation.mean = -28, f.one_step.rotation.standard_error = 8;  // B3 rep 2's moments
   EXPECT_EQ(held_out_test(f), "") << "bought with worse rotational channels";
+  f.one_step.horizontal.mean = -11.4, f.one_step.horizontal.standard_error = 10.9;  // and its horizontal force
+  EXPECT_NE(quadgen::diagnose::one_step_summary(f).find("force model alone: 0.08 m +- 0.013 m lower, bought with worse "
+                                                       "horizontal force and rotational channels"),
+            std::string::npos)
+      << quadgen::diagnose::one_step_summary(f);
+  f.one_step.horizontal.mean = 60;
   f.one_step.rotation.mean = 1, f.one_step.rotation.standard_error = 2;
   EXPECT_EQ(held_out_test(f), Finding::kByForceModelAlone);
   f.effect = "motor_gain";  // a flight's own quantity on the moments

@@ -190,7 +190,7 @@ TEST(Prediction, HoldingThePastDisturbanceRemovesAConstantOne) {
     EXPECT_NE(original.past_disturbance(k + 10, 0.5), altered.past_disturbance(k + 10, 0.5));
   }
   {  // Nor what comes before the rotor speeds are known again after a restart: a gap of a second
-     // restarts them; 0.6 s later the window's first 0.1 s would be the 0.3 s that settle them.
+     // restarts them; 0.6 s later the window's first 0.2 s would lie in the 0.3 s that settle them.
     const std::vector<double> p = quadgen::runtime::simulation_params(m, heavy);
     m.set_params(p);
     quadgen::fit::Flight gapped = f;

@@ -1,0 +1,148 @@
+#include "diagnose/draft_signature.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <boost/math/distributions/students_t.hpp>
+
+namespace quadgen::diagnose {
+
+namespace {
+
+// Means of the values in [g, g + kWindow) for g every kGrid from the first time; nullopt
+// where no sample lies in the window (a gap).
+std::vector<std::optional<double>> grid_means(const std::vector<double>& t, const std::vector<double>& y) {
+  std::vector<std::optional<double>> out;
+  if (t.empty()) return out;
+  double total = 0;
+  size_t start = 0, end = 0;
+  for (double g = t.front(); g + DraftSignature::kWindow <= t.back() + 1e-9; g += DraftSignature::kGrid) {
+    while (end < t.size() && t[end] < g + DraftSignature::kWindow) total += y[end++];
+    while (start < end && t[start] < g) total -= y[start++];
+    out.push_back(end > start ? std::optional<double>(total / static_cast<double>(end - start)) : std::nullopt);
+  }
+  return out;
+}
+
+std::vector<double> centred(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m += x / static_cast<double>(v.size());
+  std::vector<double> c;
+  for (double x : v) c.push_back(x - m);
+  return c;
+}
+
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+// y minus its least-squares fit on x and a constant.
+std::vector<double> partial_out(const std::vector<double>& y, const std::vector<double>& x) {
+  const auto xc = centred(x), yc = centred(y);
+  const double sxx = dot(xc, xc), b = sxx > 0 ? dot(xc, yc) / sxx : 0.0;
+  std::vector<double> out;
+  for (size_t i = 0; i < yc.size(); ++i) out.push_back(yc[i] - b * xc[i]);
+  return out;
+}
+
+double autocorrelation(const std::vector<double>& c, size_t lag) {
+  double num = 0;
+  for (size_t i = 0; i + lag < c.size(); ++i) num += c[i] * c[i + lag];
+  const double c0 = dot(c, c);
+  return c0 > 0 ? num / c0 : 0.0;
+}
+
+DraftSignature::Pair measure_pair(const char* force_name, const char* moment_name, double draft_slope,
+                                  const std::vector<double>& moment, const std::vector<double>& force,
+                                  const std::vector<double>& velocity) {
+  DraftSignature::Pair p;
+  p.force = force_name, p.moment = moment_name, p.draft_slope = draft_slope;
+  const auto correlation = [](const std::vector<double>& a, const std::vector<double>& b) {
+    const double aa = dot(a, a), bb = dot(b, b);
+    return aa > 0 && bb > 0 ? dot(a, b) / std::sqrt(aa * bb) : 0.0;
+  };
+  p.raw_r = correlation(centred(moment), centred(force));
+  const auto m = partial_out(moment, velocity), f = partial_out(force, velocity);
+  p.r = correlation(m, f);
+  const double mm = dot(m, m), ff = dot(f, f), mf = dot(m, f);
+  p.slope = mm > 0 ? mf / mm : 0.0;
+  p.reverse_slope = mf != 0 ? ff / mf : 0.0;
+  double inflate = 1;
+  for (size_t k = 1; k <= m.size() / 4; ++k) inflate += 2 * autocorrelation(m, k) * autocorrelation(f, k);
+  const double n = static_cast<double>(m.size());
+  p.effective_n = std::clamp(n / std::max(1.0, inflate), 3.0, n);
+  // Student's t with n_eff - 2 degrees of freedom, as residual_analysis judges its correlations.
+  const double r2 = std::min(p.r * p.r, 1 - 1e-12);
+  const double t = (draft_slope < 0 ? -p.r : p.r) * std::sqrt((p.effective_n - 2) / (1 - r2));
+  p.p = boost::math::cdf(boost::math::complement(boost::math::students_t(std::max(1.0, p.effective_n - 2)), t));
+  return p;
+}
+
+double rms(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::sqrt(dot(v, v) / static_cast<double>(v.size()));
+}
+
+}  // namespace
+
+std::vector<std::string> DraftSignature::axes_showing_it() const {
+  bool y = !parts.empty(), x = !parts.empty();
+  for (const auto& p : parts) y = y && p.y_roll.shows_draft(), x = x && p.x_pitch.shows_draft();
+  std::vector<std::string> out;
+  if (y) out.push_back("y (roll)");
+  if (x) out.push_back("x (pitch)");
+  return out;
+}
+
+DraftSignature draft_signature(const DraftSignatureInput& in) {
+  DraftSignature d;
+  if (!(in.rotor_drag_k > 0) || !(in.blade_flapping_k > 0) || !(in.mass > 0)) {
+    d.why_not = "needs rotor drag and blade flapping, both positive, in the final model";
+    return d;
+  }
+  const double ratio_y = -in.rotor_drag_k * in.J_xx / (in.blade_flapping_k * in.mass);
+  const double ratio_x = in.rotor_drag_k * in.J_yy / (in.blade_flapping_k * in.mass);
+  for (const bool held_out : {false, true}) {
+    // The part's samples, world vectors turned into the heading frame.
+    std::vector<double> t, series[6];  // ax, ay, pdot, qdot, vx, vy
+    for (size_t k = 0; k < in.t.size(); ++k) {
+      if (in.held_out[k] != held_out) continue;
+      const double* r = &in.residual[6 * k];
+      const double c = std::cos(in.heading[k]), s = std::sin(in.heading[k]);
+      const double fc = in.force_in_world ? c : 1.0, fs = in.force_in_world ? s : 0.0;
+      const double vx = in.velocity[2 * k], vy = in.velocity[2 * k + 1];
+      t.push_back(in.t[k]);
+      const double values[6] = {fc * r[0] + fs * r[1], -fs * r[0] + fc * r[1], r[3], r[4], c * vx + s * vy, -s * vx + c * vy};
+      for (int i = 0; i < 6; ++i) series[i].push_back(values[i]);
+    }
+    std::vector<std::optional<double>> slow[6];
+    for (int i = 0; i < 6; ++i) slow[i] = grid_means(t, series[i]);
+    std::vector<double> means[6];  // where every series has a window
+    for (size_t g = 0; g < slow[0].size(); ++g) {
+      bool all = true;
+      for (int i = 0; i < 6; ++i) all = all && slow[i][g].has_value();
+      if (all)
+        for (int i = 0; i < 6; ++i) means[i].push_back(*slow[i][g]);
+    }
+    if (means[0].size() < 20) {  // 2 s of means: nothing to test
+      d.why_not = std::string("the ") + (held_out ? "held-out" : "training") + " part is too short";
+      d.parts.clear();
+      return d;
+    }
+    DraftSignature::Part part;
+    part.name = held_out ? "held-out" : "training";
+    part.means = means[0].size();
+    part.y_roll = measure_pair("a_y", "pdot", ratio_y, means[2], means[1], means[5]);
+    part.x_pitch = measure_pair("a_x", "qdot", ratio_x, means[3], means[0], means[4]);
+    if (in.hover_speeds_sum > 0)
+      part.implied_speed =
+          std::hypot(rms(means[2]) * in.J_xx, rms(means[3]) * in.J_yy) / (in.blade_flapping_k * in.hover_speeds_sum);
+    d.parts.push_back(part);
+  }
+  d.measured = true;
+  return d;
+}
+
+}  // namespace quadgen::diagnose
