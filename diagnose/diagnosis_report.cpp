@@ -618,11 +618,15 @@ std::string draft_lead(const DraftSignature& d) {
   std::string s = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
                   "moving through the rotors would, on axis ";
   for (size_t i = 0; i < axes.size(); ++i) s += (i ? " and " : "") + axes[i];
-  s += " (1 s means, body velocity partialled out, p <= 0.05 on both parts";
+  s += " (1 s means, the velocity along the axis partialled out, p <= " + num(DraftSignature::kLevel, 2) +
+       " on both parts";
   for (const auto& p : d.parts) {
-    const auto& pair = axes.front() == "y (roll)" ? p.y_roll : p.x_pitch;
-    s += "; " + p.name + " r = " + num(pair.r, 2) + ", p = " + num(pair.p, 2) + ", slope " + num(pair.slope, 3) +
-         " against " + num(pair.draft_slope, 3);
+    s += "; " + p.name;
+    for (const auto& axis : axes) {
+      const auto& pair = axis == "y (roll)" ? p.y_roll : p.x_pitch;
+      s += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", p = " + num(pair.p, 2) +
+           ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
+    }
     if (p.implied_speed > 0) s += ", draft at most " + num(p.implied_speed, 2) + " m/s";
   }
   return s + "); no logged signal measures the air";

@@ -17,7 +17,9 @@ std::vector<std::optional<double>> grid_means(const std::vector<double>& t, cons
   if (t.empty()) return out;
   double total = 0;
   size_t start = 0, end = 0;
-  for (double g = t.front(); g + DraftSignature::kWindow <= t.back() + 1e-9; g += DraftSignature::kGrid) {
+  for (size_t i = 0;; ++i) {
+    const double g = t.front() + static_cast<double>(i) * DraftSignature::kGrid;  // not accumulated: no drift
+    if (g + DraftSignature::kWindow > t.back() + 1e-9) break;
     while (end < t.size() && t[end] < g + DraftSignature::kWindow) total += y[end++];
     while (start < end && t[start] < g) total -= y[start++];
     out.push_back(end > start ? std::optional<double>(total / static_cast<double>(end - start)) : std::nullopt);
@@ -74,10 +76,11 @@ DraftSignature::Pair measure_pair(const char* force_name, const char* moment_nam
   for (size_t k = 1; k <= m.size() / 4; ++k) inflate += 2 * autocorrelation(m, k) * autocorrelation(f, k);
   const double n = static_cast<double>(m.size());
   p.effective_n = std::clamp(n / std::max(1.0, inflate), 3.0, n);
-  // Student's t with n_eff - 2 degrees of freedom, as residual_analysis judges its correlations.
-  const double r2 = std::min(p.r * p.r, 1 - 1e-12);
-  const double t = (draft_slope < 0 ? -p.r : p.r) * std::sqrt((p.effective_n - 2) / (1 - r2));
-  p.p = boost::math::cdf(boost::math::complement(boost::math::students_t(std::max(1.0, p.effective_n - 2)), t));
+  // Student's t as residual_analysis judges its correlations, with one degree of freedom
+  // fewer for the velocity partialled out: n_eff - 3.
+  const double r2 = std::min(p.r * p.r, 1 - 1e-12), dof = std::max(1.0, p.effective_n - 3);
+  const double t = (draft_slope < 0 ? -p.r : p.r) * std::sqrt(dof / (1 - r2));
+  p.p = boost::math::cdf(boost::math::complement(boost::math::students_t(dof), t));
   return p;
 }
 
@@ -98,8 +101,8 @@ std::vector<std::string> DraftSignature::axes_showing_it() const {
 
 DraftSignature draft_signature(const DraftSignatureInput& in) {
   DraftSignature d;
-  if (!(in.rotor_drag_k > 0) || !(in.blade_flapping_k > 0) || !(in.mass > 0)) {
-    d.why_not = "needs rotor drag and blade flapping, both positive, in the final model";
+  if (!(in.rotor_drag_k > 0) || !(in.blade_flapping_k > 0) || !(in.mass > 0) || !(in.J_xx > 0) || !(in.J_yy > 0)) {
+    d.why_not = "needs rotor drag and blade flapping, both positive, in the final model (and its mass and inertia)";
     return d;
   }
   const double ratio_y = -in.rotor_drag_k * in.J_xx / (in.blade_flapping_k * in.mass);

@@ -13,7 +13,7 @@
 // partialled out first. Measured on the slow part of the residuals (1 s means every 0.1 s,
 // where the moment residual that drifts the open loop lives), on the training and the
 // held-out part, with Bartlett's effective sample size for two autocorrelated series and
-// Fisher's z, one-sided in the draft's direction. A hypothesis for an unmeasured draft
+// Student's t (n_eff - 3 degrees of freedom), one-sided in the draft's direction. A hypothesis for an unmeasured draft
 // (docs/validation.md, "Is the slow moment residual moving air?"), never a named cause;
 // scripts/air_draft_check.py is the same test on a diagnosis folder.
 #pragma once
@@ -25,7 +25,7 @@ namespace quadgen::diagnose {
 struct DraftSignatureInput {
   std::vector<double> t;         // s, per sample
   std::vector<double> residual;  // samples x 6 (ax, ay, az, pdot, qdot, rdot), model - measured
-  std::vector<double> velocity;  // samples x 2, m/s, world x and y
+  std::vector<double> velocity;  // samples x 2, m/s, world x and y (turned into the heading frame like the force)
   std::vector<double> heading;   // rad, per sample: world vectors are turned by it into the heading frame
   bool force_in_world = true;    // false: the force channels are already body axes (accelerometer)
   std::vector<bool> held_out;    // per sample

@@ -23,8 +23,8 @@ Noise in the moment residual pulls a regression slope towards zero, so the rever
 regression's slope (1 / slope of pdot on a_y, its bound from the other side) is printed too.
 Slow signals correlate by chance far more often than white ones, so the correlation is
 judged with Bartlett's effective sample size for two autocorrelated series,
-n / (1 + 2 sum_k rho_f(k) rho_m(k)), and Student's t with n_eff - 2 degrees of freedom, as
-diagnose's residual analysis does, one-sided in the draft's direction (diagnose's own
+n / (1 + 2 sum_k rho_f(k) rho_m(k)), and Student's t as diagnose's residual analysis does
+(n_eff - 3 degrees of freedom: one fewer for the velocity partialled out), one-sided in the draft's direction (diagnose's own
 draft check, diagnose/draft_signature.hpp, is the same test on the unthinned residuals). The running means are taken on a uniform 0.1 s grid.
 
 A common scale error of the airspeed terms (k_d and k_f off by one factor, or the rotor
@@ -137,7 +137,7 @@ def student_t_above(t, dof):
 
 def correlation_test(x, y, sign):
     """r of y on x, Bartlett's effective n and the one-sided p in the direction `sign`
-    (Student's t with n_eff - 2 degrees of freedom, as diagnose's residual analysis)."""
+    (Student's t with n_eff - 3 degrees of freedom: the velocity is partialled out)."""
     xc, yc = centred(x), centred(y)
     sxx, syy = sum(a * a for a in xc), sum(b * b for b in yc)
     sxy = sum(a * b for a, b in zip(xc, yc))
@@ -146,8 +146,9 @@ def correlation_test(x, y, sign):
     ax, ay = acf(x, lag), acf(y, lag)
     inflate = 1 + 2 * sum(ax[k] * ay[k] for k in range(1, lag + 1))
     n_eff = min(len(x), max(3.0, len(x) / max(1.0, inflate)))
-    t = sign * r * math.sqrt((n_eff - 2) / max(1 - r * r, 1e-12))
-    p = student_t_above(t, max(1.0, n_eff - 2))
+    dof = max(1.0, n_eff - 3)  # one fewer for the velocity partialled out
+    t = sign * r * math.sqrt(dof / max(1 - r * r, 1e-12))
+    p = student_t_above(t, dof)
     return r, n_eff, p, sxy / sxx, (syy / sxy if sxy else math.inf)
 
 

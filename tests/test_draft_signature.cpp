@@ -3,7 +3,7 @@
 // rotor-drag / blade-flapping ratio, and nothing else that shares only the slowness does.
 // Statistical acceptance over many synthetic flights: the check's p-values rest on Bartlett's
 // effective sample size, whose estimated autocorrelations make one test somewhat optimistic
-// (6-13 % false alarms at the 5 % level on these parts), so what is asserted is the rate of
+// (6-10.5 % false alarms at the 5 % level on these parts), so what is asserted is the rate of
 // the check's verdict (an axis showing the draft on both parts).
 #include <cmath>
 #include <random>
@@ -34,7 +34,7 @@ enum class Force {
   kSameDraft,      // the force from the draft the moments see
   kOtherDraft,     // an independent slow force
   kOppositeSign,   // tied to the moments with the wrong sign
-  kAirspeedScale,  // no draft: k_d and k_f both 20 % too large, a "draft" of -0.2 times the body velocity
+  kAirspeedScale,  // no draft: k_d and k_f both 20 % too small, a "draft" of -0.2 times the body velocity
 };
 
 // Residuals (model - measured) of a flight along a circle at 0.75 m/s, the heading turned by
