@@ -40,7 +40,9 @@ enum class Force {
 // Residuals (model - measured) of a flight along a circle at 0.75 m/s, the heading turned by
 // about 90 degrees, so that a check that forgot to turn the world force into the heading frame
 // would pair each moment with the other axis' force.
-DraftSignatureInput flight_with_draft(Force force, unsigned seed) {
+// With `accelerometer`, the force residual is given in body axes, as diagnose has it when the
+// fit uses the accelerometer instead of the differentiated pose.
+DraftSignatureInput flight_with_draft(Force force, unsigned seed, bool accelerometer = false) {
   std::mt19937 rng(seed);
   const size_t n = 6000;
   const auto wx = wandering(rng, n), wy = wandering(rng, n), ox = wandering(rng, n), oy = wandering(rng, n);
@@ -48,6 +50,7 @@ DraftSignatureInput flight_with_draft(Force force, unsigned seed) {
   DraftSignatureInput in;
   in.rotor_drag_k = kd, in.blade_flapping_k = kf, in.mass = mass, in.J_xx = Jxx, in.J_yy = Jyy;
   in.hover_speeds_sum = S;
+  in.force_in_world = !accelerometer;
   for (size_t k = 0; k < n; ++k) {
     const double t = 0.01 * k, heading = M_PI / 2 + 0.05 * std::sin(0.3 * t);
     const double c = std::cos(heading), s = std::sin(heading);
@@ -61,7 +64,8 @@ DraftSignatureInput flight_with_draft(Force force, unsigned seed) {
     in.heading.push_back(heading);
     in.held_out.push_back(t >= 42.0);
     in.velocity.push_back(vx), in.velocity.push_back(vy);
-    for (double r : {c * body_ax - s * body_ay, s * body_ax + c * body_ay, force_noise(rng),
+    const double ax = accelerometer ? body_ax : c * body_ax - s * body_ay, ay = accelerometer ? body_ay : s * body_ax + c * body_ay;
+    for (double r : {ax, ay, force_noise(rng),
                      kf * S * my / Jxx + moment_noise(rng), -kf * S * mx / Jyy + moment_noise(rng), moment_noise(rng)})
       in.residual.push_back(r);
   }
@@ -92,6 +96,8 @@ TEST(DraftSignature, ADraftThroughTheRotorsShowsItsRatioOnBothAxesAndParts) {
     }
   }
   EXPECT_GE(flights_showing_a_draft(Force::kSameDraft, true), 190) << "found on both axes in at least 95 % of flights";
+  EXPECT_EQ(quadgen::diagnose::draft_signature(flight_with_draft(Force::kSameDraft, 1, true)).axes_showing_it().size(), 2u)
+      << "the accelerometer's force is already in body axes: not turned again";
 }
 
 TEST(DraftSignature, SlowForcesThatAreNotTheSameDraftRarelyShowIt) {
