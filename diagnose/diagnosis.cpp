@@ -710,7 +710,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     d.unexplained.push_back(u);
   }
-  d.draft = draft_signature(draft_signature_input(d, used, valid, v, s.final_fit, !accel));
+  const DraftSignatureInput draft_input = draft_signature_input(d, used, valid, v, s.final_fit, !accel);
+  d.draft = draft_signature(draft_input);
+  if (joint)
+    for (const auto& one : split_by_flight(draft_input, fit::joined_start_times(flights)))
+      d.draft_per_flight.push_back(draft_signature(one));
   std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
   d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
                                 residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,

@@ -160,6 +160,9 @@ struct Diagnosis {
   // Whether the slow roll/pitch residual the final model leaves follows the horizontal force
   // as a draft through the rotors would (draft_signature.hpp): a lead, never a named cause.
   DraftSignature draft;
+  // Jointly diagnosed flights: the same check on each flight alone (its samples on the joined
+  // clock, the joint model's residuals), in the order of `flights`.
+  std::vector<DraftSignature> draft_per_flight;
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).
   std::vector<DiscoveredTerm> discovered;

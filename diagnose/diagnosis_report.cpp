@@ -403,6 +403,15 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"r", u.r}});
   j["unexplained"] = un;
   j["draft_signature"] = draft_signature_json(d.draft);
+  if (!d.draft_per_flight.empty()) {
+    json per = json::array();
+    for (size_t i = 0; i < d.draft_per_flight.size(); ++i) {
+      json one = draft_signature_json(d.draft_per_flight[i]);
+      one["flight"] = i < d.flights.size() ? d.flights[i] : "";
+      per.push_back(one);
+    }
+    j["draft_signature"]["per_flight"] = per;
+  }
   // Beyond the catalogue: one entry per channel, proposed or not (and why).
   json disc = json::array();
   for (const auto& t : d.discovered) {
@@ -698,6 +707,9 @@ std::string diagnosis_summary(const Diagnosis& d) {
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
   if (const std::string lead = draft_lead(d.draft); !lead.empty()) os << lead << "\n";
+  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
+    if (const std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
+      os << "flight " << i + 1 << " (" << output::printable(d.flights[i]) << "): " << lead << "\n";
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
@@ -936,6 +948,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << "</table>\n";
   }
   if (const std::string lead = draft_lead(d.draft); !lead.empty()) h << "<p>" << esc(lead) << "</p>\n";
+  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
+    if (const std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
+      h << "<p>flight " << esc(d.flights[i]) << ": " << esc(lead) << "</p>\n";
   discovered_terms_html(h, d);
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.

@@ -99,6 +99,25 @@ std::vector<std::string> DraftSignature::axes_showing_it() const {
   return out;
 }
 
+std::vector<DraftSignatureInput> split_by_flight(const DraftSignatureInput& in, const std::vector<double>& starts) {
+  std::vector<DraftSignatureInput> out(starts.size());
+  for (auto& f : out) {
+    f = in;
+    f.t.clear(), f.residual.clear(), f.velocity.clear(), f.heading.clear(), f.held_out.clear();
+  }
+  for (size_t k = 0; k < in.t.size(); ++k) {
+    const auto next = std::upper_bound(starts.begin(), starts.end(), in.t[k]);
+    if (next == starts.begin()) continue;  // before the first flight
+    auto& f = out[static_cast<size_t>(next - starts.begin()) - 1];
+    f.t.push_back(in.t[k]), f.heading.push_back(in.heading[k]), f.held_out.push_back(in.held_out[k]);
+    f.residual.insert(f.residual.end(), in.residual.begin() + 6 * static_cast<long>(k),
+                      in.residual.begin() + 6 * static_cast<long>(k + 1));
+    f.velocity.insert(f.velocity.end(), in.velocity.begin() + 2 * static_cast<long>(k),
+                      in.velocity.begin() + 2 * static_cast<long>(k + 1));
+  }
+  return out;
+}
+
 DraftSignature draft_signature(const DraftSignatureInput& in) {
   DraftSignature d;
   if (!(in.rotor_drag_k > 0) || !(in.blade_flapping_k > 0) || !(in.mass > 0) || !(in.J_xx > 0) || !(in.J_yy > 0)) {

@@ -68,4 +68,10 @@ struct DraftSignature {
 
 DraftSignature draft_signature(const DraftSignatureInput& in);
 
+// Flights diagnosed jointly share a clock: the samples from each start time up to the next
+// one (`starts`: where each flight begins, ascending), as inputs of their own. A draft's
+// direction in the room differs from flight to flight, so pooled flights dilute it; each
+// flight is checked alone, with the joint model's residuals.
+std::vector<DraftSignatureInput> split_by_flight(const DraftSignatureInput& in, const std::vector<double>& starts);
+
 }  // namespace quadgen::diagnose

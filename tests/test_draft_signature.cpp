@@ -112,4 +112,26 @@ TEST(DraftSignature, SlowForcesThatAreNotTheSameDraftRarelyShowIt) {
   EXPECT_FALSE(d.why_not.empty());
 }
 
+// Flights diagnosed jointly share a clock, and a draft's direction differs from flight to
+// flight: each flight is checked alone. Two flights joined 1 s apart, the first with a draft,
+// the second with its force tied to the moments by the wrong sign: only the first shows it.
+TEST(DraftSignature, JoinedFlightsAreCheckedOneByOne) {
+  const DraftSignatureInput with = flight_with_draft(Force::kSameDraft, 1), without = flight_with_draft(Force::kOppositeSign, 2);
+  DraftSignatureInput joined = with;
+  const double second_start = with.t.back() + 1.0;
+  for (size_t k = 0; k < without.t.size(); ++k) {
+    joined.t.push_back(second_start + without.t[k]);
+    joined.heading.push_back(without.heading[k]), joined.held_out.push_back(without.held_out[k]);
+    joined.velocity.insert(joined.velocity.end(), without.velocity.begin() + 2 * k, without.velocity.begin() + 2 * k + 2);
+    joined.residual.insert(joined.residual.end(), without.residual.begin() + 6 * k, without.residual.begin() + 6 * k + 6);
+  }
+  const auto flights = quadgen::diagnose::split_by_flight(joined, {0.0, second_start});
+  ASSERT_EQ(flights.size(), 2u);
+  EXPECT_EQ(flights[0].t, with.t);
+  EXPECT_EQ(flights[1].residual, without.residual);
+  EXPECT_EQ(flights[1].velocity, without.velocity);
+  EXPECT_EQ(quadgen::diagnose::draft_signature(flights[0]).axes_showing_it().size(), 2u);
+  EXPECT_TRUE(quadgen::diagnose::draft_signature(flights[1]).axes_showing_it().empty());
+}
+
 }  // namespace
