@@ -93,6 +93,21 @@ def implausible(f, environment):
             if abs(p["value"]) > limit + 1e-12]
 
 
+def draft_verdict(j):
+    """The draft check's verdict (diagnose/draft_signature.hpp): the axes showing a draft's
+    signature on both parts, "not measured" without rotor drag and blade flapping; for a joint
+    diagnosis also each flight's."""
+    d = j.get("draft_signature")
+    if not d:
+        return "?"
+    if not d.get("measured"):
+        return "not measured"
+    text = ", ".join(d.get("axes_showing_it", [])) or "none"
+    per = [f"{i + 1}: {', '.join(f.get('axes_showing_it', [])) or 'none'}"
+           for i, f in enumerate(d.get("per_flight", [])) if f.get("measured")]
+    return text + (f" (per flight {'; '.join(per)})" if per else "")
+
+
 def main(root):
     rows, bad = [], 0
     for d in sorted(pathlib.Path(root).iterdir()):
@@ -121,11 +136,12 @@ def main(root):
             return None
         pred = f"{fmt(at(pb, 0.5))} → {fmt(at(pa, 0.5))}"
         rows.append((d.name, "<br>".join(named) or "—", ", ".join(stand_ins) or "—", ", ".join(suspected) or "—",
-                     ", ".join(groups) or "—", "<br>".join(proposed) or "—", pred,
+                     ", ".join(groups) or "—", "<br>".join(proposed) or "—", draft_verdict(j), pred,
                      f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
     print("| flight | named (95 % interval) | stand-ins (not named) | suspected (failed) | look-alike groups | "
-          "proposed terms (held-out RMS before → after) | 0.5 s open-loop error before → after [m] | s |")
-    print("|---|---|---|---|---|---|---|---|")
+          "proposed terms (held-out RMS before → after) | draft hypothesis (axis; per flight when joint) | "
+          "0.5 s open-loop error before → after [m] | s |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print("| " + " | ".join(r) + " |")
     print(f"\n{bad} rule violations in {len(rows)} diagnoses")
