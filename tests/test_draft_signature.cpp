@@ -96,6 +96,14 @@ TEST(DraftSignature, ADraftThroughTheRotorsShowsItsRatioOnBothAxesAndParts) {
     }
   }
   EXPECT_GE(flights_showing_a_draft(Force::kSameDraft, true), 190) << "found on both axes in at least 95 % of flights";
+  int slopes_within = 0;  // every part and axis within 15 % of the ratio
+  for (unsigned seed = 100; seed < 300; ++seed) {
+    bool all = true;
+    for (const auto& p : quadgen::diagnose::draft_signature(flight_with_draft(Force::kSameDraft, seed)).parts)
+      for (const auto* pair : {&p.y_roll, &p.x_pitch}) all = all && std::abs(pair->slope / pair->draft_slope - 1) < 0.15;
+    slopes_within += all;
+  }
+  EXPECT_GE(slopes_within, 180) << "the slope is the ratio (noise in the 1 s moment means is small against the draft's)";
   EXPECT_EQ(quadgen::diagnose::draft_signature(flight_with_draft(Force::kSameDraft, 1, true)).axes_showing_it().size(), 2u)
       << "the accelerometer's force is already in body axes: not turned again";
 }
