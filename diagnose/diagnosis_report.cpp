@@ -641,6 +641,17 @@ std::string draft_lead(const DraftSignature& d) {
   return s + "); no logged signal measures the air";
 }
 
+// The draft check's sentences, each with the flight it is about (empty for the diagnosis as a
+// whole; a joint diagnosis adds one per flight that shows it), unescaped for each sink.
+std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (std::string lead = draft_lead(d.draft); !lead.empty()) out.emplace_back("", std::move(lead));
+  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
+    if (std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
+      out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
+  return out;
+}
+
 
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
 // finding: say so beside the rollouts' numbers, which then show no gain (or a loss).
@@ -706,10 +717,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
-  if (const std::string lead = draft_lead(d.draft); !lead.empty()) os << lead << "\n";
-  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
-    if (const std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
-      os << "flight " << i + 1 << " (" << output::printable(d.flights[i]) << "): " << lead << "\n";
+  for (const auto& [flight, lead] : draft_leads(d))
+    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
@@ -947,10 +956,8 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << "</td></tr>\n";
     h << "</table>\n";
   }
-  if (const std::string lead = draft_lead(d.draft); !lead.empty()) h << "<p>" << esc(lead) << "</p>\n";
-  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
-    if (const std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
-      h << "<p>flight " << esc(d.flights[i]) << ": " << esc(lead) << "</p>\n";
+  for (const auto& [flight, lead] : draft_leads(d))
+    h << "<p>" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
   discovered_terms_html(h, d);
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.

@@ -1,5 +1,7 @@
 #include "diagnose/draft_signature.hpp"
 
+#include "diagnose/residual_analysis.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -50,13 +52,6 @@ std::vector<double> partial_out(const std::vector<double>& y, const std::vector<
   return out;
 }
 
-double autocorrelation(const std::vector<double>& c, size_t lag) {
-  double num = 0;
-  for (size_t i = 0; i + lag < c.size(); ++i) num += c[i] * c[i + lag];
-  const double c0 = dot(c, c);
-  return c0 > 0 ? num / c0 : 0.0;
-}
-
 DraftSignature::Pair measure_pair(const char* force_name, const char* moment_name, double draft_slope,
                                   const std::vector<double>& moment, const std::vector<double>& force,
                                   const std::vector<double>& velocity) {
@@ -72,10 +67,8 @@ DraftSignature::Pair measure_pair(const char* force_name, const char* moment_nam
   const double mm = dot(m, m), ff = dot(f, f), mf = dot(m, f);
   p.slope = mm > 0 ? mf / mm : 0.0;
   p.reverse_slope = mf != 0 ? ff / mf : 0.0;
-  double inflate = 1;
-  for (size_t k = 1; k <= m.size() / 4; ++k) inflate += 2 * autocorrelation(m, k) * autocorrelation(f, k);
-  const double n = static_cast<double>(m.size());
-  p.effective_n = std::clamp(n / std::max(1.0, inflate), 3.0, n);
+  const int lag = static_cast<int>(m.size() / 4);
+  p.effective_n = bartlett_effective_n(autocorrelation(m, lag), autocorrelation(f, lag), m.size(), lag);
   // Student's t as residual_analysis judges its correlations, with one degree of freedom
   // fewer for the velocity partialled out: n_eff - 3.
   const double r2 = std::min(p.r * p.r, 1 - 1e-12), dof = std::max(1.0, p.effective_n - 3);

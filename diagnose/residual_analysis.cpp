@@ -18,7 +18,14 @@ double mean(const std::vector<double>& x) {
   return x.empty() ? 0 : s / static_cast<double>(x.size());
 }
 
-// Autocorrelation at lags 0..max_lag (biased estimator, as usual for ACF plots).
+double tau_from_acf(const std::vector<double>& acf) {
+  double tau = 1;
+  for (size_t k = 1; k < acf.size() && acf[k] > 0; ++k) tau += 2 * acf[k];
+  return tau;
+}
+
+}  // namespace
+
 std::vector<double> autocorrelation(const std::vector<double>& x, int max_lag) {
   const size_t n = x.size();
   const double m = mean(x);
@@ -34,13 +41,12 @@ std::vector<double> autocorrelation(const std::vector<double>& x, int max_lag) {
   return acf;
 }
 
-double tau_from_acf(const std::vector<double>& acf) {
-  double tau = 1;
-  for (size_t k = 1; k < acf.size() && acf[k] > 0; ++k) tau += 2 * acf[k];
-  return tau;
+double bartlett_effective_n(const std::vector<double>& acf_x, const std::vector<double>& acf_y, size_t n, int lag) {
+  double inflate = 1;
+  for (int k = 1; k <= lag; ++k) inflate += 2 * acf_x[k] * acf_y[k];
+  const double ns = static_cast<double>(n);
+  return std::clamp(ns / std::max(1.0, inflate), 3.0, ns);
 }
-
-}  // namespace
 
 double integrated_autocorrelation_time(const std::vector<double>& x, int max_lag) {
   return tau_from_acf(autocorrelation(x, max_lag));
@@ -166,9 +172,7 @@ ResidualAnalysis analyse_residuals(const std::vector<double>& r6, const std::vec
       Correlation cr;
       cr.signal = signals.names[s];
       cr.r = cxy / static_cast<double>(ns) / (sx * sy);
-      double inflate = 1;
-      for (int k = 1; k <= lag; ++k) inflate += 2 * a.acf[k] * signal_acf[s][k];
-      const double n_eff = std::clamp(static_cast<double>(ns) / std::max(1.0, inflate), 3.0, static_cast<double>(ns));
+      const double n_eff = bartlett_effective_n(a.acf, signal_acf[s], ns, lag);
       const double r2 = std::min(cr.r * cr.r, 1 - 1e-12);
       const double tstat = std::abs(cr.r) * std::sqrt((n_eff - 2) / (1 - r2));
       cr.p_value = 2 * boost::math::cdf(boost::math::complement(boost::math::students_t(n_eff - 2), tstat));

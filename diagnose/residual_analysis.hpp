@@ -52,4 +52,13 @@ ResidualAnalysis analyse_residuals(const std::vector<double>& r6, const std::vec
 // Integrated autocorrelation time of a series (used to discount autocorrelated residuals).
 double integrated_autocorrelation_time(const std::vector<double>& x, int max_lag = 100);
 
+// Autocorrelation of a series at lags 0..max_lag (its mean removed; the biased estimator, as
+// usual for ACF plots).
+std::vector<double> autocorrelation(const std::vector<double>& x, int max_lag);
+
+// Bartlett's effective sample size for the correlation of two autocorrelated series of n
+// samples, from their autocorrelations: n / (1 + 2 sum_{k=1..lag} rho_x(k) rho_y(k)), kept
+// within [3, n].
+double bartlett_effective_n(const std::vector<double>& acf_x, const std::vector<double>& acf_y, size_t n, int lag);
+
 }  // namespace quadgen::diagnose
