@@ -82,15 +82,16 @@ std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
 
 // Sums of squares of the channel groups of one fold's residuals (six channels per sample).
 struct ChannelGroupSquares {
-  double horizontal = 0, vertical = 0, rotational = 0;  // channels 0-1, 2 and 3-5
+  double horizontal = 0, vertical = 0, roll_pitch = 0, yaw = 0;  // channels 0-1, 2, 3-4 and 5
   double translational() const { return horizontal + vertical; }
+  double rotational() const { return roll_pitch + yaw; }
 };
 ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
   const std::vector<double> r = residuals_of(m, ps);
   ChannelGroupSquares ss;
   for (size_t i = 0; i < r.size(); ++i) {
     const size_t channel = i % 6;
-    (channel < 2 ? ss.horizontal : channel == 2 ? ss.vertical : ss.rotational) += r[i] * r[i];
+    (channel < 2 ? ss.horizontal : channel == 2 ? ss.vertical : channel < 5 ? ss.roll_pitch : ss.yaw) += r[i] * r[i];
   }
   return ss;
 }
@@ -116,12 +117,17 @@ bool not_worse_beyond_spread(double mean, double standard_error) { return mean >
 // force, set by the flight's thrust constant that every refit moves, counts in the sum only:
 // judged apart it refused on two real flights a rotor drag that lowered the accelerometer's
 // horizontal error by 29-52 % (docs/validation.md, "The horizontal and the vertical force
-// judged apart").
+// judged apart"). The yaw channel is judged apart from the rotational sum for the same
+// reason as the horizontal force: its residual is the smaller (the yaw torque is a fraction
+// of a roll or pitch torque), and a better roll and pitch would hide a worse yaw — the
+// motor trims and κ that carry it — in their sum. Roll and pitch, the larger part, count
+// in the sum.
 std::string worse_channel_group(const Finding::OneStep& o) {
   const std::pair<const Finding::FoldGains*, const char*> groups[] = {
       {&o.translation, "translational channels"},
       {&o.horizontal, "horizontal force"},
-      {&o.rotation, "rotational channels"}};
+      {&o.rotation, "rotational channels"},
+      {&o.yaw, "yaw"}};
   std::string worse;  // every group that is, so that the report names all it paid with
   for (const auto& [g, name] : groups)
     if (!not_worse_beyond_spread(g->mean, g->standard_error)) worse += (worse.empty() ? "" : " and ") + std::string(name);
@@ -195,10 +201,8 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
   return "";
 }
 
-// What the draft check reads from a diagnosis: the final model's residuals over the whole
-// flight, each sample's heading and part, and the coefficients and sizes the ratio needs (by
-// name from the final fit; in a joint diagnosis the first flight's c_t, which only sets the
-// implied draft speed's hover rotor speeds).
+}  // namespace
+
 DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight& used, const fit::Flight& valid,
                                           const Vehicle& v, const std::vector<fit::FitParameter>& final_fit,
                                           bool force_in_world) {
@@ -226,6 +230,8 @@ DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight&
   }
   return in;
 }
+
+namespace {
 
 // What a held-out position metric's name says about its windows: ", started every 0.1 s"
 // when they overlap, nothing when they are consecutive.
@@ -547,7 +553,9 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     for (const auto& fold : fold_ee) {
       o.cost.per_fold.push_back(percent_lower(search.cost(*fold.fit, without), search.cost(*fold.fit, d.search.final_fit)));
       const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, d.search.final_fit);
-      o.rotation.per_fold.push_back(percent_lower(gb.rotational, ga.rotational));
+      o.rotation.per_fold.push_back(percent_lower(gb.rotational(), ga.rotational()));
+      o.roll_pitch.per_fold.push_back(percent_lower(gb.roll_pitch, ga.roll_pitch));
+      o.yaw.per_fold.push_back(percent_lower(gb.yaw, ga.yaw));
       const bool own = fold.accelerometer == nullptr;  // the translational channels as the fit measures them
       const auto tb = own ? gb : channel_group_squares(*fold.accelerometer, without),
                  ta = own ? ga : channel_group_squares(*fold.accelerometer, d.search.final_fit);
@@ -555,7 +563,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
       o.horizontal.per_fold.push_back(percent_lower(tb.horizontal, ta.horizontal));
       o.vertical.per_fold.push_back(percent_lower(tb.vertical, ta.vertical));
     }
-    for (auto* g : {&o.cost, &o.translation, &o.rotation, &o.horizontal, &o.vertical})
+    for (auto* g : {&o.cost, &o.translation, &o.rotation, &o.horizontal, &o.vertical, &o.roll_pitch, &o.yaw})
       mean_and_standard_error(g->per_fold, &g->mean, &g->standard_error);
     if (pose && find_effect(e).judged_by_force_model) {
       const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(d.search.final_fit, predict::Replay::kAttitude);

@@ -68,7 +68,9 @@ struct Finding {
   // use when it differentiates the pose), else as the fit measures them. The horizontal
   // force (x, y) is judged once more apart: the vertical residual (z) is the larger, and a
   // better one would hide a worse horizontal force in their sum; the vertical is reported
-  // but counts in the sum only (worse_channel_group in diagnosis.cpp says why). (x, y, z are
+  // but counts in the sum only (worse_channel_group in diagnosis.cpp says why). Likewise the
+  // yaw channel is judged apart from the rotational sum, where roll and pitch, the larger,
+  // could hide it; roll and pitch are reported and count in the sum. (x, y, z are
   // world axes when the pose is differentiated, body axes with the accelerometer; a flying
   // multirotor tilts by tens of degrees at most, so body z stays near the vertical.)
   // Each a reduction per fold in per cent of the fold's value without the effect.
@@ -80,6 +82,7 @@ struct Finding {
     FoldGains cost;                  // the weighted equation-error cost
     FoldGains translation, rotation;  // unweighted sums of squares of each channel group
     FoldGains horizontal, vertical;    // the translational ones split: x and y, and z
+    FoldGains roll_pitch, yaw;         // the rotational ones split: p and q, and r
   } one_step;
   // A flight's own quantity acting on the force (Effect::judged_by_force_model: the marker
   // frame, a wind; with a pose) also judged by the force model alone: the same held-out
@@ -217,6 +220,16 @@ std::string held_out_test(const Finding& f);
 std::string one_step_summary(const Finding& f);
 
 bool belongs_to_flight(const std::string& parameter);
+
+// What the draft check reads from a diagnosis: the final model's residuals over the whole
+// flight (`used`: the samples they belong to, in order), each sample's heading and velocity,
+// whether it lies in the held-out part (`valid`), and the coefficients and sizes the ratio
+// needs, by name from the final fit (in a joint diagnosis the first flight's c_t, which only
+// sets the implied draft speed's hover rotor speeds). `force_in_world`: the translational
+// residuals are the differentiated pose's (world axes), not the accelerometer's.
+DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight& used, const fit::Flight& valid,
+                                          const Vehicle& v, const std::vector<fit::FitParameter>& final_fit,
+                                          bool force_in_world);
 
 // Runs the whole diagnosis. `all` is the full-catalogue symbolic model of the vehicle and
 // `model` its runtime form. Several flights of one vehicle are diagnosed jointly: one set

@@ -196,6 +196,8 @@ json one_step_json(const Finding::OneStep& o) {
   j["rotation"] = fold_gains_json(o.rotation);
   j["horizontal"] = fold_gains_json(o.horizontal);
   j["vertical"] = fold_gains_json(o.vertical);
+  j["roll_pitch"] = fold_gains_json(o.roll_pitch);
+  j["yaw"] = fold_gains_json(o.yaw);
   return j;
 }
 

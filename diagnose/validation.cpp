@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "runtime/attitude.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "predict/rollout.hpp"
@@ -37,18 +36,8 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
       if (S[k + 1].t - S[k].t > predict::Rollout::kMaxGap) break;  // a gap: a new window
       if (!roll.advance(x, k, replay)) return {k, true};
-      const auto& m = S[k + 1].x;
-      double e2 = 0, v2 = 0, w2 = 0;
-      for (int a = 0; a < 3; ++a) {
-        e2 += std::pow(x[a] - m[a], 2);
-        v2 += std::pow(x[3 + a] - m[3 + a], 2);
-        w2 += std::pow(x[10 + a] - m[10 + a], 2);
-      }
-      // Attitude error: angle of q_sim^-1 ⊗ q_true(logged, unbiased).
-      double qt[4];
-      runtime::unbias_attitude(&m[6], e.roll, e.pitch, qt);
-      const double dot = std::abs(x[6] * qt[0] + x[7] * qt[1] + x[8] * qt[2] + x[9] * qt[3]);
-      const double angle = 2 * std::acos(std::min(1.0, dot));
+      const predict::StateError err = predict::state_error(x, S[k + 1], e);
+      const double e2 = err.position_squared, v2 = err.velocity_squared, w2 = err.body_rates_squared, angle = err.angle;
       sums.pos += e2, sums.vel += v2, sums.att += angle * angle, sums.rate += w2;
       ++sums.count;
       if (!trace) continue;

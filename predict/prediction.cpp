@@ -58,31 +58,16 @@ void Prediction::merge(const Prediction& o) {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 using runtime::DataSideEffects;
-
-double heading_of(const runtime::Rotation& r) { return std::atan2(r.m[1][0], r.m[0][0]); }
 
 // Errors of a simulated state against the measured sample (attitude unbiased).
 void add_errors(const std::vector<double>& x, const fit::FlightSample& s, const DataSideEffects& e, HorizonErrors& h) {
-  double pos = 0, vel = 0, rate = 0;
-  for (int a = 0; a < 3; ++a) {
-    pos += std::pow(x[a] - s.x[a], 2);
-    vel += std::pow(x[3 + a] - s.x[3 + a], 2);
-    rate += std::pow(x[10 + a] - s.x[10 + a], 2);
-  }
-  double q[4];
-  runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
-  const runtime::Rotation rs = runtime::rotation_matrix(&x[6]), rm = runtime::rotation_matrix(q);
-  double zz = 0;
-  for (int a = 0; a < 3; ++a) zz += rs.m[a][2] * rm.m[a][2];
-  double dh = std::fmod(heading_of(rs) - heading_of(rm) + 3 * kPi, 2 * kPi) - kPi;
-  h.position.add(std::sqrt(pos));
-  h.velocity.add(std::sqrt(vel));
-  h.tilt.add(std::acos(std::clamp(zz, -1.0, 1.0)));
-  h.heading.add(std::fabs(dh));
-  h.body_rates.add(std::sqrt(rate));
+  const StateError err = state_error(x, s, e);
+  h.position.add(std::sqrt(err.position_squared));
+  h.velocity.add(std::sqrt(err.velocity_squared));
+  h.tilt.add(err.tilt);
+  h.heading.add(err.heading);
+  h.body_rates.add(std::sqrt(err.body_rates_squared));
 }
 
 double median_spacing(const fit::Flight& f) {

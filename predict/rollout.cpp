@@ -143,4 +143,25 @@ void Rollout::stage(const std::vector<double>& x, const std::vector<double>& k, 
   for (int j = 0; j < n_; ++j) tmp_[j] = x[j] + h * k[j];
 }
 
+StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e) {
+  constexpr double kPi = 3.14159265358979323846;
+  StateError out;
+  for (int a = 0; a < 3; ++a) {
+    out.position_squared += std::pow(x[a] - s.x[a], 2);
+    out.velocity_squared += std::pow(x[3 + a] - s.x[3 + a], 2);
+    out.body_rates_squared += std::pow(x[10 + a] - s.x[10 + a], 2);
+  }
+  double q[4];
+  runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
+  const double dot = std::abs(x[6] * q[0] + x[7] * q[1] + x[8] * q[2] + x[9] * q[3]);
+  out.angle = 2 * std::acos(std::min(1.0, dot));
+  const runtime::Rotation rs = runtime::rotation_matrix(&x[6]), rm = runtime::rotation_matrix(q);
+  double zz = 0;
+  for (int a = 0; a < 3; ++a) zz += rs.m[a][2] * rm.m[a][2];
+  out.tilt = std::acos(std::clamp(zz, -1.0, 1.0));
+  const auto heading_of = [](const runtime::Rotation& r) { return std::atan2(r.m[1][0], r.m[0][0]); };
+  out.heading = std::fabs(std::fmod(heading_of(rs) - heading_of(rm) + 3 * kPi, 2 * kPi) - kPi);
+  return out;
+}
+
 }  // namespace quadgen::predict

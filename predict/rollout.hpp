@@ -88,4 +88,15 @@ class Rollout {
   std::vector<std::array<double, 6>> model_acc_;
 };
 
+// How far a rolled-out state `x` is from the logged sample `s` (its attitude unbiased by the
+// rollout's data-side effects `e`), the one measure both the prediction and the diagnosis'
+// validation windows score: squared norms of the position, velocity and body-rate errors, and
+// the attitude error as one angle (of q_sim^-1 ⊗ q_logged), as the tilt between the body z
+// axes and as the heading difference (wrapped to [0, π]).
+struct StateError {
+  double position_squared = 0, velocity_squared = 0, body_rates_squared = 0;  // m^2, m^2/s^2, rad^2/s^2
+  double angle = 0, tilt = 0, heading = 0;                                    // rad
+};
+StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e);
+
 }  // namespace quadgen::predict

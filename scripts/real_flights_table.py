@@ -3,7 +3,7 @@
 checks every finding against the naming rules: a closed 95 % interval, not containing the
 parameter's "off" value (for at least one parameter), and a held-out gain above its
 standard error (open-loop position; or one-step equation error with neither the position
-gain nor any channel group's one-step gain — translational, horizontal, rotational — below
+gain nor any channel group's one-step gain — translational, horizontal, rotational, yaw — below
 minus its standard error; or, for a flight's own quantity acting on the force, the force
 model alone — position with the measured attitude replayed — with the one-step gain above and
 no channel group below its spread). Exit status 1 on a violation."""
@@ -44,7 +44,7 @@ def held_out_gain(f):
     """The open-loop position gain above its standard error over the folds; or the one-step
     (equation-error) gain above its standard error with the position gain, and the one-step gains
     of the translational channels (together, and the horizontal force apart; the vertical counts
-    in the sum only) and of the rotational ones, each not below minus its own standard error; or, for a flight's own quantity
+    in the sum only) and of the rotational ones (together, and the yaw apart), each not below minus its own standard error; or, for a flight's own quantity
     acting on the force, the force model alone's position gain above its standard error with the
     one-step gain above and no channel group below its spread."""
     g, o = f["gain"], f.get("one_step_gain") or {}
@@ -54,7 +54,8 @@ def held_out_gain(f):
     def not_worse(x):
         m, se = x.get("gain_mean"), x.get("gain_standard_error")
         return m is not None and se is not None and m >= -se
-    no_group_worse = all(not_worse(o.get(k, {})) for k in ("translation", "horizontal", "rotation"))
+    groups = ("translation", "horizontal", "rotation") + (("yaw",) if "yaw" in o else ())  # yaw: since 2026-11-27
+    no_group_worse = all(not_worse(o.get(k, {})) for k in groups)
     if f["effect"] in PER_FLIGHT:  # a flight's own quantity: the rollouts, or the force model alone
         return (f["effect"] in ON_THE_FORCE and above_spread(f.get("force_alone_gain") or {})
                 and bool(o.get("fold_gains")) and above_spread(o) and no_group_worse)

@@ -853,6 +853,14 @@ TEST(Acceptance, AOneStepGainCountsOnlyWhereTheRolloutsDoNotSpeakAgainstIt) {
   f.one_step.rotation.mean = -12, f.one_step.rotation.standard_error = 3;
   EXPECT_EQ(held_out_test(f), "") << "the force bought with worse moments";
   f.one_step.rotation.mean = 20;
+  EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
+  // Roll and pitch dominate the rotational sum: a better one can hide a worse yaw in it.
+  f.one_step.yaw.mean = -15, f.one_step.yaw.standard_error = 4;
+  EXPECT_EQ(held_out_test(f), "") << "the moments better, the yaw worse";
+  EXPECT_NE(quadgen::diagnose::one_step_summary(f).find("bought with worse yaw"), std::string::npos)
+      << quadgen::diagnose::one_step_summary(f);
+  f.one_step.yaw.mean = -2;  // within its spread
+  EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
   f.gain_mean = -0.02;  // the rollouts worse beyond their spread: they refute it
   EXPECT_EQ(held_out_test(f), "");
   f.gain_mean = -0.001;

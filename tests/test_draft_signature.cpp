@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "diagnose/diagnosis.hpp"
 #include "diagnose/draft_signature.hpp"
 
 namespace {
@@ -140,6 +141,62 @@ TEST(DraftSignature, JoinedFlightsAreCheckedOneByOne) {
   EXPECT_EQ(flights[1].velocity, without.velocity);
   EXPECT_EQ(quadgen::diagnose::draft_signature(flights[0]).axes_showing_it().size(), 2u);
   EXPECT_TRUE(quadgen::diagnose::draft_signature(flights[1]).axes_showing_it().empty());
+}
+
+// What the draft check reads from a diagnosis (draft_signature_input): each sample's heading
+// (the yaw of its attitude, whatever its roll and pitch), its world velocity, whether it lies
+// in the held-out part, the final fit's coefficients by name (in a joint diagnosis the first
+// flight's copies), and the hover's rotor speeds, which must carry the weight through the
+// thrust law F = c_t rho A (omega r)^2.
+TEST(DraftSignature, ReadsHeadingsPartsAndCoefficientsFromADiagnosis) {
+  using quadgen::fit::FitParameter;
+  // Body to world, Z-Y-X: yaw psi, then pitch theta, then roll phi (half-angle products).
+  auto quaternion = [](double psi, double theta, double phi) {
+    const double cy = std::cos(psi / 2), sy = std::sin(psi / 2), cp = std::cos(theta / 2), sp = std::sin(theta / 2),
+                 cr = std::cos(phi / 2), sr = std::sin(phi / 2);
+    return std::vector<double>{cy * cp * cr + sy * sp * sr, cy * cp * sr - sy * sp * cr, cy * sp * cr + sy * cp * sr,
+                               sy * cp * cr - cy * sp * sr};
+  };
+  const double psi[] = {0.3, -2.0, 3.0, 1.0}, vx[] = {0.5, -0.25, 1.0, 0.0}, vy[] = {0.0, 0.75, -0.5, 2.0};
+  quadgen::diagnose::Diagnosis d;
+  quadgen::fit::Flight used, valid;
+  for (int k = 0; k < 4; ++k) {
+    quadgen::fit::FlightSample s;
+    s.t = 0.01 * k;
+    const auto q = quaternion(psi[k], 0.2, -0.15);
+    s.x = {0, 0, 1, vx[k], vy[k], -0.1, q[0], q[1], q[2], q[3], 0.1, 0.2, 0.3};
+    used.samples.push_back(s);
+    if (k >= 2) valid.samples.push_back(s);
+    d.t.push_back(s.t);
+    for (int c = 0; c < 6; ++c) d.residual_after.push_back(10.0 * k + c);
+  }
+  quadgen::Vehicle v;
+  for (int r = 0; r < 4; ++r) v.rotors.push_back({"M" + std::to_string(r + 1), {}, quadgen::Spin::ccw, 0.0231, 0.00168, 0});
+  const double c_t = 0.0139, rho = 1.2, g = 9.81;
+  std::vector<FitParameter> fit;
+  for (const auto& [name, value] : std::vector<std::pair<std::string, double>>{
+           {"rotor_drag.k", kd}, {"blade_flapping.k", kf}, {"mass", mass}, {"J_xx", Jxx}, {"J_yy", Jyy},
+           {"c_t", c_t}, {"c_t@2", 2 * c_t}, {"rho", rho}, {"g", g}})
+    fit.push_back({name, "", value, 0, 0, true});
+  const DraftSignatureInput in = quadgen::diagnose::draft_signature_input(d, used, valid, v, fit, false);
+  EXPECT_EQ(in.t, d.t);
+  EXPECT_EQ(in.residual, d.residual_after);
+  EXPECT_FALSE(in.force_in_world);
+  ASSERT_EQ(in.heading.size(), 4u);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(in.heading[k], psi[k], 1e-12) << "sample " << k;
+  EXPECT_EQ(in.velocity, (std::vector<double>{0.5, 0.0, -0.25, 0.75, 1.0, -0.5, 0.0, 2.0}));
+  EXPECT_EQ(in.held_out, (std::vector<bool>{false, false, true, true}));
+  EXPECT_EQ(in.rotor_drag_k, kd);
+  EXPECT_EQ(in.blade_flapping_k, kf);
+  EXPECT_EQ(in.mass, mass);
+  EXPECT_EQ(in.J_xx, Jxx);
+  EXPECT_EQ(in.J_yy, Jyy);
+  const double omega = in.hover_speeds_sum / 4, weight = mass * g;
+  EXPECT_NEAR(4 * c_t * rho * 0.00168 * std::pow(omega * 0.0231, 2), weight, 1e-12 * weight)
+      << "the first flight's c_t: the hover's four thrusts carry the weight";
+  EXPECT_FALSE(quadgen::diagnose::draft_signature(in).measured) << "four samples: both parts too short";
+  fit.erase(fit.begin() + 1);  // no blade flapping in the final model
+  EXPECT_EQ(quadgen::diagnose::draft_signature_input(d, used, valid, v, fit, true).blade_flapping_k, 0.0);
 }
 
 }  // namespace

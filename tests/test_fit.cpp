@@ -674,8 +674,11 @@ TEST(Threads, EveryWorkerRunsOnceAndTheFirstFailureReachesTheCaller) {
   fit::run_workers(5, [&](size_t w, const std::atomic<bool>&) { ++runs[w]; });
   for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
 
+  // So many jobs that the others cannot run out of them while the failing worker is preempted
+  // between its throw and setting `stopped` (with 1e5 this failed once in a loaded suite run);
+  // a worker that did not stop would still take them all, in some seconds, and fail below.
   std::atomic<size_t> next{0}, taken{0};
-  const size_t jobs = 100000;
+  const size_t jobs = 1000000000;
   EXPECT_THROW(fit::run_workers(3, [&](size_t w, const std::atomic<bool>& stopped) {
                  for (size_t j; !stopped && (j = next++) < jobs;) {
                    ++taken;
