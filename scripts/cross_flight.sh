@@ -9,6 +9,9 @@
 # flights' airframe (quadgen diagnose --airframe): do its named effects hold there, with
 # the airframe's values?
 #   scripts/cross_flight.sh [OUT_DIR]       (default /tmp/quadgen_cross_flight; ~4 min)
+# UNSEEN=NAME holds out another usable flight instead of the helix (the other four are the
+# training flights); EXTRA_CHECKS="..." are the further flights checked against the airframe
+# (default the linear ramps B6). scripts/leave_one_flight_out.sh holds out each in turn.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_cross_flight}
@@ -16,8 +19,12 @@ q=${QUADGEN:-build/quadgen}
 data=${QUADGEN_NANOBENCH:-../shared/data/crazyflie/nanobench}
 vehicle=vehicles/crazyflie21.yaml
 mapping=data/mappings/nanobench.yaml
-train=(B2_circle_medium_rep1 B3_figure8_medium_rep1 B3_figure8_medium_rep2 B3_figure8_slow_rep1)
-unseen=B5_helix_slow_rep1
+usable=(B2_circle_medium_rep1 B3_figure8_medium_rep1 B3_figure8_medium_rep2 B3_figure8_slow_rep1 B5_helix_slow_rep1)
+unseen=${UNSEEN:-B5_helix_slow_rep1}
+extra_checks=${EXTRA_CHECKS-B6_linear_ramp_rep1}
+train=()
+for n in "${usable[@]}"; do [ "$n" = "$unseen" ] || train+=("$n"); done
+if [ "${#train[@]}" != 4 ]; then echo "UNSEEN must be one of: ${usable[*]}" >&2; exit 2; fi
 mkdir -p "$out/table"
 if [ ! -f "$out/joint_4_flights/diagnosis.json" ]; then
   logs=()
@@ -39,7 +46,7 @@ predict "$unseen" nominal
 predict "$unseen" unseen_airframe_values --params "$params"
 predict "$unseen" unseen_calibrated_first_70pct --params "$params" --calibrate
 python3 scripts/prediction_table.py "$out/table"
-for n in "$unseen" B6_linear_ramp_rep1; do
+for n in "$unseen" $extra_checks; do
   if [ ! -f "$out/check_$n/diagnosis.json" ]; then
     echo "checking $n against the airframe ..." >&2
     "$q" diagnose "$vehicle" "$data/$n.csv" --mapping "$mapping" --airframe "$params" --out "$out/check_$n" \
