@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "diagnose/agreement.hpp"
+#include "diagnose/held_out_gain.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/geometry.hpp"
@@ -64,45 +65,6 @@ double rotation_scale(const Vehicle& v, const SymbolicModel& all) {
   const auto nominal = [&](const char* n) { return all.params[all.param_index(n)].nominal; };
   const double J = std::max(nominal("J_xx"), nominal("J_yy"));
   return J > 0 ? nominal("mass") * nominal("g") * arm / J : 0.0;
-}
-
-// The validation part cut into `k` consecutive blocks of equal duration. Joined flights hold
-// their validation parts apart in time (each flight's training part lies between): a block
-// that holds no window to simulate is dropped.
-std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
-  std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
-  for (auto& f : folds) f.samples.clear();
-  const double t0 = valid.samples.front().t, span = valid.samples.back().t - t0 + 1e-9;
-  for (const auto& s : valid.samples)
-    folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>((s.t - t0) / span * k))].samples.push_back(s);
-  folds.erase(std::remove_if(folds.begin(), folds.end(), [](const fit::Flight& f) { return f.samples.size() < 2; }),
-              folds.end());
-  return folds;
-}
-
-// Sums of squares of the channel groups of one fold's residuals (six channels per sample).
-struct ChannelGroupSquares {
-  double horizontal = 0, vertical = 0, roll_pitch = 0, yaw = 0;  // channels 0-1, 2, 3-4 and 5
-  double translational() const { return horizontal + vertical; }
-  double rotational() const { return roll_pitch + yaw; }
-};
-ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  const std::vector<double> r = residuals_of(m, ps);
-  ChannelGroupSquares ss;
-  for (size_t i = 0; i < r.size(); ++i) {
-    const size_t channel = i % 6;
-    (channel < 2 ? ss.horizontal : channel == 2 ? ss.vertical : channel < 5 ? ss.roll_pitch : ss.yaw) += r[i] * r[i];
-  }
-  return ss;
-}
-
-void mean_and_standard_error(const std::vector<double>& x, double* mean, double* se) {
-  const double n = static_cast<double>(x.size());
-  *mean = 0;
-  for (double v : x) *mean += v / n;
-  double ss = 0;
-  for (double v : x) ss += (v - *mean) * (v - *mean);
-  *se = x.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
 }
 
 // A gain larger than its own uncertainty; a change no worse than minus its uncertainty.
@@ -232,12 +194,6 @@ DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight&
 }
 
 namespace {
-
-// What a held-out position metric's name says about its windows: ", started every 0.1 s"
-// when they overlap, nothing when they are consecutive.
-std::string stride_clause(double window, double start_stride) {
-  return overlapping_windows(window, start_stride) ? ", started every " + output::short_number(start_stride) + " s" : "";
-}
 
 // What the proposed terms buy in a simulation, like an effect: the full-catalogue model with
 // the terms added is derived and taped, and the held-out folds are simulated with the final
@@ -375,6 +331,199 @@ std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParamet
   return out;
 }
 
+// What is wrong, before and after, over the whole flight (`used`: the samples with
+// residuals): the residuals of the base and the final fit and their analysis.
+void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit::EquationErrorModel& all_ee,
+                           Diagnosis& d) {
+  for (const auto& smp : used.samples) d.t.push_back(smp.t);
+  d.residual_before = residuals_of(all_ee, d.search.base_fit);
+  d.residual_after = residuals_of(all_ee, d.search.final_fit);
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const SignalSet signals = physical_signals(used, rotors);
+  d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
+  d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
+}
+
+// Left over: slow structure the noise cannot explain. The final model carries the stronger
+// of each look-alike pair (either explains the discrepancy; only the name is open).
+std::vector<Unexplained> unexplained(const ResidualAnalysis& left, const DiagnoseOptions& opt) {
+  std::vector<Unexplained> out;
+  for (const auto& c : left.channels) {
+    if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
+    Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,
+                  c.worst_window_mean, "", 0};
+    if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
+    out.push_back(u);
+  }
+  return out;
+}
+
+// Candidates of a joint diagnosis: those asked for (an error when one cannot be diagnosed
+// jointly), else every applicable one, less those that cannot.
+std::vector<std::string> joint_candidates(std::vector<std::string> c, const fit::Flight& joined) {
+  const auto not_joint = [](const std::string& name) { return !find_effect(name).not_in_joint_diagnosis.empty(); };
+  for (const std::string& name : c)
+    if (not_joint(name))
+      throw fit::FitError(name + " is no candidate when several flights are diagnosed together: " +
+                          find_effect(name).not_in_joint_diagnosis);
+  if (c.empty()) c = applicable_effects(joined);
+  c.erase(std::remove_if(c.begin(), c.end(), not_joint), c.end());
+  return c;
+}
+
+// The equation-error formulation and its channels: the accelerometer's specific force (body
+// axes) or the differentiated velocity (world axes), and the differentiated gyro.
+void set_formulation(bool accelerometer, Diagnosis& d) {
+  d.formulation = accelerometer ? "equation error: accelerometer specific force (body) and gyro derivative"
+                                : "equation error: differentiated velocity (world) and gyro derivative";
+  d.channel_names = accelerometer ? std::vector<std::string>{"ax", "ay", "az", "pdot", "qdot", "rdot"}
+                                  : std::vector<std::string>{"ax_world", "ay_world", "az_world", "pdot", "qdot", "rdot"};
+  d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
+}
+
+// What the agreement check needs: each flight's training part, the joint fit, and each named
+// airframe effect (and each suspected one that still holds its estimates: a value that
+// differs between the flights is often why the joint fit gains nothing) with its start and
+// "off" values.
+AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, runtime::DynamicModel& model,
+                                 const std::vector<fit::Flight>& flights, double validation_fraction, bool accelerometer,
+                                 const std::vector<std::string>& per_flight_names) {
+  AgreementInputs in;
+  in.model = &model;
+  for (const auto& f : flights) in.training_parts.push_back(fit::split_by_time(f, 1.0 - validation_fraction).first);
+  in.use_accelerometer = accelerometer;
+  in.joint_fit = d.search.final_fit;
+  in.per_flight = per_flight_names;
+  in.weights = d.search.final_weights;
+  const auto check = [&](const Finding& f, bool named) {
+    if (find_effect(f.effect).per_flight) return;
+    AgreementInputs::Effect e{f.effect, named, {}, {}, {}};
+    for (const auto& name : effect_parameters(all, f.effect)) {
+      const auto est = std::find_if(f.parameters.begin(), f.parameters.end(),
+                                    [&](const EffectEstimate& x) { return x.name == name; });
+      if (est == f.parameters.end()) return;  // no estimate to start from (held at its reference)
+      e.parameters.push_back(name);
+      e.off.push_back(neutral_value(all.params[all.param_index(name)]));
+      e.start.push_back(est->value);
+    }
+    in.effects.push_back(e);
+  };
+  for (const auto& f : d.findings) check(f, true);
+  for (const auto& x : d.suspected) check(x.candidate, false);
+  return in;
+}
+
+// The flights a diagnosis uses, with the battery and pose signals a log lacks filled in.
+// Several flights: one whose commands sit at their limit is left out (it would bend the
+// airframe to explain motors that cannot give what was asked), unless none is usable.
+// `d` records the screening and the flights used.
+std::vector<fit::Flight> usable_flights(const std::vector<fit::Flight>& flights_in, const SymbolicModel& all,
+                                        Diagnosis& d) {
+  size_t usable = 0;
+  for (const auto& f : flights_in) {
+    d.screening.push_back(screen_flight(f));
+    usable += d.screening.back().usable ? 1 : 0;
+  }
+  const bool leave_out = flights_in.size() > 1 && usable > 0;
+  // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
+  std::vector<fit::Flight> flights;
+  for (size_t k = 0; k < flights_in.size(); ++k) {
+    if (leave_out && !d.screening[k].usable) {
+      d.screening[k].left_out = true;
+      std::cerr << "[diagnose] left out " << output::printable(flights_in[k].source) << ": " << d.screening[k].reason << "\n";
+      continue;
+    }
+    const fit::Flight& f = flights_in[k];
+    flights.push_back(predict::fill_missing_signals(f, all.params[all.param_index("vbat_ref")].nominal));
+    d.flights.push_back(f.source);
+  }
+  return flights;
+}
+
+// Each effect the search named, tested on held-out data and its intervals (acceptance_failure):
+// the survivors become d.findings, the others d.suspected.
+void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& held_out_gain, const SymbolicModel& all,
+                     bool wald_first) {
+  // Until nothing more fails: taking a suspected cause out refits the model (the extended
+  // model keeps only what is named, and carried look-alikes), which changes the others'
+  // gains and intervals, so they are tested again against what the report will show. The
+  // search gives Wald intervals: first only the held-out gains are tested; once nothing fails
+  // that, the survivors get profiles and are tested in full (intervals too).
+  bool profiled = !wald_first;
+  std::map<std::string, Finding> held_out;  // per effect, in the current final model
+  for (;;) {
+    std::vector<Finding> accepted;
+    std::vector<std::string> drop;
+    for (const auto& e : d.search.named()) {
+      if (!held_out.count(e)) held_out[e] = held_out_gain.finding_for(e, d.search);
+      Finding f = held_out.at(e);
+      f.parameters = effect_estimates(d.search, e);
+      const std::string failed = acceptance_failure(f, all, profiled);
+      if (failed.empty()) accepted.push_back(f);
+      else d.suspected.push_back({f, failed}), drop.push_back(e);
+    }
+    if (drop.empty() && !profiled) {
+      search.profile_intervals(d.search);
+      profiled = true;
+      continue;
+    }
+    if (drop.empty()) {
+      d.findings = accepted;
+      break;
+    }
+    search.remove_effects(d.search, drop);
+    held_out.clear();
+    profiled = !wald_first;
+  }
+}
+
+// Accepted, but beyond what the effect's physics can produce where the flights were flown:
+// a stand-in for missing physics, moved from d.findings to d.stand_ins.
+void separate_stand_ins(Diagnosis& d, const CandidateSearch& search, const fit::EquationErrorModel& train_ee,
+                        const SearchOptions& so) {
+  d.environment = environment_name(so.environment);
+  // It stays in the model (carried, like the stronger of a look-alike pair) and is reported
+  // with the residual it absorbs, not named.
+  for (auto it = d.findings.begin(); it != d.findings.end();) {
+    StandIn st;
+    if (!implausible_parameter(*it, so.environment, so.scales, &st)) {
+      ++it;
+      continue;
+    }
+    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
+    others.erase(it->effect);
+    double c = 0;
+    const auto without = search.fit_with(others, d.search.final_fit, &c);
+    st.channels = d.channel_names;
+    st.rms_without = six_channel_rms(train_ee, without);
+    st.rms_with = six_channel_rms(train_ee, d.search.final_fit);
+    d.search.carried.push_back(it->effect);
+    d.stand_ins.push_back(st);
+    it = d.findings.erase(it);
+  }
+}
+
+// What the search itself found wanting on held-out data, as suspects.
+void add_suspects_of_the_search(Diagnosis& d) {
+  // Significant on the training data but no held-out gain in the search itself: suspected.
+  for (const auto& ev : d.search.training_only)
+    d.suspected.push_back(held_out_suspect(ev.effect, ev, ev.validation_cost_before, ev.validation_cost_after,
+                                           "improves the training data (p = " + output::short_number(ev.p_value) +
+                                               ") but not the held-out part (its equation-error cost rises by " +
+                                               output::short_number(-ev.validation_gain_percent) + " %)"));
+  // Taken out by the backward pass because the held-out part is better without it, while
+  // the training data still want it: suspected too.
+  for (const auto& rm : d.search.removed)
+    if (rm.held_out_failure)
+      d.suspected.push_back(held_out_suspect(rm.effect, {}, rm.validation_cost_without, rm.validation_cost_with,
+                                             "significant on the training data in the final model (p = " +
+                                                 output::short_number(rm.p_value) +
+                                                 "), but the held-out part is better without it (its equation-error "
+                                                 "cost rises by " + output::short_number(-rm.validation_gain_percent) +
+                                                 " %); removed by the backward pass"));
+}
+
 }  // namespace
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
@@ -411,39 +560,11 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
-  // Several flights: one whose commands sit at their limit is left out (it would bend the
-  // airframe to explain motors that cannot give what was asked), unless none is usable.
-  size_t usable = 0;
-  for (const auto& f : flights_in) {
-    d.screening.push_back(screen_flight(f));
-    usable += d.screening.back().usable ? 1 : 0;
-  }
-  const bool leave_out = flights_in.size() > 1 && usable > 0;
-  // Without a battery or pose log, neither battery_sag nor ground_effect is a candidate.
-  std::vector<fit::Flight> flights;
-  for (size_t k = 0; k < flights_in.size(); ++k) {
-    if (leave_out && !d.screening[k].usable) {
-      d.screening[k].left_out = true;
-      std::cerr << "[diagnose] left out " << output::printable(flights_in[k].source) << ": " << d.screening[k].reason << "\n";
-      continue;
-    }
-    const fit::Flight& f = flights_in[k];
-    flights.push_back(predict::fill_missing_signals(f, all_in.params[all_in.param_index("vbat_ref")].nominal));
-    d.flights.push_back(f.source);
-  }
+  const std::vector<fit::Flight> flights = usable_flights(flights_in, all_in, d);
   const bool joint = flights.size() > 1;
   const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
   DiagnoseOptions opt = opt_in;
-  if (joint) {
-    auto& c = opt.search.candidates;
-    const auto not_joint = [](const std::string& name) { return !find_effect(name).not_in_joint_diagnosis.empty(); };
-    for (const std::string& name : c)
-      if (not_joint(name))
-        throw fit::FitError(name + " is no candidate when several flights are diagnosed together: " +
-                            find_effect(name).not_in_joint_diagnosis);
-    if (c.empty()) c = applicable_effects(flight);
-    c.erase(std::remove_if(c.begin(), c.end(), not_joint), c.end());
-  }
+  if (joint) opt.search.candidates = joint_candidates(opt.search.candidates, flight);
   // Joint: the flight's own quantities (motor trim, wind) get one value per flight; the rest
   // of the pipeline sees one model with more parameters.
   std::unique_ptr<runtime::PerFlightModel> per_flight_model;
@@ -463,11 +584,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   runtime::DynamicModel& model = joint ? *per_flight_model : model_in;
   bool accel = opt.translational == "accelerometer" || (opt.translational == "auto" && !flight.has_pose);
   if (opt.translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
-  d.formulation = accel ? "equation error: accelerometer specific force (body) and gyro derivative"
-                        : "equation error: differentiated velocity (world) and gyro derivative";
-  d.channel_names = accel ? std::vector<std::string>{"ax", "ay", "az", "pdot", "qdot", "rdot"}
-                          : std::vector<std::string>{"ax_world", "ay_world", "az_world", "pdot", "qdot", "rdot"};
-  d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
+  set_formulation(accel, d);
   const auto parts = joint ? fit::split_each_by_time(flights, 1.0 - opt.validation_fraction)
                            : fit::split_by_time(flight, 1.0 - opt.validation_fraction);
   const fit::Flight &train = parts.first, &valid = parts.second;  // (lambdas below capture valid)
@@ -489,173 +606,16 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
   d.search = search.run();
   const bool pose = flight.has_pose;
-  d.metric = pose ? "validation position RMSE (" + std::to_string(opt.window).substr(0, 3) +
-                        " s open-loop windows from measured states" +
-                        stride_clause(opt.window, opt.window_stride) + ") [m]"
-                  : "validation equation-error cost (weighted, no pose logged)";
-  // The held-out metric the report prints, per fold of the validation part.
-  const std::vector<fit::Flight> folds = validation_folds(valid, 4);
-  // The folds' one-step problems (with a pose; without one the metric already is one-step):
-  // the fit's own, and the accelerometer's where one is logged and the fit differentiates the
-  // pose instead — the translational guard then judges the force by a sensor the fit did not
-  // use (a per-flight wind once improved the differentiated pose and made the accelerometer's
-  // horizontal force 5x worse).
-  struct FoldProblems {
-    std::unique_ptr<fit::EquationErrorModel> fit, accelerometer;  // accelerometer: may be null
-  };
-  std::vector<FoldProblems> fold_ee;
-  if (pose)
-    for (const auto& f : folds)
-      try {  // a fold of short stretches between gaps has no row to differentiate: skipped
-        FoldProblems p{std::make_unique<fit::EquationErrorModel>(model, f, accel), nullptr};
-        if (!accel && f.has_accelerometer) p.accelerometer = std::make_unique<fit::EquationErrorModel>(model, f, true);
-        fold_ee.push_back(std::move(p));
-      } catch (const fit::FitError&) {
-      }
-  auto fold_metrics = [&](const std::vector<fit::FitParameter>& ps, predict::Replay replay = predict::Replay::kNothing) {
-    std::vector<double> m;
-    if (!pose) return std::vector<double>{search.cost(valid_ee, ps)};
-    for (const auto& f : folds)
-      m.push_back(simulate_windows(model, fit::parameter_values(ps), f, opt.window, opt.window_stride, false, replay).position_rmse);
-    return m;
-  };
-  auto metric = [&](const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) {
-    if (!pose) return search.cost(valid_ee, ps);
-    WindowedSimulation w = simulate_windows(model, fit::parameter_values(ps), valid, opt.window, opt.window_stride, sim != nullptr);
-    if (sim) *sim = w;
-    return w.position_rmse;
-  };
-  // The estimates of an effect's parameters in the search's current final model.
-  auto parameters_of = [&](const std::string& e) {
-    std::vector<EffectEstimate> out;
-    for (const auto& est : d.search.estimates)
-      if (est.name.rfind(e + ".", 0) == 0) out.push_back(est);
-    return out;
-  };
-  // Each named effect against the final model without it: what it buys on held-out data.
-  auto finding_for = [&](const std::string& e) {
-    Finding f;
-    f.effect = e;
-    for (const auto& step : d.search.steps)
-      if (step.selected == e) f.evidence = step.candidates.front();
-    f.parameters = parameters_of(e);
-    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
-    others.erase(e);
-    double c = 0;
-    const auto without = search.fit_with(others, d.search.final_fit, &c);
-    f.metric = d.metric;
-    f.before = metric(without, nullptr);
-    f.after = metric(d.search.final_fit, nullptr);
-    const auto mb = fold_metrics(without), ma = fold_metrics(d.search.final_fit);
-    for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
-    mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
-    auto& o = f.one_step;
-    for (const auto& fold : fold_ee) {
-      o.cost.per_fold.push_back(percent_lower(search.cost(*fold.fit, without), search.cost(*fold.fit, d.search.final_fit)));
-      const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, d.search.final_fit);
-      o.rotation.per_fold.push_back(percent_lower(gb.rotational(), ga.rotational()));
-      o.roll_pitch.per_fold.push_back(percent_lower(gb.roll_pitch, ga.roll_pitch));
-      o.yaw.per_fold.push_back(percent_lower(gb.yaw, ga.yaw));
-      const bool own = fold.accelerometer == nullptr;  // the translational channels as the fit measures them
-      const auto tb = own ? gb : channel_group_squares(*fold.accelerometer, without),
-                 ta = own ? ga : channel_group_squares(*fold.accelerometer, d.search.final_fit);
-      o.translation.per_fold.push_back(percent_lower(tb.translational(), ta.translational()));
-      o.horizontal.per_fold.push_back(percent_lower(tb.horizontal, ta.horizontal));
-      o.vertical.per_fold.push_back(percent_lower(tb.vertical, ta.vertical));
-    }
-    for (auto* g : {&o.cost, &o.translation, &o.rotation, &o.horizontal, &o.vertical, &o.roll_pitch, &o.yaw})
-      mean_and_standard_error(g->per_fold, &g->mean, &g->standard_error);
-    if (pose && find_effect(e).judged_by_force_model) {
-      const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(d.search.final_fit, predict::Replay::kAttitude);
-      for (size_t k = 0; k < fb.size(); ++k) f.force_alone.per_fold.push_back(fb[k] - fa[k]);
-      mean_and_standard_error(f.force_alone.per_fold, &f.force_alone.mean, &f.force_alone.standard_error);
-    }
-    f.accepted_by = held_out_test(f);
-    // Without a pose the report's metric itself is the held-out equation-error cost.
-    if (!pose && f.accepted_by == Finding::kByOpenLoopPosition) f.accepted_by = Finding::kByOneStep;
-    return f;
-  };
+  const HeldOutGain held_out_gain(model, search, valid, valid_ee, accel, opt.window, opt.window_stride);
+  d.metric = held_out_gain.metric_name();
   std::cerr << progress() << "acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
-  // Until nothing more fails: taking a suspected cause out refits the model (the extended
-  // model keeps only what is named, and carried look-alikes), which changes the others'
-  // gains and intervals, so they are tested again against what the report will show. The
-  // search gives Wald intervals: first only the held-out gains are tested; once nothing fails
-  // that, the survivors get profiles and are tested in full (intervals too).
-  bool profiled = !so.wald_until_accepted;
-  std::map<std::string, Finding> held_out;  // per effect, in the current final model
-  for (;;) {
-    std::vector<Finding> accepted;
-    std::vector<std::string> drop;
-    for (const auto& e : d.search.named()) {
-      if (!held_out.count(e)) held_out[e] = finding_for(e);
-      Finding f = held_out.at(e);
-      f.parameters = parameters_of(e);
-      const std::string failed = acceptance_failure(f, all, profiled);
-      if (failed.empty()) accepted.push_back(f);
-      else d.suspected.push_back({f, failed}), drop.push_back(e);
-    }
-    if (drop.empty() && !profiled) {
-      search.profile_intervals(d.search);
-      profiled = true;
-      continue;
-    }
-    if (drop.empty()) {
-      d.findings = accepted;
-      break;
-    }
-    search.remove_effects(d.search, drop);
-    held_out.clear();
-    profiled = !so.wald_until_accepted;
-  }
-  // Accepted, but beyond what the effect's physics can produce here: a stand-in for missing
-  // physics. It stays in the model (carried, like the stronger of a look-alike pair) and is
-  // reported with the residual it absorbs, not named.
-  d.environment = environment_name(so.environment);
-  for (auto it = d.findings.begin(); it != d.findings.end();) {
-    StandIn st;
-    if (!implausible_parameter(*it, so.environment, so.scales, &st)) {
-      ++it;
-      continue;
-    }
-    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
-    others.erase(it->effect);
-    double c = 0;
-    const auto without = search.fit_with(others, d.search.final_fit, &c);
-    st.channels = d.channel_names;
-    st.rms_without = six_channel_rms(train_ee, without);
-    st.rms_with = six_channel_rms(train_ee, d.search.final_fit);
-    d.search.carried.push_back(it->effect);
-    d.stand_ins.push_back(st);
-    it = d.findings.erase(it);
-  }
+  accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
+  separate_stand_ins(d, search, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {
-    AgreementInputs in;
-    in.model = &model_in;
-    for (const auto& f : flights) in.training_parts.push_back(fit::split_by_time(f, 1.0 - opt.validation_fraction).first);
-    in.use_accelerometer = accel;
-    in.joint_fit = d.search.final_fit;
-    in.per_flight = per_flight_names;
-    in.weights = d.search.final_weights;
-    const auto check = [&](const Finding& f, bool named) {
-      if (find_effect(f.effect).per_flight) return;
-      AgreementInputs::Effect e{f.effect, named, {}, {}, {}};
-      for (const auto& name : effect_parameters(all_in, f.effect)) {
-        const auto est = std::find_if(f.parameters.begin(), f.parameters.end(),
-                                      [&](const EffectEstimate& x) { return x.name == name; });
-        if (est == f.parameters.end()) return;  // no estimate to start from (held at its reference)
-        e.parameters.push_back(name);
-        e.off.push_back(neutral_value(all_in.params[all_in.param_index(name)]));
-        e.start.push_back(est->value);
-      }
-      in.effects.push_back(e);
-    };
-    for (const auto& f : d.findings) check(f, true);
-    // Candidates the acceptance tests turned down, while they still hold their estimates: a
-    // value that differs between the flights is often why the joint fit gains nothing.
-    for (const auto& x : d.suspected) check(x.candidate, false);
     const auto agreement_start = std::chrono::steady_clock::now();
-    d.agreement = per_flight_agreement(in);
+    d.agreement = per_flight_agreement(
+        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, per_flight_names));
     std::cerr << progress() << "agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
               << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - agreement_start).count())
               << " s)\n";
@@ -670,37 +630,14 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
               << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
               << " s)\n";
   }
-  // Significant on the training data but no held-out gain in the search itself: suspected.
-  for (const auto& ev : d.search.training_only)
-    d.suspected.push_back(held_out_suspect(ev.effect, ev, ev.validation_cost_before, ev.validation_cost_after,
-                                           "improves the training data (p = " + output::short_number(ev.p_value) +
-                                               ") but not the held-out part (its equation-error cost rises by " +
-                                               output::short_number(-ev.validation_gain_percent) + " %)"));
-  // Taken out by the backward pass because the held-out part is better without it, while
-  // the training data still want it: suspected too.
-  for (const auto& rm : d.search.removed)
-    if (rm.held_out_failure)
-      d.suspected.push_back(held_out_suspect(rm.effect, {}, rm.validation_cost_without, rm.validation_cost_with,
-                                             "significant on the training data in the final model (p = " +
-                                                 output::short_number(rm.p_value) +
-                                                 "), but the held-out part is better without it (its equation-error "
-                                                 "cost rises by " + output::short_number(-rm.validation_gain_percent) +
-                                                 " %); removed by the backward pass"));
+  add_suspects_of_the_search(d);
   const SearchResult& s = d.search;
-  // What is wrong, before and after, over the whole flight.
   const fit::Flight used = rows_of(flight, all_ee);
-  for (const auto& smp : used.samples) d.t.push_back(smp.t);
-  d.residual_before = residuals_of(all_ee, s.base_fit);
-  d.residual_after = residuals_of(all_ee, s.final_fit);
-  std::vector<std::string> rotors;
-  for (const auto& r : v.rotors) rotors.push_back(r.name);
-  const SignalSet signals = physical_signals(used, rotors);
-  d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
-  d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
+  analyse_what_is_wrong(v, used, all_ee, d);
   // The gain on the validation part.
   std::cerr << progress() << "validation of the base and the extended model\n";
-  d.metric_before = metric(s.base_fit, &d.sim_before);
-  d.metric_after = metric(s.final_fit, &d.sim_after);
+  d.metric_before = held_out_gain.metric(s.base_fit, &d.sim_before);
+  d.metric_after = held_out_gain.metric(s.final_fit, &d.sim_after);
   // Without a pose only the one-step view can be measured.
   std::cerr << progress() << "prediction error at horizons, before and after\n";
   d.has_prediction = true;
@@ -708,16 +645,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
   const auto rb = six_channel_rms(valid_ee, s.base_fit), ra = six_channel_rms(valid_ee, s.final_fit);
   for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
-  // Left over: slow structure the noise cannot explain. The final model carries the stronger
-  // of each look-alike pair (either explains the discrepancy; only the name is open).
-  const ResidualAnalysis& left = d.after;
-  for (const auto& c : left.channels) {
-    if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
-    Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,
-                  c.worst_window_mean, "", 0};
-    if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
-    d.unexplained.push_back(u);
-  }
+  d.unexplained = unexplained(d.after, opt);
   const DraftSignatureInput draft_input = draft_signature_input(d, used, valid, v, s.final_fit, !accel);
   d.draft = draft_signature(draft_input);
   if (joint)
@@ -730,7 +658,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (!proposed_terms(d.discovered).empty()) {
     std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
-                              pose ? folds : std::vector<fit::Flight>{}, opt.window, opt.window_stride);
+                              pose ? held_out_gain.folds() : std::vector<fit::Flight>{}, opt.window, opt.window_stride);
   }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);

@@ -4,11 +4,16 @@
 #include <cmath>
 #include <limits>
 
+#include "output/numbers.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "predict/rollout.hpp"
 
 namespace quadgen::diagnose {
+
+std::string stride_clause(double window, double start_stride) {
+  return overlapping_windows(window, start_stride) ? ", started every " + output::short_number(start_stride) + " s" : "";
+}
 
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& f, double window, double start_stride, bool keep_trace,

@@ -31,6 +31,9 @@ struct WindowedSimulation {
 
 // Whether simulate_windows scores overlapping windows for this stride.
 inline bool overlapping_windows(double window, double start_stride) { return start_stride > 0 && start_stride < window; }
+// What a held-out position metric's name says about its windows: ", started every 0.1 s"
+// when they overlap, nothing when they are consecutive.
+std::string stride_clause(double window, double start_stride);
 
 // `model` must be the full-catalogue model with `params` (effects off at their neutral values).
 // The RMSEs come from windows started every `start_stride` seconds (overlapping: see

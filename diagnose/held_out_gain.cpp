@@ -1,0 +1,149 @@
+#include "diagnose/held_out_gain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "derive/effects/effect_catalogue.hpp"
+
+namespace quadgen::diagnose {
+
+namespace {
+
+// Sums of squares of the channel groups of one fold's residuals (six channels per sample).
+struct ChannelGroupSquares {
+  double horizontal = 0, vertical = 0, roll_pitch = 0, yaw = 0;  // channels 0-1, 2, 3-4 and 5
+  double translational() const { return horizontal + vertical; }
+  double rotational() const { return roll_pitch + yaw; }
+};
+ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
+  const auto p = fit::parameter_values(ps);
+  std::vector<double> r;
+  m.all_channels(p.data(), r);
+  ChannelGroupSquares ss;
+  for (size_t i = 0; i < r.size(); ++i) {
+    const size_t channel = i % 6;
+    (channel < 2 ? ss.horizontal : channel == 2 ? ss.vertical : channel < 5 ? ss.roll_pitch : ss.yaw) += r[i] * r[i];
+  }
+  return ss;
+}
+
+void summarise(Finding::FoldGains& g) { mean_and_standard_error(g.per_fold, &g.mean, &g.standard_error); }
+
+}  // namespace
+
+void mean_and_standard_error(const std::vector<double>& x, double* mean, double* se) {
+  const double n = static_cast<double>(x.size());
+  *mean = 0;
+  for (double v : x) *mean += v / n;
+  double ss = 0;
+  for (double v : x) ss += (v - *mean) * (v - *mean);
+  *se = x.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+}
+
+std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
+  std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
+  for (auto& f : folds) f.samples.clear();
+  const double t0 = valid.samples.front().t, span = valid.samples.back().t - t0 + 1e-9;
+  for (const auto& s : valid.samples)
+    folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>((s.t - t0) / span * k))].samples.push_back(s);
+  folds.erase(std::remove_if(folds.begin(), folds.end(), [](const fit::Flight& f) { return f.samples.size() < 2; }),
+              folds.end());
+  return folds;
+}
+
+std::vector<EffectEstimate> effect_estimates(const SearchResult& s, const std::string& e) {
+  std::vector<EffectEstimate> out;
+  for (const auto& est : s.estimates)
+    if (est.name.rfind(e + ".", 0) == 0) out.push_back(est);
+  return out;
+}
+
+HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& search, const fit::Flight& valid,
+                         const fit::EquationErrorModel& valid_ee, bool accelerometer, double window,
+                         double window_stride)
+    : model_(model),
+      search_(search),
+      valid_(valid),
+      valid_ee_(valid_ee),
+      pose_(valid.has_pose),
+      window_(window),
+      window_stride_(window_stride),
+      folds_(validation_folds(valid, 4)) {
+  metric_name_ = pose_ ? "validation position RMSE (" + std::to_string(window).substr(0, 3) +
+                             " s open-loop windows from measured states" + stride_clause(window, window_stride) + ") [m]"
+                       : "validation equation-error cost (weighted, no pose logged)";
+  if (!pose_) return;  // the metric already is one-step
+  for (const auto& f : folds_)
+    try {  // a fold of short stretches between gaps has no row to differentiate: skipped
+      FoldProblems p{std::make_unique<fit::EquationErrorModel>(model, f, accelerometer), nullptr};
+      if (!accelerometer && f.has_accelerometer) p.accelerometer = std::make_unique<fit::EquationErrorModel>(model, f, true);
+      fold_problems_.push_back(std::move(p));
+    } catch (const fit::FitError&) {
+    }
+}
+
+double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const {
+  if (!pose_) return search_.cost(valid_ee_, ps);
+  WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), valid_, window_, window_stride_, sim != nullptr);
+  if (sim) *sim = w;
+  return w.position_rmse;
+}
+
+std::vector<double> HeldOutGain::fold_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const {
+  if (!pose_) return {search_.cost(valid_ee_, ps)};
+  std::vector<double> m;
+  for (const auto& f : folds_)
+    m.push_back(simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false, replay).position_rmse);
+  return m;
+}
+
+Finding::OneStep HeldOutGain::one_step(const std::vector<fit::FitParameter>& without,
+                                       const std::vector<fit::FitParameter>& with) const {
+  Finding::OneStep o;
+  for (const auto& fold : fold_problems_) {
+    o.cost.per_fold.push_back(percent_lower(search_.cost(*fold.fit, without), search_.cost(*fold.fit, with)));
+    const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, with);
+    o.rotation.per_fold.push_back(percent_lower(gb.rotational(), ga.rotational()));
+    o.roll_pitch.per_fold.push_back(percent_lower(gb.roll_pitch, ga.roll_pitch));
+    o.yaw.per_fold.push_back(percent_lower(gb.yaw, ga.yaw));
+    const bool own = fold.accelerometer == nullptr;  // the translational channels as the fit measures them
+    const auto tb = own ? gb : channel_group_squares(*fold.accelerometer, without),
+               ta = own ? ga : channel_group_squares(*fold.accelerometer, with);
+    o.translation.per_fold.push_back(percent_lower(tb.translational(), ta.translational()));
+    o.horizontal.per_fold.push_back(percent_lower(tb.horizontal, ta.horizontal));
+    o.vertical.per_fold.push_back(percent_lower(tb.vertical, ta.vertical));
+  }
+  for (auto* g : {&o.cost, &o.translation, &o.rotation, &o.horizontal, &o.vertical, &o.roll_pitch, &o.yaw}) summarise(*g);
+  return o;
+}
+
+Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) const {
+  Finding f;
+  f.effect = e;
+  for (const auto& step : s.steps)
+    if (step.selected == e) f.evidence = step.candidates.front();
+  f.parameters = effect_estimates(s, e);
+  std::set<std::string> others(s.selected.begin(), s.selected.end());
+  others.erase(e);
+  double c = 0;
+  const auto without = search_.fit_with(others, s.final_fit, &c);
+  f.metric = metric_name_;
+  f.before = metric(without, nullptr);
+  f.after = metric(s.final_fit, nullptr);
+  const auto mb = fold_metrics(without, predict::Replay::kNothing), ma = fold_metrics(s.final_fit, predict::Replay::kNothing);
+  for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
+  mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
+  f.one_step = one_step(without, s.final_fit);
+  if (pose_ && find_effect(e).judged_by_force_model) {
+    const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(s.final_fit, predict::Replay::kAttitude);
+    for (size_t k = 0; k < fb.size(); ++k) f.force_alone.per_fold.push_back(fb[k] - fa[k]);
+    summarise(f.force_alone);
+  }
+  f.accepted_by = held_out_test(f);
+  // Without a pose the report's metric itself is the held-out equation-error cost.
+  if (!pose_ && f.accepted_by == Finding::kByOpenLoopPosition) f.accepted_by = Finding::kByOneStep;
+  return f;
+}
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,79 @@
+// What one named effect buys on data the fit did not see: the search's final model against
+// the final model refitted without the effect, on four consecutive folds of the validation
+// part. Measured three ways (Finding in diagnosis.hpp holds them):
+//  - the report's metric per fold: the position RMSE of open-loop windows with a pose, else
+//    the held-out equation-error cost;
+//  - one step at a time, per kind of channel: the weighted cost, and the sums of squares of
+//    the translational (the accelerometer's where one is logged and the fit differentiates
+//    the pose), horizontal, vertical, rotational, roll/pitch and yaw channels;
+//  - for a flight's own quantity acting on the force (the marker frame, a wind; with a pose),
+//    the windows again with the measured attitude replayed: the force model alone.
+// The rules that judge these numbers are held_out_test's (diagnosis.cpp).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "diagnose/candidate_search.hpp"
+#include "diagnose/diagnosis.hpp"
+#include "diagnose/validation.hpp"
+#include "fit/equation_error.hpp"
+#include "fit/flight_data.hpp"
+#include "runtime/dynamic_model.hpp"
+
+namespace quadgen::diagnose {
+
+// The validation part cut into `k` consecutive blocks of equal duration. Joined flights hold
+// their validation parts apart in time (each flight's training part lies between): a block
+// that holds no window to simulate is dropped.
+std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k);
+
+// The mean of per-fold gains and its standard error (0 for one fold).
+void mean_and_standard_error(const std::vector<double>& x, double* mean, double* se);
+
+// The estimates of effect `e`'s parameters in the search's current final model.
+std::vector<EffectEstimate> effect_estimates(const SearchResult& s, const std::string& e);
+
+class HeldOutGain {
+ public:
+  // `valid`, `valid_ee`: the held-out part and its equation-error problem (the fit's
+  // formulation, `accelerometer` or the differentiated pose); `search` refits without an
+  // effect. All must outlive this object.
+  HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& search, const fit::Flight& valid,
+              const fit::EquationErrorModel& valid_ee, bool accelerometer, double window, double window_stride);
+
+  // The report's held-out metric of a parameter set, and its name. With `sim`, the windows'
+  // trace is kept there.
+  double metric(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const;
+  const std::string& metric_name() const { return metric_name_; }
+  // The folds (empty of windows without a pose: the metric is then one-step already).
+  const std::vector<fit::Flight>& folds() const { return folds_; }
+
+  // Effect `e` of the search's final model, against that model refitted without it.
+  Finding finding_for(const std::string& e, const SearchResult& s) const;
+
+ private:
+  // The metric per fold (one value, the whole part's cost, without a pose).
+  std::vector<double> fold_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const;
+  Finding::OneStep one_step(const std::vector<fit::FitParameter>& without, const std::vector<fit::FitParameter>& with) const;
+
+  // A fold's one-step problems: the fit's own, and the accelerometer's where one is logged
+  // and the fit differentiates the pose instead (null otherwise) — the translational guard
+  // then judges the force by a sensor the fit did not use (a per-flight wind once improved
+  // the differentiated pose and made the accelerometer's horizontal force 5x worse).
+  struct FoldProblems {
+    std::unique_ptr<fit::EquationErrorModel> fit, accelerometer;
+  };
+
+  runtime::DynamicModel& model_;
+  const CandidateSearch& search_;
+  const fit::Flight& valid_;
+  const fit::EquationErrorModel& valid_ee_;
+  const bool pose_;
+  const double window_, window_stride_;
+  std::string metric_name_;
+  std::vector<fit::Flight> folds_;
+  std::vector<FoldProblems> fold_problems_;  // with a pose; a fold without rows is skipped
+};
+
+}  // namespace quadgen::diagnose
