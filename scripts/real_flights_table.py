@@ -51,11 +51,11 @@ def held_out_gain(f):
     if above_spread(g):
         return True
 
-    def not_worse(x):
+    def not_worse(x, negligible=0.0):
         m, se = x.get("gain_mean"), x.get("gain_standard_error")
-        return m is not None and se is not None and m >= -se
+        return m is not None and se is not None and (m >= -se or m >= -negligible)
     groups = ("translation", "horizontal", "rotation") + (("yaw",) if "yaw" in o else ())  # yaw: since 2026-11-27
-    no_group_worse = all(not_worse(o.get(k, {})) for k in groups)
+    no_group_worse = all(not_worse(o.get(k, {}), 1.0) for k in groups)  # 1 %: diagnose's kNegligibleChange
     if f["effect"] in PER_FLIGHT:  # a flight's own quantity: the rollouts, or the force model alone
         return (f["effect"] in ON_THE_FORCE and above_spread(f.get("force_alone_gain") or {})
                 and bool(o.get("fold_gains")) and above_spread(o) and no_group_worse)

@@ -861,6 +861,11 @@ TEST(Acceptance, AOneStepGainCountsOnlyWhereTheRolloutsDoNotSpeakAgainstIt) {
       << quadgen::diagnose::one_step_summary(f);
   f.one_step.yaw.mean = -2;  // within its spread
   EXPECT_EQ(held_out_test(f), Finding::kByOneStep);
+  f.one_step.yaw.mean = -0.05, f.one_step.yaw.standard_error = 0.02;  // beyond its spread, but negligible
+  EXPECT_EQ(held_out_test(f), Finding::kByOneStep) << "a change of hundredths of a per cent is no price";
+  f.one_step.yaw.mean = -1.5, f.one_step.yaw.standard_error = 0.2;
+  EXPECT_EQ(held_out_test(f), "") << "1.5 % worse beyond its spread";
+  f.one_step.yaw.mean = 0;
   f.gain_mean = -0.02;  // the rollouts worse beyond their spread: they refute it
   EXPECT_EQ(held_out_test(f), "");
   f.gain_mean = -0.001;
