@@ -12,8 +12,8 @@
 // (w replaced by a multiple of the body velocity), so the velocity along the axis is
 // partialled out first. Measured on the slow part of the residuals (1 s means every 0.1 s,
 // where the moment residual that drifts the open loop lives), on the training and the
-// held-out part, with Bartlett's effective sample size for two autocorrelated series and
-// Student's t (n_eff - 3 degrees of freedom), one-sided in the draft's direction. A hypothesis for an unmeasured draft
+// held-out part, one-sided in the draft's direction, by a sign-flip test of the moment's
+// cosine coefficients (draft_signature.cpp, sign_flip_p). A hypothesis for an unmeasured draft
 // (docs/validation.md, "Is the slow moment residual moving air?"), never a named cause;
 // scripts/air_draft_check.py is the same test on a diagnosis folder.
 #pragma once
@@ -42,8 +42,8 @@ struct DraftSignature {
     double draft_slope = 0;    // the ratio a draft gives
     double raw_r = 0;          // before the velocity is partialled out
     double r = 0;              // partial correlation
-    double effective_n = 0;    // Bartlett: n / (1 + 2 sum_k rho_f(k) rho_m(k))
-    double p = 1;              // one-sided, in the draft's direction
+    double effective_n = 0;    // Bartlett: n / (1 + 2 sum_k rho_f(k) rho_m(k)), how slow the series are
+    double p = 1;              // one-sided, in the draft's direction (cosine sign-flip test)
     double slope = 0;          // least squares of the force on the moment (partialled)
     double reverse_slope = 0;  // 1 / (slope of the moment on the force): noise in the moment pulls `slope`
                                // towards zero, the reverse one away from it

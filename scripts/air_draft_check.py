@@ -22,10 +22,12 @@ pose-derived world acceleration rotated into the heading frame (the flights tilt
 Noise in the moment residual pulls a regression slope towards zero, so the reverse
 regression's slope (1 / slope of pdot on a_y, its bound from the other side) is printed too.
 Slow signals correlate by chance far more often than white ones, so the correlation is
-judged with Bartlett's effective sample size for two autocorrelated series,
-n / (1 + 2 sum_k rho_f(k) rho_m(k)), and Student's t as diagnose's residual analysis does
-(n_eff - 3 degrees of freedom: one fewer for the velocity partialled out), one-sided in the draft's direction (diagnose's own
-draft check, diagnose/draft_signature.hpp, is the same test on the unthinned residuals). The running means are taken on a uniform 0.1 s grid.
+judged by a sign-flip test of the moment's cosine (DCT-II) coefficients, which are nearly
+uncorrelated for a slow series: 1999 random sign patterns from SplitMix64 with a fixed seed,
+one-sided in the draft's direction, p = (1 + #{surrogate r >= r}) / 2000 — diagnose's own
+draft check (diagnose/draft_signature.cpp, sign_flip_p) is the same test with the same bits.
+Bartlett's effective sample size, n / (1 + 2 sum_k rho_f(k) rho_m(k)), is printed as a
+measure of how slow the series are. The running means are taken on a uniform 0.1 s grid.
 
 A common scale error of the airspeed terms (k_d and k_f off by one factor, or the rotor
 speeds S off) leaves the same signature with w replaced by a multiple of the body velocity.
@@ -104,58 +106,79 @@ def acf(v, max_lag):
     return [sum(c[i] * c[i + k] for i in range(len(c) - k)) / c0 for k in range(max_lag + 1)]
 
 
-def incomplete_beta(a, b, x):
-    """Regularized incomplete beta I_x(a, b): its continued fraction, evaluated by the
-    modified Lentz method on the side where it converges fast."""
-    if x <= 0 or x >= 1:
-        return 0.0 if x <= 0 else 1.0
-    front = math.exp(math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log(1 - x))
-    if x > (a + 1) / (a + b + 2):
-        return 1 - incomplete_beta(b, a, 1 - x)
-    tiny = 1e-300
-    c, d = 1.0, 1 - (a + b) * x / (a + 1)
-    d = 1 / (d if abs(d) > tiny else tiny)
-    h = d
-    for m in range(1, 300):
-        for num in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
-                    -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
-            d = 1 + num * d
-            d = 1 / (d if abs(d) > tiny else tiny)
-            c = 1 + num / c
-            c = c if abs(c) > tiny else tiny
-            h *= d * c
-        if abs(d * c - 1) < 1e-14:
-            break
-    return front * h / a
+MASK = (1 << 64) - 1
 
 
-def student_t_above(t, dof):
-    """P(T > t) for Student's t with `dof` degrees of freedom."""
-    tail = 0.5 * incomplete_beta(dof / 2, 0.5, dof / (dof + t * t))
-    return tail if t > 0 else 1 - tail
+def splitmix64(state):
+    """SplitMix64 (Steele, Lea & Flood 2014): the next state and its 64 random bits, the
+    stream diagnose draws its signs from, so that both give the same p."""
+    state = (state + 0x9E3779B97F4A7C15) & MASK
+    z = ((state ^ (state >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return state, z ^ (z >> 31)
 
 
-def correlation_test(x, y, sign):
-    """r of y on x, Bartlett's effective n and the one-sided p in the direction `sign`
-    (Student's t with n_eff - 3 degrees of freedom: the velocity is partialled out)."""
-    xc, yc = centred(x), centred(y)
-    sxx, syy = sum(a * a for a in xc), sum(b * b for b in yc)
-    sxy = sum(a * b for a, b in zip(xc, yc))
+def cosine_coefficients(z):
+    """Orthonormal DCT-II coefficients k = 1 .. n-1 (the mean left out)."""
+    n = len(z)
+    period = 4 * n
+    table = [math.cos(math.pi * j / (2 * n)) for j in range(period)]
+    scale = math.sqrt(2 / n)
+    return [scale * sum(z[t] * table[(k * (2 * t + 1)) % period] for t in range(n)) for k in range(1, n)]
+
+
+def sign_flip_p(moment, force_res, velocity, flips=1999, seed=0x5EED0001):
+    """One-sided p of the partial correlation of the moment means with `force_res` (turned so
+    that a draft correlates positively; velocity and constant partialled out), the velocity
+    partialled out of the moment too: the moment's cosine coefficients, nearly uncorrelated
+    for a slow series, get random signs, and the surrogate correlations at or above the
+    measured one are counted."""
+    u = centred(velocity)
+    norm = math.sqrt(sum(x * x for x in u))
+    u = [x / norm if norm > 0 else 0.0 for x in u]
+    c, d, e = cosine_coefficients(moment), cosine_coefficients(force_res), cosine_coefficients(u)
+    w = [a * b for a, b in zip(c, d)]
+    g = [a * b for a, b in zip(c, e)]
+    cc, ff = sum(x * x for x in c), sum(x * x for x in force_res)
+
+    def correlation(signs):
+        num = sum(s * x for s, x in zip(signs, w))
+        projection = sum(s * x for s, x in zip(signs, g))
+        den = (cc - projection * projection) * ff
+        return num / math.sqrt(den) if den > 0 else 0.0
+    measured = correlation([1.0] * len(w))
+    state, at_or_above = seed, 0
+    for _ in range(flips):
+        signs = []
+        for k in range(len(w)):
+            if k % 64 == 0:
+                state, word = splitmix64(state)
+            signs.append(-1.0 if (word >> (k % 64)) & 1 else 1.0)
+        at_or_above += correlation(signs) >= measured - 1e-12
+    return (1 + at_or_above) / (flips + 1)
+
+
+def correlation_test(moment, force, velocity, sign):
+    """The partial correlation r of the force means on the moment means (the velocity and a
+    constant partialled out of both), Bartlett's effective n (how slow they are), the
+    one-sided p in the direction `sign` by the sign-flip test, and the slopes."""
+    x, y = residual_on(moment, velocity), residual_on(force, velocity)
+    sxx, syy = sum(a * a for a in x), sum(b * b for b in y)
+    sxy = sum(a * b for a, b in zip(x, y))
     r = sxy / math.sqrt(sxx * syy)
     lag = len(x) // 4
     ax, ay = acf(x, lag), acf(y, lag)
     inflate = 1 + 2 * sum(ax[k] * ay[k] for k in range(1, lag + 1))
     n_eff = min(len(x), max(3.0, len(x) / max(1.0, inflate)))
-    dof = max(1.0, n_eff - 3)  # one fewer for the velocity partialled out
-    t = sign * r * math.sqrt(dof / max(1 - r * r, 1e-12))
-    p = student_t_above(t, dof)
+    p = sign_flip_p(moment, [sign * b for b in y], velocity)
     return r, n_eff, p, sxy / sxx, (syy / sxy if sxy else math.inf)
 
 
 def pair_line(name, moment, force, velocity, ratio):
     sign = math.copysign(1, ratio)
-    r_raw = correlation_test(moment, force, sign)[0]
-    r, n_eff, p, slope, reverse = correlation_test(residual_on(moment, velocity), residual_on(force, velocity), sign)
+    mc, fc = centred(moment), centred(force)
+    r_raw = sum(a * b for a, b in zip(mc, fc)) / math.sqrt(sum(a * a for a in mc) * sum(b * b for b in fc))
+    r, n_eff, p, slope, reverse = correlation_test(moment, force, velocity, sign)
     shows = p <= LEVEL
     return (f"{name}: r {r_raw:+.2f}, with the velocity partialled out {r:+.2f} (n_eff {n_eff:.1f}, p {p:.3f}"
             f"{', the draft' + chr(39) + 's sign' if shows else ''}), slope {slope:+.4f} (reverse {reverse:+.4f}; "
@@ -221,14 +244,15 @@ def self_test():
             raw.append(w)
         return [sum(raw[k * 10:k * 10 + 100]) / 100 for k in range(n)]
     n = 120  # 12 s of means, like a held-out part
-    alarms, tries = 0, 400
+    velocity = [0.75 * math.cos(0.05 * k) for k in range(n)]  # a circle's, 12.6 s per turn
+    alarms, tries = 0, 200
     for _ in range(tries):
         moment, force = [14.7 * x + rng.gauss(0, 0.3) for x in slow(n)], [0.35 * x for x in slow(n)]
-        alarms += correlation_test(moment, force, -1)[2] <= LEVEL
+        alarms += correlation_test(moment, force, velocity, -1)[2] <= LEVEL
     w = slow(n)
     moment = [14.7 * x + rng.gauss(0, 0.3) for x in w]
     force = [ratio * y + rng.gauss(0, 0.01) for y in moment]
-    r, n_eff, p, slope, _ = correlation_test(moment, force, -1)
+    r, n_eff, p, slope, _ = correlation_test(moment, force, velocity, -1)
     print(f"a draft: r {r:+.2f}, n_eff {n_eff:.1f}, p {p:.3g}, slope {slope:+.4f} (true {ratio:+.4f})")
     print(f"independent slow forces: {alarms} of {tries} pass at the {LEVEL:g} level ({100 * alarms / tries:.1f} %)")
 
