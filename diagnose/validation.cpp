@@ -41,7 +41,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
       if (S[k + 1].t - S[k].t > predict::Rollout::kMaxGap) break;  // a gap: a new window
       if (!roll.advance(x, k, replay)) return {k, true};
-      const predict::StateError err = predict::state_error(x, S[k + 1], e);
+      const predict::StateError err = predict::state_error(x, S[k + 1], e, false);
       const double e2 = err.position_squared, v2 = err.velocity_squared, w2 = err.body_rates_squared, angle = err.angle;
       sums.pos += e2, sums.vel += v2, sums.att += angle * angle, sums.rate += w2;
       ++sums.count;

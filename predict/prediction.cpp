@@ -62,7 +62,7 @@ using runtime::DataSideEffects;
 
 // Errors of a simulated state against the measured sample (attitude unbiased).
 void add_errors(const std::vector<double>& x, const fit::FlightSample& s, const DataSideEffects& e, HorizonErrors& h) {
-  const StateError err = state_error(x, s, e);
+  const StateError err = state_error(x, s, e, true);
   h.position.add(std::sqrt(err.position_squared));
   h.velocity.add(std::sqrt(err.velocity_squared));
   h.tilt.add(err.tilt);

@@ -143,7 +143,8 @@ void Rollout::stage(const std::vector<double>& x, const std::vector<double>& k, 
   for (int j = 0; j < n_; ++j) tmp_[j] = x[j] + h * k[j];
 }
 
-StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e) {
+StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e,
+                       bool tilt_and_heading) {
   constexpr double kPi = 3.14159265358979323846;
   StateError out;
   for (int a = 0; a < 3; ++a) {
@@ -155,6 +156,7 @@ StateError state_error(const std::vector<double>& x, const fit::FlightSample& s,
   runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
   const double dot = std::abs(x[6] * q[0] + x[7] * q[1] + x[8] * q[2] + x[9] * q[3]);
   out.angle = 2 * std::acos(std::min(1.0, dot));
+  if (!tilt_and_heading) return out;
   const runtime::Rotation rs = runtime::rotation_matrix(&x[6]), rm = runtime::rotation_matrix(q);
   double zz = 0;
   for (int a = 0; a < 3; ++a) zz += rs.m[a][2] * rm.m[a][2];

@@ -92,11 +92,14 @@ class Rollout {
 // rollout's data-side effects `e`), the one measure both the prediction and the diagnosis'
 // validation windows score: squared norms of the position, velocity and body-rate errors, and
 // the attitude error as one angle (of q_sim^-1 ⊗ q_logged), as the tilt between the body z
-// axes and as the heading difference (wrapped to [0, π]).
+// axes and as the heading difference (wrapped to [0, π]). The tilt and the heading need two
+// rotation matrices per sample, which only the prediction reports: `tilt_and_heading` asks
+// for them (else they stay 0), keeping them off the diagnosis' validation windows.
 struct StateError {
   double position_squared = 0, velocity_squared = 0, body_rates_squared = 0;  // m^2, m^2/s^2, rad^2/s^2
   double angle = 0, tilt = 0, heading = 0;                                    // rad
 };
-StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e);
+StateError state_error(const std::vector<double>& x, const fit::FlightSample& s, const runtime::DataSideEffects& e,
+                       bool tilt_and_heading);
 
 }  // namespace quadgen::predict
