@@ -457,32 +457,38 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
                      bool wald_first) {
   // Until nothing more fails: taking a suspected cause out refits the model (the extended
   // model keeps only what is named, and carried look-alikes), which changes the others'
-  // gains and intervals, so they are tested again against what the report will show. The
-  // search gives Wald intervals: first only the held-out gains are tested; once nothing fails
-  // that, the survivors get profiles and are tested in full (intervals too).
+  // gains and intervals, so they are tested again against what the report will show. One
+  // effect is taken out at a time, as in the search's backward pass: an effect with no gain
+  // beside a stand-in may pay once the stand-in is gone (on B3 rep 2, taking out the motor
+  // lag, whose gain was within its spread, together with the attitude bias, whose gain was
+  // negative, left a model that predicted 1.4 m instead of 0.28 m and nothing was named).
+  // The search gives Wald intervals: first only the held-out gains are tested; once nothing
+  // fails that, the survivors get profiles and are tested in full (intervals too).
   bool profiled = !wald_first;
   std::map<std::string, Finding> held_out;  // per effect, in the current final model
   for (;;) {
     std::vector<Finding> accepted;
-    std::vector<std::string> drop;
+    std::vector<std::pair<Finding, std::string>> failed;
     for (const auto& e : d.search.named()) {
       if (!held_out.count(e)) held_out[e] = held_out_gain.finding_for(e, d.search);
       Finding f = held_out.at(e);
       f.parameters = effect_estimates(d.search, e);
-      const std::string failed = acceptance_failure(f, all, profiled);
-      if (failed.empty()) accepted.push_back(f);
-      else d.suspected.push_back({f, failed}), drop.push_back(e);
+      const std::string why = acceptance_failure(f, all, profiled);
+      if (why.empty()) accepted.push_back(f);
+      else failed.push_back({f, why});
     }
-    if (drop.empty() && !profiled) {
+    if (failed.empty() && !profiled) {
       search.profile_intervals(d.search);
       profiled = true;
       continue;
     }
-    if (drop.empty()) {
+    if (failed.empty()) {
       d.findings = accepted;
       break;
     }
-    search.remove_effects(d.search, drop);
+    const auto& [f, why] = failed[clearest_failure(failed)];
+    d.suspected.push_back({f, why});
+    search.remove_effects(d.search, {f.effect});
     held_out.clear();
     profiled = !wald_first;
   }
@@ -503,8 +509,8 @@ void separate_stand_ins(Diagnosis& d, const CandidateSearch& search, const fit::
     }
     std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
     others.erase(it->effect);
-    double c = 0;
-    const auto without = search.fit_with(others, d.search.final_fit, &c);
+    std::vector<double> own_weights;
+    const auto without = search.fit_as_own_model(others, d.search.final_fit, d.search.final_weights, &own_weights);
     st.channels = d.channel_names;
     st.rms_without = six_channel_rms(train_ee, without);
     st.rms_with = six_channel_rms(train_ee, d.search.final_fit);
@@ -646,8 +652,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   analyse_what_is_wrong(v, used, all_ee, d);
   // The gain on the validation part.
   std::cerr << progress() << "validation of the base and the extended model\n";
-  d.metric_before = held_out_gain.metric(s.base_fit, &d.sim_before);
-  d.metric_after = held_out_gain.metric(s.final_fit, &d.sim_after);
+  d.metric_before = held_out_gain.metric(s.base_fit, s.final_weights, &d.sim_before);
+  d.metric_after = held_out_gain.metric(s.final_fit, s.final_weights, &d.sim_after);
   // Without a pose only the one-step view can be measured.
   std::cerr << progress() << "prediction error at horizons, before and after\n";
   d.has_prediction = true;
@@ -684,6 +690,16 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
 // rollouts or, for those acting on the force, the force model alone with the one-step gain
 // and neither kind of channel worse. `one_step_refusal` and `force_alone_refusal` hold the
 // guards.
+size_t clearest_failure(const std::vector<std::pair<Finding, std::string>>& failed) {
+  const auto z = [](const Finding& f) {
+    return f.gain_standard_error > 0 ? f.gain_mean / f.gain_standard_error : f.gain_mean * 1e300;
+  };
+  size_t worst = 0;
+  for (size_t k = 1; k < failed.size(); ++k)
+    if (z(failed[k].first) < z(failed[worst].first)) worst = k;
+  return worst;
+}
+
 std::string held_out_test(const Finding& f) {
   if (beyond_spread(f.gain_mean, f.gain_standard_error)) return Finding::kByOpenLoopPosition;
   const auto& o = f.one_step;

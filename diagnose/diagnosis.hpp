@@ -4,6 +4,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diagnose/agreement.hpp"
@@ -212,6 +213,11 @@ struct Diagnosis {
 // spread, with the one-step cost lower beyond its spread and neither the translational nor
 // the rotational channels worse beyond theirs.
 std::string held_out_test(const Finding& f);
+
+// Of the effects that failed a round of acceptance (each with why), the one to take out
+// first: the one whose held-out gain speaks most clearly against it (the lowest gain over
+// its standard error). The acceptance takes one out at a time and tests the rest again.
+size_t clearest_failure(const std::vector<std::pair<Finding, std::string>>& failed);
 
 // The held-out routes' verdicts in words, as a suspect's reason carries them after its
 // open-loop gain: "; one step: 43 % +- 9 %, bought with worse horizontal force and

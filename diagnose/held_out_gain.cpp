@@ -10,13 +10,12 @@ namespace quadgen::diagnose {
 
 namespace {
 
-// Sums of squares of the channel groups of one fold's residuals (six channels per sample).
-struct ChannelGroupSquares {
-  double horizontal = 0, vertical = 0, roll_pitch = 0, yaw = 0;  // channels 0-1, 2, 3-4 and 5
-  double translational() const { return horizontal + vertical; }
-  double rotational() const { return roll_pitch + yaw; }
-};
-ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
+void summarise(Finding::FoldGains& g) { mean_and_standard_error(g.per_fold, &g.mean, &g.standard_error); }
+
+}  // namespace
+
+HeldOutGain::ChannelGroupSquares HeldOutGain::channel_group_squares(const fit::EquationErrorModel& m,
+                                                                    const std::vector<fit::FitParameter>& ps) {
   const auto p = fit::parameter_values(ps);
   std::vector<double> r;
   m.all_channels(p.data(), r);
@@ -27,10 +26,6 @@ ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m, cons
   }
   return ss;
 }
-
-void summarise(Finding::FoldGains& g) { mean_and_standard_error(g.per_fold, &g.mean, &g.standard_error); }
-
-}  // namespace
 
 void mean_and_standard_error(const std::vector<double>& x, double* mean, double* se) {
   const double n = static_cast<double>(x.size());
@@ -83,33 +78,59 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
     }
 }
 
-double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const {
-  if (!pose_) return search_.cost(valid_ee_, ps);
+double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
+                           WindowedSimulation* sim) const {
+  if (!pose_) return CandidateSearch::cost(valid_ee_, ps, weights);
   WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), valid_, window_, window_stride_, sim != nullptr);
   if (sim) *sim = w;
   return w.position_rmse;
 }
 
-std::vector<double> HeldOutGain::fold_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const {
-  if (!pose_) return {search_.cost(valid_ee_, ps)};
+std::vector<double> HeldOutGain::fold_metrics(const std::vector<fit::FitParameter>& ps,
+                                              const std::vector<double>& weights, predict::Replay replay) const {
+  if (!pose_) return {CandidateSearch::cost(valid_ee_, ps, weights)};
   std::vector<double> m;
   for (const auto& f : folds_)
     m.push_back(simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false, replay).position_rmse);
   return m;
 }
 
-Finding::OneStep HeldOutGain::one_step(const std::vector<fit::FitParameter>& without,
-                                       const std::vector<fit::FitParameter>& with) const {
-  Finding::OneStep o;
+HeldOutGain::Scores HeldOutGain::scores(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
+                                        bool force_alone) const {
+  Scores out;
+  out.metric = metric(ps, weights, nullptr);
+  out.fold_metrics = fold_metrics(ps, weights, predict::Replay::kNothing);
+  if (force_alone) out.force_alone = fold_metrics(ps, weights, predict::Replay::kAttitude);
   for (const auto& fold : fold_problems_) {
-    o.cost.per_fold.push_back(percent_lower(search_.cost(*fold.fit, without), search_.cost(*fold.fit, with)));
-    const auto gb = channel_group_squares(*fold.fit, without), ga = channel_group_squares(*fold.fit, with);
+    out.fold_costs.push_back(CandidateSearch::cost(*fold.fit, ps, weights));
+    out.fit_groups.push_back(channel_group_squares(*fold.fit, ps));
+    // The translational channels as the fit measures them, or by the accelerometer.
+    out.translational_groups.push_back(fold.accelerometer ? channel_group_squares(*fold.accelerometer, ps)
+                                                          : out.fit_groups.back());
+  }
+  return out;
+}
+
+const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool force_alone) const {
+  const auto values = fit::parameter_values(s.final_fit);
+  if (values != cached_values_ || s.final_weights != cached_weights_ || (force_alone && !cached_force_alone_)) {
+    cached_ = scores(s.final_fit, s.final_weights, force_alone);
+    cached_values_ = values;
+    cached_weights_ = s.final_weights;
+    cached_force_alone_ = force_alone;
+  }
+  return cached_;
+}
+
+Finding::OneStep HeldOutGain::one_step(const Scores& without, const Scores& with) {
+  Finding::OneStep o;
+  for (size_t k = 0; k < with.fold_costs.size(); ++k) {
+    o.cost.per_fold.push_back(percent_lower(without.fold_costs[k], with.fold_costs[k]));
+    const auto &gb = without.fit_groups[k], &ga = with.fit_groups[k];
     o.rotation.per_fold.push_back(percent_lower(gb.rotational(), ga.rotational()));
     o.roll_pitch.per_fold.push_back(percent_lower(gb.roll_pitch, ga.roll_pitch));
     o.yaw.per_fold.push_back(percent_lower(gb.yaw, ga.yaw));
-    const bool own = fold.accelerometer == nullptr;  // the translational channels as the fit measures them
-    const auto tb = own ? gb : channel_group_squares(*fold.accelerometer, without),
-               ta = own ? ga : channel_group_squares(*fold.accelerometer, with);
+    const auto &tb = without.translational_groups[k], &ta = with.translational_groups[k];
     o.translation.per_fold.push_back(percent_lower(tb.translational(), ta.translational()));
     o.horizontal.per_fold.push_back(percent_lower(tb.horizontal, ta.horizontal));
     o.vertical.per_fold.push_back(percent_lower(tb.vertical, ta.vertical));
@@ -126,18 +147,19 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   f.parameters = effect_estimates(s, e);
   std::set<std::string> others(s.selected.begin(), s.selected.end());
   others.erase(e);
-  double c = 0;
-  const auto without = search_.fit_with(others, s.final_fit, &c);
+  std::vector<double> own_weights;
+  const auto without = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &own_weights);
+  const bool force_alone = pose_ && find_effect(e).judged_by_force_model;
+  const Scores& a = final_scores(s, force_alone);
+  const Scores b = scores(without, s.final_weights, force_alone);
   f.metric = metric_name_;
-  f.before = metric(without, nullptr);
-  f.after = metric(s.final_fit, nullptr);
-  const auto mb = fold_metrics(without, predict::Replay::kNothing), ma = fold_metrics(s.final_fit, predict::Replay::kNothing);
-  for (size_t k = 0; k < mb.size(); ++k) f.fold_gains.push_back(mb[k] - ma[k]);
+  f.before = b.metric;
+  f.after = a.metric;
+  for (size_t k = 0; k < a.fold_metrics.size(); ++k) f.fold_gains.push_back(b.fold_metrics[k] - a.fold_metrics[k]);
   mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
-  f.one_step = one_step(without, s.final_fit);
-  if (pose_ && find_effect(e).judged_by_force_model) {
-    const auto fb = fold_metrics(without, predict::Replay::kAttitude), fa = fold_metrics(s.final_fit, predict::Replay::kAttitude);
-    for (size_t k = 0; k < fb.size(); ++k) f.force_alone.per_fold.push_back(fb[k] - fa[k]);
+  f.one_step = one_step(b, a);
+  if (force_alone) {
+    for (size_t k = 0; k < a.force_alone.size(); ++k) f.force_alone.per_fold.push_back(b.force_alone[k] - a.force_alone[k]);
     summarise(f.force_alone);
   }
   f.accepted_by = held_out_test(f);

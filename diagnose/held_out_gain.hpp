@@ -1,6 +1,6 @@
 // What one named effect buys on data the fit did not see: the search's final model against
-// the final model refitted without the effect, on four consecutive folds of the validation
-// part. Measured three ways (Finding in diagnosis.hpp holds them):
+// the model fitted without the effect (under its own weights), on four consecutive folds of
+// the validation part. Measured three ways (Finding in diagnosis.hpp holds them):
 //  - the report's metric per fold: the position RMSE of open-loop windows with a pose, else
 //    the held-out equation-error cost;
 //  - one step at a time, per kind of channel: the weighted cost, and the sums of squares of
@@ -42,20 +42,43 @@ class HeldOutGain {
   HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& search, const fit::Flight& valid,
               const fit::EquationErrorModel& valid_ee, bool accelerometer, double window, double window_stride);
 
-  // The report's held-out metric of a parameter set, and its name. With `sim`, the windows'
-  // trace is kept there.
-  double metric(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const;
+  // The report's held-out metric of a parameter set, and its name; without a pose the
+  // weighted cost under `weights`. With `sim`, the windows' trace is kept there.
+  double metric(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
+                WindowedSimulation* sim) const;
   const std::string& metric_name() const { return metric_name_; }
   // The folds (empty of windows without a pose: the metric is then one-step already).
   const std::vector<fit::Flight>& folds() const { return folds_; }
 
-  // Effect `e` of the search's final model, against that model refitted without it.
+  // Effect `e` of the search's final model, against the model fitted without it under its
+  // own weights (CandidateSearch::fit_as_own_model). Both are scored under one weighting,
+  // the final model's, where a score is weighted.
   Finding finding_for(const std::string& e, const SearchResult& s) const;
 
  private:
-  // The metric per fold (one value, the whole part's cost, without a pose).
-  std::vector<double> fold_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const;
-  Finding::OneStep one_step(const std::vector<fit::FitParameter>& without, const std::vector<fit::FitParameter>& with) const;
+  // Sums of squares of one fold's channel groups (six channels per sample).
+  struct ChannelGroupSquares {
+    double horizontal = 0, vertical = 0, roll_pitch = 0, yaw = 0;  // channels 0-1, 2, 3-4 and 5
+    double translational() const { return horizontal + vertical; }
+    double rotational() const { return roll_pitch + yaw; }
+  };
+  // Everything a finding compares, for one parameter set.
+  struct Scores {
+    double metric = 0;
+    std::vector<double> fold_metrics;        // the open-loop windows per fold (one cost without a pose)
+    std::vector<double> force_alone;         // the same with the measured attitude replayed (when asked)
+    std::vector<double> fold_costs;          // one step: the weighted cost per fold
+    std::vector<ChannelGroupSquares> fit_groups, translational_groups;  // per fold; the latter as the guard reads it
+  };
+  Scores scores(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights, bool force_alone) const;
+  // The final model's scores: every finding of one acceptance round compares with the same
+  // final model, which is simulated once per round, not once per finding.
+  const Scores& final_scores(const SearchResult& s, bool force_alone) const;
+  std::vector<double> fold_metrics(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
+                                   predict::Replay replay) const;
+  static ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m,
+                                                   const std::vector<fit::FitParameter>& ps);
+  static Finding::OneStep one_step(const Scores& without, const Scores& with);
 
   // A fold's one-step problems: the fit's own, and the accelerometer's where one is logged
   // and the fit differentiates the pose instead (null otherwise) — the translational guard
@@ -74,6 +97,10 @@ class HeldOutGain {
   std::string metric_name_;
   std::vector<fit::Flight> folds_;
   std::vector<FoldProblems> fold_problems_;  // with a pose; a fold without rows is skipped
+  // final_scores' cache, keyed on the final model's values and weights.
+  mutable std::vector<double> cached_values_, cached_weights_;
+  mutable Scores cached_;
+  mutable bool cached_force_alone_ = false;
 };
 
 }  // namespace quadgen::diagnose
