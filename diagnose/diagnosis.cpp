@@ -35,16 +35,9 @@ fit::Flight rows_of(const fit::Flight& f, const fit::EquationErrorModel& m) {
   return out;
 }
 
-std::vector<double> residuals_of(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  const auto p = fit::parameter_values(ps);
-  std::vector<double> r6;
-  m.all_channels(p.data(), r6);
-  return r6;
-}
-
 // All six channels, whichever the fit used.
 std::vector<double> six_channel_rms(const fit::EquationErrorModel& m, const std::vector<fit::FitParameter>& ps) {
-  return fit::rms_by_channel(residuals_of(m, ps), 6, [](size_t i) { return i % 6; });
+  return fit::rms_by_channel(m.all_channels(ps), 6, [](size_t i) { return i % 6; });
 }
 
 // The lengths plausible ranges may be relative to: the largest distance of a rotor from the
@@ -346,8 +339,8 @@ std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParamet
 void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit::EquationErrorModel& all_ee,
                            Diagnosis& d) {
   for (const auto& smp : used.samples) d.t.push_back(smp.t);
-  d.residual_before = residuals_of(all_ee, d.search.base_fit);
-  d.residual_after = residuals_of(all_ee, d.search.final_fit);
+  d.residual_before = all_ee.all_channels(d.search.base_fit);
+  d.residual_after = all_ee.all_channels(d.search.final_fit);
   std::vector<std::string> rotors;
   for (const auto& r : v.rotors) rotors.push_back(r.name);
   const SignalSet signals = physical_signals(used, rotors);
@@ -668,8 +661,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     for (const auto& one : split_by_flight(draft_input, fit::joined_start_times(flights)))
       d.draft_per_flight.push_back(draft_signature(one));
   std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
-  d.discovered = discover_terms(rows_of(train, train_ee), residuals_of(train_ee, s.final_fit), rows_of(valid, valid_ee),
-                                residuals_of(valid_ee, s.final_fit), d.channel_names, d.channel_units,
+  d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
+                                valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,
                                 joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
   if (!proposed_terms(d.discovered).empty()) {
     std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";

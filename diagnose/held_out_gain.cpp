@@ -16,9 +16,7 @@ void summarise(Finding::FoldGains& g) { mean_and_standard_error(g.per_fold, &g.m
 
 HeldOutGain::ChannelGroupSquares HeldOutGain::channel_group_squares(const fit::EquationErrorModel& m,
                                                                     const std::vector<fit::FitParameter>& ps) {
-  const auto p = fit::parameter_values(ps);
-  std::vector<double> r;
-  m.all_channels(p.data(), r);
+  const std::vector<double> r = m.all_channels(ps);
   ChannelGroupSquares ss;
   for (size_t i = 0; i < r.size(); ++i) {
     const size_t channel = i % 6;

@@ -158,6 +158,13 @@ void EquationErrorModel::all_channels(const double* p, std::vector<double>& r6) 
   evaluate6(p, r6.data(), nullptr, {});
 }
 
+std::vector<double> EquationErrorModel::all_channels(const std::vector<FitParameter>& ps) const {
+  const auto p = parameter_values(ps);
+  std::vector<double> r6;
+  all_channels(p.data(), r6);
+  return r6;
+}
+
 void EquationErrorModel::commands_at(double t, double* u) const {
   const auto& S = flight_.samples;
   const auto it = std::lower_bound(S.begin(), S.end(), t, [](const FlightSample& s, double v) { return s.t < v; });

@@ -53,6 +53,7 @@ class EquationErrorModel : public ResidualModel {
   std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
   // Residuals of all six channels of every row (rows() x 6), at these parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
+  std::vector<double> all_channels(const std::vector<FitParameter>& ps) const;
   const Flight& flight() const { return flight_; }
 
  private:
