@@ -984,7 +984,9 @@ TEST(OneStep, ALagTheRolloutsCannotSeeIsNamedByItsOneStepGain) {
 class WeakMotorSearch : public ::testing::Test {
  protected:
   void SetUp() override {
-    const fs::path dir = fresh_directory("quadgen_own_weights");
+    // A directory per test: ctest runs the fixture's tests in parallel.
+    const fs::path dir =
+        fresh_directory(std::string("quadgen_weak_motor_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     const HiddenCase c{"own_weights", "motor_gain", {{"motor_gain.C", -0.08}}, {}, "", 1};
     const fs::path log = fly(c, dir, "flight.csv", 30);
     const quadgen::Vehicle v = quadgen::load_vehicle(vehicle_file(c));
