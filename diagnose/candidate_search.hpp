@@ -212,13 +212,14 @@ class CandidateSearch {
   void profile_intervals(SearchResult& r) const;
 
   // Fits the model with these effects active (others neutral) from `start` under the
-  // weights of its own residuals (weights_at): from `start_weights`, refitted and reweighted
-  // until the weights settle (within 1 %); the weights of the last fit in `own_weights`. A model compared with the
-  // final one on held-out data must be the model one would fit without the effect: refitted
-  // under the final model's weights instead, where an effect whitens a channel the refit
-  // trades other parameters against that channel's raised weight (on a real flight, the
-  // marker frame's tilt raised the body-y force's weight 0.76 -> 2.71 and its refit moved the
-  // CoG 0.05 mm onto a held-out roll offset; docs/validation.md).
+  // weights of its own residuals (weights_at): from `start_weights`, refitted and
+  // reweighted until the weights settle (within 1 %); the weights of the last fit in
+  // `own_weights`. A model compared with the final one on held-out data must be the model
+  // one would fit without the effect: refitted under the final model's weights instead,
+  // where an effect whitens a channel the refit trades other parameters against that
+  // channel's raised weight (on a real flight, the marker frame's tilt raised the body-y
+  // force's weight 0.76 -> 2.71 and its refit moved the CoG 0.05 mm onto a held-out roll
+  // offset; docs/validation.md).
   std::vector<fit::FitParameter> fit_as_own_model(const std::set<std::string>& effects,
                                                   const std::vector<fit::FitParameter>& start,
                                                   const std::vector<double>& start_weights,

@@ -676,13 +676,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   return d;
 }
 
-// A flight's own quantities (its trims, a wind, the marker frame) are not judged by their
-// one-step gain alone: on the end of the same flight they were fitted to it shows the
-// flight's state absorbing error as well as a cause (a per-flight wind passed it by trading
-// the accelerometer's horizontal force, 5x worse, for the moments). They need the open-loop
-// rollouts or, for those acting on the force, the force model alone with the one-step gain
-// and neither kind of channel worse. `one_step_refusal` and `force_alone_refusal` hold the
-// guards.
+// With no spread (one fold), the sign of the gain decides.
 size_t clearest_failure(const std::vector<std::pair<Finding, std::string>>& failed) {
   const auto z = [](const Finding& f) {
     return f.gain_standard_error > 0 ? f.gain_mean / f.gain_standard_error : f.gain_mean * 1e300;
@@ -693,6 +687,13 @@ size_t clearest_failure(const std::vector<std::pair<Finding, std::string>>& fail
   return worst;
 }
 
+// A flight's own quantities (its trims, a wind, the marker frame) are not judged by their
+// one-step gain alone: on the end of the same flight they were fitted to it shows the
+// flight's state absorbing error as well as a cause (a per-flight wind passed it by trading
+// the accelerometer's horizontal force, 5x worse, for the moments). They need the open-loop
+// rollouts or, for those acting on the force, the force model alone with the one-step gain
+// and neither kind of channel worse. `one_step_refusal` and `force_alone_refusal` hold the
+// guards.
 std::string held_out_test(const Finding& f) {
   if (beyond_spread(f.gain_mean, f.gain_standard_error)) return Finding::kByOpenLoopPosition;
   const auto& o = f.one_step;

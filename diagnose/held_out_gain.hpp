@@ -52,7 +52,8 @@ class HeldOutGain {
 
   // Effect `e` of the search's final model, against the model fitted without it under its
   // own weights (CandidateSearch::fit_as_own_model). Both are scored under one weighting,
-  // the final model's, where a score is weighted.
+  // the final model's, where a score is weighted. Not thread-safe: it caches the final
+  // model's scores (and the dynamic model is shared).
   Finding finding_for(const std::string& e, const SearchResult& s) const;
 
  private:
