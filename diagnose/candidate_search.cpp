@@ -118,15 +118,16 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
 
 std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::string>& effects,
                                                             const std::vector<FitParameter>& start,
-                                                            const std::vector<double>& start_weights,
+                                                            std::vector<double> start_weights,
                                                             std::vector<double>* own_weights) const {
   // Reweighted until the weights move by less than 1 % on every channel. One reweighting is
   // not enough: the model without an effect has channels whose noise level differs from the
   // final model's a hundredfold, and each refit moves them again (three to four refits reach
-  // the fixed point on the hidden-effect flights; HeldOutGain test).
+  // the fixed point on a generated flight with a weak motor: the test
+  // WeakMotorSearch.TheModelWithoutAnEffectIsFittedUnderItsOwnWeights).
   constexpr int kMaxRefits = 10;
   constexpr double kSettled = 0.01;
-  std::vector<double> w = start_weights;
+  std::vector<double> w = std::move(start_weights);
   std::vector<FitParameter> ps = start;
   for (int refit = 0; refit < kMaxRefits; ++refit) {
     double c = 0;
@@ -404,16 +405,14 @@ SearchResult CandidateSearch::run() {
   SearchResult res;
   std::set<std::string> base;
   std::vector<FitParameter> current = initial_parameters();
-  // The base fit, weighted by the nominal model's residual noise; then the weights of the
-  // search are the base fit's.
+  // The base fit, from the nominal model's residual weights to its own (settled, as the
+  // final model and every model compared with it on held-out data are: a final model left
+  // with no effect is this one, and so is the comparison model of a lone effect); then the
+  // weights of the search are the base fit's.
   weights_.assign(train_.channels().size(), 1.0);
   weights_ = weights_at(current);
+  current = fit_as_own_model(base, current, weights_, &weights_);
   double c = 0;
-  current = fit_with(base, current, &c);
-  // Refit under the base fit's own weights, as every extended model is below, so that a
-  // final model that ends with no effect is this one.
-  weights_ = weights_at(current);
-  current = fit_with(base, current, &c);
   res.base_fit = current;
   res.base_weights = weights_;
   phase_done("base model fitted");

@@ -222,7 +222,7 @@ class CandidateSearch {
   // offset; docs/validation.md).
   std::vector<fit::FitParameter> fit_as_own_model(const std::set<std::string>& effects,
                                                   const std::vector<fit::FitParameter>& start,
-                                                  const std::vector<double>& start_weights,
+                                                  std::vector<double> start_weights,
                                                   std::vector<double>* own_weights) const;
   // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals at these parameters.
   std::vector<double> weights_at(const std::vector<fit::FitParameter>& ps) const;

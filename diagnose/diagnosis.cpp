@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <iostream>
 #include <map>
 #include <set>
@@ -676,10 +677,12 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   return d;
 }
 
-// With no spread (one fold), the sign of the gain decides.
+// With no spread (one fold), the sign of the gain decides. The same ranking serves a round
+// of interval failures: the effect the held-out part wants least goes first.
 size_t clearest_failure(const std::vector<std::pair<Finding, std::string>>& failed) {
   const auto z = [](const Finding& f) {
-    return f.gain_standard_error > 0 ? f.gain_mean / f.gain_standard_error : f.gain_mean * 1e300;
+    if (f.gain_standard_error > 0) return f.gain_mean / f.gain_standard_error;
+    return f.gain_mean == 0 ? 0.0 : std::copysign(std::numeric_limits<double>::infinity(), f.gain_mean);
   };
   size_t worst = 0;
   for (size_t k = 1; k < failed.size(); ++k)

@@ -84,23 +84,22 @@ double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, const std::
   return w.position_rmse;
 }
 
-std::vector<double> HeldOutGain::fold_metrics(const std::vector<fit::FitParameter>& ps,
-                                              const std::vector<double>& weights, predict::Replay replay) const {
-  if (!pose_) return {CandidateSearch::cost(valid_ee_, ps, weights)};
+std::vector<double> HeldOutGain::rollout_metrics(const std::vector<fit::FitParameter>& ps,
+                                                 predict::Replay replay) const {
   std::vector<double> m;
   for (const auto& f : folds_)
     m.push_back(simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false, replay).position_rmse);
   return m;
 }
 
-HeldOutGain::Scores HeldOutGain::scores(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
-                                        bool force_alone) const {
+HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const {
   Scores out;
-  out.metric = metric(ps, weights, nullptr);
-  out.fold_metrics = fold_metrics(ps, weights, predict::Replay::kNothing);
-  if (force_alone) out.force_alone = fold_metrics(ps, weights, predict::Replay::kAttitude);
+  if (pose_) {
+    out.metric = metric(ps, {}, nullptr);
+    out.fold_metrics = rollout_metrics(ps, predict::Replay::kNothing);
+    if (force_alone) out.force_alone = rollout_metrics(ps, predict::Replay::kAttitude);
+  }
   for (const auto& fold : fold_problems_) {
-    out.fold_costs.push_back(CandidateSearch::cost(*fold.fit, ps, weights));
     out.fit_groups.push_back(channel_group_squares(*fold.fit, ps));
     // The translational channels as the fit measures them, or by the accelerometer.
     out.translational_groups.push_back(fold.accelerometer ? channel_group_squares(*fold.accelerometer, ps)
@@ -109,13 +108,23 @@ HeldOutGain::Scores HeldOutGain::scores(const std::vector<fit::FitParameter>& ps
   return out;
 }
 
+void HeldOutGain::weigh(Scores& s, const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights) const {
+  s.fold_costs.clear();
+  for (const auto& fold : fold_problems_) s.fold_costs.push_back(CandidateSearch::cost(*fold.fit, ps, weights));
+  if (pose_) return;
+  s.metric = CandidateSearch::cost(valid_ee_, ps, weights);
+  s.fold_metrics = {s.metric};
+}
+
 const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool force_alone) const {
   const auto values = fit::parameter_values(s.final_fit);
-  if (values != cached_values_ || s.final_weights != cached_weights_ || (force_alone && !cached_force_alone_)) {
-    cached_ = scores(s.final_fit, s.final_weights, force_alone);
+  if (values != cached_values_) {
+    cached_ = unweighted_scores(s.final_fit, force_alone);
     cached_values_ = values;
-    cached_weights_ = s.final_weights;
     cached_force_alone_ = force_alone;
+  } else if (force_alone && !cached_force_alone_ && pose_) {
+    cached_.force_alone = rollout_metrics(s.final_fit, predict::Replay::kAttitude);
+    cached_force_alone_ = true;
   }
   return cached_;
 }
@@ -147,9 +156,12 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   others.erase(e);
   std::vector<double> own_weights;
   const auto without = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &own_weights);
+  std::vector<double> between(own_weights.size());
+  for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * s.final_weights[k]);
   const bool force_alone = pose_ && find_effect(e).judged_by_force_model;
-  const Scores& a = final_scores(s, force_alone);
-  const Scores b = scores(without, s.final_weights, force_alone);
+  Scores a = final_scores(s, force_alone), b = unweighted_scores(without, force_alone);
+  weigh(a, s.final_fit, between);
+  weigh(b, without, between);
   f.metric = metric_name_;
   f.before = b.metric;
   f.after = a.metric;

@@ -51,9 +51,11 @@ class HeldOutGain {
   const std::vector<fit::Flight>& folds() const { return folds_; }
 
   // Effect `e` of the search's final model, against the model fitted without it under its
-  // own weights (CandidateSearch::fit_as_own_model). Both are scored under one weighting,
-  // the final model's, where a score is weighted. Not thread-safe: it caches the final
-  // model's scores (and the dynamic model is shared).
+  // own weights (CandidateSearch::fit_as_own_model). Where a score is weighted (the one-step
+  // cost; without a pose the metric itself), both are scored under the geometric mean of
+  // their own weights: each model is the optimum under its own, so scoring both under
+  // either one's would lean towards that model. Not thread-safe: it caches the final
+  // model's rollouts (and the dynamic model is shared).
   Finding finding_for(const std::string& e, const SearchResult& s) const;
 
  private:
@@ -65,18 +67,20 @@ class HeldOutGain {
   };
   // Everything a finding compares, for one parameter set.
   struct Scores {
+    // Unweighted: the open-loop rollouts (with a pose) and the channel groups.
     double metric = 0;
-    std::vector<double> fold_metrics;        // the open-loop windows per fold (one cost without a pose)
-    std::vector<double> force_alone;         // the same with the measured attitude replayed (when asked)
-    std::vector<double> fold_costs;          // one step: the weighted cost per fold
+    std::vector<double> fold_metrics;  // the open-loop windows per fold (one cost without a pose)
+    std::vector<double> force_alone;   // the same with the measured attitude replayed (when asked)
     std::vector<ChannelGroupSquares> fit_groups, translational_groups;  // per fold; the latter as the guard reads it
+    // Weighted (weigh): the one-step cost per fold; without a pose the metric and fold_metrics.
+    std::vector<double> fold_costs;
   };
-  Scores scores(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights, bool force_alone) const;
-  // The final model's scores: every finding of one acceptance round compares with the same
-  // final model, which is simulated once per round, not once per finding.
+  Scores unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const;
+  void weigh(Scores& s, const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights) const;
+  // The final model's unweighted scores: every finding of one acceptance round compares with
+  // the same final model, which is simulated once per round, not once per finding.
   const Scores& final_scores(const SearchResult& s, bool force_alone) const;
-  std::vector<double> fold_metrics(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
-                                   predict::Replay replay) const;
+  std::vector<double> rollout_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const;
   static ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m,
                                                    const std::vector<fit::FitParameter>& ps);
   static Finding::OneStep one_step(const Scores& without, const Scores& with);
@@ -98,8 +102,8 @@ class HeldOutGain {
   std::string metric_name_;
   std::vector<fit::Flight> folds_;
   std::vector<FoldProblems> fold_problems_;  // with a pose; a fold without rows is skipped
-  // final_scores' cache, keyed on the final model's values and weights.
-  mutable std::vector<double> cached_values_, cached_weights_;
+  // final_scores' cache, keyed on the final model's values.
+  mutable std::vector<double> cached_values_;
   mutable Scores cached_;
   mutable bool cached_force_alone_ = false;
 };
