@@ -154,8 +154,11 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   f.parameters = effect_estimates(s, e);
   std::set<std::string> others(s.selected.begin(), s.selected.end());
   others.erase(e);
-  std::vector<double> own_weights;
-  const auto without = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &own_weights);
+  // A lone effect's comparison model is the base fit, which a final model left without
+  // effects is (CandidateSearch::run says why it is not settled further).
+  std::vector<double> own_weights = s.base_weights;
+  const auto without =
+      others.empty() ? s.base_fit : search_.fit_as_own_model(others, s.final_fit, s.final_weights, &own_weights);
   std::vector<double> between(own_weights.size());
   for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * s.final_weights[k]);
   const bool force_alone = pose_ && find_effect(e).judged_by_force_model;
