@@ -138,7 +138,16 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
     // Unsettled after the last refit: the weights it was fitted under are kept, so that
     // `ps` is the optimum under `own_weights` (a profile from a point that is not one
     // finds lower costs and never closes its interval).
-    if (change < kSettled || refit + 1 == kMaxRefits) break;
+    if (change < kSettled) break;
+    if (refit + 1 == kMaxRefits) {  // said, not hidden: reweighting to a fixed point can run away
+      if (opt_.verbose_progress) {
+        std::cerr << "[diagnose] note: the model with {";
+        for (const auto& e : effects) std::cerr << (e == *effects.begin() ? "" : ", ") << e;
+        std::cerr << "} did not settle its weights in " << kMaxRefits << " refits (last change "
+                  << std::round(1000 * change) / 10 << " %); it is compared as it stands\n";
+      }
+      break;
+    }
     w = std::move(next);
   }
   *own_weights = w;
