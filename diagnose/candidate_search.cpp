@@ -135,11 +135,12 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
     std::vector<double> next = weights_at(ps);
     double change = 0;
     for (size_t k = 0; k < w.size(); ++k) change = std::max(change, std::abs(next[k] / w[k] - 1));
+    if (change < kSettled) break;
     // Unsettled after the last refit: the weights it was fitted under are kept, so that
     // `ps` is the optimum under `own_weights` (a profile from a point that is not one
-    // finds lower costs and never closes its interval).
-    if (change < kSettled) break;
-    if (refit + 1 == kMaxRefits) {  // said, not hidden: reweighting to a fixed point can run away
+    // finds lower costs and never closes its interval); said, not hidden, for reweighting
+    // to a fixed point can run away.
+    if (refit + 1 == kMaxRefits) {
       if (opt_.verbose_progress) {
         std::cerr << "[diagnose] note: the model with {";
         for (const auto& e : effects) std::cerr << (e == *effects.begin() ? "" : ", ") << e;

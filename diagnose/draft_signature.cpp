@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <optional>
 
-
 namespace quadgen::diagnose {
 
 namespace {
@@ -69,13 +68,18 @@ class SplitMix64 {
   uint64_t state_;
 };
 
-// Orthonormal DCT-II coefficients of z for k = 1 .. n-1 (k = 0, the mean, left out):
-// sqrt(2/n) sum_t z_t cos(pi k (2t + 1) / (2n)), the cosines from one table of 4n entries.
-std::vector<double> cosine_coefficients(const std::vector<double>& z) {
+// cos(pi j / (2n)) for j = 0 .. 4n-1: every cosine the DCT-II of n samples needs.
+std::vector<double> cosine_table(size_t n) {
   constexpr double kPi = 3.14159265358979323846;
-  const size_t n = z.size(), period = 4 * n;
-  std::vector<double> table(period);
-  for (size_t j = 0; j < period; ++j) table[j] = std::cos(kPi * static_cast<double>(j) / (2.0 * static_cast<double>(n)));
+  std::vector<double> table(4 * n);
+  for (size_t j = 0; j < table.size(); ++j) table[j] = std::cos(kPi * static_cast<double>(j) / (2.0 * static_cast<double>(n)));
+  return table;
+}
+
+// Orthonormal DCT-II coefficients of z for k = 1 .. n-1 (k = 0, the mean, left out):
+// sqrt(2/n) sum_t z_t cos(pi k (2t + 1) / (2n)), the cosines from cosine_table(n).
+std::vector<double> cosine_coefficients(const std::vector<double>& z, const std::vector<double>& table) {
+  const size_t n = z.size(), period = table.size();
   std::vector<double> c(n > 0 ? n - 1 : 0);
   for (size_t k = 1; k < n; ++k) {
     double s = 0;
@@ -102,7 +106,9 @@ double sign_flip_p(const std::vector<double>& moment, const std::vector<double>&
   auto u = centred(velocity);
   const double uu = std::sqrt(dot(u, u));
   for (double& x : u) x = uu > 0 ? x / uu : 0.0;
-  const auto c = cosine_coefficients(moment), d = cosine_coefficients(force_res), e = cosine_coefficients(u);
+  const auto table = cosine_table(moment.size());
+  const auto c = cosine_coefficients(moment, table), d = cosine_coefficients(force_res, table),
+             e = cosine_coefficients(u, table);
   std::vector<double> w(c.size()), g(c.size());
   for (size_t k = 0; k < c.size(); ++k) w[k] = c[k] * d[k], g[k] = c[k] * e[k];
   const double cc = dot(c, c), ff = dot(force_res, force_res);

@@ -118,11 +118,14 @@ def splitmix64(state):
     return state, z ^ (z >> 31)
 
 
-def cosine_coefficients(z):
-    """Orthonormal DCT-II coefficients k = 1 .. n-1 (the mean left out)."""
-    n = len(z)
-    period = 4 * n
-    table = [math.cos(math.pi * j / (2 * n)) for j in range(period)]
+def cosine_table(n):
+    """cos(pi j / (2n)) for j = 0 .. 4n-1: every cosine the DCT-II of n samples needs."""
+    return [math.cos(math.pi * j / (2 * n)) for j in range(4 * n)]
+
+
+def cosine_coefficients(z, table):
+    """Orthonormal DCT-II coefficients k = 1 .. n-1 (the mean left out), from cosine_table(n)."""
+    n, period = len(z), len(table)
     scale = math.sqrt(2 / n)
     return [scale * sum(z[t] * table[(k * (2 * t + 1)) % period] for t in range(n)) for k in range(1, n)]
 
@@ -136,7 +139,8 @@ def sign_flip_p(moment, force_res, velocity, flips=1999, seed=0x5EED0001):
     u = centred(velocity)
     norm = math.sqrt(sum(x * x for x in u))
     u = [x / norm if norm > 0 else 0.0 for x in u]
-    c, d, e = cosine_coefficients(moment), cosine_coefficients(force_res), cosine_coefficients(u)
+    table = cosine_table(len(moment))
+    c, d, e = (cosine_coefficients(z, table) for z in (moment, force_res, u))
     w = [a * b for a, b in zip(c, d)]
     g = [a * b for a, b in zip(c, e)]
     cc, ff = sum(x * x for x in c), sum(x * x for x in force_res)
