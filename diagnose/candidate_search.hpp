@@ -15,8 +15,9 @@
 // anything significant to the other, the data cannot tell them apart: the step reports the
 // pair as a group with the manoeuvre that would separate them, the model carries the
 // stronger of the two (unnamed), and the search goes on. A backward pass then tests each
-// named effect against the final model without it and drops those that no longer earn
-// their place (significance on training data, gain on the held-out part).
+// named effect against the final model without it and drops those that are no longer
+// significant beside the others; whether the held-out part wants an effect is judged once,
+// by acceptance (HeldOutGain), not here.
 //
 // "Physically negligible" is relative to the vehicle and the flight: an effect's size is
 // the RMS change of the model's accelerations over the training flight when it is switched
@@ -124,11 +125,9 @@ struct SelectionStep {
 // An effect the backward pass took out of the final model, and why.
 struct Removal {
   std::string effect, reason;
-  double p_value = 1, validation_gain_percent = 0;
-  // Still significant on the training data, but the held-out part is better without it:
-  // a suspected cause (the other reason, no longer significant, is plain redundancy).
-  bool held_out_failure = false;
-  double validation_cost_without = 0, validation_cost_with = 0;
+  double p_value = 1;
+  // The held-out equation-error cost's change, for the record: 100 (1 - with / without).
+  double validation_gain_percent = 0;
 };
 
 struct SearchResult {

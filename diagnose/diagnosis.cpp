@@ -490,7 +490,7 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
 
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:
 // a stand-in for missing physics, moved from d.findings to d.stand_ins.
-void separate_stand_ins(Diagnosis& d, const CandidateSearch& search, const fit::EquationErrorModel& train_ee,
+void separate_stand_ins(Diagnosis& d, const HeldOutGain& held_out_gain, const fit::EquationErrorModel& train_ee,
                         const SearchOptions& so) {
   d.environment = environment_name(so.environment);
   // It stays in the model (carried, like the stronger of a look-alike pair) and is reported
@@ -501,10 +501,9 @@ void separate_stand_ins(Diagnosis& d, const CandidateSearch& search, const fit::
       ++it;
       continue;
     }
-    std::set<std::string> others(d.search.selected.begin(), d.search.selected.end());
-    others.erase(it->effect);
+    // The model acceptance compared it with (fitted once, in the last acceptance round).
     std::vector<double> own_weights;
-    const auto without = search.fit_as_own_model(others, d.search.final_fit, d.search.final_weights, &own_weights);
+    const auto without = held_out_gain.model_without(it->effect, d.search, &own_weights);
     st.channels = d.channel_names;
     st.rms_without = six_channel_rms(train_ee, without);
     st.rms_with = six_channel_rms(train_ee, d.search.final_fit);
@@ -522,16 +521,6 @@ void add_suspects_of_the_search(Diagnosis& d) {
                                            "improves the training data (p = " + output::short_number(ev.p_value) +
                                                ") but not the held-out part (its equation-error cost rises by " +
                                                output::short_number(-ev.validation_gain_percent) + " %)"));
-  // Taken out by the backward pass because the held-out part is better without it, while
-  // the training data still want it: suspected too.
-  for (const auto& rm : d.search.removed)
-    if (rm.held_out_failure)
-      d.suspected.push_back(held_out_suspect(rm.effect, {}, rm.validation_cost_without, rm.validation_cost_with,
-                                             "significant on the training data in the final model (p = " +
-                                                 output::short_number(rm.p_value) +
-                                                 "), but the held-out part is better without it (its equation-error "
-                                                 "cost rises by " + output::short_number(-rm.validation_gain_percent) +
-                                                 " %); removed by the backward pass"));
 }
 
 }  // namespace
@@ -620,7 +609,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.metric = held_out_gain.metric_name();
   std::cerr << progress() << "acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
   accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
-  separate_stand_ins(d, search, train_ee, so);
+  separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {
     const auto agreement_start = std::chrono::steady_clock::now();
@@ -635,7 +624,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     const auto start = std::chrono::steady_clock::now();
     d.airframe_source = opt.airframe->source;
     d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
-    std::cerr << progress() << "against the airframe of " << opt.airframe->source << ": " << d.airframe_check.size()
+    std::cerr << progress() << "against the airframe of " << output::printable(opt.airframe->source) << ": " << d.airframe_check.size()
               << " parameters ("
               << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
               << " s)\n";

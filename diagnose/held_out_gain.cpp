@@ -78,7 +78,10 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
 
 double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
                            WindowedSimulation* sim) const {
-  if (!pose_) return CandidateSearch::cost(valid_ee_, ps, weights);
+  return pose_ ? open_loop_rmse(ps, sim) : CandidateSearch::cost(valid_ee_, ps, weights);
+}
+
+double HeldOutGain::open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const {
   WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), valid_, window_, window_stride_, sim != nullptr);
   if (sim) *sim = w;
   return w.position_rmse;
@@ -95,7 +98,7 @@ std::vector<double> HeldOutGain::rollout_metrics(const std::vector<fit::FitParam
 HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const {
   Scores out;
   if (pose_) {
-    out.metric = metric(ps, {}, nullptr);
+    out.metric = open_loop_rmse(ps, nullptr);
     out.fold_metrics = rollout_metrics(ps, predict::Replay::kNothing);
     if (force_alone) out.force_alone = rollout_metrics(ps, predict::Replay::kAttitude);
   }
@@ -146,19 +149,32 @@ Finding::OneStep HeldOutGain::one_step(const Scores& without, const Scores& with
   return o;
 }
 
+std::vector<fit::FitParameter> HeldOutGain::model_without(const std::string& e, const SearchResult& s,
+                                                          std::vector<double>* own_weights) const {
+  const auto values = fit::parameter_values(s.final_fit);
+  auto cached = without_.find(e);
+  if (cached == without_.end() || cached->second.final_values != values ||
+      cached->second.final_effects != s.selected) {
+    std::set<std::string> others(s.selected.begin(), s.selected.end());
+    others.erase(e);
+    // A lone effect's comparison model is the base fit, which a final model left without
+    // effects is (CandidateSearch::run says why it is not settled further).
+    Without w{s.selected, values, s.base_fit, s.base_weights};
+    if (!others.empty()) w.fit = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &w.weights);
+    cached = without_.insert_or_assign(e, std::move(w)).first;
+  }
+  *own_weights = cached->second.weights;
+  return cached->second.fit;
+}
+
 Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) const {
   Finding f;
   f.effect = e;
   for (const auto& step : s.steps)
     if (step.selected == e) f.evidence = step.candidates.front();
   f.parameters = effect_estimates(s, e);
-  std::set<std::string> others(s.selected.begin(), s.selected.end());
-  others.erase(e);
-  // A lone effect's comparison model is the base fit, which a final model left without
-  // effects is (CandidateSearch::run says why it is not settled further).
-  std::vector<double> own_weights = s.base_weights;
-  const auto without =
-      others.empty() ? s.base_fit : search_.fit_as_own_model(others, s.final_fit, s.final_weights, &own_weights);
+  std::vector<double> own_weights;
+  const auto without = model_without(e, s, &own_weights);
   std::vector<double> between(own_weights.size());
   for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * s.final_weights[k]);
   const bool force_alone = pose_ && find_effect(e).judged_by_force_model;

@@ -10,6 +10,7 @@
 //    the windows again with the measured attitude replayed: the force model alone.
 // The rules that judge these numbers are held_out_test's (diagnosis.cpp).
 #pragma once
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,6 +59,12 @@ class HeldOutGain {
   // model's rollouts (and the dynamic model is shared).
   Finding finding_for(const std::string& e, const SearchResult& s) const;
 
+  // The search's final model without effect `e`, fitted under its own weights (returned in
+  // `own_weights`); a lone effect's is the base fit. Cached per effect and final model, for
+  // finding_for and the stand-in report ask for the same model.
+  std::vector<fit::FitParameter> model_without(const std::string& e, const SearchResult& s,
+                                               std::vector<double>* own_weights) const;
+
  private:
   // Sums of squares of one fold's channel groups (six channels per sample).
   struct ChannelGroupSquares {
@@ -80,6 +87,8 @@ class HeldOutGain {
   // The final model's unweighted scores: every finding of one acceptance round compares with
   // the same final model, which is simulated once per round, not once per finding.
   const Scores& final_scores(const SearchResult& s, bool force_alone) const;
+  // The open-loop windows' position RMSE over the whole held-out part (with a pose).
+  double open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const;
   std::vector<double> rollout_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const;
   static ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m,
                                                    const std::vector<fit::FitParameter>& ps);
@@ -106,6 +115,15 @@ class HeldOutGain {
   mutable std::vector<double> cached_values_;
   mutable Scores cached_;
   mutable bool cached_force_alone_ = false;
+  // model_without's cache: per effect, the final model it was fitted from (its effects and
+  // values), the model and its weights.
+  struct Without {
+    std::vector<std::string> final_effects;
+    std::vector<double> final_values;
+    std::vector<fit::FitParameter> fit;
+    std::vector<double> weights;
+  };
+  mutable std::map<std::string, Without> without_;
 };
 
 }  // namespace quadgen::diagnose
