@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "cli/derive_command.hpp"
+#include "output/sinks.hpp"
 #include "app/derive_pipeline.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/output_set.hpp"
@@ -35,7 +36,7 @@ int run_derive(const DeriveArgs& args) {
   int step = 1;
   request.progress = [&](const std::string& what) { std::cerr << "[" << ++step << "/5] " << what << "\n"; };
   const DerivedModel d = run_derive_pipeline(vehicle, mass_properties, request);
-  std::cerr << "[5/5] writing " << args.out << "\n";
+  std::cerr << "[5/5] writing " << output::printable(args.out) << "\n";
   out.add("model.json", d.model_json);
   out.add("derivation.md", d.derivation_md);
   out.add("model.hpp", d.header.content);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli/derive_command.hpp"
+#include "cli/options.hpp"
 #include "output/sinks.hpp"
 
 int main(int argc, char** argv) {
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return quadgen::cli::report_parse_error(app, e);
   }
   try {
     return quadgen::cli::run_derive(derive);

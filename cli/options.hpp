@@ -3,6 +3,7 @@
 #pragma once
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -11,8 +12,18 @@
 #include <CLI/CLI.hpp>
 
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::cli {
+
+// A command line CLI11 refused, reported as every other error is: one line, whatever the
+// argument it quotes holds (escape sequences, a newline that would fake a second message).
+// --help and --version leave through CLI11 itself (exit code 0).
+inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
+  if (e.get_exit_code() == 0) return app.exit(e);
+  std::cerr << "quadgen: error: " << output::printable(e.what()) << "\nRun with --help for more information.\n";
+  return e.get_exit_code();
+}
 
 // What --help says a log may be, and which parameter names the options that take names
 // accept (the effects' names depend on the vehicle's rotors, so they are given as patterns).

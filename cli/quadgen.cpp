@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return quadgen::cli::report_parse_error(app, e);
   }
   fit.given = quadgen::cli::given_options(app.get_subcommand("fit"));
   try {

@@ -69,8 +69,14 @@ std::string int_list(const std::vector<int>& v) {
 void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p) {
   // Everything from a vehicle file or the command line goes through the sink's escaping:
   // comments cannot end early or splice the next line, literals cannot end early.
-  d.set("vehicle_file", output::cpp_comment(p.vehicle_file));
-  d.set("effects_flag", output::cpp_comment(p.effects_flag));
+  // The regenerate command is one a reader may paste into a shell: the path is one quoted
+  // word, and where the comment cannot hold it as it is (bytes outside printable ASCII, '%'
+  // escaped as %XX) a placeholder stands for it rather than a path that names another file.
+  const std::string word = output::shell_word(p.vehicle_file);
+  d.set("vehicle_file", output::cpp_comment(word) == word ? word : std::string("VEHICLE_FILE"));
+  // (Only a --params path can make the flags unprintable: effect names are the catalogue's.)
+  const bool flag_as_is = output::cpp_comment(p.effects_flag) == p.effects_flag;
+  d.set("effects_flag", flag_as_is ? p.effects_flag : std::string(" --params PARAMETERS_FILE"));
   d.set("vehicle", output::cpp_comment(p.vehicle_name));
   d.set("vehicle_hash", output::cpp_comment(p.vehicle_hash));
   d.set("vehicle_hash_literal", output::cpp_string_literal(p.vehicle_hash));

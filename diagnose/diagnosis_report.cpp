@@ -890,7 +890,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
   // The command's own printout, for a reader who compares it with a terminal; the sections
   // below say the same in tables.
-  h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << esc(diagnosis_summary(d))
+  h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
     << "</pre></details>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";

@@ -22,6 +22,27 @@ const std::set<std::string>& generated_header_names() {
   return names;
 }
 
+// Macros that the generated header's one include (<cmath>, which pulls in parts of <stdlib.h>
+// with glibc) or the compiler's default GNU mode define without a reserved spelling: as a
+// namespace they would be replaced by a number or an expression. The list is what g++ 14 and
+// glibc define (`echo '#include <cmath>' | g++ -dM -E -x c++ -`); the header also refuses to
+// compile with any other macro of the vehicle's name (its #error guard), this only says so
+// earlier, with the vehicle file's line.
+bool is_library_macro(const std::string& w) {
+  static const std::set<std::string> names = {
+      "BIG_ENDIAN", "BYTE_ORDER", "EXIT_FAILURE", "EXIT_SUCCESS", "FD_CLR", "FD_ISSET", "FD_SET", "FD_SETSIZE",
+      "FD_ZERO", "INFINITY", "LITTLE_ENDIAN", "MATH_ERREXCEPT", "MATH_ERRNO", "MAXFLOAT", "MB_CUR_MAX", "NAN",
+      "NFDBITS", "PDP_ENDIAN", "RAND_MAX", "WCONTINUED", "WEXITED", "WEXITSTATUS", "WIFCONTINUED", "WIFEXITED",
+      "WIFSIGNALED", "WIFSTOPPED", "WNOHANG", "WNOWAIT", "WSTOPPED", "WSTOPSIG", "WTERMSIG", "WUNTRACED", "alloca",
+      "math_errhandling", "issubnormal", "linux", "unix", "i386", "sun", "sparc", "mips", "vax"};
+  static const char* const prefixes[] = {"FP_", "M_", "HUGE_VAL", "SNAN", "htobe", "htole", "be16", "be32",
+                                         "be64", "le16", "le32", "le64"};
+  if (names.count(w)) return true;
+  for (const char* p : prefixes)
+    if (w.rfind(p, 0) == 0) return true;
+  return false;
+}
+
 }  // namespace
 
 bool is_cpp_keyword(const std::string& w) {
@@ -43,7 +64,7 @@ bool is_cpp_keyword(const std::string& w) {
 
 const char* name_rule() {
   return "a letter (A-Z, a-z), then letters, digits and single underscores, at most 64 characters, "
-         "not a C++ keyword";
+         "not a C++ keyword or a C library macro";
 }
 
 std::optional<std::string> name_problem(const std::string& name) {
@@ -56,6 +77,7 @@ std::optional<std::string> name_problem(const std::string& name) {
   if (name.find("__") != std::string::npos || name.back() == '_')
     return "the name may not hold '__' or end in '_' (reserved in C++)";
   if (is_cpp_keyword(name)) return "'" + name + "' is a C++ keyword";
+  if (is_library_macro(name)) return "'" + name + "' is a macro of the C library or the compiler";
   if (generated_header_names().count(name)) return "'" + name + "' is a name the generated header uses";
   return std::nullopt;
 }

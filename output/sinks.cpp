@@ -58,11 +58,13 @@ void for_each_char(const std::string& s, Emit emit) {
 // A character a terminal acts on instead of showing, beyond the C0 controls: the C1 controls
 // U+0080..U+009F (a UTF-8 encoded U+009B is CSI to terminals that honour C1 in UTF-8), and
 // the bidirectional overrides and isolates (U+202A..U+202E, U+2066..U+2069), which reorder
-// what a reader sees ("Trojan Source").
+// what a reader sees ("Trojan Source"), with the implicit marks that steer them (LRM and RLM,
+// U+200E and U+200F; the Arabic letter mark U+061C).
 bool invisible_control(const std::string& c) {
   const auto b = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
-  if (c.size() == 2) return b(0) == 0xC2 && b(1) >= 0x80 && b(1) <= 0x9F;
-  if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x80) return b(2) >= 0xAA && b(2) <= 0xAE;
+  if (c.size() == 2) return (b(0) == 0xC2 && b(1) >= 0x80 && b(1) <= 0x9F) || (b(0) == 0xD8 && b(1) == 0x9C);
+  if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x80)
+    return (b(2) >= 0xAA && b(2) <= 0xAE) || b(2) == 0x8E || b(2) == 0x8F;
   if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x81) return b(2) >= 0xA6 && b(2) <= 0xA9;
   return false;
 }
@@ -112,6 +114,18 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
   return s;
 }
 
+std::string shell_word(const std::string& s) {
+  static const std::string safe = "_./-+=:,@";
+  bool plain = !s.empty();
+  for (char c : s)
+    plain = plain && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      safe.find(c) != std::string::npos);
+  if (plain) return s;
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
 std::string csv_field(const std::string& s) {
   std::string out = "\"";
   // The first character a spreadsheet sees once leading blanks and control characters are
@@ -136,7 +150,8 @@ std::string gnuplot_string(const std::string& s) {
   return out + "'";
 }
 
-std::string html_text(const std::string& s) {
+namespace {
+std::string html_escaped(const std::string& s, bool keep_lines) {
   std::string out;
   for_each_char(s, [&](const std::string& c) {
     if (c == "&") out += "&amp;";
@@ -144,20 +159,48 @@ std::string html_text(const std::string& s) {
     else if (c == ">") out += "&gt;";
     else if (c == "\"") out += "&quot;";
     else if (c == "'") out += "&#39;";
+    else if (c == "\n" && keep_lines) out += c;
     else if (c == "\n" || c == "\t") out += ' ';
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) return;
+    else if (invisible_control(c)) out += printable(c);  // shown, not obeyed
     else out += c;
   });
   return out;
 }
+}  // namespace
+
+std::string html_text(const std::string& s) { return html_escaped(s, false); }
+
+std::string html_preformatted(const std::string& s) { return html_escaped(s, true); }
+
+namespace {
+// Whether the text opens a block (heading, list item, rule, setext underline) where it starts
+// a line: '#', '-' or '+' followed by a blank, the end or itself; '=' at all; digits then '.'
+// or ')' followed by a blank or the end. Returns the position of the character to escape.
+size_t block_opener(const std::string& s) {
+  const size_t first = s.find_first_not_of(' ');
+  if (first == std::string::npos) return std::string::npos;
+  const auto blank_or_end = [&](size_t k) { return k >= s.size() || s[k] == ' ' || s[k] == '\t'; };
+  const char c = s[first];
+  if (c == '=') return first;
+  if ((c == '#' || c == '-' || c == '+') && (blank_or_end(first + 1) || s[first + 1] == c)) return first;
+  size_t k = first;
+  while (k < s.size() && s[k] >= '0' && s[k] <= '9') ++k;
+  if (k > first && k < s.size() && (s[k] == '.' || s[k] == ')') && blank_or_end(k + 1)) return k;
+  return std::string::npos;
+}
+}  // namespace
 
 std::string markdown_text(const std::string& s) {
   // Inline Markdown (and GitHub's $ math): these change how the text around them renders.
   static const std::string punctuation = "\\`*_[]|$~";
+  const size_t opener = block_opener(s);
   std::string out;
+  size_t at = 0;
   for_each_char(s, [&](const std::string& c) {
-    if (c.size() == 1 && punctuation.find(c[0]) != std::string::npos) out += "\\" + c;
+    if ((c.size() == 1 && punctuation.find(c[0]) != std::string::npos) || at == opener) out += "\\" + c;
     else out += html_text(c);
+    at += c.size();
   });
   return out;
 }

@@ -30,11 +30,16 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 // the command line, become spaces. Labels are set `noenhanced`, so _ ^ @ { } stay literal.
 std::string gnuplot_string(const std::string& s);
 
-// HTML text or attribute value: & < > " ' as entities, control characters dropped.
+// HTML text or attribute value: & < > " ' as entities, control characters dropped, the
+// bidirectional controls shown as \xNN (as printable does) instead of reordering the text.
 std::string html_text(const std::string& s);
 
+// HTML text inside <pre>: as html_text, but line breaks stay.
+std::string html_preformatted(const std::string& s);
+
 // Markdown text on one line (table cells, headings): HTML-escaped, Markdown punctuation
-// backslash-escaped, line breaks become spaces.
+// backslash-escaped, line breaks become spaces; what would open a heading, a list or a rule
+// at the start of a line (# - + = "1.") is escaped there.
 std::string markdown_text(const std::string& s);
 
 // Inline code (`name`) when `s` can be one (no backtick, no control character); otherwise the
@@ -43,6 +48,10 @@ std::string markdown_code(const std::string& s);
 
 // Text inside LaTeX \text{...} or prose: the ten special characters replaced by their commands.
 std::string latex_text(const std::string& s);
+
+// One word of a POSIX shell command line: `s` itself when it holds only characters no shell
+// acts on (letters, digits, _ . / - + = : , @), else single-quoted (a ' inside as '\'').
+std::string shell_word(const std::string& s);
 
 // A CSV field (RFC 4180), quotes included: '"' doubled, control characters (a line break would
 // start a new record) as spaces, invalid UTF-8 as '?'; a field that a spreadsheet would run as

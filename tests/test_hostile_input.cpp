@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -61,6 +62,7 @@ const std::vector<std::string>& hostile_strings() {
       "\xff\xfe invalid utf-8",
       "c1 \xc2\x9b" "31m csi in utf-8",               // U+009B, CSI where C1 controls are honoured
       "bidi \xe2\x80\xae" "desrever \xe2\x81\xa6x",  // U+202E right-to-left override, U+2066 isolate
+      "mark \xe2\x80\x8f" "rtl \xd8\x9c" "alm",       // U+200F right-to-left mark, U+061C Arabic letter mark
   };
   return s;
 }
@@ -193,8 +195,10 @@ std::string yaml_quoted(const std::string& s) {
 TEST(NameRule, AcceptsIdentifiersAndRefusesEverythingElse) {
   for (const char* ok : {"finken3", "crazyflie21", "A", "M1", "upper_body", "arm_A"})
     EXPECT_FALSE(out::name_problem(ok)) << ok;
+  // The macros of <cmath> (with glibc) and of g++'s default GNU mode would replace the
+  // namespace: HUGE_VAL made the header fail to compile, linux under -std=gnu++17.
   for (const char* bad : {"", "3d", "class", "int", "std", "Model", "Scalar", "a__b", "a_", "_a", "a-b", "a b", "a.b",
-                          "ä", "a\nb"})
+                          "ä", "a\nb", "HUGE_VAL", "NAN", "M_PI", "FP_ZERO", "linux", "unix", "EXIT_SUCCESS"})
     EXPECT_TRUE(out::name_problem(bad)) << bad;
   EXPECT_TRUE(out::name_problem(std::string(65, 'a')));
   for (const auto& s : hostile_strings()) EXPECT_TRUE(out::name_problem(s)) << out::printable(s);
@@ -214,7 +218,9 @@ TEST(Sinks, TerminalTextShowsControlsAsEscapes) {
       if (c == 0xE2 && i + 2 < t.size()) {
         const auto b1 = static_cast<unsigned char>(t[i + 1]), b2 = static_cast<unsigned char>(t[i + 2]);
         if ((b1 == 0x80 && b2 >= 0xAA && b2 <= 0xAE) || (b1 == 0x81 && b2 >= 0xA6 && b2 <= 0xA9)) return true;
+        if (b1 == 0x80 && (b2 == 0x8E || b2 == 0x8F)) return true;  // LRM, RLM
       }
+      if (c == 0xD8 && i + 1 < t.size() && static_cast<unsigned char>(t[i + 1]) == 0x9C) return true;  // ALM
     }
     return false;
   };
@@ -399,6 +405,85 @@ TEST(Sinks, MarkdownAndLatexTextStayText) {
   const std::string md = quadgen::derivation_markdown(d);
   EXPECT_EQ(md.find("<script>"), std::string::npos);
   EXPECT_NE(md.find("&lt;script&gt;"), std::string::npos);
+}
+
+// What opens a block at the start of a line is escaped there (a description is a paragraph
+// of its own in derivation.md): "# Owned heading" rendered as a heading.
+TEST(Sinks, MarkdownLineStartsOpenNoBlock) {
+  EXPECT_EQ(out::markdown_text("# Owned heading"), "\\# Owned heading");
+  EXPECT_EQ(out::markdown_text("  - item"), "  \\- item");
+  EXPECT_EQ(out::markdown_text("+ item"), "\\+ item");
+  EXPECT_EQ(out::markdown_text("=== rule"), "\\=== rule");
+  EXPECT_EQ(out::markdown_text("12. item"), "12\\. item");
+  EXPECT_EQ(out::markdown_text("3) item"), "3\\) item");
+  EXPECT_EQ(out::markdown_text("---"), "\\---");
+  // Inside the text, or not followed by a blank, they are text (numbers in table cells).
+  EXPECT_EQ(out::markdown_text("a-b #3 v1.2"), "a-b #3 v1.2");
+  EXPECT_EQ(out::markdown_text("-26 %, 0.2 N, #3"), "-26 %, 0.2 N, #3");
+}
+
+// HTML shows the bidirectional controls instead of obeying them (a log named with U+202E
+// reordered the report's heading), and <pre> keeps its lines (the verdict block was one line).
+TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
+  EXPECT_EQ(out::html_text("log\xe2\x80\xae" "vsc.csv"), "log\\xE2\\x80\\xAEvsc.csv");
+  EXPECT_EQ(out::html_text("a\xe2\x80\x8f" "b"), "a\\xE2\\x80\\x8Fb");
+  EXPECT_EQ(out::html_preformatted("named:\n  <x> & y\x1b[2J"), "named:\n  &lt;x&gt; &amp; y[2J");
+  EXPECT_EQ(out::html_text("a\nb"), "a b");
+  quadgen::diagnose::Diagnosis d;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log\xe2\x80\xae" "vsc.csv", {});
+  EXPECT_EQ(html.find("\xe2\x80\xae"), std::string::npos);
+  const size_t pre = html.find("<pre>"), end = html.find("</pre>", pre);
+  ASSERT_NE(pre, std::string::npos);
+  EXPECT_NE(html.substr(pre, end - pre).find('\n'), std::string::npos) << "the verdict block lost its lines";
+}
+
+// The header's regenerate command is one a reader may paste: each path one shell word. Checked
+// by a shell: `printf %s WORD` must print the string itself, and run nothing.
+TEST(Sinks, ShellWordsAreOneWordToAShell) {
+  Scratch tmp;
+  EXPECT_EQ(out::shell_word("vehicles/cf2.yaml"), "vehicles/cf2.yaml");
+  EXPECT_EQ(out::shell_word("a b'c"), "'a b'\\''c'");
+  EXPECT_EQ(out::shell_word(""), "''");
+  std::vector<std::string> strings = hostile_strings();
+  strings.push_back("v $(touch PWNED);`touch PWNED`|x.yaml");
+  for (const auto& s : strings) {
+    if (s.find('\0') != std::string::npos) continue;  // no shell word holds a NUL
+    const fs::path script = tmp.dir / "run.sh", got = tmp.dir / "got";
+    write(script, "printf %s " + out::shell_word(s) + " > '" + got.string() + "'\n");
+    ASSERT_EQ(std::system(("cd '" + tmp.dir.string() + "' && sh '" + script.string() + "'").c_str()), 0) << out::printable(s);
+    EXPECT_EQ(read(got), s) << out::printable(s);
+    EXPECT_FALSE(fs::exists(tmp.dir / "PWNED")) << out::printable(s);
+  }
+  // In the header: quoted where needed, a placeholder where the comment cannot hold the path.
+  const quadgen::Vehicle v = quadgen::test::finken3();
+  const auto model = quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
+  quadgen::codegen::EmitOptions o;
+  o.vehicle_file = "my vehicles/cf $(x).yaml";
+  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive 'my vehicles/cf $(x).yaml' --out DIR"),
+            std::string::npos);
+  o.vehicle_file = "v\xe2\x80\xae.yaml";
+  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive VEHICLE_FILE --out DIR"),
+            std::string::npos);
+}
+
+// A command line CLI11 refuses is reported in one printable line, like every other error.
+TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
+  Scratch tmp;
+  const std::string vehicle = std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"derive", vehicle, "--out", tmp / "o", "--bogus\x1b[2J\x1b]0;X\x07"},
+        std::vector<std::string>{"diagnose", vehicle, "l.csv", "--out", tmp / "o", "--translational", "\x1b[31mx\nquadgen: fake"},
+        std::vector<std::string>{"simulate", vehicle, "--duration", "1\x1b[31m", "--out", tmp / "o.csv"}}) {
+    const CliResult r = run_quadgen(args, tmp.dir);
+    EXPECT_NE(r.rc, 0);
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << out::printable(r.err);
+    EXPECT_EQ(r.err.rfind("quadgen: error: ", 0), 0u) << out::printable(r.err);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << out::printable(r.err);  // the error and the hint
+  }
+  // A hostile --out reaches the progress lines as escapes too.
+  const CliResult r = run_quadgen({"derive", vehicle, "--out", tmp / "o\x1b[31mRED"}, tmp.dir);
+  EXPECT_EQ(r.rc, 0);
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << out::printable(r.err);
 }
 
 TEST(Sinks, LongSeriesAreThinnedKeepingTheirExtremes) {

@@ -15,6 +15,12 @@
 
 #include <cmath>
 
+// A macro of the vehicle's name (defined by the including project, or a system header this
+// validator did not know) would rewrite every use of the namespace: refused here instead.
+#if defined(finken3_all_effects)
+#error "quadgen: the model's namespace finken3_all_effects is a macro in this translation unit; rename the vehicle or #undef it before this header"
+#endif
+
 namespace quadgen_generated {
 namespace finken3_all_effects {
 
