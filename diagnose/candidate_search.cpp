@@ -119,7 +119,8 @@ std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>&
 std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::string>& effects,
                                                             const std::vector<FitParameter>& start,
                                                             std::vector<double> start_weights,
-                                                            std::vector<double>* own_weights) const {
+                                                            std::vector<double>* own_weights,
+                                                            Settling* settling) const {
   // Reweighted until the weights move by less than 1 % on every channel. One reweighting is
   // not enough: the model without an effect has channels whose noise level differs from the
   // final model's a hundredfold, and each refit moves them again (three to four refits reach
@@ -129,12 +130,16 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
   constexpr double kSettled = 0.01;
   std::vector<double> w = std::move(start_weights);
   std::vector<FitParameter> ps = start;
+  Settling record;
   for (int refit = 0; refit < kMaxRefits; ++refit) {
     double c = 0;
     ps = fit_with(effects, ps, &c, own_workspace(), w);
     std::vector<double> next = weights_at(ps);
     double change = 0;
     for (size_t k = 0; k < w.size(); ++k) change = std::max(change, std::abs(next[k] / w[k] - 1));
+    record.refits = refit + 1;
+    record.last_change_percent = 100 * change;
+    record.settled = change < kSettled;
     if (change < kSettled) break;
     // Unsettled after the last refit: the weights it was fitted under are kept, so that
     // `ps` is the optimum under `own_weights` (a profile from a point that is not one
@@ -152,6 +157,7 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
     w = std::move(next);
   }
   *own_weights = w;
+  if (settling) *settling = record;
   return ps;
 }
 
@@ -481,7 +487,8 @@ SearchResult CandidateSearch::run() {
                           res.training_only.end());
   // The final model under its own weights (settled), as every model it is compared with
   // on held-out data is fitted (fit_as_own_model): each step above reweighted once only.
-  if (!base.empty()) current = fit_as_own_model(base, current, weights_, &weights_);
+  res.final_settling.base_fit = base.empty();
+  if (!base.empty()) current = fit_as_own_model(base, current, weights_, &weights_, &res.final_settling);
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res, !opt_.wald_until_accepted);
@@ -537,6 +544,7 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       if (base.empty()) {  // back to the base model, fitted as it was
         current = r.base_fit;
         weights_ = r.base_weights;
+        r.final_settling = Settling{true, 0, true, 0};
       } else {
         current = smaller;
         weights_ = weights_at(current);
@@ -560,8 +568,9 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
   if (keep.empty()) {  // back to the base model, fitted as it was
     r.final_fit = r.base_fit;
     r.final_weights = r.base_weights;
+    r.final_settling = Settling{true, 0, true, 0};
   } else {  // the smaller model under its own weights, as the search fits each of its models
-    r.final_fit = fit_as_own_model(keep, r.final_fit, r.final_weights, &r.final_weights);
+    r.final_fit = fit_as_own_model(keep, r.final_fit, r.final_weights, &r.final_weights, &r.final_settling);
   }
   r.estimates.clear();
   r.profiles.clear();

@@ -122,6 +122,16 @@ struct SelectionStep {
   std::vector<Ambiguity> ambiguities;
 };
 
+// How a model's channel weights came to be: refitted and reweighted `refits` times until
+// they moved by less than 1 % (settled), or not (the last change, in per cent, said).
+// The base fit is reweighted once by design (CandidateSearch::run): `base_fit` says so.
+struct Settling {
+  bool base_fit = false;
+  int refits = 0;
+  bool settled = true;
+  double last_change_percent = 0;
+};
+
 // An effect the backward pass took out of the final model, and why.
 struct Removal {
   std::string effect, reason;
@@ -137,6 +147,7 @@ struct SearchResult {
   std::vector<Removal> removed;       // taken out again by the backward pass
   std::vector<fit::FitParameter> base_fit, final_fit;  // a final model without effects is the base fit
   std::vector<double> base_weights, final_weights;
+  Settling final_settling;  // how final_weights came to be
   std::vector<EffectEstimate> estimates;  // parameters of the selected effects
   std::vector<fit::Profile> profiles;
   std::vector<Ambiguity> unresolved;  // look-alike groups the data cannot separate
@@ -222,7 +233,8 @@ class CandidateSearch {
   std::vector<fit::FitParameter> fit_as_own_model(const std::set<std::string>& effects,
                                                   const std::vector<fit::FitParameter>& start,
                                                   std::vector<double> start_weights,
-                                                  std::vector<double>* own_weights) const;
+                                                  std::vector<double>* own_weights,
+                                                  Settling* settling = nullptr) const;
   // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals at these parameters.
   std::vector<double> weights_at(const std::vector<fit::FitParameter>& ps) const;
   // The weighted cost under these channel weights.

@@ -97,6 +97,10 @@ struct Finding {
   static constexpr const char* kByOneStep = "one-step equation error";
   static constexpr const char* kByForceModelAlone = "force model alone (attitude replayed)";
   std::string accepted_by;
+  // How the model without the effect was fitted: under its own weights, settled or not, or
+  // the base fit (a lone effect's). Unsettled weights make the comparison less certain than
+  // its spread says; the report shows it.
+  Settling comparison;
 };
 
 // A candidate significant on the training data that a later test does not stand behind:

@@ -201,6 +201,16 @@ json one_step_json(const Finding::OneStep& o) {
   return j;
 }
 
+// How a model's channel weights were settled (Settling): the model a finding is compared
+// with, and the extended model.
+json settling_json(const Settling& s) {
+  if (s.base_fit) return {{"model", "the base fit (weights of its own residuals, reweighted once)"}};
+  return {{"model", "refitted under the weights of its own residuals"},
+          {"refits", s.refits},
+          {"weights_settled", s.settled},
+          {"last_weight_change_percent", s.last_change_percent}};
+}
+
 json finding_json(const Finding& f) {
   json ps = json::object();
   const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
@@ -229,6 +239,7 @@ json finding_json(const Finding& f) {
                        {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
              {"one_step_gain", one_step_json(f.one_step)},
              {"accepted_by", f.accepted_by},
+             {"compared_with", settling_json(f.comparison)},
              {"evidence", evidence_json(f.evidence)}};
   if (!f.force_alone.per_fold.empty()) {
     fj["force_alone_gain"] = {{"metric", "held-out position RMSE of the same windows with the measured attitude replayed, "
@@ -502,6 +513,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["extended_model"] = {{"effects", d.search.selected},
                          {"carried_look_alikes", carried_look_alikes(d)},
                          {"carried_stand_ins", stand_in_effects(d)},
+                         {"weights", settling_json(d.search.final_settling)},
                          {"header", "extended_model.hpp"},
                          {"model_json", "extended_model.json"},
                          {"fitted_parameters", "fitted_parameters.yaml"}};
@@ -657,7 +669,7 @@ std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d)
 
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
 // finding: say so beside the rollouts' numbers, which then show no gain (or a loss).
-std::string one_step_text(const Finding& f) {
+std::string judged_by_text(const Finding& f) {
   if (f.accepted_by == Finding::kByForceModelAlone)
     return "; accepted by the force model alone: with the measured attitude replayed the held-out position RMSE is " +
            num(f.force_alone.mean, 3) + " m +- " + num(f.force_alone.standard_error, 3) +
@@ -667,6 +679,16 @@ std::string one_step_text(const Finding& f) {
   if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
   return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
          " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
+}
+
+std::string one_step_text(const Finding& f) {
+  // A comparison whose weights had not settled is less certain than its spread says.
+  const std::string unsettled =
+      f.comparison.settled ? ""
+                           : "; the model without it had not settled its weights after " +
+                                 std::to_string(f.comparison.refits) + " refits (last change " +
+                                 num(f.comparison.last_change_percent, 2) + " %)";
+  return judged_by_text(f) + unsettled;
 }
 
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.

@@ -150,7 +150,7 @@ Finding::OneStep HeldOutGain::one_step(const Scores& without, const Scores& with
 }
 
 std::vector<fit::FitParameter> HeldOutGain::model_without(const std::string& e, const SearchResult& s,
-                                                          std::vector<double>* own_weights) const {
+                                                          std::vector<double>* own_weights, Settling* settling) const {
   const auto values = fit::parameter_values(s.final_fit);
   auto cached = without_.find(e);
   if (cached == without_.end() || cached->second.final_values != values ||
@@ -159,11 +159,13 @@ std::vector<fit::FitParameter> HeldOutGain::model_without(const std::string& e, 
     others.erase(e);
     // A lone effect's comparison model is the base fit, which a final model left without
     // effects is (CandidateSearch::run says why it is not settled further).
-    Without w{s.selected, values, s.base_fit, s.base_weights};
-    if (!others.empty()) w.fit = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &w.weights);
+    Without w{s.selected, values, s.base_fit, s.base_weights, Settling{true, 0, true, 0}};
+    if (!others.empty())
+      w.fit = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &w.weights, &w.settling);
     cached = without_.insert_or_assign(e, std::move(w)).first;
   }
   *own_weights = cached->second.weights;
+  if (settling) *settling = cached->second.settling;
   return cached->second.fit;
 }
 
@@ -174,7 +176,7 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
     if (step.selected == e) f.evidence = step.candidates.front();
   f.parameters = effect_estimates(s, e);
   std::vector<double> own_weights;
-  const auto without = model_without(e, s, &own_weights);
+  const auto without = model_without(e, s, &own_weights, &f.comparison);
   std::vector<double> between(own_weights.size());
   for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * s.final_weights[k]);
   const bool force_alone = pose_ && find_effect(e).judged_by_force_model;

@@ -63,7 +63,7 @@ class HeldOutGain {
   // `own_weights`); a lone effect's is the base fit. Cached per effect and final model, for
   // finding_for and the stand-in report ask for the same model.
   std::vector<fit::FitParameter> model_without(const std::string& e, const SearchResult& s,
-                                               std::vector<double>* own_weights) const;
+                                               std::vector<double>* own_weights, Settling* settling = nullptr) const;
 
  private:
   // Sums of squares of one fold's channel groups (six channels per sample).
@@ -122,6 +122,7 @@ class HeldOutGain {
     std::vector<double> final_values;
     std::vector<fit::FitParameter> fit;
     std::vector<double> weights;
+    Settling settling;
   };
   mutable std::map<std::string, Without> without_;
 };

@@ -480,6 +480,14 @@ TEST(BackwardPass, EarlyPickMadeRedundantIsRemoved) {
   auto n = named(j);
   std::sort(n.begin(), n.end());
   EXPECT_EQ(n, (std::vector<std::string>{"ground_effect", "thrust_decay"})) << j["findings"].dump(1);
+  // Each finding says what it was compared with: with two findings, the other one's model
+  // under its own weights, whether those settled; the extended model the same.
+  for (const auto& f : j["findings"]) {
+    EXPECT_EQ(f["compared_with"]["model"], "refitted under the weights of its own residuals") << f["compared_with"].dump();
+    EXPECT_GE(f["compared_with"]["refits"].get<int>(), 1);
+    EXPECT_TRUE(f["compared_with"]["weights_settled"].is_boolean());
+  }
+  EXPECT_GE(j["extended_model"]["weights"]["refits"].get<int>(), 1) << j["extended_model"].dump();
 }
 
 // Several flights of one vehicle diagnosed jointly: the weak motor of two flights with
@@ -1031,8 +1039,13 @@ TEST_F(WeakMotorSearch, TheModelWithoutAnEffectIsFittedUnderItsOwnWeights) {
   skewed[0] *= 30;
   for (const auto& start : {r.final_weights, skewed}) {
     std::vector<double> own;
-    const auto without = search.fit_as_own_model({}, r.final_fit, start, &own);
+    quadgen::diagnose::Settling settling;
+    const auto without = search.fit_as_own_model({}, r.final_fit, start, &own, &settling);
     EXPECT_LT(relative_distance(own, r.base_weights), 0.02);  // settled within 1 %, the base fit within 0.3 %
+    // What the report says of it: settled, after more than one reweighting, the last within 1 %.
+    EXPECT_TRUE(settling.settled);
+    EXPECT_GT(settling.refits, 1);
+    EXPECT_LT(settling.last_change_percent, 1.0);
     EXPECT_NEAR(without[model->param_index("c_t")].value, r.base_fit[model->param_index("c_t")].value,
                 1e-3 * r.base_fit[model->param_index("c_t")].value);
   }
