@@ -21,7 +21,7 @@ void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std
   else if (std::set<std::string>(wanted.begin(), wanted.end()) != std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
     throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
   request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
-  request.emit.effects_flag = params == vehicle_path ? "" : " --params " + output::shell_word(params);
+  request.emit.effects_flag = params == vehicle_path ? "" : " --params " + output::shell_path(params);
   request.emit.parameter_source = "fitted values from " + params;
 }
 

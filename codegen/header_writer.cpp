@@ -72,7 +72,7 @@ void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p) {
   // The regenerate command is one a reader may paste into a shell: the path is one quoted
   // word, and where the comment cannot hold it as it is (bytes outside printable ASCII, '%'
   // escaped as %XX) a placeholder stands for it rather than a path that names another file.
-  const std::string word = output::shell_word(p.vehicle_file);
+  const std::string word = output::shell_path(p.vehicle_file);
   d.set("vehicle_file", output::cpp_comment(word) == word ? word : std::string("VEHICLE_FILE"));
   // (Only a --params path can make the flags unprintable: effect names are the catalogue's.)
   const bool flag_as_is = output::cpp_comment(p.effects_flag) == p.effects_flag;

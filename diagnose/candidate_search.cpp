@@ -544,7 +544,6 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       if (base.empty()) {  // back to the base model, fitted as it was
         current = r.base_fit;
         weights_ = r.base_weights;
-        r.final_settling = Settling{true, 0, true, 0};
       } else {
         current = smaller;
         weights_ = weights_at(current);

@@ -99,8 +99,9 @@ struct Finding {
   std::string accepted_by;
   // How the model without the effect was fitted: under its own weights, settled or not, or
   // the base fit (a lone effect's). Unsettled weights make the comparison less certain than
-  // its spread says; the report shows it.
-  Settling comparison;
+  // its spread says; the report shows it. Empty for a suspect no held-out comparison judged
+  // (one the search found wanting on its own).
+  std::optional<Settling> comparison;
 };
 
 // A candidate significant on the training data that a later test does not stand behind:

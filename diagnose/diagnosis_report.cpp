@@ -239,7 +239,7 @@ json finding_json(const Finding& f) {
                        {"gain_standard_error", number_or_null(f.gain_standard_error)}}},
              {"one_step_gain", one_step_json(f.one_step)},
              {"accepted_by", f.accepted_by},
-             {"compared_with", settling_json(f.comparison)},
+             {"compared_with", f.comparison ? settling_json(*f.comparison) : json(nullptr)},
              {"evidence", evidence_json(f.evidence)}};
   if (!f.force_alone.per_fold.empty()) {
     fj["force_alone_gain"] = {{"metric", "held-out position RMSE of the same windows with the measured attitude replayed, "
@@ -681,13 +681,13 @@ std::string judged_by_text(const Finding& f) {
          " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
 }
 
-std::string one_step_text(const Finding& f) {
+std::string beside_gain_text(const Finding& f) {
   // A comparison whose weights had not settled is less certain than its spread says.
   const std::string unsettled =
-      f.comparison.settled ? ""
-                           : "; the model without it had not settled its weights after " +
-                                 std::to_string(f.comparison.refits) + " refits (last change " +
-                                 num(f.comparison.last_change_percent, 2) + " %)";
+      !f.comparison || f.comparison->settled
+          ? ""
+          : "; the model without it had not settled its weights after " + std::to_string(f.comparison->refits) +
+                " refits (last change " + num(f.comparison->last_change_percent, 2) + " %)";
   return judged_by_text(f) + unsettled;
 }
 
@@ -708,7 +708,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
-    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << one_step_text(f) << "\n  "
+    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << beside_gain_text(f) << "\n  "
        << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {
@@ -927,7 +927,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
-      << num(reduction(f.before, f.after), 3) << " % lower)" << esc(one_step_text(f)) << ".</p>\n";
+      << num(reduction(f.before, f.after), 3) << " % lower)" << esc(beside_gain_text(f)) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
     if (per_flight) {

@@ -176,7 +176,9 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
     if (step.selected == e) f.evidence = step.candidates.front();
   f.parameters = effect_estimates(s, e);
   std::vector<double> own_weights;
-  const auto without = model_without(e, s, &own_weights, &f.comparison);
+  Settling settling;
+  const auto without = model_without(e, s, &own_weights, &settling);
+  f.comparison = settling;
   std::vector<double> between(own_weights.size());
   for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * s.final_weights[k]);
   const bool force_alone = pose_ && find_effect(e).judged_by_force_model;

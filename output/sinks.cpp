@@ -114,7 +114,8 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
   return s;
 }
 
-std::string shell_word(const std::string& s) {
+std::string shell_path(const std::string& path) {
+  const std::string s = !path.empty() && path[0] == '-' ? "./" + path : path;
   static const std::string safe = "_./-+=:,@";
   bool plain = !s.empty();
   for (char c : s)
@@ -178,9 +179,12 @@ namespace {
 // a line: '#', '-' or '+' followed by a blank, the end or itself; '=' at all; digits then '.'
 // or ')' followed by a blank or the end. Returns the position of the character to escape.
 size_t block_opener(const std::string& s) {
-  const size_t first = s.find_first_not_of(' ');
-  if (first == std::string::npos) return std::string::npos;
-  const auto blank_or_end = [&](size_t k) { return k >= s.size() || s[k] == ' ' || s[k] == '\t'; };
+  // Blanks, line breaks and control characters become spaces or vanish in the output.
+  const auto blank = [](char c) { return c == ' ' || control(static_cast<unsigned char>(c)); };
+  size_t first = 0;
+  while (first < s.size() && blank(s[first])) ++first;
+  if (first == s.size()) return std::string::npos;
+  const auto blank_or_end = [&](size_t k) { return k >= s.size() || blank(s[k]); };
   const char c = s[first];
   if (c == '=') return first;
   if ((c == '#' || c == '-' || c == '+') && (blank_or_end(first + 1) || s[first + 1] == c)) return first;

@@ -49,9 +49,10 @@ std::string markdown_code(const std::string& s);
 // Text inside LaTeX \text{...} or prose: the ten special characters replaced by their commands.
 std::string latex_text(const std::string& s);
 
-// One word of a POSIX shell command line: `s` itself when it holds only characters no shell
-// acts on (letters, digits, _ . / - + = : , @), else single-quoted (a ' inside as '\'').
-std::string shell_word(const std::string& s);
+// A path as one word of a POSIX shell command line: itself when it holds only characters no
+// shell acts on (letters, digits, _ . / - + = : , @), else single-quoted (a ' inside as
+// '\''); one that starts with '-' gets "./" first, so that no command reads it as an option.
+std::string shell_path(const std::string& path);
 
 // A CSV field (RFC 4180), quotes included: '"' doubled, control characters (a line break would
 // start a new record) as spaces, invalid UTF-8 as '?'; a field that a spreadsheet would run as

@@ -850,6 +850,35 @@ TEST(Acceptance, TheClearestFailureIsTakenOutFirst) {
   EXPECT_EQ(quadgen::diagnose::clearest_failure(failed), 0u);
   failed.push_back(failure("wind", -0.001, 0.0));  // one fold: no spread, the sign decides
   EXPECT_EQ(quadgen::diagnose::clearest_failure(failed), 2u);
+  // The one-step cost speaks too: rollouts better (+1.6 standard errors) but the one-step
+  // cost higher (-0.8) goes before rollouts merely unchanged (-0.04) with a lower cost.
+  auto thrust_decay = failure("thrust_decay", 0.0074, 0.0045);
+  thrust_decay.first.one_step.cost.per_fold = {-10, 2, 5, -12};
+  thrust_decay.first.one_step.cost.mean = -3.9, thrust_decay.first.one_step.cost.standard_error = 4.8;
+  auto marker_frame = failure("attitude_bias", -0.0005, 0.012);
+  marker_frame.first.one_step.cost.per_fold = {24, 24, 20, 8};
+  marker_frame.first.one_step.cost.mean = 18.9, marker_frame.first.one_step.cost.standard_error = 3.7;
+  EXPECT_EQ(quadgen::diagnose::clearest_failure({marker_frame, thrust_decay}), 1u);
+  EXPECT_EQ(quadgen::diagnose::clearest_failure({thrust_decay, marker_frame}), 0u);
+}
+
+// Rollouts better beyond their spread do not stand behind an effect with which the held-out
+// one-step cost rises: on the helix a thrust decay bettered the 1 s rollouts by 7 mm +- 4 mm
+// while the held-out vertical one-step error doubled (cost 3.9 % +- 4.8 % higher).
+TEST(Acceptance, RolloutsAloneDoNotStandBehindAHigherOneStepCost) {
+  using quadgen::diagnose::Finding;
+  using quadgen::diagnose::held_out_test;
+  Finding f;
+  f.effect = "thrust_decay";
+  f.gain_mean = 0.0074, f.gain_standard_error = 0.0045;
+  f.one_step.cost.per_fold = {-10, 2, 5, -12};
+  f.one_step.cost.mean = -3.9, f.one_step.cost.standard_error = 4.8;
+  EXPECT_EQ(held_out_test(f), "");
+  f.one_step.cost.mean = 0.5;  // not higher: the rollouts stand behind it
+  EXPECT_EQ(held_out_test(f), Finding::kByOpenLoopPosition);
+  f.one_step.cost.per_fold.clear();  // no pose: the rollouts are the one-step cost
+  f.one_step.cost.mean = -3.9;
+  EXPECT_EQ(held_out_test(f), Finding::kByOpenLoopPosition);
 }
 
 // A motor lag sharpens every one-step prediction while open-loop rollouts, dominated by an
@@ -1086,6 +1115,24 @@ TEST_F(WeakMotorSearch, ALoneEffectIsComparedWithTheBaseFit) {
   const double base = held_out.metric(result_.base_fit, result_.final_weights, nullptr);
   EXPECT_NEAR(f.before, base, 0.01 * base);
   EXPECT_GT(f.before - f.after, 0.1 * base) << "the weak motor must pay on held-out data";
+  ASSERT_TRUE(f.comparison.has_value());
+  EXPECT_TRUE(f.comparison->base_fit) << "the report must say it was compared with the base fit";
+}
+
+// A comparison whose weights had not settled is said beside the gain, in the summary the
+// command prints (and the report quotes); a settled one adds nothing.
+TEST(Acceptance, AnUnsettledComparisonIsSaidBesideTheGain) {
+  quadgen::diagnose::Diagnosis d;
+  quadgen::diagnose::Finding f;
+  f.effect = "motor_lag";
+  f.metric = "m";
+  f.comparison = quadgen::diagnose::Settling{false, 10, false, 12.3};
+  d.findings.push_back(f);
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("had not settled its weights after 10 refits (last change 12"),
+            std::string::npos)
+      << quadgen::diagnose::diagnosis_summary(d);
+  d.findings.front().comparison->settled = true;
+  EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find("had not settled"), std::string::npos);
 }
 
 // A real log as the target states it: the ARPL log's motor time constant, whose

@@ -417,6 +417,9 @@ TEST(Sinks, MarkdownLineStartsOpenNoBlock) {
   EXPECT_EQ(out::markdown_text("12. item"), "12\\. item");
   EXPECT_EQ(out::markdown_text("3) item"), "3\\) item");
   EXPECT_EQ(out::markdown_text("---"), "\\---");
+  // Behind what the output turns into blanks (a tab, a line break, a control character).
+  EXPECT_EQ(out::markdown_text("\t# Owned").find("\\#"), 1u);
+  EXPECT_EQ(out::markdown_text("\n\x01# Owned").find("\\#"), 1u);
   // Inside the text, or not followed by a blank, they are text (numbers in table cells).
   EXPECT_EQ(out::markdown_text("a-b #3 v1.2"), "a-b #3 v1.2");
   EXPECT_EQ(out::markdown_text("-26 %, 0.2 N, #3"), "-26 %, 0.2 N, #3");
@@ -441,15 +444,16 @@ TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
 // by a shell: `printf %s WORD` must print the string itself, and run nothing.
 TEST(Sinks, ShellWordsAreOneWordToAShell) {
   Scratch tmp;
-  EXPECT_EQ(out::shell_word("vehicles/cf2.yaml"), "vehicles/cf2.yaml");
-  EXPECT_EQ(out::shell_word("a b'c"), "'a b'\\''c'");
-  EXPECT_EQ(out::shell_word(""), "''");
+  EXPECT_EQ(out::shell_path("vehicles/cf2.yaml"), "vehicles/cf2.yaml");
+  EXPECT_EQ(out::shell_path("a b'c"), "'a b'\\''c'");
+  EXPECT_EQ(out::shell_path(""), "''");
+  EXPECT_EQ(out::shell_path("-v.yaml"), "./-v.yaml");
   std::vector<std::string> strings = hostile_strings();
   strings.push_back("v $(touch PWNED);`touch PWNED`|x.yaml");
   for (const auto& s : strings) {
     if (s.find('\0') != std::string::npos) continue;  // no shell word holds a NUL
     const fs::path script = tmp.dir / "run.sh", got = tmp.dir / "got";
-    write(script, "printf %s " + out::shell_word(s) + " > '" + got.string() + "'\n");
+    write(script, "printf %s " + out::shell_path(s) + " > '" + got.string() + "'\n");  // (no hostile string starts with '-')
     ASSERT_EQ(std::system(("cd '" + tmp.dir.string() + "' && sh '" + script.string() + "'").c_str()), 0) << out::printable(s);
     EXPECT_EQ(read(got), s) << out::printable(s);
     EXPECT_FALSE(fs::exists(tmp.dir / "PWNED")) << out::printable(s);
