@@ -11,6 +11,7 @@
 // A property of the airframe should give agreeing estimates; a value that changes from
 // flight to flight is the model's error absorbed, not a cause.
 #pragma once
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,13 @@ struct ParameterAgreement {
   double q = 0, q_p_value = 1;          // Cochran's heterogeneity statistic and its p-value
   double pooled = 0;                    // inverse-variance weighted mean of the flights' values
   double spread = 0;                    // (largest - smallest) / |joint value|
+  // The spread the flights would show if each measured the pooled value with its own
+  // standard error (the range of independent normals, integrated exactly): its median, and
+  // the chance of a spread at least as large as the one seen. A 30 % limit is out of reach
+  // of flights whose intervals are each ±20 % wide, however well they agree. NaN when a
+  // flight has no standard error.
+  double spread_if_agree = std::numeric_limits<double>::quiet_NaN();
+  double spread_p_value = std::numeric_limits<double>::quiet_NaN();
   // Every flight's interval contains the pooled value or the heterogeneity test does not
   // reject at 1 %; and the spread is below 30 %.
   bool agree = false;
@@ -61,6 +69,10 @@ struct AgreementInputs {
 };
 
 std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
+
+// P(max - min <= r) for independent normals with standard deviations `sd` (their means
+// equal): sum over which one is the smallest, integrated over its value.
+double range_cdf(const std::vector<double>& sd, double r);
 
 // The airframe a joint diagnosis found, as a flight it was not fitted to is checked against
 // it (quadgen diagnose LOG --airframe DIAGNOSIS.json).

@@ -272,6 +272,8 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
                    {"joint_value", a.joint_value},
                    {"pooled", a.pooled},
                    {"spread", number_or_null(a.spread)},
+                   {"spread_if_agree", number_or_null(a.spread_if_agree)},
+                   {"spread_p_value", number_or_null(a.spread_p_value)},
                    {"cochran_q", number_or_null(a.q)},
                    {"q_p_value", a.q_p_value},
                    {"agree", a.agree},
@@ -691,6 +693,13 @@ std::string beside_gain_text(const Finding& f) {
   return judged_by_text(f) + unsettled;
 }
 
+// What spread agreeing flights would show, beside the one seen: " (if they agree: median
+// 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
+std::string spread_context(const ParameterAgreement& a) {
+  if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
+  return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, p = " + num(a.spread_p_value, 2) + ")";
+}
+
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
 std::string interval(double lower, double upper, int prec = 4) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
@@ -713,7 +722,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
   }
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
-       << " %, Cochran's Q p = " << num(a.q_p_value, 2) << "):";
+       << " %" << spread_context(a) << ", Cochran's Q p = " << num(a.q_p_value, 2) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
     os << "\n";
@@ -834,7 +843,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
-      << num(100 * a.spread, 3) << " %, Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
+      << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
          "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
@@ -867,7 +876,10 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
        "joint estimate). \"Alone\": the effect's "
        "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
-       "value and the spread (largest &minus; smallest over the joint value) is below 30 %.</p>\n";
+       "value and the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
+       "median spread the flights would show if each measured the pooled value with its own standard error, and the "
+       "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
+       "wider, however well they agree.</p>\n";
   agreement_table_html(h, d.agreement, d.flights, "joint");
 }
 

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <random>
 #include <memory>
 #include <tuple>
 #include <sstream>
@@ -679,6 +680,34 @@ const json* agreement_of(const json& j, const std::string& parameter) {
   return nullptr;
 }
 
+// The spread agreeing flights would show: the range of independent normals with the flights'
+// standard errors. Checked against the closed form for two (|X1 - X2| is half-normal with
+// sd sqrt(s1^2 + s2^2)) and against a simulation for five of different widths.
+TEST(MultiFlight, TheSpreadOfAgreeingFlightsIsTheRangeOfTheirNormals) {
+  using quadgen::diagnose::range_cdf;
+  for (double r : {0.3, 1.0, 2.5, 6.0}) {
+    const double closed = std::erf(r / std::sqrt(2 * (1.0 + 4.0)));  // 2 Phi(r / s) - 1
+    EXPECT_NEAR(range_cdf({1.0, 2.0}, r), closed, 1e-6) << r;
+  }
+  const std::vector<double> sd = {0.5, 1.0, 1.5, 1.0, 2.0};
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  constexpr int kDraws = 200000;
+  std::vector<double> ranges;
+  for (int n = 0; n < kDraws; ++n) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (double s : sd) {
+      const double v = s * z(rng);
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    ranges.push_back(hi - lo);
+  }
+  for (double r : {1.0, 3.0, 5.0}) {
+    const double simulated = static_cast<double>(std::count_if(ranges.begin(), ranges.end(), [&](double x) { return x <= r; })) / kDraws;
+    EXPECT_NEAR(range_cdf(sd, r), simulated, 0.004) << r;  // 3.5 binomial standard errors at most
+  }
+}
+
 TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
   const double truth = 2e-5;
   const json j = rotor_drag_on_two_flights("quadgen_agree", truth, truth);
@@ -696,6 +725,8 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
     EXPECT_LT(f["alone"]["p_value"].get<double>(), 1e-3) << f.dump();
   }
   EXPECT_LT((*a)["spread"].get<double>(), 0.3);
+  EXPECT_GT((*a)["spread_if_agree"].get<double>(), 0.0);  // two flights with standard errors
+  EXPECT_GT((*a)["spread_p_value"].get<double>(), 0.01) << "agreeing flights whose spread looks unusual";
 
   // Flights no fit saw, checked against that airframe (diagnose LOG --airframe): one with the
   // same rotor drag and a trim of its own agrees, one with 2.5 times the drag does not.
