@@ -1150,6 +1150,22 @@ TEST_F(WeakMotorSearch, ALoneEffectIsComparedWithTheBaseFit) {
   EXPECT_TRUE(f.comparison->base_fit) << "the report must say it was compared with the base fit";
 }
 
+// The comparison model is cached per final model: asked again after the final model lost an
+// effect (acceptance's remove_effects), it must be fitted anew, not returned from the cache.
+TEST_F(WeakMotorSearch, TheComparisonModelFollowsTheFinalModel) {
+  const quadgen::diagnose::HeldOutGain held_out(*model_, *search_, valid_, *valid_ee_, true, 1.0, 0.1);
+  quadgen::diagnose::SearchResult two = result_;
+  two.selected = {"motor_gain", "motor_lag"};
+  std::vector<double> w;
+  quadgen::diagnose::Settling with_lag, alone, again;
+  held_out.model_without("motor_gain", two, &w, &with_lag);
+  EXPECT_FALSE(with_lag.base_fit) << "the model without the trims but with the lag is refitted";
+  held_out.model_without("motor_gain", result_, &w, &alone);
+  EXPECT_TRUE(alone.base_fit) << "a cached model of another final model was returned";
+  held_out.model_without("motor_gain", two, &w, &again);
+  EXPECT_FALSE(again.base_fit);
+}
+
 // A comparison whose weights had not settled is said beside the gain, in the summary the
 // command prints (and the report quotes); a settled one adds nothing.
 TEST(Acceptance, AnUnsettledComparisonIsSaidBesideTheGain) {
