@@ -214,7 +214,9 @@ def agreement_tables(root):
             state = "agree" if a["agree"] else "disagree"
             named = "named" if a["named"] else "suspected"
             print(f"\n{d.name}: **{a['parameter']}** [{a['unit']}] ({named}) — flights {state}: joint "
-                  f"{fmt(a['joint_value'])}, pooled {fmt(a['pooled'])}, spread {fmt(100 * a['spread'] if a['spread'] is not None else None)} %, "
+                  f"{fmt(a['joint_value'])}, pooled {fmt(a['pooled'])}, spread {fmt(100 * a['spread'] if a['spread'] is not None else None)} %"
+                  + (f" (if they agree: median {fmt(100 * a['spread_if_agree'], 2)} %, p = {fmt(a['spread_p_value'], 2)})"
+                     if a.get("spread_if_agree") is not None else "") + ", "
                   f"Cochran's Q {fmt(a['cochran_q'])} (p = {fmt(a['q_p_value'], 2)})\n")
             print("| flight | value | 95 % interval | alone: LR statistic | alone: p |")
             print("|---|---|---|---|---|")
