@@ -15,6 +15,7 @@ namespace quadgen {
 
 // Intermediate quantities an effect may change before the equations are closed.
 struct ModelContext {
+  ModelContext(const Vehicle& v, SymbolicModel& m) : vehicle(v), model(m) {}
   const Vehicle& vehicle;
   SymbolicModel& model;
 

@@ -121,6 +121,14 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
                                                             std::vector<double> start_weights,
                                                             std::vector<double>* own_weights,
                                                             Settling* settling) const {
+  return fit_as_own_model(effects, start, std::move(start_weights), own_weights, settling, own_workspace());
+}
+
+std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::string>& effects,
+                                                            const std::vector<FitParameter>& start,
+                                                            std::vector<double> start_weights,
+                                                            std::vector<double>* own_weights, Settling* settling,
+                                                            const Workspace& ws) const {
   // Reweighted until the weights move by less than 1 % on every channel. One reweighting is
   // not enough: the model without an effect has channels whose noise level differs from the
   // final model's a hundredfold, and each refit moves them again (three to four refits reach
@@ -133,8 +141,8 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
   Settling record;
   for (int refit = 0; refit < kMaxRefits; ++refit) {
     double c = 0;
-    ps = fit_with(effects, ps, &c, own_workspace(), w);
-    std::vector<double> next = weights_at(ps);
+    ps = fit_with(effects, ps, &c, ws, w);
+    std::vector<double> next = weights_at(ps, ws);
     double change = 0;
     for (size_t k = 0; k < w.size(); ++k) change = std::max(change, std::abs(next[k] / w[k] - 1));
     record.refits = refit + 1;
@@ -227,7 +235,11 @@ double lr_statistic(const std::vector<double>& small_ss, const ChannelNoise& lar
 }  // namespace
 
 std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>& ps) const {
-  const ChannelNoise n = channel_noise(train_, ps);
+  return weights_at(ps, own_workspace());
+}
+
+std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>& ps, const Workspace& ws) const {
+  const ChannelNoise n = channel_noise(*ws.train, ps);
   std::vector<double> w;
   for (double v : n.var_tau) w.push_back(1 / std::sqrt(v));
   return w;
@@ -270,6 +282,8 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.validation_gain_percent = percent_lower(base_valid_cost, ev.validation_cost_after);
   effect_size(effect, ev.parameters, ev, ws);
   const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
+  if (ev.p_value < ev.level && ev.delta_bic < 0 && relevant && !(ev.validation_cost_after < ev.validation_cost_before))
+    judge_held_out_as_own_model(with, base_fit, ev, ws);
   if (!(ev.p_value < ev.level))
     ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
   else if (!(ev.delta_bic < 0))
@@ -282,6 +296,25 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.training_only = ev.why_not == "no gain on the validation part" && relevant;
   ev.implausible = implausible_estimate(effect, ev.parameters);
   return ev;
+}
+
+// The screen above compares the candidate fitted under the step's base weights; where that
+// finds no held-out gain, the candidate is asked again the way acceptance asks: fitted under
+// the weights of its own residuals, both models scored under the geometric mean of the two
+// models' weights (each is the optimum under its own, so either one's would favour it).
+// Only then is it set aside as improving the training data alone. (Only the held-out
+// verdict changes: the statistic and the parameters the next step starts from stay the
+// candidate's under the base weights, as the likelihood ratio needs.)
+void CandidateSearch::judge_held_out_as_own_model(const std::set<std::string>& with,
+                                                  const std::vector<FitParameter>& base_fit, CandidateEvidence& ev,
+                                                  const Workspace& ws) const {
+  std::vector<double> own;
+  const auto own_fit = fit_as_own_model(with, ev.parameters, weights_, &own, nullptr, ws);
+  std::vector<double> between(own.size());
+  for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own[k] * weights_[k]);
+  ev.validation_cost_before = cost(*ws.valid, base_fit, between);
+  ev.validation_cost_after = cost(*ws.valid, own_fit, between);
+  ev.validation_gain_percent = percent_lower(ev.validation_cost_before, ev.validation_cost_after);
 }
 
 std::string CandidateSearch::implausible_estimate(const std::string& effect, const std::vector<FitParameter>& ps) const {
@@ -474,6 +507,11 @@ SearchResult CandidateSearch::run() {
     // candidates are compared with an optimum, not with a start they could improve on.
     weights_ = weights_at(current);
     current = fit_with(base, current, &c);
+    if (round + 1 == opt_.max_effects)  // (a look-alike of the one taken is reported as ambiguous)
+      for (size_t k = 1; k < step.candidates.size() && step.candidates[k].significant; ++k)
+        if (std::none_of(step.ambiguities.begin(), step.ambiguities.end(),
+                         [&](const Ambiguity& a) { return a.b == step.candidates[k].effect; }))
+          res.left_at_limit.push_back(step.candidates[k]);
     res.steps.push_back(step);
     phase_done("step " + std::to_string(round + 1) + ": " + step.selected + " refitted" +
                (step.ambiguities.empty() ? "" : ", look-alikes checked"));

@@ -145,6 +145,10 @@ struct SearchResult {
   std::vector<std::string> selected;  // effects in the final model, in order (named ones and carried look-alikes)
   std::vector<std::string> carried;   // of those, the stronger of an ambiguous pair: in the model, not named
   std::vector<Removal> removed;       // taken out again by the backward pass
+  // When the search stopped at SearchOptions::max_effects: the candidates still significant
+  // in its last step besides the one it took (against that step's base model), strongest
+  // first. Empty when it stopped because nothing more was significant.
+  std::vector<CandidateEvidence> left_at_limit;
   std::vector<fit::FitParameter> base_fit, final_fit;  // a final model without effects is the base fit
   std::vector<double> base_weights, final_weights;
   Settling final_settling;  // how final_weights came to be
@@ -258,6 +262,15 @@ class CandidateSearch {
     const fit::EquationErrorModel* valid;
   };
   Workspace own_workspace() const;
+  // fit_as_own_model and weights_at on a worker's problems.
+  std::vector<fit::FitParameter> fit_as_own_model(const std::set<std::string>& effects,
+                                                  const std::vector<fit::FitParameter>& start,
+                                                  std::vector<double> start_weights,
+                                                  std::vector<double>* own_weights, Settling* settling,
+                                                  const Workspace& ws) const;
+  std::vector<double> weights_at(const std::vector<fit::FitParameter>& ps, const Workspace& ws) const;
+  void judge_held_out_as_own_model(const std::set<std::string>& with, const std::vector<fit::FitParameter>& base_fit,
+                                   CandidateEvidence& ev, const Workspace& ws) const;
   // The weighted cost under the search's current weights.
   double cost(const fit::ResidualModel& m, const std::vector<fit::FitParameter>& ps) const;
   // Under the search's current weights, or under given ones.

@@ -388,6 +388,11 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value},
                        {"validation_gain_percent", r.validation_gain_percent}});
   j["removed_by_backward_pass"] = removed;
+  json left = json::array();
+  for (const auto& ev : d.search.left_at_limit)
+    left.push_back({{"effect", ev.effect}, {"p_value", ev.p_value}, {"statistic", ev.statistic},
+                    {"implausible", ev.implausible}});
+  j["left_at_max_effects"] = left;
   json amb = json::array();
   for (const auto& a : d.search.unresolved)
     amb.push_back({{"effects", {a.a, a.b}},
@@ -743,6 +748,13 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& x : d.suspected)
     os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
+  if (!d.search.left_at_limit.empty()) {
+    os << "the search stopped at its limit of " << d.search.steps.size()
+       << " effects (--max-effects); still significant in its last step:";
+    for (const auto& ev : d.search.left_at_limit)
+      os << " " << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible") << ")";
+    os << "\n";
+  }
   for (const auto& p : d.at_bounds)
     os << "caution: " << p.name << " = " << num(p.value) << (p.unit == "1" ? "" : " " + p.unit)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";

@@ -280,6 +280,24 @@ TEST(TwoEffects, MotorGainAndThrustDecayBothFound) {
   EXPECT_EQ(n, (std::vector<std::string>{"motor_gain", "thrust_decay"})) << j["findings"].dump(1);
 }
 
+// A search stopped by --max-effects says what was still significant: with one step allowed,
+// the second of two hidden effects is listed (before, nothing showed it had been left).
+TEST(TwoEffects, WhatTheLimitLeftOutIsReported) {
+  const HiddenCase c{"two_limit", "motor_gain,thrust_decay", {{"motor_gain.C", -0.08}, {"thrust_decay.rate", 0.002}}, {}, "", 1};
+  const fs::path dir = fresh_directory("quadgen_two_limit");
+  const fs::path log = fly(c, dir, "flight.csv");
+  const json j = diagnose_log(vehicle_file(c), log.string() + " --max-effects 1", dir);
+  ASSERT_EQ(j["selection"].size(), 1u);
+  const std::string taken = j["selection"][0]["selected"];
+  const std::string other = taken == "motor_gain" ? "thrust_decay" : "motor_gain";
+  bool listed = false;
+  for (const auto& e : j["left_at_max_effects"]) listed = listed || e["effect"] == other;
+  EXPECT_TRUE(listed) << taken << " taken; left: " << j["left_at_max_effects"].dump(1);
+  // Without the limit nothing is left over.
+  const fs::path dir2 = fresh_directory("quadgen_two_limit_none");
+  EXPECT_TRUE(diagnose_log(vehicle_file(c), log, dir2)["left_at_max_effects"].empty());
+}
+
 // A tether pulling the vehicle back is in no effect's vocabulary: the diagnosis must say
 // that something is left unexplained, and where, rather than name a wrong cause.
 TEST(OutOfCatalogue, TetherIsReportedAsUnexplained) {
