@@ -750,9 +750,12 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
   if (!d.search.left_at_limit.empty()) {
     os << "the search stopped at its limit of " << d.search.steps.size()
-       << " effects (--max-effects); still significant in its last step:";
-    for (const auto& ev : d.search.left_at_limit)
-      os << " " << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible") << ")";
+       << (d.search.steps.size() == 1 ? " effect" : " effects") << " (--max-effects); still significant in its last step:";
+    for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
+      const auto& ev = d.search.left_at_limit[k];
+      os << (k ? ", " : " ") << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible")
+         << ")";
+    }
     os << "\n";
   }
   for (const auto& p : d.at_bounds)

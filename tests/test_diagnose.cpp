@@ -293,6 +293,11 @@ TEST(TwoEffects, WhatTheLimitLeftOutIsReported) {
   bool listed = false;
   for (const auto& e : j["left_at_max_effects"]) listed = listed || e["effect"] == other;
   EXPECT_TRUE(listed) << taken << " taken; left: " << j["left_at_max_effects"].dump(1);
+  std::ifstream printed(dir / "diagnose.log");
+  const std::string text((std::istreambuf_iterator<char>(printed)), {});
+  const size_t line = text.find("the search stopped at its limit of 1 effect (--max-effects); still significant in its last step:");
+  ASSERT_NE(line, std::string::npos) << text;
+  EXPECT_NE(text.substr(line, text.find('\n', line) - line).find(" " + other + " (p = "), std::string::npos) << text;
   // Without the limit nothing is left over.
   const fs::path dir2 = fresh_directory("quadgen_two_limit_none");
   EXPECT_TRUE(diagnose_log(vehicle_file(c), log, dir2)["left_at_max_effects"].empty());
