@@ -5,6 +5,8 @@
 #include <limits>
 #include <map>
 
+#include <boost/math/distributions/normal.hpp>
+
 #include "diagnose/candidate_search.hpp"
 #include "fit/equation_error.hpp"
 #include "runtime/per_flight_model.hpp"
@@ -72,8 +74,6 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
   return out;
 }
 
-double normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
-
 // The median of the range, and P(range >= observed), by bisection on range_cdf.
 void spread_under_agreement(ParameterAgreement& a) {
   std::vector<double> sd;
@@ -128,14 +128,16 @@ double range_cdf(const std::vector<double>& sd, double r) {
   // The smallest value x (mean 0) over +-9 of the widest deviation; the integrand is smooth,
   // and 4000 trapezoids resolve the narrowest normal when it is 1/100 of the widest or more.
   constexpr int kSteps = 4000;
+  std::vector<boost::math::normal> normal;
+  for (double s : sd) normal.emplace_back(0.0, s);
   const double x0 = -9 * s_max, dx = 18 * s_max / kSteps;
   double total = 0;
   for (size_t i = 0; i < sd.size(); ++i)
     for (int k = 0; k <= kSteps; ++k) {
       const double x = x0 + k * dx;
-      double v = std::exp(-0.5 * std::pow(x / sd[i], 2)) / (sd[i] * std::sqrt(2 * M_PI));
+      double v = boost::math::pdf(normal[i], x);
       for (size_t j = 0; j < sd.size() && v > 0; ++j)
-        if (j != i) v *= normal_cdf((x + r) / sd[j]) - normal_cdf(x / sd[j]);
+        if (j != i) v *= boost::math::cdf(normal[j], x + r) - boost::math::cdf(normal[j], x);
       total += (k == 0 || k == kSteps ? 0.5 : 1.0) * v * dx;
     }
   return std::clamp(total, 0.0, 1.0);

@@ -282,18 +282,21 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   ev.validation_gain_percent = percent_lower(base_valid_cost, ev.validation_cost_after);
   effect_size(effect, ev.parameters, ev, ws);
   const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
-  if (ev.p_value < ev.level && ev.delta_bic < 0 && relevant && !(ev.validation_cost_after < ev.validation_cost_before))
+  static const std::string kNoHeldOutGain = "no gain on the validation part";
+  const auto gate = [&] {
+    if (!(ev.p_value < ev.level)) return "not significant (p = " + std::to_string(ev.p_value) + ")";
+    if (!(ev.delta_bic < 0)) return std::string("BIC does not improve");
+    if (!(ev.validation_cost_after < ev.validation_cost_before)) return kNoHeldOutGain;
+    if (!relevant) return std::string("physically negligible size");
+    return std::string();
+  };
+  ev.why_not = gate();
+  if (ev.why_not == kNoHeldOutGain && relevant) {  // asked again, as acceptance asks
     judge_held_out_as_own_model(with, base_fit, ev, ws);
-  if (!(ev.p_value < ev.level))
-    ev.why_not = "not significant (p = " + std::to_string(ev.p_value) + ")";
-  else if (!(ev.delta_bic < 0))
-    ev.why_not = "BIC does not improve";
-  else if (!(ev.validation_cost_after < ev.validation_cost_before))
-    ev.why_not = "no gain on the validation part";
-  else if (!relevant)
-    ev.why_not = "physically negligible size";
+    ev.why_not = gate();
+  }
   ev.significant = ev.why_not.empty();
-  ev.training_only = ev.why_not == "no gain on the validation part" && relevant;
+  ev.training_only = ev.why_not == kNoHeldOutGain && relevant;
   ev.implausible = implausible_estimate(effect, ev.parameters);
   return ev;
 }
@@ -525,8 +528,8 @@ SearchResult CandidateSearch::run() {
                           res.training_only.end());
   // The final model under its own weights (settled), as every model it is compared with
   // on held-out data is fitted (fit_as_own_model): each step above reweighted once only.
-  res.final_settling.base_fit = base.empty();
-  if (!base.empty()) current = fit_as_own_model(base, current, weights_, &weights_, &res.final_settling);
+  if (base.empty()) res.final_settling = Settling::of_base_fit();
+  else current = fit_as_own_model(base, current, weights_, &weights_, &res.final_settling);
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res, !opt_.wald_until_accepted);
@@ -605,7 +608,7 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
   if (keep.empty()) {  // back to the base model, fitted as it was
     r.final_fit = r.base_fit;
     r.final_weights = r.base_weights;
-    r.final_settling = Settling{true, 0, true, 0};
+    r.final_settling = Settling::of_base_fit();
   } else {  // the smaller model under its own weights, as the search fits each of its models
     r.final_fit = fit_as_own_model(keep, r.final_fit, r.final_weights, &r.final_weights, &r.final_settling);
   }

@@ -130,6 +130,7 @@ struct Settling {
   int refits = 0;
   bool settled = true;
   double last_change_percent = 0;
+  static Settling of_base_fit() { return {true, 0, true, 0}; }
 };
 
 // An effect the backward pass took out of the final model, and why.

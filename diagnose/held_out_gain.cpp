@@ -159,7 +159,7 @@ std::vector<fit::FitParameter> HeldOutGain::model_without(const std::string& e, 
     others.erase(e);
     // A lone effect's comparison model is the base fit, which a final model left without
     // effects is (CandidateSearch::run says why it is not settled further).
-    Without w{s.selected, values, s.base_fit, s.base_weights, Settling{true, 0, true, 0}};
+    Without w{s.selected, values, s.base_fit, s.base_weights, Settling::of_base_fit()};
     if (!others.empty())
       w.fit = search_.fit_as_own_model(others, s.final_fit, s.final_weights, &w.weights, &w.settling);
     cached = without_.insert_or_assign(e, std::move(w)).first;
