@@ -18,6 +18,7 @@
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
 #include "fit/evaluation_threads.hpp"
+#include "fit/normal_matrix.hpp"
 #include "output/numbers.hpp"
 
 namespace quadgen::diagnose {
@@ -617,31 +618,6 @@ void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::str
   estimate_intervals(r, !opt_.wald_until_accepted);
 }
 
-NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H) {
-  // Scaled to unit diagonal first (the correlation form): the parameters' scales differ by
-  // many orders of magnitude (blade_flapping.k ~ 1e-8 N s^2 beside a wind of 1 m/s), and on
-  // the raw matrix every well-determined direction of a small-scale parameter made the
-  // eigenvalues of all the others look near zero beside it - a joint diagnosis then found
-  // every flight's wind and motor gains "confounded" and named nothing.
-  const Eigen::Index n = H.rows();
-  NormalMatrixAnalysis out;
-  out.covariance = Eigen::MatrixXd::Zero(n, n);
-  out.confounded.assign(static_cast<size_t>(n), false);
-  if (n == 0) return out;
-  Eigen::VectorXd scale(n);
-  for (Eigen::Index a = 0; a < n; ++a) scale(a) = H(a, a) > 0 ? 1 / std::sqrt(H(a, a)) : 0.0;
-  const Eigen::MatrixXd Hs = scale.asDiagonal() * H * scale.asDiagonal();
-  out.covariance = scale.asDiagonal() * Hs.completeOrthogonalDecomposition().pseudoInverse() * scale.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Hs);
-  for (Eigen::Index k = 0; k < n; ++k)
-    if (eig.eigenvalues()(k) <= 1e-10 * std::max(1.0, eig.eigenvalues().maxCoeff()))
-      for (Eigen::Index a = 0; a < n; ++a)
-        if (std::abs(eig.eigenvectors()(a, k)) > 0.1) out.confounded[static_cast<size_t>(a)] = true;
-  for (Eigen::Index a = 0; a < n; ++a)
-    if (scale(a) == 0) out.confounded[static_cast<size_t>(a)] = true;  // a parameter the data do not touch
-  return out;
-}
-
 fit::FitOptions refit_options() {
   fit::FitOptions fo;
   fo.max_iterations = 100;
@@ -673,7 +649,7 @@ StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const s
       for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
   }
   H = H.selfadjointView<Eigen::Lower>();
-  const NormalMatrixAnalysis normal = analyse_normal_matrix(H);
+  const fit::NormalMatrixAnalysis normal = fit::analyse_normal_matrix(H);
   StandardErrors out;
   out.value.assign(ps.size(), std::numeric_limits<double>::quiet_NaN());
   out.confounded.assign(ps.size(), false);

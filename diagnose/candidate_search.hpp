@@ -183,15 +183,6 @@ std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::
 // What would separate two look-alike effects.
 std::string separating_manoeuvre(const std::string& a, const std::string& b);
 
-// The Gauss-Newton normal matrix J^T W J of a fit's free parameters: its pseudo-inverse (the
-// covariance, for standard errors) and which parameters lie along a direction the data cannot
-// determine (an eigenvalue of the unit-diagonal form near zero), computed on the matrix scaled
-// to unit diagonal so that parameters of very different size do not hide one another.
-struct NormalMatrixAnalysis {
-  Eigen::MatrixXd covariance;
-  std::vector<bool> confounded;
-};
-NormalMatrixAnalysis analyse_normal_matrix(const Eigen::MatrixXd& H);
 
 // P(chi2_dof > x): the p-value of a likelihood-ratio or heterogeneity statistic; 1 for x <= 0
 // or dof <= 0.
@@ -203,7 +194,7 @@ fit::FitOptions refit_options();
 
 // Standard errors of the free parameters at `ps` from the Gauss-Newton normal matrix of a
 // weighted fit (weights per channel, as the search uses them); NaN for fixed parameters.
-// `confounded`: along a direction the data cannot determine (analyse_normal_matrix), where
+// `confounded`: along a direction the data cannot determine (fit::analyse_normal_matrix), where
 // the pseudo-inverse gives a finite, too small error.
 struct StandardErrors {
   std::vector<double> value;

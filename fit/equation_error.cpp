@@ -66,20 +66,59 @@ void EquationErrorModel::mark_contiguous_intervals() {
 void EquationErrorModel::find_data_side_columns() {
   const auto& S = flight_.samples;
   std::map<int, SampleSpan> spans;
+  const auto reach = [&](int c, size_t k) {
+    auto [it, fresh] = spans.try_emplace(c, SampleSpan{k, k + 1});
+    if (!fresh) it->second.lo = std::min(it->second.lo, k), it->second.hi = std::max(it->second.hi, k + 1);
+  };
   for (int index : data_side_.indices()) {
     if (index < 0) continue;
-    for (size_t k = 0; k < S.size(); ++k) {
-      const int c = model_->param_column(index, S[k].t);
-      auto [it, fresh] = spans.try_emplace(c, SampleSpan{k, k + 1});
-      if (!fresh) it->second.lo = std::min(it->second.lo, k), it->second.hi = std::max(it->second.hi, k + 1);
-    }
+    for (size_t k = 0; k < S.size(); ++k) reach(model_->param_column(index, S[k].t), k);
   }
+  for (const auto& [c, k] : commanded_speed_columns()) reach(c, k);
   for (auto [c, span] : spans) {
     while (span.lo > 0 && !rotors_restart_.empty() && !rotors_restart_[span.lo - 1]) --span.lo;
     while (span.hi < S.size() && !rotors_restart_.empty() && !rotors_restart_[span.hi - 1]) ++span.hi;
     data_side_columns_.push_back(c);
     data_side_spans_.push_back(span);
   }
+}
+
+// Under a motor lag the rotor speeds are filtered on the data side (prepare()), so the model's
+// analytic df/dp cannot see a parameter that shapes the commanded speed (the motor map
+// a0..a2): its column would be zero and a fit would leave it where it started. Such a
+// parameter is found by where the speed states' derivative at zero speed (tau times the
+// commanded speed) depends on it, and is differentiated through the filter like the
+// data-side effects (only when it is free, as they are). Returns (column, sample) for
+// every sample at which a column acts.
+std::vector<std::pair<int, size_t>> EquationErrorModel::commanded_speed_columns() const {
+  std::vector<std::pair<int, size_t>> out;
+  if (speed_states_.empty()) return out;
+  const int n = model_->num_states(), nu = model_->num_inputs(), np = model_->num_params();
+  std::vector<bool> data_side(np, false);
+  for (int c : data_side_.indices())
+    if (c >= 0) data_side[c] = true;
+  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
+  std::vector<double> x(n), u(nu), f(n), B(static_cast<size_t>(n) * np);
+  model_->restrict_param_jacobian({});
+  for (size_t k = 0; k < flight_.samples.size(); ++k) {
+    const FlightSample& s = flight_.samples[k];
+    std::copy(s.x.begin(), s.x.end(), x.begin());
+    for (int i : speed_states_) x[i] = 0;
+    std::fill(u.begin(), u.end(), 0.0);
+    std::copy(s.u.begin(), s.u.end(), u.begin());
+    if (t_in >= 0) u[t_in] = s.t;
+    if (v_in >= 0) u[v_in] = s.vbat;
+    model_->rhs(x.data(), u.data(), f.data(), nullptr, B.data(), nullptr);
+    for (int c = 0; c < np; ++c) {
+      if (data_side[c]) continue;  // already differentiated on the data side
+      for (int i : speed_states_)
+        if (B[static_cast<size_t>(i) * np + c] != 0.0) {
+          out.emplace_back(c, k);
+          break;
+        }
+    }
+  }
+  return out;
 }
 
 // Savitzky-Golay derivative weights c_i (local quadratic over +-window), and the weights

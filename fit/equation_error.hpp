@@ -5,13 +5,15 @@
 // Effects that act before the dynamics are applied to the data instead: input_delay shifts
 // the logged commands, motor_lag filters the commanded rotor speeds into the rotor-speed
 // states, attitude_bias turns the logged attitude back into the true one; their Jacobian
-// columns are central differences of the residuals. Suits logs with good state estimates
+// columns are central differences of the residuals, as are those of any parameter that
+// shapes the commanded rotor speeds the lag filters (the motor map). Suits logs with good state estimates
 // and IMU data; it needs no integration and so cannot drift. (Multiple shooting, which
 // compares integrated windows with the pose, is the other formulation; see README.)
 #pragma once
 #include <array>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "runtime/data_side_effects.hpp"
@@ -89,6 +91,7 @@ class EquationErrorModel : public ResidualModel {
   double gap_ = 0;  // s: a longer sample interval is a gap
   void mark_contiguous_intervals();
   void find_data_side_columns();
+  std::vector<std::pair<int, size_t>> commanded_speed_columns() const;
   void build_filter(double window);
   Quadrature quadrature_ = Quadrature::kMidpoint;
   // Scratch of one evaluation, not state: rotor speeds averaged over each interval

@@ -1,4 +1,5 @@
 #include "fit/least_squares.hpp"
+#include "fit/normal_matrix.hpp"
 #include "runtime/dynamic_model.hpp"  // free_columns
 
 #include <algorithm>
@@ -296,54 +297,32 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   res.weights = w;
   res.num_residuals = nr;
   res.num_free = n_free;
-  // Covariance of the free parameters from Ceres (dense SVD, so a rank-deficient problem
-  // gives a pseudo-inverse instead of failing), in the tangent space of the fixed-subset
-  // manifold, i.e. over the free parameters in order.
+  // Covariance of the free parameters: the pseudo-inverse of the weighted Gauss-Newton
+  // normal matrix, scaled to unit diagonal first (normal_matrix.hpp). Ceres' covariance
+  // with a relative cut-off on the raw matrix dropped the weakest direction when the
+  // parameters' units differ by many orders (c_w beside rotor_drag.k, a motor map term in
+  // rad/s) and reported a standard error near zero along it.
   std::vector<int> free_idx;
   for (int i = 0; i < n; ++i)
     if (params[i].free) free_idx.push_back(i);
-  std::vector<double> x = parameter_values(params);
-  {
-    ceres::Problem::Options po;
-    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(po);
-    problem.AddResidualBlock(new WeightedCost(model, n, w, free_mask(params)), nullptr, x.data());
-    std::vector<int> fixed;
-    for (int i = 0; i < n; ++i)
-      if (!params[i].free) fixed.push_back(i);
-    if (!fixed.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(n, fixed));
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::DENSE_SVD;
-    co.null_space_rank = -1;
-    co.min_reciprocal_condition_number = 1e-14;
-    ceres::Covariance cov(co);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
-    // The weighted Jacobian over the free parameters, checked before Ceres sees it.
-    std::vector<double> J(static_cast<size_t>(nr) * n);
-    model.evaluate(x.data(), r.data(), J.data());
-    Eigen::MatrixXd Jf(nr, free_idx.size());
-    for (int i = 0; i < nr; ++i)
-      for (size_t k = 0; k < free_idx.size(); ++k)
-        Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
-    require_finite_information(Jf, params, free_idx);
-    std::vector<double> C(free_idx.size() * free_idx.size(), std::numeric_limits<double>::quiet_NaN());
-    if (!free_idx.empty() &&
-        (!cov.Compute(blocks, &problem) || !cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data())))
-      throw FitError("covariance of the free parameters could not be computed at " + values_text(params));
-    for (double c : C)
-      if (!std::isfinite(c)) throw FitError("covariance of the free parameters is not finite at " + values_text(params));
-    // Rank of the weighted Jacobian over the free parameters: a deficient one means some
-    // combination is not determined at all, whatever the pseudo-inverse says.
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Jf);
-    qr.setThreshold(1e-10);
-    const bool singular = qr.rank() < static_cast<long>(free_idx.size());
-    res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
-    res.covariance.assign(free_idx.size(), std::vector<double>(free_idx.size()));
-    const size_t nf = free_idx.size();
-    for (size_t a = 0; a < nf; ++a) {
-      for (size_t b = 0; b < nf; ++b) res.covariance[a][b] = C[a * nf + b];
-      res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(C[a * nf + a]);
-    }
+  const std::vector<double> x = parameter_values(params);
+  std::vector<double> J(static_cast<size_t>(nr) * n);
+  model.evaluate(x.data(), r.data(), J.data());
+  Eigen::MatrixXd Jf(nr, free_idx.size());
+  for (int i = 0; i < nr; ++i)
+    for (size_t k = 0; k < free_idx.size(); ++k)
+      Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
+  require_finite_information(Jf, params, free_idx);
+  const Eigen::MatrixXd C = analyse_normal_matrix(Jf.transpose() * Jf).covariance;
+  if (!C.allFinite()) throw FitError("covariance of the free parameters is not finite at " + values_text(params));
+  const bool singular = columns_dependent(Jf);
+  res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
+  const size_t nf = free_idx.size();
+  res.covariance.assign(nf, std::vector<double>(nf));
+  for (size_t a = 0; a < nf; ++a) {
+    for (size_t b = 0; b < nf; ++b) res.covariance[a][b] = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    const double variance = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+    res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(std::max(0.0, variance));
   }
   for (int i : free_idx) {
     if (on_bound(params[i])) res.at_bound.push_back(params[i].name);

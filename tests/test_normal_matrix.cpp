@@ -1,12 +1,12 @@
-// The normal matrix J^T W J of a fit (diagnose::analyse_normal_matrix): standard errors and
+// The normal matrix J^T W J of a fit (fit::analyse_normal_matrix): standard errors and
 // which parameters the data cannot determine, whatever the parameters' scales.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 
-#include "diagnose/candidate_search.hpp"
+#include "fit/normal_matrix.hpp"
 
-using quadgen::diagnose::analyse_normal_matrix;
+using quadgen::fit::analyse_normal_matrix;
 
 namespace {
 // J^T J of a Jacobian whose column j is scaled by 1 / scale[j] (a parameter of that size).
