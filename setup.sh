@@ -18,12 +18,13 @@ if [ "${1:-}" != "--no-run" ]; then
   build/quadgen simulate vehicles/finken3.yaml --closed-loop --duration 60 --seed 1 \
       --effects motor_gain --set motor_gain.C=-0.08 --gyro-noise 0.01 --accel-noise 0.05 --out out/weak_motor_C.csv
   build/quadgen diagnose vehicles/finken3.yaml out/weak_motor_C.csv --out out/diagnosis_weak_motor_C
-  # The real flights, when the shared data sits beside the clone.
+  # The real flights, when the shared data sits beside the clone (the Crazyflie that flew them:
+  # the stock file with its motor map's slope measured in flight, docs/crazyflie_evidence.md).
   nb=../shared/data/crazyflie/nanobench/B3_figure8_medium_rep2.csv
   if [ -f "$nb" ]; then
-    build/quadgen diagnose vehicles/crazyflie21.yaml "$nb" --mapping data/mappings/nanobench.yaml --out out/diagnosis_nanobench
+    build/quadgen diagnose vehicles/crazyflie21_nanobench.yaml "$nb" --mapping data/mappings/nanobench.yaml --out out/diagnosis_nanobench
     # The measuring stick: prediction error at horizons, as published models report it.
-    build/quadgen predict vehicles/crazyflie21.yaml "$nb" --mapping data/mappings/nanobench.yaml \
+    build/quadgen predict vehicles/crazyflie21_nanobench.yaml "$nb" --mapping data/mappings/nanobench.yaml \
         --params out/diagnosis_nanobench/diagnosis.json --out out/prediction_nanobench
   fi
   echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html; prediction: out/prediction_*/prediction.json"

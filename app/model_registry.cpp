@@ -2,6 +2,8 @@
 
 #include "generated/crazyflie21/model.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
+#include "generated/crazyflie21_nanobench/model.hpp"
+#include "generated/crazyflie21_nanobench_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
 #include "derive/dynamics.hpp"
@@ -22,7 +24,8 @@ std::unique_ptr<runtime::DynamicModel> compiled_if(const std::string& vehicle_ha
 std::unique_ptr<runtime::DynamicModel> find_compiled(const std::string& hash, const std::string& effects) {
   namespace g = quadgen_generated;
   for (auto make : {compiled_if<g::finken3::Model>, compiled_if<g::finken3_all_effects::Model>,
-                    compiled_if<g::crazyflie21::Model>, compiled_if<g::crazyflie21_all_effects::Model>})
+                    compiled_if<g::crazyflie21::Model>, compiled_if<g::crazyflie21_all_effects::Model>,
+                    compiled_if<g::crazyflie21_nanobench::Model>, compiled_if<g::crazyflie21_nanobench_all_effects::Model>})
     if (auto m = make(hash, effects)) return m;
   return nullptr;
 }

@@ -31,7 +31,7 @@ inline const char* const kLogFormats =
     "CSV in the canonical layout, or any CSV, PX4 ULog or Crazyflie uSD log through --mapping";
 // The base parameters' names come from the vehicle schema, the effects' from their descriptors.
 inline std::string parameter_names_help() {
-  return "the vehicle's (g, rho, c_w, c_t, kappa, motor_a0..motor_a2, mass, cog_x..cog_z, J_xx..J_yz, A_x..A_z, vbat_ref; "
+  return "the vehicle's (g, rho, c_w, c_t, kappa, motor_a0..motor_a2, motor_slope, mass, cog_x..cog_z, J_xx..J_yz, A_x..A_z, vbat_ref; "
          "model.json lists them) and the effects' (" + catalogue_parameter_names() + ")";
 }
 

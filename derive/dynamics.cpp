@@ -60,6 +60,18 @@ void check_derived_bounds(const Vehicle& v, const std::string& name, const std::
                      "]");
 }
 
+// The rotor speed a command asks for: the motor map a0 + a1 u + a2 u^2, turned about its
+// speed at the pivot command by `slope` when the vehicle file gives one. A stand's map holds
+// the stand's battery sag in its slope; the slope at the airframe's operating point can
+// then be fitted without moving the speed there, on which the speed-proportional effects
+// (rotor drag, blade flapping) and the thrust constant rest.
+ex commanded_rotor_speed(const ModelContext& c, const ex& u) {
+  const auto map = [&](const ex& x) { return c.p("motor_a0") + c.p("motor_a1") * x + c.p("motor_a2") * x * x; };
+  if (!c.vehicle.params.count("slope")) return map(u);
+  const ex pivot = numeric(param(c.vehicle, "pivot").nominal);
+  return map(pivot) + c.p("motor_slope") * (map(u) - map(pivot));
+}
+
 void declare_base(ModelContext& c, const MassProperties& mp) {
   const char* st[][3] = {{"x", "m", "position x, world"},      {"y", "m", "position y, world"},
                          {"z", "m", "position z (up), world"}, {"vx", "m/s", "velocity x, world"},
@@ -83,9 +95,11 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   for (const Rotor& r : c.vehicle.rotors)
     c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
 
-  for (const char* n : {"g", "rho", "c_w", "c_t", "kappa", "a0", "a1", "a2"}) {
+  for (const char* n : {"g", "rho", "c_w", "c_t", "kappa", "a0", "a1", "a2", "slope"}) {
+    if (!c.vehicle.params.count(n)) continue;  // slope: optional, with its pivot
     ParameterSpec spec = param(c.vehicle, n);  // the record without its file line
     if (n[0] == 'a' && n[1] != 0 && isdigit(n[1])) spec.name = std::string("motor_") + n;
+    if (spec.name == "slope") spec.name = "motor_slope";
     c.add_param(spec);
   }
   // Mass properties derived from the blocks become parameters with those nominal values,
@@ -123,7 +137,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
                                     c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
                                     c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z")));
     const ex u = c.model.inputs[i].sym;
-    const ex w = c.p("motor_a0") + c.p("motor_a1") * u + c.p("motor_a2") * u * u;
+    const ex w = commanded_rotor_speed(c, u);
     c.commanded_speed.push_back(w);
     c.rotor_speed.push_back(w);
     c.thrust_scale.push_back(1);

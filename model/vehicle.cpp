@@ -194,7 +194,11 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   read_section(r, root, v, "motor_map",
                {{"a0", "rad/s", true, "rotor speed at zero command"},
                 {"a1", "rad/s", true, "rotor speed per command"},
-                {"a2", "rad/s", true, "rotor speed per command squared"}});
+                {"a2", "rad/s", true, "rotor speed per command squared"},
+                {"slope", "1", false, "slope of the rotor speed over the command at the pivot, relative to a0..a2's"},
+                {"pivot", "1", false, "command about which `slope` turns the map (its speed there is kept)"}});
+  if (v.params.count("slope") != v.params.count("pivot"))
+    r.fail(root["motor_map"], "motor_map: 'slope' and 'pivot' go together (the slope turns the map about the pivot)");
   if (root["battery"])
     read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});
   else

@@ -17,7 +17,10 @@ cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_cross_flight}
 q=${QUADGEN:-build/quadgen}
 data=${QUADGEN_NANOBENCH:-../shared/data/crazyflie/nanobench}
-vehicle=vehicles/crazyflie21.yaml
+# The airframe's vehicle file (the stock one with its motor map's slope measured in flight);
+# the nominal model, the baseline of the ratios, is the stock file: nothing measured or fitted.
+vehicle=${VEHICLE:-vehicles/crazyflie21_nanobench.yaml}
+nominal_vehicle=vehicles/crazyflie21.yaml
 mapping=data/mappings/nanobench.yaml
 usable=(B2_circle_medium_rep1 B3_figure8_medium_rep1 B3_figure8_medium_rep2 B3_figure8_slow_rep1 B5_helix_slow_rep1)
 unseen=${UNSEEN:-B5_helix_slow_rep1}
@@ -34,17 +37,17 @@ if [ ! -f "$out/joint_4_flights/diagnosis.json" ]; then
     > "$out/joint_4_flights.log" 2>&1 || { echo "failed: see $out/joint_4_flights.log" >&2; exit 1; }
 fi
 params="$out/joint_4_flights/diagnosis.json"
-predict() {  # flight folder-name [flags...]
-  local n=$1 name=$2; shift 2
+predict() {  # vehicle flight folder-name [flags...]
+  local v=$1 n=$2 name=$3; shift 3
   rm -rf "$out/table/$n/$name"
   mkdir -p "$out/table/$n"
-  "$q" predict "$vehicle" "$data/$n.csv" --mapping "$mapping" "$@" --out "$out/table/$n/$name" > /dev/null 2>&1 ||
+  "$q" predict "$v" "$data/$n.csv" --mapping "$mapping" "$@" --out "$out/table/$n/$name" > /dev/null 2>&1 ||
     echo "predict $n $name failed" >&2
 }
-for n in "${train[@]}"; do predict "$n" joint_fit_own_values --params "$params"; done
-predict "$unseen" nominal
-predict "$unseen" unseen_airframe_values --params "$params"
-predict "$unseen" unseen_calibrated_first_70pct --params "$params" --calibrate
+for n in "${train[@]}"; do predict "$vehicle" "$n" joint_fit_own_values --params "$params"; done
+predict "$nominal_vehicle" "$unseen" nominal
+predict "$vehicle" "$unseen" unseen_airframe_values --params "$params"
+predict "$vehicle" "$unseen" unseen_calibrated_first_70pct --params "$params" --calibrate
 python3 scripts/prediction_table.py "$out/table"
 for n in "$unseen" $extra_checks; do
   if [ ! -f "$out/check_$n/diagnosis.json" ]; then

@@ -18,14 +18,20 @@ cd "$(dirname "$0")/.."
 out="${1:-out/prediction_benchmark}"
 data=../shared/data/crazyflie
 command -v python3 > /dev/null || { echo "python3 is needed for the table (apt-get install python3)"; exit 1; }
-vehicle=vehicles/crazyflie21.yaml
+# The NanoBench Crazyflie's vehicle file (its motor map's slope measured in flight) and the
+# stock one for the ARPL log's Crazyflie; VEHICLE=FILE overrides the NanoBench one.
+# The nominal model, the baseline of every ratio, is the stock file on every log: nothing
+# measured on the airframe or fitted.
+nanobench_vehicle=${VEHICLE:-vehicles/crazyflie21_nanobench.yaml}
+arpl_vehicle=vehicles/crazyflie21.yaml
+nominal_vehicle=vehicles/crazyflie21.yaml
 reuse="${DIAGNOSES:-}"
 q="${QUADGEN:-build/quadgen}"
-run() {  # name log mapping [extra diagnose flags...]
-  local name=$1 log=$2 mapping=$3; shift 3
+run() {  # name vehicle log mapping [extra diagnose flags...]
+  local name=$1 vehicle=$2 log=$3 mapping=$4; shift 4
   echo "== $name" >&2
   mkdir -p "$out/$name"
-  "$q" predict "$vehicle" "$log" --mapping "$mapping" "$@" --linear-correction --out "$out/$name/nominal" > /dev/null
+  "$q" predict "$nominal_vehicle" "$log" --mapping "$mapping" "$@" --linear-correction --out "$out/$name/nominal" > /dev/null
   if [ -n "$reuse" ] && [ -f "$reuse/$name/diagnosis.json" ]; then
     ln -sfn "$(cd "$reuse/$name" && pwd)" "$out/$name/diagnosis"
   else
@@ -37,7 +43,7 @@ run() {  # name log mapping [extra diagnose flags...]
   fi
 }
 for log in "$data"/nanobench/*.csv; do
-  run "$(basename "$log" .csv)" "$log" data/mappings/nanobench.yaml
+  run "$(basename "$log" .csv)" "$nanobench_vehicle" "$log" data/mappings/nanobench.yaml
 done
-run arpl_log10 "$data/arpl/log10.csv" data/mappings/arpl.yaml --resample 200
+run arpl_log10 "$arpl_vehicle" "$data/arpl/log10.csv" data/mappings/arpl.yaml --resample 200
 python3 scripts/prediction_table.py "$out"

@@ -12,13 +12,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-/tmp/quadgen_real_flights}
 q=${QUADGEN:-build/quadgen}
+vehicle=${VEHICLE:-vehicles/crazyflie21_nanobench.yaml}
 data=${QUADGEN_NANOBENCH:-../shared/data/crazyflie/nanobench}
 mkdir -p "$out"
 for f in "$data"/*.csv; do
   name=$(basename "$f" .csv)
   if [ ! -f "$out/$name/diagnosis.json" ]; then
     echo "diagnosing $name ..." >&2
-    "$q" diagnose vehicles/crazyflie21.yaml "$f" --mapping data/mappings/nanobench.yaml --out "$out/$name" \
+    "$q" diagnose "$vehicle" "$f" --mapping data/mappings/nanobench.yaml --out "$out/$name" \
       > "$out/$name.log" 2>&1 || echo "  failed: see $out/$name.log" >&2
   fi
 done
@@ -28,7 +29,7 @@ if [ "${JOINT:-0}" = 1 ] && [ ! -f "$out/joint_5_flights/diagnosis.json" ]; then
   for f in "$data"/*.csv; do
     case "$(basename "$f")" in B6_*) ;; *) logs+=("$f") ;; esac
   done
-  "$q" diagnose vehicles/crazyflie21.yaml "${logs[@]}" --mapping data/mappings/nanobench.yaml \
+  "$q" diagnose "$vehicle" "${logs[@]}" --mapping data/mappings/nanobench.yaml \
     --out "$out/joint_5_flights" > "$out/joint_5_flights.log" 2>&1 || echo "  failed: see $out/joint_5_flights.log" >&2
 fi
 python3 scripts/real_flights_table.py "$out"

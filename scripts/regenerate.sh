@@ -21,3 +21,5 @@ regen vehicles/finken3.yaml finken3
 regen vehicles/finken3.yaml finken3_all_effects all
 regen vehicles/crazyflie21.yaml crazyflie21
 regen vehicles/crazyflie21.yaml crazyflie21_all_effects all
+regen vehicles/crazyflie21_nanobench.yaml crazyflie21_nanobench
+regen vehicles/crazyflie21_nanobench.yaml crazyflie21_nanobench_all_effects all

@@ -75,6 +75,10 @@ TEST(Generated, CrazyflieJacobiansMatchFiniteDifferences) {
 TEST(Generated, CrazyflieAllEffectsJacobiansMatchFiniteDifferences) {
   check_jacobians_against_finite_differences<crazyflie21_all_effects_traits>(20);
 }
+// The NanoBench airframe's map, turned about its pivot by a slope that is a parameter.
+TEST(Generated, CrazyflieNanobenchJacobiansMatchFiniteDifferences) {
+  check_jacobians_against_finite_differences<crazyflie21_nanobench_all_effects_traits>(20);
+}
 
 TEST(Generated, MatchesSymbolicModel) {
   // The emitted f equals the GiNaC f it came from, at random points with nominal parameters.
@@ -145,6 +149,7 @@ TEST(Generated, MatchesSymbolicModelAwayFromNeutral) {
   check_f_against_symbolic_model<finken3_all_effects_traits>("vehicles/finken3.yaml", 10, 32);
   check_f_against_symbolic_model<crazyflie21_traits>("vehicles/crazyflie21.yaml", 5, 33);
   check_f_against_symbolic_model<crazyflie21_all_effects_traits>("vehicles/crazyflie21.yaml", 10, 34);
+  check_f_against_symbolic_model<crazyflie21_nanobench_all_effects_traits>("vehicles/crazyflie21_nanobench.yaml", 10, 35);
 }
 
 TEST(Generated, NullJacobianPointersGiveTheSameF) {
@@ -202,7 +207,9 @@ TEST(Generated, CheckedInHeadersAreUpToDate) {
   } cases[] = {{"vehicles/finken3.yaml", "finken3", ""},
                {"vehicles/finken3.yaml", "finken3_all_effects", "all"},
                {"vehicles/crazyflie21.yaml", "crazyflie21", ""},
-               {"vehicles/crazyflie21.yaml", "crazyflie21_all_effects", "all"}};
+               {"vehicles/crazyflie21.yaml", "crazyflie21_all_effects", "all"},
+               {"vehicles/crazyflie21_nanobench.yaml", "crazyflie21_nanobench", ""},
+               {"vehicles/crazyflie21_nanobench.yaml", "crazyflie21_nanobench_all_effects", "all"}};
   for (const auto& c : cases) {
     std::string cmd = "cd " + src + " && " + QUADGEN_BINARY + " derive " + c.vehicle + " --out " +
                       (tmp / c.name).string() + (std::string(c.effects).empty() ? "" : std::string(" --effects ") + c.effects) +
@@ -229,7 +236,8 @@ TEST(Generated, DerivationTablesHaveAsManyCellsAsTheirHeader) {
       else if (row[i] == '|') ++pipes;
     return pipes - 1;
   };
-  for (const char* name : {"finken3", "finken3_all_effects", "crazyflie21", "crazyflie21_all_effects"}) {
+  for (const char* name : {"finken3", "finken3_all_effects", "crazyflie21", "crazyflie21_all_effects", "crazyflie21_nanobench",
+                           "crazyflie21_nanobench_all_effects"}) {
     std::istringstream in(read(fs::path(QUADGEN_SOURCE_DIR) / "generated" / name / "derivation.md"));
     std::string line;
     int header = -1, rows = 0;

@@ -32,7 +32,7 @@ SymbolicModel derive(const Vehicle& v, std::vector<std::string> effects = {}) {
 }  // namespace
 
 TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
-  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml"}) {
+  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml"}) {
     const Vehicle v = load_vehicle(test::source_path(file));
     const MassProperties mp = derive_mass_properties(v);
     DeriveOptions all;
@@ -746,4 +746,33 @@ TEST(Report, NamedEquationsComposeToTheModelsForcesAndTorque) {
   EXPECT_NE(md.find("```math\n\\tau_{\\mathrm{A}} = "), std::string::npos);
   EXPECT_NE(md.find("```math\n\\tau = \\sum_i \\tau_i\n```"), std::string::npos);
   EXPECT_EQ(md.find("abs_value"), std::string::npos);  // |x|, not an operator name with an underscore
+}
+
+// The motor map's slope (vehicles/crazyflie21_nanobench.yaml): the commanded speed is turned about its
+// value at the pivot command, which it keeps, and its distance from that value scales with
+// the slope; the speed is read back from the vertical acceleration of a level vehicle at rest
+// (4 k w^2 / m - g with equal commands).
+TEST(Model, MotorSlopeTurnsTheMapAboutItsPivot) {
+  const Vehicle v = load_vehicle(test::source_path("vehicles/crazyflie21_nanobench.yaml"));
+  ASSERT_TRUE(v.params.count("slope") && v.params.count("pivot"));
+  const double pivot = v.params.at("pivot").nominal;
+  SymbolicModel m = derive(v);
+  const auto P = [&](const char* n) -> double& { return m.params[m.param_index(n)].nominal; };
+  const double k = P("c_t") * P("rho") * v.rotors[0].disc_area * v.rotors[0].radius * v.rotors[0].radius;
+  const auto speed = [&](double u) {
+    std::vector<double> x(13, 0.0);
+    x[2] = 1;
+    x[6] = 1;
+    const double az = test::eval_f(m, x, {u, u, u, u})[5];
+    return std::sqrt((az + P("g")) * P("mass") / (4 * k));
+  };
+  const auto map = [&](double u) { return P("motor_a0") + P("motor_a1") * u + P("motor_a2") * u * u; };
+  P("motor_slope") = 1.0;  // the quadratic itself
+  for (double u : {0.5, 0.8, pivot, 0.95}) EXPECT_NEAR(speed(u), map(u), 1e-9 * map(u)) << u;
+  for (double slope : {0.6, 0.3}) {
+    P("motor_slope") = slope;
+    EXPECT_NEAR(speed(pivot), map(pivot), 1e-9 * map(pivot));
+    for (double u : {0.5, 0.8, 0.95})
+      EXPECT_NEAR(speed(u) - map(pivot), slope * (map(u) - map(pivot)), 1e-9 * map(pivot)) << u;
+  }
 }

@@ -47,6 +47,7 @@ void expect_error(const std::string& text, const std::string& want) {
 TEST(VehicleInput, BundledFilesLoad) {
   EXPECT_NO_THROW(load_vehicle(test::source_path("vehicles/finken3.yaml")));
   EXPECT_NO_THROW(load_vehicle(test::source_path("vehicles/crazyflie21.yaml")));
+  EXPECT_NO_THROW(load_vehicle(test::source_path("vehicles/crazyflie21_nanobench.yaml")));
 }
 
 TEST(VehicleInput, MalformedYaml) { expect_error("name: x\nblocks: [\n", "malformed YAML"); }
@@ -222,4 +223,13 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       EXPECT_NE(std::string(e.what()).find(path + want), std::string::npos) << e.what();
     }
   }
+}
+
+// The motor map's slope turns the map about a pivot command: one without the other is refused.
+TEST(VehicleInput, MotorSlopeNeedsItsPivot) {
+  const std::string a2 = "  a2: {value: -2954.545454545, unit: rpm}";
+  expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: 1.0, unit: \"1\"}"), "'slope' and 'pivot' go together");
+  expect_error(replace(finken_text(), a2, a2 + "\n  pivot: {value: 0.5, unit: \"1\"}"), "'slope' and 'pivot' go together");
+  EXPECT_NO_THROW(parse_vehicle(replace(finken_text(), a2, a2 + "\n  slope: {value: 1.0, unit: \"1\"}\n  pivot: {value: 0.5, unit: \"1\"}"),
+                                "ok.yaml"));
 }
