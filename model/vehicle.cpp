@@ -199,6 +199,15 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
                 {"pivot", "1", false, "command about which `slope` turns the map (its speed there is kept)"}});
   if (v.params.count("slope") != v.params.count("pivot"))
     r.fail(root["motor_map"], "motor_map: 'slope' and 'pivot' go together (the slope turns the map about the pivot)");
+  if (v.params.count("slope")) {
+    const Parameter& slope = v.params.at("slope");
+    if (!(slope.nominal > 0 && slope.lower > 0))
+      r.fail(root["motor_map"]["slope"], "motor_map: 'slope' and its lower bound must be positive (a map whose speed falls "
+                                         "as the command rises)");
+    const double pivot = v.params.at("pivot").nominal;
+    if (!(pivot >= 0 && pivot <= 1))
+      r.fail(root["motor_map"]["pivot"], "motor_map: 'pivot' is a command, expected 0..1, got " + std::to_string(pivot));
+  }
   if (root["battery"])
     read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});
   else

@@ -232,4 +232,10 @@ TEST(VehicleInput, MotorSlopeNeedsItsPivot) {
   expect_error(replace(finken_text(), a2, a2 + "\n  pivot: {value: 0.5, unit: \"1\"}"), "'slope' and 'pivot' go together");
   EXPECT_NO_THROW(parse_vehicle(replace(finken_text(), a2, a2 + "\n  slope: {value: 1.0, unit: \"1\"}\n  pivot: {value: 0.5, unit: \"1\"}"),
                                 "ok.yaml"));
+  expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: -0.5, unit: \"1\"}\n  pivot: {value: 0.5, unit: \"1\"}"),
+               "'slope' and its lower bound must be positive");
+  expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: 0.5, unit: \"1\", bounds: [0, 1], fit: true}\n  pivot: {value: 0.5, unit: \"1\"}"),
+               "'slope' and its lower bound must be positive");
+  expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: 0.5, unit: \"1\"}\n  pivot: {value: 1.5, unit: \"1\"}"),
+               "'pivot' is a command, expected 0..1");
 }
