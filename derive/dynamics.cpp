@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -65,11 +66,11 @@ void check_derived_bounds(const Vehicle& v, const std::string& name, const std::
 // the stand's battery sag in its slope; the slope at the airframe's operating point can
 // then be fitted without moving the speed there, on which the speed-proportional effects
 // (rotor drag, blade flapping) and the thrust constant rest.
-ex commanded_rotor_speed(const ModelContext& c, const ex& u) {
+// `pivot`: the constant motor_pivot, or nothing without a slope.
+ex commanded_rotor_speed(const ModelContext& c, const ex& u, const std::optional<ex>& pivot) {
   const auto map = [&](const ex& x) { return c.p("motor_a0") + c.p("motor_a1") * x + c.p("motor_a2") * x * x; };
-  if (!c.vehicle.params.count("slope")) return map(u);
-  const ex pivot = numeric(param(c.vehicle, "pivot").nominal);
-  return map(pivot) + c.p("motor_slope") * (map(u) - map(pivot));
+  if (!pivot) return map(u);
+  return map(*pivot) + c.p("motor_slope") * (map(u) - map(*pivot));
 }
 
 void declare_base(ModelContext& c, const MassProperties& mp) {
@@ -128,6 +129,10 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
     derived(std::string("A_") + axes[i], "m^2", mp.areas_value[i], "exposed area along the body axis");
 
   c.cog = vec3(c.p("cog_x"), c.p("cog_y"), c.p("cog_z"));
+  std::optional<ex> pivot;
+  if (c.vehicle.params.count("slope"))
+    pivot = c.add_constant("motor_pivot", "1", param(c.vehicle, "pivot").nominal,
+                           "command about which motor_slope turns the motor map");
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
     const Rotor& r = c.vehicle.rotors[i];
     const std::string n = r.name;
@@ -137,7 +142,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
                                     c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
                                     c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z")));
     const ex u = c.model.inputs[i].sym;
-    const ex w = commanded_rotor_speed(c, u);
+    const ex w = commanded_rotor_speed(c, u, pivot);
     c.commanded_speed.push_back(w);
     c.rotor_speed.push_back(w);
     c.thrust_scale.push_back(1);
