@@ -87,6 +87,29 @@ Flight random_command_flights(std::mt19937& rng, int flights) {
   return out;
 }
 
+// Column c of an equation error's Jacobian J (at p, np columns) against central differences of
+// its residuals: the largest difference quotient, and the largest deviation from J there.
+struct ColumnCheck {
+  double scale = 0, worst = 0;
+};
+ColumnCheck column_against_differences(const EquationErrorModel& m, const std::vector<double>& p,
+                                       const std::vector<double>& J, int np, int c) {
+  const int nr = m.num_residuals();
+  std::vector<double> q = p, rp(nr), rm(nr);
+  const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
+  q[c] = p[c] + h;
+  m.evaluate(q.data(), rp.data(), nullptr);
+  q[c] = p[c] - h;
+  m.evaluate(q.data(), rm.data(), nullptr);
+  ColumnCheck out;
+  for (int i = 0; i < nr; ++i) {
+    const double fd = (rp[i] - rm[i]) / (2 * h);
+    out.scale = std::max(out.scale, std::abs(fd));
+    out.worst = std::max(out.worst, std::abs(fd - J[static_cast<size_t>(i) * np + c]));
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST(Fit, MotorStepModelJacobianMatchesFiniteDifferences) {
@@ -620,26 +643,14 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
   const int np = model.num_params(), nr = m.num_residuals();
   std::vector<double> r(nr), J(static_cast<size_t>(nr) * np);
   m.evaluate(p.data(), r.data(), J.data());
-  std::vector<double> rp(nr), rm(nr);
   int checked = 0;
   for (const auto& name : data_side)
     for (const std::string copy : {name, name + "@2"}) {
       const int c = model.param_index(copy);
       ASSERT_GE(c, 0) << copy;
-      std::vector<double> q = p;
-      const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
-      q[c] = p[c] + h;
-      m.evaluate(q.data(), rp.data(), nullptr);
-      q[c] = p[c] - h;
-      m.evaluate(q.data(), rm.data(), nullptr);
-      double scale = 0, worst = 0;
-      for (int i = 0; i < nr; ++i) {
-        const double fd = (rp[i] - rm[i]) / (2 * h);
-        scale = std::max(scale, std::abs(fd));
-        worst = std::max(worst, std::abs(fd - J[static_cast<size_t>(i) * np + c]));
-      }
-      EXPECT_GT(scale, 1e-3) << copy << " does not act on the residuals";
-      EXPECT_LE(worst, 1e-6 * scale) << copy;
+      const ColumnCheck check = column_against_differences(m, p, J, np, c);
+      EXPECT_GT(check.scale, 1e-3) << copy << " does not act on the residuals";
+      EXPECT_LE(check.worst, 1e-6 * check.scale) << copy;
       ++checked;
     }
   EXPECT_EQ(checked, 8);
@@ -1004,24 +1015,13 @@ TEST(Fit, MotorMapColumnsUnderALagMatchDifferences) {
   std::vector<double> p = model.params();
   p[model.param_index("motor_lag.tau")] = 0.04;
   const int np = model.num_params(), nr = m.num_residuals();
-  std::vector<double> r(nr), J(static_cast<size_t>(nr) * np), rp(nr), rm(nr);
+  std::vector<double> r(nr), J(static_cast<size_t>(nr) * np);
   m.evaluate(p.data(), r.data(), J.data());
   for (const char* name : {"motor_a0", "motor_a1", "motor_a2"}) {
     const int c = model.param_index(name);
     ASSERT_GE(c, 0) << name;
-    std::vector<double> q = p;
-    const double h = 1e-6 * std::max(std::abs(p[c]), 1e-2);
-    q[c] = p[c] + h;
-    m.evaluate(q.data(), rp.data(), nullptr);
-    q[c] = p[c] - h;
-    m.evaluate(q.data(), rm.data(), nullptr);
-    double scale = 0, worst = 0;
-    for (int i = 0; i < nr; ++i) {
-      const double fd = (rp[i] - rm[i]) / (2 * h);
-      scale = std::max(scale, std::abs(fd));
-      worst = std::max(worst, std::abs(fd - J[static_cast<size_t>(i) * np + c]));
-    }
-    EXPECT_GT(scale, 1e-6) << name << " does not act on the residuals";
-    EXPECT_LE(worst, 1e-6 * scale) << name;
+    const ColumnCheck check = column_against_differences(m, p, J, np, c);
+    EXPECT_GT(check.scale, 1e-6) << name << " does not act on the residuals";
+    EXPECT_LE(check.worst, 1e-6 * check.scale) << name;
   }
 }
