@@ -170,15 +170,14 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
     excludes_off = excludes_off || off < p.lower || off > p.upper;
   }
   if (!f.parameters.empty() && !excludes_off) return "every 95 % interval contains the value that means \"off\"";
-  if (held_out_test(f).empty() && beyond_spread(f.gain_mean, f.gain_standard_error))
+  if (!held_out_test(f).empty()) return "";
+  if (beyond_spread(f.gain_mean, f.gain_standard_error))
     return "held-out rollouts " + output::short_number(f.gain_mean) + " +- " + output::short_number(f.gain_standard_error) +
            " better, but the held-out one-step cost is higher with it (" + output::short_number(f.one_step.cost.mean) +
            " % +- " + output::short_number(f.one_step.cost.standard_error) + " % lower per fold)";
-  if (held_out_test(f).empty())
-    return "held-out gain " + std::to_string(f.gain_mean) + " is not above its uncertainty (standard error " +
-           std::to_string(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) +
-           " validation folds)" + one_step_summary(f);
-  return "";
+  return "held-out gain " + std::to_string(f.gain_mean) + " is not above its uncertainty (standard error " +
+         std::to_string(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) +
+         " validation folds)" + one_step_summary(f);
 }
 
 }  // namespace
