@@ -5,6 +5,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "runtime/thrust_law.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -96,11 +97,15 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   for (const Rotor& r : c.vehicle.rotors)
     c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
 
-  for (const char* n : {"g", "rho", "c_w", "c_t", "kappa", "a0", "a1", "a2", "slope"}) {
-    if (!c.vehicle.params.count(n)) continue;  // slope: optional, with its pivot
-    ParameterSpec spec = param(c.vehicle, n);  // the record without its file line
-    if (n[0] == 'a' && n[1] != 0 && isdigit(n[1])) spec.name = std::string("motor_") + n;
-    if (spec.name == "slope") spec.name = "motor_slope";
+  // The vehicle file's key and the model's name (the motor map's terms carry "motor_").
+  const std::pair<const char*, const char*> scalars[] = {
+      {"g", "g"},               {"rho", "rho"},           {"c_w", "c_w"},           {"c_t", "c_t"},
+      {"kappa", "kappa"},       {"a0", "motor_a0"},       {"a1", "motor_a1"},       {"a2", "motor_a2"},
+      {"slope", "motor_slope"}};
+  for (const auto& [key, name] : scalars) {
+    if (!c.vehicle.params.count(key)) continue;  // slope: optional, with its pivot
+    ParameterSpec spec = param(c.vehicle, key);  // the record without its file line
+    spec.name = name;
     c.add_param(spec);
   }
   // Mass properties derived from the blocks become parameters with those nominal values,

@@ -307,7 +307,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
     if (params[i].free) free_idx.push_back(i);
   const std::vector<double> x = parameter_values(params);
   std::vector<double> J(static_cast<size_t>(nr) * n);
-  model.evaluate(x.data(), r.data(), J.data());
+  model.evaluate_free(x.data(), r.data(), J.data(), free_mask(params));  // the free columns only
   Eigen::MatrixXd Jf(nr, free_idx.size());
   for (int i = 0; i < nr; ++i)
     for (size_t k = 0; k < free_idx.size(); ++k)
