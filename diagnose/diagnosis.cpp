@@ -663,6 +663,14 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (joint)
     for (const auto& one : split_by_flight(draft_input, fit::joined_start_times(flights)))
       d.draft_per_flight.push_back(draft_signature(one));
+  double g = 0;
+  for (const auto& p : s.base_fit)
+    if (p.name == "g") g = p.value;
+  const CommandGainInput gain_input = command_gain_input(all_ee, fit::parameter_values(s.base_fit), v, g, accel);
+  d.command_gain = command_gain(gain_input);
+  if (joint)
+    for (const auto& one : split_by_flight(gain_input, fit::joined_start_times(flights)))
+      d.command_gain_per_flight.push_back(command_gain(one));
   std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
   d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
                                 valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,

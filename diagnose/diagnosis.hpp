@@ -9,6 +9,7 @@
 
 #include "diagnose/agreement.hpp"
 #include "diagnose/candidate_search.hpp"
+#include "diagnose/command_gain.hpp"
 #include "diagnose/draft_signature.hpp"
 #include "diagnose/flight_screening.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -172,6 +173,11 @@ struct Diagnosis {
   // Jointly diagnosed flights: the same check on each flight alone (its samples on the joined
   // clock, the joint model's residuals), in the order of `flights`.
   std::vector<DraftSignature> draft_per_flight;
+  // How strongly the airframe answers a change of command against the base model's motor
+  // map, band by band (command_gain.hpp): a lead on the map's slope, never a named cause.
+  // Jointly diagnosed flights: each flight alone too, in the order of `flights`.
+  CommandGain command_gain;
+  std::vector<CommandGain> command_gain_per_flight;
   // Beyond the catalogue: per channel, the term sparse regression proposes for what the
   // final model still gets wrong on the training part, with its held-out gain (or why none).
   std::vector<DiscoveredTerm> discovered;

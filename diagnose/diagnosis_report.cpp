@@ -171,6 +171,34 @@ json draft_pair_json(const DraftSignature::Pair& p) {
           {"shows_draft", p.shows_draft()}};
 }
 
+json command_gain_json(const CommandGain& g) {
+  if (!g.measured) return {{"measured", false}, {"why_not", g.why_not}};
+  json axes = json::array();
+  for (const auto& a : g.axes) {
+    json bands = json::array();
+    for (const auto& b : a.bands)
+      bands.push_back({{"low_hz", b.low_hz},
+                       {"high_hz", b.high_hz},
+                       {"gain", number_or_null(b.gain)},
+                       {"r", number_or_null(b.r)},
+                       {"delay_s", b.delay_s}});
+    axes.push_back({{"axis", a.name}, {"bands", bands}});
+  }
+  const auto& lead = g.axes.front().bands[CommandGain::kLeadBand];
+  return {{"measured", true},
+          {"samples", g.rows},
+          {"mean_command", g.hover_command},
+          {"thrust_scale", number_or_null(g.thrust_scale)},
+          {"model_slope", g.model_slope},
+          {"lead_band_hz", {lead.low_hz, lead.high_hz}},
+          {"axes", axes},
+          {"roll_pitch_gain", number_or_null(g.roll_pitch_gain())},
+          {"slope_looks_off", g.slope_looks_off()},
+          {"suggested_slope", g.slope_looks_off() ? json(g.suggested_slope()) : json(nullptr)},
+          {"note", "the airframe's answer to a change of rotor command over the base model's (1: the motor map's "
+                   "slope at the operating point is right); a lead, never a named cause"}};
+}
+
 json draft_signature_json(const DraftSignature& d) {
   if (!d.measured) return {{"measured", false}, {"why_not", d.why_not}};
   json parts = json::array();
@@ -432,6 +460,16 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     }
     j["draft_signature"]["per_flight"] = per;
   }
+  j["command_gain"] = command_gain_json(d.command_gain);
+  if (!d.command_gain_per_flight.empty()) {
+    json per = json::array();
+    for (size_t i = 0; i < d.command_gain_per_flight.size(); ++i) {
+      json one = command_gain_json(d.command_gain_per_flight[i]);
+      one["flight"] = i < d.flights.size() ? d.flights[i] : "";
+      per.push_back(one);
+    }
+    j["command_gain"]["per_flight"] = per;
+  }
   // Beyond the catalogue: one entry per channel, proposed or not (and why).
   json disc = json::array();
   for (const auto& t : d.discovered) {
@@ -674,6 +712,32 @@ std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d)
 }
 
 
+// One sentence for the printout and the report when the airframe's answer to the commands
+// puts the motor map's slope in doubt ("" otherwise: the JSON holds the bands).
+std::string command_gain_lead(const CommandGain& g) {
+  if (!g.slope_looks_off()) return "";
+  const auto& roll = g.axes[0].bands[CommandGain::kLeadBand];
+  const auto& pitch = g.axes[1].bands[CommandGain::kLeadBand];
+  const auto& vertical = g.axes[2].bands[CommandGain::kLeadBand];
+  return "lead (not a named cause): at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) +
+         " Hz the airframe answers a change of rotor command at " + num(roll.gain, 2) + " (roll, r = " + num(roll.r, 2) +
+         ", " + num(1000 * roll.delay_s, 2) + " ms later) and " + num(pitch.gain, 2) + " (pitch, r = " + num(pitch.r, 2) +
+         ", " + num(1000 * pitch.delay_s, 2) + " ms later) of what the base model's motor map gives, the vertical at " +
+         num(vertical.gain, 2) + "; the map's slope at the operating point (mean command " + num(g.hover_command, 2) +
+         ") looks off: if the map was measured on a stand, measure it in flight (motor_map slope " +
+         num(g.suggested_slope(), 2) + " with pivot " + num(g.hover_command, 2) + ")";
+}
+
+// The command-gain sentences, each with the flight it is about (as draft_leads).
+std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagnosis& d) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (std::string lead = command_gain_lead(d.command_gain); !lead.empty()) out.emplace_back("", std::move(lead));
+  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
+    if (std::string lead = command_gain_lead(d.command_gain_per_flight[i]); !lead.empty())
+      out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
+  return out;
+}
+
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
 // finding: say so beside the rollouts' numbers, which then show no gain (or a loss).
 std::string judged_by_text(const Finding& f) {
@@ -767,6 +831,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
   for (const auto& [flight, lead] : draft_leads(d))
     os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
+  for (const auto& [flight, lead] : command_gain_leads(d))
+    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
@@ -785,6 +851,38 @@ namespace {
 
 // Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
 // for which none is proposed.
+// The command-gain check as a table: per flight (or the one flight) and axis, the gain,
+// correlation and delay in each band; the leads below it.
+void command_gain_html(std::ostream& h, const Diagnosis& d) {
+  std::vector<std::pair<std::string, const CommandGain*>> rows;
+  if (d.command_gain_per_flight.empty()) rows.emplace_back("", &d.command_gain);
+  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
+    rows.emplace_back(d.flights[i], &d.command_gain_per_flight[i]);
+  const CommandGain* first = nullptr;
+  for (const auto& [flight, g] : rows)
+    if (g->measured && !first) first = g;
+  if (!first) return;
+  h << "<h2>The answer to the commands</h2>\n<p>Gain of the measured on the base model's accelerations, band by band "
+       "(1: the motor map's slope at the operating point is right), with the correlation and the delay of the model "
+       "that correlates best. The lowest band carries the controller's answer to slow disturbances.</p>\n"
+       "<table><tr>"
+    << (d.command_gain_per_flight.empty() ? "" : "<th>flight</th>") << "<th>axis</th>";
+  for (const auto& b : first->axes.front().bands) h << "<th>" << num(b.low_hz, 2) << "&ndash;" << num(b.high_hz, 2) << " Hz</th>";
+  h << "</tr>\n";
+  for (const auto& [flight, g] : rows) {
+    if (!g->measured) continue;
+    for (const auto& a : g->axes) {
+      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td>" + esc(flight) + "</td>") << "<td>" << esc(a.name) << "</td>";
+      for (const auto& b : a.bands)
+        h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
+      h << "</tr>\n";
+    }
+  }
+  h << "</table>\n";
+  for (const auto& [flight, lead] : command_gain_leads(d))
+    h << "<p class=\"warn\">" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+}
+
 void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
   if (d.discovered.empty()) return;
   h << "<h2>Beyond the catalogue: proposed terms</h2>\n<p>Sparse regression (sequentially thresholded least "
@@ -1009,6 +1107,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   }
   for (const auto& [flight, lead] : draft_leads(d))
     h << "<p>" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+  command_gain_html(h, d);
   discovered_terms_html(h, d);
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.

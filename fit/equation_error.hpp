@@ -56,6 +56,11 @@ class EquationErrorModel : public ResidualModel {
   // Residuals of all six channels of every row (rows() x 6), at these parameters.
   void all_channels(const double* p, std::vector<double>& r6) const;
   std::vector<double> all_channels(const std::vector<FitParameter>& ps) const;
+  // What the residuals compare the model with, in the same six channels of every row
+  // (rows() x 6): the filtered derivatives of the log (or its stored derivatives, pointwise),
+  // the accelerometer's specific force for the translation when it is used. The model's
+  // accelerations at p are all_channels(p) plus these.
+  std::vector<double> measured_channels() const;
   const Flight& flight() const { return flight_; }
 
  private:

@@ -1,0 +1,212 @@
+#include "diagnose/command_gain.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace quadgen::diagnose {
+
+namespace {
+
+constexpr int kVertical = 2, kRoll = 3, kPitch = 4;
+constexpr size_t kMinRows = 200;
+// A command this close to either end of its range is saturated (or the rotor is idle): the
+// motor does not follow the command there.
+constexpr double kIdle = 0.05, kSaturated = 0.99;
+
+// Where each contiguous stretch of rows begins: a step over three typical sample intervals
+// (a restart, or the gap between joined flights) starts a new one.
+std::vector<size_t> stretch_of_rows(const std::vector<double>& t, double* typical_step) {
+  std::vector<double> steps;
+  for (size_t k = 1; k < t.size(); ++k)
+    if (t[k] > t[k - 1]) steps.push_back(t[k] - t[k - 1]);
+  std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2), steps.end());
+  *typical_step = steps.empty() ? 0.0 : steps[steps.size() / 2];
+  std::vector<size_t> stretch(t.size(), 0);
+  for (size_t k = 1; k < t.size(); ++k) stretch[k] = stretch[k - 1] + (t[k] - t[k - 1] > 3 * *typical_step ? 1 : 0);
+  return stretch;
+}
+
+// Means of x over [t - w, t + w] within each row's stretch (two pointers over prefix sums).
+std::vector<double> running_mean(const std::vector<double>& t, const std::vector<size_t>& stretch,
+                                 const std::vector<double>& x, double w) {
+  const size_t n = t.size();
+  std::vector<double> sum(n + 1, 0.0), out(n, 0.0);
+  for (size_t k = 0; k < n; ++k) sum[k + 1] = sum[k] + x[k];
+  size_t lo = 0, hi = 0;
+  for (size_t k = 0; k < n; ++k) {
+    while (t[lo] < t[k] - w || stretch[lo] != stretch[k]) ++lo;
+    if (hi < k) hi = k;
+    while (hi + 1 < n && stretch[hi + 1] == stretch[k] && t[hi + 1] <= t[k] + w) ++hi;
+    out[k] = (sum[hi + 1] - sum[lo]) / static_cast<double>(hi + 1 - lo);
+  }
+  return out;
+}
+
+// x at t - delay by linear interpolation within the row's stretch (clamped at its start).
+std::vector<double> delayed(const std::vector<double>& t, const std::vector<size_t>& stretch,
+                            const std::vector<double>& x, double delay) {
+  std::vector<double> out(t.size());
+  size_t j = 0;
+  for (size_t k = 0; k < t.size(); ++k) {
+    const double at = t[k] - delay;
+    while (j < k && (stretch[j] != stretch[k] || t[j + 1] <= at)) ++j;
+    if (stretch[j] != stretch[k] || t[j] >= at || j == k) {
+      out[k] = x[j];
+      continue;
+    }
+    const double a = (at - t[j]) / (t[j + 1] - t[j]);
+    out[k] = (1 - a) * x[j] + a * x[j + 1];
+  }
+  return out;
+}
+
+struct Regression {
+  double slope = 0, r = 0;
+};
+
+Regression regress(const std::vector<double>& x, const std::vector<double>& y, const std::vector<size_t>& rows) {
+  double mx = 0, my = 0;
+  for (size_t k : rows) mx += x[k], my += y[k];
+  mx /= static_cast<double>(rows.size()), my /= static_cast<double>(rows.size());
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t k : rows) {
+    sxy += (x[k] - mx) * (y[k] - my);
+    sxx += (x[k] - mx) * (x[k] - mx);
+    syy += (y[k] - my) * (y[k] - my);
+  }
+  if (sxx <= 0 || syy <= 0) return {};
+  return {sxy / sxx, sxy / std::sqrt(sxx * syy)};
+}
+
+std::vector<double> channel(const std::vector<double>& rows6, int c, double offset) {
+  std::vector<double> out(rows6.size() / 6);
+  for (size_t k = 0; k < out.size(); ++k) out[k] = rows6[k * 6 + static_cast<size_t>(c)] + offset;
+  return out;
+}
+
+}  // namespace
+
+bool CommandGain::slope_looks_off() const {
+  if (!measured || axes.size() < 2) return false;
+  const Band& roll = axes[0].bands[kLeadBand];
+  const Band& pitch = axes[1].bands[kLeadBand];
+  if (roll.r < kMinR || pitch.r < kMinR) return false;
+  const double mean = roll_pitch_gain();
+  if (std::fabs(roll.gain - pitch.gain) > 0.25 * mean) return false;
+  return mean < kRightLow || mean > kRightHigh;
+}
+
+double CommandGain::roll_pitch_gain() const {
+  if (axes.size() < 2) return 0;
+  return 0.5 * (axes[0].bands[kLeadBand].gain + axes[1].bands[kLeadBand].gain);
+}
+
+CommandGain command_gain(const CommandGainInput& in) {
+  CommandGain g;
+  g.model_slope = in.model_slope;
+  const size_t n = in.t.size();
+  if (n < kMinRows || in.rotors == 0) {
+    g.why_not = "fewer than " + std::to_string(kMinRows) + " samples";
+    return g;
+  }
+  double step = 0;
+  const std::vector<size_t> stretch = stretch_of_rows(in.t, &step);
+  std::vector<double> first(stretch.back() + 1, 0.0), last(stretch.back() + 1, 0.0);
+  for (size_t k = n; k-- > 0;) first[stretch[k]] = in.t[k];
+  for (size_t k = 0; k < n; ++k) last[stretch[k]] = in.t[k];
+  const double widest = CommandGain::kBands[3][1];
+  std::vector<size_t> rows;
+  double command_sum = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const auto u = in.commands.begin() + static_cast<long>(k * in.rotors);
+    const auto [lo, hi] = std::minmax_element(u, u + static_cast<long>(in.rotors));
+    const bool inside = in.t[k] - CommandGain::kMaxDelay - widest >= first[stretch[k]] && in.t[k] + widest <= last[stretch[k]];
+    if (!inside || *lo <= kIdle || *hi >= kSaturated) continue;
+    rows.push_back(k);
+    for (size_t i = 0; i < in.rotors; ++i) command_sum += u[static_cast<long>(i)];
+  }
+  if (rows.size() < kMinRows || step <= 0) {
+    g.why_not = "fewer than " + std::to_string(kMinRows) + " samples with every rotor between idle and saturation";
+    return g;
+  }
+  g.rows = rows.size();
+  g.hover_command = command_sum / static_cast<double>(rows.size() * in.rotors);
+  const std::vector<double> model_v = channel(in.model, kVertical, in.vertical_offset);
+  const std::vector<double> measured_v = channel(in.measured, kVertical, in.vertical_offset);
+  double sum_model = 0, sum_measured = 0;
+  for (size_t k : rows) sum_model += model_v[k], sum_measured += measured_v[k];
+  if (sum_model <= 0 || sum_measured <= 0) {
+    g.why_not = "the model or the log does not hold the vehicle up over these samples";
+    return g;
+  }
+  g.thrust_scale = sum_measured / sum_model;
+  const auto band = [&](const std::vector<double>& x, size_t b) {
+    const std::vector<double> fine = running_mean(in.t, stretch, x, CommandGain::kBands[b][0]);
+    const std::vector<double> coarse = running_mean(in.t, stretch, x, CommandGain::kBands[b][1]);
+    std::vector<double> out(x.size());
+    for (size_t k = 0; k < x.size(); ++k) out[k] = fine[k] - coarse[k];
+    return out;
+  };
+  const int delays = static_cast<int>(std::floor(CommandGain::kMaxDelay / step + 1e-9));
+  static const std::pair<const char*, int> kAxes[] = {{"roll", kRoll}, {"pitch", kPitch}, {"vertical", kVertical}};
+  for (const auto& [name, c] : kAxes) {
+    CommandGain::Axis axis;
+    axis.name = name;
+    const double offset = c == kVertical ? in.vertical_offset : 0.0;
+    const std::vector<double> model = channel(in.model, c, offset), measured = channel(in.measured, c, offset);
+    for (size_t b = 0; b < 4; ++b) {
+      CommandGain::Band best;
+      best.low_hz = 0.5 / CommandGain::kBands[b][1], best.high_hz = 0.5 / CommandGain::kBands[b][0];
+      best.r = -2;
+      const std::vector<double> y = band(measured, b);
+      for (int d = 0; d <= delays; ++d) {
+        const Regression fit = regress(band(delayed(in.t, stretch, model, d * step), b), y, rows);
+        if (fit.r <= best.r) continue;
+        best.r = fit.r, best.gain = fit.slope / g.thrust_scale, best.delay_s = d * step;
+      }
+      axis.bands.push_back(best);
+    }
+    g.axes.push_back(axis);
+  }
+  g.measured = true;
+  return g;
+}
+
+CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std::vector<double>& p, const Vehicle& v,
+                                    double g, bool accelerometer) {
+  CommandGainInput in;
+  in.rotors = v.rotors.size();
+  in.vertical_offset = accelerometer ? 0.0 : g;
+  if (const auto slope = v.params.find("motor_slope"); slope != v.params.end()) in.model_slope = slope->second.nominal;
+  in.measured = ee.measured_channels();
+  ee.all_channels(p.data(), in.model);
+  for (size_t i = 0; i < in.model.size(); ++i) in.model[i] += in.measured[i];
+  for (size_t k : ee.rows()) {
+    const auto& s = ee.flight().samples[k];
+    in.t.push_back(s.t);
+    in.commands.insert(in.commands.end(), s.u.begin(), s.u.begin() + static_cast<long>(in.rotors));
+  }
+  return in;
+}
+
+std::vector<CommandGainInput> split_by_flight(const CommandGainInput& in, const std::vector<double>& starts) {
+  std::vector<CommandGainInput> out;
+  for (size_t f = 0; f < starts.size(); ++f) {
+    CommandGainInput one;
+    one.rotors = in.rotors, one.vertical_offset = in.vertical_offset, one.model_slope = in.model_slope;
+    const double end = f + 1 < starts.size() ? starts[f + 1] : INFINITY;
+    for (size_t k = 0; k < in.t.size(); ++k) {
+      if (in.t[k] < starts[f] || in.t[k] >= end) continue;
+      one.t.push_back(in.t[k]);
+      one.model.insert(one.model.end(), in.model.begin() + static_cast<long>(k * 6), in.model.begin() + static_cast<long>(k * 6 + 6));
+      one.measured.insert(one.measured.end(), in.measured.begin() + static_cast<long>(k * 6),
+                          in.measured.begin() + static_cast<long>(k * 6 + 6));
+      one.commands.insert(one.commands.end(), in.commands.begin() + static_cast<long>(k * in.rotors),
+                          in.commands.begin() + static_cast<long>((k + 1) * in.rotors));
+    }
+    out.push_back(std::move(one));
+  }
+  return out;
+}
+
+}  // namespace quadgen::diagnose
