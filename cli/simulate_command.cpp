@@ -59,6 +59,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--yaw-per-speed", a.job.flight.yaw_per_forward_speed,
                 "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)")
       ->check(finite_range(-50.0, 50.0))->needs(cl);
+  c->add_option("--angular-disturbance", a.job.flight.angular_disturbance,
+                "closed loop: random roll and pitch angular acceleration, 10 Hz low-passed white noise [rad/s^2 RMS] (outside the catalogue)")
+      ->check(finite_range(0.0, 100.0))->needs(cl);
   c->add_option("--duration", a.job.duration, "simulated time [s]")
       ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")

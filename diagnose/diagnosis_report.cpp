@@ -723,9 +723,11 @@ std::string command_gain_lead(const CommandGain& g) {
          " Hz the airframe answers a change of rotor command at " + num(roll.gain, 2) + " (roll, r = " + num(roll.r, 2) +
          ", " + num(1000 * roll.delay_s, 2) + " ms later) and " + num(pitch.gain, 2) + " (pitch, r = " + num(pitch.r, 2) +
          ", " + num(1000 * pitch.delay_s, 2) + " ms later) of what the base model's motor map gives, the vertical at " +
-         num(vertical.gain, 2) + "; the map's slope at the operating point (mean command " + num(g.hover_command, 2) +
-         ") looks off: if the map was measured on a stand, measure it in flight (motor_map slope " +
-         num(g.suggested_slope(), 2) + " with pivot " + num(g.hover_command, 2) + ")";
+         num(vertical.gain, 2) + " (r = " + num(vertical.r, 2) + "). Either the motor map's slope at the operating " +
+         "point (mean command " + num(g.hover_command, 2) + ") is off (a map measured on a stand: motor_map slope " +
+         num(g.suggested_slope(), 2) + " with pivot " + num(g.hover_command, 2) + ") or the controller answers a " +
+         "disturbance in this band, which reads the same in closed loop; a flight with a known excitation added to " +
+         "the rate set points separates them";
 }
 
 // The command-gain sentences, each with the flight it is about (as draft_leads).

@@ -197,12 +197,22 @@ size_t block_opener(const std::string& s) {
 
 std::string markdown_text(const std::string& s) {
   // Inline Markdown (and GitHub's $ math): these change how the text around them renders.
-  static const std::string punctuation = "\\`*_[]|$~";
+  // '@' too, the ':' of "://" and the '.' of "www.": GitHub turns a bare https://...,
+  // www.... or name@host into a link, and a link is what a hostile description wants.
+  static const std::string punctuation = "\\`*_[]|$~@";
   const size_t opener = block_opener(s);
+  const auto after_www = [&](size_t at) {
+    if (at < 3) return false;
+    for (size_t k = at - 3; k < at; ++k)
+      if (s[k] != 'w' && s[k] != 'W') return false;
+    return true;
+  };
   std::string out;
   size_t at = 0;
   for_each_char(s, [&](const std::string& c) {
-    if ((c.size() == 1 && punctuation.find(c[0]) != std::string::npos) || at == opener) out += "\\" + c;
+    const bool scheme = c == ":" && s.compare(at + 1, 2, "//") == 0;
+    const bool special = c.size() == 1 && (punctuation.find(c[0]) != std::string::npos || scheme || (c[0] == '.' && after_www(at)));
+    if (special || at == opener) out += "\\" + c;
     else out += html_text(c);
     at += c.size();
   });

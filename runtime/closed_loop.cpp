@@ -141,6 +141,11 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   IntegratorOptions io;
   io.step = o.sim_step;
   io.divergence_bound = 1e4;
+  // Its own random stream, so that a flight without it is the same as before it existed.
+  std::mt19937 disturbance_rng(o.seed + 7919);
+  const double disturbance_pole = std::exp(-2 * M_PI * 10.0 * dt);
+  const double disturbance_gain = o.angular_disturbance * std::sqrt(1 - disturbance_pole * disturbance_pole);
+  double disturbance[2] = {0, 0};
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
     // Battery: open-circuit voltage falling over the flight, and a drop under load (the
@@ -245,6 +250,11 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
         x[3 + a] -= o.tether_stiffness * (x[a] - start[0]) / b.mass * dt;
       }
     }
+    if (o.angular_disturbance > 0)  // impulse of the disturbance over the period
+      for (int a = 0; a < 2; ++a) {
+        disturbance[a] = disturbance_pole * disturbance[a] + disturbance_gain * gauss(disturbance_rng);
+        x[10 + a] += disturbance[a] * dt;
+      }
     if (o.yaw_per_forward_speed != 0) {  // impulse of the yaw moment over the period
       const Rotation R = rotation_matrix(&x[6]);
       const double forward = R.m[0][0] * x[3] + R.m[1][0] * x[4] + R.m[2][0] * x[5];  // (R^T v)_x

@@ -45,6 +45,12 @@ struct ClosedLoopOptions {
   // Another, within the vocabulary of diagnose's term discovery: a yaw acceleration in
   // proportion to the forward body speed (a bent part acting as a rudder) [rad/s^2 per m/s].
   double yaw_per_forward_speed = 0;
+  // A third: a random roll and pitch angular acceleration [rad/s^2 RMS per axis], white
+  // noise through a first-order low-pass at 10 Hz (propwash, turbulence, anything the
+  // model lacks). The controller answers it within its bandwidth, so that the commands
+  // correlate with what disturbs the vehicle: the closed-loop bias of a fitted answer to the
+  // commands (diagnose/command_gain.hpp) is measured on such flights.
+  double angular_disturbance = 0;
   int command_levels = 65535;  // quantisation of logged/applied commands (16-bit PWM)
   double vbat_start = 4.15, vbat_end = 3.75;  // V, open-circuit sag over the flight (logged)
   double vbat_load_drop = 0.15;  // V, extra drop per unit of relative load above hover (internal resistance)

@@ -86,17 +86,17 @@ def best_gain(drive, response, idx, lo, hi):
 
 
 def columns(rows):
-    """Column names of commands, gyro and vertical specific force, and the latter's scale to
-    m/s^2: a NanoBench log's, or quadgen's canonical layout (a simulated flight)."""
+    """Column names of commands, gyro and vertical specific force, the latter's scale to
+    m/s^2, and the height: a NanoBench log's, or quadgen's canonical layout (a simulated flight)."""
     if "u_M1" in rows[0]:
-        return [f"u_M{i}" for i in (1, 2, 3, 4)], 1.0, ("p", "q"), "az", 1.0
-    return [f"motor_motor_m{i}" for i in (1, 2, 3, 4)], 1 / 65535, ("imu_gyro_x", "imu_gyro_y"), "imu_acc_z", G
+        return [f"u_M{i}" for i in (1, 2, 3, 4)], 1.0, ("p", "q"), "az", 1.0, "z"
+    return [f"motor_motor_m{i}" for i in (1, 2, 3, 4)], 1 / 65535, ("imu_gyro_x", "imu_gyro_y"), "imu_acc_z", G, "pz"
 
 
 def analyse(path):
     (a0, a1, a2), mass, j_xx, j_yy, arm = vehicle()
     rows = list(csv.DictReader(open(path)))
-    motor_cols, u_scale, (gyro_x, gyro_y), acc_z, acc_scale = columns(rows)
+    motor_cols, u_scale, (gyro_x, gyro_y), acc_z, acc_scale, z_col = columns(rows)
     t = [float(r["t"]) for r in rows]
     u = [[float(r[c]) * u_scale for r in rows] for c in motor_cols]
     thrust = [[(a0 + a1 * x + a2 * x * x) ** 2 for x in ui] for ui in u]  # up to the thrust constant
@@ -111,8 +111,13 @@ def analyse(path):
         return [0.0] + [(w[k + 1] - w[k - 1]) / (t[k + 1] - t[k - 1]) for k in range(1, n - 1)] + [0.0]
     p_dot, q_dot = rate_dot(gyro_x), rate_dot(gyro_y)
     a_z = [float(r[acc_z]) * acc_scale for r in rows]
-    # Airborne, no rotor saturated, away from the ends (the widest running mean).
-    idx = [k for k in range(70, n - 70) if min(u[i][k] for i in range(4)) > 0.3 and max(u[i][k] for i in range(4)) < 0.99]
+    # Airborne (above 0.1 m, as quadgen's loader keeps samples: on the ground the
+    # accelerometer does not follow the thrust), no rotor saturated, away from the ends (the
+    # widest running mean). Before 2026-11-28 the height was not checked, and the take-off and
+    # landing rows pulled the collective's gain down to 0.3-0.4 (docs/crazyflie_evidence.md).
+    z = [float(r[z_col]) for r in rows]
+    idx = [k for k in range(70, n - 70) if min(u[i][k] for i in range(4)) > 0.3 and max(u[i][k] for i in range(4)) < 0.99
+           and min(z[max(0, k - 60):k + 61]) > 0.1]
     k_over_m = sum(a_z[k] for k in idx) / sum(total[k] for k in idx)  # the hover's thrust constant / mass
     expected = {"collective": k_over_m, "roll": k_over_m * mass * arm / j_xx, "pitch": k_over_m * mass * arm / j_yy}
     out = {}

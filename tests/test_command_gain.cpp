@@ -156,3 +156,39 @@ TEST(CommandGain, RecoversTheMotorMapSlopeOfAGeneratedClosedLoopFlight) {
   EXPECT_NEAR(through_stock.suggested_slope(), 0.6, 0.06);
   EXPECT_FALSE(through_own.slope_looks_off());
 }
+
+// The check's limit, measured: a closed loop that answers a disturbance puts into the
+// commands what opposes it, and the answer to the commands reads low where the controller
+// acts. The stock Crazyflie (slope 1) flown with and without a random roll/pitch
+// disturbance: without, every band reads 1; with it, the lowest band reads well below 1.
+// So a gain below 1 alone does not tell a slope error from a disturbed closed loop
+// (docs/crazyflie_evidence.md section 8; the lead says so).
+TEST(CommandGain, ADisturbedClosedLoopReadsLowBelowTheControllersBandwidth) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_command_gain_disturbed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Vehicle v = load_vehicle(test::source_path("vehicles/crazyflie21.yaml"));
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const auto measure = [&](double disturbance) {
+    const std::string log = (dir / ("flight_" + std::to_string(disturbance) + ".csv")).string();
+    const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/crazyflie21.yaml") +
+                            " --closed-loop --duration 40 --seed 2 --excitation 0.3 --gyro-noise 0.01 --accel-noise 0.05"
+                            " --angular-disturbance " + std::to_string(disturbance) + " --out " + log + " > /dev/null 2>&1";
+    EXPECT_EQ(std::system(sim.c_str()), 0) << sim;
+    runtime::CompiledModel<quadgen_generated::crazyflie21::Model> model;
+    const fit::Flight flight = fit::load_flight(runtime::read_csv(log), rotors, {});
+    const fit::EquationErrorModel ee(model, flight, false);
+    return command_gain(command_gain_input(ee, model.params(), v, model.params()[model.param_index("g")], false));
+  };
+  const CommandGain calm = measure(0), disturbed = measure(6);
+  ASSERT_TRUE(calm.measured && disturbed.measured);
+  for (size_t a = 0; a < 2; ++a) {
+    for (const auto& b : calm.axes[a].bands) EXPECT_NEAR(b.gain, 1.0, 0.06) << calm.axes[a].name << " " << b.low_hz << " Hz";
+    const double lowest = disturbed.axes[a].bands.back().gain;
+    std::cout << disturbed.axes[a].name << ", disturbed: " << lowest << " below 2 Hz, "
+              << disturbed.axes[a].bands[CommandGain::kLeadBand].gain << " at 4-8 Hz\n";
+    EXPECT_LT(lowest, 0.85) << disturbed.axes[a].name;
+  }
+  EXPECT_FALSE(calm.slope_looks_off());
+}

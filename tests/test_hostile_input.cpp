@@ -407,6 +407,16 @@ TEST(Sinks, MarkdownAndLatexTextStayText) {
   EXPECT_NE(md.find("&lt;script&gt;"), std::string::npos);
 }
 
+// GitHub's autolinks (extended: bare https://, www., e-mail addresses) turn a description
+// into a clickable link; escaped, they stay text. The escapes are what CommonMark defines for
+// ASCII punctuation, so the text reads the same.
+TEST(Sinks, MarkdownLeavesNoBareLink) {
+  EXPECT_EQ(out::markdown_text("see https://evil.example/x"), "see https\\://evil.example/x");
+  EXPECT_EQ(out::markdown_text("WWW.evil.example"), "WWW\\.evil.example");
+  EXPECT_EQ(out::markdown_text("me@evil.example"), "me\\@evil.example");
+  EXPECT_EQ(out::markdown_text("a.b www, ratio 1:2"), "a.b www, ratio 1:2");  // a '.' or ':' elsewhere stays
+}
+
 // What opens a block at the start of a line is escaped there (a description is a paragraph
 // of its own in derivation.md): "# Owned heading" rendered as a heading.
 TEST(Sinks, MarkdownLineStartsOpenNoBlock) {
