@@ -114,8 +114,11 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   auto derived = [&](const std::string& name, const std::string& unit, double value, const std::string& doc) {
     auto it = c.vehicle.derived_overrides.find(name);
     if (it != c.vehicle.derived_overrides.end()) {
-      check_derived_bounds(c.vehicle, name, unit, value, it->second);
-      c.add_param(name, unit, value, it->second.lower, it->second.upper, it->second.fit, doc);
+      const bool given = c.vehicle.derived_given.count(name) > 0;  // the file's value, not the blocks'
+      if (given) value = it->second.nominal;
+      else check_derived_bounds(c.vehicle, name, unit, value, it->second);
+      c.add_param(name, unit, value, it->second.lower, it->second.upper, it->second.fit,
+                  given ? doc + " (given in the vehicle file, not the blocks')" : doc);
     } else
       c.add_param(name, unit, value, value, value, false, doc);
   };

@@ -97,17 +97,13 @@ std::vector<std::pair<int, size_t>> EquationErrorModel::commanded_speed_columns(
   std::vector<bool> data_side(np, false);
   for (int c : data_side_.indices())
     if (c >= 0) data_side[c] = true;
-  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
-  std::vector<double> x(n), u(nu), f(n), B(static_cast<size_t>(n) * np);
+  std::vector<double> x(n), u(nu, 0.0), f(n), B(static_cast<size_t>(n) * np);
   model_->restrict_param_jacobian({});
   for (size_t k = 0; k < flight_.samples.size(); ++k) {
     const FlightSample& s = flight_.samples[k];
     std::copy(s.x.begin(), s.x.end(), x.begin());
     for (int i : speed_states_) x[i] = 0;
-    std::fill(u.begin(), u.end(), 0.0);
-    std::copy(s.u.begin(), s.u.end(), u.begin());
-    if (t_in >= 0) u[t_in] = s.t;
-    if (v_in >= 0) u[v_in] = s.vbat;
+    inputs_at(s, s.t, u.data());
     model_->rhs(x.data(), u.data(), f.data(), nullptr, B.data(), nullptr);
     for (int c = 0; c < np; ++c) {
       if (data_side[c]) continue;  // already differentiated on the data side
@@ -217,6 +213,12 @@ std::vector<double> EquationErrorModel::measured_channels() const {
   return m;
 }
 
+void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, double* u) const {
+  commands_at(command_time, u);
+  if (const int t_in = model_->input_index("t"); t_in >= 0) u[t_in] = s.t;
+  if (const int v_in = model_->input_index("vbat"); v_in >= 0) u[v_in] = s.vbat;
+}
+
 void EquationErrorModel::commands_at(double t, double* u) const {
   const auto& S = flight_.samples;
   const auto it = std::lower_bound(S.begin(), S.end(), t, [](const FlightSample& s, double v) { return s.t < v; });
@@ -244,7 +246,6 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   const size_t ns = flight_.samples.size();
   X.assign(ns * n, 0.0);
   U.assign(ns * nu, 0.0);
-  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
   // The data-side values in effect at each sample (one per flight in a per-flight model);
   // the lags are kept for the rotor-speed filter below.
   std::vector<double> tau(ns, 0.0);
@@ -258,9 +259,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, x + 6);
     // The commands logged at t_k - d act now (held until the next sample; between
     // samples the linear interpolation is their average over the interval).
-    commands_at(s.t - e.delay, u);
-    if (t_in >= 0) u[t_in] = s.t;
-    if (v_in >= 0) u[v_in] = s.vbat;
+    inputs_at(s, s.t - e.delay, u);
   }
   if (speed_states_.empty()) return;
   // Rotor speeds: the commanded speed (the model's dw/dt at w = 0, times tau) through the

@@ -134,6 +134,9 @@ class EquationErrorModel : public ResidualModel {
   // Only the samples in `span` are filled (the others stay zero).
   void prepare(const double* p, std::vector<double>& X, std::vector<double>& U, SampleSpan span) const;
   void commands_at(double t, double* u) const;  // rotor commands interpolated at t
+  // The model's inputs at sample s with the commands logged at command_time (s.t less a
+  // delay): the rotor commands, and the time and battery voltage where the model has them.
+  void inputs_at(const FlightSample& s, double command_time, double* u) const;
   SampleSpan all_samples() const { return {0, flight_.samples.size()}; }
   // First and one-past-last residual row whose sample lies in `span`.
   std::pair<size_t, size_t> rows_in(SampleSpan span) const;

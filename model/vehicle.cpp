@@ -244,15 +244,21 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
     for (const auto& kv : d) {
       const std::string key = kv.first.as<std::string>();
       const YAML::Node spec = kv.second;
-      r.require_map(spec, "fit and bounds of derived quantity " + key);
-      r.only_keys(spec, {"fit", "bounds"}, "derived quantity " + key);
-      if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds");
-      // The nominal value comes from the blocks; parse bounds via a dummy value inside them.
-      YAML::Node tmp;
-      tmp["value"] = spec["bounds"][0];
-      tmp["bounds"] = spec["bounds"];
-      if (spec["fit"]) tmp["fit"] = spec["fit"];
-      v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
+      r.require_map(spec, "fit and bounds (or a value) of derived quantity " + key);
+      r.only_keys(spec, {"fit", "bounds", "value", "unit", "source"}, "derived quantity " + key);
+      if (spec["value"]) {  // given: it replaces the blocks' value
+        v.derived_overrides[key] = r.parameter(spec, key, derived_units.at(key), "");
+        v.derived_given.insert(key);
+      } else {
+        if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds (or a value)");
+        if (spec["unit"]) r.fail(spec["unit"], "derived quantity " + key + ": a unit belongs to a value");
+        // The nominal value comes from the blocks; parse bounds via a dummy value inside them.
+        YAML::Node tmp;
+        tmp["value"] = spec["bounds"][0];
+        tmp["bounds"] = spec["bounds"];
+        if (spec["fit"]) tmp["fit"] = spec["fit"];
+        v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
+      }
       v.derived_overrides[key].line = kv.first.Mark().line + 1;
     }
   }

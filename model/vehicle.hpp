@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <map>
+#include <set>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -54,6 +55,9 @@ struct Vehicle {
   std::map<std::string, Parameter> params;
   // Fit flags and bounds for quantities derived from the blocks (mass, J_xx, ...).
   std::map<std::string, Parameter> derived_overrides;
+  // Those of them whose value the file gives (measured, or measured in flight): it replaces
+  // the blocks' value as the nominal one.
+  std::set<std::string> derived_given;
   // The file carries a `fitted:` section (effects and fitted values, as fitted_parameters.yaml
   // holds them, written by quadgen diagnose into fitted_vehicle.yaml): `quadgen derive` then
   // builds the fitted model. Read by derive's load_fitted_parameters, at this line.

@@ -239,3 +239,26 @@ TEST(VehicleInput, MotorSlopeNeedsItsPivot) {
   expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: 0.5, unit: \"1\"}\n  pivot: {value: 1.5, unit: \"1\"}"),
                "'pivot' is a command, expected 0..1");
 }
+
+// A derived quantity given a value (measured apart, e.g. an inertia from a pendulum test or
+// from flight) replaces the blocks' value as the nominal one; without a value the blocks'
+// stays. File:line errors for a value of the wrong dimension, a unit without a value, a
+// fitted value without bounds, and bounds-only entries without bounds.
+TEST(VehicleInput, DerivedQuantityGivenAValueReplacesTheBlocks) {
+  const std::string line = "  mass: {fit: false, bounds: [0.2, 0.8]}";
+  const Vehicle blocks = parse_vehicle(finken_text(), "ok.yaml");
+  const Vehicle given = parse_vehicle(replace(finken_text(), line, line + "\n  J_xx: {value: 1.5, unit: \"g m^2\"}"), "ok.yaml");
+  const auto nominal = [](const Vehicle& v, const std::string& name) {
+    const SymbolicModel m = derive_model(v, derive_mass_properties(v), {});
+    return m.params[m.param_index(name)];
+  };
+  EXPECT_DOUBLE_EQ(nominal(given, "J_xx").nominal, 1.5e-3);
+  EXPECT_EQ(nominal(given, "J_xx").lower, nominal(given, "J_xx").upper);  // held
+  EXPECT_NE(nominal(given, "J_xx").doc.find("given in the vehicle file"), std::string::npos);
+  EXPECT_DOUBLE_EQ(nominal(given, "J_yy").nominal, nominal(blocks, "J_yy").nominal);
+  EXPECT_NE(nominal(blocks, "J_xx").nominal, 1.5e-3);
+  expect_error(replace(finken_text(), line, line + "\n  J_xx: {value: 1.5, unit: kg}"), "must have dimension");
+  expect_error(replace(finken_text(), line, line + "\n  J_xx: {unit: \"kg m^2\", bounds: [0, 1]}"), "a unit belongs to a value");
+  expect_error(replace(finken_text(), line, line + "\n  J_xx: {value: 0.001, fit: true}"), "no bounds");
+  expect_error(replace(finken_text(), line, line + "\n  J_xx: {fit: true}"), "needs bounds (or a value)");
+}
