@@ -658,6 +658,28 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
                     series("", lag, nband)}});
   }
   render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
+  // The answer to the commands, band by band: one series per flight, 1 where the model is right.
+  std::vector<std::pair<std::string, const CommandGain*>> gains;
+  if (d.command_gain_per_flight.empty()) gains.emplace_back("this flight", &d.command_gain);
+  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
+    gains.emplace_back(std::filesystem::path(d.flights[i]).stem().string(), &d.command_gain_per_flight[i]);
+  std::vector<runtime::Panel> gain_panels;
+  for (size_t a = 0; a < 3; ++a) {
+    runtime::Panel panel{"", "band centre [Hz]", "gain (1: as the model)", {}};
+    std::vector<double> hz;
+    for (const auto& [flight, g] : gains) {
+      if (!g->measured || g->axes.size() <= a) continue;
+      panel.title = g->axes[a].name + ": measured over the base model's answer to the commands";
+      std::vector<double> x, y;
+      for (const auto& b : g->axes[a].bands) x.push_back(std::sqrt(b.low_hz * b.high_hz)), y.push_back(b.gain);
+      hz = x;
+      panel.series.push_back(series(flight, x, y, 1, true));
+    }
+    if (hz.empty()) continue;
+    panel.series.push_back(series("the model", hz, std::vector<double>(hz.size(), 1.0)));
+    gain_panels.push_back(panel);
+  }
+  if (!gain_panels.empty()) render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
   if (d.has_prediction)
     render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
            predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
