@@ -84,6 +84,65 @@ std::vector<double> channel(const std::vector<double>& rows6, int c, double offs
   return out;
 }
 
+
+
+// The rows' clock: contiguous stretches and the typical step, and the band-pass and the
+// delay on it.
+struct Clock {
+  const std::vector<double>& t;
+  double step = 0;               // before `stretch`: stretch_of_rows sets it
+  std::vector<size_t> stretch;
+  explicit Clock(const std::vector<double>& times) : t(times), stretch(stretch_of_rows(times, &step)) {}
+  std::vector<double> band(const std::vector<double>& x, size_t b) const {
+    const std::vector<double> fine = running_mean(t, stretch, x, CommandGain::kBands[b][0]);
+    const std::vector<double> coarse = running_mean(t, stretch, x, CommandGain::kBands[b][1]);
+    std::vector<double> out(x.size());
+    for (size_t k = 0; k < x.size(); ++k) out[k] = fine[k] - coarse[k];
+    return out;
+  }
+  std::vector<double> delayed_by(const std::vector<double>& x, double delay) const { return delayed(t, stretch, x, delay); }
+};
+
+// The rows whose widest window (and the longest delay before it) lies within their stretch
+// and at which every rotor is between idle and saturation; their mean command.
+std::vector<size_t> usable_rows(const CommandGainInput& in, const Clock& clock, double* mean_command) {
+  const size_t n = in.t.size();
+  std::vector<double> first(clock.stretch.back() + 1, 0.0), last(clock.stretch.back() + 1, 0.0);
+  for (size_t k = n; k-- > 0;) first[clock.stretch[k]] = in.t[k];
+  for (size_t k = 0; k < n; ++k) last[clock.stretch[k]] = in.t[k];
+  const double widest = CommandGain::kBands[3][1];
+  std::vector<size_t> rows;
+  double sum = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const auto u = in.commands.begin() + static_cast<long>(k * in.rotors);
+    const auto [lo, hi] = std::minmax_element(u, u + static_cast<long>(in.rotors));
+    const size_t s = clock.stretch[k];
+    const bool inside = in.t[k] - CommandGain::kMaxDelay - widest >= first[s] && in.t[k] + widest <= last[s];
+    if (!inside || *lo <= kIdle || *hi >= kSaturated) continue;
+    rows.push_back(k);
+    for (size_t i = 0; i < in.rotors; ++i) sum += u[static_cast<long>(i)];
+  }
+  *mean_command = rows.empty() ? 0.0 : sum / static_cast<double>(rows.size() * in.rotors);
+  return rows;
+}
+
+// Band b of one axis: the measured regressed on the model's at each whole-step delay up to
+// kMaxDelay, kept at the delay of the highest correlation.
+CommandGain::Band best_band(const Clock& clock, const std::vector<double>& model, const std::vector<double>& measured,
+                            const std::vector<size_t>& rows, size_t b, double thrust_scale) {
+  CommandGain::Band best;
+  best.low_hz = 0.5 / CommandGain::kBands[b][1], best.high_hz = 0.5 / CommandGain::kBands[b][0];
+  best.r = -2;
+  const std::vector<double> y = clock.band(measured, b);
+  const int delays = static_cast<int>(std::floor(CommandGain::kMaxDelay / clock.step + 1e-9));
+  for (int d = 0; d <= delays; ++d) {
+    const Regression fit = regress(clock.band(clock.delayed_by(model, d * clock.step), b), y, rows);
+    if (fit.r <= best.r) continue;
+    best.r = fit.r, best.gain = fit.slope / thrust_scale, best.delay_s = d * clock.step;
+  }
+  return best;
+}
+
 }  // namespace
 
 bool CommandGain::slope_looks_off() const {
@@ -104,33 +163,18 @@ double CommandGain::roll_pitch_gain() const {
 CommandGain command_gain(const CommandGainInput& in) {
   CommandGain g;
   g.model_slope = in.model_slope;
-  const size_t n = in.t.size();
-  if (n < kMinRows || in.rotors == 0) {
+  if (in.t.size() < kMinRows || in.rotors == 0) {
     g.why_not = "fewer than " + std::to_string(kMinRows) + " samples";
     return g;
   }
-  double step = 0;
-  const std::vector<size_t> stretch = stretch_of_rows(in.t, &step);
-  std::vector<double> first(stretch.back() + 1, 0.0), last(stretch.back() + 1, 0.0);
-  for (size_t k = n; k-- > 0;) first[stretch[k]] = in.t[k];
-  for (size_t k = 0; k < n; ++k) last[stretch[k]] = in.t[k];
-  const double widest = CommandGain::kBands[3][1];
-  std::vector<size_t> rows;
-  double command_sum = 0;
-  for (size_t k = 0; k < n; ++k) {
-    const auto u = in.commands.begin() + static_cast<long>(k * in.rotors);
-    const auto [lo, hi] = std::minmax_element(u, u + static_cast<long>(in.rotors));
-    const bool inside = in.t[k] - CommandGain::kMaxDelay - widest >= first[stretch[k]] && in.t[k] + widest <= last[stretch[k]];
-    if (!inside || *lo <= kIdle || *hi >= kSaturated) continue;
-    rows.push_back(k);
-    for (size_t i = 0; i < in.rotors; ++i) command_sum += u[static_cast<long>(i)];
-  }
-  if (rows.size() < kMinRows || step <= 0) {
+  const Clock clock(in.t);
+  const std::vector<size_t> rows = usable_rows(in, clock, &g.hover_command);
+  if (rows.size() < kMinRows || clock.step <= 0) {
     g.why_not = "fewer than " + std::to_string(kMinRows) + " samples with every rotor between idle and saturation";
     return g;
   }
   g.rows = rows.size();
-  g.hover_command = command_sum / static_cast<double>(rows.size() * in.rotors);
+  // The hover's thrust scale: mean measured over mean model vertical thrust per mass.
   const std::vector<double> model_v = channel(in.model, kVertical, in.vertical_offset);
   const std::vector<double> measured_v = channel(in.measured, kVertical, in.vertical_offset);
   double sum_model = 0, sum_measured = 0;
@@ -140,32 +184,12 @@ CommandGain command_gain(const CommandGainInput& in) {
     return g;
   }
   g.thrust_scale = sum_measured / sum_model;
-  const auto band = [&](const std::vector<double>& x, size_t b) {
-    const std::vector<double> fine = running_mean(in.t, stretch, x, CommandGain::kBands[b][0]);
-    const std::vector<double> coarse = running_mean(in.t, stretch, x, CommandGain::kBands[b][1]);
-    std::vector<double> out(x.size());
-    for (size_t k = 0; k < x.size(); ++k) out[k] = fine[k] - coarse[k];
-    return out;
-  };
-  const int delays = static_cast<int>(std::floor(CommandGain::kMaxDelay / step + 1e-9));
   static const std::pair<const char*, int> kAxes[] = {{"roll", kRoll}, {"pitch", kPitch}, {"vertical", kVertical}};
   for (const auto& [name, c] : kAxes) {
     CommandGain::Axis axis;
     axis.name = name;
-    const double offset = c == kVertical ? in.vertical_offset : 0.0;
-    const std::vector<double> model = channel(in.model, c, offset), measured = channel(in.measured, c, offset);
-    for (size_t b = 0; b < 4; ++b) {
-      CommandGain::Band best;
-      best.low_hz = 0.5 / CommandGain::kBands[b][1], best.high_hz = 0.5 / CommandGain::kBands[b][0];
-      best.r = -2;
-      const std::vector<double> y = band(measured, b);
-      for (int d = 0; d <= delays; ++d) {
-        const Regression fit = regress(band(delayed(in.t, stretch, model, d * step), b), y, rows);
-        if (fit.r <= best.r) continue;
-        best.r = fit.r, best.gain = fit.slope / g.thrust_scale, best.delay_s = d * step;
-      }
-      axis.bands.push_back(best);
-    }
+    const std::vector<double> model = channel(in.model, c, 0.0), measured = channel(in.measured, c, 0.0);
+    for (size_t b = 0; b < 4; ++b) axis.bands.push_back(best_band(clock, model, measured, rows, b, g.thrust_scale));
     g.axes.push_back(axis);
   }
   g.measured = true;
