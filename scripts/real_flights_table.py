@@ -112,6 +112,24 @@ def draft_verdict(j):
     return text + (f" (per flight {'; '.join(per)})" if per else "")
 
 
+def command_gain_verdict(j):
+    """The command-gain check (diagnose/command_gain.hpp): roll / pitch gain at 4-8 Hz against
+    the base model (1: its motor map's slope is right), "lead" when it prints one; for a
+    joint diagnosis each flight's."""
+    g = j.get("command_gain")
+    if not g:
+        return "?"
+    if not g.get("measured"):
+        return "not measured"
+
+    def one(x):
+        band = 1  # the lead band, 4-8 Hz
+        rp = [a["bands"][band]["gain"] for a in x["axes"][:2]]
+        return f"{rp[0]:.2f} / {rp[1]:.2f}" + (" lead" if x.get("slope_looks_off") else "")
+    per = [f"{i + 1}: {one(f)}" for i, f in enumerate(g.get("per_flight", [])) if f.get("measured")]
+    return one(g) + (f" (per flight {'; '.join(per)})" if per else "")
+
+
 def main(root):
     rows, bad = [], 0
     for d in sorted(pathlib.Path(root).iterdir()):
@@ -140,12 +158,13 @@ def main(root):
             return None
         pred = f"{fmt(at(pb, 0.5))} → {fmt(at(pa, 0.5))}"
         rows.append((d.name, "<br>".join(named) or "—", ", ".join(stand_ins) or "—", ", ".join(suspected) or "—",
-                     ", ".join(groups) or "—", "<br>".join(proposed) or "—", draft_verdict(j), pred,
+                     ", ".join(groups) or "—", "<br>".join(proposed) or "—", draft_verdict(j), command_gain_verdict(j), pred,
                      f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
     print("| flight | named (95 % interval) | stand-ins (not named) | suspected (failed) | look-alike groups | "
           "proposed terms (held-out RMS before → after) | draft hypothesis (axis; per flight when joint) | "
+          "answer to the commands, roll / pitch at 4-8 Hz (1: as the model) | "
           "0.5 s open-loop error before → after [m] | s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print("| " + " | ".join(r) + " |")
     print(f"\n{bad} rule violations in {len(rows)} diagnoses")
