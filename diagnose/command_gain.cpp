@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fit/flight_data.hpp"
+
 namespace quadgen::diagnose {
 
 namespace {
@@ -83,8 +85,6 @@ std::vector<double> channel(const std::vector<double>& rows6, int c, double offs
   for (size_t k = 0; k < out.size(); ++k) out[k] = rows6[k * 6 + static_cast<size_t>(c)] + offset;
   return out;
 }
-
-
 
 // The rows' clock: contiguous stretches and the typical step, and the band-pass and the
 // delay on it.
@@ -196,14 +196,14 @@ CommandGain command_gain(const CommandGainInput& in) {
   return g;
 }
 
-CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std::vector<double>& p, const Vehicle& v,
-                                    double g, bool accelerometer) {
+CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std::vector<double>& residual,
+                                    const Vehicle& v, double g, bool accelerometer) {
   CommandGainInput in;
   in.rotors = v.rotors.size();
   in.vertical_offset = accelerometer ? 0.0 : g;
   if (const auto slope = v.params.find("motor_slope"); slope != v.params.end()) in.model_slope = slope->second.nominal;
   in.measured = ee.measured_channels();
-  ee.all_channels(p.data(), in.model);
+  in.model = residual;
   for (size_t i = 0; i < in.model.size(); ++i) in.model[i] += in.measured[i];
   for (size_t k : ee.rows()) {
     const auto& s = ee.flight().samples[k];
@@ -214,21 +214,17 @@ CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std
 }
 
 std::vector<CommandGainInput> split_by_flight(const CommandGainInput& in, const std::vector<double>& starts) {
-  std::vector<CommandGainInput> out;
-  for (size_t f = 0; f < starts.size(); ++f) {
-    CommandGainInput one;
-    one.rotors = in.rotors, one.vertical_offset = in.vertical_offset, one.model_slope = in.model_slope;
-    const double end = f + 1 < starts.size() ? starts[f + 1] : INFINITY;
-    for (size_t k = 0; k < in.t.size(); ++k) {
-      if (in.t[k] < starts[f] || in.t[k] >= end) continue;
-      one.t.push_back(in.t[k]);
-      one.model.insert(one.model.end(), in.model.begin() + static_cast<long>(k * 6), in.model.begin() + static_cast<long>(k * 6 + 6));
-      one.measured.insert(one.measured.end(), in.measured.begin() + static_cast<long>(k * 6),
-                          in.measured.begin() + static_cast<long>(k * 6 + 6));
-      one.commands.insert(one.commands.end(), in.commands.begin() + static_cast<long>(k * in.rotors),
-                          in.commands.begin() + static_cast<long>((k + 1) * in.rotors));
-    }
-    out.push_back(std::move(one));
+  std::vector<CommandGainInput> out(starts.size());
+  for (auto& f : out) f.rotors = in.rotors, f.vertical_offset = in.vertical_offset, f.model_slope = in.model_slope;
+  const auto rows_of = [](const std::vector<double>& from, size_t k, size_t width, std::vector<double>& to) {
+    to.insert(to.end(), from.begin() + static_cast<long>(k * width), from.begin() + static_cast<long>((k + 1) * width));
+  };
+  for (size_t k = 0; k < in.t.size(); ++k) {
+    const int flight = fit::joined_flight_at(starts, in.t[k]);
+    if (flight < 0) continue;
+    auto& f = out[static_cast<size_t>(flight)];
+    f.t.push_back(in.t[k]);
+    rows_of(in.model, k, 6, f.model), rows_of(in.measured, k, 6, f.measured), rows_of(in.commands, k, in.rotors, f.commands);
   }
   return out;
 }

@@ -73,13 +73,14 @@ struct CommandGain {
 
 CommandGain command_gain(const CommandGainInput& in);
 
-// What the check reads from an equation-error model at parameters p (the diagnosis passes
-// its base fit): the model's accelerations (the residuals plus what they are compared with)
-// and the measured ones on every row, and the rotor commands there. `g` [m/s^2] and
+// What the check reads from an equation-error model and its residuals at some parameters
+// (`residual`, rows() x 6 as all_channels gives them; the diagnosis passes its base fit's):
+// the model's accelerations (the residuals plus what they are compared with) and the
+// measured ones on every row, and the rotor commands there. `g` [m/s^2] and
 // `accelerometer` (the translation is the accelerometer's specific force, not the world
 // acceleration) set the vertical thrust per mass; the vehicle file gives its motor map's slope.
-CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std::vector<double>& p, const Vehicle& v,
-                                    double g, bool accelerometer);
+CommandGainInput command_gain_input(const fit::EquationErrorModel& ee, const std::vector<double>& residual,
+                                    const Vehicle& v, double g, bool accelerometer);
 
 // The rows of each flight of a joint diagnosis (`starts`: where each flight begins on the
 // joined clock, ascending), as inputs of their own.

@@ -666,7 +666,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   double g = 0;
   for (const auto& p : s.base_fit)
     if (p.name == "g") g = p.value;
-  const CommandGainInput gain_input = command_gain_input(all_ee, fit::parameter_values(s.base_fit), v, g, accel);
+  const CommandGainInput gain_input = command_gain_input(all_ee, d.residual_before, v, g, accel);  // the base fit's
   d.command_gain = command_gain(gain_input);
   if (joint)
     for (const auto& one : split_by_flight(gain_input, fit::joined_start_times(flights)))

@@ -199,6 +199,31 @@ json command_gain_json(const CommandGain& g) {
                    "slope at the operating point is right); a lead, never a named cause"}};
 }
 
+// The command-gain check per flight of a joint diagnosis (the flight's log), or the one
+// flight's (named "").
+std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(const Diagnosis& d) {
+  std::vector<std::pair<std::string, const CommandGain*>> out;
+  if (d.command_gain_per_flight.empty()) out.emplace_back("", &d.command_gain);
+  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
+    out.emplace_back(d.flights[i], &d.command_gain_per_flight[i]);
+  return out;
+}
+
+// A check's JSON for the diagnosis as a whole, with `per_flight`: the same check on each flight
+// of a joint diagnosis, named by its log (none for a single flight).
+template <class Check, class ToJson>
+json with_per_flight(json whole, const std::vector<Check>& per_flight, const Diagnosis& d, ToJson to_json) {
+  if (per_flight.empty()) return whole;
+  json per = json::array();
+  for (size_t i = 0; i < per_flight.size(); ++i) {
+    json one = to_json(per_flight[i]);
+    one["flight"] = i < d.flights.size() ? d.flights[i] : "";
+    per.push_back(one);
+  }
+  whole["per_flight"] = per;
+  return whole;
+}
+
 json draft_signature_json(const DraftSignature& d) {
   if (!d.measured) return {{"measured", false}, {"why_not", d.why_not}};
   json parts = json::array();
@@ -450,26 +475,8 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});
   j["unexplained"] = un;
-  j["draft_signature"] = draft_signature_json(d.draft);
-  if (!d.draft_per_flight.empty()) {
-    json per = json::array();
-    for (size_t i = 0; i < d.draft_per_flight.size(); ++i) {
-      json one = draft_signature_json(d.draft_per_flight[i]);
-      one["flight"] = i < d.flights.size() ? d.flights[i] : "";
-      per.push_back(one);
-    }
-    j["draft_signature"]["per_flight"] = per;
-  }
-  j["command_gain"] = command_gain_json(d.command_gain);
-  if (!d.command_gain_per_flight.empty()) {
-    json per = json::array();
-    for (size_t i = 0; i < d.command_gain_per_flight.size(); ++i) {
-      json one = command_gain_json(d.command_gain_per_flight[i]);
-      one["flight"] = i < d.flights.size() ? d.flights[i] : "";
-      per.push_back(one);
-    }
-    j["command_gain"]["per_flight"] = per;
-  }
+  j["draft_signature"] = with_per_flight(draft_signature_json(d.draft), d.draft_per_flight, d, draft_signature_json);
+  j["command_gain"] = with_per_flight(command_gain_json(d.command_gain), d.command_gain_per_flight, d, command_gain_json);
   // Beyond the catalogue: one entry per channel, proposed or not (and why).
   json disc = json::array();
   for (const auto& t : d.discovered) {
@@ -660,9 +667,8 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
   // The answer to the commands, band by band: one series per flight, 1 where the model is right.
   std::vector<std::pair<std::string, const CommandGain*>> gains;
-  if (d.command_gain_per_flight.empty()) gains.emplace_back("this flight", &d.command_gain);
-  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
-    gains.emplace_back(std::filesystem::path(d.flights[i]).stem().string(), &d.command_gain_per_flight[i]);
+  for (const auto& [flight, g] : command_gains_by_flight(d))
+    gains.emplace_back(flight.empty() ? "this flight" : std::filesystem::path(flight).stem().string(), g);
   std::vector<runtime::Panel> gain_panels;
   for (size_t a = 0; a < 3; ++a) {
     runtime::Panel panel{"", "band centre [Hz]", "gain (1: as the model)", {}};
@@ -722,17 +728,22 @@ std::string draft_lead(const DraftSignature& d) {
   return s + "); no logged signal measures the air";
 }
 
-// The draft check's sentences, each with the flight it is about (empty for the diagnosis as a
-// whole; a joint diagnosis adds one per flight that shows it), unescaped for each sink.
-std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d) {
+// A check's sentences, each with the flight it is about (empty for the diagnosis as a whole;
+// a joint diagnosis adds one per flight that shows it), unescaped for each sink.
+template <class Check, class Lead>
+std::vector<std::pair<std::string, std::string>> leads(const Check& whole, const std::vector<Check>& per_flight,
+                                                       const Diagnosis& d, Lead lead_of) {
   std::vector<std::pair<std::string, std::string>> out;
-  if (std::string lead = draft_lead(d.draft); !lead.empty()) out.emplace_back("", std::move(lead));
-  for (size_t i = 0; i < d.draft_per_flight.size() && i < d.flights.size(); ++i)
-    if (std::string lead = draft_lead(d.draft_per_flight[i]); !lead.empty())
+  if (std::string lead = lead_of(whole); !lead.empty()) out.emplace_back("", std::move(lead));
+  for (size_t i = 0; i < per_flight.size() && i < d.flights.size(); ++i)
+    if (std::string lead = lead_of(per_flight[i]); !lead.empty())
       out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
   return out;
 }
 
+std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d) {
+  return leads(d.draft, d.draft_per_flight, d, draft_lead);
+}
 
 // One sentence for the printout and the report when the airframe's answer to the commands
 // puts the motor map's slope in doubt ("" otherwise: the JSON holds the bands).
@@ -752,14 +763,8 @@ std::string command_gain_lead(const CommandGain& g) {
          "the rate set points separates them";
 }
 
-// The command-gain sentences, each with the flight it is about (as draft_leads).
 std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagnosis& d) {
-  std::vector<std::pair<std::string, std::string>> out;
-  if (std::string lead = command_gain_lead(d.command_gain); !lead.empty()) out.emplace_back("", std::move(lead));
-  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
-    if (std::string lead = command_gain_lead(d.command_gain_per_flight[i]); !lead.empty())
-      out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
-  return out;
+  return leads(d.command_gain, d.command_gain_per_flight, d, command_gain_lead);
 }
 
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
@@ -873,15 +878,10 @@ std::string diagnosis_summary(const Diagnosis& d) {
 
 namespace {
 
-// Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
-// for which none is proposed.
 // The command-gain check as a table: per flight (or the one flight) and axis, the gain,
 // correlation and delay in each band; the leads below it.
 void command_gain_html(std::ostream& h, const Diagnosis& d) {
-  std::vector<std::pair<std::string, const CommandGain*>> rows;
-  if (d.command_gain_per_flight.empty()) rows.emplace_back("", &d.command_gain);
-  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
-    rows.emplace_back(d.flights[i], &d.command_gain_per_flight[i]);
+  const auto rows = command_gains_by_flight(d);
   const CommandGain* first = nullptr;
   for (const auto& [flight, g] : rows)
     if (g->measured && !first) first = g;
@@ -907,6 +907,8 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
     h << "<p class=\"warn\">" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
 }
 
+// Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
+// for which none is proposed.
 void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
   if (d.discovered.empty()) return;
   h << "<h2>Beyond the catalogue: proposed terms</h2>\n<p>Sparse regression (sequentially thresholded least "

@@ -1,6 +1,7 @@
 #include "diagnose/draft_signature.hpp"
 
 #include "diagnose/residual_analysis.hpp"
+#include "fit/flight_data.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -179,9 +180,9 @@ std::vector<DraftSignatureInput> split_by_flight(const DraftSignatureInput& in, 
     f.t.clear(), f.residual.clear(), f.velocity.clear(), f.heading.clear(), f.held_out.clear();
   }
   for (size_t k = 0; k < in.t.size(); ++k) {
-    const auto next = std::upper_bound(starts.begin(), starts.end(), in.t[k]);
-    if (next == starts.begin()) continue;  // before the first flight
-    auto& f = out[static_cast<size_t>(next - starts.begin()) - 1];
+    const int flight = fit::joined_flight_at(starts, in.t[k]);
+    if (flight < 0) continue;  // before the first flight
+    auto& f = out[static_cast<size_t>(flight)];
     f.t.push_back(in.t[k]), f.heading.push_back(in.heading[k]), f.held_out.push_back(in.held_out[k]);
     f.residual.insert(f.residual.end(), in.residual.begin() + 6 * static_cast<long>(k),
                       in.residual.begin() + 6 * static_cast<long>(k + 1));

@@ -202,10 +202,10 @@ std::vector<double> EquationErrorModel::all_channels(const std::vector<FitParame
 
 std::vector<double> EquationErrorModel::measured_channels() const {
   std::vector<double> m(rows_.size() * 6);
+  const bool filtered = derivatives_ == Derivatives::kFiltered;
   for (size_t row = 0; row < rows_.size(); ++row) {
     const FlightSample& sample = flight_.samples[rows_[row]];
     for (int c = 0; c < 3; ++c) {
-      const bool filtered = derivatives_ == Derivatives::kFiltered;
       m[row * 6 + c] = accel_ ? sample.specific_force[c] : filtered ? measured_[row][c] : sample.acc_world[c];
       m[row * 6 + 3 + c] = filtered ? measured_[row][3 + c] : sample.rate_dot[c];
     }

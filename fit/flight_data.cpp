@@ -432,6 +432,10 @@ std::vector<double> joined_start_times(const std::vector<Flight>& flights, doubl
   return starts;
 }
 
+int joined_flight_at(const std::vector<double>& starts, double t) {
+  return static_cast<int>(std::upper_bound(starts.begin(), starts.end(), t) - starts.begin()) - 1;
+}
+
 std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights, double train_fraction, double gap) {
   const auto offsets = join_offsets(flights, gap);
   Flight train = empty_join(flights), valid = empty_join(flights);

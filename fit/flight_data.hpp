@@ -89,6 +89,9 @@ std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights,
                                              double gap = 1.0);
 // Where each flight begins on that joined clock.
 std::vector<double> joined_start_times(const std::vector<Flight>& flights, double gap = 1.0);
+// Which of the joined flights (0-based, by those start times, ascending) time t lies in; -1
+// before the first.
+int joined_flight_at(const std::vector<double>& starts, double t);
 
 // Derivative at each sample by a local quadratic least-squares fit over +-window seconds
 // (a Savitzky–Golay filter that also works for uneven sampling).

@@ -97,37 +97,31 @@ def implausible(f, environment):
             if abs(p["value"]) > limit + 1e-12]
 
 
+def per_flight_verdict(check, one):
+    """One check's verdict from diagnosis.json: `one` of the whole diagnosis, "not measured",
+    and for a joint diagnosis also each flight's."""
+    if not check:
+        return "?"
+    if not check.get("measured"):
+        return "not measured"
+    per = [f"{i + 1}: {one(f)}" for i, f in enumerate(check.get("per_flight", [])) if f.get("measured")]
+    return one(check) + (f" (per flight {'; '.join(per)})" if per else "")
+
+
 def draft_verdict(j):
     """The draft check's verdict (diagnose/draft_signature.hpp): the axes showing a draft's
-    signature on both parts, "not measured" without rotor drag and blade flapping; for a joint
-    diagnosis also each flight's."""
-    d = j.get("draft_signature")
-    if not d:
-        return "?"
-    if not d.get("measured"):
-        return "not measured"
-    text = ", ".join(d.get("axes_showing_it", [])) or "none"
-    per = [f"{i + 1}: {', '.join(f.get('axes_showing_it', [])) or 'none'}"
-           for i, f in enumerate(d.get("per_flight", [])) if f.get("measured")]
-    return text + (f" (per flight {'; '.join(per)})" if per else "")
+    signature on both parts, "not measured" without rotor drag and blade flapping."""
+    return per_flight_verdict(j.get("draft_signature"), lambda d: ", ".join(d.get("axes_showing_it", [])) or "none")
 
 
 def command_gain_verdict(j):
     """The command-gain check (diagnose/command_gain.hpp): roll / pitch gain at 4-8 Hz against
-    the base model (1: its motor map's slope is right), "lead" when it prints one; for a
-    joint diagnosis each flight's."""
-    g = j.get("command_gain")
-    if not g:
-        return "?"
-    if not g.get("measured"):
-        return "not measured"
-
+    the base model (1: its motor map's slope is right), "lead" when it prints one."""
     def one(x):
         band = 1  # the lead band, 4-8 Hz
         rp = [a["bands"][band]["gain"] for a in x["axes"][:2]]
         return f"{rp[0]:.2f} / {rp[1]:.2f}" + (" lead" if x.get("slope_looks_off") else "")
-    per = [f"{i + 1}: {one(f)}" for i, f in enumerate(g.get("per_flight", [])) if f.get("measured")]
-    return one(g) + (f" (per flight {'; '.join(per)})" if per else "")
+    return per_flight_verdict(j.get("command_gain"), one)
 
 
 def main(root):

@@ -133,7 +133,9 @@ TEST(CommandGain, RecoversTheMotorMapSlopeOfAGeneratedClosedLoopFlight) {
     p[model.param_index("c_t")] = 0.0139;  // the flight's thrust constant
     model.set_params(p);
     const fit::EquationErrorModel ee(model, flight, /*use_accelerometer=*/false);
-    return command_gain(command_gain_input(ee, p, v, p[model.param_index("g")], false));
+    std::vector<double> residual;
+    ee.all_channels(p.data(), residual);
+    return command_gain(command_gain_input(ee, residual, v, p[model.param_index("g")], false));
   };
   runtime::CompiledModel<quadgen_generated::crazyflie21::Model> stock;
   runtime::CompiledModel<quadgen_generated::crazyflie21_nanobench::Model> own;
@@ -179,7 +181,9 @@ TEST(CommandGain, ADisturbedClosedLoopReadsLowBelowTheControllersBandwidth) {
     runtime::CompiledModel<quadgen_generated::crazyflie21::Model> model;
     const fit::Flight flight = fit::load_flight(runtime::read_csv(log), rotors, {});
     const fit::EquationErrorModel ee(model, flight, false);
-    return command_gain(command_gain_input(ee, model.params(), v, model.params()[model.param_index("g")], false));
+    std::vector<double> residual;
+    ee.all_channels(model.params().data(), residual);
+    return command_gain(command_gain_input(ee, residual, v, model.params()[model.param_index("g")], false));
   };
   const CommandGain calm = measure(0), disturbed = measure(6);
   ASSERT_TRUE(calm.measured && disturbed.measured);
