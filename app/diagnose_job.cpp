@@ -19,6 +19,7 @@
 #include "fit/log_reader.hpp"
 #include "app/model_registry.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/log_file.hpp"
 
 namespace quadgen::app {
 
@@ -57,13 +58,18 @@ std::runtime_error airframe_error(const std::string& path, const std::string& wh
 // parameters each flight has its own value of, and its named airframe effects with their
 // values and standard errors. Every name must be a parameter of `all` (the same vehicle).
 diagnose::AirframeReference load_airframe(const std::string& path, const SymbolicModel& all) {
-  std::ifstream in(path);
-  if (!in) throw airframe_error(path, "cannot read the airframe's diagnosis");
+  std::string text;
+  try {  // opened as a log is: a FIFO or a directory is refused, not waited on; size-limited
+    text = runtime::LogFile(path, "a diagnosis.json").read_all();
+  } catch (const runtime::LogError& e) {
+    throw std::runtime_error(e.what());
+  }
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const nlohmann::json::exception& e) {
-    throw airframe_error(path, std::string("not JSON: ") + e.what());
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw airframe_error(path, "not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
+                                   "); expected the diagnosis.json of an earlier diagnose run");
   }
   if (!j.is_object() || !j.contains("airframe_fit") || !j.contains("findings") || !j.contains("flight_parameters"))
     throw airframe_error(path, "not a diagnosis.json of quadgen (expected airframe_fit, findings, flight_parameters)");

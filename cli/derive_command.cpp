@@ -24,7 +24,7 @@ void add_derive(CLI::App& app, DeriveArgs& args) {
 int run_derive(const DeriveArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Vehicle vehicle = load_vehicle(args.vehicle);
-  output::OutputDirectory out(args.out, {args.vehicle, args.params});  // refused before the work, not after
+  output::OutputDirectory out(args.out, "derive", {args.vehicle, args.params});  // refused before the work, not after
   DeriveRequest request;
   request.derive.effects = parse_effect_list(args.effects);
   request.emit.vehicle_file = args.vehicle;
@@ -51,6 +51,12 @@ int run_derive(const DeriveArgs& args) {
             << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
             << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
             << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n";
+  // What a user checks first against their scale and CAD (values as the model uses them:
+  // from the blocks, or measured values the vehicle file gives in `derived:`).
+  const auto nominal = [&](const std::string& name) { return model.params[model.param_index(name)].nominal; };
+  std::cout << "mass " << nominal("mass") << " kg; centre of gravity (" << nominal("cog_x") << ", " << nominal("cog_y")
+            << ", " << nominal("cog_z") << ") m; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy")
+            << ", " << nominal("J_zz") << " kg m^2\n";
   return d.audit.all_passed() ? 0 : 3;
 }
 

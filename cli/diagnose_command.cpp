@@ -61,7 +61,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   inputs.push_back(j.vehicle);
   inputs.push_back(j.mapping);
   inputs.push_back(j.airframe);
-  output::OutputDirectory out(a.out, inputs);
+  output::OutputDirectory out(a.out, "diagnose", inputs);
   const app::DiagnoseJobResult r = app::run_diagnose_job(j);
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();

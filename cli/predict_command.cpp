@@ -50,7 +50,7 @@ int run_predict(const PredictArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
-  output::OutputDirectory out(a.out, inputs);  // refused before the work, not after
+  output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
   // Every effect, at its neutral value unless --params sets it.
   std::string how;
   const std::unique_ptr<runtime::DynamicModel> model = app::model_for(v, parse_effect_list("all"), &how);

@@ -11,8 +11,17 @@ namespace quadgen {
 
 FittedParameters load_fitted_parameters(const std::string& path) {
   const YamlReader r{path};
-  const YAML::Node file = r.parse(r.read_file("fitted parameters"));
+  const std::string text = r.read_file("fitted parameters");
+  // The other files a user may hand over by mistake: name the one expected.
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && text[first] == '{')
+    throw VehicleError(path + ":1: a JSON file (a diagnosis.json or fit.json?); derive --params takes the "
+                              "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes beside its diagnosis.json");
+  const YAML::Node file = r.parse(text);
   if (!file.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
+  if (file["name"] && !file["fitted"])
+    throw VehicleError(path + ":1: a vehicle file without a 'fitted:' section; derive --params takes the "
+                              "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes");
   // A vehicle file with a `fitted:` section (fitted_vehicle.yaml) holds the same map there.
   const bool in_vehicle = file["fitted"] && file["name"];
   const YAML::Node root = in_vehicle ? file["fitted"] : file;

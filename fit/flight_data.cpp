@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "fit/least_squares.hpp"
+#include "runtime/log_file.hpp"
 #include "model/units.hpp"
 
 namespace quadgen::fit {
@@ -85,15 +86,21 @@ std::map<std::string, YAML::Node> checked_keys(const std::string& path, const YA
 double unit_scale(const std::string& path, const YAML::Node& at, const std::string& target, const std::string& unit) {
   const std::string canonical = canonical_unit(target);
   Unit u, want;
+  // The two units logs use that the unit parser reads otherwise or not at all: a percentage,
+  // and g as an acceleration (the parser's g is the gram).
+  const bool acceleration = target == "ax" || target == "ay" || target == "az";
+  const std::string hint = unit == "%"                  ? "; for a percentage write scale: 0.01 and unit: \"1\""
+                           : unit == "g" && acceleration ? "; for g as an acceleration write scale: 9.80665 and unit: m/s^2 (g is the gram)"
+                                                         : "";
   try {
     u = parse_unit(unit);
   } catch (const UnitError& e) {
-    mapping_error(path, at, "column '" + target + "': " + e.what());
+    mapping_error(path, at, "column '" + target + "': " + e.what() + hint);
   }
   want = parse_unit(canonical);
   if (u.dim != want.dim)
     mapping_error(path, at, "column '" + target + "': unit '" + unit + "' has dimension " + u.dim.str() + ", but '" + target +
-                                "' is in " + canonical + " (dimension " + want.dim.str() + ")");
+                                "' is in " + canonical + " (dimension " + want.dim.str() + ")" + hint);
   return u.scale / want.scale;
 }
 
@@ -136,11 +143,13 @@ std::string canonical_unit(const std::string& c) {
 }
 
 ColumnMapping load_mapping(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FitError(path + ": cannot open column mapping");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_mapping(ss.str(), path);
+  std::string text;
+  try {  // opened as a log is: a FIFO or a directory is refused, not waited on; size-limited
+    text = runtime::LogFile(path, "a column mapping (YAML)").read_all();
+  } catch (const runtime::LogError& e) {
+    throw FitError(e.what());
+  }
+  return parse_mapping(text, path);
 }
 
 ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
@@ -305,6 +314,24 @@ std::vector<double> smoothed_derivative(const std::vector<double>& t, const std:
   return d;
 }
 
+namespace {
+// Too few airborne samples is most often a unit: time in ms (the edge trim then takes all of
+// it), commands that never pass min_command, a height in mm. The message gives what tells.
+[[noreturn]] void throw_too_few_airborne(const std::string& path, const std::vector<double>& trel, const Flight& f,
+                                         const FlightOptions& o) {
+  std::vector<double> dt;
+  for (size_t k = 1; k < trel.size(); ++k) dt.push_back(trel[k] - trel[k - 1]);
+  std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
+  std::ostringstream os;
+  os << path << ": too few airborne samples (" << f.samples.size() << " of " << trel.size() << "; need "
+     << static_cast<int>(o.min_samples) << "): a sample counts when every motor command is above " << o.min_command
+     << (f.has_pose ? " and z above " + std::to_string(o.min_height) + " m" : std::string()) << ", more than "
+     << o.edge_trim << " s from either end; the log spans " << trel.back() << " s with a median sample interval of "
+     << dt[dt.size() / 2] << " s (is t in seconds?)";
+  throw FitError(os.str());
+}
+}  // namespace
+
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
   runtime::validate_canonical(log, rotors);
   Flight f;
@@ -370,8 +397,7 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
     const bool edge = trel[k] < o.edge_trim || trel.back() - trel[k] < o.edge_trim;
     if ((!o.airborne_only || airborne) && !edge) f.samples.push_back(fs);
   }
-  if (static_cast<double>(f.samples.size()) < o.min_samples)
-    throw FitError(log.path + ": too few airborne samples (" + std::to_string(f.samples.size()) + ")");
+  if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, trel, f, o);
   return f;
 }
 

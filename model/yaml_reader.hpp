@@ -4,6 +4,7 @@
 // silently).
 #pragma once
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -34,6 +35,12 @@ struct YamlReader {
 
   // The file's text; `what` names it in the error ("vehicle file").
   std::string read_file(const std::string& what) const {
+    // A directory reads as empty and a FIFO blocks: refuse what is not a regular file.
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status)) throw VehicleError(path + ": a directory; expected a " + what);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+      throw VehicleError(path + ": not a regular file (a FIFO or a device); expected a " + what);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw VehicleError(path + ": cannot open " + what);
     std::ostringstream ss;

@@ -26,6 +26,7 @@ namespace {
 
 constexpr const char* kManifestHeader = "quadgen output set 1";
 const std::string kStagingInfix = ".quadgen-tmp.";
+constexpr const char* kCommandKey = "command ";
 
 [[noreturn]] void fail(const fs::path& p, const std::string& what) {
   throw OutputError(printable(p.string()) + ": " + what);
@@ -87,40 +88,85 @@ std::map<FileId, std::string> identities(const std::vector<std::string>& paths) 
   return ids;
 }
 
-// The manifest of an output directory: file name -> "hash size"; empty if there is none.
-std::map<std::string, std::string> read_manifest(const fs::path& dir, bool* present) {
-  std::map<std::string, std::string> files;
-  std::ifstream in(dir / kManifestName);
-  *present = static_cast<bool>(in);
-  std::string line;
-  if (!in || !std::getline(in, line) || line != kManifestHeader) return files;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string hash, size, name;
-    if (ls >> hash >> size && std::getline(ls >> std::ws, name)) files[name] = hash + " " + size;
-  }
-  return files;
+// A name an output set may hold: a plain file name, never a path. A manifest is read from disk
+// and may have been edited: a name with '/' or ".." in it would send the removal of the
+// earlier run's files anywhere.
+bool plain_file_name(const std::string& name) {
+  return !name.empty() && name != "." && name != ".." && name.find('/') == std::string::npos &&
+         name.find('\0') == std::string::npos && name.rfind(".quadgen", 0) != 0;
 }
 
-// Refuses to replace a directory that holds anything an earlier quadgen run did not write.
-void check_replaceable(const fs::path& dir) {
+// What an output directory's manifest says: the command that wrote it (empty for manifests
+// written before the command was recorded), and file name -> "hash size".
+struct Manifest {
+  bool present = false;
+  std::string command;
+  std::map<std::string, std::string> files;
+  std::vector<std::string> bad_lines;  // names that are not plain file names, lines that are not "hash size name"
+};
+
+Manifest read_manifest(const fs::path& dir) {
+  Manifest m;
+  std::ifstream in(dir / kManifestName);
+  m.present = static_cast<bool>(in);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != kManifestHeader) return m;
+  while (std::getline(in, line)) {
+    if (line.rfind(kCommandKey, 0) == 0) {
+      m.command = line.substr(std::strlen(kCommandKey));
+      continue;
+    }
+    std::istringstream ls(line);
+    std::string hash, size, name;
+    if (ls >> hash >> size && std::getline(ls >> std::ws, name) && plain_file_name(name)) m.files[name] = hash + " " + size;
+    else m.bad_lines.push_back(line);
+  }
+  return m;
+}
+
+// "hash size" of a file, as the manifest records it.
+std::string hash_and_size(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string content = ss.str();
+  return fnv1a_hex(content) + " " + std::to_string(content.size());
+}
+
+std::string first_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (size_t i = 0; i < names.size() && i < 3; ++i) out += (i ? ", " : "") + printable(names[i]);
+  return names.size() > 3 ? out + ", ..." : out;
+}
+
+// Refuses to replace a directory unless it holds exactly what an earlier run of the same
+// command wrote: every file listed in its manifest and unchanged since (size and hash), a
+// manifest that names only plain files, and nothing else.
+void check_replaceable(const fs::path& dir, const std::string& command) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) return;
   if (!fs::is_directory(dir, ec)) fail(dir, "exists and is not a directory");
-  bool has_manifest = false;
-  const auto listed = read_manifest(dir, &has_manifest);
-  std::vector<std::string> foreign;
+  const Manifest m = read_manifest(dir);
+  if (!m.bad_lines.empty())
+    fail(dir, "its " + std::string(kManifestName) + " has a line quadgen does not write ('" + printable(m.bad_lines.front()) +
+                  "'; a manifest names plain files only); remove the directory or choose another --out");
+  if (!m.command.empty() && m.command != command)
+    fail(dir, "holds the output of 'quadgen " + printable(m.command) + "', which 'quadgen " + command +
+                  "' does not replace; choose another --out directory or remove it");
+  std::vector<std::string> foreign, changed;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     if (name == kManifestName) continue;
-    if (!listed.count(name) || !e.is_regular_file()) foreign.push_back(printable(name));
+    const auto it = m.files.find(name);
+    if (it == m.files.end() || !e.is_regular_file()) foreign.push_back(name);
+    else if (hash_and_size(e.path()) != it->second) changed.push_back(name);
   }
   if (ec) fail(dir, "cannot list the directory: " + ec.message());
-  if (foreign.empty()) return;
-  std::string names;
-  for (size_t i = 0; i < foreign.size() && i < 3; ++i) names += (i ? ", " : "") + foreign[i];
-  if (foreign.size() > 3) names += ", ...";
-  fail(dir, "holds files quadgen did not write (" + names + "); choose a new --out directory or remove them");
+  if (!foreign.empty())
+    fail(dir, "holds files quadgen did not write (" + first_names(foreign) + "); choose a new --out directory or remove them");
+  if (!changed.empty())
+    fail(dir, "holds files changed since quadgen wrote them (" + first_names(changed) +
+                  "); choose a new --out directory or move them away");
 }
 
 // Files `inputs` names that `dir` is or contains, by path and by file identity (hard links).
@@ -219,19 +265,45 @@ void test_hook_die_before_commit() {
 }
 
 void check_file_name(const std::string& name) {
-  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos ||
-      name.find('\0') != std::string::npos || name.rfind(".quadgen", 0) == 0)
-    throw OutputError("internal: '" + printable(name) + "' is not a plain output file name");
+  if (!plain_file_name(name)) throw OutputError("internal: '" + printable(name) + "' is not a plain output file name");
+}
+
+// Where an earlier run's folder goes when it still holds files after its own were removed
+// (files that appeared while this run wrote): a visible name of its own beside the output,
+// which no later run takes for a staging folder and removes.
+fs::path keep_aside(const fs::path& staged, const fs::path& target) {
+  for (int n = 0; n < 1000; ++n) {
+    const fs::path kept = target.parent_path() / (target.filename().string() + ".previous-" + std::to_string(::getpid()) +
+                                                  (n ? "-" + std::to_string(n) : ""));
+    std::error_code ec;
+    if (fs::exists(kept, ec)) continue;
+    if (::rename(staged.c_str(), kept.c_str()) == 0) return kept;
+  }
+  return staged;
+}
+
+// After the exchange, the earlier run sits in `staged`: its own files go (those that still
+// match its manifest), anything else is kept aside.
+void remove_earlier_run(const fs::path& staged, const fs::path& target) {
+  const Manifest earlier = read_manifest(staged);
+  std::error_code ec;
+  for (const auto& [name, hash_size] : earlier.files)
+    if (hash_and_size(staged / name) == hash_size) fs::remove(staged / name, ec);
+  fs::remove(staged / kManifestName, ec);
+  if (fs::remove(staged, ec)) return;
+  std::cerr << "quadgen: note: the previous output was kept at " << printable(keep_aside(staged, target).string())
+            << " (it held files that appeared or changed while this run wrote)\n";
 }
 
 }  // namespace
 
-OutputDirectory::OutputDirectory(const std::string& dir, const std::vector<std::string>& inputs) : inputs_(inputs) {
+OutputDirectory::OutputDirectory(const std::string& dir, const std::string& command, const std::vector<std::string>& inputs)
+    : command_(command), inputs_(inputs) {
   const fs::path target = resolved(dir);
   dir_ = target.string();
   check_not_above_working_directory(target);
   check_not_input(target, inputs_);
-  check_replaceable(target);
+  check_replaceable(target, command_);
   std::error_code ec;
   fs::create_directories(target.parent_path(), ec);
   if (ec) fail(target.parent_path(), "cannot create the directory: " + ec.message());
@@ -249,7 +321,7 @@ void OutputDirectory::add(const std::string& filename, const std::string& conten
 }
 
 void OutputDirectory::commit() {
-  std::string manifest = std::string(kManifestHeader) + "\n";
+  std::string manifest = std::string(kManifestHeader) + "\n" + kCommandKey + command_ + "\n";
   for (const auto& [name, hash_size] : manifest_) manifest += hash_size + " " + name + "\n";
   staging_->write(kManifestName, manifest);
   fsync_path(staging_->path(), O_RDONLY | O_DIRECTORY);
@@ -259,35 +331,41 @@ void OutputDirectory::commit() {
   // after which the earlier run sits in the staging path and is removed file by file.
   if (::rename(staged.c_str(), target.c_str()) != 0) {
     if (errno != ENOTEMPTY && errno != EEXIST) fail(target, "cannot move the output into place: " + errno_text());
-    check_replaceable(target);
+    check_replaceable(target, command_);
     check_not_input(target, inputs_);
     if (::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
       fail(target, "cannot switch the output into place: " + errno_text());
-    bool had_manifest = false;
-    std::error_code ec;
-    for (const auto& [name, unused] : read_manifest(staged, &had_manifest)) fs::remove(staged / name, ec);
-    fs::remove(staged / kManifestName, ec);
-    if (!fs::remove(staged, ec))
-      std::cerr << "quadgen: note: the previous output was kept at " << printable(staged.string())
-                << " (it held files that appeared while this run wrote)\n";
+    remove_earlier_run(staged, target);
   }
   staging_->release();
   fsync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
-OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::vector<std::string>& inputs)
-    : written_(paths.size(), false) {
+namespace {
+std::string head_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return head;
+}
+}  // namespace
+
+OutputFiles::OutputFiles(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs)
+    : written_(files.size(), false) {
   const auto ids = identities(inputs);
   std::set<fs::path> seen;
   std::error_code ec;
-  for (const auto& name : paths) {
-    const fs::path p = resolved_file(name);
+  for (const auto& file : files) {
+    const fs::path p = resolved_file(file.path);
     if (!seen.insert(p).second) fail(p, "is named for two outputs of one run (the trajectory and its plot)");
-    if (p.parent_path() != resolved_file(paths.front()).parent_path()) throw OutputError("internal: outputs in two folders");
+    if (p.parent_path() != resolved_file(files.front().path).parent_path()) throw OutputError("internal: outputs in two folders");
     if (fs::exists(p, ec) && !fs::is_regular_file(p, ec)) fail(p, "exists and is not a regular file");
     struct stat st {};
     if (::stat(p.c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
       fail(p, "is the input " + printable(ids.at({st.st_dev, st.st_ino})) + "; choose another output path");
+    if (fs::exists(p, ec) && !file.ours(head_of(p)))
+      fail(p, "exists and is not " + file.what + "; choose another path or remove it");
     paths_.push_back(p.string());
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();
@@ -320,24 +398,20 @@ bool complete_output_directory(const std::string& dir, std::string* why) {
     if (why) *why = w;
     return false;
   };
-  bool present = false;
-  const auto listed = read_manifest(dir, &present);
-  if (!present || listed.empty()) return no("no manifest");
+  const Manifest m = read_manifest(dir);
+  if (!m.present || m.files.empty()) return no("no manifest");
+  if (!m.bad_lines.empty()) return no("the manifest has a line quadgen does not write");
   std::error_code ec;
   size_t files = 0;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     if (name == kManifestName) continue;
     ++files;
-    const auto it = listed.find(name);
-    if (it == listed.end()) return no(name + " is not in the manifest");
-    std::ifstream in(e.path(), std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    const std::string content = ss.str();
-    if (it->second != fnv1a_hex(content) + " " + std::to_string(content.size())) return no(name + " differs from the manifest");
+    const auto it = m.files.find(name);
+    if (it == m.files.end()) return no(name + " is not in the manifest");
+    if (it->second != hash_and_size(e.path())) return no(name + " differs from the manifest");
   }
-  if (files != listed.size()) return no("files listed in the manifest are missing");
+  if (files != m.files.size()) return no("files listed in the manifest are missing");
   return true;
 }
 

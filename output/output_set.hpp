@@ -4,14 +4,16 @@
 // OutputDirectory (derive, fit, diagnose --out DIR): every file is written into a private
 // staging directory beside DIR and the set is switched in by one rename (an atomic exchange
 // when DIR already holds an earlier run). DIR is replaced only if it is new, empty, or holds
-// exactly what an earlier quadgen run wrote (listed in its manifest, kManifestName); a kill at
-// any moment leaves either the earlier run or the new one, and two runs into one DIR leave one
-// of them whole.
+// exactly what an earlier run of the same command wrote (listed in its manifest, kManifestName,
+// each file unchanged since); a kill at any moment leaves either the earlier run or the new
+// one, and two runs into one DIR leave one of them whole.
 //
 // OutputFiles (simulate --out TRAJ.csv, with TRAJ.svg beside it): files among other files.
-// Each file is renamed into place from the staging directory; a companion of the previous run
-// is removed first, so a kill leaves a missing plot, never a plot of another run.
+// An existing file is replaced only if it looks like one this command writes (its first bytes
+// tell). Each file is renamed into place from the staging directory; a companion of the
+// previous run is removed first, so a kill leaves a missing plot, never a plot of another run.
 #pragma once
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -33,7 +35,9 @@ class OutputDirectory {
  public:
   // Checks at once (before any long work) that `dir` may be written: not one of `inputs`, no
   // input inside it, not the working directory or above it, and replaceable (see above).
-  OutputDirectory(const std::string& dir, const std::vector<std::string>& inputs);
+  // `command` (derive, fit, ...) is recorded in the manifest: a directory one command wrote is
+  // not replaced by another (a derive into a diagnosis's folder would throw the diagnosis away).
+  OutputDirectory(const std::string& dir, const std::string& command, const std::vector<std::string>& inputs);
   ~OutputDirectory();  // a set never committed leaves nothing behind
   OutputDirectory(const OutputDirectory&) = delete;
   OutputDirectory& operator=(const OutputDirectory&) = delete;
@@ -46,15 +50,25 @@ class OutputDirectory {
 
  private:
   std::string dir_;
+  std::string command_;
   std::vector<std::string> inputs_;
   std::unique_ptr<StagingDirectory> staging_;
   std::vector<std::pair<std::string, std::string>> manifest_;  // file name, "hash size"
 };
 
+// One file of an OutputFiles set.
+struct OutputFile {
+  std::string path;
+  // Whether an existing file at `path` is one this command wrote, judged from its first 4 KiB;
+  // any other file there is refused, never replaced.
+  std::function<bool(const std::string& head)> ours;
+  std::string what;  // what `ours` accepts, for the error ("a trajectory quadgen wrote ...")
+};
+
 class OutputFiles {
  public:
-  // `paths`: the files this run writes; they must be distinct, none an input, none a directory.
-  OutputFiles(const std::vector<std::string>& paths, const std::vector<std::string>& inputs);
+  // `files`: what this run writes, in one folder; distinct, none an input, none a directory.
+  OutputFiles(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs);
   ~OutputFiles();
   OutputFiles(const OutputFiles&) = delete;
   OutputFiles& operator=(const OutputFiles&) = delete;

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 #include "output/names.hpp"
 
@@ -127,17 +128,35 @@ std::string shell_path(const std::string& path) {
   return out + "'";
 }
 
+namespace {
+// Whether `c` (one character as for_each_char gives it) shows as blank space: the ASCII blank,
+// no-break and other Unicode spaces, zero-width characters and the byte-order mark. A
+// spreadsheet may skip them before it looks for a formula's '='.
+bool blank_looking(const std::string& c) {
+  static const char* const kBlanks[] = {" ",            "\xC2\xA0",     "\xE1\x9A\x80", "\xE2\x80\xAF", "\xE2\x81\x9F",
+                                        "\xE3\x80\x80", "\xEF\xBB\xBF", "\xE2\x81\xA0"};
+  for (const char* b : kBlanks)
+    if (c == b) return true;
+  const auto u = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
+  return c.size() == 3 && u(0) == 0xE2 && u(1) == 0x80 && u(2) >= 0x80 && u(2) <= 0x8B;  // U+2000..U+200B
+}
+}  // namespace
+
 std::string csv_field(const std::string& s) {
-  std::string out = "\"";
-  // The first character a spreadsheet sees once leading blanks and control characters are
-  // skipped (a tab or a space before '=' still starts a formula in some of them).
-  const size_t first = s.find_first_not_of(std::string(" \t\r\n\v\f", 6));
-  if (first != std::string::npos && std::string("=+-@").find(s[first]) != std::string::npos) out += '\'';
+  // The text as the file will hold it: control characters as spaces, the invisible ones shown.
+  std::vector<std::string> chars;
   for_each_char(s, [&](const std::string& c) {
-    if (c == "\"") out += "\"\"";
-    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
-    else out += c;
+    if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) chars.push_back(" ");
+    else if (invisible_control(c)) chars.push_back(printable(c));
+    else chars.push_back(c);
   });
+  // The first character a spreadsheet sees once what looks blank is skipped decides whether
+  // it runs the field as a formula.
+  size_t first = 0;
+  while (first < chars.size() && blank_looking(chars[first])) ++first;
+  std::string out = "\"";
+  if (first < chars.size() && chars[first].size() == 1 && std::string("=+-@").find(chars[first][0]) != std::string::npos) out += '\'';
+  for (const auto& c : chars) out += c == "\"" ? "\"\"" : c;
   return out + "\"";
 }
 
@@ -146,6 +165,7 @@ std::string gnuplot_string(const std::string& s) {
   for_each_char(s, [&](const std::string& c) {
     if (c == "'") out += "''";
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
+    else if (invisible_control(c)) out += printable(c);  // shown, not obeyed, in the SVG and the page it lands in
     else out += c;
   });
   return out + "'";

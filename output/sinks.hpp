@@ -27,7 +27,9 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 
 // A gnuplot single-quoted string, quotes included. Inside single quotes gnuplot expands neither
 // backquotes nor macros and knows one escape ('' for '); control characters, which would end
-// the command line, become spaces. Labels are set `noenhanced`, so _ ^ @ { } stay literal.
+// the command line, become spaces, and the bidirectional controls are shown as \xNN (as
+// printable does): the SVG gnuplot writes lands in report.html. Labels are set `noenhanced`,
+// so _ ^ @ { } stay literal.
 std::string gnuplot_string(const std::string& s);
 
 // HTML text or attribute value: & < > " ' as entities, control characters dropped, the
@@ -57,8 +59,9 @@ std::string latex_text(const std::string& s);
 std::string shell_path(const std::string& path);
 
 // A CSV field (RFC 4180), quotes included: '"' doubled, control characters (a line break would
-// start a new record) as spaces, invalid UTF-8 as '?'; a field that a spreadsheet would run as
-// a formula (= + - @ first, after any blanks) gets a leading apostrophe.
+// start a new record) as spaces, bidirectional controls shown as \xNN, invalid UTF-8 as '?'; a
+// field that a spreadsheet would run as a formula (= + - @ first, after anything that looks
+// blank: spaces, controls, Unicode spaces, zero-width characters) gets a leading apostrophe.
 std::string csv_field(const std::string& s);
 
 }  // namespace quadgen::output

@@ -34,7 +34,9 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
   try {
     json_ = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw std::invalid_argument(path + ": not JSON (" + e.what() + ")");
+    throw std::invalid_argument(path + ": not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
+                                "); --params takes the diagnosis.json or fit.json a diagnose or fit run writes (the "
+                                "fitted_parameters.yaml beside it is for derive --params)");
   }
   if (!json_.is_object()) throw std::invalid_argument(path + ": expected a diagnosis.json or fit.json object");
   key_ = json_.contains("final_fit") ? "final_fit" : json_.contains("estimates") ? "estimates" : nullptr;
@@ -81,6 +83,10 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
       throw std::invalid_argument(path_ + ": '" + output::printable(name) + "': a flight's copy is name@k with k from 2 to " +
                                   std::to_string(flights_.size()) + ", the number of flights");
   }
+}
+
+std::string ParameterSource::vehicle() const {
+  return json_.contains("vehicle") && json_["vehicle"].is_string() ? json_["vehicle"].get<std::string>() : "";
 }
 
 ParameterSource::ForLog ParameterSource::for_log(const runtime::DynamicModel& model, const std::string& log) const {

@@ -22,6 +22,8 @@ class ParameterSource {
   // Reads and checks the file (path in every error message).
   explicit ParameterSource(const std::string& path);
   const std::string& path() const { return path_; }
+  // The vehicle the file was fitted for (its "vehicle" field), "" if it names none.
+  std::string vehicle() const;
 
   struct ForLog {
     std::vector<double> values;      // the model's whole parameter vector

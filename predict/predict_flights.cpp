@@ -39,6 +39,11 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   const std::vector<double> nominal = model.params();  // before any calibration moves the model's
   std::optional<ParameterSource> source;
   if (!o.params.empty()) source.emplace(o.params);
+  // Values of another vehicle file may still be what the user wants (the same airframe under
+  // another name), but never silently: the parameter names alone cannot tell.
+  if (source && !source->vehicle().empty() && source->vehicle() != v.name)
+    o.progress("note: " + output::printable(o.params) + " was fitted for the vehicle '" + output::printable(source->vehicle()) +
+               "', not '" + v.name + "'; its values are applied by parameter name");
   PredictedFlights out;
   nlohmann::ordered_json flights = nlohmann::ordered_json::array();
   for (size_t i = 0; i < logs.size(); ++i) {
@@ -71,6 +76,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   out.json = prediction_json(out.pooled);
   out.json["vehicle"] = v.name;
   out.json["parameters_from"] = o.params.empty() ? "vehicle file (nominal)" : o.params;
+  if (source && !source->vehicle().empty()) out.json["parameters_vehicle"] = source->vehicle();
   out.json["evaluated_fraction"] = o.validation;
   out.json["flights"] = flights;
   return out;

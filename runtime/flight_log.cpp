@@ -105,6 +105,9 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     if (t.columns.empty()) {
+      if (line.find(';') != std::string::npos && line.find(',') == std::string::npos)
+        fail_at(path, lineno, "the header holds ';' and no ',': quadgen reads comma-separated values (export the log with ',' "
+                              "between fields and '.' as the decimal point)");
       t.columns = split_header(line);
       std::set<std::string> seen;
       for (const auto& c : t.columns)
@@ -212,6 +215,24 @@ void check_values(const CsvTable& log) {
     }
 }
 
+// Motor commands are throttle fractions; a percentage or a raw PWM count would otherwise run
+// the model far outside its thrust map and end in NaN or parameters on their bounds. A
+// rounded scale may overshoot by a hair (65535 * 1.52590219e-5 = 1.0000000002): tolerated.
+void check_throttle_fractions(const CsvTable& log, const std::vector<std::string>& rotors) {
+  constexpr double kTolerance = 1e-6;
+  for (const auto& r : rotors) {
+    const int c = log.column("u_" + r);
+    for (size_t i = 0; i < log.rows.size(); ++i) {
+      const double v = log.rows[i][static_cast<size_t>(c)];
+      if (v < -kTolerance || v > 1 + kTolerance)
+        fail_at(log.path, log.line_of(i),
+                "column 'u_" + r + "' is " + number_text(v) +
+                    "; expected a throttle fraction 0..1 (in a log mapping, a percentage takes scale: 0.01, a 16-bit PWM "
+                    "count scale: 1.5259e-05)");
+    }
+  }
+}
+
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors) {
   if (log.column("t") < 0) throw LogError(log.path + ":1: missing column 't'");
   std::set<std::string> known(rotors.begin(), rotors.end());
@@ -225,6 +246,7 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
     if (log.column("u_" + r) < 0) throw LogError(log.path + ":1: missing column 'u_" + r + "'");
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
+  check_throttle_fractions(log, rotors);
   const int tc = log.column("t");
   for (size_t i = 0; i < log.rows.size(); ++i) {
     const int line = log.line_of(i);

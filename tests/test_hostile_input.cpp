@@ -437,6 +437,32 @@ TEST(Sinks, MarkdownLineStartsOpenNoBlock) {
 
 // HTML shows the bidirectional controls instead of obeying them (a log named with U+202E
 // reordered the report's heading), and <pre> keeps its lines (the verdict block was one line).
+// A control character shows as a blank in a CSV field, and some spreadsheets skip blanks, Unicode
+// spaces and zero-width characters before a formula's '=': none of them hides a formula.
+TEST(Sinks, CsvFormulaGuardSeesThroughEverythingThatLooksBlank) {
+  for (const std::string& lead : {std::string("\x01"), std::string("\x1b"), std::string(" \t"), std::string("\xC2\xA0"),
+                                  std::string("\xE2\x80\x8B"), std::string("\xEF\xBB\xBF"), std::string("\xE3\x80\x80")})
+    for (const std::string& formula : {"=cmd|' /C calc'!A0", "+SUM(1,2)", "-1+1", "@SUM(1)"}) {
+      const std::string field = read_rfc4180(out::csv_field(lead + formula))[0][0];
+      EXPECT_EQ(field.substr(0, 1), "'") << out::printable(lead + formula);
+    }
+  EXPECT_EQ(read_rfc4180(out::csv_field("\x01=cmd"))[0][0], "' =cmd");
+  EXPECT_EQ(read_rfc4180(out::csv_field("a\xC2\xA0=1"))[0][0], "a\xC2\xA0=1");
+  // A bidirectional override is shown, not obeyed, and then hides nothing either.
+  const std::string bidi = read_rfc4180(out::csv_field("\xE2\x80\xAE=1"))[0][0];
+  EXPECT_EQ(bidi, "\\xE2\\x80\\xAE=1");
+}
+
+// The SVG gnuplot draws is pasted into report.html: a label's bidi controls must not reorder it.
+TEST(Sinks, GnuplotStringShowsBidiControls) {
+  for (const auto& s : hostile_strings()) {
+    const std::string g = out::gnuplot_string(s);
+    for (const char* bidi : {"\xE2\x80\xAE", "\xE2\x81\xA6", "\xE2\x80\x8F", "\xD8\x9C", "\xC2\x9B"})
+      EXPECT_EQ(g.find(bidi), std::string::npos) << out::printable(s);
+  }
+  EXPECT_EQ(out::gnuplot_string("a\xE2\x80\xAE" "b"), "'a\\xE2\\x80\\xAEb'");
+}
+
 TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
   EXPECT_EQ(out::html_text("log\xe2\x80\xae" "vsc.csv"), "log\\xE2\\x80\\xAEvsc.csv");
   EXPECT_EQ(out::html_text("a\xe2\x80\x8f" "b"), "a\\xE2\\x80\\x8Fb");
@@ -560,6 +586,71 @@ TEST(DataLoss, OutputDirectoriesHoldingOtherFilesOrInputsAreRefused) {
     EXPECT_EQ(e.path().filename().string().find(".quadgen-tmp."), std::string::npos) << e.path();
 }
 
+// An edited manifest cannot turn the removal of the earlier run into the removal of files
+// elsewhere: a name with a path in it marks the directory as not quadgen's.
+TEST(DataLoss, ManifestNamingPathsRemovesNothingOutsideTheDirectory) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  write(tmp / "victim.txt", "keep me");
+  write(tmp / "absolute_victim.txt", "keep me too");
+  const std::string manifest = read(tmp / "d/.quadgen-manifest");
+  for (const std::string& line : {std::string("0 0 ../victim.txt"), "0 0 " + (tmp / "absolute_victim.txt"), std::string("0 0 ..")}) {
+    write(tmp / "d/.quadgen-manifest", manifest + line + "\n");
+    expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "a line quadgen does not write", line);
+    EXPECT_EQ(read(tmp / "victim.txt"), "keep me");
+    EXPECT_EQ(read(tmp / "absolute_victim.txt"), "keep me too");
+    EXPECT_TRUE(fs::exists(tmp / "d/model.hpp"));
+  }
+  std::string why;
+  EXPECT_FALSE(out::complete_output_directory(tmp / "d", &why));
+  EXPECT_NE(why.find("manifest"), std::string::npos) << why;
+}
+
+// A file of an earlier run that the user edited is theirs now: the run is refused, the edit kept.
+TEST(DataLoss, EditedOutputAndAnotherCommandsOutputAreNotReplaced) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  const std::string edited = read(tmp / "d/derivation.md") + "\nmy review notes\n";
+  write(tmp / "d/derivation.md", edited);
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "changed since quadgen wrote them (derivation.md)",
+                        "edited output");
+  EXPECT_EQ(read(tmp / "d/derivation.md"), edited);
+  // Another command's folder (a diagnosis, a fit) is not thrown away by a derive, nor the reverse.
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "e"}, tmp.dir).rc, 0);
+  const CliResult fit = run_quadgen({"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", tmp / "e"}, tmp.dir);
+  expect_one_line_error(fit, "holds the output of 'quadgen derive'", "fit into a derivation");
+  EXPECT_TRUE(out::complete_output_directory(tmp / "e"));
+  EXPECT_NE(read(tmp / "e/.quadgen-manifest").find("\ncommand derive\n"), std::string::npos);
+}
+
+// simulate writes files among the user's: only a trajectory or a gnuplot plot is replaced.
+TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const std::vector<std::string> hover = {"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out"};
+  const auto with_out = [&](const std::string& out) {
+    auto args = hover;
+    args.push_back(out);
+    return args;
+  };
+  write(tmp / "victim.yaml", "mass: 1\n");
+  expect_one_line_error(run_quadgen(with_out(tmp / "victim.yaml"), tmp.dir), "expected a .csv file name", "--out .yaml");
+  write(tmp / "notes.csv", "a,b\n1,2\n");
+  expect_one_line_error(run_quadgen(with_out(tmp / "notes.csv"), tmp.dir), "is not a trajectory quadgen wrote", "foreign csv");
+  write(tmp / "traj.svg", "<svg>my drawing</svg>");
+  expect_one_line_error(run_quadgen(with_out(tmp / "traj.csv"), tmp.dir), "is not a plot quadgen wrote", "foreign svg");
+  EXPECT_EQ(read(tmp / "victim.yaml"), "mass: 1\n");
+  EXPECT_EQ(read(tmp / "notes.csv"), "a,b\n1,2\n");
+  EXPECT_EQ(read(tmp / "traj.svg"), "<svg>my drawing</svg>");
+  EXPECT_FALSE(fs::exists(tmp / "traj.csv"));
+  // Its own earlier run is replaced.
+  ASSERT_EQ(run_quadgen(with_out(tmp / "run.csv"), tmp.dir).rc, 0);
+  ASSERT_EQ(run_quadgen(with_out(tmp / "run.csv"), tmp.dir).rc, 0);
+  EXPECT_EQ(read(tmp / "run.csv").substr(0, 2), "t,");
+}
+
 // Killed at random moments, a run leaves its --out directory holding one complete run: the
 // earlier one or the new one, every file matching the manifest. The kill times are drawn over
 // 1.2x the duration of an uninterrupted run measured here, so they fall into every phase
@@ -567,11 +658,12 @@ TEST(DataLoss, OutputDirectoriesHoldingOtherFilesOrInputsAreRefused) {
 TEST(DataLoss, SigkillAtRandomMomentsLeavesOneCompleteRun) {
   Scratch tmp;
   const std::string vehicle = source_path("vehicles/finken3.yaml");
-  const std::string dir = tmp / "out";
+  const std::string dir = tmp / "out", fit_dir = tmp / "fit";  // one command's output per directory
   const std::vector<std::vector<std::string>> runs = {
       {"derive", vehicle, "--out", dir, "--effects", "motor_lag"},
-      {"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", dir},
+      {"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", fit_dir},
       {"derive", vehicle, "--out", dir, "--effects", "wind"}};
+  const std::vector<std::string> out_of = {dir, fit_dir, dir};
   std::vector<double> seconds;
   for (const auto& args : runs) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -584,11 +676,13 @@ TEST(DataLoss, SigkillAtRandomMomentsLeavesOneCompleteRun) {
     const size_t which = static_cast<size_t>(k) % runs.size();
     run_quadgen(runs[which], tmp.dir, fraction(rng) * seconds[which]);
     std::string why;
-    EXPECT_TRUE(out::complete_output_directory(dir, &why)) << "after kill " << k << ": " << why;
+    EXPECT_TRUE(out::complete_output_directory(out_of[which], &why)) << "after kill " << k << ": " << why;
   }
-  // After the kills, a whole run still goes through and clears what the killed ones left.
+  // After the kills, whole runs still go through and clear what the killed ones left.
+  ASSERT_EQ(run_quadgen(runs[1], tmp.dir).rc, 0);
   ASSERT_EQ(run_quadgen(runs[0], tmp.dir).rc, 0);
   EXPECT_TRUE(out::complete_output_directory(dir));
+  EXPECT_TRUE(out::complete_output_directory(fit_dir));
   EXPECT_NE(read(fs::path(dir) / "model.hpp").find("motor_lag"), std::string::npos);
   for (const auto& e : fs::directory_iterator(tmp.dir))
     EXPECT_EQ(e.path().filename().string().find(".quadgen-tmp."), std::string::npos) << e.path();

@@ -20,6 +20,7 @@
 #include "fit/least_squares.hpp"
 #include "fit/motor_steps.hpp"
 #include "fit/thrust_stand.hpp"
+#include "model/vehicle.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;
@@ -225,6 +226,9 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
       {"scale_text.yaml", "columns:\n  p: {source: gyro, scale: fast}\n", 2,
        "column 'p': scale: expected a finite number, got 'fast'"},
       {"hz.yaml", "columns:\n  p: {source: gyro, unit: Hz}\n", 2, "'rev/s'"},
+      // The two units logs use that need the other spelling: each gets it in the message.
+      {"gee.yaml", "columns:\n  az: {source: acc_z, unit: g}\n", 2, "for g as an acceleration write scale: 9.80665 and unit: m/s^2"},
+      {"percent.yaml", "columns:\n  u_A: {source: m1, unit: \"%\"}\n", 2, "for a percentage write scale: 0.01 and unit: \"1\""},
   };
   for (const auto& c : cases) {
     const std::string path = write(c.name, c.yaml);
@@ -299,6 +303,11 @@ TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
   EXPECT_NE(
       message_of<runtime::LogError>([&] { runtime::read_csv("/dev/zero"); }).find("/dev/zero: a character device"),
       std::string::npos);
+  // The YAML inputs beside the log: a mapping, a vehicle file.
+  EXPECT_NE(message_of<FitError>([&] { load_mapping(fifo); }).find(fifo + ": a FIFO, not a regular file"), std::string::npos);
+  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(fifo); }).find(fifo + ": not a regular file"), std::string::npos);
+  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(dir_.string()); }).find(": a directory; expected a vehicle file"),
+            std::string::npos);
   EXPECT_NE(message_of<runtime::LogError>([&] {
               runtime::read_csv(dir_.string());
             }).find(": a directory, not a regular file"),

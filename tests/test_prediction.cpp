@@ -461,6 +461,14 @@ TEST(PredictParameters, EachLogGetsItsFlightsValuesOrTheAirframes) {
       EXPECT_NE(std::string(e.what()).find("diagnosis.json"), std::string::npos) << e.what();
     }
   }
+  // The YAML a diagnosis writes beside its diagnosis.json is for derive: the message says so.
+  std::ofstream(dir / "fitted_parameters.yaml") << "effects: []\nparameters:\n  c_t: {value: 1, unit: \"1\"}\n";
+  try {
+    quadgen::predict::ParameterSource{(dir / "fitted_parameters.yaml").string()};
+    ADD_FAILURE() << "YAML accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fitted_parameters.yaml beside it is for derive --params"), std::string::npos) << e.what();
+  }
   // A FIFO as the parameter file is refused at once, not waited on.
   const std::string fifo = (dir / "params.fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

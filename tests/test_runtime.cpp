@@ -521,7 +521,13 @@ TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
             std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,x,1,1\n").find("log.csv:3: column 'u_B'"), std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,nan,1,1\n").find("not finite"), std::string::npos);
+  // A percentage or a PWM count where a throttle fraction belongs: named at its line.
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,45,1,1\n").find("log.csv:3: column 'u_B' is 45; expected a throttle fraction 0..1"),
+            std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,-0.1\n1,1,1,1,1\n").find("log.csv:2: column 'u_D' is -0.1"), std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n").find("too few samples"), std::string::npos);
+  EXPECT_NE(message("t;u_A;u_B;u_C;u_D\n0;1;1;1;1\n1;1;1;1;1\n").find("log.csv:1: the header holds ';' and no ','"),
+            std::string::npos);
 }
 
 // The README's command line: `quadgen simulate vehicles/finken3.yaml --scenario climb

@@ -211,6 +211,9 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {head + "  c_w: {value: 1, unit: \"1\", bounds: [0, 2]}\n", ":4: unknown key 'bounds' in parameter c_w"},
       {"effects: [motor_gain]\neffects: []\nparameters: {}\n", ":2: key 'effects' given twice"},
       {"effects: [wind, wind]\nparameters: {}\n", ":1: effect 'wind' listed twice"},
+      // The other files a user may pass: each named, with the one expected.
+      {"{\"vehicle\": \"finken3\", \"final_fit\": {}}\n", ":1: a JSON file (a diagnosis.json or fit.json?); derive --params takes"},
+      {"name: finken3\nblocks: []\n", ":1: a vehicle file without a 'fitted:' section"},
   };
   int k = 0;
   for (const auto& [text, want] : bad) {
