@@ -110,6 +110,7 @@ const char* const kCanonicalColumns =
 ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key, const YAML::Node& value) {
   ColumnMapping::Entry e;
   e.target = scalar_text(path, key, "column name");
+  e.line = key.Mark().line + 1;
   if (canonical_unit(e.target).empty())
     mapping_error(path, key, "'" + e.target + "' is not a canonical column (expected one of " + kCanonicalColumns + ")");
   const std::string where = "column '" + e.target + "'";
@@ -161,6 +162,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   }
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
+  m.path = path;
   try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
     const auto top = checked_keys(path, root, "mapping", {"name", "columns", "environment", "frame"});
     if (!top.count("columns") || !top.at("columns").IsMap())
@@ -242,7 +244,9 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
     if (c < 0) throw FitError(raw.path + ":1: column '" + e.source + "' (mapped to '" + e.target + "' by " + m.name + ") is missing");
     src.push_back(c);
     out.columns.push_back(e.target);
+    out.name_lines.push_back(e.line);
   }
+  out.named_by = m.path;
   out.rows.reserve(raw.rows.size());
   for (const auto& row : raw.rows) {
     std::vector<double> r;
@@ -277,6 +281,8 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   runtime::CsvTable out;
   out.path = log.path;
   out.columns = log.columns;
+  out.named_by = log.named_by;
+  out.name_lines = log.name_lines;
   size_t i = 0;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;

@@ -19,10 +19,12 @@ struct ColumnMapping {
   // The axes of the mapped columns: "enu_flu" (the model's: east-north-up world, forward-
   // left-up body) or "ned_frd" (PX4's north-east-down, forward-right-down), converted.
   std::string frame = "enu_flu";
+  std::string path;  // the file, for messages about the names it gives
   struct Entry {
     std::string target, source, unit;
     double scale = 1, offset = 0;
     double unit_scale = 1;  // from parse_unit(unit); 1 without a unit
+    int line = 0;           // of the entry in the mapping file
   };
   std::vector<Entry> entries;
 };

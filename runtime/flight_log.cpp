@@ -36,6 +36,14 @@ int CsvTable::line_of(size_t row) const {
   return row < lines.size() ? lines[row] : static_cast<int>(row) + 2;
 }
 
+std::string CsvTable::where_named(int c) const {
+  if (named_by.empty()) return path + ":1";
+  const auto k = static_cast<size_t>(c);
+  return k < name_lines.size() ? named_by + ":" + std::to_string(name_lines[k]) : named_by;
+}
+
+std::string CsvTable::where_named() const { return named_by.empty() ? path + ":1" : named_by; }
+
 namespace {
 
 [[noreturn]] void fail_at(const std::string& path, int line, const std::string& what) {
@@ -234,16 +242,20 @@ void check_throttle_fractions(const CsvTable& log, const std::vector<std::string
 }
 
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors) {
-  if (log.column("t") < 0) throw LogError(log.path + ":1: missing column 't'");
+  // A name the mapping gave is the mapping's mistake: its file and line are named, not the log's.
+  const std::string maps = log.named_by.empty() ? "" : " (mapped from " + log.path + ")";
+  if (log.column("t") < 0) throw LogError(log.where_named() + ": missing column 't'" + maps);
   std::set<std::string> known(rotors.begin(), rotors.end());
-  for (const auto& c : log.columns)
-    if (c.rfind("u_", 0) == 0 && !known.count(c.substr(2))) {
-      std::string list;
-      for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
-      throw LogError(log.path + ":1: column '" + c + "' names no rotor of this vehicle (rotors: " + list + ")");
-    }
+  std::string list;
+  for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
+  for (size_t c = 0; c < log.columns.size(); ++c) {
+    const std::string& name = log.columns[c];
+    if (name.rfind("u_", 0) == 0 && !known.count(name.substr(2)))
+      throw LogError(log.where_named(static_cast<int>(c)) + ": column '" + name + "' names no rotor of this vehicle (rotors: " +
+                     list + ")" + maps);
+  }
   for (const auto& r : rotors)
-    if (log.column("u_" + r) < 0) throw LogError(log.path + ":1: missing column 'u_" + r + "'");
+    if (log.column("u_" + r) < 0) throw LogError(log.where_named() + ": missing column 'u_" + r + "'" + maps);
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
   check_throttle_fractions(log, rotors);

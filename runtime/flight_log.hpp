@@ -24,6 +24,12 @@ struct CsvTable {
   int column(const std::string& name) const;  // -1 if absent
   std::vector<double> values(const std::string& name) const;
   int line_of(size_t row) const;  // lines[row], or row + 2 where no line was recorded
+  // Where the column names come from: the header of `path` when empty; a column mapping's
+  // file when the table was mapped, with the line of each column's entry in name_lines.
+  std::string named_by;
+  std::vector<int> name_lines;
+  std::string where_named(int c) const;  // "log.csv:1" or "mapping.yaml:12"
+  std::string where_named() const;       // the file that names the columns, "log.csv:1" or "mapping.yaml"
 };
 
 // Sanity bounds on numbers in logs: a value beyond them is a corrupt or mis-scaled log,

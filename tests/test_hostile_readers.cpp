@@ -236,6 +236,21 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
   }
 }
 
+// A rotor name the mapping gives wrongly is the mapping's mistake: the message names the
+// mapping's line, not the log's header.
+TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
+  const std::string log = write("raw.csv", "time,m1,m2,m3,m4\n0,0.5,0.5,0.5,0.5\n0.01,0.5,0.5,0.5,0.5\n");
+  const std::string mapping = write("m.yaml",
+                                    "columns:\n  t: {source: time}\n  u_m1: {source: m1}\n  u_M2: {source: m2}\n"
+                                    "  u_M3: {source: m3}\n  u_M4: {source: m4}\n");
+  const auto mapped = read_log(log, mapping, 0);
+  const std::string why = message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"M1", "M2", "M3", "M4"}); });
+  expect_located(why, mapping, 3, "column 'u_m1' names no rotor of this vehicle (rotors: M1, M2, M3, M4) (mapped from " + log + ")");
+  const std::string missing =
+      message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"m1", "M2", "M3", "M4", "M5"}); });
+  EXPECT_NE(missing.find(mapping + ": missing column 'u_M5'"), std::string::npos) << missing;
+}
+
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,
 // so its columns are exactly source * scale + offset, bit for bit.
 TEST_F(Hostile, NanobenchMappingValuesUnchanged) {
