@@ -63,8 +63,11 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
       window_(window),
       window_stride_(window_stride),
       folds_(validation_folds(valid, 4)) {
+  // Every point of a window is scored (0 to `window` s ahead): less than the error at the
+  // window's end, which predict reports; the wording keeps the two apart.
   metric_name_ = pose_ ? "validation position RMSE (" + std::to_string(window).substr(0, 3) +
-                             " s open-loop windows from measured states" + stride_clause(window, window_stride) + ") [m]"
+                             " s open-loop windows from measured states" + stride_clause(window, window_stride) +
+                             "; every point of a window scored) [m]"
                        : "validation equation-error cost (weighted, no pose logged)";
   if (!pose_) return;  // the metric already is one-step
   for (const auto& f : folds_)

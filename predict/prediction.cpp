@@ -259,7 +259,7 @@ std::string what_limits_prediction(const Prediction& p) {
   const HorizonErrors &open = p.open_loop[longest], &replayed = p.attitude_replayed[longest];
   const double both = open.position.mean(), forces = replayed.position.mean();
   if (!(both > 0) || !std::isfinite(forces)) return "";
-  std::string s = "At " + output::short_number(open.horizon) + " s the open-loop position error is " + output::short_number(both) +
+  std::string s = output::short_number(open.horizon) + " s ahead (at the end of each window) the open-loop position error is " + output::short_number(both) +
                   " m; with the measured attitude replayed (the force model alone) " + output::short_number(forces) + " m";
   if (forces < both)
     s += ", so " + std::to_string(static_cast<int>(std::lround(100 * (1 - forces / both)))) +

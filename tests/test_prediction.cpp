@@ -361,7 +361,7 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.attitude_replayed = {row(0.5, 0.05, 0), row(1.0, 0.2, 0)};
   p.translation_replayed = {row(0.5, 0, 0.45), row(1.0, 0, 1.5)};
   std::string s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("At 1 s the open-loop position error is 1 m"), std::string::npos) << s;
+  EXPECT_NE(s.find("1 s ahead (at the end of each window) the open-loop position error is 1 m"), std::string::npos) << s;
   EXPECT_NE(s.find("80 % of it comes from the attitude"), std::string::npos) << s;
   EXPECT_NE(s.find("At 0.5 s the moment model alone (translation replayed) tilts by 0.45 rad against 0.3 rad"), std::string::npos) << s;
   EXPECT_NE(s.find("the moment model's own error"), std::string::npos) << s;
@@ -378,7 +378,7 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.open_loop_past_disturbance = {row(1.0, 0.4, 0), row(0.5, 0.02, 0)};
   p.disturbance_window = 0.5;
   s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("At 1 s the open-loop position error is 1 m"), std::string::npos) << s;
+  EXPECT_NE(s.find("1 s ahead (at the end of each window) the open-loop position error is 1 m"), std::string::npos) << s;
   EXPECT_NE(s.find("At 0.5 s the moment model alone"), std::string::npos) << s;
   EXPECT_NE(s.find("Holding the acceleration residual of the last 0.5 s before each start (model bias or disturbance) "
                    "lowers it to 0.4 m: 60 % of it"),
