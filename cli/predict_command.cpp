@@ -1,6 +1,7 @@
 // quadgen predict VEHICLE.yaml LOG.csv... [--mapping M] [--params FIT_OR_DIAGNOSIS.json] --out DIR
 // How well a model (nominal, fitted or extended) predicts flights, measured as published
 // models report it (predict/prediction.hpp): prediction.json, prediction.csv, prediction.svg.
+#include <cmath>
 #include <fstream>
 #include <iostream>
 
@@ -71,6 +72,15 @@ int run_predict(const PredictArgs& a) {
               << " rad, heading " << h.heading.mean() << " rad\n";
   if (const std::string limits = predict::what_limits_prediction(p.pooled); !limits.empty()) std::cout << limits << "\n";
   std::cout << "wrote " << output::printable(a.out) << "/prediction.json\n";
+  // A non-finite error is a model that left its range (commands, units or parameters wrong):
+  // the files are written for a look, but the run did not succeed.
+  for (const auto& h : p.pooled.open_loop)
+    if (!std::isfinite(h.position.mean())) {
+      std::cerr << "quadgen: error: the open-loop position error " << h.horizon
+                << " s ahead is not finite: the model left its range on this log (check the commands' scale, the "
+                   "units and --params); the output is kept for inspection\n";
+      return 4;
+    }
   return 0;
 }
 
