@@ -81,21 +81,15 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
 namespace {
 
 // The trajectory and its plot beside it (TRAJ.csv, TRAJ.svg): neither may be an input, they
-// may not be one file, and a file already there is replaced only if it is a trajectory or a
-// gnuplot plot (an earlier run's), never a file of the user's that happens to have the name.
+// may not be one file, and a file already there is replaced only if an earlier simulate wrote
+// it (output::OutputFiles keeps the record), never a log or plot of the user's with that name.
 std::string plot_path(const std::string& out) { return std::filesystem::path(out).replace_extension(".svg").string(); }
 
 output::OutputFiles output_for(const SimulateArgs& a) {
   if (std::filesystem::path(a.out).extension() != ".csv")
     throw std::invalid_argument("--out " + output::printable(a.out) +
                                 ": expected a .csv file name (the trajectory; its plot goes to the .svg beside it)");
-  const output::OutputFile trajectory{
-      a.out, [](const std::string& head) { return head.rfind("t,", 0) == 0; },
-      "a trajectory quadgen wrote (its first line starts 't,')"};
-  const output::OutputFile plot{
-      plot_path(a.out), [](const std::string& head) { return head.find("<svg") != std::string::npos && head.find("gnuplot") != std::string::npos; },
-      "a plot quadgen wrote (an SVG drawn by gnuplot)"};
-  return output::OutputFiles({trajectory, plot}, {a.job.vehicle, a.job.inputs});
+  return output::OutputFiles({a.out, plot_path(a.out)}, "simulate", {a.job.vehicle, a.job.inputs});
 }
 
 // NAME=VALUE of --set; the value a finite number.

@@ -11,14 +11,12 @@ namespace quadgen {
 
 FittedParameters load_fitted_parameters(const std::string& path) {
   const YamlReader r{path};
-  const std::string text = r.read_file("fitted parameters");
-  // The other files a user may hand over by mistake: name the one expected.
-  const size_t first = text.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && text[first] == '{')
-    throw VehicleError(path + ":1: a JSON file (a diagnosis.json or fit.json?); derive --params takes the "
-                              "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes beside its diagnosis.json");
-  const YAML::Node file = r.parse(text);
+  const YAML::Node file = r.parse(r.read_file("fitted parameters"));
   if (!file.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
+  // The other files a user may hand over by mistake (YAML reads JSON too): name the one expected.
+  if (file["final_fit"] || file["estimates"] || file["findings"])
+    throw VehicleError(path + ":1: a diagnosis.json or fit.json; derive --params takes the "
+                              "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes beside its diagnosis.json");
   if (file["name"] && !file["fitted"])
     throw VehicleError(path + ":1: a vehicle file without a 'fitted:' section; derive --params takes the "
                               "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes");

@@ -1,21 +1,36 @@
 // FNV-1a 64-bit: a fast, stable content hash (vehicle files in generated headers, output
 // manifests). Not cryptographic: it detects change, not tampering.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 
 namespace quadgen::output {
 
-inline std::string fnv1a_hex(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ull;
+// Incremental form, for content read in pieces.
+class Fnv1a {
+ public:
+  void add(const char* bytes, size_t n) {
+    for (size_t i = 0; i < n; ++i) {
+      h_ ^= static_cast<unsigned char>(bytes[i]);
+      h_ *= 1099511628211ull;
+    }
   }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  std::string hex() const {
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h_));
+    return buf;
+  }
+
+ private:
+  uint64_t h_ = 1469598103934665603ull;
+};
+
+inline std::string fnv1a_hex(const std::string& bytes) {
+  Fnv1a h;
+  h.add(bytes.data(), bytes.size());
+  return h.hex();
 }
 
 }  // namespace quadgen::output

@@ -27,6 +27,11 @@ namespace {
 constexpr const char* kManifestHeader = "quadgen output set 1";
 const std::string kStagingInfix = ".quadgen-tmp.";
 constexpr const char* kCommandKey = "command ";
+// Put into an earlier run's folder that is kept because it holds files quadgen did not write:
+// no later run removes a folder holding it as a stale staging directory.
+constexpr const char* kKeepMarker = ".quadgen-keep";
+// Beside the files OutputFiles writes (simulate's trajectory and plot): what it wrote there.
+constexpr const char* kFilesRecordName = ".quadgen-files";
 
 [[noreturn]] void fail(const fs::path& p, const std::string& what) {
   throw OutputError(printable(p.string()) + ": " + what);
@@ -96,8 +101,8 @@ bool plain_file_name(const std::string& name) {
          name.find('\0') == std::string::npos && name.rfind(".quadgen", 0) != 0;
 }
 
-// What an output directory's manifest says: the command that wrote it (empty for manifests
-// written before the command was recorded), and file name -> "hash size".
+// What a manifest says: the command that wrote it, and file name -> "hash size". Manifests
+// written before the command was recorded name none; it is inferred from their files.
 struct Manifest {
   bool present = false;
   std::string command;
@@ -105,13 +110,37 @@ struct Manifest {
   std::vector<std::string> bad_lines;  // names that are not plain file names, lines that are not "hash size name"
 };
 
-Manifest read_manifest(const fs::path& dir) {
+std::string command_from_files(const std::map<std::string, std::string>& files) {
+  for (const auto& [file, command] : std::map<std::string, std::string>{
+           {"diagnosis.json", "diagnose"}, {"fit.json", "fit"}, {"prediction.json", "predict"}, {"model.hpp", "derive"}})
+    if (files.count(file)) return command;
+  return "";
+}
+
+// A manifest is input like any other: a FIFO would block, /dev/zero never end. Only a regular
+// file (not a link) of at most 1 MiB is read; anything else is a manifest quadgen did not write.
+Manifest read_manifest_file(const fs::path& file) {
   Manifest m;
-  std::ifstream in(dir / kManifestName);
-  m.present = static_cast<bool>(in);
+  struct stat st {};
+  if (::lstat(file.c_str(), &st) != 0) return m;
+  m.present = true;
+  if (!S_ISREG(st.st_mode) || st.st_size > (1 << 20)) {
+    m.bad_lines.push_back("(not a regular file of at most 1 MiB)");
+    return m;
+  }
+  std::ifstream in(file, std::ios::binary);
   std::string line;
-  if (!in || !std::getline(in, line) || line != kManifestHeader) return m;
-  while (std::getline(in, line)) {
+  const auto next = [&] {
+    if (!std::getline(in, line)) return false;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next() || line != kManifestHeader) {
+    m.bad_lines.push_back(line);
+    return m;
+  }
+  while (next()) {
+    if (line.empty()) continue;
     if (line.rfind(kCommandKey, 0) == 0) {
       m.command = line.substr(std::strlen(kCommandKey));
       continue;
@@ -121,16 +150,34 @@ Manifest read_manifest(const fs::path& dir) {
     if (ls >> hash >> size && std::getline(ls >> std::ws, name) && plain_file_name(name)) m.files[name] = hash + " " + size;
     else m.bad_lines.push_back(line);
   }
+  if (m.command.empty()) m.command = command_from_files(m.files);
   return m;
 }
 
-// "hash size" of a file, as the manifest records it.
+Manifest read_manifest(const fs::path& dir) { return read_manifest_file(dir / kManifestName); }
+
+std::string manifest_text(const std::string& command, const std::map<std::string, std::string>& files) {
+  std::string text = std::string(kManifestHeader) + "\n" + kCommandKey + command + "\n";
+  for (const auto& [name, hash_size] : files) text += hash_size + " " + name + "\n";
+  return text;
+}
+
+// "hash size" of a file as the manifest records it, read in pieces; "" for anything but a
+// regular file (a symbolic link is never quadgen's: it wrote none).
 std::string hash_and_size(const fs::path& p) {
+  struct stat st {};
+  if (::lstat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
   std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string content = ss.str();
-  return fnv1a_hex(content) + " " + std::to_string(content.size());
+  Fnv1a h;
+  unsigned long long size = 0;
+  std::vector<char> buf(1 << 16);
+  while (in) {
+    in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+    const auto n = static_cast<size_t>(in.gcount());
+    h.add(buf.data(), n);
+    size += n;
+  }
+  return h.hex() + " " + std::to_string(size);
 }
 
 std::string first_names(const std::vector<std::string>& names) {
@@ -148,8 +195,8 @@ void check_replaceable(const fs::path& dir, const std::string& command) {
   if (!fs::is_directory(dir, ec)) fail(dir, "exists and is not a directory");
   const Manifest m = read_manifest(dir);
   if (!m.bad_lines.empty())
-    fail(dir, "its " + std::string(kManifestName) + " has a line quadgen does not write ('" + printable(m.bad_lines.front()) +
-                  "'; a manifest names plain files only); remove the directory or choose another --out");
+    fail(dir, "its " + std::string(kManifestName) + " is not one quadgen writes (at '" + printable(m.bad_lines.front()) +
+                  "'; a manifest is a small file naming plain files only); remove the directory or choose another --out");
   if (!m.command.empty() && m.command != command)
     fail(dir, "holds the output of 'quadgen " + printable(m.command) + "', which 'quadgen " + command +
                   "' does not replace; choose another --out directory or remove it");
@@ -158,7 +205,7 @@ void check_replaceable(const fs::path& dir, const std::string& command) {
     const std::string name = e.path().filename().string();
     if (name == kManifestName) continue;
     const auto it = m.files.find(name);
-    if (it == m.files.end() || !e.is_regular_file()) foreign.push_back(name);
+    if (it == m.files.end() || !fs::is_regular_file(e.symlink_status())) foreign.push_back(name);
     else if (hash_and_size(e.path()) != it->second) changed.push_back(name);
   }
   if (ec) fail(dir, "cannot list the directory: " + ec.message());
@@ -248,6 +295,8 @@ class StagingDirectory {
       const std::string name = e.path().filename().string();
       if (name.rfind(stem, 0) != 0) continue;
       const long pid = std::strtol(name.c_str() + stem.size(), nullptr, 10);
+      std::error_code keep_ec;
+      if (fs::exists(e.path() / kKeepMarker, keep_ec)) continue;  // an earlier run kept aside where it was
       if (!process_alive(pid)) remove_tree_quietly(e.path());
     }
   }
@@ -269,16 +318,20 @@ void check_file_name(const std::string& name) {
 }
 
 // Where an earlier run's folder goes when it still holds files after its own were removed
-// (files that appeared while this run wrote): a visible name of its own beside the output,
-// which no later run takes for a staging folder and removes.
+// (files that appeared while this run wrote): a visible name of its own beside the output
+// (a short one if the output's name is too long to extend). It is marked first, so that even
+// where no rename succeeds no later run takes it for a stale staging folder and removes it.
 fs::path keep_aside(const fs::path& staged, const fs::path& target) {
-  for (int n = 0; n < 1000; ++n) {
-    const fs::path kept = target.parent_path() / (target.filename().string() + ".previous-" + std::to_string(::getpid()) +
-                                                  (n ? "-" + std::to_string(n) : ""));
-    std::error_code ec;
-    if (fs::exists(kept, ec)) continue;
-    if (::rename(staged.c_str(), kept.c_str()) == 0) return kept;
-  }
+  std::ofstream(staged / kKeepMarker) << "an earlier quadgen output, kept because it held files quadgen did not write\n";
+  const std::string pid = std::to_string(::getpid());
+  for (const std::string& stem : {target.filename().string() + ".previous-" + pid, "quadgen-previous-" + pid})
+    for (int n = 0; n < 100; ++n) {
+      const fs::path kept = target.parent_path() / (stem + (n ? "-" + std::to_string(n) : ""));
+      std::error_code ec;
+      if (fs::exists(fs::symlink_status(kept, ec))) continue;
+      if (::rename(staged.c_str(), kept.c_str()) == 0) return kept;
+      if (errno == ENAMETOOLONG) break;
+    }
   return staged;
 }
 
@@ -341,34 +394,34 @@ void OutputDirectory::commit() {
   fsync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
-namespace {
-std::string head_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
-  return head;
-}
-}  // namespace
-
-OutputFiles::OutputFiles(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs)
-    : written_(files.size(), false) {
+OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::string& command, const std::vector<std::string>& inputs)
+    : command_(command), written_(paths.size(), false) {
   const auto ids = identities(inputs);
   std::set<fs::path> seen;
   std::error_code ec;
-  for (const auto& file : files) {
-    const fs::path p = resolved_file(file.path);
+  for (const auto& name : paths) {
+    const fs::path p = resolved_file(name);
     if (!seen.insert(p).second) fail(p, "is named for two outputs of one run (the trajectory and its plot)");
-    if (p.parent_path() != resolved_file(files.front().path).parent_path()) throw OutputError("internal: outputs in two folders");
-    if (fs::exists(p, ec) && !fs::is_regular_file(p, ec)) fail(p, "exists and is not a regular file");
+    if (p.parent_path() != resolved_file(paths.front()).parent_path()) throw OutputError("internal: outputs in two folders");
     struct stat st {};
     if (::stat(p.c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
       fail(p, "is the input " + printable(ids.at({st.st_dev, st.st_ino})) + "; choose another output path");
-    if (fs::exists(p, ec) && !file.ours(head_of(p)))
-      fail(p, "exists and is not " + file.what + "; choose another path or remove it");
     paths_.push_back(p.string());
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();
+  // A file already at a path is replaced only if the record beside it says this command
+  // wrote it there and it is unchanged since: a flight log of the user's looks like a
+  // trajectory, a plot of theirs may be gnuplot's too.
+  const Manifest record = read_manifest_file(parent / kFilesRecordName);
+  for (const auto& path : paths_) {
+    const fs::path p(path);
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0) continue;
+    if (!S_ISREG(st.st_mode)) fail(p, "exists and is not a regular file (a link or a directory); choose another path");
+    const auto it = record.files.find(p.filename().string());
+    if (record.command != command_ || it == record.files.end() || it->second != hash_and_size(p))
+      fail(p, "exists and is not a file 'quadgen " + command_ + "' wrote there (or it was changed since); choose another path or remove it");
+  }
   fs::create_directories(parent, ec);
   if (ec) fail(parent, "cannot create the directory: " + ec.message());
   staging_ = std::make_unique<StagingDirectory>(parent, fs::path(paths_.front()).filename().string());
@@ -390,7 +443,28 @@ void OutputFiles::commit() {
     const fs::path staged = staging_->path() / fs::path(paths_[i]).filename();
     if (::rename(staged.c_str(), paths_[i].c_str()) != 0) fail(paths_[i], "cannot move into place: " + errno_text());
   }
+  update_record();
   fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
+}
+
+// The record beside the files: this run's files with their hashes, the entries of earlier
+// runs kept where their files are still there; replaced whole by a rename.
+void OutputFiles::update_record() {
+  const fs::path parent = fs::path(paths_.front()).parent_path(), record_path = parent / kFilesRecordName;
+  Manifest record = read_manifest_file(record_path);
+  if (record.command != command_) record.files.clear();
+  for (auto it = record.files.begin(); it != record.files.end();) {
+    std::error_code ec;
+    it = fs::exists(fs::symlink_status(parent / it->first, ec)) ? std::next(it) : record.files.erase(it);
+  }
+  for (size_t i = 0; i < paths_.size(); ++i) {
+    const std::string name = fs::path(paths_[i]).filename().string();
+    if (written_[i]) record.files[name] = hash_and_size(paths_[i]);
+    else record.files.erase(name);
+  }
+  staging_->write(kFilesRecordName, manifest_text(command_, record.files));
+  const fs::path staged = staging_->path() / kFilesRecordName;
+  if (::rename(staged.c_str(), record_path.c_str()) != 0) fail(record_path, "cannot move into place: " + errno_text());
 }
 
 bool complete_output_directory(const std::string& dir, std::string* why) {
@@ -400,7 +474,7 @@ bool complete_output_directory(const std::string& dir, std::string* why) {
   };
   const Manifest m = read_manifest(dir);
   if (!m.present || m.files.empty()) return no("no manifest");
-  if (!m.bad_lines.empty()) return no("the manifest has a line quadgen does not write");
+  if (!m.bad_lines.empty()) return no("the manifest is not one quadgen writes");
   std::error_code ec;
   size_t files = 0;
   for (const auto& e : fs::directory_iterator(dir, ec)) {

@@ -9,11 +9,11 @@
 // one, and two runs into one DIR leave one of them whole.
 //
 // OutputFiles (simulate --out TRAJ.csv, with TRAJ.svg beside it): files among other files.
-// An existing file is replaced only if it looks like one this command writes (its first bytes
-// tell). Each file is renamed into place from the staging directory; a companion of the
-// previous run is removed first, so a kill leaves a missing plot, never a plot of another run.
+// An existing file is replaced only if the record beside it (.quadgen-files) says the same
+// command wrote it and it is unchanged since. Each file is renamed into place from the staging
+// directory; a companion of the previous run is removed first, so a kill leaves a missing
+// plot, never a plot of another run.
 #pragma once
-#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -56,19 +56,12 @@ class OutputDirectory {
   std::vector<std::pair<std::string, std::string>> manifest_;  // file name, "hash size"
 };
 
-// One file of an OutputFiles set.
-struct OutputFile {
-  std::string path;
-  // Whether an existing file at `path` is one this command wrote, judged from its first 4 KiB;
-  // any other file there is refused, never replaced.
-  std::function<bool(const std::string& head)> ours;
-  std::string what;  // what `ours` accepts, for the error ("a trajectory quadgen wrote ...")
-};
-
 class OutputFiles {
  public:
-  // `files`: what this run writes, in one folder; distinct, none an input, none a directory.
-  OutputFiles(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs);
+  // `paths`: what this run writes, in one folder; distinct, none an input, none a directory.
+  // A file already at a path is replaced only if `command` wrote it there and it is unchanged
+  // since (a record beside the files, .quadgen-files, lists what each run wrote).
+  OutputFiles(const std::vector<std::string>& paths, const std::string& command, const std::vector<std::string>& inputs);
   ~OutputFiles();
   OutputFiles(const OutputFiles&) = delete;
   OutputFiles& operator=(const OutputFiles&) = delete;
@@ -78,6 +71,8 @@ class OutputFiles {
   void commit();
 
  private:
+  void update_record();
+  std::string command_;
   std::vector<std::string> paths_;
   std::vector<bool> written_;
   std::unique_ptr<StagingDirectory> staging_;

@@ -597,7 +597,7 @@ TEST(DataLoss, ManifestNamingPathsRemovesNothingOutsideTheDirectory) {
   const std::string manifest = read(tmp / "d/.quadgen-manifest");
   for (const std::string& line : {std::string("0 0 ../victim.txt"), "0 0 " + (tmp / "absolute_victim.txt"), std::string("0 0 ..")}) {
     write(tmp / "d/.quadgen-manifest", manifest + line + "\n");
-    expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "a line quadgen does not write", line);
+    expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "is not one quadgen writes", line);
     EXPECT_EQ(read(tmp / "victim.txt"), "keep me");
     EXPECT_EQ(read(tmp / "absolute_victim.txt"), "keep me too");
     EXPECT_TRUE(fs::exists(tmp / "d/model.hpp"));
@@ -605,6 +605,43 @@ TEST(DataLoss, ManifestNamingPathsRemovesNothingOutsideTheDirectory) {
   std::string why;
   EXPECT_FALSE(out::complete_output_directory(tmp / "d", &why));
   EXPECT_NE(why.find("manifest"), std::string::npos) << why;
+}
+
+// What a manifest is and what sits beside it in the folder decide, not what the names say: a
+// link in the folder is not quadgen's, a manifest that is a FIFO is refused without blocking,
+// blank lines and CRLF are read, and a manifest from before the command was recorded is
+// taken as the command its files show.
+TEST(DataLoss, ManifestAndFolderAreReadWithCare) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  const std::string manifest = read(tmp / "d/.quadgen-manifest");
+  // A link with the listed name and content: not replaced (its target is the user's).
+  write(tmp / "mine.json", read(tmp / "d/model.json"));
+  fs::remove(tmp / "d/model.json");
+  fs::create_symlink(tmp / "mine.json", tmp / "d/model.json");
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "holds files quadgen did not write (model.json)",
+                        "a link");
+  EXPECT_TRUE(fs::is_symlink(tmp / "d/model.json"));
+  fs::remove(tmp / "d/model.json");
+  fs::copy_file(tmp / "mine.json", tmp / "d/model.json");
+  // A FIFO manifest.
+  fs::remove(tmp / "d/.quadgen-manifest");
+  ASSERT_EQ(::mkfifo((tmp / "d/.quadgen-manifest").c_str(), 0600), 0);
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir), "is not one quadgen writes", "a FIFO");
+  fs::remove(tmp / "d/.quadgen-manifest");
+  // CRLF and blank lines; then the same without the command line, as older versions wrote it.
+  std::string crlf;
+  for (char c : manifest) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  write(tmp / "d/.quadgen-manifest", crlf + "\r\n\n");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  const std::string current = read(tmp / "d/.quadgen-manifest");
+  const size_t cmd = current.find("command derive\n");
+  ASSERT_NE(cmd, std::string::npos);
+  write(tmp / "d/.quadgen-manifest", current.substr(0, cmd) + current.substr(cmd + 15));
+  expect_one_line_error(run_quadgen({"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", tmp / "d"}, tmp.dir),
+                        "holds the output of 'quadgen derive'", "an older manifest");
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
 }
 
 // A file of an earlier run that the user edited is theirs now: the run is refused, the edit kept.
@@ -637,18 +674,24 @@ TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
   };
   write(tmp / "victim.yaml", "mass: 1\n");
   expect_one_line_error(run_quadgen(with_out(tmp / "victim.yaml"), tmp.dir), "expected a .csv file name", "--out .yaml");
-  write(tmp / "notes.csv", "a,b\n1,2\n");
-  expect_one_line_error(run_quadgen(with_out(tmp / "notes.csv"), tmp.dir), "is not a trajectory quadgen wrote", "foreign csv");
-  write(tmp / "traj.svg", "<svg>my drawing</svg>");
-  expect_one_line_error(run_quadgen(with_out(tmp / "traj.csv"), tmp.dir), "is not a plot quadgen wrote", "foreign svg");
+  // A flight log of the user's looks like a trajectory; a plot of theirs may be gnuplot's too.
+  const std::string flight = "t,u_A,u_B,u_C,u_D\n0,0.5,0.5,0.5,0.5\n";
+  write(tmp / "flight07.csv", flight);
+  expect_one_line_error(run_quadgen(with_out(tmp / "flight07.csv"), tmp.dir), "is not a file 'quadgen simulate' wrote there",
+                        "the user's log");
+  write(tmp / "traj.svg", "<svg><desc>Produced by GNUPLOT 5.4</desc></svg>");
+  expect_one_line_error(run_quadgen(with_out(tmp / "traj.csv"), tmp.dir), "is not a file 'quadgen simulate' wrote there",
+                        "the user's plot");
   EXPECT_EQ(read(tmp / "victim.yaml"), "mass: 1\n");
-  EXPECT_EQ(read(tmp / "notes.csv"), "a,b\n1,2\n");
-  EXPECT_EQ(read(tmp / "traj.svg"), "<svg>my drawing</svg>");
+  EXPECT_EQ(read(tmp / "flight07.csv"), flight);
+  EXPECT_EQ(read(tmp / "traj.svg"), "<svg><desc>Produced by GNUPLOT 5.4</desc></svg>");
   EXPECT_FALSE(fs::exists(tmp / "traj.csv"));
-  // Its own earlier run is replaced.
+  // Its own earlier run is replaced; once edited, it is the user's.
   ASSERT_EQ(run_quadgen(with_out(tmp / "run.csv"), tmp.dir).rc, 0);
   ASSERT_EQ(run_quadgen(with_out(tmp / "run.csv"), tmp.dir).rc, 0);
   EXPECT_EQ(read(tmp / "run.csv").substr(0, 2), "t,");
+  write(tmp / "run.csv", read(tmp / "run.csv") + "my last row\n");
+  expect_one_line_error(run_quadgen(with_out(tmp / "run.csv"), tmp.dir), "or it was changed since", "an edited trajectory");
 }
 
 // Killed at random moments, a run leaves its --out directory holding one complete run: the

@@ -212,7 +212,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {"effects: [motor_gain]\neffects: []\nparameters: {}\n", ":2: key 'effects' given twice"},
       {"effects: [wind, wind]\nparameters: {}\n", ":1: effect 'wind' listed twice"},
       // The other files a user may pass: each named, with the one expected.
-      {"{\"vehicle\": \"finken3\", \"final_fit\": {}}\n", ":1: a JSON file (a diagnosis.json or fit.json?); derive --params takes"},
+      {"{\"vehicle\": \"finken3\", \"final_fit\": {}}\n", ":1: a diagnosis.json or fit.json; derive --params takes"},
       {"name: finken3\nblocks: []\n", ":1: a vehicle file without a 'fitted:' section"},
   };
   int k = 0;
