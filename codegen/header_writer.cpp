@@ -95,6 +95,69 @@ std::string model_name(const SymbolicModel& m) {
   return output::checked_cpp_identifier(s, "model namespace");
 }
 
+namespace {
+
+// The op counts and sizes the header prints in its comment and declares as constants.
+void set_counts(data& d, const SymbolicModel& m, const GeneratedHeader& out) {
+  d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
+  d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));
+  d.set("ops_before", std::to_string(std::llround(out.ops_before)));
+  d.set("ops_after", std::to_string(std::llround(out.ops_after)));
+  d.set("pre_ops", std::to_string(std::llround(out.pre_ops)));
+  d.set("pre_count", std::to_string(out.pre_count));
+  d.set("n_states", std::to_string(m.states.size()));
+  d.set("n_inputs", std::to_string(m.inputs.size()));
+  d.set("n_params", std::to_string(m.params.size()));
+  d.set("n_outputs", std::to_string(m.outputs.size()));
+  d.set("pre_size", std::to_string(out.pre_count));
+}
+
+// Names, nominal values, units, bounds and fit flags, one array entry per variable.
+void set_variable_tables(data& d, const SymbolicModel& m) {
+  d.set("states", variables(m.states));
+  d.set("inputs", variables(m.inputs));
+  d.set("params", variables(m.params));
+  d.set("state_names", quoted_list(m.states));
+  d.set("input_names", quoted_list(m.inputs));
+  d.set("param_names", quoted_list(m.params));
+  d.set("output_names", quoted_list(m.outputs));
+  std::string nominal = "{", units = "{", lower = "{", upper = "{", fit = "{";
+  for (size_t i = 0; i < m.params.size(); ++i) {
+    const Variable& v = m.params[i];
+    const std::string sep = i ? ", " : "";
+    nominal += sep + number(v.nominal);
+    units += sep + output::cpp_string_literal(v.unit);
+    lower += sep + bound(v.lower);
+    upper += sep + bound(v.upper);
+    fit += sep + (v.fit ? "true" : "false");
+  }
+  d.set("nominal_params", nominal + "}");
+  d.set("param_units", units + "}");
+  d.set("param_lower", lower + "}");
+  d.set("param_upper", upper + "}");
+  d.set("param_fit", fit + "}");
+  d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
+}
+
+// Each Jacobian's sparsity pattern (row and column of every stored entry).
+void set_sparsity(data& d, const LoweredModel& lm) {
+  list sparsity;
+  const std::pair<const char*, const SparsePattern*> sp[] = {
+      {"Dfdx", &lm.dfdx}, {"Dfdu", &lm.dfdu}, {"Dfdp", &lm.dfdp}, {"Dhdx", &lm.dhdx}, {"Dhdp", &lm.dhdp}};
+  for (const auto& [name, s] : sp) {
+    data e;
+    e.set("name", name);
+    e.set("nnz", std::to_string(s->rows.size()));
+    e.set("size", std::to_string(std::max<size_t>(1, s->rows.size())));
+    e.set("rows", int_list(s->rows));
+    e.set("cols", int_list(s->cols));
+    sparsity.push_back(e);
+  }
+  d.set("sparsity", data{sparsity});
+}
+
+}  // namespace
+
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
   const LoweredModel lm = lower_model(m);
   const PrintedFunction pre = print_cpp(*lm.plan, lm.precompute);
@@ -120,54 +183,9 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("parameter_source_line", opt.parameter_source.empty() ? std::string()
                                  : "// Parameter values (kNominalParams): " + output::cpp_comment(opt.parameter_source) + ".\n");
   d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
-  d.set("ops_f_before", std::to_string(std::llround(out.ops_f_before)));
-  d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));
-  d.set("ops_before", std::to_string(std::llround(out.ops_before)));
-  d.set("ops_after", std::to_string(std::llround(out.ops_after)));
-  d.set("pre_ops", std::to_string(std::llround(out.pre_ops)));
-  d.set("pre_count", std::to_string(out.pre_count));
-  d.set("n_states", std::to_string(m.states.size()));
-  d.set("n_inputs", std::to_string(m.inputs.size()));
-  d.set("n_params", std::to_string(m.params.size()));
-  d.set("n_outputs", std::to_string(m.outputs.size()));
-  d.set("pre_size", std::to_string(out.pre_count));
-  d.set("states", variables(m.states));
-  d.set("inputs", variables(m.inputs));
-  d.set("params", variables(m.params));
-  d.set("state_names", quoted_list(m.states));
-  d.set("input_names", quoted_list(m.inputs));
-  d.set("param_names", quoted_list(m.params));
-  d.set("output_names", quoted_list(m.outputs));
-  std::string nominal = "{";
-  for (size_t i = 0; i < m.params.size(); ++i) nominal += (i ? ", " : "") + number(m.params[i].nominal);
-  d.set("nominal_params", nominal + "}");
-  std::string units = "{", lower = "{", upper = "{", fit = "{";
-  for (size_t i = 0; i < m.params.size(); ++i) {
-    const Variable& v = m.params[i];
-    const std::string sep = i ? ", " : "";
-    units += sep + output::cpp_string_literal(v.unit);
-    lower += sep + bound(v.lower);
-    upper += sep + bound(v.upper);
-    fit += sep + (v.fit ? "true" : "false");
-  }
-  d.set("param_units", units + "}");
-  d.set("param_lower", lower + "}");
-  d.set("param_upper", upper + "}");
-  d.set("param_fit", fit + "}");
-  d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
-  list sparsity;
-  const std::pair<const char*, const SparsePattern*> sp[] = {
-      {"Dfdx", &lm.dfdx}, {"Dfdu", &lm.dfdu}, {"Dfdp", &lm.dfdp}, {"Dhdx", &lm.dhdx}, {"Dhdp", &lm.dhdp}};
-  for (const auto& [name, s] : sp) {
-    data e;
-    e.set("name", name);
-    e.set("nnz", std::to_string(s->rows.size()));
-    e.set("size", std::to_string(std::max<size_t>(1, s->rows.size())));
-    e.set("rows", int_list(s->rows));
-    e.set("cols", int_list(s->cols));
-    sparsity.push_back(e);
-  }
-  d.set("sparsity", data{sparsity});
+  set_counts(d, m, out);
+  set_variable_tables(d, m);
+  set_sparsity(d, lm);
   d.set("precompute_body", pre.body);
   d.set("rhs_body", rhs_code.body);
   d.set("rhs_f_body", f_only.body);
