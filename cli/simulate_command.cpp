@@ -1,4 +1,5 @@
 // quadgen simulate VEHICLE.yaml (--scenario NAME | --inputs LOG.csv) --duration S --out TRAJ.csv
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -86,7 +87,9 @@ namespace {
 std::string plot_path(const std::string& out) { return std::filesystem::path(out).replace_extension(".svg").string(); }
 
 output::OutputFiles output_for(const SimulateArgs& a) {
-  if (std::filesystem::path(a.out).extension() != ".csv")
+  std::string extension = std::filesystem::path(a.out).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".csv")
     throw std::invalid_argument("--out " + output::printable(a.out) +
                                 ": expected a .csv file name (the trajectory; its plot goes to the .svg beside it)");
   return output::OutputFiles({a.out, plot_path(a.out)}, "simulate", {a.job.vehicle, a.job.inputs});
