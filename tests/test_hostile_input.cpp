@@ -750,6 +750,20 @@ TEST(DataLoss, TwoRunsIntoOneDirectoryLeaveOneWhole) {
     EXPECT_EQ(e.path().filename().string().find(".quadgen-tmp."), std::string::npos) << e.path();
 }
 
+// A prediction whose errors are not finite is no success: exit 4 with the reason, files kept.
+TEST(Cli, PredictExitsNonZeroWhenTheModelLeavesItsRange) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "6", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  write(tmp / "bad.json", R"({"vehicle": "finken3", "estimates": {"J_xx": {"value": 1e-12}, "J_yy": {"value": 1e-12}}})");
+  const CliResult r = run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", tmp / "bad.json", "--out", tmp / "p"}, tmp.dir);
+  EXPECT_EQ(r.rc, 4) << r.err;
+  EXPECT_NE(r.err.find("is not finite: the model left its range"), std::string::npos) << r.err;
+  EXPECT_TRUE(out::complete_output_directory(tmp / "p"));
+  write(tmp / "good.json", R"({"vehicle": "finken3", "estimates": {}})");
+  EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", tmp / "good.json", "--out", tmp / "q"}, tmp.dir).rc, 0);
+}
+
 // ---- options -------------------------------------------------------------------------------
 
 TEST(Options, EveryNumberIsCheckedAndNothingIsSilentlyIgnored) {
