@@ -6,11 +6,19 @@ namespace {
 double nominal(const SymbolicModel& m, const char* name) { return m.params[m.param_index(name)].nominal; }
 }  // namespace
 
+// The map as the model has it (derive/dynamics.cpp, commanded_rotor_speed): turned about the
+// pivot command by the slope where the vehicle file gives one. Turned, it is still a
+// quadratic in u: w = (1 - s) map(pivot) + s map(u).
 std::vector<runtime::ThrustLaw> nominal_thrust_laws(const Vehicle& v, const SymbolicModel& m) {
+  double a0 = nominal(m, "motor_a0"), a1 = nominal(m, "motor_a1"), a2 = nominal(m, "motor_a2");
+  if (v.params.count("slope")) {
+    const double s = nominal(m, "motor_slope"), pivot = param(v, "pivot").nominal;
+    const double at_pivot = a0 + a1 * pivot + a2 * pivot * pivot;
+    a0 = (1 - s) * at_pivot + s * a0, a1 *= s, a2 *= s;
+  }
   std::vector<runtime::ThrustLaw> laws;
   for (const Rotor& r : v.rotors)
-    laws.push_back({runtime::rotor_thrust_coefficient(nominal(m, "c_t"), nominal(m, "rho"), r.disc_area, r.radius),
-                    nominal(m, "motor_a0"), nominal(m, "motor_a1"), nominal(m, "motor_a2")});
+    laws.push_back({runtime::rotor_thrust_coefficient(nominal(m, "c_t"), nominal(m, "rho"), r.disc_area, r.radius), a0, a1, a2});
   return laws;
 }
 

@@ -551,6 +551,21 @@ TEST(Simulate, ClimbReproducesThesis63And64) {
   std::filesystem::remove_all(dir);
 }
 
+// The hover scenario asks each rotor for its share of the weight through the motor map as the
+// model has it, turned about its pivot where the vehicle file gives a slope: it stays put.
+TEST(Simulate, HoverHoldsWithAMotorMapTurnedByItsSlope) {
+  const std::string dir = testing::TempDir() + "quadgen_sim_hover_" + std::to_string(::getpid());
+  std::filesystem::remove_all(dir);
+  for (const char* vehicle : {"vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml"}) {
+    const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + test::source_path(vehicle) +
+                            " --scenario hover --duration 2 --out " + dir + "/hover.csv > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << vehicle;
+    const auto z = read_csv(dir + "/hover.csv").values("z");
+    EXPECT_NEAR(z.back(), 0.0, 1e-6) << vehicle;  // was 2.8 m with the slope ignored
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Simulate, BadReplayLogFailsWithOneLineAndNoOutput) {
   const std::string dir = testing::TempDir() + "quadgen_sim_bad_" + std::to_string(::getpid());
   std::filesystem::remove_all(dir);
