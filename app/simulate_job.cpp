@@ -134,7 +134,12 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
     };
   } else {
     const CsvTable log = read_csv(a.inputs);
-    validate_canonical(log, rotors);
+    try {
+      validate_canonical(log, rotors);
+    } catch (const LogError& e) {  // the one thing a user cannot guess: replay reads no mapping
+      throw LogError(std::string(e.what()) +
+                     "; simulate --inputs replays a log in the canonical layout (t, u_<rotor>; docs/formats.md)");
+    }
     std::vector<double> t = log.values("t");
     if (a.duration > t.back() - t.front() + 1e-9)
       throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +

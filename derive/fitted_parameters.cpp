@@ -17,6 +17,9 @@ FittedParameters load_fitted_parameters(const std::string& path) {
   if (file["final_fit"] || file["estimates"] || file["findings"])
     throw VehicleError(path + ":1: a diagnosis.json or fit.json; derive --params takes the "
                               "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes beside its diagnosis.json");
+  if (file["columns"])
+    throw VehicleError(path + ":1: a column mapping; derive --params takes the fitted_parameters.yaml (or "
+                              "fitted_vehicle.yaml) a diagnose run writes");
   if (file["name"] && !file["fitted"])
     throw VehicleError(path + ":1: a vehicle file without a 'fitted:' section; derive --params takes the "
                               "fitted_parameters.yaml (or fitted_vehicle.yaml) a diagnose run writes");

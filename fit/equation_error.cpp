@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -39,7 +40,14 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     for (size_t k = 0; k < flight_.samples.size(); ++k) rows_.push_back(k);
   } else {
     build_filter(window);
-    if (rows_.empty()) throw FitError(flight_.source + ": no stretch of the log is long enough for the derivative window");
+    if (rows_.empty()) {
+      std::ostringstream os;  // most often a time unit: samples 10 s apart read as ms
+      const auto& S = flight_.samples;
+      os << flight_.source << ": no stretch of the log is long enough for the derivative window of " << window
+         << " s (its samples are " << (S.size() > 1 ? (S.back().t - S.front().t) / static_cast<double>(S.size() - 1) : 0.0)
+         << " s apart on average, over " << (S.empty() ? 0.0 : S.back().t - S.front().t) << " s: is t in seconds?)";
+      throw FitError(os.str());
+    }
   }
 }
 

@@ -409,6 +409,10 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
     paths_.push_back(p.string());
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();
+  std::error_code manifest_ec;
+  if (fs::exists(fs::symlink_status(parent / kManifestName, manifest_ec)))
+    fail(parent, "is the output directory of another quadgen run (it holds " + std::string(kManifestName) +
+                     "); a file written there would make it refuse its next run: choose another folder");
   // A file already at a path is replaced only if the record beside it says this command
   // wrote it there and it is unchanged since: a flight log of the user's looks like a
   // trajectory, a plot of theirs may be gnuplot's too.

@@ -692,6 +692,11 @@ TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
   EXPECT_EQ(read(tmp / "run.csv").substr(0, 2), "t,");
   write(tmp / "run.csv", read(tmp / "run.csv") + "my last row\n");
   expect_one_line_error(run_quadgen(with_out(tmp / "run.csv"), tmp.dir), "or it was changed since", "an edited trajectory");
+  // Not into another run's output directory, which would then refuse its next run.
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  expect_one_line_error(run_quadgen(with_out(tmp / "d/h.csv"), tmp.dir), "is the output directory of another quadgen run",
+                        "into a derive folder");
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
 }
 
 // Killed at random moments, a run leaves its --out directory holding one complete run: the

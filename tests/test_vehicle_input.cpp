@@ -214,6 +214,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       // The other files a user may pass: each named, with the one expected.
       {"{\"vehicle\": \"finken3\", \"final_fit\": {}}\n", ":1: a diagnosis.json or fit.json; derive --params takes"},
       {"name: finken3\nblocks: []\n", ":1: a vehicle file without a 'fitted:' section"},
+      {"name: nanobench\ncolumns:\n  t: {source: t}\n", ":1: a column mapping; derive --params takes"},
   };
   int k = 0;
   for (const auto& [text, want] : bad) {
