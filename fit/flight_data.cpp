@@ -338,6 +338,66 @@ namespace {
 }
 }  // namespace
 
+namespace {
+// Two unit mistakes a mapping can make that no dimension check sees, because the unit is
+// right and the number is not: a gyro in deg/s declared rad/s (57 times the rates the
+// attitude shows) and an accelerometer in g declared m/s^2 (a specific force near 1 in
+// flight, where it is near 9.8). Judged on airborne samples, only where the data can tell.
+void check_sensor_units(const std::string& path, const Flight& f) {
+  const auto& S = f.samples;
+  if (f.has_pose && f.has_gyro && S.size() > 10) {
+    // Over windows of about 0.2 s: the attitude's turn A (rotation vector of q_a^-1 q_b, body
+    // axes) against the gyro's integral G. The slope of A on G is 1 for a gyro in the right
+    // unit and is not biased by the attitude's noise (it is in A, not in G); in deg/s declared
+    // rad/s it is 1/57. Judged only where its standard error is small.
+    double ag = 0, gg = 0, aa = 0;
+    size_t n = 0;
+    for (size_t k = 0; k + 1 < S.size();) {
+      Eigen::Vector3d G = Eigen::Vector3d::Zero();
+      size_t j = k;
+      bool gap = false;
+      while (j + 1 < S.size() && S[j].t - S[k].t < 0.2) {
+        const double dt = S[j + 1].t - S[j].t;
+        gap = gap || !(dt > 0 && dt < 0.1);
+        G += Eigen::Vector3d(S[j].x[10], S[j].x[11], S[j].x[12]) * dt;
+        ++j;
+      }
+      const auto quat = [&](size_t i) { return Eigen::Quaterniond(S[i].x[6], S[i].x[7], S[i].x[8], S[i].x[9]); };
+      if (!gap && j > k) {
+        const Eigen::AngleAxisd turn(quat(k).conjugate() * quat(j));
+        const Eigen::Vector3d A = turn.axis() * turn.angle();
+        ag += A.dot(G), gg += G.squaredNorm(), aa += A.squaredNorm(), ++n;
+      }
+      k = j;
+    }
+    if (n > 20 && gg > 0) {
+      const double slope = ag / gg;
+      const double se = std::sqrt(std::max(0.0, aa - slope * ag) / static_cast<double>(3 * n - 1) / gg);
+      if ((slope + 3 * se < 0.2 || slope - 3 * se > 5) && se < 0.1 * std::max(1.0, slope)) {
+        std::ostringstream os;
+        os << path << ": the logged attitude turns " << slope << " times as far as the gyro's rates say (+- " << se
+           << ", over " << n << " windows of 0.2 s): " << (slope < 1 ? "deg/s read as rad/s? (in the mapping, unit: deg/s)"
+                                                                    : "rad/s read as deg/s?");
+        throw FitError(os.str());
+      }
+    }
+  }
+  if (f.has_accelerometer && !S.empty()) {
+    std::vector<double> magnitude;
+    for (const auto& sample : S)
+      magnitude.push_back(Eigen::Vector3d(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]).norm());
+    std::nth_element(magnitude.begin(), magnitude.begin() + static_cast<long>(magnitude.size() / 2), magnitude.end());
+    const double median = magnitude[magnitude.size() / 2];
+    if (median > 0.5 && median < 2) {
+      std::ostringstream os;
+      os << path << ": the accelerometer's specific force in flight is " << median
+         << " m/s^2 (median), where it is near 9.8: in g? (in the mapping, scale: 9.80665 and unit: m/s^2)";
+      throw FitError(os.str());
+    }
+  }
+}
+}  // namespace
+
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
   runtime::validate_canonical(log, rotors);
   Flight f;
@@ -404,6 +464,7 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
     if ((!o.airborne_only || airborne) && !edge) f.samples.push_back(fs);
   }
   if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, trel, f, o);
+  check_sensor_units(log.path, f);
   return f;
 }
 

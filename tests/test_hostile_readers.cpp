@@ -251,6 +251,30 @@ TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
   EXPECT_NE(missing.find(mapping + ": missing column 'u_M5'"), std::string::npos) << missing;
 }
 
+// Units that are right in dimension and wrong in number: a gyro in deg/s declared rad/s, an
+// accelerometer in g declared m/s^2. A generated flight with its columns so scaled is refused
+// with the hint; as generated it loads.
+TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
+  const std::string log = (dir_ / "flight.csv").string();
+  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + std::string(QUADGEN_SOURCE_DIR) +
+                          "/vehicles/finken3.yaml --closed-loop --duration 10 --out " + log + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(sim.c_str()), 0);
+  const std::vector<std::string> rotors = {"A", "B", "C", "D"};
+  const runtime::CsvTable table = runtime::read_csv(log);
+  EXPECT_NO_THROW(load_flight(table, rotors, {}));
+  const auto scaled = [&](std::initializer_list<const char*> columns, double factor) {
+    runtime::CsvTable t = table;
+    for (const char* c : columns)
+      for (auto& row : t.rows) row[static_cast<size_t>(t.column(c))] *= factor;
+    return t;
+  };
+  EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"p", "q", "r"}, 180 / M_PI), rotors, {}); }).find("deg/s read as rad/s?"),
+            std::string::npos);
+  EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"ax", "ay", "az"}, 1 / 9.80665), rotors, {}); })
+                .find("in g? (in the mapping, scale: 9.80665 and unit: m/s^2)"),
+            std::string::npos);
+}
+
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,
 // so its columns are exactly source * scale + offset, bit for bit.
 TEST_F(Hostile, NanobenchMappingValuesUnchanged) {
