@@ -346,17 +346,18 @@ namespace {
 void check_sensor_units(const std::string& path, const Flight& f) {
   const auto& S = f.samples;
   if (f.has_pose && f.has_gyro && S.size() > 10) {
-    // Over windows of about 0.2 s: the attitude's turn A (rotation vector of q_a^-1 q_b, body
+    // Over windows of up to 0.2 s: the attitude's turn A (rotation vector of q_a^-1 q_b, body
     // axes) against the gyro's integral G. The slope of A on G is 1 for a gyro in the right
     // unit and is not biased by the attitude's noise (it is in A, not in G); in deg/s declared
-    // rad/s it is 1/57. Judged only where its standard error is small.
+    // rad/s it is 1/57. A window ends once G reaches 1 rad, before A could wrap past pi in a
+    // flip. Judged only where its standard error is small.
     double ag = 0, gg = 0, aa = 0;
     size_t n = 0;
     for (size_t k = 0; k + 1 < S.size();) {
       Eigen::Vector3d G = Eigen::Vector3d::Zero();
       size_t j = k;
       bool gap = false;
-      while (j + 1 < S.size() && S[j].t - S[k].t < 0.2) {
+      while (j + 1 < S.size() && S[j].t - S[k].t < 0.2 && G.norm() < 1) {
         const double dt = S[j + 1].t - S[j].t;
         gap = gap || !(dt > 0 && dt < 0.1);
         G += Eigen::Vector3d(S[j].x[10], S[j].x[11], S[j].x[12]) * dt;
@@ -373,11 +374,19 @@ void check_sensor_units(const std::string& path, const Flight& f) {
     if (n > 20 && gg > 0) {
       const double slope = ag / gg;
       const double se = std::sqrt(std::max(0.0, aa - slope * ag) / static_cast<double>(3 * n - 1) / gg);
-      if ((slope + 3 * se < 0.2 || slope - 3 * se > 5) && se < 0.1 * std::max(1.0, slope)) {
+      if ((slope + 3 * se < 0.2 || slope - 3 * se > 5) && se < 0.1 * std::max(1.0, std::fabs(slope))) {
+        // The hint only where the slope is the unit's factor; any other disagreement is one of
+        // convention or axes.
+        const double per_degree = M_PI / 180;
+        const auto near = [&](double factor) { return std::fabs(slope - factor) < 3 * se + 0.25 * factor; };
         std::ostringstream os;
         os << path << ": the logged attitude turns " << slope << " times as far as the gyro's rates say (+- " << se
-           << ", over " << n << " windows of 0.2 s): " << (slope < 1 ? "deg/s read as rad/s? (in the mapping, unit: deg/s)"
-                                                                    : "rad/s read as deg/s?");
+           << ", over " << n << " windows of up to 0.2 s): "
+           << (near(per_degree)       ? "deg/s read as rad/s? (in the mapping, unit: deg/s)"
+               : near(1 / per_degree) ? "rad/s read as deg/s?"
+                                      : "the attitude and the gyro disagree in convention or axes: a world-to-body "
+                                        "quaternion (in the mapping, scale: -1 on qx, qy, qz), or gyro axes of another "
+                                        "frame (frame: ned_frd)?");
         throw FitError(os.str());
       }
     }
@@ -391,7 +400,8 @@ void check_sensor_units(const std::string& path, const Flight& f) {
     if (median > 0.5 && median < 2) {
       std::ostringstream os;
       os << path << ": the accelerometer's specific force in flight is " << median
-         << " m/s^2 (median), where it is near 9.8: in g? (in the mapping, scale: 9.80665 and unit: m/s^2)";
+         << " m/s^2 (median), where it is near 9.8: in g? (in the mapping, scale: 9.80665 and unit: m/s^2; quadgen "
+            "reads the specific force with gravity in it, as an IMU measures it)";
       throw FitError(os.str());
     }
   }

@@ -270,8 +270,12 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   };
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"p", "q", "r"}, 180 / M_PI), rotors, {}); }).find("deg/s read as rad/s?"),
             std::string::npos);
+  // A world-to-body quaternion turns the other way: refused, with the convention named.
+  EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"qx", "qy", "qz"}, -1), rotors, {}); })
+                .find("disagree in convention or axes: a world-to-body quaternion"),
+            std::string::npos);
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"ax", "ay", "az"}, 1 / 9.80665), rotors, {}); })
-                .find("in g? (in the mapping, scale: 9.80665 and unit: m/s^2)"),
+                .find("in g? (in the mapping, scale: 9.80665 and unit: m/s^2;"),
             std::string::npos);
 }
 
