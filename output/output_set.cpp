@@ -374,9 +374,7 @@ void OutputDirectory::add(const std::string& filename, const std::string& conten
 }
 
 void OutputDirectory::commit() {
-  std::string manifest = std::string(kManifestHeader) + "\n" + kCommandKey + command_ + "\n";
-  for (const auto& [name, hash_size] : manifest_) manifest += hash_size + " " + name + "\n";
-  staging_->write(kManifestName, manifest);
+  staging_->write(kManifestName, manifest_text(command_, {manifest_.begin(), manifest_.end()}));
   fsync_path(staging_->path(), O_RDONLY | O_DIRECTORY);
   test_hook_die_before_commit();
   const fs::path target(dir_), staged = staging_->path();
