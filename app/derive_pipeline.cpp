@@ -21,7 +21,7 @@ void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std
   else if (std::set<std::string>(wanted.begin(), wanted.end()) != std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
     throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
   request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
-  request.emit.effects_flag = params == vehicle_path ? "" : " --params " + output::shell_path(params);
+  request.emit.regenerate_flags = params == vehicle_path ? "" : " --params " + output::shell_path(params);
   request.emit.parameter_source = "fitted values from " + params;
 }
 
@@ -38,8 +38,8 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.thesis_comparison) out.thesis = compare_with_thesis(out.model, mass);
   progress("generating C++");
   codegen::EmitOptions emit = request.emit;
-  if (request.effects_flag_from_model)
-    emit.effects_flag = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
+  if (request.regenerate_flags_from_model)
+    emit.regenerate_flags = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
   out.header = codegen::generate_header(out.model, emit);
   const Derivation d{vehicle, mass, out.model, out.audit, out.thesis};
   out.model_json = model_json(d);

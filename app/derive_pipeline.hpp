@@ -21,8 +21,8 @@ struct DeriveRequest {
   DeriveOptions derive;       // effects and added terms
   codegen::EmitOptions emit;  // the header's provenance
   // The header's regenerate command names the model's effects in canonical order
-  // ("--effects motor_gain,wind") rather than emit.effects_flag.
-  bool effects_flag_from_model = false;
+  // ("--effects motor_gain,wind") rather than emit.regenerate_flags.
+  bool regenerate_flags_from_model = false;
   // Sets nominal values other than the vehicle file's (fitted ones) before the audit and the
   // emission; none when empty.
   std::function<void(SymbolicModel&)> set_nominal;

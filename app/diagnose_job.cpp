@@ -41,8 +41,7 @@ bool DiagnoseJob::IsValid(std::string* error) const {
 namespace {
 
 std::vector<fit::Flight> load_flights(const DiagnoseJob& job, const Vehicle& v, const fit::ColumnMapping& mapping) {
-  std::vector<std::string> rotors;
-  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(v);
   std::vector<fit::Flight> flights;
   for (const auto& path : job.logs)
     flights.push_back(fit::load_flight(fit::read_log(path, job.mapping.empty() ? nullptr : &mapping, job.resample), rotors, {}));

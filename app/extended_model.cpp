@@ -73,7 +73,7 @@ ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, 
   };
   request.thesis_comparison = false;  // the thesis comparison belongs to the FINken 3's own derivation
   request.emit.vehicle_file = vehicle_file;
-  request.effects_flag_from_model = true;
+  request.regenerate_flags_from_model = true;
   request.emit.parameter_source = "fitted by quadgen diagnose to " + logs_label +
                                   " (fitted_parameters.yaml); regenerating with derive gives the vehicle file's values";
   if (with_proposed_terms)

@@ -58,8 +58,7 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   }
   truth.set_params(p);
   const ControllerModel belief = nominal_controller_belief(vehicle, model);
-  std::vector<std::string> rotors;
-  for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(vehicle);
   ClosedLoopOptions o = a.flight;
   o.duration = a.duration;
   std::cerr << "flying " << a.duration << " s closed loop (seed " << o.seed << ")\n";
@@ -117,8 +116,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
   SimulateJobResult result;
   const int delay = m.input_delay_param();
-  std::vector<std::string> rotors;
-  for (const Rotor& r : vehicle.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(vehicle);
 
   std::vector<double> x0(m.num_states(), 0.0);
   x0[6] = 1.0;
@@ -180,7 +178,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
     inputs(0.0, u0.data());
     for (size_t i = 0; i < nr; ++i) {
       const int w = m.state_index("w_" + rotors[i]);
-      if (w >= 0) x0[w] = laws[i].a0 + laws[i].a1 * u0[i] + laws[i].a2 * u0[i] * u0[i];
+      if (w >= 0) x0[w] = laws[i].speed_at(u0[i]);
     }
   }
 
@@ -230,9 +228,8 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
     const int w = m.state_index("w_" + rotors[r]);
     for (size_t k = 0; k < tr.t.size(); ++k) {
       inputs(tr.t[k], ub.data());
-      const auto& L = laws[r];
-      const double speed = w >= 0 ? tr.x[k][w] : L.a0 + L.a1 * ub[r] + L.a2 * ub[r] * ub[r];
-      s.y.push_back(L.k * speed * speed);
+      const double speed = w >= 0 ? tr.x[k][w] : laws[r].speed_at(ub[r]);
+      s.y.push_back(laws[r].thrust_at_speed(speed));
     }
     thrust.series.push_back(s);
   }

@@ -5,10 +5,8 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/fit_pipeline.hpp"
-#include "derive/geometry.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "app/model_registry.hpp"
@@ -117,15 +115,7 @@ int run_fit(const FitArgs& a) {
   for (const auto& err : result.plot_errors) std::cerr << "no plot " << err << "\n";
   out.commit();
   std::cout << result.summary;
-  // A model parameter on its bound is not an estimate: on a flight log most often the log's
-  // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
-  // by design; their reports say so.)
-  if (kind == LogKind::kFlight && result.json.contains("estimates") && result.json["estimates"].is_object())
-    for (const auto& [name, e] : result.json["estimates"].items())
-      if (e.is_object() && e.value("at_bound", false))
-        std::cerr << "quadgen: warning: " << output::printable(name)
-                  << " ended on a bound of the fit, so its value is not an estimate (check the log's units and scales, "
-                     "and the vehicle file's bounds)\n";
+  for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << w << "\n";
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // Checks shared by the subcommands' flags: numbers that are finite and in range (CLI11's Range
-// lets NaN through), NAME=VALUE pairs, and which options a command line actually gave.
+// lets NaN through) and which options a command line actually gave. (The NAME=VALUE pairs of
+// simulate's --set are parsed in simulate_command.cpp.)
 #pragma once
 #include <cmath>
 #include <cstdlib>

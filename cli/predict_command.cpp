@@ -1,23 +1,14 @@
 // quadgen predict VEHICLE.yaml LOG.csv... [--mapping M] [--params FIT_OR_DIAGNOSIS.json] --out DIR
 // How well a model (nominal, fitted or extended) predicts flights, measured as published
 // models report it (predict/prediction.hpp): prediction.json, prediction.csv, prediction.svg.
-#include <cmath>
-#include <fstream>
 #include <iostream>
 
+#include "app/predict_job.hpp"
 #include "cli/commands.hpp"
-#include "derive/dynamics.hpp"
-#include "derive/effects/effect_catalogue.hpp"
-#include "derive/geometry.hpp"
-#include "output/json_document.hpp"
-#include "app/model_registry.hpp"
 #include "cli/options.hpp"
 #include "output/output_set.hpp"
-#include "fit/fit_pipeline.hpp"
 #include "predict/predict_flights.hpp"
-#include "predict/prediction.hpp"
 #include "output/sinks.hpp"
-#include "model/vehicle.hpp"
 
 namespace quadgen::cli {
 
@@ -48,39 +39,20 @@ void add_predict(CLI::App& app, PredictArgs& a) {
 }
 
 int run_predict(const PredictArgs& a) {
-  const Vehicle v = load_vehicle(a.vehicle);
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
-  // Every effect, at its neutral value unless --params sets it.
-  std::string how;
-  const std::unique_ptr<runtime::DynamicModel> model = app::model_for(v, parse_effect_list("all"), &how);
-  std::cerr << "model: " << how << "\n";
-  predict::PredictFlightsOptions o = a.options;
-  o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
-  const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), a.logs, o);
-  out.add("prediction.json", output::json_document(p.json));
-  out.add("prediction.csv", predict::prediction_csv(p.pooled));
-  std::string svg, err;
-  if (runtime::render_svg(v.name + ": prediction error against horizon", predict::horizon_panels({{"this model", &p.pooled}}), &svg, &err))
-    out.add("prediction.svg", svg);
-  else
-    std::cerr << "no plot: " << err << "\n";
+  app::PredictJob job{a.vehicle, a.logs, a.options};
+  job.options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+  const app::PredictJobResult r = app::run_predict_job(job);
+  for (const auto& note : r.notes) std::cerr << note << "\n";
+  for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
-  for (const auto& h : p.pooled.open_loop)
-    std::cout << "open loop, " << h.horizon << " s: position " << h.position.mean() << " m (mean), tilt " << h.tilt.mean()
-              << " rad, heading " << h.heading.mean() << " rad\n";
-  if (const std::string limits = predict::what_limits_prediction(p.pooled); !limits.empty()) std::cout << limits << "\n";
-  std::cout << "wrote " << output::printable(a.out) << "/prediction.json\n";
-  // A non-finite error is a model that left its range (commands, units or parameters wrong):
-  // the files are written for a look, but the run did not succeed.
-  for (const auto& h : p.pooled.open_loop)
-    if (!std::isfinite(h.position.mean())) {
-      std::cerr << "quadgen: error: the open-loop position error " << h.horizon
-                << " s ahead is not finite: the model left its range on this log (check the commands' scale, the "
-                   "units and --params); the output is kept for inspection\n";
-      return 4;
-    }
+  std::cout << r.summary << "wrote " << output::printable(a.out) << "/prediction.json\n";
+  if (!r.failure.empty()) {
+    std::cerr << "quadgen: error: " << r.failure << "\n";
+    return 4;
+  }
   return 0;
 }
 

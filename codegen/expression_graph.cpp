@@ -206,8 +206,12 @@ double ExpressionGraph::tree_ops(int id) {
 }
 
 // Shortest decimal that reads back as the same double; ".0" appended to an integer, so that
-// C++ reads it as a double (not to "inf" or "nan").
+// C++ reads it as a double. A constant that is not finite (a vehicle's numbers overflowing)
+// is refused: "inf" or "nan" in the code would be an identifier the including project may define.
 std::string double_literal(double v) {
+  if (!std::isfinite(v))
+    throw std::domain_error("generated code: a constant of the model is not finite (" + std::to_string(v) +
+                            "): the vehicle's numbers overflow a double");
   char buf[40];
   for (int prec = 1; prec <= 17; ++prec) {
     std::snprintf(buf, sizeof buf, "%.*g", prec, v);

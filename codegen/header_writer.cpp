@@ -1,6 +1,8 @@
 #include "codegen/header_writer.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <kainjow/mustache.hpp>
 
@@ -36,7 +38,13 @@ std::string quoted_list(const std::vector<Variable>& vs) {
   return s + "}";
 }
 
-std::string number(double v) { return shortest_text(v); }
+// A nominal value as C++: never "inf" or "nan", identifiers the including project may define.
+std::string number(double v) {
+  if (!std::isfinite(v))
+    throw std::domain_error("generated code: a nominal value is not finite (" + std::to_string(v) +
+                            "): the vehicle's numbers overflow a double");
+  return shortest_text(v);
+}
 
 // A bound as a C++ constant: an infinite one (no bound) is HUGE_VAL from <cmath>.
 std::string bound(double v) {
@@ -75,8 +83,8 @@ void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p) {
   const std::string word = output::shell_path(p.vehicle_file);
   d.set("vehicle_file", output::cpp_comment(word) == word ? word : std::string("VEHICLE_FILE"));
   // (Only a --params path can make the flags unprintable: effect names are the catalogue's.)
-  const bool flag_as_is = output::cpp_comment(p.effects_flag) == p.effects_flag;
-  d.set("effects_flag", flag_as_is ? p.effects_flag : std::string(" --params PARAMETERS_FILE"));
+  const bool flag_as_is = output::cpp_comment(p.regenerate_flags) == p.regenerate_flags;
+  d.set("regenerate_flags", flag_as_is ? p.regenerate_flags : std::string(" --params PARAMETERS_FILE"));
   d.set("vehicle", output::cpp_comment(p.vehicle_name));
   d.set("vehicle_hash", output::cpp_comment(p.vehicle_hash));
   d.set("vehicle_hash_literal", output::cpp_string_literal(p.vehicle_hash));
@@ -178,7 +186,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("namespace", out.name);
   d.set("version", QUADGEN_VERSION);
   set_provenance_fields(d, {m.vehicle_name, m.vehicle_hash, m.effects.empty() ? "none" : m.effect_list(", "),
-                            m.effect_list(), opt.vehicle_file, opt.effects_flag});
+                            m.effect_list(), opt.vehicle_file, opt.regenerate_flags});
   // A whole comment line or nothing (a mustache section would leave an empty line).
   d.set("parameter_source_line", opt.parameter_source.empty() ? std::string()
                                  : "// Parameter values (kNominalParams): " + output::cpp_comment(opt.parameter_source) + ".\n");

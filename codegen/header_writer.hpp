@@ -10,7 +10,7 @@ namespace quadgen::codegen {
 
 struct EmitOptions {
   std::string vehicle_file;  // as named on the command line, for the regenerate comment
-  std::string effects_flag;  // "--effects ..." or ""
+  std::string regenerate_flags;  // what follows "--out DIR" in the regenerate command: " --effects ...", " --params FILE" or ""
   // Where kNominalParams come from when not the vehicle file (e.g. "fitted by quadgen
   // diagnose to LOG"): said in the header's comment, since regenerating with derive gives
   // the vehicle file's values. Empty: the vehicle file's.
@@ -29,7 +29,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt);
 // Where a header came from, as its comments and string constants tell it: text from a vehicle
 // file and a command line.
 struct Provenance {
-  std::string vehicle_name, vehicle_hash, effects_text, effects_list, vehicle_file, effects_flag;
+  std::string vehicle_name, vehicle_hash, effects_text, effects_list, vehicle_file, regenerate_flags;
 };
 
 // Sets the template fields that carry provenance, each escaped for the C++ comment or string

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "runtime/closed_loop.hpp"
-#include "runtime/scenarios.hpp"
+#include "runtime/thrust_law.hpp"
 #include "derive/symbolic_model.hpp"
 #include "model/vehicle.hpp"
 

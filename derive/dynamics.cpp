@@ -1,5 +1,6 @@
 #include "derive/dynamics.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -69,7 +70,7 @@ void check_derived_bounds(const Vehicle& v, const std::string& name, const std::
 // (rotor drag, blade flapping) and the thrust constant rest.
 // `pivot`: the constant motor_pivot, or nothing without a slope.
 ex commanded_rotor_speed(const ModelContext& c, const ex& u, const std::optional<ex>& pivot) {
-  const auto map = [&](const ex& x) { return c.p("motor_a0") + c.p("motor_a1") * x + c.p("motor_a2") * x * x; };
+  const auto map = [&](const ex& x) { return runtime::motor_map(c.p("motor_a0"), c.p("motor_a1"), c.p("motor_a2"), x); };
   if (!pivot) return map(u);
   return map(*pivot) + c.p("motor_slope") * (map(u) - map(*pivot));
 }
@@ -112,6 +113,9 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   // so that a fit may free them and the generated code precomputes J^-1 once.
   // Declared bounds must hold the value the blocks give: a fit would start outside them.
   auto derived = [&](const std::string& name, const std::string& unit, double value, const std::string& doc) {
+    if (!std::isfinite(value))  // blocks of 1e200 kg or m: the integrals overflow a double
+      throw VehicleError(c.vehicle.source_path + ": derived quantity " + name + " is not finite (" + shortest_text(value) +
+                         " " + unit + "): a block's mass or size is too large to compute with");
     auto it = c.vehicle.derived_overrides.find(name);
     if (it != c.vehicle.derived_overrides.end()) {
       const bool given = c.vehicle.derived_given.count(name) > 0;  // the file's value, not the blocks'

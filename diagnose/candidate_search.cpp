@@ -314,11 +314,21 @@ void CandidateSearch::judge_held_out_as_own_model(const std::set<std::string>& w
                                                   const Workspace& ws) const {
   std::vector<double> own;
   const auto own_fit = fit_as_own_model(with, ev.parameters, weights_, &own, nullptr, ws);
-  std::vector<double> between(own.size());
-  for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own[k] * weights_[k]);
-  ev.validation_cost_before = cost(*ws.valid, base_fit, between);
-  ev.validation_cost_after = cost(*ws.valid, own_fit, between);
-  ev.validation_gain_percent = percent_lower(ev.validation_cost_before, ev.validation_cost_after);
+  const HeldOutCosts c = held_out_costs_between(*ws.valid, base_fit, weights_, own_fit, own);
+  ev.validation_cost_before = c.before;
+  ev.validation_cost_after = c.after;
+  ev.validation_gain_percent = percent_lower(c.before, c.after);
+  ev.rejudged = true;
+}
+
+CandidateSearch::HeldOutCosts CandidateSearch::held_out_costs_between(const fit::ResidualModel& valid,
+                                                                      const std::vector<FitParameter>& base_fit,
+                                                                      const std::vector<double>& base_weights,
+                                                                      const std::vector<FitParameter>& own_fit,
+                                                                      const std::vector<double>& own_weights) {
+  std::vector<double> between(own_weights.size());
+  for (size_t k = 0; k < between.size(); ++k) between[k] = std::sqrt(own_weights[k] * base_weights[k]);
+  return {cost(valid, base_fit, between), cost(valid, own_fit, between)};
 }
 
 std::string CandidateSearch::implausible_estimate(const std::string& effect, const std::vector<FitParameter>& ps) const {
@@ -633,22 +643,11 @@ double chi2_upper(double x, double dof) {
 
 StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const std::vector<FitParameter>& ps,
                                             const std::vector<double>& weights) {
-  std::vector<bool> free;
   std::vector<int> cols;
-  for (size_t i = 0; i < ps.size(); ++i) {
-    free.push_back(ps[i].free);
+  for (size_t i = 0; i < ps.size(); ++i)
     if (ps[i].free) cols.push_back(static_cast<int>(i));
-  }
-  const int np = static_cast<int>(ps.size()), nr = m.num_residuals();
-  std::vector<double> p = fit::parameter_values(ps), res(nr), J(static_cast<size_t>(nr) * np);
-  m.evaluate_free(p.data(), res.data(), J.data(), free);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(cols.size(), cols.size());
-  for (int i = 0; i < nr; ++i) {
-    const double w2 = std::pow(weights[m.channel_of(i)], 2);
-    for (size_t a = 0; a < cols.size(); ++a)
-      for (size_t b = 0; b <= a; ++b) H(a, b) += w2 * J[static_cast<size_t>(i) * np + cols[a]] * J[static_cast<size_t>(i) * np + cols[b]];
-  }
-  H = H.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd Jw = fit::weighted_free_jacobian(m, ps, weights);
+  const Eigen::MatrixXd H = Jw.transpose() * Jw;
   const fit::NormalMatrixAnalysis normal = fit::analyse_normal_matrix(H);
   StandardErrors out;
   out.value.assign(ps.size(), std::numeric_limits<double>::quiet_NaN());

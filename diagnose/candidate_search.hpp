@@ -105,6 +105,9 @@ struct CandidateEvidence {
   // Significant on the training data, of a relevant size, but no gain on the held-out
   // part: reported as suspected, never selected.
   bool training_only = false;
+  // Its held-out costs are those of the second asking (judge_held_out_as_own_model): the
+  // screen under the step's weights found no held-out gain.
+  bool rejudged = false;
 };
 
 struct Ambiguity {
@@ -233,6 +236,17 @@ class CandidateSearch {
                                                   Settling* settling = nullptr) const;
   // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals at these parameters.
   std::vector<double> weights_at(const std::vector<fit::FitParameter>& ps) const;
+  // Two fitted models' held-out costs, each under the geometric mean of the two models'
+  // channel weights sqrt(w_base w_own): each model is the optimum under its own weights, so
+  // either one's would favour it.
+  struct HeldOutCosts {
+    double before = 0, after = 0;
+  };
+  static HeldOutCosts held_out_costs_between(const fit::ResidualModel& valid,
+                                             const std::vector<fit::FitParameter>& base_fit,
+                                             const std::vector<double>& base_weights,
+                                             const std::vector<fit::FitParameter>& own_fit,
+                                             const std::vector<double>& own_weights);
   // The weighted cost under these channel weights.
   static double cost(const fit::ResidualModel& m, const std::vector<fit::FitParameter>& ps,
                      const std::vector<double>& weights);

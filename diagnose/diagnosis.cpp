@@ -355,8 +355,7 @@ void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit:
   for (const auto& smp : used.samples) d.t.push_back(smp.t);
   d.residual_before = all_ee.all_channels(d.search.base_fit);
   d.residual_after = all_ee.all_channels(d.search.final_fit);
-  std::vector<std::string> rotors;
-  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(v);
   const SignalSet signals = physical_signals(used, rotors);
   d.before = analyse_residuals(d.residual_before, d.channel_names, d.channel_units, d.t, signals);
   d.after = analyse_residuals(d.residual_after, d.channel_names, d.channel_units, d.t, signals);
@@ -650,7 +649,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   std::cerr << progress() << "validation of the base and the extended model\n";
   d.metric_before = held_out_gain.metric(s.base_fit, s.final_weights, &d.sim_before);
   d.metric_after = held_out_gain.metric(s.final_fit, s.final_weights, &d.sim_after);
-  // Without a pose only the one-step view can be measured.
+  // Errors at horizons as published models report them (without a pose, evaluate_prediction
+  // measures the one-step view only).
   std::cerr << progress() << "prediction error at horizons, before and after\n";
   d.has_prediction = true;
   d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});

@@ -241,8 +241,7 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
 FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
   std::string error;
   if (!o.IsValid(&error)) throw std::invalid_argument("fit: " + error);
-  std::vector<std::string> rotors;
-  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(v);
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
   const std::vector<FitParameter> params = starting_parameters(model, o);
   const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
@@ -295,6 +294,13 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
     s << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
       << side(pr.upper, pr.upper_open) << "] " << pr.verdict << "\n";
   out.summary = s.str();
+  // A model parameter on its bound is not an estimate: on a flight log most often the log's
+  // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
+  // by design; their reports say so.)
+  for (const std::string& name : best.at_bound)
+    out.warnings.push_back(output::printable(name) +
+                           " ended on a bound of the fit, so its value is not an estimate (check the log's units and "
+                           "scales, and the vehicle file's bounds)");
   return out;
 }
 

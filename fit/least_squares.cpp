@@ -161,6 +161,7 @@ double solve_scale(const FitParameter& p) {
 
 }  // namespace
 
+
 double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
@@ -305,13 +306,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   std::vector<int> free_idx;
   for (int i = 0; i < n; ++i)
     if (params[i].free) free_idx.push_back(i);
-  const std::vector<double> x = parameter_values(params);
-  std::vector<double> J(static_cast<size_t>(nr) * n);
-  model.evaluate_free(x.data(), r.data(), J.data(), free_mask(params));  // the free columns only
-  Eigen::MatrixXd Jf(nr, free_idx.size());
-  for (int i = 0; i < nr; ++i)
-    for (size_t k = 0; k < free_idx.size(); ++k)
-      Jf(i, k) = J[static_cast<size_t>(i) * n + free_idx[k]] * w[model.channel_of(i)];
+  const Eigen::MatrixXd Jf = weighted_free_jacobian(model, params, w);
   require_finite_information(Jf, params, free_idx);
   const Eigen::MatrixXd C = analyse_normal_matrix(Jf.transpose() * Jf).covariance;
   if (!C.allFinite()) throw FitError("covariance of the free parameters is not finite at " + values_text(params));

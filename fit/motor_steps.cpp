@@ -5,6 +5,7 @@
 
 #include "fit/flight_data.hpp"
 #include "runtime/flight_log.hpp"
+#include "runtime/thrust_law.hpp"
 
 namespace quadgen::fit {
 
@@ -81,7 +82,7 @@ std::vector<FitParameter> MotorStepModel::parameters() const {
 
 double MotorStepModel::predict(const double* p, size_t k, double t) const {
   const MotorStep& s = steps_[k];
-  auto ss = [&](double u) { return u == 0 ? 0.0 : p[0] + p[1] * u + p[2] * u * u; };
+  auto ss = [&](double u) { return u == 0 ? 0.0 : runtime::motor_map(p[0], p[1], p[2], u); };
   const double ts = s.t_before + p[kFirstStepTime + k];
   if (t < ts) return ss(s.u_old);
   return ss(s.u_new) + (ss(s.u_old) - ss(s.u_new)) * std::exp(-(t - ts) / p[kTau]);

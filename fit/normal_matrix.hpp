@@ -5,7 +5,15 @@
 
 #include <Eigen/Dense>
 
+#include "fit/least_squares.hpp"
+
 namespace quadgen::fit {
+
+// The Jacobian of the weighted residuals (each row times its channel's weight) in the free
+// parameters' columns only, in their order: J_w, with J_w^T J_w the normal matrix below (the
+// fit's covariance and the diagnosis' standard errors both start here).
+Eigen::MatrixXd weighted_free_jacobian(const ResidualModel& model, const std::vector<FitParameter>& params,
+                                       const std::vector<double>& channel_weights);
 
 // Its pseudo-inverse (the covariance, for standard errors) and which parameters lie along a
 // direction the data cannot determine (an eigenvalue of the unit-diagonal form near zero),

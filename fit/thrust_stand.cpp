@@ -6,6 +6,7 @@
 
 #include "fit/flight_data.hpp"
 #include "runtime/flight_log.hpp"
+#include "runtime/thrust_law.hpp"
 
 namespace quadgen::fit {
 
@@ -102,7 +103,7 @@ void SpeedVsCommand::evaluate(const double* p, double* r, double* J) const {
   for (size_t k = 0; k < s_.size(); ++k) {
     const auto& s = s_[k];
     const double w = (s.w[0] + s.w[1] + s.w[2] + s.w[3]) / 4;
-    const double map = p[0] + p[1] * s.u + p[2] * s.u * s.u;
+    const double map = runtime::motor_map(p[0], p[1], p[2], s.u);
     const double scale = std::pow(s.vbat / vref_, p[3]);
     r[k] = map * scale - w;
     if (!J) continue;

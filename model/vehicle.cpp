@@ -268,6 +268,12 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
 
 Vehicle load_vehicle(const std::string& path) { return parse_vehicle(YamlReader{path}.read_file("vehicle file"), path); }
 
+std::vector<std::string> rotor_names(const Vehicle& v) {
+  std::vector<std::string> names;
+  for (const Rotor& r : v.rotors) names.push_back(r.name);
+  return names;
+}
+
 const Parameter& param(const Vehicle& v, const std::string& name) {
   auto it = v.params.find(name);
   if (it == v.params.end()) throw VehicleError(v.source_path + ": no parameter '" + name + "'");

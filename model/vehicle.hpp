@@ -73,6 +73,9 @@ Vehicle parse_vehicle(const std::string& text, const std::string& path_for_messa
 
 const Parameter& param(const Vehicle& v, const std::string& name);
 
+// The rotors' names in the vehicle file's order (the log columns u_<name>, the inputs' order).
+std::vector<std::string> rotor_names(const Vehicle& v);
+
 using output::fnv1a_hex;
 
 }  // namespace quadgen

@@ -8,9 +8,16 @@
 
 namespace quadgen::output {
 
+// The published offset basis (Fowler, Noll, Vo: 0xcbf29ce484222325).
+constexpr uint64_t kFnv1aOffsetBasis = 14695981039346656037ull;
+// The basis with a digit dropped, which quadgen used until 2026-11-28: manifests written then
+// carry it, and are still recognised (output_set.cpp); nothing new is hashed with it.
+constexpr uint64_t kFnv1aLegacyBasis = 1469598103934665603ull;
+
 // Incremental form, for content read in pieces.
 class Fnv1a {
  public:
+  explicit Fnv1a(uint64_t basis = kFnv1aOffsetBasis) : h_(basis) {}
   void add(const char* bytes, size_t n) {
     for (size_t i = 0; i < n; ++i) {
       h_ ^= static_cast<unsigned char>(bytes[i]);
@@ -24,7 +31,7 @@ class Fnv1a {
   }
 
  private:
-  uint64_t h_ = 1469598103934665603ull;
+  uint64_t h_;
 };
 
 inline std::string fnv1a_hex(const std::string& bytes) {

@@ -95,10 +95,19 @@ std::map<FileId, std::string> identities(const std::vector<std::string>& paths) 
 
 // A name an output set may hold: a plain file name, never a path. A manifest is read from disk
 // and may have been edited: a name with '/' or ".." in it would send the removal of the
-// earlier run's files anywhere.
+// earlier run's files anywhere. A manifest line is "hash size name": a name with a line break
+// in it would forge a line of its own, one with blanks at its ends would not read back as itself.
 bool plain_file_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." && name.find('/') == std::string::npos &&
-         name.find('\0') == std::string::npos && name.rfind(".quadgen", 0) != 0;
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos ||
+      name.rfind(".quadgen", 0) == 0 || name.front() == ' ' || name.back() == ' ')
+    return false;
+  for (unsigned char c : name)
+    if (c < 0x20 || c == 0x7f) return false;
+  return true;
+}
+
+void check_file_name(const std::string& name) {
+  if (!plain_file_name(name)) throw OutputError("internal: '" + printable(name) + "' is not a plain output file name");
 }
 
 // What a manifest says: the command that wrote it, and file name -> "hash size". Manifests
@@ -115,6 +124,11 @@ std::string command_from_files(const std::map<std::string, std::string>& files) 
            {"diagnosis.json", "diagnose"}, {"fit.json", "fit"}, {"prediction.json", "predict"}, {"model.hpp", "derive"}})
     if (files.count(file)) return command;
   return "";
+}
+
+// A hash as the manifest writes it: 16 lower-case hex digits.
+bool hash_text(const std::string& s) {
+  return s.size() == 16 && s.find_first_not_of("0123456789abcdef") == std::string::npos;
 }
 
 // A manifest is input like any other: a FIFO would block, /dev/zero never end. Only a regular
@@ -147,10 +161,23 @@ Manifest read_manifest_file(const fs::path& file) {
     }
     std::istringstream ls(line);
     std::string hash, size, name;
-    if (ls >> hash >> size && std::getline(ls >> std::ws, name) && plain_file_name(name)) m.files[name] = hash + " " + size;
+    if (ls >> hash >> size && std::getline(ls >> std::ws, name) && plain_file_name(name) && hash_text(hash) &&
+        size.find_first_not_of("0123456789") == std::string::npos)
+      m.files[name] = hash + " " + size;
     else m.bad_lines.push_back(line);
   }
   if (m.command.empty()) m.command = command_from_files(m.files);
+  return m;
+}
+
+// The record beside simulate's files, read as the manifest is; a record with any line quadgen
+// would not write (an edited one) vouches for nothing.
+Manifest read_files_record(const fs::path& file) {
+  Manifest m = read_manifest_file(file);
+  if (!m.bad_lines.empty()) {
+    m.files.clear();
+    m.command.clear();
+  }
   return m;
 }
 
@@ -158,17 +185,20 @@ Manifest read_manifest(const fs::path& dir) { return read_manifest_file(dir / kM
 
 std::string manifest_text(const std::string& command, const std::map<std::string, std::string>& files) {
   std::string text = std::string(kManifestHeader) + "\n" + kCommandKey + command + "\n";
-  for (const auto& [name, hash_size] : files) text += hash_size + " " + name + "\n";
+  for (const auto& [name, hash_size] : files) {
+    check_file_name(name);
+    text += hash_size + " " + name + "\n";
+  }
   return text;
 }
 
 // "hash size" of a file as the manifest records it, read in pieces; "" for anything but a
 // regular file (a symbolic link is never quadgen's: it wrote none).
-std::string hash_and_size(const fs::path& p) {
+std::string hash_and_size(const fs::path& p, uint64_t basis = kFnv1aOffsetBasis) {
   struct stat st {};
   if (::lstat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
   std::ifstream in(p, std::ios::binary);
-  Fnv1a h;
+  Fnv1a h(basis);
   unsigned long long size = 0;
   std::vector<char> buf(1 << 16);
   while (in) {
@@ -178,6 +208,12 @@ std::string hash_and_size(const fs::path& p) {
     size += n;
   }
   return h.hex() + " " + std::to_string(size);
+}
+
+// Whether a file is what a manifest line recorded: its hash then, or, for a manifest written
+// before the offset basis was corrected, under the old basis.
+bool unchanged_since(const fs::path& p, const std::string& recorded) {
+  return recorded == hash_and_size(p) || recorded == hash_and_size(p, kFnv1aLegacyBasis);
 }
 
 std::string first_names(const std::vector<std::string>& names) {
@@ -206,7 +242,7 @@ void check_replaceable(const fs::path& dir, const std::string& command) {
     if (name == kManifestName) continue;
     const auto it = m.files.find(name);
     if (it == m.files.end() || !fs::is_regular_file(e.symlink_status())) foreign.push_back(name);
-    else if (hash_and_size(e.path()) != it->second) changed.push_back(name);
+    else if (!unchanged_since(e.path(), it->second)) changed.push_back(name);
   }
   if (ec) fail(dir, "cannot list the directory: " + ec.message());
   if (!foreign.empty())
@@ -313,10 +349,6 @@ void test_hook_die_before_commit() {
   if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
 }
 
-void check_file_name(const std::string& name) {
-  if (!plain_file_name(name)) throw OutputError("internal: '" + printable(name) + "' is not a plain output file name");
-}
-
 // Where an earlier run's folder goes when it still holds files after its own were removed
 // (files that appeared while this run wrote): a visible name of its own beside the output
 // (a short one if the output's name is too long to extend). It is marked first, so that even
@@ -341,7 +373,7 @@ void remove_earlier_run(const fs::path& staged, const fs::path& target) {
   const Manifest earlier = read_manifest(staged);
   std::error_code ec;
   for (const auto& [name, hash_size] : earlier.files)
-    if (hash_and_size(staged / name) == hash_size) fs::remove(staged / name, ec);
+    if (unchanged_since(staged / name, hash_size)) fs::remove(staged / name, ec);
   fs::remove(staged / kManifestName, ec);
   if (fs::remove(staged, ec)) return;
   std::cerr << "quadgen: note: the previous output was kept at " << printable(keep_aside(staged, target).string())
@@ -399,6 +431,9 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   std::error_code ec;
   for (const auto& name : paths) {
     const fs::path p = resolved_file(name);
+    if (!plain_file_name(p.filename().string()))
+      fail(p, "cannot be an output file name (a control character or line break in it, a blank at its start or end, "
+              "or a name beginning '.quadgen'); choose another");
     if (!seen.insert(p).second) fail(p, "is named for two outputs of one run (the trajectory and its plot)");
     if (p.parent_path() != resolved_file(paths.front()).parent_path()) throw OutputError("internal: outputs in two folders");
     struct stat st {};
@@ -414,14 +449,14 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   // A file already at a path is replaced only if the record beside it says this command
   // wrote it there and it is unchanged since: a flight log of the user's looks like a
   // trajectory, a plot of theirs may be gnuplot's too.
-  const Manifest record = read_manifest_file(parent / kFilesRecordName);
+  const Manifest record = read_files_record(parent / kFilesRecordName);
   for (const auto& path : paths_) {
     const fs::path p(path);
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) continue;
     if (!S_ISREG(st.st_mode)) fail(p, "exists and is not a regular file (a link or a directory); choose another path");
     const auto it = record.files.find(p.filename().string());
-    if (record.command != command_ || it == record.files.end() || it->second != hash_and_size(p))
+    if (record.command != command_ || it == record.files.end() || !unchanged_since(p, it->second))
       fail(p, "exists and is not a file 'quadgen " + command_ + "' wrote there (or it was changed since); choose another path or remove it");
   }
   fs::create_directories(parent, ec);
@@ -453,7 +488,7 @@ void OutputFiles::commit() {
 // runs kept where their files are still there; replaced whole by a rename.
 void OutputFiles::update_record() {
   const fs::path parent = fs::path(paths_.front()).parent_path(), record_path = parent / kFilesRecordName;
-  Manifest record = read_manifest_file(record_path);
+  Manifest record = read_files_record(record_path);
   if (record.command != command_) record.files.clear();
   for (auto it = record.files.begin(); it != record.files.end();) {
     std::error_code ec;
@@ -485,7 +520,7 @@ bool complete_output_directory(const std::string& dir, std::string* why) {
     ++files;
     const auto it = m.files.find(name);
     if (it == m.files.end()) return no(name + " is not in the manifest");
-    if (it->second != hash_and_size(e.path())) return no(name + " differs from the manifest");
+    if (!unchanged_since(e.path(), it->second)) return no(name + " differs from the manifest");
   }
   if (files != m.files.size()) return no("files listed in the manifest are missing");
   return true;

@@ -1,7 +1,7 @@
 // Output appears whole or not at all, never destroys a file quadgen did not write, and never
 // replaces one of the run's own inputs.
 //
-// OutputDirectory (derive, fit, diagnose --out DIR): every file is written into a private
+// OutputDirectory (derive, fit, diagnose, predict --out DIR): every file is written into a private
 // staging directory beside DIR and the set is switched in by one rename (an atomic exchange
 // when DIR already holds an earlier run). DIR is replaced only if it is new, empty, or holds
 // exactly what an earlier run of the same command wrote (listed in its manifest, kManifestName,

@@ -13,8 +13,7 @@ namespace quadgen::predict {
 namespace {
 
 fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlightsOptions& o) {
-  std::vector<std::string> rotors;
-  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  const std::vector<std::string> rotors = rotor_names(v);
   const runtime::CsvTable log = fit::read_log(path, o.mapping, o.resample);
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
   if (!flight.has_pose) o.progress(output::printable(path) + ": no pose logged: one-step errors only (rollouts need a measured state)");

@@ -111,8 +111,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   const double hover_u = b.thrust_laws[0].command_for(b.mass * b.g / nr);
   for (int i = 0; i < nr; ++i) {
     const int w = truth.state_index("w_" + rotors[i]);
-    const auto& L = b.thrust_laws[i];
-    if (w >= 0) x[w] = L.a0 + L.a1 * hover_u + L.a2 * hover_u * hover_u;
+    if (w >= 0) x[w] = b.thrust_laws[i].speed_at(hover_u);
   }
   GeneratedFlight out;
   out.columns = {"t"};

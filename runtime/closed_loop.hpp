@@ -10,6 +10,7 @@
 
 #include "runtime/dynamic_model.hpp"
 #include "runtime/scenarios.hpp"
+#include "runtime/thrust_law.hpp"
 
 namespace quadgen::runtime {
 

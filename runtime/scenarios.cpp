@@ -5,28 +5,6 @@
 
 namespace quadgen::runtime {
 
-double ThrustLaw::command_for(double thrust) const {
-  if (!(thrust >= 0)) throw std::invalid_argument("thrust " + std::to_string(thrust) + " N requested of a rotor");
-  const auto beyond = [&] {
-    const double w1 = a0 + a1 + a2;
-    return std::invalid_argument("thrust " + std::to_string(thrust) + " N is beyond the motor map (at most " +
-                                 std::to_string(k * w1 * w1) + " N at command 1)");
-  };
-  const double w = std::sqrt(thrust / k);
-  // Solve a2 u^2 + a1 u + (a0 - w) = 0 for the root in [0, 1].
-  double u;
-  if (std::fabs(a2) < 1e-12) {
-    u = (w - a0) / a1;
-  } else {
-    const double disc = a1 * a1 - 4 * a2 * (a0 - w);
-    if (disc < 0) throw beyond();
-    u = (-a1 + std::sqrt(disc)) / (2 * a2);
-    if (u < 0 || u > 1) u = (-a1 - std::sqrt(disc)) / (2 * a2);
-  }
-  if (!(u >= 0 && u <= 1)) throw beyond();
-  return u;
-}
-
 namespace {
 
 // Rotor positions in the X layout of the FINken 3 (A rear-left ... D front-left) are what

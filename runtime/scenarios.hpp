@@ -8,14 +8,6 @@
 
 namespace quadgen::runtime {
 
-// What it takes to turn a thrust into a command for one rotor:
-// F = k w^2 with k = c_t rho A_p r_p^2, and w = a0 + a1 u + a2 u^2.
-struct ThrustLaw {
-  double k = 0;
-  double a0 = 0, a1 = 0, a2 = 0;
-  double command_for(double thrust) const;  // throws if unreachable for u in [0, 1]
-};
-
 struct Scenario {
   std::string name;
   std::string description;

@@ -1,11 +1,16 @@
 // Header-only and dependency-free, so that derive/ (symbolic), runtime/ and fit/ share it.
 #pragma once
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace quadgen::runtime {
 
 // The one home of the thrust law: a rotor's thrust is F = k w^2 with k = c_t rho A_p r_p^2
-// (the thesis' law, c_t dimensionless). Templated so that the symbolic model (GiNaC expressions), the runtime's
-// thrust laws (doubles) and the thrust-stand fit (its inverse) write it once.
+// (the thesis' law, c_t dimensionless), and its speed follows the command through the motor
+// map w = a0 + a1 u + a2 u^2. Templated so that the symbolic model (GiNaC expressions), the
+// runtime's thrust laws (doubles) and the fits of the thrust stand and the motor steps
+// (their parameters) write each once.
 template <typename T>
 T rotor_thrust_coefficient(const T& c_t, const T& rho, const T& disc_area, const T& radius) {
   return c_t * rho * disc_area * radius * radius;
@@ -13,6 +18,42 @@ T rotor_thrust_coefficient(const T& c_t, const T& rho, const T& disc_area, const
 // c_t from a measured k: the inverse of rotor_thrust_coefficient.
 inline double thrust_coefficient_c_t(double k, double rho, double disc_area, double radius) {
   return k / rotor_thrust_coefficient(1.0, rho, disc_area, radius);
+}
+
+// The motor map: rotor speed [rad/s] at command u [0, 1].
+template <typename T, typename U>
+T motor_map(const T& a0, const T& a1, const T& a2, const U& u) {
+  return a0 + a1 * u + a2 * u * u;
+}
+
+// One rotor's law in numbers, and its inverse: what it takes to turn a thrust into a command.
+struct ThrustLaw {
+  double k = 0;
+  double a0 = 0, a1 = 0, a2 = 0;
+  double speed_at(double u) const { return motor_map(a0, a1, a2, u); }
+  double thrust_at_speed(double w) const { return k * w * w; }
+  double command_for(double thrust) const;  // throws std::invalid_argument if unreachable for u in [0, 1]
+};
+
+inline double ThrustLaw::command_for(double thrust) const {
+  if (!(thrust >= 0)) throw std::invalid_argument("thrust " + std::to_string(thrust) + " N requested of a rotor");
+  const auto beyond = [&] {
+    return std::invalid_argument("thrust " + std::to_string(thrust) + " N is beyond the motor map (at most " +
+                                 std::to_string(thrust_at_speed(speed_at(1.0))) + " N at command 1)");
+  };
+  const double w = std::sqrt(thrust / k);
+  // Solve a2 u^2 + a1 u + (a0 - w) = 0 for the root in [0, 1].
+  double u;
+  if (std::fabs(a2) < 1e-12) {
+    u = (w - a0) / a1;
+  } else {
+    const double disc = a1 * a1 - 4 * a2 * (a0 - w);
+    if (disc < 0) throw beyond();
+    u = (-a1 + std::sqrt(disc)) / (2 * a2);
+    if (u < 0 || u > 1) u = (-a1 - std::sqrt(disc)) / (2 * a2);
+  }
+  if (!(u >= 0 && u <= 1)) throw beyond();
+  return u;
 }
 
 }  // namespace quadgen::runtime

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include <boost/math/distributions/chi_squared.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -36,6 +37,7 @@
 #include "diagnose/diagnosis_report.hpp"
 #include "diagnose/flight_screening.hpp"
 #include "diagnose/held_out_gain.hpp"
+#include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
 #include "generated/finken3/model.hpp"
 #include "runtime/dynamic_model.hpp"
@@ -76,6 +78,38 @@ fs::path fly(const HiddenCase& c, const fs::path& dir, const std::string& file, 
   return dir / file;
 }
 
+// Every candidate's evidence, recomputed here from what diagnosis.json reports beside it:
+// the p-value from the likelihood-ratio statistic under the null it names (chi2 with dof
+// degrees of freedom, or the chi-bar-square 0.5 chi2_0 + 0.5 chi2_1 of a neutral value on
+// its bound), AIC's -statistic + 2 dof, one Bonferroni level alpha / (candidates of the first
+// step) for all, and "significant" exactly when every test passed.
+void expect_evidence_holds_together(const json& j) {
+  ASSERT_TRUE(j.contains("selection") && !j["selection"].empty());
+  const double alpha = 0.01;  // SearchOptions' default; these tests do not set --alpha
+  const size_t first_step = j["selection"][0]["candidates"].size();
+  for (const auto& step : j["selection"])
+    for (const auto& c : step["candidates"]) {
+      const double x = c["statistic"], p = c["p_value"];
+      const int dof = c["dof"];
+      const bool bar = c["null_distribution"].get<std::string>().rfind("chi-bar-square", 0) == 0;
+      const auto upper = [](double s, int k) {
+        return s <= 0 ? 1.0 : boost::math::cdf(boost::math::complement(boost::math::chi_squared(k), s));
+      };
+      const double expected = bar ? 0.5 * upper(x, 1) : upper(x, std::max(1, dof));
+      EXPECT_NEAR(p, expected, 1e-12 + 1e-9 * expected) << c["effect"] << " " << c["null_distribution"];
+      EXPECT_NEAR(c["delta_aic"].get<double>(), -x + 2.0 * dof, 1e-9 * (1 + std::fabs(x))) << c["effect"];
+      EXPECT_NEAR(c["level"].get<double>() * static_cast<double>(first_step), alpha, 1e-15) << c["effect"];
+      const bool passed = p < c["level"].get<double>() && c["delta_bic"].get<double>() < 0 &&
+                          c["validation_cost_after"].get<double>() < c["validation_cost_before"].get<double>();
+      if (c["significant"].get<bool>()) {
+        EXPECT_TRUE(passed) << c.dump(1);
+        EXPECT_EQ(c["why_not"], "") << c.dump(1);
+      } else {
+        EXPECT_NE(c["why_not"], "") << c.dump(1);
+      }
+    }
+}
+
 // Diagnoses a log (or several, space-separated) into dir/out; returns diagnosis.json.
 json diagnose_log(const std::string& vehicle, const fs::path& log, const fs::path& dir) {
   EXPECT_EQ(run(std::string(QUADGEN_BINARY) + " diagnose " + vehicle + " " + log.string() + " --out " + (dir / "out").string() +
@@ -95,6 +129,7 @@ json diagnose_log(const std::string& vehicle, const fs::path& log, const fs::pat
       EXPECT_TRUE(fs::exists(fs::path(e.path()).replace_extension(".csv"))) << e.path() << " has no CSV beside it";
   }
   EXPECT_GE(tables, 3);
+  expect_evidence_holds_together(j);
   return j;
 }
 
@@ -117,6 +152,22 @@ std::vector<std::string> named(const json& j) {
   return out;
 }
 
+// The named effect's estimate of a parameter: within the tolerance of the truth, the truth
+// inside its closed interval.
+void expect_estimate(const json& j, const std::string& effect, const std::string& name, double truth, double tolerance) {
+  const json* ps = nullptr;
+  for (const auto& f : j["findings"])
+    if (f["effect"] == effect) ps = &f["parameters"];
+  ASSERT_TRUE(ps && ps->contains(name)) << effect << " " << name << " not among " << j["findings"].dump(1);
+  const json& e = (*ps)[name];
+  EXPECT_TRUE(quadgen::test::has_estimate_shape(e)) << name;
+  EXPECT_NEAR(e["value"].get<double>(), truth, tolerance) << name;
+  const json& ci = e["ci95"];
+  ASSERT_TRUE(ci[0].is_number() && ci[1].is_number()) << name << " interval open: " << ci.dump();
+  EXPECT_LE(ci[0].get<double>(), truth) << name << " " << ci.dump();
+  EXPECT_GE(ci[1].get<double>(), truth) << name << " " << ci.dump();
+}
+
 class HiddenEffect : public ::testing::TestWithParam<HiddenCase> {};
 
 TEST_P(HiddenEffect, IsNamedWithItsParameters) {
@@ -124,17 +175,7 @@ TEST_P(HiddenEffect, IsNamedWithItsParameters) {
   const json j = diagnose(c);
   ASSERT_TRUE(j.contains("findings"));
   ASSERT_EQ(named(j), std::vector<std::string>{c.effects}) << j["findings"].dump(1) << j["ambiguous"].dump(1);
-  const json& ps = j["findings"][0]["parameters"];
-  for (const auto& [name, truth] : c.truth) {
-    ASSERT_TRUE(ps.contains(name)) << name;
-    const double v = ps[name]["value"];
-    EXPECT_NEAR(v, truth, c.tolerance.at(name)) << name;
-    EXPECT_TRUE(quadgen::test::has_estimate_shape(ps[name])) << name;
-    const json& ci = ps[name]["ci95"];
-    ASSERT_TRUE(ci[0].is_number() && ci[1].is_number()) << name << " interval open: " << ci.dump();
-    EXPECT_LE(ci[0].get<double>(), truth) << name << " " << ci.dump();
-    EXPECT_GE(ci[1].get<double>(), truth) << name << " " << ci.dump();
-  }
+  for (const auto& [name, truth] : c.truth) expect_estimate(j, c.effects, name, truth, c.tolerance.at(name));
   const json& gain = j["findings"][0]["gain"];
   EXPECT_TRUE(gain["before"].is_number() && gain["after"].is_number());
   for (const char* fit : {"base_fit", "final_fit", "airframe_fit"})
@@ -221,6 +262,7 @@ TEST(LookAlikes, AmbiguousPairDoesNotHideADistinctEffect) {
                            "--amplitude 0 --height-amplitude 0 --yaw-amplitude 0 --excitation 0.2", 1});
   EXPECT_TRUE(ambiguous_between(j, "attitude_bias", "wind")) << j["ambiguous"].dump(1) << j["findings"].dump(1);
   EXPECT_EQ(named(j), std::vector<std::string>{"motor_lag"}) << j["findings"].dump(1) << j["suspected"].dump(1);
+  expect_estimate(j, "motor_lag", "motor_lag.tau", 0.05, 0.01);  // the single-effect case's tolerance
   bool outcome_ambiguous = false;
   for (const auto& step : j["selection"]) outcome_ambiguous = outcome_ambiguous || step["outcome"] == "ambiguous";
   EXPECT_TRUE(outcome_ambiguous) << j["selection"].dump(1).substr(0, 2000);
@@ -270,6 +312,15 @@ TEST(Negligibility, CrazyflieRotorDragAtItsPublishedSizeIsNamed) {
   const json j = diagnose(c);
   EXPECT_EQ(named(j), std::vector<std::string>{"rotor_drag"}) << j["findings"].dump(1) << j["suspected"].dump(1)
                                                                << j["selection"].dump(1).substr(0, 3000);
+  // Within 20 % (as for the FINken's 2e-5), and the truth within twice the 95 % interval's
+  // half-width of the estimate (a 3.9-sigma check): on this seed the profile interval
+  // [0.939e-6, 1.052e-6] just misses 1.1e-6, as one seed in twenty should; seeds 2, 3 and 4
+  // (run by hand, 2026-11-28) cover it.
+  const json& e = j["findings"][0]["parameters"]["rotor_drag.k"];
+  ASSERT_TRUE(e.is_object() && e["ci95"][0].is_number() && e["ci95"][1].is_number()) << j["findings"].dump(1);
+  const double value = e["value"], lower = e["ci95"][0], upper = e["ci95"][1];
+  EXPECT_NEAR(value, 1.1e-6, 0.2 * 1.1e-6);
+  EXPECT_LT(std::fabs(value - 1.1e-6), upper - lower) << e.dump();
 }
 
 // Two effects at once: forward selection finds both.
@@ -278,6 +329,9 @@ TEST(TwoEffects, MotorGainAndThrustDecayBothFound) {
   auto n = named(j);
   std::sort(n.begin(), n.end());
   EXPECT_EQ(n, (std::vector<std::string>{"motor_gain", "thrust_decay"})) << j["findings"].dump(1);
+  // Each with its own value, not one absorbing the other (the single-effect tolerances).
+  expect_estimate(j, "motor_gain", "motor_gain.C", -0.08, 0.01);
+  expect_estimate(j, "thrust_decay", "thrust_decay.rate", 0.002, 3e-4);
 }
 
 // A search stopped by --max-effects says what was still significant: with one step allowed,
@@ -444,6 +498,88 @@ TEST(Acceptance, CauseOnlyInTheTrainingPartIsSuspectedNotNamed) {
       EXPECT_NE(x["failed"].get<std::string>().find("held-out"), std::string::npos) << x["failed"];
     }
   EXPECT_TRUE(suspected) << j["suspected"].dump(1) << j["selection"].dump(1).substr(0, 3000);
+  // The search's own route (judge_held_out_as_own_model): candidates whose screen under the
+  // step's weights found no held-out gain are asked again under their own weights; here some
+  // (a wind, an attitude bias standing in for the weak rotor) still find none, and each is
+  // set aside as a suspect by the search itself, never named.
+  int rejudged = 0;
+  for (const auto& step : j["selection"])
+    for (const auto& c : step["candidates"]) {
+      if (!c["validation_rejudged_as_own_model"].get<bool>()) continue;
+      ++rejudged;
+      EXPECT_FALSE(c["significant"].get<bool>()) << c.dump(1);
+      EXPECT_EQ(c["why_not"], "no gain on the validation part") << c.dump(1);
+      EXPECT_GE(c["validation_cost_after"].get<double>(), c["validation_cost_before"].get<double>()) << c.dump(1);
+      bool set_aside = false;
+      for (const auto& x : j["suspected"])
+        set_aside |= x["effect"] == c["effect"] &&
+                     x["failed"].get<std::string>().find("improves the training data") != std::string::npos;
+      EXPECT_TRUE(set_aside) << c["effect"] << " " << j["suspected"].dump(1);
+    }
+  EXPECT_GT(rejudged, 0) << j["selection"].dump(1).substr(0, 3000);
+}
+
+// The integrated autocorrelation time that discounts autocorrelated residuals in every
+// likelihood-ratio test, against its closed form: an AR(1) series x_k = rho x_(k-1) + e_k has
+// tau = 1 + 2 sum rho^k = (1 + rho) / (1 - rho), 9 for rho = 0.8; white noise has 1.
+TEST(Acceptance, AutocorrelationTimeOfAnAr1SeriesIsItsClosedForm) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const size_t n = 200000;
+  std::vector<double> ar(n), white(n);
+  double x = 0;
+  for (size_t k = 0; k < n; ++k) {
+    x = 0.8 * x + e(rng);
+    ar[k] = x;
+    white[k] = e(rng);
+  }
+  EXPECT_NEAR(quadgen::diagnose::integrated_autocorrelation_time(ar), 9.0, 0.05 * 9.0);
+  EXPECT_NEAR(quadgen::diagnose::integrated_autocorrelation_time(white), 1.0, 0.02);
+}
+
+namespace {
+// r_i = p x_i - y_i; residuals 0, 1 in channel 0, residuals 2, 3 in channel 1.
+class TwoChannelLine : public quadgen::fit::ResidualModel {
+ public:
+  int num_residuals() const override { return 4; }
+  void evaluate(const double* p, double* r, double* J) const override {
+    for (int i = 0; i < 4; ++i) {
+      r[i] = p[0] * x_[i] - y_[i];
+      if (J) J[i] = x_[i];
+    }
+  }
+  int channel_of(int residual) const override { return residual < 2 ? 0 : 1; }
+  std::vector<std::string> channels() const override { return {"a", "b"}; }
+
+ private:
+  const double x_[4] = {1, 2, 1, 3}, y_[4] = {0, 1, 2, 1};
+};
+
+std::vector<quadgen::fit::FitParameter> line_at(double p) {
+  quadgen::fit::FitParameter fp;
+  fp.name = "p";
+  fp.value = p;
+  return {fp};
+}
+}  // namespace
+
+// The second asking's comparison (judge_held_out_as_own_model): both models scored under
+// sqrt(w_base w_own) per channel, here (sqrt(1*9), sqrt(4*1)) = (3, 2). By hand: at p = 0.5
+// the residuals are 0.5, 0, -1.5, 0.5, so 9*0.25 + 0 + 4*2.25 + 4*0.25 = 12.25; at p = 1 they
+// are 1, 1, -1, 2, so 9 + 9 + 4 + 16 = 38.
+TEST(Acceptance, TheSecondAskingScoresBothModelsUnderTheGeometricMeanOfTheirWeights) {
+  const TwoChannelLine m;
+  const auto c = quadgen::diagnose::CandidateSearch::held_out_costs_between(m, line_at(0.5), {1, 4}, line_at(1.0), {9, 1});
+  EXPECT_DOUBLE_EQ(c.before, 12.25);
+  EXPECT_DOUBLE_EQ(c.after, 38.0);
+  // Fair to both: swapping the models' roles swaps the costs.
+  const auto swapped = quadgen::diagnose::CandidateSearch::held_out_costs_between(m, line_at(1.0), {9, 1}, line_at(0.5), {1, 4});
+  EXPECT_DOUBLE_EQ(swapped.before, 38.0);
+  EXPECT_DOUBLE_EQ(swapped.after, 12.25);
+  // Under equal weights it is the plain weighted cost: weights (2, 1) give 4*0.25 + 2.25 + 0.25.
+  const auto same = quadgen::diagnose::CandidateSearch::held_out_costs_between(m, line_at(0.5), {2, 1}, line_at(0.5), {2, 1});
+  EXPECT_DOUBLE_EQ(same.before, 3.5);
+  EXPECT_DOUBLE_EQ(same.after, 3.5);
 }
 
 // Replaces a log's battery voltage by vref (1 - rate t) GE(z) exp(sigma e(t)): the thrust
@@ -640,8 +776,8 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
            {"motor_gain.C", -0.08}, {"motor_gain.B", 0.0}, {"motor_gain.C@2", 0.0}, {"motor_gain.B@2", 0.06}}) {
     ASSERT_TRUE(ps.contains(name)) << ps.dump(1);
     EXPECT_NEAR(ps[name]["value"].get<double>(), truth, 0.01) << name;
-    EXPECT_LE(ps[name]["ci95"][0].get<double>(), truth + 0.002) << name;
-    EXPECT_GE(ps[name]["ci95"][1].get<double>(), truth - 0.002) << name;
+    EXPECT_LE(ps[name]["ci95"][0].get<double>(), truth) << name << " " << ps[name].dump();
+    EXPECT_GE(ps[name]["ci95"][1].get<double>(), truth) << name << " " << ps[name].dump();
   }
   {  // the report shows each flight's trim side by side: one row per rotor, one column per flight
     std::ifstream in(dir / "out" / "report.html");
@@ -651,6 +787,7 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
     EXPECT_NE(html.find("<td>motor_gain.B [1]</td>"), std::string::npos);
     EXPECT_EQ(html.find("<td>motor_gain.B@2"), std::string::npos);  // no copy names in the table
   }
+  ASSERT_FALSE(j["candidates_considered"].empty());
   for (const auto& e : j["candidates_considered"]) EXPECT_NE(e, "thrust_decay");  // a per-flight state
   // about 30 % of each flight held out, both flights in the validation part
   const double train = j["samples"]["training"], valid = j["samples"]["validation"];
@@ -1167,7 +1304,7 @@ TEST_F(WeakMotorSearch, ALoneEffectIsComparedWithTheBaseFit) {
   const quadgen::diagnose::HeldOutGain held_out(*model_, *search_, valid_, *valid_ee_, true, 1.0, 0.1);
   const quadgen::diagnose::Finding f = held_out.finding_for("motor_gain", result_);
   const double base = held_out.metric(result_.base_fit, result_.final_weights, nullptr);
-  EXPECT_NEAR(f.before, base, 0.01 * base);
+  EXPECT_NEAR(f.before, base, 1e-9 * base);  // the same model, not one near it (a refit was 1.5 % off)
   EXPECT_GT(f.before - f.after, 0.1 * base) << "the weak motor must pay on held-out data";
   ASSERT_TRUE(f.comparison.has_value());
   EXPECT_TRUE(f.comparison->base_fit) << "the report must say it was compared with the base fit";

@@ -268,7 +268,7 @@ TEST(Generated, IndependentOfSymbolCreationOrder) {
   const quadgen::SymbolicModel m = quadgen::derive_model(v, quadgen::derive_mass_properties(v), o);
   quadgen::codegen::EmitOptions eo;
   eo.vehicle_file = "vehicles/finken3.yaml";
-  eo.effects_flag = " --effects all";
+  eo.regenerate_flags = " --effects all";
   const std::string text = quadgen::codegen::generate_header(m, eo).content;
   EXPECT_TRUE(text == read(fs::path(QUADGEN_SOURCE_DIR) / "generated/finken3_all_effects/model.hpp"));
 }

@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <thread>
@@ -25,7 +26,9 @@
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
 #include "output/json_document.hpp"
+#include "codegen/expression_graph.hpp"
 #include "codegen/header_writer.hpp"
+#include "output/fnv1a.hpp"
 #include "output/names.hpp"
 #include "output/output_set.hpp"
 #include "runtime/plot.hpp"
@@ -280,7 +283,7 @@ TEST(Sinks, GeneratedHeaderChangesOnlyInItsCommentWhatEverThePath) {
   for (const auto& s : hostile_strings()) {
     quadgen::codegen::EmitOptions o = plain;
     o.vehicle_file = s;
-    o.effects_flag = s;
+    o.regenerate_flags = s;
     const std::string h = quadgen::codegen::generate_header(model, o).content;
     // Line 2 (the regenerate command) is the only one that may differ, and stays one line.
     const auto line2 = [](const std::string& x) {
@@ -303,13 +306,17 @@ TEST(Sinks, GeneratedHeaderChangesOnlyInItsCommentWhatEverThePath) {
 
 TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
   Scratch tmp;
-  const fs::path cwd = fs::current_path();
+  struct RestoreDirectory {  // however the test ends
+    fs::path path;
+    ~RestoreDirectory() { fs::current_path(path); }
+  } restore{fs::current_path()};
   fs::current_path(tmp.dir);  // a `system "touch PWNED"` would create the file here
   for (const auto& s : hostile_strings()) {
     quadgen::runtime::Panel p{s, s, s, {{s, {0, 1, 2}, {1, 0, 1}}, {s, {0, 1}, {0, 1}, true}}};
     std::string svg, err;
     const bool drawn = quadgen::runtime::render_svg(s, {p}, &svg, &err);
-    if (err == "gnuplot is not installed") GTEST_SKIP() << err;
+    // setup.sh installs gnuplot: without it this test would prove nothing, so it fails.
+    ASSERT_NE(err, "gnuplot is not installed");
     EXPECT_TRUE(drawn) << out::printable(s) << ": " << err;
     EXPECT_FALSE(fs::exists(tmp.dir / "PWNED")) << out::printable(s);
     std::string lower = svg;
@@ -317,7 +324,6 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
     EXPECT_EQ(lower.find("<script"), std::string::npos);
     EXPECT_EQ(lower.find("<img"), std::string::npos);
   }
-  fs::current_path(cwd);
   EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
 }
 
@@ -697,6 +703,94 @@ TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
   expect_one_line_error(run_quadgen(with_out(tmp / "d/h.csv"), tmp.dir), "is the output directory of another quadgen run",
                         "into a derive folder");
   EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
+}
+
+// The record beside simulate's files is "hash size name" per line. A --out name holding a line
+// break could forge a line vouching for a user's file (found by a review: the next run then
+// overwrote a flight log); a record with any line quadgen would not write vouches for nothing.
+TEST(DataLoss, SimulateRecordCannotBeForgedThroughANameOrAnEdit) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const auto simulate_to = [&](const std::string& out) {
+    return run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", out}, tmp.dir);
+  };
+  const std::string flight = "t,u_A,u_B,u_C,u_D\n0,0.5,0.5,0.5,0.5\n";
+  write(tmp / "flight07.csv", flight);
+  out::Fnv1a h;
+  h.add(flight.data(), flight.size());
+  const std::string forged = h.hex() + " " + std::to_string(flight.size()) + " flight07.csv";
+  for (const std::string& name : std::vector<std::string>{"x\n" + forged + "\ny.csv", "x\r" + forged + "\ry.csv",
+                                                          " run.csv", "tab\trun.csv", ".quadgen-files.csv"})
+    expect_one_line_error(simulate_to(tmp / name), "cannot be an output file name", out::printable(name));
+  expect_one_line_error(simulate_to(tmp / "run.csv "), "expected a .csv file name", "a blank at the end");
+  expect_one_line_error(simulate_to(tmp / "flight07.csv"), "is not a file 'quadgen simulate' wrote there", "after the names");
+  EXPECT_EQ(read(tmp / "flight07.csv"), flight);
+  // A record holding a line quadgen would not write (here "hash size name" in the wrong
+  // shape) vouches for nothing: not for the forged line beside it, not for simulate's own file.
+  // (A well-formed line with the right hash cannot be told from quadgen's: whoever can write
+  // the record can write the files.)
+  ASSERT_EQ(simulate_to(tmp / "run.csv").rc, 0);
+  ASSERT_EQ(simulate_to(tmp / "run.csv").rc, 0);
+  write(tmp / ".quadgen-files", read(tmp / ".quadgen-files") + forged + "\nnot a record line\n");
+  expect_one_line_error(simulate_to(tmp / "flight07.csv"), "is not a file 'quadgen simulate' wrote there", "forged line");
+  expect_one_line_error(simulate_to(tmp / "run.csv"), "is not a file 'quadgen simulate' wrote there", "edited record");
+  EXPECT_EQ(read(tmp / "flight07.csv"), flight);
+}
+
+// The manifests' hash is FNV-1a 64 as published (test vectors of Fowler, Noll and Vo); a
+// manifest written while quadgen used an offset basis with a digit dropped is still read as
+// quadgen's, so an upgrade does not make every earlier output folder "changed since".
+TEST(DataLoss, ManifestHashIsThePublishedFnv1aAndOlderManifestsStillRead) {
+  EXPECT_EQ(out::fnv1a_hex(""), "cbf29ce484222325");
+  EXPECT_EQ(out::fnv1a_hex("a"), "af63dc4c8601ec8c");
+  EXPECT_EQ(out::fnv1a_hex("foobar"), "85944171f73967e8");
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  // The manifest rewritten as the older quadgen wrote it: every hash under the old basis.
+  std::istringstream lines(read(tmp / "d/.quadgen-manifest"));
+  std::string line, older;
+  while (std::getline(lines, line)) {
+    std::istringstream ls(line);
+    std::string hash, size, name;
+    if (line.rfind("quadgen", 0) != 0 && line.rfind("command ", 0) != 0 && ls >> hash >> size >> name) {
+      const std::string content = read(tmp / ("d/" + name));
+      out::Fnv1a h(out::kFnv1aLegacyBasis);
+      h.add(content.data(), content.size());
+      ASSERT_EQ(hash, out::fnv1a_hex(content)) << name;
+      line = h.hex() + " " + size + " " + name;
+    }
+    older += line + "\n";
+  }
+  write(tmp / "d/.quadgen-manifest", older);
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
+  EXPECT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir).rc, 0);
+  // Replaced by a manifest under the published basis.
+  EXPECT_NE(read(tmp / "d/.quadgen-manifest").find(out::fnv1a_hex(read(tmp / "d/model.hpp")) + " "), std::string::npos);
+}
+
+// Numbers that overflow a double never reach the generated code as "inf" or "nan" (an
+// identifier the including project may define): derive refuses and writes nothing.
+TEST(Sinks, OverflowingVehicleNumbersAreRefusedNotEmitted) {
+  Scratch tmp;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"radius: 0.0635", "radius: 1e200"},  // rotor constants overflow in the thrust law
+      {"upper_body, mass: 0.099", "upper_body, mass: 1.7e308"}};  // the blocks' total mass
+  for (const auto& [from, to] : cases) {
+    std::string text = finken3_with(from, to);
+    if (to == "upper_body, mass: 1.7e308") {
+      const auto at = text.find("lower_body, mass: 0.132");
+      ASSERT_NE(at, std::string::npos);
+      text.replace(at, 23, "lower_body, mass: 1.7e308");
+    }
+    write(tmp / "v.yaml", text);
+    const auto r = run_quadgen({"derive", tmp / "v.yaml", "--out", tmp / "out"}, tmp.dir);
+    expect_one_line_error(r, "not finite", to);
+    EXPECT_FALSE(fs::exists(tmp / "out")) << to;
+  }
+  EXPECT_THROW(quadgen::codegen::double_literal(std::numeric_limits<double>::infinity()), std::domain_error);
+  EXPECT_THROW(quadgen::codegen::double_literal(std::nan("")), std::domain_error);
+  EXPECT_EQ(quadgen::codegen::double_literal(2.0), "2.0");
 }
 
 // Killed at random moments, a run leaves its --out directory holding one complete run: the

@@ -193,6 +193,93 @@ TEST(Model, EffectsChangeTheModelAwayFromNominal) {
 // body x at 1 m/s, every rotor at the speed its command gives. The angular accelerations
 // change by dw = J^-1 (0, -k sum(w), 0); the body origin's acceleration by -(dw x c), c the
 // CoG (the translation equation is written for the origin); nothing else changes.
+namespace {
+// Nominal values of a derived model, by name.
+struct Nominal {
+  const SymbolicModel& m;
+  double operator()(const std::string& n) const { return m.params[m.param_index(n)].nominal; }
+  Eigen::Matrix3d inertia() const {
+    const Nominal& nom = *this;
+    Eigen::Matrix3d J;
+    J << nom("J_xx"), nom("J_xy"), nom("J_xz"), nom("J_xy"), nom("J_yy"), nom("J_yz"), nom("J_xz"), nom("J_yz"),
+        nom("J_zz");
+    return J;
+  }
+  Eigen::Vector3d cog() const { return {(*this)("cog_x"), (*this)("cog_y"), (*this)("cog_z")}; }
+  // Rotor i's speed from the motor map and its thrust c_t rho A r^2 w^2 (the thesis' law).
+  double speed(double u) const { return (*this)("motor_a0") + (*this)("motor_a1") * u + (*this)("motor_a2") * u * u; }
+  double thrust(const Rotor& r, double u) const {
+    return (*this)("c_t") * (*this)("rho") * r.disc_area * r.radius * r.radius * std::pow(speed(u), 2);
+  }
+};
+
+// Closed form, written here from the vehicle file: rotor i's thrust changed by dF[i] along
+// body z changes the moment about the CoG by arm_i x dF_i plus the reaction +-kappa dF_i, the
+// body rates' derivative by J^-1 of that (the gyroscopic term does not change), and the
+// origin's acceleration by sum dF / m - dw x c (velocity rows in the world frame, level
+// attitude).
+struct RowChange {
+  Eigen::Vector3d dv, dw;
+};
+RowChange change_from_thrust(const Vehicle& v, const Nominal& nom, const std::vector<double>& dF) {
+  Eigen::Vector3d dforce = Eigen::Vector3d::Zero(), dtorque = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < v.rotors.size(); ++i) {
+    const Rotor& r = v.rotors[i];
+    const Eigen::Vector3d arm = Eigen::Vector3d(r.position[0], r.position[1], r.position[2]) - nom.cog();
+    dforce.z() += dF[i];
+    dtorque += arm.cross(Eigen::Vector3d(0, 0, dF[i]));
+    dtorque.z() += (r.spin == Spin::ccw ? -1 : 1) * nom("kappa") * dF[i];
+  }
+  const Eigen::Vector3d dw = nom.inertia().inverse() * dtorque;
+  return {dforce / nom("mass") - dw.cross(nom.cog()), dw};
+}
+
+void expect_rows_change_by(const std::vector<double>& f0, const std::vector<double>& f1, const RowChange& c) {
+  for (int i : {0, 1, 2, 6, 7, 8, 9}) EXPECT_NEAR(f1[i], f0[i], 1e-12 * (1 + std::fabs(f0[i]))) << "row " << i;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(f1[3 + a] - f0[3 + a], c.dv[a], 1e-9 * (1 + std::fabs(c.dv[a]))) << "velocity row " << a;
+    EXPECT_NEAR(f1[10 + a] - f0[10 + a], c.dw[a], 1e-9 * (1 + std::fabs(c.dw[a]))) << "rate row " << a;
+  }
+}
+
+// Level, at rest at height z, turning at p, q; the model's inputs by name (rotor commands u,
+// then the effect's own: time t, battery voltage vbat).
+std::vector<double> level_state(double z) {
+  std::vector<double> x(13, 0.0);
+  x[2] = z;
+  x[6] = 1;
+  x[10] = 0.7;
+  x[11] = -0.4;
+  return x;
+}
+std::vector<double> inputs_of(const SymbolicModel& m, const std::vector<double>& u, const std::map<std::string, double>& extra) {
+  std::vector<double> in;
+  for (size_t i = 0; i < m.inputs.size(); ++i) in.push_back(i < u.size() ? u[i] : extra.at(m.inputs[i].name));
+  return in;
+}
+
+// An effect that scales every rotor's thrust by s (a ground effect, a thrust decay, a
+// battery sag) against the closed form dF_i = (s - 1) F_i, s computed here from the law the
+// effect cites.
+void expect_thrust_scaled_by(const std::string& effect, const std::string& parameter, double value, double s,
+                             const std::vector<double>& x, const std::map<std::string, double>& extra) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {effect});
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  const auto in = inputs_of(m, u, extra);
+  const auto f0 = test::eval_f(m, x, in);
+  m.params[m.param_index(parameter)].nominal = value;
+  const auto f1 = test::eval_f(m, x, in);
+  const Nominal nom{m};
+  std::vector<double> dF;
+  for (size_t i = 0; i < v.rotors.size(); ++i) dF.push_back((s - 1) * nom.thrust(v.rotors[i], u[i]));
+  const RowChange c = change_from_thrust(v, nom, dF);
+  SCOPED_TRACE(effect);
+  expect_rows_change_by(f0, f1, c);
+  EXPECT_GT(std::fabs(c.dv.z()), 0.5);  // a change worth checking: m/s^2
+}
+}  // namespace
+
 TEST(Model, BladeFlappingMomentMatchesItsClosedForm) {
   SymbolicModel m = derive(test::finken3(), {"blade_flapping"});
   std::vector<double> x(13, 0.0);
@@ -239,29 +326,115 @@ TEST(Model, InflowThrustLossMatchesItsClosedForm) {
   const double k = 3.0;
   m.params[m.param_index("inflow.k")].nominal = k;
   const auto f1 = test::eval_f(m, x, u);
-  auto nom = [&](const char* n) { return m.params[m.param_index(n)].nominal; };
-  const Eigen::Vector3d cog(nom("cog_x"), nom("cog_y"), nom("cog_z"));
-  Eigen::Vector3d dforce = Eigen::Vector3d::Zero(), dtorque = Eigen::Vector3d::Zero();
+  const Nominal nom{m};
+  std::vector<double> dF;
   for (size_t i = 0; i < v.rotors.size(); ++i) {
     const Rotor& r = v.rotors[i];
-    const double w = nom("motor_a0") + nom("motor_a1") * u[i] + nom("motor_a2") * u[i] * u[i];
-    const Eigen::Vector3d arm = Eigen::Vector3d(r.position[0], r.position[1], r.position[2]) - cog;
+    const Eigen::Vector3d arm = Eigen::Vector3d(r.position[0], r.position[1], r.position[2]) - nom.cog();
     const double climb = x[5] + x[10] * arm.y() - x[11] * arm.x();
-    const double dF = -nom("c_t") * nom("rho") * r.disc_area * r.radius * r.radius * w * k * climb / r.radius;
-    dforce.z() += dF;
-    dtorque += arm.cross(Eigen::Vector3d(0, 0, dF));
-    dtorque.z() += (r.spin == Spin::ccw ? -1 : 1) * nom("kappa") * dF;
+    const double w = nom.speed(u[i]);
+    dF.push_back(-nom("c_t") * nom("rho") * r.disc_area * r.radius * r.radius * w * k * climb / r.radius);
   }
-  Eigen::Matrix3d J;
-  J << nom("J_xx"), nom("J_xy"), nom("J_xz"), nom("J_xy"), nom("J_yy"), nom("J_yz"), nom("J_xz"), nom("J_yz"), nom("J_zz");
-  const Eigen::Vector3d dw = J.inverse() * dtorque;
-  const Eigen::Vector3d dv = dforce / nom("mass") - dw.cross(cog);
+  const RowChange c = change_from_thrust(v, nom, dF);
+  expect_rows_change_by(f0, f1, c);
+  EXPECT_LT(c.dv.z(), -0.1);  // climbing costs thrust: m/s^2
+  EXPECT_GT(std::fabs(c.dw.x()) + std::fabs(c.dw.y()), 1.0);  // and rolling and pitching are damped: rad/s^2
+}
+
+
+// Cheeseman & Bennett: T / T_free = 1 / (1 - (R / 4z)^2); at z = 6 cm with R = 10 cm, 1.21.
+TEST(Model, GroundEffectMatchesTheCheesemanBennettLaw) {
+  const double R = 0.10, z = 0.06;
+  expect_thrust_scaled_by("ground_effect", "ground_effect.radius", R, 1.0 / (1.0 - std::pow(R / (4 * z), 2)),
+                          level_state(z), {});
+}
+
+// Thrust (1 - rate t): 1 %/s at t = 20 s is 80 % of the thrust.
+TEST(Model, ThrustDecayIsLinearInTime) {
+  expect_thrust_scaled_by("thrust_decay", "thrust_decay.rate", 0.01, 0.8, level_state(1.0), {{"t", 20.0}});
+}
+
+// Thrust (vbat / vbat_ref)^e, with vbat_ref the vehicle file's.
+TEST(Model, BatterySagIsAPowerOfTheVoltageRatio) {
+  const SymbolicModel m = derive(test::finken3(), {"battery_sag"});
+  const double vref = m.params[m.param_index("vbat_ref")].nominal, vbat = 0.85 * vref;
+  expect_thrust_scaled_by("battery_sag", "battery_sag.exponent", 1.5, std::pow(vbat / vref, 1.5), level_state(1.0),
+                          {{"vbat", vbat}});
+}
+
+// Each rotor's thrust times (1 + g_i).
+TEST(Model, MotorGainScalesEachRotorsThrust) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {"motor_gain"});
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55}, g{0.1, -0.05, 0.0, 0.2};
+  const auto x = level_state(1.0);
+  const auto f0 = test::eval_f(m, x, u);
+  for (size_t i = 0; i < v.rotors.size(); ++i) m.params[m.param_index("motor_gain." + v.rotors[i].name)].nominal = g[i];
+  const auto f1 = test::eval_f(m, x, u);
+  const Nominal nom{m};
+  std::vector<double> dF;
+  for (size_t i = 0; i < v.rotors.size(); ++i) dF.push_back(g[i] * nom.thrust(v.rotors[i], u[i]));
+  expect_rows_change_by(f0, f1, change_from_thrust(v, nom, dF));
+}
+
+// The rotor thrusts act about a CoG moved by (dx, dy): the moment changes by -dc x F (F the
+// total rotor force along body z; the inertia is the CoG's, unchanged), and the origin's
+// acceleration by -(w_dot1 x c1 - w_dot0 x c0) at rest (omega = 0: no centripetal term).
+TEST(Model, CogOffsetMovesThePointTheThrustsActAbout) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {"cog_offset"});
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  auto x = level_state(1.0);
+  x[10] = x[11] = 0;
+  const auto f0 = test::eval_f(m, x, u);
+  const Eigen::Vector3d dc(0.004, -0.003, 0);
+  m.params[m.param_index("cog_offset.x")].nominal = dc.x();
+  m.params[m.param_index("cog_offset.y")].nominal = dc.y();
+  const auto f1 = test::eval_f(m, x, u);
+  const Nominal nom{m};
+  double F = 0;
+  for (size_t i = 0; i < v.rotors.size(); ++i) F += nom.thrust(v.rotors[i], u[i]);
+  const Eigen::Vector3d w0(f0[10], f0[11], f0[12]);
+  const Eigen::Vector3d w1 = w0 + nom.inertia().inverse() * (-dc.cross(Eigen::Vector3d(0, 0, F)));
+  const Eigen::Vector3d dv = -(w1.cross(nom.cog() + dc) - w0.cross(nom.cog()));
   for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(f1[10 + a], w1[a], 1e-9 * (1 + std::fabs(w1[a]))) << "rate row " << a;
     EXPECT_NEAR(f1[3 + a] - f0[3 + a], dv[a], 1e-9 * (1 + std::fabs(dv[a]))) << "velocity row " << a;
-    EXPECT_NEAR(f1[10 + a] - f0[10 + a], dw[a], 1e-9 * (1 + std::fabs(dw[a]))) << "rate row " << a;
   }
-  EXPECT_LT(dv.z(), -0.1);  // climbing costs thrust: m/s^2
-  EXPECT_GT(std::fabs(dw.x()) + std::fabs(dw.y()), 1.0);  // and rolling and pitching are damped: rad/s^2
+  EXPECT_GT(std::fabs(w1.x() - w0.x()) + std::fabs(w1.y() - w0.y()), 1.0);  // rad/s^2
+}
+
+// A steady wind acts through the air-relative velocity: the frame drag -1/2 c_w rho A_k
+// v_k |v_k| per body axis, rotor drag -k (sum w) v_air,xy at the CoG and blade flapping
+// k (sum w) (v_air,y, -v_air,x, 0), with v_air = v - wind (level).
+TEST(Model, WindActsThroughTheAirRelativeVelocity) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {"wind", "rotor_drag", "blade_flapping"});
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  auto x = level_state(1.0);
+  x[10] = x[11] = 0;
+  x[3] = 1.0;  // flying along x
+  const double kd = 2e-5, kf = 2e-6;
+  m.params[m.param_index("rotor_drag.k")].nominal = kd;
+  m.params[m.param_index("blade_flapping.k")].nominal = kf;
+  const auto f0 = test::eval_f(m, x, u);  // still air: v_air = v
+  m.params[m.param_index("wind.x")].nominal = 0.5;
+  m.params[m.param_index("wind.y")].nominal = -1.0;
+  const auto f1 = test::eval_f(m, x, u);  // v_air = (0.5, 1, 0)
+  const Nominal nom{m};
+  double speed_sum = 0;
+  for (double ui : u) speed_sum += nom.speed(ui);
+  const Eigen::Vector3d air0(1.0, 0, 0), air1(0.5, 1.0, 0), dair = air1 - air0;
+  Eigen::Vector3d dforce = -kd * speed_sum * dair;
+  const char* areas[] = {"A_x", "A_y", "A_z"};
+  for (int k = 0; k < 3; ++k)
+    dforce[k] -= 0.5 * nom("c_w") * nom("rho") * nom(areas[k]) *
+                 (air1[k] * std::fabs(air1[k]) - air0[k] * std::fabs(air0[k]));
+  const Eigen::Vector3d dw = nom.inertia().inverse() * (kf * speed_sum * Eigen::Vector3d(dair.y(), -dair.x(), 0));
+  const Eigen::Vector3d dv = dforce / nom("mass") - dw.cross(nom.cog());
+  expect_rows_change_by(f0, f1, {dv, dw});
+  EXPECT_GT(dv.norm(), 0.05);
+  EXPECT_GT(dw.norm(), 0.5);
 }
 
 TEST(Model, AttitudeBiasChangesOnlyTheMeasurement) {

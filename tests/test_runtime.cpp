@@ -621,5 +621,18 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   const auto weak = fly_closed_loop(truth, belief, {"A", "B", "C", "D"}, co);
   const double uA = column_mean(weak, "u_A", 500), uC = column_mean(weak, "u_C", 500);
   EXPECT_GT(uC - uA, 0.01);
+  // How much, in closed form: A and C sit on one diagonal, so level flight needs their
+  // thrusts equal, (1 - 0.08) w_C^2 = w_A^2; the command giving w_C = w_A / sqrt(0.92) through
+  // the motor map w = a0 + a1 u + a2 u^2 is the root of a quadratic.
+  const auto nominal = [&](const char* n) { return p[truth.param_index(n)]; };
+  const double a0 = nominal("motor_a0"), a1 = nominal("motor_a1"), a2 = nominal("motor_a2");
+  const double wC = (a0 + a1 * uA + a2 * uA * uA) / std::sqrt(0.92);
+  double uC_expected = (wC - a0) / a1;  // the root nearest u_A
+  if (a2 != 0)
+    for (double sign : {-1.0, 1.0}) {
+      const double root = (-a1 + sign * std::sqrt(a1 * a1 - 4 * a2 * (a0 - wC))) / (2 * a2);
+      if (sign < 0 || std::fabs(root - uA) < std::fabs(uC_expected - uA)) uC_expected = root;
+    }
+  EXPECT_NEAR(uC - uA, uC_expected - uA, 0.15 * (uC_expected - uA));
   EXPECT_NEAR(column_mean(clean, "u_C", 500) - column_mean(clean, "u_A", 500), 0.0, 0.003);
 }

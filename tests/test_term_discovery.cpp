@@ -81,6 +81,19 @@ TEST(TermDiscovery, RegressorLibraryHasBodyVelocityOnlyWithAPose) {
   EXPECT_NEAR(s[1][50], std::cos(yaw) * x[3] + std::sin(yaw) * x[4], 1e-12);
 }
 
+// The mean over a flight's samples of the mean rotor command: the centre dU is taken about,
+// computed here rather than read from the code under test (-2 U v = -2 c v - 2 (U - c) v
+// holds for any c, so a coefficient checked against the code's own centre cannot fail).
+double mean_command(const fit::Flight& f) {
+  double sum = 0;
+  for (const auto& s : f.samples) {
+    double u = 0;
+    for (double ui : s.u) u += ui;
+    sum += u / static_cast<double>(s.u.size());
+  }
+  return sum / static_cast<double>(f.samples.size());
+}
+
 TEST(TermDiscovery, HiddenDragMomentIsFoundWithItsCoefficientAndHeldOutGain) {
   // Over 20 noise realisations: found every time with nothing else; its part about the mean
   // command (v_bx*dU, a sixth of its size here) too on nearly every one, with a 95 %
@@ -105,6 +118,7 @@ TEST(TermDiscovery, HiddenDragMomentIsFoundWithItsCoefficientAndHeldOutGain) {
       ASSERT_GE(t.coefficients.size(), 1u);
       ASSERT_EQ(t.centres.size(), 1u);
       const double mean_u = t.centres[0].second;
+      EXPECT_NEAR(mean_u, mean_command(train), 1e-12);  // the training part's, not the held-out one's
       EXPECT_EQ(t.coefficients[0].regressor, "v_bx");
       EXPECT_NEAR(t.coefficients[0].value, -2.0 * mean_u, 0.05);
       if (t.coefficients.size() == 1) continue;  // the weaker half left out (one-SE rule)
@@ -160,6 +174,7 @@ TEST(TermDiscovery, SeveralFlightsCrossValidateOneFlightAgainstTheOthers) {
   EXPECT_EQ(terms[4].coefficients[1].regressor, "v_bx*dU");
   EXPECT_LT(terms[4].coefficients[1].lower, -2.0);
   EXPECT_GT(terms[4].coefficients[1].upper, -2.0);
+  EXPECT_NEAR(terms[4].centres[0].second, mean_command(train), 1e-12);
   const std::string mean_term = std::to_string(-2.0 * terms[4].centres[0].second).substr(0, 4);
   EXPECT_EQ(terms[4].expression().rfind("qdot += " + mean_term, 0), 0u) << terms[4].expression();
 }

@@ -1,0 +1,29 @@
+// `quadgen derive` as a library call: a vehicle file (and the fitted values to give it) in;
+// out, in memory, the files the command writes (model.hpp, model.json, derivation.md) and
+// what it prints. The command line writes the files as one output set.
+#pragma once
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace quadgen::app {
+
+struct DeriveJob {
+  std::string vehicle;  // vehicle file (YAML)
+  std::string effects;  // comma-separated effects, or "all"; "": none (or the fitted ones)
+  std::string params;   // fitted_parameters.yaml from diagnose: its effects and values; "": none
+  // Called before each step with its description ("mass properties of 13 blocks", "audit").
+  std::function<void(const std::string&)> progress;
+};
+
+struct DeriveJobResult {
+  std::vector<std::pair<std::string, std::string>> files;  // name, contents
+  std::string summary;  // what the command prints: the model's size, the audit, op counts, mass properties
+  bool audit_passed = false;
+};
+
+// Throws the layers' own errors (a bad vehicle or parameter file, with file and line) unchanged.
+DeriveJobResult run_derive_job(const DeriveJob& job);
+
+}  // namespace quadgen::app

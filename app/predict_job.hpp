@@ -1,0 +1,32 @@
+// `quadgen predict` as a library call: a vehicle and its logs in; out, in memory, the files
+// the command writes (prediction.json, prediction.csv, prediction.svg) and what it prints.
+// The model is the vehicle's with every effect, at its neutral value unless --params sets it.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "predict/predict_flights.hpp"
+
+namespace quadgen::app {
+
+struct PredictJob {
+  std::string vehicle;            // vehicle file (YAML)
+  std::vector<std::string> logs;  // one or more flights of it
+  predict::PredictFlightsOptions options;
+};
+
+struct PredictJobResult {
+  std::vector<std::pair<std::string, std::string>> files;  // name, contents
+  std::string summary;             // what the command prints: error at each horizon, what limits it
+  std::vector<std::string> notes;  // for the terminal: a plot that could not be drawn
+  // Non-empty when the run did not succeed although its files were made: an open-loop error
+  // that is not finite is a model that left its range (commands, units or parameters wrong).
+  std::string failure;
+};
+
+// Throws std::invalid_argument for contradicting options, and the layers' own errors (a bad
+// vehicle file or log, with file and line) unchanged.
+PredictJobResult run_predict_job(const PredictJob& job);
+
+}  // namespace quadgen::app
