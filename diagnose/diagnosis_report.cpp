@@ -41,6 +41,7 @@ json evidence_json(const CandidateEvidence& e) {
           {"validation_cost_before", e.validation_cost_before},
           {"validation_cost_after", e.validation_cost_after},
           {"validation_gain_percent", e.validation_gain_percent},
+          {"validation_rejudged_as_own_model", e.rejudged},
           {"size_fraction_of_g", e.size_translation},
           {"size_fraction_of_rotation_scale", e.size_rotation},
           {"significant", e.significant},
@@ -386,37 +387,30 @@ std::vector<std::string> screening_notes(const Diagnosis& d) {
   return out;
 }
 
-}  // namespace
-
-json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
-  json j;
-  j["vehicle"] = d.vehicle;
-  j["log"] = log_path;
-  j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
-  j["flight_screening"] = screening_json(d);
-  // The same logs as absolute paths, so that quadgen predict matches them from any directory.
+// The same logs as absolute paths, so that quadgen predict matches them from any directory.
+json flight_paths_json(const Diagnosis& d) {
   json paths = json::array();
   for (const auto& f : d.flights) {
     std::error_code ec;
     const auto c = std::filesystem::weakly_canonical(std::filesystem::absolute(f, ec), ec);
     paths.push_back(ec ? f : c.string());
   }
-  j["flight_paths"] = paths;
-  // Effects with one value per flight: "name" is the first flight's, "name@k" the k-th's.
-  j["per_flight_effects"] = d.per_flight_effects;
-  j["formulation"] = d.formulation;
-  j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
-  json findings = json::array();
-  for (const auto& f : d.findings) findings.push_back(finding_json(f));
-  j["findings"] = findings;
+  return paths;
+}
+
+json suspected_json(const Diagnosis& d) {
   json suspected = json::array();
   for (const auto& x : d.suspected) {
     json sj = finding_json(x.candidate);
     sj["failed"] = x.failed;
     suspected.push_back(sj);
   }
-  j["suspected"] = suspected;
-  j["environment"] = d.environment;
+  return suspected;
+}
+
+// Accepted by every statistical test but outside what the effect's physics can produce: in
+// the extended model (carried), never named; with the residual each absorbs.
+json stand_ins_json(const Diagnosis& d) {
   json stand_ins = json::array();
   for (const auto& st : d.stand_ins) {
     json absorbs = json::array();
@@ -433,36 +427,45 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     sj["absorbs"] = absorbs;
     stand_ins.push_back(sj);
   }
-  // Accepted by every statistical test but outside what the effect's physics can produce:
-  // in the extended model (carried), never named.
-  j["stand_ins"] = stand_ins;
+  return stand_ins;
+}
+
+json removed_json(const SearchResult& s) {
   json removed = json::array();
-  for (const auto& r : d.search.removed)
+  for (const auto& r : s.removed)
     removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value},
                        {"validation_gain_percent", r.validation_gain_percent}});
-  j["removed_by_backward_pass"] = removed;
+  return removed;
+}
+
+json left_at_limit_json(const SearchResult& s) {
   json left = json::array();
-  for (const auto& ev : d.search.left_at_limit)
+  for (const auto& ev : s.left_at_limit)
     left.push_back({{"effect", ev.effect}, {"p_value", ev.p_value}, {"statistic", ev.statistic},
                     {"implausible", ev.implausible}});
-  j["left_at_max_effects"] = left;
+  return left;
+}
+
+json ambiguous_json(const SearchResult& s) {
   json amb = json::array();
-  for (const auto& a : d.search.unresolved)
+  for (const auto& a : s.unresolved)
     amb.push_back({{"effects", {a.a, a.b}},
                    {"statistics", {a.statistic_a, a.statistic_b}},
                    {"p_value_adding_second_to_first", a.b_given_a_p},
                    {"p_value_adding_first_to_second", a.a_given_b_p},
                    {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
                    {"separating_manoeuvre", a.manoeuvre}});
-  j["ambiguous"] = amb;
-  j["agreement"] = agreement_json(d.agreement, d.flights);
-  // One flight against an airframe diagnosed before: joint_value is the airframe's, cochran_q
-  // the squared z of the difference.
-  j["airframe_check"] = d.airframe_source.empty()
-                            ? json(nullptr)
-                            : json({{"airframe", d.airframe_source},
-                                    {"parameters", agreement_json(d.airframe_check, d.flights)}});
-  j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
+  return amb;
+}
+
+// One flight against an airframe diagnosed before: joint_value is the airframe's, cochran_q
+// the squared z of the difference.
+json airframe_check_json(const Diagnosis& d) {
+  if (d.airframe_source.empty()) return json(nullptr);
+  return {{"airframe", d.airframe_source}, {"parameters", agreement_json(d.airframe_check, d.flights)}};
+}
+
+json unexplained_json(const Diagnosis& d) {
   json un = json::array();
   for (const auto& u : d.unexplained)
     un.push_back({{"channel", u.channel},
@@ -474,15 +477,15 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                   {"mean_there", u.worst_mean},
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});
-  j["unexplained"] = un;
-  j["draft_signature"] = with_per_flight(draft_signature_json(d.draft), d.draft_per_flight, d, draft_signature_json);
-  j["command_gain"] = with_per_flight(command_gain_json(d.command_gain), d.command_gain_per_flight, d, command_gain_json);
-  // Beyond the catalogue: one entry per channel, proposed or not (and why).
+  return un;
+}
+
+// Beyond the catalogue: one entry per channel, proposed or not (and why).
+json discovered_terms_json(const Diagnosis& d) {
   json disc = json::array();
   for (const auto& t : d.discovered) {
     json cs = json::array();
-    for (const auto& c : t.coefficients)
-    {
+    for (const auto& c : t.coefficients) {
       json cj = {{"regressor", c.regressor}};
       cj.update(output::estimate_json({c.value, c.unit, c.lower, c.upper, "", false}));
       cs.push_back(cj);
@@ -502,40 +505,38 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
                                        {"per_block", t.fold_gains}}},
                     {"verdict", t.verdict}});
   }
-  j["discovered_terms"] = disc;
+  return disc;
+}
+
+json discovered_terms_gain_json(const Diagnosis& d) {
   const auto& tg = d.terms_gain;
-  j["discovered_terms_gain"] = {{"measured", tg.measured},
-                                {"metric", tg.metric},
-                                {"before", number_or_null(tg.before)},
-                                {"after", number_or_null(tg.after)},
-                                {"per_fold", tg.fold_gains},
-                                {"mean", number_or_null(tg.gain_mean)},
-                                {"standard_error", number_or_null(tg.gain_standard_error)},
-                                {"note", tg.note}};
-  json at_bounds = json::array();
-  for (const auto& p : d.at_bounds) at_bounds.push_back(p.name);
-  j["parameters_at_bounds"] = at_bounds;
-  j["gain"] = {{"metric", d.metric},
-               {"before", number_or_null(d.metric_before)},
-               {"after", number_or_null(d.metric_after)},
-               {"reduction_percent", reduction(d.metric_before, d.metric_after)}};
-  if (!d.sim_before.t.empty()) {
-    auto sim = [](const WindowedSimulation& w) {
-      return json{{"position_m", number_or_null(w.position_rmse)}, {"velocity_m_s", number_or_null(w.velocity_rmse)},
-                  {"attitude_rad", number_or_null(w.attitude_rmse)}, {"body_rates_rad_s", number_or_null(w.rate_rmse)}};
-    };
-    j["validation_simulation_rmse"] = {{"before", sim(d.sim_before)}, {"after", sim(d.sim_after)}};
-  }
+  return {{"measured", tg.measured},
+          {"metric", tg.metric},
+          {"before", number_or_null(tg.before)},
+          {"after", number_or_null(tg.after)},
+          {"per_fold", tg.fold_gains},
+          {"mean", number_or_null(tg.gain_mean)},
+          {"standard_error", number_or_null(tg.gain_standard_error)},
+          {"note", tg.note}};
+}
+
+json simulation_rmse_json(const WindowedSimulation& w) {
+  return json{{"position_m", number_or_null(w.position_rmse)}, {"velocity_m_s", number_or_null(w.velocity_rmse)},
+              {"attitude_rad", number_or_null(w.attitude_rmse)}, {"body_rates_rad_s", number_or_null(w.rate_rmse)}};
+}
+
+json validation_channels_json(const Diagnosis& d) {
   json cg = json::array();
   for (const auto& c : d.channel_gain)
     cg.push_back({{"channel", c.channel}, {"rms_before", c.before}, {"rms_after", c.after},
                   {"reduction_percent", reduction(c.before, c.after)}});
-  j["validation_channels"] = cg;
-  if (d.has_prediction)
-    j["prediction"] = {{"before", predict::prediction_json(d.prediction_before)},
-                       {"after", predict::prediction_json(d.prediction_after)}};
+  return cg;
+}
+
+// Every selection step with its ranked candidates, each with its evidence and estimates.
+json selection_json(const SearchResult& search) {
   json steps = json::array();
-  for (const auto& s : d.search.steps) {
+  for (const auto& s : search.steps) {
     json cands = json::array();
     for (const auto& c : s.candidates) {
       json cj = {{"effect", c.effect}};
@@ -548,27 +549,81 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
     }
     steps.push_back({{"base_effects", s.base_effects}, {"selected", s.selected}, {"outcome", s.outcome}, {"candidates", cands}});
   }
-  j["selection"] = steps;
+  return steps;
+}
+
+// Which fitted parameters belong to a flight rather than to the airframe (battery state in
+// c_t, trims, marker frame, wind): quadgen predict takes them from a flight's own fit.
+json flight_parameters_json(const SearchResult& s) {
+  json own = json::array();
+  for (const auto& p : s.final_fit)
+    if (p.free && runtime::flight_of_name(p.name) == 1 && belongs_to_flight(p.name)) own.push_back(p.name);
+  return own;
+}
+
+json extended_model_json(const Diagnosis& d) {
+  return {{"effects", d.search.selected},
+          {"carried_look_alikes", carried_look_alikes(d)},
+          {"carried_stand_ins", stand_in_effects(d)},
+          {"weights", settling_json(d.search.final_settling)},
+          {"header", "extended_model.hpp"},
+          {"model_json", "extended_model.json"},
+          {"fitted_parameters", "fitted_parameters.yaml"}};
+}
+
+}  // namespace
+
+json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
+  json j;
+  j["vehicle"] = d.vehicle;
+  j["log"] = log_path;
+  j["flights"] = d.flights;  // each flight's log; several: diagnosed jointly
+  j["flight_screening"] = screening_json(d);
+  j["flight_paths"] = flight_paths_json(d);
+  // Effects with one value per flight: "name" is the first flight's, "name@k" the k-th's.
+  j["per_flight_effects"] = d.per_flight_effects;
+  j["formulation"] = d.formulation;
+  j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
+  json findings = json::array();
+  for (const auto& f : d.findings) findings.push_back(finding_json(f));
+  j["findings"] = findings;
+  j["suspected"] = suspected_json(d);
+  j["environment"] = d.environment;
+  j["stand_ins"] = stand_ins_json(d);
+  j["removed_by_backward_pass"] = removed_json(d.search);
+  j["left_at_max_effects"] = left_at_limit_json(d.search);
+  j["ambiguous"] = ambiguous_json(d.search);
+  j["agreement"] = agreement_json(d.agreement, d.flights);
+  j["airframe_check"] = airframe_check_json(d);
+  j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
+  j["unexplained"] = unexplained_json(d);
+  j["draft_signature"] = with_per_flight(draft_signature_json(d.draft), d.draft_per_flight, d, draft_signature_json);
+  j["command_gain"] = with_per_flight(command_gain_json(d.command_gain), d.command_gain_per_flight, d, command_gain_json);
+  j["discovered_terms"] = discovered_terms_json(d);
+  j["discovered_terms_gain"] = discovered_terms_gain_json(d);
+  json at_bounds = json::array();
+  for (const auto& p : d.at_bounds) at_bounds.push_back(p.name);
+  j["parameters_at_bounds"] = at_bounds;
+  j["gain"] = {{"metric", d.metric},
+               {"before", number_or_null(d.metric_before)},
+               {"after", number_or_null(d.metric_after)},
+               {"reduction_percent", reduction(d.metric_before, d.metric_after)}};
+  if (!d.sim_before.t.empty())
+    j["validation_simulation_rmse"] = {{"before", simulation_rmse_json(d.sim_before)},
+                                       {"after", simulation_rmse_json(d.sim_after)}};
+  j["validation_channels"] = validation_channels_json(d);
+  if (d.has_prediction)
+    j["prediction"] = {{"before", predict::prediction_json(d.prediction_before)},
+                       {"after", predict::prediction_json(d.prediction_after)}};
+  j["selection"] = selection_json(d.search);
   j["candidates_considered"] = d.candidates;
   j["base_fit"] = parameters_json(d.search.base_fit);
   j["final_fit"] = parameters_json(d.search.final_fit);
-  // For predicting other flights (quadgen predict): the airframe's values, and which fitted
-  // parameters belong to a flight rather than to the airframe (battery state in c_t, trims,
-  // marker frame, wind).
+  // For predicting other flights (quadgen predict): the airframe's values.
   j["airframe_fit"] = parameters_json(d.airframe_fit.empty() ? d.search.final_fit : d.airframe_fit);
-  json own = json::array();
-  for (const auto& p : d.search.final_fit)
-    if (p.free && runtime::flight_of_name(p.name) == 1 && belongs_to_flight(p.name))
-      own.push_back(p.name);
-  j["flight_parameters"] = own;
+  j["flight_parameters"] = flight_parameters_json(d.search);
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
-  j["extended_model"] = {{"effects", d.search.selected},
-                         {"carried_look_alikes", carried_look_alikes(d)},
-                         {"carried_stand_ins", stand_in_effects(d)},
-                         {"weights", settling_json(d.search.final_settling)},
-                         {"header", "extended_model.hpp"},
-                         {"model_json", "extended_model.json"},
-                         {"fitted_parameters", "fitted_parameters.yaml"}};
+  j["extended_model"] = extended_model_json(d);
   j["timing_s"] = d.seconds;
   return j;
 }
@@ -1023,11 +1078,9 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
 }
 
 
-}  // namespace
-
-std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
-                           const std::vector<std::pair<std::string, std::string>>& plots) {
-  std::ostringstream h;
+// The page's head, the title (the flights numbered: per-flight values refer to these
+// numbers), what was fitted to what, and the screening's warnings.
+void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log_path) {
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>quadgen diagnosis: " << esc(d.vehicle)
     << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
@@ -1053,6 +1106,11 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << " validation samples from t = " << num(d.t_split, 4) << " s";
   h << "; " << num(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
+}
+
+// One line per named cause and the held-out gain, then the command's own printout (for a
+// reader who compares it with a terminal) and the overall gain.
+void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";
@@ -1067,6 +1125,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     << "</pre></details>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
     << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
+}
+
+void findings_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>Findings</h2>\n";
   if (d.findings.empty()) h << "<p>None.</p>\n";
   if (!d.per_flight_effects.empty()) {
@@ -1098,7 +1159,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ".</p>\n";
   }
-  agreement_html(h, d);
+}
+
+void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.stand_ins.empty()) {
     h << "<h2>Stand-ins for missing physics</h2>\n<p>Each passed every statistical test, but its value lies outside "
          "what its physics can produce here: it absorbs an error of something the model lacks. It stays in the "
@@ -1115,6 +1178,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     }
     h << "</table>\n";
   }
+}
+
+void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.search.unresolved.empty()) {
     h << "<h2>Ambiguous</h2>\n";
     for (const auto& a : d.search.unresolved)
@@ -1123,6 +1189,10 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
         << ".</p>\n";
   }
+}
+
+// Slow structure the catalogue leaves, and the draft check's leads.
+void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.unexplained.empty()) {
     h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
     for (const auto& u : d.unexplained)
@@ -1133,8 +1203,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   }
   for (const auto& [flight, lead] : draft_leads(d))
     h << "<p>" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
-  command_gain_html(h, d);
-  discovered_terms_html(h, d);
+}
+
+void prediction_html(std::ostringstream& h, const Diagnosis& d) {
   if (d.has_prediction) {
     // Comparable with published models: the error AT a horizon, averaged over start points.
     h << "<h2>Prediction on the validation part</h2>\n";
@@ -1163,12 +1234,19 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
       h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
   }
+}
+
+void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
     h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
       << "</td><td>" << num(c.after) << "</td><td>" << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
-  h << "</table>\n<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
+  h << "</table>\n";
+}
+
+void base_residuals_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
        "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
   for (const auto& c : d.before.channels) {
     h << "<tr><td>" << esc(c.name) << "</td><td>" << esc(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
@@ -1178,7 +1256,11 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
       h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << num(c.correlations[i].r, 2) << ")";
     h << "</td></tr>\n";
   }
-  h << "</table>\n<h2>Candidates</h2>\n";
+  h << "</table>\n";
+}
+
+void candidates_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>Candidates</h2>\n";
   for (size_t s = 0; s < d.search.steps.size(); ++s) {
     const auto& st = d.search.steps[s];
     h << "<h3>Step " << s + 1 << " (model: base";
@@ -1191,6 +1273,9 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
         << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
     h << "</table>\n";
   }
+}
+
+void plots_html(std::ostringstream& h, const std::vector<std::pair<std::string, std::string>>& plots) {
   h << "<h2>Plots</h2>\n";
   if (plots.empty()) h << "<p>No plots (gnuplot unavailable).</p>\n";
   for (const auto& [name, svg] : plots) {
@@ -1200,12 +1285,37 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
     h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
     h << "</figcaption></figure>\n";
   }
+}
+
+void method_html(std::ostringstream& h) {
   h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
        "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
        "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
        "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the validation part. "
        "Intervals are profile-likelihood intervals with the same weights, widened on both sides by the change of the "
        "estimate when the interval accelerations use the trapezoid instead of the midpoint rule (discretisation error).</p>\n</body></html>\n";
+}
+
+}  // namespace
+
+std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
+                           const std::vector<std::pair<std::string, std::string>>& plots) {
+  std::ostringstream h;
+  head_html(h, d, log_path);
+  in_short_html(h, d);
+  findings_html(h, d);
+  agreement_html(h, d);
+  stand_ins_html(h, d);
+  ambiguous_html(h, d);
+  unexplained_html(h, d);
+  command_gain_html(h, d);
+  discovered_terms_html(h, d);
+  prediction_html(h, d);
+  validation_channels_html(h, d);
+  base_residuals_html(h, d);
+  candidates_html(h, d);
+  plots_html(h, plots);
+  method_html(h);
   return h.str();
 }
 
