@@ -37,13 +37,6 @@ void check_size(const SimulateJob& a, double steps, double rows) {
                               "; shorten it, raise --step or lower --rate, or pass --no-size-limit");
 }
 
-// Fills the inputs that effects add (t, vbat) after the rotor commands.
-void fill_extra_inputs(const DynamicModel& m, double t, double vbat, double* u) {
-  for (int i = 0; i < m.num_inputs(); ++i) {
-    if (m.input_names()[i] == "t") u[i] = t;
-    if (m.input_names()[i] == "vbat") u[i] = vbat;
-  }
-}
 
 // A closed-loop test flight: the true model (effects and --set values) flown by a
 // controller that believes the nominal base model.
@@ -128,7 +121,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
       const double td = delay >= 0 ? t - m.params()[delay] : t;
       const auto F = s.thrust(td, hover, rotors);
       for (size_t i = 0; i < nr; ++i) u[i] = laws[i].command_for(F[i]);
-      fill_extra_inputs(m, t, vbat_ref, u);
+      ExtraInputs(m).fill(t, vbat_ref, u);
     };
   } else {
     const CsvTable log = read_csv(a.inputs);
@@ -169,7 +162,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
       sig->at(t0 + tt, uu, delay >= 0 ? m.params()[delay] : 0.0);
       double vb_now = vbat_ref;
       if (vbat_signal) vbat_signal->at(t0 + tt, &vb_now);
-      fill_extra_inputs(m, tt, vb_now, uu);
+      ExtraInputs(m).fill(tt, vb_now, uu);
     };
   }
   // Rotor-speed states (motor_lag) start at their commanded steady state.

@@ -191,6 +191,24 @@ ex rotor_thrust(const ModelContext& c, size_t i, const ex& w) {
   return c.thrust_scale[i] * k * w * (w - c.thrust_speed_loss[i]);
 }
 
+// Rotor i's moment about the CoG from its thrust: the thrust's moment on its arm, and the
+// reaction torque, which opposes the spin (a ccw rotor, seen from above, pushes the body
+// along -z).
+matrix rotor_torque(const ModelContext& c, size_t i, const ex& thrust) {
+  const int reaction = (c.vehicle.rotors[i].spin == Spin::ccw) ? -1 : 1;
+  const matrix arm = c.rotor_position[i].sub(c.cog);
+  return cross(arm, vec3(0, 0, thrust)).add(vec3(0, 0, reaction * c.p("kappa") * thrust));
+}
+
+// Frame drag per body axis, 1/2 c_w rho A v|v|, on the air-relative velocity (body axes).
+matrix frame_drag(const ModelContext& c, const ex (&v_air_body)[3]) {
+  const char* areas[] = {"A_x", "A_y", "A_z"};
+  matrix drag(3, 1);
+  for (int k = 0; k < 3; ++k)
+    drag(k, 0) = -numeric(1, 2) * c.p("c_w") * c.p("rho") * c.p(areas[k]) * v_air_body[k] * abs_value(v_air_body[k]);
+  return drag;
+}
+
 // The report's equations (SymbolicModel::named_equations): the same physics as assemble()
 // below, built once more with each earlier quantity as a named symbol. The symbols' names
 // are those of the effect formulas (omega_<rotor>, v_ax), so both read alike.
@@ -208,18 +226,10 @@ void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
     out.push_back({rotor_thrust_name(rotors[i].name), rotor_thrust(c, i, w), ""});
     thrust.push_back(symbol("F_" + rotors[i].name, rotor_thrust_name(rotors[i].name)));
   }
-  for (size_t i = 0; i < rotors.size(); ++i) {
-    const int reaction = (rotors[i].spin == Spin::ccw) ? -1 : 1;  // as in assemble()
-    const matrix arm = c.rotor_position[i].sub(c.cog);
-    const matrix tau = cross(arm, vec3(0, 0, thrust[i])).add(vec3(0, 0, reaction * c.p("kappa") * thrust[i]));
-    out.push_back({"\\tau_{\\mathrm{" + output::latex_text(rotors[i].name) + "}}", tau, ""});
-  }
-  const symbol va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
-  const char* areas[] = {"A_x", "A_y", "A_z"};
-  matrix drag(3, 1);
-  for (int k = 0; k < 3; ++k)
-    drag(k, 0) = -numeric(1, 2) * c.p("c_w") * c.p("rho") * c.p(areas[k]) * va[k] * abs_value(va[k]);
-  out.push_back({"F_{drag}", drag, ""});
+  for (size_t i = 0; i < rotors.size(); ++i)
+    out.push_back({"\\tau_{\\mathrm{" + output::latex_text(rotors[i].name) + "}}", rotor_torque(c, i, thrust[i]), ""});
+  const ex va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
+  out.push_back({"F_{drag}", frame_drag(c, va), ""});
   const bool extra_force = !c.extra_body_force.is_zero_matrix(), extra_torque = !c.extra_body_torque.is_zero_matrix();
   out.push_back({"F_{body}", 0, "e_z \\sum_i F_i + F_{drag}" + std::string(extra_force ? " + \\Delta F_{body}" : "")});
   out.push_back({"\\tau", 0, "\\sum_i \\tau_i" + std::string(extra_torque ? " + \\Delta \\tau" : "")});
@@ -237,21 +247,12 @@ void assemble(ModelContext& c) {
     const ex thrust = rotor_thrust(c, i, c.rotor_speed[i]);
     m.intermediates.push_back({rotor_thrust_name(r.name), thrust});
     total_thrust += thrust;
-    const matrix arm = c.rotor_position[i].sub(c.cog);
-    torque = torque.add(cross(arm, vec3(0, 0, thrust)));
-    // Reaction torque opposes the spin: a ccw rotor (seen from above) pushes the body along -z.
-    const int reaction = (r.spin == Spin::ccw) ? -1 : 1;
-    torque = torque.add(vec3(0, 0, reaction * c.p("kappa") * thrust));
+    torque = torque.add(rotor_torque(c, i, thrust));
   }
   force_body = force_body.add(vec3(0, 0, total_thrust));
-  // Frame drag per body axis, 1/2 c_w rho A v|v|, on the air-relative velocity.
   const matrix v_air_body = c.R.transpose().mul(c.air_velocity_world);
-  const char* areas[] = {"A_x", "A_y", "A_z"};
-  matrix drag(3, 1);
-  for (int k = 0; k < 3; ++k) {
-    const ex vk = v_air_body(k, 0);
-    drag(k, 0) = -numeric(1, 2) * c.p("c_w") * c.p("rho") * c.p(areas[k]) * vk * abs_value(vk);
-  }
+  const ex va[3] = {v_air_body(0, 0), v_air_body(1, 0), v_air_body(2, 0)};
+  const matrix drag = frame_drag(c, va);
   force_body = force_body.add(drag);
   m.intermediates.push_back({"F_{drag}", drag});
   m.intermediates.push_back({"F_{body}", force_body});

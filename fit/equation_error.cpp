@@ -223,8 +223,7 @@ std::vector<double> EquationErrorModel::measured_channels() const {
 
 void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, double* u) const {
   commands_at(command_time, u);
-  if (const int t_in = model_->input_index("t"); t_in >= 0) u[t_in] = s.t;
-  if (const int v_in = model_->input_index("vbat"); v_in >= 0) u[v_in] = s.vbat;
+  runtime::ExtraInputs(*model_).fill(s.t, s.vbat, u);
 }
 
 void EquationErrorModel::commands_at(double t, double* u) const {
@@ -369,7 +368,8 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
                                                 std::vector<double>* Bm, SampleSpan span,
                                                 const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
-  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
+  const runtime::ExtraInputs extra(*model_);
+  const int t_in = extra.t, v_in = extra.vbat;
   const size_t ns = flight_.samples.size(), nc = columns.size();
   F.assign(ns * 6, 0.0);
   // Only the columns asked for, packed: a search step frees a few of a per-flight model's

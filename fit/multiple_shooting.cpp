@@ -38,7 +38,7 @@ void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J,
   }
   const int nf = static_cast<int>(free_.size()), cols = n + nf;
   model_->set_params(std::vector<double>(p, p + np));
-  const int t_in = model_->input_index("t"), v_in = model_->input_index("vbat");
+  const runtime::ExtraInputs extra(*model_);
   int row = 0;
   for (const auto& [first, last] : windows_) {
     const auto& s = flight_.samples;
@@ -47,8 +47,7 @@ void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J,
       size_t k = first;
       while (k < last && s[k + 1].t - s[first].t <= t + 1e-9) ++k;
       for (size_t i = 0; i < s[k].u.size(); ++i) out[i] = s[k].u[i];
-      if (t_in >= 0) out[t_in] = s[k].t;
-      if (v_in >= 0) out[v_in] = s[k].vbat;
+      extra.fill(s[k].t, s[k].vbat, out);
       (void)nu;
     };
     runtime::IntegratorOptions o;

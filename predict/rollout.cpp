@@ -17,11 +17,8 @@ double weight(const fit::FlightSample& a, const fit::FlightSample& b, double t) 
 }  // namespace
 
 Rollout::Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step)
-    : m_(model), f_(f), start_(model, p, f), step_(step), n_(model.num_states()), u_(model.num_inputs()), k1_(n_), k2_(n_),
-      k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {
-  t_in_ = model.input_index("t");
-  v_in_ = model.input_index("vbat");
-}
+    : m_(model), f_(f), start_(model, p, f), step_(step), n_(model.num_states()), extra_(model),
+      u_(model.num_inputs()), k1_(n_), k2_(n_), k3_(n_), k4_(n_), tmp_(n_), forced_(n_) {}
 
 Rollout::Start Rollout::start_at(size_t k, Replay replay) {
   first_command_ = start_.stretch_starts()[k];
@@ -89,8 +86,7 @@ void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const 
 void Rollout::inputs(double t, double* u) const {
   const auto& s = f_.samples[command_sample(f_, t, e_.delay, first_command_)];
   std::copy(s.u.begin(), s.u.end(), u);
-  if (t_in_ >= 0) u[t_in_] = t;
-  if (v_in_ >= 0) u[v_in_] = f_.samples[held_sample(f_, t)].vbat;
+  extra_.fill(t, f_.samples[held_sample(f_, t)].vbat, u);
 }
 
 void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {

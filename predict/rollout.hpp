@@ -80,7 +80,8 @@ class Rollout {
   runtime::DataSideEffects e_;
   size_t first_command_ = 0;  // the rollout's stretch: delayed commands are not read before it
   double step_;
-  int n_, t_in_ = -1, v_in_ = -1;
+  int n_;
+  runtime::ExtraInputs extra_;
   std::vector<double> u_, k1_, k2_, k3_, k4_, tmp_, forced_;
   std::array<double, 6> held_{};  // hold_disturbance
   // The model's accelerations (world linear, body angular) at each logged sample, computed on

@@ -67,9 +67,7 @@ void StartStates::commanded_speeds(double t, double delay, size_t first, double 
   std::copy(s.x.begin(), s.x.end(), x.begin());
   const auto& cmd = flight_.samples[command_sample(flight_, t, delay, first)].u;
   std::copy(cmd.begin(), cmd.end(), u.begin());
-  const int t_in = model_.input_index("t"), v_in = model_.input_index("vbat");
-  if (t_in >= 0) u[t_in] = t;
-  if (v_in >= 0) u[v_in] = s.vbat;
+  runtime::ExtraInputs(model_).fill(t, s.vbat, u.data());
   model_.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt = (w_cmd - w) / tau
   for (size_t i = 0; i < rotors_; ++i) c[i] = tau * f[13 + i];
 }

@@ -82,47 +82,209 @@ std::string GeneratedFlight::csv() const {
   return os.str();
 }
 
+namespace {
+
+// System-identification excitation: per channel (roll, pitch, yaw rate, thrust) five sines
+// between 1 and 8 Hz with random phases, unit RMS.
+class Multisine {
+ public:
+  explicit Multisine(std::mt19937& rng) {
+    std::uniform_real_distribution<double> uphase(0, 2 * M_PI);
+    for (auto& ch : phase_)
+      for (double& p : ch) p = uphase(rng);
+  }
+  double operator()(double t, int ch) const {
+    static constexpr double kFreqs[5] = {1.1, 2.3, 3.7, 5.3, 7.9};
+    double s = 0;
+    for (int i = 0; i < 5; ++i) s += std::sin(2 * M_PI * kFreqs[i] * t + phase_[ch][i]);
+    return s * std::sqrt(2.0 / 5.0);
+  }
+
+ private:
+  double phase_[4][5];
+};
+
+// The reference at one time: value, rate and acceleration per axis (x, y, z, yaw).
+struct ReferenceAt {
+  double axis[4][3];
+  ReferenceAt(const Reference& ref, double t) {
+    for (int a = 0; a < 4; ++a) ref.at(t, a, axis[a]);
+  }
+  V3 position() const { return V3(axis[0][0], axis[1][0], axis[2][0]); }
+  V3 velocity() const { return V3(axis[0][1], axis[1][1], axis[2][1]); }
+  V3 acceleration() const { return V3(axis[0][2], axis[1][2], axis[2][2]); }
+};
+
+// The test flights' controller: position PD + I to a desired acceleration, geometric
+// attitude P on the estimated attitude to rate set points (plus the excitation), rate P + I
+// to body torques, allocated to per-rotor thrusts. It sees the true state except for the
+// attitude, which it takes from the estimate the vehicle logs.
+class CascadedController {
+ public:
+  CascadedController(const ControllerModel& b, const ClosedLoopOptions& o, const Multisine& excitation)
+      : b_(b), o_(o), excitation_(excitation) {}
+
+  std::vector<double> thrusts(double t, double dt, const ReferenceAt& r, const std::vector<double>& x,
+                              const M3& R_estimated) {
+    const V3 p(x[0], x[1], x[2]), v(x[3], x[4], x[5]), w(x[10], x[11], x[12]);
+    const V3 e_p = r.position() - p, e_v = r.velocity() - v;
+    int_pos_ += e_p * dt;
+    const V3 a_cmd = r.acceleration() + o_.kp_pos * e_p + o_.kd_pos * e_v + o_.ki_pos * int_pos_ + V3(0, 0, b_.g);
+    const double thrust = b_.mass * a_cmd.dot(R_estimated.col(2));
+    const V3 b3 = a_cmd.normalized();
+    const V3 c1(std::cos(r.axis[3][0]), std::sin(r.axis[3][0]), 0);
+    const V3 b2 = b3.cross(c1).normalized();
+    M3 Rd;
+    Rd.col(0) = b2.cross(b3);
+    Rd.col(1) = b2;
+    Rd.col(2) = b3;
+    const V3 e_R = 0.5 * vee(Rd.transpose() * R_estimated - R_estimated.transpose() * Rd);
+    V3 w_d = -o_.kp_att * e_R + V3(0, 0, r.axis[3][1]);
+    double thrust_scale = 1;
+    if (o_.excitation > 0) {
+      w_d += o_.excitation * V3(excitation_(t, 0), excitation_(t, 1), excitation_(t, 2));
+      thrust_scale += 0.1 * o_.excitation * excitation_(t, 3);
+    }
+    const V3 e_w = w - w_d;
+    int_rate_ += e_w * dt;
+    const V3 Jd(b_.J[0], b_.J[1], b_.J[2]);
+    const V3 torque = Jd.cwiseProduct(-o_.kp_rate * e_w - o_.ki_rate * int_rate_) + w.cross(Jd.cwiseProduct(w));
+    return allocate(b_, thrust * thrust_scale, torque);
+  }
+
+ private:
+  const ControllerModel& b_;
+  const ClosedLoopOptions& o_;
+  const Multisine& excitation_;
+  V3 int_pos_ = V3::Zero(), int_rate_ = V3::Zero();
+};
+
+// Per-rotor commands for the thrusts, through the believed thrust laws, saturated to [0, 1]
+// and quantised as a PWM register holds them.
+void commands_for(const ControllerModel& b, const std::vector<double>& F, int levels, std::vector<double>& u) {
+  for (size_t i = 0; i < F.size(); ++i) {
+    double ui;
+    try {
+      ui = b.thrust_laws[i].command_for(std::max(0.0, F[i]));
+    } catch (const std::invalid_argument&) {
+      ui = F[i] <= 0 ? 0.0 : 1.0;  // saturated
+    }
+    ui = std::clamp(ui, 0.0, 1.0);
+    u[i] = std::round(ui * levels) / levels;
+  }
+}
+
+// Battery: the open-circuit voltage falling over the flight, and a drop under load (the last
+// commands' thrust above hover), so that voltage is not simply a function of time.
+double battery_voltage(const ClosedLoopOptions& o, double t, bool first, const std::vector<double>& u, int nr,
+                       double hover_u) {
+  double load = 0;
+  for (int i = 0; i < nr; ++i) load += u[i] * u[i] / (hover_u * hover_u) / nr;
+  return o.vbat_start + (o.vbat_end - o.vbat_start) * t / o.duration - o.vbat_load_drop * (first ? 0.0 : load - 1.0);
+}
+
+// The start: at the reference's first point, level, at rest; rotor-speed states (motor_lag)
+// at the hover command's speed.
+std::vector<double> initial_state(const DynamicModel& truth, const ControllerModel& b, const Reference& ref,
+                                  const std::vector<std::string>& rotors, double hover_u) {
+  std::vector<double> x(truth.num_states(), 0.0);
+  const ReferenceAt r0(ref, 0.0);
+  for (int a = 0; a < 3; ++a) x[a] = r0.axis[a][0];
+  x[6] = 1;
+  for (size_t i = 0; i < rotors.size(); ++i) {
+    const int w = truth.state_index("w_" + rotors[i]);
+    if (w >= 0) x[w] = b.thrust_laws[i].speed_at(hover_u);
+  }
+  return x;
+}
+
+std::vector<std::string> flight_columns(const std::vector<std::string>& rotors) {
+  std::vector<std::string> columns = {"t"};
+  for (const auto& r : rotors) columns.push_back("u_" + r);
+  for (const char* c : {"x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "p", "q", "r", "ax", "ay", "az", "vbat",
+                        "x_ref", "y_ref", "z_ref", "psi_ref"})
+    columns.push_back(c);
+  return columns;
+}
+
+// What the vehicle logs at one control step: the commands, a mocap-like pose and velocity,
+// gyro and accelerometer with their biases and noise, the battery and the reference. The
+// accelerometer feels f, the derivative under the commands acting now. (The noise is drawn
+// in this order, so that a flight is the same for the same seed.)
+struct Sensors {
+  const ClosedLoopOptions& o;
+  V3 gyro_bias, acc_bias;
+  double g;
+  std::vector<double> row(double t, const std::vector<double>& u, int nr, const std::vector<double>& x,
+                          const Eigen::Quaterniond& q_estimated, const M3& R_true, const std::vector<double>& f,
+                          double vbat, const ReferenceAt& r, std::mt19937& rng, std::normal_distribution<double>& gauss) const {
+    std::vector<double> row{t};
+    for (int i = 0; i < nr; ++i) row.push_back(u[i]);
+    const double an = o.pose_noise;
+    const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
+    const Eigen::Quaterniond q = (q_estimated * dq).normalized();
+    for (int i = 0; i < 3; ++i) row.push_back(x[i] + an * gauss(rng));
+    for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);
+    for (int i = 3; i < 6; ++i) row.push_back(x[i] + an * 10 * gauss(rng));
+    for (int i = 0; i < 3; ++i) row.push_back(x[10 + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
+    const V3 sf = R_true.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, g));
+    for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
+    row.push_back(vbat);
+    for (double c : {r.axis[0][0], r.axis[1][0], r.axis[2][0], r.axis[3][0]}) row.push_back(c);
+    return row;
+  }
+};
+
+// Forces outside the effect catalogue, as impulses over one control period: a tether pulling
+// back to the start, a random roll and pitch disturbance (its own random stream, so that a
+// flight without it is the same as before it existed), a yaw moment in proportion to the
+// forward speed.
+struct UnmodelledForces {
+  const ClosedLoopOptions& o;
+  double mass, dt;
+  std::mt19937 rng;
+  double pole, gain;
+  double disturbance[2] = {0, 0};
+  UnmodelledForces(const ClosedLoopOptions& options, double m, double period)
+      : o(options), mass(m), dt(period), rng(options.seed + 7919), pole(std::exp(-2 * M_PI * 10.0 * period)),
+        gain(options.angular_disturbance * std::sqrt(1 - pole * pole)) {}
+  void apply(std::vector<double>& x, const Reference& ref, std::normal_distribution<double>& gauss) {
+    if (o.tether_stiffness > 0) {
+      const ReferenceAt start(ref, 0.0);
+      for (int a = 0; a < 2; ++a) x[3 + a] -= o.tether_stiffness * (x[a] - start.axis[a][0]) / mass * dt;
+    }
+    if (o.angular_disturbance > 0)
+      for (int a = 0; a < 2; ++a) {
+        disturbance[a] = pole * disturbance[a] + gain * gauss(rng);
+        x[10 + a] += disturbance[a] * dt;
+      }
+    if (o.yaw_per_forward_speed != 0) {
+      const Rotation R = rotation_matrix(&x[6]);
+      const double forward = R.m[0][0] * x[3] + R.m[1][0] * x[4] + R.m[2][0] * x[5];  // (R^T v)_x
+      x[12] += o.yaw_per_forward_speed * forward * dt;
+    }
+  }
+};
+
+}  // namespace
+
 GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel& b,
                                 const std::vector<std::string>& rotors, const ClosedLoopOptions& o) {
   std::mt19937 rng(o.seed);
   const Reference ref(o, rng);
   std::normal_distribution<double> gauss(0, 1);
-  // Multisine per channel (roll, pitch, yaw rate, thrust): unit RMS.
-  const double freqs[5] = {1.1, 2.3, 3.7, 5.3, 7.9};
-  double phase[4][5];
-  std::uniform_real_distribution<double> uphase(0, 2 * M_PI);
-  for (auto& ch : phase)
-    for (double& p : ch) p = uphase(rng);
-  auto multisine = [&](double t, int ch) {
-    double s = 0;
-    for (int i = 0; i < 5; ++i) s += std::sin(2 * M_PI * freqs[i] * t + phase[ch][i]);
-    return s * std::sqrt(2.0 / 5.0);
-  };
+  const Multisine excitation(rng);
   const int nr = static_cast<int>(rotors.size());
-  const int t_in = truth.input_index("t"), v_in = truth.input_index("vbat");
-  std::vector<double> x(truth.num_states(), 0.0);
-  double r0[3];
-  for (int a = 0; a < 3; ++a) {
-    ref.at(0, a, r0);
-    x[a] = r0[0];
-  }
-  x[6] = 1;
-  // Rotor-speed states (motor_lag) start at the hover command's speed.
+  const ExtraInputs extra(truth);
   const double hover_u = b.thrust_laws[0].command_for(b.mass * b.g / nr);
-  for (int i = 0; i < nr; ++i) {
-    const int w = truth.state_index("w_" + rotors[i]);
-    if (w >= 0) x[w] = b.thrust_laws[i].speed_at(hover_u);
-  }
+  std::vector<double> x = initial_state(truth, b, ref, rotors, hover_u);
   GeneratedFlight out;
-  out.columns = {"t"};
-  for (const auto& r : rotors) out.columns.push_back("u_" + r);
-  for (const char* c : {"x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "p", "q", "r", "ax", "ay", "az", "vbat",
-                        "x_ref", "y_ref", "z_ref", "psi_ref"})
-    out.columns.push_back(c);
+  out.columns = flight_columns(rotors);
   const double dt = 1.0 / o.log_rate;
   const long steps = std::lround(o.duration * o.log_rate);
-  V3 int_pos = V3::Zero(), int_rate = V3::Zero();
-  const V3 gyro_bias(o.gyro_bias, -o.gyro_bias, 0.5 * o.gyro_bias), acc_bias(o.accel_bias, -o.accel_bias, 0);
+  CascadedController controller(b, o, excitation);
+  const Sensors sensors{o, V3(o.gyro_bias, -o.gyro_bias, 0.5 * o.gyro_bias), V3(o.accel_bias, -o.accel_bias, 0), b.g};
+  UnmodelledForces unmodelled(o, b.mass, dt);
   // Effects outside the ODE, from the true model: the attitude the autopilot estimates and
   // logs is the model's measurement h(x) (q ⊗ q_bias under attitude_bias; it flies on that
   // estimate), and the motors act on the commands of `delay` seconds ago.
@@ -140,67 +302,18 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   IntegratorOptions io;
   io.step = o.sim_step;
   io.divergence_bound = 1e4;
-  // Its own random stream, so that a flight without it is the same as before it existed.
-  std::mt19937 disturbance_rng(o.seed + 7919);
-  const double disturbance_pole = std::exp(-2 * M_PI * 10.0 * dt);
-  const double disturbance_gain = o.angular_disturbance * std::sqrt(1 - disturbance_pole * disturbance_pole);
-  double disturbance[2] = {0, 0};
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
-    // Battery: open-circuit voltage falling over the flight, and a drop under load (the
-    // last commands' thrust above hover), so that voltage is not simply a function of time.
-    double load = 0;
-    for (int i = 0; i < nr; ++i) load += u[i] * u[i] / (hover_u * hover_u) / nr;
-    const double vbat = o.vbat_start + (o.vbat_end - o.vbat_start) * t / o.duration -
-                        o.vbat_load_drop * (k == 0 ? 0.0 : load - 1.0);
-    // --- controller (it sees the true state; the log below adds sensor noise) ---
-    double rx[3], ry[3], rz[3], ryaw[3];
-    ref.at(t, 0, rx);
-    ref.at(t, 1, ry);
-    ref.at(t, 2, rz);
-    ref.at(t, 3, ryaw);
-    const V3 p(x[0], x[1], x[2]), v(x[3], x[4], x[5]), w(x[10], x[11], x[12]);
-    const V3 e_p = V3(rx[0], ry[0], rz[0]) - p, e_v = V3(rx[1], ry[1], rz[1]) - v;
-    int_pos += e_p * dt;
-    const V3 a_cmd = V3(rx[2], ry[2], rz[2]) + o.kp_pos * e_p + o.kd_pos * e_v + o.ki_pos * int_pos + V3(0, 0, b.g);
+    const double vbat = battery_voltage(o, t, k == 0, u, nr, hover_u);
+    const ReferenceAt r(ref, t);
+    const V3 p_at_t(x[0], x[1], x[2]);
+    // --- controller, on the attitude the vehicle estimates ---
     const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[6], x[7], x[8], x[9]).normalized();
     truth.measurement(x.data(), t, logged.data(), nullptr, nullptr);
     const Eigen::Quaterniond q_est =
         Eigen::Quaterniond(logged[logged_q], logged[logged_q + 1], logged[logged_q + 2], logged[logged_q + 3]).normalized();
-    const M3 R = q_est.toRotationMatrix(), R_true = q_true.toRotationMatrix();
-    const double thrust = b.mass * a_cmd.dot(R.col(2));
-    const V3 b3 = a_cmd.normalized();
-    const V3 c1(std::cos(ryaw[0]), std::sin(ryaw[0]), 0);
-    const V3 b2 = b3.cross(c1).normalized();
-    M3 Rd;
-    Rd.col(0) = b2.cross(b3);
-    Rd.col(1) = b2;
-    Rd.col(2) = b3;
-    const V3 e_R = 0.5 * vee(Rd.transpose() * R - R.transpose() * Rd);
-    V3 w_d = -o.kp_att * e_R + V3(0, 0, ryaw[1]);
-    double thrust_scale = 1;
-    if (o.excitation > 0) {
-      const V3 ms(multisine(t, 0), multisine(t, 1), multisine(t, 2));
-      w_d += o.excitation * ms;
-      thrust_scale += 0.1 * o.excitation * multisine(t, 3);
-    }
-    const V3 e_w = w - w_d;
-    int_rate += e_w * dt;
-    const V3 Jd(b.J[0], b.J[1], b.J[2]);
-    const V3 torque = Jd.cwiseProduct(-o.kp_rate * e_w - o.ki_rate * int_rate) + w.cross(Jd.cwiseProduct(w));
-    const auto F = allocate(b, thrust * thrust_scale, torque);
-    for (int i = 0; i < nr; ++i) {
-      double ui;
-      try {
-        ui = b.thrust_laws[i].command_for(std::max(0.0, F[i]));
-      } catch (const std::invalid_argument&) {
-        ui = F[i] <= 0 ? 0.0 : 1.0;  // saturated
-      }
-      ui = std::clamp(ui, 0.0, 1.0);
-      u[i] = std::round(ui * o.command_levels) / o.command_levels;
-    }
-    if (t_in >= 0) u[t_in] = t;
-    if (v_in >= 0) u[v_in] = vbat;
+    commands_for(b, controller.thrusts(t, dt, r, x, q_est.toRotationMatrix()), o.command_levels, u);
+    extra.fill(t, vbat, u.data());
     sent.push_back(u);
     auto sent_at = [&](long i) -> const std::vector<double>& { return sent[static_cast<size_t>(std::max(0L, i))]; };
     const std::vector<double>& early = sent_at(k - delay_steps - 1);
@@ -209,21 +322,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     std::vector<double> acting = u;
     for (int i = 0; i < nr; ++i) acting[i] = (delay_rest > 0 ? early : late)[i];
     truth.rhs(x.data(), acting.data(), f.data(), nullptr, nullptr, nullptr);
-    std::vector<double> row{t};
-    for (int i = 0; i < nr; ++i) row.push_back(u[i]);
-    const double an = o.pose_noise;
-    Eigen::Quaterniond q = q_est;
-    const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
-    q = (q * dq).normalized();
-    for (int i = 0; i < 3; ++i) row.push_back(x[i] + an * gauss(rng));
-    for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);
-    for (int i = 3; i < 6; ++i) row.push_back(x[i] + an * 10 * gauss(rng));
-    for (int i = 0; i < 3; ++i) row.push_back(x[10 + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
-    const V3 sf = R_true.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, b.g));
-    for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
-    row.push_back(vbat);
-    for (double c : {rx[0], ry[0], rz[0], ryaw[0]}) row.push_back(c);
-    out.rows.push_back(row);
+    out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, rng, gauss));
     if (k == steps) break;
     // --- plant: the true model over one control period, commands held ---
     const double t0 = t;
@@ -231,8 +330,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     auto inputs = [&](double tt, double* uu) {
       const std::vector<double>& held = before_switch ? early : late;
       for (int i = 0; i < nr; ++i) uu[i] = held[i];
-      if (t_in >= 0) uu[t_in] = t0 + tt;
-      if (v_in >= 0) uu[v_in] = vbat;
+      extra.fill(t0 + tt, vbat, uu);
     };
     // The delayed command switches at delay_rest into the period: integrate up to the
     // switch and on from it, so that no RK4 step straddles it.
@@ -242,24 +340,8 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
       before_switch = false;
     }
     x = integrate_rk4(truth, x, inputs, delay_rest, dt, io).x.back();
-    if (o.tether_stiffness > 0) {  // impulse of the tether force over the period
-      double start[3];
-      for (int a = 0; a < 2; ++a) {
-        ref.at(0, a, start);
-        x[3 + a] -= o.tether_stiffness * (x[a] - start[0]) / b.mass * dt;
-      }
-    }
-    if (o.angular_disturbance > 0)  // impulse of the disturbance over the period
-      for (int a = 0; a < 2; ++a) {
-        disturbance[a] = disturbance_pole * disturbance[a] + disturbance_gain * gauss(disturbance_rng);
-        x[10 + a] += disturbance[a] * dt;
-      }
-    if (o.yaw_per_forward_speed != 0) {  // impulse of the yaw moment over the period
-      const Rotation R = rotation_matrix(&x[6]);
-      const double forward = R.m[0][0] * x[3] + R.m[1][0] * x[4] + R.m[2][0] * x[5];  // (R^T v)_x
-      x[12] += o.yaw_per_forward_speed * forward * dt;
-    }
-    if (x[2] < -5 || (p - V3(rx[0], ry[0], rz[0])).norm() > 20)
+    unmodelled.apply(x, ref, gauss);
+    if (x[2] < -5 || (p_at_t - r.position()).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
   }
   return out;

@@ -65,6 +65,17 @@ inline int DynamicModel::state_index(const std::string& n) const { return index_
 inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
 inline int DynamicModel::param_index(const std::string& n) const { return index_in(param_names(), n); }
 
+// The inputs effects add after the rotor commands, in one place: the time since the log's
+// start (thrust_decay) and the battery voltage (battery_sag); -1 where the model has none.
+struct ExtraInputs {
+  explicit ExtraInputs(const DynamicModel& m) : t(m.input_index("t")), vbat(m.input_index("vbat")) {}
+  void fill(double time, double voltage, double* u) const {
+    if (t >= 0) u[t] = time;
+    if (vbat >= 0) u[vbat] = voltage;
+  }
+  int t = -1, vbat = -1;
+};
+
 // Adapts a generated header's Model struct.
 template <class M>
 class CompiledModel : public DynamicModel {
