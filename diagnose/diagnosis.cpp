@@ -535,6 +535,44 @@ void add_suspects_of_the_search(Diagnosis& d) {
                                                output::short_number(-ev.validation_gain_percent) + " %)"));
 }
 
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// The held-out part, base against extended model: the report's metric (with its windowed
+// simulations), the errors at horizons as published models report them (without a pose,
+// evaluate_prediction measures the one-step view only) and each channel's one-step RMS.
+void measure_held_out(Diagnosis& d, const HeldOutGain& held_out_gain, runtime::DynamicModel& model,
+                      const fit::Flight& valid, const fit::EquationErrorModel& valid_ee) {
+  const SearchResult& s = d.search;
+  d.metric_before = held_out_gain.metric(s.base_fit, s.final_weights, &d.sim_before);
+  d.metric_after = held_out_gain.metric(s.final_fit, s.final_weights, &d.sim_after);
+  d.has_prediction = true;
+  d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
+  d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
+  const auto rb = six_channel_rms(valid_ee, s.base_fit), ra = six_channel_rms(valid_ee, s.final_fit);
+  for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
+}
+
+// Leads, never causes: whether the slow roll/pitch residual follows the horizontal force as
+// moving air would (the draft check, on the final model), and how strongly the airframe
+// answers a change of command (the command-gain check, on the base fit); per flight as well
+// when diagnosed jointly.
+void lead_signatures(Diagnosis& d, const Vehicle& v, const fit::Flight& used, const fit::Flight& valid,
+                     const fit::EquationErrorModel& all_ee, bool accel, const std::vector<double>& flight_starts) {
+  const bool joint = flight_starts.size() > 1;
+  const DraftSignatureInput draft_input = draft_signature_input(d, used, valid, v, d.search.final_fit, !accel);
+  d.draft = draft_signature(draft_input);
+  if (joint)
+    for (const auto& one : split_by_flight(draft_input, flight_starts)) d.draft_per_flight.push_back(draft_signature(one));
+  double g = 0;
+  for (const auto& p : d.search.base_fit)
+    if (p.name == "g") g = p.value;
+  const CommandGainInput gain_input = command_gain_input(all_ee, d.residual_before, v, g, accel);  // the base fit's
+  d.command_gain = command_gain(gain_input);
+  if (joint)
+    for (const auto& one : split_by_flight(gain_input, flight_starts)) d.command_gain_per_flight.push_back(command_gain(one));
+}
+
 }  // namespace
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
@@ -560,14 +598,9 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
 Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {
-  const auto clock0 = std::chrono::steady_clock::now();
+  const auto clock0 = Clock::now();
   // "[diagnose] 212 s: " - where a long diagnosis spends its time.
-  const auto progress = [&]() {
-    std::ostringstream os;
-    os << "[diagnose] " << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count())
-       << " s: ";
-    return os.str();
-  };
+  const auto progress = [&]() { return "[diagnose] " + std::to_string(static_cast<int>(seconds_since(clock0))) + " s: "; };
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
@@ -624,57 +657,36 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {
-    const auto agreement_start = std::chrono::steady_clock::now();
+    const auto agreement_start = Clock::now();
     d.agreement = per_flight_agreement(
         agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, per_flight_names));
     std::cerr << progress() << "agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
-              << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - agreement_start).count())
+              << static_cast<int>(seconds_since(agreement_start))
               << " s)\n";
   }
   // One flight of an airframe diagnosed before: does it show the airframe's effects?
   if (!joint && opt.airframe) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     d.airframe_source = opt.airframe->source;
     d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
     std::cerr << progress() << "against the airframe of " << output::printable(opt.airframe->source) << ": " << d.airframe_check.size()
               << " parameters ("
-              << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
+              << static_cast<int>(seconds_since(start))
               << " s)\n";
   }
   add_suspects_of_the_search(d);
   const SearchResult& s = d.search;
   const fit::Flight used = rows_of(flight, all_ee);
   analyse_what_is_wrong(v, used, all_ee, d);
-  // The gain on the validation part.
-  std::cerr << progress() << "validation of the base and the extended model\n";
-  d.metric_before = held_out_gain.metric(s.base_fit, s.final_weights, &d.sim_before);
-  d.metric_after = held_out_gain.metric(s.final_fit, s.final_weights, &d.sim_after);
-  // Errors at horizons as published models report them (without a pose, evaluate_prediction
-  // measures the one-step view only).
-  std::cerr << progress() << "prediction error at horizons, before and after\n";
-  d.has_prediction = true;
-  d.prediction_before = predict::evaluate_prediction(model, fit::parameter_values(s.base_fit), valid, {});
-  d.prediction_after = predict::evaluate_prediction(model, fit::parameter_values(s.final_fit), valid, {});
-  const auto rb = six_channel_rms(valid_ee, s.base_fit), ra = six_channel_rms(valid_ee, s.final_fit);
-  for (int c = 0; c < 6; ++c) d.channel_gain.push_back({d.channel_names[c], rb[c], ra[c]});
+  std::cerr << progress() << "validation of the base and the extended model; prediction error at horizons\n";
+  measure_held_out(d, held_out_gain, model, valid, valid_ee);
   d.unexplained = unexplained(d.after, opt);
-  const DraftSignatureInput draft_input = draft_signature_input(d, used, valid, v, s.final_fit, !accel);
-  d.draft = draft_signature(draft_input);
-  if (joint)
-    for (const auto& one : split_by_flight(draft_input, fit::joined_start_times(flights)))
-      d.draft_per_flight.push_back(draft_signature(one));
-  double g = 0;
-  for (const auto& p : s.base_fit)
-    if (p.name == "g") g = p.value;
-  const CommandGainInput gain_input = command_gain_input(all_ee, d.residual_before, v, g, accel);  // the base fit's
-  d.command_gain = command_gain(gain_input);
-  if (joint)
-    for (const auto& one : split_by_flight(gain_input, fit::joined_start_times(flights)))
-      d.command_gain_per_flight.push_back(command_gain(one));
+  const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
+  lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
   std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
   d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
                                 valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,
-                                joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
+                                flight_starts);
   if (!proposed_terms(d.discovered).empty()) {
     std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
@@ -683,7 +695,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
   d.airframe_fit = airframe_values(s.final_fit);
-  d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
+  d.seconds = seconds_since(clock0);
   return d;
 }
 
