@@ -32,12 +32,11 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
 
 }  // namespace
 
-DeriveJobResult run_derive_job(const DeriveJob& job) {
+DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto progress = [&](const std::string& what) {
     if (job.progress) job.progress(what);
   };
-  const Vehicle vehicle = load_vehicle(job.vehicle);
   DeriveRequest request;
   request.derive.effects = parse_effect_list(job.effects);
   request.emit.vehicle_file = job.vehicle;

@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "model/vehicle.hpp"
+
 namespace quadgen::app {
 
 struct DeriveJob {
@@ -23,7 +25,9 @@ struct DeriveJobResult {
   bool audit_passed = false;
 };
 
-// Throws the layers' own errors (a bad vehicle or parameter file, with file and line) unchanged.
-DeriveJobResult run_derive_job(const DeriveJob& job);
+// `vehicle`: job.vehicle as load_vehicle read it (the command line reads it first, so that a bad
+// vehicle file is reported before anything is created). Throws the layers' own errors (a bad
+// parameter file, with file and line) unchanged.
+DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle);
 
 }  // namespace quadgen::app

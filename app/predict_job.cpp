@@ -35,8 +35,7 @@ std::string failure_of(const predict::Prediction& pooled) {
 
 }  // namespace
 
-PredictJobResult run_predict_job(const PredictJob& job) {
-  const Vehicle v = load_vehicle(job.vehicle);
+PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& v) {
   PredictJobResult r;
   // Every effect, at its neutral value unless --params sets it.
   std::string how;

@@ -25,8 +25,9 @@ struct PredictJobResult {
   std::string failure;
 };
 
-// Throws std::invalid_argument for contradicting options, and the layers' own errors (a bad
-// vehicle file or log, with file and line) unchanged.
-PredictJobResult run_predict_job(const PredictJob& job);
+// `vehicle`: job.vehicle as load_vehicle read it (the command line reads it first). Throws
+// std::invalid_argument for contradicting options, and the layers' own errors (a bad log,
+// with file and line) unchanged.
+PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& vehicle);
 
 }  // namespace quadgen::app

@@ -21,11 +21,12 @@ void add_derive(CLI::App& app, DeriveArgs& args) {
 }
 
 int run_derive(const DeriveArgs& args) {
+  const Vehicle vehicle = load_vehicle(args.vehicle);  // a bad file is reported before anything is created
   output::OutputDirectory out(args.out, "derive", {args.vehicle, args.params});  // refused before the work, not after
   app::DeriveJob job{args.vehicle, args.effects, args.params, {}};
   int step = 0;
   job.progress = [&](const std::string& what) { std::cerr << "[" << ++step << "/5] " << what << "\n"; };
-  const app::DeriveJobResult r = app::run_derive_job(job);
+  const app::DeriveJobResult r = app::run_derive_job(job, vehicle);
   std::cerr << "[5/5] writing " << output::printable(args.out) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();

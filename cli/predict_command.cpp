@@ -39,12 +39,13 @@ void add_predict(CLI::App& app, PredictArgs& a) {
 }
 
 int run_predict(const PredictArgs& a) {
+  const Vehicle vehicle = load_vehicle(a.vehicle);  // a bad file is reported before anything is created
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
   app::PredictJob job{a.vehicle, a.logs, a.options};
   job.options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
-  const app::PredictJobResult r = app::run_predict_job(job);
+  const app::PredictJobResult r = app::run_predict_job(job, vehicle);
   for (const auto& note : r.notes) std::cerr << note << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();

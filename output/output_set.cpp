@@ -24,7 +24,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kManifestHeader = "quadgen output set 1";
+constexpr const char* kManifestHeader = "quadgen output set 2";
+// Manifests written until 2026-11-28: their hashes are FNV-1a under the offset basis with a
+// digit dropped (output/fnv1a.hpp), recognised under this header only.
+constexpr const char* kManifestHeaderOldBasis = "quadgen output set 1";
 const std::string kStagingInfix = ".quadgen-tmp.";
 constexpr const char* kCommandKey = "command ";
 // Put into an earlier run's folder that is kept because it holds files quadgen did not write:
@@ -117,6 +120,7 @@ struct Manifest {
   std::string command;
   std::map<std::string, std::string> files;
   std::vector<std::string> bad_lines;  // names that are not plain file names, lines that are not "hash size name"
+  bool old_basis = false;              // written under kManifestHeaderOldBasis
 };
 
 std::string command_from_files(const std::map<std::string, std::string>& files) {
@@ -149,10 +153,11 @@ Manifest read_manifest_file(const fs::path& file) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     return true;
   };
-  if (!next() || line != kManifestHeader) {
+  if (!next() || (line != kManifestHeader && line != kManifestHeaderOldBasis)) {
     m.bad_lines.push_back(line);
     return m;
   }
+  m.old_basis = line == kManifestHeaderOldBasis;
   while (next()) {
     if (line.empty()) continue;
     if (line.rfind(kCommandKey, 0) == 0) {
@@ -210,10 +215,9 @@ std::string hash_and_size(const fs::path& p, uint64_t basis = kFnv1aOffsetBasis)
   return h.hex() + " " + std::to_string(size);
 }
 
-// Whether a file is what a manifest line recorded: its hash then, or, for a manifest written
-// before the offset basis was corrected, under the old basis.
-bool unchanged_since(const fs::path& p, const std::string& recorded) {
-  return recorded == hash_and_size(p) || recorded == hash_and_size(p, kFnv1aLegacyBasis);
+// Whether a file is what a manifest line recorded, hashed as that manifest hashes.
+bool unchanged_since(const fs::path& p, const std::string& recorded, const Manifest& m) {
+  return recorded == hash_and_size(p, m.old_basis ? kFnv1aLegacyBasis : kFnv1aOffsetBasis);
 }
 
 std::string first_names(const std::vector<std::string>& names) {
@@ -242,7 +246,7 @@ void check_replaceable(const fs::path& dir, const std::string& command) {
     if (name == kManifestName) continue;
     const auto it = m.files.find(name);
     if (it == m.files.end() || !fs::is_regular_file(e.symlink_status())) foreign.push_back(name);
-    else if (!unchanged_since(e.path(), it->second)) changed.push_back(name);
+    else if (!unchanged_since(e.path(), it->second, m)) changed.push_back(name);
   }
   if (ec) fail(dir, "cannot list the directory: " + ec.message());
   if (!foreign.empty())
@@ -373,7 +377,7 @@ void remove_earlier_run(const fs::path& staged, const fs::path& target) {
   const Manifest earlier = read_manifest(staged);
   std::error_code ec;
   for (const auto& [name, hash_size] : earlier.files)
-    if (unchanged_since(staged / name, hash_size)) fs::remove(staged / name, ec);
+    if (unchanged_since(staged / name, hash_size, earlier)) fs::remove(staged / name, ec);
   fs::remove(staged / kManifestName, ec);
   if (fs::remove(staged, ec)) return;
   std::cerr << "quadgen: note: the previous output was kept at " << printable(keep_aside(staged, target).string())
@@ -382,6 +386,23 @@ void remove_earlier_run(const fs::path& staged, const fs::path& target) {
 
 }  // namespace
 
+void CreatedFolders::create(const fs::path& folder) {
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  for (fs::path p = folder; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+    missing.insert(missing.begin(), p);
+    if (p == p.parent_path()) break;
+  }
+  fs::create_directories(folder, ec);
+  if (ec) fail(folder, "cannot create the directory: " + ec.message());
+  created_ = missing;
+}
+
+CreatedFolders::~CreatedFolders() {
+  std::error_code ec;
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);  // only if empty
+}
+
 OutputDirectory::OutputDirectory(const std::string& dir, const std::string& command, const std::vector<std::string>& inputs)
     : command_(command), inputs_(inputs) {
   const fs::path target = resolved(dir);
@@ -389,9 +410,7 @@ OutputDirectory::OutputDirectory(const std::string& dir, const std::string& comm
   check_not_above_working_directory(target);
   check_not_input(target, inputs_);
   check_replaceable(target, command_);
-  std::error_code ec;
-  fs::create_directories(target.parent_path(), ec);
-  if (ec) fail(target.parent_path(), "cannot create the directory: " + ec.message());
+  created_.create(target.parent_path());
   staging_ = std::make_unique<StagingDirectory>(target.parent_path(), target.filename().string());
 }
 
@@ -421,6 +440,7 @@ void OutputDirectory::commit() {
     remove_earlier_run(staged, target);
   }
   staging_->release();
+  created_.keep();
   fsync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
@@ -456,11 +476,10 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
     if (::lstat(p.c_str(), &st) != 0) continue;
     if (!S_ISREG(st.st_mode)) fail(p, "exists and is not a regular file (a link or a directory); choose another path");
     const auto it = record.files.find(p.filename().string());
-    if (record.command != command_ || it == record.files.end() || !unchanged_since(p, it->second))
+    if (record.command != command_ || it == record.files.end() || !unchanged_since(p, it->second, record))
       fail(p, "exists and is not a file 'quadgen " + command_ + "' wrote there (or it was changed since); choose another path or remove it");
   }
-  fs::create_directories(parent, ec);
-  if (ec) fail(parent, "cannot create the directory: " + ec.message());
+  created_.create(parent);
   staging_ = std::make_unique<StagingDirectory>(parent, fs::path(paths_.front()).filename().string());
 }
 
@@ -481,6 +500,7 @@ void OutputFiles::commit() {
     if (::rename(staged.c_str(), paths_[i].c_str()) != 0) fail(paths_[i], "cannot move into place: " + errno_text());
   }
   update_record();
+  created_.keep();
   fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
@@ -492,7 +512,15 @@ void OutputFiles::update_record() {
   if (record.command != command_) record.files.clear();
   for (auto it = record.files.begin(); it != record.files.end();) {
     std::error_code ec;
-    it = fs::exists(fs::symlink_status(parent / it->first, ec)) ? std::next(it) : record.files.erase(it);
+    if (!fs::exists(fs::symlink_status(parent / it->first, ec))) {
+      it = record.files.erase(it);
+      continue;
+    }
+    // An entry of a record under the old hash basis, rewritten under the published one (the
+    // record is written anew below) if its file is unchanged; a changed one stays as it was.
+    if (record.old_basis && unchanged_since(parent / it->first, it->second, record))
+      it->second = hash_and_size(parent / it->first);
+    ++it;
   }
   for (size_t i = 0; i < paths_.size(); ++i) {
     const std::string name = fs::path(paths_[i]).filename().string();
@@ -520,7 +548,7 @@ bool complete_output_directory(const std::string& dir, std::string* why) {
     ++files;
     const auto it = m.files.find(name);
     if (it == m.files.end()) return no(name + " is not in the manifest");
-    if (!unchanged_since(e.path(), it->second)) return no(name + " differs from the manifest");
+    if (!unchanged_since(e.path(), it->second, m)) return no(name + " differs from the manifest");
   }
   if (files != m.files.size()) return no("files listed in the manifest are missing");
   return true;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <filesystem>
 #include <vector>
 
 namespace quadgen::output {
@@ -30,6 +31,19 @@ struct OutputError : std::runtime_error {
 inline constexpr const char* kManifestName = ".quadgen-manifest";
 
 class StagingDirectory;
+
+// The folders an output set had to create to hold its staging directory: removed again
+// (those left empty, deepest first) when the set is never committed, so that a run that
+// fails (a bad vehicle file, a flight that cannot be fitted) leaves nothing behind.
+class CreatedFolders {
+ public:
+  void create(const std::filesystem::path& folder);  // like create_directories, remembering what it made
+  void keep() { created_.clear(); }
+  ~CreatedFolders();
+
+ private:
+  std::vector<std::filesystem::path> created_;  // outermost first
+};
 
 class OutputDirectory {
  public:
@@ -52,6 +66,7 @@ class OutputDirectory {
   std::string dir_;
   std::string command_;
   std::vector<std::string> inputs_;
+  CreatedFolders created_;  // destroyed after the staging directory inside them
   std::unique_ptr<StagingDirectory> staging_;
   std::vector<std::pair<std::string, std::string>> manifest_;  // file name, "hash size"
 };
@@ -75,6 +90,7 @@ class OutputFiles {
   std::string command_;
   std::vector<std::string> paths_;
   std::vector<bool> written_;
+  CreatedFolders created_;  // destroyed after the staging directory inside them
   std::unique_ptr<StagingDirectory> staging_;
 };
 

@@ -236,9 +236,11 @@ struct Sensors {
 };
 
 // Forces outside the effect catalogue, as impulses over one control period: a tether pulling
-// back to the start, a random roll and pitch disturbance (its own random stream, so that a
-// flight without it is the same as before it existed), a yaw moment in proportion to the
-// forward speed.
+// back to the start, a random roll and pitch disturbance, a yaw moment in proportion to the
+// forward speed. The disturbance has an engine of its own but draws through the sensors'
+// normal distribution, whose cached second value it may take: a flight without it is the
+// same as before it existed, one with it does not share the sensor noise of the same seed
+// without it. (Kept so, since the flights generated with it are referred to as they are.)
 struct UnmodelledForces {
   const ClosedLoopOptions& o;
   double mass, dt;

@@ -82,14 +82,18 @@ fs::path fly(const HiddenCase& c, const fs::path& dir, const std::string& file, 
 // the p-value from the likelihood-ratio statistic under the null it names (chi2 with dof
 // degrees of freedom, or the chi-bar-square 0.5 chi2_0 + 0.5 chi2_1 of a neutral value on
 // its bound), AIC's -statistic + 2 dof, one Bonferroni level alpha / (candidates of the first
-// step) for all, and "significant" exactly when every test passed.
+// step) for all, and the first of the four gates it fails (significance, BIC, the held-out
+// cost, a physically negligible size), none exactly when it is significant. A candidate
+// whose fit failed has no evidence to check.
 void expect_evidence_holds_together(const json& j) {
   ASSERT_TRUE(j.contains("selection") && !j["selection"].empty());
-  const double alpha = 0.01;  // SearchOptions' default; these tests do not set --alpha
+  const double alpha = 0.01, negligible = 2e-4;  // SearchOptions' defaults; these tests set neither
   const size_t first_step = j["selection"][0]["candidates"].size();
   for (const auto& step : j["selection"])
     for (const auto& c : step["candidates"]) {
-      const double x = c["statistic"], p = c["p_value"];
+      const std::string why_not = c["why_not"];
+      if (why_not.rfind("the fit failed", 0) == 0) continue;
+      const double x = c["statistic"], p = c["p_value"], level = c["level"];
       const int dof = c["dof"];
       const bool bar = c["null_distribution"].get<std::string>().rfind("chi-bar-square", 0) == 0;
       const auto upper = [](double s, int k) {
@@ -98,15 +102,18 @@ void expect_evidence_holds_together(const json& j) {
       const double expected = bar ? 0.5 * upper(x, 1) : upper(x, std::max(1, dof));
       EXPECT_NEAR(p, expected, 1e-12 + 1e-9 * expected) << c["effect"] << " " << c["null_distribution"];
       EXPECT_NEAR(c["delta_aic"].get<double>(), -x + 2.0 * dof, 1e-9 * (1 + std::fabs(x))) << c["effect"];
-      EXPECT_NEAR(c["level"].get<double>() * static_cast<double>(first_step), alpha, 1e-15) << c["effect"];
-      const bool passed = p < c["level"].get<double>() && c["delta_bic"].get<double>() < 0 &&
-                          c["validation_cost_after"].get<double>() < c["validation_cost_before"].get<double>();
-      if (c["significant"].get<bool>()) {
-        EXPECT_TRUE(passed) << c.dump(1);
-        EXPECT_EQ(c["why_not"], "") << c.dump(1);
-      } else {
-        EXPECT_NE(c["why_not"], "") << c.dump(1);
-      }
+      EXPECT_NEAR(level * static_cast<double>(first_step), alpha, 1e-15) << c["effect"];
+      const bool relevant = c["size_fraction_of_g"].get<double>() >= negligible ||
+                            c["size_fraction_of_rotation_scale"].get<double>() >= negligible;
+      std::string gate;  // the first gate failed, as the search words it
+      if (!(p < level)) gate = "not significant";
+      else if (!(c["delta_bic"].get<double>() < 0)) gate = "BIC does not improve";
+      else if (!(c["validation_cost_after"].get<double>() < c["validation_cost_before"].get<double>()))
+        gate = "no gain on the validation part";
+      else if (!relevant) gate = "physically negligible size";
+      EXPECT_EQ(why_not.substr(0, gate.size()), gate) << c.dump(1);
+      EXPECT_EQ(why_not.empty(), gate.empty()) << c.dump(1);
+      EXPECT_EQ(c["significant"].get<bool>(), gate.empty()) << c.dump(1);
     }
 }
 
@@ -313,9 +320,10 @@ TEST(Negligibility, CrazyflieRotorDragAtItsPublishedSizeIsNamed) {
   EXPECT_EQ(named(j), std::vector<std::string>{"rotor_drag"}) << j["findings"].dump(1) << j["suspected"].dump(1)
                                                                << j["selection"].dump(1).substr(0, 3000);
   // Within 20 % (as for the FINken's 2e-5), and the truth within twice the 95 % interval's
-  // half-width of the estimate (a 3.9-sigma check): on this seed the profile interval
-  // [0.939e-6, 1.052e-6] just misses 1.1e-6, as one seed in twenty should; seeds 2, 3 and 4
-  // (run by hand, 2026-11-28) cover it.
+  // half-width of the estimate (about 3.9 standard errors). On this seed the profile interval
+  // [0.939e-6, 1.052e-6] misses 1.1e-6: the estimate is about 3.6 standard errors low, far
+  // rarer than 95 % intervals allow, and not explained yet; seeds 2, 3 and 4 (run by hand,
+  // 2026-11-28) give 1.095e-6, 1.100e-6 and 1.096e-6, each interval covering the truth.
   const json& e = j["findings"][0]["parameters"]["rotor_drag.k"];
   ASSERT_TRUE(e.is_object() && e["ci95"][0].is_number() && e["ci95"][1].is_number()) << j["findings"].dump(1);
   const double value = e["value"], lower = e["ci95"][0], upper = e["ci95"][1];

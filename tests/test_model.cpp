@@ -189,10 +189,6 @@ TEST(Model, EffectsChangeTheModelAwayFromNominal) {
   }
 }
 
-// The flapping moment against its closed form, computed here: level attitude, flying along
-// body x at 1 m/s, every rotor at the speed its command gives. The angular accelerations
-// change by dw = J^-1 (0, -k sum(w), 0); the body origin's acceleration by -(dw x c), c the
-// CoG (the translation equation is written for the origin); nothing else changes.
 namespace {
 // Nominal values of a derived model, by name.
 struct Nominal {
@@ -280,6 +276,10 @@ void expect_thrust_scaled_by(const std::string& effect, const std::string& param
 }
 }  // namespace
 
+// The flapping moment against its closed form, computed here: level attitude, flying along
+// body x at 1 m/s, every rotor at the speed its command gives. The angular accelerations
+// change by dw = J^-1 (0, -k sum(w), 0); the body origin's acceleration by -(dw x c), c the
+// CoG (the translation equation is written for the origin); nothing else changes.
 TEST(Model, BladeFlappingMomentMatchesItsClosedForm) {
   SymbolicModel m = derive(test::finken3(), {"blade_flapping"});
   std::vector<double> x(13, 0.0);
