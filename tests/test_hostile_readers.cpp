@@ -277,6 +277,18 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"ax", "ay", "az"}, 1 / 9.80665), rotors, {}); })
                 .find("in g? (in the mapping, scale: 9.80665 and unit: m/s^2;"),
             std::string::npos);
+  // A drop measures little specific force in the right unit: here 1 m/s^2, with the pose
+  // falling at 8.8 m/s^2, which says the same; it is not taken for g.
+  runtime::CsvTable drop = table;
+  const auto col = [&](const char* c) { return static_cast<size_t>(drop.column(c)); };
+  for (auto& row : drop.rows) {
+    const double t = row[col("t")];
+    row[col("z")] = 500 - 0.5 * 8.80665 * t * t;
+    row[col("vz")] = -8.80665 * t;
+    row[col("ax")] = row[col("ay")] = 0;
+    row[col("az")] = 1.0;
+  }
+  EXPECT_NO_THROW(load_flight(drop, rotors, {}));
 }
 
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,
