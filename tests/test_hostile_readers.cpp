@@ -3,6 +3,8 @@
 // numbers beyond double range. Each must end in one line "file:line: cause" of the
 // layer's error type: never a crash, a hang, a silent wrong value or a bare library message.
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -289,6 +291,23 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
     row[col("az")] = 1.0;
   }
   EXPECT_NO_THROW(load_flight(drop, rotors, {}));
+  // A fast flip (a full roll in 0.3 s, 21 rad/s) is no unit mistake: the attitude's turn over a
+  // window would wrap past pi while the gyro's integral grows, unless the window ends at 1 rad
+  // of integral. The flip is q -> q (x) R_x(theta), so the body rates become
+  // R_x(theta)^T (p, q, r) + (dtheta/dt, 0, 0).
+  runtime::CsvTable flip = table;
+  for (auto& row : flip.rows) {
+    const double t = row[static_cast<size_t>(flip.column("t"))], t0 = 4.0, length = 0.3;
+    if (t < t0) continue;
+    const double theta = 2 * M_PI * std::min(1.0, (t - t0) / length), rate = t < t0 + length ? 2 * M_PI / length : 0.0;
+    const auto at = [&](const char* c) -> double& { return row[static_cast<size_t>(flip.column(c))]; };
+    const Eigen::Quaterniond q = Eigen::Quaterniond(at("qw"), at("qx"), at("qy"), at("qz")) *
+                                 Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitX()));
+    at("qw") = q.w(), at("qx") = q.x(), at("qy") = q.y(), at("qz") = q.z();
+    const double p = at("p"), qr = at("q"), r = at("r"), c = std::cos(theta), s = std::sin(theta);
+    at("p") = p + rate, at("q") = c * qr + s * r, at("r") = -s * qr + c * r;
+  }
+  EXPECT_NO_THROW(load_flight(flip, rotors, {}));
 }
 
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,
