@@ -161,7 +161,6 @@ double solve_scale(const FitParameter& p) {
 
 }  // namespace
 
-
 double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
                       const FitOptions& opt, bool* converged, std::string* report) {
   const int n = static_cast<int>(params.size());
