@@ -42,7 +42,7 @@ DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle) {
   request.emit.vehicle_file = job.vehicle;
   request.emit.regenerate_flags = job.effects.empty() ? "" : " --effects " + job.effects;
   // The fitted values: --params, or the vehicle file's own `fitted:` section.
-  use_fitted_values(request, vehicle, job.vehicle, job.params, !job.effects.empty());
+  const std::string note = use_fitted_values(request, vehicle, job.vehicle, job.params, !job.effects.empty());
   progress("mass properties of " + std::to_string(vehicle.blocks.size()) + " blocks");
   const MassProperties mass_properties = derive_mass_properties(vehicle);
   request.progress = progress;
@@ -50,6 +50,7 @@ DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle) {
   DeriveJobResult r;
   r.files = {{"model.json", d.model_json}, {"derivation.md", d.derivation_md}, {"model.hpp", d.header.content}};
   r.audit_passed = d.audit.all_passed();
+  r.note = note;
   r.summary = summary_of(vehicle, d, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return r;
 }

@@ -22,6 +22,7 @@ struct DeriveJob {
 struct DeriveJobResult {
   std::vector<std::pair<std::string, std::string>> files;  // name, contents
   std::string summary;  // what the command prints: the model's size, the audit, op counts, mass properties
+  std::string note;     // for the terminal: parameters fitted for another vehicle; "" if none
   bool audit_passed = false;
 };
 

@@ -9,12 +9,12 @@
 
 namespace quadgen {
 
-void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,
+std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,
                        const std::string& params_path, bool effects_given) {
   if (vehicle.fitted_line > 0 && !params_path.empty())
     throw std::invalid_argument(vehicle_path + " carries fitted values already (its 'fitted:' section); leave --params out");
   const std::string params = vehicle.fitted_line > 0 ? vehicle_path : params_path;
-  if (params.empty()) return;
+  if (params.empty()) return "";
   const FittedParameters fitted = load_fitted_parameters(params);
   const auto& wanted = request.derive.effects;
   if (!effects_given) request.derive.effects = fitted.effects;
@@ -23,6 +23,9 @@ void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std
   request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
   request.emit.regenerate_flags = params == vehicle_path ? "" : " --params " + output::shell_path(params);
   request.emit.parameter_source = "fitted values from " + params;
+  if (fitted.vehicle.empty() || fitted.vehicle == vehicle.name) return "";
+  return output::printable(params) + " was fitted for the vehicle '" + output::printable(fitted.vehicle) + "', not '" +
+         vehicle.name + "'; its values are applied by parameter name";
 }
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {

@@ -42,7 +42,9 @@ struct DerivedModel {
 // Gives `request` fitted values as nominal ones: from `params_path` (a fitted_parameters.yaml),
 // or from the vehicle file's own `fitted:` section; both at once is an error. Without
 // `effects_given` the effects are the fitted ones; given, they must be the same set.
-void use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,
+// Returns a note for the user where the values were fitted for another vehicle (by name): they
+// may still be wanted (the same airframe under another name), but never silently.
+std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,
                        const std::string& params_path, bool effects_given);
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request);

@@ -28,7 +28,7 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
     if (selected(d, e))
       y << "\n# " << e << ": one value per flight in diagnosis.json; here their mean over the " << d.flights.size()
         << " flights";
-  y << "\neffects: [";
+  y << "\nvehicle: " << v.name << "\neffects: [";
   for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
   y << "]\nparameters:\n";
   for (const auto& p : d.airframe_fit)

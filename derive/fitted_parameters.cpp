@@ -27,9 +27,10 @@ FittedParameters load_fitted_parameters(const std::string& path) {
   const bool in_vehicle = file["fitted"] && file["name"];
   const YAML::Node root = in_vehicle ? file["fitted"] : file;
   if (in_vehicle && !root.IsMap()) r.fail(root, "expected 'fitted' to hold 'effects' and 'parameters'");
-  r.only_keys(root, {"effects", "parameters"}, "fitted parameters");
+  r.only_keys(root, {"vehicle", "effects", "parameters"}, "fitted parameters");
   FittedParameters out;
   out.path = path;
+  if (root["vehicle"]) out.vehicle = r.text(root["vehicle"], "the vehicle they were fitted for");
   const YAML::Node effects = root["effects"], params = root["parameters"];
   if (!effects || !effects.IsSequence()) r.fail(root, "expected a list 'effects' (may be empty: [])");
   for (const auto& e : effects) {

@@ -17,6 +17,7 @@ struct FittedValue {
 
 struct FittedParameters {
   std::string path;
+  std::string vehicle;               // the vehicle they were fitted for; "" in files written before it was recorded
   std::vector<std::string> effects;  // canonical names, as the file lists them
   std::vector<FittedValue> values;
 };

@@ -229,6 +229,30 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
   }
 }
 
+// The vehicle the values were fitted for (diagnose writes it since 2026-11-28): another one
+// is noted, never refused (the same airframe may have another name); a file without it, as
+// written before, reads as before.
+#include "app/derive_pipeline.hpp"
+TEST(FittedParameters, AnotherVehiclesValuesAreNoted) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_vehicle";
+  fs::create_directories(dir);
+  const auto file = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const Vehicle v = test::finken3();
+  const std::string body = "effects: [motor_gain]\nparameters:\n  motor_gain.C: {value: -0.08, unit: \"1\"}\n";
+  const std::string other = file("other.yaml", "vehicle: crazyflie21\n" + body);
+  EXPECT_EQ(load_fitted_parameters(other).vehicle, "crazyflie21");
+  DeriveRequest request;
+  const std::string note = use_fitted_values(request, v, "finken3.yaml", other, false);
+  EXPECT_NE(note.find("was fitted for the vehicle 'crazyflie21', not 'finken3'"), std::string::npos) << note;
+  EXPECT_EQ(request.derive.effects, std::vector<std::string>{"motor_gain"});  // applied all the same
+  DeriveRequest same, older;
+  EXPECT_EQ(use_fitted_values(same, v, "finken3.yaml", file("same.yaml", "vehicle: finken3\n" + body), false), "");
+  EXPECT_EQ(use_fitted_values(older, v, "finken3.yaml", file("older.yaml", body), false), "");
+}
+
 // The motor map's slope turns the map about a pivot command: one without the other is refused.
 TEST(VehicleInput, MotorSlopeNeedsItsPivot) {
   const std::string a2 = "  a2: {value: -2954.545454545, unit: rpm}";
