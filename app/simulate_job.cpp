@@ -115,13 +115,14 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   x0[6] = 1.0;
   InputFunction inputs;
   std::unique_ptr<InputSignal> signal;
+  const ExtraInputs extra(m);  // looked up once, not at every integrator stage
   if (!a.scenario.empty()) {
     const Scenario& s = find_scenario(a.scenario);
     inputs = [&, s, hover](double t, double* u) {
       const double td = delay >= 0 ? t - m.params()[delay] : t;
       const auto F = s.thrust(td, hover, rotors);
       for (size_t i = 0; i < nr; ++i) u[i] = laws[i].command_for(F[i]);
-      ExtraInputs(m).fill(t, vbat_ref, u);
+      extra.fill(t, vbat_ref, u);
     };
   } else {
     const CsvTable log = read_csv(a.inputs);
@@ -162,7 +163,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
       sig->at(t0 + tt, uu, delay >= 0 ? m.params()[delay] : 0.0);
       double vb_now = vbat_ref;
       if (vbat_signal) vbat_signal->at(t0 + tt, &vb_now);
-      ExtraInputs(m).fill(tt, vb_now, uu);
+      extra.fill(tt, vb_now, uu);
     };
   }
   // Rotor-speed states (motor_lag) start at their commanded steady state.

@@ -42,6 +42,11 @@ void expect_error(const std::string& text, const std::string& want) {
   }
 }
 
+// Writes `text` to `path`; returns the path.
+std::string written(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path.string();
+}
 }  // namespace
 
 TEST(VehicleInput, BundledFilesLoad) {
@@ -189,10 +194,7 @@ TEST(Cli, DeriveWritesModelJsonAndReport) {
 TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
   const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_parameters";
   fs::create_directories(dir);
-  const auto file = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / name) << text;
-    return (dir / name).string();
-  };
+  const auto file = [&](const std::string& name, const std::string& text) { return written(dir / name, text); };
   const Vehicle v = test::finken3();
   DeriveOptions o;
   o.effects = {"motor_gain"};
@@ -236,10 +238,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
 TEST(FittedParameters, AnotherVehiclesValuesAreNoted) {
   const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_vehicle";
   fs::create_directories(dir);
-  const auto file = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / name) << text;
-    return (dir / name).string();
-  };
+  const auto file = [&](const std::string& name, const std::string& text) { return written(dir / name, text); };
   const Vehicle v = test::finken3();
   const std::string body = "effects: [motor_gain]\nparameters:\n  motor_gain.C: {value: -0.08, unit: \"1\"}\n";
   const std::string other = file("other.yaml", "vehicle: crazyflie21\n" + body);
