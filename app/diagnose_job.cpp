@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -135,8 +134,8 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
 
-  std::cerr << "[diagnose] " << samples << " airborne samples in " << flights.size()
-            << (flights.size() > 1 ? " logs (diagnosed jointly)" : " log") << "; deriving the full-catalogue model\n";
+  o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
+                 (flights.size() > 1 ? " logs (diagnosed jointly)" : " log") + "; deriving the full-catalogue model");
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
@@ -144,19 +143,19 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
   bool compiled = false;
   const auto model = make_model(all, &compiled);
-  std::cerr << "[diagnose] model: " << (compiled ? "compiled header from generated/" : "interpreted tape") << "\n";
+  o.progress.say(std::string("[diagnose] model: ") + (compiled ? "compiled header from generated/" : "interpreted tape"));
   fit::Flight valid;
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
 
-  std::cerr << "[diagnose] generating the extended model\n";
+  o.progress.say("[diagnose] generating the extended model");
   std::string fitted_to;  // the flights the extended model was fitted to: a left-out log is not one
   for (const auto& f : d.flights) fitted_to += (fitted_to.empty() ? "" : ", ") + f;
   const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to);
   std::string err;
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
-  if (plots.empty()) std::cerr << "no plots: " << err << "\n";
   DiagnoseJobResult r;
+  if (plots.empty()) r.notes.push_back("no plots: " + err);
   r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, logs_label))},
              {"report.html", diagnose::diagnosis_html(d, logs_label, plots)},
              {"extended_model.hpp", ext.header},

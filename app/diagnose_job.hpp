@@ -30,6 +30,7 @@ struct DiagnoseJob {
 struct DiagnoseJobResult {
   std::vector<std::pair<std::string, std::string>> files;  // name, contents
   std::string summary;                                     // what the command prints
+  std::vector<std::string> notes;                          // what went wrong on the side (no plots)
 };
 
 // Throws std::invalid_argument for an invalid job, and the layers' own errors (a bad vehicle

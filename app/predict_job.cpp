@@ -1,7 +1,9 @@
 #include "app/predict_job.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "app/model_registry.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -14,23 +16,48 @@ namespace {
 
 std::string summary_of(const predict::Prediction& pooled) {
   std::ostringstream os;
-  for (const auto& h : pooled.open_loop)
-    os << "open loop, " << h.horizon << " s: position " << h.position.mean() << " m (mean), tilt " << h.tilt.mean()
-       << " rad, heading " << h.heading.mean() << " rad\n";
+  for (const auto& h : pooled.open_loop) {
+    os << "open loop, " << h.horizon << " s: ";
+    if (h.position.count == 0) {
+      os << "no rollout reached this horizon" << (h.diverged ? " (" + std::to_string(h.diverged) + " diverged)" : "") << "\n";
+      continue;
+    }
+    os << "position " << h.position.mean() << " m (mean), tilt " << h.tilt.mean() << " rad, heading "
+       << h.heading.mean() << " rad\n";
+  }
   if (const std::string limits = predict::what_limits_prediction(pooled); !limits.empty()) os << limits << "\n";
   return os.str();
 }
 
+// What went wrong with the model, for exit code 4 (the output is kept for inspection): at
+// some horizon every rollout left the model's range, or the errors are not finite.
 std::string failure_of(const predict::Prediction& pooled) {
-  for (const auto& h : pooled.open_loop)
-    if (!std::isfinite(h.position.mean())) {
+  for (const auto& h : pooled.open_loop) {
+    const bool all_diverged = h.position.count == 0 && h.diverged > 0;
+    if (all_diverged || (h.position.count > 0 && !std::isfinite(h.position.mean()))) {
       std::ostringstream os;
       os << "the open-loop position error " << h.horizon
          << " s ahead is not finite: the model left its range on this log (check the commands' scale, the units and "
             "--params); the output is kept for inspection";
       return os.str();
     }
+  }
   return "";
+}
+
+// A log too short to measure anything is the input's problem, not the model's: said before
+// anything is written.
+void check_something_measured(const predict::Prediction& pooled, const PredictJob& job) {
+  if (pooled.start_points > 0) return;
+  double longest = 0;
+  for (const auto& h : pooled.open_loop) longest = std::max(longest, h.horizon);
+  std::ostringstream os;
+  os << "no rollout could start: the evaluated part of the log";
+  if (job.logs.size() > 1) os << "s";
+  os << " (" << pooled.seconds_of_data << " s; --validation " << job.options.validation
+     << " of each flight, at its end) holds no airborne start with " << longest
+     << " s of samples ahead (the longest horizon); give a longer flight or a larger --validation";
+  throw std::invalid_argument(os.str());
 }
 
 }  // namespace
@@ -42,6 +69,7 @@ PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& v) {
   const std::unique_ptr<runtime::DynamicModel> model = model_for(v, parse_effect_list("all"), &how);
   if (job.options.progress) job.options.progress("model: " + how);
   const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), job.logs, job.options);
+  check_something_measured(p.pooled, job);
   r.files = {{"prediction.json", output::json_document(p.json)}, {"prediction.csv", predict::prediction_csv(p.pooled)}};
   std::string svg, err;
   if (runtime::render_svg(v.name + ": prediction error against horizon", predict::horizon_panels({{"this model", &p.pooled}}),

@@ -1,7 +1,6 @@
 #include "app/simulate_job.hpp"
 
 #include <cmath>
-#include <iostream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -13,7 +12,8 @@
 #include "derive/geometry.hpp"
 #include "runtime/integrator.hpp"
 #include "app/model_registry.hpp"
-#include "codegen/runtime_bridge.hpp"
+#include "derive/runtime_view.hpp"
+#include "runtime/rigid_body_state.hpp"
 #include "runtime/scenarios.hpp"
 #include "output/sinks.hpp"
 
@@ -54,7 +54,9 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   const std::vector<std::string> rotors = rotor_names(vehicle);
   ClosedLoopOptions o = a.flight;
   o.duration = a.duration;
-  std::cerr << "flying " << a.duration << " s closed loop (seed " << o.seed << ")\n";
+  std::ostringstream what;
+  what << "flying " << a.duration << " s closed loop (seed " << o.seed << ")";
+  a.progress.say(what.str());
   const GeneratedFlight flight = fly_closed_loop(truth, belief, rotors, o);
   result.csv = flight.csv();
   // Plot: position against reference, commands.
@@ -88,6 +90,140 @@ void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws,
     }
 }
 
+// What every open-loop simulation shares: the model, each rotor's thrust law, and the
+// values its inputs need. Input functions refer to it, so it outlives the integration.
+struct OpenLoop {
+  const Vehicle& vehicle;
+  DynamicModel& m;
+  std::vector<ThrustLaw> laws;
+  std::vector<std::string> rotors;
+  ExtraInputs extra;  // looked up once, not at every integrator stage
+  int delay;          // the input_delay parameter, or -1
+  double vbat_ref;    // V, the battery voltage where the log holds none
+  double hover;       // N per rotor
+
+  double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
+};
+
+// A thesis manoeuvre: the thrusts it asks for at each (delayed) time, turned into commands
+// by each rotor's law.
+InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
+  return [&k, s](double t, double* u) {
+    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);
+    for (size_t i = 0; i < k.rotors.size(); ++i) u[i] = k.laws[i].command_for(F[i]);
+    k.extra.fill(t, k.vbat_ref, u);
+  };
+}
+
+// The linearly interpolated battery voltage of a log, or nothing where it holds none.
+std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vector<double>& t) {
+  if (log.column("vbat") < 0) return nullptr;
+  std::vector<std::vector<double>> rows;
+  for (double x : log.values("vbat")) rows.push_back({x});
+  return std::make_shared<InputSignal>(t, rows, Interpolation::linear);
+}
+
+// A replay of a canonical log's commands (and battery voltage); x0 takes the log's first
+// pose where it has one.
+InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector<double>& x0) {
+  const CsvTable log = read_csv(a.inputs);
+  try {
+    validate_canonical(log, k.rotors);
+  } catch (const LogError& e) {  // the one thing a user cannot guess: replay reads no mapping
+    throw LogError(std::string(e.what()) +
+                   "; simulate --inputs replays a log in the canonical layout (t, u_<rotor>; docs/formats.md)");
+  }
+  const std::vector<double> t = log.values("t");
+  if (a.duration > t.back() - t.front() + 1e-9)
+    throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
+                                std::to_string(t.back() - t.front()) +
+                                " s of commands; a longer replay would hold the last command for the rest");
+  const size_t nr = k.rotors.size();
+  std::vector<std::vector<double>> u(t.size(), std::vector<double>(nr));
+  for (size_t r = 0; r < nr; ++r) {
+    const auto col = log.values("u_" + k.rotors[r]);
+    for (size_t i = 0; i < t.size(); ++i) u[i][r] = col[i];
+  }
+  const auto commands = std::make_shared<InputSignal>(t, u, a.interpolation == "linear" ? Interpolation::linear : Interpolation::hold);
+  const auto vbat = battery_signal(log, t);
+  if (k.m.input_index("vbat") >= 0 && !vbat) throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
+  for (int i = 0; i < rigid_body::kNumStates; ++i)  // start from the logged pose where the log has one
+    if (log.column(rigid_body::kStateNames[i]) >= 0) x0[i] = log.rows.front()[log.column(rigid_body::kStateNames[i])];
+  const double t0 = t.front();
+  return [&k, commands, vbat, t0](double tt, double* uu) {
+    commands->at(t0 + tt, uu, k.delay_s());
+    double vb_now = k.vbat_ref;
+    if (vbat) vbat->at(t0 + tt, &vb_now);
+    k.extra.fill(tt, vb_now, uu);
+  };
+}
+
+// Rotor-speed states (motor_lag) start at their commanded steady state.
+void start_rotor_speeds(const OpenLoop& k, const InputFunction& inputs, std::vector<double>& x0) {
+  std::vector<double> u0(k.m.num_inputs());
+  inputs(0.0, u0.data());
+  for (size_t i = 0; i < k.rotors.size(); ++i) {
+    const int w = k.m.state_index("w_" + k.rotors[i]);
+    if (w >= 0) x0[w] = k.laws[i].speed_at(u0[i]);
+  }
+}
+
+// The trajectory at the output rate: dopri5 stops at the output times, rk4 keeps every
+// step that falls on one.
+Trajectory integrate(const SimulateJob& a, DynamicModel& m, const std::vector<double>& x0, const InputFunction& inputs,
+                     Stats& stats) {
+  IntegratorOptions io;
+  io.step = a.step;
+  std::vector<double> out_times;
+  const long n_out = std::lround(a.duration * a.rate);
+  for (long k = 0; k <= n_out; ++k) out_times.push_back(a.duration * static_cast<double>(k) / static_cast<double>(n_out));
+  if (a.integrator == "dopri5") return integrate_dopri5(m, x0, inputs, out_times, io, &stats);
+  const Trajectory full = integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
+  Trajectory tr;
+  const long every = std::max(1L, std::lround(1.0 / (a.rate * io.step)));
+  for (size_t k = 0; k < full.t.size(); k += every) {
+    tr.t.push_back(full.t[k]);
+    tr.x.push_back(full.x[k]);
+  }
+  return tr;
+}
+
+// Plot like the thesis' figures: translation, rotation, thrust per rotor.
+std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, const Trajectory& tr,
+                                   const InputFunction& inputs) {
+  using namespace rigid_body;
+  // The thrust law on the rotor speed; with effects (a gain, inflow, ground effect) the model's
+  // thrust differs from it, and the title says so rather than showing the law as the model's.
+  const std::string thrust_title =
+      a.effects.empty() ? "thrust per rotor" : "thrust per rotor by the nominal law c_t rho A r^2 w^2 (effects not included)";
+  Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{thrust_title, "t [s]", "N", {}};
+  for (int i = 0; i < 3; ++i) {
+    Series s{kStateNames[kPosition + i], tr.t, {}};
+    for (const auto& x : tr.x) s.y.push_back(x[kPosition + i]);
+    trans.series.push_back(s);
+  }
+  Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
+  for (const auto& x : tr.x) {
+    const auto e = euler_zyx(x[kAttitude], x[kAttitude + 1], x[kAttitude + 2], x[kAttitude + 3]);
+    phi.y.push_back(e[0] * 180 / M_PI);
+    theta.y.push_back(e[1] * 180 / M_PI);
+    psi.y.push_back(e[2] * 180 / M_PI);
+  }
+  rot.series = {phi, theta, psi};
+  std::vector<double> ub(k.m.num_inputs());
+  for (size_t r = 0; r < k.rotors.size(); ++r) {
+    Series s{"F_" + k.rotors[r], tr.t, {}};
+    const int w = k.m.state_index("w_" + k.rotors[r]);
+    for (size_t i = 0; i < tr.t.size(); ++i) {
+      inputs(tr.t[i], ub.data());
+      const double speed = w >= 0 ? tr.x[i][w] : k.laws[r].speed_at(ub[r]);
+      s.y.push_back(k.laws[r].thrust_at_speed(speed));
+    }
+    thrust.series.push_back(s);
+  }
+  return {trans, rot, thrust};
+}
+
 }  // namespace
 
 SimulateJobResult run_simulate_job(const SimulateJob& a) {
@@ -101,139 +237,39 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
-  const size_t nr = vehicle.rotors.size();
-  const auto laws = nominal_thrust_laws(vehicle, model);
-  const double vbat_ref = param(vehicle, "vbat_ref").nominal;
-  const double hover = m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(nr);
-  check_hover_reachable(vehicle, laws, hover);
+  const OpenLoop k{vehicle,
+                   m,
+                   nominal_thrust_laws(vehicle, model),
+                   rotor_names(vehicle),
+                   ExtraInputs(m),
+                   m.input_delay_param(),
+                   param(vehicle, "vbat_ref").nominal,
+                   m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] /
+                       static_cast<double>(vehicle.rotors.size())};
+  check_hover_reachable(vehicle, k.laws, k.hover);
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
-  SimulateJobResult result;
-  const int delay = m.input_delay_param();
-  const std::vector<std::string> rotors = rotor_names(vehicle);
 
   std::vector<double> x0(m.num_states(), 0.0);
-  x0[6] = 1.0;
-  InputFunction inputs;
-  std::unique_ptr<InputSignal> signal;
-  const ExtraInputs extra(m);  // looked up once, not at every integrator stage
-  if (!a.scenario.empty()) {
-    const Scenario& s = find_scenario(a.scenario);
-    inputs = [&, s, hover](double t, double* u) {
-      const double td = delay >= 0 ? t - m.params()[delay] : t;
-      const auto F = s.thrust(td, hover, rotors);
-      for (size_t i = 0; i < nr; ++i) u[i] = laws[i].command_for(F[i]);
-      extra.fill(t, vbat_ref, u);
-    };
-  } else {
-    const CsvTable log = read_csv(a.inputs);
-    try {
-      validate_canonical(log, rotors);
-    } catch (const LogError& e) {  // the one thing a user cannot guess: replay reads no mapping
-      throw LogError(std::string(e.what()) +
-                     "; simulate --inputs replays a log in the canonical layout (t, u_<rotor>; docs/formats.md)");
-    }
-    std::vector<double> t = log.values("t");
-    if (a.duration > t.back() - t.front() + 1e-9)
-      throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
-                                  std::to_string(t.back() - t.front()) +
-                                  " s of commands; a longer replay would hold the last command for the rest");
-    std::vector<std::vector<double>> u(t.size(), std::vector<double>(nr));
-    for (size_t r = 0; r < nr; ++r) {
-      const auto col = log.values("u_" + rotors[r]);
-      for (size_t k = 0; k < t.size(); ++k) u[k][r] = col[k];
-    }
-    signal = std::make_unique<InputSignal>(t, u, a.interpolation == "linear" ? Interpolation::linear : Interpolation::hold);
-    const double t0 = t.front();
-    const bool has_vbat = log.column("vbat") >= 0;
-    if (m.input_index("vbat") >= 0 && !has_vbat)
-      throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
-    std::shared_ptr<InputSignal> vbat_signal;
-    if (has_vbat) {
-      const auto v = log.values("vbat");
-      std::vector<std::vector<double>> rows;
-      for (double x : v) rows.push_back({x});
-      vbat_signal = std::make_shared<InputSignal>(t, rows, Interpolation::linear);
-    }
-    // Start from the logged pose where the log has one.
-    const char* pose[] = {"x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r"};
-    for (int i = 0; i < 13; ++i)
-      if (log.column(pose[i]) >= 0) x0[i] = log.rows.front()[log.column(pose[i])];
-    const InputSignal* sig = signal.get();
-    inputs = [&, sig, t0, vbat_signal](double tt, double* uu) {
-      sig->at(t0 + tt, uu, delay >= 0 ? m.params()[delay] : 0.0);
-      double vb_now = vbat_ref;
-      if (vbat_signal) vbat_signal->at(t0 + tt, &vb_now);
-      extra.fill(tt, vb_now, uu);
-    };
-  }
-  // Rotor-speed states (motor_lag) start at their commanded steady state.
-  {
-    std::vector<double> u0(m.num_inputs());
-    inputs(0.0, u0.data());
-    for (size_t i = 0; i < nr; ++i) {
-      const int w = m.state_index("w_" + rotors[i]);
-      if (w >= 0) x0[w] = laws[i].speed_at(u0[i]);
-    }
-  }
-
-  IntegratorOptions io;
-  io.step = a.step;
-  std::vector<double> out_times;
-  const long n_out = std::lround(a.duration * a.rate);
-  for (long k = 0; k <= n_out; ++k) out_times.push_back(a.duration * static_cast<double>(k) / static_cast<double>(n_out));
+  x0[rigid_body::kAttitude] = 1.0;
+  const InputFunction inputs =
+      a.scenario.empty() ? replay_inputs(k, a, x0) : scenario_inputs(k, find_scenario(a.scenario));
+  start_rotor_speeds(k, inputs, x0);
   Stats stats;
-  std::cerr << "simulating " << a.duration << " s of " << vehicle.name << " with " << a.integrator << "\n";
-  Trajectory tr;
-  if (a.integrator == "dopri5") {
-    tr = integrate_dopri5(m, x0, inputs, out_times, io, &stats);
-  } else {
-    const Trajectory full = integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
-    const long every = std::max(1L, std::lround(1.0 / (a.rate * io.step)));
-    for (size_t k = 0; k < full.t.size(); k += every) {
-      tr.t.push_back(full.t[k]);
-      tr.x.push_back(full.x[k]);
-    }
-  }
+  std::ostringstream starting;
+  starting << "simulating " << a.duration << " s of " << vehicle.name << " with " << a.integrator;
+  a.progress.say(starting.str());
+  const Trajectory tr = integrate(a, m, x0, inputs, stats);
 
-  result.csv = trajectory_csv(m, tr, inputs, rotors);
-  // Plot like the thesis' figures: translation, rotation, thrust per rotor.
-  // The thrust law on the rotor speed; with effects (a gain, inflow, ground effect) the model's
-  // thrust differs from it, and the title says so rather than showing the law as the model's.
-  const std::string thrust_title =
-      a.effects.empty() ? "thrust per rotor" : "thrust per rotor by the nominal law c_t rho A r^2 w^2 (effects not included)";
-  Panel trans{"translation", "t [s]", "m", {}}, rot{"rotation", "t [s]", "deg", {}}, thrust{thrust_title, "t [s]", "N", {}};
-  const char* pos[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    Series s{pos[i], tr.t, {}};
-    for (const auto& x : tr.x) s.y.push_back(x[i]);
-    trans.series.push_back(s);
-  }
-  Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
-  for (const auto& x : tr.x) {
-    const auto e = euler_zyx(x[6], x[7], x[8], x[9]);
-    phi.y.push_back(e[0] * 180 / M_PI);
-    theta.y.push_back(e[1] * 180 / M_PI);
-    psi.y.push_back(e[2] * 180 / M_PI);
-  }
-  rot.series = {phi, theta, psi};
-  std::vector<double> ub(m.num_inputs());
-  for (size_t r = 0; r < nr; ++r) {
-    Series s{"F_" + rotors[r], tr.t, {}};
-    const int w = m.state_index("w_" + rotors[r]);
-    for (size_t k = 0; k < tr.t.size(); ++k) {
-      inputs(tr.t[k], ub.data());
-      const double speed = w >= 0 ? tr.x[k][w] : laws[r].speed_at(ub[r]);
-      s.y.push_back(laws[r].thrust_at_speed(speed));
-    }
-    thrust.series.push_back(s);
-  }
+  SimulateJobResult result;
+  result.csv = trajectory_csv(m, tr, inputs, k.rotors);
   const std::string what = a.scenario.empty() ? "replay of " + a.inputs : "scenario " + a.scenario;
   result.plot_title = vehicle.name + ": " + what;
-  result.plot = {trans, rot, thrust};
+  result.plot = simulation_plot(k, a, tr, inputs);
   const auto& xe = tr.x.back();
   std::ostringstream summary;
   summary << "simulated " << a.duration << " s (" << stats.rhs_evaluations << " rhs evaluations): final position ("
-          << xe[0] << ", " << xe[1] << ", " << xe[2] << ") m";
+          << xe[rigid_body::kPosition] << ", " << xe[rigid_body::kPosition + 1] << ", " << xe[rigid_body::kPosition + 2]
+          << ") m";
   result.summary = summary.str();
   return result;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/closed_loop.hpp"
+#include "output/progress.hpp"
 #include "runtime/plot.hpp"
 
 namespace quadgen::app {
@@ -29,6 +30,7 @@ struct SimulateJob {
   runtime::ClosedLoopOptions flight;
   std::vector<std::pair<std::string, double>> set;
   bool no_size_limit = false;  // refuse runs beyond ~1e7 steps or rows unless set
+  output::Progress progress;   // "simulating 5 s of ..."; nowhere by default
 };
 
 struct SimulateJobResult {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 #include "audit/audit.hpp"
 #include "derive/dynamics.hpp"
 #include "runtime/integrator.hpp"
@@ -246,12 +247,14 @@ Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfil
     for (int i = 0; i < 4; ++i) uu[i] = laws[i].command_for(F[i]);
   };
   std::vector<double> x0(m.num_states(), 0.0);
-  x0[6] = 1;
+  x0[runtime::rigid_body::kAttitude] = 1;
   runtime::IntegratorOptions o;
   const auto x = runtime::integrate_rk4(m, x0, inputs, 0.0, seconds, o).x.back();
-  const auto e = runtime::euler_zyx(x[6], x[7], x[8], x[9]);
+  using namespace runtime::rigid_body;
+  const double* q = &x[kAttitude];
+  const auto e = runtime::euler_zyx(q[0], q[1], q[2], q[3]);
   const double d = 180 / M_PI;
-  return Flight{x[0], x[1], x[2], d * e[0], d * e[1], d * e[2], x[5]};
+  return Flight{x[kPosition], x[kPosition + 1], x[kPosition + 2], d * e[0], d * e[1], d * e[2], x[kVelocity + 2]};
 }
 
 std::string describe(const Flight& f) {

@@ -8,6 +8,7 @@
 
 #include "runtime/dynamic_model.hpp"
 #include "derive/dynamics.hpp"
+#include "runtime/rigid_body_state.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -76,10 +77,11 @@ void jacobians(benchmark::State& st, bool compiled) {
   m->set_params(p);
   const int n = m->num_states(), nu = m->num_inputs(), np = m->num_params();
   std::vector<double> x(n, 0.0), u(nu, 0.5), f(n), A(n * n), B(n * np), Bu(n * nu);
-  x[2] = 0.5;
-  x[3] = 0.3;
-  x[6] = 1;
-  for (int i = 13; i < n; ++i) x[i] = 1500;
+  using namespace runtime::rigid_body;
+  x[kPosition + 2] = 0.5;
+  x[kVelocity] = 0.3;
+  x[kAttitude] = 1;
+  for (int i = kNumStates; i < n; ++i) x[i] = 1500;  // rotor speeds [rad/s]
   for (auto _ : st) {
     m->rhs(x.data(), u.data(), f.data(), A.data(), B.data(), Bu.data());
     benchmark::DoNotOptimize(B.data());

@@ -8,6 +8,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "cli/options.hpp"
 #include "output/output_set.hpp"
+#include "output/progress.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::cli {
@@ -48,12 +49,13 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                 "0 (consecutive windows) or from 0.01 to below --window")
       ->check(finite_range(0.0, 10.0));
   c->add_option("--airframe", j.airframe,
-                "diagnosis.json of a joint diagnosis of this vehicle: also refit its named effects on this one flight "
-                "and say whether the flight agrees with it");
+                "diagnosis.json of an earlier diagnosis of this vehicle (best a joint one: its airframe is what several "
+                "flights share): also refit its named effects on this one flight and say whether the flight agrees with it");
 }
 
 int run_diagnose(const DiagnoseArgs& a) {
-  const app::DiagnoseJob& j = a.job;
+  app::DiagnoseJob j = a.job;
+  j.options.progress = output::terminal_progress();
   std::string error;
   if (!j.IsValid(&error)) throw std::invalid_argument(error);
   // Fail before the long work if the results could not be written.
@@ -63,6 +65,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   inputs.push_back(j.airframe);
   output::OutputDirectory out(a.out, "diagnose", inputs);
   const app::DiagnoseJobResult r = app::run_diagnose_job(j);
+  for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
   std::cout << r.summary << "; wrote " << output::printable(a.out) << "/report.html\n";

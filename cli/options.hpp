@@ -20,9 +20,18 @@ namespace quadgen::cli {
 // A command line CLI11 refused, reported as every other error is: one line, whatever the
 // argument it quotes holds (escape sequences, a newline that would fake a second message).
 // --help and --version leave through CLI11 itself (exit code 0).
+// CLI11 reports a missing required option before an unknown one, so `--ouut DIR` reads as
+// "--out is required"; the words it did not understand are named beside it.
 inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
   if (e.get_exit_code() == 0) return app.exit(e);
-  std::cerr << "quadgen: error: " << output::printable(e.what()) << "\nRun with --help for more information.\n";
+  std::string not_understood;
+  if (dynamic_cast<const CLI::RequiredError*>(&e))
+    for (const CLI::App* command : app.get_subcommands())
+      for (const std::string& word : command->remaining())
+        if (word.rfind("--", 0) == 0) not_understood += (not_understood.empty() ? "" : " ") + word;
+  std::cerr << "quadgen: error: " << output::printable(e.what());
+  if (!not_understood.empty()) std::cerr << " (not understood: " << output::printable(not_understood) << ")";
+  std::cerr << "\nRun with --help for more information.\n";
   return e.get_exit_code();
 }
 

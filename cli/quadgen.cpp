@@ -1,13 +1,56 @@
 // quadgen: vehicle file -> symbolic model -> generated code -> runtime -> fit -> diagnosis.
+#include <algorithm>
 #include <iostream>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
 #include "output/sinks.hpp"
 
+namespace {
+
+const std::vector<std::string> kCommands = {"derive", "simulate", "fit", "diagnose", "predict"};
+
+// Edits (insert, delete, replace) between two words: a misspelt command is suggested back.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// CLI11 says only "A subcommand is required" for `quadgen diagnos ...`; this names the word,
+// the commands there are, and the nearest one.
+bool unknown_command(const std::string& word) {
+  if (word.empty() || word[0] == '-') return false;
+  std::string list, nearest;
+  size_t best = 3;  // suggest only within two edits
+  for (const auto& c : kCommands) {
+    if (c == word) return false;
+    list += (list.empty() ? "" : ", ") + c;
+    if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
+  }
+  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << list << ")";
+  if (!nearest.empty()) std::cerr << "; did you mean '" << nearest << "'?";
+  if (word == "generate") std::cerr << "; 'derive' writes the generated C++ (model.hpp) with the derivation";
+  std::cerr << "\nRun with --help for more information.\n";
+  return true;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  if (argc > 1 && unknown_command(argv[1])) return 106;  // CLI11's code for a missing subcommand
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("quadgen ") + QUADGEN_VERSION);

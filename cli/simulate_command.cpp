@@ -5,11 +5,11 @@
 #include <iostream>
 
 #include "runtime/closed_loop.hpp"
-#include "codegen/runtime_bridge.hpp"
 #include "runtime/attitude.hpp"
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
 #include "output/output_set.hpp"
+#include "output/progress.hpp"
 #include "output/sinks.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -27,7 +27,8 @@ using namespace quadgen::runtime;
 void add_simulate(CLI::App& app, SimulateArgs& a) {
   CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
   c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
-  auto* sc = c->add_option("--scenario", a.job.scenario, "hover, climb, right, forward, yaw, new_height");
+  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre, as fractions of the vehicle's hover thrust: hover, climb, right "
+                                 "(+x), forward (the thesis' inputs for +y; tilts towards -y), yaw, new_height");
   auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a canonical flight log (CSV)");
   auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
                          "fly a smooth random trajectory under a cascaded controller (test flights)");
@@ -110,6 +111,7 @@ std::pair<std::string, double> parse_setting(const std::string& kv) {
 int run_simulate(const SimulateArgs& a) {
   app::SimulateJob job = a.job;
   for (const std::string& kv : a.set) job.set.push_back(parse_setting(kv));
+  job.progress = output::terminal_progress();
   output::OutputFiles out = output_for(a);  // refused before the work, not after
   const app::SimulateJobResult r = app::run_simulate_job(job);
   out.set(0, r.csv);

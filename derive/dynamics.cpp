@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "runtime/thrust_law.hpp"
+#include "runtime/rigid_body_state.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/exact_number.hpp"
 #include "derive/kinematics.hpp"
@@ -85,10 +86,13 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
                          {"r", "rad/s", "body rate about z"}};
   std::vector<ex> s;
   for (auto& row : st) s.push_back(c.add_state(row[0], row[1], row[2]));
-  c.position = vec3(s[0], s[1], s[2]);
-  c.velocity = vec3(s[3], s[4], s[5]);
-  c.q = quaternion(s[6], s[7], s[8], s[9]);
-  c.omega = vec3(s[10], s[11], s[12]);
+  // In the order the runtime reads them (runtime/rigid_body_state.hpp).
+  using namespace runtime::rigid_body;
+  const auto block3 = [&](int first) { return vec3(s[first], s[first + 1], s[first + 2]); };
+  c.position = block3(kPosition);
+  c.velocity = block3(kVelocity);
+  c.q = quaternion(s[kAttitude], s[kAttitude + 1], s[kAttitude + 2], s[kAttitude + 3]);
+  c.omega = block3(kBodyRate);
   c.R = rotation_from_quaternion(c.q);
   c.measured_q = c.q;
   c.air_velocity_world = c.velocity;

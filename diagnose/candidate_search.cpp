@@ -3,13 +3,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <iostream>
 #include <limits>
 #include <mutex>
 #include <chrono>
 #include <thread>
 
-#include <unistd.h>
+#include <sstream>
 
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -155,12 +154,12 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
     // finds lower costs and never closes its interval); said, not hidden, for reweighting
     // to a fixed point can run away.
     if (refit + 1 == kMaxRefits) {
-      if (opt_.verbose_progress) {
-        std::cerr << "[diagnose] note: the model with {";
-        for (const auto& e : effects) std::cerr << (e == *effects.begin() ? "" : ", ") << e;
-        std::cerr << "} did not settle its weights in " << kMaxRefits << " refits (last change "
-                  << std::round(1000 * change) / 10 << " %); it is compared as it stands\n";
-      }
+      std::ostringstream note;
+      note << "[diagnose] note: the model with {";
+      for (const auto& e : effects) note << (e == *effects.begin() ? "" : ", ") << e;
+      note << "} did not settle its weights in " << kMaxRefits << " refits (last change "
+           << std::round(1000 * change) / 10 << " %); it is compared as it stands";
+      opt_.progress.say(note.str());
       break;
     }
     w = std::move(next);
@@ -446,11 +445,9 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
       out[i].effect = todo[i];
       out[i].why_not = std::string("the fit failed: ") + err.what();
     }
-    if (opt_.verbose_progress && isatty(2)) {
-      const std::lock_guard<std::mutex> lock(progress);
-      std::cerr << "\r[diagnose] step " << round + 1 << ": " << ++done << "/" << todo.size() << " candidates ("
-                << todo[i] << ")                    " << std::flush;
-    }
+    const std::lock_guard<std::mutex> lock(progress);
+    opt_.progress.count("[diagnose] step " + std::to_string(round + 1) + ": " + std::to_string(++done) + "/" +
+                        std::to_string(todo.size()) + " candidates (" + todo[i] + ")");
   });
   return out;
 }
@@ -460,9 +457,8 @@ SearchResult CandidateSearch::run() {
   auto phase_start = std::chrono::steady_clock::now();
   const auto phase_done = [&](const std::string& what) {
     const auto now = std::chrono::steady_clock::now();
-    if (opt_.verbose_progress)
-      std::cerr << "[diagnose] " << what << " ("
-                << static_cast<int>(std::chrono::duration<double>(now - phase_start).count()) << " s)\n";
+    opt_.progress.say("[diagnose] " + what + " (" +
+                      std::to_string(static_cast<int>(std::chrono::duration<double>(now - phase_start).count())) + " s)");
     phase_start = now;
   };
   SearchResult res;
@@ -495,11 +491,12 @@ SearchResult CandidateSearch::run() {
     const auto step_start = std::chrono::steady_clock::now();
     step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
     phase_start = std::chrono::steady_clock::now();
-    if (opt_.verbose_progress)
-      std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] step " << round + 1 << ": " << step.candidates.size()
-                << " candidates fitted ("
-                << static_cast<int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count())
-                << " s)                              \n";
+    opt_.progress.say(
+        "[diagnose] step " + std::to_string(round + 1) + ": " + std::to_string(step.candidates.size()) +
+        " candidates fitted (" +
+        std::to_string(static_cast<int>(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count())) +
+        " s)");
     for (const auto& ev : step.candidates) note_training_only(res, ev);
     rank_candidates(step.candidates);
     if (step.candidates.empty() || !step.candidates.front().significant) {
@@ -694,10 +691,10 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
   fit::ProfileOptions po;
   po.max_steps_each_side = 12;
   po.threads = 0;
-  if (opt_.verbose_progress)
-    po.progress = [](const std::string& name, int done, int count, double seconds) {
-      std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] profile " << done << "/" << count << " (" << name << ", "
-                << static_cast<int>(seconds) << " s)        " << (isatty(2) ? "" : "\n") << std::flush;
+  if (opt_.progress.counter)
+    po.progress = [this](const std::string& name, int done, int count, double seconds) {
+      opt_.progress.count("[diagnose] profile " + std::to_string(done) + "/" + std::to_string(count) + " (" + name +
+                          ", " + std::to_string(static_cast<int>(seconds)) + " s)");
     };
   // (profile_all profiles every free parameter when given none: only call it with some.)
   std::vector<fit::Profile> profiles =
@@ -738,9 +735,8 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
     if (!std::isnan(e.lower)) e.lower -= e.numerical_allowance;
     if (!std::isnan(e.upper)) e.upper += e.numerical_allowance;
   }
-  if (opt_.verbose_progress)
-    std::cerr << (isatty(2) ? "\r" : "") << "[diagnose] intervals of " << r.estimates.size() << " parameters done ("
-              << r.profiles.size() << " profiles)        \n";
+  opt_.progress.say("[diagnose] intervals of " + std::to_string(r.estimates.size()) + " parameters done (" +
+                    std::to_string(r.profiles.size()) + " profiles)");
 }
 
 }  // namespace quadgen::diagnose

@@ -36,6 +36,7 @@
 #include "fit/equation_error.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/profile_likelihood.hpp"
+#include "output/progress.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/symbolic_model.hpp"
 
@@ -51,7 +52,7 @@ struct SearchOptions {
   int max_effects = 5;
   double ambiguity_ratio = 0.5;  // runner-up statistic / winner's above which both are tested together
   std::vector<std::string> candidates;  // effects to consider (default: all that the log supports)
-  bool verbose_progress = true;
+  output::Progress progress;  // steps, counters, profiles; nowhere by default
   // Sizes below this fraction of the vehicle's scales (g; weight x arm / inertia) are
   // physically negligible, however significant statistically.
   double negligible_fraction = 2e-4;

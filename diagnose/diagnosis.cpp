@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <iostream>
 #include <map>
 #include <set>
 #include <memory>
@@ -23,6 +22,7 @@
 #include "runtime/thrust_law.hpp"
 #include "codegen/tape_builder.hpp"
 #include "output/numbers.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::diagnose {
 
@@ -190,8 +190,9 @@ DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight&
   std::vector<double> held_out_times;
   for (const auto& s : valid.samples) held_out_times.push_back(s.t);
   for (const auto& s : used.samples) {
-    in.heading.push_back(runtime::euler_zyx(s.x[6], s.x[7], s.x[8], s.x[9])[2]);
-    in.velocity.push_back(s.x[3]), in.velocity.push_back(s.x[4]);
+    using runtime::rigid_body::kVelocity;
+    in.heading.push_back(runtime::rigid_body::heading(s.x.data()));
+    in.velocity.push_back(s.x[kVelocity]), in.velocity.push_back(s.x[kVelocity + 1]);
     in.held_out.push_back(std::binary_search(held_out_times.begin(), held_out_times.end(), s.t));
   }
   auto value = [&](const std::string& name) {
@@ -435,6 +436,7 @@ AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, r
 // airframe to explain motors that cannot give what was asked), unless none is usable.
 // `d` records the screening and the flights used.
 std::vector<fit::Flight> usable_flights(const std::vector<fit::Flight>& flights_in, const SymbolicModel& all,
+                                        const output::Progress& progress,
                                         Diagnosis& d) {
   size_t usable = 0;
   for (const auto& f : flights_in) {
@@ -447,7 +449,7 @@ std::vector<fit::Flight> usable_flights(const std::vector<fit::Flight>& flights_
   for (size_t k = 0; k < flights_in.size(); ++k) {
     if (leave_out && !d.screening[k].usable) {
       d.screening[k].left_out = true;
-      std::cerr << "[diagnose] left out " << output::printable(flights_in[k].source) << ": " << d.screening[k].reason << "\n";
+      progress.say("[diagnose] left out " + flights_in[k].source + ": " + d.screening[k].reason);
       continue;
     }
     const fit::Flight& f = flights_in[k];
@@ -604,7 +606,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
-  const std::vector<fit::Flight> flights = usable_flights(flights_in, all_in, d);
+  const std::vector<fit::Flight> flights = usable_flights(flights_in, all_in, opt_in.progress, d);
   const bool joint = flights.size() > 1;
   const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
   DiagnoseOptions opt = opt_in;
@@ -643,6 +645,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
       all_ee(model, flight, accel);
   SearchOptions so = opt.search;
+  so.progress = opt.progress;
   so.rotation_scale = rotation_scale(v, all);
   so.wald_until_accepted = true;
   so.scales = vehicle_scales(v);
@@ -652,7 +655,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   const bool pose = flight.has_pose;
   const HeldOutGain held_out_gain(model, search, valid, valid_ee, accel, opt.window, opt.window_stride);
   d.metric = held_out_gain.metric_name();
-  std::cerr << progress() << "acceptance: held-out gain and intervals of " << d.search.named().size() << " candidates\n";
+  opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
+                   " candidates");
   accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
@@ -660,35 +664,34 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     const auto agreement_start = Clock::now();
     d.agreement = per_flight_agreement(
         agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, per_flight_names));
-    std::cerr << progress() << "agreement: " << d.agreement.size() << " parameters on " << flights.size() << " flights ("
-              << static_cast<int>(seconds_since(agreement_start))
-              << " s)\n";
+    opt.progress.say(progress() + "agreement: " + std::to_string(d.agreement.size()) + " parameters on " +
+                     std::to_string(flights.size()) + " flights (" +
+                     std::to_string(static_cast<int>(seconds_since(agreement_start))) + " s)");
   }
   // One flight of an airframe diagnosed before: does it show the airframe's effects?
   if (!joint && opt.airframe) {
     const auto start = Clock::now();
     d.airframe_source = opt.airframe->source;
     d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
-    std::cerr << progress() << "against the airframe of " << output::printable(opt.airframe->source) << ": " << d.airframe_check.size()
-              << " parameters ("
-              << static_cast<int>(seconds_since(start))
-              << " s)\n";
+    opt.progress.say(progress() + "against the airframe of " + opt.airframe->source + ": " +
+                     std::to_string(d.airframe_check.size()) + " parameters (" +
+                     std::to_string(static_cast<int>(seconds_since(start))) + " s)");
   }
   add_suspects_of_the_search(d);
   const SearchResult& s = d.search;
   const fit::Flight used = rows_of(flight, all_ee);
   analyse_what_is_wrong(v, used, all_ee, d);
-  std::cerr << progress() << "validation of the base and the extended model; prediction error at horizons\n";
+  opt.progress.say(progress() + "validation of the base and the extended model; prediction error at horizons");
   measure_held_out(d, held_out_gain, model, valid, valid_ee);
   d.unexplained = unexplained(d.after, opt);
   const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
-  std::cerr << progress() << "beyond the catalogue: sparse regression on what the final model leaves\n";
+  opt.progress.say(progress() + "beyond the catalogue: sparse regression on what the final model leaves");
   d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
                                 valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,
                                 flight_starts);
   if (!proposed_terms(d.discovered).empty()) {
-    std::cerr << progress() << "the proposed terms regenerated into the model and simulated on the held-out part\n";
+    opt.progress.say(progress() + "the proposed terms regenerated into the model and simulated on the held-out part");
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
                               pose ? held_out_gain.folds() : std::vector<fit::Flight>{}, opt.window, opt.window_stride);
   }

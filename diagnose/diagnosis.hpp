@@ -45,6 +45,9 @@ struct DiagnoseOptions {
   // One flight checked against an airframe diagnosed before (its named effects refitted on
   // this flight, compared with the airframe's values); none: no check.
   std::optional<AirframeReference> airframe;
+  // Where the diagnosis says how far it has got (the search's steps and profiles too);
+  // nowhere by default, the terminal from the command line.
+  output::Progress progress;
 
   // Ceres-style: false with a reason for a value no diagnosis can use.
   bool IsValid(std::string* error) const;

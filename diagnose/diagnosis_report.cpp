@@ -870,7 +870,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
-    os << "; " << f.metric << " " << num(f.before) << " -> " << num(f.after) << beside_gain_text(f) << "\n  "
+    os << "; " << f.metric << ", the final model without it -> with it: " << num(f.before) << " -> " << num(f.after)
+       << beside_gain_text(f) << "\n  "
        << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {

@@ -7,6 +7,7 @@
 #include <boost/math/distributions/students_t.hpp>
 
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::diagnose {
 
@@ -68,15 +69,13 @@ SignalSet physical_signals(const fit::Flight& f, const std::vector<std::string>&
     return sum;
   });
   for (int a = 0; a < 3; ++a)
-    add(std::string("body velocity ") + "xyz"[a], [&](size_t k) {
-      const auto& x = f.samples[k].x;
-      const runtime::Rotation R = runtime::rotation_matrix(&x[6]);  // v_body = R^T v_world
-      return R.m[0][a] * x[3] + R.m[1][a] * x[4] + R.m[2][a] * x[5];
-    });
+    add(std::string("body velocity ") + "xyz"[a],
+        [&](size_t k) { return runtime::rigid_body::body_velocity(f.samples[k].x.data())[a]; });
   if (f.has_pose) {
-    add("position x", [&](size_t k) { return f.samples[k].x[0]; });
-    add("position y", [&](size_t k) { return f.samples[k].x[1]; });
-    add("height", [&](size_t k) { return f.samples[k].x[2]; });
+    using runtime::rigid_body::kPosition;
+    add("position x", [&](size_t k) { return f.samples[k].x[kPosition]; });
+    add("position y", [&](size_t k) { return f.samples[k].x[kPosition + 1]; });
+    add("height", [&](size_t k) { return f.samples[k].x[kPosition + 2]; });
   }
   add("time", [&](size_t k) { return f.samples[k].t; });
   if (f.has_vbat) add("battery voltage", [&](size_t k) { return f.samples[k].vbat; });

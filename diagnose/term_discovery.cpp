@@ -12,6 +12,7 @@
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
 #include "output/numbers.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::diagnose {
 
@@ -29,12 +30,10 @@ RegressorLibrary physical_regressors(const fit::Flight& f, const std::vector<std
   // velocity states are not measured.
   if (f.has_pose)
     for (int a = 0; a < 3; ++a)
-      add(std::string("v_b") + "xyz"[a], "m/s", [a](const fit::FlightSample& s) {
-        const runtime::Rotation R = runtime::rotation_matrix(&s.x[6]);  // v_body = R^T v_world
-        return R.m[0][a] * s.x[3] + R.m[1][a] * s.x[4] + R.m[2][a] * s.x[5];
-      });
+      add(std::string("v_b") + "xyz"[a], "m/s",
+          [a](const fit::FlightSample& s) { return runtime::rigid_body::body_velocity(s.x.data())[a]; });
   for (int a = 0; a < 3; ++a)
-    add(std::string(1, "pqr"[a]), "rad/s", [a](const fit::FlightSample& s) { return s.x[10 + a]; });
+    add(std::string(1, "pqr"[a]), "rad/s", [a](const fit::FlightSample& s) { return s.x[runtime::rigid_body::kBodyRate + a]; });
   // The mean command and the battery voltage are taken about their means over the flight
   // given: their zero lies far outside what a flight visits, and products and powers of
   // uncentred signals give large coefficients that cancel each other.

@@ -2,6 +2,7 @@
 
 #include "fit/evaluation_threads.hpp"
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,10 +14,12 @@
 
 namespace quadgen::fit {
 
+using namespace runtime::rigid_body;
+
 EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flight, bool use_accelerometer,
                                        std::vector<std::string> use, Derivatives d, double window)
     : model_(&model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
-      data_side_(model), derivatives_(d) {
+      data_side_(model), extra_(model), derivatives_(d) {
   const auto names = all_names();
   if (use.empty()) use = names;
   for (const auto& u : use) {
@@ -24,7 +27,7 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     if (c < 0) throw FitError("unknown residual channel '" + u + "'");
     used_.push_back(c);
   }
-  for (int i = 13; i < model.num_states(); ++i) {
+  for (int i = kNumStates; i < model.num_states(); ++i) {
     const std::string& s = model.state_names()[i];
     if (data_side_.tau < 0 || s.rfind("w_", 0) != 0)
       throw FitError("equation error needs every state measured or filtered from the commands; this model has state " + s);
@@ -223,7 +226,7 @@ std::vector<double> EquationErrorModel::measured_channels() const {
 
 void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, double* u) const {
   commands_at(command_time, u);
-  runtime::ExtraInputs(*model_).fill(s.t, s.vbat, u);
+  extra_.fill(s.t, s.vbat, u);
 }
 
 void EquationErrorModel::commands_at(double t, double* u) const {
@@ -263,7 +266,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
-    runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, x + 6);
+    runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, x + kAttitude);
     // The commands logged at t_k - d act now (held until the next sample; between
     // samples the linear interpolation is their average over the interval).
     inputs_at(s, s.t - e.delay, u);
@@ -368,22 +371,21 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
                                                 std::vector<double>* Bm, SampleSpan span,
                                                 const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
-  const runtime::ExtraInputs extra(*model_);
-  const int t_in = extra.t, v_in = extra.vbat;
+  const int t_in = extra_.t, v_in = extra_.vbat;
   const size_t ns = flight_.samples.size(), nc = columns.size();
   F.assign(ns * 6, 0.0);
   // Only the columns asked for, packed: a search step frees a few of a per-flight model's
   // 28 and more parameters, and the window sums in residuals() then run over contiguous memory.
   if (Bm) Bm->assign(ns * 6 * nc, 0.0);
-  static const int kRows[6] = {3, 4, 5, 10, 11, 12};
+  // The residual rows: linear acceleration (world) and angular acceleration (body).
+  static const int kRows[6] = {kVelocity, kVelocity + 1, kVelocity + 2, kBodyRate, kBodyRate + 1, kBodyRate + 2};
   // Intervals k_lo .. k_hi - 1; each writes its own rows of F and Bm only.
   const auto part = [&](const runtime::DynamicModel& model, size_t k_lo, size_t k_hi) {
     std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
     for (size_t k = k_lo; k < k_hi; ++k) {
       if (!interval_ok_[k]) continue;
       for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
-      const double qn = std::sqrt(xm[6] * xm[6] + xm[7] * xm[7] + xm[8] * xm[8] + xm[9] * xm[9]);
-      for (int i = 6; i < 10; ++i) xm[i] /= qn;
+      runtime::normalize_quaternion(&xm[kAttitude]);
       for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = mean_speed_[k * speed_states_.size() + i];
       std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
       if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);

@@ -71,6 +71,7 @@ class EquationErrorModel : public ResidualModel {
   int g_index_;
   std::vector<int> used_;  // indices into the six channels
   runtime::DataSideParams data_side_;  // parameters applied to the data
+  runtime::ExtraInputs extra_;  // where t and vbat go (indices, the same in a clone)
   std::vector<int> speed_states_;  // w_<rotor> state of each rotor (motor_lag)
   // Samples [lo, hi) of the log: a range of whole contiguous stretches.
   struct SampleSpan {

@@ -13,8 +13,11 @@
 #include "fit/least_squares.hpp"
 #include "runtime/log_file.hpp"
 #include "model/units.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::fit {
+
+using namespace runtime::rigid_body;
 
 runtime::CsvTable read_measurement_csv(const std::string& path) {
   try {
@@ -360,10 +363,13 @@ void check_sensor_units(const std::string& path, const Flight& f) {
       while (j + 1 < S.size() && S[j].t - S[k].t < 0.2 && G.norm() < 1) {
         const double dt = S[j + 1].t - S[j].t;
         gap = gap || !(dt > 0 && dt < 0.1);
-        G += Eigen::Vector3d(S[j].x[10], S[j].x[11], S[j].x[12]) * dt;
+        G += Eigen::Map<const Eigen::Vector3d>(&S[j].x[kBodyRate]) * dt;
         ++j;
       }
-      const auto quat = [&](size_t i) { return Eigen::Quaterniond(S[i].x[6], S[i].x[7], S[i].x[8], S[i].x[9]); };
+      const auto quat = [&](size_t i) {
+        const double* q = &S[i].x[kAttitude];
+        return Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+      };
       if (!gap && j > k) {
         const Eigen::AngleAxisd turn(quat(k).conjugate() * quat(j));
         const Eigen::Vector3d A = turn.axis() * turn.angle();
@@ -418,7 +424,13 @@ void check_sensor_units(const std::string& path, const Flight& f) {
 }  // namespace
 
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
-  runtime::validate_canonical(log, rotors);
+  try {
+    runtime::validate_canonical(log, rotors);
+  } catch (const runtime::LogError& e) {  // the likeliest cause of a missing column: a layout without its mapping
+    if (!log.named_by.empty() || std::string(e.what()).find(": missing column") == std::string::npos) throw;
+    throw runtime::LogError(std::string(e.what()) +
+                            "; a log in another layout is read with --mapping M.yaml (docs/formats.md, \"Column mapping\")");
+  }
   Flight f;
   f.source = log.path;
   if (static_cast<double>(log.rows.size()) < o.min_samples)
@@ -441,18 +453,17 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   std::vector<double> trel;
   for (double v : t) trel.push_back(v - t0);
   auto col = [&](const char* c) { return log.column(c) >= 0 ? log.values(c) : std::vector<double>(t.size(), 0.0); };
-  const char* names[] = {"x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r"};
   std::vector<std::vector<double>> s;
-  for (const char* n : names) s.push_back(col(n));
-  if (!f.has_pose) s[6].assign(t.size(), 1.0);
+  for (const char* n : kStateNames) s.push_back(col(n));
+  if (!f.has_pose) s[kAttitude].assign(t.size(), 1.0);
   // Velocities from the pose where the log has none.
   const bool has_vel = has({"vx", "vy", "vz"});
   if (f.has_pose && !has_vel)
-    for (int i = 0; i < 3; ++i) s[3 + i] = smoothed_derivative(trel, s[i], o.derivative_window);
+    for (int i = 0; i < 3; ++i) s[kVelocity + i] = smoothed_derivative(trel, s[kPosition + i], o.derivative_window);
   std::vector<std::vector<double>> acc(3), rdot(3);
   for (int i = 0; i < 3; ++i) {
-    acc[i] = smoothed_derivative(trel, s[3 + i], o.derivative_window);
-    rdot[i] = smoothed_derivative(trel, s[10 + i], o.derivative_window);
+    acc[i] = smoothed_derivative(trel, s[kVelocity + i], o.derivative_window);
+    rdot[i] = smoothed_derivative(trel, s[kBodyRate + i], o.derivative_window);
   }
   const auto ax = col("ax"), ay = col("ay"), az = col("az"), vbat = col("vbat");
   std::vector<std::vector<double>> u;
@@ -460,13 +471,13 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   for (size_t k = 0; k < t.size(); ++k) {
     FlightSample fs;
     fs.t = trel[k];
-    for (int i = 0; i < 13; ++i) fs.x.push_back(s[i][k]);
+    for (int i = 0; i < kNumStates; ++i) fs.x.push_back(s[i][k]);
     double qn = 0;
-    for (int i = 6; i < 10; ++i) qn += fs.x[i] * fs.x[i];
+    for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
     qn = std::sqrt(qn);
     if (!(qn > 0.5 && qn < 1.5))
       throw FitError(log.path + ":" + std::to_string(k + 2) + ": attitude quaternion has norm " + std::to_string(qn));
-    for (int i = 6; i < 10; ++i) fs.x[i] /= qn;
+    for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
     for (const auto& uc : u) fs.u.push_back(uc[k]);
     fs.vbat = vbat[k];
     for (int i = 0; i < 3; ++i) {

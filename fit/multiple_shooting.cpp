@@ -3,15 +3,18 @@
 #include <cmath>
 
 #include "runtime/integrator.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::fit {
+
+using namespace runtime::rigid_body;
 
 MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Flight flight, double window)
     : model_(&model), flight_(std::move(flight)) {
   if (!flight_.has_pose) throw FitError(flight_.source + ": multiple shooting needs the pose (x, y, z, qw..qz)");
-  if (model.num_states() != 13)
+  if (model.num_states() != kNumStates)
     throw FitError("multiple shooting needs every state at the window starts; this model has unlogged states (" +
-                   model.state_names()[13] + ")");
+                   model.state_names()[kNumStates] + ")");
   const auto& s = flight_.samples;
   size_t start = 0;
   for (size_t k = 1; k <= s.size(); ++k) {
@@ -28,7 +31,7 @@ MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Fligh
 }
 
 void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
-  const int n = 13, np = model_->num_params(), nu = model_->num_inputs();
+  const int n = kNumStates, np = model_->num_params(), nu = model_->num_inputs();
   // The parameter columns to propagate through the sensitivities: the free ones, or all.
   std::vector<int> free_;
   if (J) {
@@ -59,14 +62,14 @@ void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J,
       const auto& xp = tr.states.x[k - first];
       const auto& S = tr.S[k - first];
       const auto& xm = s[k].x;
-      for (int i = 0; i < 3; ++i) r[row + i] = xp[i] - xm[i];
+      for (int i = 0; i < 3; ++i) r[row + i] = xp[kPosition + i] - xm[kPosition + i];
       // Attitude error: 2 vec(q_meas^-1 ⊗ q_pred), small angles about body axes.
-      const double mw = xm[6], mx = -xm[7], my = -xm[8], mz = -xm[9];
+      const double mw = xm[kAttitude], mx = -xm[kAttitude + 1], my = -xm[kAttitude + 2], mz = -xm[kAttitude + 3];
       // Rows of the linear map q_pred -> vec(q_meas^-1 ⊗ q_pred).
       const double L[3][4] = {{mx, mw, -mz, my}, {my, mz, mw, -mx}, {mz, -my, mx, mw}};
       for (int i = 0; i < 3; ++i) {
         double e = 0;
-        for (int c = 0; c < 4; ++c) e += L[i][c] * xp[6 + c];
+        for (int c = 0; c < 4; ++c) e += L[i][c] * xp[kAttitude + c];
         r[row + 3 + i] = 2 * e;
       }
       if (!J) continue;
@@ -74,10 +77,10 @@ void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J,
         for (int j = 0; j < np; ++j) J[static_cast<size_t>(row + i) * np + j] = 0;
       for (int f = 0; f < nf; ++f) {
         const int j = free_[f];
-        for (int i = 0; i < 3; ++i) J[static_cast<size_t>(row + i) * np + j] = S[i * cols + n + f];
+        for (int i = 0; i < 3; ++i) J[static_cast<size_t>(row + i) * np + j] = S[(kPosition + i) * cols + n + f];
         for (int i = 0; i < 3; ++i) {
           double d = 0;
-          for (int c = 0; c < 4; ++c) d += L[i][c] * S[(6 + c) * cols + n + f];
+          for (int c = 0; c < 4; ++c) d += L[i][c] * S[(kAttitude + c) * cols + n + f];
           J[static_cast<size_t>(row + 3 + i) * np + j] = 2 * d;
         }
       }

@@ -39,6 +39,10 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
                                 "fitted_parameters.yaml beside it is for derive --params)");
   }
   if (!json_.is_object()) throw std::invalid_argument(path + ": expected a diagnosis.json or fit.json object");
+  if (json_.value("kind", nlohmann::json()) == "thrust_stand")
+    throw std::invalid_argument(path + ": a thrust-stand fit describes the motors (thrust_vs_speed, speed_vs_command), "
+                                "not a flight model's values; its k and motor map go into the vehicle file's rotor_model "
+                                "and motor_map (docs/formats.md, fit.json)");
   key_ = json_.contains("final_fit") ? "final_fit" : json_.contains("estimates") ? "estimates" : nullptr;
   if (!key_ || !json_[key_].is_object())
     throw std::invalid_argument(path + ": expected a diagnosis.json (final_fit) or fit.json (estimates)");

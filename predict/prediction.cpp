@@ -15,8 +15,11 @@
 #include "predict/rollout.hpp"
 #include "output/estimate.hpp"
 #include "output/numbers.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::predict {
+
+using namespace runtime::rigid_body;
 
 double ErrorStats::mean() const { return count ? sum / static_cast<double>(count) : std::nan(""); }
 double ErrorStats::rms() const { return count ? std::sqrt(sum_sq / static_cast<double>(count)) : std::nan(""); }
@@ -127,10 +130,11 @@ std::vector<double> correction_regressors(const fit::FlightSample& s, const runt
   std::vector<double> x = {1.0};
   double mean_u2 = 0;
   for (double u : s.u) x.push_back(u), x.push_back(u * u), mean_u2 += u * u / static_cast<double>(s.u.size());
-  for (int a = 0; a < 3; ++a) x.push_back(s.x[10 + a]);
+  for (int a = 0; a < 3; ++a) x.push_back(s.x[kBodyRate + a]);
   if (f.has_pose)
     for (int a = 0; a < 3; ++a) {
-      const double v_body = R.m[0][a] * s.x[3] + R.m[1][a] * s.x[4] + R.m[2][a] * s.x[5];
+      const double* v = &s.x[kVelocity];  // in body axes of the unbiased attitude R
+      const double v_body = R.m[0][a] * v[0] + R.m[1][a] * v[1] + R.m[2][a] * v[2];
       x.push_back(v_body), x.push_back(v_body * mean_u2);
     }
   if (f.has_vbat) x.push_back(s.vbat * mean_u2);
@@ -151,7 +155,7 @@ OneStepRows one_step_rows(runtime::DynamicModel& model, const std::vector<double
       const auto& s = f.samples[ee.rows()[row]];
       const DataSideEffects e = data_side.at(model, p.data(), s.t);
       double q[4];
-      runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
+      runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, q);
       const runtime::Rotation R = runtime::rotation_matrix(q);
       const double* r = &r6[row * 6];
       std::array<double, 7> res;
@@ -194,7 +198,7 @@ OneStepErrors one_step(runtime::DynamicModel& model, const std::vector<double>& 
 fit::Flight fill_missing_signals(fit::Flight f, double vbat_ref) {
   for (auto& s : f.samples) {
     if (!f.has_vbat) s.vbat = vbat_ref;
-    if (!f.has_pose) s.x[2] = 1e3;
+    if (!f.has_pose) s.x[kPosition + 2] = 1e3;
   }
   return f;
 }
@@ -251,6 +255,9 @@ const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
 
 }  // namespace
 
+// m: below this at the longest horizon a model predicts the log exactly (its own flights).
+constexpr double kNegligiblePositionError = 1e-3;
+
 std::string what_limits_prediction(const Prediction& p) {
   if (p.open_loop.empty() || p.attitude_replayed.size() != p.open_loop.size()) return "";
   // The views' rows are in the order of PredictionOptions::horizons, which need not be sorted.
@@ -259,6 +266,10 @@ std::string what_limits_prediction(const Prediction& p) {
   const HorizonErrors &open = p.open_loop[longest], &replayed = p.attitude_replayed[longest];
   const double both = open.position.mean(), forces = replayed.position.mean();
   if (!(both > 0) || !std::isfinite(forces)) return "";
+  // Shares of an error below a millimetre are integration round-off, not a diagnosis.
+  if (both < kNegligiblePositionError)
+    return output::short_number(open.horizon) + " s ahead the open-loop position error is " + output::short_number(both) +
+           " m: the model predicts this log to within its integration error.";
   std::string s = output::short_number(open.horizon) + " s ahead (at the end of each window) the open-loop position error is " + output::short_number(both) +
                   " m; with the measured attitude replayed (the force model alone) " + output::short_number(forces) + " m";
   if (forces < both)

@@ -4,8 +4,11 @@
 #include <cmath>
 
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::predict {
+
+using namespace runtime::rigid_body;
 
 namespace {
 
@@ -46,7 +49,7 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
     stage(x, k3_, h);
     deriv(t + h, tmp_, k, replay, k4_);
     for (int j = 0; j < n_; ++j) x[j] += h / 6 * (k1_[j] + 2 * k2_[j] + 2 * k3_[j] + k4_[j]);
-    runtime::normalize_quaternion(&x[6]);  // after full steps only, in every view alike
+    runtime::normalize_quaternion(&x[kAttitude]);  // after full steps only, in every view alike
     impose(replay, t + h, k, x);
   }
   for (double v : x)
@@ -66,7 +69,8 @@ void Rollout::impose_translation(double t, size_t k, std::vector<double>& x) con
   const auto& a = f_.samples[k];
   const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
   const double w = weight(a, b, t);
-  for (int i = 0; i < 6; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
+  for (int first : {kPosition, kVelocity})
+    for (int i = first; i < first + 3; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
 }
 
 // The logged attitude (unbiased) and body rates at time t in [t_k, t_k+1], interpolated.
@@ -75,12 +79,12 @@ void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const 
   const auto& b = f_.samples[std::min(k + 1, f_.samples.size() - 1)];
   const double w = weight(a, b, t);
   double qa[4], qb[4];
-  runtime::unbias_attitude(&a.x[6], e_.roll, e_.pitch, qa);
-  runtime::unbias_attitude(&b.x[6], e_.roll, e_.pitch, qb);
+  runtime::unbias_attitude(&a.x[kAttitude], e_.roll, e_.pitch, qa);
+  runtime::unbias_attitude(&b.x[kAttitude], e_.roll, e_.pitch, qb);
   const double sign = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0 ? -1.0 : 1.0;
-  for (int i = 0; i < 4; ++i) x[6 + i] = (1 - w) * qa[i] + w * sign * qb[i];
-  runtime::normalize_quaternion(&x[6]);
-  for (int i = 0; i < 3; ++i) x[10 + i] = (1 - w) * a.x[10 + i] + w * b.x[10 + i];
+  for (int i = 0; i < 4; ++i) x[kAttitude + i] = (1 - w) * qa[i] + w * sign * qb[i];
+  runtime::normalize_quaternion(&x[kAttitude]);
+  for (int i = kBodyRate; i < kBodyRate + 3; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
 }
 
 void Rollout::inputs(double t, double* u) const {
@@ -98,7 +102,7 @@ void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay rep
   }
   inputs(t, u_.data());
   m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
-  for (int a = 0; a < 3; ++a) f[3 + a] += held_[a], f[10 + a] += held_[3 + a];
+  for (int a = 0; a < 3; ++a) f[kVelocity + a] += held_[a], f[kBodyRate + a] += held_[3 + a];
 }
 
 std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
@@ -112,7 +116,7 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
       const std::vector<double> x = start_at(j, Replay::kNothing).state;
       inputs(S[j].t, u_.data());
       m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
-      for (int a = 0; a < 3; ++a) model_acc_[j][a] = f[3 + a], model_acc_[j][3 + a] = f[10 + a];
+      for (int a = 0; a < 3; ++a) model_acc_[j][a] = f[kVelocity + a], model_acc_[j][3 + a] = f[kBodyRate + a];
     }
     e_ = saved, first_command_ = saved_first;
   }
@@ -129,8 +133,8 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
   for (size_t j = j0; j < k; ++j)
     for (int c = 0; c < 6; ++c) model_integral[c] += 0.5 * (S[j + 1].t - S[j].t) * (model_acc_[j][c] + model_acc_[j + 1][c]);
   for (int a = 0; a < 3; ++a) {
-    d[a] = (S[k].x[3 + a] - S[j0].x[3 + a] - model_integral[a]) / span;
-    d[3 + a] = (S[k].x[10 + a] - S[j0].x[10 + a] - model_integral[3 + a]) / span;
+    d[a] = (S[k].x[kVelocity + a] - S[j0].x[kVelocity + a] - model_integral[a]) / span;
+    d[3 + a] = (S[k].x[kBodyRate + a] - S[j0].x[kBodyRate + a] - model_integral[3 + a]) / span;
   }
   return d;
 }
@@ -144,16 +148,17 @@ StateError state_error(const std::vector<double>& x, const fit::FlightSample& s,
   constexpr double kPi = 3.14159265358979323846;
   StateError out;
   for (int a = 0; a < 3; ++a) {
-    out.position_squared += std::pow(x[a] - s.x[a], 2);
-    out.velocity_squared += std::pow(x[3 + a] - s.x[3 + a], 2);
-    out.body_rates_squared += std::pow(x[10 + a] - s.x[10 + a], 2);
+    out.position_squared += std::pow(x[kPosition + a] - s.x[kPosition + a], 2);
+    out.velocity_squared += std::pow(x[kVelocity + a] - s.x[kVelocity + a], 2);
+    out.body_rates_squared += std::pow(x[kBodyRate + a] - s.x[kBodyRate + a], 2);
   }
   double q[4];
-  runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, q);
-  const double dot = std::abs(x[6] * q[0] + x[7] * q[1] + x[8] * q[2] + x[9] * q[3]);
+  runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, q);
+  const double* xq = &x[kAttitude];
+  const double dot = std::abs(xq[0] * q[0] + xq[1] * q[1] + xq[2] * q[2] + xq[3] * q[3]);
   out.angle = 2 * std::acos(std::min(1.0, dot));
   if (!tilt_and_heading) return out;
-  const runtime::Rotation rs = runtime::rotation_matrix(&x[6]), rm = runtime::rotation_matrix(q);
+  const runtime::Rotation rs = runtime::rotation_matrix(xq), rm = runtime::rotation_matrix(q);
   double zz = 0;
   for (int a = 0; a < 3; ++a) zz += rs.m[a][2] * rm.m[a][2];
   out.tilt = std::acos(std::clamp(zz, -1.0, 1.0));

@@ -4,8 +4,11 @@
 #include <cmath>
 
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::predict {
+
+using namespace runtime::rigid_body;
 
 size_t held_sample(const fit::Flight& f, double t) {
   const auto& S = f.samples;
@@ -24,7 +27,7 @@ StartStates::StartStates(runtime::DynamicModel& model, std::vector<double> param
   for (const auto& s : S) times.push_back(s.t);
   stretch_ = runtime::stretch_starts(times);
   settled_.assign(S.size(), false);
-  if (model_.num_states() > 13) rotors_ = static_cast<size_t>(model_.num_states() - 13);
+  if (model_.num_states() > kNumStates) rotors_ = static_cast<size_t>(model_.num_states() - kNumStates);
   speeds_.assign(S.size() * rotors_, 0.0);
   std::vector<double> c(rotors_);
   double restarted = 0;  // s, time of the last restart
@@ -69,7 +72,7 @@ void StartStates::commanded_speeds(double t, double delay, size_t first, double 
   std::copy(cmd.begin(), cmd.end(), u.begin());
   runtime::ExtraInputs(model_).fill(t, s.vbat, u.data());
   model_.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt = (w_cmd - w) / tau
-  for (size_t i = 0; i < rotors_; ++i) c[i] = tau * f[13 + i];
+  for (size_t i = 0; i < rotors_; ++i) c[i] = tau * f[kNumStates + i];
 }
 
 std::vector<double> StartStates::at(size_t k) const {
@@ -77,8 +80,8 @@ std::vector<double> StartStates::at(size_t k) const {
   const auto& s = flight_.samples[k];
   std::copy(s.x.begin(), s.x.end(), x.begin());
   const runtime::DataSideEffects e = effects_at(k);
-  runtime::unbias_attitude(&s.x[6], e.roll, e.pitch, &x[6]);
-  for (size_t i = 0; i < rotors_; ++i) x[13 + i] = speeds_[k * rotors_ + i];
+  runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, &x[kAttitude]);
+  for (size_t i = 0; i < rotors_; ++i) x[kNumStates + i] = speeds_[k * rotors_ + i];
   return x;
 }
 

@@ -8,6 +8,7 @@
 
 #include "runtime/attitude.hpp"
 #include "runtime/integrator.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::runtime {
 
@@ -15,6 +16,10 @@ namespace {
 
 using V3 = Eigen::Vector3d;
 using M3 = Eigen::Matrix3d;
+using namespace rigid_body;
+
+// The three states from `first` (kPosition, kVelocity, kBodyRate) as a vector.
+V3 vec3_at(const std::vector<double>& x, int first) { return V3(x[first], x[first + 1], x[first + 2]); }
 
 // Smooth random reference: a sum of a few sinusoids per axis, with its derivatives.
 struct Reference {
@@ -126,7 +131,7 @@ class CascadedController {
 
   std::vector<double> thrusts(double t, double dt, const ReferenceAt& r, const std::vector<double>& x,
                               const M3& R_estimated) {
-    const V3 p(x[0], x[1], x[2]), v(x[3], x[4], x[5]), w(x[10], x[11], x[12]);
+    const V3 p = vec3_at(x, kPosition), v = vec3_at(x, kVelocity), w = vec3_at(x, kBodyRate);
     const V3 e_p = r.position() - p, e_v = r.velocity() - v;
     int_pos_ += e_p * dt;
     const V3 a_cmd = r.acceleration() + o_.kp_pos * e_p + o_.kd_pos * e_v + o_.ki_pos * int_pos_ + V3(0, 0, b_.g);
@@ -189,8 +194,8 @@ std::vector<double> initial_state(const DynamicModel& truth, const ControllerMod
                                   const std::vector<std::string>& rotors, double hover_u) {
   std::vector<double> x(truth.num_states(), 0.0);
   const ReferenceAt r0(ref, 0.0);
-  for (int a = 0; a < 3; ++a) x[a] = r0.axis[a][0];
-  x[6] = 1;
+  for (int a = 0; a < 3; ++a) x[kPosition + a] = r0.axis[a][0];
+  x[kAttitude] = 1;
   for (size_t i = 0; i < rotors.size(); ++i) {
     const int w = truth.state_index("w_" + rotors[i]);
     if (w >= 0) x[w] = b.thrust_laws[i].speed_at(hover_u);
@@ -223,11 +228,11 @@ struct Sensors {
     const double an = o.pose_noise;
     const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
     const Eigen::Quaterniond q = (q_estimated * dq).normalized();
-    for (int i = 0; i < 3; ++i) row.push_back(x[i] + an * gauss(rng));
+    for (int i = 0; i < 3; ++i) row.push_back(x[kPosition + i] + an * gauss(rng));
     for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);
-    for (int i = 3; i < 6; ++i) row.push_back(x[i] + an * 10 * gauss(rng));
-    for (int i = 0; i < 3; ++i) row.push_back(x[10 + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
-    const V3 sf = R_true.transpose() * (V3(f[3], f[4], f[5]) + V3(0, 0, g));
+    for (int i = 0; i < 3; ++i) row.push_back(x[kVelocity + i] + an * 10 * gauss(rng));
+    for (int i = 0; i < 3; ++i) row.push_back(x[kBodyRate + i] + gyro_bias[i] + o.gyro_noise * gauss(rng));
+    const V3 sf = R_true.transpose() * (vec3_at(f, kVelocity) + V3(0, 0, g));
     for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
     row.push_back(vbat);
     for (double c : {r.axis[0][0], r.axis[1][0], r.axis[2][0], r.axis[3][0]}) row.push_back(c);
@@ -253,17 +258,18 @@ struct UnmodelledForces {
   void apply(std::vector<double>& x, const Reference& ref, std::normal_distribution<double>& gauss) {
     if (o.tether_stiffness > 0) {
       const ReferenceAt start(ref, 0.0);
-      for (int a = 0; a < 2; ++a) x[3 + a] -= o.tether_stiffness * (x[a] - start.axis[a][0]) / mass * dt;
+      for (int a = 0; a < 2; ++a) x[kVelocity + a] -= o.tether_stiffness * (x[kPosition + a] - start.axis[a][0]) / mass * dt;
     }
     if (o.angular_disturbance > 0)
       for (int a = 0; a < 2; ++a) {
         disturbance[a] = pole * disturbance[a] + gain * gauss(rng);
-        x[10 + a] += disturbance[a] * dt;
+        x[kBodyRate + a] += disturbance[a] * dt;
       }
     if (o.yaw_per_forward_speed != 0) {
-      const Rotation R = rotation_matrix(&x[6]);
-      const double forward = R.m[0][0] * x[3] + R.m[1][0] * x[4] + R.m[2][0] * x[5];  // (R^T v)_x
-      x[12] += o.yaw_per_forward_speed * forward * dt;
+      const Rotation R = rotation_matrix(&x[kAttitude]);
+      const double* v = &x[kVelocity];
+      const double forward = R.m[0][0] * v[0] + R.m[1][0] * v[1] + R.m[2][0] * v[2];  // (R^T v)_x
+      x[kBodyRate + 2] += o.yaw_per_forward_speed * forward * dt;
     }
   }
 };
@@ -308,9 +314,9 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     const double t = static_cast<double>(k) * dt;
     const double vbat = battery_voltage(o, t, k == 0, u, nr, hover_u);
     const ReferenceAt r(ref, t);
-    const V3 p_at_t(x[0], x[1], x[2]);
+    const V3 p_at_t = vec3_at(x, kPosition);
     // --- controller, on the attitude the vehicle estimates ---
-    const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[6], x[7], x[8], x[9]).normalized();
+    const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[kAttitude], x[kAttitude + 1], x[kAttitude + 2], x[kAttitude + 3]).normalized();
     truth.measurement(x.data(), t, logged.data(), nullptr, nullptr);
     const Eigen::Quaterniond q_est =
         Eigen::Quaterniond(logged[logged_q], logged[logged_q + 1], logged[logged_q + 2], logged[logged_q + 3]).normalized();
@@ -343,7 +349,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     }
     x = integrate_rk4(truth, x, inputs, delay_rest, dt, io).x.back();
     unmodelled.apply(x, ref, gauss);
-    if (x[2] < -5 || (p_at_t - r.position()).norm() > 20)
+    if (x[kPosition + 2] < -5 || (p_at_t - r.position()).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
   }
   return out;

@@ -3,6 +3,7 @@
 #include "runtime/log_file.hpp"
 
 #include "runtime/attitude.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -116,6 +117,12 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
       if (line.find(';') != std::string::npos && line.find(',') == std::string::npos)
         fail_at(path, lineno, "the header holds ';' and no ',': quadgen reads comma-separated values (export the log with ',' "
                               "between fields and '.' as the decimal point)");
+      // Every log quadgen reads has a time and at least one more column; a first line without
+      // a comma, or a comment, is another kind of file (a vehicle file, a mapping) given where
+      // a log belongs.
+      if (line.find(',') == std::string::npos || line[0] == '#')
+        fail_at(path, lineno, "no CSV header: the first line is " + quoted_cell(line) +
+                                  "; expected comma-separated column names such as t,u_M1,... (is this a flight log?)");
       t.columns = split_header(line);
       std::set<std::string> seen;
       for (const auto& c : t.columns)
@@ -268,19 +275,25 @@ std::string trajectory_csv(const DynamicModel& m, const Trajectory& tr, const In
   os << "t";
   for (const auto& r : rotors) os << ",u_" << r;
   os << ",x,y,z,qw,qx,qy,qz,phi,theta,psi,vx,vy,vz,p,q,r";
-  for (int i = 13; i < m.num_states(); ++i) os << "," << m.state_names()[i];
+  for (int i = rigid_body::kNumStates; i < m.num_states(); ++i) os << "," << m.state_names()[i];
   os << "\n";
   std::vector<double> ub(m.num_inputs());
   for (size_t k = 0; k < tr.t.size(); ++k) {
     const auto& x = tr.x[k];
+    const auto states = [&](int first, int count) {
+      for (int i = first; i < first + count; ++i) os << "," << x[i];
+    };
     u(tr.t[k], ub.data());
     os << tr.t[k];
     for (size_t r = 0; r < rotors.size(); ++r) os << "," << ub[r];
-    const auto [phi, theta, psi] = euler_zyx(x[6], x[7], x[8], x[9]);
-    os << "," << x[0] << "," << x[1] << "," << x[2] << "," << x[6] << "," << x[7] << "," << x[8] << "," << x[9]
-       << "," << phi << "," << theta << "," << psi << "," << x[3] << "," << x[4] << "," << x[5] << "," << x[10] << "," << x[11]
-       << "," << x[12];
-    for (int i = 13; i < m.num_states(); ++i) os << "," << x[i];
+    const double* q = &x[rigid_body::kAttitude];
+    const auto [phi, theta, psi] = euler_zyx(q[0], q[1], q[2], q[3]);
+    states(rigid_body::kPosition, 3);
+    states(rigid_body::kAttitude, 4);
+    os << "," << phi << "," << theta << "," << psi;
+    states(rigid_body::kVelocity, 3);
+    states(rigid_body::kBodyRate, 3);
+    states(rigid_body::kNumStates, m.num_states() - rigid_body::kNumStates);
     os << "\n";
   }
   return os.str();

@@ -26,10 +26,10 @@ const char* file_kind(mode_t m) {
 
 LogFile::LogFile(const std::string& path, const std::string& expected) : path_(path) {
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) throw LogError(path + ": cannot open log: " + std::strerror(errno));
+  if (fd_ < 0) throw LogError(path + ": cannot open " + expected + ": " + std::strerror(errno));
   try {
     struct stat st {};
-    if (::fstat(fd_, &st) != 0) throw LogError(path + ": cannot stat log: " + std::strerror(errno));
+    if (::fstat(fd_, &st) != 0) throw LogError(path + ": cannot stat " + expected + ": " + std::strerror(errno));
     if (!S_ISREG(st.st_mode))
       throw LogError(path + ": " + file_kind(st.st_mode) + ", not a regular file (expected " + expected + ")");
     size_ = static_cast<unsigned long long>(st.st_size);

@@ -30,6 +30,12 @@ void write_number(std::ostream& os, double v) {
   else os << "NaN";  // gnuplot skips it; "inf" or "nan" as printed by iostreams are not numbers to it
 }
 
+bool has_finite_point(const Series& s) {
+  for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
+    if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) return true;
+  return false;
+}
+
 // One file descriptor pair end, closed when it goes out of scope.
 struct Fd {
   int fd = -1;
@@ -161,7 +167,7 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
     std::ostringstream plot;
     for (const Series& full : p.series) {
       const Series s = decimated(full);
-      if (s.x.empty() || s.y.empty()) continue;
+      if (!has_finite_point(s)) continue;  // gnuplot refuses a series whose every value is undefined
       const std::string name = "$d" + std::to_string(block++);
       script << name << " << EOD\n";
       for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {

@@ -16,20 +16,30 @@ bool in(size_t i, std::initializer_list<size_t> set) {
 }
 bool between(double t, double a, double b) { return t >= a && t < b; }
 
-const double kDelta = 0.02;  // N: step of the manoeuvre thrusts (a few % of hover)
+// The thesis flies its manoeuvres in newtons for the FINken 3, whose hover thrust is 0.9491 N
+// per rotor (thesis (60)). They are flown here as the same fractions of each vehicle's own
+// hover thrust h, so that a 27 g Crazyflie (0.066 N per rotor) flies the same manoeuvre
+// rather than being asked for 17 times its weight.
+constexpr double kThesisHover = 0.9491;  // N per rotor
+constexpr double kThesisClimb = 1.1;     // N per rotor (thesis 2.3.1 b)
+constexpr double kThesisDelta = 0.02;    // N: the step of the manoeuvre thrusts, 2.1 % of hover
+
+double step(double h) { return kThesisDelta / kThesisHover * h; }
 
 std::vector<double> hover(double, double h, const std::vector<std::string>& r) { return std::vector<double>(r.size(), h); }
 
-// Thesis 2.3.1 b): 1.1 N on every rotor.
-std::vector<double> climb(double, double, const std::vector<std::string>& r) { return std::vector<double>(r.size(), 1.1); }
+// Thesis 2.3.1 b): 1.1 N on every rotor, 1.16 times hover.
+std::vector<double> climb(double, double h, const std::vector<std::string>& r) {
+  return std::vector<double>(r.size(), kThesisClimb / kThesisHover * h);
+}
 
 // Tilt doublet, hold, reverse doublet: raise `first` then `second`, later the reverse.
 std::vector<double> doublet(double t, double h, const std::vector<std::string>& r, std::initializer_list<size_t> first,
                             std::initializer_list<size_t> second) {
   std::vector<double> F(r.size(), h);
   for (size_t i = 0; i < r.size(); ++i) {
-    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && in(i, first)) F[i] += kDelta;
-    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && in(i, second)) F[i] += kDelta;
+    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && in(i, first)) F[i] += step(h);
+    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && in(i, second)) F[i] += step(h);
   }
   return F;
 }
@@ -41,14 +51,14 @@ std::vector<double> forward(double t, double h, const std::vector<std::string>& 
 std::vector<double> yaw(double t, double h, const std::vector<std::string>& r) {
   std::vector<double> F(r.size(), h);
   for (size_t i = 0; i < r.size(); ++i)
-    if (between(t, 0.5, 1.5) && in(i, {0, 2})) F[i] += kDelta;
+    if (between(t, 0.5, 1.5) && in(i, {0, 2})) F[i] += step(h);
   return F;
 }
 // Thesis 2.3.2 d): all up, coast, all down by the same amount: a new constant height.
 std::vector<double> new_height(double t, double h, const std::vector<std::string>& r) {
   double d = 0;
-  if (between(t, 0.5, 1.0)) d = 5 * kDelta;
-  if (between(t, 2.0, 2.5)) d = -5 * kDelta;
+  if (between(t, 0.5, 1.0)) d = 5 * step(h);
+  if (between(t, 2.0, 2.5)) d = -5 * step(h);
   return std::vector<double>(r.size(), h + d);
 }
 
@@ -57,11 +67,14 @@ std::vector<double> new_height(double t, double h, const std::vector<std::string
 const std::vector<Scenario>& scenario_catalogue() {
   static const std::vector<Scenario> list = {
       {"hover", "every rotor at hover thrust m g / n (thesis (60))", hover},
-      {"climb", "1.1 N on every rotor (thesis 2.3.1 b, (63)-(64))", climb},
-      {"right", "A and D raised 0.02 N for 0.1 s, then B and C; reversed at 1.5 s (thesis 2.3.2 a)", right},
-      {"forward", "C and D raised 0.02 N for 0.1 s, then A and B; reversed at 1.5 s (thesis 2.3.2 b)", forward},
-      {"yaw", "A and C raised 0.02 N from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
-      {"new_height", "all rotors +0.1 N from 0.5 to 1.0 s, -0.1 N from 2.0 to 2.5 s (thesis 2.3.2 d)", new_height},
+      {"climb", "1.16 times hover thrust on every rotor (the thesis' 1.1 N; 2.3.1 b, (63)-(64))", climb},
+      {"right", "rotors 1 and 4 (A, D) raised 2.1 % of hover for 0.1 s, then 2 and 3; reversed at 1.5 s: tilts "
+                "towards +x (thesis 2.3.2 a)", right},
+      {"forward", "rotors 3 and 4 (C, D) raised 2.1 % of hover for 0.1 s, then 1 and 2; reversed at 1.5 s: the "
+                  "thesis' inputs for +y, which tilt towards -y (thesis 2.3.2 b)", forward},
+      {"yaw", "rotors 1 and 3 (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
+      {"new_height", "all rotors +10.5 % of hover from 0.5 to 1.0 s, -10.5 % from 2.0 to 2.5 s (thesis 2.3.2 d)",
+       new_height},
   };
   return list;
 }

@@ -1236,7 +1236,6 @@ class WeakMotorSearch : public ::testing::Test {
     valid_ee_ = std::make_unique<quadgen::fit::EquationErrorModel>(*model_, valid_, true);
     quadgen::diagnose::SearchOptions so;
     so.candidates = {"motor_gain"};
-    so.verbose_progress = false;
     search_ = std::make_unique<quadgen::diagnose::CandidateSearch>(*all_, *model_, *train_ee_, *valid_ee_, so);
     result_ = search_->run();
     ASSERT_EQ(result_.named(), std::vector<std::string>{"motor_gain"});

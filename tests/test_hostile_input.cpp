@@ -32,6 +32,7 @@
 #include "output/names.hpp"
 #include "output/output_set.hpp"
 #include "runtime/plot.hpp"
+#include "runtime/flight_log.hpp"
 #include "audit/report.hpp"
 #include "output/sinks.hpp"
 #include "tests/test_helpers.hpp"
@@ -891,6 +892,56 @@ TEST(Cli, PredictExitsNonZeroWhenTheModelLeavesItsRange) {
   EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", tmp / "good.json", "--out", tmp / "q"}, tmp.dir).rc, 0);
 }
 
+// A newcomer's likely mistakes (a review that used the tool as a new user would): each gets one
+// line that names the word, the file or the missing piece, and what would work.
+TEST(Cli, NewcomerMistakesAreNamed) {
+  Scratch tmp;
+  const std::string f3 = source_path("vehicles/finken3.yaml"), cf = source_path("vehicles/crazyflie21.yaml");
+  const auto expect_error = [&](const std::vector<std::string>& args, int rc, const std::string& says) {
+    const CliResult r = run_quadgen(args, tmp.dir);
+    EXPECT_EQ(r.rc, rc) << args.front() << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp / "o")) << r.err;
+  };
+  // A misspelt or imagined command.
+  expect_error({"diagnos", f3, "--out", tmp / "o"}, 106, "unknown command 'diagnos' (commands: derive, simulate, fit, "
+                                                          "diagnose, predict); did you mean 'diagnose'?");
+  expect_error({"generate", f3, "--out", tmp / "o"}, 106, "'derive' writes the generated C++");
+  // A misspelt required option: CLI11 alone says only that --out is missing.
+  expect_error({"derive", f3, "--ouut", tmp / "o"}, 106, "--out is required (not understood: --ouut)");
+  // Files that are not logs are named as what they should have been.
+  ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,
+               "missing.yaml: cannot open a column mapping (YAML)");
+  expect_error({"predict", cf, tmp / "f.csv", "--params", tmp / "nope.json", "--out", tmp / "o"}, 2,
+               "nope.json: cannot open a diagnosis.json or fit.json");
+  // A log of another layout without its mapping; a vehicle file given as the log.
+  write(tmp / "other.csv", "time,m1,m2,m3,m4\n0,0.5,0.5,0.5,0.5\n0.01,0.5,0.5,0.5,0.5\n");
+  expect_error({"fit", cf, tmp / "other.csv", "--out", tmp / "o"}, 2,
+               "missing column 't'; a log in another layout is read with --mapping M.yaml");
+  expect_error({"diagnose", cf, f3, "--out", tmp / "o"}, 2, "finken3.yaml:1: no CSV header");
+  // A stray comma in an effect list; a thrust-stand fit given as a flight model's values.
+  expect_error({"derive", f3, "--effects", "motor_lag,", "--out", tmp / "o"}, 2, "has an empty name");
+  write(tmp / "stand.json", R"({"kind": "thrust_stand", "summary": {}, "thrust_vs_speed": {"estimates": {}}})");
+  expect_error({"predict", cf, tmp / "f.csv", "--params", tmp / "stand.json", "--out", tmp / "o"}, 2,
+               "a thrust-stand fit describes the motors");
+}
+
+// A log whose evaluated part is too short for one rollout is the input's problem: refused with
+// what would work, nothing written (before, every horizon read NaN and predict blamed the model).
+TEST(Cli, PredictRefusesALogTooShortForOneRollout) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "3", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  const CliResult r = run_quadgen({"predict", vehicle, tmp / "f.csv", "--out", tmp / "p"}, tmp.dir);
+  EXPECT_EQ(r.rc, 2) << r.err;
+  EXPECT_NE(r.err.find("no rollout could start"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("give a longer flight or a larger --validation"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp / "p"));
+  // All of it evaluated, there is room for rollouts.
+  EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--validation", "1", "--out", tmp / "q"}, tmp.dir).rc, 0);
+}
+
 // ---- options -------------------------------------------------------------------------------
 
 TEST(Options, EveryNumberIsCheckedAndNothingIsSilentlyIgnored) {
@@ -965,4 +1016,44 @@ TEST(Sinks, PlotColoursAndMarksAreDataNotScript) {
   const size_t arrow = script.find("set arrow from 0.5");
   ASSERT_NE(arrow, std::string::npos);
   EXPECT_NE(script.find("unset arrow", arrow), std::string::npos);  // cleared before the second panel
+}
+
+// gnuplot refuses a series whose every point is undefined ("all points y value undefined"):
+// such a series (a horizon no rollout reached) is left out, and the figure is drawn.
+TEST(Sinks, ASeriesWithoutOneFinitePointIsLeftOutOfThePlot) {
+  using quadgen::runtime::Panel;
+  using quadgen::runtime::Series;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Series drawn{"drawn", {0.1, 0.5}, {0.01, nan}}, undefined{"undefined", {0.1, 0.5}, {nan, nan}};
+  const std::string script = quadgen::runtime::gnuplot_script("t", {Panel{"a", "h", "m", {drawn, undefined}}});
+  EXPECT_NE(script.find("'drawn'"), std::string::npos);
+  EXPECT_EQ(script.find("'undefined'"), std::string::npos);
+  std::string svg, err;
+  EXPECT_TRUE(quadgen::runtime::render_svg("t", {Panel{"a", "h", "m", {drawn, undefined}}}, &svg, &err)) << err;
+  EXPECT_TRUE(quadgen::runtime::render_svg("t", {Panel{"a", "h", "m", {undefined}}}, &svg, &err)) << err;
+}
+
+// The thesis' manoeuvres are flown as fractions of each vehicle's own hover thrust, so every
+// scenario flies the 27 g Crazyflie too (in newtons it was asked for 17 times its weight).
+// The climb's start is checked against its closed form: (1.1 / 0.9491 - 1) g upwards, the
+// thesis' 1.1 N per rotor on its 0.9491 N hover, whatever the vehicle.
+TEST(Cli, EveryScenarioFliesAnyVehicle) {
+  Scratch tmp;
+  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml"}) {
+    for (const char* scenario : {"hover", "climb", "right", "forward", "yaw", "new_height"}) {
+      const std::string out = tmp / (std::string(scenario) + ".csv");
+      const CliResult r =
+          run_quadgen({"simulate", source_path(file), "--scenario", scenario, "--duration", "3", "--out", out}, tmp.dir);
+      ASSERT_EQ(r.rc, 0) << file << " " << scenario << ": " << r.err;
+    }
+    const quadgen::runtime::CsvTable climb = quadgen::runtime::read_csv(tmp / "climb.csv");
+    const double t_end = 0.3, a = (1.1 / 0.9491 - 1) * 9.81;
+    size_t k = 0;
+    while (k + 1 < climb.rows.size() && climb.rows[k][climb.column("t")] < t_end - 1e-9) ++k;
+    ASSERT_NEAR(climb.rows[k][climb.column("t")], t_end, 1e-9);
+    EXPECT_NEAR(climb.rows[k][climb.column("z")], 0.5 * a * t_end * t_end, 0.05 * 0.5 * a * t_end * t_end) << file;
+    for (const char* scenario : {"hover", "climb", "right", "forward", "yaw", "new_height"})
+      fs::remove(tmp / (std::string(scenario) + ".csv")), fs::remove(tmp / (std::string(scenario) + ".svg"));
+    fs::remove(tmp / ".quadgen-files");
+  }
 }

@@ -19,6 +19,7 @@
 #include "tests/test_helpers.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/units.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;
@@ -134,6 +135,29 @@ TEST(Model, HoverIsAnEquilibrium) {
   x[6] = 1;
   const auto f = test::eval_f(m, x, {u, u, u, u});
   for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(f[i], 0.0, 1e-12) << m.states[i].name;
+}
+
+// The runtime reads poses out of state vectors at fixed offsets (runtime/rigid_body_state.hpp);
+// the derivation must put them there, with or without effects that add states, and each
+// block must mean what its name says: the position moves with the velocity, the attitude
+// turns with the body rates (q' = q ⊗ (0, w) / 2).
+TEST(Model, RigidBodyStatesComeFirstInTheirOrder) {
+  using namespace runtime::rigid_body;
+  for (const std::vector<std::string>& effects : {std::vector<std::string>{}, std::vector<std::string>{"motor_lag"}}) {
+    const SymbolicModel m = derive(test::finken3(), effects);
+    ASSERT_GE(m.states.size(), static_cast<size_t>(kNumStates));
+    for (int i = 0; i < kNumStates; ++i) EXPECT_EQ(m.states[i].name, kStateNames[i]) << i;
+    std::vector<double> x(m.states.size(), 0.0), u(m.inputs.size(), 0.0);
+    x[kAttitude] = 1;
+    x[kVelocity + 1] = 0.7;
+    x[kBodyRate] = 0.4;
+    const auto f = test::eval_f(m, x, u);
+    EXPECT_NEAR(f[kPosition + 1], 0.7, 1e-12);
+    EXPECT_NEAR(f[kPosition], 0.0, 1e-12);
+    EXPECT_NEAR(f[kAttitude + 1], 0.2, 1e-12);  // q'_x = w_x / 2 at the identity
+    EXPECT_NEAR(f[kAttitude], 0.0, 1e-12);
+  }
+  EXPECT_EQ(derive(test::finken3(), {"motor_lag"}).states[kNumStates].name.rfind("w_", 0), 0u);
 }
 
 TEST(Model, EveryEffectAtNominalValuesReproducesTheBaseModel) {

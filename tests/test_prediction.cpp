@@ -390,6 +390,10 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.open_loop_past_disturbance = {row(1.0, 1.001, 0), row(0.5, 0.02, 0)};
   s = quadgen::predict::what_limits_prediction(p);
   EXPECT_NE(s.find("leaves it at 1 m"), std::string::npos) << s;
+  // A model predicting its own flight: shares of round-off are not a diagnosis.
+  p.open_loop = {row(1.0, 1e-9, 0), row(0.5, 1e-10, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_EQ(s, "1 s ahead the open-loop position error is 1e-09 m: the model predicts this log to within its integration error.");
 }
 
 // The linear correction (the regression baseline of `predict --linear-correction`), fitted on

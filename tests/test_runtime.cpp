@@ -585,7 +585,7 @@ TEST(Simulate, BadReplayLogFailsWithOneLineAndNoOutput) {
 // integrators compensate a weak motor with a larger command (what the thesis saw as
 // motor signals offset from each other).
 #include "runtime/closed_loop.hpp"
-#include "codegen/runtime_bridge.hpp"
+#include "derive/runtime_view.hpp"
 namespace {
 double column_mean(const GeneratedFlight& f, const std::string& name, size_t from) {
   const int c = index_in(f.columns, name);

@@ -374,7 +374,7 @@ TEST(Ulog, ReadUlogReadsRegularFilesOnly) {
     return std::string();
   };
   EXPECT_EQ(error(dir.string()), dir.string() + ": a directory, not a regular file (expected a ULog file)");
-  EXPECT_EQ(error((dir / "missing.ulg").string()).rfind((dir / "missing.ulg").string() + ": cannot open log", 0), 0u);
+  EXPECT_EQ(error((dir / "missing.ulg").string()).rfind((dir / "missing.ulg").string() + ": cannot open a ULog file", 0), 0u);
   std::ofstream((dir / "cut.ulg").string(), std::ios::binary) << bytes.substr(0, bytes.size() - 5);
   EXPECT_TRUE(read_ulog((dir / "cut.ulg").string()).truncated);
   fs::remove_all(dir);

@@ -125,6 +125,8 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
     for (const auto& e : effect_catalogue()) out.push_back(e.name);
     return out;
   }
+  if (text.front() == ',' || text.back() == ',' || text.find(",,") != std::string::npos)
+    throw std::invalid_argument("effect list '" + text + "' has an empty name (a ',' at an end or two in a row)");
   std::set<std::string> known, seen;
   for (const auto& e : effect_catalogue()) known.insert(e.name);
   std::stringstream ss(text);

@@ -1,4 +1,4 @@
-#include "codegen/runtime_bridge.hpp"
+#include "derive/runtime_view.hpp"
 
 namespace quadgen {
 

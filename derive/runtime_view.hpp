@@ -1,6 +1,7 @@
-// What the runtime needs to know about a derived vehicle at its nominal parameters: each
-// rotor's thrust law (command <-> thrust) and the controller's belief for closed-loop
-// flights. One place, so simulation, tests and reports build them alike.
+// The derived vehicle at its nominal parameters, as the runtime takes it: each rotor's thrust
+// law (command <-> thrust) and the controller's belief for closed-loop flights. One place, so
+// simulation, tests and reports build them alike. Numbers only (the runtime's header-only
+// types): derive/ links nothing of the runtime.
 #pragma once
 #include <vector>
 

@@ -1,0 +1,30 @@
+// How long work tells a person how far it has got, kept apart from where the words go: the
+// command line sends them to the terminal (terminal_progress), a library caller wherever it
+// likes, and by default they go nowhere. Text is passed as it is; the terminal escapes it.
+#pragma once
+#include <functional>
+#include <string>
+
+namespace quadgen::output {
+
+struct Progress {
+  // A finished line: "[diagnose] base model fitted (12 s)".
+  std::function<void(const std::string&)> line;
+  // A counter the next report replaces: "[diagnose] step 1: 3/12 candidates (wind)". Called
+  // from worker threads under the caller's lock.
+  std::function<void(const std::string&)> counter;
+
+  void say(const std::string& text) const {
+    if (line) line(text);
+  }
+  void count(const std::string& text) const {
+    if (counter) counter(text);
+  }
+};
+
+// Standard error: lines as they come, every control character shown as an escape; counters
+// rewritten in place where standard error is a terminal, left out where it is a file (a CI
+// log would keep every one of them).
+Progress terminal_progress();
+
+}  // namespace quadgen::output

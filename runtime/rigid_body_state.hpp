@@ -1,0 +1,38 @@
+// Where the rigid body sits in every derived model's state vector. derive/dynamics.cpp
+// declares these thirteen states first and in this order for every vehicle; effects append
+// theirs after them (motor_lag: one rotor speed per rotor). Runtime code that reads a pose
+// out of a state vector uses these offsets rather than bare numbers
+// (`Model.RigidBodyStatesComeFirstInTheirOrder` checks the order against a derived model).
+#pragma once
+#include <array>
+
+#include "runtime/attitude.hpp"
+
+namespace quadgen::runtime::rigid_body {
+
+inline constexpr int kPosition = 0;    // x, y, z [m], world frame, z up
+inline constexpr int kVelocity = 3;    // vx, vy, vz [m/s], world frame
+inline constexpr int kAttitude = 6;    // qw, qx, qy, qz [1], body -> world, scalar first
+inline constexpr int kBodyRate = 10;   // p, q, r [rad/s], body frame
+inline constexpr int kNumStates = 13;  // the first state an effect adds
+
+// The states' names, in order (also the canonical flight-log columns of a pose).
+inline constexpr const char* kStateNames[kNumStates] = {"x",  "y",  "z",  "vx", "vy", "vz", "qw",
+                                                        "qx", "qy", "qz", "p",  "q",  "r"};
+
+// The velocity in body axes, R^T v, of a state vector.
+inline std::array<double, 3> body_velocity(const double* x) {
+  const Rotation R = rotation_matrix(&x[kAttitude]);
+  const double* v = &x[kVelocity];
+  std::array<double, 3> b{};
+  for (int a = 0; a < 3; ++a) b[a] = R.m[0][a] * v[0] + R.m[1][a] * v[1] + R.m[2][a] * v[2];
+  return b;
+}
+
+// The heading (Z-Y-X yaw) of a state vector [rad].
+inline double heading(const double* x) {
+  const double* q = &x[kAttitude];
+  return euler_zyx(q[0], q[1], q[2], q[3])[2];
+}
+
+}  // namespace quadgen::runtime::rigid_body
