@@ -1,6 +1,8 @@
 // diagnosis.json (the fields of docs/formats.md "diagnosis.json", with the evidence behind
 // every finding) and the report a person reads: one self-contained HTML page with its plots
-// inlined as SVG, so it renders in a browser without network access.
+// inlined as SVG, so it renders in a browser without network access. One file each
+// (diagnosis_json.cpp, diagnosis_plots.cpp, diagnosis_html.cpp, diagnosis_text.cpp for the
+// terminal summary); the sentences they share are in report_words.hpp.
 #pragma once
 #include <string>
 #include <utility>

@@ -353,11 +353,13 @@ void test_hook_die_before_commit() {
   if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
 }
 
+}  // namespace
+
 // Where an earlier run's folder goes when it still holds files after its own were removed
 // (files that appeared while this run wrote): a visible name of its own beside the output
 // (a short one if the output's name is too long to extend). It is marked first, so that even
 // where no rename succeeds no later run takes it for a stale staging folder and removes it.
-fs::path keep_aside(const fs::path& staged, const fs::path& target) {
+fs::path detail::keep_aside(const fs::path& staged, const fs::path& target) {
   std::ofstream(staged / kKeepMarker) << "an earlier quadgen output, kept because it held files quadgen did not write\n";
   const std::string pid = std::to_string(::getpid());
   for (const std::string& stem : {target.filename().string() + ".previous-" + pid, "quadgen-previous-" + pid})
@@ -371,6 +373,8 @@ fs::path keep_aside(const fs::path& staged, const fs::path& target) {
   return staged;
 }
 
+namespace {
+
 // After the exchange, the earlier run sits in `staged`: its own files go (those that still
 // match its manifest), anything else is kept aside.
 void remove_earlier_run(const fs::path& staged, const fs::path& target) {
@@ -380,7 +384,7 @@ void remove_earlier_run(const fs::path& staged, const fs::path& target) {
     if (unchanged_since(staged / name, hash_size, earlier)) fs::remove(staged / name, ec);
   fs::remove(staged / kManifestName, ec);
   if (fs::remove(staged, ec)) return;
-  std::cerr << "quadgen: note: the previous output was kept at " << printable(keep_aside(staged, target).string())
+  std::cerr << "quadgen: note: the previous output was kept at " << printable(detail::keep_aside(staged, target).string())
             << " (it held files that appeared or changed while this run wrote)\n";
 }
 

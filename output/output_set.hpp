@@ -99,4 +99,12 @@ class OutputFiles {
 // for users checking an output directory.
 bool complete_output_directory(const std::string& dir, std::string* why = nullptr);
 
+namespace detail {
+// Moves an earlier run's folder `staged` that still holds files quadgen did not write to a
+// visible name beside `target` ("<target>.previous-<pid>", or "quadgen-previous-<pid>" where
+// that name would be too long), marked so that no later run removes it; returns where it is
+// (`staged` itself if no rename succeeded). Declared here for its test.
+std::filesystem::path keep_aside(const std::filesystem::path& staged, const std::filesystem::path& target);
+}  // namespace detail
+
 }  // namespace quadgen::output

@@ -42,6 +42,7 @@
 #include "generated/finken3/model.hpp"
 #include "runtime/dynamic_model.hpp"
 #include "tests/estimate_shape.hpp"
+#include "tests/shared_data.hpp"
 
 namespace {
 
@@ -1352,8 +1353,8 @@ TEST(Acceptance, AnUnsettledComparisonIsSaidBesideTheGain) {
 // point let this log's vertical weight run down, halved c_t and named an input delay
 // instead of the lag (fifteenth session).
 TEST(RealData, ArplMotorLagIntervalContainsTheAuthorsValue) {
-  const fs::path log = fs::path(QUADGEN_SOURCE_DIR) / "../shared/data/crazyflie/arpl/log10.csv";
-  if (!fs::exists(log)) GTEST_SKIP() << "no ../shared/data beside the clone";
+  const fs::path log = quadgen::test::shared_data("crazyflie/arpl/log10.csv");
+  QUADGEN_NEEDS_SHARED_DATA(log);
   const fs::path dir = fresh_directory("quadgen_arpl_lag");
   const std::string source = QUADGEN_SOURCE_DIR;
   ASSERT_EQ(run(std::string(QUADGEN_BINARY) + " diagnose " + source + "/vehicles/crazyflie21.yaml " + log.string() +

@@ -1057,3 +1057,25 @@ TEST(Cli, EveryScenarioFliesAnyVehicle) {
     fs::remove(tmp / ".quadgen-files");
   }
 }
+
+// An earlier output that still holds files quadgen did not write is kept aside, under a name
+// beside the output; where "<name>.previous-<pid>" would pass the file system's name limit
+// (255 bytes), under a short one. Marked either way, so no later run takes it for a stale
+// staging folder.
+TEST(DataLoss, AnEarlierOutputIsKeptAsideEvenUnderALongName) {
+  Scratch tmp;
+  const std::string pid = std::to_string(::getpid());
+  for (const size_t length : {size_t{8}, size_t{250}}) {
+    const fs::path target = tmp.dir / std::string(length, 'o');
+    const fs::path staged = tmp.dir / ".staged";
+    fs::create_directories(staged);
+    write((staged / "notes.txt").string(), "a user's file\n");
+    const fs::path kept = quadgen::output::detail::keep_aside(staged, target);
+    const std::string expected = length < 200 ? target.filename().string() + ".previous-" + pid : "quadgen-previous-" + pid;
+    EXPECT_EQ(kept, tmp.dir / expected) << length;
+    EXPECT_FALSE(fs::exists(staged));
+    EXPECT_EQ(read(kept / "notes.txt"), "a user's file\n");
+    EXPECT_TRUE(fs::exists(kept / ".quadgen-keep"));
+    fs::remove_all(kept);
+  }
+}

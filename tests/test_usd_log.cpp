@@ -14,6 +14,7 @@
 #include "fit/log_reader.hpp"
 #include "runtime/usd_log.hpp"
 #include "tests/usd_log_writer.hpp"
+#include "tests/shared_data.hpp"
 
 using namespace quadgen;
 using namespace quadgen::runtime;
@@ -245,8 +246,8 @@ TEST(UsdLog, FilesAreRecognisedByTheirFirstBytes) {
 // read through data/mappings/crazyflie_usd.yaml must give the flight that the CSV gives through
 // data/mappings/arpl.yaml, to float precision.
 TEST(UsdLog, ARealFlightReadsAsItsDecodedCsvDoes) {
-  const fs::path source = fs::path(QUADGEN_SOURCE_DIR) / "../shared/data/crazyflie/arpl/log10.csv";
-  if (!fs::exists(source)) GTEST_SKIP() << "needs the shared data beside the clone: " << source;
+  const fs::path source = quadgen::test::shared_data("crazyflie/arpl/log10.csv");
+  QUADGEN_NEEDS_SHARED_DATA(source);
   std::ifstream in(source);
   std::string line, csv;
   std::getline(in, line);

@@ -1,0 +1,427 @@
+#include "diagnose/diagnosis_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "derive/effects/effect_catalogue.hpp"
+#include "diagnose/report_words.hpp"
+#include "fit/fit_report.hpp"
+#include "output/estimate.hpp"
+#include "output/sinks.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "runtime/plot.hpp"
+
+namespace quadgen::diagnose {
+
+using namespace words;
+
+namespace {
+
+std::string esc(const std::string& s) { return output::html_text(s); }
+
+// A discovered term's verdict for the report: "proposed" in bold, said once (the verdict
+// text may already begin with it).
+std::string verdict_cell(const DiscoveredTerm& t) {
+  const std::string said = t.proposed ? "proposed" : "not proposed";
+  const bool begins = t.verdict.rfind(said, 0) == 0;
+  const std::string rest = begins ? t.verdict.substr(said.size()) : ": " + t.verdict;
+  return (t.proposed ? "<b>proposed</b>" : said) + output::html_text(rest);
+}
+
+// The unit of a residual channel, as the diagnosis names its channels.
+std::string channel_unit(const Diagnosis& d, const std::string& channel) {
+  for (size_t c = 0; c < d.channel_names.size() && c < d.channel_units.size(); ++c)
+    if (d.channel_names[c] == channel) return d.channel_units[c];
+  return "";
+}
+
+// The command-gain check as a table: per flight (or the one flight) and axis, the gain,
+// correlation and delay in each band; the leads below it.
+void command_gain_html(std::ostream& h, const Diagnosis& d) {
+  const auto rows = command_gains_by_flight(d);
+  const CommandGain* first = nullptr;
+  for (const auto& [flight, g] : rows)
+    if (g->measured && !first) first = g;
+  if (!first) return;
+  h << "<h2>The answer to the commands</h2>\n<p>Gain of the measured on the base model's accelerations, band by band "
+       "(1: the motor map's slope at the operating point is right), with the correlation and the delay of the model "
+       "that correlates best. The lowest band carries the controller's answer to slow disturbances.</p>\n"
+       "<table><tr>"
+    << (d.command_gain_per_flight.empty() ? "" : "<th>flight</th>") << "<th>axis</th>";
+  for (const auto& b : first->axes.front().bands) h << "<th>" << num(b.low_hz, 2) << "&ndash;" << num(b.high_hz, 2) << " Hz</th>";
+  h << "</tr>\n";
+  for (const auto& [flight, g] : rows) {
+    if (!g->measured) continue;
+    for (const auto& a : g->axes) {
+      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td>" + esc(flight) + "</td>") << "<td>" << esc(a.name) << "</td>";
+      for (const auto& b : a.bands)
+        h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
+      h << "</tr>\n";
+    }
+  }
+  h << "</table>\n";
+  for (const auto& [flight, lead] : command_gain_leads(d))
+    h << "<p class=\"warn\">" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+}
+
+// Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
+// for which none is proposed.
+void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
+  if (d.discovered.empty()) return;
+  h << "<h2>Beyond the catalogue: proposed terms</h2>\n<p>Sparse regression (sequentially thresholded least "
+       "squares) of what the final model still gets wrong on the training part, over the constant, body velocity, "
+       "body rates, mean command U, battery voltage and their pairwise products; sparsity chosen by "
+       "cross-validation, a term kept only if significant after correction for the regressors searched, and "
+       "proposed only if it predicts the held-out part better. What a term means physically is for you to "
+       "decide; it is not a named cause.</p>\n<table><tr><th>channel</th><th>term added to the model</th>"
+       "<th>coefficients (95 % interval)</th><th>held-out RMS</th><th>verdict</th></tr>\n";
+  for (const auto& t : d.discovered) {
+    h << "<tr><td>" << esc(t.channel) << "</td><td>" << (t.coefficients.empty() ? "&mdash;" : esc(t.expression()))
+      << "</td><td>";
+    for (size_t i = 0; i < t.coefficients.size(); ++i) {
+      const auto& c = t.coefficients[i];
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, 3) << " " << interval(c.lower, c.upper, 3) << " " << esc(c.unit);
+    }
+    h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
+      << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+  const auto& g = d.terms_gain;
+  if (g.measured)
+    h << "<p>With the proposed terms regenerated into the model (<code>discovered_model.hpp</code>) and simulated like an "
+         "effect: "
+      << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per validation fold "
+      << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ").</p>\n";
+  else if (!g.note.empty())
+    h << "<p>" << esc(g.note) << ".</p>\n";
+}
+
+// A per-flight finding at a glance: one row per parameter, one column per flight, each cell
+// the value and its 95 % interval (and the verdict when it is not "identifiable").
+void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
+  std::map<std::string, std::vector<const EffectEstimate*>> rows;
+  std::map<std::string, std::string> units;
+  for (const auto& p : f.parameters) {
+    auto& row = rows[runtime::shared_name(p.name)];
+    row.resize(flights, nullptr);
+    const size_t k = static_cast<size_t>(runtime::flight_of_name(p.name)) - 1;
+    if (k < flights) row[k] = &p;
+    units[runtime::shared_name(p.name)] = p.unit;
+  }
+  h << "<table><tr><th>parameter [unit]</th>";
+  for (size_t k = 0; k < flights; ++k) h << "<th>flight " << k + 1 << "</th>";
+  h << "</tr>\n";
+  for (const auto& [name, row] : rows) {
+    h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
+    for (const auto* p : row)
+      if (p)
+        h << "<td>" << num(p->value, 3) << " " << interval(p->lower, p->upper, 3)
+          << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
+      else h << "<td>–</td>";
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+}
+
+// Each named airframe parameter per flight as a forest plot in the table: the flight's 95 %
+// interval as a bar, its value as a dot, the joint value as a vertical line; agreeing
+// flights' bars all cross the line.
+void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgreement>& list,
+                          const std::vector<std::string>& flights, const std::string& reference_name) {
+  for (const auto& a : list) {
+    double lo = a.joint_value, hi = a.joint_value;
+    for (const auto& f : a.flights)
+      for (double v : {f.value, f.lower, f.upper})
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    const double pad = 0.05 * (hi - lo) + 1e-300;
+    lo -= pad, hi += pad;
+    const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
+    h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
+      << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>"
+      << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
+      << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
+      << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
+         "<th style=\"width:40%\">at a glance</th></tr>\n";
+    for (size_t k = 0; k < a.flights.size(); ++k) {
+      const FlightEstimate& f = a.flights[k];
+      h << "<tr><td>" << k + 1 << ". " << esc(k < flights.size() ? flights[k] : std::string()) << "</td><td>"
+        << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
+        << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
+        << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
+      if (std::isfinite(f.lower) && std::isfinite(f.upper))
+        h << "<div style=\"position:absolute;left:" << at(f.lower) << ";width:calc(" << at(f.upper) << " - " << at(f.lower)
+          << ");top:5px;height:4px;background:#357\"></div>";
+      h << "<div style=\"position:absolute;left:calc(" << at(f.value) << " - 4px);top:3px;width:8px;height:8px;"
+        << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
+    }
+    h << "</table>\n";
+  }
+}
+
+void agreement_html(std::ostringstream& h, const Diagnosis& d) {
+  if (!d.airframe_check.empty()) {
+    h << "<h2>Against the airframe</h2>\n<p>The named effects of the airframe in " << esc(d.airframe_source)
+      << " refitted on this flight's training part (the airframe's other values held, this flight's own thrust "
+         "constant and trims free). The flight agrees with the airframe when the difference is within 1.96 of its "
+         "standard error (both estimates' errors) and below 30 %. Line: the airframe's value.</p>\n";
+    agreement_table_html(h, d.airframe_check, d.flights, "airframe");
+  }
+  if (d.agreement.empty()) return;
+  h << "<h2>Do the flights agree?</h2>\n<p>Each named airframe effect refitted on each flight's training part alone "
+       "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
+       "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
+       "joint estimate). \"Alone\": the effect's "
+       "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
+       "value and the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
+       "median spread the flights would show if each measured the pooled value with its own standard error, and the "
+       "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
+       "wider, however well they agree.</p>\n";
+  agreement_table_html(h, d.agreement, d.flights, "joint");
+}
+
+// The page's head, the title (the flights numbered: per-flight values refer to these
+// numbers), what was fitted to what, and the screening's warnings.
+void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log_path) {
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>quadgen diagnosis: " << esc(d.vehicle)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+       "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+       "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
+       "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
+       ".headline{font-size:1.1em}</style></head><body>\n";
+  // Several flights: their count in the title (their paths, a wall of text there, numbered
+  // below it: the per-flight values refer to these numbers).
+  const std::string subject = d.flights.size() > 1    ? std::to_string(d.flights.size()) + " flights"
+                              : d.flights.size() == 1 ? d.flights[0]  // the others left out, said below
+                                                      : log_path;
+  h << "<h1>Diagnosis of " << esc(subject) << " (" << esc(d.vehicle) << ")</h1>\n";
+  if (d.flights.size() > 1) {
+    h << "<ol>\n";
+    for (const auto& f : d.flights) h << "<li>" << esc(f) << "</li>\n";
+    h << "</ol>\n";
+  }
+  h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples;
+  if (d.flights.size() > 1)
+    h << " validation samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
+      << "vehicle parameters)";
+  else
+    h << " validation samples from t = " << num(d.t_split, 4) << " s";
+  h << "; " << num(d.seconds, 3) << " s.</p>\n";
+  for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
+}
+
+// One line per named cause and the held-out gain, then the command's own printout (for a
+// reader who compares it with a terminal) and the overall gain.
+void in_short_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
+  if (d.findings.empty()) h << "<li>No cause named.</li>\n";
+  for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";
+  if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
+  if (!d.findings.empty())
+    h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
+      << num(reduction(d.metric_before, d.metric_after), 2) << " % better (" << esc(d.metric) << " "
+      << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
+  // The command's own printout, for a reader who compares it with a terminal; the sections
+  // below say the same in tables.
+  h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
+    << "</pre></details>\n";
+  h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
+    << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
+}
+
+void findings_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>Findings</h2>\n";
+  if (d.findings.empty()) h << "<p>None.</p>\n";
+  if (!d.per_flight_effects.empty()) {
+    h << "<p>One value per flight for ";
+    for (size_t i = 0; i < d.per_flight_effects.size(); ++i) h << (i ? ", " : "") << esc(d.per_flight_effects[i]);
+    h << " (a property of the flight, not of the airframe): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
+         "<i>k</i>'s (flights numbered as under the title).</p>\n";
+  }
+  for (const auto& f : d.findings) {
+    h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
+      << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
+      << num(reduction(f.before, f.after), 3) << " % lower)" << esc(beside_gain_text(f)) << ".</p>\n";
+    const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
+                                                              f.effect) != d.per_flight_effects.end();
+    if (per_flight) {
+      per_flight_table(h, f, d.flights.size());
+      h << "<p>Intervals: each flight's value &plusmn; 1.96 standard errors of the joint fit (Wald), which includes "
+           "the uncertainty of the airframe's parameters; the airframe's parameters have profile-likelihood "
+           "intervals.</p>\n";
+    }
+    else {
+      h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
+      for (const auto& p : f.parameters)
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>" << interval(p.lower, p.upper)
+          << "</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+      h << "</table>\n";
+    }
+    h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
+      << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
+      << ".</p>\n";
+  }
+}
+
+void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
+  if (!d.stand_ins.empty()) {
+    h << "<h2>Stand-ins for missing physics</h2>\n<p>Each passed every statistical test, but its value lies outside "
+         "what its physics can produce here: it absorbs an error of something the model lacks. It stays in the "
+         "extended model and is not named.</p>\n<table><tr><th>effect</th><th>value</th><th>plausible</th><th>why</th>"
+         "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
+    for (const auto& st : d.stand_ins) {
+      h << "<tr><td>" << esc(st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
+        << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
+        << esc(st.why) << "</td><td>";
+      for (size_t c = 0; c < st.channels.size(); ++c)
+        h << (c ? "; " : "") << esc(st.channels[c]) << " " << num(st.rms_without[c], 3) << " &rarr; "
+          << num(st.rms_with[c], 3);
+      h << "</td></tr>\n";
+    }
+    h << "</table>\n";
+  }
+}
+
+void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
+  if (!d.search.unresolved.empty()) {
+    h << "<h2>Ambiguous</h2>\n";
+    for (const auto& a : d.search.unresolved)
+      h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b)
+        << "</b>: both explain the discrepancy and neither adds anything significant to the other (p = "
+        << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
+        << ".</p>\n";
+  }
+}
+
+// Slow structure the catalogue leaves, and the draft check's leads.
+void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
+  if (!d.unexplained.empty()) {
+    h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
+    for (const auto& u : d.unexplained)
+      h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << esc(u.unit) << "</td><td>" << num(u.ratio, 3)
+        << "</td><td>" << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
+        << "</td></tr>\n";
+    h << "</table>\n";
+  }
+  for (const auto& [flight, lead] : draft_leads(d))
+    h << "<p>" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+}
+
+void prediction_html(std::ostringstream& h, const Diagnosis& d) {
+  if (d.has_prediction) {
+    // Comparable with published models: the error AT a horizon, averaged over start points.
+    h << "<h2>Prediction on the validation part</h2>\n";
+    if (d.prediction_after.open_loop.empty())
+      h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state); one-step errors only.</p>\n";
+    h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
+         "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
+         "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
+         "<th>position, past disturbance held, extended [m]</th></tr>\n";
+    const auto& b = d.prediction_before;
+    const auto& a = d.prediction_after;
+    for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
+      h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << num(b.open_loop[i].position.mean()) << "</td><td>"
+        << num(a.open_loop[i].position.mean()) << "</td><td>" << num(a.open_loop[i].tilt.mean()) << "</td><td>"
+        << num(a.open_loop[i].heading.mean()) << "</td><td>"
+        << (i < a.attitude_replayed.size() ? num(a.attitude_replayed[i].position.mean()) : "–") << "</td><td>"
+        << (i < a.translation_replayed.size() ? num(a.translation_replayed[i].tilt.mean()) : "–") << "</td><td>"
+        << (i < a.open_loop_past_disturbance.size() ? num(a.open_loop_past_disturbance[i].position.mean()) : "–")
+        << "</td></tr>\n";
+    h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
+      << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "
+      << num(a.one_step.specific_force[2].rms(), 3) << " m/s², angular acceleration "
+      << num(a.one_step.angular_acceleration[0].rms(), 3) << " / " << num(a.one_step.angular_acceleration[1].rms(), 3) << " / "
+      << num(a.one_step.angular_acceleration[2].rms(), 3) << " rad/s², world vertical acceleration "
+      << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
+    if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
+      h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
+  }
+}
+
+void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
+       "<th>reduction %</th></tr>\n";
+  for (const auto& c : d.channel_gain)
+    h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
+      << "</td><td>" << num(c.after) << "</td><td>" << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
+  h << "</table>\n";
+}
+
+void base_residuals_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
+       "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
+  for (const auto& c : d.before.channels) {
+    h << "<tr><td>" << esc(c.name) << "</td><td>" << esc(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
+      << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
+      << "</td><td>" << num(c.slow_ratio, 3) << "</td><td>";
+    for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)
+      h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << num(c.correlations[i].r, 2) << ")";
+    h << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
+
+void candidates_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<h2>Candidates</h2>\n";
+  for (size_t s = 0; s < d.search.steps.size(); ++s) {
+    const auto& st = d.search.steps[s];
+    h << "<h3>Step " << s + 1 << " (model: base";
+    for (const auto& e : st.base_effects) h << " + " << esc(e);
+    h << ")</h3>\n<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
+    for (const auto& c : st.candidates)
+      h << "<tr><td>" << esc(c.effect) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
+        << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
+        << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not))
+        << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
+    h << "</table>\n";
+  }
+}
+
+void plots_html(std::ostringstream& h, const std::vector<std::pair<std::string, std::string>>& plots) {
+  h << "<h2>Plots</h2>\n";
+  if (plots.empty()) h << "<p>No plots (gnuplot unavailable).</p>\n";
+  for (const auto& [name, svg] : plots) {
+    const size_t at = svg.find("<svg");
+    const std::string stem = name.substr(0, name.rfind('.'));
+    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name);
+    h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
+    h << "</figcaption></figure>\n";
+  }
+}
+
+void method_html(std::ostringstream& h) {
+  h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
+       "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
+       "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
+       "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the validation part. "
+       "Intervals are profile-likelihood intervals with the same weights, widened on both sides by the change of the "
+       "estimate when the interval accelerations use the trapezoid instead of the midpoint rule (discretisation error).</p>\n</body></html>\n";
+}
+
+}  // namespace
+
+std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
+                           const std::vector<std::pair<std::string, std::string>>& plots) {
+  std::ostringstream h;
+  head_html(h, d, log_path);
+  in_short_html(h, d);
+  findings_html(h, d);
+  agreement_html(h, d);
+  stand_ins_html(h, d);
+  ambiguous_html(h, d);
+  unexplained_html(h, d);
+  command_gain_html(h, d);
+  discovered_terms_html(h, d);
+  prediction_html(h, d);
+  validation_channels_html(h, d);
+  base_residuals_html(h, d);
+  candidates_html(h, d);
+  plots_html(h, plots);
+  method_html(h);
+  return h.str();
+}
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,142 @@
+#include "diagnose/diagnosis_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "derive/effects/effect_catalogue.hpp"
+#include "diagnose/report_words.hpp"
+#include "fit/fit_report.hpp"
+#include "output/estimate.hpp"
+#include "output/sinks.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "runtime/plot.hpp"
+
+namespace quadgen::diagnose {
+
+using namespace words;
+
+namespace {
+
+runtime::Series series(const std::string& label, const std::vector<double>& x, const std::vector<double>& y,
+                       size_t stride = 1, bool points = false) {
+  runtime::Series s{label, {}, {}, points};
+  for (size_t i = 0; i < x.size() && i < y.size(); i += stride) {
+    s.x.push_back(x[i]);
+    s.y.push_back(y[i]);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(
+    const Diagnosis& d, const fit::Flight& valid, std::string* error,
+    std::vector<std::pair<std::string, std::string>>* data) {
+  std::vector<std::pair<std::string, std::string>> out;
+  // One colour per model in every plot: measured black, base model red, extended model blue.
+  const std::map<std::string, std::string> colours = {{"measured", "#000000"},
+                                                       {"base model", "#d62728"},
+                                                       {"extended model", "#1f77b4"},
+                                                       {"95 % white-noise band", "#7f7f7f"},
+                                                       {"", "#7f7f7f"}};
+  auto render = [&](const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
+    for (auto& p : panels)
+      for (auto& s : p.series)
+        for (const auto& [model, colour] : colours)  // "base model, tilt" is the base model's too
+          if (!model.empty() && (s.label == model || s.label.rfind(model + ",", 0) == 0)) s.color = colour;
+    if (data) data->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
+    std::string svg;
+    if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
+  };
+  const size_t stride = std::max<size_t>(1, d.t.size() / 3000);
+  // Measured vs simulated positions on the validation part.
+  if (!d.sim_before.t.empty()) {
+    std::vector<runtime::Panel> panels;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> tm, ym;
+      for (const auto& s : valid.samples) tm.push_back(s.t), ym.push_back(s.x[a]);
+      const auto& yb = a == 0 ? d.sim_before.x : a == 1 ? d.sim_before.y : d.sim_before.z;
+      const auto& ya = a == 0 ? d.sim_after.x : a == 1 ? d.sim_after.y : d.sim_after.z;
+      panels.push_back({std::string("position ") + axes[a] + " (validation, open-loop windows)", "t [s]", "m",
+                        {series("measured", tm, ym, 1, true), series("base model", d.sim_before.t, yb),
+                         series("extended model", d.sim_after.t, ya)}});
+    }
+    render("validation.svg", d.vehicle + ": measured vs simulated, before and after", panels);
+    // The simulation's error over time, per quantity.
+    const struct {
+      const char* title;
+      const char* unit;
+      std::vector<double> WindowedSimulation::*err;
+    } quantities[] = {{"position error", "m", &WindowedSimulation::e_pos},
+                      {"velocity error", "m/s", &WindowedSimulation::e_vel},
+                      {"attitude error (rotation angle)", "rad", &WindowedSimulation::e_att},
+                      {"body-rate error", "rad/s", &WindowedSimulation::e_rate}};
+    std::vector<runtime::Panel> errs;
+    for (const auto& q : quantities)
+      errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", q.unit,
+                      {series("base model", d.sim_before.t, d.sim_before.*q.err),
+                       series("extended model", d.sim_after.t, d.sim_after.*q.err)}});
+    render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", errs);
+  }
+  // Residuals over time.
+  std::vector<runtime::Panel> res;
+  for (int c = 0; c < 6; ++c) {
+    std::vector<double> rb, ra;
+    for (size_t k = 0; k < d.t.size(); ++k) rb.push_back(d.residual_before[k * 6 + c]), ra.push_back(d.residual_after[k * 6 + c]);
+    res.push_back({d.channel_names[c] + " residual (model - measured; dashed: held-out part starts)", "t [s]",
+                   d.channel_units[c], {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)},
+                   d.validation_starts});
+  }
+  render("residuals.svg",
+         d.vehicle + ": equation-error residuals (" +
+             (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
+                                   : "validation from t = " + std::to_string(d.t_split).substr(0, 5) + " s") + ")",
+         res);
+  // Autocorrelation with the white-noise band.
+  std::vector<runtime::Panel> acf;
+  for (size_t c = 0; c < d.before.channels.size(); ++c) {
+    const auto& b = d.before.channels[c];
+    const auto& a = d.after.channels[c];
+    std::vector<double> lag, band, nband;
+    const double dt = d.t.size() > 1 ? (d.t.back() - d.t.front()) / static_cast<double>(d.t.size() - 1) : 0.01;
+    for (size_t k = 0; k < b.acf.size(); ++k) lag.push_back(static_cast<double>(k) * dt), band.push_back(b.acf_band), nband.push_back(-b.acf_band);
+    acf.push_back({b.name + " autocorrelation", "lag [s]", "1",
+                   {series("base model", lag, b.acf), series("extended model", lag, a.acf), series("95 % white-noise band", lag, band),
+                    series("", lag, nband)}});
+  }
+  render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
+  // The answer to the commands, band by band: one series per flight, 1 where the model is right.
+  std::vector<std::pair<std::string, const CommandGain*>> gains;
+  for (const auto& [flight, g] : command_gains_by_flight(d))
+    gains.emplace_back(flight.empty() ? "this flight" : std::filesystem::path(flight).stem().string(), g);
+  std::vector<runtime::Panel> gain_panels;
+  for (size_t a = 0; a < 3; ++a) {
+    runtime::Panel panel{"", "band centre [Hz]", "gain (1: as the model)", {}};
+    std::vector<double> hz;
+    for (const auto& [flight, g] : gains) {
+      if (!g->measured || g->axes.size() <= a) continue;
+      panel.title = g->axes[a].name + ": measured over the base model's answer to the commands";
+      std::vector<double> x, y;
+      for (const auto& b : g->axes[a].bands) x.push_back(std::sqrt(b.low_hz * b.high_hz)), y.push_back(b.gain);
+      hz = x;
+      panel.series.push_back(series(flight, x, y, 1, true));
+    }
+    if (hz.empty()) continue;
+    panel.series.push_back(series("the model", hz, std::vector<double>(hz.size(), 1.0)));
+    gain_panels.push_back(panel);
+  }
+  if (!gain_panels.empty()) render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
+  if (d.has_prediction)
+    render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
+           predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
+  if (!d.search.profiles.empty())
+    render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", fit::profile_panels(d.search.profiles));
+  return out;
+}
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,93 @@
+#include "diagnose/diagnosis_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "derive/effects/effect_catalogue.hpp"
+#include "diagnose/report_words.hpp"
+#include "fit/fit_report.hpp"
+#include "output/estimate.hpp"
+#include "output/sinks.hpp"
+#include "runtime/per_flight_model.hpp"
+#include "runtime/plot.hpp"
+
+namespace quadgen::diagnose {
+
+using namespace words;
+
+std::string diagnosis_summary(const Diagnosis& d) {
+  std::ostringstream os;
+  for (const auto& note : screening_notes(d)) os << note << "\n";
+  if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
+    os << "no significant discrepancy: the base model explains the flight\n";
+  for (const auto& f : d.findings) {
+    os << "found " << f.effect << ":";
+    for (const auto& p : f.parameters)
+      os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
+    os << "; " << f.metric << ", the final model without it -> with it: " << num(f.before) << " -> " << num(f.after)
+       << beside_gain_text(f) << "\n  "
+       << headline(f) << "\n";
+  }
+  for (const auto& a : d.agreement) {
+    os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+       << " %" << spread_context(a) << ", Cochran's Q p = " << num(a.q_p_value, 2) << "):";
+    for (size_t k = 0; k < a.flights.size(); ++k)
+      os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
+    os << "\n";
+  }
+  for (const auto& a : d.airframe_check)
+    os << "this flight " << (a.agree ? "agrees" : "disagrees") << " with the airframe on " << a.parameter << ": "
+       << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
+       << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
+       << ")\n";
+  for (const auto& a : d.search.unresolved)
+    os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
+       << "); to separate them: " << a.manoeuvre << "\n";
+  for (const auto& st : d.stand_ins)
+    os << "stands in for missing physics, not named: " << st.candidate.effect << " (" << st.parameter << " = "
+       << num(st.value) << " " << st.unit << " lies outside [" << num(st.plausible_lower) << ", "
+       << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
+       << ": " << st.why << ")\n";
+  for (const auto& x : d.suspected)
+    os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
+  for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
+  if (!d.search.left_at_limit.empty()) {
+    os << "the search stopped at its limit of " << d.search.steps.size()
+       << (d.search.steps.size() == 1 ? " effect" : " effects") << " (--max-effects); still significant in its last step:";
+    for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
+      const auto& ev = d.search.left_at_limit[k];
+      os << (k ? ", " : " ") << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible")
+         << ")";
+    }
+    os << "\n";
+  }
+  for (const auto& p : d.at_bounds)
+    os << "caution: " << p.name << " = " << num(p.value) << (p.unit == "1" ? "" : " " + p.unit)
+       << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
+  for (const auto& u : d.unexplained)
+    os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
+       << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
+       << u.signal << " (r = " << num(u.r, 2) << ")\n";
+  for (const auto& [flight, lead] : draft_leads(d))
+    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
+  for (const auto& [flight, lead] : command_gain_leads(d))
+    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
+  for (const auto& t : d.discovered)
+    if (t.proposed)
+      os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
+         << t.verdict << "\n";
+  if (d.terms_gain.measured)
+    os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
+       << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
+       << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")\n";
+  if (d.has_prediction)
+    if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
+      os << "prediction of the extended model on the held-out part: " << limits << "\n";
+  return os.str();
+}
+
+}  // namespace quadgen::diagnose

@@ -1,0 +1,204 @@
+#include "diagnose/report_words.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "fit/fit_report.hpp"
+#include "output/estimate.hpp"
+#include "output/sinks.hpp"
+
+namespace quadgen::diagnose::words {
+
+using output::number_or_null;
+
+namespace {
+
+// One sentence for the printout and the report when an axis shows the draft's signature on
+// both parts ("" otherwise: then there is nothing to say beyond the JSON).
+std::string draft_lead(const DraftSignature& d) {
+  const auto axes = d.axes_showing_it();
+  if (axes.empty()) return "";
+  std::string s = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
+                  "moving through the rotors would, on axis ";
+  for (size_t i = 0; i < axes.size(); ++i) s += (i ? " and " : "") + axes[i];
+  s += " (1 s means, the velocity along the axis partialled out, p <= " + num(DraftSignature::kLevel, 2) +
+       " on both parts";
+  for (const auto& p : d.parts) {
+    s += "; " + p.name;
+    for (const auto& axis : axes) {
+      const auto& pair = axis == "y (roll)" ? p.y_roll : p.x_pitch;
+      s += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", p = " + num(pair.p, 2) +
+           ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
+    }
+    if (p.implied_speed > 0) s += ", draft at most " + num(p.implied_speed, 2) + " m/s";
+  }
+  return s + "); no logged signal measures the air";
+}
+
+// A check's sentences, each with the flight it is about (empty for the diagnosis as a whole;
+// a joint diagnosis adds one per flight that shows it), unescaped for each sink.
+template <class Check, class Lead>
+std::vector<std::pair<std::string, std::string>> leads(const Check& whole, const std::vector<Check>& per_flight,
+                                                       const Diagnosis& d, Lead lead_of) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (std::string lead = lead_of(whole); !lead.empty()) out.emplace_back("", std::move(lead));
+  for (size_t i = 0; i < per_flight.size() && i < d.flights.size(); ++i)
+    if (std::string lead = lead_of(per_flight[i]); !lead.empty())
+      out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
+  return out;
+}
+
+// One sentence for the printout and the report when the airframe's answer to the commands
+// puts the motor map's slope in doubt ("" otherwise: the JSON holds the bands).
+std::string command_gain_lead(const CommandGain& g) {
+  if (!g.slope_looks_off()) return "";
+  const auto& roll = g.axes[0].bands[CommandGain::kLeadBand];
+  const auto& pitch = g.axes[1].bands[CommandGain::kLeadBand];
+  const auto& vertical = g.axes[2].bands[CommandGain::kLeadBand];
+  return "lead (not a named cause): at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) +
+         " Hz the airframe answers a change of rotor command at " + num(roll.gain, 2) + " (roll, r = " + num(roll.r, 2) +
+         ", " + num(1000 * roll.delay_s, 2) + " ms later) and " + num(pitch.gain, 2) + " (pitch, r = " + num(pitch.r, 2) +
+         ", " + num(1000 * pitch.delay_s, 2) + " ms later) of what the base model's motor map gives, the vertical at " +
+         num(vertical.gain, 2) + " (r = " + num(vertical.r, 2) + "). Either the motor map's slope at the operating " +
+         "point (mean command " + num(g.hover_command, 2) + ") is off (a map measured on a stand: motor_map slope " +
+         num(g.suggested_slope(), 2) + " with pivot " + num(g.hover_command, 2) + ") or the controller answers a " +
+         "disturbance in this band, which reads the same in closed loop; a flight with a known excitation added to " +
+         "the rate set points separates them";
+}
+
+}  // namespace
+
+// A reduction to show: 0 where it is undefined (a diverged simulation, nothing before).
+double reduction(double before, double after) {
+  return before > 0 && std::isfinite(before) && std::isfinite(after) ? percent_lower(before, after) : 0.0;
+}
+
+// The finding in one sentence (the effect's own words), from its values: a per-flight
+// parameter at its mean over the flights.
+std::string headline(const Finding& f) {
+  const Effect& e = find_effect(f.effect);
+  std::vector<std::pair<std::string, double>> named;
+  for (const auto& p : f.parameters) named.emplace_back(p.name, p.value);
+  const std::map<std::string, double> values = runtime::mean_over_flights(named);
+  std::string reference;
+  if (e.first_parameter_is_reference)
+    for (const auto& p : f.evidence.parameters)
+      if (effect_of_parameter(p.name) == f.effect && !p.free && runtime::flight_of_name(p.name) == 1) {
+        reference = p.name;
+        break;
+      }
+  std::string s = e.headline(values, reference);
+  if (values.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
+  return s;
+}
+
+// Where the rotor drag force acts, when the diagnosis names both halves of it: the force
+// (rotor_drag, at the CoG) and its forward-flight moment (blade_flapping) have coefficients of
+// their own, and a force at height h above the CoG gives exactly blade_flapping.k =
+// h rotor_drag.k (r x F with r = (0, 0, h)). Their ratio is that height, estimated rather than
+// assumed from the blocks. The interval is the delta method on the two standard errors with
+// their covariance neglected: a rough one, said so in diagnosis.json.
+
+std::optional<PointOfAction> point_of_action(const Diagnosis& d) {
+  const EffectEstimate *drag = nullptr, *flap = nullptr;
+  for (const auto& f : d.findings)
+    for (const auto& p : f.parameters) {
+      if (p.name == "rotor_drag.k") drag = &p;
+      if (p.name == "blade_flapping.k") flap = &p;
+    }
+  if (!drag || !flap || !(std::fabs(drag->value) > 0)) return std::nullopt;
+  PointOfAction out;
+  out.height = flap->value / drag->value;
+  const double rel_f = flap->standard_error / flap->value, rel_d = drag->standard_error / drag->value;
+  const double se = std::fabs(out.height) * std::sqrt(rel_f * rel_f + rel_d * rel_d);
+  if (std::isfinite(se) && se > 0) out.lower = out.height - fit::kZ95 * se, out.upper = out.height + fit::kZ95 * se;
+  return out;
+}
+
+std::string point_of_action_headline(const PointOfAction& p) {
+  std::ostringstream os;
+  os << "The rotor drag force acts " << std::fixed << std::setprecision(0) << std::fabs(1000 * p.height) << " mm "
+     << (p.height >= 0 ? "above" : "below") << " the centre of gravity (blade_flapping.k / rotor_drag.k)";
+  return os.str();
+}
+
+// The command-gain check per flight of a joint diagnosis (the flight's log), or the one
+// flight's (named "").
+std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(const Diagnosis& d) {
+  std::vector<std::pair<std::string, const CommandGain*>> out;
+  if (d.command_gain_per_flight.empty()) out.emplace_back("", &d.command_gain);
+  for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
+    out.emplace_back(d.flights[i], &d.command_gain_per_flight[i]);
+  return out;
+}
+
+// What the screening says in words: flights left out, or a caution on an unusable flight
+// diagnosed anyway (alone, or when no flight given was usable).
+std::vector<std::string> screening_notes(const Diagnosis& d) {
+  std::vector<std::string> out;
+  for (const auto& s : d.screening) {
+    if (s.usable) continue;
+    const std::string source = output::printable(s.source);  // printed to a terminal too
+    out.push_back(s.left_out ? "left out: " + source + ": " + s.reason +
+                                   "; it would bend the airframe to explain motors that cannot give what was asked"
+                             : "caution: " + source + ": " + s.reason +
+                                   "; the commands there do not tell the thrust, and what is found may stand in for that");
+  }
+  return out;
+}
+
+std::string num(double v, int prec) {
+  if (!std::isfinite(v)) return "–";
+  std::ostringstream os;
+  os.precision(prec);
+  os << v;
+  return os.str();
+}
+
+std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d) {
+  return leads(d.draft, d.draft_per_flight, d, draft_lead);
+}
+
+std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagnosis& d) {
+  return leads(d.command_gain, d.command_gain_per_flight, d, command_gain_lead);
+}
+
+// Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a
+// finding: say so beside the rollouts' numbers, which then show no gain (or a loss).
+std::string judged_by_text(const Finding& f) {
+  if (f.accepted_by == Finding::kByForceModelAlone)
+    return "; accepted by the force model alone: with the measured attitude replayed the held-out position RMSE is " +
+           num(f.force_alone.mean, 3) + " m +- " + num(f.force_alone.standard_error, 3) +
+           " m lower per fold, and the equation-error cost " + num(f.one_step.cost.mean, 3) + " % +- " +
+           num(f.one_step.cost.standard_error, 3) +
+           " % lower, neither kind of channel worse (the open loop is dominated by the moment model's attitude drift)";
+  if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
+  return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
+         " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
+}
+
+std::string beside_gain_text(const Finding& f) {
+  // A comparison whose weights had not settled is less certain than its spread says.
+  const std::string unsettled =
+      !f.comparison || f.comparison->settled
+          ? ""
+          : "; the model without it had not settled its weights after " + std::to_string(f.comparison->refits) +
+                " refits (last change " + num(f.comparison->last_change_percent, 2) + " %)";
+  return judged_by_text(f) + unsettled;
+}
+
+// What spread agreeing flights would show, beside the one seen: " (if they agree: median
+// 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
+std::string spread_context(const ParameterAgreement& a) {
+  if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
+  return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, p = " + num(a.spread_p_value, 2) + ")";
+}
+
+// A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
+std::string interval(double lower, double upper, int prec) {
+  const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
+  return "[" + side(lower) + ", " + side(upper) + "]";
+}
+
+}  // namespace quadgen::diagnose::words

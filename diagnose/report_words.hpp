@@ -1,0 +1,51 @@
+// The words and numbers a diagnosis is told in, shared by its four outputs (diagnosis.json,
+// the terminal summary, report.html and the plots: diagnosis_report.hpp), so that each says a
+// finding, an interval or a lead the same way. Text comes back unescaped; each sink escapes it.
+#pragma once
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnose/diagnosis.hpp"
+
+namespace quadgen::diagnose::words {
+
+// A reduction to show [%]: 0 where it is undefined (a diverged simulation, nothing before).
+double reduction(double before, double after);
+// A finding in one sentence ("Motor M4 gives 6.9 % less thrust than motor M1").
+std::string headline(const Finding& f);
+
+// Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
+struct PointOfAction {
+  double height = 0, lower = NAN, upper = NAN;  // m above the CoG
+};
+std::optional<PointOfAction> point_of_action(const Diagnosis& d);  // none without both effects
+std::string point_of_action_headline(const PointOfAction& p);
+
+// The command-gain check per flight of a joint diagnosis (the flight's log), or the one
+// flight's (named "").
+std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(const Diagnosis& d);
+// What the screening says in words: flights left out, or a caution on an unusable flight
+// diagnosed anyway (the flight's path made printable: these go to a terminal too).
+std::vector<std::string> screening_notes(const Diagnosis& d);
+
+// A number with `prec` significant digits ("–" where it is not finite); a 95 % interval,
+// "open" on a side its profile never closed.
+std::string num(double v, int prec = 4);
+std::string interval(double lower, double upper, int prec = 4);
+
+// The draft check's and the command-gain check's sentences, each with the flight it is
+// about ("" for the diagnosis as a whole).
+std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d);
+std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagnosis& d);
+
+// What stood behind a finding when the rollouts did not (the one-step test, the force model
+// alone), and that text with a note on unsettled weights: said beside the gain.
+std::string judged_by_text(const Finding& f);
+std::string beside_gain_text(const Finding& f);
+// A parameter's spread across flights beside what agreeing flights with these intervals show.
+std::string spread_context(const ParameterAgreement& a);
+
+}  // namespace quadgen::diagnose::words
