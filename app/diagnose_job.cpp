@@ -125,22 +125,24 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!job.IsValid(&error)) throw std::invalid_argument("diagnose: " + error);
   const Vehicle v = load_vehicle(job.vehicle);
   const fit::ColumnMapping mapping = job.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(job.mapping);
-  const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
-  std::string logs_label;  // what the outputs say was diagnosed
-  for (const auto& path : job.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
-  size_t samples = 0;
-  for (const auto& f : flights) samples += f.samples.size();
   diagnose::DiagnoseOptions o = job.options;
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
-
-  o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
-                 (flights.size() > 1 ? " logs (diagnosed jointly)" : " log") + "; deriving the full-catalogue model");
+  // The model and the airframe first: a wrong --airframe file is said before the logs are read.
+  o.progress.say("[diagnose] deriving the full-catalogue model");
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
   const SymbolicModel all = derive_model(v, mp, all_opt);
   if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
+
+  const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
+  std::string logs_label;  // what the outputs say was diagnosed
+  for (const auto& path : job.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
+  size_t samples = 0;
+  for (const auto& f : flights) samples += f.samples.size();
+  o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
+                 (flights.size() > 1 ? " logs (diagnosed jointly)" : " log"));
   bool compiled = false;
   const auto model = make_model(all, &compiled);
   o.progress.say(std::string("[diagnose] model: ") + (compiled ? "compiled header from generated/" : "interpreted tape"));

@@ -8,6 +8,7 @@
 #include "app/model_registry.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/json_document.hpp"
+#include "output/numbers.hpp"
 #include "runtime/plot.hpp"
 
 namespace quadgen::app {
@@ -22,8 +23,8 @@ std::string summary_of(const predict::Prediction& pooled) {
       os << "no rollout reached this horizon" << (h.diverged ? " (" + std::to_string(h.diverged) + " diverged)" : "") << "\n";
       continue;
     }
-    os << "position " << h.position.mean() << " m (mean), tilt " << h.tilt.mean() << " rad, heading "
-       << h.heading.mean() << " rad\n";
+    os << "position " << output::short_number(h.position.mean()) << " m (mean), tilt "
+       << output::short_number(h.tilt.mean()) << " rad, heading " << output::short_number(h.heading.mean()) << " rad\n";
   }
   if (const std::string limits = predict::what_limits_prediction(pooled); !limits.empty()) os << limits << "\n";
   return os.str();
@@ -45,10 +46,10 @@ std::string failure_of(const predict::Prediction& pooled) {
   return "";
 }
 
-// A log too short to measure anything is the input's problem, not the model's: said before
-// anything is written.
+// A log too short for one rollout is the input's problem, not the model's: said before
+// anything is written. Logs without a pose have no rollouts at all (one-step errors only).
 void check_something_measured(const predict::Prediction& pooled, const PredictJob& job) {
-  if (pooled.start_points > 0) return;
+  if (pooled.start_points > 0 || pooled.open_loop.empty()) return;
   double longest = 0;
   for (const auto& h : pooled.open_loop) longest = std::max(longest, h.horizon);
   std::ostringstream os;
@@ -67,7 +68,7 @@ PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& v) {
   // Every effect, at its neutral value unless --params sets it.
   std::string how;
   const std::unique_ptr<runtime::DynamicModel> model = model_for(v, parse_effect_list("all"), &how);
-  if (job.options.progress) job.options.progress("model: " + how);
+  job.options.progress.say("model: " + how);
   const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), job.logs, job.options);
   check_something_measured(p.pooled, job);
   r.files = {{"prediction.json", output::json_document(p.json)}, {"prediction.csv", predict::prediction_csv(p.pooled)}};

@@ -93,7 +93,6 @@ void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws,
 // What every open-loop simulation shares: the model, each rotor's thrust law, and the
 // values its inputs need. Input functions refer to it, so it outlives the integration.
 struct OpenLoop {
-  const Vehicle& vehicle;
   DynamicModel& m;
   std::vector<ThrustLaw> laws;
   std::vector<std::string> rotors;
@@ -237,8 +236,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
-  const OpenLoop k{vehicle,
-                   m,
+  const OpenLoop k{m,
                    nominal_thrust_laws(vehicle, model),
                    rotor_names(vehicle),
                    ExtraInputs(m),

@@ -254,7 +254,8 @@ Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfil
   const double* q = &x[kAttitude];
   const auto e = runtime::euler_zyx(q[0], q[1], q[2], q[3]);
   const double d = 180 / M_PI;
-  return Flight{x[kPosition], x[kPosition + 1], x[kPosition + 2], d * e[0], d * e[1], d * e[2], x[kVelocity + 2]};
+  const double* p = &x[kPosition];
+  return Flight{p[0], p[1], p[2], d * e[0], d * e[1], d * e[2], x[kVelocity + 2]};
 }
 
 std::string describe(const Flight& f) {

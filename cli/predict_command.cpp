@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
 #include "output/output_set.hpp"
+#include "output/progress.hpp"
 #include "predict/predict_flights.hpp"
 #include "output/sinks.hpp"
 
@@ -44,7 +45,7 @@ int run_predict(const PredictArgs& a) {
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
   app::PredictJob job{a.vehicle, a.logs, a.options};
-  job.options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+  job.options.progress = output::terminal_progress();
   const app::PredictJobResult r = app::run_predict_job(job, vehicle);
   for (const auto& note : r.notes) std::cerr << note << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);

@@ -11,8 +11,6 @@
 
 namespace {
 
-const std::vector<std::string> kCommands = {"derive", "simulate", "fit", "diagnose", "predict"};
-
 // Edits (insert, delete, replace) between two words: a misspelt command is suggested back.
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
@@ -31,11 +29,12 @@ size_t edit_distance(const std::string& a, const std::string& b) {
 
 // CLI11 says only "A subcommand is required" for `quadgen diagnos ...`; this names the word,
 // the commands there are, and the nearest one.
-bool unknown_command(const std::string& word) {
+bool unknown_command(const CLI::App& app, const std::string& word) {
   if (word.empty() || word[0] == '-') return false;
   std::string list, nearest;
   size_t best = 3;  // suggest only within two edits
-  for (const auto& c : kCommands) {
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    const std::string& c = command->get_name();
     if (c == word) return false;
     list += (list.empty() ? "" : ", ") + c;
     if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
@@ -50,7 +49,6 @@ bool unknown_command(const std::string& word) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && unknown_command(argv[1])) return 106;  // CLI11's code for a missing subcommand
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("quadgen ") + QUADGEN_VERSION);
@@ -65,8 +63,12 @@ int main(int argc, char** argv) {
   quadgen::cli::add_diagnose(app, diagnose);
   quadgen::cli::PredictArgs predict;
   quadgen::cli::add_predict(app, predict);
+  std::vector<char*> args(argv, argv + argc);
+  std::string help = "--help";
+  if (argc > 1 && std::string(argv[1]) == "help") args[1] = help.data();  // `quadgen help` as git has it
+  if (argc > 1 && unknown_command(app, args[1])) return 106;  // CLI11's code for a missing subcommand
   try {
-    app.parse(argc, argv);
+    app.parse(argc, args.data());
   } catch (const CLI::ParseError& e) {
     return quadgen::cli::report_parse_error(app, e);
   }

@@ -33,7 +33,8 @@ RegressorLibrary physical_regressors(const fit::Flight& f, const std::vector<std
       add(std::string("v_b") + "xyz"[a], "m/s",
           [a](const fit::FlightSample& s) { return runtime::rigid_body::body_velocity(s.x.data())[a]; });
   for (int a = 0; a < 3; ++a)
-    add(std::string(1, "pqr"[a]), "rad/s", [a](const fit::FlightSample& s) { return s.x[runtime::rigid_body::kBodyRate + a]; });
+    add(std::string(1, "pqr"[a]), "rad/s",
+        [a](const fit::FlightSample& s) { return s.x[runtime::rigid_body::kBodyRate + a]; });
   // The mean command and the battery voltage are taken about their means over the flight
   // given: their zero lies far outside what a flight visits, and products and powers of
   // uncentred signals give large coefficients that cancel each other.

@@ -10,9 +10,10 @@ namespace quadgen::output {
 struct Progress {
   // A finished line: "[diagnose] base model fitted (12 s)".
   std::function<void(const std::string&)> line;
-  // A counter the next report replaces: "[diagnose] step 1: 3/12 candidates (wind)". Called
-  // from worker threads under the caller's lock.
+  // A counter the next report replaces: "[diagnose] step 1: 3/12 candidates (wind)".
   std::function<void(const std::string&)> counter;
+  // Either may be called from worker threads at once (a diagnosis fits its candidates on
+  // every core): a caller's functions must be safe for that, as the terminal's are.
 
   void say(const std::string& text) const {
     if (line) line(text);
@@ -22,9 +23,9 @@ struct Progress {
   }
 };
 
-// Standard error: lines as they come, every control character shown as an escape; counters
-// rewritten in place where standard error is a terminal, left out where it is a file (a CI
-// log would keep every one of them).
+// Standard error, one report at a time: lines as they come, every control character shown as
+// an escape; counters rewritten in place where standard error is a terminal (a line blanks
+// what is left of one), left out where it is a file (a CI log would keep every one of them).
 Progress terminal_progress();
 
 }  // namespace quadgen::output

@@ -11,6 +11,7 @@
 
 #include "runtime/dynamic_model.hpp"
 #include "fit/least_squares.hpp"
+#include "output/progress.hpp"
 #include "predict/prediction.hpp"
 #include "model/vehicle.hpp"
 
@@ -26,7 +27,7 @@ struct PredictFlightsOptions {
   // (linearly_corrected_one_step; needs validation below 1).
   bool linear_correction = false;
   PredictionOptions prediction;
-  std::function<void(const std::string&)> progress = [](const std::string&) {};
+  output::Progress progress;  // which log, calibration, notes; nowhere by default
 };
 
 struct PredictedFlights {

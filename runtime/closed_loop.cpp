@@ -258,7 +258,8 @@ struct UnmodelledForces {
   void apply(std::vector<double>& x, const Reference& ref, std::normal_distribution<double>& gauss) {
     if (o.tether_stiffness > 0) {
       const ReferenceAt start(ref, 0.0);
-      for (int a = 0; a < 2; ++a) x[kVelocity + a] -= o.tether_stiffness * (x[kPosition + a] - start.axis[a][0]) / mass * dt;
+      for (int a = 0; a < 2; ++a)
+        x[kVelocity + a] -= o.tether_stiffness * (x[kPosition + a] - start.axis[a][0]) / mass * dt;
     }
     if (o.angular_disturbance > 0)
       for (int a = 0; a < 2; ++a) {
@@ -266,9 +267,7 @@ struct UnmodelledForces {
         x[kBodyRate + a] += disturbance[a] * dt;
       }
     if (o.yaw_per_forward_speed != 0) {
-      const Rotation R = rotation_matrix(&x[kAttitude]);
-      const double* v = &x[kVelocity];
-      const double forward = R.m[0][0] * v[0] + R.m[1][0] * v[1] + R.m[2][0] * v[2];  // (R^T v)_x
+      const double forward = body_velocity(x.data())[0];
       x[kBodyRate + 2] += o.yaw_per_forward_speed * forward * dt;
     }
   }
@@ -316,7 +315,8 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     const ReferenceAt r(ref, t);
     const V3 p_at_t = vec3_at(x, kPosition);
     // --- controller, on the attitude the vehicle estimates ---
-    const Eigen::Quaterniond q_true = Eigen::Quaterniond(x[kAttitude], x[kAttitude + 1], x[kAttitude + 2], x[kAttitude + 3]).normalized();
+    const double* q = &x[kAttitude];
+    const Eigen::Quaterniond q_true = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
     truth.measurement(x.data(), t, logged.data(), nullptr, nullptr);
     const Eigen::Quaterniond q_est =
         Eigen::Quaterniond(logged[logged_q], logged[logged_q + 1], logged[logged_q + 2], logged[logged_q + 3]).normalized();

@@ -925,6 +925,9 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   write(tmp / "stand.json", R"({"kind": "thrust_stand", "summary": {}, "thrust_vs_speed": {"estimates": {}}})");
   expect_error({"predict", cf, tmp / "f.csv", "--params", tmp / "stand.json", "--out", tmp / "o"}, 2,
                "a thrust-stand fit describes the motors");
+  // A wrong --airframe file is said before the logs are read (here one that does not exist).
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "stand.json", "--out", tmp / "o"}, 2,
+               "not a diagnosis.json of quadgen");
 }
 
 // A log whose evaluated part is too short for one rollout is the input's problem: refused with
@@ -940,6 +943,25 @@ TEST(Cli, PredictRefusesALogTooShortForOneRollout) {
   EXPECT_FALSE(fs::exists(tmp / "p"));
   // All of it evaluated, there is room for rollouts.
   EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--validation", "1", "--out", tmp / "q"}, tmp.dir).rc, 0);
+  // A log without a pose has no rollouts at all, whatever its length: its one-step errors are
+  // measured, and that is no refusal (the ARPL log is one).
+  const quadgen::runtime::CsvTable flight = quadgen::runtime::read_csv(tmp / "f.csv");
+  std::vector<int> kept;
+  for (size_t c = 0; c < flight.columns.size(); ++c)
+    for (const char* name : {"t", "u_A", "u_B", "u_C", "u_D", "p", "q", "r", "ax", "ay", "az", "vbat"})
+      if (flight.columns[c] == name) kept.push_back(static_cast<int>(c));
+  std::ostringstream imu;
+  imu.precision(17);
+  for (size_t i = 0; i < kept.size(); ++i) imu << (i ? "," : "") << flight.columns[kept[i]];
+  for (const auto& row : flight.rows) {
+    imu << "\n";
+    for (size_t i = 0; i < kept.size(); ++i) imu << (i ? "," : "") << row[kept[i]];
+  }
+  write(tmp / "imu.csv", imu.str() + "\n");
+  ASSERT_EQ(kept.size(), 12u);
+  const CliResult r_imu = run_quadgen({"predict", vehicle, tmp / "imu.csv", "--out", tmp / "i"}, tmp.dir);
+  EXPECT_EQ(r_imu.rc, 0) << r_imu.err;
+  EXPECT_NE(r_imu.err.find("no pose logged: one-step errors only"), std::string::npos) << r_imu.err;
 }
 
 // ---- options -------------------------------------------------------------------------------
