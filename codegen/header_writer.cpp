@@ -125,6 +125,7 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("states", variables(m.states));
   d.set("inputs", variables(m.inputs));
   d.set("params", variables(m.params));
+  d.set("outputs", variables(m.outputs));
   d.set("state_names", quoted_list(m.states));
   d.set("input_names", quoted_list(m.inputs));
   d.set("param_names", quoted_list(m.params));

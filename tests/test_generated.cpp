@@ -15,6 +15,7 @@
 #include "tests/generated_models.hpp"
 #include "codegen/header_writer.hpp"
 #include "tests/test_helpers.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace fs = std::filesystem;
 
@@ -63,6 +64,35 @@ void check_jacobians_against_finite_differences(int trials) {
     compare(pt.u, M::kNumInputs, dfdu, M::kDfduNnz, M::dfdu_row, M::dfdu_col, "dfdu");
     compare(pt.p, M::kNumParams, dfdp, M::kDfdpNnz, M::dfdp_row, M::dfdp_col, "dfdp");
   }
+}
+
+// On the ground (z = 0), at nominal values, as a simulation starts and firmware sits before
+// take-off: f and every Jacobian finite. The ground-effect law divides by z^2; with the effect
+// off (radius 0) that was 0/0, and every all-effects header gave NaN there (a review found it
+// compiling the headers as firmware would). vbat at its reference (battery_sag's log needs it
+// positive, as the header says).
+template <class M>
+void expect_finite_on_the_ground() {
+  double x[M::kNumStates] = {}, u[M::kNumInputs], p[M::kNumParams];
+  x[quadgen::runtime::rigid_body::kAttitude] = 1;
+  for (int i = 0; i < M::kNumInputs; ++i) u[i] = std::string(M::input_names[i]) == "t" ? 0.0 : 0.5;
+  for (int i = 0; i < M::kNumParams; ++i) p[i] = M::nominal[i];
+  for (int i = 0; i < M::kNumInputs; ++i)
+    if (std::string(M::input_names[i]) == "vbat") u[i] = p[index_of_param<M>("vbat_ref")];
+  double f[M::kNumStates], dfdx[M::kDfdxNnz + 1], dfdu[M::kDfduNnz + 1], dfdp[M::kDfdpNnz + 1];
+  M::f(x, u, p, f, dfdx, dfdu, dfdp);
+  for (double v : f) EXPECT_TRUE(std::isfinite(v)) << M::effects;
+  for (int k = 0; k < M::kDfdxNnz; ++k) EXPECT_TRUE(std::isfinite(dfdx[k])) << "dfdx " << k;
+  for (int k = 0; k < M::kDfduNnz; ++k) EXPECT_TRUE(std::isfinite(dfdu[k])) << "dfdu " << k;
+  for (int k = 0; k < M::kDfdpNnz; ++k) EXPECT_TRUE(std::isfinite(dfdp[k])) << "dfdp " << k;
+}
+
+TEST(Generated, EveryModelIsFiniteOnTheGround) {
+  expect_finite_on_the_ground<finken3_traits>();
+  expect_finite_on_the_ground<finken3_all_effects_traits>();
+  expect_finite_on_the_ground<crazyflie21_traits>();
+  expect_finite_on_the_ground<crazyflie21_all_effects_traits>();
+  expect_finite_on_the_ground<crazyflie21_nanobench_all_effects_traits>();
 }
 
 TEST(Generated, Finken3JacobiansMatchFiniteDifferences) { check_jacobians_against_finite_differences<finken3_traits>(20); }

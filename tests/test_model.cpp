@@ -373,6 +373,19 @@ TEST(Model, GroundEffectMatchesTheCheesemanBennettLaw) {
                           level_state(z), {});
 }
 
+// On the ground (z = 0) with the effect off, as every all-effects model has it until it is
+// fitted, the law's R^2 / z^2 was 0/0: the whole model, and its generated header, gave NaN
+// there (a firmware review found it). Now the factor is 1 there, and finite with R > 0.
+TEST(Model, GroundEffectOffChangesNothingOnTheGround) {
+  SymbolicModel m = derive(test::finken3(), {"ground_effect"});
+  const SymbolicModel base = derive(test::finken3());
+  const std::vector<double> x = level_state(0.0), u{0.4, 0.45, 0.5, 0.55};
+  const auto with = test::eval_f(m, x, u), without = test::eval_f(base, x, u);
+  for (size_t i = 0; i < with.size(); ++i) EXPECT_NEAR(with[i], without[i], 1e-12 * (1 + std::fabs(without[i]))) << m.states[i].name;
+  m.params[m.param_index("ground_effect.radius")].nominal = 0.1;
+  for (double v : test::eval_f(m, x, u)) EXPECT_TRUE(std::isfinite(v));
+}
+
 // Thrust (1 - rate t): 1 %/s at t = 20 s is 80 % of the thrust.
 TEST(Model, ThrustDecayIsLinearInTime) {
   expect_thrust_scaled_by("thrust_decay", "thrust_decay.rate", 0.01, 0.8, level_state(1.0), {{"t", 20.0}});

@@ -11,8 +11,14 @@ namespace {
 
 void terms(ModelContext& c) {
   const ex radius = c.add_param("ground_effect.radius", "m", 0.0, 0.0, 0.5, true, "rotor radius in the ground-effect law");
+  // (R / 4z)^2 with z^2 + (1 um)^2 for z^2: on the ground (z = 0) the law has R^2 / 0, which
+  // with the effect off (R = 0, as in every all-effects model until it is fitted) made the
+  // whole model NaN there. Now it is exactly 1 then; above 1 cm the change is below 1e-8 of
+  // the term. The law itself holds only well above z = R / 4, where it is singular.
   const ex z = c.position(2, 0);
-  for (ex& s : c.thrust_scale) s = s / (1 - pow(radius / (4 * z), 2));
+  const ex floor = c.add_constant("ground_effect.floor", "m", 1e-6, "height below which the ground-effect law is not resolved");
+  const ex z_squared = pow(z, 2) + pow(floor, 2);
+  for (ex& s : c.thrust_scale) s = s / (1 - pow(radius, 2) / (16 * z_squared));
 }
 
 }  // namespace

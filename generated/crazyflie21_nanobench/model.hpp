@@ -7,11 +7,21 @@
 //   rhs(f + all Jacobians) 159064 as expression trees, 2074 after CSE
 //   precompute()          699 for 284 parameter-only values
 //
-// Self-contained: only the C++ standard library. Scalar may be float, double or ceres::Jet.
-// No heap allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of
-// dfdx is d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass nullptr for any output you do not need,
-// or call rhs(x, u, p, pre, f) for f alone.
+// Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
+// allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of dfdx is
+// d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass a null pointer of the Scalar type for any output
+// you do not need (static_cast<double*>(nullptr): a bare nullptr names no Scalar), or call
+// rhs(x, u, p, pre, f) for f alone.
+// Conventions: SI units; world frame z up; body frame x, y in the rotor plane, z up, its
+// origin the vehicle file's reference point (position and velocity are the origin's, not the
+// centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
+// Inputs named vbat (a battery voltage) must be positive; the measurement h is indexed by
+// Output, not State.
 #pragma once
+
+#if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
+#error "quadgen: the generated model needs C++17 (inline variables)"
+#endif
 
 #include <cmath>
 
@@ -83,6 +93,17 @@ struct Param {
     A_x = 19,  // A_x [m^2] exposed area along the body axis
     A_y = 20,  // A_y [m^2] exposed area along the body axis
     A_z = 21,  // A_z [m^2] exposed area along the body axis
+  };
+};
+struct Output {
+  enum : int {
+    x = 0,  // x [m] position x
+    y = 1,  // y [m] position y
+    z = 2,  // z [m] position z
+    qw = 3,  // qw [1] logged attitude w
+    qx = 4,  // qx [1] logged attitude x
+    qy = 5,  // qy [1] logged attitude y
+    qz = 6,  // qz [1] logged attitude z
   };
 };
 
