@@ -88,7 +88,8 @@ def build_model(vehicle_path, model_json_path):
         if "battery_sag" in effects:
             scale *= (In["vbat"] / Pm["vbat_ref"]) ** Pm["battery_sag.exponent"]
         if "ground_effect" in effects:
-            scale /= 1 - (Pm["ground_effect.radius"] / (4 * S["z"])) ** 2
+            # z^2 + (1 um)^2 for z^2, as docs/effects.md gives the law (finite on the ground)
+            scale /= 1 - Pm["ground_effect.radius"] ** 2 / (16 * (S["z"] ** 2 + sp.Rational(1, 10**12)))
         loss = 0  # thrust loss with the rotor's climb speed through the air
         if "inflow" in effects:
             climb = vb[2] + w.cross(arm)[2]

@@ -10,6 +10,7 @@
 
 #include "generated/crazyflie21/model.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
+#include "generated/crazyflie21_nanobench/model.hpp"
 #include "generated/crazyflie21_nanobench_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
@@ -59,6 +60,7 @@ QUADGEN_MODEL_TRAITS(finken3)
 QUADGEN_MODEL_TRAITS(finken3_all_effects)
 QUADGEN_MODEL_TRAITS(crazyflie21)
 QUADGEN_MODEL_TRAITS(crazyflie21_all_effects)
+QUADGEN_MODEL_TRAITS(crazyflie21_nanobench)
 QUADGEN_MODEL_TRAITS(crazyflie21_nanobench_all_effects)
 
 template <class M>

@@ -92,6 +92,7 @@ TEST(Generated, EveryModelIsFiniteOnTheGround) {
   expect_finite_on_the_ground<finken3_all_effects_traits>();
   expect_finite_on_the_ground<crazyflie21_traits>();
   expect_finite_on_the_ground<crazyflie21_all_effects_traits>();
+  expect_finite_on_the_ground<crazyflie21_nanobench_traits>();
   expect_finite_on_the_ground<crazyflie21_nanobench_all_effects_traits>();
 }
 
