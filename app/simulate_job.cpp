@@ -203,7 +203,7 @@ std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, cons
   }
   Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
   for (const auto& x : tr.x) {
-    const auto e = euler_zyx(x[kAttitude], x[kAttitude + 1], x[kAttitude + 2], x[kAttitude + 3]);
+    const auto e = euler_angles(x.data());
     phi.y.push_back(e[0] * 180 / M_PI);
     theta.y.push_back(e[1] * 180 / M_PI);
     psi.y.push_back(e[2] * 180 / M_PI);

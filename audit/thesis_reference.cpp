@@ -251,8 +251,7 @@ Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfil
   runtime::IntegratorOptions o;
   const auto x = runtime::integrate_rk4(m, x0, inputs, 0.0, seconds, o).x.back();
   using namespace runtime::rigid_body;
-  const double* q = &x[kAttitude];
-  const auto e = runtime::euler_zyx(q[0], q[1], q[2], q[3]);
+  const auto e = euler_angles(x.data());
   const double d = 180 / M_PI;
   const double* p = &x[kPosition];
   return Flight{p[0], p[1], p[2], d * e[0], d * e[1], d * e[2], x[kVelocity + 2]};

@@ -424,13 +424,11 @@ void check_sensor_units(const std::string& path, const Flight& f) {
 }  // namespace
 
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
-  try {
-    runtime::validate_canonical(log, rotors);
-  } catch (const runtime::LogError& e) {  // the likeliest cause of a missing column: a layout without its mapping
-    if (!log.named_by.empty() || std::string(e.what()).find(": missing column") == std::string::npos) throw;
-    throw runtime::LogError(std::string(e.what()) +
-                            "; a log in another layout is read with --mapping M.yaml (docs/formats.md, \"Column mapping\")");
-  }
+  // The likeliest cause of a missing column in a log read without a mapping: it needs one.
+  runtime::validate_canonical(log, rotors,
+                              log.named_by.empty() ? "; a log in another layout is read with --mapping M.yaml "
+                                                     "(docs/formats.md, \"Column mapping\")"
+                                                   : "");
   Flight f;
   f.source = log.path;
   if (static_cast<double>(log.rows.size()) < o.min_samples)

@@ -6,7 +6,6 @@
 
 #include "fit/log_reader.hpp"
 #include "predict/parameter_source.hpp"
-#include "output/sinks.hpp"
 
 namespace quadgen::predict {
 
@@ -16,7 +15,7 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   const std::vector<std::string> rotors = rotor_names(v);
   const runtime::CsvTable log = fit::read_log(path, o.mapping, o.resample);
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
-  if (!flight.has_pose) o.progress.say(output::printable(path) + ": no pose logged: one-step errors only (rollouts need a measured state)");
+  if (!flight.has_pose) o.progress.say(path + ": no pose logged: one-step errors only (rollouts need a measured state)");
   return flight;
 }
 
@@ -41,12 +40,12 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   // Values of another vehicle file may still be what the user wants (the same airframe under
   // another name), but never silently: the parameter names alone cannot tell.
   if (source && !source->vehicle().empty() && source->vehicle() != v.name)
-    o.progress.say("note: " + output::printable(o.params) + " was fitted for the vehicle '" + output::printable(source->vehicle()) +
+    o.progress.say("note: " + o.params + " was fitted for the vehicle '" + source->vehicle() +
                "', not '" + v.name + "'; its values are applied by parameter name");
   PredictedFlights out;
   nlohmann::ordered_json flights = nlohmann::ordered_json::array();
   for (size_t i = 0; i < logs.size(); ++i) {
-    o.progress.say("[" + std::to_string(i + 1) + "/" + std::to_string(logs.size()) + "] " + output::printable(logs[i]));
+    o.progress.say("[" + std::to_string(i + 1) + "/" + std::to_string(logs.size()) + "] " + logs[i]);
     const fit::Flight whole = load(logs[i], v, o);
     const auto [before, evaluated] = o.validation >= 1.0 ? std::pair<fit::Flight, fit::Flight>{{}, whole}
                                                          : fit::split_by_time(whole, 1.0 - o.validation);

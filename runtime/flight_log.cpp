@@ -242,10 +242,10 @@ void check_values(const CsvTable& log) {
     }
 }
 
-void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors) {
+void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors, const std::string& missing_hint) {
   // A name the mapping gave is the mapping's mistake: its file and line are named, not the log's.
   const std::string maps = log.named_by.empty() ? "" : " (mapped from " + log.path + ")";
-  if (log.column("t") < 0) throw LogError(log.where_named() + ": missing column 't'" + maps);
+  if (log.column("t") < 0) throw LogError(log.where_named() + ": missing column 't'" + maps + missing_hint);
   std::set<std::string> known(rotors.begin(), rotors.end());
   std::string list;
   for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
@@ -256,7 +256,7 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
                      list + ")" + maps);
   }
   for (const auto& r : rotors)
-    if (log.column("u_" + r) < 0) throw LogError(log.where_named() + ": missing column 'u_" + r + "'" + maps);
+    if (log.column("u_" + r) < 0) throw LogError(log.where_named() + ": missing column 'u_" + r + "'" + maps + missing_hint);
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
   const int tc = log.column("t");
@@ -286,8 +286,7 @@ std::string trajectory_csv(const DynamicModel& m, const Trajectory& tr, const In
     u(tr.t[k], ub.data());
     os << tr.t[k];
     for (size_t r = 0; r < rotors.size(); ++r) os << "," << ub[r];
-    const double* q = &x[rigid_body::kAttitude];
-    const auto [phi, theta, psi] = euler_zyx(q[0], q[1], q[2], q[3]);
+    const auto [phi, theta, psi] = rigid_body::euler_angles(x.data());
     states(rigid_body::kPosition, 3);
     states(rigid_body::kAttitude, 4);
     os << "," << phi << "," << theta << "," << psi;

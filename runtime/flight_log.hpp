@@ -58,7 +58,9 @@ void check_values(const CsvTable& log);
 // Checks the canonical layout for these rotors: t strictly increasing, u_<rotor> present
 // for every rotor and no u_ column for an unknown rotor, finite values within the sanity
 // bounds above, at least 2 rows.
-void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotor_names);
+// `missing_hint` is appended to a missing column's message (what the caller knows of why).
+void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotor_names,
+                        const std::string& missing_hint = "");
 
 // Canonical-layout CSV of a trajectory: t, u_*, x, y, z, qw..qz, phi, theta, psi, vx, vy,
 // vz, p, q, r, then any further states (w_* rotor speeds).

@@ -29,10 +29,13 @@ inline std::array<double, 3> body_velocity(const double* x) {
   return b;
 }
 
-// The heading (Z-Y-X yaw) of a state vector [rad].
-inline double heading(const double* x) {
+// The Z-Y-X Euler angles (roll, pitch, yaw) of a state vector's attitude [rad].
+inline std::array<double, 3> euler_angles(const double* x) {
   const double* q = &x[kAttitude];
-  return euler_zyx(q[0], q[1], q[2], q[3])[2];
+  return euler_zyx(q[0], q[1], q[2], q[3]);
 }
+
+// The heading (Z-Y-X yaw) of a state vector [rad].
+inline double heading(const double* x) { return euler_angles(x)[2]; }
 
 }  // namespace quadgen::runtime::rigid_body
