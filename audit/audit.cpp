@@ -9,6 +9,7 @@
 #include "audit/dimension_checker.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/kinematics.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen {
 using namespace GiNaC;
@@ -104,7 +105,7 @@ std::vector<AuditCheck> check_rotation() {
 std::vector<AuditCheck> check_quaternion_norm(const SymbolicModel& m) {
   // d/dt |q|^2 = 2 q . dq/dt must vanish identically for the model's own quaternion rows.
   ex s = 0;
-  for (int i = 0; i < 4; ++i) s += m.states[6 + i].sym * m.f(6 + i, 0);
+  for (int i = 0; i < 4; ++i) s += m.states[runtime::rigid_body::kAttitude + i].sym * m.f(runtime::rigid_body::kAttitude + i, 0);
   const bool ok = expand(s).is_zero();
   return {make("rotation", "quaternion kinematics preserve |q|", ok,
                "q . dq/dt of the model's rows 7-10 expands to 0")};
@@ -146,11 +147,11 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   return out;
 }
 
-// With thrust (c_t = 0), gravity (g = 0), every effect whose own formula adds a moment
-// (Δτ: the flapping moment) and any term added beyond the catalogue (term_*: an external
-// force or moment found in data) removed there are no torques (rotor drag is a force at the
-// CoG); the model's rotational rows must then conserve 1/2 ω·Jω and |Jω|^2.
-std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
+// The substitutions that leave a model without torques: thrust (c_t = 0), gravity (g = 0),
+// every effect whose own formula adds a moment (Δτ: the flapping moment) and any term added
+// beyond the catalogue (term_*: an external force or moment found in data) switched off.
+// Rotor drag is a force at the CoG and adds none.
+lst torque_free(const SymbolicModel& m) {
   lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
   std::set<std::string> adds_moment;
   for (const auto& f : m.effect_formulas)
@@ -158,10 +159,61 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
       if (line.first == "\\Delta \\tau") adds_moment.insert(f.effect);
   for (const auto& p : m.params)
     if (adds_moment.count(effect_of_parameter(p.name)) || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
+  return off;
+}
+
+// The body -> world rotation of a unit quaternion (Hamilton, scalar first), written out here
+// rather than taken from derive/kinematics, so that the momentum check below does not lean on
+// the code it checks.
+matrix body_to_world(const ex& w, const ex& x, const ex& y, const ex& z) {
+  return matrix(3, 3, lst{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                          2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                          2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)});
+}
+
+// Without torques a rigid body keeps its angular momentum in the world frame, L = R(q) J ω.
+// Only this check tells the sign of the gyroscopic term: ω·(ω × Jω) and (Jω)·(ω × Jω) vanish
+// for every J, so the energy and |Jω| checks pass for J dω/dt = -ω × Jω, for the thesis' (35)
+// sign +ω × Jω and with the term dropped alike (they are necessary conditions, kept because
+// they do not involve the attitude). dL/dt takes the model's own quaternion rows (dR/dt =
+// Σ ∂R/∂q_i dq_i/dt) and body-rate rows, so a kinematics written for world-frame rates fails
+// it too. Since R is invertible, R^T dL/dt = R^T dR/dt J ω + J dω/dt is tested for zero, modulo
+// |q|^2 = 1, for a general symmetric J.
+AuditCheck check_world_angular_momentum(const SymbolicModel& m, const matrix& J, const lst& off) {
+  using namespace runtime::rigid_body;
+  ex q[4];
+  for (int i = 0; i < 4; ++i) q[i] = m.states[kAttitude + i].sym;
+  const matrix R = body_to_world(q[0], q[1], q[2], q[3]);
+  matrix Rdot(3, 3), w(3, 1), wdot(3, 1);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 4; ++i)
+        Rdot(r, c) += R(r, c).diff(ex_to<symbol>(q[i])) * m.f(kAttitude + i, 0).subs(off);
+  for (int i = 0; i < 3; ++i) {
+    w(i, 0) = m.states[kBodyRate + i].sym;
+    wdot(i, 0) = m.f(kBodyRate + i, 0).subs(off);
+  }
+  const matrix from_attitude = R.transpose().mul(Rdot).mul(J.mul(w)), from_rates = J.mul(wdot);
+  bool kept = true;
+  for (int i = 0; i < 3; ++i) {
+    const ex sum = normal(reduce_unit_quaternion(from_attitude(i, 0), q[0], q[1], q[2], q[3]) + from_rates(i, 0));
+    if (!reduce_unit_quaternion(numer(sum), q[0], q[1], q[2], q[3]).is_zero()) kept = false;
+  }
+  return make("energy", "angular momentum conserved in the world frame", kept,
+              "R^T d/dt (R(q) J ω) of the model's quaternion and body-rate rows, torques off as above, reduces to 0 "
+              "modulo |q|^2 = 1 for a general symmetric J (R(q) written out in the audit); the only one of the three "
+              "that tells the sign of ω × Jω");
+}
+
+// The model's rotational rows without torques conserve 1/2 ω·Jω and |Jω|^2 (necessary
+// conditions) and the world-frame angular momentum (the sharp one).
+std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
+  using namespace runtime::rigid_body;
+  const lst off = torque_free(m);
   matrix w(3, 1), wdot(3, 1);
   for (int i = 0; i < 3; ++i) {
-    w(i, 0) = m.states[10 + i].sym;
-    wdot(i, 0) = m.f(10 + i, 0).subs(off);
+    w(i, 0) = m.states[kBodyRate + i].sym;
+    wdot(i, 0) = m.f(kBodyRate + i, 0).subs(off);
   }
   auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
   const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
@@ -173,10 +225,11 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
     dL += Jw(i, 0) * Jwdot(i, 0);
   }
   return {make("energy", "rotational kinetic energy conserved", normal(dE).is_zero(),
-               "d/dt (1/2 ω^T J ω) = ω^T J dω/dt of the model's rows with c_t = g = 0 (and blade_flapping.k = 0) normalises to 0 "
-               "for a general symmetric J"),
+               "d/dt (1/2 ω^T J ω) = ω^T J dω/dt of the model's rows with c_t = g = 0 (and blade_flapping.k = 0) normalises "
+               "to 0 for a general symmetric J (a necessary condition: it holds for either sign of ω × Jω)"),
           make("energy", "angular momentum magnitude conserved", normal(dL).is_zero(),
-               "d/dt |Jω|^2 / 2 = (Jω)^T J dω/dt normalises to 0")};
+               "d/dt |Jω|^2 / 2 = (Jω)^T J dω/dt normalises to 0 (a necessary condition, as above)"),
+          check_world_angular_momentum(m, J, off)};
 }
 
 }  // namespace

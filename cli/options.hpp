@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/sinks.hpp"
 
@@ -39,10 +40,12 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
 // accept (the effects' names depend on the vehicle's rotors, so they are given as patterns).
 inline const char* const kLogFormats =
     "CSV in the canonical layout, or any CSV, PX4 ULog or Crazyflie uSD log through --mapping";
-// The base parameters' names come from the vehicle schema, the effects' from their descriptors.
+// The base parameters' names come from the derivation, the effects' from their descriptors.
 inline std::string parameter_names_help() {
-  return "the vehicle's (g, rho, c_w, c_t, kappa, motor_a0..motor_a2, motor_slope, mass, cog_x..cog_z, J_xx..J_yz, A_x..A_z, vbat_ref; "
-         "model.json lists them) and the effects' (" + catalogue_parameter_names() + ")";
+  std::string base;
+  for (const std::string& name : base_parameter_names()) base += name + ", ";
+  return "the vehicle's (" + base + "and vbat_ref with battery_sag; model.json lists a model's) and the effects' (" +
+         catalogue_parameter_names() + ")";
 }
 
 // A finite number of the whole text, or nothing.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -76,18 +77,34 @@ ex commanded_rotor_speed(const ModelContext& c, const ex& u, const std::optional
   return map(*pivot) + c.p("motor_slope") * (map(u) - map(*pivot));
 }
 
+// The thirteen rigid-body states' units and meanings, in runtime::rigid_body's order.
+constexpr const char* kStateUnitsAndMeanings[runtime::rigid_body::kNumStates][2] = {
+    {"m", "position x, world"},     {"m", "position y, world"},     {"m", "position z (up), world"},
+    {"m/s", "velocity x, world"},   {"m/s", "velocity y, world"},   {"m/s", "velocity z, world"},
+    {"1", "attitude quaternion w"}, {"1", "attitude quaternion x"}, {"1", "attitude quaternion y"},
+    {"1", "attitude quaternion z"}, {"rad/s", "body rate about x"}, {"rad/s", "body rate about y"},
+    {"rad/s", "body rate about z"}};
+
+// The vehicle file's scalar keys and the model's names for them (the motor map's terms carry
+// "motor_"). `slope` is optional and comes with its pivot.
+constexpr std::pair<const char*, const char*> kScalarParameters[] = {
+    {"g", "g"},         {"rho", "rho"},     {"c_w", "c_w"},     {"c_t", "c_t"},        {"kappa", "kappa"},
+    {"a0", "motor_a0"}, {"a1", "motor_a1"}, {"a2", "motor_a2"}, {"slope", "motor_slope"}};
+
+// The values of kDerivedQuantities (model/vehicle.hpp), in its order.
+std::vector<double> derived_values(const MassProperties& mp) {
+  const auto& J = mp.inertia_cog_value;
+  return {mp.mass_value,     mp.cog_value[0],   mp.cog_value[1],   mp.cog_value[2], J[0][0],
+          J[1][1],           J[2][2],           J[0][1],           J[0][2],         J[1][2],
+          mp.areas_value[0], mp.areas_value[1], mp.areas_value[2]};
+}
+
 void declare_base(ModelContext& c, const MassProperties& mp) {
-  const char* st[][3] = {{"x", "m", "position x, world"},      {"y", "m", "position y, world"},
-                         {"z", "m", "position z (up), world"}, {"vx", "m/s", "velocity x, world"},
-                         {"vy", "m/s", "velocity y, world"},   {"vz", "m/s", "velocity z, world"},
-                         {"qw", "1", "attitude quaternion w"}, {"qx", "1", "attitude quaternion x"},
-                         {"qy", "1", "attitude quaternion y"}, {"qz", "1", "attitude quaternion z"},
-                         {"p", "rad/s", "body rate about x"},  {"q", "rad/s", "body rate about y"},
-                         {"r", "rad/s", "body rate about z"}};
-  std::vector<ex> s;
-  for (auto& row : st) s.push_back(c.add_state(row[0], row[1], row[2]));
-  // In the order the runtime reads them (runtime/rigid_body_state.hpp).
   using namespace runtime::rigid_body;
+  // The names are the runtime's (runtime/rigid_body_state.hpp), in the order it reads them.
+  std::vector<ex> s;
+  for (int i = 0; i < kNumStates; ++i)
+    s.push_back(c.add_state(kStateNames[i], kStateUnitsAndMeanings[i][0], kStateUnitsAndMeanings[i][1]));
   const auto block3 = [&](int first) { return vec3(s[first], s[first + 1], s[first + 2]); };
   c.position = block3(kPosition);
   c.velocity = block3(kVelocity);
@@ -102,12 +119,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   for (const Rotor& r : c.vehicle.rotors)
     c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
 
-  // The vehicle file's key and the model's name (the motor map's terms carry "motor_").
-  const std::pair<const char*, const char*> scalars[] = {
-      {"g", "g"},               {"rho", "rho"},           {"c_w", "c_w"},           {"c_t", "c_t"},
-      {"kappa", "kappa"},       {"a0", "motor_a0"},       {"a1", "motor_a1"},       {"a2", "motor_a2"},
-      {"slope", "motor_slope"}};
-  for (const auto& [key, name] : scalars) {
+  for (const auto& [key, name] : kScalarParameters) {
     if (!c.vehicle.params.count(key)) continue;  // slope: optional, with its pivot
     ParameterSpec spec = param(c.vehicle, key);  // the record without its file line
     spec.name = name;
@@ -130,19 +142,10 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
     } else
       c.add_param(name, unit, value, value, value, false, doc);
   };
-  derived("mass", "kg", mp.mass_value, "total mass (sum of blocks)");
-  const char* axes = "xyz";
-  for (int i = 0; i < 3; ++i)
-    derived(std::string("cog_") + axes[i], "m", mp.cog_value[i], "centre of gravity, body frame");
-  const auto& J = mp.inertia_cog_value;
-  derived("J_xx", "kg m^2", J[0][0], "inertia tensor about the CoG");
-  derived("J_yy", "kg m^2", J[1][1], "inertia tensor about the CoG");
-  derived("J_zz", "kg m^2", J[2][2], "inertia tensor about the CoG");
-  derived("J_xy", "kg m^2", J[0][1], "inertia tensor entry (= -product of inertia)");
-  derived("J_xz", "kg m^2", J[0][2], "inertia tensor entry (= -product of inertia)");
-  derived("J_yz", "kg m^2", J[1][2], "inertia tensor entry (= -product of inertia)");
-  for (int i = 0; i < 3; ++i)
-    derived(std::string("A_") + axes[i], "m^2", mp.areas_value[i], "exposed area along the body axis");
+  const std::vector<double> values = derived_values(mp);
+  static_assert(std::size(kDerivedQuantities) == 13, "derived_values lists thirteen values");
+  for (size_t i = 0; i < values.size(); ++i)
+    derived(kDerivedQuantities[i].name, kDerivedQuantities[i].unit, values[i], kDerivedQuantities[i].meaning);
 
   c.cog = vec3(c.p("cog_x"), c.p("cog_y"), c.p("cog_z"));
   std::optional<ex> pivot;
@@ -487,6 +490,13 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
 
 std::string rotor_thrust_name(const std::string& rotor) {
   return "F_{\\mathrm{" + output::latex_text(rotor) + "}}";  // a rotor called front_left stays one subscript
+}
+
+std::vector<std::string> base_parameter_names() {
+  std::vector<std::string> names;
+  for (const auto& scalar : kScalarParameters) names.push_back(scalar.second);
+  for (const auto& derived : kDerivedQuantities) names.push_back(derived.name);
+  return names;
 }
 
 }  // namespace quadgen

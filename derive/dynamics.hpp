@@ -58,6 +58,11 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
 // Computes dfdx, dfdu, dfdp, dhdx, dhdp from f and h.
 void differentiate(SymbolicModel& m);
 
+// The names of the parameters every model has (the vehicle file's scalars as the model calls
+// them, then the quantities the blocks give), in the order derive_model declares them;
+// motor_slope only where the file gives a slope.
+std::vector<std::string> base_parameter_names();
+
 // The TeX name of rotor `rotor`'s thrust among SymbolicModel::intermediates ("F_{\mathrm{A}}").
 std::string rotor_thrust_name(const std::string& rotor);
 

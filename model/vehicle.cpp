@@ -233,11 +233,8 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (root["derived"]) {
     const YAML::Node d = root["derived"];
     r.require_map(d, "section 'derived'");
-    static const std::map<std::string, std::string> derived_units = {
-        {"mass", "kg"},       {"cog_x", "m"},        {"cog_y", "m"},        {"cog_z", "m"},
-        {"J_xx", "kg m^2"},   {"J_yy", "kg m^2"},    {"J_zz", "kg m^2"},    {"J_xy", "kg m^2"},
-        {"J_xz", "kg m^2"},   {"J_yz", "kg m^2"},    {"A_x", "m^2"},        {"A_y", "m^2"},
-        {"A_z", "m^2"}};
+    std::map<std::string, std::string> derived_units;  // name -> unit
+    for (const DerivedQuantity& q : kDerivedQuantities) derived_units[q.name] = q.unit;
     std::set<std::string> allowed;
     for (const auto& kv : derived_units) allowed.insert(kv.first);
     r.only_keys(d, allowed, "section 'derived'");

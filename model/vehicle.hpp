@@ -44,6 +44,28 @@ struct Rotor {
   int line = 0;
 };
 
+// The quantities derive computes from the blocks, which a file's `derived` section may bound
+// or give (name, unit, meaning), in the order the model declares them as parameters.
+struct DerivedQuantity {
+  const char* name;
+  const char* unit;
+  const char* meaning;
+};
+inline constexpr DerivedQuantity kDerivedQuantities[] = {
+    {"mass", "kg", "total mass (sum of blocks)"},
+    {"cog_x", "m", "centre of gravity, body frame"},
+    {"cog_y", "m", "centre of gravity, body frame"},
+    {"cog_z", "m", "centre of gravity, body frame"},
+    {"J_xx", "kg m^2", "inertia tensor about the CoG"},
+    {"J_yy", "kg m^2", "inertia tensor about the CoG"},
+    {"J_zz", "kg m^2", "inertia tensor about the CoG"},
+    {"J_xy", "kg m^2", "inertia tensor entry (= -product of inertia)"},
+    {"J_xz", "kg m^2", "inertia tensor entry (= -product of inertia)"},
+    {"J_yz", "kg m^2", "inertia tensor entry (= -product of inertia)"},
+    {"A_x", "m^2", "exposed area along the body axis"},
+    {"A_y", "m^2", "exposed area along the body axis"},
+    {"A_z", "m^2", "exposed area along the body axis"}};
+
 struct Vehicle {
   std::string name;
   std::string source_path;
@@ -51,9 +73,10 @@ struct Vehicle {
   std::string description;
   std::vector<Block> blocks;
   std::vector<Rotor> rotors;
-  // Named scalar parameters: g, rho, c_w, c_t, kappa, motor_a0..a2, vbat_ref.
+  // Named scalar parameters under the file's keys: g, rho, c_w, c_t, kappa, a0..a2, slope,
+  // pivot, vbat_ref.
   std::map<std::string, Parameter> params;
-  // Fit flags and bounds for quantities derived from the blocks (mass, J_xx, ...).
+  // Fit flags and bounds for quantities derived from the blocks (kDerivedQuantities).
   std::map<std::string, Parameter> derived_overrides;
   // Those of them whose value the file gives (measured, or measured in flight): it replaces
   // the blocks' value as the nominal one.

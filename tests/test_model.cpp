@@ -16,6 +16,7 @@
 #include "audit/report.hpp"
 #include "audit/tex_writer.hpp"
 #include "codegen/cpp_printer.hpp"
+#include "derive/kinematics.hpp"
 #include "tests/test_helpers.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/units.hpp"
@@ -67,14 +68,15 @@ TEST(Model, InertiaAuditHoldsForBlocksAtAnyAngle) {
 }
 
 // The parameter names --help lists (cli/options.hpp) are every name of the full-catalogue
-// model, ranges and the rotor written as patterns: a new effect must be added there too.
+// model: the base ones come from the derivation's own table, the effects' from their
+// descriptors, where the rotor and the axes are written as patterns (a new effect's names
+// must be added to its descriptor).
 TEST(Model, HelpListsEveryParameterName) {
   const SymbolicModel m = derive(test::finken3(), parse_effect_list("all"));
   const std::string help = quadgen::cli::parameter_names_help();
   const std::vector<std::pair<std::regex, std::string>> patterns = {
-      {std::regex("motor_gain\\..*"), "motor_gain.<rotor>"}, {std::regex("motor_a[0-2]"), "motor_a0..motor_a2"},
-      {std::regex("cog_[xyz]"), "cog_x..cog_z"},              {std::regex("J_[xyz][xyz]"), "J_xx..J_yz"},
-      {std::regex("A_[xyz]"), "A_x..A_z"},                    {std::regex("(cog_offset|wind)\\.[xy]"), "$1.x/y"},
+      {std::regex("motor_gain\\..*"), "motor_gain.<rotor>"},
+      {std::regex("(cog_offset|wind)\\.[xy]"), "$1.x/y"},
       {std::regex("attitude_bias\\..*"), "attitude_bias.roll/pitch"}};
   for (const auto& p : m.params) {
     std::string shown = p.name;
@@ -99,24 +101,53 @@ TEST(Model, UnitCheckerRejectsInconsistentEquation) {
     if (c.name == "dvy/dt") EXPECT_FALSE(c.passed);
 }
 
-TEST(Model, EnergyCheckCatchesWrongGyroscopicSign) {
-  // The thesis' (35) sign: J dω/dt = τ + ω × Jω. The energy audit must reject it.
-  SymbolicModel m = derive(test::finken3());
-  const AuditResult good = audit(m, derive_mass_properties(test::finken3()));
-  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
-  const ex p = m.states[10].sym, q = m.states[11].sym, r = m.states[12].sym;
-  // Diagonal-J form with the thesis' sign, thrust and gravity left in.
-  m.f(10, 0) = (P("J_zz") - P("J_yy")) * q * r / P("J_xx");
-  m.f(11, 0) = (P("J_xx") - P("J_zz")) * p * r / P("J_yy");
-  m.f(12, 0) = (P("J_yy") - P("J_xx")) * p * q / P("J_zz");
-  const AuditResult bad = audit(m, derive_mass_properties(test::finken3()));
-  auto energy_ok = [](const AuditResult& a) {
-    for (const auto& c : a.checks)
-      if (c.name == "rotational kinetic energy conserved") return c.passed;
+// The rotational rows are replaced by a wrong law for a general (not diagonal) J: the thesis'
+// (35) sign J dω/dt = τ + ω × Jω, the gyroscopic term dropped (J dω/dt = τ), and the right
+// rates with the quaternion kinematics written for world-frame rates (dq/dt = 1/2 (0, ω) ⊗ q).
+// Only the world-frame angular momentum rejects them all: ω·(ω × Jω) = (Jω)·(ω × Jω) = 0 for
+// every J, so the energy checks pass for either sign and without the term (asserted here
+// too, as the reason the momentum check exists), and they never look at the attitude.
+TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
+  using namespace runtime::rigid_body;
+  const Vehicle v = test::finken3();
+  const SymbolicModel good = derive(v);
+  auto P = [&](const char* n) { return good.params[good.param_index(n)].sym; };
+  const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
+                           P("J_xz"), P("J_yz"), P("J_zz")});
+  const matrix Jinv = J.inverse();
+  matrix w(3, 1);
+  for (int i = 0; i < 3; ++i) w(i, 0) = good.states[kBodyRate + i].sym;
+  const matrix Jw = J.mul(w);
+  const matrix gyro = vec3(w(1, 0) * Jw(2, 0) - w(2, 0) * Jw(1, 0), w(2, 0) * Jw(0, 0) - w(0, 0) * Jw(2, 0),
+                           w(0, 0) * Jw(1, 0) - w(1, 0) * Jw(0, 0));  // ω × Jω
+  auto with_rates = [&](const matrix& Jwdot_without_torque) {
+    SymbolicModel m = good;
+    const matrix wdot = Jinv.mul(Jwdot_without_torque);
+    for (int i = 0; i < 3; ++i) m.f(kBodyRate + i, 0) = wdot(i, 0);
+    return m;
+  };
+  SymbolicModel world_rates = good;
+  {
+    const matrix q = quaternion(good.states[kAttitude].sym, good.states[kAttitude + 1].sym, good.states[kAttitude + 2].sym,
+                                good.states[kAttitude + 3].sym);
+    const matrix qdot = quaternion_product(quaternion(0, w(0, 0), w(1, 0), w(2, 0)), q);
+    for (int i = 0; i < 4; ++i) world_rates.f(kAttitude + i, 0) = qdot(i, 0) / 2;
+  }
+  auto passed = [&](const SymbolicModel& m, const std::string& check) {
+    for (const auto& c : audit(m, derive_mass_properties(v)).checks)
+      if (c.name == check) return c.passed;
+    ADD_FAILURE() << "no check " << check;
     return false;
   };
-  EXPECT_TRUE(energy_ok(good));
-  EXPECT_FALSE(energy_ok(bad));
+  const std::string momentum = "angular momentum conserved in the world frame",
+                    energy = "rotational kinetic energy conserved";
+  EXPECT_TRUE(passed(good, momentum));
+  EXPECT_TRUE(passed(with_rates(gyro.mul_scalar(-1)), momentum));  // the right law, written out again
+  EXPECT_FALSE(passed(with_rates(gyro), momentum));                // the thesis' sign
+  EXPECT_FALSE(passed(with_rates(matrix(3, 1)), momentum));        // the term dropped
+  EXPECT_FALSE(passed(world_rates, momentum));
+  EXPECT_TRUE(passed(with_rates(gyro), energy));  // why the energy check alone is not enough
+  EXPECT_TRUE(passed(with_rates(matrix(3, 1)), energy));
 }
 
 TEST(Model, HoverIsAnEquilibrium) {
