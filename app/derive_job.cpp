@@ -27,6 +27,8 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
      << "mass " << nominal("mass") << " kg; centre of gravity (" << nominal("cog_x") << ", " << nominal("cog_y") << ", "
      << nominal("cog_z") << ") m; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", "
      << nominal("J_zz") << " kg m^2\n";
+  for (const AuditCheck* w : d.audit.warnings())
+    os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   return os.str();
 }
 

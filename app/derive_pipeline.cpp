@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "audit/report.hpp"
+#include "audit/vehicle_checks.hpp"
 #include "derive/fitted_parameters.hpp"
 #include "output/sinks.hpp"
 
@@ -38,6 +39,7 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.set_nominal) request.set_nominal(out.model);
   progress("audit");
   out.audit = audit(out.model, mass);
+  for (AuditCheck& c : check_vehicle_can_fly(vehicle, out.model)) out.audit.checks.push_back(std::move(c));
   if (request.thesis_comparison) out.thesis = compare_with_thesis(out.model, mass);
   progress("generating C++");
   codegen::EmitOptions emit = request.emit;

@@ -79,14 +79,30 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   return result;
 }
 
+// Each rotor's hover thrust [N]: m g / n where the layout balances that (a symmetric vehicle;
+// kept exact), else the least-norm trim through the rotor layout (runtime::allocate: a rotor
+// off the symmetric place carries more or less).
+std::vector<double> hover_thrusts(const Vehicle& v, const SymbolicModel& model, double even_share) {
+  const size_t n = v.rotors.size();
+  const std::vector<double> trim =
+      allocate(nominal_controller_belief(v, model), even_share * static_cast<double>(n), {0, 0, 0});
+  for (double f : trim)
+    if (std::fabs(f - even_share) > 1e-9 * even_share) return trim;
+  return std::vector<double>(n, even_share);
+}
+
 // Hover must be within reach of every rotor's motor map, or no manoeuvre can be flown; said
 // once, naming the vehicle file, instead of failing somewhere inside the flight.
-void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws, double hover_thrust) {
+void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws, const std::vector<double>& hover) {
+  for (size_t i = 0; i < laws.size(); ++i)  // first the sign, then the reach
+    if (hover[i] < 0)
+      throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: it would have to pull down " +
+                                  std::to_string(-hover[i]) + " N (the centre of gravity lies outside the rotors)");
   for (size_t i = 0; i < laws.size(); ++i) try {
-      laws[i].command_for(hover_thrust);
+      laws[i].command_for(hover[i]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: " + e.what() +
-                                  "; check c_t (rotor_model) and a0, a1, a2 (motor_map)");
+                                  "; check the masses, c_t (rotor_model) and a0, a1, a2 (motor_map)");
     }
 }
 
@@ -99,17 +115,18 @@ struct OpenLoop {
   ExtraInputs extra;  // looked up once, not at every integrator stage
   int delay;          // the input_delay parameter, or -1
   double vbat_ref;    // V, the battery voltage where the log holds none
-  double hover;       // N per rotor
+  double hover;       // N per rotor, m g / n: the thesis' manoeuvres are fractions of it
+  std::vector<double> hover_trim;  // N, each rotor's own hover thrust (hover_thrusts)
 
   double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
 };
 
-// A thesis manoeuvre: the thrusts it asks for at each (delayed) time, turned into commands
-// by each rotor's law.
+// A thesis manoeuvre: the thrusts it asks for at each (delayed) time, moved by each rotor's
+// own trim (zero on a symmetric vehicle), turned into commands by each rotor's law.
 InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   return [&k, s](double t, double* u) {
-    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);
-    for (size_t i = 0; i < k.rotors.size(); ++i) u[i] = k.laws[i].command_for(F[i]);
+    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);  // about the even share m g / n
+    for (size_t i = 0; i < k.rotors.size(); ++i) u[i] = k.laws[i].command_for(F[i] + (k.hover_trim[i] - k.hover));
     k.extra.fill(t, k.vbat_ref, u);
   };
 }
@@ -236,15 +253,22 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
+  const double even_share =
+      m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
   const OpenLoop k{m,
                    nominal_thrust_laws(vehicle, model),
                    rotor_names(vehicle),
                    ExtraInputs(m),
                    m.input_delay_param(),
                    param(vehicle, "vbat_ref").nominal,
-                   m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] /
-                       static_cast<double>(vehicle.rotors.size())};
-  check_hover_reachable(vehicle, k.laws, k.hover);
+                   even_share,
+                   hover_thrusts(vehicle, model, even_share)};
+  check_hover_reachable(vehicle, k.laws, k.hover_trim);
+  if (!a.scenario.empty() && find_scenario(a.scenario).rotor_roles && vehicle.rotors.size() != 4)
+    throw std::invalid_argument("--scenario " + a.scenario + " gives the thesis' rotor roles A..D to rotors 1..4, and " +
+                                vehicle.name + " has " + std::to_string(vehicle.rotors.size()) +
+                                " rotors: fly it with --closed-loop, or replay commands with --inputs (hover, climb "
+                                "and new_height fly any vehicle)");
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
 
   std::vector<double> x0(m.num_states(), 0.0);

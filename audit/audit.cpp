@@ -16,8 +16,15 @@ using namespace GiNaC;
 
 bool AuditResult::all_passed() const {
   for (const auto& c : checks)
-    if (!c.passed) return false;
+    if (!c.passed && !c.advisory) return false;
   return true;
+}
+
+std::vector<const AuditCheck*> AuditResult::warnings() const {
+  std::vector<const AuditCheck*> out;
+  for (const auto& c : checks)
+    if (!c.passed && c.advisory) out.push_back(&c);
+  return out;
 }
 
 namespace {
@@ -147,21 +154,6 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   return out;
 }
 
-// The substitutions that leave a model without torques: thrust (c_t = 0), gravity (g = 0),
-// every effect whose own formula adds a moment (Δτ: the flapping moment) and any term added
-// beyond the catalogue (term_*: an external force or moment found in data) switched off.
-// Rotor drag is a force at the CoG and adds none.
-lst torque_free(const SymbolicModel& m) {
-  lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
-  std::set<std::string> adds_moment;
-  for (const auto& f : m.effect_formulas)
-    for (const auto& line : f.lines)
-      if (line.first == "\\Delta \\tau") adds_moment.insert(f.effect);
-  for (const auto& p : m.params)
-    if (adds_moment.count(effect_of_parameter(p.name)) || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
-  return off;
-}
-
 // The body -> world rotation of a unit quaternion (Hamilton, scalar first), written out here
 // rather than taken from derive/kinematics, so that the momentum check below does not lean on
 // the code it checks.
@@ -209,7 +201,7 @@ AuditCheck check_world_angular_momentum(const SymbolicModel& m, const matrix& J,
 // conditions) and the world-frame angular momentum (the sharp one).
 std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
   using namespace runtime::rigid_body;
-  const lst off = torque_free(m);
+  const lst off = torque_free_substitutions(m);
   matrix w(3, 1), wdot(3, 1);
   for (int i = 0; i < 3; ++i) {
     w(i, 0) = m.states[kBodyRate + i].sym;
@@ -233,6 +225,21 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
 }
 
 }  // namespace
+
+// The substitutions that leave a model without torques: thrust (c_t = 0), gravity (g = 0),
+// every effect whose own formula adds a moment (Δτ: the flapping moment) and any term added
+// beyond the catalogue (term_*: an external force or moment found in data) switched off.
+// Rotor drag is a force at the CoG and adds none.
+lst torque_free_substitutions(const SymbolicModel& m) {
+  lst off{m.params[m.param_index("c_t")].sym == 0, m.params[m.param_index("g")].sym == 0};
+  std::set<std::string> adds_moment;
+  for (const auto& f : m.effect_formulas)
+    for (const auto& line : f.lines)
+      if (line.first == "\\Delta \\tau") adds_moment.insert(f.effect);
+  for (const auto& p : m.params)
+    if (adds_moment.count(effect_of_parameter(p.name)) || p.name.rfind("term_", 0) == 0) off.append(p.sym == 0);
+  return off;
+}
 
 ex reduce_trig(const ex& e, const std::vector<ex>& angles) {
   // Replace sin(a), cos(a) by symbols s, c and divide out c^2 + s^2 - 1 as a polynomial in c.

@@ -10,15 +10,18 @@
 namespace quadgen {
 
 struct AuditCheck {
-  std::string group;   // "units", "rotation", "inertia", "energy"
+  std::string group;   // "units", "rotation", "inertia", "energy", "vehicle"
   std::string name;
   bool passed = false;
   std::string detail;  // what was computed, in words a reviewer can follow
+  // About the vehicle, not the derivation (audit/vehicle_checks.hpp): a failure is a warning.
+  bool advisory = false;
 };
 
 struct AuditResult {
   std::vector<AuditCheck> checks;
-  bool all_passed() const;
+  bool all_passed() const;  // every check that is not advisory
+  std::vector<const AuditCheck*> warnings() const;  // the advisory checks that failed
 };
 
 AuditResult audit(const SymbolicModel& m, const MassProperties& mp);
@@ -31,6 +34,9 @@ GiNaC::ex reduce_trig(const GiNaC::ex& e, const std::vector<GiNaC::ex>& angles);
 // Reduces modulo qw^2 + qx^2 + qy^2 + qz^2 = 1 (eliminating qw^2).
 GiNaC::ex reduce_unit_quaternion(const GiNaC::ex& e, const GiNaC::ex& qw, const GiNaC::ex& qx,
                                  const GiNaC::ex& qy, const GiNaC::ex& qz);
+// The substitutions that switch off every torque of a model (thrust, gravity, effects whose
+// formula adds a moment, terms beyond the catalogue), as the energy checks use them.
+GiNaC::lst torque_free_substitutions(const SymbolicModel& m);
 // Closed-form inertia of a cuboid about its centre, m/12 diag(b^2+c^2, a^2+c^2, a^2+b^2),
 // rotated and moved to the origin with the parallel-axis theorem.
 GiNaC::matrix closed_form_block_inertia(const BlockSymbols& s);

@@ -158,6 +158,10 @@ void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& t
         "g\\,e_z\n```\n\n"
      << "Rotation (angular-momentum balance about the centre of gravity, body axes):\n\n"
      << "```math\nJ\\dot\\omega = \\tau - \\omega \\times J\\omega\n```\n\n"
+     << "Not modelled: the rotors' own angular momentum. A spinning rotor adds a gyroscopic moment "
+        "J_r Ω_i (ω × e_z) as the body turns and a reaction moment J_r dΩ_i/dt as it speeds up; the rotors "
+        "here are massless discs whose only moments are their thrust's arm and κF_i (both small on a "
+        "vehicle whose rotors cancel in pairs, and absorbed by a fitted κ where they are not).\n\n"
      << "Right-hand side rows short enough to read (the others are these vector equations written out; "
         "the generated code holds them in full):\n\n";
   for (size_t i = 0; i < m.states.size(); ++i) {
@@ -187,11 +191,15 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
 }
 
 void section_audit(std::ostringstream& md, const Derivation& d) {
-  md << "## 7. Audit\n\n**" << (d.audit.all_passed() ? "All checks passed." : "SOME CHECKS FAILED.") << "**\n\n"
-     << "| group | check | result | how |\n|---|---|---|---|\n";
+  const size_t warnings = d.audit.warnings().size();
+  md << "## 7. Audit\n\n**" << (d.audit.all_passed() ? "All checks of the derivation passed." : "SOME CHECKS FAILED.") << "**";
+  if (warnings)
+    md << " **" << warnings << " warning" << (warnings > 1 ? "s" : "")
+       << " about the vehicle** (group `vehicle`: the derivation holds, but the vehicle as described cannot fly)";
+  md << "\n\n| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
-    md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | " << (c.passed ? "pass" : "**FAIL**")
-       << " | " << output::markdown_text(c.detail) << " |\n";
+    md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "
+       << (c.passed ? "pass" : c.advisory ? "**warning**" : "**FAIL**") << " | " << output::markdown_text(c.detail) << " |\n";
   md << "\n";
 }
 
@@ -199,12 +207,16 @@ void section_thesis(std::ostringstream& md, const Derivation& d) {
   if (d.thesis.empty()) return;
   md << "## 8. Comparison with the thesis\n\n"
      << "The thesis' equations and numbers are encoded in `audit/thesis_reference.cpp`; each row compares "
-        "them with the derived model at its nominal parameters.\n\n"
-     << "| ref | topic | thesis | derived | verdict | cause | size |\n|---|---|---|---|---|---|---|\n";
+        "them with the derived model at its nominal parameters. *Verdict from* says how each verdict was reached: "
+        "computed from the derived model (its equations or an integration of them), computed by arithmetic on the "
+        "quantities quadgen derives (mass, inertia, areas), or read from the equations' form (stated in "
+        "`thesis_reference.cpp`, not computed).\n\n"
+     << "| ref | topic | thesis | derived | verdict | verdict from | cause | size |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& t : d.thesis)
     md << "| " << output::markdown_text(t.ref) << " | " << output::markdown_text(t.topic) << " | " << output::markdown_text(t.thesis)
        << " | " << output::markdown_text(t.derived) << " | " << (t.agrees ? "agrees" : "**differs**") << " | "
-       << output::markdown_text(t.cause) << " | " << output::markdown_text(t.size) << " |\n";
+       << output::markdown_text(t.basis) << " | " << output::markdown_text(t.cause) << " | " << output::markdown_text(t.size)
+       << " |\n";
   md << "\n";
 }
 
@@ -273,12 +285,12 @@ std::string model_json(const Derivation& d) {
   j["blocks"] = blocks;
   ordered_json checks = ordered_json::array();
   for (const auto& c : d.audit.checks)
-    checks.push_back({{"group", c.group}, {"check", c.name}, {"passed", c.passed}, {"detail", c.detail}});
+    checks.push_back({{"group", c.group}, {"check", c.name}, {"passed", c.passed}, {"advisory", c.advisory}, {"detail", c.detail}});
   j["audit"] = {{"passed", d.audit.all_passed()}, {"checks", checks}};
   ordered_json th = ordered_json::array();
   for (const auto& t : d.thesis)
     th.push_back({{"ref", t.ref}, {"topic", t.topic}, {"thesis", t.thesis}, {"derived", t.derived},
-                  {"agrees", t.agrees}, {"cause", t.cause}, {"size", t.size}});
+                  {"agrees", t.agrees}, {"basis", t.basis}, {"cause", t.cause}, {"size", t.size}});
   j["thesis_comparison"] = th;
   return output::json_document(j);
 }

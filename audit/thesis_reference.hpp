@@ -18,10 +18,15 @@ struct ThesisItem {
   bool agrees = false;
   std::string cause;    // why they differ (physics or algebra), empty when they agree
   std::string size;     // how large the difference is numerically
+  std::string basis;    // how the verdict was reached: kFromModel, kFromArithmetic or kFromReading, and how
 };
 
-// Whether a model is of the thesis' vehicle, the FINken 3 (vehicles/finken3.yaml, name
-// "finken3"): the one place that decides it.
+// The ways a verdict is reached, first words of ThesisItem::basis.
+inline constexpr const char* kFromModel = "computed from the model";
+inline constexpr const char* kFromArithmetic = "computed by arithmetic";
+inline constexpr const char* kFromReading = "reading of the equations";
+
+// Whether a model is of the thesis' vehicle (model/vehicle.hpp decides it by name).
 bool is_thesis_vehicle(const SymbolicModel& m);
 
 // The comparison, item by item; empty for any other vehicle.
@@ -29,5 +34,7 @@ std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassPr
 
 // The thesis' transformation matrix (3)/(81), as printed.
 GiNaC::matrix thesis_transformation(const GiNaC::ex& phi, const GiNaC::ex& theta, const GiNaC::ex& psi);
+// The thesis' rotation about y (78), as printed (not a rotation: det -1).
+GiNaC::matrix thesis_rotation_about_y(const GiNaC::ex& theta);
 
 }  // namespace quadgen

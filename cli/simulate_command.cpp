@@ -27,8 +27,8 @@ using namespace quadgen::runtime;
 void add_simulate(CLI::App& app, SimulateArgs& a) {
   CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
   c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
-  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre, as fractions of the vehicle's hover thrust, rotor i in the "
-                                 "role of the thesis' i-th (A..D): hover, climb, right, forward, yaw, new_height");
+  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust: hover, climb, new_height (any "
+                                 "vehicle); right, forward, yaw (four rotors only: rotor i in the role of the thesis' i-th, A..D)");
   auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a canonical flight log (CSV)");
   auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
                          "fly a smooth random trajectory under a cascaded controller (test flights)");

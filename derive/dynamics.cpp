@@ -155,7 +155,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
     const Rotor& r = c.vehicle.rotors[i];
     const std::string n = r.name;
-    c.rotor_disc_area.push_back(c.add_constant(n + ".A_p", "m^2", r.disc_area, "disc area of rotor " + n));
+    c.rotor_disc_area.push_back(c.add_constant(n + ".A_p", "m^2", r.disc_area, "thrust-law area of rotor " + n + " (its disc_area)"));
     c.rotor_radius.push_back(c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n));
     c.rotor_position.push_back(vec3(c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x"),
                                     c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),

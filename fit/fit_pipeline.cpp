@@ -106,9 +106,10 @@ FitOptions fit_options(const FitJobOptions& o) {
 }
 
 // Like the thesis' Figure 24: every step normalised to 0..1 and aligned at its fitted step
-// instant; a first-order lag is then one curve, 1 - exp(-t / tau).
-std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const std::vector<double>& p) {
-  runtime::Series meas{"Table 2, normalised", {}, {}, true}, fitted{"fitted tau", {}, {}},
+// instant; a first-order lag is then one curve, 1 - exp(-t / tau). The thesis' tau beside it
+// for the thesis' vehicle only.
+std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const std::vector<double>& p, bool with_thesis) {
+  runtime::Series meas{"steps, normalised", {}, {}, true}, fitted{"fitted tau", {}, {}},
       thesis{"thesis tau = 0.128 s", {}, {}};
   const double tau = p[MotorStepModel::kTau];
   for (size_t k = 0; k < model.steps().size(); ++k) {
@@ -128,7 +129,9 @@ std::vector<runtime::Panel> normalised_steps(const MotorStepModel& model, const 
     thesis.x.push_back(t);
     thesis.y.push_back(1 - std::exp(-t / kThesisMotorTau));
   }
-  return {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", {meas, fitted, thesis}}};
+  std::vector<runtime::Series> series{meas, fitted};
+  if (with_thesis) series.push_back(thesis);
+  return {{"normalised rotor speed after each throttle step", "time after the fitted step instant [s]", "1", series}};
 }
 
 }  // namespace
@@ -172,17 +175,20 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   j["kind"] = "motor_steps";
   j["vehicle"] = v.name;
   j["log"] = path;
-  j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
-                     {"thesis_method", "read off one normalised step at 63 % (thesis 2.3.4, Figure 24)"},
-                     {"tau", j["estimates"]["tau"]}};
+  const bool thesis = is_thesis_vehicle(v.name);  // the thesis' value belongs to its vehicle only
+  if (thesis)
+    j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
+                       {"thesis_method", "read off one normalised step at 63 % (thesis 2.3.4, Figure 24)"},
+                       {"tau", j["estimates"]["tau"]}};
   add_profile_plot(out, v.name + ": motor step profiles", profiles);
-  add_plot(out, "fit.svg", v.name + ": motor steps (thesis Table 2)", normalised_steps(model, parameter_values(best.parameters)));
+  add_plot(out, "fit.svg", v.name + ": motor steps", normalised_steps(model, parameter_values(best.parameters), thesis));
   std::ostringstream s;
   s << "tau = " << tau_s << " s";
   if (tau)
     s << ", 95 % profile interval [" << side(tau->lower, tau->lower_open) << ", " << side(tau->upper, tau->upper_open) << "] ("
       << tau->verdict << ")";
-  s << "; thesis: " << kThesisMotorTau << " s\n";
+  if (thesis) s << "; thesis: " << kThesisMotorTau << " s";
+  s << "\n";
   out.summary = s.str();
   return out;
 }
@@ -323,7 +329,7 @@ std::vector<runtime::Panel> stand_panels(const std::vector<StandSample>& samples
   std::vector<double> r(thrust.num_residuals());
   thrust.evaluate(pv.data(), r.data(), nullptr);
   for (size_t i = 0; i < samples.size(); ++i) {
-    const double wm = (samples[i].w[0] + samples[i].w[1] + samples[i].w[2] + samples[i].w[3]) / 4;
+    const double wm = samples[i].mean_speed();
     meas.x.push_back(wm);
     meas.y.push_back(samples[i].thrust);
     model.x.push_back(wm);
@@ -340,7 +346,7 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   const double vref = param(v, "vbat_ref").nominal;
   const StandFit f = fit_stand(samples, vref, fit_options(o), profile_options(o));
   const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
-  const int n_k = shared ? 1 : static_cast<int>(StandSample::kMotors);
+  const int n_k = shared ? 1 : static_cast<int>(samples.front().w.size());
   double k = 0;
   for (int i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / n_k;
   const Rotor& r0 = v.rotors.front();

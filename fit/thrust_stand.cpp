@@ -25,14 +25,29 @@ double checked(const runtime::CsvTable& t, size_t row, int col, double lo, doubl
 
 }  // namespace
 
+double StandSample::mean_speed() const {
+  double sum = 0;
+  for (double v : w) sum += v;
+  return sum / static_cast<double>(w.size());
+}
+
+double StandSample::sum_of_squared_speeds() const {
+  double sum = 0;
+  for (double v : w) sum += v * v;
+  return sum;
+}
+
 // Sanity bounds (the file's units): weight[g] is signed, the tared scale reads a little
 // below zero at rest, but |weight| <= 1e9 g; 0 <= pwm <= 65535 (a 16-bit command);
 // 0 <= vbat[V] <= 1000 and > 0 where the motors run (the speed model takes log(vbat));
 // 0 <= rpm_i <= 1e9. parse_csv has already refused non-finite values.
 std::vector<StandSample> read_thrust_stand(const std::string& path) {
   const runtime::CsvTable t = read_measurement_csv(path);
-  for (const char* c : {"weight[g]", "pwm", "vbat[V]", "rpm1", "rpm2", "rpm3", "rpm4"})
+  for (const char* c : {"weight[g]", "pwm", "vbat[V]", "rpm1"})
     if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (thrust-stand layout)");
+  std::vector<int> speed_columns;
+  while (t.column("rpm" + std::to_string(speed_columns.size() + 1)) >= 0)
+    speed_columns.push_back(t.column("rpm" + std::to_string(speed_columns.size() + 1)));
   const double rpm = 2 * M_PI / 60;
   const int cw = t.column("weight[g]"), cu = t.column("pwm"), cv = t.column("vbat[V]");
   std::vector<StandSample> out;
@@ -41,8 +56,7 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
     s.thrust = checked(t, k, cw, -1e9, 1e9, "|weight| <= 1e9 g") * 1e-3 * 9.80665;  // grams-force -> N
     s.u = checked(t, k, cu, 0, 65535, "a PWM command in [0, 65535]") / 65535.0;
     s.vbat = checked(t, k, cv, 0, 1000, "a battery voltage in [0, 1000] V");
-    for (int i = 0; i < 4; ++i)
-      s.w[i] = checked(t, k, t.column("rpm" + std::to_string(i + 1)), 0, 1e9, "a rotor speed in [0, 1e9] rpm") * rpm;
+    for (int c : speed_columns) s.w.push_back(checked(t, k, c, 0, 1e9, "a rotor speed in [0, 1e9] rpm") * rpm);
     if (!(s.u > 0 && s.w[0] > 0)) continue;
     if (!(s.vbat > 0)) checked(t, k, cv, 1e-300, 1000, "a positive battery voltage where the motors run");
     out.push_back(s);
@@ -53,41 +67,53 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
 
 double motor_speed_ratio_variation(const std::vector<StandSample>& s) {
   if (s.size() < 2) return 0.0;
+  const size_t motors = s.front().w.size();
   double variance_sum = 0;
-  for (int i = 0; i < 4; ++i) {
+  for (size_t i = 0; i < motors; ++i) {
     double sum = 0, sum2 = 0;
     for (const auto& q : s) {
-      const double ratio = q.w[i] / ((q.w[0] + q.w[1] + q.w[2] + q.w[3]) / 4);
+      const double ratio = q.w[i] / q.mean_speed();
       sum += ratio;
       sum2 += ratio * ratio;
     }
     const double n = static_cast<double>(s.size()), mean = sum / n;
     variance_sum += std::max(0.0, sum2 / n - mean * mean);
   }
-  return std::sqrt(variance_sum / 4);
+  return std::sqrt(variance_sum / static_cast<double>(motors));
 }
 
 std::vector<FitParameter> ThrustVsSpeed::parameters() const {
+  // T = k sum w^2 in closed form (least squares through the origin), and the scale's range.
+  double ts = 0, ss = 0, largest = 0;
+  for (const auto& q : s_) {
+    const double S = q.sum_of_squared_speeds();
+    ts += q.thrust * S;
+    ss += S * S;
+    largest = std::max(largest, std::fabs(q.thrust));
+  }
+  const double k0 = ss > 0 && ts > 0 ? ts / ss : 2e-8, tare = std::max(0.1, 0.1 * largest);
   std::vector<FitParameter> p;
   if (c_ == Coefficients::kShared) {
-    p.push_back({"k", "N s^2", 2e-8, 1e-10, 1e-6, true});
+    p.push_back({"k", "N s^2", k0, k0 / 1000, k0 * 1000, true});
   } else {
-    for (int i = 1; i <= 4; ++i) p.push_back({"k_" + std::to_string(i), "N s^2", 2e-8, 1e-10, 1e-6, true});
+    for (size_t i = 1; i <= motors(); ++i)
+      p.push_back({"k_" + std::to_string(i), "N s^2", k0, k0 / 1000, k0 * 1000, true});
   }
-  p.push_back({"tare", "N", 0.0, -0.1, 0.1, true});
+  p.push_back({"tare", "N", 0.0, -tare, tare, true});
   return p;
 }
 
 void ThrustVsSpeed::evaluate(const double* p, double* r, double* J) const {
   const bool shared = c_ == Coefficients::kShared;
-  const int np = shared ? 2 : 5, tare = np - 1;
+  const size_t motors = this->motors();
+  const int np = shared ? 2 : static_cast<int>(motors) + 1, tare = np - 1;
   for (size_t k = 0; k < s_.size(); ++k) {
     double T = p[tare];
-    for (int i = 0; i < 4; ++i) T += p[shared ? 0 : i] * s_[k].w[i] * s_[k].w[i];
+    for (size_t i = 0; i < motors; ++i) T += p[shared ? 0 : i] * s_[k].w[i] * s_[k].w[i];
     r[k] = T - s_[k].thrust;
     if (!J) continue;
     for (int j = 0; j < np; ++j) J[k * np + j] = 0;
-    for (int i = 0; i < 4; ++i) J[k * np + (shared ? 0 : i)] += s_[k].w[i] * s_[k].w[i];
+    for (size_t i = 0; i < motors; ++i) J[k * np + (shared ? 0 : static_cast<int>(i))] += s_[k].w[i] * s_[k].w[i];
     J[k * np + tare] = 1;
   }
 }
@@ -102,7 +128,7 @@ std::vector<FitParameter> SpeedVsCommand::parameters() {
 void SpeedVsCommand::evaluate(const double* p, double* r, double* J) const {
   for (size_t k = 0; k < s_.size(); ++k) {
     const auto& s = s_[k];
-    const double w = (s.w[0] + s.w[1] + s.w[2] + s.w[3]) / 4;
+    const double w = s.mean_speed();
     const double map = runtime::motor_map(p[0], p[1], p[2], s.u);
     const double scale = std::pow(s.vbat / vref_, p[3]);
     r[k] = map * scale - w;
@@ -142,10 +168,10 @@ StandFit fit_stand(const std::vector<StandSample>& samples, double vref, const F
     out.thrust_profiles = out.per_motor_profiles;
   } else {
     out.coefficients = ThrustVsSpeed::Coefficients::kShared;
-    out.coefficients_reason = "the per-motor coefficients are not identifiable from this run (the four speeds moved "
-                              "together: their ratios to the mean varied by " + percent(out.ratio_variation) +
+    out.coefficients_reason = "the per-motor coefficients are not identifiable from this run (the " +
+                              std::to_string(samples.front().w.size()) + " speeds moved together: their ratios to the mean varied by " + percent(out.ratio_variation) +
                               " RMS, too little to separate them against the thrust noise, so total thrust fixes only "
-                              "sum k_i w_i^2): one coefficient k is fitted for all four";
+                              "sum k_i w_i^2): one coefficient k is fitted for all of them";
     ThrustVsSpeed shared(samples, ThrustVsSpeed::Coefficients::kShared);
     out.thrust = fit_least_squares(shared, shared.parameters(), fo);
     out.thrust_profiles = profile_all(shared, out.thrust, fo, po);

@@ -1,5 +1,6 @@
-// Thrust-stand measurements (Bitcraze's Crazyflie 2.1 stand): total thrust of the four
-// rotors, each rotor's speed, the PWM command and the battery voltage.
+// Thrust-stand measurements (the layout of Bitcraze's Crazyflie 2.1 stand, weight[g], pwm,
+// vbat[V], rpm1..rpmN): total thrust of the N rotors on the stand, each rotor's speed, the
+// PWM command and the battery voltage.
 //  - ThrustVsSpeed: T = b + sum_i k_i w_i^2, a thrust coefficient per motor plus the
 //    scale's tare offset; or T = b + k sum_i w_i^2, one coefficient for all, which is all
 //    that total thrust determines when the motors run at nearly the same speed.
@@ -17,17 +18,19 @@
 namespace quadgen::fit {
 
 struct StandSample {
-  static constexpr int kMotors = 4;  // the Crazyflie stand logs four rotors
-  double thrust = 0;  // N, all four rotors
-  double u = 0;       // PWM / 65535
-  double vbat = 0;    // V
-  double w[kMotors] = {0, 0, 0, 0};  // rad/s
+  double thrust = 0;      // N, all the logged rotors together
+  double u = 0;           // PWM / 65535
+  double vbat = 0;        // V
+  std::vector<double> w;  // rad/s, each logged rotor (rpm1..rpmN)
+  double mean_speed() const;
+  double sum_of_squared_speeds() const;
 };
 
-std::vector<StandSample> read_thrust_stand(const std::string& path);  // rows with PWM > 0
+// Rows with PWM > 0; as many rotors as the file has consecutive columns rpm1, rpm2, ...
+std::vector<StandSample> read_thrust_stand(const std::string& path);
 
 // How independently the motors' speeds moved: RMS over motors of the standard deviation,
-// over samples, of each motor's speed relative to the four motors' mean. Total thrust
+// over samples, of each motor's speed relative to the motors' mean. Total thrust
 // separates per-motor coefficients only through this variation (a constant ratio makes
 // the columns w_i^2 proportional).
 double motor_speed_ratio_variation(const std::vector<StandSample>& s);
@@ -42,8 +45,11 @@ class ThrustVsSpeed : public ResidualModel {
   int channel_of(int) const override { return 0; }
   std::vector<std::string> channels() const override { return {"thrust"}; }
   std::unique_ptr<ResidualModel> clone() const override { return std::make_unique<ThrustVsSpeed>(*this); }
-  // Per motor: k_1..k_4 [N s^2], tare [N]. Shared: k [N s^2], tare [N].
+  // Per motor: k_1..k_N [N s^2], tare [N]. Shared: k [N s^2], tare [N]. Started at the
+  // shared coefficient the data give in closed form, bounded a thousandfold either side of
+  // it, so that a stand of any size starts near its answer.
   std::vector<FitParameter> parameters() const;
+  size_t motors() const { return s_.front().w.size(); }
 
  private:
   std::vector<StandSample> s_;
@@ -68,7 +74,7 @@ class SpeedVsCommand : public ResidualModel {
 // What a stand run determines, fitted so that no reported value sits on a bound or rests
 // on an open profile:
 //  - thrust: per-motor coefficients when every one is identifiable, else one coefficient
-//    shared by the four (total thrust fixes only the sum when the speeds barely differ);
+//    shared by all (total thrust fixes only the sum when the speeds barely differ);
 //  - rotor speed: the motor map with the voltage exponent when it is identifiable, else
 //    without it (the voltage then varied only with the load, confounded with the command).
 struct StandFit {

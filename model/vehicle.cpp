@@ -76,8 +76,18 @@ struct Reader : YamlReader {
         p.lower = number(b[0], "lower bound of " + name) * scale;
         p.upper = number(b[1], "upper bound of " + name) * scale;
         if (!(p.lower < p.upper)) fail(b, "expected lower < upper in bounds of " + name);
-        if (p.nominal < p.lower || p.nominal > p.upper)
-          fail(b, "nominal value of " + name + " lies outside its bounds");
+        if (p.nominal < p.lower || p.nominal > p.upper) {
+          const std::string unit = n["unit"] ? " " + n["unit"].as<std::string>() : "";
+          const auto shortest_text = [](double v) {
+            std::ostringstream os;
+            os.precision(12);
+            os << v;
+            return os.str();
+          };
+          fail(b, "nominal value of " + name + ", " + shortest_text(p.nominal / scale) + unit + ", lies outside its bounds [" +
+                      shortest_text(p.lower / scale) + ", " + shortest_text(p.upper / scale) + "]" + unit +
+                      (unit.empty() ? "" : " (bounds are in the value's unit)"));
+        }
       }
       if (n["fit"]) {
         try {

@@ -57,23 +57,25 @@ struct Reference {
 
 V3 vee(const M3& S) { return V3(S(2, 1), S(0, 2), S(1, 0)); }
 
-// Per-rotor thrusts for a total thrust and body torques, by the (pseudo-)inverse of the
-// allocation matrix of the believed rotor layout.
-std::vector<double> allocate(const ControllerModel& b, double thrust, const V3& torque) {
-  const int n = static_cast<int>(b.rotor_x.size());
+}  // namespace
+
+std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b) {
+  std::vector<std::array<double, 4>> columns;
+  for (size_t i = 0; i < b.rotor_x.size(); ++i)
+    columns.push_back({1.0, b.rotor_y[i], -b.rotor_x[i], -b.spin[i] * b.kappa});
+  return columns;
+}
+
+std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque) {
+  const auto columns = allocation_columns(b);
+  const int n = static_cast<int>(columns.size());
   Eigen::MatrixXd A(4, n);
-  for (int i = 0; i < n; ++i) {
-    A(0, i) = 1;
-    A(1, i) = b.rotor_y[i];
-    A(2, i) = -b.rotor_x[i];
-    A(3, i) = -b.spin[i] * b.kappa;
-  }
-  Eigen::Vector4d w(thrust, torque.x(), torque.y(), torque.z());
+  for (int i = 0; i < n; ++i)
+    for (int r = 0; r < 4; ++r) A(r, i) = columns[static_cast<size_t>(i)][static_cast<size_t>(r)];
+  Eigen::Vector4d w(thrust, torque[0], torque[1], torque[2]);
   const Eigen::VectorXd F = A.completeOrthogonalDecomposition().solve(w);
   return std::vector<double>(F.data(), F.data() + n);
 }
-
-}  // namespace
 
 std::string GeneratedFlight::csv() const {
   std::ostringstream os;
@@ -154,7 +156,7 @@ class CascadedController {
     int_rate_ += e_w * dt;
     const V3 Jd(b_.J[0], b_.J[1], b_.J[2]);
     const V3 torque = Jd.cwiseProduct(-o_.kp_rate * e_w - o_.ki_rate * int_rate_) + w.cross(Jd.cwiseProduct(w));
-    return allocate(b_, thrust * thrust_scale, torque);
+    return allocate(b_, thrust * thrust_scale, {torque.x(), torque.y(), torque.z()});
   }
 
  private:

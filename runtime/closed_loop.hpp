@@ -5,6 +5,7 @@
 // mocap-like pose noise and optional IMU noise and bias. Used to hide effects in flights
 // that the diagnosis must then find, and as a simulator feature in its own right.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,15 @@ struct ControllerModel {
   std::vector<double> rotor_x, rotor_y, spin;  // spin +1 ccw seen from above
   std::vector<ThrustLaw> thrust_laws;          // command <-> thrust
 };
+
+// What each rotor's thrust does to the body, per newton, in the believed layout: (total thrust
+// [1], roll and pitch moment about the CoG [m], yaw reaction [m]; a counter-clockwise rotor
+// turns the body with -kappa F), one column per rotor. The controller allocates through it,
+// simulate's scenarios trim hover with it, and derive's vehicle checks read its rank.
+std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b);
+// Per-rotor thrusts [N] for a total thrust [N] and body torques [N m]: the least-norm solution
+// through the allocation (exact where it has rank 4).
+std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque);
 
 struct ClosedLoopOptions {
   double duration = 60;        // s

@@ -66,13 +66,13 @@ std::vector<double> new_height(double t, double h, const std::vector<std::string
 
 const std::vector<Scenario>& scenario_catalogue() {
   static const std::vector<Scenario> list = {
-      {"hover", "every rotor at hover thrust m g / n (thesis (60))", hover},
+      {"hover", "every rotor at its hover thrust (m g / n on a symmetric vehicle; thesis (60))", hover},
       {"climb", "1.16 times hover thrust on every rotor (the thesis' 1.1 N; 2.3.1 b, (63)-(64))", climb},
       {"right", "rotors 1 and 4 (A, D) raised 2.1 % of hover for 0.1 s, then 2 and 3; reversed at 1.5 s (thesis "
-                "2.3.2 a; the FINken 3 tilts towards +x)", right},
+                "2.3.2 a; the FINken 3 tilts towards +x)", right, true},
       {"forward", "rotors 3 and 4 (C, D) raised 2.1 % of hover for 0.1 s, then 1 and 2; reversed at 1.5 s (thesis "
-                  "2.3.2 b, its inputs for +y; the FINken 3 tilts towards -y)", forward},
-      {"yaw", "rotors 1 and 3 (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
+                  "2.3.2 b, its inputs for +y; the FINken 3 tilts towards -y)", forward, true},
+      {"yaw", "rotors 1 and 3 (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw, true},
       {"new_height", "all rotors +10.5 % of hover from 0.5 to 1.0 s, -10.5 % from 2.0 to 2.5 s (thesis 2.3.2 d)",
        new_height},
   };

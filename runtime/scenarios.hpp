@@ -13,6 +13,9 @@ struct Scenario {
   std::string description;
   // Thrust per rotor [N] at time t; rotors in vehicle order.
   std::vector<double> (*thrust)(double t, double hover, const std::vector<std::string>& rotors);
+  // Gives the thesis' rotor roles A..D to rotors 1..4 (a tilt or yaw manoeuvre): flown only on
+  // a vehicle with four rotors. The others change every rotor alike and fly any vehicle.
+  bool rotor_roles = false;
 };
 
 const std::vector<Scenario>& scenario_catalogue();

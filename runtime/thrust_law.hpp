@@ -1,5 +1,6 @@
 // Header-only and dependency-free, so that derive/ (symbolic), runtime/ and fit/ share it.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -37,7 +38,16 @@ struct ThrustLaw {
 
 inline double ThrustLaw::command_for(double thrust) const {
   if (!(thrust >= 0)) throw std::invalid_argument("thrust " + std::to_string(thrust) + " N requested of a rotor");
-  const auto beyond = [&] {
+  // Why no command gives it: a map that does not rise over 0..1, or a thrust below what
+  // command 0 gives, or above what command 1 gives.
+  const auto unreachable = [&] {
+    if (!(a1 > 0 && a1 + 2 * a2 > 0))
+      return std::invalid_argument("the motor map's speed does not rise with the command over 0..1 (a1 = " +
+                                   std::to_string(a1) + ", a2 = " + std::to_string(a2) + " rad/s)");
+    const double lowest = thrust_at_speed(std::max(speed_at(0.0), 0.0));
+    if (thrust < lowest)
+      return std::invalid_argument("thrust " + std::to_string(thrust) + " N is below what the motor map gives at command 0 (" +
+                                   std::to_string(lowest) + " N)");
     return std::invalid_argument("thrust " + std::to_string(thrust) + " N is beyond the motor map (at most " +
                                  std::to_string(thrust_at_speed(speed_at(1.0))) + " N at command 1)");
   };
@@ -48,11 +58,11 @@ inline double ThrustLaw::command_for(double thrust) const {
     u = (w - a0) / a1;
   } else {
     const double disc = a1 * a1 - 4 * a2 * (a0 - w);
-    if (disc < 0) throw beyond();
+    if (disc < 0) throw unreachable();
     u = (-a1 + std::sqrt(disc)) / (2 * a2);
     if (u < 0 || u > 1) u = (-a1 - std::sqrt(disc)) / (2 * a2);
   }
-  if (!(u >= 0 && u <= 1)) throw beyond();
+  if (!(u >= 0 && u <= 1)) throw unreachable();
   return u;
 }
 

@@ -17,7 +17,7 @@ def main():
     if len(sys.argv) != 4:
         sys.exit(__doc__)
     rotors, blocks, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-    if rotors < 3 or rotors % 2:
+    if rotors < 4 or rotors % 2:
         sys.exit("ROTORS: an even number, at least 4")
     fixed = 1 + 2 * rotors
     if blocks < fixed:

@@ -418,21 +418,24 @@ namespace {
 // A synthetic stand run: thrust sum k w_i^2 + tare with noise; each motor's speed is the
 // common speed times its own factor, varied per sample by `independent`; the battery
 // voltage varies independently of the command when `voltage_varies`.
-std::vector<StandSample> synthetic_stand(double independent, bool voltage_varies, std::mt19937& rng) {
+std::vector<StandSample> synthetic_stand(double independent, bool voltage_varies, std::mt19937& rng,
+                                        size_t motors = 4, double k = 2e-8, double speed_scale = 1,
+                                        double thrust_sd = 0.002) {
   std::uniform_real_distribution<double> cmd(0.1, 1.0), indep(-independent, independent), volt(3.0, 4.1);
-  std::normal_distribution<double> thrust_noise(0, 0.002), speed_noise(0, 1);
-  const double k = 2e-8, tare = 0.01, vref = 3.7, e = 0.5;
+  std::normal_distribution<double> thrust_noise(0, thrust_sd), speed_noise(0, 1);
+  const double tare = 0.01, vref = 3.7, e = 0.5;
+  const double ratio[6] = {1.03, 0.98, 1.01, 0.98, 1.02, 0.99};
   std::vector<StandSample> out;
   for (int n = 0; n < 600; ++n) {
     StandSample s;
     s.u = cmd(rng);
     s.vbat = voltage_varies ? volt(rng) : 3.7;
-    const double w = (300 + 2700 * s.u - 600 * s.u * s.u) * std::pow(s.vbat / vref, e);
-    const double ratio[4] = {1.03, 0.98, 1.01, 0.98};
-    for (int i = 0; i < 4; ++i) s.w[i] = w * ratio[i] * (1 + indep(rng));
-    const double mean = (s.w[0] + s.w[1] + s.w[2] + s.w[3]) / 4;
+    const double w = speed_scale * (300 + 2700 * s.u - 600 * s.u * s.u) * std::pow(s.vbat / vref, e);
+    s.w.resize(motors);
+    for (size_t i = 0; i < motors; ++i) s.w[i] = w * ratio[i] * (1 + indep(rng));
+    const double mean = s.mean_speed();
     s.thrust = tare + thrust_noise(rng);
-    for (int i = 0; i < 4; ++i) {
+    for (size_t i = 0; i < motors; ++i) {
       s.w[i] += w - mean;  // the mean speed follows the motor map
       s.thrust += k * s.w[i] * s.w[i];
       s.w[i] += speed_noise(rng);
@@ -469,6 +472,23 @@ TEST(Fit, ThrustStandFitsWhatTheDataIdentify) {
   }
   EXPECT_TRUE(apart.voltage_exponent_identified);
   EXPECT_NEAR(apart.speed.parameters[3].value, 0.5, 0.05);
+}
+
+// A stand of another size and rotor count (six rotors of a 2 kg hexacopter: k 250 times the
+// Crazyflie's, speeds a third): every logged rotor is fitted, the estimate starts near the
+// data's own answer and sits on no bound.
+TEST(Fit, ThrustStandOfAnySizeAndRotorCount) {
+  std::mt19937 rng(11);
+  FitOptions fo;
+  fo.account_autocorrelation = false;
+  const StandFit f = fit_stand(synthetic_stand(0.15, true, rng, 6, 5e-6, 1.0 / 3, 0.05), 3.7, fo, {});
+  EXPECT_EQ(f.coefficients, ThrustVsSpeed::Coefficients::kPerMotor);
+  ASSERT_EQ(f.thrust.parameters.size(), 7u);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(f.thrust_profiles[i].verdict, "identifiable") << i;
+    EXPECT_NEAR(f.thrust.parameters[i].value, 5e-6, 0.1e-6) << i;
+  }
+  EXPECT_TRUE(f.thrust.at_bound.empty());
 }
 
 TEST(FitCli, ProfilesOnDemand) {

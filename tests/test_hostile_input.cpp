@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -1099,5 +1100,43 @@ TEST(DataLoss, AnEarlierOutputIsKeptAsideEvenUnderALongName) {
     EXPECT_EQ(read(kept / "notes.txt"), "a user's file\n");
     EXPECT_TRUE(fs::exists(kept / ".quadgen-keep"));
     fs::remove_all(kept);
+  }
+}
+
+// Scenarios on other layouts: a hexacopter hovers with every rotor alike but is refused the
+// manoeuvres that give rotors the thesis' A..D roles (with what to do instead), and a quad
+// whose centre of gravity is off the middle hovers level on its trimmed thrusts.
+TEST(Cli, ScenariosFollowTheVehiclesLayout) {
+  Scratch tmp;
+  const std::string finken = read(source_path("vehicles/finken3.yaml"));
+  const size_t rotors_at = finken.find("\nrotors:");
+  ASSERT_NE(rotors_at, std::string::npos);
+  std::string hexa = finken.substr(0, rotors_at) + "\nrotors:\n";
+  for (int i = 0; i < 6; ++i) {
+    const double a = M_PI / 6 + i * M_PI / 3, r = 0.1056;
+    char line[200];
+    std::snprintf(line, sizeof line, "  - {name: R%d, position: [%.6f, %.6f, 0], spin: %s, radius: 0.0635, disc_area: 1.646e-3}\n",
+                  i + 1, r * std::cos(a), r * std::sin(a), i % 2 ? "cw" : "ccw");
+    hexa += line;
+  }
+  write(tmp.dir / "hexa.yaml", hexa);
+  CliResult r = run_quadgen({"simulate", tmp / "hexa.yaml", "--scenario", "yaw", "--duration", "2", "--out", tmp / "yaw.csv"}, tmp.dir);
+  EXPECT_EQ(r.rc, 2) << r.err;
+  EXPECT_NE(r.err.find("has 6 rotors"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--closed-loop"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp.dir / "yaw.csv"));
+
+  std::string off_centre = finken;  // the upper body 2 cm towards +x: the CoG 5.1 mm off the middle
+  const std::string upper = "centre: [0, 0, 0.036]";
+  ASSERT_NE(off_centre.find(upper), std::string::npos);
+  off_centre.replace(off_centre.find(upper), upper.size(), "centre: [0.02, 0, 0.036]");
+  write(tmp.dir / "off_centre.yaml", off_centre);
+  for (const char* file : {"hexa.yaml", "off_centre.yaml"}) {
+    const std::string out = tmp / (std::string(file) + ".csv");
+    r = run_quadgen({"simulate", tmp / file, "--scenario", "hover", "--duration", "2", "--out", out}, tmp.dir);
+    ASSERT_EQ(r.rc, 0) << file << ": " << r.err;
+    const quadgen::runtime::CsvTable t = quadgen::runtime::read_csv(out);
+    const auto& last = t.rows.back();
+    for (const char* c : {"x", "y", "z", "qx", "qy"}) EXPECT_NEAR(last[t.column(c)], 0.0, 1e-6) << file << " " << c;
   }
 }

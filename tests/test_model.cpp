@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "audit/audit.hpp"
+#include "audit/vehicle_checks.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "audit/report.hpp"
 #include "audit/tex_writer.hpp"
@@ -669,11 +670,42 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   }
   EXPECT_FALSE(verdict.at("(3), (77)-(81)"));  // T is a reflection
   EXPECT_TRUE(verdict.at("(34)"));             // torques agree symbolically
+  EXPECT_FALSE(verdict.at("(35)-(38), (54)"));  // the gyroscopic sign
   EXPECT_TRUE(verdict.at("(59), (60)"));       // hover thrust
   EXPECT_TRUE(verdict.at("(63), (64)"));       // climb
   EXPECT_FALSE(verdict.at("(65), (67), (68)"));  // rad vs deg
+  EXPECT_FALSE(verdict.at("(73), (76)"));        // c_t: rad/s vs rev/s
   realsymbol a("a"), b("b"), c("c");
   EXPECT_TRUE(reduce_trig(thesis_transformation(a, b, c).determinant() + 1, {a, b, c}).is_zero());
+  EXPECT_TRUE(reduce_trig(thesis_rotation_about_y(b).determinant() + 1, {b}).is_zero());
+  // Every verdict says how it was reached, and only the form of the translation law is a reading.
+  for (const auto& t : items) {
+    const bool known = t.basis.rfind(kFromModel, 0) == 0 || t.basis.rfind(kFromArithmetic, 0) == 0 ||
+                       t.basis.rfind(kFromReading, 0) == 0;
+    EXPECT_TRUE(known) << t.ref << ": " << t.basis;
+    if (t.basis.rfind(kFromReading, 0) == 0) EXPECT_EQ(t.ref, "(22)-(24), (53)");
+  }
+}
+
+// The verdicts computed from the model follow the model: with the thesis' sign of the
+// gyroscopic term written into the model's body-rate rows, (35) agrees.
+TEST(Thesis, AGyroscopicVerdictFollowsTheModel) {
+  using namespace runtime::rigid_body;
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  SymbolicModel m = derive_model(v, mp, {});
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  const ex p = m.states[kBodyRate].sym, q = m.states[kBodyRate + 1].sym, r = m.states[kBodyRate + 2].sym;
+  m.f(kBodyRate, 0) = (P("J_zz") - P("J_yy")) * q * r / P("J_xx");
+  m.f(kBodyRate + 1, 0) = (P("J_xx") - P("J_zz")) * p * r / P("J_yy");
+  m.f(kBodyRate + 2, 0) = (P("J_yy") - P("J_xx")) * p * q / P("J_zz");
+  bool found = false;
+  for (const auto& t : compare_with_thesis(m, mp))
+    if (t.ref == "(35)-(38), (54)") {
+      found = true;
+      EXPECT_TRUE(t.agrees);
+    }
+  EXPECT_TRUE(found);
 }
 
 // Every effect says what it found in a sentence with the units a reader expects; spot checks
@@ -1016,4 +1048,62 @@ TEST(Model, MotorSlopeTurnsTheMapAboutItsPivot) {
     for (double u : {0.5, 0.8, 0.95})
       EXPECT_NEAR(speed(u) - map(pivot), slope * (map(u) - map(pivot)), 1e-9 * map(pivot)) << u;
   }
+}
+
+// The vehicle advisories (audit/vehicle_checks.hpp) pass for the bundled vehicles and name
+// what a new vehicle's author most often gets wrong, each alone; the audit itself still passes.
+TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
+  auto checks_of = [](const Vehicle& v) {
+    std::map<std::string, AuditCheck> by_name;
+    for (auto& c : check_vehicle_can_fly(v, derive_model(v, derive_mass_properties(v), {}))) by_name[c.name] = c;
+    return by_name;
+  };
+  const std::string map = "the motor map rises with the command", apart = "thrust, roll, pitch and yaw can be set apart",
+                    trim = "a hover trim exists within the motors' reach";
+  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml"}) {
+    const auto checks = checks_of(load_vehicle(test::source_path(file)));
+    ASSERT_EQ(checks.size(), 3u);
+    for (const auto& [name, c] : checks) {
+      EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
+      EXPECT_TRUE(c.advisory);
+    }
+  }
+  const Vehicle good = test::finken3();
+  {  // masses in grams written as kilograms: hover beyond the motor map
+    Vehicle v = good;
+    for (auto& b : v.blocks) b.mass *= 1000;
+    v.derived_overrides.clear();  // the file's bounds on the mass would stop it earlier
+    const auto c = checks_of(v);
+    EXPECT_FALSE(c.at(trim).passed);
+    EXPECT_NE(c.at(trim).detail.find("beyond the motor map"), std::string::npos) << c.at(trim).detail;
+    EXPECT_TRUE(c.at(apart).passed);
+  }
+  {  // the centre of gravity outside the rotors: one would have to pull down
+    Vehicle v = good;
+    for (auto& r : v.rotors) r.position[0] += 0.2;
+    const auto c = checks_of(v);
+    EXPECT_FALSE(c.at(trim).passed);
+    EXPECT_NE(c.at(trim).detail.find("pull down"), std::string::npos) << c.at(trim).detail;
+  }
+  {  // every rotor counter-clockwise: yaw cannot be held apart from thrust
+    Vehicle v = good;
+    for (auto& r : v.rotors) r.spin = Spin::ccw;
+    const auto c = checks_of(v);
+    EXPECT_FALSE(c.at(apart).passed);
+    EXPECT_NE(c.at(apart).detail.find("cannot set apart thrust and yaw"), std::string::npos) << c.at(apart).detail;
+  }
+  {  // a motor map copied with the wrong sign
+    Vehicle v = good;
+    Parameter& a1 = v.params.at("a1");
+    a1.nominal = a1.lower = a1.upper = -a1.nominal;
+    const auto c = checks_of(v);
+    EXPECT_FALSE(c.at(map).passed);
+  }
+  // A warning leaves the derivation's audit passed.
+  AuditResult r;
+  r.checks.push_back({"vehicle", trim, false, "", true});
+  EXPECT_TRUE(r.all_passed());
+  EXPECT_EQ(r.warnings().size(), 1u);
+  r.checks.push_back({"units", "dx/dt", false, ""});
+  EXPECT_FALSE(r.all_passed());
 }

@@ -1,0 +1,117 @@
+#include "audit/vehicle_checks.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "derive/runtime_view.hpp"
+
+namespace quadgen {
+
+namespace {
+
+AuditCheck advisory(const std::string& name, bool ok, const std::string& detail) {
+  AuditCheck c{"vehicle", name, ok, detail};
+  c.advisory = true;
+  return c;
+}
+
+// The allocation of the layout the vehicle file gives (runtime::allocation_columns), rows
+// total thrust, roll, pitch, yaw.
+Eigen::MatrixXd allocation(const runtime::ControllerModel& b) {
+  const auto columns = runtime::allocation_columns(b);
+  Eigen::MatrixXd B(4, static_cast<Eigen::Index>(columns.size()));
+  for (size_t i = 0; i < columns.size(); ++i)
+    for (size_t r = 0; r < 4; ++r) B(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(i)) = columns[i][r];
+  return B;
+}
+
+std::string numbers(const Eigen::VectorXd& x, const char* unit) {
+  std::ostringstream os;
+  os.precision(4);
+  for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << x(i);
+  if (*unit) os << " " << unit;
+  return os.str();
+}
+
+AuditCheck check_motor_map(const std::vector<runtime::ThrustLaw>& laws) {
+  const runtime::ThrustLaw& l = laws.front();  // one map for every rotor
+  const bool rises = l.a1 > 0 && l.a1 + 2 * l.a2 > 0;
+  std::ostringstream os;
+  os.precision(5);
+  os << "d(speed)/d(command) = a1 + 2 a2 u is " << l.a1 << " rad/s at u = 0 and " << l.a1 + 2 * l.a2
+     << " at u = 1 (the map as the model turns it)";
+  return advisory("the motor map rises with the command", rises, os.str());
+}
+
+// Thrust, roll, pitch and yaw apart: the allocation has rank 4. Rows scaled to their largest
+// entry first (newtons and newton-metres of arms of centimetres), which leaves the rank as it is.
+AuditCheck check_controllable(const Eigen::MatrixXd& B) {
+  Eigen::MatrixXd scaled = B;
+  for (Eigen::Index r = 0; r < 4; ++r) {
+    const double top = scaled.row(r).cwiseAbs().maxCoeff();
+    if (top > 0) scaled.row(r) /= top;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullU);
+  const Eigen::VectorXd s = svd.singularValues();
+  int rank = 0;
+  for (Eigen::Index i = 0; i < s.size(); ++i)
+    if (s(i) > 1e-9 * s(0)) ++rank;
+  const char* axes[4] = {"thrust", "roll", "pitch", "yaw"};
+  std::string detail = "rank " + std::to_string(rank) + " of 4 of the map from the rotors' thrusts to (thrust, roll, "
+                       "pitch, yaw)";
+  if (rank < 4) {
+    // The combination of the four the rotors cannot produce: the axes with a share in it are
+    // the ones tied together (all counter-clockwise: thrust and yaw move as one).
+    const Eigen::VectorXd lost = svd.matrixU().col(3).cwiseAbs();
+    std::string tied;
+    for (Eigen::Index i = 0; i < 4; ++i)
+      if (lost(i) >= 0.25 * lost.maxCoeff()) tied += std::string(tied.empty() ? "" : " and ") + axes[i];
+    detail += "; the rotors cannot set apart " + tied +
+              (lost(3) >= 0.25 * lost.maxCoeff() ? " (do the spins cancel? as many ccw as cw rotors, placed in pairs)"
+                                                 : " (where are the rotors?)");
+  }
+  return advisory("thrust, roll, pitch and yaw can be set apart", rank == 4, detail);
+}
+
+// A hover trim: thrusts F >= 0 with B F = (m g, 0, 0, 0), each within its motor's reach. The
+// least-norm solution is the one checked (with more than four rotors another may exist).
+AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b, const Eigen::MatrixXd& B) {
+  const double weight = b.mass * b.g;
+  const std::vector<double> trim = runtime::allocate(b, weight, {0, 0, 0});
+  const Eigen::VectorXd F = Eigen::Map<const Eigen::VectorXd>(trim.data(), static_cast<Eigen::Index>(trim.size()));
+  const double miss = (B * F - Eigen::Vector4d(weight, 0, 0, 0)).norm();
+  std::string why;
+  if (!(miss <= 1e-6 * weight)) why = "no thrusts balance the weight without a moment";
+  for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i)  // first the sign, then the reach
+    if (trim[i] < 0)
+      why = "rotor " + v.rotors[i].name + " would have to pull down (the centre of gravity lies outside the rotors)";
+  for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i) {
+    try {
+      b.thrust_laws[i].command_for(trim[i]);
+    } catch (const std::invalid_argument& e) {
+      why = "rotor " + v.rotors[i].name + ": " + e.what() + " (check the masses, c_t and the motor map)";
+    }
+  }
+  std::string detail = "least-norm thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(weight) + " N)";
+  if (why.empty()) {
+    Eigen::VectorXd u(F.size());
+    for (Eigen::Index i = 0; i < F.size(); ++i) u(i) = b.thrust_laws[static_cast<size_t>(i)].command_for(F(i));
+    detail += ", commands " + numbers(u, "");
+  } else {
+    detail += ": " + why;
+  }
+  return advisory("a hover trim exists within the motors' reach", why.empty(), detail);
+}
+
+}  // namespace
+
+std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
+  const runtime::ControllerModel b = nominal_controller_belief(v, m);
+  const Eigen::MatrixXd B = allocation(b);
+  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b, B)};
+}
+
+}  // namespace quadgen

@@ -1,0 +1,22 @@
+// Whether the vehicle a file describes can fly, checked at its nominal values: the motor maps
+// rise with the command, thrust, roll, pitch and yaw can be set apart from one another, and a
+// hover trim exists within every motor's reach. These are advisories about the vehicle, not
+// about the derivation (which is right for a vehicle that cannot fly, too): a failed one is a
+// warning in derive's summary and in derivation.md, and the audit still passes.
+//
+// They catch what a new vehicle's author gets wrong most often and no unit check sees: masses
+// in grams written as kilograms (hover beyond the motor map), a centre of gravity outside the
+// rotors (a rotor would have to pull down), spins that do not cancel (yaw cannot be held), a
+// motor map copied with the wrong sign.
+#pragma once
+#include <vector>
+
+#include "audit/audit.hpp"
+#include "derive/symbolic_model.hpp"
+#include "model/vehicle.hpp"
+
+namespace quadgen {
+
+std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m);
+
+}  // namespace quadgen
