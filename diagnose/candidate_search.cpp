@@ -604,6 +604,122 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
   }
 }
 
+std::vector<FitParameter> CandidateSearch::fit_holding(const std::set<std::string>& effects,
+                                                       const std::set<std::string>& held,
+                                                       const std::vector<FitParameter>& start,
+                                                       const std::vector<double>& weights, double* cost) const {
+  std::vector<FitParameter> ps = start;
+  for (size_t i = 0; i < ps.size(); ++i) {
+    if (!is_effect_parameter(ps[i].name)) continue;
+    const std::string e = effect_of_parameter(ps[i].name);
+    if (held.count(e)) {  // in the model at its value in `start`
+      ps[i].free = false;
+      continue;
+    }
+    const bool on = effects.count(e) > 0 && all_.params[i].fit;
+    ps[i].free = on;
+    if (!on) ps[i].value = neutral_value(all_.params[i]);
+  }
+  for (int i : reference_params_) ps[i].free = false;
+  *cost = fit::solve_weighted(train_, ps, weights, refit_options());
+  return ps;
+}
+
+// A richer effect can reproduce a poorer look-alike and add something of its own: with six
+// rotors, five motor gains make a CoG offset's moment (the offset's moment is total thrust x
+// offset at every thrust level, and gains proportional to each rotor's arm give the same,
+// with no yaw under the hexacopter's mixer) and still fit a weak motor. The poorer one then
+// adds nothing beside the richer (the backward pass drops it, or it is never selected) while
+// the richer adds something beside the poorer: not "neither adds to the other", so the step's
+// check_look_alikes does not see it, and the richer effect's values (+20 %, +27 % for a 15 mm
+// offset) were named with intervals that hold only if the poorer one is absent.
+// Asked of the accepted model, for each named effect F and each declared look-alike E that
+// was significant and plausible on its own at some step but is not in the model:
+//  - E off is not rejected beside F (p_off), and E held at its own estimate, the rest
+//    refitted, is not rejected either (p_own): the data cannot say how much of it is there;
+//  - and F's named values are rejected once E is held at its own estimate (p_named): they
+//    hold only without E. Without this a look-alike whose own estimate is too small to
+//    matter (a CoG offset of 0.7 mm on the NanoBench helix) would unname F for nothing.
+// Then the pair is reported ambiguous and F carried, its values not named.
+std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResult& r) const {
+  std::vector<std::string> unnamed;
+  const std::set<std::string> base(r.selected.begin(), r.selected.end());
+  const std::vector<FitParameter>& current = r.final_fit;
+  const std::vector<double>& weights = r.final_weights;
+  const double level = opt_.alpha / static_cast<double>(candidates_.size());
+  const std::vector<double> current_ss = channel_noise(train_, current).ss;
+  const auto declared = [](const std::string& x, const std::string& y) {
+    for (const auto& l : find_effect(x).look_alikes)
+      if (l.effect == y) return true;
+    return false;
+  };
+  const auto values_of = [&](const std::string& effect, const std::vector<FitParameter>& ps) {
+    std::ostringstream os;
+    for (int i : effect_params_.at(effect))
+      if (ps[i].free)
+        os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
+           << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
+    return os.str();
+  };
+  for (const std::string& f : r.named()) {
+    for (const std::string& e : candidates_) {
+      if (base.count(e) || (!declared(f, e) && !declared(e, f))) continue;
+      const CandidateEvidence* own = nullptr;  // its strongest showing on its own
+      double f_statistic = 0;
+      for (const auto& step : r.steps)
+        for (const auto& ev : step.candidates) {
+          if (ev.effect == f) f_statistic = std::max(f_statistic, ev.statistic);
+          if (ev.effect == e && ev.significant && ev.implausible.empty() && (!own || ev.statistic > own->statistic))
+            own = &ev;
+        }
+      if (!own) continue;
+      std::vector<FitParameter> start = current;
+      for (int i : effect_params_.at(e)) start[i].value = own->parameters[i].value;
+      std::set<std::string> with = base;
+      with.insert(e);
+      double c_held = 0, c_named = 0, c_joint = 0, c_joint2 = 0;
+      const std::vector<FitParameter> held = fit_holding(base, {e}, start, weights, &c_held);
+      const std::vector<FitParameter> named_kept = fit_holding(base, {e, f}, start, weights, &c_named);
+      std::vector<FitParameter> joint = fit_holding(with, {}, held, weights, &c_joint);
+      const std::vector<FitParameter> joint2 = fit_holding(with, {}, current, weights, &c_joint2);
+      if (c_joint2 < c_joint) joint = joint2;
+      const ChannelNoise nj = channel_noise(train_, joint), nh = channel_noise(train_, held);
+      int dof_e = 0, dof_f = 0;
+      for (int i : effect_params_.at(e)) dof_e += joint[i].free ? 1 : 0;
+      for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
+      const double p_off = p_value_of(e, lr_statistic(current_ss, nj), dof_e);
+      const double p_own = chi2_upper(lr_statistic(nh.ss, nj), std::max(1, dof_e));
+      const double p_named = p_value_of(f, lr_statistic(channel_noise(train_, named_kept).ss, nh), dof_f);
+      opt_.progress.say("[diagnose] " + e + " beside " + f + ": off p = " + output::short_number(p_off) +
+                        ", at its own estimate p = " + output::short_number(p_own) + ", " + f +
+                        "'s values kept then p = " + output::short_number(p_named));
+      if (p_off < level || p_own < level || p_named >= level) continue;
+      std::set<std::string> without_f = with;
+      without_f.erase(f);
+      double c_wf = 0;
+      const std::vector<FitParameter> wf = fit_holding(without_f, {}, joint, weights, &c_wf);
+      Ambiguity am;
+      am.a = f;
+      am.b = e;
+      am.statistic_a = f_statistic;
+      am.statistic_b = own->statistic;
+      am.b_given_a_p = p_off;
+      am.a_given_b_p = p_value_of(f, lr_statistic(channel_noise(train_, wf).ss, nj), dof_f);
+      am.manoeuvre = separating_manoeuvre(f, e);
+      am.absorbed = true;
+      am.b_at_own_estimate_p = p_own;
+      am.b_own_estimate = values_of(e, own->parameters);
+      am.a_with_b_held = values_of(f, held);
+      opt_.progress.say("[diagnose] with " + am.b_own_estimate + ": " + am.a_with_b_held);
+      r.unresolved.push_back(am);
+      r.carried.push_back(f);
+      unnamed.push_back(f);
+      break;  // f is carried now; one look-alike is enough to say so
+    }
+  }
+  return unnamed;
+}
+
 void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::string>& effects) const {
   if (effects.empty()) return;
   std::set<std::string> keep;

@@ -116,6 +116,13 @@ struct Ambiguity {
   double statistic_a = 0, statistic_b = 0;
   double a_given_b_p = 1, b_given_a_p = 1;  // p of adding one to the other
   std::string manoeuvre;
+  // A look-alike absorbed by the richer effect a (CandidateSearch::check_absorbed_look_alikes):
+  // b explained the discrepancy on its own, adds nothing beside a, and the final model fits
+  // as well with b held at the estimate it had on its own (p of that, and the estimate).
+  bool absorbed = false;
+  double b_at_own_estimate_p = 1;
+  std::string b_own_estimate;
+  std::string a_with_b_held;  // a's values in the model with b held at its own estimate
 };
 
 struct SelectionStep {
@@ -214,6 +221,11 @@ class CandidateSearch {
   CandidateSearch(const SymbolicModel& all, runtime::DynamicModel& model, const fit::EquationErrorModel& train,
                   const fit::EquationErrorModel& valid, SearchOptions opt);
   SearchResult run();
+  // After acceptance: a named effect F whose values hold only without a declared look-alike E
+  // that explained the discrepancy on its own and that the data cannot rule out beside F (five
+  // motor gains of a hexacopter copying a CoG offset): the pair goes to r.unresolved (absorbed)
+  // and F is carried, not named. Returns the effects so unnamed (candidate_search.cpp says how).
+  std::vector<std::string> check_absorbed_look_alikes(SearchResult& r) const;
   // Takes `effects` out of the result's final model (refit, new intervals): for candidates
   // that a later test (held-out prediction, interval) does not stand behind.
   void remove_effects(SearchResult& r, const std::vector<std::string>& effects) const;
@@ -307,6 +319,11 @@ class CandidateSearch {
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
+  // fit_with for `effects` under `weights`, with the `held` effects' parameters in the model at
+  // their values in `start`, not fitted.
+  std::vector<fit::FitParameter> fit_holding(const std::set<std::string>& effects, const std::set<std::string>& held,
+                                             const std::vector<fit::FitParameter>& start,
+                                             const std::vector<double>& weights, double* cost) const;
   // CandidateEvidence::implausible of this effect's estimates in `ps`.
   std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,

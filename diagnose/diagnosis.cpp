@@ -658,6 +658,9 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
                    " candidates");
   accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
+  for (const std::string& e : search.check_absorbed_look_alikes(d.search))  // carried now, not named
+    d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
+                     d.findings.end());
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {

@@ -289,10 +289,19 @@ void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.search.unresolved.empty()) {
     h << "<h2>Ambiguous</h2>\n";
     for (const auto& a : d.search.unresolved)
-      h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b)
-        << "</b>: both explain the discrepancy and neither adds anything significant to the other (p = "
-        << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
-        << ".</p>\n";
+      if (a.absorbed)
+        h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b) << "</b>: " << esc(a.b)
+          << " explains the discrepancy on its own (" << esc(a.b_own_estimate) << ") and adds nothing beside " << esc(a.a)
+          << " (p = " << num(a.b_given_a_p, 3) << "), and the model fits as well with it held there (p = "
+          << num(a.b_at_own_estimate_p, 3) << "): " << esc(a.a) << " can reproduce it, so how much of the discrepancy is "
+          << esc(a.b) << " the data cannot say (with it held there: " << esc(a.a_with_b_held) << "). " << esc(a.a)
+          << " is carried, its values not named. To separate them: "
+          << esc(a.manoeuvre) << ".</p>\n";
+      else
+        h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b)
+          << "</b>: both explain the discrepancy and neither adds anything significant to the other (p = "
+          << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
+          << ".</p>\n";
   }
 }
 

@@ -347,13 +347,24 @@ json left_at_limit_json(const SearchResult& s) {
 
 json ambiguous_json(const SearchResult& s) {
   json amb = json::array();
-  for (const auto& a : s.unresolved)
-    amb.push_back({{"effects", {a.a, a.b}},
-                   {"statistics", {a.statistic_a, a.statistic_b}},
-                   {"p_value_adding_second_to_first", a.b_given_a_p},
-                   {"p_value_adding_first_to_second", a.a_given_b_p},
-                   {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
-                   {"separating_manoeuvre", a.manoeuvre}});
+  for (const auto& a : s.unresolved) {
+    json one = {{"effects", {a.a, a.b}},
+                {"statistics", {a.statistic_a, a.statistic_b}},
+                {"p_value_adding_second_to_first", a.b_given_a_p},
+                {"p_value_adding_first_to_second", a.a_given_b_p},
+                {"verdict", "both explain the discrepancy and neither adds anything to the other: not named"},
+                {"separating_manoeuvre", a.manoeuvre}};
+    if (a.absorbed) {  // the first reproduces the second (CandidateSearch::check_absorbed_look_alikes)
+      one["verdict"] = a.b + " explains the discrepancy on its own (" + a.b_own_estimate + ") and adds nothing beside " +
+                       a.a + ", and the final model fits as well with it held there, where " + a.a +
+                       "'s values as fitted without it are rejected: how much of the discrepancy is " + a.b +
+                       " the data cannot say, so " + a.a + "'s values are not named";
+      one["second_own_estimate"] = a.b_own_estimate;
+      one["p_value_second_held_at_its_own_estimate"] = a.b_at_own_estimate_p;
+      one["first_with_second_held"] = a.a_with_b_held;
+    }
+    amb.push_back(one);
+  }
   return amb;
 }
 

@@ -50,9 +50,17 @@ Effect motor_gain() {
   e.plausible = {{"", -0.35, 0.35, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "motors of one type differ by up to ~20 % in thrust at one command, worn brushed motors by ~30 % "
                   "(the NanoBench trims reach a duty ratio of 1.2); beyond, a motor is broken or something else acts"}};
+  // Thrust levels do not separate them: gains proportional to each rotor's arm give a CoG
+  // offset's torque (total thrust x offset) at every thrust level, and on a hexacopter also
+  // under every roll, pitch and yaw command of its mixer. What is left to tell them apart is
+  // the offset's lever arm at the logged origin (omega_dot x c, omega x (omega x c)), the
+  // gains' change of total thrust with a pitch or roll acceleration, and, for a single weak
+  // motor, its reaction torque in yaw.
   e.look_alikes = {{"cog_offset",
-                    "climb and descend at several thrust levels while hovering level: a CoG offset's torque grows "
-                    "with total thrust on one axis, a weak motor's torque also shows in yaw (its reaction torque)"}};
+                    "fast yaw turns and sharp roll and pitch rate steps: a CoG offset moves the logged origin's "
+                    "acceleration by omega x (omega x c) and omega_dot x c, which motor gains that copy its torque "
+                    "do not (thrust levels do not separate them: both torques grow with thrust); a single weak "
+                    "motor's torque also shows in yaw (its reaction torque)"}};
   e.headline = headline;
   return e;
 }
