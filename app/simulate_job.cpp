@@ -97,7 +97,10 @@ void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws,
   for (size_t i = 0; i < laws.size(); ++i)  // first the sign, then the reach
     if (hover[i] < 0)
       throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: it would have to pull down " +
-                                  std::to_string(-hover[i]) + " N (the centre of gravity lies outside the rotors)");
+                                  std::to_string(-hover[i]) + " N" +
+                                  (v.rotors.size() > 4 ? " in the least-norm trim, which simulate flies (with more than four "
+                                                         "rotors another trim may exist; fly it with --closed-loop)"
+                                                       : " (the centre of gravity lies outside the rotors)"));
   for (size_t i = 0; i < laws.size(); ++i) try {
       laws[i].command_for(hover[i]);
     } catch (const std::invalid_argument& e) {
@@ -121,12 +124,15 @@ struct OpenLoop {
   double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
 };
 
-// A thesis manoeuvre: the thrusts it asks for at each (delayed) time, moved by each rotor's
-// own trim (zero on a symmetric vehicle), turned into commands by each rotor's law.
+// A thesis manoeuvre: the thrusts it asks for at each (delayed) time, scaled by each rotor's
+// own trim (1 on a symmetric vehicle), turned into commands by each rotor's law.
 InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   return [&k, s](double t, double* u) {
-    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);  // about the even share m g / n
-    for (size_t i = 0; i < k.rotors.size(); ++i) u[i] = k.laws[i].command_for(F[i] + (k.hover_trim[i] - k.hover));
+    // About the even share m g / n; on a trimmed vehicle each rotor's thrust scaled by its trim,
+    // so that a change of every rotor alike (climb) keeps the moments balanced.
+    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);
+    for (size_t i = 0; i < k.rotors.size(); ++i)
+      u[i] = k.laws[i].command_for(k.hover_trim[i] == k.hover ? F[i] : F[i] * (k.hover_trim[i] / k.hover));
     k.extra.fill(t, k.vbat_ref, u);
   };
 }

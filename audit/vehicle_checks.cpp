@@ -46,14 +46,16 @@ AuditCheck check_motor_map(const std::vector<runtime::ThrustLaw>& laws) {
   return advisory("the motor map rises with the command", rises, os.str());
 }
 
-// Thrust, roll, pitch and yaw apart: the allocation has rank 4. Rows scaled to their largest
-// entry first (newtons and newton-metres of arms of centimetres), which leaves the rank as it is.
+// Thrust, roll, pitch and yaw apart: the allocation has rank 4. Rows scaled first (newtons
+// and newton-metres of arms of centimetres), which leaves the rank as it is: roll and pitch
+// by the longest arm together, so that a row of rounding noise (sin 180 deg) stays noise, and
+// yaw by its largest entry.
 AuditCheck check_controllable(const Eigen::MatrixXd& B) {
   Eigen::MatrixXd scaled = B;
-  for (Eigen::Index r = 0; r < 4; ++r) {
-    const double top = scaled.row(r).cwiseAbs().maxCoeff();
-    if (top > 0) scaled.row(r) /= top;
-  }
+  const double arm = std::max(B.row(1).cwiseAbs().maxCoeff(), B.row(2).cwiseAbs().maxCoeff());
+  if (arm > 0) scaled.middleRows(1, 2) /= arm;
+  const double yaw = B.row(3).cwiseAbs().maxCoeff();
+  if (yaw > 0) scaled.row(3) /= yaw;
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullU);
   const Eigen::VectorXd s = svd.singularValues();
   int rank = 0;
@@ -87,7 +89,10 @@ AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b,
   if (!(miss <= 1e-6 * weight)) why = "no thrusts balance the weight without a moment";
   for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i)  // first the sign, then the reach
     if (trim[i] < 0)
-      why = "rotor " + v.rotors[i].name + " would have to pull down (the centre of gravity lies outside the rotors)";
+      why = "rotor " + v.rotors[i].name + " would have to pull down" +
+            (v.rotors.size() > 4 ? " in the least-norm trim (with more than four rotors another trim may exist; "
+                                   "none was searched): is the centre of gravity far off the middle?"
+                                 : " (the centre of gravity lies outside the rotors)");
   for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i) {
     try {
       b.thrust_laws[i].command_for(trim[i]);

@@ -689,7 +689,9 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
       const double p_off = p_value_of(e, lr_statistic(current_ss, nj), dof_e);
       const double p_own = chi2_upper(lr_statistic(nh.ss, nj), std::max(1, dof_e));
-      const double p_named = p_value_of(f, lr_statistic(channel_noise(train_, named_kept).ss, nh), dof_f);
+      // Held at its fitted values, an interior point: the plain chi-squared (p_value_of halves p
+      // for an effect whose neutral value sits on a bound, right only for a test against it).
+      const double p_named = chi2_upper(lr_statistic(channel_noise(train_, named_kept).ss, nh), std::max(1, dof_f));
       opt_.progress.say("[diagnose] " + e + " beside " + f + ": off p = " + output::short_number(p_off) +
                         ", at its own estimate p = " + output::short_number(p_own) + ", " + f +
                         "'s values kept then p = " + output::short_number(p_named));

@@ -1131,12 +1131,16 @@ TEST(Cli, ScenariosFollowTheVehiclesLayout) {
   ASSERT_NE(off_centre.find(upper), std::string::npos);
   off_centre.replace(off_centre.find(upper), upper.size(), "centre: [0.02, 0, 0.036]");
   write(tmp.dir / "off_centre.yaml", off_centre);
-  for (const char* file : {"hexa.yaml", "off_centre.yaml"}) {
-    const std::string out = tmp / (std::string(file) + ".csv");
-    r = run_quadgen({"simulate", tmp / file, "--scenario", "hover", "--duration", "2", "--out", out}, tmp.dir);
-    ASSERT_EQ(r.rc, 0) << file << ": " << r.err;
-    const quadgen::runtime::CsvTable t = quadgen::runtime::read_csv(out);
-    const auto& last = t.rows.back();
-    for (const char* c : {"x", "y", "z", "qx", "qy"}) EXPECT_NEAR(last[t.column(c)], 0.0, 1e-6) << file << " " << c;
-  }
+  // Every rotor alike, about its own trim: level and in place (hover) or straight up.
+  for (const char* file : {"hexa.yaml", "off_centre.yaml"})
+    for (const char* scenario : {"hover", "climb", "new_height"}) {
+      const std::string out = tmp / (std::string(file) + "_" + scenario + ".csv");
+      r = run_quadgen({"simulate", tmp / file, "--scenario", scenario, "--duration", "3", "--out", out}, tmp.dir);
+      ASSERT_EQ(r.rc, 0) << file << " " << scenario << ": " << r.err;
+      const quadgen::runtime::CsvTable t = quadgen::runtime::read_csv(out);
+      const auto& last = t.rows.back();
+      for (const char* c : {"x", "y", "qx", "qy"}) EXPECT_NEAR(last[t.column(c)], 0.0, 1e-6) << file << " " << scenario << " " << c;
+      if (std::string(scenario) == "hover") EXPECT_NEAR(last[t.column("z")], 0.0, 1e-6) << file;
+      else EXPECT_GT(last[t.column("z")], 0.1) << file << " " << scenario;
+    }
 }
