@@ -448,7 +448,9 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
     tilt.series.push_back(sh);
     moments.series.push_back(sm);
   }
-  runtime::Series published{"published (IDSIA, NanoBench)", {}, {}, true};
+  // Published for the Crazyflie only; drawn for every vehicle as the scale of the state of the
+  // art, and labelled with the vehicle they are of.
+  runtime::Series published{"published for the Crazyflie (IDSIA, NanoBench)", {}, {}, true};
   for (const auto& pt : published_position_errors()) published.x.push_back(pt.horizon_s), published.y.push_back(pt.position_m);
   open.series.push_back(published);
   return {open, replay, tilt, moments};
