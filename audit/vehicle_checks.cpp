@@ -1,5 +1,6 @@
 #include "audit/vehicle_checks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -111,12 +112,33 @@ AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b,
   return advisory("a hover trim exists within the motors' reach", why.empty(), detail);
 }
 
+// No two rotor discs cut through each other: hubs in one plane (within a quarter of the
+// smaller radius in z) closer than the sum of the radii. A coaxial pair (same place in x and
+// y, apart in z, as on a Y6) is a design, not a mistake.
+AuditCheck check_discs_apart(const Vehicle& v) {
+  std::string clash;
+  for (size_t i = 0; i < v.rotors.size() && clash.empty(); ++i)
+    for (size_t j = i + 1; j < v.rotors.size() && clash.empty(); ++j) {
+      const Rotor &a = v.rotors[i], &b = v.rotors[j];
+      const double dx = a.position[0] - b.position[0], dy = a.position[1] - b.position[1];
+      const double dz = std::fabs(a.position[2] - b.position[2]), apart = std::hypot(dx, dy);
+      if (dz >= 0.25 * std::min(a.radius, b.radius) || apart >= a.radius + b.radius) continue;
+      std::ostringstream os;
+      os.precision(4);
+      os << "rotors " << a.name << " and " << b.name << ": hubs " << apart << " m apart in one plane, radii " << a.radius
+         << " and " << b.radius << " m" << (apart < 1e-9 ? " (the same place: a copied line?)" : "");
+      clash = os.str();
+    }
+  return advisory("no two rotor discs overlap", clash.empty(),
+                  clash.empty() ? "every pair of hubs in one plane is at least the sum of their radii apart" : clash);
+}
+
 }  // namespace
 
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
   const Eigen::MatrixXd B = allocation(b);
-  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b, B)};
+  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b, B), check_discs_apart(v)};
 }
 
 }  // namespace quadgen

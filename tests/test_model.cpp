@@ -1062,7 +1062,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
                     trim = "a hover trim exists within the motors' reach";
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 3u);
+    ASSERT_EQ(checks.size(), 4u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1098,6 +1098,18 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     a1.nominal = a1.lower = a1.upper = -a1.nominal;
     const auto c = checks_of(v);
     EXPECT_FALSE(c.at(map).passed);
+  }
+  const std::string discs = "no two rotor discs overlap";
+  {  // a rotor line copied without changing its place, and a propeller too large for the arms
+    Vehicle v = good;
+    v.rotors[1].position = v.rotors[0].position;
+    EXPECT_NE(checks_of(v).at(discs).detail.find("the same place"), std::string::npos);
+    v = good;
+    for (auto& r : v.rotors) r.radius = 0.08;  // 0.149 m between neighbouring hubs
+    EXPECT_FALSE(checks_of(v).at(discs).passed);
+    v.rotors[1].position[2] += 0.05;  // a coaxial-like step in height: apart
+    v.rotors[3].position[2] += 0.05;
+    EXPECT_TRUE(checks_of(v).at(discs).passed) << checks_of(v).at(discs).detail;
   }
   // A warning leaves the derivation's audit passed.
   AuditResult r;
