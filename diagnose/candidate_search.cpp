@@ -171,11 +171,16 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
 
 std::vector<FitParameter> CandidateSearch::fit_with(const std::set<std::string>& effects,
                                                     const std::vector<FitParameter>& start, double* cost,
-                                                    const Workspace& ws, const std::vector<double>& weights) const {
+                                                    const Workspace& ws, const std::vector<double>& weights,
+                                                    const std::set<std::string>& held) const {
   std::vector<FitParameter> ps = start;
   for (size_t i = 0; i < ps.size(); ++i) {
     const std::string e = effect_of_parameter(ps[i].name);
     if (!is_effect_parameter(ps[i].name)) continue;
+    if (held.count(e)) {  // in the model at its value in `start`
+      ps[i].free = false;
+      continue;
+    }
     const bool on = effects.count(e) > 0 && all_.params[i].fit;
     ps[i].free = on;
     if (!on) ps[i].value = neutral_value(all_.params[i]);
@@ -604,27 +609,6 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
   }
 }
 
-std::vector<FitParameter> CandidateSearch::fit_holding(const std::set<std::string>& effects,
-                                                       const std::set<std::string>& held,
-                                                       const std::vector<FitParameter>& start,
-                                                       const std::vector<double>& weights, double* cost) const {
-  std::vector<FitParameter> ps = start;
-  for (size_t i = 0; i < ps.size(); ++i) {
-    if (!is_effect_parameter(ps[i].name)) continue;
-    const std::string e = effect_of_parameter(ps[i].name);
-    if (held.count(e)) {  // in the model at its value in `start`
-      ps[i].free = false;
-      continue;
-    }
-    const bool on = effects.count(e) > 0 && all_.params[i].fit;
-    ps[i].free = on;
-    if (!on) ps[i].value = neutral_value(all_.params[i]);
-  }
-  for (int i : reference_params_) ps[i].free = false;
-  *cost = fit::solve_weighted(train_, ps, weights, refit_options());
-  return ps;
-}
-
 // A richer effect can reproduce a poorer look-alike and add something of its own: with six
 // rotors, five motor gains make a CoG offset's moment (the offset's moment is total thrust x
 // offset at every thrust level, and gains proportional to each rotor's arm give the same,
@@ -646,6 +630,7 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
   const std::set<std::string> base(r.selected.begin(), r.selected.end());
   const std::vector<FitParameter>& current = r.final_fit;
   const std::vector<double>& weights = r.final_weights;
+  const Workspace ws = own_workspace();
   const double level = opt_.alpha / static_cast<double>(candidates_.size());
   const std::vector<double> current_ss = channel_noise(train_, current).ss;
   const auto declared = [](const std::string& x, const std::string& y) {
@@ -678,10 +663,10 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       std::set<std::string> with = base;
       with.insert(e);
       double c_held = 0, c_named = 0, c_joint = 0, c_joint2 = 0;
-      const std::vector<FitParameter> held = fit_holding(base, {e}, start, weights, &c_held);
-      const std::vector<FitParameter> named_kept = fit_holding(base, {e, f}, start, weights, &c_named);
-      std::vector<FitParameter> joint = fit_holding(with, {}, held, weights, &c_joint);
-      const std::vector<FitParameter> joint2 = fit_holding(with, {}, current, weights, &c_joint2);
+      const std::vector<FitParameter> held = fit_with(base, start, &c_held, ws, weights, {e});
+      const std::vector<FitParameter> named_kept = fit_with(base, start, &c_named, ws, weights, {e, f});
+      std::vector<FitParameter> joint = fit_with(with, held, &c_joint, ws, weights);
+      const std::vector<FitParameter> joint2 = fit_with(with, current, &c_joint2, ws, weights);
       if (c_joint2 < c_joint) joint = joint2;
       const ChannelNoise nj = channel_noise(train_, joint), nh = channel_noise(train_, held);
       int dof_e = 0, dof_f = 0;
@@ -699,7 +684,7 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       std::set<std::string> without_f = with;
       without_f.erase(f);
       double c_wf = 0;
-      const std::vector<FitParameter> wf = fit_holding(without_f, {}, joint, weights, &c_wf);
+      const std::vector<FitParameter> wf = fit_with(without_f, joint, &c_wf, ws, weights);
       Ambiguity am;
       am.a = f;
       am.b = e;

@@ -298,9 +298,11 @@ class CandidateSearch {
   std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
                                           const std::vector<fit::FitParameter>& start, double* cost,
                                           const Workspace& ws) const;
+  // With `held` effects in the model at their values in `start`, not fitted.
   std::vector<fit::FitParameter> fit_with(const std::set<std::string>& effects,
                                           const std::vector<fit::FitParameter>& start, double* cost,
-                                          const Workspace& ws, const std::vector<double>& weights) const;
+                                          const Workspace& ws, const std::vector<double>& weights,
+                                          const std::set<std::string>& held = {}) const;
 
   std::vector<fit::FitParameter> initial_parameters() const;
   // base_ss: the step's base model's residual sum of squares per channel (computed once
@@ -319,11 +321,6 @@ class CandidateSearch {
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
-  // fit_with for `effects` under `weights`, with the `held` effects' parameters in the model at
-  // their values in `start`, not fitted.
-  std::vector<fit::FitParameter> fit_holding(const std::set<std::string>& effects, const std::set<std::string>& held,
-                                             const std::vector<fit::FitParameter>& start,
-                                             const std::vector<double>& weights, double* cost) const;
   // CandidateEvidence::implausible of this effect's estimates in `ps`.
   std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,
