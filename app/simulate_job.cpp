@@ -79,34 +79,14 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   return result;
 }
 
-// Each rotor's hover thrust [N]: m g / n where the layout balances that (a symmetric vehicle;
-// kept exact), else the least-norm trim through the rotor layout (runtime::allocate: a rotor
-// off the symmetric place carries more or less).
-std::vector<double> hover_thrusts(const Vehicle& v, const SymbolicModel& model, double even_share) {
-  const size_t n = v.rotors.size();
-  const std::vector<double> trim =
-      allocate(nominal_controller_belief(v, model), even_share * static_cast<double>(n), {0, 0, 0});
-  for (double f : trim)
-    if (std::fabs(f - even_share) > 1e-9 * even_share) return trim;
-  return std::vector<double>(n, even_share);
-}
-
-// Hover must be within reach of every rotor's motor map, or no manoeuvre can be flown; said
-// once, naming the vehicle file, instead of failing somewhere inside the flight.
-void check_hover_reachable(const Vehicle& v, const std::vector<ThrustLaw>& laws, const std::vector<double>& hover) {
-  for (size_t i = 0; i < laws.size(); ++i)  // first the sign, then the reach
-    if (hover[i] < 0)
-      throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: it would have to pull down " +
-                                  std::to_string(-hover[i]) + " N" +
-                                  (v.rotors.size() > 4 ? " in the least-norm trim, which simulate flies (with more than four "
-                                                         "rotors another trim may exist; fly it with --closed-loop)"
-                                                       : " (the centre of gravity lies outside the rotors)"));
-  for (size_t i = 0; i < laws.size(); ++i) try {
-      laws[i].command_for(hover[i]);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(v.source_path + ": rotor " + v.rotors[i].name + " cannot hover: " + e.what() +
-                                  "; check the masses, c_t (rotor_model) and a0, a1, a2 (motor_map)");
-    }
+// Each rotor's hover thrust [N] (runtime::hover_trim: m g / n on a symmetric vehicle, a rotor
+// off the symmetric place carrying more or less). Hover must be within every motor's reach, or
+// no manoeuvre can be flown: said once, naming the vehicle file, instead of failing somewhere
+// inside the flight.
+std::vector<double> hover_thrusts(const Vehicle& v, const SymbolicModel& model) {
+  const runtime::HoverTrim trim = runtime::hover_trim(nominal_controller_belief(v, model), rotor_names(v));
+  if (!trim.found()) throw std::invalid_argument(v.source_path + ": the vehicle cannot hover: " + trim.why_not);
+  return trim.thrusts;
 }
 
 // What every open-loop simulation shares: the model, each rotor's thrust law, and the
@@ -268,8 +248,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
                    m.input_delay_param(),
                    param(vehicle, "vbat_ref").nominal,
                    even_share,
-                   hover_thrusts(vehicle, model, even_share)};
-  check_hover_reachable(vehicle, k.laws, k.hover_trim);
+                   hover_thrusts(vehicle, model)};
   if (!a.scenario.empty() && find_scenario(a.scenario).rotor_roles && vehicle.rotors.size() != 4)
     throw std::invalid_argument("--scenario " + a.scenario + " gives the thesis' rotor roles A..D to rotors 1..4, and " +
                                 vehicle.name + " has " + std::to_string(vehicle.rotors.size()) +

@@ -79,37 +79,23 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
   return advisory("thrust, roll, pitch and yaw can be set apart", rank == 4, detail);
 }
 
-// A hover trim: thrusts F >= 0 with B F = (m g, 0, 0, 0), each within its motor's reach. The
-// least-norm solution is the one checked (with more than four rotors another may exist).
-AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b, const Eigen::MatrixXd& B) {
-  const double weight = b.mass * b.g;
-  const std::vector<double> trim = runtime::allocate(b, weight, {0, 0, 0});
-  const Eigen::VectorXd F = Eigen::Map<const Eigen::VectorXd>(trim.data(), static_cast<Eigen::Index>(trim.size()));
-  const double miss = (B * F - Eigen::Vector4d(weight, 0, 0, 0)).norm();
-  std::string why;
-  if (!(miss <= 1e-6 * weight)) why = "no thrusts balance the weight without a moment";
-  for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i)  // first the sign, then the reach
-    if (trim[i] < 0)
-      why = "rotor " + v.rotors[i].name + " would have to pull down" +
-            (v.rotors.size() > 4 ? " in the least-norm trim (with more than four rotors another trim may exist; "
-                                   "none was searched): is the centre of gravity far off the middle?"
-                                 : " (the centre of gravity lies outside the rotors)");
-  for (size_t i = 0; why.empty() && i < v.rotors.size(); ++i) {
-    try {
-      b.thrust_laws[i].command_for(trim[i]);
-    } catch (const std::invalid_argument& e) {
-      why = "rotor " + v.rotors[i].name + ": " + e.what() + " (check the masses, c_t and the motor map)";
-    }
-  }
-  std::string detail = "least-norm thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(weight) + " N)";
-  if (why.empty()) {
-    Eigen::VectorXd u(F.size());
-    for (Eigen::Index i = 0; i < F.size(); ++i) u(i) = b.thrust_laws[static_cast<size_t>(i)].command_for(F(i));
+// A hover trim (runtime::hover_trim, which simulate's scenarios fly): every rotor pushing and
+// within its motor's reach.
+AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b) {
+  std::vector<std::string> names;
+  for (const Rotor& r : v.rotors) names.push_back(r.name);
+  const runtime::HoverTrim trim = runtime::hover_trim(b, names);
+  const Eigen::VectorXd F =
+      Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
+  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(b.mass * b.g) + " N)";
+  if (trim.found()) {
+    const Eigen::VectorXd u =
+        Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
     detail += ", commands " + numbers(u, "");
   } else {
-    detail += ": " + why;
+    detail += ": " + trim.why_not;
   }
-  return advisory("a hover trim exists within the motors' reach", why.empty(), detail);
+  return advisory("a hover trim exists within the motors' reach", trim.found(), detail);
 }
 
 // No two rotor discs cut through each other: hubs in one plane (within a quarter of the
@@ -138,7 +124,7 @@ AuditCheck check_discs_apart(const Vehicle& v) {
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
   const Eigen::MatrixXd B = allocation(b);
-  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b, B), check_discs_apart(v)};
+  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b), check_discs_apart(v)};
 }
 
 }  // namespace quadgen

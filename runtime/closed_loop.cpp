@@ -66,15 +66,68 @@ std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b) 
   return columns;
 }
 
-std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque) {
+namespace {
+
+Eigen::MatrixXd allocation_matrix(const ControllerModel& b) {
   const auto columns = allocation_columns(b);
-  const int n = static_cast<int>(columns.size());
-  Eigen::MatrixXd A(4, n);
-  for (int i = 0; i < n; ++i)
-    for (int r = 0; r < 4; ++r) A(r, i) = columns[static_cast<size_t>(i)][static_cast<size_t>(r)];
-  Eigen::Vector4d w(thrust, torque[0], torque[1], torque[2]);
-  const Eigen::VectorXd F = A.completeOrthogonalDecomposition().solve(w);
-  return std::vector<double>(F.data(), F.data() + n);
+  Eigen::MatrixXd A(4, static_cast<Eigen::Index>(columns.size()));
+  for (size_t i = 0; i < columns.size(); ++i)
+    for (size_t r = 0; r < 4; ++r) A(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(i)) = columns[i][r];
+  return A;
+}
+
+// The least-norm thrusts for the wrench w with the rotors not in `free` held at zero.
+Eigen::VectorXd trim_with(const Eigen::MatrixXd& A, const std::vector<bool>& free, const Eigen::Vector4d& w) {
+  Eigen::MatrixXd held = A;
+  for (Eigen::Index i = 0; i < A.cols(); ++i)
+    if (!free[static_cast<size_t>(i)]) held.col(i).setZero();
+  return held.completeOrthogonalDecomposition().solve(w);
+}
+
+}  // namespace
+
+std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque) {
+  const Eigen::Vector4d w(thrust, torque[0], torque[1], torque[2]);
+  const Eigen::VectorXd F = allocation_matrix(b).completeOrthogonalDecomposition().solve(w);
+  return std::vector<double>(F.data(), F.data() + F.size());
+}
+
+HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names) {
+  const Eigen::MatrixXd A = allocation_matrix(b);
+  const size_t n = static_cast<size_t>(A.cols());
+  const double weight = b.mass * b.g, even = weight / static_cast<double>(n);
+  const Eigen::Vector4d w(weight, 0, 0, 0);
+  const auto balances = [&](const Eigen::VectorXd& F) { return (A * F - w).norm() <= 1e-6 * weight; };
+  std::vector<bool> free(n, true);
+  const Eigen::VectorXd least_norm = trim_with(A, free, w);
+  Eigen::VectorXd F = least_norm;
+  Eigen::Index most_pulling = 0;
+  while (balances(F) && F.minCoeff(&most_pulling) < 0) {  // hold the most pulling rotor at zero
+    free[static_cast<size_t>(most_pulling)] = false;
+    F = trim_with(A, free, w);
+  }
+  HoverTrim t;
+  const bool pushes = balances(F) && F.minCoeff() >= 0;
+  if (!pushes) F = least_norm;
+  t.thrusts.assign(F.data(), F.data() + F.size());
+  if ((F.array() - even).abs().maxCoeff() <= 1e-9 * even) t.thrusts.assign(n, even);  // symmetric: exact
+  if (!balances(least_norm)) {
+    t.why_not = "no thrusts balance the weight without a moment";
+  } else if (!pushes) {
+    least_norm.minCoeff(&most_pulling);
+    t.why_not = "rotor " + rotor_names[static_cast<size_t>(most_pulling)] + " would have to pull down " +
+                std::to_string(-least_norm(most_pulling)) + " N" +
+                (n > 4 ? " (with more than four rotors: no trim with every rotor pushing was found, holding the "
+                         "pulling rotors at zero in turn)"
+                       : " (the centre of gravity lies outside the rotors)");
+  }
+  for (size_t i = 0; t.found() && i < n; ++i) try {
+      t.commands.push_back(b.thrust_laws[i].command_for(t.thrusts[i]));
+    } catch (const std::invalid_argument& e) {
+      t.why_not = "rotor " + rotor_names[i] + ": " + e.what() + "; check the masses, c_t and the motor map's a0, a1, a2";
+      t.commands.clear();
+    }
+  return t;
 }
 
 std::string GeneratedFlight::csv() const {

@@ -33,6 +33,20 @@ std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b);
 // through the allocation (exact where it has rank 4).
 std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque);
 
+// A hover trim: each rotor's thrust [N] holding the weight without a moment, every one
+// pushing (F >= 0) and within its motor's reach. The least-norm trim first, exactly m g / n
+// per rotor where the layout is symmetric. With more than four rotors the least-norm trim
+// can need a rotor to pull where another trim exists: then the most pulling rotor is held at
+// zero and the rest trimmed again, until every rotor pushes or the rest cannot balance. One
+// home for derive's vehicle check and simulate's scenarios, which word the reason their way.
+struct HoverTrim {
+  std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)
+  std::vector<double> commands;  // each rotor's command for its thrust; empty if out of reach
+  std::string why_not;           // empty where a trim was found, else why not (names the rotor)
+  bool found() const { return why_not.empty(); }
+};
+HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names);
+
 struct ClosedLoopOptions {
   double duration = 60;        // s
   unsigned seed = 1;

@@ -636,3 +636,60 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   EXPECT_NEAR(uC - uA, uC_expected - uA, 0.15 * (uC_expected - uA));
   EXPECT_NEAR(column_mean(clean, "u_C", 500) - column_mean(clean, "u_A", 500), 0.0, 0.003);
 }
+
+// The hover trim simulate flies and derive checks. A hexacopter whose centre of gravity lies
+// 12 cm toward rotor 0 (inside the rotors): the least-norm trim needs the far rotor to pull,
+// yet a trim with every rotor pushing exists (by hand: rotor 3 at zero, rotors 1 and 5 five
+// times rotors 2 and 4, rotor 0 eight times). The trim found is checked against the moments
+// summed from the rotor positions here, not through the allocation it was solved with.
+TEST(HoverTrim, FindsATrimWithEveryRotorPushingWhereTheLeastNormPulls) {
+  ControllerModel b;
+  b.mass = 2.0;
+  b.kappa = 0.02;
+  const double arm = 0.2, cog_x = 0.12;
+  for (int i = 0; i < 6; ++i) {
+    b.rotor_x.push_back(arm * std::cos(i * M_PI / 3) - cog_x);
+    b.rotor_y.push_back(arm * std::sin(i * M_PI / 3));
+    b.spin.push_back(i % 2 == 0 ? 1.0 : -1.0);
+    b.thrust_laws.push_back({1e-5, 0, 1000, 0});  // at most 10 N at command 1
+  }
+  const std::vector<std::string> names = {"R0", "R1", "R2", "R3", "R4", "R5"};
+  const std::vector<double> least_norm = allocate(b, b.mass * b.g, {0, 0, 0});
+  ASSERT_LT(least_norm[3], 0) << "the case must be one where the least-norm trim pulls";
+
+  const HoverTrim trim = hover_trim(b, names);
+  ASSERT_TRUE(trim.found()) << trim.why_not;
+  double total = 0, roll = 0, pitch = 0, yaw = 0;
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_GE(trim.thrusts[i], 0) << names[i];
+    total += trim.thrusts[i];
+    roll += trim.thrusts[i] * b.rotor_y[i];
+    pitch += trim.thrusts[i] * b.rotor_x[i];
+    yaw += trim.thrusts[i] * b.spin[i];
+    EXPECT_NEAR(b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(trim.commands[i])), trim.thrusts[i], 1e-9);
+  }
+  EXPECT_NEAR(total, b.mass * b.g, 1e-9);
+  EXPECT_NEAR(roll, 0, 1e-9);
+  EXPECT_NEAR(pitch, 0, 1e-9);
+  EXPECT_NEAR(yaw, 0, 1e-9);
+
+  // The centre of gravity beyond rotor 0: no trim pushes, and the reason names the rotor.
+  ControllerModel outside = b;
+  for (double& x : outside.rotor_x) x -= 0.1;
+  const HoverTrim none = hover_trim(outside, names);
+  EXPECT_FALSE(none.found());
+  EXPECT_NE(none.why_not.find("would have to pull down"), std::string::npos) << none.why_not;
+  EXPECT_NE(none.why_not.find("no trim with every rotor pushing was found"), std::string::npos) << none.why_not;
+
+  // Centred: m g / 6 each, exactly; and too heavy for the motors: which rotor, and why.
+  ControllerModel centred = b;
+  for (double& x : centred.rotor_x) x += cog_x;
+  const HoverTrim even = hover_trim(centred, names);
+  ASSERT_TRUE(even.found()) << even.why_not;
+  for (double f : even.thrusts) EXPECT_EQ(f, centred.mass * centred.g / 6);
+  centred.mass = 10;
+  const HoverTrim heavy = hover_trim(centred, names);
+  EXPECT_FALSE(heavy.found());
+  EXPECT_NE(heavy.why_not.find("rotor R0: thrust"), std::string::npos) << heavy.why_not;
+  EXPECT_NE(heavy.why_not.find("beyond the motor map"), std::string::npos) << heavy.why_not;
+}
