@@ -474,7 +474,8 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
     for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
     qn = std::sqrt(qn);
     if (!(qn > 0.5 && qn < 1.5))
-      throw FitError(log.path + ":" + std::to_string(k + 2) + ": attitude quaternion has norm " + std::to_string(qn));
+      throw FitError(log.path + ":" + std::to_string(log.line_of(k)) + ": attitude quaternion has norm " +
+                     std::to_string(qn));
     for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
     for (const auto& uc : u) fs.u.push_back(uc[k]);
     fs.vbat = vbat[k];

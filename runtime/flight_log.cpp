@@ -225,6 +225,9 @@ void check_values(const CsvTable& log) {
   constexpr double kMaxThrottle = 1 + 1e-6;
   std::vector<bool> throttle(log.columns.size());
   for (size_t c = 0; c < log.columns.size(); ++c) throttle[c] = log.columns[c].rfind("u_", 0) == 0;
+  // A battery voltage is positive: battery_sag scales thrust by a power of it and its
+  // derivatives take its logarithm, so 0 (a logger before its first reading) would be NaN.
+  const int vbat = log.column("vbat");
   for (size_t i = 0; i < log.rows.size(); ++i)
     for (size_t c = 0; c < log.columns.size(); ++c) {
       const double v = log.rows[i][c];
@@ -234,6 +237,11 @@ void check_values(const CsvTable& log) {
         fail_at(log.path, log.line_of(i),
                 "column '" + log.columns[c] + "' is " + number_text(v) + ", beyond the sanity bound |value| <= " +
                     number_text(bound) + " (canonical SI units)");
+      if (static_cast<int>(c) == vbat && !(v > 0))
+        fail_at(log.path, log.line_of(i),
+                "column 'vbat' is " + number_text(v) +
+                    " V; a battery voltage must be positive (a logger writes 0 before its first reading: drop those "
+                    "rows, or the column where battery_sag is not wanted)");
       if (throttle[c] && v > kMaxThrottle)
         fail_at(log.path, log.line_of(i),
                 "column '" + log.columns[c] + "' is " + number_text(v) +

@@ -239,6 +239,9 @@ TEST(FitCli, BadDataFailsClearlyWithoutOutput) {
       {"short.csv", "t,u_M1,u_M2,u_M3,u_M4,p,q,r,ax,ay,az\n0,1,1,1,1,0,0,0,0,0,9\n0.1,1,1,1,1,0,0,0,0,0,9\n", "",
        "too few"},
       {"unbounded.csv", good, "--free J_xx", "has no bounds"},
+      // A logger's 0 before its first battery reading, after a blank line: named on its own line.
+      {"vbat.csv", "t,u_M1,u_M2,u_M3,u_M4,p,q,r,ax,ay,az,vbat\n0,1,1,1,1,0,0,0,0,0,9,3.9\n\n0.1,1,1,1,1,0,0,0,0,0,9,0\n", "",
+       "vbat.csv:4: column 'vbat' is 0 V; a battery voltage must be positive"},
   };
   for (const auto& c : cases) {
     const std::string out = (dir / ("out_" + c.name)).string();
