@@ -119,12 +119,46 @@ AuditCheck check_discs_apart(const Vehicle& v) {
                   clash.empty() ? "every pair of hubs in one plane is at least the sum of their radii apart" : clash);
 }
 
+// Rotors and blocks on one scale: a number without a unit is read as metres, so a position or
+// radius copied in millimetres puts a rotor a thousand times too far out, and an area in mm^2
+// makes the disc larger than its radius allows. Thresholds wide enough for real layouts (a
+// hull larger than its rotors' circle, the FINken 3's thrust-law area 0.13 of its disc).
+AuditCheck check_one_scale(const Vehicle& v) {
+  double reach = 0, farthest = 0;  // m, of the blocks (corners) and of the rotors (hub and tip)
+  for (const Block& b : v.blocks)
+    reach = std::max(reach, std::hypot(b.centre[0], b.centre[1], b.centre[2]) +
+                                0.5 * std::hypot(b.size[0], b.size[1], b.size[2]));
+  std::ostringstream os;
+  os.precision(4);
+  for (const Rotor& r : v.rotors) {
+    const double out = std::hypot(r.position[0], r.position[1], r.position[2]) + r.radius;
+    farthest = std::max(farthest, out);
+    if (out > 3 * reach)
+      os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << " reaches " << out << " m from the origin, the blocks "
+         << reach << " m (a position or radius in mm read as m?)";
+    const double disc = M_PI * r.radius * r.radius;
+    if (r.disc_area > 1.01 * disc)
+      os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << ": disc_area " << r.disc_area
+         << " m^2 is more than the disc its radius sweeps, pi r^2 = " << disc << " m^2 (an area in mm^2 or a diameter as the radius?)";
+  }
+  if (farthest > 0 && reach > 20 * farthest)
+    os << (os.tellp() > 0 ? "; " : "") << "the blocks reach " << reach << " m from the origin, the rotors " << farthest
+       << " m (a block's size or centre in mm read as m?)";
+  const std::string found = os.str();
+  std::ostringstream fine;
+  fine.precision(4);
+  fine << "the blocks reach " << reach << " m from the origin, the rotors " << farthest
+       << " m; every disc_area at most pi r^2";
+  return advisory("rotors and blocks on one scale", found.empty(), found.empty() ? fine.str() : found);
+}
+
 }  // namespace
 
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
   const Eigen::MatrixXd B = allocation(b);
-  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b), check_discs_apart(v)};
+  return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b), check_discs_apart(v),
+          check_one_scale(v)};
 }
 
 }  // namespace quadgen

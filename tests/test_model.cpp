@@ -1060,9 +1060,10 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   };
   const std::string map = "the motor map rises with the command", apart = "thrust, roll, pitch and yaw can be set apart",
                     trim = "a hover trim exists within the motors' reach";
-  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml"}) {
+  for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
+                           "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 4u);
+    ASSERT_EQ(checks.size(), 5u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1110,6 +1111,28 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     v.rotors[1].position[2] += 0.05;  // a coaxial-like step in height: apart
     v.rotors[3].position[2] += 0.05;
     EXPECT_TRUE(checks_of(v).at(discs).passed) << checks_of(v).at(discs).detail;
+  }
+  const std::string scale = "rotors and blocks on one scale";
+  {  // numbers copied in millimetres where the file reads metres: one at a time
+    Vehicle v = good;
+    for (double& x : v.rotors[2].position) x *= 1000;
+    auto c = checks_of(v).at(scale);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("rotor " + v.rotors[2].name + " reaches"), std::string::npos) << c.detail;
+    v = good;
+    v.rotors[0].disc_area *= 1e6;
+    c = checks_of(v).at(scale);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("more than the disc its radius sweeps"), std::string::npos) << c.detail;
+    v = good;
+    for (auto& b : v.blocks) {
+      for (double& x : b.size) x *= 1000;
+      for (double& x : b.centre) x *= 1000;
+    }
+    v.derived_overrides.clear();  // the file's bounds on the inertia would stop it earlier
+    c = checks_of(v).at(scale);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("a block's size or centre in mm"), std::string::npos) << c.detail;
   }
   // A warning leaves the derivation's audit passed.
   AuditResult r;
