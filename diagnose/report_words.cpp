@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "fit/fit_report.hpp"
@@ -76,10 +77,26 @@ double reduction(double before, double after) {
 
 // The finding in one sentence (the effect's own words), from its values: a per-flight
 // parameter at its mean over the flights.
+// Where the first parameter is the reference (motor gains), one whose interval holds 0 on every
+// flight is not told apart from the reference: the sentence names the others and says so,
+// instead of "motor M2 gives 1.2 % more thrust" for a gain that may be none. Where every
+// interval holds 0 (the gains significant only together) all are named, and that is said.
 std::string headline(const Finding& f) {
   const Effect& e = find_effect(f.effect);
+  std::set<std::string> apart;  // shared names with an interval away from 0 on some flight
+  for (const auto& p : f.parameters)
+    if (p.lower - p.numerical_allowance > 0 || p.upper + p.numerical_allowance < 0)
+      apart.insert(runtime::shared_name(p.name));
+  const bool drop_unresolved = e.first_parameter_is_reference && !apart.empty();
   std::vector<std::pair<std::string, double>> named;
-  for (const auto& p : f.parameters) named.emplace_back(p.name, p.value);
+  size_t dropped = 0;
+  for (const auto& p : f.parameters) {
+    if (drop_unresolved && !apart.count(runtime::shared_name(p.name))) {
+      ++dropped;
+      continue;
+    }
+    named.emplace_back(p.name, p.value);
+  }
   const std::map<std::string, double> values = runtime::mean_over_flights(named);
   std::string reference;
   if (e.first_parameter_is_reference)
@@ -89,7 +106,10 @@ std::string headline(const Finding& f) {
         break;
       }
   std::string s = e.headline(values, reference);
-  if (values.size() < f.parameters.size()) s += " (mean over the flights; each flight's values below)";
+  if (values.size() < named.size()) s += " (mean over the flights; each flight's values below)";
+  if (dropped > 0) s += " The others are within their intervals of the reference.";
+  else if (e.first_parameter_is_reference && apart.empty() && !values.empty())
+    s += " Each interval holds 0: the values are significant only together.";
   return s;
 }
 

@@ -39,6 +39,7 @@
 #include "diagnose/held_out_gain.hpp"
 #include "diagnose/residual_analysis.hpp"
 #include "diagnose/validation.hpp"
+#include "diagnose/report_words.hpp"
 #include "generated/finken3/model.hpp"
 #include "runtime/dynamic_model.hpp"
 #include "tests/estimate_shape.hpp"
@@ -1391,4 +1392,33 @@ TEST(RealData, ArplMotorLagIntervalContainsTheAuthorsValue) {
   ASSERT_NE(tau, nullptr) << "the motor lag is not named: " << named(j).size() << " findings";
   EXPECT_LE((*tau)["ci95"][0].get<double>(), 0.072);
   EXPECT_GE((*tau)["ci95"][1].get<double>(), 0.072);
+}
+
+// The motor-gain sentence names the gains told apart from the reference and says what it
+// leaves out, instead of "motor M2 gives 1.2 % more thrust" for a gain whose interval holds 0.
+TEST(ReportWords, TheMotorGainSentenceNamesOnlyGainsToldApartFromTheReference) {
+  using namespace quadgen::diagnose;
+  Finding f;
+  f.effect = "motor_gain";
+  f.evidence.parameters.push_back({"motor_gain.M1", "1", 0, -0.5, 0.5, false});
+  const auto gain = [](const char* name, double value, double lower, double upper) {
+    EffectEstimate e;
+    e.name = name, e.value = value, e.lower = lower, e.upper = upper;
+    return e;
+  };
+  f.parameters = {gain("motor_gain.M2", 0.012, -0.004, 0.028), gain("motor_gain.M3", -0.08, -0.09, -0.07),
+                  gain("motor_gain.M4", 0.002, -0.01, 0.014)};
+  EXPECT_EQ(words::headline(f),
+            "Motor M3 gives 8.0 % less thrust than motor M1. The others are within their intervals of the reference.");
+  // Its interval widened by the numerical allowance to reach 0: left out, too.
+  f.parameters[1].numerical_allowance = 0.075;
+  const std::string none_apart = words::headline(f);
+  EXPECT_NE(none_apart.find("Each interval holds 0: the values are significant only together."), std::string::npos)
+      << none_apart;
+  EXPECT_NE(none_apart.find("Motor M2 gives 1.2 % more thrust than motor M1"), std::string::npos) << none_apart;
+  // Every gain told apart: the sentence as the effect words it, nothing added.
+  f.parameters[1].numerical_allowance = 0;
+  f.parameters[0].lower = 0.002;
+  f.parameters[2].lower = 0.001;
+  EXPECT_EQ(words::headline(f), "Motor M2 gives 1.2 % more thrust than motor M1; motor M3 8.0 % less; motor M4 0.20 % more.");
 }
