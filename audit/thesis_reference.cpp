@@ -267,11 +267,13 @@ void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, cons
                          "moment from c_z, and the weight none about the CoG",
                          right_case_angular_acceleration(n) * n.cog[2], right_case_angular_acceleration(n)),
                  std::string(kFromArithmetic) + ": the blocks' centre of gravity against 0.94 mm, within 0.05 mm"});
+  const bool mass_agrees = std::fabs(mp.mass_value - 0.387) < 1e-9;
   out.push_back({"1.1, appendix A, (14)", "mass",
                  "387 g in total; arm mass 0.039 kg (appendix A) but density (14) implies 0.019 kg",
                  fmt("m = %.4g kg from the blocks with 0.019 kg per arm", mp.mass_value),
-                 std::fabs(mp.mass_value - 0.387) < 1e-9, "",
-                 "total agrees; with 0.039 kg per arm the blocks would weigh 0.467 kg",
+                 mass_agrees, mass_agrees ? "" : "the vehicle file's blocks are not the thesis' (edited since?)",
+                 mass_agrees ? std::string("total agrees; with 0.039 kg per arm the blocks would weigh 0.467 kg")
+                             : fmt("the blocks weigh %.4g kg against 0.387 kg", mp.mass_value),
                  std::string(kFromArithmetic) + ": the blocks' total mass against 387 g"});
 }
 
@@ -512,7 +514,12 @@ matrix thesis_rotation_about_y(const ex& theta) {
   return matrix(3, 3, lst{-cos(theta), 0, sin(theta), 0, 1, 0, sin(theta), 0, cos(theta)});
 }
 
-bool is_thesis_vehicle(const SymbolicModel& m) { return is_thesis_vehicle(m.vehicle_name); }
+bool is_thesis_vehicle(const SymbolicModel& m) {
+  std::vector<std::string> rotors;  // from the motor-command inputs u_<rotor>, in the file's order
+  for (const auto& in : m.inputs)
+    if (in.name.rfind("u_", 0) == 0) rotors.push_back(in.name.substr(2));
+  return is_thesis_vehicle(m.vehicle_name, rotors);
+}
 
 std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp) {
   if (!is_thesis_vehicle(m)) return {};

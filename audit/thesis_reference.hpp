@@ -1,6 +1,6 @@
 // The thesis' published equations and numbers, encoded as a reference, and their
 // comparison with the derived model: what agrees, what differs, why, and by how much.
-// Only meaningful for the FINken 3 (vehicle name "finken3").
+// Only meaningful for the FINken 3 (vehicle name "finken3" with rotors A..D: is_thesis_vehicle).
 #pragma once
 #include <string>
 #include <vector>

@@ -175,7 +175,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   j["kind"] = "motor_steps";
   j["vehicle"] = v.name;
   j["log"] = path;
-  const bool thesis = is_thesis_vehicle(v.name);  // the thesis' value belongs to its vehicle only
+  const bool thesis = is_thesis_vehicle(v);  // the thesis' value belongs to its vehicle only
   if (thesis)
     j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
                        {"thesis_method", "read off one normalised step at 63 % (thesis 2.3.4, Figure 24)"},

@@ -87,9 +87,13 @@ struct Vehicle {
   int fitted_line = 0;
 };
 
-// Whether a vehicle is the thesis' FINken 3 (vehicles/finken3.yaml, name "finken3"), whose
-// numbers the thesis comparisons use: the one place that decides it.
-inline bool is_thesis_vehicle(const std::string& vehicle_name) { return vehicle_name == "finken3"; }
+// Whether a vehicle is the thesis' FINken 3 (vehicles/finken3.yaml), whose numbers the thesis
+// comparisons use: named "finken3" with the thesis' four rotors A, B, C, D in that order. The
+// name alone let a hexacopter copied under that name into the comparison, which then looked
+// for rotors A..D and stopped derive. The one place that decides it.
+inline bool is_thesis_vehicle(const std::string& vehicle_name, const std::vector<std::string>& rotor_names) {
+  return vehicle_name == "finken3" && rotor_names == std::vector<std::string>{"A", "B", "C", "D"};
+}
 
 struct VehicleError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -102,6 +106,7 @@ const Parameter& param(const Vehicle& v, const std::string& name);
 
 // The rotors' names in the vehicle file's order (the log columns u_<name>, the inputs' order).
 std::vector<std::string> rotor_names(const Vehicle& v);
+inline bool is_thesis_vehicle(const Vehicle& v) { return is_thesis_vehicle(v.name, rotor_names(v)); }
 
 using output::fnv1a_hex;
 

@@ -11,10 +11,11 @@ bool ascii_digit(char c) { return c >= '0' && c <= '9'; }
 
 // Names the generated header (templates/model.hpp.mustache) declares next to or inside the
 // vehicle's namespace, and the namespaces it opens: a vehicle called "Model" or "std" would
-// shadow them and the header would not compile, or compile to something else.
+// shadow them and the header would not compile, or compile to something else. The test
+// NameRule.RefusesEveryNameTheHeaderTemplateDeclares reads the template for the list.
 const std::set<std::string>& generated_header_names() {
   static const std::set<std::string> names = {
-      "std", "quadgen_generated", "Model", "Scalar", "State", "Input", "Param", "Precomputed",
+      "std", "quadgen_generated", "Model", "Scalar", "State", "Input", "Param", "Output", "Precomputed",
       "abs_value", "sign_of", "precompute", "rhs", "measurement", "kNumStates", "kNumInputs",
       "kNumParams", "kNumOutputs", "kNumPrecomputed", "kVehicleHash", "kEffects", "kStateNames",
       "kInputNames", "kParamNames", "kOutputNames", "kNominalParams", "kInputDelayParam", "kParamUnits", "kParamLower",

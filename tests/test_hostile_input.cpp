@@ -18,8 +18,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -232,6 +234,24 @@ TEST(Sinks, TerminalTextShowsControlsAsEscapes) {
   for (const auto& s : hostile_strings()) EXPECT_FALSE(acts_on(out::printable(s))) << out::printable(s);
   EXPECT_EQ(out::printable("F\xc3\xb6rster \xe2\x80\x94 \xce\xbc"), "F\xc3\xb6rster \xe2\x80\x94 \xce\xbc");
   EXPECT_EQ(out::printable("a\xc2\x9b" "b"), "a\\xC2\\x9Bb");
+}
+
+// A vehicle named after a type the generated header declares broke it: "Output" was added to
+// the template and not to the reserved names, and derive wrote a header that did not compile.
+// The names are read from the template itself, so the next one added cannot be missed.
+TEST(NameRule, RefusesEveryNameTheHeaderTemplateDeclares) {
+  std::ifstream in(source_path("templates/model.hpp.mustache"));
+  ASSERT_TRUE(in);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // struct X, namespace X, inline ... X( or X = / X[ at the start of a declaration, template <typename X>.
+  const std::regex declared(
+      R"((?:struct|namespace|typename)\s+([A-Za-z_]\w*)|inline\s+(?:constexpr\s+)?[\w:<>*\s]*?\b([A-Za-z_]\w*)\s*(?:\(|=|\[))");
+  std::set<std::string> names;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), declared); it != std::sregex_iterator(); ++it)
+    names.insert((*it)[1].matched ? (*it)[1].str() : (*it)[2].str());
+  for (const char* expected : {"Output", "State", "Precomputed", "quadgen_generated", "kNumStates", "rhs", "Scalar"})
+    EXPECT_TRUE(names.count(expected)) << expected << " not read from the template: the pattern is out of date";
+  for (const auto& n : names) EXPECT_TRUE(out::name_problem(n)) << n << " is declared by the header but accepted as a name";
 }
 
 TEST(NameRule, VehicleParserRefusesHostileNamesWithFileAndLine) {

@@ -708,6 +708,23 @@ TEST(Thesis, AGyroscopicVerdictFollowsTheModel) {
   EXPECT_TRUE(found);
 }
 
+// Another vehicle saved under the thesis' name gets no thesis comparison: the hexacopter and
+// the Crazyflie (rotors M1..M4) named "finken3" used to stop derive looking for rotors A..D.
+TEST(Thesis, OnlyTheThesisVehicleIsComparedNotItsName) {
+  for (const char* file : {"vehicles/hexa_plus.yaml", "vehicles/crazyflie21.yaml"}) {
+    Vehicle v = load_vehicle(test::source_path(file));
+    v.name = "finken3";
+    EXPECT_FALSE(is_thesis_vehicle(v)) << file;
+    const MassProperties mp = derive_mass_properties(v);
+    const SymbolicModel m = derive_model(v, mp, {});
+    EXPECT_FALSE(is_thesis_vehicle(m)) << file;
+    EXPECT_TRUE(compare_with_thesis(m, mp).empty()) << file;
+  }
+  const Vehicle thesis = test::finken3();
+  EXPECT_TRUE(is_thesis_vehicle(thesis));
+  EXPECT_TRUE(is_thesis_vehicle(derive_model(thesis, derive_mass_properties(thesis), {})));
+}
+
 // Every effect says what it found in a sentence with the units a reader expects; spot checks
 // of the numbers against the values (written here) for a few.
 TEST(Effects, EachFindingReadsAsASentence) {
