@@ -31,7 +31,7 @@ int run_derive(const DeriveArgs& args) {
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
   if (!r.note.empty()) std::cerr << "quadgen: note: " << r.note << "\n";
-  std::cout << r.summary;
+  std::cout << output::printable_lines(r.summary);
   return r.audit_passed ? 0 : 3;
 }
 

@@ -68,7 +68,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
-  std::cout << r.summary << "; wrote " << output::printable(a.out) << "/report.html\n";
+  std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "/report.html\n";
   return 0;
 }
 

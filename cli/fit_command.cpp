@@ -114,7 +114,7 @@ int run_fit(const FitArgs& a) {
   for (const auto& [file, svg] : result.plots) out.add(file, svg);
   for (const auto& err : result.plot_errors) std::cerr << "no plot " << err << "\n";
   out.commit();
-  std::cout << result.summary;
+  std::cout << output::printable_lines(result.summary);
   for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << w << "\n";
   return 0;
 }

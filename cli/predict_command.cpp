@@ -50,7 +50,7 @@ int run_predict(const PredictArgs& a) {
   for (const auto& note : r.notes) std::cerr << note << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
-  std::cout << r.summary << "wrote " << output::printable(a.out) << "/prediction.json\n";
+  std::cout << output::printable_lines(r.summary) << "wrote " << output::printable(a.out) << "/prediction.json\n";
   if (!r.failure.empty()) {
     std::cerr << "quadgen: error: " << r.failure << "\n";
     return 4;

@@ -119,7 +119,7 @@ int run_simulate(const SimulateArgs& a) {
   if (render_svg(r.plot_title, r.plot, &svg, &err)) out.set(1, svg);
   else std::cerr << "no plot: " << err << "\n";
   out.commit();
-  std::cout << r.summary << "; wrote " << output::printable(a.out) << "\n";
+  std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "\n";
   return 0;
 }
 

@@ -81,6 +81,14 @@ std::string printable(const std::string& s) {
   return out;
 }
 
+std::string printable_lines(const std::string& text) {
+  std::string out;
+  size_t start = 0;
+  for (size_t end; (end = text.find('\n', start)) != std::string::npos; start = end + 1)
+    out += printable(text.substr(start, end - start)) + "\n";
+  return out + printable(text.substr(start));
+}
+
 std::string cpp_comment(const std::string& s) {
   std::string out;
   for (size_t i = 0; i < s.size(); ++i) {

@@ -12,6 +12,9 @@ namespace quadgen::output {
 // controls and the bidirectional overrides in their UTF-8 form too) become \xNN, invalid
 // UTF-8 becomes '?'.
 std::string printable(const std::string& s);
+// Several lines for a terminal (a command's summary): each line as printable makes it, the
+// line breaks kept. Summaries quote log paths, which may carry escape sequences.
+std::string printable_lines(const std::string& text);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
 // trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);

@@ -408,6 +408,24 @@ TEST(Sinks, HtmlReportQuotesNoMarkup) {
     // The JSON beside it stays valid JSON whatever the bytes of the path.
     EXPECT_NO_THROW(nlohmann::json::parse(out::json_document(quadgen::diagnose::diagnosis_json(d, s))));
   }
+  // Filled where paths reach a diagnosis (the flights, the airframe file, the screening's
+  // reasons), in the report and its JSON: the empty diagnosis above has none of these sections.
+  for (const auto& s : hostile_strings()) {
+    quadgen::diagnose::Diagnosis f;
+    f.vehicle = "finken3";
+    f.flights = {s, s + "2"};
+    f.airframe_source = s;
+    f.screening = {{s, 0.4, false, "commands saturated in " + s, true}, {s + "2", 0, true, "", false}};
+    const std::string html = quadgen::diagnose::diagnosis_html(f, s, {{s, "<svg></svg>"}});
+    EXPECT_EQ(html.find("<script>alert"), std::string::npos) << out::printable(s);
+    EXPECT_EQ(html.find("<img"), std::string::npos) << out::printable(s);
+    EXPECT_NO_THROW(nlohmann::json::parse(out::json_document(quadgen::diagnose::diagnosis_json(f, s))));
+    // The terminal summary quotes the paths: as the commands print it (printable_lines), no
+    // escape sequence or other control reaches the terminal and the lines stay lines.
+    const std::string text = out::printable_lines(quadgen::diagnose::diagnosis_summary(f));
+    for (char c : text) EXPECT_TRUE(c == '\n' || static_cast<unsigned char>(c) >= 0x20) << out::printable(text);
+  }
+  EXPECT_EQ(out::printable_lines("a\x1b[31m\nb\n"), "a\\x1B[31m\nb\n");
 }
 
 TEST(Sinks, MarkdownAndLatexTextStayText) {
