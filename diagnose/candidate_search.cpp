@@ -625,6 +625,16 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
 //    hold only without E. Without this a look-alike whose own estimate is too small to
 //    matter (a CoG offset of 0.7 mm on the NanoBench helix) would unname F for nothing.
 // Then the pair is reported ambiguous and F carried, its values not named.
+// "cog_offset.x = 0.0137 m, cog_offset.y = -0.002 m": an effect's free values as a report quotes them.
+std::string CandidateSearch::values_in_words(const std::string& effect, const std::vector<FitParameter>& ps) const {
+  std::ostringstream os;
+  for (int i : effect_params_.at(effect))
+    if (ps[i].free)
+      os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
+         << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
+  return os.str();
+}
+
 std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResult& r) const {
   std::vector<std::string> unnamed;
   const std::set<std::string> base(r.selected.begin(), r.selected.end());
@@ -639,12 +649,7 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
     return false;
   };
   const auto values_of = [&](const std::string& effect, const std::vector<FitParameter>& ps) {
-    std::ostringstream os;
-    for (int i : effect_params_.at(effect))
-      if (ps[i].free)
-        os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
-           << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
-    return os.str();
+    return values_in_words(effect, ps);
   };
   for (const std::string& f : r.named()) {
     for (const std::string& e : candidates_) {
@@ -705,6 +710,54 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
     }
   }
   return unnamed;
+}
+
+// Asked once per suspect and named look-alike, with the suspect held at its estimate (from
+// acceptance, where it was fitted beside the named effects): the named effect refitted, and
+// kept at its named values. Rejected kept (p_named below the search's level): the named values
+// hold only without the suspect, which the training data want (it was significant), so the
+// suspect is carried. It stays unnamed: its held-out test failed.
+std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_need(
+    SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const {
+  std::vector<CarriedSuspect> carried;
+  const Workspace ws = own_workspace();
+  const double level = opt_.alpha / static_cast<double>(candidates_.size());
+  const auto declared = [](const std::string& x, const std::string& y) {
+    for (const auto& l : find_effect(x).look_alikes)
+      if (l.effect == y) return true;
+    return false;
+  };
+  for (const auto& [e, estimate] : suspects) {
+    if (std::find(r.selected.begin(), r.selected.end(), e) != r.selected.end()) continue;
+    for (const std::string& f : r.named()) {
+      if (!declared(f, e) && !declared(e, f)) continue;
+      const std::set<std::string> base(r.selected.begin(), r.selected.end());
+      std::vector<FitParameter> start = r.final_fit;
+      for (int i : effect_params_.at(e))
+        if (estimate.count(start[i].name)) start[i].value = estimate.at(start[i].name);
+      double c_held = 0, c_kept = 0;
+      const std::vector<FitParameter> held = fit_with(base, start, &c_held, ws, r.final_weights, {e});
+      const std::vector<FitParameter> kept = fit_with(base, start, &c_kept, ws, r.final_weights, {e, f});
+      int dof_f = 0;
+      for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
+      const double p_named = chi2_upper(
+          lr_statistic(channel_noise(train_, kept).ss, channel_noise(train_, held)), std::max(1, dof_f));
+      opt_.progress.say("[diagnose] suspected " + e + " held at its estimate beside " + f + ": " + f +
+                        "'s values kept then p = " + output::short_number(p_named));
+      if (p_named >= level) continue;
+      CarriedSuspect c{e, f, p_named, values_in_words(f, r.final_fit), ""};
+      r.selected.push_back(e);
+      r.carried.push_back(e);
+      r.final_fit = fit_as_own_model(std::set<std::string>(r.selected.begin(), r.selected.end()), held,
+                                     r.final_weights, &r.final_weights, &r.final_settling);
+      c.with = values_in_words(f, r.final_fit);
+      opt_.progress.say("[diagnose] " + e + " carried: " + c.without + " -> " + c.with);
+      carried.push_back(c);
+      break;  // carried now; one named look-alike is enough
+    }
+  }
+  if (!carried.empty()) estimate_intervals(r, true);
+  return carried;
 }
 
 void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::string>& effects) const {

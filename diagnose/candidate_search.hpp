@@ -125,6 +125,14 @@ struct Ambiguity {
   std::string a_with_b_held;  // a's values in the model with b held at its own estimate
 };
 
+// A suspected effect carried in the final model because a named look-alike's values need it
+// (CandidateSearch::carry_suspects_the_named_values_need).
+struct CarriedSuspect {
+  std::string effect, beside;  // the suspect, and the named look-alike whose values need it
+  double named_values_p = 1;   // the named values kept, the suspect held at its estimate
+  std::string without, with;   // the named effect's values without the suspect and with it carried
+};
+
 struct SelectionStep {
   std::vector<std::string> base_effects;
   std::vector<CandidateEvidence> candidates;  // in rank_candidates' order: the selected one first
@@ -226,6 +234,13 @@ class CandidateSearch {
   // motor gains of a hexacopter copying a CoG offset): the pair goes to r.unresolved (absorbed)
   // and F is carried, not named. Returns the effects so unnamed (candidate_search.cpp says how).
   std::vector<std::string> check_absorbed_look_alikes(SearchResult& r) const;
+  // After acceptance, the other way round: a suspected effect E (significant, but no held-out
+  // gain), declared a look-alike of a named F, with F's values rejected once E is held at its
+  // estimate (a hexacopter's weak motor whose torque a named CoG offset took up: 13.7 mm for
+  // 15). E is carried in the model, not named, and F's values are those beside it.
+  // `suspects`: each suspected effect with its estimates by parameter name.
+  std::vector<CarriedSuspect> carry_suspects_the_named_values_need(
+      SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const;
   // Takes `effects` out of the result's final model (refit, new intervals): for candidates
   // that a later test (held-out prediction, interval) does not stand behind.
   void remove_effects(SearchResult& r, const std::vector<std::string>& effects) const;
@@ -265,6 +280,8 @@ class CandidateSearch {
                      const std::vector<double>& weights);
 
  private:
+  std::string values_in_words(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;
+
   const SymbolicModel& all_;
   runtime::DynamicModel& model_;
   const fit::EquationErrorModel& train_;

@@ -502,6 +502,24 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
   }
 }
 
+// A suspect the named values need (CandidateSearch::carry_suspects_the_named_values_need) is
+// carried; the findings' values and intervals are then those beside it. Their held-out gains
+// stay those of acceptance, measured without it.
+void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& search) {
+  std::vector<std::pair<std::string, std::map<std::string, double>>> suspects;
+  for (const auto& x : d.suspected) {
+    std::map<std::string, double> values;
+    for (const auto& p : x.candidate.parameters) values[p.name] = p.value;
+    suspects.emplace_back(x.candidate.effect, values);
+  }
+  const std::vector<CarriedSuspect> carried = search.carry_suspects_the_named_values_need(d.search, suspects);
+  for (const auto& c : carried)
+    for (auto& x : d.suspected)
+      if (x.candidate.effect == c.effect) x.carried = c;
+  if (!carried.empty())
+    for (auto& f : d.findings) f.parameters = effect_estimates(d.search, f.effect);
+}
+
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:
 // a stand-in for missing physics, moved from d.findings to d.stand_ins.
 void separate_stand_ins(Diagnosis& d, const HeldOutGain& held_out_gain, const fit::EquationErrorModel& train_ee,
@@ -661,6 +679,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   for (const std::string& e : search.check_absorbed_look_alikes(d.search))  // carried now, not named
     d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
                      d.findings.end());
+  carry_suspects_the_findings_need(d, search);
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {

@@ -113,6 +113,9 @@ struct Finding {
 struct Suspected {
   Finding candidate;
   std::string failed;
+  // Carried in the final model because a named look-alike's values need it (empty: not
+  // carried); its values are then those of that fit, not `candidate`'s.
+  std::optional<CarriedSuspect> carried;
 };
 
 // A finding whose value lies outside what its effect's physics can produce (a steady wind

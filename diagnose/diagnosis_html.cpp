@@ -286,8 +286,14 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
 }
 
 void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
-  if (!d.search.unresolved.empty()) {
+  bool carried = false;
+  for (const auto& x : d.suspected) carried = carried || x.carried;
+  if (!d.search.unresolved.empty() || carried) {
     h << "<h2>Ambiguous</h2>\n";
+    for (const auto& x : d.suspected)
+      if (x.carried)
+        h << "<p class=\"warn\"><b>" << esc(x.candidate.effect) << "</b> (suspected: " << esc(x.failed) << ") is "
+          << esc(words::carried_suspect(*x.carried)) << ".</p>\n";
     for (const auto& a : d.search.unresolved)
       if (a.absorbed)
         h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b) << "</b>: " << esc(a.b)

@@ -302,6 +302,12 @@ json suspected_json(const Diagnosis& d) {
   for (const auto& x : d.suspected) {
     json sj = finding_json(x.candidate);
     sj["failed"] = x.failed;
+    sj["carried_beside"] = nullptr;
+    if (x.carried)
+      sj["carried_beside"] = {{"effect", x.carried->beside},
+                              {"named_values_p", x.carried->named_values_p},
+                              {"values_without", x.carried->without},
+                              {"values_with", x.carried->with}};
     suspected.push_back(sj);
   }
   return suspected;

@@ -52,8 +52,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
        << num(st.value) << " " << st.unit << " lies outside [" << num(st.plausible_lower) << ", "
        << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
-  for (const auto& x : d.suspected)
-    os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")\n";
+  for (const auto& x : d.suspected) {
+    os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")";
+    if (x.carried) os << "; " << words::carried_suspect(*x.carried);
+    os << "\n";
+  }
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
   if (!d.search.left_at_limit.empty()) {
     os << "the search stopped at its limit of " << d.search.steps.size()

@@ -7,6 +7,7 @@
 
 #include "fit/fit_report.hpp"
 #include "output/estimate.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::diagnose::words {
@@ -111,6 +112,12 @@ std::string headline(const Finding& f) {
   else if (e.first_parameter_is_reference && apart.empty() && !values.empty())
     s += " Each interval holds 0: the values are significant only together.";
   return s;
+}
+
+std::string carried_suspect(const CarriedSuspect& c) {
+  return "carried in the model, not named: " + c.beside + "'s values fitted without it (" + c.without +
+         ") are rejected once it is held at its estimate (p = " + output::short_number(c.named_values_p) +
+         "); beside it they are " + c.with;
 }
 
 // Where the rotor drag force acts, when the diagnosis names both halves of it: the force

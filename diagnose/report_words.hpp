@@ -16,6 +16,8 @@ namespace quadgen::diagnose::words {
 double reduction(double before, double after);
 // A finding in one sentence ("Motor M4 gives 6.9 % less thrust than motor M1").
 std::string headline(const Finding& f);
+// A suspect carried for a named look-alike's sake, in one sentence.
+std::string carried_suspect(const CarriedSuspect& c);
 
 // Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
 struct PointOfAction {
