@@ -745,12 +745,25 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
       opt_.progress.say("[diagnose] suspected " + e + " held at its estimate beside " + f + ": " + f +
                         "'s values kept then p = " + output::short_number(p_named));
       if (p_named >= level) continue;
-      CarriedSuspect c{e, f, p_named, values_in_words(f, r.final_fit), ""};
+      // Beside it the pair must stay physical: on a quad the trims and a CoG offset fitted
+      // together can trade wildly (the NanoBench B3 figure-8 made trims of -42 % beside a
+      // carried offset), and values no airframe has are no better than the named ones.
+      std::set<std::string> with = base;
+      with.insert(e);
+      std::vector<double> weights;
+      Settling settling;
+      const std::vector<FitParameter> beside = fit_as_own_model(with, held, r.final_weights, &weights, &settling);
+      const std::string implausible = implausible_estimate(f, beside) + implausible_estimate(e, beside);
+      if (!implausible.empty()) {
+        opt_.progress.say("[diagnose] " + e + " not carried: beside it " + implausible);
+        continue;
+      }
+      CarriedSuspect c{e, f, p_named, values_in_words(f, r.final_fit), values_in_words(f, beside)};
       r.selected.push_back(e);
       r.carried.push_back(e);
-      r.final_fit = fit_as_own_model(std::set<std::string>(r.selected.begin(), r.selected.end()), held,
-                                     r.final_weights, &r.final_weights, &r.final_settling);
-      c.with = values_in_words(f, r.final_fit);
+      r.final_fit = beside;
+      r.final_weights = weights;
+      r.final_settling = settling;
       opt_.progress.say("[diagnose] " + e + " carried: " + c.without + " -> " + c.with);
       carried.push_back(c);
       break;  // carried now; one named look-alike is enough
