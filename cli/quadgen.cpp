@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
+#include "output/output_set.hpp"
 #include "output/sinks.hpp"
 
 namespace {
@@ -49,6 +50,7 @@ bool unknown_command(const CLI::App& app, const std::string& word) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  quadgen::output::remove_empty_outputs_on_interrupt();
   CLI::App app{"quadgen: derived, generated and audited multirotor flight models"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("quadgen ") + QUADGEN_VERSION);

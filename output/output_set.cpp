@@ -291,6 +291,50 @@ void remove_tree_quietly(const fs::path& p) {
 
 // A private directory beside the target (same file system, so renames are atomic), named
 // .<target>.quadgen-tmp.<pid>.XXXXXX. Removed with everything in it unless released.
+// Empty folders to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP): the
+// staging directories and the folders created to hold them, which stay empty through the
+// long work (files are staged only at its end). A signal handler may call rmdir but not
+// walk a tree, so a folder that already holds files (the last moments of a run) is left to
+// the next run into the same place, as after SIGKILL. Slots are filled in the order the
+// folders are made (outermost first, the staging directory last) and emptied from the top.
+namespace interrupt {
+constexpr int kSlots = 32;
+constexpr size_t kPathBytes = 4096;
+char paths[kSlots][kPathBytes];
+volatile sig_atomic_t used[kSlots];
+
+int remember(const fs::path& p) {
+  const std::string s = p.string();
+  if (s.size() >= kPathBytes) return -1;
+  for (int i = 0; i < kSlots; ++i)
+    if (!used[i]) {
+      std::memcpy(paths[i], s.c_str(), s.size() + 1);
+      used[i] = 1;
+      return i;
+    }
+  return -1;  // more than kSlots at once: left to the next run
+}
+
+void forget(int slot) {
+  if (slot >= 0) used[slot] = 0;
+}
+
+void on_signal(int sig) {
+  // A freed slot may be refilled out of order: passes until nothing more goes (a folder
+  // empties once the one inside it is gone).
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (int i = kSlots - 1; i >= 0; --i)
+      if (used[i] && ::rmdir(paths[i]) == 0) {  // only if empty
+        used[i] = 0;
+        removed = true;
+      }
+  }
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+}  // namespace interrupt
+
 class StagingDirectory {
  public:
   StagingDirectory(const fs::path& parent, const std::string& target_name) {
@@ -299,12 +343,18 @@ class StagingDirectory {
     std::string templ = (parent / (stem + std::to_string(::getpid()) + ".XXXXXX")).string();
     if (!::mkdtemp(templ.data())) fail(parent, "cannot create a staging directory: " + errno_text());
     path_ = templ;
+    slot_ = interrupt::remember(path_);
   }
   ~StagingDirectory() {
+    interrupt::forget(slot_);
     if (!released_) remove_tree_quietly(path_);
   }
   const fs::path& path() const { return path_; }
-  void release() { released_ = true; }
+  void release() {
+    interrupt::forget(slot_);
+    slot_ = -1;
+    released_ = true;
+  }
 
   void write(const std::string& name, const std::string& content) {
     const fs::path p = path_ / name;
@@ -343,6 +393,7 @@ class StagingDirectory {
 
   fs::path path_;
   bool released_ = false;
+  int slot_ = -1;  // in interrupt::paths
 };
 
 namespace {
@@ -400,11 +451,26 @@ void CreatedFolders::create(const fs::path& folder) {
   fs::create_directories(folder, ec);
   if (ec) fail(folder, "cannot create the directory: " + ec.message());
   created_ = missing;
+  for (const auto& p : created_) slots_.push_back(interrupt::remember(p));
+}
+
+void CreatedFolders::keep() {
+  for (int slot : slots_) interrupt::forget(slot);
+  slots_.clear();
+  created_.clear();
 }
 
 CreatedFolders::~CreatedFolders() {
+  for (int slot : slots_) interrupt::forget(slot);
   std::error_code ec;
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);  // only if empty
+}
+
+void remove_empty_outputs_on_interrupt() {
+  struct sigaction sa {};
+  sa.sa_handler = interrupt::on_signal;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
 }
 
 OutputDirectory::OutputDirectory(const std::string& dir, const std::string& command, const std::vector<std::string>& inputs)

@@ -38,12 +38,19 @@ class StagingDirectory;
 class CreatedFolders {
  public:
   void create(const std::filesystem::path& folder);  // like create_directories, remembering what it made
-  void keep() { created_.clear(); }
+  void keep();
   ~CreatedFolders();
 
  private:
   std::vector<std::filesystem::path> created_;  // outermost first
+  std::vector<int> slots_;                      // where the interrupt handler finds them
 };
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the empty staging directories
+// and the folders created for them before the process dies of the signal, so that Ctrl-C
+// during a long diagnosis leaves nothing behind (SIGKILL cannot be caught: the next run into
+// the same place removes what it leaves). For the command-line program's main.
+void remove_empty_outputs_on_interrupt();
 
 class OutputDirectory {
  public:

@@ -100,8 +100,15 @@ struct CliResult {
   std::string err;
 };
 
+// How a test interrupts a run: `signal` after `after_s` seconds, or once `exists` exists.
+struct Interrupt {
+  double after_s = -1;  // < 0: not by time
+  fs::path exists;      // empty: not by a path
+  int signal = SIGKILL;
+};
+
 // Runs quadgen with `args` (each one argv element: no shell parses them) in `cwd`.
-CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd, double kill_after_s = -1) {
+CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd, Interrupt interrupt = {}) {
   const fs::path err = cwd / ".stderr";
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -119,9 +126,14 @@ CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd,
     ::execv(bin.c_str(), argv.data());
     _exit(98);
   }
-  if (kill_after_s >= 0) {
-    std::this_thread::sleep_for(std::chrono::duration<double>(kill_after_s));
-    ::kill(pid, SIGKILL);
+  if (interrupt.after_s >= 0) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(interrupt.after_s));
+    ::kill(pid, interrupt.signal);
+  } else if (!interrupt.exists.empty()) {
+    std::error_code ec;
+    for (int k = 0; k < 6000 && !fs::exists(interrupt.exists, ec) && ::waitpid(pid, nullptr, WNOHANG) == 0; ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ::kill(pid, interrupt.signal);
   }
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -837,6 +849,21 @@ TEST(DataLoss, AFailedRunLeavesNoFoldersBehind) {
   EXPECT_EQ(read(tmp / "mine/notes.txt"), "mine\n");
 }
 
+// Interrupted (Ctrl-C, a terminal closed, a job killed politely), a long run leaves nothing
+// behind: its empty staging directory and the folders made for --out go before it dies of
+// the signal. Before, they stayed until the next run into the same place.
+TEST(DataLoss, AnInterruptedRunLeavesNoFoldersBehind) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "30", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  for (int sig : {SIGINT, SIGTERM}) {
+    const auto r = run_quadgen({"diagnose", vehicle, tmp / "f.csv", "--out", tmp / "a/b/c"}, tmp.dir,
+                               {-1, tmp / "a/b", sig});
+    EXPECT_EQ(r.rc, 128 + sig) << "the run must still be working when it is interrupted: " << r.err;
+    EXPECT_FALSE(fs::exists(tmp / "a")) << strsignal(sig);
+  }
+}
+
 // Numbers that overflow a double never reach the generated code as "inf" or "nan" (an
 // identifier the including project may define): derive refuses and writes nothing.
 TEST(Sinks, OverflowingVehicleNumbersAreRefusedNotEmitted) {
@@ -884,7 +911,7 @@ TEST(DataLoss, SigkillAtRandomMomentsLeavesOneCompleteRun) {
   std::uniform_real_distribution<double> fraction(0.0, 1.2);
   for (int k = 0; k < 12; ++k) {
     const size_t which = static_cast<size_t>(k) % runs.size();
-    run_quadgen(runs[which], tmp.dir, fraction(rng) * seconds[which]);
+    run_quadgen(runs[which], tmp.dir, {fraction(rng) * seconds[which]});
     std::string why;
     EXPECT_TRUE(out::complete_output_directory(out_of[which], &why)) << "after kill " << k << ": " << why;
   }
