@@ -82,9 +82,7 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
 // A hover trim (runtime::hover_trim, which simulate's scenarios fly): every rotor pushing and
 // within its motor's reach.
 AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b) {
-  std::vector<std::string> names;
-  for (const Rotor& r : v.rotors) names.push_back(r.name);
-  const runtime::HoverTrim trim = runtime::hover_trim(b, names);
+  const runtime::HoverTrim trim = runtime::hover_trim(b, rotor_names(v));
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
   std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(b.mass * b.g) + " N)";
@@ -122,7 +120,9 @@ AuditCheck check_discs_apart(const Vehicle& v) {
 // Rotors and blocks on one scale: a number without a unit is read as metres, so a position or
 // radius copied in millimetres puts a rotor a thousand times too far out, and an area in mm^2
 // makes the disc larger than its radius allows. Thresholds wide enough for real layouts (a
-// hull larger than its rotors' circle, the FINken 3's thrust-law area 0.13 of its disc).
+// file of one hub block, with mass and inertia given, whose rotors reach 5x past it; a hull
+// larger than its rotors' circle; the FINken 3's thrust-law area 0.13 of its disc), far
+// below the factor of 1000 of the mistake.
 AuditCheck check_one_scale(const Vehicle& v) {
   double reach = 0, farthest = 0;  // m, of the blocks (corners) and of the rotors (hub and tip)
   for (const Block& b : v.blocks)
@@ -133,7 +133,7 @@ AuditCheck check_one_scale(const Vehicle& v) {
   for (const Rotor& r : v.rotors) {
     const double out = std::hypot(r.position[0], r.position[1], r.position[2]) + r.radius;
     farthest = std::max(farthest, out);
-    if (out > 3 * reach)
+    if (out > 30 * reach)
       os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << " reaches " << out << " m from the origin, the blocks "
          << reach << " m (a position or radius in mm read as m?)";
     const double disc = M_PI * r.radius * r.radius;

@@ -30,7 +30,7 @@ int run_derive(const DeriveArgs& args) {
   std::cerr << "[5/5] writing " << output::printable(args.out) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
-  if (!r.note.empty()) std::cerr << "quadgen: note: " << r.note << "\n";
+  if (!r.note.empty()) std::cerr << "quadgen: note: " << output::printable_lines(r.note) << "\n";
   std::cout << output::printable_lines(r.summary);
   return r.audit_passed ? 0 : 3;
 }

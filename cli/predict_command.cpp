@@ -47,7 +47,7 @@ int run_predict(const PredictArgs& a) {
   app::PredictJob job{a.vehicle, a.logs, a.options};
   job.options.progress = output::terminal_progress();
   const app::PredictJobResult r = app::run_predict_job(job, vehicle);
-  for (const auto& note : r.notes) std::cerr << note << "\n";
+  for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   out.commit();
   std::cout << output::printable_lines(r.summary) << "wrote " << output::printable(a.out) << "/prediction.json\n";

@@ -609,6 +609,25 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
   }
 }
 
+// "cog_offset.x = 0.0137 m, cog_offset.y = -0.002 m": an effect's free values as a report quotes them.
+std::string CandidateSearch::values_in_words(const std::string& effect, const std::vector<FitParameter>& ps) const {
+  std::ostringstream os;
+  for (int i : effect_params_.at(effect))
+    if (ps[i].free)
+      os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
+         << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
+  return os.str();
+}
+
+// Whether either of two effects declares the other a look-alike.
+static bool declared_look_alikes(const std::string& x, const std::string& y) {
+  for (const auto& l : find_effect(x).look_alikes)
+    if (l.effect == y) return true;
+  for (const auto& l : find_effect(y).look_alikes)
+    if (l.effect == x) return true;
+  return false;
+}
+
 // A richer effect can reproduce a poorer look-alike and add something of its own: with six
 // rotors, five motor gains make a CoG offset's moment (the offset's moment is total thrust x
 // offset at every thrust level, and gains proportional to each rotor's arm give the same,
@@ -625,16 +644,6 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
 //    hold only without E. Without this a look-alike whose own estimate is too small to
 //    matter (a CoG offset of 0.7 mm on the NanoBench helix) would unname F for nothing.
 // Then the pair is reported ambiguous and F carried, its values not named.
-// "cog_offset.x = 0.0137 m, cog_offset.y = -0.002 m": an effect's free values as a report quotes them.
-std::string CandidateSearch::values_in_words(const std::string& effect, const std::vector<FitParameter>& ps) const {
-  std::ostringstream os;
-  for (int i : effect_params_.at(effect))
-    if (ps[i].free)
-      os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
-         << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
-  return os.str();
-}
-
 std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResult& r) const {
   std::vector<std::string> unnamed;
   const std::set<std::string> base(r.selected.begin(), r.selected.end());
@@ -643,17 +652,9 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
   const Workspace ws = own_workspace();
   const double level = opt_.alpha / static_cast<double>(candidates_.size());
   const std::vector<double> current_ss = channel_noise(train_, current).ss;
-  const auto declared = [](const std::string& x, const std::string& y) {
-    for (const auto& l : find_effect(x).look_alikes)
-      if (l.effect == y) return true;
-    return false;
-  };
-  const auto values_of = [&](const std::string& effect, const std::vector<FitParameter>& ps) {
-    return values_in_words(effect, ps);
-  };
   for (const std::string& f : r.named()) {
     for (const std::string& e : candidates_) {
-      if (base.count(e) || (!declared(f, e) && !declared(e, f))) continue;
+      if (base.count(e) || !declared_look_alikes(f, e)) continue;
       const CandidateEvidence* own = nullptr;  // its strongest showing on its own
       double f_statistic = 0;
       for (const auto& step : r.steps)
@@ -700,8 +701,8 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       am.manoeuvre = separating_manoeuvre(f, e);
       am.absorbed = true;
       am.b_at_own_estimate_p = p_own;
-      am.b_own_estimate = values_of(e, own->parameters);
-      am.a_with_b_held = values_of(f, held);
+      am.b_own_estimate = values_in_words(e, own->parameters);
+      am.a_with_b_held = values_in_words(f, held);
       opt_.progress.say("[diagnose] with " + am.b_own_estimate + ": " + am.a_with_b_held);
       r.unresolved.push_back(am);
       r.carried.push_back(f);
@@ -713,24 +714,20 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
 }
 
 // Asked once per suspect and named look-alike, with the suspect held at its estimate (from
-// acceptance, where it was fitted beside the named effects): the named effect refitted, and
-// kept at its named values. Rejected kept (p_named below the search's level): the named values
-// hold only without the suspect, which the training data want (it was significant), so the
-// suspect is carried. It stays unnamed: its held-out test failed.
+// acceptance, where it was fitted beside the named effects), as check_absorbed_look_alikes
+// asks: the suspect carried when the training data want it beside the final model (off
+// rejected, p_off), accept its estimate there (held, not rejected against it free, p_own),
+// and reject the named values beside it (p_named): they hold only without it. It stays
+// unnamed: its held-out test failed.
 std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_need(
     SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const {
   std::vector<CarriedSuspect> carried;
   const Workspace ws = own_workspace();
   const double level = opt_.alpha / static_cast<double>(candidates_.size());
-  const auto declared = [](const std::string& x, const std::string& y) {
-    for (const auto& l : find_effect(x).look_alikes)
-      if (l.effect == y) return true;
-    return false;
-  };
   for (const auto& [e, estimate] : suspects) {
     if (std::find(r.selected.begin(), r.selected.end(), e) != r.selected.end()) continue;
     for (const std::string& f : r.named()) {
-      if (!declared(f, e) && !declared(e, f)) continue;
+      if (!declared_look_alikes(f, e)) continue;
       const std::set<std::string> base(r.selected.begin(), r.selected.end());
       std::vector<FitParameter> start = r.final_fit;
       for (int i : effect_params_.at(e))
@@ -738,24 +735,33 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
       double c_held = 0, c_kept = 0;
       const std::vector<FitParameter> held = fit_with(base, start, &c_held, ws, r.final_weights, {e});
       const std::vector<FitParameter> kept = fit_with(base, start, &c_kept, ws, r.final_weights, {e, f});
-      int dof_f = 0;
+      std::set<std::string> with = base;
+      with.insert(e);
+      double c_joint = 0, c_joint2 = 0;
+      std::vector<FitParameter> joint = fit_with(with, held, &c_joint, ws, r.final_weights);
+      const std::vector<FitParameter> joint2 = fit_with(with, r.final_fit, &c_joint2, ws, r.final_weights);
+      if (c_joint2 < c_joint) joint = joint2;
+      const ChannelNoise nj = channel_noise(train_, joint), nh = channel_noise(train_, held);
+      int dof_e = 0, dof_f = 0;
+      for (int i : effect_params_.at(e)) dof_e += joint[i].free ? 1 : 0;
       for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
-      const double p_named = chi2_upper(
-          lr_statistic(channel_noise(train_, kept).ss, channel_noise(train_, held)), std::max(1, dof_f));
-      opt_.progress.say("[diagnose] suspected " + e + " held at its estimate beside " + f + ": " + f +
+      const double p_off = p_value_of(e, lr_statistic(channel_noise(train_, r.final_fit).ss, nj), dof_e);
+      const double p_own = chi2_upper(lr_statistic(nh.ss, nj), std::max(1, dof_e));
+      const double p_named = chi2_upper(lr_statistic(channel_noise(train_, kept).ss, nh), std::max(1, dof_f));
+      opt_.progress.say("[diagnose] suspected " + e + " beside " + f + ": off p = " + output::short_number(p_off) +
+                        ", at its estimate p = " + output::short_number(p_own) + ", " + f +
                         "'s values kept then p = " + output::short_number(p_named));
-      if (p_named >= level) continue;
+      if (p_off >= level || p_own < level || p_named >= level) continue;
       // Beside it the pair must stay physical: on a quad the trims and a CoG offset fitted
       // together can trade wildly (the NanoBench B3 figure-8 made trims of -42 % beside a
       // carried offset), and values no airframe has are no better than the named ones.
-      std::set<std::string> with = base;
-      with.insert(e);
       std::vector<double> weights;
       Settling settling;
-      const std::vector<FitParameter> beside = fit_as_own_model(with, held, r.final_weights, &weights, &settling);
-      const std::string implausible = implausible_estimate(f, beside) + implausible_estimate(e, beside);
-      if (!implausible.empty()) {
-        opt_.progress.say("[diagnose] " + e + " not carried: beside it " + implausible);
+      const std::vector<FitParameter> beside = fit_as_own_model(with, joint, r.final_weights, &weights, &settling);
+      const std::string implausible_f = implausible_estimate(f, beside), implausible_e = implausible_estimate(e, beside);
+      if (!implausible_f.empty() || !implausible_e.empty()) {
+        opt_.progress.say("[diagnose] " + e + " not carried: beside it " + implausible_f +
+                          (implausible_f.empty() || implausible_e.empty() ? "" : "; ") + implausible_e);
         continue;
       }
       CarriedSuspect c{e, f, p_named, values_in_words(f, r.final_fit), values_in_words(f, beside)};

@@ -505,7 +505,10 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
 // A suspect the named values need (CandidateSearch::carry_suspects_the_named_values_need) is
 // carried; the findings' values and intervals are then those beside it. Their held-out gains
 // stay those of acceptance, measured without it.
-void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& search) {
+// A finding whose intervals beside the carried suspect no longer pass acceptance (open, or
+// holding the effect's off value) is not named either: carried, and listed as suspected with
+// that reason.
+void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& search, const SymbolicModel& all) {
   std::vector<std::pair<std::string, std::map<std::string, double>>> suspects;
   for (const auto& x : d.suspected) {
     std::map<std::string, double> values;
@@ -513,11 +516,24 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
     suspects.emplace_back(x.candidate.effect, values);
   }
   const std::vector<CarriedSuspect> carried = search.carry_suspects_the_named_values_need(d.search, suspects);
+  if (carried.empty()) return;
   for (const auto& c : carried)
     for (auto& x : d.suspected)
-      if (x.candidate.effect == c.effect) x.carried = c;
-  if (!carried.empty())
-    for (auto& f : d.findings) f.parameters = effect_estimates(d.search, f.effect);
+      if (x.candidate.effect == c.effect) {
+        x.carried = c;
+        x.candidate.parameters = effect_estimates(d.search, c.effect);  // its values in the model now
+      }
+  for (auto it = d.findings.begin(); it != d.findings.end();) {
+    it->parameters = effect_estimates(d.search, it->effect);
+    const std::string why = acceptance_failure(*it, all, true);
+    if (why.empty()) {
+      ++it;
+      continue;
+    }
+    d.search.carried.push_back(it->effect);
+    d.suspected.push_back({*it, "beside the carried suspect, " + why});
+    it = d.findings.erase(it);
+  }
 }
 
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:
@@ -679,7 +695,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   for (const std::string& e : search.check_absorbed_look_alikes(d.search))  // carried now, not named
     d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
                      d.findings.end());
-  carry_suspects_the_findings_need(d, search);
+  carry_suspects_the_findings_need(d, search, all);
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {

@@ -54,7 +54,8 @@ json parameters_json(const std::vector<fit::FitParameter>& ps) {
   return j;
 }
 
-// Effects the extended model carries without naming them: the stronger of a look-alike pair,
+// Effects the extended model carries without naming them: the stronger of a look-alike pair
+// (or a named effect's absorbed look-alike, or a suspect a named look-alike's values need),
 // and stand-ins for missing physics (kept apart in the outputs).
 std::vector<std::string> stand_in_effects(const Diagnosis& d) {
   std::vector<std::string> out;

@@ -76,12 +76,20 @@ Eigen::MatrixXd allocation_matrix(const ControllerModel& b) {
   return A;
 }
 
-// The least-norm thrusts for the wrench w with the rotors not in `free` held at zero.
-Eigen::VectorXd trim_with(const Eigen::MatrixXd& A, const std::vector<bool>& free, const Eigen::Vector4d& w) {
-  Eigen::MatrixXd held = A;
+// The least-norm thrusts for the wrench w, the rotors not `free` held at their `least` thrust.
+Eigen::VectorXd trim_with(const Eigen::MatrixXd& A, const std::vector<bool>& free, const Eigen::VectorXd& least,
+                          const Eigen::Vector4d& w) {
+  Eigen::MatrixXd open = A;
+  Eigen::Vector4d rest = w;
   for (Eigen::Index i = 0; i < A.cols(); ++i)
-    if (!free[static_cast<size_t>(i)]) held.col(i).setZero();
-  return held.completeOrthogonalDecomposition().solve(w);
+    if (!free[static_cast<size_t>(i)]) {
+      rest -= A.col(i) * least(i);
+      open.col(i).setZero();
+    }
+  Eigen::VectorXd F = open.completeOrthogonalDecomposition().solve(rest);
+  for (Eigen::Index i = 0; i < A.cols(); ++i)
+    if (!free[static_cast<size_t>(i)]) F(i) = least(i);
+  return F;
 }
 
 }  // namespace
@@ -98,31 +106,43 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   const double weight = b.mass * b.g, even = weight / static_cast<double>(n);
   const Eigen::Vector4d w(weight, 0, 0, 0);
   const auto balances = [&](const Eigen::VectorXd& F) { return (A * F - w).norm() <= 1e-6 * weight; };
+  // The least a rotor gives: its thrust at command 0 (a motor map with a0 > 0 idles above 0 N).
+  Eigen::VectorXd least(A.cols());
+  for (size_t i = 0; i < n; ++i) {
+    const ThrustLaw& l = b.thrust_laws[i];
+    least(static_cast<Eigen::Index>(i)) = l.thrust_at_speed(std::max(l.speed_at(0.0), 0.0));
+  }
   std::vector<bool> free(n, true);
-  const Eigen::VectorXd least_norm = trim_with(A, free, w);
+  const Eigen::VectorXd least_norm = trim_with(A, free, least, w);
   Eigen::VectorXd F = least_norm;
-  Eigen::Index most_pulling = 0;
-  while (balances(F) && F.minCoeff(&most_pulling) < 0) {  // hold the most pulling rotor at zero
-    free[static_cast<size_t>(most_pulling)] = false;
-    F = trim_with(A, free, w);
+  Eigen::Index short_most = 0;
+  while (balances(F) && (F - least).minCoeff(&short_most) < -1e-12 * weight &&
+         free[static_cast<size_t>(short_most)]) {  // hold the rotor furthest below its least at its least
+    free[static_cast<size_t>(short_most)] = false;
+    F = trim_with(A, free, least, w);
   }
   HoverTrim t;
-  const bool pushes = balances(F) && F.minCoeff() >= 0;
-  if (!pushes) F = least_norm;
+  const bool reachable_below = balances(F) && (F - least).minCoeff() >= -1e-12 * weight;
+  if (!reachable_below) F = least_norm;
   t.thrusts.assign(F.data(), F.data() + F.size());
   if ((F.array() - even).abs().maxCoeff() <= 1e-9 * even) t.thrusts.assign(n, even);  // symmetric: exact
   if (!balances(least_norm)) {
     t.why_not = "no thrusts balance the weight without a moment";
-  } else if (!pushes) {
-    least_norm.minCoeff(&most_pulling);
-    t.why_not = "rotor " + rotor_names[static_cast<size_t>(most_pulling)] + " would have to pull down " +
-                std::to_string(-least_norm(most_pulling)) + " N" +
-                (n > 4 ? " (with more than four rotors: no trim with every rotor pushing was found, holding the "
-                         "pulling rotors at zero in turn)"
-                       : " (the centre of gravity lies outside the rotors)");
+  } else if (!reachable_below) {
+    (least_norm - least).minCoeff(&short_most);
+    const size_t i = static_cast<size_t>(short_most);
+    t.why_not = "rotor " + rotor_names[i] +
+                (least_norm(short_most) < 0
+                     ? " would have to pull down " + std::to_string(-least_norm(short_most)) + " N"
+                     : " would have to give " + std::to_string(least_norm(short_most)) +
+                           " N, less than its motor map gives at command 0 (" + std::to_string(least(short_most)) + " N)") +
+                (n > 4 ? " (with more than four rotors: no other trim was found, holding such rotors at command 0 "
+                         "in turn)"
+                 : least_norm(short_most) < 0 ? " (the centre of gravity lies outside the rotors)"
+                                              : " (the centre of gravity lies too far towards the other rotors)");
   }
   for (size_t i = 0; t.found() && i < n; ++i) try {
-      t.commands.push_back(b.thrust_laws[i].command_for(t.thrusts[i]));
+      t.commands.push_back(free[i] ? b.thrust_laws[i].command_for(t.thrusts[i]) : 0.0);  // held: command 0
     } catch (const std::invalid_argument& e) {
       t.why_not = "rotor " + rotor_names[i] + ": " + e.what() + "; check the masses, c_t and the motor map's a0, a1, a2";
       t.commands.clear();

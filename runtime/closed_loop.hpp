@@ -34,14 +34,16 @@ std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b);
 std::vector<double> allocate(const ControllerModel& b, double thrust, const std::array<double, 3>& torque);
 
 // A hover trim: each rotor's thrust [N] holding the weight without a moment, every one
-// pushing (F >= 0) and within its motor's reach. The least-norm trim first, exactly m g / n
-// per rotor where the layout is symmetric. With more than four rotors the least-norm trim
-// can need a rotor to pull where another trim exists: then the most pulling rotor is held at
-// zero and the rest trimmed again, until every rotor pushes or the rest cannot balance. One
-// home for derive's vehicle check and simulate's scenarios, which word the reason their way.
+// within its motor's reach: at least what command 0 gives (a motor map with a0 > 0 idles
+// above 0 N), at most what command 1 gives. The least-norm trim first, exactly m g / n per
+// rotor where the layout is symmetric. With more than four rotors the least-norm trim can
+// ask a rotor for less (even a pull) where another trim exists: then the rotor furthest
+// below its least is held at command 0 and the rest trimmed again, until every rotor is
+// within reach or the rest cannot balance. One home for derive's vehicle check and
+// simulate's scenarios.
 struct HoverTrim {
   std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)
-  std::vector<double> commands;  // each rotor's command for its thrust; empty if out of reach
+  std::vector<double> commands;  // each rotor's command for its thrust (0 where held); empty if none found
   std::string why_not;           // empty where a trim was found, else why not (names the rotor)
   bool found() const { return why_not.empty(); }
 };

@@ -62,6 +62,8 @@ inline double ThrustLaw::command_for(double thrust) const {
     u = (-a1 + std::sqrt(disc)) / (2 * a2);
     if (u < 0 || u > 1) u = (-a1 - std::sqrt(disc)) / (2 * a2);
   }
+  if (u < 0 && u > -1e-12) u = 0;  // rounding at the ends: the thrust at command 0 or 1 itself
+  if (u > 1 && u < 1 + 1e-12) u = 1;
   if (!(u >= 0 && u <= 1)) throw unreachable();
   return u;
 }

@@ -673,13 +673,31 @@ TEST(HoverTrim, FindsATrimWithEveryRotorPushingWhereTheLeastNormPulls) {
   EXPECT_NEAR(pitch, 0, 1e-9);
   EXPECT_NEAR(yaw, 0, 1e-9);
 
+  // Motors that idle above 0 N (a0 > 0, as every bundled motor map has): the far rotor is held
+  // at its thrust at command 0, not at 0 N, which no command gives.
+  ControllerModel idling = b;
+  for (auto& l : idling.thrust_laws) l.a0 = 200;  // 0.4 N at command 0
+  const HoverTrim idle = hover_trim(idling, names);
+  ASSERT_TRUE(idle.found()) << idle.why_not;
+  double idle_pitch = 0, idle_total = 0;
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_GE(idle.thrusts[i], 0.4 - 1e-12) << names[i];
+    EXPECT_NEAR(idling.thrust_laws[i].thrust_at_speed(idling.thrust_laws[i].speed_at(idle.commands[i])), idle.thrusts[i],
+                1e-9);
+    idle_pitch += idle.thrusts[i] * idling.rotor_x[i];
+    idle_total += idle.thrusts[i];
+  }
+  EXPECT_EQ(idle.commands[3], 0.0);
+  EXPECT_NEAR(idle_pitch, 0, 1e-9);
+  EXPECT_NEAR(idle_total, idling.mass * idling.g, 1e-9);
+
   // The centre of gravity beyond rotor 0: no trim pushes, and the reason names the rotor.
   ControllerModel outside = b;
   for (double& x : outside.rotor_x) x -= 0.1;
   const HoverTrim none = hover_trim(outside, names);
   EXPECT_FALSE(none.found());
   EXPECT_NE(none.why_not.find("would have to pull down"), std::string::npos) << none.why_not;
-  EXPECT_NE(none.why_not.find("no trim with every rotor pushing was found"), std::string::npos) << none.why_not;
+  EXPECT_NE(none.why_not.find("no other trim was found"), std::string::npos) << none.why_not;
 
   // Centred: m g / 6 each, exactly; and too heavy for the motors: which rotor, and why.
   ControllerModel centred = b;
