@@ -82,6 +82,7 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
   };
   diagnose::AirframeReference ref;
   ref.source = path;
+  ref.flights = j.contains("flights") && j["flights"].is_array() ? j["flights"].size() : 0;
   for (const auto& p : all.params)
     ref.values.push_back({p.name, p.unit, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, p.lower,
                           p.upper, false});

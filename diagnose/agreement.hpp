@@ -78,6 +78,7 @@ double range_cdf(const std::vector<double>& sd, double r);
 // it (quadgen diagnose LOG --airframe DIAGNOSIS.json).
 struct AirframeReference {
   std::string source;                       // the diagnosis.json it came from
+  size_t flights = 0;                       // how many flights that diagnosis fitted jointly
   std::vector<fit::FitParameter> values;    // its airframe_fit: the model's parameters
   std::vector<std::string> flight_parameters;  // its own on every flight (c_t, the trims): freed here
   struct Effect {

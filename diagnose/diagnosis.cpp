@@ -710,6 +710,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (!joint && opt.airframe) {
     const auto start = Clock::now();
     d.airframe_source = opt.airframe->source;
+    d.airframe_flights = opt.airframe->flights;
     d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
     opt.progress.say(progress() + "against the airframe of " + opt.airframe->source + ": " +
                      std::to_string(d.airframe_check.size()) + " parameters (" +

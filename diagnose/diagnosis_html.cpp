@@ -168,6 +168,8 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
       << " refitted on this flight's training part (the airframe's other values held, this flight's own thrust "
          "constant and trims free). The flight agrees with the airframe when the difference is within 1.96 of its "
          "standard error (both estimates' errors) and below 30 %. Line: the airframe's value.</p>\n";
+    if (!words::airframe_from_one_flight(d).empty())
+      h << "<p class=\"warn\">Note: " << esc(words::airframe_from_one_flight(d)) << ".</p>\n";
     agreement_table_html(h, d.airframe_check, d.flights, "airframe");
   }
   if (d.agreement.empty()) return;

@@ -379,7 +379,9 @@ json ambiguous_json(const SearchResult& s) {
 // the squared z of the difference.
 json airframe_check_json(const Diagnosis& d) {
   if (d.airframe_source.empty()) return json(nullptr);
-  return {{"airframe", d.airframe_source}, {"parameters", agreement_json(d.airframe_check, d.flights)}};
+  return {{"airframe", d.airframe_source},
+          {"airframe_flights", d.airframe_flights},
+          {"parameters", agreement_json(d.airframe_check, d.flights)}};
 }
 
 json unexplained_json(const Diagnosis& d) {

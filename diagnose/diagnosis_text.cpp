@@ -39,6 +39,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
       os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
     os << "\n";
   }
+  if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())
+    os << "note: " << words::airframe_from_one_flight(d) << "\n";
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : "disagrees") << " with the airframe on " << a.parameter << ": "
        << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)

@@ -114,6 +114,12 @@ std::string headline(const Finding& f) {
   return s;
 }
 
+std::string airframe_from_one_flight(const Diagnosis& d) {
+  if (d.airframe_source.empty() || d.airframe_flights != 1) return "";
+  return "the airframe comes from the diagnosis of one flight: its values are that flight's, and the agreement is "
+         "between two flights (several flights diagnosed together give the airframe's)";
+}
+
 std::string carried_suspect(const CarriedSuspect& c) {
   return "carried in the model, not named: " + c.beside + "'s values fitted without it (" + c.without +
          ") are rejected once it is held at its estimate (p = " + output::short_number(c.named_values_p) +

@@ -16,6 +16,8 @@ namespace quadgen::diagnose::words {
 double reduction(double before, double after);
 // A finding in one sentence ("Motor M4 gives 6.9 % less thrust than motor M1").
 std::string headline(const Finding& f);
+// Said where the airframe a flight is checked against came from one flight's diagnosis ("" else).
+std::string airframe_from_one_flight(const Diagnosis& d);
 // A suspect carried for a named look-alike's sake, in one sentence.
 std::string carried_suspect(const CarriedSuspect& c);
 

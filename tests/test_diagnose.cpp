@@ -961,6 +961,7 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
     ASSERT_TRUE(j->contains("airframe_check") && (*j)["airframe_check"].is_object()) << j->dump(1).substr(0, 2000);
     ASSERT_EQ((*j)["airframe_check"]["parameters"].size(), 1u) << (*j)["airframe_check"].dump(1);
   }
+  EXPECT_EQ(same["airframe_check"]["airframe_flights"], 2);  // a joint airframe: no note
   const json& s = same["airframe_check"]["parameters"][0];
   const json& o = other["airframe_check"]["parameters"][0];
   EXPECT_EQ(s["parameter"], "rotor_drag.k");
@@ -1416,6 +1417,17 @@ TEST(RealData, ArplMotorLagIntervalContainsTheAuthorsValue) {
   ASSERT_NE(tau, nullptr) << "the motor lag is not named: " << named(j).size() << " findings";
   EXPECT_LE((*tau)["ci95"][0].get<double>(), 0.072);
   EXPECT_GE((*tau)["ci95"][1].get<double>(), 0.072);
+}
+
+// An airframe from one flight's diagnosis is said to be that flight's values.
+TEST(ReportWords, AnAirframeOfOneFlightIsSaidToBeThatFlights) {
+  quadgen::diagnose::Diagnosis d;
+  EXPECT_EQ(quadgen::diagnose::words::airframe_from_one_flight(d), "");  // no --airframe
+  d.airframe_source = "a/diagnosis.json";
+  d.airframe_flights = 5;
+  EXPECT_EQ(quadgen::diagnose::words::airframe_from_one_flight(d), "");
+  d.airframe_flights = 1;
+  EXPECT_NE(quadgen::diagnose::words::airframe_from_one_flight(d).find("one flight"), std::string::npos);
 }
 
 // The motor-gain sentence names the gains told apart from the reference and says what it
