@@ -171,7 +171,7 @@ struct Diagnosis {
   std::vector<ParameterAgreement> agreement;
   // One flight diagnosed with an airframe: its named effects on this flight against it.
   std::string airframe_source;
-  size_t airframe_flights = 0;  // the flights the airframe's diagnosis fitted (1: one flight's values)
+  size_t airframe_flights = 0;  // the flights the airframe's diagnosis fitted (1: one flight's values; 0: not said)
   std::vector<ParameterAgreement> airframe_check;
   std::vector<Unexplained> unexplained;
   // Whether the slow roll/pitch residual the final model leaves follows the horizontal force

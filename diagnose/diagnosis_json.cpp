@@ -380,7 +380,7 @@ json ambiguous_json(const SearchResult& s) {
 json airframe_check_json(const Diagnosis& d) {
   if (d.airframe_source.empty()) return json(nullptr);
   return {{"airframe", d.airframe_source},
-          {"airframe_flights", d.airframe_flights},
+          {"airframe_flights", d.airframe_flights > 0 ? json(d.airframe_flights) : json(nullptr)},
           {"parameters", agreement_json(d.airframe_check, d.flights)}};
 }
 

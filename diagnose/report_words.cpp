@@ -116,8 +116,8 @@ std::string headline(const Finding& f) {
 
 std::string airframe_from_one_flight(const Diagnosis& d) {
   if (d.airframe_source.empty() || d.airframe_flights != 1) return "";
-  return "the airframe comes from the diagnosis of one flight: its values are that flight's, and the agreement is "
-         "between two flights (several flights diagnosed together give the airframe's)";
+  return "the airframe comes from the diagnosis of one flight: its values are that flight's (several flights "
+         "diagnosed together give the airframe's)";
 }
 
 std::string carried_suspect(const CarriedSuspect& c) {

@@ -1,11 +1,13 @@
 #include "output/output_set.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -289,65 +291,83 @@ void remove_tree_quietly(const fs::path& p) {
 
 }  // namespace
 
-// A private directory beside the target (same file system, so renames are atomic), named
-// .<target>.quadgen-tmp.<pid>.XXXXXX. Removed with everything in it unless released.
 // Empty folders to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP): the
 // staging directories and the folders created to hold them, which stay empty through the
 // long work (files are staged only at its end). A signal handler may call rmdir but not
 // walk a tree, so a folder that already holds files (the last moments of a run) is left to
-// the next run into the same place, as after SIGKILL. Slots are filled in the order the
-// folders are made (outermost first, the staging directory last) and emptied from the top.
+// the next run into the same place, as after SIGKILL. A folder is created and remembered
+// with those signals blocked (Blocked), so none arrives between the two; `used` is an
+// atomic published after the path is written, for a handler on any thread.
 namespace interrupt {
 constexpr int kSlots = 32;
 constexpr size_t kPathBytes = 4096;
 char paths[kSlots][kPathBytes];
-volatile sig_atomic_t used[kSlots];
+std::atomic<int> used[kSlots];
+static_assert(std::atomic<int>::is_always_lock_free, "read in a signal handler");
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 int remember(const fs::path& p) {
   const std::string s = p.string();
   if (s.size() >= kPathBytes) return -1;
   for (int i = 0; i < kSlots; ++i)
-    if (!used[i]) {
+    if (!used[i].load(std::memory_order_acquire)) {
       std::memcpy(paths[i], s.c_str(), s.size() + 1);
-      used[i] = 1;
+      used[i].store(1, std::memory_order_release);
       return i;
     }
   return -1;  // more than kSlots at once: left to the next run
 }
 
 void forget(int slot) {
-  if (slot >= 0) used[slot] = 0;
+  if (slot >= 0) used[slot].store(0, std::memory_order_release);
 }
 
 void on_signal(int sig) {
-  // A freed slot may be refilled out of order: passes until nothing more goes (a folder
-  // empties once the one inside it is gone).
+  // Passes until nothing more goes: a folder empties once the one inside it is gone.
   for (bool removed = true; removed;) {
     removed = false;
     for (int i = kSlots - 1; i >= 0; --i)
-      if (used[i] && ::rmdir(paths[i]) == 0) {  // only if empty
-        used[i] = 0;
+      if (used[i].load(std::memory_order_acquire) && ::rmdir(paths[i]) == 0) {  // only if empty
+        used[i].store(0, std::memory_order_relaxed);
         removed = true;
       }
   }
   ::signal(sig, SIG_DFL);
   ::raise(sig);
 }
+
+// The interrupt signals blocked on this thread while it lives.
+class Blocked {
+ public:
+  Blocked() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : kSignals) sigaddset(&set, sig);
+    ::pthread_sigmask(SIG_BLOCK, &set, &old_);
+  }
+  ~Blocked() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+
+ private:
+  sigset_t old_;
+};
 }  // namespace interrupt
 
+// A private directory beside the target (same file system, so renames are atomic), named
+// .<target>.quadgen-tmp.<pid>.XXXXXX. Removed with everything in it unless released.
 class StagingDirectory {
  public:
   StagingDirectory(const fs::path& parent, const std::string& target_name) {
     const std::string stem = "." + target_name.substr(0, 100) + kStagingInfix;
     remove_stale(parent, stem);
     std::string templ = (parent / (stem + std::to_string(::getpid()) + ".XXXXXX")).string();
+    const interrupt::Blocked blocked;  // made and remembered as one step
     if (!::mkdtemp(templ.data())) fail(parent, "cannot create a staging directory: " + errno_text());
     path_ = templ;
     slot_ = interrupt::remember(path_);
   }
   ~StagingDirectory() {
-    interrupt::forget(slot_);
     if (!released_) remove_tree_quietly(path_);
+    interrupt::forget(slot_);  // after: an interrupt in between finds it gone, or removes it
   }
   const fs::path& path() const { return path_; }
   void release() {
@@ -448,6 +468,7 @@ void CreatedFolders::create(const fs::path& folder) {
     missing.insert(missing.begin(), p);
     if (p == p.parent_path()) break;
   }
+  const interrupt::Blocked blocked;  // made and remembered as one step
   fs::create_directories(folder, ec);
   if (ec) fail(folder, "cannot create the directory: " + ec.message());
   created_ = missing;
@@ -461,16 +482,22 @@ void CreatedFolders::keep() {
 }
 
 CreatedFolders::~CreatedFolders() {
-  for (int slot : slots_) interrupt::forget(slot);
   std::error_code ec;
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);  // only if empty
+  for (int slot : slots_) interrupt::forget(slot);
 }
 
 void remove_empty_outputs_on_interrupt() {
   struct sigaction sa {};
   sa.sa_handler = interrupt::on_signal;
   sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+  for (int sig : interrupt::kSignals) {
+    // A signal the caller ignores stays ignored: under nohup, SIGHUP must not end the run, nor
+    // SIGINT a job a non-interactive shell started in the background.
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
 }
 
 OutputDirectory::OutputDirectory(const std::string& dir, const std::string& command, const std::vector<std::string>& inputs)

@@ -1428,6 +1428,15 @@ TEST(ReportWords, AnAirframeOfOneFlightIsSaidToBeThatFlights) {
   EXPECT_EQ(quadgen::diagnose::words::airframe_from_one_flight(d), "");
   d.airframe_flights = 1;
   EXPECT_NE(quadgen::diagnose::words::airframe_from_one_flight(d).find("one flight"), std::string::npos);
+  // and the summary says it beside the check
+  quadgen::diagnose::ParameterAgreement a;
+  a.parameter = "rotor_drag.k";
+  a.flights.resize(1);
+  d.airframe_check = {a};
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("note: the airframe comes from the diagnosis of one flight"),
+            std::string::npos)
+      << quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_EQ(quadgen::diagnose::diagnosis_json(d, "f.csv")["airframe_check"]["airframe_flights"], 1);
 }
 
 // The motor-gain sentence names the gains told apart from the reference and says what it

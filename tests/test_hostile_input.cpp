@@ -113,6 +113,8 @@ CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd,
   const pid_t pid = ::fork();
   if (pid == 0) {
     if (::chdir(cwd.c_str()) != 0) _exit(99);
+    // quadgen keeps a signal its caller ignores ignored; the tests' signals must act.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
     FILE* e = std::freopen(err.c_str(), "w", stderr);
     FILE* o = std::freopen("/dev/null", "w", stdout);
     (void)e;
@@ -131,9 +133,15 @@ CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd,
     ::kill(pid, interrupt.signal);
   } else if (!interrupt.exists.empty()) {
     std::error_code ec;
-    for (int k = 0; k < 6000 && !fs::exists(interrupt.exists, ec) && ::waitpid(pid, nullptr, WNOHANG) == 0; ++k)
+    siginfo_t info{};
+    for (int k = 0; k < 6000 && !fs::exists(interrupt.exists, ec); ++k) {
+      info.si_pid = 0;  // still running? (WNOWAIT: its status stays for the waitpid below)
+      if (::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == pid) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    ::kill(pid, interrupt.signal);
+    }
+    const bool seen = fs::exists(interrupt.exists, ec);
+    if (seen) ::kill(pid, interrupt.signal);
+    EXPECT_TRUE(seen) << interrupt.exists << " never appeared: nothing was interrupted";
   }
   int status = 0;
   ::waitpid(pid, &status, 0);
