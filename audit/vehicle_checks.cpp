@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "derive/runtime_view.hpp"
+#include "runtime/allocation_matrix.hpp"
 
 namespace quadgen {
 
@@ -17,16 +18,6 @@ AuditCheck advisory(const std::string& name, bool ok, const std::string& detail)
   AuditCheck c{"vehicle", name, ok, detail};
   c.advisory = true;
   return c;
-}
-
-// The allocation of the layout the vehicle file gives (runtime::allocation_columns), rows
-// total thrust, roll, pitch, yaw.
-Eigen::MatrixXd allocation(const runtime::ControllerModel& b) {
-  const auto columns = runtime::allocation_columns(b);
-  Eigen::MatrixXd B(4, static_cast<Eigen::Index>(columns.size()));
-  for (size_t i = 0; i < columns.size(); ++i)
-    for (size_t r = 0; r < 4; ++r) B(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(i)) = columns[i][r];
-  return B;
 }
 
 std::string numbers(const Eigen::VectorXd& x, const char* unit) {
@@ -156,7 +147,7 @@ AuditCheck check_one_scale(const Vehicle& v) {
 
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
-  const Eigen::MatrixXd B = allocation(b);
+  const Eigen::MatrixXd B = runtime::allocation_matrix(b);
   return {check_motor_map(b.thrust_laws), check_controllable(B), check_hover_trim(v, b), check_discs_apart(v),
           check_one_scale(v)};
 }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "runtime/allocation_matrix.hpp"
 #include "runtime/attitude.hpp"
 #include "runtime/integrator.hpp"
 #include "runtime/rigid_body_state.hpp"
@@ -67,14 +68,6 @@ std::vector<std::array<double, 4>> allocation_columns(const ControllerModel& b) 
 }
 
 namespace {
-
-Eigen::MatrixXd allocation_matrix(const ControllerModel& b) {
-  const auto columns = allocation_columns(b);
-  Eigen::MatrixXd A(4, static_cast<Eigen::Index>(columns.size()));
-  for (size_t i = 0; i < columns.size(); ++i)
-    for (size_t r = 0; r < 4; ++r) A(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(i)) = columns[i][r];
-  return A;
-}
 
 // The least-norm thrusts for the wrench w, the rotors not `free` held at their `least` thrust.
 Eigen::VectorXd trim_with(const Eigen::MatrixXd& A, const std::vector<bool>& free, const Eigen::VectorXd& least,
