@@ -40,7 +40,7 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   progress("audit");
   out.audit = audit(out.model, mass);
   for (AuditCheck& c : check_vehicle_can_fly(vehicle, out.model)) out.audit.checks.push_back(std::move(c));
-  if (request.thesis_comparison) out.thesis = compare_with_thesis(out.model, mass);
+  if (request.thesis_comparison) out.thesis = compare_with_thesis(vehicle, out.model, mass);
   progress("generating C++");
   codegen::EmitOptions emit = request.emit;
   if (request.regenerate_flags_from_model)

@@ -15,6 +15,7 @@
 #include "derive/kinematics.hpp"
 #include "runtime/scenarios.hpp"
 #include "codegen/tape_builder.hpp"
+#include "derive/runtime_view.hpp"
 
 namespace quadgen {
 using namespace GiNaC;
@@ -302,18 +303,8 @@ struct Flight {
   double x, y, z, roll_deg, pitch_deg, yaw_deg, vz, turn_x, turn_y;
 };
 using ThrustProfile = std::function<std::vector<double>(double t)>;
-Flight fly(runtime::TapeModel& m, const SymbolicModel& model, const ThrustProfile& thrust, double seconds) {
-  auto P = [&](const char* n) { return m.params()[m.param_index(n)]; };
-  std::vector<runtime::ThrustLaw> laws;
-  for (int i = 0; i < 4; ++i) {
-    const std::string r(1, "ABCD"[i]);
-    double Ap = 0, rp = 0;
-    for (const auto& c : model.constants) {
-      if (c.name == r + ".A_p") Ap = c.nominal;
-      if (c.name == r + ".r_p") rp = c.nominal;
-    }
-    laws.push_back({runtime::rotor_thrust_coefficient(P("c_t"), P("rho"), Ap, rp), P("motor_a0"), P("motor_a1"), P("motor_a2")});
-  }
+Flight fly(runtime::TapeModel& m, const std::vector<runtime::ThrustLaw>& laws, const ThrustProfile& thrust,
+           double seconds) {
   auto inputs = [&](double t, double* uu) {
     const auto F = thrust(t);
     for (int i = 0; i < 4; ++i) uu[i] = laws[i].command_for(F[i]);
@@ -349,12 +340,13 @@ struct Flights {
   Flight scenario_right, scenario_forward, scenario_yaw, scenario_height;  // quadgen's scenarios, 3 s
 };
 
-Flights fly_all(const SymbolicModel& model) {
+Flights fly_all(const Vehicle& v, const SymbolicModel& model) {
   runtime::TapeModel tape(codegen::build_tape(model));
+  const std::vector<runtime::ThrustLaw> laws = nominal_thrust_laws(v, model);
   Flights f;
-  f.right = fly(tape, model, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
-  f.forward = fly(tape, model, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
-  f.climb = fly(tape, model, [](double) { return std::vector<double>{1.1, 1.1, 1.1, 1.1}; }, 1.0);
+  f.right = fly(tape, laws, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
+  f.forward = fly(tape, laws, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
+  f.climb = fly(tape, laws, [](double) { return std::vector<double>{1.1, 1.1, 1.1, 1.1}; }, 1.0);
   const std::vector<std::string> rotors{"A", "B", "C", "D"};
   double hover = 0;
   for (const auto& p : model.params)
@@ -363,7 +355,7 @@ Flights fly_all(const SymbolicModel& model) {
     if (p.name == "g") hover *= p.nominal / 9.81;
   auto scenario = [&](const char* name) {
     const runtime::Scenario& s = runtime::find_scenario(name);
-    return fly(tape, model, [&](double t) { return s.thrust(t, hover, rotors); }, 3.0);
+    return fly(tape, laws, [&](double t) { return s.thrust(t, hover, rotors); }, 3.0);
   };
   f.scenario_right = scenario("right");
   f.scenario_forward = scenario("forward");
@@ -521,12 +513,12 @@ bool is_thesis_vehicle(const SymbolicModel& m) {
   return is_thesis_vehicle(m.vehicle_name, rotors);
 }
 
-std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp) {
-  if (!is_thesis_vehicle(m)) return {};
+std::vector<ThesisItem> compare_with_thesis(const Vehicle& v, const SymbolicModel& m, const MassProperties& mp) {
+  if (!is_thesis_vehicle(v)) return {};
   std::vector<ThesisItem> out;
   const Numbers n = nominal(m, mp);
   std::optional<Flights> flights;
-  if (m.effects.empty()) flights = fly_all(m);
+  if (m.effects.empty()) flights = fly_all(v, m);
   transformation_items(out);
   translation_items(out, n);
   rotation_items(out, m, n);

@@ -7,6 +7,7 @@
 
 #include "derive/geometry.hpp"
 #include "derive/symbolic_model.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 
@@ -30,7 +31,7 @@ inline constexpr const char* kFromReading = "reading of the equations";
 bool is_thesis_vehicle(const SymbolicModel& m);
 
 // The comparison, item by item; empty for any other vehicle.
-std::vector<ThesisItem> compare_with_thesis(const SymbolicModel& m, const MassProperties& mp);
+std::vector<ThesisItem> compare_with_thesis(const Vehicle& v, const SymbolicModel& m, const MassProperties& mp);
 
 // The thesis' transformation matrix (3)/(81), as printed.
 GiNaC::matrix thesis_transformation(const GiNaC::ex& phi, const GiNaC::ex& theta, const GiNaC::ex& psi);

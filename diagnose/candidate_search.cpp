@@ -628,6 +628,46 @@ static bool declared_look_alikes(const std::string& x, const std::string& y) {
   return false;
 }
 
+// The three fits both look-alike checks below rest on, for a look-alike E of the named F
+// with E's values in `start` (the rest at the final model's): E held there and the rest
+// refitted (held); E and F's values both held (kept); E free beside the final model
+// (joint, from the better of two starts). All under the final model's weights.
+struct CandidateSearch::LookAlikeTest {
+  std::vector<FitParameter> held, joint;
+  ChannelNoise joint_noise;
+  int dof_named = 0;  // F's free parameters
+  double p_off = 1;   // E off, against E free beside the final model
+  double p_own = 1;   // E held at its estimate, against E free
+  double p_named = 1; // F's named values kept, against F refitted, E held at its estimate
+};
+
+CandidateSearch::LookAlikeTest CandidateSearch::test_look_alike(const SearchResult& r, const std::string& e,
+                                                                const std::string& f,
+                                                                const std::vector<FitParameter>& start,
+                                                                const Workspace& ws) const {
+  const std::set<std::string> base(r.selected.begin(), r.selected.end());
+  std::set<std::string> with = base;
+  with.insert(e);
+  LookAlikeTest t;
+  double c_held = 0, c_kept = 0, c_joint = 0, c_joint2 = 0;
+  t.held = fit_with(base, start, &c_held, ws, r.final_weights, {e});
+  const std::vector<FitParameter> kept = fit_with(base, start, &c_kept, ws, r.final_weights, {e, f});
+  t.joint = fit_with(with, t.held, &c_joint, ws, r.final_weights);
+  const std::vector<FitParameter> joint2 = fit_with(with, r.final_fit, &c_joint2, ws, r.final_weights);
+  if (c_joint2 < c_joint) t.joint = joint2;
+  t.joint_noise = channel_noise(train_, t.joint);
+  const ChannelNoise nh = channel_noise(train_, t.held);
+  int dof_e = 0;
+  for (int i : effect_params_.at(e)) dof_e += t.joint[i].free ? 1 : 0;
+  for (int i : effect_params_.at(f)) t.dof_named += t.held[i].free ? 1 : 0;
+  t.p_off = p_value_of(e, lr_statistic(channel_noise(train_, r.final_fit).ss, t.joint_noise), dof_e);
+  t.p_own = chi2_upper(lr_statistic(nh.ss, t.joint_noise), std::max(1, dof_e));
+  // Held at its fitted values, an interior point: the plain chi-squared (p_value_of halves p
+  // for an effect whose neutral value sits on a bound, right only for a test against it).
+  t.p_named = chi2_upper(lr_statistic(channel_noise(train_, kept).ss, nh), std::max(1, t.dof_named));
+  return t;
+}
+
 // A richer effect can reproduce a poorer look-alike and add something of its own: with six
 // rotors, five motor gains make a CoG offset's moment (the offset's moment is total thrust x
 // offset at every thrust level, and gains proportional to each rotor's arm give the same,
@@ -651,7 +691,6 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
   const std::vector<double>& weights = r.final_weights;
   const Workspace ws = own_workspace();
   const double level = opt_.alpha / static_cast<double>(candidates_.size());
-  const std::vector<double> current_ss = channel_noise(train_, current).ss;
   for (const std::string& f : r.named()) {
     for (const std::string& e : candidates_) {
       if (base.count(e) || !declared_look_alikes(f, e)) continue;
@@ -666,43 +705,28 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       if (!own) continue;
       std::vector<FitParameter> start = current;
       for (int i : effect_params_.at(e)) start[i].value = own->parameters[i].value;
-      std::set<std::string> with = base;
-      with.insert(e);
-      double c_held = 0, c_named = 0, c_joint = 0, c_joint2 = 0;
-      const std::vector<FitParameter> held = fit_with(base, start, &c_held, ws, weights, {e});
-      const std::vector<FitParameter> named_kept = fit_with(base, start, &c_named, ws, weights, {e, f});
-      std::vector<FitParameter> joint = fit_with(with, held, &c_joint, ws, weights);
-      const std::vector<FitParameter> joint2 = fit_with(with, current, &c_joint2, ws, weights);
-      if (c_joint2 < c_joint) joint = joint2;
-      const ChannelNoise nj = channel_noise(train_, joint), nh = channel_noise(train_, held);
-      int dof_e = 0, dof_f = 0;
-      for (int i : effect_params_.at(e)) dof_e += joint[i].free ? 1 : 0;
-      for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
-      const double p_off = p_value_of(e, lr_statistic(current_ss, nj), dof_e);
-      const double p_own = chi2_upper(lr_statistic(nh.ss, nj), std::max(1, dof_e));
-      // Held at its fitted values, an interior point: the plain chi-squared (p_value_of halves p
-      // for an effect whose neutral value sits on a bound, right only for a test against it).
-      const double p_named = chi2_upper(lr_statistic(channel_noise(train_, named_kept).ss, nh), std::max(1, dof_f));
-      opt_.progress.say("[diagnose] " + e + " beside " + f + ": off p = " + output::short_number(p_off) +
-                        ", at its own estimate p = " + output::short_number(p_own) + ", " + f +
-                        "'s values kept then p = " + output::short_number(p_named));
-      if (p_off < level || p_own < level || p_named >= level) continue;
-      std::set<std::string> without_f = with;
+      const LookAlikeTest t = test_look_alike(r, e, f, start, ws);
+      opt_.progress.say("[diagnose] " + e + " beside " + f + ": off p = " + output::short_number(t.p_off) +
+                        ", at its own estimate p = " + output::short_number(t.p_own) + ", " + f +
+                        "'s values kept then p = " + output::short_number(t.p_named));
+      if (t.p_off < level || t.p_own < level || t.p_named >= level) continue;
+      std::set<std::string> without_f = base;
       without_f.erase(f);
+      without_f.insert(e);
       double c_wf = 0;
-      const std::vector<FitParameter> wf = fit_with(without_f, joint, &c_wf, ws, weights);
+      const std::vector<FitParameter> wf = fit_with(without_f, t.joint, &c_wf, ws, weights);
       Ambiguity am;
       am.a = f;
       am.b = e;
       am.statistic_a = f_statistic;
       am.statistic_b = own->statistic;
-      am.b_given_a_p = p_off;
-      am.a_given_b_p = p_value_of(f, lr_statistic(channel_noise(train_, wf).ss, nj), dof_f);
+      am.b_given_a_p = t.p_off;
+      am.a_given_b_p = p_value_of(f, lr_statistic(channel_noise(train_, wf).ss, t.joint_noise), t.dof_named);
       am.manoeuvre = separating_manoeuvre(f, e);
       am.absorbed = true;
-      am.b_at_own_estimate_p = p_own;
+      am.b_at_own_estimate_p = t.p_own;
       am.b_own_estimate = values_in_words(e, own->parameters);
-      am.a_with_b_held = values_in_words(f, held);
+      am.a_with_b_held = values_in_words(f, t.held);
       opt_.progress.say("[diagnose] with " + am.b_own_estimate + ": " + am.a_with_b_held);
       r.unresolved.push_back(am);
       r.carried.push_back(f);
@@ -716,8 +740,8 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
 // Asked once per suspect and named look-alike, with the suspect held at its estimate (from
 // acceptance, where it was fitted beside the named effects), as check_absorbed_look_alikes
 // asks: the suspect carried when the training data want it beside the final model (off
-// rejected, p_off), accept its estimate there (held, not rejected against it free, p_own),
-// and reject the named values beside it (p_named): they hold only without it. It stays
+// rejected, t.p_off), accept its estimate there (held, not rejected against it free, t.p_own),
+// and reject the named values beside it (t.p_named): they hold only without it. It stays
 // unnamed: its held-out test failed.
 std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_need(
     SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const {
@@ -728,43 +752,29 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
     if (std::find(r.selected.begin(), r.selected.end(), e) != r.selected.end()) continue;
     for (const std::string& f : r.named()) {
       if (!declared_look_alikes(f, e)) continue;
-      const std::set<std::string> base(r.selected.begin(), r.selected.end());
       std::vector<FitParameter> start = r.final_fit;
       for (int i : effect_params_.at(e))
         if (estimate.count(start[i].name)) start[i].value = estimate.at(start[i].name);
-      double c_held = 0, c_kept = 0;
-      const std::vector<FitParameter> held = fit_with(base, start, &c_held, ws, r.final_weights, {e});
-      const std::vector<FitParameter> kept = fit_with(base, start, &c_kept, ws, r.final_weights, {e, f});
-      std::set<std::string> with = base;
-      with.insert(e);
-      double c_joint = 0, c_joint2 = 0;
-      std::vector<FitParameter> joint = fit_with(with, held, &c_joint, ws, r.final_weights);
-      const std::vector<FitParameter> joint2 = fit_with(with, r.final_fit, &c_joint2, ws, r.final_weights);
-      if (c_joint2 < c_joint) joint = joint2;
-      const ChannelNoise nj = channel_noise(train_, joint), nh = channel_noise(train_, held);
-      int dof_e = 0, dof_f = 0;
-      for (int i : effect_params_.at(e)) dof_e += joint[i].free ? 1 : 0;
-      for (int i : effect_params_.at(f)) dof_f += held[i].free ? 1 : 0;
-      const double p_off = p_value_of(e, lr_statistic(channel_noise(train_, r.final_fit).ss, nj), dof_e);
-      const double p_own = chi2_upper(lr_statistic(nh.ss, nj), std::max(1, dof_e));
-      const double p_named = chi2_upper(lr_statistic(channel_noise(train_, kept).ss, nh), std::max(1, dof_f));
-      opt_.progress.say("[diagnose] suspected " + e + " beside " + f + ": off p = " + output::short_number(p_off) +
-                        ", at its estimate p = " + output::short_number(p_own) + ", " + f +
-                        "'s values kept then p = " + output::short_number(p_named));
-      if (p_off >= level || p_own < level || p_named >= level) continue;
+      const LookAlikeTest t = test_look_alike(r, e, f, start, ws);
+      opt_.progress.say("[diagnose] suspected " + e + " beside " + f + ": off p = " + output::short_number(t.p_off) +
+                        ", at its estimate p = " + output::short_number(t.p_own) + ", " + f +
+                        "'s values kept then p = " + output::short_number(t.p_named));
+      if (t.p_off >= level || t.p_own < level || t.p_named >= level) continue;
       // Beside it the pair must stay physical: on a quad the trims and a CoG offset fitted
       // together can trade wildly (the NanoBench B3 figure-8 made trims of -42 % beside a
       // carried offset), and values no airframe has are no better than the named ones.
+      std::set<std::string> with(r.selected.begin(), r.selected.end());
+      with.insert(e);
       std::vector<double> weights;
       Settling settling;
-      const std::vector<FitParameter> beside = fit_as_own_model(with, joint, r.final_weights, &weights, &settling);
+      const std::vector<FitParameter> beside = fit_as_own_model(with, t.joint, r.final_weights, &weights, &settling);
       const std::string implausible_f = implausible_estimate(f, beside), implausible_e = implausible_estimate(e, beside);
       if (!implausible_f.empty() || !implausible_e.empty()) {
         opt_.progress.say("[diagnose] " + e + " not carried: beside it " + implausible_f +
                           (implausible_f.empty() || implausible_e.empty() ? "" : "; ") + implausible_e);
         continue;
       }
-      CarriedSuspect c{e, f, p_named, values_in_words(f, r.final_fit), values_in_words(f, beside)};
+      CarriedSuspect c{e, f, t.p_named, values_in_words(f, r.final_fit), values_in_words(f, beside)};
       r.selected.push_back(e);
       r.carried.push_back(e);
       r.final_fit = beside;

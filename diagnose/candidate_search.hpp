@@ -336,6 +336,11 @@ class CandidateSearch {
                                               const std::vector<fit::FitParameter>& base_fit,
                                               const std::vector<double>& base_ss, double base_valid, int round) const;
   std::vector<Ambiguity> check_look_alikes(const SelectionStep& step, const std::set<std::string>& base) const;
+  // The fits and p-values both look-alike checks of the accepted model rest on
+  // (check_absorbed_look_alikes, carry_suspects_the_named_values_need; candidate_search.cpp).
+  struct LookAlikeTest;
+  LookAlikeTest test_look_alike(const SearchResult& r, const std::string& e, const std::string& f,
+                                const std::vector<fit::FitParameter>& start, const Workspace& ws) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
   // CandidateEvidence::implausible of this effect's estimates in `ps`.

@@ -271,7 +271,7 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   f.metric = "validation equation-error cost (weighted)";
   f.before = cost_without;
   f.after = cost_with;
-  return {f, why};
+  return {f, why, std::nullopt};
 }
 
 // The first parameter of a finding outside its plausible range in this environment; false
@@ -495,7 +495,7 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
       break;
     }
     const auto& [f, why] = failed[clearest_failure(failed)];
-    d.suspected.push_back({f, why});
+    d.suspected.push_back({f, why, std::nullopt});
     search.remove_effects(d.search, {f.effect});
     held_out.clear();
     profiled = !wald_first;
@@ -531,7 +531,7 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
       continue;
     }
     d.search.carried.push_back(it->effect);
-    d.suspected.push_back({*it, "beside the carried suspect, " + why});
+    d.suspected.push_back({*it, "beside the carried suspect, " + why, std::nullopt});
     it = d.findings.erase(it);
   }
 }

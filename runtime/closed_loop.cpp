@@ -93,6 +93,27 @@ std::vector<double> allocate(const ControllerModel& b, double thrust, const std:
   return std::vector<double>(F.data(), F.data() + F.size());
 }
 
+namespace {
+// Why the least-norm trim (balancing, but asking some rotor for less than its command 0 gives)
+// had no alternative: names the rotor furthest below its least and where the CoG must lie.
+std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eigen::VectorXd& least,
+                                    const std::vector<std::string>& rotor_names) {
+  Eigen::Index k = 0;
+  (least_norm - least).minCoeff(&k);
+  const double asked = least_norm(k);
+  const std::string what =
+      asked < 0 ? " would have to pull down " + std::to_string(-asked) + " N"
+                : " would have to give " + std::to_string(asked) + " N, less than its motor map gives at command 0 (" +
+                      std::to_string(least(k)) + " N)";
+  const std::string where =
+      least_norm.size() > 4 ? " (with more than four rotors: no other trim was found, holding such rotors at command 0 "
+                              "in turn)"
+      : asked < 0           ? " (the centre of gravity lies outside the rotors)"
+                            : " (the centre of gravity lies too far towards the other rotors)";
+  return "rotor " + rotor_names[static_cast<size_t>(k)] + what + where;
+}
+}  // namespace
+
 HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names) {
   const Eigen::MatrixXd A = allocation_matrix(b);
   const size_t n = static_cast<size_t>(A.cols());
@@ -122,17 +143,7 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   if (!balances(least_norm)) {
     t.why_not = "no thrusts balance the weight without a moment";
   } else if (!reachable_below) {
-    (least_norm - least).minCoeff(&short_most);
-    const size_t i = static_cast<size_t>(short_most);
-    t.why_not = "rotor " + rotor_names[i] +
-                (least_norm(short_most) < 0
-                     ? " would have to pull down " + std::to_string(-least_norm(short_most)) + " N"
-                     : " would have to give " + std::to_string(least_norm(short_most)) +
-                           " N, less than its motor map gives at command 0 (" + std::to_string(least(short_most)) + " N)") +
-                (n > 4 ? " (with more than four rotors: no other trim was found, holding such rotors at command 0 "
-                         "in turn)"
-                 : least_norm(short_most) < 0 ? " (the centre of gravity lies outside the rotors)"
-                                              : " (the centre of gravity lies too far towards the other rotors)");
+    t.why_not = why_no_trim_above_least(least_norm, least, rotor_names);
   }
   for (size_t i = 0; t.found() && i < n; ++i) try {
       t.commands.push_back(free[i] ? b.thrust_laws[i].command_for(t.thrusts[i]) : 0.0);  // held: command 0

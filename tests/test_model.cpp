@@ -659,7 +659,7 @@ TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
 TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   const Vehicle v = test::finken3();
   const MassProperties mp = derive_mass_properties(v);
-  const auto items = compare_with_thesis(derive_model(v, mp, {}), mp);
+  const auto items = compare_with_thesis(v, derive_model(v, mp, {}), mp);
   std::map<std::string, bool> verdict;
   for (const auto& t : items) {
     verdict[t.ref] = t.agrees;
@@ -700,7 +700,7 @@ TEST(Thesis, AGyroscopicVerdictFollowsTheModel) {
   m.f(kBodyRate + 1, 0) = (P("J_xx") - P("J_zz")) * p * r / P("J_yy");
   m.f(kBodyRate + 2, 0) = (P("J_yy") - P("J_xx")) * p * q / P("J_zz");
   bool found = false;
-  for (const auto& t : compare_with_thesis(m, mp))
+  for (const auto& t : compare_with_thesis(v, m, mp))
     if (t.ref == "(35)-(38), (54)") {
       found = true;
       EXPECT_TRUE(t.agrees);
@@ -718,7 +718,7 @@ TEST(Thesis, OnlyTheThesisVehicleIsComparedNotItsName) {
     const MassProperties mp = derive_mass_properties(v);
     const SymbolicModel m = derive_model(v, mp, {});
     EXPECT_FALSE(is_thesis_vehicle(m)) << file;
-    EXPECT_TRUE(compare_with_thesis(m, mp).empty()) << file;
+    EXPECT_TRUE(compare_with_thesis(v, m, mp).empty()) << file;
   }
   const Vehicle thesis = test::finken3();
   EXPECT_TRUE(is_thesis_vehicle(thesis));
