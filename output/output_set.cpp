@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <map>
 #include <set>
@@ -291,44 +292,53 @@ void remove_tree_quietly(const fs::path& p) {
 
 }  // namespace
 
-// Empty folders to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP): the
-// staging directories and the folders created to hold them, which stay empty through the
-// long work (files are staged only at its end). A signal handler may call rmdir but not
-// walk a tree, so a folder that already holds files (the last moments of a run) is left to
-// the next run into the same place, as after SIGKILL. A folder is created and remembered
-// with those signals blocked (Blocked), so none arrives between the two; `used` is an
-// atomic published after the path is written, for a handler on any thread.
+// What to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP): the staging
+// directories, the files staged in them (only at the end of the work) and the folders
+// created to hold them. A signal handler may call unlink and rmdir but not walk a tree, so
+// each path is remembered as it is made: a folder is created, a file named, and each
+// remembered with those signals blocked (Blocked), so none arrives between the two. The
+// staged files are forgotten just before they move into place (after the exchange with an
+// earlier run the staging path holds that run's files, which are not this run's to remove).
 namespace interrupt {
-constexpr int kSlots = 32;
 constexpr size_t kPathBytes = 4096;
-char paths[kSlots][kPathBytes];
-std::atomic<int> used[kSlots];
-static_assert(std::atomic<int>::is_always_lock_free, "read in a signal handler");
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+static_assert(std::atomic<int>::is_always_lock_free, "read in a signal handler");
 
-int remember(const fs::path& p) {
-  const std::string s = p.string();
-  if (s.size() >= kPathBytes) return -1;
-  for (int i = 0; i < kSlots; ++i)
-    if (!used[i].load(std::memory_order_acquire)) {
-      std::memcpy(paths[i], s.c_str(), s.size() + 1);
-      used[i].store(1, std::memory_order_release);
-      return i;
-    }
-  return -1;  // more than kSlots at once: left to the next run
-}
+// Paths a handler may read: a slot's `used` is published after its path is written.
+template <int N>
+struct Slots {
+  char paths[N][kPathBytes];
+  std::atomic<int> used[N];
 
-void forget(int slot) {
-  if (slot >= 0) used[slot].store(0, std::memory_order_release);
-}
+  int remember(const fs::path& p) {
+    const std::string s = p.string();
+    if (s.size() >= kPathBytes) return -1;
+    for (int i = 0; i < N; ++i)
+      if (!used[i].load(std::memory_order_acquire)) {
+        std::memcpy(paths[i], s.c_str(), s.size() + 1);
+        used[i].store(1, std::memory_order_release);
+        return i;
+      }
+    return -1;  // more at once than there are slots: left to the next run
+  }
+  void forget(int slot) {
+    if (slot >= 0) used[slot].store(0, std::memory_order_release);
+  }
+};
+Slots<32> folders;  // staging directories and the folders made for them
+Slots<64> files;    // files staged in them (a diagnosis stages about 25)
 
 void on_signal(int sig) {
-  // Passes until nothing more goes: a folder empties once the one inside it is gone.
+  // The staged files first (unlink, as rmdir, may be called in a handler; walking a tree may
+  // not), then passes over the folders until nothing more goes: a folder empties once the
+  // one inside it is gone.
+  for (int i = 0; i < static_cast<int>(std::size(files.used)); ++i)
+    if (files.used[i].load(std::memory_order_acquire)) ::unlink(files.paths[i]);
   for (bool removed = true; removed;) {
     removed = false;
-    for (int i = kSlots - 1; i >= 0; --i)
-      if (used[i].load(std::memory_order_acquire) && ::rmdir(paths[i]) == 0) {  // only if empty
-        used[i].store(0, std::memory_order_relaxed);
+    for (int i = static_cast<int>(std::size(folders.used)) - 1; i >= 0; --i)
+      if (folders.used[i].load(std::memory_order_acquire) && ::rmdir(folders.paths[i]) == 0) {  // only if empty
+        folders.used[i].store(0, std::memory_order_relaxed);
         removed = true;
       }
   }
@@ -363,21 +373,32 @@ class StagingDirectory {
     const interrupt::Blocked blocked;  // made and remembered as one step
     if (!::mkdtemp(templ.data())) fail(parent, "cannot create a staging directory: " + errno_text());
     path_ = templ;
-    slot_ = interrupt::remember(path_);
+    slot_ = interrupt::folders.remember(path_);
   }
   ~StagingDirectory() {
     if (!released_) remove_tree_quietly(path_);
-    interrupt::forget(slot_);  // after: an interrupt in between finds it gone, or removes it
+    forget_files();  // after: an interrupt in between finds them gone, or removes them
+    interrupt::folders.forget(slot_);
   }
   const fs::path& path() const { return path_; }
   void release() {
-    interrupt::forget(slot_);
+    forget_files();
+    interrupt::folders.forget(slot_);
     slot_ = -1;
     released_ = true;
+  }
+  // Before the staged files move into place: from then on they are not the handler's to remove.
+  void forget_files() {
+    for (int slot : file_slots_) interrupt::files.forget(slot);
+    file_slots_.clear();
   }
 
   void write(const std::string& name, const std::string& content) {
     const fs::path p = path_ / name;
+    {
+      const interrupt::Blocked blocked;  // remembered before it exists: never there unremembered
+      file_slots_.push_back(interrupt::files.remember(p));
+    }
     const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) fail(p, "cannot create: " + errno_text());
     size_t done = 0;
@@ -413,7 +434,8 @@ class StagingDirectory {
 
   fs::path path_;
   bool released_ = false;
-  int slot_ = -1;  // in interrupt::paths
+  int slot_ = -1;               // in interrupt::folders
+  std::vector<int> file_slots_;  // in interrupt::files
 };
 
 namespace {
@@ -422,6 +444,7 @@ namespace {
 // process would (tests/test_robustness.cpp).
 void test_hook_die_before_commit() {
   if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
+  if (const char* sig = std::getenv("QUADGEN_TEST_SIGNAL_BEFORE_COMMIT")) ::raise(std::atoi(sig));
 }
 
 }  // namespace
@@ -472,11 +495,11 @@ void CreatedFolders::create(const fs::path& folder) {
   fs::create_directories(folder, ec);
   if (ec) fail(folder, "cannot create the directory: " + ec.message());
   created_ = missing;
-  for (const auto& p : created_) slots_.push_back(interrupt::remember(p));
+  for (const auto& p : created_) slots_.push_back(interrupt::folders.remember(p));
 }
 
 void CreatedFolders::keep() {
-  for (int slot : slots_) interrupt::forget(slot);
+  for (int slot : slots_) interrupt::folders.forget(slot);
   slots_.clear();
   created_.clear();
 }
@@ -484,7 +507,7 @@ void CreatedFolders::keep() {
 CreatedFolders::~CreatedFolders() {
   std::error_code ec;
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);  // only if empty
-  for (int slot : slots_) interrupt::forget(slot);
+  for (int slot : slots_) interrupt::folders.forget(slot);
 }
 
 void remove_empty_outputs_on_interrupt() {
@@ -528,7 +551,13 @@ void OutputDirectory::commit() {
   const fs::path target(dir_), staged = staging_->path();
   // A new or empty target: one plain rename. An earlier run in the way: one atomic exchange,
   // after which the earlier run sits in the staging path and is removed file by file.
-  if (::rename(staged.c_str(), target.c_str()) != 0) {
+  bool renamed = false;
+  {
+    const interrupt::Blocked blocked;  // forgotten and moved as one step
+    staging_->forget_files();
+    renamed = ::rename(staged.c_str(), target.c_str()) == 0;
+  }
+  if (!renamed) {
     if (errno != ENOTEMPTY && errno != EEXIST) fail(target, "cannot move the output into place: " + errno_text());
     check_replaceable(target, command_);
     check_not_input(target, inputs_);

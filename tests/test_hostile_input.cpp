@@ -107,12 +107,15 @@ struct Interrupt {
   int signal = SIGKILL;
 };
 
-// Runs quadgen with `args` (each one argv element: no shell parses them) in `cwd`.
-CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd, Interrupt interrupt = {}) {
+// Runs quadgen with `args` (each one argv element: no shell parses them) in `cwd`, with
+// `env` ("NAME=value") added to its environment.
+CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd, Interrupt interrupt = {},
+                      std::vector<std::string> env = {}) {
   const fs::path err = cwd / ".stderr";
   const pid_t pid = ::fork();
   if (pid == 0) {
     if (::chdir(cwd.c_str()) != 0) _exit(99);
+    for (auto& v : env) ::putenv(v.data());  // the child's own copy, alive until execv
     // quadgen keeps a signal its caller ignores ignored; the tests' signals must act.
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
     FILE* e = std::freopen(err.c_str(), "w", stderr);
@@ -870,6 +873,34 @@ TEST(DataLoss, AnInterruptedRunLeavesNoFoldersBehind) {
     EXPECT_EQ(r.rc, 128 + sig) << "the run must still be working when it is interrupted: " << r.err;
     EXPECT_FALSE(fs::exists(tmp / "a")) << strsignal(sig);
   }
+}
+
+// Interrupted in its last moments, with its files staged (a signal raised where the staging
+// is complete and nothing has moved into place), a run still leaves nothing behind: the
+// staged files are remembered as they are named. Before, the staging directory and its
+// files stayed until the next run into the same place. A directory and files of an earlier
+// run in the way are untouched.
+TEST(DataLoss, ARunInterruptedWithItsFilesStagedLeavesNothingBehind) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "kept"}, tmp.dir).rc, 0);
+  const std::string kept_header = read(tmp / "kept/model.hpp");
+  for (int sig : {SIGINT, SIGTERM}) {
+    const std::string raise = "QUADGEN_TEST_SIGNAL_BEFORE_COMMIT=" + std::to_string(sig);
+    const auto fresh = run_quadgen({"derive", vehicle, "--out", tmp / "a/b/c"}, tmp.dir, {}, {raise});
+    EXPECT_EQ(fresh.rc, 128 + sig) << fresh.err;
+    EXPECT_FALSE(fs::exists(tmp / "a")) << strsignal(sig);
+    const auto over = run_quadgen({"derive", vehicle, "--out", tmp / "kept", "--effects", "motor_lag"}, tmp.dir, {},
+                                  {raise});
+    EXPECT_EQ(over.rc, 128 + sig) << over.err;
+    EXPECT_EQ(read(tmp / "kept/model.hpp"), kept_header) << strsignal(sig);
+    for (const auto& e : fs::directory_iterator(tmp.dir))
+      EXPECT_EQ(e.path().filename().string().find(".kept"), std::string::npos) << e.path();
+  }
+  const auto traj = run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.2", "--out",
+                                 tmp / "s/t/f.csv"}, tmp.dir, {}, {"QUADGEN_TEST_SIGNAL_BEFORE_COMMIT=15"});
+  EXPECT_EQ(traj.rc, 128 + SIGTERM) << traj.err;
+  EXPECT_FALSE(fs::exists(tmp / "s"));
 }
 
 // Numbers that overflow a double never reach the generated code as "inf" or "nan" (an
