@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <iostream>
 #include <map>
@@ -297,8 +298,11 @@ void remove_tree_quietly(const fs::path& p) {
 // created to hold them. A signal handler may call unlink and rmdir but not walk a tree, so
 // each path is remembered as it is made: a folder is created, a file named, and each
 // remembered with those signals blocked (Blocked), so none arrives between the two. The
-// staged files are forgotten just before they move into place (after the exchange with an
-// earlier run the staging path holds that run's files, which are not this run's to remove).
+// staged files are forgotten once the staging directory has moved into place, with the
+// signals blocked between (after the exchange with an earlier run the staging path holds
+// that run's files, which are not this run's to remove); OutputFiles moves its files out
+// one by one and leaves their staged paths empty. A path of kPathBytes or more, or more
+// paths at once than a table has slots, is not remembered: left to the next run.
 namespace interrupt {
 constexpr size_t kPathBytes = 4096;
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
@@ -376,8 +380,9 @@ class StagingDirectory {
     slot_ = interrupt::folders.remember(path_);
   }
   ~StagingDirectory() {
+    const interrupt::Blocked blocked;  // removed and forgotten as one step
     if (!released_) remove_tree_quietly(path_);
-    forget_files();  // after: an interrupt in between finds them gone, or removes them
+    forget_files();
     interrupt::folders.forget(slot_);
   }
   const fs::path& path() const { return path_; }
@@ -387,7 +392,16 @@ class StagingDirectory {
     slot_ = -1;
     released_ = true;
   }
-  // Before the staged files move into place: from then on they are not the handler's to remove.
+  // Moves the staging directory into place (`op`, a rename or an exchange; errno in `why`)
+  // and forgets its files if it moved, with the signals blocked between: from then on the
+  // staging path holds nothing of this run's (after an exchange, the earlier run's files).
+  bool move(const std::function<bool()>& op, int* why) {
+    const interrupt::Blocked blocked;
+    const bool moved = op();
+    *why = errno;
+    if (moved) forget_files();
+    return moved;
+  }
   void forget_files() {
     for (int slot : file_slots_) interrupt::files.forget(slot);
     file_slots_.clear();
@@ -444,7 +458,16 @@ namespace {
 // process would (tests/test_robustness.cpp).
 void test_hook_die_before_commit() {
   if (std::getenv("QUADGEN_TEST_DIE_BEFORE_COMMIT")) _exit(70);
-  if (const char* sig = std::getenv("QUADGEN_TEST_SIGNAL_BEFORE_COMMIT")) ::raise(std::atoi(sig));
+}
+
+// Test hook: QUADGEN_TEST_SIGNAL=<place>:<signal> raises the signal at that place of a commit
+// ("before-commit", "before-exchange", "after-exchange"), as an interrupt arriving there would.
+void test_hook_signal(const char* place) {
+  const char* spec = std::getenv("QUADGEN_TEST_SIGNAL");
+  if (!spec) return;
+  const std::string s(spec), p(place);
+  if (s.size() > p.size() && s.compare(0, p.size(), p) == 0 && s[p.size()] == ':')
+    ::raise(std::atoi(s.c_str() + p.size() + 1));
 }
 
 }  // namespace
@@ -548,21 +571,25 @@ void OutputDirectory::commit() {
   staging_->write(kManifestName, manifest_text(command_, {manifest_.begin(), manifest_.end()}));
   fsync_path(staging_->path(), O_RDONLY | O_DIRECTORY);
   test_hook_die_before_commit();
+  test_hook_signal("before-commit");
   const fs::path target(dir_), staged = staging_->path();
   // A new or empty target: one plain rename. An earlier run in the way: one atomic exchange,
-  // after which the earlier run sits in the staging path and is removed file by file.
-  bool renamed = false;
-  {
-    const interrupt::Blocked blocked;  // forgotten and moved as one step
-    staging_->forget_files();
-    renamed = ::rename(staged.c_str(), target.c_str()) == 0;
-  }
-  if (!renamed) {
-    if (errno != ENOTEMPTY && errno != EEXIST) fail(target, "cannot move the output into place: " + errno_text());
+  // after which the earlier run sits in the staging path and is removed file by file. The
+  // staged files are forgotten once moved, with the signals blocked between (not before: a
+  // signal in the checks before the exchange must still find them).
+  int why = 0;
+  if (!staging_->move([&] { return ::rename(staged.c_str(), target.c_str()) == 0; }, &why)) {
+    if (why != ENOTEMPTY && why != EEXIST)
+      fail(target, "cannot move the output into place: " + std::string(std::strerror(why)));
     check_replaceable(target, command_);
     check_not_input(target, inputs_);
-    if (::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
-      fail(target, "cannot switch the output into place: " + errno_text());
+    test_hook_signal("before-exchange");
+    const auto exchange = [&] {
+      return ::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0;
+    };
+    if (!staging_->move(exchange, &why))
+      fail(target, "cannot switch the output into place: " + std::string(std::strerror(why)));
+    test_hook_signal("after-exchange");
     remove_earlier_run(staged, target);
   }
   staging_->release();
@@ -618,6 +645,7 @@ void OutputFiles::set(size_t i, const std::string& content) {
 
 void OutputFiles::commit() {
   test_hook_die_before_commit();
+  test_hook_signal("before-commit");
   std::error_code ec;
   for (size_t i = 1; i < paths_.size(); ++i) fs::remove(paths_[i], ec);  // no companion of another run
   for (size_t i = 0; i < paths_.size(); ++i) {

@@ -46,8 +46,8 @@ class CreatedFolders {
   std::vector<int> slots_;                      // where the interrupt handler finds them
 };
 
-// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the empty staging directories
-// and the folders created for them before the process dies of the signal, so that Ctrl-C
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the staging directories, the
+// files staged in them and the folders created for them before the process dies of the signal, so that Ctrl-C
 // during a long diagnosis leaves nothing behind (SIGKILL cannot be caught: the next run into
 // the same place removes what it leaves). For the command-line program's main.
 void remove_empty_outputs_on_interrupt();

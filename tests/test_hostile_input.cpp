@@ -876,29 +876,45 @@ TEST(DataLoss, AnInterruptedRunLeavesNoFoldersBehind) {
 }
 
 // Interrupted in its last moments, with its files staged (a signal raised where the staging
-// is complete and nothing has moved into place), a run still leaves nothing behind: the
-// staged files are remembered as they are named. Before, the staging directory and its
-// files stayed until the next run into the same place. A directory and files of an earlier
-// run in the way are untouched.
+// is complete and nothing has moved into place, or where an earlier run in the way has been
+// checked and not yet exchanged), a run still leaves nothing behind: the staged files are
+// remembered as they are named. Before, the staging directory and its files stayed until
+// the next run into the same place. Once exchanged, the staging path holds the earlier
+// run's files, which the interrupt must not remove.
 TEST(DataLoss, ARunInterruptedWithItsFilesStagedLeavesNothingBehind) {
   Scratch tmp;
   const std::string vehicle = source_path("vehicles/finken3.yaml");
-  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "kept"}, tmp.dir).rc, 0);
-  const std::string kept_header = read(tmp / "kept/model.hpp");
+  const auto staging_folders = [&] {
+    std::vector<fs::path> found;
+    for (const auto& e : fs::directory_iterator(tmp.dir))
+      if (e.path().filename().string().find(".quadgen-tmp.") != std::string::npos) found.push_back(e.path());
+    return found;
+  };
   for (int sig : {SIGINT, SIGTERM}) {
-    const std::string raise = "QUADGEN_TEST_SIGNAL_BEFORE_COMMIT=" + std::to_string(sig);
-    const auto fresh = run_quadgen({"derive", vehicle, "--out", tmp / "a/b/c"}, tmp.dir, {}, {raise});
+    const auto at = [&](const std::string& place) { return "QUADGEN_TEST_SIGNAL=" + place + ":" + std::to_string(sig); };
+    const auto fresh = run_quadgen({"derive", vehicle, "--out", tmp / "a/b/c"}, tmp.dir, {}, {at("before-commit")});
     EXPECT_EQ(fresh.rc, 128 + sig) << fresh.err;
     EXPECT_FALSE(fs::exists(tmp / "a")) << strsignal(sig);
-    const auto over = run_quadgen({"derive", vehicle, "--out", tmp / "kept", "--effects", "motor_lag"}, tmp.dir, {},
-                                  {raise});
-    EXPECT_EQ(over.rc, 128 + sig) << over.err;
-    EXPECT_EQ(read(tmp / "kept/model.hpp"), kept_header) << strsignal(sig);
-    for (const auto& e : fs::directory_iterator(tmp.dir))
-      EXPECT_EQ(e.path().filename().string().find(".kept"), std::string::npos) << e.path();
+    const fs::path kept = tmp / ("kept" + std::to_string(sig));
+    ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", kept}, tmp.dir).rc, 0);
+    const std::string earlier = read(kept / "model.hpp");
+    for (const char* place : {"before-commit", "before-exchange"}) {
+      const auto over = run_quadgen({"derive", vehicle, "--out", kept, "--effects", "motor_lag"}, tmp.dir, {}, {at(place)});
+      EXPECT_EQ(over.rc, 128 + sig) << place << ": " << over.err;
+      EXPECT_EQ(read(kept / "model.hpp"), earlier) << place << ", " << strsignal(sig);
+      EXPECT_TRUE(staging_folders().empty()) << place << ", " << strsignal(sig);
+    }
+    const auto after = run_quadgen({"derive", vehicle, "--out", kept, "--effects", "motor_lag"}, tmp.dir, {},
+                                   {at("after-exchange")});
+    EXPECT_EQ(after.rc, 128 + sig) << after.err;
+    EXPECT_NE(read(kept / "model.hpp"), earlier) << "the new run is in place";
+    const auto left = staging_folders();  // the earlier run, as after SIGKILL: the next run removes it
+    ASSERT_EQ(left.size(), 1u) << strsignal(sig);
+    EXPECT_EQ(read(left.front() / "model.hpp"), earlier) << "the earlier run's files are not the interrupt's to remove";
+    fs::remove_all(left.front());
   }
   const auto traj = run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.2", "--out",
-                                 tmp / "s/t/f.csv"}, tmp.dir, {}, {"QUADGEN_TEST_SIGNAL_BEFORE_COMMIT=15"});
+                                 tmp / "s/t/f.csv"}, tmp.dir, {}, {"QUADGEN_TEST_SIGNAL=before-commit:15"});
   EXPECT_EQ(traj.rc, 128 + SIGTERM) << traj.err;
   EXPECT_FALSE(fs::exists(tmp / "s"));
 }
