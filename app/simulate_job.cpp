@@ -95,6 +95,7 @@ struct OpenLoop {
   DynamicModel& m;
   std::vector<ThrustLaw> laws;
   std::vector<std::string> rotors;
+  std::vector<RotorPlace> places;  // where the rotors sit, for the tilt and yaw manoeuvres
   ExtraInputs extra;  // looked up once, not at every integrator stage
   int delay;          // the input_delay parameter, or -1
   double vbat_ref;    // V, the battery voltage where the log holds none
@@ -110,7 +111,7 @@ InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   return [&k, s](double t, double* u) {
     // About the even share m g / n; on a trimmed vehicle each rotor's thrust scaled by its trim,
     // so that a change of every rotor alike (climb) keeps the moments balanced.
-    const auto F = s.thrust(t - k.delay_s(), k.hover, k.rotors);
+    const auto F = s.thrust(t - k.delay_s(), k.hover, k.places);
     for (size_t i = 0; i < k.rotors.size(); ++i)
       u[i] = k.laws[i].command_for(k.hover_trim[i] == k.hover ? F[i] : F[i] * (k.hover_trim[i] / k.hover));
     k.extra.fill(t, k.vbat_ref, u);
@@ -244,16 +245,12 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const OpenLoop k{m,
                    nominal_thrust_laws(vehicle, model),
                    rotor_names(vehicle),
+                   rotor_places(vehicle, model),
                    ExtraInputs(m),
                    m.input_delay_param(),
                    param(vehicle, "vbat_ref").nominal,
                    even_share,
                    hover_thrusts(vehicle, model)};
-  if (!a.scenario.empty() && find_scenario(a.scenario).rotor_roles && vehicle.rotors.size() != 4)
-    throw std::invalid_argument("--scenario " + a.scenario + " gives the thesis' rotor roles A..D to rotors 1..4, and " +
-                                vehicle.name + " has " + std::to_string(vehicle.rotors.size()) +
-                                " rotors: fly it with --closed-loop, or replay commands with --inputs (hover, climb "
-                                "and new_height fly any vehicle)");
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
 
   std::vector<double> x0(m.num_states(), 0.0);

@@ -347,7 +347,7 @@ Flights fly_all(const Vehicle& v, const SymbolicModel& model) {
   f.right = fly(tape, laws, [](double) { return std::vector<double>{1.1, 1.0, 1.0, 1.1}; }, 1.0);
   f.forward = fly(tape, laws, [](double) { return std::vector<double>{1.0, 1.0, 1.1, 1.1}; }, 1.0);
   f.climb = fly(tape, laws, [](double) { return std::vector<double>{1.1, 1.1, 1.1, 1.1}; }, 1.0);
-  const std::vector<std::string> rotors{"A", "B", "C", "D"};
+  const std::vector<runtime::RotorPlace> rotors = rotor_places(v, model);
   double hover = 0;
   for (const auto& p : model.params)
     if (p.name == "mass") hover = p.nominal * 9.81 / 4;

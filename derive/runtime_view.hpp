@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "runtime/closed_loop.hpp"
+#include "runtime/scenarios.hpp"
 #include "runtime/thrust_law.hpp"
 #include "derive/symbolic_model.hpp"
 #include "model/vehicle.hpp"
@@ -14,5 +15,8 @@ namespace quadgen {
 
 std::vector<runtime::ThrustLaw> nominal_thrust_laws(const Vehicle& v, const SymbolicModel& m);
 runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const SymbolicModel& m);
+// Where each rotor sits relative to the nominal centre of gravity, and its spin: what the
+// thesis' tilt and yaw manoeuvres choose their rotors by (runtime/scenarios.hpp).
+std::vector<runtime::RotorPlace> rotor_places(const Vehicle& v, const SymbolicModel& m);
 
 }  // namespace quadgen

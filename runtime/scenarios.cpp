@@ -1,5 +1,6 @@
 #include "runtime/scenarios.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -7,11 +8,22 @@ namespace quadgen::runtime {
 
 namespace {
 
-// Rotor positions in the X layout of the FINken 3 (A rear-left ... D front-left) are what
-// the thesis' manoeuvres name; other vehicles map rotor i to the same role by order.
-bool in(size_t i, std::initializer_list<size_t> set) {
-  for (size_t s : set)
-    if (s == i) return true;
+// The thesis names its manoeuvres by the FINken 3's rotors (A rear-left at (-x, -y), B at
+// (+x, -y), C at (+x, +y), D at (-x, +y); A and C spin ccw). Each is flown here by the rule
+// it follows there, a side of the centre of gravity or a spin, so that on any layout it
+// turns the vehicle the same way. A rotor within 0.1 % of the largest arm of an axis sits on
+// it, on neither side.
+enum class Side { kMinusX, kPlusX, kMinusY, kPlusY };
+bool on(const RotorPlace& r, Side side, const std::vector<RotorPlace>& all) {
+  double arm = 0;
+  for (const auto& o : all) arm = std::max(arm, std::hypot(o.x, o.y));
+  const double band = 1e-3 * arm;
+  switch (side) {
+    case Side::kMinusX: return r.x < -band;
+    case Side::kPlusX: return r.x > band;
+    case Side::kMinusY: return r.y < -band;
+    case Side::kPlusY: return r.y > band;
+  }
   return false;
 }
 bool between(double t, double a, double b) { return t >= a && t < b; }
@@ -26,36 +38,39 @@ constexpr double kThesisDelta = 0.02;    // N: the step of the manoeuvre thrusts
 
 double step(double h) { return kThesisDelta / kThesisHover * h; }
 
-std::vector<double> hover(double, double h, const std::vector<std::string>& r) { return std::vector<double>(r.size(), h); }
+std::vector<double> hover(double, double h, const std::vector<RotorPlace>& r) { return std::vector<double>(r.size(), h); }
 
 // Thesis 2.3.1 b): 1.1 N on every rotor, 1.16 times hover.
-std::vector<double> climb(double, double h, const std::vector<std::string>& r) {
+std::vector<double> climb(double, double h, const std::vector<RotorPlace>& r) {
   return std::vector<double>(r.size(), kThesisClimb / kThesisHover * h);
 }
 
-// Tilt doublet, hold, reverse doublet: raise `first` then `second`, later the reverse.
-std::vector<double> doublet(double t, double h, const std::vector<std::string>& r, std::initializer_list<size_t> first,
-                            std::initializer_list<size_t> second) {
+// Tilt doublet, hold, reverse doublet: raise the `first` side then the `second`, later the reverse.
+std::vector<double> doublet(double t, double h, const std::vector<RotorPlace>& r, Side first, Side second) {
   std::vector<double> F(r.size(), h);
   for (size_t i = 0; i < r.size(); ++i) {
-    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && in(i, first)) F[i] += step(h);
-    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && in(i, second)) F[i] += step(h);
+    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && on(r[i], first, r)) F[i] += step(h);
+    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && on(r[i], second, r)) F[i] += step(h);
   }
   return F;
 }
 // Thesis 2.3.2 a): raise A and D (the -x side) to tilt towards +x.
-std::vector<double> right(double t, double h, const std::vector<std::string>& r) { return doublet(t, h, r, {0, 3}, {1, 2}); }
-// Thesis 2.3.2 b): raise C and D, as the thesis does for "forward (+y)".
-std::vector<double> forward(double t, double h, const std::vector<std::string>& r) { return doublet(t, h, r, {2, 3}, {0, 1}); }
-// Thesis 2.3.2 c): raise A and C (same spin) for a second.
-std::vector<double> yaw(double t, double h, const std::vector<std::string>& r) {
+std::vector<double> right(double t, double h, const std::vector<RotorPlace>& r) {
+  return doublet(t, h, r, Side::kMinusX, Side::kPlusX);
+}
+// Thesis 2.3.2 b): raise C and D (the +y side), as the thesis does for "forward (+y)".
+std::vector<double> forward(double t, double h, const std::vector<RotorPlace>& r) {
+  return doublet(t, h, r, Side::kPlusY, Side::kMinusY);
+}
+// Thesis 2.3.2 c): raise A and C (the ccw rotors) for a second.
+std::vector<double> yaw(double t, double h, const std::vector<RotorPlace>& r) {
   std::vector<double> F(r.size(), h);
   for (size_t i = 0; i < r.size(); ++i)
-    if (between(t, 0.5, 1.5) && in(i, {0, 2})) F[i] += step(h);
+    if (between(t, 0.5, 1.5) && r[i].ccw) F[i] += step(h);
   return F;
 }
 // Thesis 2.3.2 d): all up, coast, all down by the same amount: a new constant height.
-std::vector<double> new_height(double t, double h, const std::vector<std::string>& r) {
+std::vector<double> new_height(double t, double h, const std::vector<RotorPlace>& r) {
   double d = 0;
   if (between(t, 0.5, 1.0)) d = 5 * step(h);
   if (between(t, 2.0, 2.5)) d = -5 * step(h);
@@ -68,11 +83,11 @@ const std::vector<Scenario>& scenario_catalogue() {
   static const std::vector<Scenario> list = {
       {"hover", "every rotor at its hover thrust (m g / n on a symmetric vehicle; thesis (60))", hover},
       {"climb", "1.16 times hover thrust on every rotor (the thesis' 1.1 N; 2.3.1 b, (63)-(64))", climb},
-      {"right", "rotors 1 and 4 (A, D) raised 2.1 % of hover for 0.1 s, then 2 and 3; reversed at 1.5 s (thesis "
-                "2.3.2 a; the FINken 3 tilts towards +x)", right, true},
-      {"forward", "rotors 3 and 4 (C, D) raised 2.1 % of hover for 0.1 s, then 1 and 2; reversed at 1.5 s (thesis "
-                  "2.3.2 b, its inputs for +y; the FINken 3 tilts towards -y)", forward, true},
-      {"yaw", "rotors 1 and 3 (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw, true},
+      {"right", "the rotors on the -x side of the centre of gravity (A, D) raised 2.1 % of hover for 0.1 s, then "
+                "those on +x; reversed at 1.5 s (thesis 2.3.2 a): tilts towards +x", right},
+      {"forward", "the rotors on the +y side (C, D) raised 2.1 % of hover for 0.1 s, then those on -y; reversed at "
+                  "1.5 s (thesis 2.3.2 b, its inputs for +y): tilts towards -y", forward},
+      {"yaw", "the ccw rotors (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
       {"new_height", "all rotors +10.5 % of hover from 0.5 to 1.0 s, -10.5 % from 2.0 to 2.5 s (thesis 2.3.2 d)",
        new_height},
   };

@@ -8,14 +8,21 @@
 
 namespace quadgen::runtime {
 
+// Where a rotor sits relative to the centre of gravity (body frame) and which way it spins:
+// what the tilt and yaw manoeuvres choose their rotors by.
+struct RotorPlace {
+  double x = 0, y = 0;  // m
+  bool ccw = true;
+};
+
 struct Scenario {
   std::string name;
   std::string description;
-  // Thrust per rotor [N] at time t; rotors in vehicle order.
-  std::vector<double> (*thrust)(double t, double hover, const std::vector<std::string>& rotors);
-  // Gives the thesis' rotor roles A..D to rotors 1..4 (a tilt or yaw manoeuvre): flown only on
-  // a vehicle with four rotors. The others change every rotor alike and fly any vehicle.
-  bool rotor_roles = false;
+  // Thrust per rotor [N] at time t; rotors in vehicle order. The tilt and yaw manoeuvres raise
+  // the rotors on one side of the centre of gravity, or those of one spin, wherever they are
+  // listed: the thesis' rotor roles on the FINken 3 (A, D on -x; C, D on +y; A, C ccw), and
+  // the same manoeuvre on any layout.
+  std::vector<double> (*thrust)(double t, double hover, const std::vector<RotorPlace>& rotors);
 };
 
 const std::vector<Scenario>& scenario_catalogue();

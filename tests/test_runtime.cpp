@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "runtime/attitude.hpp"
 #include "runtime/dynamic_model.hpp"
@@ -710,4 +711,45 @@ TEST(HoverTrim, FindsATrimWithEveryRotorPushingWhereTheLeastNormPulls) {
   EXPECT_FALSE(heavy.found());
   EXPECT_NE(heavy.why_not.find("rotor R0: thrust"), std::string::npos) << heavy.why_not;
   EXPECT_NE(heavy.why_not.find("beyond the motor map"), std::string::npos) << heavy.why_not;
+}
+
+// The thesis' tilt and yaw manoeuvres choose their rotors by where they sit and how they
+// spin, checked against the thesis' own rotor roles (2.3.2: A and D raised first for "right",
+// C and D for "forward", A and C for "yaw"), against the Crazyflie's layout read from its
+// firmware's numbering (M1 front-right ... M4 front-left, M1 and M3 ccw), and on the FINken 3
+// with its rotors listed in another order. Before, rotor i took the i-th thesis role by
+// its place in the file: the Crazyflie's "right" raised M1 and M4 and tilted towards -x.
+#include "runtime/scenarios.hpp"
+namespace {
+std::set<std::string> raised(const char* scenario, double t, const Vehicle& v) {
+  const SymbolicModel m = derive_model(v, derive_mass_properties(v), {});
+  const std::vector<double> F = runtime::find_scenario(scenario).thrust(t, 1.0, rotor_places(v, m));
+  std::set<std::string> out;
+  for (size_t i = 0; i < F.size(); ++i)
+    if (F[i] > 1.0 + 1e-9) out.insert(v.rotors[i].name);
+  return out;
+}
+}  // namespace
+
+TEST(Scenario, TiltsAndYawsChooseTheirRotorsByWhereTheySitNotByOrder) {
+  using S = std::set<std::string>;
+  Vehicle shuffled = test::finken3();
+  std::swap(shuffled.rotors[0], shuffled.rotors[3]);  // D, B, C, A
+  std::swap(shuffled.rotors[1], shuffled.rotors[2]);  // D, C, B, A
+  for (const Vehicle& v : {test::finken3(), shuffled}) {
+    EXPECT_EQ(raised("right", 0.55, v), (S{"A", "D"}));
+    EXPECT_EQ(raised("right", 0.65, v), (S{"B", "C"}));
+    EXPECT_EQ(raised("right", 1.55, v), (S{"B", "C"}));
+    EXPECT_EQ(raised("forward", 0.55, v), (S{"C", "D"}));
+    EXPECT_EQ(raised("forward", 0.65, v), (S{"A", "B"}));
+    EXPECT_EQ(raised("yaw", 1.0, v), (S{"A", "C"}));
+    EXPECT_EQ(raised("yaw", 1.6, v), S{});
+  }
+  const Vehicle cf = load_vehicle(test::source_path("vehicles/crazyflie21.yaml"));
+  EXPECT_EQ(raised("right", 0.55, cf), (S{"M2", "M3"}));
+  EXPECT_EQ(raised("forward", 0.55, cf), (S{"M3", "M4"}));
+  EXPECT_EQ(raised("yaw", 1.0, cf), (S{"M1", "M3"}));
+  const Vehicle hexa = load_vehicle(test::source_path("vehicles/hexa_plus.yaml"));
+  EXPECT_EQ(raised("right", 0.55, hexa), (S{"R3", "R4", "R5"}));
+  EXPECT_EQ(raised("forward", 0.55, hexa), (S{"R2", "R3"}));  // R1 and R4 sit on the x axis
 }
