@@ -1,5 +1,6 @@
 #include "derive/dynamics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -166,6 +167,7 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
     c.rotor_speed.push_back(w);
     c.thrust_scale.push_back(1);
     c.thrust_speed_loss.push_back(0);
+    c.lag_factor.push_back(1);
   }
 }
 
@@ -438,6 +440,8 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
       f.lines.push_back({"\\text{thrust factor } " + rotor("s"), c.thrust_scale[0]});
     if (!(c.thrust_speed_loss[0] - before.thrust_speed_loss[0]).is_zero())
       f.lines.push_back({"\\text{thrust speed loss } " + rotor("\\omega", "\\mathrm{loss}"), c.thrust_speed_loss[0]});
+    if (!(c.lag_factor[0] - before.lag_factor[0]).is_zero())
+      f.lines.push_back({"\\text{time constant factor } " + rotor("f", "\\tau"), c.lag_factor[0]});
     if (!(c.rotor_speed[0] - before.rotor_speed[0]).is_zero())
       f.lines.push_back({"\\text{rotor speed } " + rotor("\\omega"), c.rotor_speed[0]});
   }
@@ -460,7 +464,8 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
              scratch.params[*scratch.input_delay_param].name + ")";
   else if (v.rotors.size() > 1 && (!(c.thrust_scale[0] - before.thrust_scale[0]).is_zero() ||
                                    !(c.rotor_speed[0] - before.rotor_speed[0]).is_zero() ||
-                                   !(c.thrust_speed_loss[0] - before.thrust_speed_loss[0]).is_zero()))
+                                   !(c.thrust_speed_loss[0] - before.thrust_speed_loss[0]).is_zero() ||
+                                   !(c.lag_factor[0] - before.lag_factor[0]).is_zero()))
     f.note = "shown for rotor " + v.rotors[0].name + "; every rotor alike";
   return f;
 }
@@ -482,6 +487,12 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
     wanted.erase(e.name);
   }
   if (!wanted.empty()) throw std::invalid_argument("unknown effect '" + *wanted.begin() + "'");
+  for (const std::string& e : m.effects) {
+    const std::string& refined = find_effect(e).refines;
+    if (!refined.empty() && std::find(m.effects.begin(), m.effects.end(), refined) == m.effects.end())
+      throw std::invalid_argument("effect '" + e + "' scales " + refined + "'s terms and changes nothing without it: add " +
+                                  refined + " too");
+  }
   add_terms(c, opt.terms);
   assemble(c);
   differentiate(m);

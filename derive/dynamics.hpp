@@ -31,6 +31,9 @@ struct ModelContext {
   // Each rotor's thrust is thrust_scale c_t rho A_p r_p^2 w (w - thrust_speed_loss): an
   // effect that lowers the thrust in proportion to w (inflow) sets the loss [rad/s].
   std::vector<GiNaC::ex> thrust_speed_loss;
+  // Multiplies motor_lag's time constant for each rotor (1 unless motor_lag_spread sets it;
+  // without motor_lag there is no lag to scale).
+  std::vector<GiNaC::ex> lag_factor;
   std::vector<GiNaC::matrix> rotor_position;  // m, body frame, each rotor's hub (named constants)
   std::vector<GiNaC::ex> rotor_radius;        // m, r_p
   std::vector<GiNaC::ex> rotor_disc_area;     // m^2, A_p

@@ -536,6 +536,28 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
   }
 }
 
+// An effect that refines another (motor_lag_spread scales motor_lag's time constant) changes
+// nothing once that one has left the model (acceptance took it out): it goes too, listed as
+// suspected with that reason, so the extended model never holds it alone.
+void drop_refinements_without_their_effect(Diagnosis& d, const CandidateSearch& search) {
+  const auto in_model = [&](const std::string& e) {
+    return std::find(d.search.selected.begin(), d.search.selected.end(), e) != d.search.selected.end();
+  };
+  std::vector<std::string> orphans;
+  for (const std::string& e : d.search.selected)
+    if (!find_effect(e).refines.empty() && !in_model(find_effect(e).refines)) orphans.push_back(e);
+  if (orphans.empty()) return;
+  for (const std::string& e : orphans) {
+    const auto it = std::find_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; });
+    if (it == d.findings.end()) continue;
+    d.suspected.push_back({*it, find_effect(e).refines + ", whose terms it scales, left the model", std::nullopt});
+    d.findings.erase(it);
+  }
+  for (const std::string& e : orphans)
+    d.search.carried.erase(std::remove(d.search.carried.begin(), d.search.carried.end(), e), d.search.carried.end());
+  search.remove_effects(d.search, orphans);
+}
+
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:
 // a stand-in for missing physics, moved from d.findings to d.stand_ins.
 void separate_stand_ins(Diagnosis& d, const HeldOutGain& held_out_gain, const fit::EquationErrorModel& train_ee,
@@ -696,6 +718,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
                      d.findings.end());
   carry_suspects_the_findings_need(d, search, all);
+  drop_refinements_without_their_effect(d, search);
   separate_stand_ins(d, held_out_gain, train_ee, so);
   // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
   if (joint) {

@@ -257,12 +257,13 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   X.assign(ns * n, 0.0);
   U.assign(ns * nu, 0.0);
   // The data-side values in effect at each sample (one per flight in a per-flight model);
-  // the lags are kept for the rotor-speed filter below.
-  std::vector<double> tau(ns, 0.0);
+  // each rotor's lag is kept for the rotor-speed filter below.
+  const size_t nr = speed_states_.size();
+  std::vector<double> tau(ns * nr, 0.0);
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
-    tau[k] = e.tau;
+    for (size_t i = 0; i < nr; ++i) tau[k * nr + i] = data_side_.rotor_tau(*model_, p, s.t, i, e.tau);
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
@@ -276,7 +277,6 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // first-order lag, started in steady state; the commands are held between samples, for
   // which the discretisation is exact. The mean over each interval (what its mid-interval
   // acceleration sees) goes to mean_speed_; as tau -> 0 it is the held command's speed.
-  const size_t nr = speed_states_.size();
   mean_speed_.assign(ns * nr, 0.0);
   std::vector<double> f(n), c(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
@@ -287,11 +287,13 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     const bool restart = k == span.lo || !rotors_continue(k);
     if (!restart) {
       const double h = flight_.samples[k].t - flight_.samples[k - 1].t;
-      const double a = std::exp(-h / tau[k]);
       for (size_t i = 0; i < nr; ++i) {
+        // exp of less than -700 is 0 in a double; libm's underflow path for it (a lag of 1 us,
+        // the "no lag" of the search, over a 10 ms interval) costs more than the rest of the filter.
+        const double t_i = tau[k * nr + i], a = h > 700 * t_i ? 0.0 : std::exp(-h / t_i);
         const double w0 = X[(k - 1) * n + speed_states_[i]];
         x[speed_states_[i]] = a * w0 + (1 - a) * c[i];
-        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * tau[k] / h * (1 - a);
+        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * t_i / h * (1 - a);
       }
     }
     // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
@@ -299,7 +301,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     for (size_t i = 0; i < nr; ++i) w_now[i] = x[speed_states_[i]], x[speed_states_[i]] = 0;
     model_->rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
     for (size_t i = 0; i < nr; ++i) {
-      c[i] = tau[k] * f[speed_states_[i]];
+      c[i] = tau[k * nr + i] * f[speed_states_[i]];
       x[speed_states_[i]] = restart ? c[i] : w_now[i];
     }
   }

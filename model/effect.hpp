@@ -77,6 +77,10 @@ struct Effect {
   // (a delay), or on what the log measures (a misaligned IMU). The last two have no term of f:
   // the runtime applies them to the log (runtime/data_side_effects.hpp).
   enum class ActsOn { kDynamics, kCommands, kMeasurement } acts_on = ActsOn::kDynamics;
+  // The effect whose terms it scales (motor_lag_spread: motor_lag's time constant): without
+  // that one in the model it changes nothing, so derive refuses it alone and a diagnosis
+  // drops it where that one is not in the final model. Empty: it stands alone.
+  std::string refines;
   // Why it is no candidate when several flights are diagnosed together; empty: it is one.
   std::string not_in_joint_diagnosis;
   // Plausible values of its parameters (none for a parameter: any value in its bounds).

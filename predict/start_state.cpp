@@ -50,8 +50,11 @@ StartStates::StartStates(runtime::DynamicModel& model, std::vector<double> param
         const double next_change = j + 1 < S.size() ? S[j + 1].t + e.delay : S[k].t;
         const double t_end = std::min(S[k].t, std::max(next_change, t + 1e-9));
         commanded_speeds(t, e.delay, stretch_[k - 1], e.tau, c);
-        const double a = e.tau > 0 ? std::exp(-(t_end - t) / e.tau) : 0.0;
-        for (size_t i = 0; i < rotors_; ++i) w[i] = c[i] + (w[i] - c[i]) * a;
+        for (size_t i = 0; i < rotors_; ++i) {
+          const double tau = rotor_tau(S[k].t, i, e.tau);
+          const double a = tau > 0 && t_end - t < 700 * tau ? std::exp(-(t_end - t) / tau) : 0.0;
+          w[i] = c[i] + (w[i] - c[i]) * a;
+        }
         t = t_end;
       }
     }
@@ -71,8 +74,12 @@ void StartStates::commanded_speeds(double t, double delay, size_t first, double 
   const auto& cmd = flight_.samples[command_sample(flight_, t, delay, first)].u;
   std::copy(cmd.begin(), cmd.end(), u.begin());
   runtime::ExtraInputs(model_).fill(t, s.vbat, u.data());
-  model_.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt = (w_cmd - w) / tau
-  for (size_t i = 0; i < rotors_; ++i) c[i] = tau * f[kNumStates + i];
+  model_.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt = (w_cmd - w) / tau_i
+  for (size_t i = 0; i < rotors_; ++i) c[i] = rotor_tau(t, i, tau) * f[kNumStates + i];
+}
+
+double StartStates::rotor_tau(double t, size_t i, double tau_all) const {
+  return data_side_.rotor_tau(model_, params_.data(), t, i, tau_all);
 }
 
 std::vector<double> StartStates::at(size_t k) const {

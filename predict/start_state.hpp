@@ -59,6 +59,8 @@ class StartStates {
   // The commanded rotor speeds at time t (the model's dw/dt at w = 0, times tau), of the
   // command command_sample gives, with the battery voltage held at t.
   void commanded_speeds(double t, double delay, size_t first, double tau, std::vector<double>& c) const;
+  // Rotor i's time constant at time t (runtime::DataSideParams::rotor_tau).
+  double rotor_tau(double t, size_t i, double tau_all) const;
 };
 
 }  // namespace quadgen::predict

@@ -2,7 +2,9 @@
 // parameters are looked up by name:
 //  - input_delay: the commands logged at t - delay act at t;
 //  - attitude_bias: the logged attitude is the true one rotated by roll and pitch;
-//  - motor_lag: the commanded rotor speeds reach the rotors through a first-order lag.
+//  - motor_lag: the commanded rotor speeds reach the rotors through a first-order lag, each
+//    rotor's time constant scaled by motor_lag_spread's factor (1 + value) where the model
+//    has it.
 // A fit or a simulation against a log applies them to the log (the equation error, the
 // validation windows, the prediction rollouts); their values may differ by flight, so they
 // are read through DynamicModel::param_column at the sample's time.
@@ -10,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "runtime/dynamic_model.hpp"
@@ -29,11 +32,17 @@ struct DataSideEffects {
 struct DataSideParams {
   int delay = -1, roll = -1, pitch = -1, tau = -1;
 
+  // motor_lag_spread.<rotor> of each rotor-speed state w_<rotor>, in state order (-1: none).
+  std::vector<int> lag_spread;
+
   explicit DataSideParams(const DynamicModel& model)
       : delay(model.input_delay_param()),
         roll(model.param_index("attitude_bias.roll")),
         pitch(model.param_index("attitude_bias.pitch")),
-        tau(model.param_index("motor_lag.tau")) {}
+        tau(model.param_index("motor_lag.tau")) {
+    for (const std::string& state : model.state_names())
+      if (state.rfind("w_", 0) == 0) lag_spread.push_back(model.param_index("motor_lag_spread." + state.substr(2)));
+  }
 
   std::array<int, 4> indices() const { return {delay, roll, pitch, tau}; }
 
@@ -41,6 +50,12 @@ struct DataSideParams {
   DataSideEffects at(const DynamicModel& model, const double* p, double t) const {
     const auto value = [&](int index) { return index >= 0 ? p[model.param_column(index, t)] : 0.0; };
     return {value(delay), value(roll), value(pitch), value(tau)};
+  }
+
+  // Rotor `i`'s time constant at time t: motor_lag.tau times motor_lag_spread's (1 + value).
+  double rotor_tau(const DynamicModel& model, const double* p, double t, size_t i, double tau_all) const {
+    const int s = i < lag_spread.size() ? lag_spread[i] : -1;
+    return s >= 0 ? tau_all * (1 + p[model.param_column(s, t)]) : tau_all;
   }
 };
 

@@ -77,6 +77,7 @@ TEST(Model, HelpListsEveryParameterName) {
   const std::string help = quadgen::cli::parameter_names_help();
   const std::vector<std::pair<std::regex, std::string>> patterns = {
       {std::regex("motor_gain\\..*"), "motor_gain.<rotor>"},
+      {std::regex("motor_lag_spread\\..*"), "motor_lag_spread.<rotor>"},
       {std::regex("(cog_offset|wind)\\.[xy]"), "$1.x/y"},
       {std::regex("attitude_bias\\..*"), "attitude_bias.roll/pitch"}};
   for (const auto& p : m.params) {
@@ -198,7 +199,7 @@ TEST(Model, EveryEffectAtNominalValuesReproducesTheBaseModel) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> cmd(0.2, 0.8);
   for (const Effect& e : effect_catalogue()) {
-    const SymbolicModel ext = derive(v, {e.name});
+    const SymbolicModel ext = derive(v, effect_with_what_it_refines(e.name));
     for (int trial = 0; trial < 3; ++trial) {
       const std::vector<double> x = test::random_state(rng);
       std::vector<double> u(4);
@@ -626,8 +627,36 @@ TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
   }
   std::vector<std::string> names;
   for (const auto& p : all.params) names.push_back(p.name);
-  EXPECT_EQ(reference_parameters(names), std::vector<std::string>{"motor_gain.A"});
+  EXPECT_EQ(reference_parameters(names), (std::vector<std::string>{"motor_gain.A", "motor_lag_spread.A"}));
   EXPECT_THROW(find_effect("tether"), std::invalid_argument);
+}
+
+// motor_lag_spread scales motor_lag's time constant: alone it would change nothing, so derive
+// refuses it and says what to add; beside the lag each rotor's speed follows its own time
+// constant, tau (1 + value), checked on the derived rate of each rotor-speed state.
+TEST(Model, ALagSpreadNeedsTheLagAndGivesEachRotorItsOwnTimeConstant) {
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  try {
+    derive_model(v, mp, {{"motor_lag_spread"}, {}});
+    ADD_FAILURE() << "derived a spread without the lag";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("add motor_lag too"), std::string::npos) << e.what();
+  }
+  const SymbolicModel m = derive_model(v, mp, {{"motor_lag", "motor_lag_spread"}, {}});
+  GiNaC::exmap at;
+  for (const auto& p : m.params) at[p.sym] = p.name == "motor_lag.tau" ? 0.05 : p.name == "motor_lag_spread.C" ? 0.8 : p.nominal;
+  for (const auto& st : m.states) at[st.sym] = 0;
+  for (const auto& in : m.inputs) at[in.sym] = 0.5;
+  for (const char* r : {"A", "B", "C", "D"}) {
+    const int w = m.state_index(std::string("w_") + r);
+    ASSERT_GE(w, 0);
+    // dw/dt = (w_cmd - w) / tau_i: at w = 0 and w = 1 it differs by 1 / tau_i.
+    GiNaC::exmap at1 = at;
+    at1[m.states[w].sym] = 1;
+    const double slope = GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(m.f(w, 0).subs(at) - m.f(w, 0).subs(at1))).to_double();
+    EXPECT_NEAR(1 / slope, std::string(r) == "C" ? 0.05 * 1.8 : 0.05, 1e-12) << r;
+  }
 }
 
 // A reviewer diffs derivation.md after a vehicle change: it must not depend on the order
@@ -731,7 +760,7 @@ TEST(Effects, EachFindingReadsAsASentence) {
   for (const auto& e : effect_catalogue()) {
     ASSERT_TRUE(e.headline) << e.name;
     std::map<std::string, double> values;
-    const SymbolicModel m = derive(test::finken3(), {e.name});
+    const SymbolicModel m = derive(test::finken3(), effect_with_what_it_refines(e.name));
     for (const auto& p : m.params)
       if (effect_of_parameter(p.name) == e.name) values[p.name] = 0.5 * (p.lower + p.upper) + 0.1 * (p.upper - p.lower);
     const std::string s = e.headline(values, "");
@@ -740,6 +769,9 @@ TEST(Effects, EachFindingReadsAsASentence) {
     EXPECT_EQ(s.find("nan"), std::string::npos) << s;
     EXPECT_EQ(s.find("inf"), std::string::npos) << s;
   }
+  EXPECT_EQ(find_effect("motor_lag_spread").headline({{"motor_lag_spread.C", 0.8}, {"motor_lag_spread.D", -0.1}},
+                                                     "motor_lag_spread.A"),
+            "Motor C's time constant is 80.0 % longer than motor A's; motor D's 10.0 % shorter.");
   EXPECT_EQ(find_effect("motor_gain").headline({{"motor_gain.C", -0.08}, {"motor_gain.D", 0.031}}, "motor_gain.A"),
             "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more.");
   EXPECT_EQ(find_effect("input_delay").headline({{"input_delay.seconds", 0.045}}, ""),

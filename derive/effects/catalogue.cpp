@@ -11,20 +11,25 @@ namespace quadgen {
 
 namespace {
 
-// Canonical order: the order effects are applied in. wind comes before the airspeed
+// Canonical order: the order effects are applied in. motor_lag_spread comes before motor_lag,
+// whose time constant it scales (ModelContext::lag_factor). wind comes before the airspeed
 // effects (rotor_drag, blade_flapping, inflow) because they act on the air-relative velocity
 // it changes; thrust scalings commute, so their order only fixes the parameter order.
 std::vector<Effect> build_catalogue() {
-  std::vector<Effect> list = {effects::motor_gain(),    effects::motor_lag(),      effects::input_delay(),
-                              effects::cog_offset(),    effects::wind(),           effects::rotor_drag(),
-                              effects::blade_flapping(), effects::attitude_bias(), effects::thrust_decay(),
-                              effects::battery_sag(),   effects::ground_effect(),  effects::inflow()};
+  std::vector<Effect> list = {effects::motor_gain(),     effects::motor_lag_spread(), effects::motor_lag(),
+                              effects::input_delay(),    effects::cog_offset(),       effects::wind(),
+                              effects::rotor_drag(),     effects::blade_flapping(),   effects::attitude_bias(),
+                              effects::thrust_decay(),   effects::battery_sag(),      effects::ground_effect(),
+                              effects::inflow()};
   std::set<std::string> names;
   for (const Effect& e : list) {
     if (e.name.empty() || !e.apply || !e.headline || e.meaning.empty())
       throw std::logic_error("effect '" + e.name + "' lacks a name, terms, a meaning or a headline");
     if (!names.insert(e.name).second) throw std::logic_error("effect '" + e.name + "' listed twice");
   }
+  for (const Effect& e : list)
+    if (!e.refines.empty() && !names.count(e.refines))
+      throw std::logic_error("effect '" + e.name + "' refines an unknown effect");
   for (const Effect& e : list)
     for (const LookAlike& l : e.look_alikes)
       if (!names.count(l.effect)) throw std::logic_error("effect '" + e.name + "' names an unknown look-alike");
@@ -54,6 +59,12 @@ const Effect& find_effect(const std::string& name) {
   for (const auto& e : effect_catalogue())
     if (e.name == name) return e;
   throw std::invalid_argument("unknown effect '" + name + "'");
+}
+
+std::vector<std::string> effect_with_what_it_refines(const std::string& name) {
+  const Effect& e = find_effect(name);
+  if (e.refines.empty()) return {name};
+  return {e.refines, name};
 }
 
 std::string effect_of_parameter(const std::string& parameter) {

@@ -6,6 +6,7 @@
 namespace quadgen::effects {
 
 Effect motor_gain();
+Effect motor_lag_spread();
 Effect motor_lag();
 Effect input_delay();
 Effect cog_offset();

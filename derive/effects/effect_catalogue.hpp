@@ -20,6 +20,9 @@ std::string catalogue_parameter_names();
 
 // The catalogue entry of this name; std::invalid_argument if there is none.
 const Effect& find_effect(const std::string& name);
+// The effect and the one it refines, in canonical order ({"motor_lag", "motor_lag_spread"}
+// for motor_lag_spread), or the effect alone: the smallest model it can be derived in.
+std::vector<std::string> effect_with_what_it_refines(const std::string& name);
 
 // The effect a parameter belongs to ("motor_gain.A" -> "motor_gain"); "" for a parameter of
 // the base model.

@@ -16,7 +16,7 @@ void terms(ModelContext& c) {
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
     const std::string n = c.vehicle.rotors[i].name;
     const ex w = c.add_state("w_" + n, "rad/s", "rotor speed of rotor " + n);
-    c.extra_rates.push_back((c.commanded_speed[i] - w) / tau);
+    c.extra_rates.push_back((c.commanded_speed[i] - w) / (tau * c.lag_factor[i]));  // motor_lag_spread's factor
     c.rotor_speed[i] = w;
   }
 }
