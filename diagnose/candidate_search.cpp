@@ -25,6 +25,20 @@ namespace quadgen::diagnose {
 using fit::FitParameter;
 
 namespace {
+// An effect that refines another (motor_lag_spread: motor_lag's time constant) changes
+// nothing without it: no candidate until that one is in the model, and out of the model with it.
+bool testable_beside(const std::string& e, const std::set<std::string>& base) {
+  const std::string& refined = find_effect(e).refines;
+  return refined.empty() || base.count(refined) > 0;
+}
+// `effects` and the refinements of any of them among `in_model`, in_model's order for those.
+std::vector<std::string> with_their_refinements(std::vector<std::string> effects, const std::vector<std::string>& in_model) {
+  for (const auto& r : in_model)
+    if (std::find(effects.begin(), effects.end(), r) == effects.end() &&
+        std::find(effects.begin(), effects.end(), find_effect(r).refines) != effects.end())
+      effects.push_back(r);
+  return effects;
+}
 
 // A start away from the neutral value for effects whose cost is flat there (the effect's
 // typical_start); NaN for the others.
@@ -491,8 +505,8 @@ SearchResult CandidateSearch::run() {
     const double base_valid = cost(valid_, current);
     const std::vector<double> base_ss = channel_noise(train_, current).ss;
     std::vector<std::string> todo;
-    for (const auto& e : candidates_)
-      if (!base.count(e)) todo.push_back(e);
+    for (const auto& e : candidates_)  // the level stays alpha / all candidates: each may be tested
+      if (!base.count(e) && testable_beside(e, base)) todo.push_back(e);
     const auto step_start = std::chrono::steady_clock::now();
     step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
     phase_start = std::chrono::steady_clock::now();
@@ -567,21 +581,27 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
     // The final model without each named effect in turn: independent fits, on every core.
     const std::vector<std::string> named = r.named();
     std::vector<std::vector<FitParameter>> without_each(named.size());
-    on_every_core(named.size(), [&](size_t k, const Workspace& ws) {
+    // An effect goes with its refinements (they change nothing without it).
+    const std::vector<std::string> in_model(base.begin(), base.end());
+    const auto going = [&](const std::string& e) { return with_their_refinements({e}, in_model); };
+    const auto without_going = [&](const std::string& e) {
       std::set<std::string> without = base;
-      without.erase(named[k]);
+      for (const auto& g : going(e)) without.erase(g);
+      return without;
+    };
+    on_every_core(named.size(), [&](size_t k, const Workspace& ws) {
       double c = 0;
-      without_each[k] = fit_with(without, current, &c, ws);
+      without_each[k] = fit_with(without_going(named[k]), current, &c, ws);
     });
     for (size_t k = 0; k < named.size(); ++k) {
       const std::string& e = named[k];
-      std::set<std::string> without = base;
-      without.erase(e);
+      const std::set<std::string> without = without_going(e);
       const std::vector<FitParameter>& smaller = without_each[k];
       const ChannelNoise full = channel_noise(train_, current);
       const double statistic = lr_statistic(channel_noise(train_, smaller).ss, full);
       int dof = 0;
-      for (int i : effect_params_.at(e)) dof += current[i].free ? 1 : 0;
+      for (const auto& g : going(e))
+        for (int i : effect_params_.at(g)) dof += current[i].free ? 1 : 0;
       const double p = p_value_of(e, statistic, dof), level = opt_.alpha / static_cast<double>(candidates_.size());
       // Significance only. Whether the held-out part wants the effect is acceptance's
       // question (HeldOutGain), which fits the model without it under that model's own
@@ -592,7 +612,11 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
       const double gain = percent_lower(cost(valid_, smaller), cost(valid_, current));
       r.removed.push_back({e, "no longer significant" + beside + " (p = " + std::to_string(p) + ")", p, gain});
-      r.selected.erase(std::find(r.selected.begin(), r.selected.end(), e));
+      for (const auto& g : going(e)) {
+        if (g != e) r.removed.push_back({g, "taken out with " + e + ", whose terms it scales", p, gain});
+        r.selected.erase(std::find(r.selected.begin(), r.selected.end(), g));
+        r.carried.erase(std::remove(r.carried.begin(), r.carried.end(), g), r.carried.end());
+      }
       base = without;
       double c = 0;
       if (base.empty()) {  // back to the base model, fitted as it was
@@ -789,8 +813,11 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
   return carried;
 }
 
-void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::string>& effects) const {
-  if (effects.empty()) return;
+void CandidateSearch::remove_effects(SearchResult& r, const std::vector<std::string>& named_effects) const {
+  if (named_effects.empty()) return;
+  const std::vector<std::string> effects = with_their_refinements(named_effects, r.selected);
+  for (const auto& e : effects)  // a refinement carried beside what it refines goes with it
+    r.carried.erase(std::remove(r.carried.begin(), r.carried.end(), e), r.carried.end());
   std::set<std::string> keep;
   for (const auto& e : r.selected)
     if (std::find(effects.begin(), effects.end(), e) == effects.end()) keep.insert(e);

@@ -242,7 +242,8 @@ class CandidateSearch {
   std::vector<CarriedSuspect> carry_suspects_the_named_values_need(
       SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const;
   // Takes `effects` out of the result's final model (refit, new intervals): for candidates
-  // that a later test (held-out prediction, interval) does not stand behind.
+  // that a later test (held-out prediction, interval) does not stand behind. Their
+  // refinements in the model (Effect::refines) go with them.
   void remove_effects(SearchResult& r, const std::vector<std::string>& effects) const;
   // Profile-likelihood intervals for the effects in r's final model (with
   // wald_until_accepted, once what to name is decided).

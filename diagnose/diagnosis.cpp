@@ -496,7 +496,12 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
     }
     const auto& [f, why] = failed[clearest_failure(failed)];
     d.suspected.push_back({f, why, std::nullopt});
-    search.remove_effects(d.search, {f.effect});
+    const std::vector<std::string> named_before = d.search.named();
+    search.remove_effects(d.search, {f.effect});  // its refinements go with it
+    for (const auto& e : named_before)
+      if (e != f.effect && held_out.count(e) &&
+          std::find(d.search.selected.begin(), d.search.selected.end(), e) == d.search.selected.end())
+        d.suspected.push_back({held_out.at(e), f.effect + ", whose terms it scales, left the model", std::nullopt});
     held_out.clear();
     profiled = !wald_first;
   }
@@ -537,9 +542,11 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
 }
 
 // An effect that refines another (motor_lag_spread scales motor_lag's time constant) changes
-// nothing once that one has left the model (acceptance took it out): it goes too, listed as
-// suspected with that reason, so the extended model never holds it alone.
-void drop_refinements_without_their_effect(Diagnosis& d, const CandidateSearch& search) {
+// nothing without it. remove_effects and the backward pass take refinements out with what
+// they refine; this is the net after the look-alike checks, which may carry or unname
+// effects: a refinement left without its effect goes, listed as suspected where it was
+// named, its look-alike pairs with it, and the intervals are profiled again.
+void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search) {
   const auto in_model = [&](const std::string& e) {
     return std::find(d.search.selected.begin(), d.search.selected.end(), e) != d.search.selected.end();
   };
@@ -547,15 +554,21 @@ void drop_refinements_without_their_effect(Diagnosis& d, const CandidateSearch& 
   for (const std::string& e : d.search.selected)
     if (!find_effect(e).refines.empty() && !in_model(find_effect(e).refines)) orphans.push_back(e);
   if (orphans.empty()) return;
-  for (const std::string& e : orphans) {
-    const auto it = std::find_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; });
-    if (it == d.findings.end()) continue;
-    d.suspected.push_back({*it, find_effect(e).refines + ", whose terms it scales, left the model", std::nullopt});
-    d.findings.erase(it);
+  const auto orphan = [&](const std::string& e) { return std::find(orphans.begin(), orphans.end(), e) != orphans.end(); };
+  for (auto it = d.findings.begin(); it != d.findings.end();) {
+    if (!orphan(it->effect)) {
+      ++it;
+      continue;
+    }
+    d.suspected.push_back({*it, find_effect(it->effect).refines + ", whose terms it scales, left the model", std::nullopt});
+    it = d.findings.erase(it);
   }
-  for (const std::string& e : orphans)
-    d.search.carried.erase(std::remove(d.search.carried.begin(), d.search.carried.end(), e), d.search.carried.end());
+  auto& pairs = d.search.unresolved;
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [&](const Ambiguity& a) { return orphan(a.a) || orphan(a.b); }),
+              pairs.end());
   search.remove_effects(d.search, orphans);
+  search.profile_intervals(d.search);
+  for (auto& f : d.findings) f.parameters = effect_estimates(d.search, f.effect);
 }
 
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:

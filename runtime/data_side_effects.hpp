@@ -59,13 +59,19 @@ struct DataSideParams {
   }
 };
 
-// The parameters a simulation of `model` runs with: every flight's copy of the motor lag at
-// least 1 ms. A lag below that (the equation error's "no lag") would make RK4 at 1 ms steps
-// unstable; over a second, 1 ms of lag is invisible.
+// The parameters a simulation of `model` runs with: every rotor's lag at least 1 ms, the
+// shared motor_lag.tau raised where motor_lag_spread's smallest factor (1 + value) would
+// take a rotor below it. A lag below that (the equation error's "no lag") would make RK4 at
+// 1 ms steps unstable; over a second, 1 ms of lag is invisible.
 inline std::vector<double> simulation_params(const DynamicModel& model, std::vector<double> p) {
   constexpr double kShortestSimulatedLag = 1e-3;  // s
+  double smallest_factor = 1;
   for (int i = 0; i < model.num_params(); ++i)
-    if (shared_name(model.param_names()[i]) == "motor_lag.tau") p[i] = std::max(p[i], kShortestSimulatedLag);
+    if (shared_name(model.param_names()[i]).rfind("motor_lag_spread.", 0) == 0)
+      smallest_factor = std::min(smallest_factor, 1 + p[i]);
+  for (int i = 0; i < model.num_params(); ++i)
+    if (shared_name(model.param_names()[i]) == "motor_lag.tau")
+      p[i] = std::max(p[i], kShortestSimulatedLag / std::max(smallest_factor, 1e-3));
   return p;
 }
 

@@ -89,14 +89,15 @@ fs::path fly(const HiddenCase& c, const fs::path& dir, const std::string& file, 
 // Every candidate's evidence, recomputed here from what diagnosis.json reports beside it:
 // the p-value from the likelihood-ratio statistic under the null it names (chi2 with dof
 // degrees of freedom, or the chi-bar-square 0.5 chi2_0 + 0.5 chi2_1 of a neutral value on
-// its bound), AIC's -statistic + 2 dof, one Bonferroni level alpha / (candidates of the first
-// step) for all, and the first of the four gates it fails (significance, BIC, the held-out
+// its bound), AIC's -statistic + 2 dof, one Bonferroni level alpha / (candidates considered)
+// for all, and the first of the four gates it fails (significance, BIC, the held-out
 // cost, a physically negligible size), none exactly when it is significant. A candidate
 // whose fit failed has no evidence to check.
 void expect_evidence_holds_together(const json& j) {
   ASSERT_TRUE(j.contains("selection") && !j["selection"].empty());
   const double alpha = 0.01, negligible = 2e-4;  // SearchOptions' defaults; these tests set neither
-  const size_t first_step = j["selection"][0]["candidates"].size();
+  // Every candidate considered, tested at a step or not (a refinement waits for what it refines).
+  const size_t first_step = j["candidates_considered"].size();
   for (const auto& step : j["selection"])
     for (const auto& c : step["candidates"]) {
       const std::string why_not = c["why_not"];

@@ -1048,10 +1048,14 @@ TEST(Fit, MotorMapColumnsUnderALagMatchDifferences) {
   EquationErrorModel m(model, flight, false);
   std::vector<double> p = model.params();
   p[model.param_index("motor_lag.tau")] = 0.04;
+  p[model.param_index("motor_lag_spread.C")] = 0.5;  // each rotor its own time constant
+  p[model.param_index("motor_lag_spread.D")] = -0.3;
   const int np = model.num_params(), nr = m.num_residuals();
   std::vector<double> r(nr), J(static_cast<size_t>(nr) * np);
   m.evaluate(p.data(), r.data(), J.data());
-  for (const char* name : {"motor_a0", "motor_a1", "motor_a2"}) {
+  // The spread's columns too: it shapes each rotor's filter, not the model's accelerations.
+  for (const char* name : {"motor_a0", "motor_a1", "motor_a2", "motor_lag_spread.B", "motor_lag_spread.C",
+                           "motor_lag_spread.D"}) {
     const int c = model.param_index(name);
     ASSERT_GE(c, 0) << name;
     const ColumnCheck check = column_against_differences(m, p, J, np, c);

@@ -920,6 +920,23 @@ TEST(DataLoss, ARunInterruptedWithItsFilesStagedLeavesNothingBehind) {
   EXPECT_FALSE(fs::exists(tmp / "s"));
 }
 
+// motor_lag_spread scales motor_lag's time constant: asked for without it, derive and
+// diagnose --candidates say to add motor_lag, and write nothing.
+TEST(Cli, ALagSpreadAloneIsRefusedWithWhatToAdd) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "1", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"derive", vehicle, "--effects", "motor_lag_spread", "--out", tmp / "out"},
+        std::vector<std::string>{"diagnose", vehicle, tmp / "f.csv", "--candidates", "motor_gain,motor_lag_spread", "--out",
+                                 tmp / "out"}}) {
+    const CliResult r = run_quadgen(args, tmp.dir);
+    EXPECT_EQ(r.rc, 2) << args.front() << ": " << r.err;
+    EXPECT_NE(r.err.find("add motor_lag too"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp / "out")) << args.front();
+  }
+}
+
 // Numbers that overflow a double never reach the generated code as "inf" or "nan" (an
 // identifier the including project may define): derive refuses and writes nothing.
 TEST(Sinks, OverflowingVehicleNumbersAreRefusedNotEmitted) {
