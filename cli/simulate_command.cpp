@@ -27,8 +27,9 @@ using namespace quadgen::runtime;
 void add_simulate(CLI::App& app, SimulateArgs& a) {
   CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
   c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
-  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust: hover, climb, new_height (any "
-                                 "vehicle); right, forward, yaw (four rotors only: rotor i in the role of the thesis' i-th, A..D)");
+  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust, on any layout: hover, climb, new_height "
+                                 "(every rotor alike); right, forward, yaw (the rotors on the -x side, on +y, or spinning "
+                                 "ccw, as A, D / C, D / A, C on the thesis' FINken 3)");
   auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a canonical flight log (CSV)");
   auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
                          "fly a smooth random trajectory under a cascaded controller (test flights)");
