@@ -128,12 +128,10 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   const fit::ColumnMapping mapping = job.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(job.mapping);
   diagnose::DiagnoseOptions o = job.options;
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);
-  for (const auto& e : o.search.candidates) {  // a refinement is only ever tested beside what it refines
+  for (const auto& e : refinements_without_their_effect(o.search.candidates)) {  // only ever tested beside it
     const std::string& refined = find_effect(e).refines;
-    if (!refined.empty() &&
-        std::find(o.search.candidates.begin(), o.search.candidates.end(), refined) == o.search.candidates.end())
-      throw std::invalid_argument("--candidates: " + e + " scales " + refined + "'s terms and is only tested beside it: add " +
-                                  refined + " too");
+    throw std::invalid_argument("--candidates: " + e + " scales " + refined + "'s terms and is only tested beside it: add " +
+                                refined + " too");
   }
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
   // The model and the airframe first: a wrong --airframe file is said before the logs are read.

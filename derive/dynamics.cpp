@@ -487,11 +487,10 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
     wanted.erase(e.name);
   }
   if (!wanted.empty()) throw std::invalid_argument("unknown effect '" + *wanted.begin() + "'");
-  for (const std::string& e : m.effects) {
+  for (const std::string& e : refinements_without_their_effect(m.effects)) {
     const std::string& refined = find_effect(e).refines;
-    if (!refined.empty() && std::find(m.effects.begin(), m.effects.end(), refined) == m.effects.end())
-      throw std::invalid_argument("effect '" + e + "' scales " + refined + "'s terms and changes nothing without it: add " +
-                                  refined + " too");
+    throw std::invalid_argument("effect '" + e + "' scales " + refined + "'s terms and changes nothing without it: add " +
+                                refined + " too");
   }
   add_terms(c, opt.terms);
   assemble(c);

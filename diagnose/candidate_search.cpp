@@ -764,8 +764,8 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
 // Asked once per suspect and named look-alike, with the suspect held at its estimate (from
 // acceptance, where it was fitted beside the named effects), as check_absorbed_look_alikes
 // asks: the suspect carried when the training data want it beside the final model (off
-// rejected, t.p_off), accept its estimate there (held, not rejected against it free, t.p_own),
-// and reject the named values beside it (t.p_named): they hold only without it. It stays
+// rejected, p_off), accept its estimate there (held, not rejected against it free, p_own),
+// and reject the named values beside it (p_named): they hold only without it. It stays
 // unnamed: its held-out test failed.
 std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_need(
     SearchResult& r, const std::vector<std::pair<std::string, std::map<std::string, double>>>& suspects) const {

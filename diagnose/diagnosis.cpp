@@ -459,6 +459,11 @@ std::vector<fit::Flight> usable_flights(const std::vector<fit::Flight>& flights_
   return flights;
 }
 
+// Why a refinement (Effect::refines) is suspected once what it refines is out of the model.
+std::string left_the_model(const std::string& refinement) {
+  return find_effect(refinement).refines + ", whose terms it scales, left the model";
+}
+
 // Each effect the search named, tested on held-out data and its intervals (acceptance_failure):
 // the survivors become d.findings, the others d.suspected.
 void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& held_out_gain, const SymbolicModel& all,
@@ -501,7 +506,7 @@ void accept_findings(Diagnosis& d, CandidateSearch& search, const HeldOutGain& h
     for (const auto& e : named_before)
       if (e != f.effect && held_out.count(e) &&
           std::find(d.search.selected.begin(), d.search.selected.end(), e) == d.search.selected.end())
-        d.suspected.push_back({held_out.at(e), f.effect + ", whose terms it scales, left the model", std::nullopt});
+        d.suspected.push_back({held_out.at(e), left_the_model(e), std::nullopt});
     held_out.clear();
     profiled = !wald_first;
   }
@@ -547,12 +552,7 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
 // effects: a refinement left without its effect goes, listed as suspected where it was
 // named, its look-alike pairs with it, and the intervals are profiled again.
 void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search) {
-  const auto in_model = [&](const std::string& e) {
-    return std::find(d.search.selected.begin(), d.search.selected.end(), e) != d.search.selected.end();
-  };
-  std::vector<std::string> orphans;
-  for (const std::string& e : d.search.selected)
-    if (!find_effect(e).refines.empty() && !in_model(find_effect(e).refines)) orphans.push_back(e);
+  const std::vector<std::string> orphans = refinements_without_their_effect(d.search.selected);
   if (orphans.empty()) return;
   const auto orphan = [&](const std::string& e) { return std::find(orphans.begin(), orphans.end(), e) != orphans.end(); };
   for (auto it = d.findings.begin(); it != d.findings.end();) {
@@ -560,7 +560,7 @@ void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search
       ++it;
       continue;
     }
-    d.suspected.push_back({*it, find_effect(it->effect).refines + ", whose terms it scales, left the model", std::nullopt});
+    d.suspected.push_back({*it, left_the_model(it->effect), std::nullopt});
     it = d.findings.erase(it);
   }
   auto& pairs = d.search.unresolved;

@@ -61,6 +61,15 @@ const Effect& find_effect(const std::string& name) {
   throw std::invalid_argument("unknown effect '" + name + "'");
 }
 
+std::vector<std::string> refinements_without_their_effect(const std::vector<std::string>& effects) {
+  std::vector<std::string> out;
+  for (const auto& e : effects) {
+    const std::string& refined = find_effect(e).refines;
+    if (!refined.empty() && std::find(effects.begin(), effects.end(), refined) == effects.end()) out.push_back(e);
+  }
+  return out;
+}
+
 std::vector<std::string> effect_with_what_it_refines(const std::string& name) {
   const Effect& e = find_effect(name);
   if (e.refines.empty()) return {name};

@@ -23,6 +23,9 @@ const Effect& find_effect(const std::string& name);
 // The effect and the one it refines, in canonical order ({"motor_lag", "motor_lag_spread"}
 // for motor_lag_spread), or the effect alone: the smallest model it can be derived in.
 std::vector<std::string> effect_with_what_it_refines(const std::string& name);
+// The effects of `effects` that refine one not among them (Effect::refines): they change
+// nothing there. Empty when every refinement has what it refines.
+std::vector<std::string> refinements_without_their_effect(const std::vector<std::string>& effects);
 
 // The effect a parameter belongs to ("motor_gain.A" -> "motor_gain"); "" for a parameter of
 // the base model.
