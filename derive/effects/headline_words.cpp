@@ -21,4 +21,17 @@ double value_of(const std::map<std::string, double>& values, const std::string& 
 
 std::string after_dot(const std::string& name) { return name.substr(name.find('.') + 1); }
 
+std::string motor_comparison(const std::map<std::string, double>& values, const std::string& reference,
+                             const MotorComparisonWords& w) {
+  std::ostringstream os;
+  bool first = true;
+  for (const auto& [name, v] : values) {
+    os << (first ? "Motor " : "; motor ") << after_dot(name) << (first ? w.first_lead : w.lead)
+       << words(100 * std::fabs(v)) << " % " << (v < 0 ? w.less : w.more) << (first ? w.first_tail : "");
+    if (first && !reference.empty()) os << " than motor " << after_dot(reference) << w.reference_tail;
+    first = false;
+  }
+  return os.str() + ".";
+}
+
 }  // namespace quadgen::headline

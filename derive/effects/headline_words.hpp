@@ -16,6 +16,23 @@ double value_of(const std::map<std::string, double>& values, const std::string& 
 // "motor_gain.C" -> "C".
 std::string after_dot(const std::string& name);
 
+// How one motor is said to differ from the reference motor, e.g. for thrust
+// {" gives ", " ", "less", "more", " thrust", ""}:
+// "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more."
+struct MotorComparisonWords {
+  const char* first_lead;      // after the first motor's letter
+  const char* lead;            // after every later motor's letter
+  const char* less;
+  const char* more;
+  const char* first_tail;      // after the first motor's amount
+  const char* reference_tail;  // after the reference motor's letter
+};
+
+// One sentence over the per-motor values (a fraction each, e.g. -0.08 for 8 % less), each
+// against `reference` (left out when empty).
+std::string motor_comparison(const std::map<std::string, double>& values, const std::string& reference,
+                             const MotorComparisonWords& w);
+
 constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
 
 }  // namespace quadgen::headline

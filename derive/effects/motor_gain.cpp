@@ -1,7 +1,5 @@
 // motor_gain: the thrust of each rotor scaled by (1 + gain). Beside c_t only the ratios
 // between rotors are identifiable, so the first rotor is the reference.
-#include <cmath>
-#include <sstream>
 
 #include "derive/effects/definitions.hpp"
 #include "derive/dynamics.hpp"
@@ -22,17 +20,7 @@ void terms(ModelContext& c) {
 
 // "Motor C gives 8.0 % less thrust than motor A; motor D 3.1 % more."
 std::string headline(const std::map<std::string, double>& v, const std::string& reference) {
-  using headline::after_dot;
-  using headline::words;
-  std::ostringstream os;
-  bool first = true;
-  for (const auto& [name, g] : v) {
-    os << (first ? "Motor " : "; motor ") << after_dot(name) << (first ? " gives " : " ") << words(100 * std::fabs(g))
-       << " % " << (g < 0 ? "less" : "more") << (first ? " thrust" : "");
-    if (first && !reference.empty()) os << " than motor " << after_dot(reference);
-    first = false;
-  }
-  return os.str() + ".";
+  return headline::motor_comparison(v, reference, {" gives ", " ", "less", "more", " thrust", ""});
 }
 
 }  // namespace

@@ -3,8 +3,6 @@
 // the full catalogue with the lag off, a time constant of 1e-6 s scaled stays negligible:
 // the search cannot find it where no lag is), and beside it only the ratios between the
 // motors are identifiable, so the first rotor is the reference.
-#include <cmath>
-#include <sstream>
 
 #include "derive/effects/definitions.hpp"
 #include "derive/dynamics.hpp"
@@ -27,17 +25,7 @@ void terms(ModelContext& c) {
 
 // "Motor C's time constant is 80.0 % longer than motor A's; motor D's 10.0 % shorter."
 std::string headline(const std::map<std::string, double>& v, const std::string& reference) {
-  using headline::after_dot;
-  using headline::words;
-  std::ostringstream os;
-  bool first = true;
-  for (const auto& [name, s] : v) {
-    os << (first ? "Motor " : "; motor ") << after_dot(name) << "'s " << (first ? "time constant is " : "")
-       << words(100 * std::fabs(s)) << " % " << (s < 0 ? "shorter" : "longer");
-    if (first && !reference.empty()) os << " than motor " << after_dot(reference) << "'s";
-    first = false;
-  }
-  return os.str() + ".";
+  return headline::motor_comparison(v, reference, {"'s time constant is ", "'s ", "shorter", "longer", "", "'s"});
 }
 
 }  // namespace
