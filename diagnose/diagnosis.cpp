@@ -546,31 +546,6 @@ void carry_suspects_the_findings_need(Diagnosis& d, const CandidateSearch& searc
   }
 }
 
-// An effect that refines another (motor_lag_spread scales motor_lag's time constant) changes
-// nothing without it. remove_effects and the backward pass take refinements out with what
-// they refine; this is the net after the look-alike checks, which may carry or unname
-// effects: a refinement left without its effect goes, listed as suspected where it was
-// named, its look-alike pairs with it, and the intervals are profiled again.
-void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search) {
-  const std::vector<std::string> orphans = refinements_without_their_effect(d.search.selected);
-  if (orphans.empty()) return;
-  const auto orphan = [&](const std::string& e) { return std::find(orphans.begin(), orphans.end(), e) != orphans.end(); };
-  for (auto it = d.findings.begin(); it != d.findings.end();) {
-    if (!orphan(it->effect)) {
-      ++it;
-      continue;
-    }
-    d.suspected.push_back({*it, left_the_model(it->effect), std::nullopt});
-    it = d.findings.erase(it);
-  }
-  auto& pairs = d.search.unresolved;
-  pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [&](const Ambiguity& a) { return orphan(a.a) || orphan(a.b); }),
-              pairs.end());
-  search.remove_effects(d.search, orphans);
-  search.profile_intervals(d.search);
-  for (auto& f : d.findings) f.parameters = effect_estimates(d.search, f.effect);
-}
-
 // Accepted, but beyond what the effect's physics can produce where the flights were flown:
 // a stand-in for missing physics, moved from d.findings to d.stand_ins.
 void separate_stand_ins(Diagnosis& d, const HeldOutGain& held_out_gain, const fit::EquationErrorModel& train_ee,
@@ -645,6 +620,26 @@ void lead_signatures(Diagnosis& d, const Vehicle& v, const fit::Flight& used, co
 }
 
 }  // namespace
+
+void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search) {
+  const std::vector<std::string> orphans = refinements_without_their_effect(d.search.selected);
+  if (orphans.empty()) return;
+  const auto orphan = [&](const std::string& e) { return std::find(orphans.begin(), orphans.end(), e) != orphans.end(); };
+  for (auto it = d.findings.begin(); it != d.findings.end();) {
+    if (!orphan(it->effect)) {
+      ++it;
+      continue;
+    }
+    d.suspected.push_back({*it, left_the_model(it->effect), std::nullopt});
+    it = d.findings.erase(it);
+  }
+  auto& pairs = d.search.unresolved;
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [&](const Ambiguity& a) { return orphan(a.a) || orphan(a.b); }),
+              pairs.end());
+  search.remove_effects(d.search, orphans);
+  search.profile_intervals(d.search);
+  for (auto& f : d.findings) f.parameters = effect_estimates(d.search, f.effect);
+}
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
   const auto fail = [&](const std::string& why) {

@@ -245,6 +245,14 @@ std::string one_step_summary(const Finding& f);
 
 bool belongs_to_flight(const std::string& parameter);
 
+// An effect that refines another (motor_lag_spread scales motor_lag's time constant) changes
+// nothing without it. remove_effects and the backward pass take refinements out with what
+// they refine, and the look-alike checks only add to the model; this is the net behind them
+// (run after the look-alike checks), for any later step that does not: a refinement left
+// without its effect goes, listed as suspected where it was named, its look-alike pairs
+// with it, and the intervals are profiled again.
+void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search);
+
 // What the draft check reads from a diagnosis: the final model's residuals over the whole
 // flight (`used`: the samples they belong to, in order), each sample's heading and velocity,
 // whether it lies in the held-out part (`valid`), and the coefficients and sizes the ratio
