@@ -14,10 +14,12 @@ namespace {
 // turns the vehicle the same way. A rotor within 0.1 % of the largest arm of an axis sits on
 // it, on neither side.
 enum class Side { kMinusX, kPlusX, kMinusY, kPlusY };
-bool on(const RotorPlace& r, Side side, const std::vector<RotorPlace>& all) {
+double on_axis_band(const std::vector<RotorPlace>& all) {
   double arm = 0;
   for (const auto& o : all) arm = std::max(arm, std::hypot(o.x, o.y));
-  const double band = 1e-3 * arm;
+  return 1e-3 * arm;
+}
+bool on(const RotorPlace& r, Side side, double band) {
   switch (side) {
     case Side::kMinusX: return r.x < -band;
     case Side::kPlusX: return r.x > band;
@@ -48,9 +50,10 @@ std::vector<double> climb(double, double h, const std::vector<RotorPlace>& r) {
 // Tilt doublet, hold, reverse doublet: raise the `first` side then the `second`, later the reverse.
 std::vector<double> doublet(double t, double h, const std::vector<RotorPlace>& r, Side first, Side second) {
   std::vector<double> F(r.size(), h);
+  const double band = on_axis_band(r);
   for (size_t i = 0; i < r.size(); ++i) {
-    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && on(r[i], first, r)) F[i] += step(h);
-    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && on(r[i], second, r)) F[i] += step(h);
+    if ((between(t, 0.5, 0.6) || between(t, 1.6, 1.7)) && on(r[i], first, band)) F[i] += step(h);
+    if ((between(t, 0.6, 0.7) || between(t, 1.5, 1.6)) && on(r[i], second, band)) F[i] += step(h);
   }
   return F;
 }
