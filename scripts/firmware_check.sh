@@ -4,7 +4,9 @@
 # float, -O2, no exceptions, no RTTI) and reports, per model and entry point, the code size,
 # what the object still needs from outside, and whether any double-precision arithmetic is
 # left (soft-float calls on this FPU, or .f64 instructions). Fails on any of these, or if the
-# object needs the heap, exceptions or RTTI.
+# object needs the heap, exceptions or RTTI. The stack column is gcc's -fstack-usage: each
+# entry point's own frame plus that of the rhs it calls (what the C library's sinf, cosf,
+# powf and logf take comes on top); a frame of dynamic size fails the check.
 #   scripts/firmware_check.sh
 # Installs the Debian cross compiler (gcc-arm-none-eabi) if it is missing.
 set -euo pipefail
@@ -17,10 +19,10 @@ fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 flags=(-std=c++17 -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -ffunction-sections
-       -fno-exceptions -fno-rtti -Wall -Wdouble-promotion -Werror=double-promotion -Wno-unused-variable)
+       -fno-exceptions -fno-rtti -fstack-usage -Wall -Wdouble-promotion -Werror=double-promotion -Wno-unused-variable)
 status=0
-echo "| model | rhs, f only [B] | rhs, f + Jacobians [B] | precompute [B] | precomputed values in RAM [B] | external symbols | double-precision calls |"
-echo "|---|---|---|---|---|---|---|"
+echo "| model | rhs, f only [B] | rhs, f + Jacobians [B] | precompute [B] | precomputed values in RAM [B] | stack: f / f + Jacobians / precompute [B] | external symbols | double-precision calls |"
+echo "|---|---|---|---|---|---|---|---|"
 for dir in generated/*/; do
   name=$(basename "$dir")
   obj="$tmp/$name.o"
@@ -38,6 +40,15 @@ for dir in generated/*/; do
   # The two instantiations of rhs<float>: f only (5 arguments) and with the Jacobians (8).
   f_only=$(size_of 'rhs<float>\(([^,]*,){4}[^,]*\)$')
   f_jac=$(size_of 'rhs<float>\(([^,]*,){7}[^,]*\)$')
+  # gcc writes the frames next to the object ($name.su): "file:line:col:signature<TAB>bytes<TAB>kind".
+  frame_of() {  # the largest frame whose signature matches $1; 0 when inlined away
+    grep -E "$1" "$tmp/$name.su" | awk -F'\t' 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }'
+  }
+  rhs_sig='rhs\(([^,]*,){%d}[^,]*\) \[with Scalar = float\]'
+  stack="$(( $(frame_of 'void quadgen_f\(') + $(frame_of "$(printf "$rhs_sig" 4)") ))"
+  stack+=" / $(( $(frame_of 'void quadgen_f_jacobians\(') + $(frame_of "$(printf "$rhs_sig" 7)") ))"
+  stack+=" / $(frame_of 'void quadgen_precompute\(')"
+  if grep -q -P '\tdynamic' "$tmp/$name.su"; then stack+=" — DYNAMIC"; status=1; fi
   undefined=$(arm-none-eabi-nm -u "$obj" | awk '{print $2}' | sort -u)
   # Double precision either as soft-float calls (this FPU has none for doubles) or as .f64
   # instructions in the disassembly (there should be neither).
@@ -45,6 +56,6 @@ for dir in generated/*/; do
   [ "$doubles" -gt 0 ] && status=1
   forbidden=$(echo "$undefined" | grep -E '^(malloc|free|_Znw|_Zdl|_Zna|_Zda|__cxa_|__gxx_personality|_Unwind)' || true)
   [ -n "$forbidden" ] && status=1
-  echo "| $name | $f_only | $f_jac | $(size_of ' quadgen_precompute$') | $(size_of ' quadgen_pre$') | $(echo ${undefined:-none} | tr ' ' ',')${forbidden:+ — FORBIDDEN: $forbidden} | $doubles |"
+  echo "| $name | $f_only | $f_jac | $(size_of ' quadgen_precompute$') | $(size_of ' quadgen_pre$') | $stack | $(echo ${undefined:-none} | tr ' ' ',')${forbidden:+ — FORBIDDEN: $forbidden} | $doubles |"
 done
 exit $status
