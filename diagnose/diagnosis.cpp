@@ -619,6 +619,69 @@ void lead_signatures(Diagnosis& d, const Vehicle& v, const fit::Flight& used, co
     for (const auto& one : split_by_flight(gain_input, flight_starts)) d.command_gain_per_flight.push_back(command_gain(one));
 }
 
+// Several flights: the flight's own quantities (motor trim, wind) get one value per flight,
+// so the rest of the pipeline sees one model with more parameters. `model` wraps the
+// vehicle's runtime model; `all` is the symbolic model with the per-flight copies.
+struct FlightModels {
+  std::unique_ptr<runtime::PerFlightModel> model;
+  SymbolicModel all;
+  std::vector<double> later_starts;  // where flights 2..K begin on the joined clock
+  std::vector<std::string> per_flight_names;
+};
+FlightModels per_flight_models(const SymbolicModel& all_in, runtime::DynamicModel& model_in,
+                               const std::vector<fit::Flight>& flights, const std::vector<std::string>& candidates,
+                               Diagnosis& d) {
+  FlightModels m;
+  const auto starts = fit::joined_start_times(flights);
+  m.later_starts.assign(starts.begin() + 1, starts.end());
+  m.per_flight_names = per_flight_parameters(all_in, candidates);
+  m.model = std::make_unique<runtime::PerFlightModel>(model_in, m.later_starts, m.per_flight_names);
+  m.all = with_per_flight_copies(all_in, *m.model);
+  for (const auto& e : candidates)
+    if (find_effect(e).per_flight) d.per_flight_effects.push_back(e);
+  return m;
+}
+
+// The accelerometer's specific force or the differentiated pose for the translation
+// ("auto": the pose where the log has one).
+bool use_accelerometer(const std::string& translational, const fit::Flight& flight) {
+  if (translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
+  return translational == "accelerometer" || (translational == "auto" && !flight.has_pose);
+}
+
+// The training part and the held-out end (of each flight, when there are several), recorded
+// in `d`; a part too short to fit or judge is refused.
+std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::Flight>& flights,
+                                                         const fit::Flight& flight, double validation_fraction,
+                                                         Diagnosis& d) {
+  const bool joint = flights.size() > 1;
+  auto parts = joint ? fit::split_each_by_time(flights, 1.0 - validation_fraction)
+                     : fit::split_by_time(flight, 1.0 - validation_fraction);
+  const fit::Flight &train = parts.first, &valid = parts.second;
+  if (train.samples.size() < 50 || valid.samples.size() < 50)
+    throw fit::FitError(flight.source + ": too short to hold out " + std::to_string(validation_fraction) +
+                        " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples)");
+  d.train_samples = train.samples.size();
+  d.valid_samples = valid.samples.size();
+  d.t_split = valid.samples.front().t;
+  d.validation_starts = held_out_starts(valid, joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
+  return parts;
+}
+
+// From what the search named to what the diagnosis names: each candidate tested on held-out
+// data, the look-alike checks after acceptance (an absorbed look-alike, a suspect the named
+// values need), the net for refinements, and findings beyond their physics set apart.
+void name_the_causes(Diagnosis& d, CandidateSearch& search, const HeldOutGain& held_out_gain, const SymbolicModel& all,
+                     const fit::EquationErrorModel& train_ee, const SearchOptions& so) {
+  accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
+  for (const std::string& e : search.check_absorbed_look_alikes(d.search))  // carried now, not named
+    d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
+                     d.findings.end());
+  carry_suspects_the_findings_need(d, search, all);
+  drop_refinements_without_their_effect(d, search);
+  separate_stand_ins(d, held_out_gain, train_ee, so);
+}
+
 }  // namespace
 
 void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search) {
@@ -675,39 +738,19 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
   DiagnoseOptions opt = opt_in;
   if (joint) opt.search.candidates = joint_candidates(opt.search.candidates, flight);
-  // Joint: the flight's own quantities (motor trim, wind) get one value per flight; the rest
-  // of the pipeline sees one model with more parameters.
-  std::unique_ptr<runtime::PerFlightModel> per_flight_model;
-  SymbolicModel per_flight_all;
-  std::vector<double> later_starts;  // where flights 2..K begin on the joined clock
-  std::vector<std::string> per_flight_names;
-  if (joint) {
-    const auto starts = fit::joined_start_times(flights);
-    later_starts.assign(starts.begin() + 1, starts.end());
-    per_flight_names = per_flight_parameters(all_in, opt.search.candidates);
-    per_flight_model = std::make_unique<runtime::PerFlightModel>(model_in, later_starts, per_flight_names);
-    per_flight_all = with_per_flight_copies(all_in, *per_flight_model);
-    for (const auto& e : opt.search.candidates)
-      if (find_effect(e).per_flight) d.per_flight_effects.push_back(e);
-  }
-  const SymbolicModel& all = joint ? per_flight_all : all_in;
-  runtime::DynamicModel& model = joint ? *per_flight_model : model_in;
-  bool accel = opt.translational == "accelerometer" || (opt.translational == "auto" && !flight.has_pose);
-  if (opt.translational == "pose" && !flight.has_pose) throw fit::FitError(flight.source + ": no pose to differentiate");
+  const FlightModels fm = joint ? per_flight_models(all_in, model_in, flights, opt.search.candidates, d)
+                                : FlightModels{};
+  const SymbolicModel& all = joint ? fm.all : all_in;
+  runtime::DynamicModel& model = joint ? *fm.model : model_in;
+  const bool accel = use_accelerometer(opt.translational, flight);
   set_formulation(accel, d);
-  const auto parts = joint ? fit::split_each_by_time(flights, 1.0 - opt.validation_fraction)
-                           : fit::split_by_time(flight, 1.0 - opt.validation_fraction);
-  const fit::Flight &train = parts.first, &valid = parts.second;  // (lambdas below capture valid)
-  if (train.samples.size() < 50 || valid.samples.size() < 50)
-    throw fit::FitError(flight.source + ": too short to hold out " + std::to_string(opt.validation_fraction) +
-                        " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples)");
-  d.train_samples = train.samples.size();
-  d.valid_samples = valid.samples.size();
-  d.t_split = valid.samples.front().t;
-  d.validation_starts = held_out_starts(valid, joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
+  const auto parts = split_for_validation(flights, flight, opt.validation_fraction, d);
+  const fit::Flight &train = parts.first, &valid = parts.second;
   *validation_out = valid;
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
       all_ee(model, flight, accel);
+
+  // 1. The search: which candidates the training data want.
   SearchOptions so = opt.search;
   so.progress = opt.progress;
   so.rotation_scale = rotation_scale(v, all);
@@ -716,28 +759,23 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   CandidateSearch search(all, model, train_ee, valid_ee, so);
   d.candidates = opt.search.candidates.empty() ? applicable_effects(flight) : opt.search.candidates;
   d.search = search.run();
-  const bool pose = flight.has_pose;
+
+  // 2. Which of them are causes: held-out data, look-alikes, plausibility.
   const HeldOutGain held_out_gain(model, search, valid, valid_ee, accel, opt.window, opt.window_stride);
   d.metric = held_out_gain.metric_name();
   opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
                    " candidates");
-  accept_findings(d, search, held_out_gain, all, so.wald_until_accepted);
-  for (const std::string& e : search.check_absorbed_look_alikes(d.search))  // carried now, not named
-    d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }),
-                     d.findings.end());
-  carry_suspects_the_findings_need(d, search, all);
-  drop_refinements_without_their_effect(d, search);
-  separate_stand_ins(d, held_out_gain, train_ee, so);
-  // Jointly diagnosed: does each flight alone show the named airframe effects, with one value?
+  name_the_causes(d, search, held_out_gain, all, train_ee, so);
+
+  // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
   if (joint) {
-    const auto agreement_start = Clock::now();
+    const auto start = Clock::now();
     d.agreement = per_flight_agreement(
-        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, per_flight_names));
+        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names));
     opt.progress.say(progress() + "agreement: " + std::to_string(d.agreement.size()) + " parameters on " +
                      std::to_string(flights.size()) + " flights (" +
-                     std::to_string(static_cast<int>(seconds_since(agreement_start))) + " s)");
+                     std::to_string(static_cast<int>(seconds_since(start))) + " s)");
   }
-  // One flight of an airframe diagnosed before: does it show the airframe's effects?
   if (!joint && opt.airframe) {
     const auto start = Clock::now();
     d.airframe_source = opt.airframe->source;
@@ -748,7 +786,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
                      std::to_string(static_cast<int>(seconds_since(start))) + " s)");
   }
   add_suspects_of_the_search(d);
-  const SearchResult& s = d.search;
+
+  // 4. What the extended model still gets wrong, and what it gains on the held-out part.
   const fit::Flight used = rows_of(flight, all_ee);
   analyse_what_is_wrong(v, used, all_ee, d);
   opt.progress.say(progress() + "validation of the base and the extended model; prediction error at horizons");
@@ -756,14 +795,18 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   d.unexplained = unexplained(d.after, opt);
   const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
+
+  // 5. Beyond the catalogue: a term proposed from what is left, regenerated and tested.
   opt.progress.say(progress() + "beyond the catalogue: sparse regression on what the final model leaves");
+  const SearchResult& s = d.search;
   d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
                                 valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,
                                 flight_starts);
   if (!proposed_terms(d.discovered).empty()) {
     opt.progress.say(progress() + "the proposed terms regenerated into the model and simulated on the held-out part");
-    d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), later_starts, per_flight_names, s.final_fit,
-                              pose ? held_out_gain.folds() : std::vector<fit::Flight>{}, opt.window, opt.window_stride);
+    d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), fm.later_starts, fm.per_flight_names,
+                              s.final_fit, flight.has_pose ? held_out_gain.folds() : std::vector<fit::Flight>{},
+                              opt.window, opt.window_stride);
   }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
