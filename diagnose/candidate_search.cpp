@@ -472,82 +472,15 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
 }
 
 SearchResult CandidateSearch::run() {
-  // "[diagnose] base model fitted (12 s)": the serial parts between the parallel steps.
-  auto phase_start = std::chrono::steady_clock::now();
-  const auto phase_done = [&](const std::string& what) {
-    const auto now = std::chrono::steady_clock::now();
-    opt_.progress.say("[diagnose] " + what + " (" +
-                      std::to_string(static_cast<int>(std::chrono::duration<double>(now - phase_start).count())) + " s)");
-    phase_start = now;
-  };
+  output::PhaseTimer phase(opt_.progress);  // the serial parts between the parallel steps
   SearchResult res;
   std::set<std::string> base;
-  std::vector<FitParameter> current = initial_parameters();
-  // The base fit, weighted by the nominal model's residual noise; then refitted under the
-  // base fit's own weights, as every extended model is below; the weights of the search are
-  // the base fit's. Not settled further (as the final model is): on the ARPL log, reweighted
-  // to its fixed point, the base model let the vertical channel's weight run down and moved
-  // c_t to half its value (vertical error 1.4 -> 6.4 m/s^2), and the search named an input
-  // delay instead of the motor lag. A lone effect is therefore compared with this fit
-  // (HeldOutGain::finding_for), the model a final model without effects is.
-  weights_.assign(train_.channels().size(), 1.0);
-  weights_ = weights_at(current);
-  double c = 0;
-  current = fit_with(base, current, &c);
-  weights_ = weights_at(current);
-  current = fit_with(base, current, &c);
-  res.base_fit = current;
-  res.base_weights = weights_;
-  phase_done("base model fitted");
-  for (int round = 0; round < opt_.max_effects; ++round) {
-    SelectionStep step;
-    step.base_effects.assign(base.begin(), base.end());
-    const double base_valid = cost(valid_, current);
-    const std::vector<double> base_ss = channel_noise(train_, current).ss;
-    std::vector<std::string> todo;
-    for (const auto& e : candidates_)  // the level stays alpha / all candidates: each may be tested
-      if (!base.count(e) && testable_beside(e, base)) todo.push_back(e);
-    const auto step_start = std::chrono::steady_clock::now();
-    step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
-    phase_start = std::chrono::steady_clock::now();
-    opt_.progress.say(
-        "[diagnose] step " + std::to_string(round + 1) + ": " + std::to_string(step.candidates.size()) +
-        " candidates fitted (" +
-        std::to_string(static_cast<int>(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count())) +
-        " s)");
-    for (const auto& ev : step.candidates) note_training_only(res, ev);
-    rank_candidates(step.candidates);
-    if (step.candidates.empty() || !step.candidates.front().significant) {
-      step.outcome = "nothing significant";
-      res.steps.push_back(step);
-      break;
-    }
-    step.ambiguities = check_look_alikes(step, base);
-    step.selected = step.candidates.front().effect;
-    step.outcome = step.ambiguities.empty() ? "selected" : "ambiguous";
-    if (!step.ambiguities.empty()) {  // the group is reported; its stronger member stands in
-      res.unresolved.insert(res.unresolved.end(), step.ambiguities.begin(), step.ambiguities.end());
-      res.carried.push_back(step.selected);
-    }
-    base.insert(step.selected);
-    res.selected.push_back(step.selected);
-    current = step.candidates.front().parameters;
-    // New weights for the new model's noise; refit under them so that the next step's
-    // candidates are compared with an optimum, not with a start they could improve on.
-    weights_ = weights_at(current);
-    current = fit_with(base, current, &c);
-    if (round + 1 == opt_.max_effects)  // (a look-alike of the one taken is reported as ambiguous)
-      for (size_t k = 1; k < step.candidates.size() && step.candidates[k].significant; ++k)
-        if (std::none_of(step.ambiguities.begin(), step.ambiguities.end(),
-                         [&](const Ambiguity& a) { return a.b == step.candidates[k].effect; }))
-          res.left_at_limit.push_back(step.candidates[k]);
-    res.steps.push_back(step);
-    phase_done("step " + std::to_string(round + 1) + ": " + step.selected + " refitted" +
-               (step.ambiguities.empty() ? "" : ", look-alikes checked"));
-  }
+  std::vector<FitParameter> current = fit_base(res);
+  phase.done("base model fitted");
+  for (int round = 0; round < opt_.max_effects; ++round)
+    if (!take_step(round, base, current, res, phase)) break;
   backward_pass(res, base, current);
-  phase_done("backward elimination");
+  phase.done("backward elimination");
   const auto in_model = [&](const CandidateEvidence& ev) {
     return std::find(res.selected.begin(), res.selected.end(), ev.effect) != res.selected.end();
   };
@@ -560,8 +493,75 @@ SearchResult CandidateSearch::run() {
   res.final_fit = current;
   res.final_weights = weights_;
   estimate_intervals(res, !opt_.wald_until_accepted);
-  phase_done("intervals");
+  phase.done("intervals");
   return res;
+}
+
+// The base fit, weighted by the nominal model's residual noise; then refitted under the
+// base fit's own weights, as every extended model is below; the weights of the search are
+// the base fit's. Not settled further (as the final model is): on the ARPL log, reweighted
+// to its fixed point, the base model let the vertical channel's weight run down and moved
+// c_t to half its value (vertical error 1.4 -> 6.4 m/s^2), and the search named an input
+// delay instead of the motor lag. A lone effect is therefore compared with this fit
+// (HeldOutGain::finding_for), the model a final model without effects is.
+std::vector<FitParameter> CandidateSearch::fit_base(SearchResult& res) {
+  const std::set<std::string> none;
+  std::vector<FitParameter> current = initial_parameters();
+  weights_.assign(train_.channels().size(), 1.0);
+  weights_ = weights_at(current);
+  double c = 0;
+  current = fit_with(none, current, &c);
+  weights_ = weights_at(current);
+  current = fit_with(none, current, &c);
+  res.base_fit = current;
+  res.base_weights = weights_;
+  return current;
+}
+
+bool CandidateSearch::take_step(int round, std::set<std::string>& base, std::vector<FitParameter>& current,
+                                SearchResult& res, output::PhaseTimer& phase) {
+  SelectionStep step;
+  step.base_effects.assign(base.begin(), base.end());
+  const double base_valid = cost(valid_, current);
+  const std::vector<double> base_ss = channel_noise(train_, current).ss;
+  std::vector<std::string> todo;
+  for (const auto& e : candidates_)  // the level stays alpha / all candidates: each may be tested
+    if (!base.count(e) && testable_beside(e, base)) todo.push_back(e);
+  phase.restart();
+  step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
+  phase.done("step " + std::to_string(round + 1) + ": " + std::to_string(step.candidates.size()) +
+             " candidates fitted");
+  for (const auto& ev : step.candidates) note_training_only(res, ev);
+  rank_candidates(step.candidates);
+  if (step.candidates.empty() || !step.candidates.front().significant) {
+    step.outcome = "nothing significant";
+    res.steps.push_back(step);
+    return false;
+  }
+  step.ambiguities = check_look_alikes(step, base);
+  step.selected = step.candidates.front().effect;
+  step.outcome = step.ambiguities.empty() ? "selected" : "ambiguous";
+  if (!step.ambiguities.empty()) {  // the group is reported; its stronger member stands in
+    res.unresolved.insert(res.unresolved.end(), step.ambiguities.begin(), step.ambiguities.end());
+    res.carried.push_back(step.selected);
+  }
+  base.insert(step.selected);
+  res.selected.push_back(step.selected);
+  current = step.candidates.front().parameters;
+  // New weights for the new model's noise; refit under them so that the next step's
+  // candidates are compared with an optimum, not with a start they could improve on.
+  weights_ = weights_at(current);
+  double c = 0;
+  current = fit_with(base, current, &c);
+  if (round + 1 == opt_.max_effects)  // (a look-alike of the one taken is reported as ambiguous)
+    for (size_t k = 1; k < step.candidates.size() && step.candidates[k].significant; ++k)
+      if (std::none_of(step.ambiguities.begin(), step.ambiguities.end(),
+                       [&](const Ambiguity& a) { return a.b == step.candidates[k].effect; }))
+        res.left_at_limit.push_back(step.candidates[k]);
+  res.steps.push_back(step);
+  phase.done("step " + std::to_string(round + 1) + ": " + step.selected + " refitted" +
+             (step.ambiguities.empty() ? "" : ", look-alikes checked"));
+  return true;
 }
 
 // Keeps the strongest training-only evidence of each effect.

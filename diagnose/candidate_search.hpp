@@ -343,6 +343,14 @@ class CandidateSearch {
   LookAlikeTest test_look_alike(const SearchResult& r, const std::string& e, const std::string& f,
                                 const std::vector<fit::FitParameter>& start, const Workspace& ws) const;
   static void note_training_only(SearchResult& r, const CandidateEvidence& ev);
+  // The base model fitted and refitted under its own weights; the search's weights then
+  // are the base fit's.
+  std::vector<fit::FitParameter> fit_base(SearchResult& r);
+  // One forward step: every candidate testable beside `base` fitted, the strongest taken
+  // into it (with its look-alikes checked) and the model refitted. False when none is
+  // significant: the forward search stops.
+  bool take_step(int round, std::set<std::string>& base, std::vector<fit::FitParameter>& current, SearchResult& r,
+                 output::PhaseTimer& phase);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
   // CandidateEvidence::implausible of this effect's estimates in `ps`.
   std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;

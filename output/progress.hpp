@@ -2,6 +2,7 @@
 // command line sends them to the terminal (terminal_progress), a library caller wherever it
 // likes, and by default they go nowhere. Text is passed as it is; the terminal escapes it.
 #pragma once
+#include <chrono>
 #include <functional>
 #include <string>
 
@@ -21,6 +22,26 @@ struct Progress {
   void count(const std::string& text) const {
     if (counter) counter(text);
   }
+};
+
+// Where a long job spends its time, phase by phase: "[diagnose] base model fitted (12 s)"
+// counts from where the last phase ended.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(const Progress& progress) : progress_(progress) {}
+  // Seconds since the last phase ended (or the timer started).
+  double seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  // Says "[diagnose] <what> (N s)" and starts the next phase.
+  void done(const std::string& what) {
+    progress_.say("[diagnose] " + what + " (" + std::to_string(static_cast<int>(seconds())) + " s)");
+    restart();
+  }
+  void restart() { start_ = Clock::now(); }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  const Progress& progress_;
+  Clock::time_point start_ = Clock::now();
 };
 
 // Standard error, one report at a time: lines as they come, every control character shown as
