@@ -155,6 +155,77 @@ struct GenericBlock {
   std::map<std::array<long, 3>, Placed> orientations;  // by thousandths of a degree, as exact_angle
 };
 
+// The terms the vehicle's totals are sums of, block by block: as expressions in the blocks'
+// symbols, and as the blocks' exact values. `second` holds second moments (expressions) or
+// inertias about the origin (values): whichever the block's closed forms give cheaply.
+struct TotalTerms {
+  exvector mass;
+  std::array<exvector, 3> first, areas;
+  std::array<std::array<exvector, 3>, 3> second;
+  void add(const ex& m, const ex c[3], const matrix& areas_col, const matrix& second_3x3) {
+    mass.push_back(m);
+    for (int i = 0; i < 3; ++i) {
+      first[i].push_back(m * c[i]);
+      areas[i].push_back(areas_col(i, 0));
+      for (int j = 0; j < 3; ++j) second[i][j].push_back(second_3x3(i, j));
+    }
+  }
+};
+
+struct Totals {
+  ex mass;
+  matrix cog{3, 1}, inertia_origin{3, 3}, inertia_cog{3, 3}, areas{3, 1};
+};
+
+// The same steps for the expressions and for the exact values: the sums built in one go
+// (adding term by term copies the growing sum each time), then the parallel-axis shift.
+Totals totals(const TotalTerms& t, bool is_second_moment) {
+  Totals r;
+  r.mass = add(t.mass);
+  matrix sum(3, 3);
+  for (int i = 0; i < 3; ++i) {
+    r.cog(i, 0) = add(t.first[i]) / r.mass;
+    r.areas(i, 0) = add(t.areas[i]);
+    for (int j = 0; j < 3; ++j) sum(i, j) = add(t.second[i][j]);
+  }
+  r.inertia_origin = is_second_moment ? inertia_from_second_moment(sum) : sum;
+  // Parallel-axis shift to the centre of gravity: J_cg = J_o - m (|c|^2 I - c c^T).
+  const ex cc = (r.cog.transpose().mul(r.cog))(0, 0);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r.inertia_cog(i, j) = r.inertia_origin(i, j) - r.mass * ((i == j ? cc : ex(0)) - r.cog(i, 0) * r.cog(j, 0));
+  return r;
+}
+
+// One block's contribution: the generic block's closed forms with its symbols and with its
+// numbers substituted (two substitutions, by lookup), its terms added to both totals.
+BlockContribution contribution(const Block& b, const GenericBlock& generic, const GenericBlock::Placed& placed,
+                               const BlockSymbols& s, MassProperties& mp, TotalTerms& sym, TotalTerms& num) {
+  const unsigned by_lookup = subs_options::no_pattern | subs_options::pattern_is_not_product;
+  const exmap to_symbols = generic.to_symbols(s), to_numbers = generic.to_numbers(b);
+  for (const symbol* g : {&generic.m, &generic.a, &generic.b, &generic.c, &generic.x, &generic.y, &generic.z})
+    mp.values.append(to_symbols.at(*g) == to_numbers.at(*g));
+
+  BlockContribution bc;
+  bc.name = b.name;
+  bc.local_second_moment = ex_to<matrix>(ex(generic.S).subs(to_symbols, by_lookup));
+  const matrix S_body = placed.substitute(placed.S_body, to_symbols);
+  bc.inertia_origin = inertia_from_second_moment(S_body);
+  bc.areas = ex_to<matrix>(ex(placed.areas).subs(to_symbols, by_lookup));
+  const matrix inertia_exact = placed.substitute(placed.inertia, to_numbers);
+  const matrix areas_exact = ex_to<matrix>(ex(placed.areas).subs(to_numbers, by_lookup));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      bc.inertia_origin_value[i][j] = j < i && placed.symmetric ? bc.inertia_origin_value[j][i] : to_double(inertia_exact(i, j));
+  for (int i = 0; i < 3; ++i) bc.areas_value[i] = to_double(areas_exact(i, 0));
+
+  const ex centre_symbols[3] = {s.cx, s.cy, s.cz};
+  const ex centre[3] = {to_numbers.at(generic.x), to_numbers.at(generic.y), to_numbers.at(generic.z)};
+  sym.add(s.m, centre_symbols, bc.areas, S_body);
+  num.add(to_numbers.at(generic.m), centre, areas_exact, inertia_exact);
+  return bc;
+}
+
 }  // namespace
 
 matrix block_rotation(const Vec3& ypr) {
@@ -163,99 +234,38 @@ matrix block_rotation(const Vec3& ypr) {
 
 // Linear in the number of blocks. Each block costs two substitutions into the generic
 // block's closed forms (its symbols, its numbers); the symbolic sums are built in one go
-// from the collected terms (adding term by term copies the growing sum each time); the
-// totals' values are the same formulas applied to the sums of the blocks' exact values
-// (exact arithmetic, so the same numbers as substituting all values into the symbolic
-// totals, which costs a walk over expressions of the vehicle's size per entry). Before,
-// every block was evaluated with a list of all 7N values (subs with a list matches every
-// symbol against every relation in turn): 1,000 blocks took about a minute.
+// from the collected terms; the totals' values are the same formulas applied to the sums of
+// the blocks' exact values (exact arithmetic, so the same numbers as substituting all values
+// into the symbolic totals, which costs a walk over expressions of the vehicle's size per
+// entry). Before, every block was evaluated with a list of all 7N values (subs with a list
+// matches every symbol against every relation in turn): 1,000 blocks took about a minute.
 MassProperties derive_mass_properties(const Vehicle& v) {
-  const unsigned by_lookup = subs_options::no_pattern | subs_options::pattern_is_not_product;
   GenericBlock generic;
   MassProperties mp;
   mp.symbols.reserve(v.blocks.size());
   mp.blocks.reserve(v.blocks.size());
-  exvector mass_terms, mass_numbers;
-  std::array<exvector, 3> first_terms, first_numbers, area_terms, area_numbers;
-  std::array<std::array<exvector, 3>, 3> second_terms, inertia_numbers;
+  TotalTerms sym, num;
   for (const Block& b : v.blocks) {
     const GenericBlock::Placed& placed = generic.placed(b.yaw_pitch_roll_deg);
     BlockSymbols s = make_symbols(b, placed.R);
-    const exmap to_symbols = generic.to_symbols(s), to_numbers = generic.to_numbers(b);
-    for (const symbol* g : {&generic.m, &generic.a, &generic.b, &generic.c, &generic.x, &generic.y, &generic.z})
-      mp.values.append(to_symbols.at(*g) == to_numbers.at(*g));
-
-    BlockContribution bc;
-    bc.name = b.name;
-    bc.local_second_moment = ex_to<matrix>(ex(generic.S).subs(to_symbols, by_lookup));
-    const matrix S_body = placed.substitute(placed.S_body, to_symbols);
-    bc.inertia_origin = inertia_from_second_moment(S_body);
-    bc.areas = ex_to<matrix>(ex(placed.areas).subs(to_symbols, by_lookup));
-    const matrix inertia_exact = placed.substitute(placed.inertia, to_numbers);
-    const matrix areas_exact = ex_to<matrix>(ex(placed.areas).subs(to_numbers, by_lookup));
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        bc.inertia_origin_value[i][j] = j < i && placed.symmetric ? bc.inertia_origin_value[j][i] : to_double(inertia_exact(i, j));
-    for (int i = 0; i < 3; ++i) bc.areas_value[i] = to_double(areas_exact(i, 0));
-
-    const ex m = to_numbers.at(generic.m);
-    const ex centre[3] = {to_numbers.at(generic.x), to_numbers.at(generic.y), to_numbers.at(generic.z)};
-    mass_terms.push_back(s.m);
-    mass_numbers.push_back(m);
-    const ex c[3] = {s.cx, s.cy, s.cz};
-    for (int i = 0; i < 3; ++i) {
-      first_terms[i].push_back(s.m * c[i]);
-      first_numbers[i].push_back(m * centre[i]);
-      area_terms[i].push_back(bc.areas(i, 0));
-      area_numbers[i].push_back(areas_exact(i, 0));
-      for (int j = 0; j < 3; ++j) {
-        second_terms[i][j].push_back(S_body(i, j));
-        inertia_numbers[i][j].push_back(inertia_exact(i, j));
-      }
-    }
+    mp.blocks.push_back(contribution(b, generic, placed, s, mp, sym, num));
     mp.symbols.push_back(std::move(s));
-    mp.blocks.push_back(std::move(bc));
   }
+  const Totals t = totals(sym, true);
+  mp.mass = t.mass;
+  mp.cog = t.cog;
+  mp.inertia_origin = t.inertia_origin;
+  mp.inertia_cog = t.inertia_cog;
+  mp.areas = t.areas;
 
-  // The same steps for the expressions and for the exact values.
-  struct Totals {
-    ex mass;
-    matrix cog{3, 1}, inertia_origin{3, 3}, inertia_cog{3, 3}, areas{3, 1};
-  };
-  auto totals = [](const exvector& mass, const std::array<exvector, 3>& first,
-                   const std::array<std::array<exvector, 3>, 3>& second_or_inertia, bool is_second_moment,
-                   const std::array<exvector, 3>& areas) {
-    Totals t;
-    t.mass = add(mass);
-    matrix sum(3, 3);
-    for (int i = 0; i < 3; ++i) {
-      t.cog(i, 0) = add(first[i]) / t.mass;
-      t.areas(i, 0) = add(areas[i]);
-      for (int j = 0; j < 3; ++j) sum(i, j) = add(second_or_inertia[i][j]);
-    }
-    t.inertia_origin = is_second_moment ? inertia_from_second_moment(sum) : sum;
-    // Parallel-axis shift to the centre of gravity: J_cg = J_o - m (|c|^2 I - c c^T).
-    const ex cc = (t.cog.transpose().mul(t.cog))(0, 0);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        t.inertia_cog(i, j) = t.inertia_origin(i, j) - t.mass * ((i == j ? cc : ex(0)) - t.cog(i, 0) * t.cog(j, 0));
-    return t;
-  };
-  Totals sym = totals(mass_terms, first_terms, second_terms, true, area_terms);
-  mp.mass = sym.mass;
-  mp.cog = sym.cog;
-  mp.inertia_origin = sym.inertia_origin;
-  mp.inertia_cog = sym.inertia_cog;
-  mp.areas = sym.areas;
-
-  const Totals num = totals(mass_numbers, first_numbers, inertia_numbers, false, area_numbers);
-  mp.mass_value = to_double(num.mass);
+  const Totals n = totals(num, false);
+  mp.mass_value = to_double(n.mass);
   for (int i = 0; i < 3; ++i) {
-    mp.cog_value[i] = to_double(num.cog(i, 0));
-    mp.areas_value[i] = to_double(num.areas(i, 0));
+    mp.cog_value[i] = to_double(n.cog(i, 0));
+    mp.areas_value[i] = to_double(n.areas(i, 0));
   }
-  mp.inertia_origin_value = to_mat3(num.inertia_origin);
-  mp.inertia_cog_value = to_mat3(num.inertia_cog);
+  mp.inertia_origin_value = to_mat3(n.inertia_origin);
+  mp.inertia_cog_value = to_mat3(n.inertia_cog);
   return mp;
 }
 
