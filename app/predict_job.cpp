@@ -7,6 +7,7 @@
 
 #include "app/model_registry.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "fit/flight_data.hpp"
 #include "output/json_document.hpp"
 #include "output/numbers.hpp"
 #include "runtime/plot.hpp"
@@ -63,8 +64,11 @@ void check_something_measured(const predict::Prediction& pooled, const PredictJo
 
 }  // namespace
 
-PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& v) {
+PredictJobResult run_predict_job(const PredictJob& job_in, const Vehicle& v) {
   PredictJobResult r;
+  PredictJob job = job_in;
+  const std::string mapping_environment = job.options.mapping.empty() ? "" : fit::load_mapping(job.options.mapping).environment;
+  job.options.environment = parse_environment(job.environment.empty() ? mapping_environment : job.environment);
   // Every effect, at its neutral value unless --params sets it.
   std::string how;
   const std::unique_ptr<runtime::DynamicModel> model = model_for(v, parse_effect_list("all"), &how);

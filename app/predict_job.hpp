@@ -13,6 +13,8 @@ namespace quadgen::app {
 struct PredictJob {
   std::string vehicle;            // vehicle file (YAML)
   std::vector<std::string> logs;  // one or more flights of it
+  // "indoor", "outdoor" or "unknown"; empty: the mapping's environment, else unknown.
+  std::string environment;
   predict::PredictFlightsOptions options;
 };
 

@@ -29,6 +29,10 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");
+  c->add_option("--environment", a.environment,
+                 "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
+                 "unknown); with --calibrate, a calibrated value beyond what is plausible there is said")
+      ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
   c->add_flag("--linear-correction", a.options.linear_correction,
               "also the one-step errors after a linear correction fitted on the part before the evaluated one (on "
               "the nominal model: a linear-regression baseline on the same split)");
@@ -44,7 +48,7 @@ int run_predict(const PredictArgs& a) {
   std::vector<std::string> inputs = a.logs;
   inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
   output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
-  app::PredictJob job{a.vehicle, a.logs, a.options};
+  app::PredictJob job{a.vehicle, a.logs, a.environment, a.options};
   job.options.progress = output::terminal_progress();
   const app::PredictJobResult r = app::run_predict_job(job, vehicle);
   for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";

@@ -41,17 +41,6 @@ std::vector<double> six_channel_rms(const fit::EquationErrorModel& m, const std:
   return fit::rms_by_channel(m.all_channels(ps), 6, [](size_t i) { return i % 6; });
 }
 
-// The lengths plausible ranges may be relative to: the largest distance of a rotor from the
-// body z axis, and the largest rotor radius.
-VehicleScales vehicle_scales(const Vehicle& v) {
-  VehicleScales s;
-  for (const auto& r : v.rotors) {
-    s.rotor_arm = std::max(s.rotor_arm, std::hypot(r.position[0], r.position[1]));
-    s.rotor_radius = std::max(s.rotor_radius, r.radius);
-  }
-  return s;
-}
-
 // m g arm / J: the angular acceleration the vehicle's weight gives at its rotor arm, the scale
 // against which a moment is negligible.
 double rotation_scale(const Vehicle& v, const SymbolicModel& all) {

@@ -4,7 +4,9 @@
 #include <sstream>
 #include <utility>
 
+#include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
+#include "output/numbers.hpp"
 #include "predict/parameter_source.hpp"
 
 namespace quadgen::predict {
@@ -17,6 +19,30 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
   if (!flight.has_pose) o.progress.say(path + ": no pose logged: one-step errors only (rollouts need a measured state)");
   return flight;
+}
+
+// Calibrated values beyond what the flight's environment makes plausible (a steady wind of
+// 0.8 m/s indoors): the flight's own quantities then stand in for something the airframe's
+// held values miss on this flight, and the prediction says so rather than scoring it silently.
+nlohmann::ordered_json implausible_calibration(const Vehicle& v, const runtime::DynamicModel& model,
+                                               const std::vector<double>& values, const std::vector<int>& calibrated,
+                                               const std::vector<fit::FitParameter>& bounds,
+                                               const PredictFlightsOptions& o) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (int k : calibrated) {
+    const std::string& name = model.param_names()[k];
+    double lower = 0, upper = 0;
+    std::string why;
+    if (!outside_plausible_range(name, values[k], o.environment, vehicle_scales(v), &lower, &upper, &why)) continue;
+    const std::string unit = bounds[k].unit.empty() ? "" : " " + bounds[k].unit;
+    o.progress.say("  note: calibrated " + name + " = " + output::short_number(values[k]) + unit +
+                   " lies outside what is plausible " + environment_name(o.environment) + " (" +
+                   output::short_number(lower) + " to " + output::short_number(upper) + unit + ": " + why +
+                   "): this flight's own quantities stand in for something the airframe's values miss here; "
+                   "quadgen diagnose of this flight with --airframe tests which of them it rejects");
+    out.push_back({{"parameter", name}, {"value", values[k]}, {"lower", lower}, {"upper", upper}, {"why", why}});
+  }
+  return out;
 }
 
 std::string percent(double fraction) {
@@ -54,12 +80,14 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
     values.origin = "vehicle file (nominal)";
     if (source) values = source->for_log(model, logs[i]);
     nlohmann::ordered_json calibrated = nlohmann::ordered_json::object();
+    nlohmann::ordered_json implausible = nlohmann::ordered_json::array();
     if (o.calibrate && values.flight == 0 && !values.flight_params.empty()) {
       o.progress.say("  calibrating " + std::to_string(values.flight_params.size()) + " flight parameters on the first " +
                  percent(1.0 - o.validation) + " %");
       values.values = calibrate(model, values.values, values.flight_params, bounds, before);
       for (int k : values.flight_params) calibrated[model.param_names()[k]] = values.values[k];
       values.origin += ", flight parameters calibrated on the part before";
+      implausible = implausible_calibration(v, model, values.values, values.flight_params, bounds, o);
     }
     Prediction p = evaluate_prediction(model, values.values, evaluated, o.prediction);
     if (o.linear_correction) p.one_step_corrected = linearly_corrected_one_step(model, values.values, before, evaluated);
@@ -67,6 +95,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
     j["log"] = logs[i];
     j["parameters_from"] = values.origin;
     if (!calibrated.empty()) j["calibrated"] = calibrated;
+    if (!implausible.empty()) j["calibrated_implausible"] = implausible;
     j["evaluated_from_s"] = evaluated.samples.empty() ? 0.0 : evaluated.samples.front().t;
     flights.push_back(j);
     out.pooled.merge(p);

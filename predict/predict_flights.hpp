@@ -13,6 +13,7 @@
 #include "fit/least_squares.hpp"
 #include "output/progress.hpp"
 #include "predict/prediction.hpp"
+#include "model/effect.hpp"
 #include "model/vehicle.hpp"
 
 namespace quadgen::predict {
@@ -23,6 +24,9 @@ struct PredictFlightsOptions {
   double validation = 0.3;  // fraction of each flight (at its end) evaluated; 1: all of it
   std::string params;    // a fit.json or diagnosis.json; empty: the vehicle file's nominal values
   bool calibrate = false;   // fit an unseen log's own parameters on the part before (needs params)
+  // Where the flights were flown: a calibrated value outside what is plausible there (a
+  // steady wind indoors) is said, as diagnose says a stand-in.
+  Environment environment = Environment::kUnknown;
   // Also the one-step errors left after a linear correction fitted on the part before
   // (linearly_corrected_one_step; needs validation below 1).
   bool linear_correction = false;

@@ -538,6 +538,49 @@ TEST(PredictParameters, CalibrationRecoversTheFlightsOwnTrim) {
   EXPECT_LT(with.open_loop[2].position.mean(), 0.5 * without.open_loop[2].position.mean());
 }
 
+// A flight's own quantity calibrated beyond what is plausible where it was flown (a steady
+// wind of 1.5 m/s indoors) is said, on the terminal and in prediction.json, as diagnose
+// says a stand-in; the same calibration where a wind is plausible (outdoors) says nothing.
+TEST(PredictParameters, ACalibratedValueBeyondItsPlausibleRangeIsSaid) {
+  const fs::path dir = fs::temp_directory_path() / ("quadgen_predict_implausible_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string csv = (dir / "f.csv").string(), params = (dir / "diagnosis.json").string();
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + vehicle +
+                         " --closed-loop --duration 20 --seed 3 --effects wind --set wind.x=1.5 --out " + csv +
+                         " > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  // The airframe of another flight, with the wind as each flight's own quantity.
+  std::ofstream(params) << R"({"final_fit": {}, "flights": ["another.csv"], "flight_parameters": ["wind.x", "wind.y"]})";
+  for (const std::string where : {"indoor", "outdoor"}) {
+    const fs::path out = dir / where, err = dir / (std::string(where) + ".err");
+    const std::string cmd = std::string(QUADGEN_BINARY) + " predict " + vehicle + " " + csv + " --params " + params +
+                            " --calibrate --environment " + where + " --out " + out.string() + " > /dev/null 2> " +
+                            err.string();
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream in(err);
+    const std::string said((std::istreambuf_iterator<char>(in)), {});
+    std::ifstream json_in(out / "prediction.json");
+    const auto j = nlohmann::json::parse(json_in);
+    const auto& flight = j["flights"][0];
+    EXPECT_NEAR(flight["calibrated"]["wind.x"].get<double>(), 1.5, 0.15) << "the calibration did not find the wind";
+    if (std::string(where) == "indoor") {
+      EXPECT_NE(said.find("calibrated wind.x = 1."), std::string::npos) << said;
+      EXPECT_NE(said.find("outside what is plausible indoor"), std::string::npos) << said;
+      ASSERT_TRUE(flight.contains("calibrated_implausible"));
+      ASSERT_EQ(flight["calibrated_implausible"].size(), 1u) << flight["calibrated_implausible"].dump();
+      EXPECT_EQ(flight["calibrated_implausible"][0]["parameter"], "wind.x");
+      EXPECT_EQ(flight["calibrated_implausible"][0]["upper"].get<double>(), 0.5);
+    } else {
+      EXPECT_EQ(said.find("outside what is plausible"), std::string::npos) << said;
+      EXPECT_FALSE(flight.contains("calibrated_implausible"));
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // --calibrate without a diagnosis to calibrate, or with nothing before the evaluated part,
 // is refused before any work and leaves no output.
 TEST(PredictParameters, CalibrateRefusedWithoutWhatItNeeds) {

@@ -1,6 +1,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -131,6 +132,15 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
   *upper = found->upper * unit;
   *why = found->why;
   return true;
+}
+
+VehicleScales vehicle_scales(const Vehicle& v) {
+  VehicleScales s;
+  for (const auto& r : v.rotors) {
+    s.rotor_arm = std::max(s.rotor_arm, std::hypot(r.position[0], r.position[1]));
+    s.rotor_radius = std::max(s.rotor_radius, r.radius);
+  }
+  return s;
 }
 
 bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,

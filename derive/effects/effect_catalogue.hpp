@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "model/effect.hpp"
+#include "model/vehicle.hpp"
 
 namespace quadgen {
 
@@ -54,6 +55,8 @@ std::string environment_name(Environment e);
 struct VehicleScales {
   double rotor_arm = 0, rotor_radius = 0;  // m
 };
+// The largest distance of a rotor from the body z axis, and the largest rotor radius.
+VehicleScales vehicle_scales(const Vehicle& v);
 // The plausible range of a parameter in this environment, in SI (lower, upper, why); false
 // when its effect declares none, or declares it relative to a length `scales` does not give.
 bool plausible_range(const std::string& parameter, Environment where, const VehicleScales& scales, double* lower,
