@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "cli/derive_command.hpp"
+#include "cli/options.hpp"
 #include "output/sinks.hpp"
 #include "app/derive_job.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -29,7 +30,7 @@ int run_derive(const DeriveArgs& args) {
   const app::DeriveJobResult r = app::run_derive_job(job, vehicle);
   std::cerr << "[5/5] writing " << output::printable(args.out) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
-  out.commit();
+  commit_and_say(out, "derive");
   if (!r.note.empty()) std::cerr << "quadgen: note: " << output::printable_lines(r.note) << "\n";
   std::cout << output::printable_lines(r.summary);
   return r.audit_passed ? 0 : 3;

@@ -67,7 +67,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   const app::DiagnoseJobResult r = app::run_diagnose_job(j);
   for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
-  out.commit();
+  commit_and_say(out, "diagnose");
   std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "/report.html\n";
   return 0;
 }

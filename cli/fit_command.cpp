@@ -113,7 +113,7 @@ int run_fit(const FitArgs& a) {
   out.add("fit.json", output::json_document(result.json));
   for (const auto& [file, svg] : result.plots) out.add(file, svg);
   for (const auto& err : result.plot_errors) std::cerr << "no plot " << output::printable_lines(err) << "\n";
-  out.commit();
+  commit_and_say(out, "fit");
   std::cout << output::printable_lines(result.summary);
   for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << w << "\n";
   return 0;

@@ -2,6 +2,7 @@
 // lets NaN through) and which options a command line actually gave. (The NAME=VALUE pairs of
 // simulate's --set are parsed in simulate_command.cpp.)
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -9,29 +10,66 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/output_set.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::cli {
+
+// Edits (insert, delete, replace) between two words: a misspelt command or option is
+// suggested back.
+inline size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// The option of `command` nearest to `word` ("--maping" -> "--mapping"), within two edits;
+// "" when none is.
+inline std::string nearest_option(const CLI::App& command, const std::string& word) {
+  const std::string bare = word.substr(0, word.find('='));
+  std::string nearest;
+  size_t best = 3;
+  for (const CLI::Option* o : command.get_options())
+    for (const std::string& name : o->get_lnames())
+      if (const size_t d = edit_distance(bare, "--" + name); d < best) best = d, nearest = "--" + name;
+  return nearest;
+}
 
 // A command line CLI11 refused, reported as every other error is: one line, whatever the
 // argument it quotes holds (escape sequences, a newline that would fake a second message).
 // --help and --version leave through CLI11 itself (exit code 0).
 // CLI11 reports a missing required option before an unknown one, so `--ouut DIR` reads as
-// "--out is required"; the words it did not understand are named beside it.
+// "--out is required"; the words it did not understand are named beside it, and a misspelt
+// option gets the nearest one back.
 inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
   if (e.get_exit_code() == 0) return app.exit(e);
-  std::string not_understood;
-  if (dynamic_cast<const CLI::RequiredError*>(&e))
-    for (const CLI::App* command : app.get_subcommands())
-      for (const std::string& word : command->remaining())
-        if (word.rfind("--", 0) == 0) not_understood += (not_understood.empty() ? "" : " ") + word;
+  std::string not_understood, suggestions;
+  for (const CLI::App* command : app.get_subcommands())
+    for (const std::string& word : command->remaining()) {
+      if (word.rfind("--", 0) != 0) continue;
+      not_understood += (not_understood.empty() ? "" : " ") + word;
+      if (const std::string near = nearest_option(*command, word); !near.empty() && near != word)
+        suggestions += std::string(suggestions.empty() ? "" : ", ") + "'" + near + "' for '" + word + "'";
+    }
   std::cerr << "quadgen: error: " << output::printable(e.what());
-  if (!not_understood.empty()) std::cerr << " (not understood: " << output::printable(not_understood) << ")";
+  if (!not_understood.empty() && dynamic_cast<const CLI::RequiredError*>(&e))
+    std::cerr << " (not understood: " << output::printable(not_understood) << ")";
+  if (!suggestions.empty()) std::cerr << "; did you mean " << output::printable(suggestions) << "?";
   std::cerr << "\nRun with --help for more information.\n";
   return e.get_exit_code();
 }
@@ -74,6 +112,14 @@ inline CLI::Validator finite_range(double lo, double hi) {
         return {};
       },
       "in " + range_text(lo, hi));
+}
+
+// Switches a command's output in and says when it replaced an earlier run of the same
+// command in that folder (two runs given one --out keep only the second).
+inline void commit_and_say(output::OutputDirectory& out, const std::string& command) {
+  out.commit();
+  if (out.replaced_earlier_run())
+    std::cerr << "quadgen: note: replaced the earlier " << command << " output in " << output::printable(out.dir()) << "\n";
 }
 
 // The long names of the options of `sub` that the command line gave.

@@ -53,7 +53,7 @@ int run_predict(const PredictArgs& a) {
   const app::PredictJobResult r = app::run_predict_job(job, vehicle);
   for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";
   for (const auto& [name, contents] : r.files) out.add(name, contents);
-  out.commit();
+  commit_and_say(out, "predict");
   std::cout << output::printable_lines(r.summary) << "wrote " << output::printable(a.out) << "/prediction.json\n";
   if (!r.failure.empty()) {
     std::cerr << "quadgen: error: " << r.failure << "\n";

@@ -12,22 +12,6 @@
 
 namespace {
 
-// Edits (insert, delete, replace) between two words: a misspelt command is suggested back.
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 // CLI11 says only "A subcommand is required" for `quadgen diagnos ...`; this names the word,
 // the commands there are, and the nearest one.
 bool unknown_command(const CLI::App& app, const std::string& word) {
@@ -38,7 +22,7 @@ bool unknown_command(const CLI::App& app, const std::string& word) {
     const std::string& c = command->get_name();
     if (c == word) return false;
     list += (list.empty() ? "" : ", ") + c;
-    if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
+    if (const size_t d = quadgen::cli::edit_distance(word, c); d < best) best = d, nearest = c;
   }
   std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << list << ")";
   if (!nearest.empty()) std::cerr << "; did you mean '" << nearest << "'?";

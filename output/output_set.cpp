@@ -591,6 +591,7 @@ void OutputDirectory::commit() {
       fail(target, "cannot switch the output into place: " + std::string(std::strerror(why)));
     test_hook_signal("after-exchange");
     remove_earlier_run(staged, target);
+    replaced_ = true;
   }
   staging_->release();
   created_.keep();

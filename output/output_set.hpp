@@ -68,10 +68,14 @@ class OutputDirectory {
   // Switches the whole set in.
   void commit();
   const std::string& dir() const { return dir_; }
+  // After commit: whether an earlier run of the same command was replaced (the command line
+  // says so: two runs given one --out keep only the second).
+  bool replaced_earlier_run() const { return replaced_; }
 
  private:
   std::string dir_;
   std::string command_;
+  bool replaced_ = false;
   std::vector<std::string> inputs_;
   CreatedFolders created_;  // destroyed after the staging directory inside them
   std::unique_ptr<StagingDirectory> staging_;

@@ -732,6 +732,21 @@ TEST(DataLoss, EditedOutputAndAnotherCommandsOutputAreNotReplaced) {
   EXPECT_NE(read(tmp / "e/.quadgen-manifest").find("\ncommand derive\n"), std::string::npos);
 }
 
+// An earlier run of the same command is replaced whole, and the run says so (a newcomer gave
+// two diagnoses one --out and lost the first without a word); a first run says nothing.
+TEST(DataLoss, ReplacingAnEarlierRunIsSaid) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const CliResult first = run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir);
+  ASSERT_EQ(first.rc, 0);
+  EXPECT_EQ(first.err.find("replaced"), std::string::npos) << first.err;
+  const CliResult second = run_quadgen({"derive", vehicle, "--out", tmp / "d"}, tmp.dir);
+  ASSERT_EQ(second.rc, 0);
+  EXPECT_NE(second.err.find("quadgen: note: replaced the earlier derive output in " + (tmp / "d")), std::string::npos)
+      << second.err;
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
+}
+
 // simulate writes files among the user's: only a trajectory or a gnuplot plot is replaced.
 TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
   Scratch tmp;
@@ -1047,7 +1062,14 @@ TEST(Cli, NewcomerMistakesAreNamed) {
                                                           "diagnose, predict); did you mean 'diagnose'?");
   expect_error({"generate", f3, "--out", tmp / "o"}, 106, "'derive' writes the generated C++");
   // A misspelt required option: CLI11 alone says only that --out is missing.
-  expect_error({"derive", f3, "--ouut", tmp / "o"}, 106, "--out is required (not understood: --ouut)");
+  expect_error({"derive", f3, "--ouut", tmp / "o"}, 106,
+               "--out is required (not understood: --ouut); did you mean '--out' for '--ouut'?");
+  // A misspelt option gets the nearest of that command's options back; a word near none, nothing.
+  expect_error({"diagnose", f3, "x.csv", "--maping", "M.yaml", "--out", tmp / "o"}, 109,
+               "not expected: --maping; did you mean '--mapping' for '--maping'?");
+  expect_error({"predict", f3, "x.csv", "--calibrat", "--out", tmp / "o"}, 109, "did you mean '--calibrate'");
+  const CliResult far = run_quadgen({"predict", f3, "x.csv", "--zzzzzzzz", "--out", tmp / "o"}, tmp.dir);
+  EXPECT_EQ(far.err.find("did you mean"), std::string::npos) << far.err;
   // Files that are not logs are named as what they should have been.
   ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
   expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,
