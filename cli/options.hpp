@@ -16,38 +16,19 @@
 
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::cli {
 
-// Edits (insert, delete, replace) between two words: a misspelt command or option is
-// suggested back.
-inline size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 // The option of `command` nearest to `word` ("--maping" -> "--mapping"), within two edits;
 // "" when none is.
 inline std::string nearest_option(const CLI::App& command, const std::string& word) {
-  const std::string bare = word.substr(0, word.find('='));
-  std::string nearest;
-  size_t best = 3;
+  std::vector<std::string> options;
   for (const CLI::Option* o : command.get_options())
-    for (const std::string& name : o->get_lnames())
-      if (const size_t d = edit_distance(bare, "--" + name); d < best) best = d, nearest = "--" + name;
-  return nearest;
+    for (const std::string& name : o->get_lnames()) options.push_back("--" + name);
+  return output::nearest_word(word.substr(0, word.find('=')), options);
 }
 
 // A command line CLI11 refused, reported as every other error is: one line, whatever the

@@ -16,14 +16,15 @@ namespace {
 // the commands there are, and the nearest one.
 bool unknown_command(const CLI::App& app, const std::string& word) {
   if (word.empty() || word[0] == '-') return false;
-  std::string list, nearest;
-  size_t best = 3;  // suggest only within two edits
+  std::string list;
+  std::vector<std::string> commands;
   for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
     const std::string& c = command->get_name();
     if (c == word) return false;
     list += (list.empty() ? "" : ", ") + c;
-    if (const size_t d = quadgen::cli::edit_distance(word, c); d < best) best = d, nearest = c;
+    commands.push_back(c);
   }
+  const std::string nearest = quadgen::output::nearest_word(word, commands);
   std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << list << ")";
   if (!nearest.empty()) std::cerr << "; did you mean '" << nearest << "'?";
   if (word == "generate") std::cerr << "; 'derive' writes the generated C++ (model.hpp) with the derivation";

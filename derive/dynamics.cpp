@@ -55,6 +55,29 @@ std::string outside_text(double x, double lower, double upper) {
   return buf;
 }
 
+// A total a thousand times (or a thousandth of) what its bounds expect is most often a unit
+// slip in the blocks: grams written as kilograms, millimetres as metres. Said with the block
+// that gives most of it; "" otherwise.
+std::string unit_slip(const Vehicle& v, const std::string& name, double value, const Parameter& declared) {
+  const double expected = 0.5 * (declared.lower + declared.upper);
+  if (!(expected > 0) || !(value > 0)) return "";
+  const double ratio = value / expected;
+  const bool thousand = ratio > 300 && ratio < 3000, thousandth = ratio > 1.0 / 3000 && ratio < 1.0 / 300;
+  if (!thousand && !thousandth) return "";
+  if (name != "mass") return " (about " + std::string(thousand ? "1000 times" : "a thousandth of") +
+                             " the bounds: block sizes or positions in millimetres where the file reads metres?)";
+  const Block* heaviest = nullptr;
+  for (const auto& b : v.blocks)
+    if (!heaviest || b.mass > heaviest->mass) heaviest = &b;
+  std::string said = " (about " + std::string(thousand ? "1000 times" : "a thousandth of") + " the bounds: masses in " +
+                     (thousand ? "grams written as kilograms" : "kilograms where grams were meant") + "?";
+  if (heaviest)
+    said += " The heaviest block, '" + output::printable(heaviest->name) + "'" +
+            (heaviest->line > 0 ? " at line " + std::to_string(heaviest->line) : "") + ", has " +
+            shortest_text(heaviest->mass) + " kg";
+  return said + ")";
+}
+
 // The vehicle file's `derived:` entry for a quantity, against what the blocks give.
 void check_derived_bounds(const Vehicle& v, const std::string& name, const std::string& unit, double value,
                           const Parameter& declared) {
@@ -63,7 +86,7 @@ void check_derived_bounds(const Vehicle& v, const std::string& name, const std::
   throw VehicleError(v.source_path + where + ": derived quantity " + name + ": the blocks give " +
                      outside_text(value, declared.lower, declared.upper) + " " + unit +
                      ", outside its bounds [" + shortest_text(declared.lower) + ", " + shortest_text(declared.upper) +
-                     "]");
+                     "]" + unit_slip(v, name, value, declared));
 }
 
 // The rotor speed a command asks for: the motor map a0 + a1 u + a2 u^2, turned about its

@@ -11,6 +11,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "fit/least_squares.hpp"
+#include "model/yaml_reader.hpp"
+#include "output/nearest_word.hpp"
 #include "runtime/log_file.hpp"
 #include "model/units.hpp"
 #include "runtime/rigid_body_state.hpp"
@@ -161,7 +163,8 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
+    throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg +
+                   yaml_slip(text, e.mark.line, e.msg));
   }
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
@@ -237,6 +240,20 @@ void ned_frd_to_enu_flu(runtime::CsvTable& t, const std::string& mapping_name) {
 
 }  // namespace
 
+namespace {
+
+// A source column the log does not have is the mapping's line to fix (or the wrong log):
+// named there, with the log's column it probably meant.
+std::string missing_source(const runtime::CsvTable& raw, const ColumnMapping& m, const ColumnMapping::Entry& e) {
+  const std::string where = m.path.empty() ? raw.path + ":1" : m.path + (e.line > 0 ? ":" + std::to_string(e.line) : "");
+  std::string said = where + ": column '" + e.source + "' (for '" + e.target + "') is not in the header of " + raw.path;
+  if (const std::string near = output::nearest_word(e.source, raw.columns); !near.empty())
+    said += "; did you mean '" + near + "'?";
+  return said;
+}
+
+}  // namespace
+
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m) {
   runtime::CsvTable out;
   out.path = raw.path;
@@ -244,7 +261,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);
-    if (c < 0) throw FitError(raw.path + ":1: column '" + e.source + "' (mapped to '" + e.target + "' by " + m.name + ") is missing");
+    if (c < 0) throw FitError(missing_source(raw, m, e));
     src.push_back(c);
     out.columns.push_back(e.target);
     out.name_lines.push_back(e.line);
@@ -423,6 +440,20 @@ void check_sensor_units(const std::string& path, const Flight& f) {
 }
 }  // namespace
 
+namespace {
+
+// Which of `columns` a log lacks, blamed on the mapping where one named its columns.
+std::string missing_columns(const runtime::CsvTable& log, const std::vector<std::string>& columns, const std::string& what) {
+  std::string missing;
+  for (const auto& c : columns)
+    if (log.column(c) < 0) missing += (missing.empty() ? "'" : ", '") + c + "'";
+  if (log.named_by.empty()) return log.path + ":1: missing column " + missing + ": " + what;
+  return log.named_by + ": maps no column of " + log.path + " to " + missing + ": " + what +
+         " (add each under columns:, e.g. p: {source: <the log's column>, unit: rad/s})";
+}
+
+}  // namespace
+
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
   // The likeliest cause of a missing column in a log read without a mapping: it needs one.
   runtime::validate_canonical(log, rotors,
@@ -443,7 +474,7 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   f.has_gyro = has({"p", "q", "r"});
   f.has_accelerometer = has({"ax", "ay", "az"});
   f.has_vbat = has({"vbat"});
-  if (!f.has_gyro) throw FitError(log.path + ":1: missing body rates p, q, r (gyro)");
+  if (!f.has_gyro) throw FitError(missing_columns(log, {"p", "q", "r"}, "the body rates (gyro)"));
   if (!f.has_pose && !f.has_accelerometer)
     throw FitError(log.path + ":1: need a pose (x, y, z, qw..qz) or an accelerometer (ax, ay, az)");
   const auto t = log.values("t");

@@ -17,6 +17,22 @@
 
 namespace quadgen {
 
+// What yaml-cpp's words mean in a hand-written file ("end of map not found" for a tab in the
+// indentation, "end of map flow not found" for a missing comma): the likely slip, appended
+// to its message; "" when none is recognised. `line` counts from 0, as yaml-cpp's marks do.
+inline std::string yaml_slip(const std::string& text, int line, const std::string& message) {
+  std::istringstream in(text);
+  std::string l;
+  for (int n = 0; std::getline(in, l) && n <= line; ++n) {
+    const size_t indent = l.find_first_not_of(" \t");
+    if (l.find('\t') < indent && indent != std::string::npos)
+      return " (line " + std::to_string(n + 1) + " indents with a tab: YAML indents with spaces only)";
+  }
+  if (message.find("flow") != std::string::npos)
+    return " (a '{...}' or '[...]' left open, or two of its entries without a comma between them)";
+  return "";
+}
+
 struct YamlReader {
   std::string path;
 
@@ -52,7 +68,7 @@ struct YamlReader {
     try {
       return YAML::Load(content);
     } catch (const YAML::ParserException& e) {
-      fail_at(e.mark, "malformed YAML: " + e.msg);
+      fail_at(e.mark, "malformed YAML: " + e.msg + yaml_slip(content, e.mark.line, e.msg));
     }
   }
 

@@ -1,6 +1,7 @@
 #include "runtime/closed_loop.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <sstream>
 
@@ -96,19 +97,27 @@ std::vector<double> allocate(const ControllerModel& b, double thrust, const std:
 namespace {
 // Why the least-norm trim (balancing, but asking some rotor for less than its command 0 gives)
 // had no alternative: names the rotor furthest below its least and where the CoG must lie.
+// A thrust within rounding of 0 (a rotor the trim does not need: 1e-17 N either side) is 0,
+// not a pull.
 std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eigen::VectorXd& least,
-                                    const std::vector<std::string>& rotor_names) {
+                                    const std::vector<std::string>& rotor_names, double weight) {
   Eigen::Index k = 0;
   (least_norm - least).minCoeff(&k);
-  const double asked = least_norm(k);
+  const bool pulls = least_norm(k) < -1e-9 * weight;
+  const double asked = pulls ? least_norm(k) : std::max(least_norm(k), 0.0);
+  const auto newtons = [](double f) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g N", f);
+    return std::string(buf);
+  };
   const std::string what =
-      asked < 0 ? " would have to pull down " + std::to_string(-asked) + " N"
-                : " would have to give " + std::to_string(asked) + " N, less than its motor map gives at command 0 (" +
-                      std::to_string(least(k)) + " N)";
+      pulls ? " would have to pull down " + newtons(-asked)
+            : " would have to give " + newtons(asked) + ", less than its motor map gives at command 0 (" +
+                  newtons(least(k)) + ")";
   const std::string where =
       least_norm.size() > 4 ? " (with more than four rotors: no other trim was found, holding such rotors at command 0 "
                               "in turn)"
-      : asked < 0           ? " (the centre of gravity lies outside the rotors)"
+      : pulls               ? " (the centre of gravity lies outside the rotors)"
                             : " (the centre of gravity lies too far towards the other rotors)";
   return "rotor " + rotor_names[static_cast<size_t>(k)] + what + where;
 }
@@ -143,7 +152,7 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   if (!balances(least_norm)) {
     t.why_not = "no thrusts balance the weight without a moment";
   } else if (!reachable_below) {
-    t.why_not = why_no_trim_above_least(least_norm, least, rotor_names);
+    t.why_not = why_no_trim_above_least(least_norm, least, rotor_names, weight);
   }
   for (size_t i = 0; t.found() && i < n; ++i) try {
       t.commands.push_back(free[i] ? b.thrust_laws[i].command_for(t.thrusts[i]) : 0.0);  // held: command 0

@@ -252,8 +252,14 @@ void check_values(const CsvTable& log) {
 
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors, const std::string& missing_hint) {
   // A name the mapping gave is the mapping's mistake: its file and line are named, not the log's.
-  const std::string maps = log.named_by.empty() ? "" : " (mapped from " + log.path + ")";
-  if (log.column("t") < 0) throw LogError(log.where_named() + ": missing column 't'" + maps + missing_hint);
+  const std::string maps = log.named_by.empty() ? "" : " (in the mapping read for " + log.path + ")";
+  // A canonical column the mapping does not give: the entry to add, and where.
+  const auto missing = [&](const std::string& column) {
+    if (log.named_by.empty()) return LogError(log.where_named() + ": missing column '" + column + "'" + missing_hint);
+    return LogError(log.named_by + ": maps no column of " + log.path + " to '" + column + "' (add '" + column +
+                    ": {source: <the log's column>}' under columns:)");
+  };
+  if (log.column("t") < 0) throw missing("t");
   std::set<std::string> known(rotors.begin(), rotors.end());
   std::string list;
   for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
@@ -264,7 +270,7 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
                      list + ")" + maps);
   }
   for (const auto& r : rotors)
-    if (log.column("u_" + r) < 0) throw LogError(log.where_named() + ": missing column 'u_" + r + "'" + maps + missing_hint);
+    if (log.column("u_" + r) < 0) throw missing("u_" + r);
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
   const int tc = log.column("t");

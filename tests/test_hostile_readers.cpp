@@ -247,10 +247,27 @@ TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
                                     "  u_M3: {source: m3}\n  u_M4: {source: m4}\n");
   const auto mapped = read_log(log, mapping, 0);
   const std::string why = message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"M1", "M2", "M3", "M4"}); });
-  expect_located(why, mapping, 3, "column 'u_m1' names no rotor of this vehicle (rotors: M1, M2, M3, M4) (mapped from " + log + ")");
+  expect_located(why, mapping, 3,
+                 "column 'u_m1' names no rotor of this vehicle (rotors: M1, M2, M3, M4) (in the mapping read for " + log + ")");
   const std::string missing =
       message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"m1", "M2", "M3", "M4", "M5"}); });
-  EXPECT_NE(missing.find(mapping + ": missing column 'u_M5'"), std::string::npos) << missing;
+  EXPECT_NE(missing.find(mapping + ": maps no column of " + log + " to 'u_M5' (add 'u_M5: {source: <the log's column>}' "
+                                   "under columns:)"),
+            std::string::npos)
+      << missing;
+  // A source column the log lacks: the mapping's line, and the column it probably meant.
+  const std::string typo = write("typo.yaml", "columns:\n  t: {source: time}\n  u_M1: {source: M1}\n");
+  const std::string wrong_case = message_of<FitError>([&] { read_log(log, typo, 0); });
+  expect_located(wrong_case, typo, 3, "column 'M1' (for 'u_M1') is not in the header of " + log + "; did you mean 'm1'?");
+  // The gyro not mapped: which body rates, and that the mapping should give them.
+  const std::string no_gyro = write("nogyro.yaml", "columns:\n  t: {source: time}\n  u_M1: {source: m1}\n  u_M2: "
+                                                   "{source: m2}\n  u_M3: {source: m3}\n  u_M4: {source: m4}\n");
+  FlightOptions two_rows;
+  two_rows.min_samples = 2;
+  const std::string gyro =
+      message_of<FitError>([&] { load_flight(read_log(log, no_gyro, 0), {"M1", "M2", "M3", "M4"}, two_rows); });
+  EXPECT_NE(gyro.find(no_gyro + ": maps no column of " + log + " to 'p', 'q', 'r': the body rates (gyro)"), std::string::npos)
+      << gyro;
 }
 
 // Units that are right in dimension and wrong in number: a gyro in deg/s declared rad/s, an

@@ -1154,6 +1154,12 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     Vehicle v = good;
     v.rotors[1].position = v.rotors[0].position;
     EXPECT_NE(checks_of(v).at(discs).detail.find("the same place"), std::string::npos);
+    // The slip is said first, before the flight checks it makes fail; a rotor the trim does
+    // not need (1e-17 N either side of 0) is asked for 0 N, not to pull down.
+    const auto in_order = check_vehicle_can_fly(v, derive_model(v, derive_mass_properties(v), {}));
+    ASSERT_FALSE(in_order.empty());
+    EXPECT_EQ(in_order.front().name, discs);
+    EXPECT_EQ(checks_of(v).at(trim).detail.find("pull down"), std::string::npos) << checks_of(v).at(trim).detail;
     v = good;
     for (auto& r : v.rotors) r.radius = 0.08;  // 0.149 m between neighbouring hubs
     EXPECT_FALSE(checks_of(v).at(discs).passed);

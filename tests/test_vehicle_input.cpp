@@ -9,6 +9,9 @@
 #include <Eigen/Dense>
 
 #include "derive/effects/effect_catalogue.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/geometry.hpp"
+#include "model/yaml_reader.hpp"
 #include "tests/test_helpers.hpp"
 
 using namespace quadgen;
@@ -56,6 +59,41 @@ TEST(VehicleInput, BundledFilesLoad) {
 }
 
 TEST(VehicleInput, MalformedYaml) { expect_error("name: x\nblocks: [\n", "malformed YAML"); }
+// yaml-cpp's words for two common slips, said in a hand-writer's terms.
+TEST(VehicleInput, MalformedYamlNamesTheLikelySlip) {
+  std::string tabbed = finken_text();
+  const auto pos = tabbed.find("\n  c_t:");
+  ASSERT_NE(pos, std::string::npos);
+  tabbed.replace(pos + 1, 2, "\t");
+  expect_error(tabbed, "indents with a tab: YAML indents with spaces only");
+  expect_error("name: x\nrotors:\n  - {name: A position: [0, 0, 0]}\n",
+               "a '{...}' or '[...]' left open, or two of its entries without a comma between them");
+  EXPECT_EQ(quadgen::yaml_slip("a: 1\n", 0, "end of map not found"), "");
+}
+
+// A mass a thousand times its declared bounds is most likely grams written as kilograms: said,
+// with the heaviest block and its line.
+TEST(VehicleInput, GramsWrittenAsKilogramsAreNamed) {
+  // Every block's mass in grams (0.099 -> 99): the FINken 3 then weighs 387 kg.
+  const std::regex kilograms("mass: (0\\.[0-9]+)");
+  std::string text, rest = finken_text();
+  std::smatch m;
+  while (std::regex_search(rest, m, kilograms)) {
+    text += m.prefix().str() + "mass: " + std::to_string(std::stod(m[1].str()) * 1000);
+    rest = m.suffix().str();
+  }
+  text += rest;
+  const quadgen::Vehicle v = quadgen::parse_vehicle(text, "g.yaml");
+  try {
+    quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
+    ADD_FAILURE() << "a 387 kg FINken 3 passed the mass bounds";
+  } catch (const quadgen::VehicleError& e) {
+    EXPECT_NE(std::string(e.what()).find("masses in grams written as kilograms? The heaviest block, 'lower_body' at line 46"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(VehicleInput, MissingKey) { expect_error(replace(finken_text(), "name: finken3\n", ""), "missing key 'name'"); }
 // Every section parameter is required, the rotor model's and the frame's too (they once
 // parsed without: a row of strings had their doc text in the "required" slot).

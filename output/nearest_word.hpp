@@ -1,0 +1,44 @@
+// The word a person probably meant: a misspelt command, option or log column is suggested
+// back ("--maping": did you mean '--mapping'?).
+#pragma once
+#include <algorithm>
+#include <cctype>
+#include <string>
+#include <vector>
+
+namespace quadgen::output {
+
+// Edits (insert, delete, replace) between two words.
+inline size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// Of `candidates`, the one `word` differs from only in case, else the nearest within
+// `max_edits` edits (the first of equals); "" when none is that near.
+inline std::string nearest_word(const std::string& word, const std::vector<std::string>& candidates,
+                                size_t max_edits = 2) {
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  for (const auto& c : candidates)
+    if (c != word && lower(c) == lower(word)) return c;
+  std::string nearest;
+  size_t best = max_edits + 1;
+  for (const auto& c : candidates)
+    if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
+  return nearest;
+}
+
+}  // namespace quadgen::output
