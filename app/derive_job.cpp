@@ -1,5 +1,6 @@
 #include "app/derive_job.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 
@@ -24,9 +25,17 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
      << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
      << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
      << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n"
-     << "mass " << nominal("mass") << " kg; centre of gravity (" << nominal("cog_x") << ", " << nominal("cog_y") << ", "
-     << nominal("cog_z") << ") m; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", "
-     << nominal("J_zz") << " kg m^2\n";
+     << "mass " << nominal("mass") << " kg; centre of gravity of the blocks (" << nominal("cog_x") << ", "
+     << nominal("cog_y") << ", " << nominal("cog_z") << ") m";
+  // A fitted CoG offset moves the point the thrust's moments act about; the blocks' centre
+  // stays what the file describes, so both are said.
+  const auto has = [&](const std::string& name) {
+    return std::any_of(model.params.begin(), model.params.end(), [&](const auto& p) { return p.name == name; });
+  };
+  if (has("cog_offset.x"))
+    os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
+  os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
+     << " kg m^2\n";
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   return os.str();

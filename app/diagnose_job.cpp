@@ -135,7 +135,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   }
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
   // The model and the airframe first: a wrong --airframe file is said before the logs are read.
-  o.progress.say("[diagnose] deriving the full-catalogue model");
+  o.progress.say("[diagnose] deriving the full-catalogue model's equations (its parameters, units and structure)");
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;
   all_opt.effects = parse_effect_list("all");
@@ -151,7 +151,9 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
                  (flights.size() > 1 ? " logs (diagnosed jointly)" : " log"));
   bool compiled = false;
   const auto model = make_model(all, &compiled);
-  o.progress.say(std::string("[diagnose] model: ") + (compiled ? "compiled header from generated/" : "interpreted tape"));
+  o.progress.say(std::string("[diagnose] evaluating it with ") +
+                 (compiled ? "the compiled header in generated/, derived from the same equations"
+                           : "an interpreted tape of the equations (no compiled header matches this vehicle)"));
   fit::Flight valid;
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
 

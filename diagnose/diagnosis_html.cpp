@@ -220,7 +220,16 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
 void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
-  for (const auto& f : d.findings) h << "<li>" << esc(headline(f)) << "</li>\n";
+  for (const auto& f : d.findings) {
+    h << "<li>" << esc(headline(f));
+    // A cause named jointly that the flights alone do not agree on is not one value of the
+    // airframe: said here, not only in the agreement table further down.
+    for (const auto& a : d.agreement)
+      if (a.effect == f.effect && !a.agree)
+        h << " <span class=\"warn\">The flights disagree on " << esc(a.parameter) << " (Cochran's Q p = "
+          << num(a.q_p_value, 2) << "; see <i>Do the flights agree?</i>).</span>";
+    h << "</li>\n";
+  }
   if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
   if (!d.findings.empty())
     h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "

@@ -24,13 +24,15 @@ std::string diagnosis_summary(const Diagnosis& d) {
   for (const auto& note : screening_notes(d)) os << note << "\n";
   if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
     os << "no significant discrepancy: the base model explains the flight\n";
+  // The held-out measure is said once; a finding judged by another says its own.
+  if (!d.findings.empty())
+    os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
   for (const auto& f : d.findings) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
-    os << "; " << f.metric << ", the final model without it -> with it: " << num(f.before) << " -> " << num(f.after)
-       << beside_gain_text(f) << "\n  "
-       << headline(f) << "\n";
+    os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
+       << beside_gain_text(f) << "\n  " << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
@@ -88,7 +90,12 @@ std::string diagnosis_summary(const Diagnosis& d) {
   if (d.terms_gain.measured)
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
        << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
-       << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")\n";
+       << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")"
+       << (d.terms_gain.gain_mean > d.terms_gain.gain_standard_error
+               ? ": a gain beyond its spread"
+               : ": no gain beyond its spread, so the term fits the residual without helping the prediction: not worth "
+                 "adding")
+       << "\n";
   if (d.has_prediction)
     if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
       os << "prediction of the extended model on the held-out part: " << limits << "\n";

@@ -14,6 +14,9 @@ import sys
 
 
 def main():
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return
     if len(sys.argv) != 4:
         sys.exit(__doc__)
     rotors, blocks, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]

@@ -11,7 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 regen() {  # vehicle-file folder-name [effects]
   local args=(derive "$1" --out "$tmp/$2")
   [ -n "${3:-}" ] && args+=(--effects "$3")
-  build/quadgen-derive "${args[@]}" > /dev/null 2>&1
+  build/quadgen-derive "${args[@]}" > /dev/null 2> "$tmp/err" || { cat "$tmp/err" >&2; exit 1; }
   mkdir -p "generated/$2"
   cp "$tmp/$2/model.hpp" "generated/$2/model.hpp"
   cp "$tmp/$2/derivation.md" "generated/$2/derivation.md"

@@ -569,10 +569,10 @@ TEST(Sinks, ShellWordsAreOneWordToAShell) {
   const auto model = quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
   quadgen::codegen::EmitOptions o;
   o.vehicle_file = "my vehicles/cf $(x).yaml";
-  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive 'my vehicles/cf $(x).yaml' --out DIR"),
+  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive 'my vehicles/cf $(x).yaml' --out <folder>"),
             std::string::npos);
   o.vehicle_file = "v\xe2\x80\xae.yaml";
-  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive VEHICLE_FILE --out DIR"),
+  EXPECT_NE(quadgen::codegen::generate_header(model, o).content.find("quadgen derive VEHICLE_FILE --out <folder>"),
             std::string::npos);
 }
 
