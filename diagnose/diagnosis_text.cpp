@@ -32,7 +32,10 @@ std::string diagnosis_summary(const Diagnosis& d) {
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
-       << beside_gain_text(f) << "\n  " << headline(f) << "\n";
+       << beside_gain_text(f);
+    for (const auto& a : d.agreement)
+      if (a.effect == f.effect && !a.agree) os << "; the flights disagree on " << a.parameter << " (below)";
+    os << "\n  " << headline(f) << "\n";
   }
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)

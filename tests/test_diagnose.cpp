@@ -1087,6 +1087,31 @@ TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
   EXPECT_EQ(html.find("nan"), std::string::npos);
 }
 
+// A cause named jointly that the flights alone disagree on is flagged where it is named (the
+// summary's line and the report's "In short"), not only in the agreement table; one they
+// agree on is not.
+TEST(DiagnosisReport, AJointCauseTheFlightsDisagreeOnIsFlaggedWhereItIsNamed) {
+  quadgen::diagnose::Diagnosis d;
+  quadgen::diagnose::Finding f;
+  f.effect = "rotor_drag";
+  f.metric = d.metric = "position RMSE [m]", f.before = 0.27, f.after = 0.26;
+  d.findings.push_back(f);
+  quadgen::diagnose::ParameterAgreement a;
+  a.parameter = "rotor_drag.k", a.effect = "rotor_drag", a.named = true, a.agree = false, a.q_p_value = 0.0016;
+  d.agreement.push_back(a);
+  const std::string says = "the flights disagree on rotor_drag.k", says_html = "The flights disagree on rotor_drag.k";
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("0.26; " + says), std::string::npos)
+      << quadgen::diagnose::diagnosis_summary(d);
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
+  const size_t in_short = html.find("<h2>In short</h2>"), findings = html.find("<h2>Findings</h2>");
+  ASSERT_NE(in_short, std::string::npos);
+  const size_t flagged = html.find(says_html, in_short);
+  EXPECT_TRUE(flagged != std::string::npos && flagged < findings) << html.substr(in_short, 600);
+  d.agreement.front().agree = true;
+  EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find(says), std::string::npos);
+  EXPECT_EQ(quadgen::diagnose::diagnosis_html(d, "log.csv", {}).find(says_html), std::string::npos);
+}
+
 // Joined flights hold their held-out parts apart in time, so a block of equal duration may
 // hold no sample; simulating such a flight gives no windows (it read the first sample of an
 // empty flight, and a two-flight diagnosis crashed).
