@@ -32,7 +32,7 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
   const auto has = [&](const std::string& name) {
     return std::any_of(model.params.begin(), model.params.end(), [&](const auto& p) { return p.name == name; });
   };
-  if (has("cog_offset.x"))
+  if (has("cog_offset.x") && (nominal("cog_offset.x") != 0 || nominal("cog_offset.y") != 0))
     os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
   os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
      << " kg m^2\n";

@@ -20,10 +20,12 @@ AuditCheck advisory(const std::string& name, bool ok, const std::string& detail)
   return c;
 }
 
+// Rounding residue (1e-17 N beside 0.13 N) reads as 0, as the trim's reason does.
 std::string numbers(const Eigen::VectorXd& x, const char* unit) {
   std::ostringstream os;
   os.precision(4);
-  for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << x(i);
+  const double scale = x.size() ? x.cwiseAbs().maxCoeff() : 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << (std::abs(x(i)) <= 1e-9 * scale ? 0.0 : x(i));
   if (*unit) os << " " << unit;
   return os.str();
 }

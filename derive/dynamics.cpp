@@ -55,29 +55,6 @@ std::string outside_text(double x, double lower, double upper) {
   return buf;
 }
 
-// A total a thousand times (or a thousandth of) what its bounds expect is most often a unit
-// slip in the blocks: grams written as kilograms, millimetres as metres. Said with the block
-// that gives most of it; "" otherwise.
-std::string unit_slip(const Vehicle& v, const std::string& name, double value, const Parameter& declared) {
-  const double expected = 0.5 * (declared.lower + declared.upper);
-  if (!(expected > 0) || !(value > 0)) return "";
-  const double ratio = value / expected;
-  const bool thousand = ratio > 300 && ratio < 3000, thousandth = ratio > 1.0 / 3000 && ratio < 1.0 / 300;
-  if (!thousand && !thousandth) return "";
-  if (name != "mass") return " (about " + std::string(thousand ? "1000 times" : "a thousandth of") +
-                             " the bounds: block sizes or positions in millimetres where the file reads metres?)";
-  const Block* heaviest = nullptr;
-  for (const auto& b : v.blocks)
-    if (!heaviest || b.mass > heaviest->mass) heaviest = &b;
-  std::string said = " (about " + std::string(thousand ? "1000 times" : "a thousandth of") + " the bounds: masses in " +
-                     (thousand ? "grams written as kilograms" : "kilograms where grams were meant") + "?";
-  if (heaviest)
-    said += " The heaviest block, '" + output::printable(heaviest->name) + "'" +
-            (heaviest->line > 0 ? " at line " + std::to_string(heaviest->line) : "") + ", has " +
-            shortest_text(heaviest->mass) + " kg";
-  return said + ")";
-}
-
 // The vehicle file's `derived:` entry for a quantity, against what the blocks give.
 void check_derived_bounds(const Vehicle& v, const std::string& name, const std::string& unit, double value,
                           const Parameter& declared) {
@@ -331,6 +308,30 @@ void assemble(ModelContext& c) {
 }
 
 }  // namespace
+
+// A total far beyond what its bounds expect is most often a unit slip in the blocks: masses
+// in grams written as kilograms scale the mass and the inertia by 1000, sizes and positions
+// in millimetres written as metres the inertia and the areas by a million. Said with the
+// block that gives most of the mass; "" otherwise. `expected`: the bounds' geometric mean.
+std::string unit_slip(const Vehicle& v, const std::string& name, double value, const Parameter& declared) {
+  if (!(declared.lower > 0) || !(value > 0)) return "";
+  const double ratio = value / std::sqrt(declared.lower * declared.upper);
+  const auto near = [&](double factor) { return ratio > factor / 3 && ratio < factor * 3; };
+  const bool inertia = name.rfind("J_", 0) == 0, area = name.rfind("A_", 0) == 0;
+  if ((inertia || area) && near(1e6))
+    return " (about a million times the bounds: block sizes or positions in millimetres written as metres?)";
+  if ((name != "mass" && !inertia) || !near(1e3)) return "";
+  const Block* heaviest = nullptr;
+  for (const auto& b : v.blocks)
+    if (!heaviest || b.mass > heaviest->mass) heaviest = &b;
+  std::string said = " (about 1000 times the bounds: masses in grams written as kilograms?";
+  if (heaviest)
+    said += " The heaviest block, '" + output::printable(heaviest->name) + "'" +
+            (heaviest->line > 0 ? " at line " + std::to_string(heaviest->line) : "") + ", has " +
+            shortest_text(heaviest->mass) + " kg";
+  return said + ")";
+}
+
 
 symbol ModelContext::add_param(const ParameterSpec& spec) {
   Variable v;

@@ -69,4 +69,8 @@ std::vector<std::string> base_parameter_names();
 // The TeX name of rotor `rotor`'s thrust among SymbolicModel::intermediates ("F_{\mathrm{A}}").
 std::string rotor_thrust_name(const std::string& rotor);
 
+// A derived total (mass, J_*, A_*) far beyond its `derived:` bounds, as a unit slip in the
+// blocks would give it: the likely slip in words, to append to the error; "" when none fits.
+std::string unit_slip(const Vehicle& v, const std::string& name, double value, const Parameter& declared);
+
 }  // namespace quadgen

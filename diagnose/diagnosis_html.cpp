@@ -95,7 +95,8 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
     h << "<p>With the proposed terms regenerated into the model (<code>discovered_model.hpp</code>) and simulated like an "
          "effect: "
       << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per validation fold "
-      << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ").</p>\n";
+      << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ")"
+      << esc(terms_gain_verdict(g.gain_mean, g.gain_standard_error)) << ".</p>\n";
   else if (!g.note.empty())
     h << "<p>" << esc(g.note) << ".</p>\n";
 }

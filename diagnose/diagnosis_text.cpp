@@ -94,11 +94,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
        << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
        << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")"
-       << (d.terms_gain.gain_mean > d.terms_gain.gain_standard_error
-               ? ": a gain beyond its spread"
-               : ": no gain beyond its spread, so the term fits the residual without helping the prediction: not worth "
-                 "adding")
-       << "\n";
+       << terms_gain_verdict(d.terms_gain.gain_mean, d.terms_gain.gain_standard_error) << "\n";
   if (d.has_prediction)
     if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
       os << "prediction of the extended model on the held-out part: " << limits << "\n";

@@ -221,6 +221,13 @@ std::string beside_gain_text(const Finding& f) {
   return judged_by_text(f) + unsettled;
 }
 
+std::string terms_gain_verdict(double gain_mean, double gain_standard_error) {
+  return gain_mean > 0 && gain_mean > gain_standard_error
+             ? ": a gain beyond its spread"
+             : ": no gain beyond its spread, so the term fits the residual without helping the prediction: not worth "
+               "adding";
+}
+
 // What spread agreeing flights would show, beside the one seen: " (if they agree: median
 // 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
 std::string spread_context(const ParameterAgreement& a) {

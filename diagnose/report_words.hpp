@@ -49,6 +49,9 @@ std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagno
 // alone), and that text with a note on unsettled weights: said beside the gain.
 std::string judged_by_text(const Finding& f);
 std::string beside_gain_text(const Finding& f);
+// Whether the proposed terms, regenerated into the model, gain on held-out data beyond the
+// spread of their per-fold gains, as an effect must: ": a gain beyond its spread" or why not.
+std::string terms_gain_verdict(double gain_mean, double gain_standard_error);
 // A parameter's spread across flights beside what agreeing flights with these intervals show.
 std::string spread_context(const ParameterAgreement& a);
 

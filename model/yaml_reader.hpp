@@ -20,15 +20,19 @@ namespace quadgen {
 // What yaml-cpp's words mean in a hand-written file ("end of map not found" for a tab in the
 // indentation, "end of map flow not found" for a missing comma): the likely slip, appended
 // to its message; "" when none is recognised. `line` counts from 0, as yaml-cpp's marks do.
+// Only the error's line and the one before are read for a tab (a tab inside a block scalar
+// further up is valid YAML).
 inline std::string yaml_slip(const std::string& text, int line, const std::string& message) {
   std::istringstream in(text);
   std::string l;
   for (int n = 0; std::getline(in, l) && n <= line; ++n) {
+    if (n < line - 1) continue;
     const size_t indent = l.find_first_not_of(" \t");
-    if (l.find('\t') < indent && indent != std::string::npos)
+    if (indent != std::string::npos && l.find('\t') < indent)
       return " (line " + std::to_string(n + 1) + " indents with a tab: YAML indents with spaces only)";
   }
-  if (message.find("flow") != std::string::npos)
+  if (message.find("end of map flow not found") != std::string::npos ||
+      message.find("end of sequence flow not found") != std::string::npos)
     return " (a '{...}' or '[...]' left open, or two of its entries without a comma between them)";
   return "";
 }

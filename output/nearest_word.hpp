@@ -25,9 +25,12 @@ inline size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 // Of `candidates`, the one `word` differs from only in case, else the nearest within
-// `max_edits` edits (the first of equals); "" when none is that near.
+// `max_edits` edits, and within a third of the word's length (leading dashes aside: 'w' is
+// not a slip for 't', nor '--x' for '--dt'); the first of equals; "" when none is that near.
 inline std::string nearest_word(const std::string& word, const std::vector<std::string>& candidates,
                                 size_t max_edits = 2) {
+  const size_t letters = word.size() - std::min(word.find_first_not_of('-'), word.size());
+  max_edits = std::min(max_edits, letters / 3);
   const auto lower = [](std::string s) {
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;

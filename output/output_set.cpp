@@ -493,16 +493,17 @@ fs::path detail::keep_aside(const fs::path& staged, const fs::path& target) {
 namespace {
 
 // After the exchange, the earlier run sits in `staged`: its own files go (those that still
-// match its manifest), anything else is kept aside.
-void remove_earlier_run(const fs::path& staged, const fs::path& target) {
+// match its manifest), anything else is kept aside (said; false then).
+bool remove_earlier_run(const fs::path& staged, const fs::path& target) {
   const Manifest earlier = read_manifest(staged);
   std::error_code ec;
   for (const auto& [name, hash_size] : earlier.files)
     if (unchanged_since(staged / name, hash_size, earlier)) fs::remove(staged / name, ec);
   fs::remove(staged / kManifestName, ec);
-  if (fs::remove(staged, ec)) return;
+  if (fs::remove(staged, ec)) return true;
   std::cerr << "quadgen: note: the previous output was kept at " << printable(detail::keep_aside(staged, target).string())
             << " (it held files that appeared or changed while this run wrote)\n";
+  return false;
 }
 
 }  // namespace
@@ -590,8 +591,7 @@ void OutputDirectory::commit() {
     if (!staging_->move(exchange, &why))
       fail(target, "cannot switch the output into place: " + std::string(std::strerror(why)));
     test_hook_signal("after-exchange");
-    remove_earlier_run(staged, target);
-    replaced_ = true;
+    replaced_ = remove_earlier_run(staged, target);
   }
   staging_->release();
   created_.keep();

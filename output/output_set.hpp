@@ -68,8 +68,9 @@ class OutputDirectory {
   // Switches the whole set in.
   void commit();
   const std::string& dir() const { return dir_; }
-  // After commit: whether an earlier run of the same command was replaced (the command line
-  // says so: two runs given one --out keep only the second).
+  // After commit: whether an earlier run of the same command was replaced and removed (the
+  // command line says so: two runs given one --out keep only the second). An earlier run
+  // kept aside, because files appeared in it meanwhile, is said where it is kept instead.
   bool replaced_earlier_run() const { return replaced_; }
 
  private:

@@ -21,6 +21,11 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   return flight;
 }
 
+// "indoors", "outdoors", "in any environment".
+std::string where_words(Environment e) {
+  return e == Environment::kUnknown ? "in any environment" : environment_name(e) + "s";
+}
+
 // Calibrated values beyond what the flight's environment makes plausible (a steady wind of
 // 0.8 m/s indoors): the flight's own quantities then stand in for something the airframe's
 // held values miss on this flight, and the prediction says so rather than scoring it silently.
@@ -36,11 +41,11 @@ nlohmann::ordered_json implausible_calibration(const Vehicle& v, const runtime::
     if (!outside_plausible_range(name, values[k], o.environment, vehicle_scales(v), &lower, &upper, &why)) continue;
     const std::string unit = bounds[k].unit.empty() ? "" : " " + bounds[k].unit;
     o.progress.say("  note: calibrated " + name + " = " + output::short_number(values[k]) + unit +
-                   " lies outside what is plausible " + environment_name(o.environment) + " (" +
+                   " lies outside what is plausible " + where_words(o.environment) + " (" +
                    output::short_number(lower) + " to " + output::short_number(upper) + unit + ": " + why +
                    "): this flight's own quantities stand in for something the airframe's values miss here; "
                    "quadgen diagnose of this flight with --airframe tests which of them it rejects");
-    out.push_back({{"parameter", name}, {"value", values[k]}, {"lower", lower}, {"upper", upper}, {"why", why}});
+    out.push_back({{"parameter", name}, {"value", values[k]}, {"plausible", {lower, upper}}, {"why", why}});
   }
   return out;
 }
@@ -105,6 +110,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   out.json["parameters_from"] = o.params.empty() ? "vehicle file (nominal)" : o.params;
   if (source && !source->vehicle().empty()) out.json["parameters_vehicle"] = source->vehicle();
   out.json["evaluated_fraction"] = o.validation;
+  out.json["environment"] = environment_name(o.environment);
   out.json["flights"] = flights;
   return out;
 }

@@ -42,12 +42,12 @@ for dir in generated/*/; do
   f_jac=$(size_of 'rhs<float>\(([^,]*,){7}[^,]*\)$')
   # gcc writes the frames next to the object ($name.su): "file:line:col:signature<TAB>bytes<TAB>kind".
   frame_of() {  # the largest frame whose signature matches $1; 0 when inlined away
-    grep -E "$1" "$tmp/$name.su" | awk -F'\t' 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }'
+    { grep -E "$1" "$tmp/$name.su" || true; } | awk -F'\t' 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }'
   }
   rhs_sig='rhs\(([^,]*,){%d}[^,]*\) \[with Scalar = float\]'
   stack="$(( $(frame_of 'void quadgen_f\(') + $(frame_of "$(printf "$rhs_sig" 4)") ))"
   stack+=" / $(( $(frame_of 'void quadgen_f_jacobians\(') + $(frame_of "$(printf "$rhs_sig" 7)") ))"
-  stack+=" / $(frame_of 'void quadgen_precompute\(')"
+  stack+=" / $(( $(frame_of 'void quadgen_precompute\(') + $(frame_of 'precompute\(const Scalar\*, Precomputed<Scalar>\*\) \[with Scalar = float\]') ))"
   if grep -q -P '\tdynamic' "$tmp/$name.su"; then stack+=" — DYNAMIC"; status=1; fi
   undefined=$(arm-none-eabi-nm -u "$obj" | awk '{print $2}' | sort -u)
   # Double precision either as soft-float calls (this FPU has none for doubles) or as .f64

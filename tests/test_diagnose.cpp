@@ -1451,6 +1451,8 @@ TEST_F(WeakMotorSearch, ARefinementLeftWithoutItsEffectIsDroppedAndSuspected) {
   gain.effect = "motor_gain";
   spread.effect = "motor_lag_spread";
   d.findings = {gain, spread};
+  d.search.estimates.clear();  // so that only profiling them again can fill them
+  d.search.profiles.clear();
   quadgen::diagnose::drop_refinements_without_their_effect(d, *search_);
   ASSERT_EQ(d.findings.size(), 1u);
   EXPECT_EQ(d.findings[0].effect, "motor_gain");
@@ -1462,6 +1464,8 @@ TEST_F(WeakMotorSearch, ARefinementLeftWithoutItsEffectIsDroppedAndSuspected) {
   ASSERT_EQ(d.search.unresolved.size(), 1u);
   EXPECT_EQ(d.search.unresolved[0].b, "cog_offset");
   EXPECT_FALSE(d.search.estimates.empty()) << "the intervals are not profiled again";
+  EXPECT_FALSE(d.search.profiles.empty()) << "the intervals are not profiled again";
+  for (const auto& e : d.search.estimates) EXPECT_EQ(e.name.rfind("motor_lag_spread", 0), std::string::npos) << e.name;
   // Nothing to drop: nothing changes.
   const auto before = d.search.selected;
   quadgen::diagnose::drop_refinements_without_their_effect(d, *search_);

@@ -34,6 +34,7 @@
 #include "codegen/header_writer.hpp"
 #include "output/fnv1a.hpp"
 #include "output/names.hpp"
+#include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
 #include "runtime/plot.hpp"
 #include "runtime/flight_log.hpp"
@@ -1070,6 +1071,10 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   expect_error({"predict", f3, "x.csv", "--calibrat", "--out", tmp / "o"}, 109, "did you mean '--calibrate'");
   const CliResult far = run_quadgen({"predict", f3, "x.csv", "--zzzzzzzz", "--out", tmp / "o"}, tmp.dir);
   EXPECT_EQ(far.err.find("did you mean"), std::string::npos) << far.err;
+  // Short words are not slips for other short words ('w' for 't', '--x' for '--dt').
+  EXPECT_EQ(quadgen::output::nearest_word("w", {"t", "x", "vbat"}), "");
+  EXPECT_EQ(quadgen::output::nearest_word("--x", {"--dt", "--out"}), "");
+  EXPECT_EQ(quadgen::output::nearest_word("motor_motor_M3", {"motor_motor_m3", "motor_motor_m4"}), "motor_motor_m3");
   // Files that are not logs are named as what they should have been.
   ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
   expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "generated/finken3_all_effects/model.hpp"
@@ -568,16 +569,37 @@ TEST(PredictParameters, ACalibratedValueBeyondItsPlausibleRangeIsSaid) {
     EXPECT_NEAR(flight["calibrated"]["wind.x"].get<double>(), 1.5, 0.15) << "the calibration did not find the wind";
     if (std::string(where) == "indoor") {
       EXPECT_NE(said.find("calibrated wind.x = 1."), std::string::npos) << said;
-      EXPECT_NE(said.find("outside what is plausible indoor"), std::string::npos) << said;
+      EXPECT_NE(said.find("outside what is plausible indoors"), std::string::npos) << said;
       ASSERT_TRUE(flight.contains("calibrated_implausible"));
       ASSERT_EQ(flight["calibrated_implausible"].size(), 1u) << flight["calibrated_implausible"].dump();
       EXPECT_EQ(flight["calibrated_implausible"][0]["parameter"], "wind.x");
-      EXPECT_EQ(flight["calibrated_implausible"][0]["upper"].get<double>(), 0.5);
+      EXPECT_EQ(flight["calibrated_implausible"][0]["plausible"][1].get<double>(), 0.5);
     } else {
       EXPECT_EQ(said.find("outside what is plausible"), std::string::npos) << said;
       EXPECT_FALSE(flight.contains("calibrated_implausible"));
     }
   }
+  // Without --environment, the mapping's `environment:` judges: every column mapped to itself.
+  std::ifstream header_in(csv);
+  std::string header;
+  std::getline(header_in, header);
+  std::ostringstream mapping;
+  mapping << "environment: indoor\ncolumns:\n";
+  std::istringstream columns(header);
+  for (std::string c; std::getline(columns, c, ',');)
+    if (c.find("_ref") == std::string::npos) mapping << "  " << c << ": {source: " << c << "}\n";  // (the references are no log column)
+  const std::string mapping_path = (dir / "same.yaml").string();
+  std::ofstream(mapping_path) << mapping.str();
+  const std::string err = (dir / "mapped.err").string();
+  const std::string cmd = std::string(QUADGEN_BINARY) + " predict " + vehicle + " " + csv + " --params " + params +
+                          " --calibrate --mapping " + mapping_path + " --out " + (dir / "mapped").string() +
+                          " > /dev/null 2> " + err;
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream err_in(err);
+  const std::string said((std::istreambuf_iterator<char>(err_in)), {});
+  EXPECT_NE(said.find("outside what is plausible indoors"), std::string::npos) << said;
+  std::ifstream json_in(dir / "mapped" / "prediction.json");
+  EXPECT_EQ(nlohmann::json::parse(json_in)["environment"], "indoor");
   fs::remove_all(dir);
 }
 

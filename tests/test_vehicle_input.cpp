@@ -69,6 +69,10 @@ TEST(VehicleInput, MalformedYamlNamesTheLikelySlip) {
   expect_error("name: x\nrotors:\n  - {name: A position: [0, 0, 0]}\n",
                "a '{...}' or '[...]' left open, or two of its entries without a comma between them");
   EXPECT_EQ(quadgen::yaml_slip("a: 1\n", 0, "end of map not found"), "");
+  // A tab in a block scalar further up is valid YAML, and a stray '}' is no missing comma.
+  EXPECT_EQ(quadgen::yaml_slip("a: |\n  x\n\ty\nb: 1\nc: {d: 1 e: 2}\n", 4, "end of map flow not found"),
+            " (a '{...}' or '[...]' left open, or two of its entries without a comma between them)");
+  EXPECT_EQ(quadgen::yaml_slip("a: 1}\n", 0, "illegal flow end"), "");
 }
 
 // A mass a thousand times its declared bounds is most likely grams written as kilograms: said,
@@ -92,6 +96,12 @@ TEST(VehicleInput, GramsWrittenAsKilogramsAreNamed) {
               std::string::npos)
         << e.what();
   }
+  // The same slip seen through the inertia's bounds; millimetres for metres scale it a million times.
+  Parameter j_zz;
+  j_zz.lower = 5e-4, j_zz.upper = 2e-3;
+  EXPECT_NE(quadgen::unit_slip(v, "J_zz", 1.24, j_zz).find("grams written as kilograms"), std::string::npos);
+  EXPECT_NE(quadgen::unit_slip(v, "J_zz", 1240, j_zz).find("millimetres written as metres"), std::string::npos);
+  EXPECT_EQ(quadgen::unit_slip(v, "J_zz", 2.5e-3, j_zz), "");
 }
 
 TEST(VehicleInput, MissingKey) { expect_error(replace(finken_text(), "name: finken3\n", ""), "missing key 'name'"); }
