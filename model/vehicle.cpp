@@ -180,21 +180,9 @@ Vehicle parse_vehicle(const std::string& content, const std::string& path) {
 }
 
 namespace {
-Vehicle parse_vehicle_checked(const std::string& content, const std::string& path) {
-  const Reader r{{path}};
-  const YAML::Node root = r.parse(content);
-  if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
-  r.require_map(root, "a vehicle description");
-  r.only_keys(root, {"name", "description", "environment", "frame", "rotor_model", "motor_map",
-                     "battery", "blocks", "rotors", "derived", "fitted"},
-              "the vehicle file");
-  Vehicle v;
-  if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
-  v.source_path = path;
-  v.content_hash = fnv1a_hex(content);
-  v.name = r.name(r.need(root, "name", "the vehicle file"), "vehicle name");
-  if (root["description"]) v.description = r.text(root["description"], "description");
-
+// The sections of named parameters: environment, frame, rotor model, motor map (with its
+// optional slope and pivot, which go together) and battery (4 V when absent).
+void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v) {
   read_section(r, root, v, "environment",
                {{"g", "m/s^2", true, "gravitational acceleration"}, {"rho", "kg/m^3", true, "air density"}});
   read_section(r, root, v, "frame", {{"c_w", "1", true, "drag coefficient of the frame"}});
@@ -223,52 +211,73 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   else
     v.params["vbat_ref"] = Parameter{{"vbat_ref", "V", parse_unit("V").dim, 4.0, 4.0, 4.0, false,
                                       "reference battery voltage"}};
+}
 
-  const YAML::Node blocks = r.need(root, "blocks", "the vehicle file");
-  if (!blocks.IsSequence() || blocks.size() == 0) r.fail(blocks, "expected a non-empty list of blocks");
+// A non-empty list of blocks or rotors (`what`), each read by `read` and named once.
+template <class Item, class ReadItem>
+std::vector<Item> read_named_list(const Reader& r, const YAML::Node& root, const char* key, const std::string& what,
+                                  ReadItem read) {
+  const YAML::Node list = r.need(root, key, "the vehicle file");
+  if (!list.IsSequence() || list.size() == 0) r.fail(list, "expected a non-empty list of " + std::string(key));
+  std::vector<Item> items;
   std::set<std::string> names;
-  for (const auto& b : blocks) {
-    v.blocks.push_back(read_block(r, b));
-    if (!names.insert(v.blocks.back().name).second)
-      r.fail(b["name"], "duplicate block name '" + v.blocks.back().name + "'");
+  for (const auto& node : list) {
+    items.push_back(read(r, node));
+    if (!names.insert(items.back().name).second)
+      r.fail(node["name"], "duplicate " + what + " name '" + items.back().name + "'");
   }
-  const YAML::Node rotors = r.need(root, "rotors", "the vehicle file");
-  if (!rotors.IsSequence() || rotors.size() == 0) r.fail(rotors, "expected a non-empty list of rotors");
-  names.clear();
-  for (const auto& ro : rotors) {
-    v.rotors.push_back(read_rotor(r, ro));
-    if (!names.insert(v.rotors.back().name).second)
-      r.fail(ro["name"], "duplicate rotor name '" + v.rotors.back().name + "'");
-  }
-  if (root["derived"]) {
-    const YAML::Node d = root["derived"];
-    r.require_map(d, "section 'derived'");
-    std::map<std::string, std::string> derived_units;  // name -> unit
-    for (const DerivedQuantity& q : kDerivedQuantities) derived_units[q.name] = q.unit;
-    std::set<std::string> allowed;
-    for (const auto& kv : derived_units) allowed.insert(kv.first);
-    r.only_keys(d, allowed, "section 'derived'");
-    for (const auto& kv : d) {
-      const std::string key = kv.first.as<std::string>();
-      const YAML::Node spec = kv.second;
-      r.require_map(spec, "fit and bounds (or a value) of derived quantity " + key);
-      r.only_keys(spec, {"fit", "bounds", "value", "unit", "source"}, "derived quantity " + key);
-      if (spec["value"]) {  // given: it replaces the blocks' value
-        v.derived_overrides[key] = r.parameter(spec, key, derived_units.at(key), "");
-        v.derived_given.insert(key);
-      } else {
-        if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds (or a value)");
-        if (spec["unit"]) r.fail(spec["unit"], "derived quantity " + key + ": a unit belongs to a value");
-        // The nominal value comes from the blocks; parse bounds via a dummy value inside them.
-        YAML::Node tmp;
-        tmp["value"] = spec["bounds"][0];
-        tmp["bounds"] = spec["bounds"];
-        if (spec["fit"]) tmp["fit"] = spec["fit"];
-        v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
-      }
-      v.derived_overrides[key].line = kv.first.Mark().line + 1;
+  return items;
+}
+
+// `derived:` — each quantity the blocks give (mass, inertia, areas) either with bounds (and
+// whether it may be fitted) or with a measured value that replaces the blocks'.
+void read_derived(const Reader& r, const YAML::Node& d, Vehicle& v) {
+  r.require_map(d, "section 'derived'");
+  std::map<std::string, std::string> derived_units;  // name -> unit
+  for (const DerivedQuantity& q : kDerivedQuantities) derived_units[q.name] = q.unit;
+  std::set<std::string> allowed;
+  for (const auto& kv : derived_units) allowed.insert(kv.first);
+  r.only_keys(d, allowed, "section 'derived'");
+  for (const auto& kv : d) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node spec = kv.second;
+    r.require_map(spec, "fit and bounds (or a value) of derived quantity " + key);
+    r.only_keys(spec, {"fit", "bounds", "value", "unit", "source"}, "derived quantity " + key);
+    if (spec["value"]) {  // given: it replaces the blocks' value
+      v.derived_overrides[key] = r.parameter(spec, key, derived_units.at(key), "");
+      v.derived_given.insert(key);
+    } else {
+      if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds (or a value)");
+      if (spec["unit"]) r.fail(spec["unit"], "derived quantity " + key + ": a unit belongs to a value");
+      // The nominal value comes from the blocks; parse bounds via a dummy value inside them.
+      YAML::Node tmp;
+      tmp["value"] = spec["bounds"][0];
+      tmp["bounds"] = spec["bounds"];
+      if (spec["fit"]) tmp["fit"] = spec["fit"];
+      v.derived_overrides[key] = r.parameter(tmp, key, derived_units.at(key), "");
     }
+    v.derived_overrides[key].line = kv.first.Mark().line + 1;
   }
+}
+
+Vehicle parse_vehicle_checked(const std::string& content, const std::string& path) {
+  const Reader r{{path}};
+  const YAML::Node root = r.parse(content);
+  if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
+  r.require_map(root, "a vehicle description");
+  r.only_keys(root, {"name", "description", "environment", "frame", "rotor_model", "motor_map",
+                     "battery", "blocks", "rotors", "derived", "fitted"},
+              "the vehicle file");
+  Vehicle v;
+  if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
+  v.source_path = path;
+  v.content_hash = fnv1a_hex(content);
+  v.name = r.name(r.need(root, "name", "the vehicle file"), "vehicle name");
+  if (root["description"]) v.description = r.text(root["description"], "description");
+  read_parameter_sections(r, root, v);
+  v.blocks = read_named_list<Block>(r, root, "blocks", "block", read_block);
+  v.rotors = read_named_list<Rotor>(r, root, "rotors", "rotor", read_rotor);
+  if (root["derived"]) read_derived(r, root["derived"], v);
   return v;
 }
 }  // namespace
