@@ -233,62 +233,106 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   return 2 * summary.final_cost;
 }
 
-FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt) {
-  const int nr = model.num_residuals();
-  const int n = static_cast<int>(params.size());
-  const auto channels = model.channels();
-  const int nc = static_cast<int>(channels.size());
+namespace {
+
+// Refuses a fit that cannot be made: fewer residuals than free parameters, or a free
+// parameter without bounds. Returns the number of free parameters.
+int check_fit_inputs(int num_residuals, const std::vector<FitParameter>& params) {
   int n_free = 0;
   for (const auto& p : params) n_free += p.free;
-  if (nr <= n_free) throw FitError("too few samples: " + std::to_string(nr) + " residuals for " + std::to_string(n_free) + " free parameters");
+  if (num_residuals <= n_free)
+    throw FitError("too few samples: " + std::to_string(num_residuals) + " residuals for " + std::to_string(n_free) +
+                   " free parameters");
   for (const auto& p : params)
     if (p.free && !(p.lower < p.upper))
       throw FitError("parameter " + p.name + " is to be fitted but has no bounds (add bounds: [lower, upper])");
+  return n_free;
+}
 
+// Each channel's noise from the residuals at `params`: its sigma (the degrees of freedom
+// shared out over the channels in proportion to their size), lag-1 autocorrelation and
+// effective sample size, into `channels`; the weights that make every channel count in
+// units of its own noise, into `w`.
+void estimate_channel_noise(const ResidualModel& model, const std::vector<FitParameter>& params, int n_free,
+                            const FitOptions& opt, std::vector<ChannelStats>& channels, std::vector<double>& w) {
+  const int nr = model.num_residuals(), nc = static_cast<int>(channels.size());
+  std::vector<double> r(nr);
+  model.evaluate(parameter_values(params).data(), r.data(), nullptr);
+  std::vector<std::vector<double>> per(nc);
+  for (int i = 0; i < nr; ++i) {
+    if (!std::isfinite(r[i]))
+      throw FitError("residual " + std::to_string(i) + " (channel " + channels[model.channel_of(i)].name +
+                     ") is not finite at " + values_text(params));
+    per[model.channel_of(i)].push_back(r[i]);
+  }
+  for (int c = 0; c < nc; ++c) {
+    auto& s = channels[c];
+    const auto& v = per[c];
+    s.count = static_cast<int>(v.size());
+    if (v.size() < 2) throw FitError("channel " + s.name + " has fewer than 2 samples");
+    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+    double ss = 0, lag = 0, rss = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      ss += (v[i] - mean) * (v[i] - mean);
+      rss += v[i] * v[i];
+      if (i) lag += (v[i] - mean) * (v[i - 1] - mean);
+    }
+    const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
+    s.sigma = std::sqrt(rss / std::max(dof, 1.0));
+    if (!std::isfinite(s.sigma))
+      throw FitError("channel " + s.name + ": the residuals' sum of squares overflows (residuals beyond ~1e150: a "
+                     "corrupt or mis-scaled sample?)");
+    if (!(s.sigma > 0)) s.sigma = 1e-300;
+    s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
+    const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
+    s.effective_n = static_cast<double>(v.size()) * (1 - rho) / (1 + rho);
+    w[c] = std::sqrt(s.effective_n / static_cast<double>(v.size())) / s.sigma;
+  }
+}
+
+// Covariance of the free parameters: the pseudo-inverse of the weighted Gauss-Newton
+// normal matrix, scaled to unit diagonal first (normal_matrix.hpp). Ceres' covariance
+// with a relative cut-off on the raw matrix dropped the weakest direction when the
+// parameters' units differ by many orders (c_w beside rotor_drag.k, a motor map term in
+// rad/s) and reported a standard error near zero along it.
+void free_parameter_covariance(const ResidualModel& model, const std::vector<FitParameter>& params,
+                               const std::vector<double>& w, FitResult& res) {
+  std::vector<int> free_idx;
+  for (int i = 0; i < static_cast<int>(params.size()); ++i)
+    if (params[i].free) free_idx.push_back(i);
+  const Eigen::MatrixXd Jf = weighted_free_jacobian(model, params, w);
+  require_finite_information(Jf, params, free_idx);
+  const Eigen::MatrixXd C = analyse_normal_matrix(Jf.transpose() * Jf).covariance;
+  if (!C.allFinite()) throw FitError("covariance of the free parameters is not finite at " + values_text(params));
+  const bool singular = columns_dependent(Jf);
+  res.standard_errors.assign(params.size(), std::numeric_limits<double>::quiet_NaN());
+  const size_t nf = free_idx.size();
+  res.covariance.assign(nf, std::vector<double>(nf));
+  for (size_t a = 0; a < nf; ++a) {
+    for (size_t b = 0; b < nf; ++b) res.covariance[a][b] = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    const double variance = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+    res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(std::max(0.0, variance));
+  }
+  for (int i : free_idx)
+    if (on_bound(params[i])) res.at_bound.push_back(params[i].name);
+}
+
+}  // namespace
+
+FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt) {
+  const int nr = model.num_residuals();
+  const int n_free = check_fit_inputs(nr, params);
+  const auto channels = model.channels();
   FitResult res;
-  res.channels.resize(nc);
-  for (int c = 0; c < nc; ++c) res.channels[c].name = channels[c];
-  std::vector<double> w(nc, 1.0), r(nr);
+  res.channels.resize(channels.size());
+  for (size_t c = 0; c < channels.size(); ++c) res.channels[c].name = channels[c];
+  std::vector<double> w(channels.size(), 1.0);
   // Noise per channel from the residuals: first at the starting point (so that no channel's
   // units dominate the first solve), then at the estimate, re-solving in between.
-  auto estimate_noise = [&]() {
-    model.evaluate(parameter_values(params).data(), r.data(), nullptr);
-    std::vector<std::vector<double>> per(nc);
-    for (int i = 0; i < nr; ++i) {
-      if (!std::isfinite(r[i]))
-        throw FitError("residual " + std::to_string(i) + " (channel " + channels[model.channel_of(i)] +
-                       ") is not finite at " + values_text(params));
-      per[model.channel_of(i)].push_back(r[i]);
-    }
-    for (int c = 0; c < nc; ++c) {
-      auto& s = res.channels[c];
-      const auto& v = per[c];
-      s.count = static_cast<int>(v.size());
-      if (v.size() < 2) throw FitError("channel " + channels[c] + " has fewer than 2 samples");
-      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-      double ss = 0, lag = 0, rss = 0;
-      for (size_t i = 0; i < v.size(); ++i) {
-        ss += (v[i] - mean) * (v[i] - mean);
-        rss += v[i] * v[i];
-        if (i) lag += (v[i] - mean) * (v[i - 1] - mean);
-      }
-      // Degrees of freedom shared out over channels in proportion to their size.
-      const double dof = static_cast<double>(v.size()) * (1.0 - static_cast<double>(n_free) / nr);
-      s.sigma = std::sqrt(rss / std::max(dof, 1.0));
-      if (!std::isfinite(s.sigma))
-        throw FitError("channel " + channels[c] + ": the residuals' sum of squares overflows (residuals beyond ~1e150: a "
-                       "corrupt or mis-scaled sample?)");
-      if (!(s.sigma > 0)) s.sigma = 1e-300;
-      s.lag1 = ss > 0 ? std::clamp(lag / ss, -0.99, 0.99) : 0.0;
-      const double rho = opt.account_autocorrelation ? std::max(0.0, s.lag1) : 0.0;
-      s.effective_n = static_cast<double>(v.size()) * (1 - rho) / (1 + rho);
-      w[c] = std::sqrt(s.effective_n / static_cast<double>(v.size())) / s.sigma;
-    }
-  };
-  estimate_noise();
+  estimate_channel_noise(model, params, n_free, opt, res.channels, w);
   for (int pass = 0; pass < 2; ++pass) {
     solve_weighted(model, params, w, opt);
-    estimate_noise();
+    estimate_channel_noise(model, params, n_free, opt, res.channels, w);
   }
   // Pass 2: weighted, so chi2 is in units of the noise with autocorrelation accounted for.
   bool conv = false;
@@ -297,30 +341,7 @@ FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter
   res.weights = w;
   res.num_residuals = nr;
   res.num_free = n_free;
-  // Covariance of the free parameters: the pseudo-inverse of the weighted Gauss-Newton
-  // normal matrix, scaled to unit diagonal first (normal_matrix.hpp). Ceres' covariance
-  // with a relative cut-off on the raw matrix dropped the weakest direction when the
-  // parameters' units differ by many orders (c_w beside rotor_drag.k, a motor map term in
-  // rad/s) and reported a standard error near zero along it.
-  std::vector<int> free_idx;
-  for (int i = 0; i < n; ++i)
-    if (params[i].free) free_idx.push_back(i);
-  const Eigen::MatrixXd Jf = weighted_free_jacobian(model, params, w);
-  require_finite_information(Jf, params, free_idx);
-  const Eigen::MatrixXd C = analyse_normal_matrix(Jf.transpose() * Jf).covariance;
-  if (!C.allFinite()) throw FitError("covariance of the free parameters is not finite at " + values_text(params));
-  const bool singular = columns_dependent(Jf);
-  res.standard_errors.assign(n, std::numeric_limits<double>::quiet_NaN());
-  const size_t nf = free_idx.size();
-  res.covariance.assign(nf, std::vector<double>(nf));
-  for (size_t a = 0; a < nf; ++a) {
-    for (size_t b = 0; b < nf; ++b) res.covariance[a][b] = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
-    const double variance = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
-    res.standard_errors[free_idx[a]] = singular ? std::numeric_limits<double>::infinity() : std::sqrt(std::max(0.0, variance));
-  }
-  for (int i : free_idx) {
-    if (on_bound(params[i])) res.at_bound.push_back(params[i].name);
-  }
+  free_parameter_covariance(model, params, w, res);
   res.parameters = params;
   return res;
 }
