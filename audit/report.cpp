@@ -82,8 +82,22 @@ void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
         "with these nominal values, so that a fit may free them.\n\n";
 }
 
-void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
-  const SymbolicModel& m = d.model;
+// An equation a reader can follow: up to this many nodes it is written out, beyond it named.
+constexpr size_t kReadable = 1500;
+// MathJax (GitHub's renderer too) takes at most 5 KB of TeX in one formula and shows a longer
+// one as raw text: a vector beyond that is written one component per formula, a component
+// beyond it is named only (scripts/render_derivation.sh checks the result in a browser).
+constexpr size_t kMathJaxLimit = 4800;  // characters, with room for the left-hand side
+
+void write_equation(std::ostringstream& md, const std::string& lhs, const std::string& rhs) {
+  if (rhs.size() > kMathJaxLimit)
+    md << "$" << lhs << "$: " << rhs.size() << " characters of TeX, more than MathJax renders in one formula; the "
+       << "generated code holds it in full.\n\n";
+  else
+    md << "```math\n" << lhs << " = " << rhs << "\n```\n\n";
+}
+
+void section_kinematics(std::ostringstream& md) {
   md << "## 3. Kinematics\n\n"
      << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton). Its rotation "
         "matrix and rate:\n\n"
@@ -92,19 +106,12 @@ void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& t
         "1-2(q_x^2+q_y^2)\\end{pmatrix},\\qquad \\dot q = \\tfrac12\\, q \\otimes (0, \\omega)\n```\n\n"
      << "For reports, Z-Y-X Euler angles give $R = R_z(\\psi) R_y(\\theta) R_x(\\phi)$; the audit shows both "
         "forms agree.\n\n";
+}
+
+// Section 4: the named quantities (air velocity, rotor speeds and thrusts, moments, drag),
+// each written with the ones before it as symbols.
+void section_forces_and_torques(std::ostringstream& md, const SymbolicModel& m, TexWriter& tex) {
   md << "## 4. Forces and torques\n\n";
-  constexpr size_t kReadable = 1500;  // nodes: beyond this an equation is not read but searched
-  // MathJax (GitHub's renderer too) takes at most 5 KB of TeX in one formula and shows a longer
-  // one as raw text: a vector beyond that is written one component per formula, a component
-  // beyond it is named only (scripts/render_derivation.sh checks the result in a browser).
-  constexpr size_t kMathJaxLimit = 4800;  // characters, with room for the left-hand side
-  const auto equation = [&](const std::string& lhs, const std::string& rhs) {
-    if (rhs.size() > kMathJaxLimit)
-      md << "$" << lhs << "$: " << rhs.size() << " characters of TeX, more than MathJax renders in one formula; the "
-         << "generated code holds it in full.\n\n";
-    else
-      md << "```math\n" << lhs << " = " << rhs << "\n```\n\n";
-  };
   md << "The air velocity in body axes $v_a = R^T (v - v_{wind})$; each rotor's speed $\\omega_i$ and thrust "
         "$F_i$ (along body $+z$ at its hub); the moment $\\tau_i$ of that thrust about the centre of gravity with "
         "the reaction moment of the spin (a counter-clockwise rotor, seen from above, turns the body with "
@@ -125,32 +132,38 @@ void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& t
       continue;
     }
     if (!is_a<matrix>(e)) {
-      equation(eq.lhs, tex.tex(e));
+      write_equation(md, eq.lhs, tex.tex(e));
       continue;
     }
     const matrix& v = ex_to<matrix>(e);
     const std::string whole = tex.matrix(v);
     if (whole.size() <= kMathJaxLimit || v.cols() != 1 || v.rows() != 3) {
-      equation(eq.lhs, whole);
+      write_equation(md, eq.lhs, whole);
       continue;
     }
-    for (unsigned i = 0; i < 3; ++i) equation("\\left(" + eq.lhs + "\\right)_" + "xyz"[i], tex.tex(v(i, 0)));
+    for (unsigned i = 0; i < 3; ++i) write_equation(md, "\\left(" + eq.lhs + "\\right)_" + "xyz"[i], tex.tex(v(i, 0)));
   }
   if (effect_terms)
     md << "$\\Delta F_{body}$ and $\\Delta \\tau$ are the sums of what the effects add below.\n\n";
-  if (!m.effect_formulas.empty()) {
-    md << "### What each effect adds\n\nEach effect applied alone to the base model, in body axes ($R = I$; "
-          "$v_a$ is the air velocity, in body axes unless said), with the quantity it changes: a rotor's thrust is "
-          "$s\\,c_t \\rho A_p r_p^2\\,\\omega(\\omega - \\omega_{\\mathrm{loss}})$, $\\Delta c$ moves the centre of "
-          "gravity, $\\Delta F_{body}$ and $\\Delta\\tau$ add to the body force and the moment about the centre of "
-          "gravity.\n\n";
-    for (const auto& f : m.effect_formulas) {
-      md << "**" << output::markdown_text(f.effect) << "**" << (f.note.empty() ? "" : " (" + output::markdown_text(f.note) + ")")
-         << (f.lines.empty() ? "\n\n" : ":\n\n");
-      for (const auto& [lhs, value] : f.lines)
-        equation(lhs, is_a<matrix>(value) ? tex.matrix(ex_to<matrix>(value)) : tex.tex(value));
-    }
+}
+
+// What each effect adds, applied alone to the base model.
+void section_effect_terms(std::ostringstream& md, const SymbolicModel& m, TexWriter& tex) {
+  if (m.effect_formulas.empty()) return;
+  md << "### What each effect adds\n\nEach effect applied alone to the base model, in body axes ($R = I$; "
+        "$v_a$ is the air velocity, in body axes unless said), with the quantity it changes: a rotor's thrust is "
+        "$s\\,c_t \\rho A_p r_p^2\\,\\omega(\\omega - \\omega_{\\mathrm{loss}})$, $\\Delta c$ moves the centre of "
+        "gravity, $\\Delta F_{body}$ and $\\Delta\\tau$ add to the body force and the moment about the centre of "
+        "gravity.\n\n";
+  for (const auto& f : m.effect_formulas) {
+    md << "**" << output::markdown_text(f.effect) << "**" << (f.note.empty() ? "" : " (" + output::markdown_text(f.note) + ")")
+       << (f.lines.empty() ? "\n\n" : ":\n\n");
+    for (const auto& [lhs, value] : f.lines)
+      write_equation(md, lhs, is_a<matrix>(value) ? tex.matrix(ex_to<matrix>(value)) : tex.tex(value));
   }
+}
+
+void section_equations_of_motion(std::ostringstream& md, const SymbolicModel& m, TexWriter& tex) {
   md << "## 5. Equations of motion\n\n"
      << "Translation (D'Alembert: the inertial force balances the applied forces) for the centre of "
         "gravity, expressed for the body origin that the logs record:\n\n"
@@ -173,6 +186,13 @@ void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& t
   for (const std::string& e : m.effects)  // what acts on them, as its formula below shows
     if (find_effect(e).acts_on == Effect::ActsOn::kMeasurement) md << "; " << output::markdown_code(e) << " acts on them";
   md << ".\n\n";
+}
+
+void section_equations(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
+  section_kinematics(md);
+  section_forces_and_torques(md, d.model, tex);
+  section_effect_terms(md, d.model, tex);
+  section_equations_of_motion(md, d.model, tex);
 }
 
 void variable_table(std::ostringstream& md, const std::string& title, const std::vector<Variable>& vars, bool params) {
