@@ -144,10 +144,12 @@ LoweredPlan::Mono LoweredPlan::convert(int gid) {
   return m;
 }
 
-// A sum of monomials: like terms combined, factors common to every term (and a common
-// coefficient magnitude) taken out, parameter-only terms combined into one (precomputed)
-// term, the sign normalised so that the term with the lowest id is added.
-LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
+namespace {
+
+// Like terms (equal factors) added, in first-seen order; those that cancel dropped. (Term:
+// LoweredPlan's private monomial, {coeff, factors}.)
+template <class Term>
+std::vector<Term> combine_like_terms(const std::vector<Term>& in) {
   std::map<Factors, double> like;
   std::vector<Factors> order;
   for (const auto& t : in) {
@@ -155,90 +157,109 @@ LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
     if (fresh) order.push_back(t.f);
     it->second += t.coeff;
   }
-  std::vector<Mono> terms;
+  std::vector<Term> terms;
   for (const auto& f : order)
-    if (like[f] != 0) terms.push_back(Mono{like[f], f});
-  if (terms.empty()) return Mono{0, {}};
-  if (terms.size() == 1) return terms[0];
+    if (like[f] != 0) terms.push_back(Term{like[f], f});
+  return terms;
+}
 
-  // Common factors: a base present in every term with exponents of one sign.
-  Factors common = terms[0].f;
-  for (size_t k = 1; k < terms.size() && !common.empty(); ++k) {
+// The factors every term has (a base with exponents of one sign in all, at its smallest
+// power) and the coefficient magnitude they share (1 unless all are equal), divided out of
+// the terms.
+template <class Term>
+void take_out_common(std::vector<Term>& terms, Factors* common, double* ccoeff) {
+  *common = terms[0].f;
+  for (size_t k = 1; k < terms.size() && !common->empty(); ++k) {
     Factors next;
-    for (const auto& [b, e] : common) {
+    for (const auto& [b, e] : *common) {
       for (const auto& [b2, e2] : terms[k].f)
         if (b2 == b && (e > 0) == (e2 > 0)) next.push_back({b, e > 0 ? std::min(e, e2) : std::max(e, e2)});
     }
-    common = next;
+    *common = next;
   }
-  double ccoeff = std::fabs(terms[0].coeff);
+  *ccoeff = std::fabs(terms[0].coeff);
   for (const auto& t : terms)
-    if (std::fabs(t.coeff) != ccoeff) ccoeff = 1;
+    if (std::fabs(t.coeff) != *ccoeff) *ccoeff = 1;
   for (auto& t : terms) {
-    t.f = merge(t.f, common, -1);
-    t.coeff /= ccoeff;
+    t.f = merge(t.f, *common, -1);
+    t.coeff /= *ccoeff;
   }
+}
 
-  auto is_static = [&](const Mono& t) {
-    for (const auto& [b, e] : t.f)
-      if (ir_[b].dynamic) return false;
-    return true;
-  };
+}  // namespace
 
-  // Greedy factoring: the factor shared by the most terms (a dynamic base, or a whole
-  // parameter-only part, which is one precomputed value) is taken out of those terms,
-  // c*a + c*b -> c*(a + b), until no factor is shared by two terms.
-  if (terms.size() > 2) {
-    for (;;) {
-      // Candidates: (dynamic base, exponent direction) or the parameter-only part.
-      using Cand = std::tuple<int, int, double, Factors>;  // (kind 0 base / 1 static part, base or 0, coeff, statics)
-      std::map<Cand, int> count;
-      auto static_part = [&](const Mono& t) {
-        Factors st;
-        for (const auto& fe : t.f)
-          if (!ir_[fe.first].dynamic) st.push_back(fe);
-        return Cand{1, 0, std::fabs(t.coeff), st};
-      };
-      for (const auto& t : terms) {
-        if (is_static(t)) continue;
-        const Cand sp = static_part(t);
-        if (std::get<2>(sp) != 1 || !std::get<3>(sp).empty()) count[sp]++;
-        for (const auto& [b, e] : t.f)
-          if (ir_[b].dynamic) count[Cand{0, b, e > 0 ? 1.0 : -1.0, {}}]++;
-      }
-      const Cand* best = nullptr;
-      int best_n = 1;
-      for (const auto& [c, n] : count)
-        if (n > best_n) best = &c, best_n = n;
-      if (!best) break;
-      const Cand cand = *best;
-      std::vector<Mono> group, rest;
-      for (const auto& t : terms) {
-        bool has = false;
-        if (!is_static(t)) {
-          if (std::get<0>(cand) == 1) has = static_part(t) == cand;
-          else
-            for (const auto& [b, e] : t.f)
-              if (b == std::get<1>(cand) && (e > 0 ? 1.0 : -1.0) == std::get<2>(cand)) has = true;
-        }
-        (has ? group : rest).push_back(t);
-      }
-      Mono taken;
-      if (std::get<0>(cand) == 1) {
-        taken = Mono{std::get<2>(cand), std::get<3>(cand)};
-      } else {
-        taken = Mono{1, {{std::get<1>(cand), static_cast<int>(std::get<2>(cand))}}};
-      }
-      for (auto& t : group) {
-        t.f = merge(t.f, taken.f, -1);
-        t.coeff /= taken.coeff;
-      }
-      const Mono inner = make_sum(group);
-      rest.push_back(Mono{inner.coeff * taken.coeff, merge(inner.f, taken.f)});
-      terms = rest;
-      if (terms.size() == 1) break;
+bool LoweredPlan::is_static(const Mono& t) const {
+  for (const auto& [b, e] : t.f)
+    if (ir_[b].dynamic) return false;
+  return true;
+}
+
+// Greedy factoring: the factor shared by the most terms (a dynamic base, or a whole
+// parameter-only part, which is one precomputed value) is taken out of those terms,
+// c*a + c*b -> c*(a + b), until no factor is shared by two terms.
+void LoweredPlan::factor_greedily(std::vector<Mono>& terms) {
+  for (;;) {
+    // Candidates: (dynamic base, exponent direction) or the parameter-only part.
+    using Cand = std::tuple<int, int, double, Factors>;  // (kind 0 base / 1 static part, base or 0, coeff, statics)
+    std::map<Cand, int> count;
+    auto static_part = [&](const Mono& t) {
+      Factors st;
+      for (const auto& fe : t.f)
+        if (!ir_[fe.first].dynamic) st.push_back(fe);
+      return Cand{1, 0, std::fabs(t.coeff), st};
+    };
+    for (const auto& t : terms) {
+      if (is_static(t)) continue;
+      const Cand sp = static_part(t);
+      if (std::get<2>(sp) != 1 || !std::get<3>(sp).empty()) count[sp]++;
+      for (const auto& [b, e] : t.f)
+        if (ir_[b].dynamic) count[Cand{0, b, e > 0 ? 1.0 : -1.0, {}}]++;
     }
+    const Cand* best = nullptr;
+    int best_n = 1;
+    for (const auto& [c, n] : count)
+      if (n > best_n) best = &c, best_n = n;
+    if (!best) return;
+    const Cand cand = *best;
+    std::vector<Mono> group, rest;
+    for (const auto& t : terms) {
+      bool has = false;
+      if (!is_static(t)) {
+        if (std::get<0>(cand) == 1) has = static_part(t) == cand;
+        else
+          for (const auto& [b, e] : t.f)
+            if (b == std::get<1>(cand) && (e > 0 ? 1.0 : -1.0) == std::get<2>(cand)) has = true;
+      }
+      (has ? group : rest).push_back(t);
+    }
+    Mono taken;
+    if (std::get<0>(cand) == 1) {
+      taken = Mono{std::get<2>(cand), std::get<3>(cand)};
+    } else {
+      taken = Mono{1, {{std::get<1>(cand), static_cast<int>(std::get<2>(cand))}}};
+    }
+    for (auto& t : group) {
+      t.f = merge(t.f, taken.f, -1);
+      t.coeff /= taken.coeff;
+    }
+    const Mono inner = make_sum(group);
+    rest.push_back(Mono{inner.coeff * taken.coeff, merge(inner.f, taken.f)});
+    terms = rest;
+    if (terms.size() == 1) return;
   }
+}
+
+// A sum of monomials: like terms combined, factors common to every term (and a common
+// coefficient magnitude) taken out, parameter-only terms combined into one (precomputed)
+// term, the sign normalised so that the term with the lowest id is added.
+LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
+  std::vector<Mono> terms = combine_like_terms(in);
+  if (terms.empty()) return Mono{0, {}};
+  if (terms.size() == 1) return terms[0];
+  Factors common;
+  double ccoeff = 1;
+  take_out_common(terms, &common, &ccoeff);
+  if (terms.size() > 2) factor_greedily(terms);
   // Everything factored into one term, (c*a + c*b) -> c*(a + b): the factors and the
   // coefficient common to all terms, divided out above, go back on it.
   if (terms.size() == 1) return Mono{terms[0].coeff * ccoeff, merge(terms[0].f, common)};
@@ -259,8 +280,7 @@ LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
   std::vector<std::pair<int, int>> st;
   for (const auto& s : mat) st.push_back({s.id, s.sign * outer});
   const int id = sum(st);
-  Mono r{outer * ccoeff, merge(common, Factors{{id, 1}})};
-  return r;
+  return Mono{outer * ccoeff, merge(common, Factors{{id, 1}})};
 }
 
 // A monomial as sign * node: constants and parameter-only factors are one factor (a

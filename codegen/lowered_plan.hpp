@@ -124,6 +124,10 @@ class LoweredPlan {
   int negate(int id);
   Mono convert(int gid);
   Mono make_sum(std::vector<Mono> terms);
+  // make_sum's steps (lowered_plan.cpp): a dynamic base or a parameter-only part shared by
+  // terms taken out of them while any is shared, and whether a term has no dynamic base.
+  void factor_greedily(std::vector<Mono>& terms);
+  bool is_static(const Mono& t) const;
   Signed materialize(const Mono& m);
   int materialize_positive(const Mono& m);
   void extract_pairs(Kind kind);
