@@ -22,8 +22,8 @@
 
 namespace quadgen::cli {
 
-// The option of `command` nearest to `word` ("--maping" -> "--mapping"), within two edits;
-// "" when none is.
+// The option of `command` nearest to `word` ("--maping" -> "--mapping"), as nearest_word
+// judges nearness; "" when none is near.
 inline std::string nearest_option(const CLI::App& command, const std::string& word) {
   std::vector<std::string> options;
   for (const CLI::Option* o : command.get_options())
