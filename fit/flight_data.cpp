@@ -440,20 +440,6 @@ void check_sensor_units(const std::string& path, const Flight& f) {
 }
 }  // namespace
 
-namespace {
-
-// Which of `columns` a log lacks, blamed on the mapping where one named its columns.
-std::string missing_columns(const runtime::CsvTable& log, const std::vector<std::string>& columns, const std::string& what) {
-  std::string missing;
-  for (const auto& c : columns)
-    if (log.column(c) < 0) missing += (missing.empty() ? "'" : ", '") + c + "'";
-  if (log.named_by.empty()) return log.path + ":1: missing column " + missing + ": " + what;
-  return log.named_by + ": maps no column of " + log.path + " to " + missing + ": " + what +
-         " (add each under columns:, e.g. p: {source: <the log's column>, unit: rad/s})";
-}
-
-}  // namespace
-
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
   // The likeliest cause of a missing column in a log read without a mapping: it needs one.
   runtime::validate_canonical(log, rotors,
@@ -474,7 +460,8 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   f.has_gyro = has({"p", "q", "r"});
   f.has_accelerometer = has({"ax", "ay", "az"});
   f.has_vbat = has({"vbat"});
-  if (!f.has_gyro) throw FitError(missing_columns(log, {"p", "q", "r"}, "the body rates (gyro)"));
+  if (!f.has_gyro)
+    throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
   if (!f.has_pose && !f.has_accelerometer)
     throw FitError(log.path + ":1: need a pose (x, y, z, qw..qz) or an accelerometer (ax, ay, az)");
   const auto t = log.values("t");

@@ -250,27 +250,46 @@ void check_values(const CsvTable& log) {
     }
 }
 
+std::string missing_columns_message(const CsvTable& log, const std::vector<std::string>& columns,
+                                    const MissingColumns& how) {
+  std::vector<std::string> missing;
+  for (const auto& c : columns)
+    if (log.column(c) < 0) missing.push_back(c);
+  if (missing.empty()) return "";
+  std::string list;
+  for (const auto& c : missing) list += (list.empty() ? "'" : ", '") + c + "'";
+  const std::string what = how.what.empty() ? "" : ": " + how.what;
+  if (log.named_by.empty())
+    return log.path + ":1: missing column" + (missing.size() > 1 ? "s " : " ") + list + what + how.hint_without_mapping;
+  const std::string entry = "'" + missing.front() + ": {source: <the log's column>" +
+                            (how.unit.empty() ? "" : ", unit: " + how.unit) + "}'";
+  return log.named_by + ": maps no column of " + log.path + " to " + list + what +
+         (missing.size() > 1 ? " (add each under columns:, e.g. " + entry + ")" : " (add " + entry + " under columns:)");
+}
+
 void validate_canonical(const CsvTable& log, const std::vector<std::string>& rotors, const std::string& missing_hint) {
   // A name the mapping gave is the mapping's mistake: its file and line are named, not the log's.
   const std::string maps = log.named_by.empty() ? "" : " (in the mapping read for " + log.path + ")";
-  // A canonical column the mapping does not give: the entry to add, and where.
-  const auto missing = [&](const std::string& column) {
-    if (log.named_by.empty()) return LogError(log.where_named() + ": missing column '" + column + "'" + missing_hint);
-    return LogError(log.named_by + ": maps no column of " + log.path + " to '" + column + "' (add '" + column +
-                    ": {source: <the log's column>}' under columns:)");
-  };
-  if (log.column("t") < 0) throw missing("t");
   std::set<std::string> known(rotors.begin(), rotors.end());
   std::string list;
   for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
+  // A command column for a rotor the vehicle lacks first: a misspelt rotor is why its own
+  // column is then missing.
   for (size_t c = 0; c < log.columns.size(); ++c) {
     const std::string& name = log.columns[c];
     if (name.rfind("u_", 0) == 0 && !known.count(name.substr(2)))
       throw LogError(log.where_named(static_cast<int>(c)) + ": column '" + name + "' names no rotor of this vehicle (rotors: " +
                      list + ")" + maps);
   }
-  for (const auto& r : rotors)
-    if (log.column("u_" + r) < 0) throw missing("u_" + r);
+  std::vector<std::string> needed{"t"};
+  for (const auto& r : rotors) needed.push_back("u_" + r);
+  const bool lacks_time = log.column("t") < 0;
+  const bool lacks_commands = std::any_of(rotors.begin(), rotors.end(), [&](const auto& r) { return log.column("u_" + r) < 0; });
+  const std::string what = lacks_time && lacks_commands ? "the time and the rotor commands"
+                           : lacks_time                 ? "the time (s)"
+                                                        : "the rotor commands";
+  const std::string missing = missing_columns_message(log, needed, {what, "", missing_hint});
+  if (!missing.empty()) throw LogError(missing);
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
   const int tc = log.column("t");

@@ -55,6 +55,22 @@ CsvTable parse_csv(const std::string& text, const std::string& path);
 // kMaxAbsTime); throws LogError "path:line: ..." naming the column.
 void check_values(const CsvTable& log);
 
+// Canonical columns a log lacks, and how to say so: what they are ("the body rates (gyro)"),
+// the unit of the example entry a mapping should add, and what to append when no mapping
+// named the columns (what the caller knows of why).
+struct MissingColumns {
+  std::string what;
+  std::string unit;
+  std::string hint_without_mapping;
+};
+
+// Which of `columns` the log lacks, every one in one message, blamed on the file that names
+// the columns: "log.csv:1: missing column 'u_D': the rotor commands" from a header, or from a
+// mapping "m.yaml: maps no column of log.csv to 'u_D': ... (add 'u_D: {source: <the log's
+// column>}' under columns:)". Empty when none is missing.
+std::string missing_columns_message(const CsvTable& log, const std::vector<std::string>& columns,
+                                    const MissingColumns& how);
+
 // Checks the canonical layout for these rotors: t strictly increasing, u_<rotor> present
 // for every rotor and no u_ column for an unknown rotor, finite values within the sanity
 // bounds above, at least 2 rows.

@@ -1084,7 +1084,8 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // A log of another layout without its mapping; a vehicle file given as the log.
   write(tmp / "other.csv", "time,m1,m2,m3,m4\n0,0.5,0.5,0.5,0.5\n0.01,0.5,0.5,0.5,0.5\n");
   expect_error({"fit", cf, tmp / "other.csv", "--out", tmp / "o"}, 2,
-               "missing column 't'; a log in another layout is read with --mapping M.yaml");
+               "other.csv:1: missing columns 't', 'u_M1', 'u_M2', 'u_M3', 'u_M4': the time and the rotor commands; a "
+               "log in another layout is read with --mapping M.yaml");
   expect_error({"diagnose", cf, f3, "--out", tmp / "o"}, 2, "finken3.yaml:1: no CSV header");
   // A stray comma in an effect list; a thrust-stand fit given as a flight model's values.
   expect_error({"derive", f3, "--effects", "motor_lag,", "--out", tmp / "o"}, 2, "has an empty name");

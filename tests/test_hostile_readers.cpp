@@ -251,10 +251,16 @@ TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
                  "column 'u_m1' names no rotor of this vehicle (rotors: M1, M2, M3, M4) (in the mapping read for " + log + ")");
   const std::string missing =
       message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"m1", "M2", "M3", "M4", "M5"}); });
-  EXPECT_NE(missing.find(mapping + ": maps no column of " + log + " to 'u_M5' (add 'u_M5: {source: <the log's column>}' "
+  EXPECT_NE(missing.find(mapping + ": maps no column of " + log + " to 'u_M5': the rotor commands (add 'u_M5: {source: <the log's column>}' "
                                    "under columns:)"),
             std::string::npos)
       << missing;
+  const std::string two_missing = message_of<runtime::LogError>(
+      [&] { runtime::validate_canonical(mapped, {"m1", "M2", "M3", "M4", "M5", "M6"}); });
+  EXPECT_NE(two_missing.find(mapping + ": maps no column of " + log + " to 'u_M5', 'u_M6': the rotor commands (add each "
+                                       "under columns:, e.g. 'u_M5: {source: <the log's column>}')"),
+            std::string::npos)
+      << two_missing;
   // A source column the log lacks: the mapping's line, and the column it probably meant.
   const std::string typo = write("typo.yaml", "columns:\n  t: {source: time}\n  u_M1: {source: M1}\n");
   const std::string wrong_case = message_of<FitError>([&] { read_log(log, typo, 0); });

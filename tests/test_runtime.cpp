@@ -518,7 +518,12 @@ TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
     return std::string("accepted");
   };
   EXPECT_NE(message("t,u_A,u_B,u_C,u_E\n0,1,1,1,1\n1,1,1,1,1\n").find("'u_E' names no rotor"), std::string::npos);
-  EXPECT_NE(message("t,u_A,u_B,u_C\n0,1,1,1\n1,1,1,1\n").find("missing column 'u_D'"), std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C\n0,1,1,1\n1,1,1,1\n").find("log.csv:1: missing column 'u_D': the rotor commands"),
+            std::string::npos);
+  // Every missing column in one message, not one per run.
+  EXPECT_NE(message("u_A,u_B\n0,1\n1,1\n").find("missing columns 't', 'u_C', 'u_D': the time and the rotor commands"),
+            std::string::npos);
+  EXPECT_NE(message("u_A,u_B,u_C,u_D\n0,1,1,1\n1,1,1,1\n").find("missing column 't': the time (s)"), std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n0,1,1,1,1\n").find("log.csv:3: time not strictly increasing"),
             std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,x,1,1\n").find("log.csv:3: column 'u_B'"), std::string::npos);
