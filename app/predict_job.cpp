@@ -67,7 +67,8 @@ void check_something_measured(const predict::Prediction& pooled, const PredictJo
 PredictJobResult run_predict_job(const PredictJob& job_in, const Vehicle& v) {
   PredictJobResult r;
   PredictJob job = job_in;
-  const std::string mapping_environment = job.options.mapping.empty() ? "" : fit::load_mapping(job.options.mapping).environment;
+  if (!job.mapping.empty()) job.options.mapping = fit::load_mapping(job.mapping);  // read once, for every log
+  const std::string mapping_environment = job.options.mapping ? job.options.mapping->environment : "";
   job.options.environment = parse_environment(job.environment.empty() ? mapping_environment : job.environment);
   // Every effect, at its neutral value unless --params sets it.
   std::string how;

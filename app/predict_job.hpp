@@ -13,6 +13,7 @@ namespace quadgen::app {
 struct PredictJob {
   std::string vehicle;            // vehicle file (YAML)
   std::vector<std::string> logs;  // one or more flights of it
+  std::string mapping;            // column mapping (YAML) for logs not in the canonical layout
   // "indoor", "outdoor" or "unknown"; empty: the mapping's environment, else unknown.
   std::string environment;
   predict::PredictFlightsOptions options;

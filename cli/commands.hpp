@@ -41,7 +41,7 @@ int run_diagnose(const DiagnoseArgs& args);
 struct PredictArgs {
   std::string vehicle, out;
   std::vector<std::string> logs;
-  std::string environment;
+  std::string mapping, environment;
   predict::PredictFlightsOptions options;  // the flags land here; defaults are the library's
 };
 void add_predict(CLI::App& app, PredictArgs& args);

@@ -18,7 +18,7 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_option("vehicle", a.vehicle, "vehicle description (YAML)")->required();
   c->add_option("logs", a.logs, std::string("flight logs, one or more: ") + kLogFormats)->required()->default_str("");
   c->add_option("--out", a.out, "output directory")->required();
-  c->add_option("--mapping", a.options.mapping, "column mapping (YAML) for logs not in the canonical layout");
+  c->add_option("--mapping", a.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--params", a.options.params,
                 "parameter values from a fit.json or diagnosis.json (default: the vehicle file's nominal values)");
   c->add_option("--validation", a.options.validation,
@@ -46,9 +46,9 @@ void add_predict(CLI::App& app, PredictArgs& a) {
 int run_predict(const PredictArgs& a) {
   const Vehicle vehicle = load_vehicle(a.vehicle);  // a bad file is reported before anything is created
   std::vector<std::string> inputs = a.logs;
-  inputs.insert(inputs.end(), {a.vehicle, a.options.mapping, a.options.params});
+  inputs.insert(inputs.end(), {a.vehicle, a.mapping, a.options.params});
   output::OutputDirectory out(a.out, "predict", inputs);  // refused before the work, not after
-  app::PredictJob job{a.vehicle, a.logs, a.environment, a.options};
+  app::PredictJob job{a.vehicle, a.logs, a.mapping, a.environment, a.options};
   job.options.progress = output::terminal_progress();
   const app::PredictJobResult r = app::run_predict_job(job, vehicle);
   for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";

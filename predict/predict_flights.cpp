@@ -15,7 +15,7 @@ namespace {
 
 fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlightsOptions& o) {
   const std::vector<std::string> rotors = rotor_names(v);
-  const runtime::CsvTable log = fit::read_log(path, o.mapping, o.resample);
+  const runtime::CsvTable log = fit::read_log(path, o.mapping ? &*o.mapping : nullptr, o.resample);
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
   if (!flight.has_pose) o.progress.say(path + ": no pose logged: one-step errors only (rollouts need a measured state)");
   return flight;

@@ -4,12 +4,14 @@
 // the evaluated one. The command line only turns flags into PredictFlightsOptions.
 #pragma once
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "runtime/dynamic_model.hpp"
+#include "fit/flight_data.hpp"
 #include "fit/least_squares.hpp"
 #include "output/progress.hpp"
 #include "predict/prediction.hpp"
@@ -19,7 +21,8 @@
 namespace quadgen::predict {
 
 struct PredictFlightsOptions {
-  std::string mapping;   // column mapping (YAML) for logs not in the canonical layout
+  // The column mapping for logs not in the canonical layout, read once (fit::load_mapping).
+  std::optional<fit::ColumnMapping> mapping;
   double resample = 0;   // resample each log onto a uniform grid at this rate [Hz] first (0: no)
   double validation = 0.3;  // fraction of each flight (at its end) evaluated; 1: all of it
   std::string params;    // a fit.json or diagnosis.json; empty: the vehicle file's nominal values
