@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdlib>
@@ -366,12 +367,35 @@ class Blocked {
 };
 }  // namespace interrupt
 
+// ".<target>.quadgen-tmp.": the start of the target's staging folders' names. A long target
+// name is cut (a file name has 255 bytes) and told apart from others with the same start by
+// a hash of the whole name, so that one output never takes another's folders for its own.
+std::string detail::staging_stem(const std::string& target_name) {
+  if (target_name.size() <= 100) return "." + target_name + kStagingInfix;
+  Fnv1a h;
+  h.add(target_name.data(), target_name.size());
+  return "." + target_name.substr(0, 100) + "~" + h.hex() + kStagingInfix;
+}
+
+// The pid in a staging folder's name <stem><pid>.XXXXXX, or -1 when the name is not one.
+long detail::staging_pid(const std::string& name, const std::string& stem) {
+  if (name.rfind(stem, 0) != 0) return -1;
+  const std::string rest = name.substr(stem.size());
+  const size_t dot = rest.find('.');
+  if (dot == 0 || dot == std::string::npos || dot > 18 || rest.size() != dot + 7) return -1;
+  const auto is_digit = [](char c) { return c >= '0' && c <= '9'; };
+  const auto is_alnum = [&](char c) { return is_digit(c) || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); };
+  if (!std::all_of(rest.begin(), rest.begin() + dot, is_digit)) return -1;
+  if (!std::all_of(rest.begin() + dot + 1, rest.end(), is_alnum)) return -1;
+  return std::strtol(rest.c_str(), nullptr, 10);
+}
+
 // A private directory beside the target (same file system, so renames are atomic), named
 // .<target>.quadgen-tmp.<pid>.XXXXXX. Removed with everything in it unless released.
 class StagingDirectory {
  public:
   StagingDirectory(const fs::path& parent, const std::string& target_name) {
-    const std::string stem = "." + target_name.substr(0, 100) + kStagingInfix;
+    const std::string stem = detail::staging_stem(target_name);
     remove_stale(parent, stem);
     std::string templ = (parent / (stem + std::to_string(::getpid()) + ".XXXXXX")).string();
     const interrupt::Blocked blocked;  // made and remembered as one step
@@ -434,12 +458,15 @@ class StagingDirectory {
  private:
   // Staging directories of runs that were killed: their process is gone. Those of running
   // processes are never touched.
+  // Only a folder named exactly as this class names its own counts: <stem><pid>.XXXXXX, the
+  // pid in digits and mkdtemp's six letters or digits. A user's ".res.quadgen-tmp.notes"
+  // beside --out res is not quadgen's to remove.
   static void remove_stale(const fs::path& parent, const std::string& stem) {
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(parent, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.rfind(stem, 0) != 0) continue;
-      const long pid = std::strtol(name.c_str() + stem.size(), nullptr, 10);
+      const long pid = detail::staging_pid(e.path().filename().string(), stem);
+      std::error_code type_ec;
+      if (pid <= 0 || !fs::is_directory(fs::symlink_status(e.path(), type_ec))) continue;
       std::error_code keep_ec;
       if (fs::exists(e.path() / kKeepMarker, keep_ec)) continue;  // an earlier run kept aside where it was
       if (!process_alive(pid)) remove_tree_quietly(e.path());

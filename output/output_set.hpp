@@ -117,6 +117,11 @@ namespace detail {
 // that name would be too long), marked so that no later run removes it; returns where it is
 // (`staged` itself if no rename succeeded). Declared here for its test.
 std::filesystem::path keep_aside(const std::filesystem::path& staged, const std::filesystem::path& target);
+// The start of a target's staging folders' names, ".<target>.quadgen-tmp." (a long name cut
+// and told apart by a hash), and the pid in such a folder's full name "<stem><pid>.XXXXXX"
+// (-1 for any other name: only folders named so are ever removed as stale). For their test.
+std::string staging_stem(const std::string& target_name);
+long staging_pid(const std::string& name, const std::string& stem);
 }  // namespace detail
 
 }  // namespace quadgen::output

@@ -1269,6 +1269,36 @@ TEST(DataLoss, AnEarlierOutputIsKeptAsideEvenUnderALongName) {
   }
 }
 
+// Only folders named as quadgen names its staging folders are removed as stale: a user's
+// ".res.quadgen-tmp.notes" beside --out res survives a run (it did not, when any name with
+// that start and no live pid in it counted), and a long output name's folders are not
+// another long name's with the same first 100 characters.
+TEST(DataLoss, OnlyQuadgensOwnStagingFoldersAreRemovedAsStale) {
+  using quadgen::output::detail::staging_pid;
+  using quadgen::output::detail::staging_stem;
+  const std::string stem = staging_stem("res");
+  EXPECT_EQ(stem, ".res.quadgen-tmp.");
+  EXPECT_EQ(staging_pid(stem + "4242.aB3xY9", stem), 4242);
+  for (const std::string& other : {stem + "notes", stem + "4242", stem + "4242.abc", stem + "4242.abcdefg",
+                                   stem + ".abcdef", stem + "42x2.abcdef", stem + "4242.abc/ef", std::string(".res.quadgen-tmp.1.quadgen-tmp.4242.abcdef")})
+    EXPECT_EQ(staging_pid(other, stem), -1) << other;
+  const std::string a = std::string(120, 'o') + "a", b = std::string(120, 'o') + "b";
+  EXPECT_NE(staging_stem(a), staging_stem(b));
+  EXPECT_EQ(staging_stem(a).rfind(staging_stem(b), 0), std::string::npos);
+  EXPECT_LT(staging_stem(a).size() + 25, size_t{255});
+
+  Scratch tmp;
+  const fs::path users = tmp.dir / ".res.quadgen-tmp.notes";
+  fs::create_directories(users);
+  write((users / "keep.txt").string(), "mine\n");
+  const fs::path stale = tmp.dir / ".res.quadgen-tmp.999999999.abcdef";  // beyond any pid_max: a dead run's
+  fs::create_directories(stale);
+  write((stale / "f.csv").string(), "left by a killed run\n");
+  ASSERT_EQ(run_quadgen({"derive", source_path("vehicles/crazyflie21.yaml"), "--out", tmp / "res"}, tmp.dir).rc, 0);
+  EXPECT_EQ(read(users / "keep.txt"), "mine\n");
+  EXPECT_FALSE(fs::exists(stale));
+}
+
 // Scenarios on other layouts: the tilt and yaw manoeuvres turn every vehicle the way they
 // turn the FINken 3 (right towards +x, forward towards -y, yaw clockwise seen from above),
 // a hexacopter included (it was refused them, when rotors took the thesis' A..D roles by
