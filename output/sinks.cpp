@@ -169,8 +169,13 @@ std::string csv_field(const std::string& s) {
 }
 
 std::string gnuplot_string(const std::string& s) {
+  // gnuplot's SVG terminal writes & as &amp; except where "&#x" starts, which it passes on as a
+  // character reference: a log named "x&#x202E;.csv" would reach the page as a bidi override,
+  // "&#x0;" would break the SVG. Its & is written as the reference &#x26; (an &, shown as such).
+  std::string safe;
+  for (size_t i = 0; i < s.size(); ++i) safe += s.compare(i, 3, "&#x") == 0 ? "&#x26;" : std::string(1, s[i]);
   std::string out = "'";
-  for_each_char(s, [&](const std::string& c) {
+  for_each_char(safe, [&](const std::string& c) {
     if (c == "'") out += "''";
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
     else if (invisible_control(c)) out += printable(c);  // shown, not obeyed, in the SVG and the page it lands in

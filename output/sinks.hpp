@@ -31,8 +31,9 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 // A gnuplot single-quoted string, quotes included. Inside single quotes gnuplot expands neither
 // backquotes nor macros and knows one escape ('' for '); control characters, which would end
 // the command line, become spaces, and the bidirectional controls are shown as \xNN (as
-// printable does): the SVG gnuplot writes lands in report.html. Labels are set `noenhanced`,
-// so _ ^ @ { } stay literal.
+// printable does): the SVG gnuplot writes lands in report.html. The & of "&#x", which the SVG
+// terminal would pass on as a character reference, is written as &#x26; (shown as &). Labels
+// are set `noenhanced`, so _ ^ @ { } stay literal.
 std::string gnuplot_string(const std::string& s);
 
 // HTML text or attribute value: & < > " ' as entities, control characters dropped, the

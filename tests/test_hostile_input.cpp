@@ -532,6 +532,19 @@ TEST(Sinks, GnuplotStringShowsBidiControls) {
       EXPECT_EQ(g.find(bidi), std::string::npos) << out::printable(s);
   }
   EXPECT_EQ(out::gnuplot_string("a\xE2\x80\xAE" "b"), "'a\\xE2\\x80\\xAEb'");
+  // A character reference in a name reaches the SVG as text, not as the character: gnuplot's
+  // SVG terminal passes "&#x" through (it decoded U+202E into report.html, and "&#x0;" broke
+  // the SVG). gnuplot is one of the project's dependencies (scripts/install-deps.sh).
+  EXPECT_EQ(out::gnuplot_string("x&#x202E;y & z"), "'x&#x26;#x202E;y & z'");
+  std::string svg, error;
+  const std::vector<double> t{0, 1, 2};
+  quadgen::runtime::Panel panel;
+  panel.title = "log y&#x0;.csv";
+  panel.series.push_back({"x&#x202E;vsc.gol", t, t});
+  ASSERT_TRUE(quadgen::runtime::render_svg("replay of x&#x202E;vsc.gol.csv", {panel}, &svg, &error)) << error;
+  EXPECT_EQ(svg.find("&#x202E;"), std::string::npos);
+  EXPECT_EQ(svg.find("&#x0;"), std::string::npos);
+  EXPECT_NE(svg.find("x&#x26;#x202E;vsc.gol"), std::string::npos) << svg.substr(0, 2000);
 }
 
 TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
