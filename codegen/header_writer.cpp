@@ -94,11 +94,11 @@ void set_provenance_fields(kainjow::mustache::data& d, const Provenance& p) {
 
 std::string model_name(const SymbolicModel& m) {
   std::string s = m.vehicle_name;
-  if (m.effects.size() == effect_catalogue().size()) s += "_all_effects";
-  else if (!m.effects.empty()) s += "_with";
+  if (m.effects.size() == effect_catalogue().size()) s += output::kAllEffectsSuffix;
+  else if (!m.effects.empty()) s += output::kEffectsInfix;
   if (m.effects.size() != effect_catalogue().size())
     for (const auto& e : m.effects) s += "_" + e;
-  if (const auto problem = output::name_problem(m.vehicle_name))
+  if (const auto problem = output::vehicle_name_problem(m.vehicle_name))
     throw std::invalid_argument("vehicle name '" + output::printable(m.vehicle_name) + "': " + *problem);
   return output::checked_cpp_identifier(s, "model namespace");
 }

@@ -272,7 +272,9 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
   v.source_path = path;
   v.content_hash = fnv1a_hex(content);
-  v.name = r.name(r.need(root, "name", "the vehicle file"), "vehicle name");
+  const YAML::Node name = r.need(root, "name", "the vehicle file");
+  v.name = r.name(name, "vehicle name");
+  if (const auto problem = output::vehicle_name_problem(v.name)) r.fail(name, "vehicle name '" + v.name + "': " + *problem);
   if (root["description"]) v.description = r.text(root["description"], "description");
   read_parameter_sections(r, root, v);
   v.blocks = read_named_list<Block>(r, root, "blocks", "block", read_block);

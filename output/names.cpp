@@ -83,4 +83,23 @@ std::optional<std::string> name_problem(const std::string& name) {
   return std::nullopt;
 }
 
+std::optional<std::string> vehicle_name_problem(const std::string& name) {
+  if (auto problem = name_problem(name)) return problem;
+  const std::string with = std::string(kEffectsInfix) + "_", all = kAllEffectsSuffix;
+  const auto ends_with = [&](const std::string& end) {
+    return name.size() >= end.size() && name.compare(name.size() - end.size(), end.size(), end) == 0;
+  };
+  if (name.find(with) != std::string::npos || ends_with(kEffectsInfix) || ends_with(all))
+    return "the name contains '" + with + "' or ends in '" + std::string(kEffectsInfix) + "' or '" + all +
+           "', which the code generator appends for a model with effects: two vehicles' models would share one "
+           "C++ namespace (rename it, e.g. '" + [&] {
+             std::string r = name;
+             for (size_t at; (at = r.find(with)) != std::string::npos;) r.replace(at, with.size(), "_w_");
+             if (ends_with(all)) r.replace(r.size() - all.size(), all.size(), "_all");
+             else if (ends_with(kEffectsInfix)) r.replace(r.size() - 5, 5, "_w");
+             return r;
+           }() + "')";
+  return std::nullopt;
+}
+
 }  // namespace quadgen::output

@@ -18,6 +18,16 @@ std::optional<std::string> name_problem(const std::string& name);
 // The rule in words, for error messages and docs.
 const char* name_rule();
 
+// What the code generator appends to a vehicle's name for a model's namespace and folder:
+// "<vehicle>_with_<effect>_<effect>..." or "<vehicle>_all_effects".
+inline constexpr const char* kEffectsInfix = "_with";
+inline constexpr const char* kAllEffectsSuffix = "_all_effects";
+
+// name_problem, and for a vehicle's name also what would make two models' namespaces one: a
+// vehicle named "cf_with_wind" (or "cf_all_effects") would generate the namespace of "cf"
+// with the wind effect (or with all), and the linker would keep one model's code for both.
+std::optional<std::string> vehicle_name_problem(const std::string& name);
+
 // True for a C++ keyword or alternative token (class, int, and, ...).
 bool is_cpp_keyword(const std::string& word);
 

@@ -297,6 +297,25 @@ TEST(NameRule, VehicleParserRefusesHostileNamesWithFileAndLine) {
   }
 }
 
+// Two vehicles whose models would share one namespace: "cf_with_wind" bare and "cf" with the
+// wind effect both made quadgen_generated::cf_with_wind, and two translation units linked one
+// rhs for both (an address sanitizer saw the other's parameter array overrun). The vehicle
+// name may not contain what the generator appends.
+TEST(NameRule, AVehicleNameCannotBeAnotherModelsNamespace) {
+  for (const char* ok : {"finken3", "cf_within", "with_cf", "cf_all", "crazyflie21_nanobench"})
+    EXPECT_FALSE(out::vehicle_name_problem(ok)) << ok;
+  for (const char* bad : {"cf_with_wind", "cf_with", "cf_all_effects", "a_with_b_c"})
+    EXPECT_TRUE(out::vehicle_name_problem(bad)) << bad;
+  try {
+    quadgen::parse_vehicle(finken3_with("name: finken3", "name: finken3_with_motor_lag"), "twin.yaml");
+    ADD_FAILURE() << "a vehicle named as finken3's model with motor_lag was accepted";
+  } catch (const quadgen::VehicleError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("twin.yaml:", 0), 0u) << msg;
+    EXPECT_NE(msg.find("share one C++ namespace (rename it, e.g. 'finken3_w_motor_lag')"), std::string::npos) << msg;
+  }
+}
+
 TEST(NameRule, DuplicateKeysInVehicleFilesAreRefused) {
   try {
     quadgen::parse_vehicle(finken3_with("name: finken3", "name: finken3\nname: other"), "dup.yaml");
