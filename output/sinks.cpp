@@ -228,10 +228,16 @@ size_t block_opener(const std::string& s) {
 }
 }  // namespace
 
-std::string markdown_text(const std::string& s) {
+std::string markdown_text(const std::string& text) {
+  // Blanks at the start go: four of them open a code block where the text starts a line.
+  size_t start = 0;
+  while (start < text.size() && (text[start] == ' ' || control(static_cast<unsigned char>(text[start])))) ++start;
+  const std::string s = text.substr(start);
   // Inline Markdown (and GitHub's $ math): these change how the text around them renders.
   // '@' too, the ':' of "://" and the '.' of "www.": GitHub turns a bare https://...,
   // www.... or name@host into a link, and a link is what a hostile description wants.
+  // GitHub's e-mail autolinks see through the escape of '@' (the text is joined before they
+  // are looked for), so a word joiner (U+2060, invisible) follows it: no domain starts there.
   static const std::string punctuation = "\\`*_[]|$~@";
   const size_t opener = block_opener(s);
   const auto after_www = [&](size_t at) {
@@ -245,7 +251,8 @@ std::string markdown_text(const std::string& s) {
   for_each_char(s, [&](const std::string& c) {
     const bool scheme = c == ":" && s.compare(at + 1, 2, "//") == 0;
     const bool special = c.size() == 1 && (punctuation.find(c[0]) != std::string::npos || scheme || (c[0] == '.' && after_www(at)));
-    if (special || at == opener) out += "\\" + c;
+    if (c == "@") out += "\\@\xE2\x81\xA0";  // U+2060 WORD JOINER
+    else if (special || at == opener) out += "\\" + c;
     else out += html_text(c);
     at += c.size();
   });

@@ -45,9 +45,10 @@ std::string html_preformatted(const std::string& s);
 
 // Markdown text on one line (table cells, headings): HTML-escaped, Markdown punctuation
 // backslash-escaped, line breaks become spaces; what would open a heading, a list or a rule
-// at the start of a line (# - + = "1.") is escaped there; no bare URL, www. address or
-// e-mail address is left for GitHub to turn into a link (the : of ://, @ and the . after www
-// escaped).
+// at the start of a line (# - + = "1.") is escaped there, and blanks there dropped (four
+// would open a code block); no bare URL, www. address or e-mail address is left for GitHub
+// to turn into a link (the : of :// and the . after www escaped, @ escaped and followed by
+// an invisible word joiner, U+2060, which no domain starts with).
 std::string markdown_text(const std::string& s);
 
 // Inline code (`name`) when `s` can be one (no backtick, no control character); otherwise the

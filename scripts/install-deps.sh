@@ -12,6 +12,7 @@ packages=(
   libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds
   libkainjow-mustache-dev               # text templates for generated code
   gnuplot-nox                           # plots (SVG) of simulations and fits
+  cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown
   clang libclang-rt-14-dev              # libFuzzer targets (scripts/fuzz.sh)
 )
 missing=()
