@@ -51,6 +51,8 @@ std::runtime_error airframe_error(const std::string& path, const std::string& wh
   return std::runtime_error(output::printable(path) + ": " + what);
 }
 
+diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::string& path, const SymbolicModel& all);
+
 // The airframe an earlier diagnosis found, from its diagnosis.json: its fitted values
 // (airframe_fit; parameters it did not fit at the model's nominal or "off" values), the
 // parameters each flight has its own value of, and its named airframe effects with their
@@ -69,6 +71,17 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
     throw airframe_error(path, "not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
                                    "); expected the diagnosis.json of an earlier diagnose run");
   }
+  try {
+    return read_airframe(j, path, all);
+  } catch (const nlohmann::json::exception& e) {  // an entry of another type than quadgen writes
+    const std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw airframe_error(path, "not the diagnosis.json layout quadgen writes (" +
+                                   output::printable(bracket == std::string::npos ? what : what.substr(bracket + 2)) + ")");
+  }
+}
+
+diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::string& path, const SymbolicModel& all) {
   if (!j.is_object() || !j.contains("airframe_fit") || !j.contains("findings") || !j.contains("flight_parameters"))
     throw airframe_error(path, "not a diagnosis.json of quadgen (expected airframe_fit, findings, flight_parameters)");
   const auto known = [&](const std::string& name) {

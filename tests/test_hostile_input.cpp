@@ -1154,6 +1154,11 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // A wrong --airframe file is said before the logs are read (here one that does not exist).
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "stand.json", "--out", tmp / "o"}, 2,
                "not a diagnosis.json of quadgen");
+  // One of the right shape with an entry of another type: the file named, not the JSON
+  // library's bare message.
+  write(tmp / "typed.json", R"({"airframe_fit": {}, "flight_parameters": [], "findings": [{"effect": 123, "parameters": {}}]})");
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "typed.json", "--out", tmp / "o"}, 2,
+               "typed.json: not the diagnosis.json layout quadgen writes (type must be string, but is number)");
 }
 
 // A log whose evaluated part is too short for one rollout is the input's problem: refused with
