@@ -39,6 +39,16 @@ std::string channel_unit(const Diagnosis& d, const std::string& channel) {
   return "";
 }
 
+// A check's leads: each claim once, the numbers of each source that shows it below.
+void lead_html(std::ostream& h, const std::vector<Lead>& leads, const Diagnosis& d, const std::string& css_class) {
+  for (const auto& lead : leads) {
+    h << "<p" << (css_class.empty() ? "" : " class=\"" + css_class + "\"") << ">" << esc(lead.claim) << "</p>\n<ul>\n";
+    for (const auto& [source, numbers] : lead.evidence)
+      h << "<li>" << esc(lead_source(source, d)) << ": " << esc(numbers) << "</li>\n";
+    h << "</ul>\n";
+  }
+}
+
 // The command-gain check as a table: per flight (or the one flight) and axis, the gain,
 // correlation and delay in each band; the leads below it.
 void command_gain_html(std::ostream& h, const Diagnosis& d) {
@@ -64,8 +74,7 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
     }
   }
   h << "</table>\n";
-  for (const auto& [flight, lead] : command_gain_leads(d))
-    h << "<p class=\"warn\">" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+  lead_html(h, command_gain_leads(d), d, "warn");
 }
 
 // Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
@@ -333,8 +342,7 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
         << "</td></tr>\n";
     h << "</table>\n";
   }
-  for (const auto& [flight, lead] : draft_leads(d))
-    h << "<p>" << (flight.empty() ? "" : esc(flight) + ": ") << esc(lead) << "</p>\n";
+  lead_html(h, draft_leads(d), d, "");
 }
 
 void prediction_html(std::ostringstream& h, const Diagnosis& d) {

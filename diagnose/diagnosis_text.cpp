@@ -82,10 +82,12 @@ std::string diagnosis_summary(const Diagnosis& d) {
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
        << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
-  for (const auto& [flight, lead] : draft_leads(d))
-    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
-  for (const auto& [flight, lead] : command_gain_leads(d))
-    os << (flight.empty() ? "" : output::printable(flight) + ": ") << lead << "\n";
+  for (const auto& leads : {draft_leads(d), command_gain_leads(d)})
+    for (const auto& lead : leads) {
+      os << lead.claim << "\n";
+      for (const auto& [source, numbers] : lead.evidence)
+        os << "  " << output::printable(lead_source(source, d)) << ": " << numbers << "\n";
+    }
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "

@@ -16,57 +16,69 @@ using output::number_or_null;
 
 namespace {
 
-// One sentence for the printout and the report when an axis shows the draft's signature on
-// both parts ("" otherwise: then there is nothing to say beyond the JSON).
-std::string draft_lead(const DraftSignature& d) {
+// A lead's claim and its numbers, or an empty claim when there is nothing to say beyond the JSON.
+struct OneLead {
+  std::string claim, evidence;
+};
+
+// When an axis shows the draft's signature on both parts.
+OneLead draft_lead(const DraftSignature& d) {
   const auto axes = d.axes_showing_it();
-  if (axes.empty()) return "";
-  std::string s = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
-                  "moving through the rotors would, on axis ";
-  for (size_t i = 0; i < axes.size(); ++i) s += (i ? " and " : "") + axes[i];
-  s += " (1 s means, the velocity along the axis partialled out, p <= " + num(DraftSignature::kLevel, 2) +
-       " on both parts";
+  if (axes.empty()) return {};
+  std::string claim = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
+                      "moving through the rotors would, on axis ";
+  for (size_t i = 0; i < axes.size(); ++i) claim += (i ? " and " : "") + axes[i];
+  claim += " (1 s means, the velocity along the axis partialled out, p <= " + num(DraftSignature::kLevel, 2) +
+           " on both parts); no logged signal measures the air";
+  std::string numbers;
   for (const auto& p : d.parts) {
-    s += "; " + p.name;
+    numbers += (numbers.empty() ? "" : "; ") + p.name;
     for (const auto& axis : axes) {
       const auto& pair = axis == "y (roll)" ? p.y_roll : p.x_pitch;
-      s += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", p = " + num(pair.p, 2) +
-           ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
+      numbers += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", p = " +
+                 num(pair.p, 2) + ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
     }
-    if (p.implied_speed > 0) s += ", draft at most " + num(p.implied_speed, 2) + " m/s";
+    if (p.implied_speed > 0) numbers += ", draft at most " + num(p.implied_speed, 2) + " m/s";
   }
-  return s + "); no logged signal measures the air";
+  return {claim, numbers};
 }
 
-// A check's sentences, each with the flight it is about (empty for the diagnosis as a whole;
-// a joint diagnosis adds one per flight that shows it), unescaped for each sink.
-template <class Check, class Lead>
-std::vector<std::pair<std::string, std::string>> leads(const Check& whole, const std::vector<Check>& per_flight,
-                                                       const Diagnosis& d, Lead lead_of) {
-  std::vector<std::pair<std::string, std::string>> out;
-  if (std::string lead = lead_of(whole); !lead.empty()) out.emplace_back("", std::move(lead));
-  for (size_t i = 0; i < per_flight.size() && i < d.flights.size(); ++i)
-    if (std::string lead = lead_of(per_flight[i]); !lead.empty())
-      out.emplace_back("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", std::move(lead));
-  return out;
-}
-
-// One sentence for the printout and the report when the airframe's answer to the commands
-// puts the motor map's slope in doubt ("" otherwise: the JSON holds the bands).
-std::string command_gain_lead(const CommandGain& g) {
-  if (!g.slope_looks_off()) return "";
+// When the airframe's answer to the commands puts the motor map's slope in doubt.
+OneLead command_gain_lead(const CommandGain& g) {
+  if (!g.slope_looks_off()) return {};
   const auto& roll = g.axes[0].bands[CommandGain::kLeadBand];
   const auto& pitch = g.axes[1].bands[CommandGain::kLeadBand];
   const auto& vertical = g.axes[2].bands[CommandGain::kLeadBand];
-  return "lead (not a named cause): at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) +
-         " Hz the airframe answers a change of rotor command at " + num(roll.gain, 2) + " (roll, r = " + num(roll.r, 2) +
-         ", " + num(1000 * roll.delay_s, 2) + " ms later) and " + num(pitch.gain, 2) + " (pitch, r = " + num(pitch.r, 2) +
-         ", " + num(1000 * pitch.delay_s, 2) + " ms later) of what the base model's motor map gives, the vertical at " +
-         num(vertical.gain, 2) + " (r = " + num(vertical.r, 2) + "). Either the motor map's slope at the operating " +
-         "point (mean command " + num(g.hover_command, 2) + ") is off (a map measured on a stand: motor_map slope " +
-         num(g.suggested_slope(), 2) + " with pivot " + num(g.hover_command, 2) + ") or the controller answers a " +
-         "disturbance in this band, which reads the same in closed loop; a flight with a known excitation added to " +
-         "the rate set points separates them";
+  const std::string claim =
+      "lead (not a named cause): the airframe answers a change of rotor command " +
+      std::string(g.roll_pitch_gain() < 1 ? "more weakly" : "more strongly") +
+      " than the base model's motor map gives. Either the map's slope at the operating point is off (a map measured on "
+      "a stand) or the controller answers a disturbance in this band, which reads the same in closed loop; a flight "
+      "with a known excitation added to the rate set points separates them";
+  const std::string numbers =
+      "at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) + " Hz roll " + num(roll.gain, 2) + " (r = " +
+      num(roll.r, 2) + ", " + num(1000 * roll.delay_s, 2) + " ms later), pitch " + num(pitch.gain, 2) + " (r = " +
+      num(pitch.r, 2) + ", " + num(1000 * pitch.delay_s, 2) + " ms later), vertical " + num(vertical.gain, 2) +
+      " (r = " + num(vertical.r, 2) + ") of the map's; if it is the map: motor_map slope " + num(g.suggested_slope(), 2) +
+      " with pivot " + num(g.hover_command, 2) + " (the mean command)";
+  return {claim, numbers};
+}
+
+// A check's leads: the diagnosis as a whole first, then each flight of a joint diagnosis that
+// shows it; sources with the same claim share one lead.
+template <class Check, class LeadOf>
+std::vector<Lead> leads(const Check& whole, const std::vector<Check>& per_flight, const Diagnosis& d, LeadOf lead_of) {
+  std::vector<Lead> out;
+  const auto add = [&](const std::string& source, const OneLead& one) {
+    if (one.claim.empty()) return;
+    auto same = std::find_if(out.begin(), out.end(), [&](const Lead& l) { return l.claim == one.claim; });
+    if (same == out.end()) same = out.insert(out.end(), Lead{one.claim, {}});
+    same->evidence.emplace_back(source, one.evidence);
+  };
+  add("", lead_of(whole));
+  for (size_t i = 0; i < per_flight.size() && i < d.flights.size(); ++i)
+    add("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", lead_of(per_flight[i]));
+  return out;
 }
 
 }  // namespace
@@ -189,12 +201,15 @@ std::string num(double v, int prec) {
   return os.str();
 }
 
-std::vector<std::pair<std::string, std::string>> draft_leads(const Diagnosis& d) {
-  return leads(d.draft, d.draft_per_flight, d, draft_lead);
+std::vector<Lead> draft_leads(const Diagnosis& d) { return leads(d.draft, d.draft_per_flight, d, draft_lead); }
+
+std::vector<Lead> command_gain_leads(const Diagnosis& d) {
+  return leads(d.command_gain, d.command_gain_per_flight, d, command_gain_lead);
 }
 
-std::vector<std::pair<std::string, std::string>> command_gain_leads(const Diagnosis& d) {
-  return leads(d.command_gain, d.command_gain_per_flight, d, command_gain_lead);
+std::string lead_source(const std::string& source, const Diagnosis& d) {
+  if (!source.empty()) return source;
+  return d.flights.size() > 1 ? "the flights together" : "this flight";
 }
 
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a

@@ -363,7 +363,9 @@ namespace {
 // right and the number is not: a gyro in deg/s declared rad/s (57 times the rates the
 // attitude shows) and an accelerometer in g declared m/s^2 (a specific force near 1 in
 // flight, where it is near 9.8). Judged on airborne samples, only where the data can tell.
-void check_sensor_units(const std::string& path, const Flight& f) {
+// Over windows of up to 0.2 s: whether the attitude turns as far as the gyro says (a gyro in
+// deg/s declared rad/s turns it 57 times too little).
+void check_gyro_against_attitude(const std::string& path, const Flight& f) {
   const auto& S = f.samples;
   if (f.has_pose && f.has_gyro && S.size() > 10) {
     // Over windows of up to 0.2 s: the attitude's turn A (rotation vector of q_a^-1 q_b, body
@@ -414,6 +416,11 @@ void check_sensor_units(const std::string& path, const Flight& f) {
       }
     }
   }
+}
+
+// Whether the accelerometer's specific force is in m/s^2 (an IMU in g reads near 1 in flight).
+void check_accelerometer_unit(const std::string& path, const Flight& f) {
+  const auto& S = f.samples;
   if (f.has_accelerometer && !S.empty()) {
     const auto median_of = [](std::vector<double> v) {
       std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
@@ -438,6 +445,84 @@ void check_sensor_units(const std::string& path, const Flight& f) {
     }
   }
 }
+
+// Which signals the log holds, refused where it lacks what a fit needs (the gyro, and a pose
+// or an accelerometer).
+void read_signals(const runtime::CsvTable& log, Flight& f) {
+  auto has = [&](std::initializer_list<const char*> cs) {
+    return std::all_of(cs.begin(), cs.end(), [&](const char* c) { return log.column(c) >= 0; });
+  };
+  f.has_pose = has({"x", "y", "z", "qw", "qx", "qy", "qz"});
+  f.has_gyro = has({"p", "q", "r"});
+  f.has_accelerometer = has({"ax", "ay", "az"});
+  f.has_vbat = has({"vbat"});
+  if (!f.has_gyro)
+    throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
+  if (!f.has_pose && !f.has_accelerometer)
+    throw FitError(log.path + ":1: need a pose (x, y, z, qw..qz) or an accelerometer (ax, ay, az)");
+}
+
+// The log's columns as the samples take them: time from the first row, the states (velocities
+// from the pose where none are logged), the derivatives, the sensors and the commands.
+struct FlightColumns {
+  std::vector<double> t;                          // s, from the first row
+  std::vector<std::vector<double>> states;        // kStateNames, 0 where not logged
+  std::vector<std::vector<double>> acc, rate_dot;  // world acceleration, body-rate derivative
+  std::vector<double> ax, ay, az, vbat;
+  std::vector<std::vector<double>> commands;      // per rotor
+};
+
+FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const Flight& f,
+                           const FlightOptions& o) {
+  FlightColumns c;
+  const auto t = log.values("t");
+  for (double v : t) c.t.push_back(v - t.front());
+  auto col = [&](const char* name) { return log.column(name) >= 0 ? log.values(name) : std::vector<double>(t.size(), 0.0); };
+  for (const char* n : kStateNames) c.states.push_back(col(n));
+  if (!f.has_pose) c.states[kAttitude].assign(t.size(), 1.0);
+  const bool has_velocity = log.column("vx") >= 0 && log.column("vy") >= 0 && log.column("vz") >= 0;
+  if (f.has_pose && !has_velocity)
+    for (int i = 0; i < 3; ++i) c.states[kVelocity + i] = smoothed_derivative(c.t, c.states[kPosition + i], o.derivative_window);
+  for (int i = 0; i < 3; ++i) {
+    c.acc.push_back(smoothed_derivative(c.t, c.states[kVelocity + i], o.derivative_window));
+    c.rate_dot.push_back(smoothed_derivative(c.t, c.states[kBodyRate + i], o.derivative_window));
+  }
+  c.ax = col("ax"), c.ay = col("ay"), c.az = col("az"), c.vbat = col("vbat");
+  for (const auto& r : rotors) c.commands.push_back(log.values("u_" + r));
+  return c;
+}
+
+// Row k as a sample, its attitude quaternion normalised (refused far from unit norm).
+FlightSample sample_at(const FlightColumns& c, size_t k, const runtime::CsvTable& log) {
+  FlightSample fs;
+  fs.t = c.t[k];
+  for (int i = 0; i < kNumStates; ++i) fs.x.push_back(c.states[i][k]);
+  double qn = 0;
+  for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
+  qn = std::sqrt(qn);
+  if (!(qn > 0.5 && qn < 1.5))
+    throw FitError(log.path + ":" + std::to_string(log.line_of(k)) + ": attitude quaternion has norm " + std::to_string(qn));
+  for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
+  for (const auto& uc : c.commands) fs.u.push_back(uc[k]);
+  fs.vbat = c.vbat[k];
+  for (int i = 0; i < 3; ++i) {
+    fs.acc_world[i] = c.acc[i][k];
+    fs.rate_dot[i] = c.rate_dot[i][k];
+  }
+  fs.specific_force[0] = c.ax[k];
+  fs.specific_force[1] = c.ay[k];
+  fs.specific_force[2] = c.az[k];
+  return fs;
+}
+
+// Whether a sample is kept: airborne (every command above min_command and, with a pose, above
+// min_height) unless all rows are asked for, and away from the log's ends.
+bool kept(const FlightSample& fs, const Flight& f, double duration, const FlightOptions& o) {
+  bool airborne = std::all_of(fs.u.begin(), fs.u.end(), [&](double uc) { return uc > o.min_command; });
+  if (f.has_pose) airborne = airborne && fs.x[2] > o.min_height;
+  const bool edge = fs.t < o.edge_trim || duration - fs.t < o.edge_trim;
+  return (!o.airborne_only || airborne) && !edge;
+}
 }  // namespace
 
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
@@ -451,67 +536,15 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   if (static_cast<double>(log.rows.size()) < o.min_samples)
     throw FitError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ", need " +
                    std::to_string(static_cast<int>(o.min_samples)) + ")");
-  auto has = [&](std::initializer_list<const char*> cs) {
-    for (const char* c : cs)
-      if (log.column(c) < 0) return false;
-    return true;
-  };
-  f.has_pose = has({"x", "y", "z", "qw", "qx", "qy", "qz"});
-  f.has_gyro = has({"p", "q", "r"});
-  f.has_accelerometer = has({"ax", "ay", "az"});
-  f.has_vbat = has({"vbat"});
-  if (!f.has_gyro)
-    throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
-  if (!f.has_pose && !f.has_accelerometer)
-    throw FitError(log.path + ":1: need a pose (x, y, z, qw..qz) or an accelerometer (ax, ay, az)");
-  const auto t = log.values("t");
-  const double t0 = t.front();
-  std::vector<double> trel;
-  for (double v : t) trel.push_back(v - t0);
-  auto col = [&](const char* c) { return log.column(c) >= 0 ? log.values(c) : std::vector<double>(t.size(), 0.0); };
-  std::vector<std::vector<double>> s;
-  for (const char* n : kStateNames) s.push_back(col(n));
-  if (!f.has_pose) s[kAttitude].assign(t.size(), 1.0);
-  // Velocities from the pose where the log has none.
-  const bool has_vel = has({"vx", "vy", "vz"});
-  if (f.has_pose && !has_vel)
-    for (int i = 0; i < 3; ++i) s[kVelocity + i] = smoothed_derivative(trel, s[kPosition + i], o.derivative_window);
-  std::vector<std::vector<double>> acc(3), rdot(3);
-  for (int i = 0; i < 3; ++i) {
-    acc[i] = smoothed_derivative(trel, s[kVelocity + i], o.derivative_window);
-    rdot[i] = smoothed_derivative(trel, s[kBodyRate + i], o.derivative_window);
+  read_signals(log, f);
+  const FlightColumns columns = read_columns(log, rotors, f, o);
+  for (size_t k = 0; k < columns.t.size(); ++k) {
+    FlightSample fs = sample_at(columns, k, log);
+    if (kept(fs, f, columns.t.back(), o)) f.samples.push_back(std::move(fs));
   }
-  const auto ax = col("ax"), ay = col("ay"), az = col("az"), vbat = col("vbat");
-  std::vector<std::vector<double>> u;
-  for (const auto& r : rotors) u.push_back(log.values("u_" + r));
-  for (size_t k = 0; k < t.size(); ++k) {
-    FlightSample fs;
-    fs.t = trel[k];
-    for (int i = 0; i < kNumStates; ++i) fs.x.push_back(s[i][k]);
-    double qn = 0;
-    for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
-    qn = std::sqrt(qn);
-    if (!(qn > 0.5 && qn < 1.5))
-      throw FitError(log.path + ":" + std::to_string(log.line_of(k)) + ": attitude quaternion has norm " +
-                     std::to_string(qn));
-    for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
-    for (const auto& uc : u) fs.u.push_back(uc[k]);
-    fs.vbat = vbat[k];
-    for (int i = 0; i < 3; ++i) {
-      fs.acc_world[i] = acc[i][k];
-      fs.rate_dot[i] = rdot[i][k];
-    }
-    fs.specific_force[0] = ax[k];
-    fs.specific_force[1] = ay[k];
-    fs.specific_force[2] = az[k];
-    bool airborne = true;
-    for (double uc : fs.u) airborne = airborne && uc > o.min_command;
-    if (f.has_pose) airborne = airborne && fs.x[2] > o.min_height;
-    const bool edge = trel[k] < o.edge_trim || trel.back() - trel[k] < o.edge_trim;
-    if ((!o.airborne_only || airborne) && !edge) f.samples.push_back(fs);
-  }
-  if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, trel, f, o);
-  check_sensor_units(log.path, f);
+  if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, columns.t, f, o);
+  check_gyro_against_attitude(log.path, f);
+  check_accelerometer_unit(log.path, f);
   return f;
 }
 

@@ -12,6 +12,8 @@
 
 #include "diagnose/diagnosis.hpp"
 #include "diagnose/draft_signature.hpp"
+#include "diagnose/diagnosis_report.hpp"
+#include "diagnose/report_words.hpp"
 
 namespace {
 
@@ -213,3 +215,43 @@ TEST(DraftSignature, ReadsHeadingsPartsAndCoefficientsFromADiagnosis) {
 }
 
 }  // namespace
+
+// A lead the flights of a joint diagnosis share is said once, with each flight's numbers on a
+// line of its own below it (each flight repeated the 400-500 character sentence before); a
+// flight whose lead differs (another axis) gets its own.
+TEST(DraftSignature, ALeadSharedByFlightsIsSaidOnceWithEachFlightsNumbers) {
+  using quadgen::diagnose::DraftSignature;
+  const auto showing = [](bool roll, bool pitch, double r) {
+    DraftSignature s;
+    s.measured = true;
+    for (const char* name : {"training", "held-out"}) {
+      DraftSignature::Part p;
+      p.name = name;
+      p.y_roll.p = roll ? 0.001 : 0.5;
+      p.x_pitch.p = pitch ? 0.001 : 0.5;
+      p.y_roll.r = r;
+      s.parts.push_back(p);
+    }
+    return s;
+  };
+  quadgen::diagnose::Diagnosis d;
+  d.flights = {"a.csv", "b.csv", "c.csv"};
+  d.draft = showing(true, false, -0.47);
+  d.draft_per_flight = {showing(true, false, -0.5), showing(false, false, 0), showing(true, true, -0.61)};
+  const auto leads = quadgen::diagnose::words::draft_leads(d);
+  ASSERT_EQ(leads.size(), 2u);
+  ASSERT_EQ(leads[0].evidence.size(), 2u);  // the flights together and flight 1; flight 2 shows nothing
+  EXPECT_EQ(leads[0].evidence[0].first, "");
+  EXPECT_EQ(leads[0].evidence[1].first, "flight 1 (a.csv)");
+  EXPECT_NE(leads[1].claim.find("on axis y (roll) and x (pitch)"), std::string::npos) << leads[1].claim;
+  const std::string text = quadgen::diagnose::diagnosis_summary(d);
+  const std::string claim = "air moving through the rotors would, on axis y (roll) (1 s means";
+  EXPECT_NE(text.find(claim), std::string::npos) << text;
+  EXPECT_EQ(text.find(claim, text.find(claim) + 1), std::string::npos) << "said twice:\n" << text;
+  EXPECT_NE(text.find("\n  the flights together: training r = -0.47"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n  flight 1 (a.csv): training r = -0.5"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n  flight 3 (c.csv): training y: r = -0.61"), std::string::npos) << text;
+  EXPECT_EQ(text.find("flight 2 (b.csv)"), std::string::npos) << text;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "a.csv", {});
+  EXPECT_NE(html.find("<li>flight 1 (a.csv): training r = -0.5"), std::string::npos);
+}
