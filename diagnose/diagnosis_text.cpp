@@ -19,14 +19,13 @@ namespace quadgen::diagnose {
 
 using namespace words;
 
-std::string diagnosis_summary(const Diagnosis& d) {
-  std::ostringstream os;
-  for (const auto& note : screening_notes(d)) os << note << "\n";
-  if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
-    os << "no significant discrepancy: the base model explains the flight\n";
+namespace {
+
+// Each finding with its values and the held-out measure before and after, and its sentence.
+void write_findings(std::ostream& os, const Diagnosis& d) {
+  if (d.findings.empty()) return;
   // The held-out measure is said once; a finding judged by another says its own.
-  if (!d.findings.empty())
-    os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
+  os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
   for (const auto& f : d.findings) {
     os << "found " << f.effect << ":";
     for (const auto& p : f.parameters)
@@ -37,6 +36,10 @@ std::string diagnosis_summary(const Diagnosis& d) {
       if (a.effect == f.effect && !a.agree) os << "; the flights disagree on " << a.parameter << " (below)";
     os << "\n  " << headline(f) << "\n";
   }
+}
+
+// Whether the flights of a joint diagnosis agree, or this flight with an airframe found before.
+void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q p = " << num(a.q_p_value, 2) << "):";
@@ -51,6 +54,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
        << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
        << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
        << ")\n";
+}
+
+// What was not named and why: look-alikes, stand-ins, suspects, what the backward pass
+// dropped, what the search's limit left.
+void write_not_named(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.search.unresolved)
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
        << "); to separate them: " << a.manoeuvre << "\n";
@@ -75,6 +83,11 @@ std::string diagnosis_summary(const Diagnosis& d) {
     }
     os << "\n";
   }
+}
+
+// What the model still gets wrong: parameters at a bound, slow residual structure, the
+// checks' leads, proposed terms, and what limits the prediction.
+void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& p : d.at_bounds)
     os << "caution: " << p.name << " = " << num(p.value) << (p.unit == "1" ? "" : " " + p.unit)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
@@ -100,6 +113,19 @@ std::string diagnosis_summary(const Diagnosis& d) {
   if (d.has_prediction)
     if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
       os << "prediction of the extended model on the held-out part: " << limits << "\n";
+}
+
+}  // namespace
+
+std::string diagnosis_summary(const Diagnosis& d) {
+  std::ostringstream os;
+  for (const auto& note : screening_notes(d)) os << note << "\n";
+  if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
+    os << "no significant discrepancy: the base model explains the flight\n";
+  write_findings(os, d);
+  write_agreement(os, d);
+  write_not_named(os, d);
+  write_what_is_left(os, d);
   return os.str();
 }
 
