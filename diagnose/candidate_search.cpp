@@ -898,6 +898,20 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
       const bool per_flight = model_.param_index(runtime::per_flight_name(shared, 2)) >= 0;
       (per_flight || !with_profiles ? wald : profiled).push_back(i);
     }
+  add_profiled_estimates(r, best, profiled);
+  add_wald_estimates(r, se, wald);
+  std::stable_sort(r.estimates.begin(), r.estimates.end(), [&](const EffectEstimate& a, const EffectEstimate& b) {
+    return model_.param_index(a.name) < model_.param_index(b.name);
+  });
+  widen_by_discretisation(r);
+  opt_.progress.say("[diagnose] intervals of " + std::to_string(r.estimates.size()) + " parameters done (" +
+                    std::to_string(r.profiles.size()) + " profiles)");
+}
+
+void CandidateSearch::add_profiled_estimates(SearchResult& r, const fit::FitResult& best,
+                                             const std::vector<int>& profiled) const {
+  // (profile_all profiles every free parameter when given none: only call it with some.)
+  if (profiled.empty()) return;
   fit::FitOptions fo;
   fo.max_iterations = 50;
   fit::ProfileOptions po;
@@ -908,10 +922,7 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
       opt_.progress.count("[diagnose] profile " + std::to_string(done) + "/" + std::to_string(count) + " (" + name +
                           ", " + std::to_string(static_cast<int>(seconds)) + " s)");
     };
-  // (profile_all profiles every free parameter when given none: only call it with some.)
-  std::vector<fit::Profile> profiles =
-      profiled.empty() ? std::vector<fit::Profile>{} : fit::profile_all(train_, best, fo, po, profiled);
-  for (auto& pr : profiles) {
+  for (auto& pr : fit::profile_all(train_, best, fo, po, profiled)) {
     const int i = pr.index;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, r.final_fit[i].value, best.standard_errors[i],
                            pr.lower_open ? std::numeric_limits<double>::quiet_NaN() : pr.lower,
@@ -919,6 +930,9 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
                            "profile", fit::on_bound(r.final_fit[i])});
     r.profiles.push_back(std::move(pr));
   }
+}
+
+void CandidateSearch::add_wald_estimates(SearchResult& r, const StandardErrors& se, const std::vector<int>& wald) const {
   // A per-flight copy that the data cannot separate from other parameters has no Wald
   // interval: the pseudo-inverse would give it a finite, too small one.
   for (int i : wald) {
@@ -931,9 +945,9 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
                            finite ? "identifiable" : "structurally non-identifiable", "wald",
                            fit::on_bound(r.final_fit[i])});
   }
-  std::stable_sort(r.estimates.begin(), r.estimates.end(), [&](const EffectEstimate& a, const EffectEstimate& b) {
-    return model_.param_index(a.name) < model_.param_index(b.name);
-  });
+}
+
+void CandidateSearch::widen_by_discretisation(SearchResult& r) const {
   // Discretisation allowance: refit with the other quadrature rule, on a copy of the
   // training problem (it shares the dynamic model, and runs on this thread).
   std::set<std::string> sel(r.selected.begin(), r.selected.end());
@@ -947,8 +961,6 @@ void CandidateSearch::estimate_intervals(SearchResult& r, bool with_profiles) co
     if (!std::isnan(e.lower)) e.lower -= e.numerical_allowance;
     if (!std::isnan(e.upper)) e.upper += e.numerical_allowance;
   }
-  opt_.progress.say("[diagnose] intervals of " + std::to_string(r.estimates.size()) + " parameters done (" +
-                    std::to_string(r.profiles.size()) + " profiles)");
 }
 
 }  // namespace quadgen::diagnose

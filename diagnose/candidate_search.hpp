@@ -359,6 +359,11 @@ class CandidateSearch {
   double p_value_of(const std::string& effect, double statistic, int dof) const;
   // with_profiles: profile likelihood for the airframe's parameters; else Wald for all.
   void estimate_intervals(SearchResult& r, bool with_profiles) const;
+  // The steps of estimate_intervals: profiles of `profiled` about `best`, Wald intervals of
+  // `wald` from the standard errors, and every interval widened by the discretisation's allowance.
+  void add_profiled_estimates(SearchResult& r, const fit::FitResult& best, const std::vector<int>& profiled) const;
+  void add_wald_estimates(SearchResult& r, const StandardErrors& se, const std::vector<int>& wald) const;
+  void widen_by_discretisation(SearchResult& r) const;
 };
 
 }  // namespace quadgen::diagnose
