@@ -100,9 +100,10 @@ std::vector<double> derived_values(const MassProperties& mp) {
           mp.areas_value[0], mp.areas_value[1], mp.areas_value[2]};
 }
 
-void declare_base(ModelContext& c, const MassProperties& mp) {
+// The rigid body's states, in the runtime's order (runtime/rigid_body_state.hpp), and the
+// kinematic quantities built from them.
+void declare_rigid_body(ModelContext& c) {
   using namespace runtime::rigid_body;
-  // The names are the runtime's (runtime/rigid_body_state.hpp), in the order it reads them.
   std::vector<ex> s;
   for (int i = 0; i < kNumStates; ++i)
     s.push_back(c.add_state(kStateNames[i], kStateUnitsAndMeanings[i][0], kStateUnitsAndMeanings[i][1]));
@@ -116,19 +117,19 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   c.air_velocity_world = c.velocity;
   c.extra_body_force = vec3(0, 0, 0);
   c.extra_body_torque = vec3(0, 0, 0);
+}
 
-  for (const Rotor& r : c.vehicle.rotors)
-    c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
-
+// The vehicle file's scalar parameters, then the mass properties derived from the blocks as
+// parameters with those nominal values, so that a fit may free them and the generated code
+// precomputes J^-1 once. Declared bounds must hold the value the blocks give: a fit would
+// start outside them.
+void declare_parameters(ModelContext& c, const MassProperties& mp) {
   for (const auto& [key, name] : kScalarParameters) {
     if (!c.vehicle.params.count(key)) continue;  // slope: optional, with its pivot
     ParameterSpec spec = param(c.vehicle, key);  // the record without its file line
     spec.name = name;
     c.add_param(spec);
   }
-  // Mass properties derived from the blocks become parameters with those nominal values,
-  // so that a fit may free them and the generated code precomputes J^-1 once.
-  // Declared bounds must hold the value the blocks give: a fit would start outside them.
   auto derived = [&](const std::string& name, const std::string& unit, double value, const std::string& doc) {
     if (!std::isfinite(value))  // blocks of 1e200 kg or m: the integrals overflow a double
       throw VehicleError(c.vehicle.source_path + ": derived quantity " + name + " is not finite (" + shortest_text(value) +
@@ -147,8 +148,12 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
   static_assert(std::size(kDerivedQuantities) == 13, "derived_values lists thirteen values");
   for (size_t i = 0; i < values.size(); ++i)
     derived(kDerivedQuantities[i].name, kDerivedQuantities[i].unit, values[i], kDerivedQuantities[i].meaning);
-
   c.cog = vec3(c.p("cog_x"), c.p("cog_y"), c.p("cog_z"));
+}
+
+// Each rotor's geometry as constants and its speed as the motor map commands it; the
+// effects' per-rotor factors start neutral.
+void declare_rotors(ModelContext& c) {
   std::optional<ex> pivot;
   if (c.vehicle.params.count("slope"))
     pivot = c.add_constant("motor_pivot", "1", param(c.vehicle, "pivot").nominal,
@@ -169,6 +174,16 @@ void declare_base(ModelContext& c, const MassProperties& mp) {
     c.thrust_speed_loss.push_back(0);
     c.lag_factor.push_back(1);
   }
+}
+
+// States, inputs (one command per rotor), parameters and rotors, in the order the generated
+// code numbers them.
+void declare_base(ModelContext& c, const MassProperties& mp) {
+  declare_rigid_body(c);
+  for (const Rotor& r : c.vehicle.rotors)
+    c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
+  declare_parameters(c, mp);
+  declare_rotors(c);
 }
 
 // J^-1 = adj(J) / det(J) written out. GiNaC's matrix::inverse() normalises its result,
