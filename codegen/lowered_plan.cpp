@@ -5,9 +5,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 namespace quadgen::codegen {
 
@@ -335,6 +339,105 @@ std::vector<int> LoweredPlan::reachable(Kind kind) const {
   return out;
 }
 
+namespace {
+
+// The operand lists of the sums (or products) being rewritten, and for every pair of operands
+// (with its relative sign in a sum) the nodes that hold it, most shared first.
+class PairIndex {
+ public:
+  using Key = std::tuple<int, int, int>;  // a <= b, relative sign (sums) or 0
+
+  PairIndex(bool is_sum, std::vector<std::vector<int>> args, std::vector<std::vector<signed char>> sign)
+      : is_sum_(is_sum), args_(std::move(args)), sign_(std::move(sign)), modified_(args_.size(), 0) {}
+
+  void add_node(int id) {
+    for (const auto& k : pairs_of(id)) update(k, id, true);
+  }
+  // The most shared pair while one is held by two nodes or more.
+  std::optional<Key> most_shared() const {
+    if (queue_.empty() || -std::get<0>(*queue_.begin()) < 2) return std::nullopt;
+    const auto& [negcount, a, b, rel] = *queue_.begin();
+    return Key{a, b, rel};
+  }
+  void drop_most_shared() { queue_.erase(queue_.begin()); }
+  std::set<int> holders(const Key& k) { return where_[k]; }
+  void grow(size_t size) {
+    if (size <= args_.size()) return;
+    args_.resize(size);
+    sign_.resize(size);
+    modified_.resize(size, 0);
+  }
+  // Node `id` takes the new node `p` in place of one occurrence of the pair `k`.
+  void replace(int id, const Key& k, int p) {
+    const auto [a, b, rel] = k;
+    for (const auto& old : pairs_of(id)) update(old, id, false);
+    auto& l = args_[id];
+    auto& s = sign_[id];
+    // Find one occurrence of a and one of b (with the right relative sign).
+    int ia = -1, ib = -1;
+    for (size_t i = 0; i < l.size() && ia < 0; ++i)
+      if (l[i] == a) ia = static_cast<int>(i);
+    for (size_t j = 0; j < l.size() && ib < 0; ++j)
+      if (static_cast<int>(j) != ia && l[j] == b && (!is_sum_ || s[ia] * s[j] == rel)) ib = static_cast<int>(j);
+    const int sa = is_sum_ ? s[ia] : 1;
+    std::vector<int> nl;
+    std::vector<signed char> ns;
+    for (size_t i = 0; i < l.size(); ++i)
+      if (static_cast<int>(i) != ia && static_cast<int>(i) != ib) {
+        nl.push_back(l[i]);
+        if (is_sum_) ns.push_back(s[i]);
+      }
+    nl.push_back(p);
+    if (is_sum_) ns.push_back(static_cast<signed char>(sa));
+    l = nl;
+    s = ns;
+    modified_[id] = 1;
+    add_node(id);
+  }
+  // The rewritten operand lists (empty for nodes left as they were), `size` entries.
+  std::pair<std::vector<std::vector<int>>, std::vector<std::vector<signed char>>> rewritten(size_t size) const {
+    std::vector<std::vector<int>> args(size);
+    std::vector<std::vector<signed char>> sign(size);
+    for (size_t id = 0; id < modified_.size(); ++id)
+      if (modified_[id]) args[id] = args_[id], sign[id] = sign_[id];
+    return {args, sign};
+  }
+
+ private:
+  std::set<Key> pairs_of(int id) const {
+    std::set<Key> ks;
+    const auto& l = args_[id];
+    for (size_t i = 0; i < l.size(); ++i)
+      for (size_t j = i + 1; j < l.size(); ++j) {
+        int a = l[i], b = l[j];
+        int sa = is_sum_ ? sign_[id][i] : 1, sb = is_sum_ ? sign_[id][j] : 1;
+        if (a > b) std::swap(a, b), std::swap(sa, sb);
+        if (is_sum_ && a == b) continue;
+        ks.insert({a, b, is_sum_ ? sa * sb : 0});
+      }
+    return ks;
+  }
+  void update(const Key& k, int id, bool add) {
+    auto& s = where_[k];
+    if (!s.empty()) queue_.erase({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
+    if (add) s.insert(id);
+    else s.erase(id);
+    if (!s.empty()) queue_.insert({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
+  }
+
+  bool is_sum_;
+  std::vector<std::vector<int>> args_;
+  std::vector<std::vector<signed char>> sign_;
+  std::vector<char> modified_;
+  std::map<Key, std::set<int>> where_;
+  std::set<std::tuple<int, int, int, int>> queue_;  // (-count, a, b, rel)
+};
+
+}  // namespace
+
+// Greedy pair extraction: the pair of operands shared by most sums (or products) becomes a
+// node of its own, replaces the pair where it occurs, and the counts are updated, until no
+// pair is shared by two nodes.
 void LoweredPlan::extract_pairs(Kind kind) {
   const bool is_sum = kind == Kind::sum;
   const std::vector<int> nodes = reachable(kind);
@@ -344,83 +447,18 @@ void LoweredPlan::extract_pairs(Kind kind) {
     args[id] = ir_[id].args;
     sign[id] = ir_[id].sign;
   }
-  using Key = std::tuple<int, int, int>;  // a <= b, relative sign (sums) or 0
-  std::map<Key, std::set<int>> where;
-  std::set<std::tuple<int, int, int, int>> queue;  // (-count, a, b, rel)
-  auto pairs_of = [&](int id) {
-    std::set<Key> ks;
-    const auto& l = args[id];
-    for (size_t i = 0; i < l.size(); ++i)
-      for (size_t j = i + 1; j < l.size(); ++j) {
-        int a = l[i], b = l[j];
-        int sa = is_sum ? sign[id][i] : 1, sb = is_sum ? sign[id][j] : 1;
-        if (a > b) std::swap(a, b), std::swap(sa, sb);
-        if (is_sum && a == b) continue;
-        ks.insert({a, b, is_sum ? sa * sb : 0});
-      }
-    return ks;
-  };
-  auto update = [&](const Key& k, int id, bool add) {
-    auto& s = where[k];
-    if (!s.empty()) queue.erase({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
-    if (add) s.insert(id);
-    else s.erase(id);
-    if (!s.empty()) queue.insert({-static_cast<int>(s.size()), std::get<0>(k), std::get<1>(k), std::get<2>(k)});
-  };
-  for (int id : nodes)
-    for (const auto& k : pairs_of(id)) update(k, id, true);
-
-  std::vector<char> modified(ir_.size(), 0);
-  while (!queue.empty()) {
-    const auto [negcount, a, b, rel] = *queue.begin();
-    if (-negcount < 2) break;
+  PairIndex index(is_sum, std::move(args), std::move(sign));
+  for (int id : nodes) index.add_node(id);
+  while (const auto key = index.most_shared()) {
+    const auto [a, b, rel] = *key;
     const int p = is_sum ? sum({{a, 1}, {b, rel}}) : prod({a, b});
-    if (static_cast<size_t>(p) >= args.size()) {
-      args.resize(ir_.size());
-      sign.resize(ir_.size());
-      modified.resize(ir_.size(), 0);
-    }
-    const std::set<int> holders = where[{a, b, rel}];
+    index.grow(ir_.size());
     bool changed = false;
-    for (int id : holders) {
-      if (id == p) continue;
-      for (const auto& k : pairs_of(id)) update(k, id, false);
-      auto& l = args[id];
-      auto& s = sign[id];
-      // Find one occurrence of a and one of b (with the right relative sign).
-      int ia = -1, ib = -1;
-      for (size_t i = 0; i < l.size() && ia < 0; ++i)
-        if (l[i] == a) ia = static_cast<int>(i);
-      for (size_t j = 0; j < l.size() && ib < 0; ++j)
-        if (static_cast<int>(j) != ia && l[j] == b && (!is_sum || s[ia] * s[j] == rel)) ib = static_cast<int>(j);
-      const int sa = is_sum ? s[ia] : 1;
-      std::vector<int> nl;
-      std::vector<signed char> ns;
-      for (size_t i = 0; i < l.size(); ++i)
-        if (static_cast<int>(i) != ia && static_cast<int>(i) != ib) {
-          nl.push_back(l[i]);
-          if (is_sum) ns.push_back(s[i]);
-        }
-      nl.push_back(p);
-      if (is_sum) ns.push_back(static_cast<signed char>(sa));
-      l = nl;
-      s = ns;
-      modified[id] = 1;
-      changed = true;
-      for (const auto& k : pairs_of(id)) update(k, id, true);
-    }
-    if (!changed) {  // only the pair node itself holds the pair: drop it from the queue
-      queue.erase(queue.begin());
-    }
+    for (int id : index.holders(*key))
+      if (id != p) index.replace(id, *key, p), changed = true;
+    if (!changed) index.drop_most_shared();  // only the pair node itself holds the pair
   }
-
-  std::vector<std::vector<int>> final_args(ir_.size());
-  std::vector<std::vector<signed char>> final_sign(ir_.size());
-  for (size_t id = 0; id < modified.size(); ++id)
-    if (modified[id]) {
-      final_args[id] = args[id];
-      final_sign[id] = sign[id];
-    }
+  const auto [final_args, final_sign] = index.rewritten(ir_.size());
   std::vector<int> memo(ir_.size(), -1);
   for (auto& r : roots_) r.id = rebuild(r.id, final_args, final_sign, memo);
   for (auto& [gid, s] : out_) s.id = rebuild(s.id, final_args, final_sign, memo);
