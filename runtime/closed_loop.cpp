@@ -1,6 +1,7 @@
 #include "runtime/closed_loop.hpp"
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 #include <sstream>
@@ -115,8 +116,10 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
             : " would have to give " + newtons(asked) + ", less than its motor map gives at command 0 (" +
                   newtons(least(k)) + ")";
   const std::string where =
-      least_norm.size() > 4 ? " (with more than four rotors: no other trim was found, holding such rotors at command 0 "
-                              "in turn)"
+      least_norm.size() > static_cast<Eigen::Index>(kExactTrimRotors)
+          ? " (with more than " + std::to_string(kExactTrimRotors) +
+                " rotors: no other trim was found, holding such rotors at command 0 in turn)"
+      : least_norm.size() > 4 ? " (nor with any set of rotors held at command 0: no trim keeps every rotor within reach)"
       : pulls               ? " (the centre of gravity lies outside the rotors)"
                             : " (the centre of gravity lies too far towards the other rotors)";
   return "rotor " + rotor_names[static_cast<size_t>(k)] + what + where;
@@ -137,15 +140,32 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   }
   std::vector<bool> free(n, true);
   const Eigen::VectorXd least_norm = trim_with(A, free, least, w);
+  const auto within_reach = [&](const Eigen::VectorXd& F) {
+    return balances(F) && (F - least).minCoeff() >= -1e-12 * weight;
+  };
   Eigen::VectorXd F = least_norm;
-  Eigen::Index short_most = 0;
-  while (balances(F) && (F - least).minCoeff(&short_most) < -1e-12 * weight &&
-         free[static_cast<size_t>(short_most)]) {  // hold the rotor furthest below its least at its least
-    free[static_cast<size_t>(short_most)] = false;
-    F = trim_with(A, free, least, w);
+  if (!within_reach(F) && n <= kExactTrimRotors) {
+    // The least-norm trim with every rotor within reach holds some set of rotors at their
+    // least and is the least-norm trim of the others: of all sets, the least-norm trim that
+    // is within reach. (2^n small solves; a greedy choice of the set missed trims.)
+    double best = std::numeric_limits<double>::infinity();
+    for (unsigned held = 1; held < (1u << n); ++held) {
+      std::vector<bool> f(n);
+      for (size_t i = 0; i < n; ++i) f[i] = !(held >> i & 1u);
+      const Eigen::VectorXd candidate = trim_with(A, f, least, w);
+      if (within_reach(candidate) && candidate.squaredNorm() < best)
+        best = candidate.squaredNorm(), F = candidate, free = f;
+    }
+  } else if (!within_reach(F)) {
+    Eigen::Index short_most = 0;
+    while (balances(F) && (F - least).minCoeff(&short_most) < -1e-12 * weight &&
+           free[static_cast<size_t>(short_most)]) {  // hold the rotor furthest below its least at its least
+      free[static_cast<size_t>(short_most)] = false;
+      F = trim_with(A, free, least, w);
+    }
   }
   HoverTrim t;
-  const bool reachable_below = balances(F) && (F - least).minCoeff() >= -1e-12 * weight;
+  const bool reachable_below = within_reach(F);
   if (!reachable_below) F = least_norm;
   t.thrusts.assign(F.data(), F.data() + F.size());
   if ((F.array() - even).abs().maxCoeff() <= 1e-9 * even) t.thrusts.assign(n, even);  // symmetric: exact
