@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iomanip>
 #include <sstream>
 
 #include "app/derive_pipeline.hpp"
@@ -21,7 +22,8 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
   std::ostringstream os;
   os << "derived " << vehicle.name << ": " << model.states.size() << " states, " << model.inputs.size() << " inputs, "
      << model.params.size() << " parameters; audit " << (d.audit.all_passed() ? "passed" : "FAILED") << " ("
-     << d.audit.checks.size() << " checks); " << seconds << " s\n"
+     << d.audit.checks.size() << " checks); derived, audited and generated in " << std::setprecision(3) << seconds
+     << std::setprecision(6) << " s (writing the files not counted)\n"
      << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
      << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
      << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n"

@@ -53,8 +53,8 @@ OneLead command_gain_lead(const CommandGain& g) {
       "lead (not a named cause): the airframe answers a change of rotor command " +
       std::string(g.roll_pitch_gain() < 1 ? "more weakly" : "more strongly") +
       " than the base model's motor map gives. Either the map's slope at the operating point is off (a map measured on "
-      "a stand) or the controller answers a disturbance in this band, which reads the same in closed loop; a flight "
-      "with a known excitation added to the rate set points separates them";
+      "a stand) or the controller answers a disturbance at these frequencies, which reads the same in closed loop; a "
+      "flight with a known excitation added to the rate set points separates them";
   const std::string numbers =
       "at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) + " Hz roll " + num(roll.gain, 2) + " (r = " +
       num(roll.r, 2) + ", " + num(1000 * roll.delay_s, 2) + " ms later), pitch " + num(pitch.gain, 2) + " (r = " +

@@ -132,22 +132,30 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   const double weight = b.mass * b.g, even = weight / static_cast<double>(n);
   const Eigen::Vector4d w(weight, 0, 0, 0);
   const auto balances = [&](const Eigen::VectorXd& F) { return (A * F - w).norm() <= 1e-6 * weight; };
-  // The least a rotor gives: its thrust at command 0 (a motor map with a0 > 0 idles above 0 N).
-  Eigen::VectorXd least(A.cols());
+  // The least a rotor gives: its thrust at command 0 (a motor map with a0 > 0 idles above 0 N);
+  // the most: its thrust at command 1.
+  Eigen::VectorXd least(A.cols()), most(A.cols());
   for (size_t i = 0; i < n; ++i) {
     const ThrustLaw& l = b.thrust_laws[i];
     least(static_cast<Eigen::Index>(i)) = l.thrust_at_speed(std::max(l.speed_at(0.0), 0.0));
+    most(static_cast<Eigen::Index>(i)) = l.thrust_at_speed(std::max(l.speed_at(1.0), 0.0));
   }
   std::vector<bool> free(n, true);
   const Eigen::VectorXd least_norm = trim_with(A, free, least, w);
-  const auto within_reach = [&](const Eigen::VectorXd& F) {
+  const auto above_least = [&](const Eigen::VectorXd& F) {
     return balances(F) && (F - least).minCoeff() >= -1e-12 * weight;
+  };
+  const auto within_reach = [&](const Eigen::VectorXd& F) {
+    return above_least(F) && (most - F).minCoeff() >= -1e-12 * weight;
   };
   Eigen::VectorXd F = least_norm;
   if (!within_reach(F) && n <= kExactTrimRotors) {
-    // The least-norm trim with every rotor within reach holds some set of rotors at their
-    // least and is the least-norm trim of the others: of all sets, the least-norm trim that
-    // is within reach. (2^n small solves; a greedy choice of the set missed trims.)
+    // Every set of rotors held at their least in turn, the others trimmed with least norm:
+    // of those trims, the least-norm one with every rotor within reach (commands 0 to 1).
+    // That is the least-norm trim within reach where only command 0 binds (a KKT point of
+    // the least-norm problem holds its active rotors at their least); where command 1 binds
+    // too, a trim within reach is still found if holding rotors at command 0 gives one.
+    // (2^n - 1 small solves; a greedy choice of the set missed trims.)
     double best = std::numeric_limits<double>::infinity();
     for (unsigned held = 1; held < (1u << n); ++held) {
       std::vector<bool> f(n);
@@ -156,7 +164,7 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
       if (within_reach(candidate) && candidate.squaredNorm() < best)
         best = candidate.squaredNorm(), F = candidate, free = f;
     }
-  } else if (!within_reach(F)) {
+  } else if (!above_least(F)) {
     Eigen::Index short_most = 0;
     while (balances(F) && (F - least).minCoeff(&short_most) < -1e-12 * weight &&
            free[static_cast<size_t>(short_most)]) {  // hold the rotor furthest below its least at its least
@@ -165,7 +173,9 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
     }
   }
   HoverTrim t;
-  const bool reachable_below = within_reach(F);
+  // Where no trim is within reach but the least-norm one is above every least, the rotor
+  // beyond its command 1 is named below (command_for), as before the search.
+  const bool reachable_below = above_least(F);
   if (!reachable_below) F = least_norm;
   t.thrusts.assign(F.data(), F.data() + F.size());
   if ((F.array() - even).abs().maxCoeff() <= 1e-9 * even) t.thrusts.assign(n, even);  // symmetric: exact

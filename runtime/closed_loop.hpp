@@ -37,11 +37,11 @@ std::vector<double> allocate(const ControllerModel& b, double thrust, const std:
 // within its motor's reach: at least what command 0 gives (a motor map with a0 > 0 idles
 // above 0 N), at most what command 1 gives. The least-norm trim first, exactly m g / n per
 // rotor where the layout is symmetric. With more than four rotors the least-norm trim can
-// ask a rotor for less (even a pull) where another trim exists: then every set of rotors is
-// held at command 0 in turn, the rest trimmed, and the least-norm trim within reach taken
-// (the least-norm trim within reach, exactly, up to kExactTrimRotors rotors; above, the
-// rotor furthest below its least is held and the rest trimmed again, greedily). One home
-// for derive's vehicle check and simulate's scenarios.
+// ask a rotor for less (even a pull) or more than command 1 gives where another trim exists:
+// then, up to kExactTrimRotors rotors, every set of rotors is held at command 0 in turn, the
+// rest trimmed with least norm, and the least-norm of those trims within reach (commands 0
+// to 1) taken; above, the rotor furthest below its least is held and the rest trimmed again,
+// greedily. One home for derive's vehicle check and simulate's scenarios.
 inline constexpr size_t kExactTrimRotors = 12;
 struct HoverTrim {
   std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """How far the roll and pitch moment residual a diagnosis leaves carries an open-loop
-rollout by itself: a floor for the 1 s position error of any model that cannot predict it.
+rollout by itself: an estimate (linearised, no damping) of the 1 s position error it makes,
+as it is and after simple corrections a better model might make.
 
 Reads a diagnosis folder's residuals.csv (the extended model's equation-error residuals of
 pdot and qdot, rad/s^2) and diagnosis.json (where the held-out part starts). From every start
@@ -14,11 +15,15 @@ Printed: mean and RMS over the starts of the position error's length at the hori
   - less its mean over the held-out part (a model that knew the flight's mean imbalance);
   - less its mean over the 0.5 s before each start (the past disturbance held, as
     `quadgen predict --disturbance-window 0.5` does for the whole acceleration);
-  - less its mean over each start's own horizon (an oracle that knew every second's mean
-    moment error: what is left is the wander within the second);
+  - less its plain mean over each start's own horizon (an oracle that knew every second's
+    mean moment error; what is left is the wander within the second. Not a bound: another
+    single number per second, the mean weighted by (T - s)^3, would zero the error at T);
 
 beside the diagnosis's own 1 s open-loop error (prediction.csv, extended model), which
 this linear floor should approach when the moment residual is what sets it.
+
+A single-flight diagnosis only (a joint one shares a clock over its flights). residuals.csv
+is plot data, thinned above 3000 samples a channel: a thinned file is refused.
 
 Usage: disturbance_floor.py DIAGNOSIS_DIR [--horizon 1.0] [--stride 0.05]"""
 import csv
@@ -32,13 +37,23 @@ MAX_GAP = 0.05  # s: a start whose horizon holds a longer gap is skipped (take-o
 
 def held_out_residuals(diagnosis):
     rows = list(csv.DictReader(open(f"{diagnosis}/residuals.csv")))
-    start = json.load(open(f"{diagnosis}/diagnosis.json"))["samples"]["validation_from_s"]
-    series = {}
+    meta = json.load(open(f"{diagnosis}/diagnosis.json"))
+    if len(meta.get("flights", [])) > 1:
+        sys.exit(f"{diagnosis}: a joint diagnosis of {len(meta['flights'])} flights; give a single flight's")
+    start = meta["samples"]["validation_from_s"]
+    all_samples = meta["samples"]["training"] + meta["samples"]["validation"]
+    series, every_pdot = {}, 0
     for r in rows:
+        every_pdot += r["series"].startswith("extended") and r["panel"].startswith("pdot")
         channel = r["panel"].split(" ")[0]
         if r["series"].startswith("extended") and channel in ("pdot", "qdot") and float(r["x"]) >= start:
             series.setdefault(channel, []).append((float(r["x"]), float(r["y"])))
     p, q = sorted(series["pdot"]), sorted(series["qdot"])
+    # One residual per interval between samples: a few fewer than samples (gaps, ends); a
+    # plot thinned by a stride of 2 or more holds half of them or fewer.
+    if every_pdot < 0.9 * all_samples:
+        sys.exit(f"{diagnosis}: residuals.csv holds {every_pdot} residuals of {all_samples} samples: thinned for its "
+                 "plot, too coarse to integrate")
     if len(p) != len(q) or any(abs(a[0] - b[0]) > 1e-9 for a, b in zip(p, q)):
         sys.exit(f"{diagnosis}: pdot and qdot residuals are not on one time grid")
     return [t for t, _ in p], [v for _, v in p], [v for _, v in q]
@@ -58,7 +73,7 @@ def integrate_four_times(t, b):
 
 def floors(t, p, q, horizon, stride):
     mean_p, mean_q = sum(p) / len(p), sum(q) / len(q)
-    views = {"as it is": [], "less the held-out mean": [], "less the past 0.5 s mean": [], "less each horizon's own mean": []}
+    views = {"as it is": [], "less the held-out mean": [], "less the past 0.5 s mean": [], "less each horizon's plain mean": []}
     next_start = t[0] + 0.5  # the past window must exist
     for i, t0 in enumerate(t):
         if t0 < next_start:
@@ -78,7 +93,7 @@ def floors(t, p, q, horizon, stride):
             "as it is": (0.0, 0.0),
             "less the held-out mean": (mean_p, mean_q),
             "less the past 0.5 s mean": (sum(p[k] for k in past) / len(past), sum(q[k] for k in past) / len(past)),
-            "less each horizon's own mean": (sum(p[k] for k in window) / len(window), sum(q[k] for k in window) / len(window)),
+            "less each horizon's plain mean": (sum(p[k] for k in window) / len(window), sum(q[k] for k in window) / len(window)),
         }
         for view, (cp, cq) in corrections.items():
             y = G * integrate_four_times(ts, [p[k] - cp for k in window])
