@@ -388,10 +388,8 @@ void set_formulation(bool accelerometer, Diagnosis& d) {
   d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
 }
 
-// What the agreement check needs: each flight's training part, the joint fit, and each named
-// airframe effect (and each suspected one that still holds its estimates: a value that
-// differs between the flights is often why the joint fit gains nothing) with its start and
-// "off" values.
+}  // namespace
+
 AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, runtime::DynamicModel& model,
                                  const std::vector<fit::Flight>& flights, double validation_fraction, bool accelerometer,
                                  const std::vector<std::string>& per_flight_names) {
@@ -402,13 +400,25 @@ AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, r
   in.joint_fit = d.search.final_fit;
   in.per_flight = per_flight_names;
   in.weights = d.search.final_weights;
+  std::vector<std::string> names;
+  for (const auto& p : all.params) names.push_back(p.name);
+  const std::vector<std::string> references = reference_parameters(names);
   const auto check = [&](const Finding& f, bool named) {
-    if (find_effect(f.effect).per_flight) return;
+    const Effect& effect = find_effect(f.effect);
+    if (effect.per_flight) return;
+    // A refinement without what it refines scales nothing (motor_lag_spread with the lag
+    // off): each flight's value would be its start.
+    if (!effect.refines.empty() && std::none_of(d.findings.begin(), d.findings.end(),
+                                                [&](const Finding& g) { return g.effect == effect.refines; }))
+      return;
     AgreementInputs::Effect e{f.effect, named, {}, {}, {}};
     for (const auto& name : effect_parameters(all, f.effect)) {
+      // A reference (the spread's first rotor) is held at off in every fit, the others
+      // relative to it: not refitted per flight.
+      if (std::find(references.begin(), references.end(), name) != references.end()) continue;
       const auto est = std::find_if(f.parameters.begin(), f.parameters.end(),
                                     [&](const EffectEstimate& x) { return x.name == name; });
-      if (est == f.parameters.end()) return;  // no estimate to start from (held at its reference)
+      if (est == f.parameters.end()) return;  // no estimate to start from
       e.parameters.push_back(name);
       e.off.push_back(neutral_value(all.params[all.param_index(name)]));
       e.start.push_back(est->value);
@@ -419,6 +429,8 @@ AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, r
   for (const auto& x : d.suspected) check(x.candidate, false);
   return in;
 }
+
+namespace {
 
 // The flights a diagnosis uses, with the battery and pose signals a log lacks filled in.
 // Several flights: one whose commands sit at their limit is left out (it would bend the

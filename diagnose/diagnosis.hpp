@@ -253,6 +253,16 @@ bool belongs_to_flight(const std::string& parameter);
 // with it, and the intervals are profiled again.
 void drop_refinements_without_their_effect(Diagnosis& d, CandidateSearch& search);
 
+// What the agreement check of a joint diagnosis refits on each flight: each flight's training
+// part, the joint fit, and each named airframe effect (and each suspected one that still holds
+// its estimates: a value that differs between the flights is often why the joint fit gains
+// nothing) with its start and "off" values. Not a per-flight effect, not a reference parameter
+// (held at off, the others relative to it), not a refinement whose effect is not named.
+// Declared here for its test.
+AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, runtime::DynamicModel& model,
+                                 const std::vector<fit::Flight>& flights, double validation_fraction, bool accelerometer,
+                                 const std::vector<std::string>& per_flight_names);
+
 // What the draft check reads from a diagnosis: the final model's residuals over the whole
 // flight (`used`: the samples they belong to, in order), each sample's heading and velocity,
 // whether it lies in the held-out part (`valid`), and the coefficients and sizes the ratio

@@ -1473,6 +1473,37 @@ TEST_F(WeakMotorSearch, ARefinementLeftWithoutItsEffectIsDroppedAndSuspected) {
   EXPECT_EQ(d.suspected.size(), 1u);
 }
 
+// A joint diagnosis refits a named lag spread per flight without its reference rotor (held at
+// 0, the others relative to it); before, the reference's missing estimate left the spread out
+// of the agreement check altogether. A spread whose lag is not named is left out: with the lag
+// off it scales nothing, and each flight's value would be its start.
+TEST_F(WeakMotorSearch, TheAgreementCheckRefitsASpreadWithItsLagButNotItsReference) {
+  const auto spread_params = quadgen::diagnose::effect_parameters(*all_, "motor_lag_spread");
+  ASSERT_GE(spread_params.size(), 4u);
+  quadgen::diagnose::Finding lag, spread, gain;
+  lag.effect = "motor_lag";
+  lag.parameters.push_back({"motor_lag.tau", "s", 0.05, 0.001, 0.04, 0.06});
+  spread.effect = "motor_lag_spread";
+  for (size_t i = 1; i < spread_params.size(); ++i)  // the first rotor is the reference: no estimate
+    spread.parameters.push_back({spread_params[i], "1", 0.1 * static_cast<double>(i), 0.01, 0.0, 0.5});
+  gain.effect = "motor_gain";  // a flight's own quantity: each flight has its own value anyway
+  quadgen::diagnose::Diagnosis d;
+  d.search = result_;
+  d.findings = {lag, spread, gain};
+  const auto in = quadgen::diagnose::agreement_inputs(d, *all_, *model_, {}, 0.3, false, {});
+  ASSERT_EQ(in.effects.size(), 2u);
+  EXPECT_EQ(in.effects[0].name, "motor_lag");
+  EXPECT_EQ(in.effects[1].name, "motor_lag_spread");
+  EXPECT_EQ(in.effects[1].parameters, std::vector<std::string>(spread_params.begin() + 1, spread_params.end()));
+  EXPECT_DOUBLE_EQ(in.effects[1].start[1], 0.2);
+  // The lag gone (suspected, say): a suspected spread without it is not refitted either.
+  d.findings = {gain};
+  quadgen::diagnose::Suspected suspect;
+  suspect.candidate = spread;
+  d.suspected = {suspect};
+  EXPECT_TRUE(quadgen::diagnose::agreement_inputs(d, *all_, *model_, {}, 0.3, false, {}).effects.empty());
+}
+
 // A comparison whose weights had not settled is said beside the gain, in the summary the
 // command prints (and the report quotes); a settled one adds nothing.
 TEST(Acceptance, AnUnsettledComparisonIsSaidBesideTheGain) {
