@@ -718,14 +718,11 @@ TEST(HoverTrim, FindsATrimWithEveryRotorPushingWhereTheLeastNormPulls) {
   EXPECT_NE(heavy.why_not.find("beyond the motor map"), std::string::npos) << heavy.why_not;
 }
 
-// An irregular hexacopter whose motors idle above 0 N (a0 from 16 to 580 rad/s): the
-// least-norm trim asks rotor 4 for less than its idle thrust; the greedy search that held the
-// rotor furthest below its idle in turn (rotor 2, then 1, then 4; until the twenty-seventh
-// session) reported no trim. One exists: found by trying every set of held rotors, checked
-// here by summing the moments.
-TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
-  const double rows[6][4] = {{0.2182, -0.0386, -1, 117.2}, {0.0194, 0.1259, -1, 429.1}, {-0.0967, 0.1481, -1, 580.0},
-                             {-0.3520, 0.0895, +1, 16.1},  {-0.2019, -0.1418, -1, 47.9}, {-0.0137, -0.0923, +1, 548.2}};
+namespace {
+
+// A 2 kg hexacopter from rows of rotor x, y [m], spin and motor-map a0 [rad/s] (k 1e-5, a1
+// as given, a2 0).
+ControllerModel hexacopter(const double (&rows)[6][4], double a1) {
   ControllerModel b;
   b.mass = 2.0;
   b.kappa = 0.02;
@@ -733,17 +730,21 @@ TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
     b.rotor_x.push_back(r[0]);
     b.rotor_y.push_back(r[1]);
     b.spin.push_back(r[2]);
-    b.thrust_laws.push_back({1e-5, r[3], 1000, 0});
+    b.thrust_laws.push_back({1e-5, r[3], a1, 0});
   }
-  const std::vector<std::string> names = {"R0", "R1", "R2", "R3", "R4", "R5"};
-  ASSERT_LT(allocate(b, b.mass * b.g, {0, 0, 0})[4], 0) << "the case must be one where the least-norm trim pulls";
-  const HoverTrim trim = hover_trim(b, names);
-  ASSERT_TRUE(trim.found()) << trim.why_not;
+  return b;
+}
+
+// A trim's thrusts within every motor map (commands 0 to 1), each its command's thrust, and
+// balancing: weight, roll, pitch and yaw summed from the rotor positions here, not through
+// the allocation the trim was solved with.
+void expect_trim_within_reach_and_balanced(const ControllerModel& b, const HoverTrim& trim) {
+  const auto law = [&](size_t i, double u) { return b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(u)); };
   double total = 0, roll = 0, pitch = 0, yaw = 0;
-  for (size_t i = 0; i < 6; ++i) {
-    const double idle = b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(0.0));
-    EXPECT_GE(trim.thrusts[i], idle - 1e-12) << names[i];
-    EXPECT_NEAR(b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(trim.commands[i])), trim.thrusts[i], 1e-9);
+  for (size_t i = 0; i < trim.thrusts.size(); ++i) {
+    EXPECT_GE(trim.thrusts[i], law(i, 0.0) - 1e-12) << i;
+    EXPECT_LE(trim.thrusts[i], law(i, 1.0) + 1e-12) << i;
+    EXPECT_NEAR(law(i, trim.commands[i]), trim.thrusts[i], 1e-9) << i;
     total += trim.thrusts[i];
     roll += trim.thrusts[i] * b.rotor_y[i];
     pitch += trim.thrusts[i] * b.rotor_x[i];
@@ -753,6 +754,24 @@ TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
   EXPECT_NEAR(roll, 0, 1e-9);
   EXPECT_NEAR(pitch, 0, 1e-9);
   EXPECT_NEAR(yaw, 0, 1e-9);
+}
+
+const std::vector<std::string> kHexaNames = {"R0", "R1", "R2", "R3", "R4", "R5"};
+
+}  // namespace
+
+// An irregular hexacopter whose motors idle above 0 N (a0 from 16 to 580 rad/s): the
+// least-norm trim asks rotor 4 for less than its idle thrust; the greedy search that held the
+// rotor furthest below its idle in turn (rotor 2, then 1, then 4; until the twenty-seventh
+// session) reported no trim. One exists: found by trying every set of held rotors.
+TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
+  const double rows[6][4] = {{0.2182, -0.0386, -1, 117.2}, {0.0194, 0.1259, -1, 429.1}, {-0.0967, 0.1481, -1, 580.0},
+                             {-0.3520, 0.0895, +1, 16.1},  {-0.2019, -0.1418, -1, 47.9}, {-0.0137, -0.0923, +1, 548.2}};
+  const ControllerModel b = hexacopter(rows, 1000);
+  ASSERT_LT(allocate(b, b.mass * b.g, {0, 0, 0})[4], 0) << "the case must be one where the least-norm trim pulls";
+  const HoverTrim trim = hover_trim(b, kHexaNames);
+  ASSERT_TRUE(trim.found()) << trim.why_not;
+  expect_trim_within_reach_and_balanced(b, trim);
   EXPECT_EQ(trim.commands[4], 0.0);  // held at its idle
 }
 
@@ -764,37 +783,15 @@ TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
 TEST(HoverTrim, HoldingRotorsAtIdleKeepsEveryOneBelowCommandOne) {
   const double rows[6][4] = {{-0.0749, -0.2935, -1, 0.6},  {0.0872, -0.2098, +1, 192.9}, {-0.3169, 0.1564, +1, 243.8},
                              {0.1430, 0.0598, +1, 182.3},  {-0.1304, -0.1915, +1, 467.4}, {0.0089, 0.0807, -1, 267.7}};
-  ControllerModel b;
-  b.mass = 2.0;
-  b.kappa = 0.02;
-  for (const auto& r : rows) {
-    b.rotor_x.push_back(r[0]);
-    b.rotor_y.push_back(r[1]);
-    b.spin.push_back(r[2]);
-    b.thrust_laws.push_back({1e-5, r[3], 600, 0});
-  }
-  const std::vector<std::string> names = {"R0", "R1", "R2", "R3", "R4", "R5"};
-  const auto law = [&](size_t i, double u) { return b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(u)); };
+  const ControllerModel b = hexacopter(rows, 600);
   const std::vector<double> least_norm = allocate(b, b.mass * b.g, {0, 0, 0});
   bool below_idle = false;
-  for (size_t i = 0; i < 6; ++i) below_idle = below_idle || least_norm[i] < law(i, 0.0);
+  for (size_t i = 0; i < 6; ++i)
+    below_idle = below_idle || least_norm[i] < b.thrust_laws[i].thrust_at_speed(b.thrust_laws[i].speed_at(0.0));
   ASSERT_TRUE(below_idle) << "the least-norm trim must ask a rotor for less than its idle";
-  const HoverTrim trim = hover_trim(b, names);
+  const HoverTrim trim = hover_trim(b, kHexaNames);
   ASSERT_TRUE(trim.found()) << trim.why_not;
-  double total = 0, roll = 0, pitch = 0, yaw = 0;
-  for (size_t i = 0; i < 6; ++i) {
-    EXPECT_GE(trim.thrusts[i], law(i, 0.0) - 1e-12) << names[i];
-    EXPECT_LE(trim.thrusts[i], law(i, 1.0) + 1e-12) << names[i];
-    EXPECT_NEAR(law(i, trim.commands[i]), trim.thrusts[i], 1e-9);
-    total += trim.thrusts[i];
-    roll += trim.thrusts[i] * b.rotor_y[i];
-    pitch += trim.thrusts[i] * b.rotor_x[i];
-    yaw += trim.thrusts[i] * b.spin[i];
-  }
-  EXPECT_NEAR(total, b.mass * b.g, 1e-9);
-  EXPECT_NEAR(roll, 0, 1e-9);
-  EXPECT_NEAR(pitch, 0, 1e-9);
-  EXPECT_NEAR(yaw, 0, 1e-9);
+  expect_trim_within_reach_and_balanced(b, trim);
 }
 
 // The thesis' tilt and yaw manoeuvres choose their rotors by where they sit and how they
