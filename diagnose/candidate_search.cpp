@@ -88,6 +88,12 @@ std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::
   return out;
 }
 
+std::vector<std::string> reference_parameters(const SymbolicModel& all) {
+  std::vector<std::string> names;
+  for (const auto& p : all.params) names.push_back(p.name);
+  return quadgen::reference_parameters(names);
+}
+
 std::string separating_manoeuvre(const std::string& a, const std::string& b) {
   for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}})
     for (const auto& l : find_effect(x).look_alikes)
@@ -105,9 +111,7 @@ CandidateSearch::CandidateSearch(const SymbolicModel& all, runtime::DynamicModel
       throw fit::FitError("candidate effect '" + e + "' is not in the model");
     for (const auto& name : effect_parameters(all, e)) effect_params_[e].push_back(model.param_index(name));
   }
-  std::vector<std::string> names;
-  for (const auto& p : all.params) names.push_back(p.name);
-  for (const auto& ref : reference_parameters(names)) reference_params_.push_back(model.param_index(ref));
+  for (const auto& ref : reference_parameters(all)) reference_params_.push_back(model.param_index(ref));
 }
 
 std::vector<FitParameter> CandidateSearch::initial_parameters() const {

@@ -199,6 +199,10 @@ std::vector<std::string> applicable_effects(const fit::Flight& flight);
 // The parameters of an effect, in model order ("motor_gain" -> motor_gain.A, ...).
 std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::string& effect);
 
+// The model's reference parameters, held at off in every fit (reference_parameters of the
+// catalogue over the model's parameter names: motor_gain's and motor_lag_spread's first rotor).
+std::vector<std::string> reference_parameters(const SymbolicModel& all);
+
 // What would separate two look-alike effects.
 std::string separating_manoeuvre(const std::string& a, const std::string& b);
 

@@ -297,11 +297,10 @@ std::vector<double> held_out_starts(const fit::Flight& valid, const std::vector<
 // In a joint diagnosis, the parameters that take one value per flight: c_t when fitted, and
 // those of the per-flight effects among the candidates, except a reference held at off.
 std::vector<std::string> per_flight_parameters(const SymbolicModel& all, const std::vector<std::string>& candidates) {
-  std::vector<std::string> names, out;
-  for (const auto& p : all.params) names.push_back(p.name);
+  std::vector<std::string> out;
   for (const auto& p : all.params)
     if (p.fit && effect_of_parameter(p.name).empty() && belongs_to_flight(p.name)) out.push_back(p.name);
-  const auto references = reference_parameters(names);
+  const auto references = reference_parameters(all);
   for (const auto& e : candidates) {
     if (!find_effect(e).per_flight) continue;
     for (const auto& n : effect_parameters(all, e))
@@ -400,9 +399,7 @@ AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, r
   in.joint_fit = d.search.final_fit;
   in.per_flight = per_flight_names;
   in.weights = d.search.final_weights;
-  std::vector<std::string> names;
-  for (const auto& p : all.params) names.push_back(p.name);
-  const std::vector<std::string> references = reference_parameters(names);
+  const std::vector<std::string> references = reference_parameters(all);
   const auto check = [&](const Finding& f, bool named) {
     const Effect& effect = find_effect(f.effect);
     if (effect.per_flight) return;

@@ -40,11 +40,11 @@ std::string channel_unit(const Diagnosis& d, const std::string& channel) {
 }
 
 // A check's leads: each claim once, the numbers of each source that shows it below.
-void lead_html(std::ostream& h, const std::vector<Lead>& leads, const Diagnosis& d, const std::string& css_class) {
+void lead_html(std::ostream& h, const std::vector<Lead>& leads, const std::string& css_class) {
   for (const auto& lead : leads) {
     h << "<p" << (css_class.empty() ? "" : " class=\"" + css_class + "\"") << ">" << esc(lead.claim) << "</p>\n<ul>\n";
     for (const auto& [source, numbers] : lead.evidence)
-      h << "<li>" << esc(lead_source(source, d)) << ": " << esc(numbers) << "</li>\n";
+      h << "<li>" << esc(source) << ": " << esc(numbers) << "</li>\n";
     h << "</ul>\n";
   }
 }
@@ -74,7 +74,7 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
     }
   }
   h << "</table>\n";
-  lead_html(h, command_gain_leads(d), d, "warn");
+  lead_html(h, command_gain_leads(d), "warn");
 }
 
 // Beyond the catalogue: the proposed terms with their coefficients, and one line per channel
@@ -342,7 +342,7 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
         << "</td></tr>\n";
     h << "</table>\n";
   }
-  lead_html(h, draft_leads(d), d, "");
+  lead_html(h, draft_leads(d), "");
 }
 
 void prediction_html(std::ostringstream& h, const Diagnosis& d) {

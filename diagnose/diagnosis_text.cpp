@@ -99,7 +99,7 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
     for (const auto& lead : leads) {
       os << lead.claim << "\n";
       for (const auto& [source, numbers] : lead.evidence)
-        os << "  " << output::printable(lead_source(source, d)) << ": " << numbers << "\n";
+        os << "  " << output::printable(source) << ": " << numbers << "\n";
     }
   for (const auto& t : d.discovered)
     if (t.proposed)

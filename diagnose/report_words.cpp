@@ -64,8 +64,9 @@ OneLead command_gain_lead(const CommandGain& g) {
   return {claim, numbers};
 }
 
-// A check's leads: the diagnosis as a whole first, then each flight of a joint diagnosis that
-// shows it; sources with the same claim share one lead.
+// A check's leads: the diagnosis as a whole first ("this flight", or "the flights together"
+// in a joint diagnosis), then each flight of a joint diagnosis that shows it; sources with the
+// same claim share one lead.
 template <class Check, class LeadOf>
 std::vector<Lead> leads(const Check& whole, const std::vector<Check>& per_flight, const Diagnosis& d, LeadOf lead_of) {
   std::vector<Lead> out;
@@ -75,7 +76,7 @@ std::vector<Lead> leads(const Check& whole, const std::vector<Check>& per_flight
     if (same == out.end()) same = out.insert(out.end(), Lead{one.claim, {}});
     same->evidence.emplace_back(source, one.evidence);
   };
-  add("", lead_of(whole));
+  add(d.flights.size() > 1 ? "the flights together" : "this flight", lead_of(whole));
   for (size_t i = 0; i < per_flight.size() && i < d.flights.size(); ++i)
     add("flight " + std::to_string(i + 1) + " (" + d.flights[i] + ")", lead_of(per_flight[i]));
   return out;
@@ -205,11 +206,6 @@ std::vector<Lead> draft_leads(const Diagnosis& d) { return leads(d.draft, d.draf
 
 std::vector<Lead> command_gain_leads(const Diagnosis& d) {
   return leads(d.command_gain, d.command_gain_per_flight, d, command_gain_lead);
-}
-
-std::string lead_source(const std::string& source, const Diagnosis& d) {
-  if (!source.empty()) return source;
-  return d.flights.size() > 1 ? "the flights together" : "this flight";
 }
 
 // Where the one-step test or the force model alone, not the open-loop rollouts, stood behind a

@@ -41,8 +41,9 @@ std::string num(double v, int prec = 4);
 std::string interval(double lower, double upper, int prec = 4);
 
 // A check's lead: what it suggests, said once, and the numbers of each source that shows it
-// ("" for the diagnosis as a whole, "flight k (path)" for a flight of a joint one). A joint
-// diagnosis whose flights show the same said it once per flight, 400-500 characters each.
+// ("this flight" or "the flights together" for the diagnosis as a whole, "flight k (path)"
+// for a flight of a joint one). A joint diagnosis whose flights show the same said it once
+// per flight, 400-500 characters each.
 struct Lead {
   std::string claim;
   std::vector<std::pair<std::string, std::string>> evidence;  // source, numbers
@@ -52,8 +53,6 @@ struct Lead {
 std::vector<Lead> draft_leads(const Diagnosis& d);
 std::vector<Lead> command_gain_leads(const Diagnosis& d);
 
-// The name a lead's source goes by: "" is the diagnosis as a whole.
-std::string lead_source(const std::string& source, const Diagnosis& d);
 
 // What stood behind a finding when the rollouts did not (the one-step test, the force model
 // alone), and that text with a note on unsettled weights: said beside the gain.

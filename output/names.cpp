@@ -85,21 +85,19 @@ std::optional<std::string> name_problem(const std::string& name) {
 
 std::optional<std::string> vehicle_name_problem(const std::string& name) {
   if (auto problem = name_problem(name)) return problem;
-  const std::string with = std::string(kEffectsInfix) + "_", all = kAllEffectsSuffix;
-  const auto ends_with = [&](const std::string& end) {
-    return name.size() >= end.size() && name.compare(name.size() - end.size(), end.size(), end) == 0;
+  const std::string infix = kEffectsInfix, with = infix + "_", all = kAllEffectsSuffix;
+  const auto ends_with = [](const std::string& s, const std::string& end) {
+    return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
   };
-  if (name.find(with) != std::string::npos || ends_with(kEffectsInfix) || ends_with(all))
-    return "the name contains '" + with + "' or ends in '" + std::string(kEffectsInfix) + "' or '" + all +
-           "', which the code generator appends for a model with effects: two vehicles' models would share one "
-           "C++ namespace (rename it, e.g. '" + [&] {
-             std::string r = name;
-             for (size_t at; (at = r.find(with)) != std::string::npos;) r.replace(at, with.size(), "_w_");
-             if (ends_with(all)) r.replace(r.size() - all.size(), all.size(), "_all");
-             else if (ends_with(kEffectsInfix)) r.replace(r.size() - 5, 5, "_w");
-             return r;
-           }() + "')";
-  return std::nullopt;
+  if (name.find(with) == std::string::npos && !ends_with(name, infix) && !ends_with(name, all)) return std::nullopt;
+  // A name to use instead: "_with_" as "_w_", a trailing "_with" as "_w", "_all_effects" as "_all".
+  std::string instead = name;
+  for (size_t at; (at = instead.find(with)) != std::string::npos;) instead.replace(at, with.size(), "_w_");
+  if (ends_with(instead, all)) instead.replace(instead.size() - all.size(), all.size(), "_all");
+  else if (ends_with(instead, infix)) instead.replace(instead.size() - infix.size(), infix.size(), "_w");
+  return "the name contains '" + with + "' or ends in '" + infix + "' or '" + all +
+         "', which the code generator appends for a model with effects: two vehicles' models would share one C++ "
+         "namespace (rename it, e.g. '" + instead + "')";
 }
 
 }  // namespace quadgen::output

@@ -208,22 +208,23 @@ std::string html_text(const std::string& s) { return html_escaped(s, false); }
 std::string html_preformatted(const std::string& s) { return html_escaped(s, true); }
 
 namespace {
-// Whether the text opens a block (heading, list item, rule, setext underline) where it starts
-// a line: '#', '-' or '+' followed by a blank, the end or itself; '=' at all; digits then '.'
-// or ')' followed by a blank or the end. Returns the position of the character to escape.
+// What Markdown output shows as a blank: blanks, line breaks and control characters become
+// spaces or vanish in it.
+bool markdown_blank(char c) { return c == ' ' || control(static_cast<unsigned char>(c)); }
+
+// Whether the text, which starts with no blank, opens a block (heading, list item, rule,
+// setext underline) where it starts a line: '#', '-' or '+' followed by a blank, the end or
+// itself; '=' at all; digits then '.' or ')' followed by a blank or the end. Returns the
+// position of the character to escape.
 size_t block_opener(const std::string& s) {
-  // Blanks, line breaks and control characters become spaces or vanish in the output.
-  const auto blank = [](char c) { return c == ' ' || control(static_cast<unsigned char>(c)); };
-  size_t first = 0;
-  while (first < s.size() && blank(s[first])) ++first;
-  if (first == s.size()) return std::string::npos;
-  const auto blank_or_end = [&](size_t k) { return k >= s.size() || blank(s[k]); };
-  const char c = s[first];
-  if (c == '=') return first;
-  if ((c == '#' || c == '-' || c == '+') && (blank_or_end(first + 1) || s[first + 1] == c)) return first;
-  size_t k = first;
+  if (s.empty()) return std::string::npos;
+  const auto blank_or_end = [&](size_t k) { return k >= s.size() || markdown_blank(s[k]); };
+  const char c = s[0];
+  if (c == '=') return 0;
+  if ((c == '#' || c == '-' || c == '+') && (blank_or_end(1) || s[1] == c)) return 0;
+  size_t k = 0;
   while (k < s.size() && s[k] >= '0' && s[k] <= '9') ++k;
-  if (k > first && k < s.size() && (s[k] == '.' || s[k] == ')') && blank_or_end(k + 1)) return k;
+  if (k > 0 && k < s.size() && (s[k] == '.' || s[k] == ')') && blank_or_end(k + 1)) return k;
   return std::string::npos;
 }
 }  // namespace
@@ -231,14 +232,14 @@ size_t block_opener(const std::string& s) {
 std::string markdown_text(const std::string& text) {
   // Blanks at the start go: four of them open a code block where the text starts a line.
   size_t start = 0;
-  while (start < text.size() && (text[start] == ' ' || control(static_cast<unsigned char>(text[start])))) ++start;
+  while (start < text.size() && markdown_blank(text[start])) ++start;
   const std::string s = text.substr(start);
   // Inline Markdown (and GitHub's $ math): these change how the text around them renders.
-  // '@' too, the ':' of "://" and the '.' of "www.": GitHub turns a bare https://...,
-  // www.... or name@host into a link, and a link is what a hostile description wants.
-  // GitHub's e-mail autolinks see through the escape of '@' (the text is joined before they
-  // are looked for), so a word joiner (U+2060, invisible) follows it: no domain starts there.
-  static const std::string punctuation = "\\`*_[]|$~@";
+  // The ':' of "://" and the '.' of "www." too: GitHub turns a bare https://... or www....
+  // into a link, and a link is what a hostile description wants. So does it name@host, and
+  // its e-mail autolinks see through an escaped '@' (the text is joined before they are
+  // looked for): a word joiner (U+2060, invisible) follows the '@', and no domain starts there.
+  static const std::string punctuation = "\\`*_[]|$~";
   const size_t opener = block_opener(s);
   const auto after_www = [&](size_t at) {
     if (at < 3) return false;

@@ -241,7 +241,7 @@ TEST(DraftSignature, ALeadSharedByFlightsIsSaidOnceWithEachFlightsNumbers) {
   const auto leads = quadgen::diagnose::words::draft_leads(d);
   ASSERT_EQ(leads.size(), 2u);
   ASSERT_EQ(leads[0].evidence.size(), 2u);  // the flights together and flight 1; flight 2 shows nothing
-  EXPECT_EQ(leads[0].evidence[0].first, "");
+  EXPECT_EQ(leads[0].evidence[0].first, "the flights together");
   EXPECT_EQ(leads[0].evidence[1].first, "flight 1 (a.csv)");
   EXPECT_NE(leads[1].claim.find("on axis y (roll) and x (pitch)"), std::string::npos) << leads[1].claim;
   const std::string text = quadgen::diagnose::diagnosis_summary(d);
