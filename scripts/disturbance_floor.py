@@ -27,33 +27,27 @@ is plot data, thinned above 3000 samples a channel: a thinned file is refused.
 
 Usage: disturbance_floor.py DIAGNOSIS_DIR [--horizon 1.0] [--stride 0.05]"""
 import csv
-import json
 import math
 import sys
+
+import moment_residuals
 
 G = 9.80665
 MAX_GAP = 0.05  # s: a start whose horizon holds a longer gap is skipped (take-off, landing)
 
 
 def held_out_residuals(diagnosis):
-    rows = list(csv.DictReader(open(f"{diagnosis}/residuals.csv")))
-    meta = json.load(open(f"{diagnosis}/diagnosis.json"))
+    series, meta = moment_residuals.read(diagnosis)
     if len(meta.get("flights", [])) > 1:
         sys.exit(f"{diagnosis}: a joint diagnosis of {len(meta['flights'])} flights; give a single flight's")
-    start = meta["samples"]["validation_from_s"]
+    start = moment_residuals.held_out_from(meta)
     all_samples = meta["samples"]["training"] + meta["samples"]["validation"]
-    series, every_pdot = {}, 0
-    for r in rows:
-        every_pdot += r["series"].startswith("extended") and r["panel"].startswith("pdot")
-        channel = r["panel"].split(" ")[0]
-        if r["series"].startswith("extended") and channel in ("pdot", "qdot") and float(r["x"]) >= start:
-            series.setdefault(channel, []).append((float(r["x"]), float(r["y"])))
-    p, q = sorted(series["pdot"]), sorted(series["qdot"])
     # One residual per interval between samples: a few fewer than samples (gaps, ends); a
     # plot thinned by a stride of 2 or more holds half of them or fewer.
-    if every_pdot < 0.9 * all_samples:
-        sys.exit(f"{diagnosis}: residuals.csv holds {every_pdot} residuals of {all_samples} samples: thinned for its "
-                 "plot, too coarse to integrate")
+    if len(series["pdot"]) < 0.9 * all_samples:
+        sys.exit(f"{diagnosis}: residuals.csv holds {len(series['pdot'])} residuals of {all_samples} samples: thinned "
+                 "for its plot, too coarse to integrate")
+    p, q = ([point for point in series[c] if point[0] >= start] for c in moment_residuals.CHANNELS)
     if len(p) != len(q) or any(abs(a[0] - b[0]) > 1e-9 for a, b in zip(p, q)):
         sys.exit(f"{diagnosis}: pdot and qdot residuals are not on one time grid")
     return [t for t, _ in p], [v for _, v in p], [v for _, v in q]

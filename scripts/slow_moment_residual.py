@@ -18,9 +18,10 @@ samples.validation_from_s) and the log it was fitted to (the NanoBench column na
 Usage: slow_moment_residual.py DIAGNOSIS_DIR LOG.csv"""
 import bisect
 import csv
-import json
 import math
 import sys
+
+import moment_residuals
 
 CORRECTIONS = ["constant", "time", "vbat", "u2", "u2 vbat", "u2 time", "position"]
 
@@ -76,14 +77,10 @@ def main(diagnosis, log_path):
     log = list(csv.DictReader(open(log_path)))
     t_first = float(log[0]["t"])
     log_t = [float(r["t"]) - t_first for r in log]
-    rows = list(csv.DictReader(open(f"{diagnosis}/residuals.csv")))
-    held_out_from = json.load(open(f"{diagnosis}/diagnosis.json"))["samples"]["validation_from_s"]
-    for channel in ("pdot", "qdot"):
-        data = []
-        for r in rows:
-            if r["series"].startswith("extended") and r["panel"].split(" ")[0] == channel:
-                t = float(r["x"])
-                data.append((t, log[min(bisect.bisect_left(log_t, t), len(log) - 1)], float(r["y"])))
+    series, meta = moment_residuals.read(diagnosis)
+    held_out_from = moment_residuals.held_out_from(meta)
+    for channel in moment_residuals.CHANNELS:
+        data = [(t, log[min(bisect.bisect_left(log_t, t), len(log) - 1)], y) for t, y in series[channel]]
         train = [d for d in data if d[0] < held_out_from]
         held = [d for d in data if d[0] >= held_out_from]
         y = [v for *_, v in held]
