@@ -111,6 +111,7 @@ void set_counts(data& d, const SymbolicModel& m, const GeneratedHeader& out) {
   d.set("ops_f_after", std::to_string(std::llround(out.ops_f_after)));
   d.set("ops_before", std::to_string(std::llround(out.ops_before)));
   d.set("ops_after", std::to_string(std::llround(out.ops_after)));
+  d.set("ops_speeds_after", std::to_string(std::llround(out.ops_speeds_after)));
   d.set("pre_ops", std::to_string(std::llround(out.pre_ops)));
   d.set("pre_count", std::to_string(out.pre_count));
   d.set("n_states", std::to_string(m.states.size()));
@@ -118,6 +119,9 @@ void set_counts(data& d, const SymbolicModel& m, const GeneratedHeader& out) {
   d.set("n_params", std::to_string(m.params.size()));
   d.set("n_outputs", std::to_string(m.outputs.size()));
   d.set("pre_size", std::to_string(out.pre_count));
+  std::vector<int> speed_rows(m.rotor_speed_states.begin(), m.rotor_speed_states.end());
+  d.set("n_rotor_speed_states", std::to_string(speed_rows.size()));
+  d.set("rotor_speed_states", int_list(speed_rows));
 }
 
 // Names, nominal values, units, bounds and fit flags, one array entry per variable.
@@ -171,6 +175,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   const LoweredModel lm = lower_model(m);
   const PrintedFunction pre = print_cpp(*lm.plan, lm.precompute);
   const PrintedFunction f_only = print_cpp(*lm.plan, lm.rhs_f);
+  const PrintedFunction speeds = print_cpp(*lm.plan, lm.rotor_speed_rates);
   const PrintedFunction rhs_code = print_cpp(*lm.plan, lm.rhs);
   const PrintedFunction meas_code = print_cpp(*lm.plan, lm.measurement);
 
@@ -180,6 +185,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   out.ops_after = rhs_code.ops_after;
   out.ops_f_before = f_only.ops_before;
   out.ops_f_after = f_only.ops_after;
+  out.ops_speeds_after = speeds.ops_after;
   out.pre_ops = pre.ops_after;
   out.pre_count = lm.plan->precompute_count();
 
@@ -198,6 +204,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("precompute_body", pre.body);
   d.set("rhs_body", rhs_code.body);
   d.set("rhs_f_body", f_only.body);
+  d.set("rotor_speed_rates_body", speeds.body);
   d.set("measurement_body", meas_code.body);
   mustache tmpl{std::string(kModelHeaderTemplate)};
   if (!tmpl.is_valid()) throw std::runtime_error("templates/model.hpp.mustache: " + tmpl.error_message());

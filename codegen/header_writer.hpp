@@ -20,7 +20,7 @@ struct EmitOptions {
 struct GeneratedHeader {
   std::string name;     // namespace and folder name, e.g. "finken3_with_motor_lag"
   std::string content;
-  double ops_before = 0, ops_after = 0, ops_f_before = 0, ops_f_after = 0, pre_ops = 0;
+  double ops_before = 0, ops_after = 0, ops_f_before = 0, ops_f_after = 0, ops_speeds_after = 0, pre_ops = 0;
   int pre_count = 0;
 };
 

@@ -1,6 +1,6 @@
 // A symbolic model lowered once for every back end: its canonical DAG, the one lowered
-// plan, and the four functions a model has (precompute, rhs for f only, rhs with its
-// Jacobians, the measurement with its Jacobians). header_writer prints these; tape_builder
+// plan, and the five functions a model has (precompute, rhs for f only, the rotor speeds'
+// rates, rhs with its Jacobians, the measurement with its Jacobians). header_writer prints these; tape_builder
 // turns the same functions into the runtime's instructions.
 #pragma once
 #include <memory>
@@ -25,6 +25,7 @@ struct LoweredModel {
   SparsePattern dfdx, dfdu, dfdp, dhdx, dhdp;
   LoweredPlan::Function precompute;
   LoweredPlan::Function rhs_f;        // groups: f
+  LoweredPlan::Function rotor_speed_rates;  // groups: f's rows of the rotor speed states
   LoweredPlan::Function rhs;          // groups: f, dfdx, dfdu, dfdp
   LoweredPlan::Function measurement;  // groups: h, dhdx, dhdp
 };

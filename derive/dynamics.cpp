@@ -306,6 +306,9 @@ void assemble(ModelContext& c) {
   }
   for (int i = 0; i < 4; ++i) m.f(6 + i, 0) = q_dot(i, 0);
   for (size_t i = 0; i < c.extra_rates.size(); ++i) m.f(13 + i, 0) = c.extra_rates[i];
+  for (const ex& w : c.rotor_speed)
+    for (size_t i = 0; i < n; ++i)
+      if (w.is_equal(m.states[i].sym)) m.rotor_speed_states.push_back(i);
 
   m.omega_dot = {symbol("omegadot_x"), symbol("omegadot_y"), symbol("omegadot_z")};
   const matrix accel_split = accel_world_for(vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]));

@@ -30,6 +30,10 @@ struct SymbolicModel {
   std::vector<Variable> constants;
 
   GiNaC::matrix f;  // dx/dt, states.size() x 1
+  // The states that are rotor speeds (motor_lag's w_<rotor>), in rotor order; empty when the
+  // rotors follow their commands at once. Their rows of f have a generated function of their
+  // own (a fit that filters the commands through the lag needs only them at every sample).
+  std::vector<size_t> rotor_speed_states;
   std::vector<Variable> outputs;  // what is measured (pose), names and units
   GiNaC::matrix h;  // outputs.size() x 1, depends on x and p
 

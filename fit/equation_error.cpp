@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -260,6 +261,9 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // each rotor's lag is kept for the rotor-speed filter below.
   const size_t nr = speed_states_.size();
   std::vector<double> tau(ns * nr, 0.0);
+  // The attitude bias is one pair of angles per flight: its rotation is recomputed only when
+  // their bits change (NaN: not yet computed; -0 and +0 kept apart, so results stay bit for bit).
+  double bias_roll = std::nan(""), bias_pitch = std::nan(""), conj_q_bias[4] = {1, 0, 0, 0};
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
@@ -267,7 +271,11 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
-    runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, x + kAttitude);
+    if (std::memcmp(&e.roll, &bias_roll, sizeof(double)) != 0 || std::memcmp(&e.pitch, &bias_pitch, sizeof(double)) != 0) {
+      bias_roll = e.roll, bias_pitch = e.pitch;
+      runtime::attitude_bias_conjugate(bias_roll, bias_pitch, conj_q_bias);
+    }
+    runtime::quaternion_product(&s.x[kAttitude], conj_q_bias, x + kAttitude);
     // The commands logged at t_k - d act now (held until the next sample; between
     // samples the linear interpolation is their average over the interval).
     inputs_at(s, s.t - e.delay, u);
@@ -278,7 +286,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // which the discretisation is exact. The mean over each interval (what its mid-interval
   // acceleration sees) goes to mean_speed_; as tau -> 0 it is the held command's speed.
   mean_speed_.assign(ns * nr, 0.0);
-  std::vector<double> f(n), c(nr);
+  std::vector<double> f(n), c(nr), w_now(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
     // After a long gap the rotors restart in steady state with the commands, as at the start
@@ -297,9 +305,8 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
       }
     }
     // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
-    std::vector<double> w_now(nr);
     for (size_t i = 0; i < nr; ++i) w_now[i] = x[speed_states_[i]], x[speed_states_[i]] = 0;
-    model_->rhs(x, &U[k * nu], f.data(), nullptr, nullptr, nullptr);
+    model_->rhs_rows(x, &U[k * nu], speed_states_, f.data());
     for (size_t i = 0; i < nr; ++i) {
       c[i] = tau[k * nr + i] * f[speed_states_[i]];
       x[speed_states_[i]] = restart ? c[i] : w_now[i];

@@ -16,10 +16,10 @@ bool ascii_digit(char c) { return c >= '0' && c <= '9'; }
 const std::set<std::string>& generated_header_names() {
   static const std::set<std::string> names = {
       "std", "quadgen_generated", "Model", "Scalar", "State", "Input", "Param", "Output", "Precomputed",
-      "abs_value", "sign_of", "precompute", "rhs", "measurement", "kNumStates", "kNumInputs",
-      "kNumParams", "kNumOutputs", "kNumPrecomputed", "kVehicleHash", "kEffects", "kStateNames",
-      "kInputNames", "kParamNames", "kOutputNames", "kNominalParams", "kInputDelayParam", "kParamUnits", "kParamLower",
-      "kParamUpper", "kParamFit"};
+      "abs_value", "sign_of", "precompute", "rhs", "rotor_speed_rates", "measurement", "kNumStates",
+      "kNumInputs", "kNumParams", "kNumOutputs", "kNumPrecomputed", "kNumRotorSpeedStates", "kRotorSpeedStates",
+      "kVehicleHash", "kEffects", "kStateNames", "kInputNames", "kParamNames", "kOutputNames", "kNominalParams",
+      "kInputDelayParam", "kParamUnits", "kParamLower", "kParamUpper", "kParamFit"};
   return names;
 }
 

@@ -40,13 +40,17 @@ inline void quaternion_product(const double* a, const double* b, double* q) {
 }
 
 // True attitude from a logged one under attitude_bias (docs/effects.md: q_log = q ⊗ q_bias,
-// q_bias = q_y(pitch) ⊗ q_x(roll)): q = q_log ⊗ conj(q_bias).
-inline void unbias_attitude(const double* q_log, double roll, double pitch, double* q) {
+// q_bias = q_y(pitch) ⊗ q_x(roll)): q = q_log ⊗ conj(q_bias). In two steps for callers that
+// unbias many samples with the same angles (the trigonometry once, not per sample).
+inline void attitude_bias_conjugate(double roll, double pitch, double* conj_q_bias) {
   const double qp[4] = {std::cos(pitch / 2), 0, std::sin(pitch / 2), 0};
   const double qr[4] = {std::cos(roll / 2), std::sin(roll / 2), 0, 0};
+  quaternion_product(qp, qr, conj_q_bias);
+  for (int i = 1; i < 4; ++i) conj_q_bias[i] = -conj_q_bias[i];
+}
+inline void unbias_attitude(const double* q_log, double roll, double pitch, double* q) {
   double qb[4];
-  quaternion_product(qp, qr, qb);
-  for (int i = 1; i < 4; ++i) qb[i] = -qb[i];
+  attitude_bias_conjugate(roll, pitch, qb);
   quaternion_product(q_log, qb, q);
 }
 

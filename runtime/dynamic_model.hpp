@@ -3,6 +3,7 @@
 // header (fast, fixed at compile time); TapeModel interprets the same expression DAG at
 // run time, so `quadgen simulate` works for any vehicle file without a compiler.
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ class DynamicModel {
   // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
+  // f[i] for the rows i in `rows` only (the other entries of f unwritten), equal to rhs()'s
+  // bit for bit. For a caller that needs a few rates at every sample (the rotor speeds'
+  // commanded values): a TapeModel then runs only the instructions those rows need.
+  virtual void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const;
   // What a flight log records, h(x, p) (the generated measurement function): position, and
   // the attitude quaternion as the autopilot logs it (q ⊗ q_bias under attitude_bias). H =
   // dh/dx (num_outputs x n) and Hp = dh/dp (num_outputs x np), dense row-major, from the
@@ -60,6 +65,12 @@ inline int index_in(const std::vector<std::string>& names, const std::string& n)
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i] == n) return static_cast<int>(i);
   return -1;
+}
+inline void DynamicModel::rhs_rows(const double* x, const double* u, const std::vector<int>& rows,
+                                   double* f) const {
+  std::vector<double> all(num_states());
+  rhs(x, u, all.data(), nullptr, nullptr, nullptr);
+  for (int i : rows) f[i] = all[i];
 }
 inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
 inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
@@ -104,6 +115,13 @@ class CompiledModel : public DynamicModel {
     if (A) scatter(A, n, sx, M::kDfdxNnz, M::kDfdxRow, M::kDfdxCol);
     if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
+  }
+  // The rotor speeds' rows have a generated function of their own; other rows take rhs().
+  void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override {
+    if (M::kNumRotorSpeedStates > 0 && rows.size() == static_cast<size_t>(M::kNumRotorSpeedStates) &&
+        std::equal(rows.begin(), rows.end(), M::kRotorSpeedStates))
+      return M::rotor_speed_rates(x, u, p_.data(), pre_, f);
+    DynamicModel::rhs_rows(x, u, rows, f);
   }
   std::vector<Parameter> parameters() const override {
     std::vector<Parameter> out;

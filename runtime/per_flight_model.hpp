@@ -50,6 +50,9 @@ class PerFlightModel : public DynamicModel {
   const std::vector<double>& params() const override { return p_; }
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
+  void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override {
+    flights_[flight_at(u[t_input_])]->rhs_rows(x, u, rows, f);
+  }
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::vector<Parameter> parameters() const override;  // a flight's copy as flight 1's, renamed
   int num_outputs() const override { return flights_[0]->num_outputs(); }

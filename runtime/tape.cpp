@@ -1,5 +1,6 @@
 #include "runtime/tape.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <utility>
@@ -150,6 +151,29 @@ void TapeModel::rhs(const double* x, const double* u, double* f, double* A, doub
   if (A) scatter(A, tape_->nx, tape_->nx, fn.groups[kDfdxGroup], r);
   if (Bu) scatter(Bu, tape_->nx, tape_->nu, fn.groups[kDfduGroup], r);
   if (B) scatter(B, tape_->nx, tape_->np, fn.groups[kDfdpGroup], r);
+}
+
+void TapeModel::rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const {
+  if (!rows_program_ || rows != rows_asked_) {
+    const TapeFunction& value = programs_->rhs_for[0];  // f alone
+    TapeFunction wanted{value.code, {SparseOutputs{}}};
+    const SparseOutputs& all = value.groups[0];
+    SparseOutputs& kept = wanted.groups[0];
+    for (size_t k = 0; k < all.reg.size(); ++k) {
+      if (std::find(rows.begin(), rows.end(), all.row[k]) == rows.end()) continue;
+      kept.row.push_back(all.row[k]);
+      kept.col.push_back(all.col[k]);
+      kept.reg.push_back(all.reg[k]);
+    }
+    rows_program_ = std::make_shared<const TapeFunction>(pruned(wanted, 0, -1, {}, tape_->num_registers));
+    rows_asked_ = rows;
+  }
+  double* r = reg_.data();
+  for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
+  for (int i = 0; i < tape_->nu; ++i) r[tape_->u_reg(i)] = u[i];
+  run(rows_program_->code, r);
+  const SparseOutputs& out = rows_program_->groups[0];
+  for (size_t k = 0; k < out.reg.size(); ++k) f[out.row[k]] = r[out.reg[k]];
 }
 
 }  // namespace quadgen::runtime

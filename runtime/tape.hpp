@@ -63,6 +63,7 @@ class TapeModel : public DynamicModel {
   const std::vector<double>& params() const override { return p_; }
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
+  void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override;
   void restrict_param_jacobian(const std::vector<int>& columns) override;
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<TapeModel>(*this); }
   std::vector<Parameter> parameters() const override;
@@ -88,6 +89,10 @@ class TapeModel : public DynamicModel {
   std::shared_ptr<const Programs> programs_;
   std::vector<double> p_;
   mutable std::vector<double> reg_;  // scratch of rhs() and measurement()
+  // rhs_rows(): the rows of the last call and the value program pruned to them (a cache:
+  // callers ask for the same rows at every sample).
+  mutable std::vector<int> rows_asked_;
+  mutable std::shared_ptr<const TapeFunction> rows_program_;
 };
 
 }  // namespace quadgen::runtime

@@ -5,6 +5,7 @@
 // Operation counts (+ - * / and calls; integer powers as products):
 //   rhs(f only)           6471 as expression trees, 237 after CSE
 //   rhs(f + all Jacobians) 102792 as expression trees, 1946 after CSE
+//   rotor_speed_rates()   0 after CSE
 //   precompute()          649 for 257 parameter-only values
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
@@ -39,6 +40,10 @@ inline constexpr int kNumInputs = 4;
 inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 257;
+// The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
+// their rows of f.
+inline constexpr int kNumRotorSpeedStates = 0;
+inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
 // file (FNV-1a of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "6aa8b7225c24d6d6";
@@ -1356,6 +1361,16 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   f[12] = (t18*pre.c[28] + t17*pre.c[29] + t15*pre.c[27])*pre.c[21];
 }
 
+// f's rows of the rotor speed states alone (kRotorSpeedStates; the other entries of f are
+// not written), equal to rhs()'s: for a caller that filters the commands through the motor
+// lag at every sample and needs nothing else of f.
+template <typename Scalar>
+inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                              Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre; (void)f;
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1391,6 +1406,8 @@ struct Model {
   static constexpr int kNumParams = crazyflie21::kNumParams;
   static constexpr int kNumOutputs = crazyflie21::kNumOutputs;
   static constexpr int kInputDelayParam = crazyflie21::kInputDelayParam;
+  static constexpr int kNumRotorSpeedStates = crazyflie21::kNumRotorSpeedStates;
+  static constexpr const int* kRotorSpeedStates = crazyflie21::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21::kDfdxNnz;
   static constexpr const int* kDfdxRow = crazyflie21::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21::kDfdxCol;
@@ -1432,6 +1449,11 @@ struct Model {
   template <typename Scalar>
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
     crazyflie21::rhs(x, u, p, pre, f);
+  }
+  template <typename Scalar>
+  static void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                                Scalar* f) {
+    crazyflie21::rotor_speed_rates(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

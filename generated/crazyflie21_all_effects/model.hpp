@@ -5,6 +5,7 @@
 // Operation counts (+ - * / and calls; integer powers as products):
 //   rhs(f only)           22218 as expression trees, 315 after CSE
 //   rhs(f + all Jacobians) 502890 as expression trees, 3056 after CSE
+//   rotor_speed_rates()   28 after CSE
 //   precompute()          1023 for 407 parameter-only values
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
@@ -39,6 +40,10 @@ inline constexpr int kNumInputs = 6;
 inline constexpr int kNumParams = 44;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 407;
+// The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
+// their rows of f.
+inline constexpr int kNumRotorSpeedStates = 4;
+inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {13, 14, 15, 16};
 // What this header was generated from: a runtime may use it only for the same vehicle
 // file (FNV-1a of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "6aa8b7225c24d6d6";
@@ -2031,6 +2036,20 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   f[16] = -(x[16] - p[5] - (p[6] + p[7]*u[3])*u[3])*pre.c[53];
 }
 
+// f's rows of the rotor speed states alone (kRotorSpeedStates; the other entries of f are
+// not written), equal to rhs()'s: for a caller that filters the commands through the motor
+// lag at every sample and needs nothing else of f.
+template <typename Scalar>
+inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                              Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre; (void)f;
+  f[13] = -(x[13] - p[5] - (p[6] + p[7]*u[0])*u[0])*pre.c[50];
+  f[14] = -(x[14] - p[5] - (p[6] + p[7]*u[1])*u[1])*pre.c[51];
+  f[15] = -(x[15] - p[5] - (p[6] + p[7]*u[2])*u[2])*pre.c[52];
+  f[16] = -(x[16] - p[5] - (p[6] + p[7]*u[3])*u[3])*pre.c[53];
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -2098,6 +2117,8 @@ struct Model {
   static constexpr int kNumParams = crazyflie21_all_effects::kNumParams;
   static constexpr int kNumOutputs = crazyflie21_all_effects::kNumOutputs;
   static constexpr int kInputDelayParam = crazyflie21_all_effects::kInputDelayParam;
+  static constexpr int kNumRotorSpeedStates = crazyflie21_all_effects::kNumRotorSpeedStates;
+  static constexpr const int* kRotorSpeedStates = crazyflie21_all_effects::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_all_effects::kDfdxNnz;
   static constexpr const int* kDfdxRow = crazyflie21_all_effects::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_all_effects::kDfdxCol;
@@ -2139,6 +2160,11 @@ struct Model {
   template <typename Scalar>
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
     crazyflie21_all_effects::rhs(x, u, p, pre, f);
+  }
+  template <typename Scalar>
+  static void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                                Scalar* f) {
+    crazyflie21_all_effects::rotor_speed_rates(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

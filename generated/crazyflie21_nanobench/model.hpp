@@ -5,6 +5,7 @@
 // Operation counts (+ - * / and calls; integer powers as products):
 //   rhs(f only)           9909 as expression trees, 251 after CSE
 //   rhs(f + all Jacobians) 159064 as expression trees, 2074 after CSE
+//   rotor_speed_rates()   0 after CSE
 //   precompute()          699 for 284 parameter-only values
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
@@ -39,6 +40,10 @@ inline constexpr int kNumInputs = 4;
 inline constexpr int kNumParams = 22;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 284;
+// The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
+// their rows of f.
+inline constexpr int kNumRotorSpeedStates = 0;
+inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
 // file (FNV-1a of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "67d47c8cd4f4ace5";
@@ -1444,6 +1449,16 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   f[12] = (t20*pre.c[29] + t19*pre.c[31] + t17*pre.c[30])*pre.c[23];
 }
 
+// f's rows of the rotor speed states alone (kRotorSpeedStates; the other entries of f are
+// not written), equal to rhs()'s: for a caller that filters the commands through the motor
+// lag at every sample and needs nothing else of f.
+template <typename Scalar>
+inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                              Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre; (void)f;
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1479,6 +1494,8 @@ struct Model {
   static constexpr int kNumParams = crazyflie21_nanobench::kNumParams;
   static constexpr int kNumOutputs = crazyflie21_nanobench::kNumOutputs;
   static constexpr int kInputDelayParam = crazyflie21_nanobench::kInputDelayParam;
+  static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench::kNumRotorSpeedStates;
+  static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_nanobench::kDfdxNnz;
   static constexpr const int* kDfdxRow = crazyflie21_nanobench::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_nanobench::kDfdxCol;
@@ -1520,6 +1537,11 @@ struct Model {
   template <typename Scalar>
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
     crazyflie21_nanobench::rhs(x, u, p, pre, f);
+  }
+  template <typename Scalar>
+  static void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                                Scalar* f) {
+    crazyflie21_nanobench::rotor_speed_rates(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

@@ -5,6 +5,7 @@
 // Operation counts (+ - * / and calls; integer powers as products):
 //   rhs(f only)           22274 as expression trees, 327 after CSE
 //   rhs(f + all Jacobians) 503151 as expression trees, 3116 after CSE
+//   rotor_speed_rates()   40 after CSE
 //   precompute()          1041 for 421 parameter-only values
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
@@ -39,6 +40,10 @@ inline constexpr int kNumInputs = 6;
 inline constexpr int kNumParams = 45;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 421;
+// The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
+// their rows of f.
+inline constexpr int kNumRotorSpeedStates = 4;
+inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {13, 14, 15, 16};
 // What this header was generated from: a runtime may use it only for the same vehicle
 // file (FNV-1a of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "67d47c8cd4f4ace5";
@@ -2070,6 +2075,20 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   f[16] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[3])*(Scalar(2.5e+03)*u[3]))*p[8] - Scalar(2.5e+03)*x[16])*pre.c[55];
 }
 
+// f's rows of the rotor speed states alone (kRotorSpeedStates; the other entries of f are
+// not written), equal to rhs()'s: for a caller that filters the commands through the motor
+// lag at every sample and needs nothing else of f.
+template <typename Scalar>
+inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                              Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre; (void)f;
+  f[13] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[0])*(Scalar(2.5e+03)*u[0]))*p[8] - Scalar(2.5e+03)*x[13])*pre.c[50];
+  f[14] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[1])*(Scalar(2.5e+03)*u[1]))*p[8] - Scalar(2.5e+03)*x[14])*pre.c[53];
+  f[15] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[2])*(Scalar(2.5e+03)*u[2]))*p[8] - Scalar(2.5e+03)*x[15])*pre.c[54];
+  f[16] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[3])*(Scalar(2.5e+03)*u[3]))*p[8] - Scalar(2.5e+03)*x[16])*pre.c[55];
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -2137,6 +2156,8 @@ struct Model {
   static constexpr int kNumParams = crazyflie21_nanobench_all_effects::kNumParams;
   static constexpr int kNumOutputs = crazyflie21_nanobench_all_effects::kNumOutputs;
   static constexpr int kInputDelayParam = crazyflie21_nanobench_all_effects::kInputDelayParam;
+  static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench_all_effects::kNumRotorSpeedStates;
+  static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench_all_effects::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_nanobench_all_effects::kDfdxNnz;
   static constexpr const int* kDfdxRow = crazyflie21_nanobench_all_effects::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_nanobench_all_effects::kDfdxCol;
@@ -2178,6 +2199,11 @@ struct Model {
   template <typename Scalar>
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
     crazyflie21_nanobench_all_effects::rhs(x, u, p, pre, f);
+  }
+  template <typename Scalar>
+  static void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                                Scalar* f) {
+    crazyflie21_nanobench_all_effects::rotor_speed_rates(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,

@@ -5,6 +5,7 @@
 // Operation counts (+ - * / and calls; integer powers as products):
 //   rhs(f only)           6471 as expression trees, 237 after CSE
 //   rhs(f + all Jacobians) 102815 as expression trees, 1937 after CSE
+//   rotor_speed_rates()   0 after CSE
 //   precompute()          649 for 257 parameter-only values
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
@@ -39,6 +40,10 @@ inline constexpr int kNumInputs = 4;
 inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 257;
+// The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
+// their rows of f.
+inline constexpr int kNumRotorSpeedStates = 0;
+inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
 // file (FNV-1a of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "148d1c0475a7048a";
@@ -1358,6 +1363,16 @@ inline void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomp
   f[12] = -(t27*pre.c[29] + t24*pre.c[28] - t22*pre.c[27])*pre.c[21];
 }
 
+// f's rows of the rotor speed states alone (kRotorSpeedStates; the other entries of f are
+// not written), equal to rhs()'s: for a caller that filters the commands through the motor
+// lag at every sample and needs nothing else of f.
+template <typename Scalar>
+inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                              Scalar* f) {
+  using std::cos; using std::log; using std::pow; using std::sin;
+  (void)x; (void)u; (void)p; (void)pre; (void)f;
+}
+
 // What a flight log records: position and attitude quaternion, h(x, p).
 template <typename Scalar>
 inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h, Scalar* dhdx,
@@ -1393,6 +1408,8 @@ struct Model {
   static constexpr int kNumParams = finken3::kNumParams;
   static constexpr int kNumOutputs = finken3::kNumOutputs;
   static constexpr int kInputDelayParam = finken3::kInputDelayParam;
+  static constexpr int kNumRotorSpeedStates = finken3::kNumRotorSpeedStates;
+  static constexpr const int* kRotorSpeedStates = finken3::kRotorSpeedStates;
   static constexpr int kDfdxNnz = finken3::kDfdxNnz;
   static constexpr const int* kDfdxRow = finken3::kDfdxRow;
   static constexpr const int* kDfdxCol = finken3::kDfdxCol;
@@ -1434,6 +1451,11 @@ struct Model {
   template <typename Scalar>
   static void rhs(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* f) {
     finken3::rhs(x, u, p, pre, f);
+  }
+  template <typename Scalar>
+  static void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p, const Precomputed<Scalar>& pre,
+                                Scalar* f) {
+    finken3::rotor_speed_rates(x, u, p, pre, f);
   }
   template <typename Scalar>
   static void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scalar>& pre, Scalar* h,
