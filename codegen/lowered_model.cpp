@@ -49,10 +49,9 @@ LoweredModel lower_model(const SymbolicModel& m) {
   lm.plan = std::make_unique<LoweredPlan>(g, all);
   lm.precompute = lm.plan->precompute_function();
   lm.rhs_f = lm.plan->function({rhs[0]});
-  OutputGroup speeds;
-  for (size_t i : m.rotor_speed_states) speeds.outputs.push_back(rhs[0].outputs[i]);
-  lm.rotor_speed_rates = lm.plan->function({speeds});
   lm.rhs = lm.plan->function(rhs);
+  lm.rotor_speed_rates =
+      lm.plan->part_of(lm.rhs, 0, std::vector<int>(m.rotor_speed_states.begin(), m.rotor_speed_states.end()));
   lm.measurement = lm.plan->function(meas);
   return lm;
 }

@@ -1,7 +1,8 @@
 // A symbolic model lowered once for every back end: its canonical DAG, the one lowered
 // plan, and the five functions a model has (precompute, rhs for f only, the rotor speeds'
-// rates, rhs with its Jacobians, the measurement with its Jacobians). header_writer prints these; tape_builder
-// turns the same functions into the runtime's instructions.
+// rates, rhs with its Jacobians, the measurement with its Jacobians). header_writer prints
+// all five; tape_builder turns precompute, rhs and measurement into the runtime's
+// instructions (a tape prunes its rhs to f, or to a few rows, by itself).
 #pragma once
 #include <memory>
 #include <vector>
@@ -25,7 +26,7 @@ struct LoweredModel {
   SparsePattern dfdx, dfdu, dfdp, dhdx, dhdp;
   LoweredPlan::Function precompute;
   LoweredPlan::Function rhs_f;        // groups: f
-  LoweredPlan::Function rotor_speed_rates;  // groups: f's rows of the rotor speed states
+  LoweredPlan::Function rotor_speed_rates;  // rhs's steps for f's rotor-speed rows (part_of)
   LoweredPlan::Function rhs;          // groups: f, dfdx, dfdu, dfdp
   LoweredPlan::Function measurement;  // groups: h, dhdx, dhdp
 };

@@ -646,6 +646,46 @@ LoweredPlan::Function LoweredPlan::precompute_function() const {
   return fn;
 }
 
+LoweredPlan::Function LoweredPlan::part_of(const Function& full, int group, const std::vector<int>& outputs) const {
+  using StepKind = Function::StepKind;
+  if (!full.groups.at(group).guard.empty()) throw std::logic_error("LoweredPlan::part_of: a guarded group");
+  Function part;
+  part.uses = full.uses;
+  part.temp = full.temp;
+  part.num_temps = full.num_temps;
+  part.groups.push_back({"", {}});
+  // Every node the kept outputs read, inline or as a temporary.
+  std::vector<char> needed(ir_.size(), 0);
+  std::vector<int> stack;
+  for (int k : outputs) {
+    const Output& o = full.groups[group].outputs.at(k);
+    part.groups[0].outputs.push_back(o);
+    part.ops_before += g_.tree_ops(o.node);
+    stack.push_back(out_.at(o.node).id);
+  }
+  while (!stack.empty()) {
+    const int id = stack.back();
+    stack.pop_back();
+    if (needed[id]) continue;
+    needed[id] = 1;
+    if (ir_[id].kind == Kind::leaf || !inside(full, id)) continue;
+    for (int a : ir_[id].args) stack.push_back(a);
+  }
+  // full's steps in full's order: its definitions the kept outputs need and their
+  // assignments, renumbered into the part's one group.
+  for (const Function::Step& s : full.steps) {
+    if (s.kind == StepKind::define && needed[s.node]) part.steps.push_back(s);
+    if (s.kind != StepKind::assign || s.group != group) continue;
+    const auto kept = std::find(outputs.begin(), outputs.end(), s.output);
+    if (kept == outputs.end()) continue;
+    Function::Step step = s;
+    step.group = 0;
+    step.output = static_cast<int>(kept - outputs.begin());
+    part.steps.push_back(step);
+  }
+  return part;
+}
+
 LoweredPlan::Function LoweredPlan::function(const std::vector<OutputGroup>& groups) const {
   using StepKind = Function::StepKind;
   Function fn;

@@ -92,6 +92,12 @@ class LoweredPlan {
 
   Function precompute_function() const;
   Function function(const std::vector<OutputGroup>& groups) const;
+  // Outputs `outputs` of `full`'s unguarded group `group`, alone: `full`'s steps that they
+  // need, with `full`'s use counts and temporaries. Planned on its own (function()), a part
+  // would count its uses afresh, and a reciprocal or a negated sum that `full` names as a
+  // temporary could be written inline, in other operations; taken out of `full`, every value
+  // is computed exactly as `full` computes it.
+  Function part_of(const Function& full, int group, const std::vector<int>& outputs) const;
 
   // Rules both back ends follow to the letter, so that they compute the same operations:
   // the operands of a sum or product are written in the shared reading order

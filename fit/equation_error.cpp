@@ -262,8 +262,9 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   const size_t nr = speed_states_.size();
   std::vector<double> tau(ns * nr, 0.0);
   // The attitude bias is one pair of angles per flight: its rotation is recomputed only when
-  // their bits change (NaN: not yet computed; -0 and +0 kept apart, so results stay bit for bit).
-  double bias_roll = std::nan(""), bias_pitch = std::nan(""), conj_q_bias[4] = {1, 0, 0, 0};
+  // their bits change (-0 and +0 kept apart, so results stay bit for bit).
+  bool have_bias = false;
+  double bias_roll = 0, bias_pitch = 0, conj_q_bias[4] = {1, 0, 0, 0};
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
@@ -271,8 +272,9 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     double* x = &X[k * n];
     double* u = &U[k * nu];
     std::copy(s.x.begin(), s.x.end(), x);
-    if (std::memcmp(&e.roll, &bias_roll, sizeof(double)) != 0 || std::memcmp(&e.pitch, &bias_pitch, sizeof(double)) != 0) {
-      bias_roll = e.roll, bias_pitch = e.pitch;
+    if (!have_bias || std::memcmp(&e.roll, &bias_roll, sizeof(double)) != 0 ||
+        std::memcmp(&e.pitch, &bias_pitch, sizeof(double)) != 0) {
+      have_bias = true, bias_roll = e.roll, bias_pitch = e.pitch;
       runtime::attitude_bias_conjugate(bias_roll, bias_pitch, conj_q_bias);
     }
     runtime::quaternion_product(&s.x[kAttitude], conj_q_bias, x + kAttitude);

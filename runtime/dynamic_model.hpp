@@ -28,8 +28,8 @@ class DynamicModel {
   // f = dx/dt; A = df/dx (n x n), B = df/dp (n x np), Bu = df/du (n x nu), all dense
   // row-major; any of A, B, Bu may be nullptr.
   virtual void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const = 0;
-  // f[i] for the rows i in `rows` only (the other entries of f unwritten), equal to rhs()'s
-  // bit for bit. For a caller that needs a few rates at every sample (the rotor speeds'
+  // f[i] for the rows i in `rows` only (each in 0..num_states()-1; the other entries of f
+  // unwritten), equal to rhs()'s bit for bit. For a caller that needs a few rates at every sample (the rotor speeds'
   // commanded values): a TapeModel then runs only the instructions those rows need.
   virtual void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const;
   // What a flight log records, h(x, p) (the generated measurement function): position, and

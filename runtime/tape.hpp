@@ -88,9 +88,10 @@ class TapeModel : public DynamicModel {
   std::shared_ptr<const Tape> tape_;
   std::shared_ptr<const Programs> programs_;
   std::vector<double> p_;
-  mutable std::vector<double> reg_;  // scratch of rhs() and measurement()
-  // rhs_rows(): the rows of the last call and the value program pruned to them (a cache:
-  // callers ask for the same rows at every sample).
+  mutable std::vector<double> reg_;  // scratch of rhs(), rhs_rows() and measurement()
+  // rhs_rows(): the rows of the last call and the value program pruned to them (a cache of
+  // one: the one caller asks for the same rows at every sample; callers alternating two sets
+  // on one instance would rebuild it at every call).
   mutable std::vector<int> rows_asked_;
   mutable std::shared_ptr<const TapeFunction> rows_program_;
 };

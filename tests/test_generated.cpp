@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -221,6 +222,67 @@ TEST(Generated, FOnlyEntryPointGivesTheSameF) {
       double dx[m::kDfdxNnz], du[m::kDfduNnz], dp[m::kDfdpNnz];
       check_f_only(pt.x, pt.u, pre, pt.p, m::kNumStates,
                    [&](auto... a) { m::rhs(a..., dx, du, dp); }, [](auto... a) { m::rhs(a...); });
+    }
+  }
+}
+
+// rotor_speed_rates() is rhs()'s rotor-speed rows bit for bit, on every header with the
+// motor lag (distinct rotor speeds, so a row reading another rotor's state shows), and its
+// kRotorSpeedStates are the w_<rotor> states in rotor order.
+template <class Traits, class Model>
+void check_rotor_speed_rates(std::mt19937& rng) {
+  ASSERT_EQ(Model::kNumRotorSpeedStates, 4);
+  for (int i = 0; i < Model::kNumRotorSpeedStates; ++i)
+    EXPECT_EQ(std::string(Model::kStateNames[Model::kRotorSpeedStates[i]]).substr(0, 2), "w_");
+  for (int t = 0; t < 20; ++t) {
+    auto pt = random_point<Traits>(rng);
+    typename Model::template Precomputed<double> pre;
+    Model::precompute(pt.p, &pre);
+    double full[Model::kNumStates], dx[Model::kDfdxNnz], du[Model::kDfduNnz], dp[Model::kDfdpNnz];
+    double rows[Model::kNumStates];
+    std::fill(rows, rows + Model::kNumStates, -7.5);
+    Model::rotor_speed_rates(pt.x, pt.u, pt.p, pre, rows);
+    Model::rhs(pt.x, pt.u, pt.p, pre, full, dx, du, dp);
+    for (int i = 0; i < Model::kNumStates; ++i) {
+      const bool speed = std::find(Model::kRotorSpeedStates, Model::kRotorSpeedStates + 4, i) != Model::kRotorSpeedStates + 4;
+      if (speed)
+        EXPECT_EQ(std::memcmp(&rows[i], &full[i], sizeof(double)), 0) << Model::kStateNames[i];
+      else
+        EXPECT_EQ(rows[i], -7.5) << Model::kStateNames[i] << " written";
+    }
+  }
+}
+TEST(Generated, RotorSpeedRatesAreTheRotorSpeedRowsOfRhsBitForBit) {
+  std::mt19937 rng(13);
+  check_rotor_speed_rates<finken3_all_effects_traits, gen::finken3_all_effects::Model>(rng);
+  check_rotor_speed_rates<crazyflie21_all_effects_traits, gen::crazyflie21_all_effects::Model>(rng);
+  check_rotor_speed_rates<crazyflie21_nanobench_all_effects_traits, gen::crazyflie21_nanobench_all_effects::Model>(rng);
+  EXPECT_EQ(gen::finken3::kNumRotorSpeedStates, 0);  // no motor lag, no rotor-speed states
+}
+
+// Why they are equal by construction: rotor_speed_rates() is taken out of rhs()'s plan
+// (LoweredPlan::part_of), so each of its lines is one of rhs()'s, in rhs()'s order. A part
+// planned on its own could write a shared reciprocal as a division, in other operations.
+TEST(Generated, RotorSpeedRatesAreLinesOfRhsInItsOrder) {
+  for (const char* name : {"finken3_all_effects", "crazyflie21_all_effects", "crazyflie21_nanobench_all_effects"}) {
+    const std::string h = read(fs::path(QUADGEN_SOURCE_DIR) / "generated" / name / "model.hpp");
+    auto body = [&](const std::string& signature_start) {
+      const size_t at = h.find(signature_start);
+      const size_t open = h.find("(void)", at), close = h.find("\n}\n", open);
+      EXPECT_NE(at, std::string::npos) << name << ": " << signature_start;
+      std::vector<std::string> lines;
+      std::istringstream in(h.substr(h.find('\n', open) + 1, close - h.find('\n', open)));
+      for (std::string line; std::getline(in, line);)
+        if (!line.empty()) lines.push_back(line);
+      return lines;
+    };
+    const std::vector<std::string> part = body("inline void rotor_speed_rates("), rhs = body("inline void rhs(");
+    ASSERT_FALSE(part.empty()) << name;
+    size_t from = 0;
+    for (const std::string& line : part) {
+      const auto it = std::find(rhs.begin() + static_cast<long>(from), rhs.end(), line);
+      ASSERT_NE(it, rhs.end()) << name << ": not a line of rhs() after the previous one: " << line;
+      from = static_cast<size_t>(it - rhs.begin()) + 1;
     }
   }
 }

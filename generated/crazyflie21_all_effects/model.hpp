@@ -2044,10 +2044,14 @@ inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p,
                               Scalar* f) {
   using std::cos; using std::log; using std::pow; using std::sin;
   (void)x; (void)u; (void)p; (void)pre; (void)f;
-  f[13] = -(x[13] - p[5] - (p[6] + p[7]*u[0])*u[0])*pre.c[50];
-  f[14] = -(x[14] - p[5] - (p[6] + p[7]*u[1])*u[1])*pre.c[51];
-  f[15] = -(x[15] - p[5] - (p[6] + p[7]*u[2])*u[2])*pre.c[52];
-  f[16] = -(x[16] - p[5] - (p[6] + p[7]*u[3])*u[3])*pre.c[53];
+  const Scalar t97 = x[13] - p[5] - (p[6] + p[7]*u[0])*u[0];
+  f[13] = -t97*pre.c[50];
+  const Scalar t98 = x[14] - p[5] - (p[6] + p[7]*u[1])*u[1];
+  f[14] = -t98*pre.c[51];
+  const Scalar t99 = x[15] - p[5] - (p[6] + p[7]*u[2])*u[2];
+  f[15] = -t99*pre.c[52];
+  const Scalar t100 = x[16] - p[5] - (p[6] + p[7]*u[3])*u[3];
+  f[16] = -t100*pre.c[53];
 }
 
 // What a flight log records: position and attitude quaternion, h(x, p).

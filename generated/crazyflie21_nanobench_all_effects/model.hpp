@@ -2083,10 +2083,22 @@ inline void rotor_speed_rates(const Scalar* x, const Scalar* u, const Scalar* p,
                               Scalar* f) {
   using std::cos; using std::log; using std::pow; using std::sin;
   (void)x; (void)u; (void)p; (void)pre; (void)f;
-  f[13] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[0])*(Scalar(2.5e+03)*u[0]))*p[8] - Scalar(2.5e+03)*x[13])*pre.c[50];
-  f[14] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[1])*(Scalar(2.5e+03)*u[1]))*p[8] - Scalar(2.5e+03)*x[14])*pre.c[53];
-  f[15] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[2])*(Scalar(2.5e+03)*u[2]))*p[8] - Scalar(2.5e+03)*x[15])*pre.c[54];
-  f[16] = (pre.c[51] - (pre.c[52] - (p[6] + p[7]*u[3])*(Scalar(2.5e+03)*u[3]))*p[8] - Scalar(2.5e+03)*x[16])*pre.c[55];
+  const Scalar t97 = Scalar(2.5e+03)*u[0];
+  const Scalar t98 = pre.c[52] - (p[6] + p[7]*u[0])*t97;
+  const Scalar t99 = pre.c[51] - t98*p[8] - Scalar(2.5e+03)*x[13];
+  f[13] = t99*pre.c[50];
+  const Scalar t100 = Scalar(2.5e+03)*u[1];
+  const Scalar t101 = pre.c[52] - (p[6] + p[7]*u[1])*t100;
+  const Scalar t102 = pre.c[51] - t101*p[8] - Scalar(2.5e+03)*x[14];
+  f[14] = t102*pre.c[53];
+  const Scalar t103 = Scalar(2.5e+03)*u[2];
+  const Scalar t104 = pre.c[52] - (p[6] + p[7]*u[2])*t103;
+  const Scalar t105 = pre.c[51] - t104*p[8] - Scalar(2.5e+03)*x[15];
+  f[15] = t105*pre.c[54];
+  const Scalar t106 = Scalar(2.5e+03)*u[3];
+  const Scalar t107 = pre.c[52] - (p[6] + p[7]*u[3])*t106;
+  const Scalar t108 = pre.c[51] - t107*p[8] - Scalar(2.5e+03)*x[16];
+  f[16] = t108*pre.c[55];
 }
 
 // What a flight log records: position and attitude quaternion, h(x, p).
