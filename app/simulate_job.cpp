@@ -166,7 +166,7 @@ void start_rotor_speeds(const OpenLoop& k, const InputFunction& inputs, std::vec
   std::vector<double> u0(k.m.num_inputs());
   inputs(0.0, u0.data());
   for (size_t i = 0; i < k.rotors.size(); ++i) {
-    const int w = k.m.state_index("w_" + k.rotors[i]);
+    const int w = runtime::rotor_speed_state(k.m, i);
     if (w >= 0) x0[w] = k.laws[i].speed_at(u0[i]);
   }
 }
@@ -216,7 +216,7 @@ std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, cons
   std::vector<double> ub(k.m.num_inputs());
   for (size_t r = 0; r < k.rotors.size(); ++r) {
     Series s{"F_" + k.rotors[r], tr.t, {}};
-    const int w = k.m.state_index("w_" + k.rotors[r]);
+    const int w = runtime::rotor_speed_state(k.m, r);
     for (size_t i = 0; i < tr.t.size(); ++i) {
       inputs(tr.t[i], ub.data());
       const double speed = w >= 0 ? tr.x[i][w] : k.laws[r].speed_at(ub[r]);

@@ -107,9 +107,7 @@ void rotor_speed_rates(benchmark::State& st, bool compiled, bool rows_only) {
   const auto m = crazyflie_all_effects(compiled);
   const int n = m->num_states(), nu = m->num_inputs();
   std::vector<double> x = moving_state(*m), u(nu, 0.5), f(n);
-  std::vector<int> speeds;
-  for (int i = 0; i < n; ++i)
-    if (m->state_names()[i].rfind("w_", 0) == 0) speeds.push_back(i);
+  const std::vector<int>& speeds = m->rotor_speed_states();
   for (auto _ : st) {
     if (rows_only)
       m->rhs_rows(x.data(), u.data(), speeds, f.data());

@@ -178,6 +178,7 @@ runtime::Tape build_tape(const SymbolicModel& m) {
     t.param_fit.push_back(v.fit ? 1 : 0);
   }
   t.input_delay_param = m.input_delay_param ? static_cast<int>(*m.input_delay_param) : -1;
+  t.rotor_speed_states.assign(m.rotor_speed_states.begin(), m.rotor_speed_states.end());
 
   const LoweredModel lm = lower_model(m);
   Registers regs{t, t.nx + t.nu + t.np, {}, std::vector<int>(lm.plan->precompute_count(), -1)};

@@ -28,11 +28,12 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
     if (c < 0) throw FitError("unknown residual channel '" + u + "'");
     used_.push_back(c);
   }
+  speed_states_ = model.rotor_speed_states();
   for (int i = kNumStates; i < model.num_states(); ++i) {
-    const std::string& s = model.state_names()[i];
-    if (data_side_.tau < 0 || s.rfind("w_", 0) != 0)
-      throw FitError("equation error needs every state measured or filtered from the commands; this model has state " + s);
-    speed_states_.push_back(i);
+    const bool filtered = std::find(speed_states_.begin(), speed_states_.end(), i) != speed_states_.end();
+    if (data_side_.tau < 0 || !filtered)
+      throw FitError("equation error needs every state measured or filtered from the commands; this model has state " +
+                     model.state_names()[i]);
   }
   if (!flight_.samples.empty() && speed_states_.size() > flight_.samples.front().u.size())
     throw FitError("more rotor-speed states than logged commands");
@@ -189,7 +190,10 @@ void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, co
   if (used_.size() == 6) return evaluate6(p, r, J, free);
   const int np = model_->num_params();
   const size_t ns = rows_.size();
-  std::vector<double> r6(ns * 6), J6(J ? ns * 6 * np : 0);
+  std::vector<double>& r6 = scratch_.r6;
+  std::vector<double>& J6 = scratch_.J6;
+  r6.assign(ns * 6, 0.0);
+  J6.assign(J ? ns * 6 * np : 0, 0.0);
   evaluate6(p, r6.data(), J ? J6.data() : nullptr, free);
   const size_t nu = used_.size();
   for (size_t k = 0; k < ns; ++k)
@@ -260,7 +264,8 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // The data-side values in effect at each sample (one per flight in a per-flight model);
   // each rotor's lag is kept for the rotor-speed filter below.
   const size_t nr = speed_states_.size();
-  std::vector<double> tau(ns * nr, 0.0);
+  std::vector<double>& tau = scratch_.tau;
+  tau.assign(ns * nr, 0.0);
   // The attitude bias is one pair of angles per flight: its rotation is recomputed only when
   // their bits change (-0 and +0 kept apart, so results stay bit for bit).
   bool have_bias = false;
@@ -431,9 +436,9 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
                                    const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params();
   model_->set_params(std::vector<double>(p, p + np));
-  std::vector<double> X, U;
+  std::vector<double>&X = scratch_.X, &U = scratch_.U;
   prepare(p, X, U, span);
-  std::vector<double> F, Bm;
+  std::vector<double>&F = scratch_.F, &Bm = scratch_.Bm;
   if (derivatives_ == Derivatives::kFiltered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
   const Evaluation e{p, X, U, F, Bm, columns, J != nullptr};
   const auto rows = rows_in(span);  // not a structured binding: C++17 lambdas cannot capture one

@@ -315,7 +315,7 @@ std::vector<double> initial_state(const DynamicModel& truth, const ControllerMod
   for (int a = 0; a < 3; ++a) x[kPosition + a] = r0.axis[a][0];
   x[kAttitude] = 1;
   for (size_t i = 0; i < rotors.size(); ++i) {
-    const int w = truth.state_index("w_" + rotors[i]);
+    const int w = rotor_speed_state(truth, i);
     if (w >= 0) x[w] = b.thrust_laws[i].speed_at(hover_u);
   }
   return x;

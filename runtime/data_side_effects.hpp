@@ -32,7 +32,8 @@ struct DataSideEffects {
 struct DataSideParams {
   int delay = -1, roll = -1, pitch = -1, tau = -1;
 
-  // motor_lag_spread.<rotor> of each rotor-speed state w_<rotor>, in state order (-1: none).
+  // motor_lag_spread.<rotor> of each rotor-speed state w_<rotor>, in the order of
+  // DynamicModel::rotor_speed_states() (-1: none).
   std::vector<int> lag_spread;
 
   explicit DataSideParams(const DynamicModel& model)
@@ -40,8 +41,8 @@ struct DataSideParams {
         roll(model.param_index("attitude_bias.roll")),
         pitch(model.param_index("attitude_bias.pitch")),
         tau(model.param_index("motor_lag.tau")) {
-    for (const std::string& state : model.state_names())
-      if (state.rfind("w_", 0) == 0) lag_spread.push_back(model.param_index("motor_lag_spread." + state.substr(2)));
+    for (int s : model.rotor_speed_states())
+      lag_spread.push_back(model.param_index("motor_lag_spread." + model.state_names()[s].substr(2)));
   }
 
   std::array<int, 4> indices() const { return {delay, roll, pitch, tau}; }

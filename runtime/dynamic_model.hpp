@@ -32,6 +32,11 @@ class DynamicModel {
   // unwritten), equal to rhs()'s bit for bit. For a caller that needs a few rates at every sample (the rotor speeds'
   // commanded values): a TapeModel then runs only the instructions those rows need.
   virtual void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const;
+  // The rotor-speed states (motor_lag's w_<rotor>), in rotor order; empty without a motor lag.
+  // Where the model is derived they are the rotors' speed symbols among the states
+  // (SymbolicModel::rotor_speed_states); every runtime user takes them from here, so the
+  // rows the equation error filters are the ones the header's rotor_speed_rates() computes.
+  virtual const std::vector<int>& rotor_speed_states() const = 0;
   // What a flight log records, h(x, p) (the generated measurement function): position, and
   // the attitude quaternion as the autopilot logs it (q ⊗ q_bias under attitude_bias). H =
   // dh/dx (num_outputs x n) and Hp = dh/dp (num_outputs x np), dense row-major, from the
@@ -73,6 +78,11 @@ inline void DynamicModel::rhs_rows(const double* x, const double* u, const std::
   for (int i : rows) f[i] = all[i];
 }
 inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
+// Rotor i's speed state (rotors in the vehicle's order), or -1 without a motor lag.
+inline int rotor_speed_state(const DynamicModel& m, size_t i) {
+  const std::vector<int>& s = m.rotor_speed_states();
+  return i < s.size() ? s[i] : -1;
+}
 inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
 inline int DynamicModel::param_index(const std::string& n) const { return index_in(param_names(), n); }
 
@@ -93,6 +103,7 @@ class CompiledModel : public DynamicModel {
  public:
   CompiledModel() : p_(M::kNominalParams, M::kNominalParams + M::kNumParams) {
     for (int i = 0; i < M::kNumStates; ++i) states_.push_back(M::kStateNames[i]);
+    speed_states_.assign(M::kRotorSpeedStates, M::kRotorSpeedStates + M::kNumRotorSpeedStates);
     for (int i = 0; i < M::kNumInputs; ++i) inputs_.push_back(M::kInputNames[i]);
     for (int i = 0; i < M::kNumParams; ++i) param_names_.push_back(M::kParamNames[i]);
     M::precompute(p_.data(), &pre_);
@@ -101,6 +112,7 @@ class CompiledModel : public DynamicModel {
   int num_inputs() const override { return M::kNumInputs; }
   int num_params() const override { return M::kNumParams; }
   const std::vector<std::string>& state_names() const override { return states_; }
+  const std::vector<int>& rotor_speed_states() const override { return speed_states_; }
   const std::vector<std::string>& input_names() const override { return inputs_; }
   const std::vector<std::string>& param_names() const override { return param_names_; }
   const std::vector<double>& params() const override { return p_; }
@@ -118,8 +130,7 @@ class CompiledModel : public DynamicModel {
   }
   // The rotor speeds' rows have a generated function of their own; other rows take rhs().
   void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override {
-    if (M::kNumRotorSpeedStates > 0 && rows.size() == static_cast<size_t>(M::kNumRotorSpeedStates) &&
-        std::equal(rows.begin(), rows.end(), M::kRotorSpeedStates))
+    if (!speed_states_.empty() && rows == speed_states_)
       return M::rotor_speed_rates(x, u, p_.data(), pre_, f);
     DynamicModel::rhs_rows(x, u, rows, f);
   }
@@ -148,6 +159,7 @@ class CompiledModel : public DynamicModel {
   std::vector<double> p_;
   typename M::template Precomputed<double> pre_;
   std::vector<std::string> states_, inputs_, param_names_;
+  std::vector<int> speed_states_;
 };
 
 // The indices of the true entries of a free-parameter mask (empty mask: none, which

@@ -58,6 +58,7 @@ class PerFlightModel : public DynamicModel {
   int num_outputs() const override { return flights_[0]->num_outputs(); }
   void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
   int input_delay_param() const override { return flights_[0]->input_delay_param(); }  // flight 1's copy
+  const std::vector<int>& rotor_speed_states() const override { return flights_[0]->rotor_speed_states(); }
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<PerFlightModel>(*this); }
   int param_column(int index, double t) const override;
 

@@ -9,24 +9,33 @@ namespace quadgen::runtime {
 
 namespace {
 
-void run(const std::vector<Instruction>& code, double* r) {
-  for (const Instruction& in : code) {
-    const double a = r[in.a];
-    double v = 0;
-    switch (in.op) {
-      case TapeOp::add: v = a + r[in.b]; break;
-      case TapeOp::sub: v = a - r[in.b]; break;
-      case TapeOp::mul: v = a * r[in.b]; break;
-      case TapeOp::div: v = a / r[in.b]; break;
-      case TapeOp::neg: v = -a; break;
-      case TapeOp::pow: v = std::pow(a, r[in.b]); break;
-      case TapeOp::sin: v = std::sin(a); break;
-      case TapeOp::cos: v = std::cos(a); break;
-      case TapeOp::log: v = std::log(a); break;
-      case TapeOp::abs: v = a < 0 ? -a : a; break;
-      case TapeOp::sign: v = a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); break;
+// One run: n instructions of the same operation, a loop without a branch per instruction.
+template <class Op>
+void binary_run(const Instruction* in, uint32_t n, double* r, Op op) {
+  for (uint32_t i = 0; i < n; ++i) r[in[i].dst] = op(r[in[i].a], r[in[i].b]);
+}
+template <class Op>
+void unary_run(const Instruction* in, uint32_t n, double* r, Op op) {
+  for (uint32_t i = 0; i < n; ++i) r[in[i].dst] = op(r[in[i].a]);
+}
+
+void run(const TapeFunction& fn, double* r) {
+  const Instruction* in = fn.code.data();
+  for (const OpRun& g : fn.runs) {
+    switch (g.op) {
+      case TapeOp::add: binary_run(in, g.count, r, [](double a, double b) { return a + b; }); break;
+      case TapeOp::sub: binary_run(in, g.count, r, [](double a, double b) { return a - b; }); break;
+      case TapeOp::mul: binary_run(in, g.count, r, [](double a, double b) { return a * b; }); break;
+      case TapeOp::div: binary_run(in, g.count, r, [](double a, double b) { return a / b; }); break;
+      case TapeOp::pow: binary_run(in, g.count, r, [](double a, double b) { return std::pow(a, b); }); break;
+      case TapeOp::neg: unary_run(in, g.count, r, [](double a) { return -a; }); break;
+      case TapeOp::sin: unary_run(in, g.count, r, [](double a) { return std::sin(a); }); break;
+      case TapeOp::cos: unary_run(in, g.count, r, [](double a) { return std::cos(a); }); break;
+      case TapeOp::log: unary_run(in, g.count, r, [](double a) { return std::log(a); }); break;
+      case TapeOp::abs: unary_run(in, g.count, r, [](double a) { return a < 0 ? -a : a; }); break;
+      case TapeOp::sign: unary_run(in, g.count, r, [](double a) { return a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); }); break;
     }
-    r[in.dst] = v;
+    in += g.count;
   }
 }
 
@@ -81,14 +90,44 @@ TapeFunction pruned(const TapeFunction& fn, unsigned mask, int restricted, const
     if (is_binary(it->op)) live[it->b] = 1;
   }
   out.code.assign(kept.rbegin(), kept.rend());
+  schedule_by_level(out, num_registers);
   return out;
 }
 
 }  // namespace
 
+void schedule_by_level(TapeFunction& fn, int num_registers) {
+  std::vector<int> level_of_register(num_registers, 0), level(fn.code.size());
+  for (size_t k = 0; k < fn.code.size(); ++k) {
+    const Instruction& in = fn.code[k];
+    int l = level_of_register[in.a];
+    if (is_binary(in.op)) l = std::max(l, level_of_register[in.b]);
+    level[k] = level_of_register[in.dst] = l + 1;
+  }
+  std::vector<size_t> order(fn.code.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) {
+    return level[i] != level[j] ? level[i] < level[j] : fn.code[i].op < fn.code[j].op;
+  });
+  std::vector<Instruction> code;
+  code.reserve(order.size());
+  fn.runs.clear();
+  for (size_t k : order) {  // a run may continue into the next level: it executes in order
+    const Instruction& in = fn.code[k];
+    if (fn.runs.empty() || fn.runs.back().op != in.op) fn.runs.push_back({in.op, 0});
+    ++fn.runs.back().count;
+    code.push_back(in);
+  }
+  fn.code = std::move(code);
+}
+
 TapeModel::TapeModel(Tape t)
     : tape_(std::make_shared<const Tape>(std::move(t))), reg_(tape_->num_registers, 0.0) {
   for (const auto& [r, v] : tape_->constants) reg_[r] = v;
+  auto precompute = std::make_shared<TapeFunction>();
+  precompute->code = tape_->precompute;
+  schedule_by_level(*precompute, tape_->num_registers);
+  precompute_ = precompute;
   programs_ = programs_for(*tape_, {}, nullptr);
   set_params(tape_->nominal);
 }
@@ -120,7 +159,7 @@ void TapeModel::restrict_param_jacobian(const std::vector<int>& columns) {
 void TapeModel::set_params(const std::vector<double>& p) {
   p_ = p;
   for (int i = 0; i < tape_->np; ++i) reg_[tape_->p_reg(i)] = p[i];
-  run(tape_->precompute, reg_.data());
+  run(*precompute_, reg_.data());
 }
 
 std::vector<Parameter> TapeModel::parameters() const {
@@ -135,7 +174,7 @@ void TapeModel::measurement(const double* x, double /*t*/, double* h, double* H,
   double* r = reg_.data();
   for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
   const TapeFunction& fn = programs_->measurement_for[request({{H, kDhdxGroup}, {Hp, kDhdpGroup}})];
-  run(fn.code, r);
+  run(fn, r);
   for (int i = 0; i < tape_->ny; ++i) h[i] = r[fn.groups[0].reg[i]];
   if (H) scatter(H, tape_->ny, tape_->nx, fn.groups[kDhdxGroup], r);
   if (Hp) scatter(Hp, tape_->ny, tape_->np, fn.groups[kDhdpGroup], r);
@@ -146,7 +185,7 @@ void TapeModel::rhs(const double* x, const double* u, double* f, double* A, doub
   for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
   for (int i = 0; i < tape_->nu; ++i) r[tape_->u_reg(i)] = u[i];
   const TapeFunction& fn = programs_->rhs_for[request({{A, kDfdxGroup}, {Bu, kDfduGroup}, {B, kDfdpGroup}})];
-  run(fn.code, r);
+  run(fn, r);
   for (int i = 0; i < tape_->nx; ++i) f[i] = r[fn.groups[0].reg[i]];
   if (A) scatter(A, tape_->nx, tape_->nx, fn.groups[kDfdxGroup], r);
   if (Bu) scatter(Bu, tape_->nx, tape_->nu, fn.groups[kDfduGroup], r);
@@ -156,7 +195,7 @@ void TapeModel::rhs(const double* x, const double* u, double* f, double* A, doub
 void TapeModel::rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const {
   if (!rows_program_ || rows != rows_asked_) {
     const TapeFunction& value = programs_->rhs_for[0];  // f alone
-    TapeFunction wanted{value.code, {SparseOutputs{}}};
+    TapeFunction wanted{value.code, {SparseOutputs{}}, {}};
     const SparseOutputs& all = value.groups[0];
     SparseOutputs& kept = wanted.groups[0];
     for (size_t k = 0; k < all.reg.size(); ++k) {
@@ -171,7 +210,7 @@ void TapeModel::rhs_rows(const double* x, const double* u, const std::vector<int
   double* r = reg_.data();
   for (int i = 0; i < tape_->nx; ++i) r[tape_->x_reg(i)] = x[i];
   for (int i = 0; i < tape_->nu; ++i) r[tape_->u_reg(i)] = u[i];
-  run(rows_program_->code, r);
+  run(*rows_program_, r);
   const SparseOutputs& out = rows_program_->groups[0];
   for (size_t k = 0; k < out.reg.size(); ++k) f[out.row[k]] = r[out.reg[k]];
 }

@@ -25,13 +25,31 @@ struct SparseOutputs {
   std::vector<int> row, col, reg;
 };
 
+// `count` consecutive instructions of one operation.
+struct OpRun {
+  TapeOp op;
+  uint32_t count;
+};
+
 // One function of the header (rhs or measurement) as instructions. Group 0 is the value
 // (f, or h; col 0), then its Jacobians in the header's sparse layout: rhs: dfdx, dfdu,
 // dfdp; measurement: dhdx, dhdp. Every register is written once.
+//
+// As lowered, the code is in the header's order. The model runs it scheduled
+// (schedule_by_level): ordered by dependency level, each level's instructions grouped by
+// operation into `runs`, so the interpreter dispatches once per run rather than once per
+// instruction. Each instruction still applies the same operation to the same operands, so
+// the results are the header's bit for bit; only independent instructions change places.
 struct TapeFunction {
   std::vector<Instruction> code;
   std::vector<SparseOutputs> groups;
+  std::vector<OpRun> runs;  // empty until scheduled
 };
+
+// Reorders `fn.code` by dependency level (an instruction's level is one more than its
+// operands' highest; x, u, p and constants are level 0), then by operation within a level,
+// keeping the lowered order otherwise, and sets `fn.runs`.
+void schedule_by_level(TapeFunction& fn, int num_registers);
 
 struct Tape {
   int nx = 0, nu = 0, np = 0, ny = 0;
@@ -45,6 +63,7 @@ struct Tape {
   std::vector<double> param_lower, param_upper;
   std::vector<char> param_fit;
   int input_delay_param = -1;
+  std::vector<int> rotor_speed_states;  // DynamicModel::rotor_speed_states()
   // Registers 0..nx-1 are x, then u, then p, then constants and nodes.
   int x_reg(int i) const { return i; }
   int u_reg(int i) const { return nx + i; }
@@ -70,6 +89,7 @@ class TapeModel : public DynamicModel {
   int num_outputs() const override { return tape_->ny; }
   void measurement(const double* x, double t, double* h, double* H, double* Hp) const override;
   int input_delay_param() const override { return tape_->input_delay_param; }
+  const std::vector<int>& rotor_speed_states() const override { return tape_->rotor_speed_states; }
 
  private:
   // The functions pruned (backward liveness) to the outputs asked for, one per combination
@@ -86,6 +106,7 @@ class TapeModel : public DynamicModel {
 
   // Immutable, so shared by clones: a clone costs its registers and parameters only.
   std::shared_ptr<const Tape> tape_;
+  std::shared_ptr<const TapeFunction> precompute_;  // tape_->precompute, scheduled
   std::shared_ptr<const Programs> programs_;
   std::vector<double> p_;
   mutable std::vector<double> reg_;  // scratch of rhs(), rhs_rows() and measurement()

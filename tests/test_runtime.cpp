@@ -152,8 +152,7 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
   p.push_back(0.05);  // motor_lag.tau@2
   joint.set_params(p);
   const int n = tape.num_states(), nu = tape.num_inputs();
-  const std::vector<int> speeds = {tape.state_index("w_A"), tape.state_index("w_B"), tape.state_index("w_C"),
-                                   tape.state_index("w_D")};
+  const std::vector<int> speeds = tape.rotor_speed_states();
   using M = quadgen_generated::finken3_all_effects::Model;
   ASSERT_EQ(speeds, std::vector<int>(M::kRotorSpeedStates, M::kRotorSpeedStates + M::kNumRotorSpeedStates))
       << "the compiled model's generated path would not be taken";
@@ -187,6 +186,24 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
     }
     if (!tape_copy) tape_copy = tape.clone();  // its cache holds the speed rows; asked next for others
   }
+}
+
+// One definition of the rotor-speed states for every model kind: the derivation's (through
+// the tape), the header's kRotorSpeedStates, a joint model's; the w_<rotor> states in rotor
+// order under motor_lag, none without it. The equation error filters exactly these rows.
+TEST(Runtime, EveryModelKindNamesTheSameRotorSpeedStates) {
+  TapeModel tape = finken3_tape(parse_effect_list("all"));
+  CompiledModel<quadgen_generated::finken3_all_effects::Model> compiled;
+  PerFlightModel joint(tape, {10.0}, {"motor_lag.tau"});
+  std::vector<int> w;
+  for (const char* rotor : {"A", "B", "C", "D"}) w.push_back(tape.state_index(std::string("w_") + rotor));
+  ASSERT_EQ(std::count(w.begin(), w.end(), -1), 0);
+  EXPECT_EQ(tape.rotor_speed_states(), w);
+  EXPECT_EQ(compiled.rotor_speed_states(), w);
+  EXPECT_EQ(joint.rotor_speed_states(), w);
+  EXPECT_EQ(tape.clone()->rotor_speed_states(), w);
+  EXPECT_TRUE(finken3_tape({}).rotor_speed_states().empty());
+  EXPECT_TRUE(CompiledModel<quadgen_generated::finken3::Model>().rotor_speed_states().empty());
 }
 
 // The generated measurement h(x, p) through DynamicModel: compiled and interpreted agree,
