@@ -291,8 +291,8 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // Rotor speeds: the commanded speed (the model's dw/dt at w = 0, times tau) through the
   // first-order lag, started in steady state; the commands are held between samples, for
   // which the discretisation is exact. The mean over each interval (what its mid-interval
-  // acceleration sees) goes to mean_speed_; as tau -> 0 it is the held command's speed.
-  mean_speed_.assign(ns * nr, 0.0);
+  // acceleration sees) goes to scratch_.mean_speed; as tau -> 0 it is the held command's speed.
+  scratch_.mean_speed.assign(ns * nr, 0.0);
   std::vector<double> f(n), c(nr), w_now(nr);
   for (size_t k = span.lo; k < span.hi; ++k) {
     double* x = &X[k * n];
@@ -308,7 +308,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
         const double t_i = tau[k * nr + i], a = h > 700 * t_i ? 0.0 : std::exp(-h / t_i);
         const double w0 = X[(k - 1) * n + speed_states_[i]];
         x[speed_states_[i]] = a * w0 + (1 - a) * c[i];
-        mean_speed_[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * t_i / h * (1 - a);
+        scratch_.mean_speed[(k - 1) * nr + i] = c[i] + (w0 - c[i]) * t_i / h * (1 - a);
       }
     }
     // dw/dt = (w_cmd - w) / tau, so at w = 0 it gives the commanded speed.
@@ -402,7 +402,7 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
       if (!interval_ok_[k]) continue;
       for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
       runtime::normalize_quaternion(&xm[kAttitude]);
-      for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = mean_speed_[k * speed_states_.size() + i];
+      for (size_t i = 0; i < speed_states_.size(); ++i) xm[speed_states_[i]] = scratch_.mean_speed[k * speed_states_.size() + i];
       std::copy(&U[k * nu], &U[k * nu] + nu, um.begin());
       if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
       if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
@@ -436,9 +436,11 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
                                    const std::vector<int>& columns) const {
   const int n = model_->num_states(), np = model_->num_params();
   model_->set_params(std::vector<double>(p, p + np));
-  std::vector<double>&X = scratch_.X, &U = scratch_.U;
+  std::vector<double>& X = scratch_.X;
+  std::vector<double>& U = scratch_.U;
   prepare(p, X, U, span);
-  std::vector<double>&F = scratch_.F, &Bm = scratch_.Bm;
+  std::vector<double>& F = scratch_.F;
+  std::vector<double>& Bm = scratch_.Bm;
   if (derivatives_ == Derivatives::kFiltered) interval_accelerations(p, X, U, F, J ? &Bm : nullptr, span, columns);
   const Evaluation e{p, X, U, F, Bm, columns, J != nullptr};
   const auto rows = rows_in(span);  // not a structured binding: C++17 lambdas cannot capture one

@@ -103,16 +103,18 @@ class EquationErrorModel : public ResidualModel {
   // Scratch of one evaluation, not state, kept to reuse the allocations (one instance serves
   // one thread; clone()): a search evaluates thousands of times, and arrays of the whole
   // flight allocated afresh each time cost page faults (a third of an instrumented run's time,
-  // whose allocator hands out fresh memory) and zero-filling.
+  // whose allocator hands out fresh memory) and zero-filling. Not copied with the instance.
   struct Scratch {
     std::vector<double> X, U;    // prepare(): states and inputs of every sample
     std::vector<double> tau;     // prepare(): each rotor's lag at every sample
     std::vector<double> F, Bm;   // interval_accelerations()
     std::vector<double> r6, J6;  // evaluate_free() of fewer than six channels
+    std::vector<double> mean_speed;  // prepare(): rotor speeds averaged over each interval (motor_lag)
+    Scratch() = default;
+    Scratch(const Scratch&) {}
+    Scratch& operator=(const Scratch&) { return *this; }
   };
   mutable Scratch scratch_;
-  // Rotor speeds averaged over each interval (motor_lag), scratch like scratch_.
-  mutable std::vector<double> mean_speed_;
   // Copies of the dynamic model for the helper threads of a split evaluation
   // (evaluation_threads.hpp), made when first needed; each remembers the parameters and
   // Jacobian columns it was last given (a residuals() call splits twice, and setting

@@ -27,7 +27,7 @@ StartStates::StartStates(runtime::DynamicModel& model, std::vector<double> param
   for (const auto& s : S) times.push_back(s.t);
   stretch_ = runtime::stretch_starts(times);
   settled_.assign(S.size(), false);
-  if (model_.num_states() > kNumStates) rotors_ = static_cast<size_t>(model_.num_states() - kNumStates);
+  rotors_ = model_.rotor_speed_states().size();
   speeds_.assign(S.size() * rotors_, 0.0);
   std::vector<double> c(rotors_);
   double restarted = 0;  // s, time of the last restart
@@ -74,8 +74,9 @@ void StartStates::commanded_speeds(double t, double delay, size_t first, double 
   const auto& cmd = flight_.samples[command_sample(flight_, t, delay, first)].u;
   std::copy(cmd.begin(), cmd.end(), u.begin());
   runtime::ExtraInputs(model_).fill(t, s.vbat, u.data());
-  model_.rhs(x.data(), u.data(), f.data(), nullptr, nullptr, nullptr);  // dw/dt = (w_cmd - w) / tau_i
-  for (size_t i = 0; i < rotors_; ++i) c[i] = rotor_tau(t, i, tau) * f[kNumStates + i];
+  const std::vector<int>& speed = model_.rotor_speed_states();
+  model_.rhs_rows(x.data(), u.data(), speed, f.data());  // dw/dt = (w_cmd - w) / tau_i
+  for (size_t i = 0; i < rotors_; ++i) c[i] = rotor_tau(t, i, tau) * f[speed[i]];
 }
 
 double StartStates::rotor_tau(double t, size_t i, double tau_all) const {
@@ -88,7 +89,8 @@ std::vector<double> StartStates::at(size_t k) const {
   std::copy(s.x.begin(), s.x.end(), x.begin());
   const runtime::DataSideEffects e = effects_at(k);
   runtime::unbias_attitude(&s.x[kAttitude], e.roll, e.pitch, &x[kAttitude]);
-  for (size_t i = 0; i < rotors_; ++i) x[kNumStates + i] = speeds_[k * rotors_ + i];
+  const std::vector<int>& speed = model_.rotor_speed_states();
+  for (size_t i = 0; i < rotors_; ++i) x[speed[i]] = speeds_[k * rotors_ + i];
   return x;
 }
 

@@ -54,7 +54,7 @@ class StartStates {
   runtime::DataSideParams data_side_;
   std::vector<size_t> stretch_;
   std::vector<bool> settled_;
-  size_t rotors_ = 0;           // rotor-speed states (13 .. 13 + rotors_)
+  size_t rotors_ = 0;           // rotor-speed states (DynamicModel::rotor_speed_states())
   std::vector<double> speeds_;  // samples x rotors_, at each sample's time
   // The commanded rotor speeds at time t (the model's dw/dt at w = 0, times tau), of the
   // command command_sample gives, with the battery voltage held at t.

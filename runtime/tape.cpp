@@ -1,6 +1,7 @@
 #include "runtime/tape.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <initializer_list>
 #include <utility>
@@ -20,6 +21,7 @@ void unary_run(const Instruction* in, uint32_t n, double* r, Op op) {
 }
 
 void run(const TapeFunction& fn, double* r) {
+  assert(fn.code.empty() || !fn.runs.empty());  // unscheduled code would run nothing
   const Instruction* in = fn.code.data();
   for (const OpRun& g : fn.runs) {
     switch (g.op) {

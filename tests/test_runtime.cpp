@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <tuple>
 
 #include "runtime/attitude.hpp"
 #include "runtime/dynamic_model.hpp"
@@ -185,6 +186,51 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
       }
     }
     if (!tape_copy) tape_copy = tape.clone();  // its cache holds the speed rows; asked next for others
+  }
+}
+
+// The tape's schedule (runtime::schedule_by_level) only moves independent instructions: the
+// scheduled code is the lowered code's instructions, each operand written before it is read
+// (or an input, parameter or constant), and the runs cover the code with one operation each.
+// The bit-for-bit comparisons with the headers check the results; this checks the order.
+TEST(Runtime, TheTapesScheduleReadsEveryRegisterAfterItIsWritten) {
+  const Vehicle v = test::finken3();
+  DeriveOptions o;
+  o.effects = parse_effect_list("all");
+  const Tape tape = codegen::build_tape(derive_model(v, derive_mass_properties(v), o));
+  const TapeFunction precompute{tape.precompute, {}, {}};
+  for (const TapeFunction* lowered : {&tape.rhs, &tape.measurement, &precompute}) {
+    TapeFunction scheduled = *lowered;
+    schedule_by_level(scheduled, tape.num_registers);
+    const auto key = [](const Instruction& in) { return std::make_tuple(in.dst, static_cast<int>(in.op), in.a, in.b); };
+    std::vector<std::tuple<int, int, int, int>> before, after;
+    for (const Instruction& in : lowered->code) before.push_back(key(in));
+    for (const Instruction& in : scheduled.code) after.push_back(key(in));
+    std::sort(before.begin(), before.end());
+    std::sort(after.begin(), after.end());
+    ASSERT_EQ(before, after);
+    std::vector<char> computed(tape.num_registers, 0), written(tape.num_registers, 0), constant(tape.num_registers, 0);
+    for (const auto& c : tape.constants) constant[c.first] = 1;
+    for (const Instruction& in : lowered->code) computed[in.dst] = 1;
+    const auto ready = [&](int r) { return !computed[r] || written[r]; };
+    size_t k = 0;
+    for (const OpRun& run : scheduled.runs)
+      for (uint32_t i = 0; i < run.count; ++i, ++k) {
+        ASSERT_LT(k, scheduled.code.size()) << "the runs cover more than the code";
+        const Instruction& in = scheduled.code[k];
+        ASSERT_GE(in.dst, tape.nx + tape.nu + tape.np) << "instruction " << k << " writes an input or a parameter";
+        ASSERT_FALSE(written[in.dst]) << "register " << in.dst << " written twice";
+        ASSERT_FALSE(constant[in.dst]) << "instruction " << k << " writes a constant";
+        ASSERT_EQ(in.op, run.op) << "instruction " << k;
+        ASSERT_TRUE(ready(in.a)) << "instruction " << k << " reads register " << in.a << " before it is written";
+        const bool binary = in.op == TapeOp::add || in.op == TapeOp::sub || in.op == TapeOp::mul ||
+                            in.op == TapeOp::div || in.op == TapeOp::pow;
+        if (binary) ASSERT_TRUE(ready(in.b)) << "instruction " << k << " reads register " << in.b << " before it is written";
+        written[in.dst] = 1;
+      }
+    EXPECT_EQ(k, scheduled.code.size());
+    // What the schedule is for: far fewer dispatches than instructions (rhs and h).
+    if (lowered != &precompute) EXPECT_LT(scheduled.runs.size() * 4, scheduled.code.size()) << scheduled.runs.size() << " runs";
   }
 }
 
