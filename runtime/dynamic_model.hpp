@@ -78,13 +78,13 @@ inline void DynamicModel::rhs_rows(const double* x, const double* u, const std::
   for (int i : rows) f[i] = all[i];
 }
 inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
+inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
+inline int DynamicModel::param_index(const std::string& n) const { return index_in(param_names(), n); }
 // Rotor i's speed state (rotors in the vehicle's order), or -1 without a motor lag.
 inline int rotor_speed_state(const DynamicModel& m, size_t i) {
   const std::vector<int>& s = m.rotor_speed_states();
   return i < s.size() ? s[i] : -1;
 }
-inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
-inline int DynamicModel::param_index(const std::string& n) const { return index_in(param_names(), n); }
 
 // The inputs effects add after the rotor commands, in one place: the time since the log's
 // start (thrust_decay) and the battery voltage (battery_sag); -1 where the model has none.

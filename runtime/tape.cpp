@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <initializer_list>
+#include <numeric>
 #include <utility>
 
 namespace quadgen::runtime {
@@ -39,10 +40,6 @@ void run(const TapeFunction& fn, double* r) {
     }
     in += g.count;
   }
-}
-
-bool is_binary(TapeOp op) {
-  return op == TapeOp::add || op == TapeOp::sub || op == TapeOp::mul || op == TapeOp::div || op == TapeOp::pow;
 }
 
 void scatter(double* dense, int rows, int cols, const SparseOutputs& s, const double* r) {
@@ -107,7 +104,7 @@ void schedule_by_level(TapeFunction& fn, int num_registers) {
     level[k] = level_of_register[in.dst] = l + 1;
   }
   std::vector<size_t> order(fn.code.size());
-  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::iota(order.begin(), order.end(), size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) {
     return level[i] != level[j] ? level[i] < level[j] : fn.code[i].op < fn.code[j].op;
   });

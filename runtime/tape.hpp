@@ -21,6 +21,10 @@ struct Instruction {
   int dst, a, b;  // registers; b unused for unary ops
 };
 
+inline bool is_binary(TapeOp op) {
+  return op == TapeOp::add || op == TapeOp::sub || op == TapeOp::mul || op == TapeOp::div || op == TapeOp::pow;
+}
+
 struct SparseOutputs {
   std::vector<int> row, col, reg;
 };

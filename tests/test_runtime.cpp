@@ -223,9 +223,7 @@ TEST(Runtime, TheTapesScheduleReadsEveryRegisterAfterItIsWritten) {
         ASSERT_FALSE(constant[in.dst]) << "instruction " << k << " writes a constant";
         ASSERT_EQ(in.op, run.op) << "instruction " << k;
         ASSERT_TRUE(ready(in.a)) << "instruction " << k << " reads register " << in.a << " before it is written";
-        const bool binary = in.op == TapeOp::add || in.op == TapeOp::sub || in.op == TapeOp::mul ||
-                            in.op == TapeOp::div || in.op == TapeOp::pow;
-        if (binary) ASSERT_TRUE(ready(in.b)) << "instruction " << k << " reads register " << in.b << " before it is written";
+        if (is_binary(in.op)) ASSERT_TRUE(ready(in.b)) << "instruction " << k << " reads register " << in.b << " before it is written";
         written[in.dst] = 1;
       }
     EXPECT_EQ(k, scheduled.code.size());
