@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
 #include <Eigen/Dense>
 
+#include "derive/geometry.hpp"
 #include "derive/runtime_view.hpp"
 #include "runtime/allocation_matrix.hpp"
 
@@ -110,6 +112,60 @@ AuditCheck check_discs_apart(const Vehicle& v) {
                   clash.empty() ? "every pair of hubs in one plane is at least the sum of their radii apart" : clash);
 }
 
+// No propeller sweeps through a block: each rotor's disc (its radius about the hub, in the
+// plane through the hub normal to body z, where the model's thrust acts) kept out of every
+// block's interior. Two slips show so: a hub placed at its motor's centre rather than on top
+// (the thrust point, and with it the arm of every rotor force about the centre of gravity,
+// half a motor too low), and a block or rotor copied to the wrong place. The disc is sampled
+// on a polar grid (fine enough for a clip of a few per cent of the radius); a point counts
+// as inside where it lies deeper than 1 % of the rotor's radius, so that a hub on a block's
+// face, as a propeller sits on its motor, is outside, and so is a file's rounding.
+AuditCheck check_discs_clear_of_blocks(const Vehicle& v) {
+  constexpr int kRings = 16, kSpokes = 64;
+  std::ostringstream os;
+  os.precision(3);
+  for (const Rotor& r : v.rotors)
+    for (const Block& b : v.blocks) {
+      const Mat3 R = to_mat3(block_rotation(b.yaw_pitch_roll_deg));
+      const double h[3] = {b.size[0] / 2, b.size[1] / 2, b.size[2] / 2};
+      // How deep a point of the body frame lies inside the block (negative: outside).
+      const auto depth = [&](double x, double y, double z) {
+        const double d[3] = {x - b.centre[0], y - b.centre[1], z - b.centre[2]};
+        double least = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < 3; ++i) {
+          const double local = R[0][i] * d[0] + R[1][i] * d[1] + R[2][i] * d[2];  // R^T d
+          least = std::min(least, h[i] - std::fabs(local));
+        }
+        return least;
+      };
+      const double tol = 0.01 * r.radius;
+      const bool hub_inside = depth(r.position[0], r.position[1], r.position[2]) > tol;
+      bool cuts = hub_inside;
+      for (int k = 1; k <= kRings && !cuts; ++k)
+        for (int j = 0; j < kSpokes && !cuts; ++j) {
+          const double rho = r.radius * k / kRings, phi = 2 * M_PI * j / kSpokes;
+          cuts = depth(r.position[0] + rho * std::cos(phi), r.position[1] + rho * std::sin(phi), r.position[2]) > tol;
+        }
+      if (!cuts) continue;
+      // The block's reach along body z about the disc's plane (from its corners): which way
+      // the hub or the block would have to move.
+      double above = 0, below = 0;  // m
+      for (int corner = 0; corner < 8; ++corner) {
+        double z = b.centre[2];
+        for (int i = 0; i < 3; ++i) z += R[2][i] * ((corner >> i & 1) ? h[i] : -h[i]);
+        above = std::max(above, z - r.position[2]);
+        below = std::max(below, r.position[2] - z);
+      }
+      os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << "'s disc passes through block " << b.name
+         << ", which reaches " << above * 1e3 << " mm above and " << below * 1e3 << " mm below the disc's plane"
+         << (hub_inside ? " (its hub inside the block: is the hub's z the propeller's height, on top of the motor?)"
+                        : " (a propeller cannot pass through it: is the block or the rotor misplaced?)");
+    }
+  const std::string found = os.str();
+  return advisory("no propeller sweeps through a block", found.empty(),
+                  found.empty() ? "every rotor's disc is clear of every block" : found);
+}
+
 // Rotors and blocks on one scale: a number without a unit is read as metres, so a position or
 // radius copied in millimetres puts a rotor a thousand times too far out, and an area in mm^2
 // makes the disc larger than its radius allows. Thresholds wide enough for real layouts (a
@@ -152,7 +208,7 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   const Eigen::MatrixXd B = runtime::allocation_matrix(b);
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
-  return {check_discs_apart(v), check_one_scale(v), check_motor_map(b.thrust_laws), check_controllable(B),
+  return {check_discs_apart(v), check_discs_clear_of_blocks(v), check_one_scale(v), check_motor_map(b.thrust_laws), check_controllable(B),
           check_hover_trim(v, b)};
 }
 

@@ -7,7 +7,8 @@
 // They catch what a new vehicle's author gets wrong most often and no unit check sees: masses
 // in grams written as kilograms (hover beyond the motor map), a centre of gravity outside the
 // rotors (a rotor would have to pull down), spins that do not cancel (yaw cannot be held), a
-// motor map copied with the wrong sign, two rotor discs in one place (a copied line), numbers
+// motor map copied with the wrong sign, two rotor discs in one place (a copied line), a
+// propeller sweeping through a block (a hub at its motor's centre rather than on top), numbers
 // in millimetres where the file reads metres (rotors and blocks on different scales).
 #pragma once
 #include <vector>

@@ -1112,7 +1112,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
                            "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 5u);
+    ASSERT_EQ(checks.size(), 6u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1166,6 +1166,35 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     v.rotors[1].position[2] += 0.05;  // a coaxial-like step in height: apart
     v.rotors[3].position[2] += 0.05;
     EXPECT_TRUE(checks_of(v).at(discs).passed) << checks_of(v).at(discs).detail;
+  }
+  const std::string clear = "no propeller sweeps through a block";
+  {  // a hub at its motor's centre rather than on top, and a block moved under a disc
+    const Vehicle cf = load_vehicle(test::source_path("vehicles/crazyflie21.yaml"));
+    ASSERT_EQ(cf.rotors[0].position[2], 0.008);  // on the top face of motor_M1 (z -0.008 to 0.008)
+    Vehicle v = cf;
+    v.rotors[0].position[2] = 0.0;  // at motor_M1's centre
+    auto c = checks_of(v).at(clear);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("rotor M1's disc passes through block motor_M1, which reaches 8 mm above and 8 mm below "
+                            "the disc's plane (its hub inside"),
+              std::string::npos)
+        << c.detail;
+    EXPECT_EQ(c.detail.find("M2"), std::string::npos) << c.detail;  // the others sit on their motors
+    v.rotors[0].position[2] = 0.0079;  // a tenth of a millimetre into the motor: a file's rounding
+    EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
+    // The battery (7.5 mm thick) raised to the discs' plane and slid towards M4's hub until
+    // 5 mm of the disc's edge, hub outside, sweeps through it.
+    v = cf;
+    Block& battery = *std::find_if(v.blocks.begin(), v.blocks.end(), [](const Block& b) { return b.name == "battery"; });
+    battery.centre = {0.005 + 0.0325 - 0.0225 - 0.016, 0.0325, 0.008};
+    c = checks_of(v).at(clear);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("rotor M4's disc passes through block battery, which reaches 3.75 mm above and 3.75 mm "
+                            "below the disc's plane (a propeller cannot pass"),
+              std::string::npos)
+        << c.detail;
+    battery.centre[2] = 0.008 + 0.0075 / 2 + 1e-4;  // lifted just clear of the disc's plane
+    EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
   }
   const std::string scale = "rotors and blocks on one scale";
   {  // numbers copied in millimetres where the file reads metres: one at a time
