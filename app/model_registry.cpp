@@ -14,43 +14,68 @@
 namespace quadgen::app {
 
 namespace {
+
+std::vector<std::string> names_of(const std::vector<Variable>& vars) {
+  std::vector<std::string> out;
+  for (const Variable& v : vars) out.push_back(v.name);
+  return out;
+}
+
+bool names_equal(const char* const* header, int count, const std::vector<std::string>& names) {
+  if (names.size() != static_cast<size_t>(count)) return false;
+  for (int i = 0; i < count; ++i)
+    if (names[i] != header[i]) return false;
+  return true;
+}
+
+// A header runs in place of derivation `m` only where it was generated from the same vehicle
+// file (its SHA-256, output/sha256.hpp: no file can pass for another) and effects, and where
+// its states, inputs, parameters and nominal values are the derivation's, so that no header
+// ever runs with another vehicle's shape (a simulation writes one command per rotor into an
+// input vector of the header's size). A forgeable FNV-1a hash once let a six-rotor file run
+// on a four-rotor header.
 template <class M>
-std::unique_ptr<runtime::DynamicModel> compiled_if(const std::string& vehicle_hash, const std::string& effects) {
-  if (vehicle_hash != M::kVehicleHash || effects != M::kEffects) return nullptr;
+std::unique_ptr<runtime::DynamicModel> compiled_if(const SymbolicModel& m) {
+  if (m.vehicle_hash != M::kVehicleHash || m.effect_list() != M::kEffects) return nullptr;
+  if (!names_equal(M::kStateNames, M::kNumStates, names_of(m.states)) ||
+      !names_equal(M::kInputNames, M::kNumInputs, names_of(m.inputs)) ||
+      !names_equal(M::kParamNames, M::kNumParams, names_of(m.params)))
+    return nullptr;
+  for (int i = 0; i < M::kNumParams; ++i)
+    if (m.params[i].nominal != M::kNominalParams[i]) return nullptr;
   return std::make_unique<runtime::CompiledModel<M>>();
 }
 
-// The header generated from this vehicle file hash and canonical effect list, if any.
-std::unique_ptr<runtime::DynamicModel> find_compiled(const std::string& hash, const std::string& effects) {
+// The header generated from this derivation's vehicle file and effects, if any.
+std::unique_ptr<runtime::DynamicModel> find_compiled(const SymbolicModel& m) {
   namespace g = quadgen_generated;
   for (auto make : {compiled_if<g::finken3::Model>, compiled_if<g::finken3_all_effects::Model>,
                     compiled_if<g::crazyflie21::Model>, compiled_if<g::crazyflie21_all_effects::Model>,
                     compiled_if<g::crazyflie21_nanobench::Model>, compiled_if<g::crazyflie21_nanobench_all_effects::Model>})
-    if (auto m = make(hash, effects)) return m;
+    if (auto model = make(m)) return model;
   return nullptr;
 }
+
 }  // namespace
 
 std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* compiled) {
-  auto model = find_compiled(m.vehicle_hash, m.effect_list());
+  auto model = find_compiled(m);
   if (compiled) *compiled = model != nullptr;
   return model ? std::move(model) : std::make_unique<runtime::TapeModel>(codegen::build_tape(m));
 }
 
-std::unique_ptr<runtime::DynamicModel> compiled_model_for(const Vehicle& v, const std::vector<std::string>& effects) {
-  return find_compiled(v.content_hash, canonical_effect_list(effects));
-}
-
 std::unique_ptr<runtime::DynamicModel> model_for(const Vehicle& v, const std::vector<std::string>& effects,
                                                  std::string* how) {
-  if (auto compiled = compiled_model_for(v, effects)) {
-    if (how) *how = "compiled header from generated/ (no derivation needed)";
-    return compiled;
-  }
+  // The symbolic model only (no derivatives, which only a tape needs): tens of milliseconds,
+  // and what a header must equal to be used.
   DeriveOptions o;
   o.effects = effects;
-  if (how) *how = "interpreted tape (no matching generated header)";
-  return make_model(derive_model(v, derive_mass_properties(v), o));
+  bool compiled = false;
+  auto model = make_model(derive_model(v, derive_mass_properties(v), o), &compiled);
+  if (how)
+    *how = compiled ? "compiled header from generated/ (the derivation matches it)"
+                    : "interpreted tape (no matching generated header)";
+  return model;
 }
 
 }  // namespace quadgen::app

@@ -13,6 +13,7 @@
 #include "output/sinks.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "model/vehicle.hpp"
+#include "output/fnv1a.hpp"
 
 extern const char* const kModelHeaderTemplate;  // templates/model.hpp.mustache, embedded by CMake
 
@@ -197,7 +198,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   // A whole comment line or nothing (a mustache section would leave an empty line).
   d.set("parameter_source_line", opt.parameter_source.empty() ? std::string()
                                  : "// Parameter values (kNominalParams): " + output::cpp_comment(opt.parameter_source) + ".\n");
-  d.set("options_hash", fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
+  d.set("options_hash", output::fnv1a_hex(m.vehicle_hash + "|" + m.effect_list(", ") + "|" + QUADGEN_VERSION));
   set_counts(d, m, out);
   set_variable_tables(d, m);
   set_sparsity(d, lm);

@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "output/fnv1a.hpp"
 #include "model/parameter_spec.hpp"
 #include "model/units.hpp"
 
@@ -69,7 +68,7 @@ inline constexpr DerivedQuantity kDerivedQuantities[] = {
 struct Vehicle {
   std::string name;
   std::string source_path;
-  std::string content_hash;  // FNV-1a of the file bytes, hex
+  std::string content_hash;  // SHA-256 of the file bytes, hex (output/sha256.hpp: why not FNV-1a)
   std::string description;
   std::vector<Block> blocks;
   std::vector<Rotor> rotors;
@@ -107,7 +106,5 @@ const Parameter& param(const Vehicle& v, const std::string& name);
 // The rotors' names in the vehicle file's order (the log columns u_<name>, the inputs' order).
 std::vector<std::string> rotor_names(const Vehicle& v);
 inline bool is_thesis_vehicle(const Vehicle& v) { return is_thesis_vehicle(v.name, rotor_names(v)); }
-
-using output::fnv1a_hex;
 
 }  // namespace quadgen

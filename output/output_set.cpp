@@ -294,7 +294,9 @@ void remove_tree_quietly(const fs::path& p) {
 
 }  // namespace
 
-// What to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP): the staging
+// What to remove when the process is interrupted (SIGINT, SIGTERM, SIGHUP, and SIGPIPE: a
+// reader gone, as in `quadgen derive ... 2>&1 | head -1`, ends the run at its next line of
+// progress; gnuplot is written to with MSG_NOSIGNAL, runtime/plot.cpp): the staging
 // directories, the files staged in them (only at the end of the work) and the folders
 // created to hold them. A signal handler may call unlink and rmdir but not walk a tree, so
 // each path is remembered as it is made: a folder is created, a file named, and each
@@ -306,7 +308,7 @@ void remove_tree_quietly(const fs::path& p) {
 // paths at once than a table has slots, is not remembered: left to the next run.
 namespace interrupt {
 constexpr size_t kPathBytes = 4096;
-constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
 static_assert(std::atomic<int>::is_always_lock_free, "read in a signal handler");
 
 // Paths a handler may read: a slot's `used` is published after its path is written.

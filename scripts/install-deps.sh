@@ -10,6 +10,7 @@ packages=(
   libcli11-dev                          # command line
   nlohmann-json3-dev                    # model.json and friends
   libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds
+  libssl-dev                            # SHA-256 of vehicle files (which generated header is whose)
   libkainjow-mustache-dev               # text templates for generated code
   gnuplot-nox                           # plots (SVG) of simulations and fits
   cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown

@@ -33,11 +33,13 @@
 #include "codegen/expression_graph.hpp"
 #include "codegen/header_writer.hpp"
 #include "output/fnv1a.hpp"
+#include "output/sha256.hpp"
 #include "output/names.hpp"
 #include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
 #include "runtime/plot.hpp"
 #include "runtime/flight_log.hpp"
+#include "app/model_registry.hpp"
 #include "audit/report.hpp"
 #include "output/sinks.hpp"
 #include "tests/test_helpers.hpp"
@@ -107,6 +109,7 @@ struct Interrupt {
   double after_s = -1;  // < 0: not by time
   fs::path exists;      // empty: not by a path
   int signal = SIGKILL;
+  bool reader_gone = false;  // stderr a pipe whose reader has closed it: SIGPIPE at the first line
 };
 
 // Runs quadgen with `args` (each one argv element: no shell parses them) in `cwd`, with
@@ -119,8 +122,10 @@ CliResult run_quadgen(const std::vector<std::string>& args, const fs::path& cwd,
     if (::chdir(cwd.c_str()) != 0) _exit(99);
     for (auto& v : env) ::putenv(v.data());  // the child's own copy, alive until execv
     // quadgen keeps a signal its caller ignores ignored; the tests' signals must act.
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(sig, SIG_DFL);
     FILE* e = std::freopen(err.c_str(), "w", stderr);
+    int gone[2];
+    if (interrupt.reader_gone && (::pipe(gone) != 0 || ::close(gone[0]) != 0 || ::dup2(gone[1], 2) < 0)) _exit(97);
     FILE* o = std::freopen("/dev/null", "w", stdout);
     (void)e;
     (void)o;
@@ -314,6 +319,43 @@ TEST(NameRule, AVehicleNameCannotBeAnotherModelsNamespace) {
     EXPECT_EQ(msg.rfind("twin.yaml:", 0), 0u) << msg;
     EXPECT_NE(msg.find("share one C++ namespace (rename it, e.g. 'finken3_w_motor_lag')"), std::string::npos) << msg;
   }
+}
+
+// A generated header runs only for the vehicle file it was generated from and only with the
+// derivation's shape. It was chosen by the file's FNV-1a hash, which sixteen bytes appended
+// in a comment can forge (helper-54, 2026-12-01): a six-rotor file with crazyflie21's hash
+// ran on that header, and simulate wrote six commands into its four inputs (heap corruption);
+// a heavier Crazyflie flew with the stock one's physics. Now the hash is SHA-256 (checked
+// against FIPS 180-2's vectors), and a header whose hash and effects match is still refused
+// unless its states, inputs, parameters and nominal values are the derivation's: here the
+// hash is set by hand, as a forgery would make it.
+TEST(HostileVehicle, AGeneratedHeaderRunsOnlyForTheFileAndShapeItWasGeneratedFrom) {
+  EXPECT_EQ(out::sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(out::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(out::sha256_hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  const auto compiled = [](const quadgen::Vehicle& v, int* inputs = nullptr) {
+    bool is_compiled = false;
+    const auto model = quadgen::app::make_model(quadgen::derive_model(v, quadgen::derive_mass_properties(v), {}),
+                                                &is_compiled);
+    if (inputs) *inputs = model->num_inputs();
+    return is_compiled;
+  };
+  const quadgen::Vehicle cf = quadgen::load_vehicle(source_path("vehicles/crazyflie21.yaml"));
+  EXPECT_EQ(cf.content_hash.size(), 64u);
+  EXPECT_TRUE(compiled(cf));  // the bundled header of generated/crazyflie21
+  quadgen::Vehicle hexa = quadgen::load_vehicle(source_path("vehicles/hexa_plus.yaml"));
+  hexa.content_hash = cf.content_hash;
+  int inputs = 0;
+  EXPECT_FALSE(compiled(hexa, &inputs));
+  EXPECT_EQ(inputs, 6);  // its own tape
+  quadgen::Vehicle heavier = cf;  // same rotors, a heavier battery
+  for (auto& b : heavier.blocks)
+    if (b.name == "battery") b.mass += 0.005;
+  EXPECT_FALSE(compiled(heavier));
+  quadgen::Vehicle renamed = cf;
+  renamed.rotors[0].name = "M0";
+  EXPECT_FALSE(compiled(renamed));
 }
 
 TEST(NameRule, DuplicateKeysInVehicleFilesAreRefused) {
@@ -934,6 +976,18 @@ TEST(DataLoss, AFailedRunLeavesNoFoldersBehind) {
   expect_one_line_error(run_quadgen({"derive", tmp / "bad.yaml", "--out", tmp / "mine"}, tmp.dir), "bad.yaml",
                         "a bad vehicle into a folder of the user's");
   EXPECT_EQ(read(tmp / "mine/notes.txt"), "mine\n");
+}
+
+// A run whose reader has gone (`quadgen derive ... 2>&1 | head -1`) dies of SIGPIPE at its
+// next line of progress; its staging directory and the folders made for --out go first, as
+// for the signals below (helper-54 found them left, 2026-12-01).
+TEST(DataLoss, ARunWhoseReaderHasGoneLeavesNoFoldersBehind) {
+  Scratch tmp;
+  Interrupt gone;
+  gone.reader_gone = true;
+  const auto r = run_quadgen({"derive", source_path("vehicles/crazyflie21.yaml"), "--out", tmp / "a/b/out"}, tmp.dir, gone);
+  EXPECT_EQ(r.rc, 128 + SIGPIPE);
+  EXPECT_FALSE(fs::exists(tmp / "a"));
 }
 
 // Interrupted (Ctrl-C, a terminal closed, a job killed politely), a long run leaves nothing
