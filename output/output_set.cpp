@@ -47,6 +47,26 @@ constexpr const char* kFilesRecordName = ".quadgen-files";
 
 std::string errno_text() { return std::strerror(errno); }
 
+// The process's umask, read without changing it (/proc/self/status, Linux 4.7 and later:
+// umask() itself sets it, which another thread could see); 022, the common default, where
+// that file cannot say.
+mode_t current_umask() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::strtol(line.c_str() + 6, nullptr, 8) & 0777);
+  return 022;
+}
+
+// The mode an output folder gets as it moves into place: that of the folder it replaces,
+// else what mkdir would give it (0777 less the umask). Staging folders are made private by
+// mkdtemp (0700), which kept every output folder from others who could read its parent.
+mode_t published_mode(const fs::path& target) {
+  struct stat st {};
+  if (::stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) return st.st_mode & 07777;
+  return 0777 & ~current_umask();
+}
+
 void fsync_path(const fs::path& p, int flags) {
   const int fd = ::open(p.c_str(), flags | O_CLOEXEC);
   if (fd < 0) fail(p, "cannot open to sync: " + errno_text());
@@ -505,8 +525,18 @@ void test_hook_signal(const char* place) {
 // (files that appeared while this run wrote): a visible name of its own beside the output
 // (a short one if the output's name is too long to extend). It is marked first, so that even
 // where no rename succeeds no later run takes it for a stale staging folder and removes it.
+// The marker is written without following a link: one planted under its name by whoever could
+// write to the earlier output would have had this run overwrite the file it points to.
 fs::path detail::keep_aside(const fs::path& staged, const fs::path& target) {
-  std::ofstream(staged / kKeepMarker) << "an earlier quadgen output, kept because it held files quadgen did not write\n";
+  const fs::path marker = staged / kKeepMarker;
+  ::unlink(marker.c_str());  // a link or an older marker: replaced; O_EXCL refuses one planted since
+  const int fd = ::open(marker.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd >= 0) {
+    const std::string text = "an earlier quadgen output, kept because it held files quadgen did not write\n";
+    const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+    ::close(fd);
+    (void)written;  // a best effort: the folder is kept aside either way
+  }
   const std::string pid = std::to_string(::getpid());
   for (const std::string& stem : {target.filename().string() + ".previous-" + pid, "quadgen-previous-" + pid})
     for (int n = 0; n < 100; ++n) {
@@ -607,6 +637,7 @@ void OutputDirectory::commit() {
   // after which the earlier run sits in the staging path and is removed file by file. The
   // staged files are forgotten once moved, with the signals blocked between (not before: a
   // signal in the checks before the exchange must still find them).
+  if (::chmod(staged.c_str(), published_mode(target)) != 0) fail(staged, "cannot set its mode: " + errno_text());
   int why = 0;
   if (!staging_->move([&] { return ::rename(staged.c_str(), target.c_str()) == 0; }, &why)) {
     if (why != ENOTEMPTY && why != EEXIST)

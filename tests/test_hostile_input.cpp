@@ -959,6 +959,31 @@ TEST(DataLoss, ManifestHashIsThePublishedFnv1aAndOlderManifestsStillRead) {
 // file into a nested --out, for each command that writes an output set (found by a review:
 // derive and predict, which had started to create the set before reading the vehicle, left
 // a/ and a/b/). The vehicle file's error is the one reported, whatever --out holds.
+// An output folder gets the mode mkdir would give it (0777 less the umask) or keeps that of
+// the folder it replaces. Staging folders are private (mkdtemp's 0700), and every output
+// folder used to stay so, unreadable to a group that could read its parent (helper-54,
+// 2026-12-01).
+TEST(DataLoss, AnOutputFolderHasTheModeMkdirWouldGiveIt) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  const auto mode = [](const fs::path& p) {
+    struct stat st {};
+    EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
+    return st.st_mode & 07777;
+  };
+  const mode_t saved = ::umask(027);  // inherited by the run; neither 0700 nor the usual 0755
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "new"}, tmp.dir).rc, 0);
+  EXPECT_EQ(mode(tmp / "new"), 0750u);
+  fs::create_directories(tmp / "mine");
+  ::chmod((tmp / "mine").c_str(), 0751);  // an empty folder of the user's
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "mine"}, tmp.dir).rc, 0);
+  EXPECT_EQ(mode(tmp / "mine"), 0751u);
+  ::chmod((tmp / "new").c_str(), 0711);  // an earlier run's folder, replaced
+  ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "new"}, tmp.dir).rc, 0);
+  EXPECT_EQ(mode(tmp / "new"), 0711u);
+  ::umask(saved);
+}
+
 TEST(DataLoss, AFailedRunLeavesNoFoldersBehind) {
   Scratch tmp;
   write(tmp / "bad.yaml", "name: [\n");
@@ -1385,6 +1410,17 @@ TEST(DataLoss, AnEarlierOutputIsKeptAsideEvenUnderALongName) {
     EXPECT_TRUE(fs::exists(kept / ".quadgen-keep"));
     fs::remove_all(kept);
   }
+  // A link planted under the marker's name by whoever could write to the earlier output:
+  // replaced, the file it points to untouched (std::ofstream followed it).
+  const fs::path staged = tmp.dir / ".staged";
+  fs::create_directories(staged);
+  write((staged / "notes.txt").string(), "a user's file\n");
+  write((tmp.dir / "victim.txt").string(), "someone's file\n");
+  fs::create_symlink(tmp.dir / "victim.txt", staged / ".quadgen-keep");
+  const fs::path kept = quadgen::output::detail::keep_aside(staged, tmp.dir / "out");
+  EXPECT_EQ(read(tmp.dir / "victim.txt"), "someone's file\n");
+  EXPECT_FALSE(fs::is_symlink(kept / ".quadgen-keep"));
+  EXPECT_NE(read(kept / ".quadgen-keep").find("an earlier quadgen output"), std::string::npos);
 }
 
 // Only folders named as quadgen names its staging folders are removed as stale: a user's
