@@ -1,5 +1,8 @@
 #include "app/model_registry.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "generated/crazyflie21/model.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/crazyflie21_nanobench/model.hpp"
@@ -29,11 +32,14 @@ bool names_equal(const char* const* header, int count, const std::vector<std::st
 }
 
 // A header runs in place of derivation `m` only where it was generated from the same vehicle
-// file (its SHA-256, output/sha256.hpp: no file can pass for another) and effects, and where
+// file (its SHA-256, model/sha256.hpp: no file can pass for another) and effects, and where
 // its states, inputs, parameters and nominal values are the derivation's, so that no header
 // ever runs with another vehicle's shape (a simulation writes one command per rotor into an
 // input vector of the header's size). A forgeable FNV-1a hash once let a six-rotor file run
-// on a four-rotor header.
+// on a four-rotor header. What the header's code holds as fixed numbers (rotor places,
+// radii, spins) and its bounds rest on the hash alone. Nominal values agree to 1e-12
+// relative, not bit for bit: a compiler that contracts a*b+c may round the derived inertia
+// differently from the machine that generated the header.
 template <class M>
 std::unique_ptr<runtime::DynamicModel> compiled_if(const SymbolicModel& m) {
   if (m.vehicle_hash != M::kVehicleHash || m.effect_list() != M::kEffects) return nullptr;
@@ -41,8 +47,10 @@ std::unique_ptr<runtime::DynamicModel> compiled_if(const SymbolicModel& m) {
       !names_equal(M::kInputNames, M::kNumInputs, names_of(m.inputs)) ||
       !names_equal(M::kParamNames, M::kNumParams, names_of(m.params)))
     return nullptr;
-  for (int i = 0; i < M::kNumParams; ++i)
-    if (m.params[i].nominal != M::kNominalParams[i]) return nullptr;
+  for (int i = 0; i < M::kNumParams; ++i) {
+    const double a = m.params[i].nominal, b = M::kNominalParams[i];
+    if (!(std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b)))) return nullptr;
+  }
   return std::make_unique<runtime::CompiledModel<M>>();
 }
 
@@ -66,8 +74,8 @@ std::unique_ptr<runtime::DynamicModel> make_model(const SymbolicModel& m, bool* 
 
 std::unique_ptr<runtime::DynamicModel> model_for(const Vehicle& v, const std::vector<std::string>& effects,
                                                  std::string* how) {
-  // The symbolic model only (no derivatives, which only a tape needs): tens of milliseconds,
-  // and what a header must equal to be used.
+  // Derived first, whether or not a header matches (about 0.2 s with every effect): the
+  // derivation is what a header must equal to be used.
   DeriveOptions o;
   o.effects = effects;
   bool compiled = false;

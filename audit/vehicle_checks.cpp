@@ -1,10 +1,12 @@
 #include "audit/vehicle_checks.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -112,53 +114,98 @@ AuditCheck check_discs_apart(const Vehicle& v) {
                   clash.empty() ? "every pair of hubs in one plane is at least the sum of their radii apart" : clash);
 }
 
+using Point2 = std::array<double, 2>;
+
+// The convex hull of points in a plane, counter-clockwise (Andrew's monotone chain).
+std::vector<Point2> convex_hull(std::vector<Point2> p) {
+  std::sort(p.begin(), p.end());
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  const auto turn = [](const Point2& o, const Point2& a, const Point2& b) {
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  };
+  std::vector<Point2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// The distance from q to a convex polygon given counter-clockwise: 0 inside.
+double distance_to_polygon(const Point2& q, const std::vector<Point2>& poly) {
+  bool inside = poly.size() >= 3;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Point2 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+    const double ex = b[0] - a[0], ey = b[1] - a[1], qx = q[0] - a[0], qy = q[1] - a[1];
+    if (ex * qy - ey * qx < 0) inside = false;
+    const double length2 = ex * ex + ey * ey;
+    const double t = length2 > 0 ? std::clamp((qx * ex + qy * ey) / length2, 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, std::hypot(qx - t * ex, qy - t * ey));
+  }
+  return inside ? 0.0 : nearest;
+}
+
+// A block cut by the horizontal plane z = z0 of the body frame: how far it reaches above and
+// below the plane, and the cut's outline in body x and y (where its edges cross the plane).
+struct PlaneCut {
+  double above = 0, below = 0;  // m
+  std::vector<Point2> outline;  // convex, counter-clockwise
+};
+PlaneCut cut_at_height(const Block& b, double z0) {
+  const Mat3 R = to_mat3(block_rotation(b.yaw_pitch_roll_deg));  // block -> body
+  std::array<std::array<double, 3>, 8> corner{};
+  PlaneCut cut;
+  for (int k = 0; k < 8; ++k) {
+    for (int row = 0; row < 3; ++row) {
+      corner[k][row] = b.centre[row];
+      for (int i = 0; i < 3; ++i) corner[k][row] += R[row][i] * ((k >> i & 1) ? 0.5 : -0.5) * b.size[i];
+    }
+    cut.above = std::max(cut.above, corner[k][2] - z0);
+    cut.below = std::max(cut.below, z0 - corner[k][2]);
+  }
+  std::vector<Point2> crossings;
+  for (int k = 0; k < 8; ++k) {
+    if (corner[k][2] == z0) crossings.push_back({corner[k][0], corner[k][1]});
+    for (int i = 0; i < 3; ++i) {  // the edge to the corner one bit up
+      const int j = k | 1 << i;
+      if (j == k || (corner[k][2] - z0) * (corner[j][2] - z0) >= 0) continue;
+      const double t = (z0 - corner[k][2]) / (corner[j][2] - corner[k][2]);
+      crossings.push_back({corner[k][0] + t * (corner[j][0] - corner[k][0]), corner[k][1] + t * (corner[j][1] - corner[k][1])});
+    }
+  }
+  cut.outline = convex_hull(crossings);
+  return cut;
+}
+
 // No propeller sweeps through a block: each rotor's disc (its radius about the hub, in the
 // plane through the hub normal to body z, where the model's thrust acts) kept out of every
-// block's interior. Two slips show so: a hub placed at its motor's centre rather than on top
-// (the thrust point, and with it the arm of every rotor force about the centre of gravity,
-// half a motor too low), and a block or rotor copied to the wrong place. The disc is sampled
-// on a polar grid (fine enough for a clip of a few per cent of the radius); a point counts
-// as inside where it lies deeper than 1 % of the rotor's radius, so that a hub on a block's
-// face, as a propeller sits on its motor, is outside, and so is a file's rounding.
+// block. Two slips show so: a hub placed at its motor's centre rather than on top (the thrust
+// point, and with it the arm of every rotor force about the centre of gravity, half a motor
+// too low), and a block or rotor copied to the wrong place. Exact: the block is cut by the
+// disc's plane and the cut's distance from the hub compared with the radius. 1 % of the
+// radius is allowed either way, so that a propeller on its motor's top face, a disc's rim
+// on a block's edge and a file's rounding pass.
 AuditCheck check_discs_clear_of_blocks(const Vehicle& v) {
-  constexpr int kRings = 16, kSpokes = 64;
   std::ostringstream os;
   os.precision(3);
   for (const Rotor& r : v.rotors)
     for (const Block& b : v.blocks) {
-      const Mat3 R = to_mat3(block_rotation(b.yaw_pitch_roll_deg));
-      const double h[3] = {b.size[0] / 2, b.size[1] / 2, b.size[2] / 2};
-      // How deep a point of the body frame lies inside the block (negative: outside).
-      const auto depth = [&](double x, double y, double z) {
-        const double d[3] = {x - b.centre[0], y - b.centre[1], z - b.centre[2]};
-        double least = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < 3; ++i) {
-          const double local = R[0][i] * d[0] + R[1][i] * d[1] + R[2][i] * d[2];  // R^T d
-          least = std::min(least, h[i] - std::fabs(local));
-        }
-        return least;
-      };
       const double tol = 0.01 * r.radius;
-      const bool hub_inside = depth(r.position[0], r.position[1], r.position[2]) > tol;
-      bool cuts = hub_inside;
-      for (int k = 1; k <= kRings && !cuts; ++k)
-        for (int j = 0; j < kSpokes && !cuts; ++j) {
-          const double rho = r.radius * k / kRings, phi = 2 * M_PI * j / kSpokes;
-          cuts = depth(r.position[0] + rho * std::cos(phi), r.position[1] + rho * std::sin(phi), r.position[2]) > tol;
-        }
-      if (!cuts) continue;
-      // The block's reach along body z about the disc's plane (from its corners): which way
-      // the hub or the block would have to move.
-      double above = 0, below = 0;  // m
-      for (int corner = 0; corner < 8; ++corner) {
-        double z = b.centre[2];
-        for (int i = 0; i < 3; ++i) z += R[2][i] * ((corner >> i & 1) ? h[i] : -h[i]);
-        above = std::max(above, z - r.position[2]);
-        below = std::max(below, r.position[2] - z);
-      }
+      const PlaneCut cut = cut_at_height(b, r.position[2]);
+      if (cut.above <= tol || cut.below <= tol) continue;
+      const double apart = distance_to_polygon({r.position[0], r.position[1]}, cut.outline);
+      if (apart >= r.radius - tol) continue;
       os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << "'s disc passes through block " << b.name
-         << ", which reaches " << above * 1e3 << " mm above and " << below * 1e3 << " mm below the disc's plane"
-         << (hub_inside ? " (its hub inside the block: is the hub's z the propeller's height, on top of the motor?)"
+         << ", which reaches " << cut.above * 1e3 << " mm above and " << cut.below * 1e3 << " mm below the disc's plane"
+         << (apart == 0 ? " (its hub inside the block: is the hub's z the propeller's height, on top of the motor?)"
                         : " (a propeller cannot pass through it: is the block or the rotor misplaced?)");
     }
   const std::string found = os.str();
@@ -208,8 +255,8 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   const Eigen::MatrixXd B = runtime::allocation_matrix(b);
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
-  return {check_discs_apart(v), check_discs_clear_of_blocks(v), check_one_scale(v), check_motor_map(b.thrust_laws), check_controllable(B),
-          check_hover_trim(v, b)};
+  return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
+          check_motor_map(b.thrust_laws), check_controllable(B),          check_hover_trim(v, b)};
 }
 
 }  // namespace quadgen

@@ -8,8 +8,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "output/names.hpp"
+#include "model/sha256.hpp"
 #include "model/yaml_reader.hpp"
-#include "output/sha256.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen {
@@ -272,7 +272,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   Vehicle v;
   if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
   v.source_path = path;
-  v.content_hash = output::sha256_hex(content);
+  v.content_hash = sha256_hex(content);
   const YAML::Node name = r.need(root, "name", "the vehicle file");
   v.name = r.name(name, "vehicle name");
   if (const auto problem = output::vehicle_name_problem(v.name)) r.fail(name, "vehicle name '" + v.name + "': " + *problem);

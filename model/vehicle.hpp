@@ -68,7 +68,7 @@ inline constexpr DerivedQuantity kDerivedQuantities[] = {
 struct Vehicle {
   std::string name;
   std::string source_path;
-  std::string content_hash;  // SHA-256 of the file bytes, hex (output/sha256.hpp: why not FNV-1a)
+  std::string content_hash;  // SHA-256 of the file bytes, hex (model/sha256.hpp: why not FNV-1a)
   std::string description;
   std::vector<Block> blocks;
   std::vector<Rotor> rotors;

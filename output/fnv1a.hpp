@@ -1,6 +1,6 @@
 // FNV-1a 64-bit: a fast, stable content hash (output manifests, the generator's options
 // hash). Not cryptographic: it detects change, not tampering; a vehicle file's identity, which
-// a forgery could abuse, is SHA-256 (sha256.hpp).
+// a forgery could abuse, is SHA-256 (model/sha256.hpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>

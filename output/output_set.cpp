@@ -61,10 +61,15 @@ mode_t current_umask() {
 // The mode an output folder gets as it moves into place: that of the folder it replaces,
 // else what mkdir would give it (0777 less the umask). Staging folders are made private by
 // mkdtemp (0700), which kept every output folder from others who could read its parent.
-mode_t published_mode(const fs::path& target) {
+// The set-group-ID bit a folder inherits in a shared group's folder is kept. A best effort:
+// some file systems (vfat, some network mounts) refuse chmod, and the output is no less
+// complete for it.
+void set_published_mode(const fs::path& staged, const fs::path& target) {
   struct stat st {};
-  if (::stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) return st.st_mode & 07777;
-  return 0777 & ~current_umask();
+  mode_t mode = 0777 & ~current_umask();
+  if (::stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) mode = st.st_mode & 07777;
+  if (::stat(staged.c_str(), &st) == 0) mode |= st.st_mode & S_ISGID;
+  (void)::chmod(staged.c_str(), mode);
 }
 
 void fsync_path(const fs::path& p, int flags) {
@@ -560,7 +565,10 @@ bool remove_earlier_run(const fs::path& staged, const fs::path& target) {
     if (unchanged_since(staged / name, hash_size, earlier)) fs::remove(staged / name, ec);
   fs::remove(staged / kManifestName, ec);
   if (fs::remove(staged, ec)) return true;
-  std::cerr << "quadgen: note: the previous output was kept at " << printable(detail::keep_aside(staged, target).string())
+  // Kept aside and marked before it is said: the note may be the write that meets a closed
+  // pipe (SIGPIPE), and a folder left under its staging name unmarked is swept as stale.
+  const fs::path kept = detail::keep_aside(staged, target);
+  std::cerr << "quadgen: note: the previous output was kept at " << printable(kept.string())
             << " (it held files that appeared or changed while this run wrote)\n";
   return false;
 }
@@ -637,7 +645,7 @@ void OutputDirectory::commit() {
   // after which the earlier run sits in the staging path and is removed file by file. The
   // staged files are forgotten once moved, with the signals blocked between (not before: a
   // signal in the checks before the exchange must still find them).
-  if (::chmod(staged.c_str(), published_mode(target)) != 0) fail(staged, "cannot set its mode: " + errno_text());
+  set_published_mode(staged, target);
   int why = 0;
   if (!staging_->move([&] { return ::rename(staged.c_str(), target.c_str()) == 0; }, &why)) {
     if (why != ENOTEMPTY && why != EEXIST)

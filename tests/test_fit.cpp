@@ -538,10 +538,10 @@ TEST(FitCli, MotorGainReferenceIsHeld) {
   EXPECT_NEAR(j["estimates"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.01);
 }
 
-// A generated header carries each parameter's unit, bounds and fit flag, so a fit with a
-// matching compiled header derives nothing; the same vehicle with one comment more (another
-// hash: no header matches) is derived and interpreted. Both give the same fit.
-TEST(FitCli, CompiledHeaderNeedsNoDerivationAndFitsTheSame) {
+// A fit whose vehicle file and derivation match a generated header runs the compiled header;
+// the same vehicle with one comment more (another hash: no header matches) runs the
+// interpreted tape. Both give the same fit.
+TEST(FitCli, CompiledHeaderAndTapeFitTheSame) {
   const fs::path dir = fs::temp_directory_path() / "quadgen_fit_compiled";
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -33,7 +33,7 @@
 #include "codegen/expression_graph.hpp"
 #include "codegen/header_writer.hpp"
 #include "output/fnv1a.hpp"
-#include "output/sha256.hpp"
+#include "model/sha256.hpp"
 #include "output/names.hpp"
 #include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
@@ -330,9 +330,9 @@ TEST(NameRule, AVehicleNameCannotBeAnotherModelsNamespace) {
 // unless its states, inputs, parameters and nominal values are the derivation's: here the
 // hash is set by hand, as a forgery would make it.
 TEST(HostileVehicle, AGeneratedHeaderRunsOnlyForTheFileAndShapeItWasGeneratedFrom) {
-  EXPECT_EQ(out::sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
-  EXPECT_EQ(out::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  EXPECT_EQ(out::sha256_hex(std::string(1000000, 'a')),
+  EXPECT_EQ(quadgen::sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(quadgen::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(quadgen::sha256_hex(std::string(1000000, 'a')),
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
   const auto compiled = [](const quadgen::Vehicle& v, int* inputs = nullptr) {
     bool is_compiled = false;
@@ -955,10 +955,6 @@ TEST(DataLoss, ManifestHashIsThePublishedFnv1aAndOlderManifestsStillRead) {
   EXPECT_NE(read(tmp / "d/.quadgen-manifest").find(out::fnv1a_hex(read(tmp / "d/model.hpp")) + " "), std::string::npos);
 }
 
-// A run that fails leaves nothing behind, not even the folders --out needed: a bad vehicle
-// file into a nested --out, for each command that writes an output set (found by a review:
-// derive and predict, which had started to create the set before reading the vehicle, left
-// a/ and a/b/). The vehicle file's error is the one reported, whatever --out holds.
 // An output folder gets the mode mkdir would give it (0777 less the umask) or keeps that of
 // the folder it replaces. Staging folders are private (mkdtemp's 0700), and every output
 // folder used to stay so, unreadable to a group that could read its parent (helper-54,
@@ -971,7 +967,10 @@ TEST(DataLoss, AnOutputFolderHasTheModeMkdirWouldGiveIt) {
     EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
     return st.st_mode & 07777;
   };
-  const mode_t saved = ::umask(027);  // inherited by the run; neither 0700 nor the usual 0755
+  struct Umask {  // the run inherits it; neither 0700 nor the usual 0755
+    mode_t saved = ::umask(027);
+    ~Umask() { ::umask(saved); }
+  } umask_027;
   ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "new"}, tmp.dir).rc, 0);
   EXPECT_EQ(mode(tmp / "new"), 0750u);
   fs::create_directories(tmp / "mine");
@@ -981,9 +980,12 @@ TEST(DataLoss, AnOutputFolderHasTheModeMkdirWouldGiveIt) {
   ::chmod((tmp / "new").c_str(), 0711);  // an earlier run's folder, replaced
   ASSERT_EQ(run_quadgen({"derive", vehicle, "--out", tmp / "new"}, tmp.dir).rc, 0);
   EXPECT_EQ(mode(tmp / "new"), 0711u);
-  ::umask(saved);
 }
 
+// A run that fails leaves nothing behind, not even the folders --out needed: a bad vehicle
+// file into a nested --out, for each command that writes an output set (found by a review:
+// derive and predict, which had started to create the set before reading the vehicle, left
+// a/ and a/b/). The vehicle file's error is the one reported, whatever --out holds.
 TEST(DataLoss, AFailedRunLeavesNoFoldersBehind) {
   Scratch tmp;
   write(tmp / "bad.yaml", "name: [\n");

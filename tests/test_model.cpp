@@ -1183,7 +1183,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     v.rotors[0].position[2] = 0.0079;  // a tenth of a millimetre into the motor: a file's rounding
     EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
     // The battery (7.5 mm thick) raised to the discs' plane and slid towards M4's hub until
-    // 5 mm of the disc's edge, hub outside, sweeps through it.
+    // 5 mm of the disc's edge, hub outside, sweeps through it (and 7 mm of M3's).
     v = cf;
     Block& battery = *std::find_if(v.blocks.begin(), v.blocks.end(), [](const Block& b) { return b.name == "battery"; });
     battery.centre = {0.005 + 0.0325 - 0.0225 - 0.016, 0.0325, 0.008};
@@ -1193,8 +1193,30 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
                             "below the disc's plane (a propeller cannot pass"),
               std::string::npos)
         << c.detail;
+    EXPECT_NE(c.detail.find("rotor M3's disc passes through block battery"), std::string::npos) << c.detail;
+    EXPECT_EQ(c.detail.find("rotor M1"), std::string::npos) << c.detail;
     battery.centre[2] = 0.008 + 0.0075 / 2 + 1e-4;  // lifted just clear of the disc's plane
     EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
+    // Blocks a sampled disc could miss (helper-55): a 1 mm mast through M1's disc at 0.9 of
+    // its radius, and a 0.6 mm plate about M1's hub.
+    v = cf;
+    v.blocks.push_back({"mast", 1e-4, {0.001, 0.001, 0.03}, {0.0325 + 0.9 * 0.0225, -0.0325, 0.008}, {0, 0, 0}, 0});
+    c = checks_of(v).at(clear);
+    EXPECT_NE(c.detail.find("rotor M1's disc passes through block mast, which reaches 15 mm above and 15 mm below"),
+              std::string::npos)
+        << c.detail;
+    v.blocks.back() = {"plate", 1e-4, {0.05, 0.05, 0.0006}, {0.0325, -0.0325, 0.008}, {0, 0, 0}, 0};
+    c = checks_of(v).at(clear);
+    EXPECT_NE(c.detail.find("rotor M1's disc passes through block plate, which reaches 0.3 mm above and 0.3 mm below "
+                            "the disc's plane (its hub inside"),
+              std::string::npos)
+        << c.detail;
+    v.blocks.back().centre = {0.0325 + 0.0225 + 0.025 + 1e-4, -0.0325, 0.008};  // its edge just past the rim
+    EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
+    v.blocks.back().yaw_pitch_roll_deg = {0, 0, 90};  // stood on edge, rolled about x: still clear
+    EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
+    v.blocks.back().centre[0] -= 0.002;  // and 2 mm into the disc
+    EXPECT_FALSE(checks_of(v).at(clear).passed);
   }
   const std::string scale = "rotors and blocks on one scale";
   {  // numbers copied in millimetres where the file reads metres: one at a time

@@ -1,10 +1,10 @@
-#include "output/sha256.hpp"
+#include "model/sha256.hpp"
 
 #include <openssl/evp.h>
 
 #include <stdexcept>
 
-namespace quadgen::output {
+namespace quadgen {
 
 std::string sha256_hex(const std::string& bytes) {
   unsigned char digest[EVP_MAX_MD_SIZE];
@@ -20,4 +20,4 @@ std::string sha256_hex(const std::string& bytes) {
   return hex;
 }
 
-}  // namespace quadgen::output
+}  // namespace quadgen
