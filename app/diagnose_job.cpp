@@ -148,6 +148,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   }
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
   // The model and the airframe first: a wrong --airframe file is said before the logs are read.
+  if (const std::string note = fitted_section_note(v, "diagnose"); !note.empty()) o.progress.say("[diagnose] " + note);
   o.progress.say("[diagnose] deriving the full-catalogue model's equations (its parameters, units and structure)");
   const MassProperties mp = derive_mass_properties(v);
   DeriveOptions all_opt;

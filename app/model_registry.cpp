@@ -24,6 +24,16 @@ std::vector<std::string> names_of(const std::vector<Variable>& vars) {
   return out;
 }
 
+// Equal to 1e-12 relative, not bit for bit: a compiler that contracts a*b+c may round a
+// derived quantity differently from the machine that generated the header.
+bool values_equal(const double* header, const std::vector<Variable>& vars) {
+  for (size_t i = 0; i < vars.size(); ++i) {
+    const double a = vars[i].nominal, b = header[i];
+    if (!(std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b)))) return false;
+  }
+  return true;
+}
+
 bool names_equal(const char* const* header, int count, const std::vector<std::string>& names) {
   if (names.size() != static_cast<size_t>(count)) return false;
   for (int i = 0; i < count; ++i)
@@ -36,21 +46,17 @@ bool names_equal(const char* const* header, int count, const std::vector<std::st
 // its states, inputs, parameters and nominal values are the derivation's, so that no header
 // ever runs with another vehicle's shape (a simulation writes one command per rotor into an
 // input vector of the header's size). A forgeable FNV-1a hash once let a six-rotor file run
-// on a four-rotor header. What the header's code holds as fixed numbers (rotor places,
-// radii, spins) and its bounds rest on the hash alone. Nominal values agree to 1e-12
-// relative, not bit for bit: a compiler that contracts a*b+c may round the derived inertia
-// differently from the machine that generated the header.
+// on a four-rotor header. The fixed numbers its code holds (rotor places, radii, areas) are
+// compared too; the rotors' spins and the parameters' bounds rest on the hash alone.
 template <class M>
 std::unique_ptr<runtime::DynamicModel> compiled_if(const SymbolicModel& m) {
   if (m.vehicle_hash != M::kVehicleHash || m.effect_list() != M::kEffects) return nullptr;
   if (!names_equal(M::kStateNames, M::kNumStates, names_of(m.states)) ||
       !names_equal(M::kInputNames, M::kNumInputs, names_of(m.inputs)) ||
-      !names_equal(M::kParamNames, M::kNumParams, names_of(m.params)))
+      !names_equal(M::kParamNames, M::kNumParams, names_of(m.params)) ||
+      !names_equal(M::kConstantNames, M::kNumConstants, names_of(m.constants)))
     return nullptr;
-  for (int i = 0; i < M::kNumParams; ++i) {
-    const double a = m.params[i].nominal, b = M::kNominalParams[i];
-    if (!(std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b)))) return nullptr;
-  }
+  if (!values_equal(M::kNominalParams, m.params) || !values_equal(M::kConstantValues, m.constants)) return nullptr;
   return std::make_unique<runtime::CompiledModel<M>>();
 }
 

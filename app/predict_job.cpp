@@ -74,6 +74,7 @@ PredictJobResult run_predict_job(const PredictJob& job_in, const Vehicle& v) {
   std::string how;
   const std::unique_ptr<runtime::DynamicModel> model = model_for(v, parse_effect_list("all"), &how);
   job.options.progress.say("model: " + how);
+  if (const std::string note = fitted_section_note(v, "predict"); !note.empty()) job.options.progress.say(note);
   const predict::PredictedFlights p = predict::predict_flights(v, *model, model->parameters(), job.logs, job.options);
   check_something_measured(p.pooled, job);
   r.files = {{"prediction.json", output::json_document(p.json)}, {"prediction.csv", predict::prediction_csv(p.pooled)}};

@@ -93,6 +93,7 @@ void check_flight_options(const FitArgs& a) {
 
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);
+  if (const std::string note = fitted_section_note(v, "fit"); !note.empty()) std::cerr << note << "\n";
   const LogKind kind = log_kind(a.log);
   output::OutputDirectory out(a.out, "fit", {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
   const FitJobOptions o = job_options(a);

@@ -27,7 +27,7 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_option("--resample", a.options.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(0.1, 1e5));
   c->add_flag("--calibrate", a.options.calibrate,
-              "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (motor trims, "
+              "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (c_t, motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");
   c->add_option("--environment", a.environment,
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "

@@ -151,6 +151,11 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("param_upper", upper + "}");
   d.set("param_fit", fit + "}");
   d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
+  d.set("n_constants", std::to_string(m.constants.size()));
+  d.set("constant_names", quoted_list(m.constants));
+  std::string values = "{";
+  for (size_t i = 0; i < m.constants.size(); ++i) values += (i ? ", " : "") + number(m.constants[i].nominal);
+  d.set("constant_values", values + "}");
 }
 
 // Each Jacobian's sparsity pattern (row and column of every stored entry).

@@ -163,9 +163,12 @@ void declare_rotors(ModelContext& c) {
     const std::string n = r.name;
     c.rotor_disc_area.push_back(c.add_constant(n + ".A_p", "m^2", r.disc_area, "thrust-law area of rotor " + n + " (its disc_area)"));
     c.rotor_radius.push_back(c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n));
-    c.rotor_position.push_back(vec3(c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x"),
-                                    c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y"),
-                                    c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z")));
+    // One statement each: the order of a call's arguments is unspecified, and it is the
+    // order of the constants in the model (GCC declared z, y, x; another compiler x, y, z).
+    const ex x = c.add_constant(n + ".x", "m", r.position[0], "rotor " + n + " position x");
+    const ex y = c.add_constant(n + ".y", "m", r.position[1], "rotor " + n + " position y");
+    const ex z = c.add_constant(n + ".z", "m", r.position[2], "rotor " + n + " position z");
+    c.rotor_position.push_back(vec3(x, y, z));
     const ex u = c.model.inputs[i].sym;
     const ex w = commanded_rotor_speed(c, u, pivot);
     c.commanded_speed.push_back(w);

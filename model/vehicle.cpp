@@ -287,6 +287,15 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
 
 Vehicle load_vehicle(const std::string& path) { return parse_vehicle(YamlReader{path}.read_file("vehicle file"), path); }
 
+std::string fitted_section_note(const Vehicle& v, const std::string& command) {
+  if (v.fitted_line == 0) return "";
+  std::string note = "note: " + output::printable(v.source_path) + ":" + std::to_string(v.fitted_line) +
+                     ": its `fitted:` section is read only by `quadgen derive`; " + command +
+                     " uses the file's own values";
+  if (command == "predict") note += " (to predict with a diagnosis' values, pass its diagnosis.json with --params)";
+  return note;
+}
+
 std::vector<std::string> rotor_names(const Vehicle& v) {
   std::vector<std::string> names;
   for (const Rotor& r : v.rotors) names.push_back(r.name);

@@ -103,6 +103,11 @@ Vehicle parse_vehicle(const std::string& text, const std::string& path_for_messa
 
 const Parameter& param(const Vehicle& v, const std::string& name);
 
+// What `command` (fit, diagnose, predict) tells a user who hands it a file with a `fitted:`
+// section (a diagnosis' fitted_vehicle.yaml): only derive reads that section, so the run uses
+// the file's own values. Empty where the file has none. The path is made printable.
+std::string fitted_section_note(const Vehicle& v, const std::string& command);
+
 // The rotors' names in the vehicle file's order (the log columns u_<name>, the inputs' order).
 std::vector<std::string> rotor_names(const Vehicle& v);
 inline bool is_thesis_vehicle(const Vehicle& v) { return is_thesis_vehicle(v.name, rotor_names(v)); }

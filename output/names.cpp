@@ -19,7 +19,8 @@ const std::set<std::string>& generated_header_names() {
       "abs_value", "sign_of", "precompute", "rhs", "rotor_speed_rates", "measurement", "kNumStates",
       "kNumInputs", "kNumParams", "kNumOutputs", "kNumPrecomputed", "kNumRotorSpeedStates", "kRotorSpeedStates",
       "kVehicleHash", "kEffects", "kStateNames", "kInputNames", "kParamNames", "kOutputNames", "kNominalParams",
-      "kInputDelayParam", "kParamUnits", "kParamLower", "kParamUpper", "kParamFit"};
+      "kInputDelayParam", "kParamUnits", "kParamLower", "kParamUpper", "kParamFit", "kNumConstants", "kConstantNames",
+      "kConstantValues"};
   return names;
 }
 

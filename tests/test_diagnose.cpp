@@ -896,6 +896,16 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
                 (dir / "out" / "fitted_parameters.yaml").string() + " --out " + (dir / "both").string() +
                 " > /dev/null 2>&1"),
             "");
+  // predict reads the file's own values, not `fitted:`, and says so with what to pass instead
+  ASSERT_EQ(run(std::string(QUADGEN_BINARY) + " predict " + (dir / "out" / "fitted_vehicle.yaml").string() + " " +
+                fa.string() + " --out " + (dir / "predicted").string() + " > /dev/null 2> " + (dir / "predict.err").string()),
+            "");
+  std::ifstream pe(dir / "predict.err");
+  const std::string said((std::istreambuf_iterator<char>(pe)), {});
+  EXPECT_NE(said.find(": its `fitted:` section is read only by `quadgen derive`; predict uses the file's own values (to "
+                      "predict with a diagnosis' values, pass its diagnosis.json with --params)"),
+            std::string::npos)
+      << said;
 }
 
 // Two flights of one airframe: each flight alone must show the named airframe effect with the

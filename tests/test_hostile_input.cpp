@@ -356,6 +356,9 @@ TEST(HostileVehicle, AGeneratedHeaderRunsOnlyForTheFileAndShapeItWasGeneratedFro
   quadgen::Vehicle renamed = cf;
   renamed.rotors[0].name = "M0";
   EXPECT_FALSE(compiled(renamed));
+  quadgen::Vehicle longer_arms = cf;  // the same blocks and parameters: only the header's constants differ
+  for (auto& r : longer_arms.rotors) r.position[0] *= 1.1, r.position[1] *= 1.1;
+  EXPECT_FALSE(compiled(longer_arms));
 }
 
 TEST(NameRule, DuplicateKeysInVehicleFilesAreRefused) {

@@ -48,6 +48,12 @@ inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeed
 // file (SHA-256 of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "31d748da5c783245545025d4e50de6b544acc263f0d248f7f7c7613ac981266b";
 inline constexpr const char* kEffects = "";
+// The fixed numbers (SI) the code below holds as literals, as the derivation names them: each
+// rotor's thrust-law area, radius and position, the motor map's pivot where it has one. A
+// runtime compares them with the vehicle's before it runs this header in place of a derivation.
+inline constexpr int kNumConstants = 21;
+inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"motor_pivot", "M1.A_p", "M1.r_p", "M1.x", "M1.y", "M1.z", "M2.A_p", "M2.r_p", "M2.x", "M2.y", "M2.z", "M3.A_p", "M3.r_p", "M3.x", "M3.y", "M3.z", "M4.A_p", "M4.r_p", "M4.x", "M4.y", "M4.z"};
+inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.86, 0.0015904, 0.0225, 0.0325, -0.0325, 0.008, 0.0015904, 0.0225, -0.0325, -0.0325, 0.008, 0.0015904, 0.0225, -0.0325, 0.0325, 0.008, 0.0015904, 0.0225, 0.0325, 0.0325, 0.008};
 
 struct State {
   enum : int {
@@ -1522,6 +1528,9 @@ struct Model {
   static constexpr const bool* kParamFit = crazyflie21_nanobench::kParamFit;
   static constexpr const char* kVehicleHash = crazyflie21_nanobench::kVehicleHash;
   static constexpr const char* kEffects = crazyflie21_nanobench::kEffects;
+  static constexpr int kNumConstants = crazyflie21_nanobench::kNumConstants;
+  static constexpr const char* const* kConstantNames = crazyflie21_nanobench::kConstantNames;
+  static constexpr const double* kConstantValues = crazyflie21_nanobench::kConstantValues;
   template <typename Scalar>
   using Precomputed = crazyflie21_nanobench::Precomputed<Scalar>;
 

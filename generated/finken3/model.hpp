@@ -48,6 +48,12 @@ inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeed
 // file (SHA-256 of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "9839b4003bc225a0b4f07835457206e56680261276c0280cbf2348d9010f673e";
 inline constexpr const char* kEffects = "";
+// The fixed numbers (SI) the code below holds as literals, as the derivation names them: each
+// rotor's thrust-law area, radius and position, the motor map's pivot where it has one. A
+// runtime compares them with the vehicle's before it runs this header in place of a derivation.
+inline constexpr int kNumConstants = 20;
+inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"A.A_p", "A.r_p", "A.x", "A.y", "A.z", "B.A_p", "B.r_p", "B.x", "B.y", "B.z", "C.A_p", "C.r_p", "C.x", "C.y", "C.z", "D.A_p", "D.r_p", "D.x", "D.y", "D.z"};
+inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.001646, 0.0635, -0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, 0.07465, 0, 0.001646, 0.0635, -0.07465, 0.07465, 0};
 
 struct State {
   enum : int {
@@ -1436,6 +1442,9 @@ struct Model {
   static constexpr const bool* kParamFit = finken3::kParamFit;
   static constexpr const char* kVehicleHash = finken3::kVehicleHash;
   static constexpr const char* kEffects = finken3::kEffects;
+  static constexpr int kNumConstants = finken3::kNumConstants;
+  static constexpr const char* const* kConstantNames = finken3::kConstantNames;
+  static constexpr const double* kConstantValues = finken3::kConstantValues;
   template <typename Scalar>
   using Precomputed = finken3::Precomputed<Scalar>;
 

@@ -48,6 +48,12 @@ inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeed
 // file (SHA-256 of its bytes) and effect list.
 inline constexpr const char* kVehicleHash = "9839b4003bc225a0b4f07835457206e56680261276c0280cbf2348d9010f673e";
 inline constexpr const char* kEffects = "motor_gain,motor_lag_spread,motor_lag,input_delay,cog_offset,wind,rotor_drag,blade_flapping,attitude_bias,thrust_decay,battery_sag,ground_effect,inflow";
+// The fixed numbers (SI) the code below holds as literals, as the derivation names them: each
+// rotor's thrust-law area, radius and position, the motor map's pivot where it has one. A
+// runtime compares them with the vehicle's before it runs this header in place of a derivation.
+inline constexpr int kNumConstants = 21;
+inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"A.A_p", "A.r_p", "A.x", "A.y", "A.z", "B.A_p", "B.r_p", "B.x", "B.y", "B.z", "C.A_p", "C.r_p", "C.x", "C.y", "C.z", "D.A_p", "D.r_p", "D.x", "D.y", "D.z", "ground_effect.floor"};
+inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.001646, 0.0635, -0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, 0.07465, 0, 0.001646, 0.0635, -0.07465, 0.07465, 0, 1e-06};
 
 struct State {
   enum : int {
@@ -2151,6 +2157,9 @@ struct Model {
   static constexpr const bool* kParamFit = finken3_all_effects::kParamFit;
   static constexpr const char* kVehicleHash = finken3_all_effects::kVehicleHash;
   static constexpr const char* kEffects = finken3_all_effects::kEffects;
+  static constexpr int kNumConstants = finken3_all_effects::kNumConstants;
+  static constexpr const char* const* kConstantNames = finken3_all_effects::kConstantNames;
+  static constexpr const double* kConstantValues = finken3_all_effects::kConstantValues;
   template <typename Scalar>
   using Precomputed = finken3_all_effects::Precomputed<Scalar>;
 
