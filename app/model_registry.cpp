@@ -25,7 +25,8 @@ std::vector<std::string> names_of(const std::vector<Variable>& vars) {
 }
 
 // Equal to 1e-12 relative, not bit for bit: a compiler that contracts a*b+c may round a
-// derived quantity differently from the machine that generated the header.
+// derived quantity differently from the machine that generated the header. The header's
+// array has the length of `vars` (names_equal checks it first).
 bool values_equal(const double* header, const std::vector<Variable>& vars) {
   for (size_t i = 0; i < vars.size(); ++i) {
     const double a = vars[i].nominal, b = header[i];
