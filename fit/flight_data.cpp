@@ -110,7 +110,8 @@ double unit_scale(const std::string& path, const YAML::Node& at, const std::stri
 }
 
 const char* const kCanonicalColumns =
-    "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>";
+    "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>, "
+    "phi_ref, theta_ref";
 
 ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key, const YAML::Node& value) {
   ColumnMapping::Entry e;
@@ -139,7 +140,7 @@ std::string canonical_unit(const std::string& c) {
       {"t", "s"},       {"x", "m"},       {"y", "m"},         {"z", "m"},       {"vx", "m/s"},    {"vy", "m/s"},
       {"vz", "m/s"},    {"qw", "1"},      {"qx", "1"},        {"qy", "1"},      {"qz", "1"},      {"phi", "rad"},
       {"theta", "rad"}, {"psi", "rad"},   {"p", "rad/s"},     {"q", "rad/s"},   {"r", "rad/s"},   {"ax", "m/s^2"},
-      {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},
+      {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},     {"phi_ref", "rad"}, {"theta_ref", "rad"},
   };
   const auto it = units.find(c);
   if (it != units.end()) return it->second;
@@ -206,7 +207,7 @@ namespace {
 // q_frd<-flu = (0, 1, 0, 0).
 void ned_frd_to_enu_flu(runtime::CsvTable& t, const std::string& mapping_name) {
   const auto col = [&](const char* n) { return t.column(n); };
-  for (const char* euler : {"phi", "theta", "psi"})
+  for (const char* euler : {"phi", "theta", "psi", "phi_ref", "theta_ref"})
     if (col(euler) >= 0)
       throw FitError(mapping_name + ": frame ned_frd converts a quaternion attitude (qw..qz), not Euler angles ('" +
                      std::string(euler) + "')");
@@ -456,6 +457,7 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   f.has_gyro = has({"p", "q", "r"});
   f.has_accelerometer = has({"ax", "ay", "az"});
   f.has_vbat = has({"vbat"});
+  f.has_attitude_ref = has({"phi_ref", "theta_ref"});
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
   if (!f.has_pose && !f.has_accelerometer)
@@ -468,7 +470,7 @@ struct FlightColumns {
   std::vector<double> t;                          // s, from the first row
   std::vector<std::vector<double>> states;        // kStateNames, 0 where not logged
   std::vector<std::vector<double>> acc, rate_dot;  // world acceleration, body-rate derivative
-  std::vector<double> ax, ay, az, vbat;
+  std::vector<double> ax, ay, az, vbat, phi_ref, theta_ref;
   std::vector<std::vector<double>> commands;      // per rotor
 };
 
@@ -488,6 +490,7 @@ FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::
     c.rate_dot.push_back(smoothed_derivative(c.t, c.states[kBodyRate + i], o.derivative_window));
   }
   c.ax = col("ax"), c.ay = col("ay"), c.az = col("az"), c.vbat = col("vbat");
+  c.phi_ref = col("phi_ref"), c.theta_ref = col("theta_ref");
   for (const auto& r : rotors) c.commands.push_back(log.values("u_" + r));
   return c;
 }
@@ -512,6 +515,8 @@ FlightSample sample_at(const FlightColumns& c, size_t k, const runtime::CsvTable
   fs.specific_force[0] = c.ax[k];
   fs.specific_force[1] = c.ay[k];
   fs.specific_force[2] = c.az[k];
+  fs.attitude_ref[0] = c.phi_ref[k];
+  fs.attitude_ref[1] = c.theta_ref[k];
   return fs;
 }
 
@@ -574,13 +579,14 @@ std::vector<double> join_offsets(const std::vector<Flight>& flights, double gap)
 
 Flight empty_join(const std::vector<Flight>& flights) {
   Flight out;
-  out.has_accelerometer = out.has_gyro = out.has_pose = out.has_vbat = true;
+  out.has_accelerometer = out.has_gyro = out.has_pose = out.has_vbat = out.has_attitude_ref = true;
   for (const auto& f : flights) {
     out.source += (out.source.empty() ? "" : " + ") + f.source;
     out.has_accelerometer = out.has_accelerometer && f.has_accelerometer;
     out.has_gyro = out.has_gyro && f.has_gyro;
     out.has_pose = out.has_pose && f.has_pose;
     out.has_vbat = out.has_vbat && f.has_vbat;
+    out.has_attitude_ref = out.has_attitude_ref && f.has_attitude_ref;
   }
   return out;
 }

@@ -50,12 +50,16 @@ struct FlightSample {
   double acc_world[3] = {0, 0, 0};  // d(v)/dt, world frame (smoothed derivative)
   double rate_dot[3] = {0, 0, 0};   // d(p,q,r)/dt, body (smoothed derivative)
   double specific_force[3] = {0, 0, 0};  // accelerometer, body frame, where logged
+  // The roll and pitch set points the flight controller's attitude loop followed (Z-Y-X Euler
+  // angles, rad), where logged (phi_ref, theta_ref): what predict's set-points-flown view flies.
+  double attitude_ref[2] = {0, 0};
 };
 
 struct Flight {
   std::string source;
   std::vector<FlightSample> samples;
   bool has_accelerometer = false, has_gyro = false, has_pose = false, has_vbat = false;
+  bool has_attitude_ref = false;  // phi_ref and theta_ref logged
 };
 
 struct FlightOptions {

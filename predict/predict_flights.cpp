@@ -18,7 +18,21 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   const runtime::CsvTable log = fit::read_log(path, o.mapping ? &*o.mapping : nullptr, o.resample);
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
   if (!flight.has_pose) o.progress.say(path + ": no pose logged: one-step errors only (rollouts need a measured state)");
+  if (!o.set_point_controller.empty() && !flight.has_attitude_ref)
+    throw fit::FitError(path + ":1: --controller " + o.set_point_controller +
+                        " flies the log's attitude set points, but it has no phi_ref and theta_ref columns "
+                        "(docs/formats.md; data/mappings/nanobench.yaml maps them for the NanoBench logs)");
   return flight;
+}
+
+// The controller of --controller, mixed by the vehicle's rotor positions.
+std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::string& controller) {
+  if (controller.empty()) return std::nullopt;
+  if (controller != "crazyflie-pid")
+    throw std::invalid_argument("--controller: unknown controller '" + controller + "' (expected crazyflie-pid)");
+  std::vector<std::array<double, 3>> positions;
+  for (const auto& r : v.rotors) positions.push_back(r.position);
+  return SetPointFlying{runtime::AttitudePidOptions{}, runtime::AttitudeMixer::quad_x(positions)};
 }
 
 // "indoors", "outdoors", "in any environment".
@@ -65,6 +79,8 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
     throw std::invalid_argument("--calibrate needs a part before the evaluated one: --validation below 1");
   if (o.linear_correction && o.validation >= 1.0)
     throw std::invalid_argument("--linear-correction needs a part before the evaluated one to fit on: --validation below 1");
+  PredictionOptions prediction = o.prediction;
+  prediction.set_points = set_point_flying(v, o.set_point_controller);
   const std::vector<double> nominal = model.params();  // before any calibration moves the model's
   std::optional<ParameterSource> source;
   if (!o.params.empty()) source.emplace(o.params);
@@ -94,7 +110,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
       values.origin += ", flight parameters calibrated on the part before";
       implausible = implausible_calibration(v, model, values.values, values.flight_params, bounds, o);
     }
-    Prediction p = evaluate_prediction(model, values.values, evaluated, o.prediction);
+    Prediction p = evaluate_prediction(model, values.values, evaluated, prediction);
     if (o.linear_correction) p.one_step_corrected = linearly_corrected_one_step(model, values.values, before, evaluated);
     auto j = prediction_json(p);
     j["log"] = logs[i];

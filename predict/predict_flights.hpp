@@ -33,6 +33,10 @@ struct PredictFlightsOptions {
   // Also the one-step errors left after a linear correction fitted on the part before
   // (linearly_corrected_one_step; needs validation below 1).
   bool linear_correction = false;
+  // Also fly each log's attitude set points (phi_ref, theta_ref) with this controller: "" (not
+  // run) or "crazyflie-pid" (runtime::AttitudePidOptions' defaults, mixed by the vehicle's
+  // rotor positions). Sets prediction.set_points; a log without set points is refused.
+  std::string set_point_controller;
   PredictionOptions prediction;
   output::Progress progress;  // which log, calibration, notes; nowhere by default
 };

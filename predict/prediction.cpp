@@ -49,6 +49,7 @@ void Prediction::merge(const Prediction& o) {
   merge_rows(attitude_replayed, o.attitude_replayed);
   merge_rows(translation_replayed, o.translation_replayed);
   merge_rows(open_loop_past_disturbance, o.open_loop_past_disturbance);
+  merge_rows(set_points_flown, o.set_points_flown);
   one_step.merge(o.one_step);
   if (o.one_step_corrected) {
     if (!one_step_corrected) one_step_corrected = OneStepErrors{};
@@ -220,6 +221,10 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
     out.disturbance_window = o.disturbance_window;
     out.open_loop_past_disturbance = rollouts(roll, f, o, Replay::kNothing, nullptr, o.disturbance_window);
   }
+  if (o.set_points && f.has_attitude_ref) {
+    roll.fly_set_points(*o.set_points);
+    out.set_points_flown = rollouts(roll, f, o, Replay::kSetPoints);
+  }
   return out;
 }
 
@@ -361,6 +366,7 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
           {"translation_replayed", moments},
           {"open_loop_past_disturbance", full_rows(p.open_loop_past_disturbance)},
           {"disturbance_window_s", p.disturbance_window},
+          {"set_points_flown", full_rows(p.set_points_flown)},
           {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
@@ -397,6 +403,7 @@ std::string prediction_csv(const Prediction& p) {
     row("attitude_replayed", h.horizon, "velocity", "m/s", h.velocity);
   }
   open_loop_rows("open_loop_past_disturbance", p.open_loop_past_disturbance);
+  open_loop_rows("set_points_flown", p.set_points_flown);
   for (const auto& h : p.translation_replayed) {
     row("translation_replayed", h.horizon, "tilt", "rad", h.tilt);
     row("translation_replayed", h.horizon, "heading", "rad", h.heading);
@@ -432,7 +439,8 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   for (const auto& [label, p] : predictions) {
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
     runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true},
-        sm{label, {}, {}}, sd{label + ", past disturbance held", {}, {}, true};
+        sm{label, {}, {}}, sd{label + ", past disturbance held", {}, {}, true},
+        sf{label + ", set points flown", {}, {}, true};
     for (const auto& h : p->open_loop) {
       so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
       st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());
@@ -441,8 +449,10 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
     for (const auto& h : p->attitude_replayed) sr.x.push_back(h.horizon), sr.y.push_back(h.position.mean());
     for (const auto& h : p->translation_replayed) sm.x.push_back(h.horizon), sm.y.push_back(h.tilt.mean());
     for (const auto& h : p->open_loop_past_disturbance) sd.x.push_back(h.horizon), sd.y.push_back(h.position.mean());
+    for (const auto& h : p->set_points_flown) sf.x.push_back(h.horizon), sf.y.push_back(h.position.mean());
     open.series.push_back(so);
     if (!sd.x.empty()) open.series.push_back(sd);
+    if (!sf.x.empty()) open.series.push_back(sf);
     replay.series.push_back(sr);
     tilt.series.push_back(st);
     tilt.series.push_back(sh);

@@ -13,6 +13,13 @@
 //  - open loop, past disturbance held: the open loop with the acceleration residual of the
 //    log's last disturbance_window seconds before each start added over the rollout
 //    (Rollout::past_disturbance): how much of the error is slow enough to persist.
+//  - set points flown (where the log holds attitude set points and a controller is given):
+//    the open loop with the roll and pitch part of the commands from a replica of the
+//    vehicle's attitude controller flying the logged set points (Rollout::fly_set_points),
+//    the collective and yaw logged. Not a published measure and not the open loop: its
+//    inputs are the controller's set points, one loop further out than the motor commands.
+//    It says how far the model carries the translation when the attitude is held the way the
+//    vehicle's controller held it.
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
@@ -27,6 +34,7 @@
 #include "runtime/dynamic_model.hpp"
 #include "fit/flight_data.hpp"
 #include "runtime/plot.hpp"
+#include "predict/rollout.hpp"
 
 namespace quadgen::predict {
 
@@ -39,6 +47,9 @@ struct PredictionOptions {
   // Seconds of log before each start from which the open loop with the past disturbance
   // takes the disturbance it holds (Rollout::past_disturbance); 0: that view is not run.
   double disturbance_window = 0.5;
+  // The controller that flies the logged attitude set points (the set-points-flown view);
+  // none: that view is not run, nor on a log without set points.
+  std::optional<SetPointFlying> set_points;
 };
 
 // Mean and RMS of an error over start points; kept as sums so that flights can be pooled.
@@ -84,6 +95,8 @@ struct Prediction {
   // over the horizon, which the model does not carry.
   std::vector<HorizonErrors> open_loop_past_disturbance;
   double disturbance_window = 0;  // s
+  // The open loop with the attitude controller flying the logged set points (see above).
+  std::vector<HorizonErrors> set_points_flown;
   OneStepErrors one_step;
   // With a linear correction fitted on the part before (linearly_corrected_one_step).
   std::optional<OneStepErrors> one_step_corrected;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "runtime/attitude.hpp"
 #include "runtime/rigid_body_state.hpp"
@@ -32,7 +33,42 @@ Rollout::Start Rollout::start_at(size_t k, Replay replay) {
   // unbiased with this rollout's bias, renormalised), so that a replayed view starts exactly
   // on what it replays.
   impose(replay, f_.samples[k].t, k, x);
+  flying_now_ = replay == Replay::kSetPoints;
+  if (flying_now_) start_controller(k, x);
   return {e_, x};
+}
+
+namespace {
+
+std::array<double, 2> roll_and_pitch(const std::vector<double>& x) {
+  const auto e = runtime::euler_zyx(x[kAttitude], x[kAttitude + 1], x[kAttitude + 2], x[kAttitude + 3]);
+  return {e[0], e[1]};
+}
+
+}  // namespace
+
+void Rollout::start_controller(size_t k, const std::vector<double>& x) {
+  if (!flying_ || !f_.has_attitude_ref)
+    throw std::logic_error("Rollout: flying set points needs fly_set_points and a flight with phi_ref, theta_ref");
+  const auto& s = f_.samples[k];
+  pid_ = runtime::AttitudePid(flying_->pid);
+  pid_.start(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, {s.attitude_ref[0], s.attitude_ref[1]},
+             flying_->mixer.outputs_in(s.u.data(), flying_->pid.counts_per_command));
+  flight_start_ = s.t;
+  updates_ = 0;
+  flown_.clear();
+}
+
+// The controller's steps due by time t (its clock starts at the rollout's first sample), on
+// the simulated state and the set points logged at or before each step.
+void Rollout::update_controller(double t, const std::vector<double>& x) {
+  while (flight_start_ + static_cast<double>(updates_) * pid_.period() <= t + 1e-9) {
+    const double tu = flight_start_ + static_cast<double>(updates_) * pid_.period();
+    const auto& s = f_.samples[held_sample(f_, tu)];
+    const auto out = pid_.update(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, {s.attitude_ref[0], s.attitude_ref[1]});
+    flown_.push_back({tu, out[0], out[1]});
+    ++updates_;
+  }
 }
 
 bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
@@ -41,6 +77,7 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
   const double h = (t1 - t0) / steps;
   for (int i = 0; i < steps; ++i) {
     const double t = t0 + i * h;
+    if (flying_now_) update_controller(t, x);
     deriv(t, x, k, replay, k1_);
     stage(x, k1_, h / 2);
     deriv(t + h / 2, tmp_, k, replay, k2_);
@@ -90,7 +127,24 @@ void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const 
 void Rollout::inputs(double t, double* u) const {
   const auto& s = f_.samples[command_sample(f_, t, e_.delay, first_command_)];
   std::copy(s.u.begin(), s.u.end(), u);
+  if (flying_now_) replace_roll_and_pitch(t, u);
   extra_.fill(t, f_.samples[held_sample(f_, t)].vbat, u);
+}
+
+// The logged commands' roll and pitch parts replaced by the controller's output of the
+// latest step at or before t - delay (a step's own time counts, as command_sample's does);
+// before the first, the logged commands act unchanged.
+void Rollout::replace_roll_and_pitch(double t, double* u) const {
+  const double acting = t - e_.delay + 1e-9;
+  const auto after = std::upper_bound(flown_.begin(), flown_.end(), acting,
+                                      [](double v, const std::array<double, 3>& f) { return v < f[0]; });
+  if (after == flown_.begin()) return;
+  const std::array<double, 3>& out = *(after - 1);
+  const auto& mix = flying_->mixer;
+  const double counts = flying_->pid.counts_per_command;
+  const auto logged = mix.outputs_in(u, counts);
+  for (size_t i = 0; i < mix.roll.size(); ++i)
+    u[i] = std::clamp(u[i] + (mix.roll[i] * (out[1] - logged[0]) + mix.pitch[i] * (out[2] - logged[1])) / counts, 0.0, 1.0);
 }
 
 void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {
@@ -110,6 +164,7 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
   if (model_acc_.empty()) {  // once per flight: the model at every logged state
     const runtime::DataSideEffects saved = e_;
     const size_t saved_first = first_command_;
+    const bool saved_flying = flying_now_;
     std::vector<double> f(n_);
     model_acc_.resize(S.size());
     for (size_t j = 0; j < S.size(); ++j) {
@@ -118,7 +173,7 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
       m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
       for (int a = 0; a < 3; ++a) model_acc_[j][a] = f[kVelocity + a], model_acc_[j][3 + a] = f[kBodyRate + a];
     }
-    e_ = saved, first_command_ = saved_first;
+    e_ = saved, first_command_ = saved_first, flying_now_ = saved_flying;
   }
   // The window stays within the sample's stretch and after the rotor speeds are known: just
   // after a restart the states carry the steady-state guess, and the model's accelerations

@@ -12,10 +12,12 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "fit/flight_data.hpp"
 #include "predict/start_state.hpp"
+#include "runtime/attitude_pid.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "runtime/dynamic_model.hpp"
 
@@ -24,8 +26,16 @@ namespace quadgen::predict {
 // What a rollout takes from the log at every RK4 stage instead of integrating it: nothing
 // (open loop), the attitude and body rates (the force model alone), or the position and
 // velocity (the moment model alone: the attitude it drifts to through its own moments, with
-// the airspeed terms read at the measured velocity).
-enum class Replay { kNothing, kAttitude, kTranslation };
+// the airspeed terms read at the measured velocity). kSetPoints imposes nothing either, but
+// takes the roll and pitch part of the commands from a controller flying the logged attitude
+// set points (Rollout::fly_set_points) instead of from the log.
+enum class Replay { kNothing, kAttitude, kTranslation, kSetPoints };
+
+// The controller that flies the set points and how its outputs reach the rotors.
+struct SetPointFlying {
+  runtime::AttitudePidOptions pid;
+  runtime::AttitudeMixer mixer;
+};
 
 class Rollout {
  public:
@@ -33,6 +43,14 @@ class Rollout {
   // set in `model`. `model` and `f` must outlive the rollout.
   Rollout(runtime::DynamicModel& model, const fit::Flight& f, const std::vector<double>& p, double step = 1e-3);
   Rollout(runtime::DynamicModel&, const fit::Flight&&, const std::vector<double>&, double = 1e-3) = delete;
+
+  // Replay::kSetPoints flies with this controller (the flight must hold attitude set points).
+  // The controller starts at each rollout's first sample where the vehicle's was (its
+  // integrals such that it commands what the log holds there: AttitudePid::start), runs at
+  // its own rate on the simulated state, and its output acts after the model's input delay;
+  // until then, and for the collective and yaw throughout, the logged commands act. Commands
+  // are held within [0, 1].
+  void fly_set_points(const SetPointFlying& s) { flying_ = s; }
 
   // Whether a rollout may start at sample k (its rotor speeds known: StartStates::settled).
   bool may_start_at(size_t k) const { return start_.settled(k); }
@@ -71,6 +89,9 @@ class Rollout {
   void impose_translation(double t, size_t k, std::vector<double>& x) const;
   void impose_attitude(double t, size_t k, std::vector<double>& x) const;
   void inputs(double t, double* u) const;
+  void start_controller(size_t k, const std::vector<double>& x);
+  void update_controller(double t, const std::vector<double>& x);
+  void replace_roll_and_pitch(double t, double* u) const;
   void deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f);
   void stage(const std::vector<double>& x, const std::vector<double>& k, double h);
 
@@ -84,6 +105,14 @@ class Rollout {
   runtime::ExtraInputs extra_;
   std::vector<double> u_, k1_, k2_, k3_, k4_, tmp_, forced_;
   std::array<double, 6> held_{};  // hold_disturbance
+  // Flying the set points (fly_set_points): the controller, the rollout's start time, its
+  // updates so far and each update's output [counts] (time, roll, pitch).
+  std::optional<SetPointFlying> flying_;
+  bool flying_now_ = false;
+  runtime::AttitudePid pid_;
+  double flight_start_ = 0;
+  long updates_ = 0;
+  std::vector<std::array<double, 3>> flown_;
   // The model's accelerations (world linear, body angular) at each logged sample, computed on
   // the first past_disturbance call.
   std::vector<std::array<double, 6>> model_acc_;

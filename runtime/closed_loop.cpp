@@ -261,6 +261,7 @@ class CascadedController {
     Rd.col(0) = b2.cross(b3);
     Rd.col(1) = b2;
     Rd.col(2) = b3;
+    desired_ = Rd;
     const V3 e_R = 0.5 * vee(Rd.transpose() * R_estimated - R_estimated.transpose() * Rd);
     V3 w_d = -o_.kp_att * e_R + V3(0, 0, r.axis[3][1]);
     double thrust_scale = 1;
@@ -274,12 +275,15 @@ class CascadedController {
     const V3 torque = Jd.cwiseProduct(-o_.kp_rate * e_w - o_.ki_rate * int_rate_) + w.cross(Jd.cwiseProduct(w));
     return allocate(b_, thrust * thrust_scale, {torque.x(), torque.y(), torque.z()});
   }
+  // The attitude the last step asked for (logged as phi_ref, theta_ref).
+  const M3& desired() const { return desired_; }
 
  private:
   const ControllerModel& b_;
   const ClosedLoopOptions& o_;
   const Multisine& excitation_;
   V3 int_pos_ = V3::Zero(), int_rate_ = V3::Zero();
+  M3 desired_ = M3::Identity();
 };
 
 // Per-rotor commands for the thrusts, through the believed thrust laws, saturated to [0, 1]
@@ -325,13 +329,14 @@ std::vector<std::string> flight_columns(const std::vector<std::string>& rotors) 
   std::vector<std::string> columns = {"t"};
   for (const auto& r : rotors) columns.push_back("u_" + r);
   for (const char* c : {"x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "p", "q", "r", "ax", "ay", "az", "vbat",
-                        "x_ref", "y_ref", "z_ref", "psi_ref"})
+                        "x_ref", "y_ref", "z_ref", "psi_ref", "phi_ref", "theta_ref"})
     columns.push_back(c);
   return columns;
 }
 
 // What the vehicle logs at one control step: the commands, a mocap-like pose and velocity,
-// gyro and accelerometer with their biases and noise, the battery and the reference. The
+// gyro and accelerometer with their biases and noise, the battery, the reference and the
+// attitude the controller asked for (its roll and pitch, as an autopilot logs them). The
 // accelerometer feels f, the derivative under the commands acting now. (The noise is drawn
 // in this order, so that a flight is the same for the same seed.)
 struct Sensors {
@@ -340,7 +345,8 @@ struct Sensors {
   double g;
   std::vector<double> row(double t, const std::vector<double>& u, int nr, const std::vector<double>& x,
                           const Eigen::Quaterniond& q_estimated, const M3& R_true, const std::vector<double>& f,
-                          double vbat, const ReferenceAt& r, std::mt19937& rng, std::normal_distribution<double>& gauss) const {
+                          double vbat, const ReferenceAt& r, const M3& desired, std::mt19937& rng,
+                          std::normal_distribution<double>& gauss) const {
     std::vector<double> row{t};
     for (int i = 0; i < nr; ++i) row.push_back(u[i]);
     const double an = o.pose_noise;
@@ -354,6 +360,9 @@ struct Sensors {
     for (int i = 0; i < 3; ++i) row.push_back(sf[i] + acc_bias[i] + o.accel_noise * gauss(rng));
     row.push_back(vbat);
     for (double c : {r.axis[0][0], r.axis[1][0], r.axis[2][0], r.axis[3][0]}) row.push_back(c);
+    const Eigen::Quaterniond qd(desired);
+    const auto euler = euler_zyx(qd.w(), qd.x(), qd.y(), qd.z());
+    row.push_back(euler[0]), row.push_back(euler[1]);
     return row;
   }
 };
@@ -448,7 +457,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     std::vector<double> acting = u;
     for (int i = 0; i < nr; ++i) acting[i] = (delay_rest > 0 ? early : late)[i];
     truth.rhs(x.data(), acting.data(), f.data(), nullptr, nullptr, nullptr);
-    out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, rng, gauss));
+    out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, controller.desired(), rng, gauss));
     if (k == steps) break;
     // --- plant: the true model over one control period, commands held ---
     const double t0 = t;

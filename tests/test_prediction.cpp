@@ -13,7 +13,9 @@
 #include <sstream>
 #include <string>
 
+#include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
+#include "runtime/attitude_pid.hpp"
 #include "runtime/dynamic_model.hpp"
 #include "fit/flight_data.hpp"
 #include "runtime/flight_log.hpp"
@@ -621,5 +623,168 @@ TEST(PredictParameters, CalibrateRefusedWithoutWhatItNeeds) {
     EXPECT_NE(err.find(want), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(dir / "out")) << extra;
   }
+  fs::remove_all(dir);
+}
+
+// ---- Flying the logged attitude set points (predict --controller) ----
+
+namespace {
+
+using quadgen::runtime::AttitudeMixer;
+using quadgen::runtime::AttitudePid;
+
+std::vector<std::array<double, 3>> crazyflie_rotor_positions() {
+  std::vector<std::array<double, 3>> out;
+  for (const auto& r : quadgen::load_vehicle(source_path("vehicles/crazyflie21.yaml")).rotors) out.push_back(r.position);
+  return out;
+}
+
+}  // namespace
+
+// The firmware's legacy quad-X power distribution (power_distribution_quadrotor.c):
+// m1 = T - r + p + y, m2 = T - r - p - y, m3 = T + r - p + y, m4 = T + r + p - y with r and p
+// half the roll and pitch outputs, its pitch positive nose up. In the body frame used here
+// (pitch positive nose down) each rotor's share follows from where the Crazyflie file puts it.
+TEST(FlyingSetPoints, TheMixerIsTheFirmwaresQuadXFromTheRotorPositions) {
+  const AttitudeMixer m = AttitudeMixer::quad_x(crazyflie_rotor_positions());
+  const std::vector<double> roll = {-0.5, -0.5, 0.5, 0.5}, pitch_nose_up = {0.5, -0.5, -0.5, 0.5};
+  ASSERT_EQ(m.roll.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(m.roll[i], roll[i]) << i;
+    EXPECT_EQ(m.pitch[i], -pitch_nose_up[i]) << i;
+  }
+  // A command holding outputs R and P on top of a collective and a yaw gives them back.
+  const double counts = 65535, R = 1200, P = -800, T = 0.8, Y = 0.01;
+  const double yaw[4] = {1, -1, 1, -1};
+  double u[4];
+  for (int i = 0; i < 4; ++i) u[i] = T + (m.roll[i] * R + m.pitch[i] * P) / counts + yaw[i] * Y;
+  const auto out = m.outputs_in(u, counts);
+  EXPECT_NEAR(out[0], R, 1e-9);
+  EXPECT_NEAR(out[1], P, 1e-9);
+}
+
+// Started where a running loop would be, the loop's next output is the one it was started
+// with, but for one period of the attitude integral (kp_rate * ki_att * error * dt and a
+// second-order term: under 2 counts for a 1 degree error).
+TEST(FlyingSetPoints, TheControllerStartsWithoutAKick) {
+  AttitudePid pid;
+  const std::array<double, 2> angle = {0.10, -0.05}, rate = {0.3, -0.2}, ref = {0.11, -0.06}, output = {1500, -2500};
+  pid.start(angle, rate, ref, output);
+  const auto out = pid.update(angle, rate, ref);
+  for (int a = 0; a < 2; ++a) EXPECT_NEAR(out[a], output[a], 2.0) << a;
+}
+
+// The loop closed around a rigid axis behind a motor lag (J theta'' = b m + d, m following the
+// output with a 30 ms time constant; the firmware's 500 Hz with a zero-order hold): a 5
+// degree step of the set point is reached and held against a constant disturbance moment
+// (the integrals; the attitude integral, at ki / kp = 0.5 /s, takes seconds to settle), and
+// the step gives no derivative kick (D on the measured rate): the first output moves by the
+// proportional and integral terms alone.
+TEST(FlyingSetPoints, TheLoopReachesASetPointStepAgainstAConstantMoment) {
+  AttitudePid pid;
+  // kg m^2; N m per count (4 motors, half a count each, 0.13 N per unit command, 32.5 mm
+  // arms); s; N m (a 0.15 mm CoG offset's worth)
+  const double J = 1.4e-5, b = 1.3e-7, tau = 0.03, d = 4e-5;
+  double theta = 0, omega = 0, acting = -d / b;
+  pid.start({theta, 0}, {omega, 0}, {0, 0}, {acting, 0});  // trimmed against the moment
+  const double step = 5 * M_PI / 180, dt = pid.period();
+  const auto first = pid.update({theta, 0}, {omega, 0}, {step, 0});
+  const auto& o = pid.options();
+  const double rate_ref = o.attitude.kp * 5.0 + o.attitude.ki * 5.0 * dt;  // deg/s
+  const double no_kick = o.rate.kp * rate_ref + o.rate.ki * rate_ref * dt;
+  EXPECT_NEAR(first[0] - acting, no_kick, 1e-9 * no_kick);
+  double out = first[0];
+  for (int k = 0; k < 10 * 500; ++k) {
+    const int sub = 20;  // the plant between controller steps, finer
+    for (int s = 0; s < sub; ++s) {
+      acting += (out - acting) / tau * dt / sub;
+      omega += (b * acting + d) / J * dt / sub;
+      theta += omega * dt / sub;
+    }
+    out = pid.update({theta, 0}, {omega, 0}, {step, 0})[0];
+  }
+  EXPECT_NEAR(theta * 180 / M_PI, 5.0, 0.05);
+  EXPECT_NEAR(omega, 0, 1e-3);
+  EXPECT_NEAR(out, -d / b, 0.02 * std::fabs(d / b));
+}
+
+namespace {
+
+// A 12 s closed-loop Crazyflie flight (its controller logs the attitude it asked for as
+// phi_ref, theta_ref), with these extra `simulate` flags.
+quadgen::fit::Flight crazyflie_flight(const std::string& extra_flags) {
+  const fs::path dir = fs::temp_directory_path() / ("quadgen_set_points_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string csv = (dir / "f.csv").string();
+  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/crazyflie21.yaml") +
+                          " --closed-loop --duration 12 --seed 4 --pose-noise 0 " + extra_flags + " --out " + csv +
+                          " > /dev/null 2>&1";
+  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("simulate failed");
+  auto f = quadgen::predict::fill_missing_signals(
+      quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), {"M1", "M2", "M3", "M4"}, {}), 3.15);
+  fs::remove_all(dir);
+  return f;
+}
+
+quadgen::predict::PredictionOptions flying_options() {
+  quadgen::predict::PredictionOptions o;
+  o.disturbance_window = 0;
+  o.set_points = quadgen::predict::SetPointFlying{{}, AttitudeMixer::quad_x(crazyflie_rotor_positions())};
+  return o;
+}
+
+using CrazyflieModel = quadgen::runtime::CompiledModel<quadgen_generated::crazyflie21_all_effects::Model>;
+
+}  // namespace
+
+// A moment the model lacks (a CoG offset of 2 mm on each axis in the flight, none in the
+// model) turns the open loop over within a second; the replica flying the logged set points
+// holds the attitude as the vehicle's controller did, so the translation stays predicted.
+// On the model's own flight the views differ only by the two controllers' dynamics (the
+// flight's is not the replica).
+TEST(FlyingSetPoints, AMissingMomentTurnsTheOpenLoopOverButNotTheFlownSetPoints) {
+  CrazyflieModel m;
+  const auto o = flying_options();
+  const auto own = quadgen::predict::evaluate_prediction(m, m.params(), crazyflie_flight(""), o);
+  ASSERT_EQ(own.set_points_flown.size(), 4u);
+  EXPECT_GT(own.set_points_flown.back().position.count, 100u);
+  EXPECT_LT(own.set_points_flown.back().position.mean(), 0.06);
+  EXPECT_LT(own.set_points_flown.back().tilt.mean(), 0.03);
+  const auto offset = quadgen::predict::evaluate_prediction(
+      m, m.params(), crazyflie_flight("--effects cog_offset --set cog_offset.x=0.002 --set cog_offset.y=-0.002"), o);
+  const double open = offset.open_loop.back().position.mean(), flown = offset.set_points_flown.back().position.mean();
+  EXPECT_GT(open, 1.0);
+  EXPECT_LT(flown, 0.1 * open);
+  EXPECT_LT(flown, 0.3);
+  EXPECT_EQ(offset.set_points_flown.back().diverged, 0u);
+}
+
+// Without set points in the log the view is not run; predict --controller refuses such a log
+// with its name and line, before writing anything.
+TEST(FlyingSetPoints, ALogWithoutSetPointsIsRefusedByName) {
+  CrazyflieModel m;
+  quadgen::fit::Flight f = crazyflie_flight("");
+  f.has_attitude_ref = false;
+  EXPECT_TRUE(quadgen::predict::evaluate_prediction(m, m.params(), f, flying_options()).set_points_flown.empty());
+  const fs::path dir = fs::temp_directory_path() / ("quadgen_set_points_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string flown = (dir / "flown.csv").string(), log = (dir / "f.csv").string();
+  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/crazyflie21.yaml") +
+                          " --closed-loop --duration 3 --out " + flown + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(sim.c_str()), 0);
+  {  // the same flight without its last two columns (phi_ref, theta_ref)
+    std::ifstream in(flown);
+    std::ofstream out(log);
+    for (std::string line; std::getline(in, line);) out << line.substr(0, line.rfind(',', line.rfind(',') - 1)) << "\n";
+  }
+  const std::string cmd = std::string(QUADGEN_BINARY) + " predict " + source_path("vehicles/crazyflie21.yaml") + " " + log +
+                          " --validation 1 --controller crazyflie-pid --out " + (dir / "out").string() +
+                          " > /dev/null 2> " + (dir / "err").string();
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  std::ifstream in(dir / "err");
+  const std::string err((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(err.find(log + ":1:"), std::string::npos) << err;
+  EXPECT_NE(err.find("phi_ref"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
