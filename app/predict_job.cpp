@@ -28,6 +28,10 @@ std::string summary_of(const predict::Prediction& pooled) {
        << output::short_number(h.tilt.mean()) << " rad, heading " << output::short_number(h.heading.mean()) << " rad\n";
   }
   if (const std::string limits = predict::what_limits_prediction(pooled); !limits.empty()) os << limits << "\n";
+  for (const auto& h : pooled.set_points_flown)  // --controller: not the open loop, said so
+    if (h.position.count > 0)
+      os << "set points flown by the attitude loop's replica (not the open loop), " << h.horizon << " s: position "
+         << output::short_number(h.position.mean()) << " m (mean), tilt " << output::short_number(h.tilt.mean()) << " rad\n";
   return os.str();
 }
 

@@ -36,11 +36,16 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_flag("--linear-correction", a.options.linear_correction,
               "also the one-step errors after a linear correction fitted on the part before the evaluated one (on "
               "the nominal model: a linear-regression baseline on the same split)");
-  c->add_option("--controller", a.options.set_point_controller,
+  auto* controller = c->add_option("--controller", a.options.set_point_controller,
                 "also fly each log's attitude set points (phi_ref, theta_ref) with a replica of this attitude "
                 "controller: crazyflie-pid (the Crazyflie firmware's defaults); the roll and pitch commands come "
                 "from it, the collective and yaw from the log")
       ->check(CLI::IsMember({"crazyflie-pid"}));
+  c->add_option("--controller-gain", a.options.controller_output_scale,
+                "with --controller: logged command counts per count of the loop's output (the firmware's battery "
+                "compensation between them; 1: none)")
+      ->check(finite_range(0.05, 20))
+      ->needs(controller);
   c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(0.001, 10));
   c->add_option("--disturbance-window", a.options.prediction.disturbance_window,
                 "seconds of log before each start whose mean acceleration residual the open loop with the past "

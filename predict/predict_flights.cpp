@@ -26,13 +26,20 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
 }
 
 // The controller of --controller, mixed by the vehicle's rotor positions.
-std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::string& controller) {
+std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::string& controller, double output_scale) {
   if (controller.empty()) return std::nullopt;
   if (controller != "crazyflie-pid")
     throw std::invalid_argument("--controller: unknown controller '" + controller + "' (expected crazyflie-pid)");
   std::vector<std::array<double, 3>> positions;
-  for (const auto& r : v.rotors) positions.push_back(r.position);
-  return SetPointFlying{runtime::AttitudePidOptions{}, runtime::AttitudeMixer::quad_x(positions)};
+  std::vector<int> spins;
+  for (const auto& r : v.rotors) positions.push_back(r.position), spins.push_back(r.spin == Spin::ccw ? 1 : -1);
+  runtime::AttitudePidOptions pid;
+  pid.output_scale = output_scale;
+  try {
+    return SetPointFlying{pid, runtime::AttitudeMixer::quad_x(positions, spins)};
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("--controller " + controller + ": " + e.what() + " (vehicle " + v.name + ")");
+  }
 }
 
 // "indoors", "outdoors", "in any environment".
@@ -80,7 +87,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
   if (o.linear_correction && o.validation >= 1.0)
     throw std::invalid_argument("--linear-correction needs a part before the evaluated one to fit on: --validation below 1");
   PredictionOptions prediction = o.prediction;
-  prediction.set_points = set_point_flying(v, o.set_point_controller);
+  prediction.set_points = set_point_flying(v, o.set_point_controller, o.controller_output_scale);
   const std::vector<double> nominal = model.params();  // before any calibration moves the model's
   std::optional<ParameterSource> source;
   if (!o.params.empty()) source.emplace(o.params);

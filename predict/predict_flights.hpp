@@ -37,6 +37,7 @@ struct PredictFlightsOptions {
   // run) or "crazyflie-pid" (runtime::AttitudePidOptions' defaults, mixed by the vehicle's
   // rotor positions). Sets prediction.set_points; a log without set points is refused.
   std::string set_point_controller;
+  double controller_output_scale = 1;  // runtime::AttitudePidOptions::output_scale
   PredictionOptions prediction;
   output::Progress progress;  // which log, calibration, notes; nowhere by default
 };

@@ -366,13 +366,13 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
           {"translation_replayed", moments},
           {"open_loop_past_disturbance", full_rows(p.open_loop_past_disturbance)},
           {"disturbance_window_s", p.disturbance_window},
-          {"set_points_flown", full_rows(p.set_points_flown)},
           {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
           {"definition",
            "error at each horizon after a start from the measured state, averaged over start points; "
            "tilt = angle between body z axes, heading = yaw difference"}};
+  if (!p.set_points_flown.empty()) out["set_points_flown"] = full_rows(p.set_points_flown);
   if (p.one_step_corrected) {
     out["one_step_linear_correction"] = one_step_json(*p.one_step_corrected);
     out["one_step_linear_correction"]["statistic"] =

@@ -47,28 +47,54 @@ std::array<double, 2> roll_and_pitch(const std::vector<double>& x) {
 
 }  // namespace
 
+void Rollout::fly_set_points(const SetPointFlying& s) {
+  if (step_ > runtime::AttitudePid(s.pid).period() + 1e-12)
+    throw std::invalid_argument("Rollout: an integration step longer than the attitude loop's period");
+  flying_ = s;
+}
+
+// The loop's integrals from the log's window before sample k (AttitudePid::start): the means
+// of the measured rate, of the angle error against the set points (the logged attitude
+// unbiased as the rollout's is) and of the output the logged commands hold, over the samples
+// of k's stretch at most start_window before it.
 void Rollout::start_controller(size_t k, const std::vector<double>& x) {
   if (!flying_ || !f_.has_attitude_ref)
     throw std::logic_error("Rollout: flying set points needs fly_set_points and a flight with phi_ref, theta_ref");
-  const auto& s = f_.samples[k];
-  pid_ = runtime::AttitudePid(flying_->pid);
-  pid_.start(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, {s.attitude_ref[0], s.attitude_ref[1]},
-             flying_->mixer.outputs_in(s.u.data(), flying_->pid.counts_per_command));
-  flight_start_ = s.t;
+  const auto& S = f_.samples;
+  const runtime::AttitudePidOptions& o = flying_->pid;
+  size_t j0 = k;
+  while (j0 > first_command_ && S[k].t - S[j0 - 1].t <= flying_->start_window + 1e-9) --j0;
+  std::array<double, 2> output{}, rate{}, error{};
+  for (size_t j = j0; j <= k; ++j) {
+    double q[4];
+    runtime::unbias_attitude(&S[j].x[kAttitude], e_.roll, e_.pitch, q);
+    const auto angle = runtime::euler_zyx(q[0], q[1], q[2], q[3]);
+    const auto out = flying_->mixer.outputs_in(S[j].u.data(), o.counts_per_command);
+    for (int a = 0; a < 2; ++a) {
+      output[a] += out[a] / o.output_scale;
+      rate[a] += S[j].x[kBodyRate + a];
+      error[a] += S[j].attitude_ref[a] - angle[a];
+    }
+  }
+  const double n = static_cast<double>(k - j0 + 1);
+  for (int a = 0; a < 2; ++a) output[a] /= n, rate[a] /= n, error[a] /= n;
+  pid_ = runtime::AttitudePid(o);
+  pid_.start(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, output, rate, error);
+  flight_start_ = S[k].t;
   updates_ = 0;
   flown_.clear();
 }
 
-// The controller's steps due by time t (its clock starts at the rollout's first sample), on
-// the simulated state and the set points logged at or before each step.
+// The controller's steps due by time t (on its 500 Hz grid from the rollout's first sample),
+// on the state at t and the set points logged at or before t. Each output is stamped with t,
+// the time of the state it used: the integration steps (at most one period) need not fall on
+// the grid.
 void Rollout::update_controller(double t, const std::vector<double>& x) {
-  while (flight_start_ + static_cast<double>(updates_) * pid_.period() <= t + 1e-9) {
-    const double tu = flight_start_ + static_cast<double>(updates_) * pid_.period();
-    const auto& s = f_.samples[held_sample(f_, tu)];
-    const auto out = pid_.update(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, {s.attitude_ref[0], s.attitude_ref[1]});
-    flown_.push_back({tu, out[0], out[1]});
-    ++updates_;
-  }
+  if (flight_start_ + static_cast<double>(updates_) * pid_.period() > t + 1e-9) return;
+  while (flight_start_ + static_cast<double>(updates_) * pid_.period() <= t + 1e-9) ++updates_;
+  const auto& s = f_.samples[held_sample(f_, t)];
+  const auto out = pid_.update(roll_and_pitch(x), {x[kBodyRate], x[kBodyRate + 1]}, {s.attitude_ref[0], s.attitude_ref[1]});
+  flown_.push_back({t, out[0], out[1]});
 }
 
 bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
@@ -142,9 +168,11 @@ void Rollout::replace_roll_and_pitch(double t, double* u) const {
   const std::array<double, 3>& out = *(after - 1);
   const auto& mix = flying_->mixer;
   const double counts = flying_->pid.counts_per_command;
+  const double scale = flying_->pid.output_scale;
   const auto logged = mix.outputs_in(u, counts);
   for (size_t i = 0; i < mix.roll.size(); ++i)
-    u[i] = std::clamp(u[i] + (mix.roll[i] * (out[1] - logged[0]) + mix.pitch[i] * (out[2] - logged[1])) / counts, 0.0, 1.0);
+    u[i] = std::clamp(u[i] + (mix.roll[i] * (scale * out[1] - logged[0]) + mix.pitch[i] * (scale * out[2] - logged[1])) / counts,
+                      0.0, 1.0);
 }
 
 void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {

@@ -35,6 +35,7 @@ enum class Replay { kNothing, kAttitude, kTranslation, kSetPoints };
 struct SetPointFlying {
   runtime::AttitudePidOptions pid;
   runtime::AttitudeMixer mixer;
+  double start_window = 1.0;  // s of log before a start from which the loop's integrals are set
 };
 
 class Rollout {
@@ -45,12 +46,12 @@ class Rollout {
   Rollout(runtime::DynamicModel&, const fit::Flight&&, const std::vector<double>&, double = 1e-3) = delete;
 
   // Replay::kSetPoints flies with this controller (the flight must hold attitude set points).
-  // The controller starts at each rollout's first sample where the vehicle's was (its
-  // integrals such that it commands what the log holds there: AttitudePid::start), runs at
-  // its own rate on the simulated state, and its output acts after the model's input delay;
-  // until then, and for the collective and yaw throughout, the logged commands act. Commands
-  // are held within [0, 1].
-  void fly_set_points(const SetPointFlying& s) { flying_ = s; }
+  // The controller starts at each rollout's first sample where the vehicle's was on average
+  // over the window before it (AttitudePid::start), runs at its own rate on the simulated
+  // state, and its output acts after the model's input delay; until then, and for the
+  // collective and yaw throughout, the logged commands act. Commands are held within [0, 1].
+  // Throws std::invalid_argument when the rollout's step is longer than the loop's period.
+  void fly_set_points(const SetPointFlying& s);
 
   // Whether a rollout may start at sample k (its rotor speeds known: StartStates::settled).
   bool may_start_at(size_t k) const { return start_.settled(k); }

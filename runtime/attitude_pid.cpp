@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace quadgen::runtime {
 
@@ -15,12 +17,27 @@ double sign_of(double v, double tolerance) { return v > tolerance ? 1.0 : (v < -
 
 }  // namespace
 
-AttitudeMixer AttitudeMixer::quad_x(const std::vector<std::array<double, 3>>& rotor_positions) {
+AttitudeMixer AttitudeMixer::quad_x(const std::vector<std::array<double, 3>>& rotor_positions,
+                                    const std::vector<int>& spins) {
+  if (rotor_positions.size() != 4 || spins.size() != 4)
+    throw std::invalid_argument("the attitude loop's mixing is the quad X's: the vehicle has " +
+                                std::to_string(rotor_positions.size()) + " rotors, not 4");
   AttitudeMixer m;
+  int quadrants = 0;
   for (const auto& p : rotor_positions) {
     m.roll.push_back(0.5 * sign_of(p[1], 1e-6));
     m.pitch.push_back(-0.5 * sign_of(p[0], 1e-6));
+    if (m.roll.back() != 0 && m.pitch.back() != 0) quadrants |= 1 << ((m.roll.back() > 0) * 2 + (m.pitch.back() > 0));
   }
+  double roll_sum = 0, pitch_sum = 0, roll_yaw = 0, pitch_yaw = 0;
+  for (size_t i = 0; i < 4; ++i) {
+    roll_sum += m.roll[i], pitch_sum += m.pitch[i];
+    roll_yaw += m.roll[i] * spins[i], pitch_yaw += m.pitch[i] * spins[i];
+  }
+  if (quadrants != 0xF)
+    throw std::invalid_argument("the attitude loop's mixing is the quad X's: a rotor in each quadrant of the body's x-y plane");
+  if (roll_sum != 0 || pitch_sum != 0 || roll_yaw != 0 || pitch_yaw != 0)
+    throw std::invalid_argument("the attitude loop's mixing is the quad X's: diagonal rotors spinning the same way");
   return m;
 }
 
@@ -36,16 +53,17 @@ std::array<double, 2> AttitudeMixer::outputs_in(const double* u, double counts_p
 }
 
 void AttitudePid::start(const std::array<double, 2>& angle, const std::array<double, 2>& rate,
-                        const std::array<double, 2>& ref, const std::array<double, 2>& output) {
+                        const std::array<double, 2>& mean_output, const std::array<double, 2>& mean_rate,
+                        const std::array<double, 2>& mean_angle_error) {
   for (int a = 0; a < 2; ++a) {
     Axis& x = axes_[a];
-    const double angle_error = kDegPerRad * (ref[a] - angle[a]), measured_rate = kDegPerRad * rate[a];
     const PidGains &att = o_.attitude, &r = o_.rate;
-    x.attitude_integral = att.ki != 0 ? clamp_to((measured_rate - att.kp * angle_error) / att.ki, att.integral_limit) : 0;
-    const double rate_ref = att.kp * angle_error + att.ki * x.attitude_integral;
-    const double rate_error = rate_ref - measured_rate;
-    x.rate_integral = r.ki != 0 ? clamp_to((output[a] - r.kp * rate_error) / r.ki, r.integral_limit) : 0;
-    x.previous_angle = kDegPerRad * angle[a], x.previous_rate = measured_rate;
+    const double held = kDegPerRad * mean_rate[a] - att.kp * kDegPerRad * mean_angle_error[a];  // deg/s
+    x.attitude_integral = att.ki != 0 ? clamp_to(held / att.ki, att.integral_limit) : 0;
+    // Zero but where the attitude integral met its limit.
+    const double mean_rate_error = att.kp * kDegPerRad * mean_angle_error[a] + att.ki * x.attitude_integral - kDegPerRad * mean_rate[a];
+    x.rate_integral = r.ki != 0 ? clamp_to((mean_output[a] - r.kp * mean_rate_error) / r.ki, r.integral_limit) : 0;
+    x.previous_angle = kDegPerRad * angle[a], x.previous_rate = kDegPerRad * rate[a];
   }
 }
 

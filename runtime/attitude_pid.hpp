@@ -8,9 +8,11 @@
 // src/modules/src/controller/attitude_pid_controller.c with the CF2 platform defaults;
 // docs/simulation.md "Flying the logged set points" cites the values), in its units: angles
 // in degrees, rates in deg/s, the output in PWM counts of which each motor takes plus or
-// minus half (the quad-X power distribution). The firmware's yaw loop, its derivative
-// filters and its battery compensation are not replicated: the yaw command stays the logged
-// one, and the others change the answer by a few per cent at most (docs/simulation.md).
+// minus half (the quad-X power distribution). Not replicated: the yaw loop (the yaw command
+// stays the logged one), the derivative filters (off by default in the firmware) and the
+// battery compensation between the mixer and the logged motor commands, whose local slope
+// `output_scale` stands for (1: none; on the NanoBench flights the collective suggests about
+// 0.5-0.8, and halving the scale moves the 1 s errors by -11 to +15 %: docs/simulation.md).
 #pragma once
 #include <array>
 #include <vector>
@@ -28,16 +30,22 @@ struct AttitudePidOptions {
   double rate_hz = 500;                      // both loops
   double counts_per_command = 65535;         // PWM counts at a command (throttle fraction) of 1
   double output_limit = 32767;               // |output| at most this (the firmware's int16)
+  // Logged command counts per count of the loop's output (the battery compensation's local
+  // slope between them; 1: none).
+  double output_scale = 1;
 };
 
 // How a roll or pitch output moves each rotor's command: per rotor, the counts it takes per
-// count of output. For the quad X the firmware's +-1/2: roll by the side a rotor is on
-// (+1/2 at y > 0: a positive output rolls the body about +x), pitch by its end (-1/2 at
-// x > 0: a positive output pitches about +y, nose down, in the body frame x forward, z up).
+// count of output, the firmware's +-1/2 of the quad X: roll by the side a rotor is on (+1/2
+// at y > 0: a positive output rolls the body about +x), pitch by its end (-1/2 at x > 0: a
+// positive output pitches about +y, nose down, in the body frame x forward, z up).
 struct AttitudeMixer {
   std::vector<double> roll, pitch;
-  // From rotor positions [m, body frame]; a rotor on an axis takes no part in that axis.
-  static AttitudeMixer quad_x(const std::vector<std::array<double, 3>>& rotor_positions);
+  // From the rotor positions [m, body frame] and spins (+1 counter-clockwise seen from
+  // above). Only a quad X: four rotors, one in each quadrant, whose roll and pitch columns
+  // leave the collective and the yaw (the spins' pattern) alone, as the firmware's mixing
+  // assumes; anything else throws std::invalid_argument saying why.
+  static AttitudeMixer quad_x(const std::vector<std::array<double, 3>>& rotor_positions, const std::vector<int>& spins);
   // The roll and pitch outputs [counts] the commands `u` (throttle fractions) hold: their
   // least-squares projection on each axis' mixing column.
   std::array<double, 2> outputs_in(const double* u, double counts_per_command) const;
@@ -47,12 +55,16 @@ class AttitudePid {
  public:
   explicit AttitudePid(const AttitudePidOptions& o = {}) : o_(o) {}
 
-  // Starts the loop where a running one would be, so that it does not kick: the attitude
-  // loop's integral set so that its rate set point is the measured rate, the rate loop's so
-  // that its output is `output` (what the logged commands hold), both within their limits,
-  // and the previous angle and rate set to the present ones. Angles and rates in rad, rad/s.
-  void start(const std::array<double, 2>& angle, const std::array<double, 2>& rate, const std::array<double, 2>& ref,
-             const std::array<double, 2>& output);
+  // Starts the loop where the vehicle's was, as far as a log tells: its integrals are what a
+  // loop holds that tracks its set points on average over a window before the start (the
+  // integrals are slow: kp / ki is 2 s and 0.5 s in the firmware): the attitude loop's the
+  // mean measured rate minus kp times the mean angle error, the rate loop's the mean output
+  // the logged commands hold (their mean rate error being zero so). Means, not the start's
+  // values: a single sample's output carries the derivative term's noise and the rate error
+  // of that instant, which an integral set from it would hold for seconds. Angles and rates
+  // in rad, rad/s; integrals within their limits; the previous angle and rate the present.
+  void start(const std::array<double, 2>& angle, const std::array<double, 2>& rate, const std::array<double, 2>& mean_output,
+             const std::array<double, 2>& mean_rate, const std::array<double, 2>& mean_angle_error);
   // One step of 1 / rate_hz: the roll and pitch outputs [counts].
   std::array<double, 2> update(const std::array<double, 2>& angle, const std::array<double, 2>& rate,
                                const std::array<double, 2>& ref);

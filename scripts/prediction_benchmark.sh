@@ -11,6 +11,13 @@
 # scored with a linear correction fitted on the first 70 % (`predict --linear-correction`): on
 # the nominal model a linear-regression baseline on the same split, on the joint fit what a
 # linear model of the same signals would still explain.
+# On the NanoBench flights, which log the firmware's attitude set points, the extended model
+# and the joint fit also fly them with the replica of the firmware's attitude loop
+# (`predict --controller crazyflie-pid`, the "set points flown" columns): not the open loop,
+# and not what the published models report (their inputs are the motor commands). The loop's
+# output reaches the logged commands through the firmware's battery compensation, whose
+# slope there (0.48-0.77, median 0.57, on five flights: scripts/set_point_kinematics.py
+# --slopes) CONTROLLER_GAIN sets (default 0.6, the median rounded).
 # QUADGEN=BINARY selects the quadgen binary (default build/quadgen), as in real_flights.sh.
 # Needs the build (./setup.sh --no-run), ../shared/data beside the clone, and python3.
 set -euo pipefail
@@ -37,9 +44,15 @@ run() {  # name vehicle log mapping [extra diagnose flags...]
   else
     "$q" diagnose "$vehicle" "$log" --mapping "$mapping" "$@" --out "$out/$name/diagnosis" > /dev/null
   fi
+  local fly=()
+  [ "$name" != arpl_log10 ] && fly=(--controller crazyflie-pid --controller-gain "${CONTROLLER_GAIN:-0.6}")
+  if [ ${#fly[@]} -gt 0 ]; then
+    "$q" predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$out/$name/diagnosis/diagnosis.json" \
+      "${fly[@]}" --out "$out/$name/extended_set_points_flown" > /dev/null
+  fi
   if [ -n "$reuse" ] && [ -f "$reuse/joint_5_flights/diagnosis.json" ] && [ "$name" != arpl_log10 ]; then
     "$q" predict "$vehicle" "$log" --mapping "$mapping" "$@" --params "$reuse/joint_5_flights/diagnosis.json" \
-      --linear-correction --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
+      --linear-correction "${fly[@]}" --out "$out/$name/joint_fit" > /dev/null 2>&1 || echo "  (not in the joint diagnosis)" >&2
   fi
 }
 for log in "$data"/nanobench/*.csv; do
