@@ -38,19 +38,27 @@ struct GeneratedFlight {
   double mean_thrust_per_mass = 0;  // m/s^2, over the flight: |a_world + g e_z|
 };
 
-// A 12 s closed-loop flight of the FINken 3 simulated with these extra `simulate` flags.
-GeneratedFlight generate_flight(const std::string& extra_flags) {
+// A 12 s closed-loop flight of `vehicle` (its rotors `rotors`, the battery voltage its file
+// refers to `vbat_ref`) simulated with these extra `simulate` flags, loaded as predict loads it.
+quadgen::fit::Flight simulated_flight(const std::string& vehicle, const std::vector<std::string>& rotors, double vbat_ref,
+                                      const std::string& extra_flags) {
   const fs::path dir = fs::temp_directory_path() / ("quadgen_prediction_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string csv = (dir / "f.csv").string();
-  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/finken3.yaml") +
+  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path(vehicle) +
                           " --closed-loop --duration 12 --seed 4 --pose-noise 0 " + extra_flags + " --out " + csv +
                           " > /dev/null 2>&1";
   if (std::system(cmd.c_str()) != 0) throw std::runtime_error("simulate failed");
-  GeneratedFlight out;
-  out.flight = quadgen::predict::fill_missing_signals(
-      quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), {"A", "B", "C", "D"}, {}), 4.0);
+  auto f = quadgen::predict::fill_missing_signals(quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), rotors, {}),
+                                                  vbat_ref);
   fs::remove_all(dir);
+  return f;
+}
+
+// The FINken 3's, with its mean thrust per mass.
+GeneratedFlight generate_flight(const std::string& extra_flags) {
+  GeneratedFlight out;
+  out.flight = simulated_flight("vehicles/finken3.yaml", {"A", "B", "C", "D"}, 4.0, extra_flags);
   double sum = 0;
   for (const auto& s : out.flight.samples)
     sum += std::sqrt(std::pow(s.acc_world[0], 2) + std::pow(s.acc_world[1], 2) + std::pow(s.acc_world[2] + 9.81, 2));
@@ -738,20 +746,9 @@ TEST(FlyingSetPoints, TheLoopReachesASetPointStepAgainstAConstantMoment) {
 
 namespace {
 
-// A 12 s closed-loop Crazyflie flight (its controller logs the attitude it asked for as
-// phi_ref, theta_ref), with these extra `simulate` flags.
+// A Crazyflie's (its controller logs the attitude it asked for as phi_ref, theta_ref).
 quadgen::fit::Flight crazyflie_flight(const std::string& extra_flags) {
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_set_points_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string csv = (dir / "f.csv").string();
-  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/crazyflie21.yaml") +
-                          " --closed-loop --duration 12 --seed 4 --pose-noise 0 " + extra_flags + " --out " + csv +
-                          " > /dev/null 2>&1";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("simulate failed");
-  auto f = quadgen::predict::fill_missing_signals(
-      quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), {"M1", "M2", "M3", "M4"}, {}), 3.15);
-  fs::remove_all(dir);
-  return f;
+  return simulated_flight("vehicles/crazyflie21.yaml", {"M1", "M2", "M3", "M4"}, 3.15, extra_flags);
 }
 
 // The flight without extra flags, generated once for the tests that share it.
