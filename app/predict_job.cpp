@@ -36,19 +36,25 @@ std::string summary_of(const predict::Prediction& pooled) {
 }
 
 // What went wrong with the model, for exit code 4 (the output is kept for inspection): at
-// some horizon every rollout left the model's range, or the errors are not finite.
+// some horizon of a view every rollout left the model's range, or the errors are not finite.
+// The set points flown can fail where the open loop does not: the replica's loop rings at
+// too high a gain.
 std::string failure_of(const predict::Prediction& pooled) {
-  for (const auto& h : pooled.open_loop) {
-    const bool all_diverged = h.position.count == 0 && h.diverged > 0;
-    if (all_diverged || (h.position.count > 0 && !std::isfinite(h.position.mean()))) {
-      std::ostringstream os;
-      os << "the open-loop position error " << h.horizon
-         << " s ahead is not finite: the model left its range on this log (check the commands' scale, the units and "
-            "--params); the output is kept for inspection";
-      return os.str();
-    }
-  }
-  return "";
+  const auto failed = [](const std::vector<predict::HorizonErrors>& rows) -> const predict::HorizonErrors* {
+    for (const auto& h : rows)
+      if ((h.position.count == 0 && h.diverged > 0) || (h.position.count > 0 && !std::isfinite(h.position.mean()))) return &h;
+    return nullptr;
+  };
+  std::ostringstream os;
+  if (const auto* h = failed(pooled.open_loop))
+    os << "the open-loop position error " << h->horizon
+       << " s ahead is not finite: the model left its range on this log (check the commands' scale, the units and "
+          "--params); the output is kept for inspection";
+  else if (const auto* s = failed(pooled.set_points_flown))
+    os << "with the set points flown, the position error " << s->horizon
+       << " s ahead is not finite: the model left its range under the attitude loop's replica (check "
+          "--controller-gain and the set points' units and signs); the output is kept for inspection";
+  return os.str();
 }
 
 // A log too short for one rollout is the input's problem, not the model's: said before
