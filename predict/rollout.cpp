@@ -33,8 +33,7 @@ Rollout::Start Rollout::start_at(size_t k, Replay replay) {
   // unbiased with this rollout's bias, renormalised), so that a replayed view starts exactly
   // on what it replays.
   impose(replay, f_.samples[k].t, k, x);
-  flying_now_ = replay == Replay::kSetPoints;
-  if (flying_now_) start_controller(k, x);
+  if (replay == Replay::kSetPoints) start_controller(k, x);
   return {e_, x};
 }
 
@@ -103,7 +102,7 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
   const double h = (t1 - t0) / steps;
   for (int i = 0; i < steps; ++i) {
     const double t = t0 + i * h;
-    if (flying_now_) update_controller(t, x);
+    if (replay == Replay::kSetPoints) update_controller(t, x);
     deriv(t, x, k, replay, k1_);
     stage(x, k1_, h / 2);
     deriv(t + h / 2, tmp_, k, replay, k2_);
@@ -150,10 +149,10 @@ void Rollout::impose_attitude(double t, size_t k, std::vector<double>& x) const 
   for (int i = kBodyRate; i < kBodyRate + 3; ++i) x[i] = (1 - w) * a.x[i] + w * b.x[i];
 }
 
-void Rollout::inputs(double t, double* u) const {
+void Rollout::inputs(double t, Replay replay, double* u) const {
   const auto& s = f_.samples[command_sample(f_, t, e_.delay, first_command_)];
   std::copy(s.u.begin(), s.u.end(), u);
-  if (flying_now_) replace_roll_and_pitch(t, u);
+  if (replay == Replay::kSetPoints) replace_roll_and_pitch(t, u);
   extra_.fill(t, f_.samples[held_sample(f_, t)].vbat, u);
 }
 
@@ -182,7 +181,7 @@ void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay rep
     impose(replay, t, k, forced_);
     state = &forced_;
   }
-  inputs(t, u_.data());
+  inputs(t, replay, u_.data());
   m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
   for (int a = 0; a < 3; ++a) f[kVelocity + a] += held_[a], f[kBodyRate + a] += held_[3 + a];
 }
@@ -192,16 +191,15 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
   if (model_acc_.empty()) {  // once per flight: the model at every logged state
     const runtime::DataSideEffects saved = e_;
     const size_t saved_first = first_command_;
-    const bool saved_flying = flying_now_;
     std::vector<double> f(n_);
     model_acc_.resize(S.size());
     for (size_t j = 0; j < S.size(); ++j) {
       const std::vector<double> x = start_at(j, Replay::kNothing).state;
-      inputs(S[j].t, u_.data());
+      inputs(S[j].t, Replay::kNothing, u_.data());
       m_.rhs(x.data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
       for (int a = 0; a < 3; ++a) model_acc_[j][a] = f[kVelocity + a], model_acc_[j][3 + a] = f[kBodyRate + a];
     }
-    e_ = saved, first_command_ = saved_first, flying_now_ = saved_flying;
+    e_ = saved, first_command_ = saved_first;
   }
   // The window stays within the sample's stretch and after the rotor speeds are known: just
   // after a restart the states carry the steady-state guess, and the model's accelerations

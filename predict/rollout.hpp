@@ -89,7 +89,9 @@ class Rollout {
   void impose(Replay replay, double t, size_t k, std::vector<double>& x) const;
   void impose_translation(double t, size_t k, std::vector<double>& x) const;
   void impose_attitude(double t, size_t k, std::vector<double>& x) const;
-  void inputs(double t, double* u) const;
+  // The commands acting at time t (Replay::kSetPoints: their roll and pitch from the
+  // controller) and the extra inputs.
+  void inputs(double t, Replay replay, double* u) const;
   void start_controller(size_t k, const std::vector<double>& x);
   void update_controller(double t, const std::vector<double>& x);
   void replace_roll_and_pitch(double t, double* u) const;
@@ -109,7 +111,6 @@ class Rollout {
   // Flying the set points (fly_set_points): the controller, the rollout's start time, its
   // updates so far and each update's output [counts] (time, roll, pitch).
   std::optional<SetPointFlying> flying_;
-  bool flying_now_ = false;
   runtime::AttitudePid pid_;
   double flight_start_ = 0;
   long updates_ = 0;
