@@ -27,6 +27,18 @@ std::string summary_of(const predict::Prediction& pooled) {
     os << "position " << output::short_number(h.position.mean()) << " m (mean), tilt "
        << output::short_number(h.tilt.mean()) << " rad, heading " << output::short_number(h.heading.mean()) << " rad\n";
   }
+  // The predictors without the moment model and with no model, a line each.
+  const auto positions = [&os](const char* what, const std::vector<predict::HorizonErrors>& rows) {
+    if (rows.empty()) return;
+    os << what << ", mean position error:";
+    for (const auto& h : rows)
+      os << (&h == &rows.front() ? " " : ", ") << h.horizon << " s "
+         << (h.position.count > 0 ? output::short_number(h.position.mean()) + " m" : "-");
+    os << "\n";
+  };
+  positions("body rates held (no moment model)", pooled.body_rates_held);
+  positions("attitude held (no moment model)", pooled.attitude_held);
+  positions("constant velocity (no model)", pooled.constant_velocity);
   if (const std::string limits = predict::what_limits_prediction(pooled); !limits.empty()) os << limits << "\n";
   for (const auto& h : pooled.set_points_flown)  // --controller: not the open loop, said so
     if (h.position.count > 0)

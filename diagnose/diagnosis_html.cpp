@@ -354,7 +354,8 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
          "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
          "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
-         "<th>position, past disturbance held, extended [m]</th></tr>\n";
+         "<th>position, past disturbance held, extended [m]</th><th>position, body rates held, extended [m]</th><th>position, attitude held, extended [m]</th>"
+         "<th>position, constant velocity (no model) [m]</th></tr>\n";
     const auto& b = d.prediction_before;
     const auto& a = d.prediction_after;
     for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
@@ -364,6 +365,9 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d) {
         << (i < a.attitude_replayed.size() ? num(a.attitude_replayed[i].position.mean()) : "–") << "</td><td>"
         << (i < a.translation_replayed.size() ? num(a.translation_replayed[i].tilt.mean()) : "–") << "</td><td>"
         << (i < a.open_loop_past_disturbance.size() ? num(a.open_loop_past_disturbance[i].position.mean()) : "–")
+        << "</td><td>" << (i < a.body_rates_held.size() ? num(a.body_rates_held[i].position.mean()) : "–")
+        << "</td><td>" << (i < a.attitude_held.size() ? num(a.attitude_held[i].position.mean()) : "–")
+        << "</td><td>" << (i < a.constant_velocity.size() ? num(a.constant_velocity[i].position.mean()) : "–")
         << "</td></tr>\n";
     h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
       << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "

@@ -50,6 +50,9 @@ void Prediction::merge(const Prediction& o) {
   merge_rows(translation_replayed, o.translation_replayed);
   merge_rows(open_loop_past_disturbance, o.open_loop_past_disturbance);
   merge_rows(set_points_flown, o.set_points_flown);
+  merge_rows(body_rates_held, o.body_rates_held);
+  merge_rows(attitude_held, o.attitude_held);
+  merge_rows(constant_velocity, o.constant_velocity);
   one_step.merge(o.one_step);
   if (o.one_step_corrected) {
     if (!one_step_corrected) one_step_corrected = OneStepErrors{};
@@ -82,10 +85,14 @@ double median_spacing(const fit::Flight& f) {
   return dt[dt.size() / 2];
 }
 
-// Rollouts from start points every `stride` seconds; the error at each horizon is taken at
-// the first sample at or after start + horizon (within a quarter of a sample spacing).
-std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, Replay replay,
-                                    size_t* starts = nullptr, double disturbance_window = 0) {
+// Trajectories from start points every `stride` seconds, scored against the log: `begin(k0)`
+// gives a trajectory's data-side effects and start state (Rollout::Start), `advance(x, k)`
+// carries x from sample k to k + 1 (false: it diverged). The error at each horizon is taken at
+// the first sample at or after start + horizon (within a quarter of a sample spacing). Every
+// view, with or without a model, goes through here: the same start points, gaps and samples.
+template <class Begin, class Advance>
+std::vector<HorizonErrors> score_from_starts(const Rollout& roll, const fit::Flight& f, const PredictionOptions& o,
+                                             size_t* starts, Begin begin, Advance advance) {
   std::vector<HorizonErrors> rows;
   for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
   const auto& S = f.samples;
@@ -96,12 +103,11 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     next_start = S[k0].t + o.start_stride;
     if (S.back().t - S[k0].t < longest - 0.25 * dt) break;  // the longest horizon must fit
     if (starts) ++*starts;
-    auto [e, x] = roll.start_at(k0, replay);
-    if (disturbance_window > 0) roll.hold_disturbance(roll.past_disturbance(k0, disturbance_window));
+    auto [e, x] = begin(k0);
     size_t next = 0;  // the next horizon to score
     for (size_t k = k0; k + 1 < S.size() && next < rows.size(); ++k) {
       if (S[k + 1].t - S[k].t > o.max_gap) break;
-      if (!roll.advance(x, k, replay)) {
+      if (!advance(x, k)) {
         for (; next < rows.size(); ++next) ++rows[next].diverged;
         break;
       }
@@ -112,6 +118,43 @@ std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const P
     }
   }
   return rows;
+}
+
+// The model's rollouts, with what `replay` takes from the log (and the past disturbance held
+// when a window is given).
+std::vector<HorizonErrors> rollouts(Rollout& roll, const fit::Flight& f, const PredictionOptions& o, Replay replay,
+                                    size_t* starts = nullptr, double disturbance_window = 0) {
+  return score_from_starts(
+      roll, f, o, starts,
+      [&](size_t k0) {
+        Rollout::Start s = roll.start_at(k0, replay);
+        if (disturbance_window > 0) roll.hold_disturbance(roll.past_disturbance(k0, disturbance_window));
+        return s;
+      },
+      [&](std::vector<double>& x, size_t k) { return roll.advance(x, k, replay); });
+}
+
+// No model: the start state's position moved on at its velocity, everything else held (the
+// attitude, the body rates). The start state is the rollouts' own, so the baseline and the
+// model differ only in what carries the state forward.
+std::vector<HorizonErrors> constant_velocity(Rollout& roll, const fit::Flight& f, const PredictionOptions& o) {
+  using runtime::rigid_body::kPosition;
+  using runtime::rigid_body::kVelocity;
+  std::vector<double> x0;
+  double t0 = 0;
+  return score_from_starts(
+      roll, f, o, nullptr,
+      [&](size_t k0) {
+        Rollout::Start s = roll.start_at(k0, Replay::kNothing);
+        x0 = s.state;
+        t0 = f.samples[k0].t;
+        return s;
+      },
+      [&](std::vector<double>& x, size_t k) {
+        const double elapsed = f.samples[k + 1].t - t0;
+        for (int a = 0; a < 3; ++a) x[kPosition + a] = x0[kPosition + a] + x0[kVelocity + a] * elapsed;
+        return true;
+      });
 }
 
 // One-step residuals (model - measured) of every usable sample of `f`: body specific force
@@ -215,6 +258,9 @@ Prediction evaluate_prediction(runtime::DynamicModel& model, const std::vector<d
   if (!f.has_pose) return out;  // an IMU-only log: no state to start from or compare with
   Rollout roll(model, f, p, o.step);
   out.open_loop = rollouts(roll, f, o, Replay::kNothing, &out.start_points);
+  out.body_rates_held = rollouts(roll, f, o, Replay::kBodyRatesHeld);
+  out.attitude_held = rollouts(roll, f, o, Replay::kAttitudeHeld);
+  out.constant_velocity = constant_velocity(roll, f, o);
   out.attitude_replayed = rollouts(roll, f, o, Replay::kAttitude);
   out.translation_replayed = rollouts(roll, f, o, Replay::kTranslation);
   if (o.disturbance_window > 0) {
@@ -258,6 +304,27 @@ const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
   });
 }
 
+// The open loop against moving on at the measured velocity (no model), in words: at the
+// longest horizon, and up to which horizon the model is the better predictor ("" without
+// that view).
+std::string against_constant_velocity(const Prediction& p) {
+  if (p.constant_velocity.size() != p.open_loop.size()) return "";
+  std::vector<size_t> order(p.open_loop.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return p.open_loop[a].horizon < p.open_loop[b].horizon; });
+  const double model = p.open_loop[order.back()].position.mean(), none = p.constant_velocity[order.back()].position.mean();
+  if (!std::isfinite(model) || !std::isfinite(none)) return "";
+  std::string s = " Moving on at the measured velocity, with no model, is " + output::short_number(none) + " m off";
+  if (model <= none) return s + ": the model predicts better.";
+  double better_up_to = 0;  // s, the longest horizon up to which the model is at least as close
+  for (size_t i : order) {
+    if (!(p.open_loop[i].position.mean() <= p.constant_velocity[i].position.mean())) break;
+    better_up_to = p.open_loop[i].horizon;
+  }
+  s += ": at this horizon the model predicts less than the vehicle's momentum does";
+  return s + (better_up_to > 0 ? " (it is the closer up to " + output::short_number(better_up_to) + " s)." : " (and at every shorter horizon).");
+}
+
 }  // namespace
 
 // m: below this at the longest horizon a model predicts the log exactly (its own flights).
@@ -282,6 +349,12 @@ std::string what_limits_prediction(const Prediction& p) {
          " % of it comes from the attitude.";
   else
     s += ": the attitude does not add to it, the force model is what limits it.";
+  if (p.attitude_held.size() == p.open_loop.size() && std::isfinite(p.attitude_held[longest].position.mean())) {
+    const double held = p.attitude_held[longest].position.mean();
+    s += " With the attitude held at the start's (no moment model) it is " + output::short_number(held) + " m: " +
+         (held < both ? "the moment model adds to the error at this horizon." : "the moment model helps at this horizon.");
+  }
+  s += against_constant_velocity(p);
   if (p.open_loop_past_disturbance.size() == p.open_loop.size()) {
     const double held = p.open_loop_past_disturbance[longest].position.mean();
     const long lower = std::lround(100 * (1 - held / both));  // per cent
@@ -366,6 +439,9 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
           {"translation_replayed", moments},
           {"open_loop_past_disturbance", full_rows(p.open_loop_past_disturbance)},
           {"disturbance_window_s", p.disturbance_window},
+          {"body_rates_held", full_rows(p.body_rates_held)},
+          {"attitude_held", full_rows(p.attitude_held)},
+          {"constant_velocity", full_rows(p.constant_velocity)},
           {"one_step", one_step_json(p.one_step)},
           {"start_points", p.start_points},
           {"seconds_of_data", p.seconds_of_data},
@@ -404,6 +480,9 @@ std::string prediction_csv(const Prediction& p) {
   }
   open_loop_rows("open_loop_past_disturbance", p.open_loop_past_disturbance);
   open_loop_rows("set_points_flown", p.set_points_flown);
+  open_loop_rows("body_rates_held", p.body_rates_held);
+  open_loop_rows("attitude_held", p.attitude_held);
+  open_loop_rows("constant_velocity", p.constant_velocity);
   for (const auto& h : p.translation_replayed) {
     row("translation_replayed", h.horizon, "tilt", "rad", h.tilt);
     row("translation_replayed", h.horizon, "heading", "rad", h.heading);
@@ -433,37 +512,39 @@ const std::vector<PublishedPoint>& published_position_errors() {
 
 std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::string, const Prediction*>>& predictions) {
   runtime::Panel open{"open loop: mean position error at a horizon", "horizon [s]", "m", {}};
+  runtime::Panel reduced{"without the moment model, and with no model: mean position error", "horizon [s]", "m", {}};
   runtime::Panel replay{"attitude replayed (force model alone): mean position error", "horizon [s]", "m", {}};
   runtime::Panel tilt{"open loop: mean tilt and heading error", "horizon [s]", "rad", {}};
   runtime::Panel moments{"translation replayed (moment model alone): mean tilt error", "horizon [s]", "rad", {}};
+  // One series of a view's mean errors (of `quantity`); markers where `points`. Empty views
+  // (not run) add nothing.
+  const auto add = [](runtime::Panel& panel, const std::string& label, const std::vector<HorizonErrors>& rows,
+                      ErrorStats HorizonErrors::*quantity, bool points) {
+    runtime::Series s{label, {}, {}, points};
+    for (const auto& h : rows) s.x.push_back(h.horizon), s.y.push_back((h.*quantity).mean());
+    if (!s.x.empty()) panel.series.push_back(s);
+  };
   for (const auto& [label, p] : predictions) {
+    add(open, label, p->open_loop, &HorizonErrors::position, false);
+    add(open, label + ", past disturbance held", p->open_loop_past_disturbance, &HorizonErrors::position, true);
+    add(open, label + ", set points flown", p->set_points_flown, &HorizonErrors::position, true);
+    add(reduced, label + ", open loop", p->open_loop, &HorizonErrors::position, false);
+    add(reduced, label + ", body rates held", p->body_rates_held, &HorizonErrors::position, true);
+    add(reduced, label + ", attitude held", p->attitude_held, &HorizonErrors::position, true);
+    add(reduced, label + ", constant velocity (no model)", p->constant_velocity, &HorizonErrors::position, true);
+    add(replay, label, p->attitude_replayed, &HorizonErrors::position, false);
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
-    runtime::Series so{label, {}, {}}, sr{label, {}, {}}, st{label + ", tilt", {}, {}}, sh{label + ", heading", {}, {}, true},
-        sm{label, {}, {}}, sd{label + ", past disturbance held", {}, {}, true},
-        sf{label + ", set points flown", {}, {}, true};
-    for (const auto& h : p->open_loop) {
-      so.x.push_back(h.horizon), so.y.push_back(h.position.mean());
-      st.x.push_back(h.horizon), st.y.push_back(h.tilt.mean());
-      sh.x.push_back(h.horizon), sh.y.push_back(h.heading.mean());
-    }
-    for (const auto& h : p->attitude_replayed) sr.x.push_back(h.horizon), sr.y.push_back(h.position.mean());
-    for (const auto& h : p->translation_replayed) sm.x.push_back(h.horizon), sm.y.push_back(h.tilt.mean());
-    for (const auto& h : p->open_loop_past_disturbance) sd.x.push_back(h.horizon), sd.y.push_back(h.position.mean());
-    for (const auto& h : p->set_points_flown) sf.x.push_back(h.horizon), sf.y.push_back(h.position.mean());
-    open.series.push_back(so);
-    if (!sd.x.empty()) open.series.push_back(sd);
-    if (!sf.x.empty()) open.series.push_back(sf);
-    replay.series.push_back(sr);
-    tilt.series.push_back(st);
-    tilt.series.push_back(sh);
-    moments.series.push_back(sm);
+    add(tilt, label + ", tilt", p->open_loop, &HorizonErrors::tilt, false);
+    add(tilt, label + ", heading", p->open_loop, &HorizonErrors::heading, true);
+    add(moments, label, p->translation_replayed, &HorizonErrors::tilt, false);
   }
   // Published for the Crazyflie only; drawn for every vehicle as the scale of the state of the
   // art, and labelled with the vehicle they are of.
   runtime::Series published{"published for the Crazyflie (IDSIA, NanoBench)", {}, {}, true};
   for (const auto& pt : published_position_errors()) published.x.push_back(pt.horizon_s), published.y.push_back(pt.position_m);
   open.series.push_back(published);
-  return {open, replay, tilt, moments};
+  reduced.series.push_back(published);
+  return {open, reduced, replay, tilt, moments};
 }
 
 }  // namespace quadgen::predict

@@ -20,6 +20,17 @@
 //    inputs are the controller's set points, one loop further out than the motor commands.
 //    It says how far the model carries the translation when the attitude is held the way the
 //    vehicle's controller held it.
+//  - body rates held, attitude held: reduced predictors from the same start states and logged
+//    commands, which leave out the moment model. Body rates held takes the model's angular
+//    acceleration as zero (the rates stay the start's, the attitude turns at them; the IDSIA
+//    benchmark's physics baseline); attitude held keeps the start's attitude as well, so the
+//    force model acts along it. They are open-loop predictions in the published sense (no
+//    measurement after the start is read) of a model without moments: against the open loop
+//    they say whether the moment model helps the prediction or harms it at a horizon.
+//  - constant velocity: no model. From the same start states, the position moves on at the
+//    measured start velocity and the attitude and body rates stay as they were. The baseline
+//    any model has to beat: a rollout worse than it at a horizon predicts less than the
+//    vehicle's momentum does (on the NanoBench flights the open loop is, at 1 s).
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)
@@ -97,6 +108,11 @@ struct Prediction {
   double disturbance_window = 0;  // s
   // The open loop with the attitude controller flying the logged set points (see above).
   std::vector<HorizonErrors> set_points_flown;
+  // No model: the measured start state moved on at its velocity (see above); empty without a
+  // pose, like the open loop.
+  std::vector<HorizonErrors> constant_velocity;
+  // The reduced predictors (see above; Replay::kBodyRatesHeld, Replay::kAttitudeHeld).
+  std::vector<HorizonErrors> body_rates_held, attitude_held;
   OneStepErrors one_step;
   // With a linear correction fitted on the part before (linearly_corrected_one_step).
   std::optional<OneStepErrors> one_step_corrected;
@@ -125,14 +141,16 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 
 // In words, what limits the open-loop prediction ("" without rollouts): the share of the
 // position error at the longest horizon that the attitude causes (open loop against attitude
-// replayed), and near 0.5 s whether the attitude drift is the moment model's own (translation
+// replayed), against the attitude held (no moment model) and constant velocity (no model),
+// and near 0.5 s whether the attitude drift is the moment model's own (translation
 // replayed drifts at least 80 % as far as the open loop) or grows through the simulated
 // translation; and how much of the error at the longest horizon holding the past
 // disturbance removes.
 std::string what_limits_prediction(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
-// translation_replayed, open_loop_past_disturbance, disturbance_window_s, one_step.
+// translation_replayed, open_loop_past_disturbance, disturbance_window_s, body_rates_held,
+// attitude_held, constant_velocity, one_step (set_points_flown and one_step_linear_correction where they ran).
 nlohmann::ordered_json prediction_json(const Prediction& p);
 
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.

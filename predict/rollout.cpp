@@ -184,6 +184,12 @@ void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay rep
   inputs(t, replay, u_.data());
   m_.rhs(state->data(), u_.data(), f.data(), nullptr, nullptr, nullptr);
   for (int a = 0; a < 3; ++a) f[kVelocity + a] += held_[a], f[kBodyRate + a] += held_[3 + a];
+  // The reduced predictors: no angular acceleration (the body rates stay the start's), and
+  // for kAttitudeHeld no turning either.
+  if (replay == Replay::kBodyRatesHeld || replay == Replay::kAttitudeHeld)
+    for (int a = 0; a < 3; ++a) f[kBodyRate + a] = 0;
+  if (replay == Replay::kAttitudeHeld)
+    for (int a = 0; a < 4; ++a) f[kAttitude + a] = 0;
 }
 
 std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {

@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
 """Prints the prediction benchmark's table (scripts/prediction_benchmark.sh) as Markdown:
 per flight, the nominal model, the diagnosis' base fit and its extended model, and any
-further model in a folder of its own beside them, with the targets and the published anchors. Usage: prediction_table.py OUT_DIR"""
+further model in a folder of its own beside them, with the targets and the published anchors.
+The body-rates-held and attitude-held columns are the model without its moments (angular
+acceleration zero, or the attitude kept at the start's); the constant-velocity columns use no
+model (the measured start moved on at its velocity): the baseline any model's open loop has
+to beat at that horizon. Usage: prediction_table.py OUT_DIR"""
 import json
 import math
 import sys
@@ -11,6 +15,12 @@ COLUMNS = [  # (header, view, horizon or axis, quantity, statistic)
     ("pos 0.1 s [m]", "open_loop", 0.1, "position_m", "mean"),
     ("pos 0.5 s [m]", "open_loop", 0.5, "position_m", "mean"),
     ("pos 1 s [m]", "open_loop", 1.0, "position_m", "mean"),
+    ("body rates held: pos 0.5 s [m]", "body_rates_held", 0.5, "position_m", "mean"),
+    ("body rates held: pos 1 s [m]", "body_rates_held", 1.0, "position_m", "mean"),
+    ("attitude held: pos 0.5 s [m]", "attitude_held", 0.5, "position_m", "mean"),
+    ("attitude held: pos 1 s [m]", "attitude_held", 1.0, "position_m", "mean"),
+    ("constant velocity, no model: pos 0.5 s [m]", "constant_velocity", 0.5, "position_m", "mean"),
+    ("constant velocity, no model: pos 1 s [m]", "constant_velocity", 1.0, "position_m", "mean"),
     ("past disturbance held: pos 1 s [m]", "open_loop_past_disturbance", 1.0, "position_m", "mean"),
     ("tilt 0.5 s [rad]", "open_loop", 0.5, "tilt_rad", "mean"),
     ("moments alone: tilt 0.5 s [rad]", "translation_replayed", 0.5, "tilt_rad", "mean"),
@@ -25,8 +35,8 @@ COLUMNS = [  # (header, view, horizon or axis, quantity, statistic)
     ("q̇ [rad/s²]", "one_step", "y", "angular_acceleration_rad_s2", None),
     ("vertical [m/s²]", "one_step", None, "vertical_acceleration_world_m_s2", None),
 ]
-TARGETS = ["≤ 0.01", "≤ 0.10", "≤ 0.30", "—", "≤ 0.10", "≤ 0.10", "≤ 0.05", "≤ 0.10", "—", "—", "≤ 0.25", "≤ 0.25", "≤ 0.5", "≤ 4", "≤ 4", "—"]
-PUBLISHED = ["IDSIA best 0.0126", "IDSIA 0.112; NanoBench MLP 0.193", "NanoBench MLP 0.533", "—", "IDSIA att. 0.227", "—", "—", "—",
+TARGETS = ["≤ 0.01", "≤ 0.10", "≤ 0.10 (#14; 0.30 in the first prediction issue)", "—", "—", "—", "—", "—", "—", "—", "≤ 0.10", "≤ 0.10", "≤ 0.05", "≤ 0.10", "—", "—", "≤ 0.25", "≤ 0.25", "≤ 0.5", "≤ 4", "≤ 4", "—"]
+PUBLISHED = ["IDSIA best 0.0126", "IDSIA 0.112; NanoBench MLP 0.193", "NanoBench MLP 0.533", "IDSIA's physics baseline (code)", "IDSIA's physics baseline (code)", "—", "—", "the baseline to beat", "the baseline to beat", "—", "IDSIA att. 0.227", "—", "—", "—",
              "none (other inputs)", "none (other inputs)",
              "NeuroBEM 0.24", "NeuroBEM 0.25", "NeuroBEM 0.79", "NeuroBEM ≈3.9", "NeuroBEM ≈5.0", "NanoBench Task 1: 2.17"]
 

@@ -380,6 +380,92 @@ TEST(Prediction, TranslationReplayedFeedsTheMeasuredVelocityToTheMoments) {
   }
 }
 
+// The baseline with no model, against closed forms: the generated flight's pose replaced by a
+// motion of constant acceleration a (p = p0 + v0 t + a t^2 / 2, attitude level, body rates
+// zero) gives, moved on at the start velocity, a position error of |a| h^2 / 2 and a velocity
+// error of |a| h at horizon h from every start, and no attitude error; with a = 0 no error at
+// all. The model's own rollouts on the real pose are untouched by this view (their start
+// states are shared, not changed).
+TEST(Prediction, ConstantVelocityIsTheClosedFormOfAMotionItDoesNotModel) {
+  const double a[3] = {0.8, -0.6, 0.0};  // m/s^2, |a| = 1
+  const double v0[3] = {0.3, 0.2, -0.1};  // m/s
+  quadgen::fit::Flight f = flight().flight;
+  for (auto& smp : f.samples) {
+    const double t = smp.t;
+    for (int i = 0; i < 3; ++i) {
+      smp.x[i] = 1.0 + v0[i] * t + 0.5 * a[i] * t * t;
+      smp.x[3 + i] = v0[i] + a[i] * t;
+    }
+    smp.x[6] = 1, smp.x[7] = smp.x[8] = smp.x[9] = 0;
+    smp.x[10] = smp.x[11] = smp.x[12] = 0;
+  }
+  Model m;
+  const auto p = quadgen::predict::evaluate_prediction(m, m.params(), f, {});
+  ASSERT_EQ(p.constant_velocity.size(), 4u);
+  for (const auto& h : p.constant_velocity) {
+    ASSERT_GT(h.position.count, 100u) << h.horizon;
+    // Scored at the first sample at or after the horizon: within one 10 ms sample of it.
+    const double lo = 0.5 * h.horizon * h.horizon, hi = 0.5 * (h.horizon + 0.0101) * (h.horizon + 0.0101);
+    EXPECT_GE(h.position.mean(), lo * (1 - 1e-9)) << h.horizon;
+    EXPECT_LE(h.position.mean(), hi) << h.horizon;
+    EXPECT_GE(h.velocity.mean(), h.horizon * (1 - 1e-9)) << h.horizon;
+    EXPECT_LE(h.velocity.mean(), h.horizon + 0.0101) << h.horizon;
+    EXPECT_LT(h.tilt.mean(), 1e-12);
+    EXPECT_LT(h.body_rates.mean(), 1e-12);
+    EXPECT_EQ(h.diverged, 0u);
+  }
+  // The same start points as the open loop, on the flight as it was.
+  const auto own = quadgen::predict::evaluate_prediction(m, m.params(), flight().flight, {});
+  for (size_t i = 0; i < own.open_loop.size(); ++i)
+    EXPECT_EQ(own.constant_velocity[i].position.count, own.open_loop[i].position.count) << own.open_loop[i].horizon;
+  // A model that predicts its flight beats moving on at constant velocity by far at 1 s (the
+  // closed-loop flight turns and brakes); on the motion without acceleration nothing is left.
+  EXPECT_LT(own.open_loop.back().position.mean(), 0.1 * own.constant_velocity.back().position.mean());
+  for (auto& smp : f.samples)
+    for (int i = 0; i < 3; ++i) smp.x[i] = 1.0 + v0[i] * smp.t, smp.x[3 + i] = v0[i];
+  const auto still = quadgen::predict::evaluate_prediction(m, m.params(), f, {});
+  for (const auto& h : still.constant_velocity) EXPECT_LT(h.position.mean(), 1e-12) << h.horizon;
+}
+
+// The predictors without the moment model, against closed forms: the generated flight's
+// attitude replaced by a level turn at a constant yaw rate r (q = yaw(r t), body rates (0, 0,
+// r)). Holding the body rates carries the attitude exactly along it; holding the attitude
+// (and moving on at constant velocity) misses the heading by r h at horizon h. Both keep the
+// start's body rates, so their rate error is the change of the measured rates (none here).
+TEST(Prediction, HeldBodyRatesTurnTheAttitudeAndAHeldAttitudeStays) {
+  const double r = 0.5;  // rad/s
+  quadgen::fit::Flight f = flight().flight;
+  for (auto& smp : f.samples) {
+    smp.x[6] = std::cos(0.5 * r * smp.t), smp.x[7] = smp.x[8] = 0, smp.x[9] = std::sin(0.5 * r * smp.t);
+    smp.x[10] = smp.x[11] = 0, smp.x[12] = r;
+  }
+  Model m;
+  const auto p = quadgen::predict::evaluate_prediction(m, m.params(), f, {});
+  ASSERT_EQ(p.body_rates_held.size(), 4u);
+  ASSERT_EQ(p.attitude_held.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const double h = p.body_rates_held[i].horizon;
+    ASSERT_GT(p.body_rates_held[i].heading.count, 100u) << h;
+    EXPECT_LT(p.body_rates_held[i].heading.mean(), 1e-6) << h;
+    EXPECT_LT(p.body_rates_held[i].tilt.mean(), 1e-6) << h;
+    EXPECT_LT(p.body_rates_held[i].body_rates.mean(), 1e-12) << h;
+    // Scored at the first sample at or after the horizon: within one 10 ms sample of it.
+    for (const auto* held : {&p.attitude_held[i], &p.constant_velocity[i]}) {
+      EXPECT_GE(held->heading.mean(), r * h * (1 - 1e-9)) << h;
+      EXPECT_LE(held->heading.mean(), r * (h + 0.0101)) << h;
+      EXPECT_LT(held->tilt.mean(), 1e-9) << h;
+    }
+  }
+  // On the flight as it was: the held attitude's tilt and heading are the constant
+  // velocity's, which holds it by other code; neither turns, the open loop does.
+  const auto own = quadgen::predict::evaluate_prediction(m, m.params(), flight().flight, {});
+  for (size_t i = 0; i < own.attitude_held.size(); ++i) {
+    EXPECT_NEAR(own.attitude_held[i].tilt.mean(), own.constant_velocity[i].tilt.mean(), 1e-9);
+    EXPECT_NEAR(own.attitude_held[i].heading.mean(), own.constant_velocity[i].heading.mean(), 1e-9);
+    EXPECT_GT(own.attitude_held[i].tilt.mean(), 10 * own.open_loop[i].tilt.mean()) << own.open_loop[i].horizon;
+  }
+}
+
 // The sentence that says what limits a prediction, on made-up errors: the attitude's share of
 // the position error at the longest horizon, and whose drift it is near 0.5 s.
 TEST(Prediction, WhatLimitsItIsSaidInWords) {
@@ -426,6 +512,32 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.open_loop_past_disturbance = {row(1.0, 1.001, 0), row(0.5, 0.02, 0)};
   s = quadgen::predict::what_limits_prediction(p);
   EXPECT_NE(s.find("leaves it at 1 m"), std::string::npos) << s;
+  // Against moving on at the measured velocity (no model): said at the longest horizon, with
+  // the horizon up to which the model is the closer.
+  p.open_loop_past_disturbance.clear();
+  p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.2, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("Moving on at the measured velocity, with no model, is 0.4 m off: at this horizon the model predicts "
+                   "less than the vehicle's momentum does (it is the closer up to 0.5 s)."),
+            std::string::npos)
+      << s;
+  p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.05, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("(and at every shorter horizon)."), std::string::npos) << s;
+  p.constant_velocity = {row(1.0, 2.0, 0), row(0.5, 0.05, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("is 2 m off: the model predicts better."), std::string::npos) << s;
+  EXPECT_EQ(s.find("attitude held"), std::string::npos) << s;  // that view not run
+  p.attitude_held = {row(1.0, 0.3, 0), row(0.5, 0.05, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("With the attitude held at the start's (no moment model) it is 0.3 m: the moment model adds to the "
+                   "error at this horizon."),
+            std::string::npos)
+      << s;
+  p.attitude_held = {row(1.0, 1.3, 0), row(0.5, 0.05, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("it is 1.3 m: the moment model helps at this horizon."), std::string::npos) << s;
+  p.attitude_held.clear();
   // A model predicting its own flight: shares of round-off are not a diagnosis.
   p.open_loop = {row(1.0, 1e-9, 0), row(0.5, 1e-10, 0)};
   s = quadgen::predict::what_limits_prediction(p);
