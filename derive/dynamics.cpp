@@ -222,7 +222,7 @@ ex rotor_thrust(const ModelContext& c, size_t i, const ex& w) {
 // reaction torque, which opposes the spin (a ccw rotor, seen from above, pushes the body
 // along -z).
 matrix rotor_torque(const ModelContext& c, size_t i, const ex& thrust) {
-  const int reaction = (c.vehicle.rotors[i].spin == Spin::ccw) ? -1 : 1;
+  const int reaction = -spin_sign(c.vehicle.rotors[i]);
   const matrix arm = c.rotor_position[i].sub(c.cog);
   return cross(arm, vec3(0, 0, thrust)).add(vec3(0, 0, reaction * c.p("kappa") * thrust));
 }

@@ -33,7 +33,7 @@ runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const Symbo
   for (const Rotor& r : v.rotors) {
     b.rotor_x.push_back(r.position[0] - nominal(m, "cog_x"));
     b.rotor_y.push_back(r.position[1] - nominal(m, "cog_y"));
-    b.spin.push_back(r.spin == Spin::ccw ? 1.0 : -1.0);
+    b.spin.push_back(spin_sign(r));
   }
   b.thrust_laws = nominal_thrust_laws(v, m);
   return b;

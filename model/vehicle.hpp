@@ -43,6 +43,10 @@ struct Rotor {
   int line = 0;
 };
 
+// +1 for a rotor spinning counter-clockwise seen from above, -1 clockwise: the sign of its
+// spin about body +z (its drag torque on the body has the opposite sign).
+inline int spin_sign(const Rotor& r) { return r.spin == Spin::ccw ? 1 : -1; }
+
 // The quantities derive computes from the blocks, which a file's `derived` section may bound
 // or give (name, unit, meaning), in the order the model declares them as parameters.
 struct DerivedQuantity {

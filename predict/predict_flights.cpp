@@ -32,7 +32,7 @@ std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::stri
     throw std::invalid_argument("--controller: unknown controller '" + controller + "' (expected crazyflie-pid)");
   std::vector<std::array<double, 3>> positions;
   std::vector<int> spins;
-  for (const auto& r : v.rotors) positions.push_back(r.position), spins.push_back(r.spin == Spin::ccw ? 1 : -1);
+  for (const auto& r : v.rotors) positions.push_back(r.position), spins.push_back(spin_sign(r));
   runtime::AttitudePidOptions pid;
   pid.output_scale = output_scale;
   try {

@@ -61,8 +61,7 @@ void Rollout::start_controller(size_t k, const std::vector<double>& x) {
     throw std::logic_error("Rollout: flying set points needs fly_set_points and a flight with phi_ref, theta_ref");
   const auto& S = f_.samples;
   const runtime::AttitudePidOptions& o = flying_->pid;
-  size_t j0 = k;
-  while (j0 > first_command_ && S[k].t - S[j0 - 1].t <= flying_->start_window + 1e-9) --j0;
+  const size_t j0 = window_start(k, flying_->start_window, false);
   std::array<double, 2> output{}, rate{}, error{};
   for (size_t j = j0; j <= k; ++j) {
     double q[4];
@@ -210,9 +209,7 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
   // The window stays within the sample's stretch and after the rotor speeds are known: just
   // after a restart the states carry the steady-state guess, and the model's accelerations
   // there would be part of the residual.
-  size_t j0 = k;
-  const size_t first = start_.stretch_starts()[k];
-  while (j0 > first && start_.settled(j0 - 1) && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
+  const size_t j0 = window_start(k, window, true);
   std::array<double, 6> d{};
   const double span = S[k].t - S[j0].t;
   if (j0 == k || !(span >= 0.5 * window)) return d;
@@ -224,6 +221,14 @@ std::array<double, 6> Rollout::past_disturbance(size_t k, double window) {
     d[3 + a] = (S[k].x[kBodyRate + a] - S[j0].x[kBodyRate + a] - model_integral[3 + a]) / span;
   }
   return d;
+}
+
+size_t Rollout::window_start(size_t k, double window, bool settled_only) const {
+  const auto& S = f_.samples;
+  const size_t first = start_.stretch_starts()[k];
+  size_t j0 = k;
+  while (j0 > first && (!settled_only || start_.settled(j0 - 1)) && S[k].t - S[j0 - 1].t <= window + 1e-9) --j0;
+  return j0;
 }
 
 void Rollout::stage(const std::vector<double>& x, const std::vector<double>& k, double h) {

@@ -97,6 +97,9 @@ class Rollout {
   // The commands acting at time t (Replay::kSetPoints: their roll and pitch from the
   // controller) and the extra inputs.
   void inputs(double t, Replay replay, double* u) const;
+  // The first sample of the `window` seconds up to sample k within k's stretch; with
+  // `settled_only`, also where the rotor speeds were known (StartStates::settled).
+  size_t window_start(size_t k, double window, bool settled_only) const;
   void start_controller(size_t k, const std::vector<double>& x);
   void update_controller(double t, const std::vector<double>& x);
   void replace_roll_and_pitch(double t, double* u) const;

@@ -759,7 +759,7 @@ AttitudeMixer mixer_of(const std::string& vehicle_file) {
   std::vector<std::array<double, 3>> positions;
   std::vector<int> spins;
   for (const auto& r : quadgen::load_vehicle(source_path(vehicle_file)).rotors)
-    positions.push_back(r.position), spins.push_back(r.spin == quadgen::Spin::ccw ? 1 : -1);
+    positions.push_back(r.position), spins.push_back(quadgen::spin_sign(r));
   return AttitudeMixer::quad_x(positions, spins);
 }
 
