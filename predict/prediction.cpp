@@ -304,9 +304,8 @@ const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
   });
 }
 
-// The open loop against moving on at the measured velocity (no model), in words: at the
-// longest horizon, and up to which horizon the model is the better predictor ("" without
-// that view).
+// The open loop against extrapolating at the measured start velocity (no model), in words: at
+// the longest horizon, and at which horizons the model is the closer ("" without that view).
 std::string against_constant_velocity(const Prediction& p) {
   if (p.constant_velocity.size() != p.open_loop.size()) return "";
   std::vector<size_t> order(p.open_loop.size());
@@ -314,15 +313,14 @@ std::string against_constant_velocity(const Prediction& p) {
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return p.open_loop[a].horizon < p.open_loop[b].horizon; });
   const double model = p.open_loop[order.back()].position.mean(), none = p.constant_velocity[order.back()].position.mean();
   if (!std::isfinite(model) || !std::isfinite(none)) return "";
-  std::string s = " Moving on at the measured velocity, with no model, is " + output::short_number(none) + " m off";
-  if (model <= none) return s + ": the model predicts better.";
-  double better_up_to = 0;  // s, the longest horizon up to which the model is at least as close
-  for (size_t i : order) {
-    if (!(p.open_loop[i].position.mean() <= p.constant_velocity[i].position.mean())) break;
-    better_up_to = p.open_loop[i].horizon;
-  }
-  s += ": at this horizon the model predicts less than the vehicle's momentum does";
-  return s + (better_up_to > 0 ? " (it is the closer up to " + output::short_number(better_up_to) + " s)." : " (and at every shorter horizon).");
+  std::string s = " Extrapolating at the measured start velocity, with no model, is " + output::short_number(none) + " m off";
+  if (model <= none) return s + ": the model predicts better at this horizon.";
+  std::string closer;  // the horizons at which the model is at least as close
+  for (size_t i : order)
+    if (p.open_loop[i].position.mean() <= p.constant_velocity[i].position.mean())
+      closer += (closer.empty() ? "" : ", ") + output::short_number(p.open_loop[i].horizon) + " s";
+  s += ": at this horizon the model is worse than that";
+  return s + (closer.empty() ? " (and at every horizon)." : " (the model is the closer at " + closer + ").");
 }
 
 }  // namespace
@@ -349,10 +347,10 @@ std::string what_limits_prediction(const Prediction& p) {
          " % of it comes from the attitude.";
   else
     s += ": the attitude does not add to it, the force model is what limits it.";
-  if (p.attitude_held.size() == p.open_loop.size() && std::isfinite(p.attitude_held[longest].position.mean())) {
-    const double held = p.attitude_held[longest].position.mean();
-    s += " With the attitude held at the start's (no moment model) it is " + output::short_number(held) + " m: " +
-         (held < both ? "the moment model adds to the error at this horizon." : "the moment model helps at this horizon.");
+  if (p.body_rates_held.size() == p.open_loop.size() && std::isfinite(p.body_rates_held[longest].position.mean())) {
+    const double held = p.body_rates_held[longest].position.mean();
+    s += " Without the moment model (the body rates held at those measured at the start) it is " + output::short_number(held) +
+         " m: " + (held < both ? "the moment model adds to the error at this horizon." : "the moment model helps at this horizon.");
   }
   s += against_constant_velocity(p);
   if (p.open_loop_past_disturbance.size() == p.open_loop.size()) {
@@ -531,13 +529,15 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
     add(reduced, label + ", open loop", p->open_loop, &HorizonErrors::position, false);
     add(reduced, label + ", body rates held", p->body_rates_held, &HorizonErrors::position, true);
     add(reduced, label + ", attitude held", p->attitude_held, &HorizonErrors::position, true);
-    add(reduced, label + ", constant velocity (no model)", p->constant_velocity, &HorizonErrors::position, true);
     add(replay, label, p->attitude_replayed, &HorizonErrors::position, false);
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
     add(tilt, label + ", tilt", p->open_loop, &HorizonErrors::tilt, false);
     add(tilt, label + ", heading", p->open_loop, &HorizonErrors::heading, true);
     add(moments, label, p->translation_replayed, &HorizonErrors::tilt, false);
   }
+  // No model: the same for every model of the same log, drawn once.
+  if (!predictions.empty())
+    add(reduced, "constant velocity (no model)", predictions.front().second->constant_velocity, &HorizonErrors::position, true);
   // Published for the Crazyflie only; drawn for every vehicle as the scale of the state of the
   // art, and labelled with the vehicle they are of.
   runtime::Series published{"published for the Crazyflie (IDSIA, NanoBench)", {}, {}, true};

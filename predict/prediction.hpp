@@ -22,15 +22,15 @@
 //    vehicle's controller held it.
 //  - body rates held, attitude held: reduced predictors from the same start states and logged
 //    commands, which leave out the moment model. Body rates held takes the model's angular
-//    acceleration as zero (the rates stay the start's, the attitude turns at them; the IDSIA
-//    benchmark's physics baseline); attitude held keeps the start's attitude as well, so the
-//    force model acts along it. They are open-loop predictions in the published sense (no
+//    acceleration as zero (the rates stay those measured at the start, the attitude turns at
+//    them; the structure of the IDSIA benchmark code's physics baseline); attitude held keeps
+//    the attitude measured at the start as well, so the force model acts along it. They are open-loop predictions in the published sense (no
 //    measurement after the start is read) of a model without moments: against the open loop
 //    they say whether the moment model helps the prediction or harms it at a horizon.
 //  - constant velocity: no model. From the same start states, the position moves on at the
 //    measured start velocity and the attitude and body rates stay as they were. The baseline
-//    any model has to beat: a rollout worse than it at a horizon predicts less than the
-//    vehicle's momentum does (on the NanoBench flights the open loop is, at 1 s).
+//    any model has to beat (on the NanoBench flights the open loop does not, at 1 s). It never
+//    diverges, so where open-loop rollouts diverge it counts samples the open loop does not.
 //  - one step: body-frame specific force and angular-acceleration residuals per axis, RMS
 //    (NeuroBEM), and the world-vertical acceleration RMSE (NanoBench Task 1).
 // Evaluated on the data given: callers pass held-out data. A log without a pose (IMU only)

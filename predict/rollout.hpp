@@ -30,10 +30,11 @@ namespace quadgen::predict {
 // takes the roll and pitch part of the commands from a controller flying the logged attitude
 // set points (Rollout::fly_set_points) instead of from the log. The last two impose nothing
 // from the log after the start but hold part of the start state, as reduced predictors do:
-// kBodyRatesHeld takes the model's angular acceleration as zero (the body rates stay the
-// start's and the attitude turns at them: the physics baseline of the IDSIA nano-drone
-// benchmark, Busetto et al. 2025), kAttitudeHeld the attitude's rate of change as well (the
-// force model acting along the start's attitude). Neither uses the moment model.
+// kBodyRatesHeld takes the model's angular acceleration as zero (the body rates stay those
+// measured at the start and the attitude turns at them: the structure of the physics baseline
+// in the IDSIA nano-drone benchmark's code, Busetto et al. 2025), kAttitudeHeld the attitude's
+// rate of change as well (the force model acting along the attitude measured at the start).
+// Neither uses the moment model; a held disturbance's angular part is dropped with it.
 enum class Replay { kNothing, kAttitude, kTranslation, kSetPoints, kBodyRatesHeld, kAttitudeHeld };
 
 // The controller that flies the set points and how its outputs reach the rotors.

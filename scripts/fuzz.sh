@@ -4,7 +4,7 @@
 # fuzz/crashes/; keep it as a regression by moving it to fuzz/regressions/<target>/.
 # Line tables only (-g1): a crash report still names file:line in each frame, and the
 # build is faster than with full debug information.
-#   scripts/fuzz.sh            about a minute per target (what CI runs)
+#   scripts/fuzz.sh            a minute per target (CI runs it for 25 s: .ci/sanitize)
 #   scripts/fuzz.sh 600        the longer run (10 minutes per target)
 set -euo pipefail
 cd "$(dirname "$0")/.."

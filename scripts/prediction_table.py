@@ -36,7 +36,7 @@ COLUMNS = [  # (header, view, horizon or axis, quantity, statistic)
     ("vertical [m/s²]", "one_step", None, "vertical_acceleration_world_m_s2", None),
 ]
 TARGETS = ["≤ 0.01", "≤ 0.10", "≤ 0.10 (#14; 0.30 in the first prediction issue)", "—", "—", "—", "—", "—", "—", "—", "≤ 0.10", "≤ 0.10", "≤ 0.05", "≤ 0.10", "—", "—", "≤ 0.25", "≤ 0.25", "≤ 0.5", "≤ 4", "≤ 4", "—"]
-PUBLISHED = ["IDSIA best 0.0126", "IDSIA 0.112; NanoBench MLP 0.193", "NanoBench MLP 0.533", "IDSIA's physics baseline (code)", "IDSIA's physics baseline (code)", "—", "—", "the baseline to beat", "the baseline to beat", "—", "IDSIA att. 0.227", "—", "—", "—",
+PUBLISHED = ["IDSIA best 0.0126", "IDSIA 0.112; NanoBench MLP 0.193", "NanoBench MLP 0.533", "—", "—", "—", "—", "—", "—", "—", "IDSIA att. 0.227", "—", "—", "—",
              "none (other inputs)", "none (other inputs)",
              "NeuroBEM 0.24", "NeuroBEM 0.25", "NeuroBEM 0.79", "NeuroBEM ≈3.9", "NeuroBEM ≈5.0", "NanoBench Task 1: 2.17"]
 

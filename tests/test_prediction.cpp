@@ -454,6 +454,7 @@ TEST(Prediction, HeldBodyRatesTurnTheAttitudeAndAHeldAttitudeStays) {
       EXPECT_GE(held->heading.mean(), r * h * (1 - 1e-9)) << h;
       EXPECT_LE(held->heading.mean(), r * (h + 0.0101)) << h;
       EXPECT_LT(held->tilt.mean(), 1e-9) << h;
+      EXPECT_LT(held->body_rates.mean(), 1e-12) << h;  // no angular acceleration either
     }
   }
   // On the flight as it was: the held attitude's tilt and heading are the constant
@@ -464,6 +465,48 @@ TEST(Prediction, HeldBodyRatesTurnTheAttitudeAndAHeldAttitudeStays) {
     EXPECT_NEAR(own.attitude_held[i].heading.mean(), own.constant_velocity[i].heading.mean(), 1e-9);
     EXPECT_GT(own.attitude_held[i].tilt.mean(), 10 * own.open_loop[i].tilt.mean()) << own.open_loop[i].horizon;
   }
+}
+
+// prediction.json and prediction.csv carry every view that ran, each horizon and quantity, with
+// the numbers of the evaluation (docs/formats.md); a view that did not run (set points flown,
+// without --controller) is absent from the JSON and has no CSV rows.
+TEST(Prediction, EveryViewReachesTheJsonAndTheCsv) {
+  Model m;
+  const auto p = quadgen::predict::evaluate_prediction(m, m.params(), flight().flight, {});
+  const auto j = quadgen::predict::prediction_json(p);
+  const std::pair<const char*, const std::vector<quadgen::predict::HorizonErrors>*> full[] = {
+      {"open_loop", &p.open_loop},
+      {"open_loop_past_disturbance", &p.open_loop_past_disturbance},
+      {"body_rates_held", &p.body_rates_held},
+      {"attitude_held", &p.attitude_held},
+      {"constant_velocity", &p.constant_velocity}};
+  const std::string csv = quadgen::predict::prediction_csv(p);
+  size_t expected_rows = 1;  // the header
+  for (const auto& [name, rows] : full) {
+    ASSERT_TRUE(j.contains(name)) << name;
+    ASSERT_EQ(j[name].size(), rows->size()) << name;
+    ASSERT_EQ(rows->size(), 4u) << name;
+    for (size_t i = 0; i < rows->size(); ++i) {
+      const auto& h = (*rows)[i];
+      EXPECT_EQ(j[name][i]["horizon_s"].get<double>(), h.horizon) << name;
+      for (const char* q : {"position_m", "velocity_m_s", "tilt_rad", "heading_rad", "body_rates_rad_s"})
+        EXPECT_TRUE(j[name][i].contains(q)) << name << " " << q;
+      EXPECT_EQ(j[name][i]["position_m"]["count"].get<size_t>(), h.position.count) << name;
+      EXPECT_DOUBLE_EQ(j[name][i]["position_m"]["mean"].get<double>(), h.position.mean()) << name;
+      // The CSV row of the position, its mean to the six digits written.
+      std::ostringstream key;
+      key.precision(6);
+      key << "\n" << name << ',' << h.horizon << ",position,m,";
+      const size_t at = csv.find(key.str());
+      ASSERT_NE(at, std::string::npos) << key.str();
+      EXPECT_NEAR(std::stod(csv.substr(at + key.str().size())), h.position.mean(), 1e-5 * h.position.mean()) << name;
+    }
+    expected_rows += 5 * rows->size();
+  }
+  EXPECT_FALSE(j.contains("set_points_flown"));
+  EXPECT_EQ(csv.find("set_points_flown"), std::string::npos);
+  expected_rows += 2 * p.attitude_replayed.size() + 3 * p.translation_replayed.size() + 7;  // + one step
+  EXPECT_EQ(static_cast<size_t>(std::count(csv.begin(), csv.end(), '\n')), expected_rows);
 }
 
 // The sentence that says what limits a prediction, on made-up errors: the attitude's share of
@@ -517,27 +560,35 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.open_loop_past_disturbance.clear();
   p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.2, 0)};
   s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("Moving on at the measured velocity, with no model, is 0.4 m off: at this horizon the model predicts "
-                   "less than the vehicle's momentum does (it is the closer up to 0.5 s)."),
+  EXPECT_NE(s.find("Extrapolating at the measured start velocity, with no model, is 0.4 m off: at this horizon the "
+                   "model is worse than that (the model is the closer at 0.5 s)."),
             std::string::npos)
       << s;
   p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("(and at every shorter horizon)."), std::string::npos) << s;
+  EXPECT_NE(s.find("(and at every horizon)."), std::string::npos) << s;
+  // Closer at an intermediate horizon only: named, though not at the shortest.
+  p.open_loop.push_back(row(0.1, 0.01, 0));
+  p.attitude_replayed.push_back(row(0.1, 0.01, 0));
+  p.translation_replayed.push_back(row(0.1, 0, 0.01));
+  p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.2, 0), row(0.1, 0.005, 0)};
+  s = quadgen::predict::what_limits_prediction(p);
+  EXPECT_NE(s.find("(the model is the closer at 0.5 s)."), std::string::npos) << s;
+  p.open_loop.pop_back(), p.attitude_replayed.pop_back(), p.translation_replayed.pop_back();
   p.constant_velocity = {row(1.0, 2.0, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("is 2 m off: the model predicts better."), std::string::npos) << s;
-  EXPECT_EQ(s.find("attitude held"), std::string::npos) << s;  // that view not run
-  p.attitude_held = {row(1.0, 0.3, 0), row(0.5, 0.05, 0)};
+  EXPECT_NE(s.find("is 2 m off: the model predicts better at this horizon."), std::string::npos) << s;
+  EXPECT_EQ(s.find("Without the moment model"), std::string::npos) << s;  // that view not run
+  p.body_rates_held = {row(1.0, 0.3, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);
-  EXPECT_NE(s.find("With the attitude held at the start's (no moment model) it is 0.3 m: the moment model adds to the "
-                   "error at this horizon."),
+  EXPECT_NE(s.find("Without the moment model (the body rates held at those measured at the start) it is 0.3 m: the "
+                   "moment model adds to the error at this horizon."),
             std::string::npos)
       << s;
-  p.attitude_held = {row(1.0, 1.3, 0), row(0.5, 0.05, 0)};
+  p.body_rates_held = {row(1.0, 1.3, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);
   EXPECT_NE(s.find("it is 1.3 m: the moment model helps at this horizon."), std::string::npos) << s;
-  p.attitude_held.clear();
+  p.body_rates_held.clear();
   // A model predicting its own flight: shares of round-off are not a diagnosis.
   p.open_loop = {row(1.0, 1e-9, 0), row(0.5, 1e-10, 0)};
   s = quadgen::predict::what_limits_prediction(p);
