@@ -175,7 +175,7 @@ void Rollout::replace_roll_and_pitch(double t, double* u) const {
 
 void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {
   const std::vector<double>* state = &x;
-  if (replay != Replay::kNothing) {
+  if (replay == Replay::kAttitude || replay == Replay::kTranslation) {  // the views that impose part of the log
     forced_ = x;
     impose(replay, t, k, forced_);
     state = &forced_;
