@@ -555,8 +555,8 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.open_loop_past_disturbance = {row(1.0, 1.001, 0), row(0.5, 0.02, 0)};
   s = quadgen::predict::what_limits_prediction(p);
   EXPECT_NE(s.find("leaves it at 1 m"), std::string::npos) << s;
-  // Against moving on at the measured velocity (no model): said at the longest horizon, with
-  // the horizon up to which the model is the closer.
+  // Against extrapolating at the measured start velocity (no model): said at the longest
+  // horizon, with the horizons at which the model is the closer.
   p.open_loop_past_disturbance.clear();
   p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.2, 0)};
   s = quadgen::predict::what_limits_prediction(p);
