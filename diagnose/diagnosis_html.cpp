@@ -354,21 +354,24 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
          "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
          "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
-         "<th>position, past disturbance held, extended [m]</th><th>position, body rates held, extended [m]</th><th>position, attitude held, extended [m]</th>"
-         "<th>position, constant velocity (no model) [m]</th></tr>\n";
+         "<th>position, past disturbance held, extended [m]</th><th>position, body rates held, extended [m]</th>"
+         "<th>position, attitude held, extended [m]</th><th>position, constant velocity (no model) [m]</th></tr>\n";
     const auto& b = d.prediction_before;
     const auto& a = d.prediction_after;
+    // The mean of `quantity` at the i-th horizon of a view, "–" where the view has no such row.
+    const auto mean_at = [](const std::vector<predict::HorizonErrors>& rows, size_t i,
+                            predict::ErrorStats predict::HorizonErrors::*quantity) -> std::string {
+      return i < rows.size() ? num((rows[i].*quantity).mean()) : "–";
+    };
+    using H = predict::HorizonErrors;
     for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
-      h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << num(b.open_loop[i].position.mean()) << "</td><td>"
-        << num(a.open_loop[i].position.mean()) << "</td><td>" << num(a.open_loop[i].tilt.mean()) << "</td><td>"
-        << num(a.open_loop[i].heading.mean()) << "</td><td>"
-        << (i < a.attitude_replayed.size() ? num(a.attitude_replayed[i].position.mean()) : "–") << "</td><td>"
-        << (i < a.translation_replayed.size() ? num(a.translation_replayed[i].tilt.mean()) : "–") << "</td><td>"
-        << (i < a.open_loop_past_disturbance.size() ? num(a.open_loop_past_disturbance[i].position.mean()) : "–")
-        << "</td><td>" << (i < a.body_rates_held.size() ? num(a.body_rates_held[i].position.mean()) : "–")
-        << "</td><td>" << (i < a.attitude_held.size() ? num(a.attitude_held[i].position.mean()) : "–")
-        << "</td><td>" << (i < a.constant_velocity.size() ? num(a.constant_velocity[i].position.mean()) : "–")
-        << "</td></tr>\n";
+      h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << mean_at(b.open_loop, i, &H::position) << "</td><td>"
+        << mean_at(a.open_loop, i, &H::position) << "</td><td>" << mean_at(a.open_loop, i, &H::tilt) << "</td><td>"
+        << mean_at(a.open_loop, i, &H::heading) << "</td><td>" << mean_at(a.attitude_replayed, i, &H::position)
+        << "</td><td>" << mean_at(a.translation_replayed, i, &H::tilt) << "</td><td>"
+        << mean_at(a.open_loop_past_disturbance, i, &H::position) << "</td><td>" << mean_at(a.body_rates_held, i, &H::position)
+        << "</td><td>" << mean_at(a.attitude_held, i, &H::position) << "</td><td>"
+        << mean_at(a.constant_velocity, i, &H::position) << "</td></tr>\n";
     h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
       << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "
       << num(a.one_step.specific_force[2].rms(), 3) << " m/s², angular acceleration "

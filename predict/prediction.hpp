@@ -24,9 +24,10 @@
 //    commands, which leave out the moment model. Body rates held takes the model's angular
 //    acceleration as zero (the rates stay those measured at the start, the attitude turns at
 //    them; the structure of the IDSIA benchmark code's physics baseline); attitude held keeps
-//    the attitude measured at the start as well, so the force model acts along it. They are open-loop predictions in the published sense (no
-//    measurement after the start is read) of a model without moments: against the open loop
-//    they say whether the moment model helps the prediction or harms it at a horizon.
+//    the attitude measured at the start as well, so the force model acts along it. They are
+//    open-loop predictions in the published sense (no measurement after the start is read) of
+//    a model without moments: against the open loop they say whether the moment model helps
+//    the prediction or harms it at a horizon.
 //  - constant velocity: no model. From the same start states, the position moves on at the
 //    measured start velocity and the attitude and body rates stay as they were. The baseline
 //    any model has to beat (on the NanoBench flights the open loop does not, at 1 s). It never
@@ -150,7 +151,8 @@ std::string what_limits_prediction(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
 // translation_replayed, open_loop_past_disturbance, disturbance_window_s, body_rates_held,
-// attitude_held, constant_velocity, one_step (set_points_flown and one_step_linear_correction where they ran).
+// attitude_held, constant_velocity, one_step (set_points_flown and one_step_linear_correction
+// where they ran).
 nlohmann::ordered_json prediction_json(const Prediction& p);
 
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.
