@@ -40,7 +40,7 @@ void add_predict(CLI::App& app, PredictArgs& a) {
                 "also fly each log's attitude set points (phi_ref, theta_ref) with a replica of this attitude "
                 "controller: crazyflie-pid (the Crazyflie firmware's defaults); the roll and pitch commands come "
                 "from it, the collective and yaw from the log")
-      ->check(CLI::IsMember({"crazyflie-pid"}));
+      ->check(CLI::IsMember(predict::kSetPointControllers));
   c->add_option("--controller-gain", a.options.controller_output_scale,
                 "with --controller: logged command counts per count of the loop's output (the firmware's battery "
                 "compensation between them; 1: none)")

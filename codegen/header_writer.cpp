@@ -135,27 +135,20 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("input_names", quoted_list(m.inputs));
   d.set("param_names", quoted_list(m.params));
   d.set("output_names", quoted_list(m.outputs));
-  std::string nominal = "{", units = "{", lower = "{", upper = "{", fit = "{";
-  for (size_t i = 0; i < m.params.size(); ++i) {
-    const Variable& v = m.params[i];
-    const std::string sep = i ? ", " : "";
-    nominal += sep + number(v.nominal);
-    units += sep + output::cpp_string_literal(v.unit);
-    lower += sep + bound(v.lower);
-    upper += sep + bound(v.upper);
-    fit += sep + (v.fit ? "true" : "false");
-  }
-  d.set("nominal_params", nominal + "}");
-  d.set("param_units", units + "}");
-  d.set("param_lower", lower + "}");
-  d.set("param_upper", upper + "}");
-  d.set("param_fit", fit + "}");
+  const auto table = [](const std::vector<Variable>& vs, auto entry) {
+    std::string out = "{";
+    for (size_t i = 0; i < vs.size(); ++i) out += (i ? ", " : "") + entry(vs[i]);
+    return out + "}";
+  };
+  d.set("nominal_params", table(m.params, [](const Variable& v) { return number(v.nominal); }));
+  d.set("param_units", table(m.params, [](const Variable& v) { return output::cpp_string_literal(v.unit); }));
+  d.set("param_lower", table(m.params, [](const Variable& v) { return bound(v.lower); }));
+  d.set("param_upper", table(m.params, [](const Variable& v) { return bound(v.upper); }));
+  d.set("param_fit", table(m.params, [](const Variable& v) { return std::string(v.fit ? "true" : "false"); }));
   d.set("input_delay_param", m.input_delay_param ? std::to_string(*m.input_delay_param) : std::string("-1"));
   d.set("n_constants", std::to_string(m.constants.size()));
   d.set("constant_names", quoted_list(m.constants));
-  std::string values = "{";
-  for (size_t i = 0; i < m.constants.size(); ++i) values += (i ? ", " : "") + number(m.constants[i].nominal);
-  d.set("constant_values", values + "}");
+  d.set("constant_values", table(m.constants, [](const Variable& v) { return number(v.nominal); }));
 }
 
 // Each Jacobian's sparsity pattern (row and column of every stored entry).

@@ -1,5 +1,6 @@
 #include "predict/predict_flights.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -28,8 +29,11 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
 // The controller of --controller, mixed by the vehicle's rotor positions.
 std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::string& controller, double output_scale) {
   if (controller.empty()) return std::nullopt;
-  if (controller != "crazyflie-pid")
-    throw std::invalid_argument("--controller: unknown controller '" + controller + "' (expected crazyflie-pid)");
+  if (std::find(kSetPointControllers.begin(), kSetPointControllers.end(), controller) == kSetPointControllers.end()) {
+    std::string known;
+    for (const auto& c : kSetPointControllers) known += (known.empty() ? "" : ", ") + c;
+    throw std::invalid_argument("--controller: unknown controller (expected one of: " + known + ")");
+  }
   std::vector<std::array<double, 3>> positions;
   std::vector<int> spins;
   for (const auto& r : v.rotors) positions.push_back(r.position), spins.push_back(spin_sign(r));

@@ -20,6 +20,9 @@
 
 namespace quadgen::predict {
 
+// The controllers PredictFlightsOptions::set_point_controller may name (the CLI's choices too).
+inline const std::vector<std::string> kSetPointControllers = {"crazyflie-pid"};
+
 struct PredictFlightsOptions {
   // The column mapping for logs not in the canonical layout, read once (fit::load_mapping).
   std::optional<fit::ColumnMapping> mapping;
@@ -34,8 +37,9 @@ struct PredictFlightsOptions {
   // (linearly_corrected_one_step; needs validation below 1).
   bool linear_correction = false;
   // Also fly each log's attitude set points (phi_ref, theta_ref) with this controller: "" (not
-  // run) or "crazyflie-pid" (runtime::AttitudePidOptions' defaults, mixed by the vehicle's
-  // rotor positions). Sets prediction.set_points; a log without set points is refused.
+  // run) or one of kSetPointControllers (crazyflie-pid: runtime::AttitudePidOptions' defaults,
+  // mixed by the vehicle's rotor positions). Sets prediction.set_points; a log without set
+  // points is refused.
   std::string set_point_controller;
   double controller_output_scale = 1;  // runtime::AttitudePidOptions::output_scale
   PredictionOptions prediction;

@@ -121,8 +121,11 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
 // An imposed attitude is a unit quaternion; an integrated one is left as the RK4 stage made
 // it, as in the open loop.
 void Rollout::impose(Replay replay, double t, size_t k, std::vector<double>& x) const {
-  if (replay == Replay::kAttitude) impose_attitude(t, k, x);
-  if (replay == Replay::kTranslation) impose_translation(t, k, x);
+  if (!imposes_from_log(replay)) return;
+  if (replay == Replay::kAttitude)
+    impose_attitude(t, k, x);
+  else
+    impose_translation(t, k, x);
 }
 
 // The logged position and velocity at time t in [t_k, t_k+1], interpolated.
@@ -175,7 +178,7 @@ void Rollout::replace_roll_and_pitch(double t, double* u) const {
 
 void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay replay, std::vector<double>& f) {
   const std::vector<double>* state = &x;
-  if (replay == Replay::kAttitude || replay == Replay::kTranslation) {  // the views that impose part of the log
+  if (imposes_from_log(replay)) {
     forced_ = x;
     impose(replay, t, k, forced_);
     state = &forced_;
@@ -185,9 +188,9 @@ void Rollout::deriv(double t, const std::vector<double>& x, size_t k, Replay rep
   for (int a = 0; a < 3; ++a) f[kVelocity + a] += held_[a], f[kBodyRate + a] += held_[3 + a];
   // The reduced predictors: no angular acceleration (the body rates stay the start's), and
   // for kAttitudeHeld no turning either.
-  if (replay == Replay::kBodyRatesHeld || replay == Replay::kAttitudeHeld)
+  if (holds_body_rates(replay))
     for (int a = 0; a < 3; ++a) f[kBodyRate + a] = 0;
-  if (replay == Replay::kAttitudeHeld)
+  if (holds_attitude(replay))
     for (int a = 0; a < 4; ++a) f[kAttitude + a] = 0;
 }
 

@@ -37,6 +37,12 @@ namespace quadgen::predict {
 // Neither uses the moment model; a held disturbance's angular part is dropped with it.
 enum class Replay { kNothing, kAttitude, kTranslation, kSetPoints, kBodyRatesHeld, kAttitudeHeld };
 
+// The one home for what each view does to the state: which impose part of the log at every
+// RK4 stage, which drop the model's angular acceleration, which its turning as well.
+constexpr bool imposes_from_log(Replay r) { return r == Replay::kAttitude || r == Replay::kTranslation; }
+constexpr bool holds_body_rates(Replay r) { return r == Replay::kBodyRatesHeld || r == Replay::kAttitudeHeld; }
+constexpr bool holds_attitude(Replay r) { return r == Replay::kAttitudeHeld; }
+
 // The controller that flies the set points and how its outputs reach the rotors.
 struct SetPointFlying {
   runtime::AttitudePidOptions pid;

@@ -283,7 +283,8 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   }
   std::vector<std::string> needed{"t"};
   for (const auto& r : rotors) needed.push_back("u_" + r);
-  const bool lacks_time = log.column("t") < 0;
+  const int tc = log.column("t");
+  const bool lacks_time = tc < 0;
   const bool lacks_commands = std::any_of(rotors.begin(), rotors.end(), [&](const auto& r) { return log.column("u_" + r) < 0; });
   const std::string what = lacks_time && lacks_commands ? "the time and the rotor commands"
                            : lacks_time                 ? "the time (s)"
@@ -292,7 +293,6 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   if (!missing.empty()) throw LogError(missing);
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
-  const int tc = log.column("t");
   for (size_t i = 0; i < log.rows.size(); ++i) {
     const int line = log.line_of(i);
     if (i > 0 && !(log.rows[i][tc] > log.rows[i - 1][tc]))
