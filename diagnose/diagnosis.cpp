@@ -81,7 +81,7 @@ bool pays_for_it(const Finding::FoldGains& g) {
 // and the larger vertical residual must not hide it getting worse in the sum. The vertical
 // force, set by the flight's thrust constant that every refit moves, counts in the sum only:
 // judged apart it refused on two real flights a rotor drag that lowered the accelerometer's
-// horizontal error by 29-52 % (docs/validation.md, "The horizontal and the vertical force
+// horizontal error by 29-52 % (docs/history.md, "The horizontal and the vertical force
 // judged apart"). The yaw channel is judged apart from the rotational sum for the same
 // reason as the horizontal force: its residual is the smaller (the yaw torque is a fraction
 // of a roll or pitch torque), and a better roll and pitch would hide a worse yaw — the

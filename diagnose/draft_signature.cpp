@@ -99,7 +99,7 @@ std::vector<double> cosine_coefficients(const std::vector<double>& z, const std:
 // Fourier modes, whose ends do not match on a short part) and counts the surrogate
 // correlations at or above the measured one. Bartlett's effective sample size with n_eff - 3
 // degrees of freedom gave 6-11 % false alarms at the 5 % level on short parts once the
-// slow velocity was partialled out; this test 4-6 % (docs/validation.md).
+// slow velocity was partialled out; this test 4-6 % (docs/history.md, the fourteenth session).
 double sign_flip_p(const std::vector<double>& moment, const std::vector<double>& force_res,
                    const std::vector<double>& velocity) {
   constexpr int kSignFlips = 1999;

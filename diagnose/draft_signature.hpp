@@ -14,7 +14,7 @@
 // where the moment residual that drifts the open loop lives), on the training and the
 // held-out part, one-sided in the draft's direction, by a sign-flip test of the moment's
 // cosine coefficients (draft_signature.cpp, sign_flip_p). A hypothesis for an unmeasured draft
-// (docs/validation.md, "Is the slow moment residual moving air?"), never a named cause;
+// (docs/history.md, "Is the slow moment residual moving air?"), never a named cause;
 // scripts/air_draft_check.py is the same test on a diagnosis folder.
 #pragma once
 #include <string>

@@ -369,7 +369,7 @@ std::string what_limits_prediction(const Prediction& p) {
   // views agree by construction), short enough that the open loop has not yet left the
   // measured velocity so far that its airspeed terms (flapping) act on another flight. 0.8:
   // the moments alone drifting at least 80 % as far means the translation adds at most a
-  // fifth (on the real flights they drift 1.2-1.8 times as far: docs/validation.md).
+  // fifth (on the real flights they drift 1.2-1.8 times as far: docs/history.md).
   const HorizonErrors &tilt_open = nearest(p.open_loop, 0.5), &tilt_moments = nearest(p.translation_replayed, 0.5);
   const double a = tilt_open.tilt.mean(), m = tilt_moments.tilt.mean();
   if (!std::isfinite(a) || !std::isfinite(m)) return s;

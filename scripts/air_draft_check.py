@@ -15,7 +15,7 @@ so, whatever S and w, the force residual is tied to the moment residual by a fix
 A trim or a CoG offset has no reason to keep that sign. (The frame's own drag, 1/2 c_w rho A
 v|v| on the air-relative velocity, adds a speed-dependent force to a draft's, so the ratio
 holds only where that is small.) This script takes the slow part of the residuals (running
-means over 1 s, where the moment residual lives; docs/validation.md, "Where the open-loop error comes from") on the training
+means over 1 s, where the moment residual lives; docs/history.md, "Where the open-loop error comes from") on the training
 and the held-out part and prints the regression of the force residual on the moment residual
 (slope and correlation r) beside the ratio the draft predicts. The force residual is the
 pose-derived world acceleration rotated into the heading frame (the flights tilt little).
