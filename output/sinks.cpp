@@ -60,12 +60,13 @@ void for_each_char(const std::string& s, Emit emit) {
 // U+0080..U+009F (a UTF-8 encoded U+009B is CSI to terminals that honour C1 in UTF-8), and
 // the bidirectional overrides and isolates (U+202A..U+202E, U+2066..U+2069), which reorder
 // what a reader sees ("Trojan Source"), with the implicit marks that steer them (LRM and RLM,
-// U+200E and U+200F; the Arabic letter mark U+061C).
+// U+200E and U+200F; the Arabic letter mark U+061C), and the line and paragraph separators
+// (U+2028, U+2029), which editors, some terminals and JavaScript take as line breaks.
 bool invisible_control(const std::string& c) {
   const auto b = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
   if (c.size() == 2) return (b(0) == 0xC2 && b(1) >= 0x80 && b(1) <= 0x9F) || (b(0) == 0xD8 && b(1) == 0x9C);
   if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x80)
-    return (b(2) >= 0xAA && b(2) <= 0xAE) || b(2) == 0x8E || b(2) == 0x8F;
+    return (b(2) >= 0xA8 && b(2) <= 0xAE) || b(2) == 0x8E || b(2) == 0x8F;
   if (c.size() == 3 && b(0) == 0xE2 && b(1) == 0x81) return b(2) >= 0xA6 && b(2) <= 0xA9;
   return false;
 }
@@ -126,7 +127,8 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 std::string shell_path(const std::string& path) {
   const std::string s = !path.empty() && path[0] == '-' ? "./" + path : path;
   static const std::string safe = "_./-+=:,@";
-  bool plain = !s.empty();
+  // A word that starts with '=' is a command's path to zsh (its EQUALS option): quoted.
+  bool plain = !s.empty() && s[0] != '=';
   for (char c : s)
     plain = plain && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
                       safe.find(c) != std::string::npos);
@@ -172,13 +174,20 @@ std::string gnuplot_string(const std::string& s) {
   // gnuplot's SVG terminal writes & as &amp; except where "&#x" starts, which it passes on as a
   // character reference: a log named "x&#x202E;.csv" would reach the page as a bidi override,
   // "&#x0;" would break the SVG. Its & is written as the reference &#x26; (an &, shown as such).
+  // It passes "]]>" and the noncharacters U+FFFE, U+FFFF on as they are, and XML allows
+  // neither in text: the SVG would not parse. "]]>" is written "]] >", they "?".
   std::string safe;
-  for (size_t i = 0; i < s.size(); ++i) safe += s.compare(i, 3, "&#x") == 0 ? "&#x26;" : std::string(1, s[i]);
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s.compare(i, 3, "&#x") == 0) safe += "&#x26;";
+    else if (s.compare(i, 3, "]]>") == 0) safe += "]] >", i += 2;
+    else safe += s[i];
+  }
   std::string out = "'";
   for_each_char(safe, [&](const std::string& c) {
     if (c == "'") out += "''";
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
     else if (invisible_control(c)) out += printable(c);  // shown, not obeyed, in the SVG and the page it lands in
+    else if (c == "\xEF\xBF\xBE" || c == "\xEF\xBF\xBF") out += '?';
     else out += c;
   });
   return out + "'";

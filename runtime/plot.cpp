@@ -107,15 +107,20 @@ GnuplotRun run_gnuplot(const std::string& script) {
   return run;
 }
 
-// A whole SVG document, and nothing that would run as script when the SVG is inlined into a
-// page (gnuplot escapes < and & in text; this is the second line of defence).
+// A whole SVG document, and no tag that would run as script when the SVG is inlined into a
+// page (gnuplot escapes < and & in text; this is the second line of defence). Only the tags
+// are searched: a label's text may say "javascript:" (a log's name did, and lost its plot).
 bool whole_svg(const std::string& svg) {
   const size_t end = svg.find_last_not_of(" \n\r\t");
   if (svg.find("<svg") == std::string::npos || end == std::string::npos || end < 5 || svg.compare(end - 5, 6, "</svg>") != 0)
     return false;
-  std::string lower(svg);
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  return lower.find("<script") == std::string::npos && lower.find("javascript:") == std::string::npos;
+  for (size_t open = svg.find('<'); open != std::string::npos; open = svg.find('<', open + 1)) {
+    const size_t close = svg.find('>', open);
+    std::string tag = svg.substr(open, close == std::string::npos ? std::string::npos : close - open + 1);
+    std::transform(tag.begin(), tag.end(), tag.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (tag.rfind("<script", 0) == 0 || tag.find("javascript:") != std::string::npos) return false;
+  }
+  return true;
 }
 
 }  // namespace

@@ -12,6 +12,8 @@ import math
 import sys
 from pathlib import Path
 
+from markdown_cell import cell  # folder and file names shown as text
+
 MODELS = [("nominal", "nominal"), ("airframe", "unseen_airframe_values"),
           ("calibrated", "unseen_calibrated_first_70pct")]
 AIRFRAME = ["blade_flapping.k", "rotor_drag.k", "motor_lag.tau", "cog_offset.x", "cog_offset.y"]
@@ -72,11 +74,11 @@ def main(out):
             first = label == "nominal"
             held = f"{fmt(open_loop(pred, 0.5, 'attitude_held'))} / {fmt(open_loop(pred, 1.0, 'attitude_held'))}"
             still = f"{fmt(open_loop(pred, 0.5, 'constant_velocity'))} / {fmt(open_loop(pred, 1.0, 'constant_velocity'))}"
-            print(f"| {name if first else ''} | {names if first else ''} | {label} | {fmt(open_loop(pred, 0.5))} "
+            print(f"| {cell(name) if first else ''} | {names if first else ''} | {label} | {fmt(open_loop(pred, 0.5))} "
                   f"| {fmt(open_loop(pred, 1.0))} | {held} | {still} | {fmt(a['x'])} / {fmt(a['y'])} | {below} "
                   f"| {fmt(pred['one_step']['vertical_acceleration_world_m_s2'])} | {agreement(check) if first else ''} |")
     print()
-    print("| airframe parameter | " + " | ".join(f"without {d.name}" for d in folds) + " | spread |")
+    print("| airframe parameter | " + " | ".join(f"without {cell(d.name)}" for d in folds) + " | spread |")
     print("|---|" + "---|" * (len(folds) + 1))
     for p, per in values.items():
         vs = list(per.values())

@@ -29,6 +29,8 @@ import sys
 
 import yaml
 
+from markdown_cell import cell  # folder and file names shown as text
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "crazyflie" / "nanobench"
 FLIGHTS = ["B2_circle_medium_rep1", "B3_figure8_medium_rep1", "B3_figure8_medium_rep2",
@@ -136,7 +138,7 @@ def main(paths):
         out, hover_u = analyse(path)
         for axis in ("roll", "pitch", "collective"):
             cells = " | ".join(f"{g:.2f} (r {r:.2f}, {d})" for g, r, d in out[axis])
-            print(f"| {pathlib.Path(path).stem} | {hover_u:.2f} | {axis} | {cells} |")
+            print(f"| {cell(pathlib.Path(path).stem)} | {hover_u:.2f} | {axis} | {cells} |")
 
 
 if __name__ == "__main__":

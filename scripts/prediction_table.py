@@ -11,6 +11,8 @@ import math
 import sys
 from pathlib import Path
 
+from markdown_cell import cell  # folder and file names shown as text
+
 COLUMNS = [  # (header, view, horizon or axis, quantity, statistic)
     ("pos 0.1 s [m]", "open_loop", 0.1, "position_m", "mean"),
     ("pos 0.5 s [m]", "open_loop", 0.5, "position_m", "mean"),
@@ -73,10 +75,10 @@ def main(out):
             if (sub / "prediction.json").exists():
                 models.append((sub.name, json.loads((sub / "prediction.json").read_text())))
         for name, pred in models:
-            print(f"| {flight.name} | {name} | " + " | ".join(value(pred, *c[1:]) for c in COLUMNS) + " |")
+            print(f"| {cell(flight.name)} | {cell(name)} | " + " | ".join(value(pred, *c[1:]) for c in COLUMNS) + " |")
             if "one_step_linear_correction" in pred:  # one-step columns only
                 corrected = {"one_step": pred["one_step_linear_correction"]}
-                print(f"| {flight.name} | {name} + linear correction (fitted on the first 70 %) | " +
+                print(f"| {cell(flight.name)} | {cell(name)} + linear correction (fitted on the first 70 %) | " +
                       " | ".join(value(corrected, *c[1:]) for c in COLUMNS) + " |")
 
 

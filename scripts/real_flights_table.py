@@ -12,6 +12,8 @@ import math
 import pathlib
 import sys
 
+from markdown_cell import cell  # folder and file names shown as text
+
 
 def fmt(v, digits=3):
     return "open" if v is None else f"{v:.{digits}g}"
@@ -151,7 +153,7 @@ def main(root):
                     return e["position_m"]["mean"]
             return None
         pred = f"{fmt(at(pb, 0.5))} → {fmt(at(pa, 0.5))}"
-        rows.append((d.name, "<br>".join(named) or "—", ", ".join(stand_ins) or "—", ", ".join(suspected) or "—",
+        rows.append((cell(d.name), "<br>".join(named) or "—", ", ".join(stand_ins) or "—", ", ".join(suspected) or "—",
                      ", ".join(groups) or "—", "<br>".join(proposed) or "—", draft_verdict(j), command_gain_verdict(j), pred,
                      f"{j.get('timing_s', float('nan')):.0f}" if isinstance(j.get("timing_s"), (int, float)) else "?"))
     print("| flight | named (95 % interval) | stand-ins (not named) | suspected (failed) | look-alike groups | "
@@ -201,7 +203,7 @@ def look_alike_classes(root):
         classes.setdefault(find(e), []).append(e)
     print("\nFlights diagnosed alone, look-alikes joined (named: which member; ambiguous: a pair the flight "
           "cannot separate, its stronger member carried; suspected; —: absent)\n")
-    print("| effect (or look-alikes) | " + " | ".join(n for n, _ in singles) + " | named, or carried as an ambiguous pair, on |")
+    print("| effect (or look-alikes) | " + " | ".join(cell(n) for n, _ in singles) + " | named, or carried as an ambiguous pair, on |")
     print("|---|" + "---|" * len(singles) + "---|")
     for members in sorted(classes.values(), key=lambda m: m[0]):
         cells, in_model = [], 0
@@ -226,7 +228,7 @@ def agreement_tables(root):
         for a in json.loads(j_path.read_text()).get("agreement", []):
             state = "agree" if a["agree"] else "disagree"
             named = "named" if a["named"] else "suspected"
-            print(f"\n{d.name}: **{a['parameter']}** [{a['unit']}] ({named}) — flights {state}: joint "
+            print(f"\n{cell(d.name)}: **{a['parameter']}** [{a['unit']}] ({named}) — flights {state}: joint "
                   f"{fmt(a['joint_value'])}, pooled {fmt(a['pooled'])}, spread {fmt(100 * a['spread'] if a['spread'] is not None else None)} %"
                   + (f" (if they agree: median {fmt(100 * a['spread_if_agree'], 2)} %, p = {fmt(a['spread_p_value'], 2)})"
                      if a.get("spread_if_agree") is not None else "") + ", "
@@ -235,7 +237,7 @@ def agreement_tables(root):
             print("|---|---|---|---|---|")
             for f in a["flights"]:
                 lo, hi = f["ci95"]
-                print(f"| {pathlib.Path(f['flight']).stem} | {fmt(f['value'])} | [{fmt(lo)}, {fmt(hi)}] | "
+                print(f"| {cell(pathlib.Path(f['flight']).stem)} | {fmt(f['value'])} | [{fmt(lo)}, {fmt(hi)}] | "
                       f"{fmt(f['alone']['statistic'])} | {fmt(f['alone']['p_value'], 2)} |")
 
 

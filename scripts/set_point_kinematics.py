@@ -24,6 +24,8 @@ import math
 import sys
 from pathlib import Path
 
+from markdown_cell import cell  # folder and file names shown as text
+
 DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data" / "crazyflie" / "nanobench"
 G0 = 9.80665  # the accelerometer's unit, g
 HORIZON = 100  # samples at 100 Hz: 1 s
@@ -90,14 +92,14 @@ def main():
         print("|---|---|")
         for path in sorted(DATA.glob("*.csv")):
             slope = collective_slope(path)
-            print(f"| {path.stem} | {'– (no usable rows: the motors saturate)' if slope is None else f'{slope:.3f}'} |")
+            print(f"| {cell(path.stem)} | {'– (no usable rows: the motors saturate)' if slope is None else f'{slope:.3f}'} |")
         return
     delay = int(sys.argv[1]) if len(sys.argv) > 1 else 12
     print(f"| flight | set points ({10 * delay} ms earlier): pos 1 s [m] | measured attitude: pos 1 s [m] | starts |")
     print("|---|---|---|---|")
     for path in sorted(DATA.glob("*.csv")):
         means, starts = flight(path, delay)
-        print(f"| {path.stem} | {means['set points']:.3f} | {means['measured attitude']:.3f} | {starts} |")
+        print(f"| {cell(path.stem)} | {means['set points']:.3f} | {means['measured attitude']:.3f} | {starts} |")
 
 
 if __name__ == "__main__":

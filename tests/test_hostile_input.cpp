@@ -74,6 +74,9 @@ const std::vector<std::string>& hostile_strings() {
       "c1 \xc2\x9b" "31m csi in utf-8",               // U+009B, CSI where C1 controls are honoured
       "bidi \xe2\x80\xae" "desrever \xe2\x81\xa6x",  // U+202E right-to-left override, U+2066 isolate
       "mark \xe2\x80\x8f" "rtl \xd8\x9c" "alm",       // U+200F right-to-left mark, U+061C Arabic letter mark
+      "sep \xe2\x80\xa8" "line \xe2\x80\xa9" "para",     // U+2028 line and U+2029 paragraph separators
+      "cdata ]]]> end \xef\xbf\xbf" "nonchar",           // neither allowed in XML text (an SVG)
+      "javascript:alert(1)",
   };
   return s;
 }
@@ -254,7 +257,7 @@ TEST(Sinks, TerminalTextShowsControlsAsEscapes) {
         return true;
       if (c == 0xE2 && i + 2 < t.size()) {
         const auto b1 = static_cast<unsigned char>(t[i + 1]), b2 = static_cast<unsigned char>(t[i + 2]);
-        if ((b1 == 0x80 && b2 >= 0xAA && b2 <= 0xAE) || (b1 == 0x81 && b2 >= 0xA6 && b2 <= 0xA9)) return true;
+        if ((b1 == 0x80 && b2 >= 0xA8 && b2 <= 0xAE) || (b1 == 0x81 && b2 >= 0xA6 && b2 <= 0xA9)) return true;
         if (b1 == 0x80 && (b2 == 0x8E || b2 == 0x8F)) return true;  // LRM, RLM
       }
       if (c == 0xD8 && i + 1 < t.size() && static_cast<unsigned char>(t[i + 1]) == 0x9C) return true;  // ALM
@@ -434,6 +437,10 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
     std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
     EXPECT_EQ(lower.find("<script"), std::string::npos);
     EXPECT_EQ(lower.find("<img"), std::string::npos);
+    // What XML does not allow in text, which would leave an SVG a browser refuses to show.
+    EXPECT_EQ(svg.find("]]>"), std::string::npos) << out::printable(s);
+    EXPECT_EQ(svg.find("\xef\xbf\xbf"), std::string::npos) << out::printable(s);
+    EXPECT_EQ(svg.find("\xef\xbf\xbe"), std::string::npos) << out::printable(s);
   }
   EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
 }
@@ -485,6 +492,20 @@ TEST(Sinks, PlotDataCsvKeepsEveryLabelInItsField) {
   EXPECT_EQ(read_rfc4180(out::csv_field("a\nb"))[0][0], "a b");
   EXPECT_EQ(read_rfc4180(out::csv_field(" \t=1+1"))[0][0], "'  =1+1");  // blanks do not hide a formula
   EXPECT_EQ(read_rfc4180(out::csv_field("a=1"))[0][0], "a=1");
+}
+
+// JSON: valid whatever the bytes, and the line separators, valid in a JSON string but a line
+// break to older JavaScript and to some editors, escaped; the string reads back unchanged.
+TEST(Sinks, JsonEscapesTheLineSeparators) {
+  for (const auto& s : hostile_strings()) {
+    const std::string doc = out::json_document(nlohmann::json{{"path", s}});
+    EXPECT_EQ(doc.find("\xe2\x80\xa8"), std::string::npos) << out::printable(s);
+    EXPECT_EQ(doc.find("\xe2\x80\xa9"), std::string::npos) << out::printable(s);
+    const auto back = nlohmann::json::parse(doc)["path"].get<std::string>();
+    if (s.find('\xff') == std::string::npos) EXPECT_EQ(back, s) << out::printable(s);  // invalid UTF-8 is replaced
+  }
+  EXPECT_EQ(out::json_document(nlohmann::json{{"a", "x\xe2\x80\xa8y\xe2\x80\xa9z\xe2\x80\xa6"}}),
+            "{\n  \"a\": \"x\\u2028y\\u2029z\xe2\x80\xa6\"\n}\n");  // U+2026, an ellipsis, kept
 }
 
 TEST(Sinks, HtmlReportQuotesNoMarkup) {
@@ -659,6 +680,8 @@ TEST(Sinks, ShellWordsAreOneWordToAShell) {
   EXPECT_EQ(out::shell_path("a b'c"), "'a b'\\''c'");
   EXPECT_EQ(out::shell_path(""), "''");
   EXPECT_EQ(out::shell_path("-v.yaml"), "./-v.yaml");
+  EXPECT_EQ(out::shell_path("=v.yaml"), "'=v.yaml'");  // zsh would expand =word to a command's path
+  EXPECT_EQ(out::shell_path("a=v.yaml"), "a=v.yaml");
   std::vector<std::string> strings = hostile_strings();
   strings.push_back("v $(touch PWNED);`touch PWNED`|x.yaml");
   for (const auto& s : strings) {

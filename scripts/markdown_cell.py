@@ -1,0 +1,31 @@
+"""One table cell of Markdown from a string the scripts did not write (a folder or file name):
+shown as text, never as markup. Newlines and other controls become spaces; the characters
+that end a cell (|), start markup (* _ ` [ ] ~ and the backslash) or HTML (< > &) are
+escaped. The tables go into the README and docs, which GitHub renders."""
+
+_ESCAPED = set("\\|*_`[]~")
+
+
+def cell(text):
+    out = []
+    for ch in str(text):
+        if ord(ch) < 0x20 or ord(ch) == 0x7F or ch in "\u2028\u2029":
+            out.append(" ")
+        elif ch == "<":
+            out.append("&lt;")
+        elif ch == ">":
+            out.append("&gt;")
+        elif ch == "&":
+            out.append("&amp;")
+        elif ch in _ESCAPED:
+            out.append("\\" + ch)
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+if __name__ == "__main__":  # a self-check: python3 scripts/markdown_cell.py
+    assert cell("x|y<img src=x onerror=alert(1)>") == "x\\|y&lt;img src=x onerror=alert(1)&gt;"
+    assert cell("B3_figure8\nrep2") == "B3\\_figure8 rep2"
+    assert cell("plain name 1.5") == "plain name 1.5"
+    print("ok")
