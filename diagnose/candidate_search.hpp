@@ -261,7 +261,7 @@ class CandidateSearch {
   // where an effect whitens a channel the refit trades other parameters against that
   // channel's raised weight (on a real flight, the marker frame's tilt raised the body-y
   // force's weight 0.76 -> 2.71 and its refit moved the CoG 0.05 mm onto a held-out roll
-  // offset; docs/validation.md).
+  // offset; docs/history.md, "Why B3 rep 2's moments get worse with the marker frame").
   std::vector<fit::FitParameter> fit_as_own_model(const std::set<std::string>& effects,
                                                   const std::vector<fit::FitParameter>& start,
                                                   std::vector<double> start_weights,

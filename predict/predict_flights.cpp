@@ -8,6 +8,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
 #include "output/numbers.hpp"
+#include "output/sinks.hpp"
 #include "predict/parameter_source.hpp"
 
 namespace quadgen::predict {
@@ -32,7 +33,8 @@ std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::stri
   if (std::find(kSetPointControllers.begin(), kSetPointControllers.end(), controller) == kSetPointControllers.end()) {
     std::string known;
     for (const auto& c : kSetPointControllers) known += (known.empty() ? "" : ", ") + c;
-    throw std::invalid_argument("--controller: unknown controller (expected one of: " + known + ")");
+    throw std::invalid_argument("--controller: unknown controller '" + output::printable(controller) +
+                                "' (expected one of: " + known + ")");
   }
   std::vector<std::array<double, 3>> positions;
   std::vector<int> spins;

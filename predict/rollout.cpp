@@ -121,11 +121,11 @@ bool Rollout::advance(std::vector<double>& x, size_t k, Replay replay) {
 // An imposed attitude is a unit quaternion; an integrated one is left as the RK4 stage made
 // it, as in the open loop.
 void Rollout::impose(Replay replay, double t, size_t k, std::vector<double>& x) const {
-  if (!imposes_from_log(replay)) return;
-  if (replay == Replay::kAttitude)
-    impose_attitude(t, k, x);
-  else
-    impose_translation(t, k, x);
+  switch (replay) {  // no default: a new view must say here what it imposes (-Wswitch)
+    case Replay::kAttitude: impose_attitude(t, k, x); break;
+    case Replay::kTranslation: impose_translation(t, k, x); break;
+    case Replay::kNothing: case Replay::kSetPoints: case Replay::kBodyRatesHeld: case Replay::kAttitudeHeld: break;
+  }
 }
 
 // The logged position and velocity at time t in [t_k, t_k+1], interpolated.

@@ -39,7 +39,7 @@ enum class Replay { kNothing, kAttitude, kTranslation, kSetPoints, kBodyRatesHel
 
 // The one home for what each view does to the state: which impose part of the log at every
 // RK4 stage, which drop the model's angular acceleration, which its turning as well.
-constexpr bool imposes_from_log(Replay r) { return r == Replay::kAttitude || r == Replay::kTranslation; }
+constexpr bool imposes_from_log(Replay r) { return r == Replay::kAttitude || r == Replay::kTranslation; }  // as impose()
 constexpr bool holds_body_rates(Replay r) { return r == Replay::kBodyRatesHeld || r == Replay::kAttitudeHeld; }
 constexpr bool holds_attitude(Replay r) { return r == Replay::kAttitudeHeld; }
 

@@ -107,23 +107,49 @@ GnuplotRun run_gnuplot(const std::string& script) {
   return run;
 }
 
-// A whole SVG document, and no tag that would run as script when the SVG is inlined into a
-// page (gnuplot escapes < and & in text; this is the second line of defence). Only the tags
-// are searched: a label's text may say "javascript:" (a log's name did, and lost its plot).
-bool whole_svg(const std::string& svg) {
+}  // namespace
+
+// Tags are read with their quoted attribute values whole (XML allows a raw '>' inside one), in
+// one pass; every '<' of text is escaped by gnuplot, so text cannot open a tag.
+bool whole_inert_svg(const std::string& svg) {
   const size_t end = svg.find_last_not_of(" \n\r\t");
   if (svg.find("<svg") == std::string::npos || end == std::string::npos || end < 5 || svg.compare(end - 5, 6, "</svg>") != 0)
     return false;
-  for (size_t open = svg.find('<'); open != std::string::npos; open = svg.find('<', open + 1)) {
-    const size_t close = svg.find('>', open);
-    std::string tag = svg.substr(open, close == std::string::npos ? std::string::npos : close - open + 1);
-    std::transform(tag.begin(), tag.end(), tag.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (tag.rfind("<script", 0) == 0 || tag.find("javascript:") != std::string::npos) return false;
+  const auto refused = [](const std::string& tag) {
+    if (tag.find("<script") != std::string::npos || tag.find(":script") != std::string::npos ||
+        tag.find("javascript:") != std::string::npos)
+      return true;
+    for (size_t on = tag.find("on"); on != std::string::npos; on = tag.find("on", on + 1)) {  // an event handler
+      if (on == 0 || !std::isspace(static_cast<unsigned char>(tag[on - 1]))) continue;
+      size_t k = on + 2;
+      while (k < tag.size() && std::isalpha(static_cast<unsigned char>(tag[k]))) ++k;
+      while (k < tag.size() && std::isspace(static_cast<unsigned char>(tag[k]))) ++k;
+      if (k > on + 2 && k < tag.size() && tag[k] == '=') return true;
+    }
+    return false;
+  };
+  std::string tag;
+  char quote = 0;
+  bool in_tag = false;
+  for (const char raw : svg) {
+    const char c = static_cast<char>(std::tolower(static_cast<unsigned char>(raw)));
+    if (!in_tag) {
+      if (c != '<') continue;
+      in_tag = true;
+      tag.clear();
+    }
+    tag += c;
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      in_tag = false;
+      if (refused(tag)) return false;
+    }
   }
-  return true;
+  return !in_tag;
 }
-
-}  // namespace
 
 Series decimated(const Series& s) {
   const size_t n = std::min(s.x.size(), s.y.size());
@@ -209,7 +235,7 @@ bool render_svg(const std::string& title, const std::vector<Panel>& panels, std:
   if (!run.failure.empty()) why = run.failure;
   else if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0)
     why = "gnuplot failed: " + output::printable(run.err.substr(0, 300));
-  else if (!whole_svg(run.out)) why = "gnuplot returned no complete SVG document";
+  else if (!whole_inert_svg(run.out)) why = "gnuplot returned no complete SVG document, or one with script in a tag";
   if (!why.empty()) {
     if (error) *error = why;
     return false;

@@ -31,6 +31,11 @@ inline constexpr size_t kMaxPlotPointsPerSeries = 4000;
 // whole SVG document; the caller decides whether that is fatal.
 bool render_svg(const std::string& title, const std::vector<Panel>& panels, std::string* svg, std::string* error);
 
+// Whether `svg` is one whole SVG document with no tag that would run as script inlined into a
+// page: a <script> (any namespace), a javascript: URL or an on...= event handler in a tag.
+// Text is not searched (a label may say "javascript:"). render_svg's second line of defence.
+bool whole_inert_svg(const std::string& svg);
+
 // The gnuplot script render_svg sends (exposed for tests and the fuzz target).
 std::string gnuplot_script(const std::string& title, const std::vector<Panel>& panels);
 

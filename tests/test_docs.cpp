@@ -4,6 +4,8 @@
 // here (no network: links to other sites are not followed).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -61,11 +63,15 @@ void append_utf8(std::string& out, char32_t c) {
   }
 }
 
-// GitHub's anchor of a heading: lower case; letters, digits, '_', '-' and spaces kept, spaces
-// turned into '-', everything else (punctuation, symbols, dashes, backquotes) dropped. Of the
-// non-ASCII characters only those the docs use as letters are known here: Latin-1 and Latin
-// Extended letters, Greek, superscript digits.
+// GitHub's anchor of a heading: trimmed, lower case; letters, digits, '_', '-' and spaces
+// kept, spaces turned into '-', everything else (punctuation, symbols, dashes, backquotes,
+// superscript digits) dropped. Of the non-ASCII letters only those the docs may use are
+// known here: Latin-1, Latin Extended and Greek kept, the Latin-1 and Greek capitals lower-
+// cased. A link to a heading beyond that (a Cyrillic word, a capital Ł) fails the check
+// below, which then needs this function extended, not the link changed.
 std::string anchor_of(std::string heading) {
+  heading.erase(heading.find_last_not_of(" \t") + 1);
+  heading.erase(0, std::min(heading.size(), heading.find_first_not_of(" \t")));
   // A link in a heading counts by its text: "[text](target)" -> "text".
   for (size_t open; (open = heading.find("](")) != std::string::npos;) {
     const size_t close = heading.find(')', open);
@@ -83,8 +89,7 @@ std::string anchor_of(std::string heading) {
     }
     const bool latin = (c >= 0xC0 && c <= 0x24F && c != 0xD7 && c != 0xF7);
     const bool greek = c >= 0x391 && c <= 0x3C9;
-    const bool superscript = c == 0xB2 || c == 0xB3 || c == 0xB9 || (c >= 0x2070 && c <= 0x2079);
-    if (!latin && !greek && !superscript) continue;
+    if (!latin && !greek) continue;
     if ((c >= 0xC0 && c <= 0xDE && c != 0xD7) || (c >= 0x391 && c <= 0x3A9)) c += 0x20;
     append_utf8(out, c);
   }
@@ -153,7 +158,8 @@ TEST(Docs, AnchorsAreGitHubs) {
             "fit-on-some-flights-predict-another-scriptscross_flightsh");
   EXPECT_EQ(anchor_of("8. The answer — re-measured (2026-11-28, eighteenth session)"),
             "8-the-answer--re-measured-2026-11-28-eighteenth-session");
-  EXPECT_EQ(anchor_of("Förster's τ ≤ 2 m/s²"), "försters-τ--2-ms²");
+  EXPECT_EQ(anchor_of("Förster's τ ≤ 2 m/s²"), "försters-τ--2-ms");
+  EXPECT_EQ(anchor_of("Trailing blank "), "trailing-blank");
   EXPECT_EQ(anchor_of("See [the table](x.md#y) here"), "see-the-table-here");
   const std::set<std::string> twice = anchors_in("# A\n```\n# not a heading\n```\n## A\n#nospace\n");
   EXPECT_EQ(twice, (std::set<std::string>{"a", "a-1"}));

@@ -75,7 +75,7 @@ const std::vector<std::string>& hostile_strings() {
       "bidi \xe2\x80\xae" "desrever \xe2\x81\xa6x",  // U+202E right-to-left override, U+2066 isolate
       "mark \xe2\x80\x8f" "rtl \xd8\x9c" "alm",       // U+200F right-to-left mark, U+061C Arabic letter mark
       "sep \xe2\x80\xa8" "line \xe2\x80\xa9" "para",     // U+2028 line and U+2029 paragraph separators
-      "cdata ]]]> end \xef\xbf\xbf" "nonchar",           // neither allowed in XML text (an SVG)
+      "cdata ]]]> end \xef\xbf\xbf" "nonchar \xef\xbf\xbe",  // none allowed in XML text (an SVG)
       "javascript:alert(1)",
   };
   return s;
@@ -443,6 +443,20 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
     EXPECT_EQ(svg.find("\xef\xbf\xbe"), std::string::npos) << out::printable(s);
   }
   EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
+}
+
+// The second line of defence behind gnuplot's escaping: an SVG whose tags hold script is
+// refused, whatever hides it in an attribute; the same words as text are drawn.
+TEST(Sinks, AnSvgWithScriptInATagIsRefusedAndTextIsNot) {
+  const auto doc = [](const std::string& body) { return "<?xml version=\"1.0\"?>\n<svg width=\"10\">" + body + "</svg>\n"; };
+  EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<text>javascript:alert(1) onload=x &lt;script</text>")));
+  EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<path d=\"M 1 2 L 3 4\" stroke=\"rgb(0, 0, 0)\"/>")));
+  for (const std::string bad : {"<script>alert(1)</script>", "<svg:script>x</svg:script>",
+                                "<a xlink:href=\"x>javascript:alert(1)\">y</a>", "<a href='JavaScript:x'>y</a>",
+                                "<g onload=\"x\">y</g>", "<g\tONCLICK = 'x'>y</g>", "<g id=\"a\" onmouseover=x>y</g>"})
+    EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc(bad))) << bad;
+  EXPECT_FALSE(quadgen::runtime::whole_inert_svg("<svg><text>cut short"));
+  EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc("<g id=\"unclosed>") ));
 }
 
 // A plot's series as CSV: read back with an RFC 4180 reader written here, every hostile label
