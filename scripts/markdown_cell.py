@@ -1,8 +1,7 @@
 """One table cell of Markdown from a string the scripts did not write (a folder or file name):
 shown as text, never as markup. Newlines, other controls and bidirectional marks become
-spaces; the characters
-that end a cell (|), start markup (* _ ` [ ] ~ and the backslash) or HTML (< > &) are
-escaped. The tables go into the README and docs, which GitHub renders."""
+spaces; the characters that end a cell (|), start markup (* _ ` [ ] ~ and the backslash) or
+HTML (< > &) are escaped. The tables go into the README and docs, which GitHub renders."""
 
 _ESCAPED = set("\\|*_`[]~")
 # Shown as a space: the line and paragraph separators and the bidirectional controls and
