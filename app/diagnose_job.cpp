@@ -13,6 +13,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "app/extended_model.hpp"
 #include "derive/geometry.hpp"
+#include "output/joined.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "fit/log_reader.hpp"
@@ -134,6 +135,11 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
 
 }  // namespace
 
+std::string logs_label(const std::vector<std::string>& paths) {
+  if (paths.size() == 1) return paths[0];
+  return output::joined(paths, ", ", [](const std::string& p) { return output::shell_path(p); });
+}
+
 DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   std::string error;
   if (!job.IsValid(&error)) throw std::invalid_argument("diagnose: " + error);
@@ -157,8 +163,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
 
   const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
-  std::string logs_label;  // what the outputs say was diagnosed
-  for (const auto& path : job.logs) logs_label += (logs_label.empty() ? "" : ", ") + path;
+  const std::string diagnosed = logs_label(job.logs);  // what the outputs say was diagnosed
   size_t samples = 0;
   for (const auto& f : flights) samples += f.samples.size();
   o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
@@ -172,16 +177,15 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
 
   o.progress.say("[diagnose] generating the extended model");
-  std::string fitted_to;  // the flights the extended model was fitted to: a left-out log is not one
-  for (const auto& f : d.flights) fitted_to += (fitted_to.empty() ? "" : ", ") + f;
+  const std::string fitted_to = logs_label(d.flights);  // a left-out log is not one of them
   const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to);
   std::string err;
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
   DiagnoseJobResult r;
   if (plots.empty()) r.notes.push_back("no plots: " + err);
-  r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, logs_label))},
-             {"report.html", diagnose::diagnosis_html(d, logs_label, plots)},
+  r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, diagnosed))},
+             {"report.html", diagnose::diagnosis_html(d, diagnosed, plots)},
              {"extended_model.hpp", ext.header},
              {"extended_model.json", ext.model_json},
              {"extended_derivation.md", ext.derivation_markdown},

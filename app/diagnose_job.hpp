@@ -33,6 +33,11 @@ struct DiagnoseJobResult {
   std::vector<std::string> notes;                          // what went wrong on the side (no plots)
 };
 
+// The logs a diagnosis read, as its outputs name them (diagnosis.json's "log", the report's
+// head, the extended header's comment): one log as its path; several joined with ", ", each
+// quoted as one shell word (output::shell_path), so that a path holding ", " reads as one.
+std::string logs_label(const std::vector<std::string>& paths);
+
 // Throws std::invalid_argument for an invalid job, and the layers' own errors (a bad vehicle
 // file or log, with file and line) unchanged.
 DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "output/joined.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen {
@@ -135,9 +136,7 @@ std::string TexWriter::product(const ex& e) {
   sort(above);
   sort(below);
   const auto join = [](const std::vector<Written>& v) {
-    std::string s;
-    for (const auto& x : v) s += (s.empty() ? "" : " ") + x.text;
-    return s.empty() ? std::string("1") : s;
+    return v.empty() ? std::string("1") : output::joined(v, " ", [](const Written& x) { return x.text; });
   };
   if (flipped) coefficient = -coefficient;
   std::string sign = coefficient.is_negative() ? "-" : "";
@@ -158,17 +157,16 @@ std::string TexWriter::power(const ex& e) {
 }
 
 std::string TexWriter::function(const ex& e) {
-  std::string args;
   const std::string name = ex_to<GiNaC::function>(e).get_name();
   const bool even = name == "abs_value" || name == "abs";
-  for (const auto& a : e) {
+  const std::string args = output::joined(e, ", ", [&](const ex& a) {
     const bool flip = even && is_a<add>(a) && leading_term_negative(a);  // |-x| = |x|
-    args += (args.empty() ? "" : ", ") + tex(flip ? negated_sum(a) : a);
-  }
+    return tex(flip ? negated_sum(a) : a);
+  });
   if (even) return "\\left|" + args + "\\right|";
   if (name == "sign_of") return "\\operatorname{sgn}\\left(" + args + "\\right)";
   const bool known = name == "sin" || name == "cos" || name == "tan" || name == "exp" || name == "log";
-  return (known ? "\\" + name : "\\operatorname{" + output::latex_text(name) + "}") + "\\left(" + args + "\\right)";
+  return (known ? "\\" + name : "\\operatorname{" + output::latex_math_text(name) + "}") + "\\left(" + args + "\\right)";
 }
 
 }  // namespace quadgen

@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/fit_pipeline.hpp"
+#include "output/joined.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "app/model_registry.hpp"
@@ -75,10 +76,8 @@ FitJobOptions job_options(const FitArgs& a) {
 void refuse_options(const FitArgs& a, const std::string& kind, const std::set<std::string>& used) {
   for (const auto& opt : a.given)
     if (!used.count(opt)) {
-      std::string list;
-      for (const auto& u : used) list += (list.empty() ? "" : ", ") + u;
       throw std::invalid_argument(opt + ": not used when fitting " + kind +
-                                  " (the log's columns choose the kind of fit); this kind takes " + list);
+                                  " (the log's columns choose the kind of fit); this kind takes " + output::joined(used));
     }
 }
 

@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
+#include "output/joined.hpp"
 #include "output/output_set.hpp"
 #include "output/sinks.hpp"
 
@@ -16,16 +17,13 @@ namespace {
 // the commands there are, and the nearest one.
 bool unknown_command(const CLI::App& app, const std::string& word) {
   if (word.empty() || word[0] == '-') return false;
-  std::string list;
   std::vector<std::string> commands;
   for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
-    const std::string& c = command->get_name();
-    if (c == word) return false;
-    list += (list.empty() ? "" : ", ") + c;
-    commands.push_back(c);
+    if (command->get_name() == word) return false;
+    commands.push_back(command->get_name());
   }
   const std::string nearest = quadgen::output::nearest_word(word, commands);
-  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << list << ")";
+  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << quadgen::output::joined(commands) << ")";
   if (!nearest.empty()) std::cerr << "; did you mean '" << nearest << "'?";
   if (word == "generate") std::cerr << "; 'derive' writes the generated C++ (model.hpp) with the derivation";
   std::cerr << "\nRun with --help for more information.\n";

@@ -30,7 +30,7 @@ std::string tex_of(const std::string& name) {
       {"mass", "m"},    {"p", "p"},           {"q", "q"},     {"r", "r"}};
   auto it = greek.find(name);
   if (it != greek.end()) return it->second;
-  return "\\mathrm{" + output::latex_text(name) + "}";
+  return "\\mathrm{" + output::latex_math_text(name) + "}";
 }
 
 Variable make_variable(const std::string& name, const std::string& unit, const std::string& doc) {
@@ -247,14 +247,14 @@ void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
   // written out: GiNaC multiplies a number into the sum v_a is, so it cannot be found again there.
   std::vector<ex> thrust;
   for (size_t i = 0; i < rotors.size(); ++i) {
-    const std::string n = output::latex_text(rotors[i].name);
+    const std::string n = output::latex_math_text(rotors[i].name);
     const symbol w("omega_" + rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
     out.push_back({"\\omega_{\\mathrm{" + n + "}}", c.rotor_speed[i], ""});
     out.push_back({rotor_thrust_name(rotors[i].name), rotor_thrust(c, i, w), ""});
     thrust.push_back(symbol("F_" + rotors[i].name, rotor_thrust_name(rotors[i].name)));
   }
   for (size_t i = 0; i < rotors.size(); ++i)
-    out.push_back({"\\tau_{\\mathrm{" + output::latex_text(rotors[i].name) + "}}", rotor_torque(c, i, thrust[i]), ""});
+    out.push_back({"\\tau_{\\mathrm{" + output::latex_math_text(rotors[i].name) + "}}", rotor_torque(c, i, thrust[i]), ""});
   const ex va[3] = {symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}")};
   out.push_back({"F_{drag}", frame_drag(c, va), ""});
   const bool extra_force = !c.extra_body_force.is_zero_matrix(), extra_torque = !c.extra_body_torque.is_zero_matrix();
@@ -465,7 +465,7 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
   // Rotor speeds as symbols rather than the motor map, and a level vehicle (q = 1), so that
   // an attitude bias shows as the rotation it applies.
   for (size_t i = 0; i < v.rotors.size(); ++i) {
-    const std::string n = output::latex_text(v.rotors[i].name);
+    const std::string n = output::latex_math_text(v.rotors[i].name);
     c.rotor_speed[i] = symbol("omega_" + v.rotors[i].name, "\\omega_{\\mathrm{" + n + "}}");
     c.commanded_speed[i] = symbol("wcmd_" + v.rotors[i].name, "\\omega_{\\mathrm{cmd},\\mathrm{" + n + "}}");
   }
@@ -475,7 +475,7 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
   e.apply(c);
   SymbolicModel::EffectFormula f{e.name, {}, ""};
   const auto changed = [](const matrix& a, const matrix& b) { return !(a.sub(b)).is_zero_matrix(); };
-  const std::string r0 = v.rotors.empty() ? std::string() : output::latex_text(v.rotors[0].name);
+  const std::string r0 = v.rotors.empty() ? std::string() : output::latex_math_text(v.rotors[0].name);
   // "\omega" -> "\omega_{\mathrm{M1}}", with a subscript already there ("loss") joined to it.
   const auto rotor = [&](const std::string& base, const std::string& sub = "") {
     return base + "_{" + (sub.empty() ? "" : sub + ",") + "\\mathrm{" + r0 + "}}";
@@ -544,7 +544,7 @@ SymbolicModel derive_model(const Vehicle& v, const MassProperties& mp, const Der
 }
 
 std::string rotor_thrust_name(const std::string& rotor) {
-  return "F_{\\mathrm{" + output::latex_text(rotor) + "}}";  // a rotor called front_left stays one subscript
+  return "F_{\\mathrm{" + output::latex_math_text(rotor) + "}}";  // a rotor called front_left stays one subscript
 }
 
 std::vector<std::string> base_parameter_names() {

@@ -7,6 +7,7 @@
 
 #include "derive/exact_number.hpp"
 #include "derive/kinematics.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen {
 using namespace GiNaC;
@@ -33,15 +34,9 @@ ex exact_angle(double deg) {
   return numeric(milli, 180000) * Pi;
 }
 
-std::string tex_name(const std::string& s) {
-  std::string out;
-  for (char c : s) out += (c == '_') ? std::string("\\_") : std::string(1, c);
-  return out;
-}
-
 BlockSymbols make_symbols(const Block& b, const matrix& R) {
   const std::string n = b.name;
-  const std::string t = "{\\mathrm{" + tex_name(n) + "}}";
+  const std::string t = "{\\mathrm{" + output::latex_math_text(n) + "}}";
   return BlockSymbols{n,
                       symbol("m_" + n, "m_" + t),
                       symbol("a_" + n, "a_" + t),

@@ -12,6 +12,7 @@
 
 #include "fit/least_squares.hpp"
 #include "model/yaml_reader.hpp"
+#include "output/joined.hpp"
 #include "output/nearest_word.hpp"
 #include "runtime/log_file.hpp"
 #include "model/units.hpp"
@@ -54,12 +55,6 @@ namespace {
   throw FitError(path + ":" + std::to_string(at.Mark().line >= 0 ? at.Mark().line + 1 : 1) + ": " + what);
 }
 
-std::string join(const std::vector<std::string>& v) {
-  std::string out;
-  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
-
 std::string scalar_text(const std::string& path, const YAML::Node& n, const std::string& what) {
   if (!n.IsScalar()) mapping_error(path, n, what + ": expected a single value");
   return n.Scalar();
@@ -80,9 +75,9 @@ std::map<std::string, YAML::Node> checked_keys(const std::string& path, const YA
   for (const auto& kv : map) {
     const std::string key = scalar_text(path, kv.first, where + ": key");
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + join(allowed) + ")");
+      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + output::joined(allowed) + ")");
     if (!out.emplace(key, kv.second).second)
-      mapping_error(path, kv.first, where + ": duplicate key '" + key + "' (each of " + join(allowed) + " at most once)");
+      mapping_error(path, kv.first, where + ": duplicate key '" + key + "' (each of " + output::joined(allowed) + " at most once)");
   }
   return out;
 }

@@ -6,6 +6,7 @@
 
 #include "fit/least_squares.hpp"  // FitError
 #include "runtime/log_file.hpp"
+#include "output/joined.hpp"
 
 namespace quadgen::fit {
 
@@ -27,8 +28,7 @@ struct Signal {
 
 const runtime::LogTopic& find_topic(const runtime::TopicLog& log, const std::string& topic, const std::string& source) {
   if (const runtime::LogTopic* tp = log.find(topic)) return *tp;
-  std::string have;
-  for (const auto& t : log.topics) have += (have.empty() ? "" : ", ") + t.name;
+  const std::string have = output::joined(log.topics, ", ", [](const runtime::LogTopic& t) { return t.name; });
   throw FitError(log.path + ": no topic '" + topic + "' for '" + source + "' (the log has: " + have + ")");
 }
 
@@ -39,9 +39,8 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   const runtime::LogTopic& tp = find_topic(log, topic, e.source);
   const int c = dot == std::string::npos ? -1 : tp.column(e.source.substr(dot + 1));
   if (c < 0) {
-    std::string have;
-    for (const auto& f : tp.fields) have += (have.empty() ? "" : ", ") + f;
-    throw FitError(log.path + ": topic '" + topic + "' has no field for '" + e.source + "' (fields: " + have + ")");
+    throw FitError(log.path + ": topic '" + topic + "' has no field for '" + e.source + "' (fields: " +
+                   output::joined(tp.fields) + ")");
   }
   Signal s{e.source, e.target, {}, {}, 0};
   for (const auto& row : tp.rows) {

@@ -1,4 +1,5 @@
 #include "model/units.hpp"
+#include "output/joined.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -102,8 +103,7 @@ Unit parse_factor(const std::string& tok, const std::string& whole) {
   if (refused != refused_units().end()) throw UnitError("unit '" + whole + "': '" + name + "' " + refused->second);
   auto it = unit_table().find(name);
   if (it == unit_table().end()) {
-    std::string known;
-    for (const auto& [n, u] : unit_table()) known += (known.empty() ? "" : ", ") + n;
+    const std::string known = output::joined(unit_table(), ", ", [](const auto& entry) { return entry.first; });
     throw UnitError("unit '" + whole + "': unknown unit '" + name + "' (known: " + known + ", combined as in \"kg m^2\", \"N s/m\")");
   }
   Unit u;

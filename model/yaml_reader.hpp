@@ -12,6 +12,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "output/joined.hpp"
 #include "output/sinks.hpp"
 #include "model/vehicle.hpp"
 
@@ -97,9 +98,8 @@ struct YamlReader {
     for (const auto& kv : n) {
       const std::string key = kv.first.Scalar();
       if (allowed.count(key)) continue;
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " + list + ")");
+      fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " +
+                         output::joined(allowed) + ")");
     }
   }
 

@@ -274,14 +274,14 @@ std::string markdown_code(const std::string& s) {
   return plain ? "`" + s + "`" : markdown_text(s);
 }
 
-std::string latex_text(const std::string& s) {
+std::string latex_math_text(const std::string& s) {
   std::string out;
   for_each_char(s, [&](const std::string& c) {
-    if (c == "\\") out += "\\textbackslash{}";
-    else if (c == "~") out += "\\textasciitilde{}";
-    else if (c == "^") out += "\\textasciicircum{}";
+    if (c == "\\") out += "\\backslash{}";
+    else if (c == "~") out += "\\sim{}";
+    else if (c == "^") out += "\\wedge{}";
     else if (c == "{" || c == "}" || c == "$" || c == "&" || c == "#" || c == "_" || c == "%") out += "\\" + c;
-    else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
+    else if (c == " " || (c.size() == 1 && control(static_cast<unsigned char>(c[0])))) out += "\\ ";
     else out += c;
   });
   return out;

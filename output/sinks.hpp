@@ -55,8 +55,11 @@ std::string markdown_text(const std::string& s);
 // same text escaped as markdown_text.
 std::string markdown_code(const std::string& s);
 
-// Text inside LaTeX \text{...} or prose: the ten special characters replaced by their commands.
-std::string latex_text(const std::string& s);
+// A name inside \mathrm{...} or \operatorname{...} in math mode (derivation.md's math blocks,
+// which GitHub renders with MathJax): TeX's ten special characters as the commands math mode
+// has (\_ \{ \} \$ \& \# \%, \backslash, \sim, and \wedge for ^: the text-mode
+// \textbackslash and kin are errors there), a control character as a space "\ ".
+std::string latex_math_text(const std::string& s);
 
 // A path as one word of a POSIX shell command line: itself when it holds only characters no
 // shell acts on (letters, digits, _ . / - + = : , @), else single-quoted (a ' inside as

@@ -7,6 +7,7 @@
 
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "predict/parameter_source.hpp"
@@ -31,10 +32,8 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
 std::optional<SetPointFlying> set_point_flying(const Vehicle& v, const std::string& controller, double output_scale) {
   if (controller.empty()) return std::nullopt;
   if (std::find(kSetPointControllers.begin(), kSetPointControllers.end(), controller) == kSetPointControllers.end()) {
-    std::string known;
-    for (const auto& c : kSetPointControllers) known += (known.empty() ? "" : ", ") + c;
     throw std::invalid_argument("--controller: unknown controller '" + output::printable(controller) +
-                                "' (expected one of: " + known + ")");
+                                "' (expected one of: " + output::joined(kSetPointControllers) + ")");
   }
   std::vector<std::array<double, 3>> positions;
   std::vector<int> spins;

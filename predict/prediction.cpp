@@ -13,6 +13,7 @@
 #include "runtime/data_side_effects.hpp"
 #include "fit/equation_error.hpp"
 #include "predict/rollout.hpp"
+#include "output/joined.hpp"
 #include "output/estimate.hpp"
 #include "output/numbers.hpp"
 #include "runtime/rigid_body_state.hpp"
@@ -315,12 +316,12 @@ std::string against_constant_velocity(const Prediction& p) {
   if (!std::isfinite(model) || !std::isfinite(none)) return "";
   std::string s = " Extrapolating at the measured start velocity, with no model, is " + output::short_number(none) + " m off";
   if (model <= none) return s + ": the model predicts better at this horizon.";
-  std::string closer;  // the horizons at which the model is at least as close
+  std::vector<std::string> closer;  // the horizons at which the model is at least as close
   for (size_t i : order)
     if (p.open_loop[i].position.mean() <= p.constant_velocity[i].position.mean())
-      closer += (closer.empty() ? "" : ", ") + output::short_number(p.open_loop[i].horizon) + " s";
+      closer.push_back(output::short_number(p.open_loop[i].horizon) + " s");
   s += ": at this horizon the model is worse than that";
-  return s + (closer.empty() ? " (and at every horizon)." : " (the model is the closer at " + closer + ").");
+  return s + (closer.empty() ? " (and at every horizon)." : " (the model is the closer at " + output::joined(closer) + ").");
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "runtime/attitude.hpp"
 #include "runtime/rigid_body_state.hpp"
+#include "output/joined.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -271,8 +272,7 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   // A name the mapping gave is the mapping's mistake: its file and line are named, not the log's.
   const std::string maps = log.named_by.empty() ? "" : " (in the mapping read for " + log.path + ")";
   std::set<std::string> known(rotors.begin(), rotors.end());
-  std::string list;
-  for (const auto& r : rotors) list += (list.empty() ? "" : ", ") + r;
+  const std::string list = output::joined(rotors);
   // A command column for a rotor the vehicle lacks first: a misspelt rotor is why its own
   // column is then missing.
   for (size_t c = 0; c < log.columns.size(); ++c) {

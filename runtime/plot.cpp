@@ -13,6 +13,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -109,6 +111,58 @@ GnuplotRun run_gnuplot(const std::string& script) {
 
 }  // namespace
 
+namespace {
+
+// A character reference at tag[at] == '&', as an HTML parser reads one (the SVG is also
+// inlined into report.html): "&#106;", "&#x6a", without ';' too, or one of XML's five named
+// ones. Sets `end` to its last character and returns the character's code; -1 for a lone '&';
+// -2 for any other named reference: HTML knows two thousand ("&colon;"), so one is refused.
+long character_reference(const std::string& tag, size_t at, size_t* end) {
+  static const std::map<std::string, char> named = {{"amp", '&'}, {"lt", '<'}, {"gt", '>'}, {"quot", '"'}, {"apos", '\''}};
+  size_t k = at + 1;
+  if (k < tag.size() && tag[k] == '#') {
+    const bool hex = k + 1 < tag.size() && tag[k + 1] == 'x';
+    const size_t first = k + (hex ? 2 : 1);
+    const auto digit = [hex](char d) -> long {  // the tag is lower case
+      if (d >= '0' && d <= '9') return d - '0';
+      return hex && d >= 'a' && d <= 'f' ? d - 'a' + 10 : -1;
+    };
+    long code = 0;
+    for (k = first; k < tag.size() && digit(tag[k]) >= 0; ++k) code = std::min(code * (hex ? 16 : 10) + digit(tag[k]), 0x110000L);
+    if (k == first) return -1;
+    *end = k < tag.size() && tag[k] == ';' ? k : k - 1;
+    return code;
+  }
+  while (k < tag.size() && std::isalnum(static_cast<unsigned char>(tag[k]))) ++k;
+  if (k == at + 1) return -1;
+  const auto it = named.find(tag.substr(at + 1, k - at - 1));
+  if (it == named.end() || k >= tag.size() || tag[k] != ';') return -2;
+  *end = k;
+  return it->second;
+}
+
+// A tag (lower case) as a browser reads a URL in it: character references decoded (the XML or
+// HTML parser does that before the URL parser sees the value) and the ASCII tabs, line breaks
+// and other controls dropped, which the URL parser drops from a scheme ("java&#9;script:").
+// Nothing when the tag holds a named reference beyond XML's five.
+std::optional<std::string> as_browser_reads(const std::string& tag) {
+  std::string out;
+  for (size_t i = 0; i < tag.size(); ++i) {
+    char c = tag[i];
+    size_t end = i;
+    if (const long code = c == '&' ? character_reference(tag, i, &end) : -1; code == -2) {
+      return std::nullopt;
+    } else if (code >= 0) {
+      c = code < 128 ? static_cast<char>(std::tolower(static_cast<int>(code))) : '?';
+      i = end;
+    }
+    if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
 // Tags are read with their quoted attribute values whole (XML allows a raw '>' inside one), in
 // one pass; every '<' of text is escaped by gnuplot, so text cannot open a tag.
 bool whole_inert_svg(const std::string& svg) {
@@ -116,8 +170,9 @@ bool whole_inert_svg(const std::string& svg) {
   if (svg.find("<svg") == std::string::npos || end == std::string::npos || end < 5 || svg.compare(end - 5, 6, "</svg>") != 0)
     return false;
   const auto refused = [](const std::string& tag) {
-    if (tag.find("<script") != std::string::npos || tag.find(":script") != std::string::npos ||
-        tag.find("javascript:") != std::string::npos)
+    const std::optional<std::string> read = as_browser_reads(tag);
+    if (!read || tag.find("<script") != std::string::npos || tag.find(":script") != std::string::npos ||
+        read->find("javascript:") != std::string::npos || read->find("vbscript:") != std::string::npos)
       return true;
     for (size_t on = tag.find("on"); on != std::string::npos; on = tag.find("on", on + 1)) {  // an event handler
       if (on == 0 || !std::isspace(static_cast<unsigned char>(tag[on - 1]))) continue;

@@ -1,4 +1,5 @@
 #include "runtime/scenarios.hpp"
+#include "output/joined.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -98,11 +99,9 @@ const std::vector<Scenario>& scenario_catalogue() {
 }
 
 const Scenario& find_scenario(const std::string& name) {
-  std::string known;
-  for (const auto& s : scenario_catalogue()) {
+  for (const auto& s : scenario_catalogue())
     if (s.name == name) return s;
-    known += (known.empty() ? "" : ", ") + s.name;
-  }
+  const std::string known = output::joined(scenario_catalogue(), ", ", [](const Scenario& s) { return s.name; });
   throw std::invalid_argument("unknown scenario '" + name + "' (known: " + known + ")");
 }
 

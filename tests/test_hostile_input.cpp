@@ -26,6 +26,7 @@
 #include <string>
 #include <thread>
 
+#include "app/diagnose_job.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
@@ -451,12 +452,25 @@ TEST(Sinks, AnSvgWithScriptInATagIsRefusedAndTextIsNot) {
   const auto doc = [](const std::string& body) { return "<?xml version=\"1.0\"?>\n<svg width=\"10\">" + body + "</svg>\n"; };
   EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<text>javascript:alert(1) onload=x &lt;script</text>")));
   EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<path d=\"M 1 2 L 3 4\" stroke=\"rgb(0, 0, 0)\"/>")));
+  EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<g id=\"a&amp;b &#38; c & d\">javascript&colon;</g>")));
   for (const std::string bad : {"<script>alert(1)</script>", "<svg:script>x</svg:script>",
                                 "<a xlink:href=\"x>javascript:alert(1)\">y</a>", "<a href='JavaScript:x'>y</a>",
-                                "<g onload=\"x\">y</g>", "<g\tONCLICK = 'x'>y</g>", "<g id=\"a\" onmouseover=x>y</g>"})
+                                "<g onload=\"x\">y</g>", "<g\tONCLICK = 'x'>y</g>", "<g id=\"a\" onmouseover=x>y</g>",
+                                // character references and the controls a URL parser drops
+                                "<a href=\"&#106;avascript:x\">y</a>", "<a href=\"&#x4A;ava&#X53;cript:x\">y</a>",
+                                "<a href=\"java&#9;script:x\">y</a>", "<a href=\"java\nscript&#58;x\">y</a>",
+                                "<a href=\"&#106avascript:x\">y</a>", "<a href=\"javascript&colon;x\">y</a>",
+                                "<a href=\"vbscript:x\">y</a>"})
     EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc(bad))) << bad;
   EXPECT_FALSE(quadgen::runtime::whole_inert_svg("<svg><text>cut short"));
   EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc("<g id=\"unclosed>") ));
+}
+
+// Several logs named in one line (diagnosis.json's "log", the report, the extended header):
+// a path holding ", " or a quote stays one item, and one log is its path as given.
+TEST(Sinks, SeveralLogPathsReadAsSeveral) {
+  EXPECT_EQ(quadgen::app::logs_label({"a b, c.csv"}), "a b, c.csv");
+  EXPECT_EQ(quadgen::app::logs_label({"x/a.csv", "a b, c.csv", "it's.csv"}), "x/a.csv, 'a b, c.csv', 'it'\\''s.csv'");
 }
 
 // A plot's series as CSV: read back with an RFC 4180 reader written here, every hostile label
@@ -559,10 +573,19 @@ TEST(Sinks, MarkdownAndLatexTextStayText) {
     EXPECT_EQ(md.find('<'), std::string::npos);
     for (size_t i = 0; i < md.size(); ++i)
       if (md[i] == '|' || md[i] == '`' || md[i] == '$') EXPECT_TRUE(i > 0 && md[i - 1] == '\\') << md;
-    const std::string tex = out::latex_text(s);
-    for (size_t i = 0; i < tex.size(); ++i)
-      if (std::string("$&%#_{}").find(tex[i]) != std::string::npos && tex[i] != '{' && tex[i] != '}')
-        EXPECT_TRUE(i > 0 && tex[i - 1] == '\\') << tex;
+    // In math mode every backslash starts an escape or a command math mode has (a text-mode
+    // command such as \textbackslash is an error there), and every special is escaped.
+    const std::string tex = out::latex_math_text(s);
+    for (size_t i = 0; i < tex.size(); ++i) {
+      if (tex[i] == '\\') {
+        const std::string rest = tex.substr(i + 1);
+        const bool command = rest.rfind("backslash{}", 0) == 0 || rest.rfind("sim{}", 0) == 0 || rest.rfind("wedge{}", 0) == 0;
+        EXPECT_TRUE(command || (!rest.empty() && std::string("$&%#_{} ").find(rest[0]) != std::string::npos)) << tex;
+        i += command ? rest.find('}') + 1 : 1;
+      } else {
+        EXPECT_EQ(std::string("$&%#_{}~^\n").find(tex[i]), std::string::npos) << tex;
+      }
+    }
   }
   // The derivation report of a vehicle with a hostile description.
   quadgen::Vehicle v = quadgen::test::finken3();

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "derive/effects/definitions.hpp"
+#include "output/joined.hpp"
 
 namespace quadgen {
 
@@ -45,15 +46,11 @@ const std::vector<Effect>& effect_catalogue() {
 }
 
 std::string catalogue_names() {
-  std::string out;
-  for (const Effect& e : effect_catalogue()) out += (out.empty() ? "" : ", ") + e.name;
-  return out;
+  return output::joined(effect_catalogue(), ", ", [](const Effect& e) { return e.name; });
 }
 
 std::string catalogue_parameter_names() {
-  std::string out;
-  for (const Effect& e : effect_catalogue()) out += (out.empty() ? "" : ", ") + e.parameter_names;
-  return out;
+  return output::joined(effect_catalogue(), ", ", [](const Effect& e) { return e.parameter_names; });
 }
 
 const Effect& find_effect(const std::string& name) {
@@ -163,9 +160,7 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
   std::string item;
   while (std::getline(ss, item, ',')) {
     if (!known.count(item)) {
-      std::string list;
-      for (const auto& e : effect_catalogue()) list += (list.empty() ? "" : ", ") + e.name;
-      throw std::invalid_argument("unknown effect '" + item + "' (known: " + list + ", or all)");
+      throw std::invalid_argument("unknown effect '" + item + "' (known: " + catalogue_names() + ", or all)");
     }
     if (!seen.insert(item).second) throw std::invalid_argument("effect '" + item + "' named twice");
     out.push_back(item);
