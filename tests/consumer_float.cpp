@@ -1,8 +1,10 @@
 // A consumer that sees only a generated header: built with -O2 -Wall -Wextra -Werror
 // -Wdouble-promotion -Wconversion (see tests/CMakeLists.txt), instantiated for float and
-// double; exits non-zero if float disagrees with double beyond float precision.
+// double; exits non-zero if float disagrees with double beyond float precision, at 1.2 m, at
+// the old pole of the ground-effect law (z = R / 4) and on the ground, where float must stay finite.
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 
 #include "generated/finken3_all_effects/model.hpp"
 
@@ -31,21 +33,25 @@ int main() {
   double u[m::kNumInputs] = {0.4, 0.45, 0.5, 0.42, 3.0, 3.9};
   double fd[m::kNumStates], Jd[m::kDfdxNnz], Pd[m::kDfdpNnz];
   float ff[m::kNumStates], Jf[m::kDfdxNnz], Pf[m::kDfdpNnz];
-  evaluate<double>(x, u, fd, Jd, Pd);
-  evaluate<float>(x, u, ff, Jf, Pf);
   int bad = 0;
+  double z = 0;
   auto check = [&](const double* d, const float* f, int n, const char* what) {
     double scale = 0;
     for (int i = 0; i < n; ++i) scale = std::fmax(scale, std::fabs(d[i]));
     for (int i = 0; i < n; ++i)
-      if (std::fabs(static_cast<double>(f[i]) - d[i]) > 1e-4 * (std::fabs(d[i]) + 1e-3 * scale)) {
-        std::printf("%s[%d]: float %g vs double %g\n", what, i, static_cast<double>(f[i]), d[i]);
+      if (!std::isfinite(f[i]) || std::fabs(static_cast<double>(f[i]) - d[i]) > 1e-4 * (std::fabs(d[i]) + 1e-3 * scale)) {
+        std::printf("z = %g m, %s[%d]: float %g vs double %g\n", z, what, i, static_cast<double>(f[i]), d[i]);
         ++bad;
       }
   };
-  check(fd, ff, m::kNumStates, "f");
-  check(Jd, Jf, m::kDfdxNnz, "dfdx");
-  check(Pd, Pf, m::kDfdpNnz, "dfdp");
+  for (const double height : {1.2, 0.06 / 4, 0.0}) {  // the radius set in evaluate: 0.06 m
+    x[2] = z = height;
+    evaluate<double>(x, u, fd, Jd, Pd);
+    evaluate<float>(x, u, ff, Jf, Pf);
+    check(fd, ff, m::kNumStates, "f");
+    check(Jd, Jf, m::kDfdxNnz, "dfdx");
+    check(Pd, Pf, m::kDfdpNnz, "dfdp");
+  }
   std::printf("float vs double: %d mismatches\n", bad);
   return bad == 0 ? 0 : 1;
 }

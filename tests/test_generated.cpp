@@ -71,7 +71,8 @@ void check_jacobians_against_finite_differences(int trials) {
 // take-off: f and every Jacobian finite. The ground-effect law divides by z^2; with the effect
 // off (radius 0) that was 0/0, and every all-effects header gave NaN there (a review found it
 // compiling the headers as firmware would). vbat at its reference (battery_sag's log needs it
-// positive, as the header says).
+// positive, as the header says). With a ground-effect radius of 10 cm too, on the ground and
+// at the law's pole (z = R / 4), which the law is now held away from.
 template <class M>
 void expect_finite_on_the_ground() {
   double x[M::kNumStates] = {}, u[M::kNumInputs], p[M::kNumParams];
@@ -80,12 +81,22 @@ void expect_finite_on_the_ground() {
   for (int i = 0; i < M::kNumParams; ++i) p[i] = M::nominal[i];
   for (int i = 0; i < M::kNumInputs; ++i)
     if (std::string(M::input_names[i]) == "vbat") u[i] = p[index_of_param<M>("vbat_ref")];
-  double f[M::kNumStates], dfdx[M::kDfdxNnz + 1], dfdu[M::kDfduNnz + 1], dfdp[M::kDfdpNnz + 1];
-  M::f(x, u, p, f, dfdx, dfdu, dfdp);
-  for (double v : f) EXPECT_TRUE(std::isfinite(v)) << M::effects;
-  for (int k = 0; k < M::kDfdxNnz; ++k) EXPECT_TRUE(std::isfinite(dfdx[k])) << "dfdx " << k;
-  for (int k = 0; k < M::kDfduNnz; ++k) EXPECT_TRUE(std::isfinite(dfdu[k])) << "dfdu " << k;
-  for (int k = 0; k < M::kDfdpNnz; ++k) EXPECT_TRUE(std::isfinite(dfdp[k])) << "dfdp " << k;
+  const auto expect_finite = [&](const std::string& where) {
+    double f[M::kNumStates], dfdx[M::kDfdxNnz + 1], dfdu[M::kDfduNnz + 1], dfdp[M::kDfdpNnz + 1];
+    M::f(x, u, p, f, dfdx, dfdu, dfdp);
+    for (double v : f) EXPECT_TRUE(std::isfinite(v)) << M::effects << where;
+    for (int k = 0; k < M::kDfdxNnz; ++k) EXPECT_TRUE(std::isfinite(dfdx[k])) << "dfdx " << k << where;
+    for (int k = 0; k < M::kDfduNnz; ++k) EXPECT_TRUE(std::isfinite(dfdu[k])) << "dfdu " << k << where;
+    for (int k = 0; k < M::kDfdpNnz; ++k) EXPECT_TRUE(std::isfinite(dfdp[k])) << "dfdp " << k << where;
+  };
+  expect_finite(" (nominal)");
+  for (int i = 0; i < M::kNumParams; ++i)
+    if (std::string(M::param_names[i]) == "ground_effect.radius") {
+      p[i] = 0.1;
+      expect_finite(" (R = 0.1 m, on the ground)");
+      x[2] = 0.1 / 4;
+      expect_finite(" (R = 0.1 m, z = R / 4)");
+    }
 }
 
 TEST(Generated, EveryModelIsFiniteOnTheGround) {

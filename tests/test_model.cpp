@@ -399,11 +399,45 @@ TEST(Model, InflowThrustLossMatchesItsClosedForm) {
 }
 
 
-// Cheeseman & Bennett: T / T_free = 1 / (1 - (R / 4z)^2); at z = 6 cm with R = 10 cm, 1.21.
+// Cheeseman & Bennett: T / T_free = 1 / (1 - x), x = (R / 4z)^2, with x held below 1/2 as
+// x / (1 + (2x)^4)^(1/4); at z = 6 cm with R = 10 cm, 1.209 (the law alone: 1.210).
+double held_ground_effect(double R, double z) {
+  const double x = std::pow(R / (4 * z), 2);
+  return 1.0 / (1.0 - x / std::pow(1 + std::pow(2 * x, 4), 0.25));
+}
+
 TEST(Model, GroundEffectMatchesTheCheesemanBennettLaw) {
   const double R = 0.10, z = 0.06;
-  expect_thrust_scaled_by("ground_effect", "ground_effect.radius", R, 1.0 / (1.0 - std::pow(R / (4 * z), 2)),
-                          level_state(z), {});
+  expect_thrust_scaled_by("ground_effect", "ground_effect.radius", R, held_ground_effect(R, z), level_state(z), {});
+  EXPECT_NEAR(held_ground_effect(R, z), 1.0 / (1.0 - std::pow(R / (4 * z), 2)), 1e-3);
+}
+
+// The law's pole at z = R / 4 (infinite thrust, negative below) is what a vehicle landing met.
+// The factor, read off the vertical acceleration at each height, rises as the ground nears, to
+// twice the thrust on the ground, never beyond, and is the law's within 0.5 % from z = R / 2 up.
+TEST(Model, GroundEffectStaysFiniteAndAtMostDoubleDownToTheGround) {
+  const Vehicle v = test::finken3();
+  SymbolicModel m = derive(v, {"ground_effect"});
+  const double R = 0.10;
+  const std::vector<double> u{0.4, 0.45, 0.5, 0.55};
+  const Nominal nom{m};
+  std::vector<double> thrust;  // the change that doubles each rotor's thrust
+  for (size_t i = 0; i < v.rotors.size(); ++i) thrust.push_back(nom.thrust(v.rotors[i], u[i]));
+  const double doubled = change_from_thrust(v, nom, thrust).dv.z();
+  double above = 1.0;  // the factor at the height above, coming down
+  for (double z : {1.0, 0.2, 0.1, 0.06, 0.05, 0.04, 0.03, 0.026, 0.025, 0.024, 0.02, 0.01, 0.005, 0.001, 0.0}) {
+    m.params[m.param_index("ground_effect.radius")].nominal = 0.0;
+    const double off = test::eval_f(m, level_state(z), u)[5];
+    m.params[m.param_index("ground_effect.radius")].nominal = R;
+    const double s = 1.0 + (test::eval_f(m, level_state(z), u)[5] - off) / doubled;
+    SCOPED_TRACE("z = " + std::to_string(z));
+    EXPECT_GE(s, above - 1e-12);
+    EXPECT_LE(s, 2.0 + 1e-9);
+    const double law = 1.0 / (1.0 - std::pow(R / (4 * z), 2));
+    if (z >= R / 2) EXPECT_NEAR(s, law, 0.005 * law);  // 0.499 % at z = R / 2
+    above = s;
+  }
+  EXPECT_NEAR(above, 2.0, 1e-6);  // on the ground
 }
 
 // On the ground (z = 0) with the effect off, as every all-effects model has it until it is

@@ -1,5 +1,6 @@
 // ground_effect: thrust near the ground scaled by 1 / (1 - (R / 4z)^2) (Cheeseman & Bennett,
-// "The effect of the ground on a helicopter rotor in forward flight", ARC R&M 3021, 1955).
+// "The effect of the ground on a helicopter rotor in forward flight", ARC R&M 3021, 1955),
+// held below twice the thrust where the law runs to its pole.
 #include "derive/effects/definitions.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/headline_words.hpp"
@@ -11,13 +12,21 @@ namespace {
 
 void terms(ModelContext& c) {
   const ex radius = c.add_param("ground_effect.radius", "m", 0.0, 0.0, 0.5, true, "rotor radius in the ground-effect law");
-  // (R / 4z)^2 with z^2 + (1 um)^2 for z^2: on the ground (z = 0) the law has R^2 / 0, which
-  // with the effect off (R = 0, as in every all-effects model until it is fitted) made the
-  // whole model NaN there. Now it is exactly 1 then; above 1 cm the change is below 1e-8 of
-  // the term. The law itself holds only well above z = R / 4, where it is singular.
+  // The law's x = (R / 4z)^2 reaches 1 at z = R / 4, where the thrust would be infinite, and
+  // turns it negative below: a vehicle taking off or landing, or a fit trying a large R, met
+  // that pole. So z^2 is taken as (z^8 + z_min^8 + floor^8)^(1/4), z_min = R / (4 sqrt(x_max))
+  // the height where x = x_max = 1/2: x is then x / (1 + (x / x_max)^4)^(1/4), held below 1/2
+  // (thrust at most doubled), within 0.5 % of the law's factor where the law is used (z >= R/2;
+  // 0.07 % at z = 0.6 R) and smooth; the law, a point source above its mirror image, is no
+  // guide closer to the ground anyway. Written in z rather than x, no power overflows a float
+  // on the ground. The floor keeps the effect off (R = 0) exact 1 there, where R^2 / z^2 was
+  // 0/0 and made every all-effects model NaN, and its derivatives finite; at 1 cm it changes
+  // z^2 by 1e-16.
   const ex z = c.position(2, 0);
-  const ex floor = c.add_constant("ground_effect.floor", "m", 1e-6, "height below which the ground-effect law is not resolved");
-  const ex z_squared = pow(z, 2) + pow(floor, 2);
+  const ex floor = c.add_constant("ground_effect.floor", "m", 1e-4, "height below which the ground-effect law is not resolved");
+  const ex x_max = c.add_constant("ground_effect.x_max", "1", 0.5, "largest (R / 4z)^2 the ground-effect law is given");
+  const ex z_min = radius / (4 * sqrt(x_max));
+  const ex z_squared = pow(pow(z, 8) + pow(z_min, 8) + pow(floor, 8), numeric(1, 4));
   for (ex& s : c.thrust_scale) s = s / (1 - pow(radius, 2) / (16 * z_squared));
 }
 
