@@ -26,6 +26,10 @@ if [ "${1:-}" != "--no-run" ]; then
     # The measuring stick: prediction error at horizons, as published models report it.
     build/quadgen predict vehicles/crazyflie21_nanobench.yaml "$nb" --mapping data/mappings/nanobench.yaml \
         --params out/diagnosis_nanobench/diagnosis.json --out out/prediction_nanobench
+    echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html; prediction: out/prediction_nanobench/prediction.json"
+  else
+    echo "skipped: the real NanoBench flight's diagnosis and prediction ($nb not found: the reference data is"
+    echo "  not part of the clone; the README's 'The reference data' says where it comes from)"
+    echo "derivation reports: out/*/derivation.md; diagnosis: out/diagnosis_weak_motor_C/report.html"
   fi
-  echo "derivation reports: out/*/derivation.md; diagnoses: out/diagnosis_*/report.html; prediction: out/prediction_*/prediction.json"
 fi

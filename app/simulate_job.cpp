@@ -10,6 +10,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "runtime/flight_log.hpp"
 #include "derive/geometry.hpp"
+#include "fit/log_reader.hpp"
 #include "runtime/integrator.hpp"
 #include "app/model_registry.hpp"
 #include "derive/runtime_view.hpp"
@@ -126,15 +127,16 @@ std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vect
   return std::make_shared<InputSignal>(t, rows, Interpolation::linear);
 }
 
-// A replay of a canonical log's commands (and battery voltage); x0 takes the log's first
-// pose where it has one.
+// A replay of a log's commands (and battery voltage), read through the job's mapping when it
+// has one, as fit, diagnose and predict read logs; x0 takes the log's first pose where it has one.
 InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector<double>& x0) {
-  const CsvTable log = read_csv(a.inputs);
+  const CsvTable log = fit::read_log(a.inputs, a.mapping, 0);
   try {
     validate_canonical(log, k.rotors);
-  } catch (const LogError& e) {  // the one thing a user cannot guess: replay reads no mapping
-    throw LogError(std::string(e.what()) +
-                   "; simulate --inputs replays a log in the canonical layout (t, u_<rotor>; docs/formats.md)");
+  } catch (const LogError& e) {  // what a user may not guess: a log of another layout needs a mapping
+    throw LogError(std::string(e.what()) + (a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout "
+                                                                "(t, u_<rotor>; docs/formats.md), or another through --mapping"
+                                                              : ""));
   }
   const std::vector<double> t = log.values("t");
   if (a.duration > t.back() - t.front() + 1e-9)

@@ -16,7 +16,8 @@ namespace quadgen::app {
 struct SimulateJob {
   std::string vehicle;      // vehicle file (YAML)
   std::string scenario;     // one of the thesis' manoeuvres, or
-  std::string inputs;       // a canonical log whose motor commands are replayed, or
+  std::string inputs;       // a log whose motor commands are replayed, or
+  std::string mapping;      // column mapping (YAML) for `inputs` of another layout; "": canonical
   bool closed_loop = false;  // a closed-loop test flight
   std::string effects;      // comma-separated effects of the simulated (true) model
   double duration = 0;      // s

@@ -30,7 +30,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust, on any layout: hover, climb, new_height "
                                  "(every rotor alike); right, forward, yaw (the rotors on the -x side, on +y, or spinning "
                                  "ccw, as A, D / C, D / A, C on the thesis' FINken 3)");
-  auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a canonical flight log (CSV)");
+  auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a flight log (canonical CSV, or any layout with --mapping)");
+  c->add_option("--mapping", a.job.mapping, "column mapping (YAML) for an --inputs log not in the canonical layout (a CSV, a PX4 ULog, a Crazyflie uSD log)")
+      ->needs(in);
   auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
                          "fly a smooth random trajectory under a cascaded controller (test flights)");
   sc->excludes(in);
@@ -94,7 +96,7 @@ output::OutputFiles output_for(const SimulateArgs& a) {
   if (extension != ".csv")
     throw std::invalid_argument("--out " + output::printable(a.out) +
                                 ": expected a .csv file name (the trajectory; its plot goes to the .svg beside it)");
-  return output::OutputFiles({a.out, plot_path(a.out)}, "simulate", {a.job.vehicle, a.job.inputs});
+  return output::OutputFiles({a.out, plot_path(a.out)}, "simulate", {a.job.vehicle, a.job.inputs, a.job.mapping});
 }
 
 // NAME=VALUE of --set; the value a finite number.
