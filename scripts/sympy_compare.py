@@ -70,7 +70,10 @@ def build_model(vehicle_path, model_json_path):
         commanded = Pm["motor_a0"] + Pm["motor_a1"] * u + Pm["motor_a2"] * u**2  # rad/s
         if "motor_lag" in effects:  # first-order lag: the rotor speed is a state
             speed = S["w_" + rot["name"]]
-            extra_rates.append((commanded - speed) / Pm["motor_lag.tau"])
+            tau = Pm["motor_lag.tau"]
+            if "motor_lag_spread" in effects:  # each motor its own time constant, tau (1 + spread)
+                tau = tau * (1 + Pm["motor_lag_spread." + rot["name"]])
+            extra_rates.append((commanded - speed) / tau)
         else:
             speed = commanded
         speeds.append(speed)
@@ -91,10 +94,10 @@ def build_model(vehicle_path, model_json_path):
             # As docs/effects.md gives the law: z^2 taken as (z^8 + z_min^8 + floor^8)^(1/4), with
             # z_min = R / (4 sqrt(1/2)) where (R / 4z)^2 reaches 1/2, and a floor of 0.1 mm
             # (held below twice the thrust, finite on the ground)
-            R = Pm["ground_effect.radius"]
-            z_min = R / (4 * sp.sqrt(sp.Rational(1, 2)))
+            radius_ge = Pm["ground_effect.radius"]
+            z_min = radius_ge / (4 * sp.sqrt(sp.Rational(1, 2)))
             z2 = (S["z"] ** 8 + z_min**8 + sp.Rational(1, 10**4) ** 8) ** sp.Rational(1, 4)
-            scale /= 1 - R**2 / (16 * z2)
+            scale /= 1 - radius_ge**2 / (16 * z2)
         loss = 0  # thrust loss with the rotor's climb speed through the air
         if "inflow" in effects:
             climb = vb[2] + w.cross(arm)[2]
