@@ -16,8 +16,9 @@
 // Conventions: SI units; world frame z up; body frame x, y in the rotor plane, z up, its
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
-// World z = 0 is the ground (ground_effect, which holds well above z = R/4 only). Inputs named
-// vbat (a battery voltage) must be positive; the measurement h is indexed by Output, not State.
+// World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
+// below twice the thrust closer to it). Inputs named vbat (a battery voltage) must be
+// positive; the measurement h is indexed by Output, not State.
 #pragma once
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
