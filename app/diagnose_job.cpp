@@ -136,7 +136,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
 }  // namespace
 
 std::string logs_label(const std::vector<std::string>& paths) {
-  if (paths.size() == 1) return paths[0];
+  if (paths.size() == 1 && paths[0].find(", ") == std::string::npos) return paths[0];
   return output::joined(paths, ", ", [](const std::string& p) { return output::shell_path(p); });
 }
 

@@ -35,7 +35,8 @@ struct DiagnoseJobResult {
 
 // The logs a diagnosis read, as its outputs name them (diagnosis.json's "log", the report's
 // head, the extended header's comment): one log as its path; several joined with ", ", each
-// quoted as one shell word (output::shell_path), so that a path holding ", " reads as one.
+// quoted as one shell word (output::shell_path), and so one log whose path holds ", ", so that
+// such a path never reads as two.
 std::string logs_label(const std::vector<std::string>& paths);
 
 // Throws std::invalid_argument for an invalid job, and the layers' own errors (a bad vehicle

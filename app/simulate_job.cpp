@@ -234,6 +234,7 @@ std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, cons
 SimulateJobResult run_simulate_job(const SimulateJob& a) {
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
+  if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
   const Vehicle vehicle = load_vehicle(a.vehicle);
   if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
   else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);

@@ -169,17 +169,24 @@ bool whole_inert_svg(const std::string& svg) {
   const size_t end = svg.find_last_not_of(" \n\r\t");
   if (svg.find("<svg") == std::string::npos || end == std::string::npos || end < 5 || svg.compare(end - 5, 6, "</svg>") != 0)
     return false;
+  // Elements and attributes that carry a document or script of their own; gnuplot writes none.
+  static const char* const kForeign[] = {"<script", ":script", "<iframe", "<foreignobject", "<object", "<embed", "srcdoc"};
   const auto refused = [](const std::string& tag) {
     const std::optional<std::string> read = as_browser_reads(tag);
-    if (!read || tag.find("<script") != std::string::npos || tag.find(":script") != std::string::npos ||
-        read->find("javascript:") != std::string::npos || read->find("vbscript:") != std::string::npos)
-      return true;
-    for (size_t on = tag.find("on"); on != std::string::npos; on = tag.find("on", on + 1)) {  // an event handler
-      if (on == 0 || !std::isspace(static_cast<unsigned char>(tag[on - 1]))) continue;
-      size_t k = on + 2;
-      while (k < tag.size() && std::isalpha(static_cast<unsigned char>(tag[k]))) ++k;
-      while (k < tag.size() && std::isspace(static_cast<unsigned char>(tag[k]))) ++k;
-      if (k > on + 2 && k < tag.size() && tag[k] == '=') return true;
+    if (!read) return true;
+    for (const std::string& form : {tag, *read}) {  // as written, and with its references decoded
+      for (const char* foreign : kForeign)
+        if (form.find(foreign) != std::string::npos) return true;
+      if (form.find("javascript:") != std::string::npos || form.find("vbscript:") != std::string::npos) return true;
+      for (size_t on = form.find("on"); on != std::string::npos; on = form.find("on", on + 1)) {  // an event handler
+        // An attribute's name starts after anything a name cannot hold: a blank, '/', a quote.
+        const char before = on == 0 ? ' ' : form[on - 1];
+        if (std::isalnum(static_cast<unsigned char>(before)) || std::string("_:.-").find(before) != std::string::npos) continue;
+        size_t k = on + 2;
+        while (k < form.size() && std::isalpha(static_cast<unsigned char>(form[k]))) ++k;
+        while (k < form.size() && std::isspace(static_cast<unsigned char>(form[k]))) ++k;
+        if (k > on + 2 && k < form.size() && form[k] == '=') return true;
+      }
     }
     return false;
   };

@@ -92,11 +92,11 @@ def build_model(vehicle_path, model_json_path):
             scale *= (In["vbat"] / Pm["vbat_ref"]) ** Pm["battery_sag.exponent"]
         if "ground_effect" in effects:
             # As docs/effects.md gives the law: z^2 taken as (z^8 + z_min^8 + floor^8)^(1/4), with
-            # z_min = R / (4 sqrt(1/2)) where (R / 4z)^2 reaches 1/2, and a floor of 0.1 mm
+            # z_min = R / (4 sqrt(1/2)) where (R / 4z)^2 reaches 1/2, and a floor of 1 mm
             # (held below twice the thrust, finite on the ground)
             radius_ge = Pm["ground_effect.radius"]
             z_min = radius_ge / (4 * sp.sqrt(sp.Rational(1, 2)))
-            z2 = (S["z"] ** 8 + z_min**8 + sp.Rational(1, 10**4) ** 8) ** sp.Rational(1, 4)
+            z2 = (S["z"] ** 8 + z_min**8 + sp.Rational(1, 10**3) ** 8) ** sp.Rational(1, 4)
             scale /= 1 - radius_ge**2 / (16 * z2)
         loss = 0  # thrust loss with the rotor's climb speed through the air
         if "inflow" in effects:

@@ -1,7 +1,9 @@
 // A consumer that sees only a generated header: built with -O2 -Wall -Wextra -Werror
 // -Wdouble-promotion -Wconversion (see tests/CMakeLists.txt), instantiated for float and
 // double; exits non-zero if float disagrees with double beyond float precision, at 1.2 m, at
-// the old pole of the ground-effect law (z = R / 4) and on the ground, where float must stay finite.
+// the old pole of the ground-effect law (z = R / 4) and on the ground, where float must stay
+// finite, with the effect on (R = 6 cm) and off (R = 0: its derivatives' largest power there
+// is set by the law's floor).
 #include <cmath>
 #include <cstdio>
 #include <initializer_list>
@@ -11,13 +13,13 @@
 namespace m = quadgen_generated::finken3_all_effects;
 
 template <typename S>
-void evaluate(const double* xd, const double* ud, S* f, S* dfdx, S* dfdp) {
+void evaluate(const double* xd, const double* ud, double radius, S* f, S* dfdx, S* dfdp) {
   S x[m::kNumStates], u[m::kNumInputs], p[m::kNumParams];
   for (int i = 0; i < m::kNumStates; ++i) x[i] = static_cast<S>(xd[i]);
   for (int i = 0; i < m::kNumInputs; ++i) u[i] = static_cast<S>(ud[i]);
   for (int i = 0; i < m::kNumParams; ++i) p[i] = static_cast<S>(m::kNominalParams[i]);
   p[m::Param::motor_lag_tau] = static_cast<S>(0.03);
-  p[m::Param::ground_effect_radius] = static_cast<S>(0.06);
+  p[m::Param::ground_effect_radius] = static_cast<S>(radius);
   m::Precomputed<S> pre;
   m::precompute(p, &pre);
   m::rhs(x, u, p, pre, f, dfdx, static_cast<S*>(nullptr), dfdp);
@@ -34,24 +36,26 @@ int main() {
   double fd[m::kNumStates], Jd[m::kDfdxNnz], Pd[m::kDfdpNnz];
   float ff[m::kNumStates], Jf[m::kDfdxNnz], Pf[m::kDfdpNnz];
   int bad = 0;
-  double z = 0;
+  double z = 0, radius = 0;
   auto check = [&](const double* d, const float* f, int n, const char* what) {
     double scale = 0;
     for (int i = 0; i < n; ++i) scale = std::fmax(scale, std::fabs(d[i]));
     for (int i = 0; i < n; ++i)
       if (!std::isfinite(f[i]) || std::fabs(static_cast<double>(f[i]) - d[i]) > 1e-4 * (std::fabs(d[i]) + 1e-3 * scale)) {
-        std::printf("z = %g m, %s[%d]: float %g vs double %g\n", z, what, i, static_cast<double>(f[i]), d[i]);
+        std::printf("R = %g m, z = %g m, %s[%d]: float %g vs double %g\n", radius, z, what, i, static_cast<double>(f[i]), d[i]);
         ++bad;
       }
   };
-  for (const double height : {1.2, 0.06 / 4, 0.0}) {  // the radius set in evaluate: 0.06 m
-    x[2] = z = height;
-    evaluate<double>(x, u, fd, Jd, Pd);
-    evaluate<float>(x, u, ff, Jf, Pf);
-    check(fd, ff, m::kNumStates, "f");
-    check(Jd, Jf, m::kDfdxNnz, "dfdx");
-    check(Pd, Pf, m::kDfdpNnz, "dfdp");
-  }
+  for (const double r : {0.06, 0.0})
+    for (const double height : {1.2, 0.06 / 4, 1e-4, 0.0}) {
+      radius = r;
+      x[2] = z = height;
+      evaluate<double>(x, u, radius, fd, Jd, Pd);
+      evaluate<float>(x, u, radius, ff, Jf, Pf);
+      check(fd, ff, m::kNumStates, "f");
+      check(Jd, Jf, m::kDfdxNnz, "dfdx");
+      check(Pd, Pf, m::kDfdpNnz, "dfdp");
+    }
   std::printf("float vs double: %d mismatches\n", bad);
   return bad == 0 ? 0 : 1;
 }

@@ -453,6 +453,8 @@ TEST(Sinks, AnSvgWithScriptInATagIsRefusedAndTextIsNot) {
   EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<text>javascript:alert(1) onload=x &lt;script</text>")));
   EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<path d=\"M 1 2 L 3 4\" stroke=\"rgb(0, 0, 0)\"/>")));
   EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<g id=\"a&amp;b &#38; c & d\">javascript&colon;</g>")));
+  // references that are none stay literal: no read past the tag, nothing decoded
+  EXPECT_TRUE(quadgen::runtime::whole_inert_svg(doc("<g id=\"&#; &#x; &# &#xg &#99999999999999999999999;\" class=\"font-family_on\">y</g>")));
   for (const std::string bad : {"<script>alert(1)</script>", "<svg:script>x</svg:script>",
                                 "<a xlink:href=\"x>javascript:alert(1)\">y</a>", "<a href='JavaScript:x'>y</a>",
                                 "<g onload=\"x\">y</g>", "<g\tONCLICK = 'x'>y</g>", "<g id=\"a\" onmouseover=x>y</g>",
@@ -460,7 +462,11 @@ TEST(Sinks, AnSvgWithScriptInATagIsRefusedAndTextIsNot) {
                                 "<a href=\"&#106;avascript:x\">y</a>", "<a href=\"&#x4A;ava&#X53;cript:x\">y</a>",
                                 "<a href=\"java&#9;script:x\">y</a>", "<a href=\"java\nscript&#58;x\">y</a>",
                                 "<a href=\"&#106avascript:x\">y</a>", "<a href=\"javascript&colon;x\">y</a>",
-                                "<a href=\"vbscript:x\">y</a>"})
+                                "<a href=\"vbscript:x\">y</a>", "<g id=\"a&amp b\">y</g>",
+                                // a document of its own, and handlers after '/' or a quote (helper-66)
+                                "<foreignObject><iframe srcdoc=\"&lt;script&gt;alert(1)&lt;/script&gt;\"></iframe></foreignObject>",
+                                "<image href=\"x\"/onerror=\"alert(1)\"/>", "<image href=\"x\"onerror=\"alert(1)\"/>",
+                                "<g/onclick=\"alert(1)\">y</g>", "<embed src=\"x.svg\"/>", "<object data=\"x\"></object>"})
     EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc(bad))) << bad;
   EXPECT_FALSE(quadgen::runtime::whole_inert_svg("<svg><text>cut short"));
   EXPECT_FALSE(quadgen::runtime::whole_inert_svg(doc("<g id=\"unclosed>") ));
@@ -469,7 +475,9 @@ TEST(Sinks, AnSvgWithScriptInATagIsRefusedAndTextIsNot) {
 // Several logs named in one line (diagnosis.json's "log", the report, the extended header):
 // a path holding ", " or a quote stays one item, and one log is its path as given.
 TEST(Sinks, SeveralLogPathsReadAsSeveral) {
-  EXPECT_EQ(quadgen::app::logs_label({"a b, c.csv"}), "a b, c.csv");
+  EXPECT_EQ(quadgen::app::logs_label({"a b.csv"}), "a b.csv");
+  EXPECT_EQ(quadgen::app::logs_label({"x/a.csv, y.csv"}), "'x/a.csv, y.csv'");  // one log, not two
+  EXPECT_EQ(quadgen::app::logs_label({"x/a.csv", "y.csv"}), "x/a.csv, y.csv");
   EXPECT_EQ(quadgen::app::logs_label({"x/a.csv", "a b, c.csv", "it's.csv"}), "x/a.csv, 'a b, c.csv', 'it'\\''s.csv'");
 }
 

@@ -17,13 +17,14 @@ void terms(ModelContext& c) {
   // that pole. So z^2 is taken as (z^8 + z_min^8 + floor^8)^(1/4), z_min = R / (4 sqrt(x_max))
   // the height where x = x_max = 1/2: x is then x / (1 + (x / x_max)^4)^(1/4), held below 1/2
   // (thrust at most doubled), within 0.5 % of the law's factor where the law is used (z >= R/2;
-  // 0.07 % at z = 0.6 R) and smooth; the law, a point source above its mirror image, is no
+  // 0.08 % at z = 0.6 R) and smooth; the law, a point source above its mirror image, is no
   // guide closer to the ground anyway. Written in z rather than x, no power overflows a float
   // on the ground. The floor keeps the effect off (R = 0) exact 1 there, where R^2 / z^2 was
-  // 0/0 and made every all-effects model NaN, and its derivatives finite; at 1 cm it changes
-  // z^2 by 1e-16.
+  // 0/0 and made every all-effects model NaN, and its derivatives finite: their
+  // (...)^(-5/4) is floor^-10, 1e30 at 1 mm, which a float holds (0.1 mm gave 1e40, inf, and
+  // NaN Jacobians in float). At 5 cm the floor changes z^2 by 6e-15 of itself.
   const ex z = c.position(2, 0);
-  const ex floor = c.add_constant("ground_effect.floor", "m", 1e-4, "height below which the ground-effect law is not resolved");
+  const ex floor = c.add_constant("ground_effect.floor", "m", 1e-3, "height below which the ground-effect law is not resolved");
   const ex x_max = c.add_constant("ground_effect.x_max", "1", 0.5, "largest (R / 4z)^2 the ground-effect law is given");
   const ex z_min = radius / (4 * sqrt(x_max));
   const ex z_squared = pow(pow(z, 8) + pow(z_min, 8) + pow(floor, 8), numeric(1, 4));
