@@ -109,10 +109,6 @@ GnuplotRun run_gnuplot(const std::string& script) {
   return run;
 }
 
-}  // namespace
-
-namespace {
-
 // A character reference at tag[at] == '&', as an HTML parser reads one (the SVG is also
 // inlined into report.html): "&#106;", "&#x6a", without ';' too, or one of XML's five named
 // ones. Sets `end` to its last character and returns the character's code; -1 for a lone '&';

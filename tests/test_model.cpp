@@ -399,17 +399,22 @@ TEST(Model, InflowThrustLossMatchesItsClosedForm) {
 }
 
 
-// Cheeseman & Bennett: T / T_free = 1 / (1 - x), x = (R / 4z)^2, with x held below 1/2 as
-// x / (1 + (2x)^4)^(1/4); at z = 6 cm with R = 10 cm, 1.209 (the law alone: 1.210).
+namespace {
+// Cheeseman & Bennett: T / T_free = 1 / (1 - x), x = (R / 4z)^2.
+double cheeseman_bennett(double R, double z) { return 1.0 / (1.0 - std::pow(R / (4 * z), 2)); }
+
+// The same with x held below 1/2 as x / (1 + (2x)^4)^(1/4), as the model has it.
 double held_ground_effect(double R, double z) {
   const double x = std::pow(R / (4 * z), 2);
   return 1.0 / (1.0 - x / std::pow(1 + std::pow(2 * x, 4), 0.25));
 }
+}  // namespace
 
+// At z = 6 cm with R = 10 cm: 1.209 (the law alone: 1.210).
 TEST(Model, GroundEffectMatchesTheCheesemanBennettLaw) {
   const double R = 0.10, z = 0.06;
   expect_thrust_scaled_by("ground_effect", "ground_effect.radius", R, held_ground_effect(R, z), level_state(z), {});
-  EXPECT_NEAR(held_ground_effect(R, z), 1.0 / (1.0 - std::pow(R / (4 * z), 2)), 1e-3);
+  EXPECT_NEAR(held_ground_effect(R, z), cheeseman_bennett(R, z), 1e-3);
 }
 
 // The law's pole at z = R / 4 (infinite thrust, negative below) is what a vehicle landing met.
@@ -433,7 +438,7 @@ TEST(Model, GroundEffectStaysFiniteAndAtMostDoubleDownToTheGround) {
     SCOPED_TRACE("z = " + std::to_string(z));
     EXPECT_GE(s, above - 1e-12);
     EXPECT_LE(s, 2.0 + 1e-9);
-    const double law = 1.0 / (1.0 - std::pow(R / (4 * z), 2));
+    const double law = cheeseman_bennett(R, z);
     if (z >= R / 2) EXPECT_NEAR(s, law, 0.005 * law);  // 0.499 % at z = R / 2
     above = s;
   }
