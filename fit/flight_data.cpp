@@ -14,6 +14,7 @@
 #include "model/yaml_reader.hpp"
 #include "output/joined.hpp"
 #include "output/nearest_word.hpp"
+#include "runtime/attitude.hpp"
 #include "runtime/log_file.hpp"
 #include "model/units.hpp"
 #include "runtime/rigid_body_state.hpp"
@@ -25,6 +26,14 @@ using namespace runtime::rigid_body;
 runtime::CsvTable read_measurement_csv(const std::string& path) {
   try {
     return runtime::read_csv(path);
+  } catch (const runtime::LogError& e) {
+    throw FitError(e.what());
+  }
+}
+
+int measurement_column(const runtime::CsvTable& t, const std::string& name) {
+  try {
+    return t.column(name);
   } catch (const runtime::LogError& e) {
     throw FitError(e.what());
   }
@@ -448,7 +457,8 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   auto has = [&](std::initializer_list<const char*> cs) {
     return std::all_of(cs.begin(), cs.end(), [&](const char* c) { return log.column(c) >= 0; });
   };
-  f.has_pose = has({"x", "y", "z", "qw", "qx", "qy", "qz"});
+  // The attitude as a quaternion or as Z-Y-X Euler angles (the quaternion where both are logged).
+  f.has_pose = has({"x", "y", "z"}) && (has({"qw", "qx", "qy", "qz"}) || has({"phi", "theta", "psi"}));
   f.has_gyro = has({"p", "q", "r"});
   f.has_accelerometer = has({"ax", "ay", "az"});
   f.has_vbat = has({"vbat"});
@@ -456,7 +466,7 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
   if (!f.has_pose && !f.has_accelerometer)
-    throw FitError(log.path + ":1: need a pose (x, y, z, qw..qz) or an accelerometer (ax, ay, az)");
+    throw FitError(log.path + ":1: need a pose (x, y, z and qw..qz or phi, theta, psi) or an accelerometer (ax, ay, az)");
 }
 
 // The log's columns as the samples take them: time from the first row, the states (velocities
@@ -477,6 +487,13 @@ FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::
   auto col = [&](const char* name) { return log.column(name) >= 0 ? log.values(name) : std::vector<double>(t.size(), 0.0); };
   for (const char* n : kStateNames) c.states.push_back(col(n));
   if (!f.has_pose) c.states[kAttitude].assign(t.size(), 1.0);
+  if (f.has_pose && log.column("qw") < 0) {  // the attitude logged as Euler angles
+    const auto phi = log.values("phi"), theta = log.values("theta"), psi = log.values("psi");
+    for (size_t k = 0; k < t.size(); ++k) {
+      const auto q = runtime::quaternion_from_euler_zyx(phi[k], theta[k], psi[k]);
+      for (int i = 0; i < 4; ++i) c.states[kAttitude + i][k] = q[i];
+    }
+  }
   const bool has_velocity = log.column("vx") >= 0 && log.column("vy") >= 0 && log.column("vz") >= 0;
   if (f.has_pose && !has_velocity)
     for (int i = 0; i < 3; ++i) c.states[kVelocity + i] = smoothed_derivative(c.t, c.states[kPosition + i], o.derivative_window);

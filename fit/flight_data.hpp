@@ -32,6 +32,9 @@ struct ColumnMapping {
 // A CSV file of measurements (thrust stand, motor steps): the reader's errors (file:line,
 // non-finite cells, size) as this layer's FitError.
 runtime::CsvTable read_measurement_csv(const std::string& path);
+// Column `name` of such a file, -1 if absent; one with a cell that is no finite number is a
+// FitError naming that cell's line (columns the layout does not read may hold anything).
+int measurement_column(const runtime::CsvTable& t, const std::string& name);
 
 ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);

@@ -11,7 +11,7 @@ namespace quadgen::fit {
 
 namespace {
 
-// Sanity bounds (the file's units; parse_csv has refused non-finite values):
+// Sanity bounds (the file's units; measurement_column has refused columns with a non-finite cell):
 // |time_ms| <= 1e13 (a Unix time in ms is allowed), 0 <= throttle_percent <= 100,
 // 0 <= rpm <= 1e9.
 void check_row(const runtime::CsvTable& t, size_t row) {
@@ -37,7 +37,7 @@ void check_row(const runtime::CsvTable& t, size_t row) {
 std::vector<MotorStep> read_motor_steps(const std::string& path) {
   const runtime::CsvTable t = read_measurement_csv(path);
   for (const char* c : {"time_ms", "throttle_percent", "rpm"})
-    if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (motor step layout)");
+    if (measurement_column(t, c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (motor step layout)");
   for (size_t i = 0; i < t.rows.size(); ++i) check_row(t, i);
   const auto time = t.values("time_ms"), thr = t.values("throttle_percent"), rpm = t.values("rpm");
   std::vector<MotorStep> steps;

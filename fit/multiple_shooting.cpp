@@ -11,7 +11,7 @@ using namespace runtime::rigid_body;
 
 MultipleShootingModel::MultipleShootingModel(runtime::DynamicModel& model, Flight flight, double window)
     : model_(&model), flight_(std::move(flight)) {
-  if (!flight_.has_pose) throw FitError(flight_.source + ": multiple shooting needs the pose (x, y, z, qw..qz)");
+  if (!flight_.has_pose) throw FitError(flight_.source + ": multiple shooting needs the pose (x, y, z and qw..qz or phi, theta, psi)");
   if (model.num_states() != kNumStates)
     throw FitError("multiple shooting needs every state at the window starts; this model has unlogged states (" +
                    model.state_names()[kNumStates] + ")");

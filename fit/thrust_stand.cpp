@@ -40,14 +40,14 @@ double StandSample::sum_of_squared_speeds() const {
 // Sanity bounds (the file's units): weight[g] is signed, the tared scale reads a little
 // below zero at rest, but |weight| <= 1e9 g; 0 <= pwm <= 65535 (a 16-bit command);
 // 0 <= vbat[V] <= 1000 and > 0 where the motors run (the speed model takes log(vbat));
-// 0 <= rpm_i <= 1e9. parse_csv has already refused non-finite values.
+// 0 <= rpm_i <= 1e9. measurement_column has refused columns with a non-finite cell.
 std::vector<StandSample> read_thrust_stand(const std::string& path) {
   const runtime::CsvTable t = read_measurement_csv(path);
   for (const char* c : {"weight[g]", "pwm", "vbat[V]", "rpm1"})
-    if (t.column(c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (thrust-stand layout)");
+    if (measurement_column(t, c) < 0) throw FitError(path + ":1: missing column '" + std::string(c) + "' (thrust-stand layout)");
   std::vector<int> speed_columns;
-  while (t.column("rpm" + std::to_string(speed_columns.size() + 1)) >= 0)
-    speed_columns.push_back(t.column("rpm" + std::to_string(speed_columns.size() + 1)));
+  for (int c; (c = measurement_column(t, "rpm" + std::to_string(speed_columns.size() + 1))) >= 0;)
+    speed_columns.push_back(c);
   const double rpm = 2 * M_PI / 60;
   const int cw = t.column("weight[g]"), cu = t.column("pwm"), cv = t.column("vbat[V]");
   std::vector<StandSample> out;

@@ -12,6 +12,16 @@ inline std::array<double, 3> euler_zyx(double w, double x, double y, double z) {
           std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))};
 }
 
+// The unit quaternion (w, x, y, z) of Z-Y-X Euler angles, q = q_z(psi) ⊗ q_y(theta) ⊗ q_x(phi),
+// with w >= 0 for |phi|, |theta|, |psi| <= pi: the inverse of euler_zyx, for logs that give
+// their attitude as angles.
+inline std::array<double, 4> quaternion_from_euler_zyx(double phi, double theta, double psi) {
+  const double cr = std::cos(phi / 2), sr = std::sin(phi / 2), cp = std::cos(theta / 2), sp = std::sin(theta / 2),
+               cy = std::cos(psi / 2), sy = std::sin(psi / 2);
+  return {cy * cp * cr + sy * sp * sr, cy * cp * sr - sy * sp * cr, cy * sp * cr + sy * cp * sr,
+          sy * cp * cr - cy * sp * sr};
+}
+
 // Body -> world rotation matrix of a unit quaternion (w, x, y, z).
 struct Rotation {
   double m[3][3];

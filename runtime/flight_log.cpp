@@ -23,7 +23,13 @@
 
 namespace quadgen::runtime {
 
-int CsvTable::column(const std::string& name) const { return index_in(columns, name); }
+int CsvTable::column(const std::string& name) const {
+  const int c = index_in(columns, name);
+  if (c >= 0) return c;
+  for (const auto& u : unreadable)
+    if (u.name == name) throw LogError(path + ":" + std::to_string(u.line) + ": column '" + name + "'" + u.why);
+  return -1;
+}
 
 std::vector<double> CsvTable::values(const std::string& name) const {
   const int c = column(name);
@@ -75,8 +81,11 @@ std::vector<std::string> split_header(const std::string& s) {
 }
 
 // One data line into `row`. Each cell must be a finite number in full: strtod alone would
-// accept "1\0junk" (it stops at the NUL) and turn "1e400" into inf.
-void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vector<double>& row) {
+// accept "1\0junk" (it stops at the NUL) and turn "1e400" into inf. A cell that is not is
+// NaN in `row`, and the first such cell of each column is kept in `unreadable` (its
+// column's index; the column is left out of the table at the end).
+void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vector<double>& row,
+               std::vector<UnreadableColumn>& unreadable) {
   const size_t n = static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
   if (n != t.columns.size())
     fail_at(t.path, lineno, "expected " + std::to_string(t.columns.size()) + " values, got " + std::to_string(n));
@@ -91,11 +100,34 @@ void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vect
     start = stop + 1;
     char* end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end != cell.c_str() + cell.size())
-      fail_at(t.path, lineno, "column '" + t.columns[i] + "': expected a number, got " + quoted_cell(cell));
-    if (!std::isfinite(v))
-      fail_at(t.path, lineno, "column '" + t.columns[i] + "' is not finite (" + quoted_cell(cell) + "; expected a finite number)");
+    const bool number = !cell.empty() && end == cell.c_str() + cell.size();
+    if (!number || !std::isfinite(v)) {
+      if (unreadable[i].line == 0)
+        unreadable[i] = {t.columns[i], lineno,
+                         number ? " is not finite (" + quoted_cell(cell) + "; expected a finite number)"
+                                : ": expected a number, got " + quoted_cell(cell)};
+      row.push_back(std::numeric_limits<double>::quiet_NaN());
+      continue;
+    }
     row.push_back(v);
+  }
+}
+
+// Leaves out the columns with a cell that is no finite number, keeping each one's first bad
+// cell in t.unreadable for the message should anything ask for the column.
+void leave_out_unreadable(CsvTable& t, const std::vector<UnreadableColumn>& found) {
+  std::vector<size_t> keep;
+  for (size_t c = 0; c < found.size(); ++c) {
+    if (found[c].line == 0) keep.push_back(c);
+    else t.unreadable.push_back(found[c]);
+  }
+  if (keep.size() == t.columns.size()) return;
+  std::vector<std::string> columns;
+  for (size_t c : keep) columns.push_back(t.columns[c]);
+  t.columns = std::move(columns);
+  for (auto& row : t.rows) {
+    for (size_t k = 0; k < keep.size(); ++k) row[k] = row[keep[k]];
+    row.resize(keep.size());
   }
 }
 
@@ -107,6 +139,7 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
   t.path = path;
   std::string line;
   std::vector<double> row;
+  std::vector<UnreadableColumn> unreadable;  // per column; line 0 while every cell read
   int lineno = 0;
   while (next_line(line)) {
     if (lineno == std::numeric_limits<int>::max()) fail_at(path, lineno, "too many lines (line numbers are int)");
@@ -128,9 +161,10 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
       std::set<std::string> seen;
       for (const auto& c : t.columns)
         if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column '" + c + "'");
+      unreadable.resize(t.columns.size());
       continue;
     }
-    parse_row(line, t, lineno, row);
+    parse_row(line, t, lineno, row, unreadable);
     try {
       if (t.rows.empty() && size_hint > 0) {
         const size_t estimate = static_cast<size_t>(size_hint / (line.size() + 1)) + 16;
@@ -145,6 +179,7 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
     }
   }
   if (t.columns.empty()) fail_at(path, 1, "empty log (expected a header line)");
+  leave_out_unreadable(t, unreadable);
   return t;
 }
 
@@ -274,7 +309,9 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   std::set<std::string> known(rotors.begin(), rotors.end());
   const std::string list = output::joined(rotors);
   // A command column for a rotor the vehicle lacks first: a misspelt rotor is why its own
-  // column is then missing.
+  // column is then missing. One with a cell that is no number is that error (column() says it).
+  for (const auto& u : log.unreadable)
+    if (u.name.rfind("u_", 0) == 0) log.column(u.name);
   for (size_t c = 0; c < log.columns.size(); ++c) {
     const std::string& name = log.columns[c];
     if (name.rfind("u_", 0) == 0 && !known.count(name.substr(2)))

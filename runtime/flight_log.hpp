@@ -14,6 +14,15 @@ struct LogError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A column of a CSV file left out of its table because a cell of it is no finite number
+// (text such as a flight mode, an empty cell, nan, inf, an overflowing literal): where the
+// first such cell is, for the error should anything ask for the column.
+struct UnreadableColumn {
+  std::string name;
+  int line = 0;     // in the file; 0 while no bad cell was seen
+  std::string why;  // ": expected a number, got 'abc'" or " is not finite ('nan'; ...)"
+};
+
 struct CsvTable {
   std::string path;
   std::vector<std::string> columns;
@@ -21,7 +30,11 @@ struct CsvTable {
   // Line in `path` of each row (blank lines and the header are skipped, so row k is not
   // always on line k + 2). Tables built in code may leave it empty: see line_of.
   std::vector<int> lines;
-  int column(const std::string& name) const;  // -1 if absent
+  // The index of column `name`, -1 if absent. A column left out as unreadable is a LogError
+  // "path:line: column 'name': expected a number, got 'abc'": quadgen reads only what it
+  // asks for, so a column nothing asks for may hold anything.
+  int column(const std::string& name) const;
+  std::vector<UnreadableColumn> unreadable;
   std::vector<double> values(const std::string& name) const;
   int line_of(size_t row) const;  // lines[row], or row + 2 where no line was recorded
   // Where the column names come from: the header of `path` when empty; a column mapping's
@@ -44,8 +57,10 @@ constexpr double kMaxAbsTime = 1e10;
 constexpr unsigned long long kDefaultMaxInputBytes = 2ULL << 30;
 unsigned long long max_input_bytes();  // throws LogError for a malformed variable
 
-// Finite numbers only (an empty cell, nan, inf or an overflowing literal is an error); a
-// UTF-8 byte-order mark before the header is skipped; throws LogError "path:line: ...".
+// A column with a cell that is no finite number (empty, text, nan, inf, an overflowing
+// literal) is left out of the table and kept in `unreadable`: asking for it is the error,
+// with the line of its first bad cell. A row with too few or too many cells is an error at
+// once. A UTF-8 byte-order mark before the header is skipped; throws LogError "path:line: ...".
 // read_csv refuses anything but a regular file (a FIFO or a device would block or never
 // end) and files above max_input_bytes(), and parses line by line.
 CsvTable read_csv(const std::string& path);

@@ -5,8 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "runtime/dynamic_model.hpp"
@@ -16,6 +18,7 @@
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
 #include "runtime/per_flight_model.hpp"
+#include "runtime/rigid_body_state.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/motor_steps.hpp"
 #include "fit/profile_likelihood.hpp"
@@ -353,6 +356,43 @@ TEST(FitData, ResampleInterpolatesOntoAUniformGrid) {
   EXPECT_NEAR(r.rows[3][2], 5.0, 1e-12);
   EXPECT_NEAR(r.rows[4][2], 6.0, 1e-12);
   EXPECT_NEAR(r.rows[2][2], 5.0, 1e-12);
+}
+
+// A log may give its attitude as Z-Y-X Euler angles instead of a quaternion (docs/formats.md):
+// the flight read from the angles has the attitude Eigen composes from them, Rz Ry Rx, at
+// angles that wrap (yaw past pi), tilt far and pitch near its singularity.
+TEST(FitData, EulerAnglesGiveTheAttitudeOfTheirRotations) {
+  const std::vector<std::array<double, 3>> angles = {
+      {0, 0, 0}, {0.3, -0.2, 3.0}, {-1.2, 0.7, -2.9}, {2.5, 1.5, 0.4}, {0.1, -1.55, -1.0}, {-3.0, 0.2, 3.1}};
+  std::string quaternion = "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz,p,q,r\n", euler = "t,u_A,u_B,u_C,u_D,x,y,z,phi,theta,psi,p,q,r\n";
+  std::vector<Eigen::Quaterniond> expected;
+  for (int k = 0; k < 60; ++k) {
+    const auto& a = angles[static_cast<size_t>(k) % angles.size()];
+    const Eigen::Quaterniond q = Eigen::AngleAxisd(a[2], Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(a[1], Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitX());
+    expected.push_back(q);
+    std::ostringstream head, qrow, erow;
+    head.precision(17), qrow.precision(17), erow.precision(17);
+    head << 0.01 * k << ",0.5,0.5,0.5,0.5,0,0,1,";
+    qrow << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << ",0,0,0\n";
+    erow << a[0] << "," << a[1] << "," << a[2] << ",0,0,0\n";
+    quaternion += head.str() + qrow.str();
+    euler += head.str() + erow.str();
+  }
+  FlightOptions all_rows;
+  all_rows.airborne_only = false;
+  all_rows.edge_trim = 0;
+  const Flight from_q = load_flight(runtime::parse_csv(quaternion, "q.csv"), {"A", "B", "C", "D"}, all_rows);
+  const Flight from_e = load_flight(runtime::parse_csv(euler, "e.csv"), {"A", "B", "C", "D"}, all_rows);
+  ASSERT_TRUE(from_e.has_pose);
+  ASSERT_EQ(from_e.samples.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    const double* q = &from_e.samples[k].x[runtime::rigid_body::kAttitude];
+    const double dot = q[0] * expected[k].w() + q[1] * expected[k].x() + q[2] * expected[k].y() + q[3] * expected[k].z();
+    EXPECT_NEAR(std::fabs(dot), 1.0, 1e-12) << "sample " << k;  // q and -q are one attitude
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(q[i], from_q.samples[k].x[runtime::rigid_body::kAttitude + i], 1e-12);
+  }
 }
 
 // A bound is hit when the value is within 1e-9 of the bounds' span of it, on either side.

@@ -379,12 +379,73 @@ TEST_F(Hostile, FlightLogLinesBomAndCrlf) {
                  }),
                  crlf, 7, "time not strictly increasing");
   // a NUL inside a cell is no number (strtod alone would stop at it and accept "1")
-  const std::string nul = write("nul.csv", std::string("t,u_A\n0,1\n0.1,1\0junk\n", 22));
-  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(nul); }), nul, 3,
-                 "column 'u_A': expected a number");
+  // (the reader leaves such a column out; asking for it, as the layout check does, is the error)
+  const std::string nul = write("nul.csv", std::string("t,u_A\n0,1\n0.1,1\0junk\n", 21));
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(nul), {"A"}); }),
+                 nul, 3, "column 'u_A': expected a number");
   const std::string over = write("over.csv", "t,u_A\n0,1\n0.1,1e400\n");
-  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(over); }), over, 3,
-                 "column 'u_A' is not finite ('1e400'; expected a finite number)");
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(over), {"A"}); }),
+                 over, 3, "column 'u_A' is not finite ('1e400'; expected a finite number)");
+}
+
+// A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as
+// an empty cell, nan): it is left out, and only asking for it is the error, at the line of
+// its first bad cell. Before, any such cell stopped every command.
+TEST_F(Hostile, ColumnsNothingReadsMayHoldTextAndColumnsReadMayNot) {
+  std::string text = "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz,p,q,r,mode,note,debug\n";
+  for (int k = 0; k < 30; ++k) {
+    const std::string row = canonical_row(0.01 * k);
+    text += row.substr(0, row.size() - 1) + (k < 10 ? ",TAKEOFF," : ",HOVER,") + (k == 3 ? "" : "1") + ",nan\n";
+  }
+  const std::string log = write("mode.csv", text);
+  const auto table = runtime::read_csv(log);
+  EXPECT_EQ(table.columns.size(), 15u);
+  EXPECT_EQ(table.rows.front().size(), 15u);
+  EXPECT_EQ(table.rows.back()[table.column("p")], 0.01);
+  EXPECT_EQ(table.column("absent"), -1);
+  ASSERT_EQ(table.unreadable.size(), 3u);
+  FlightOptions all_rows;
+  all_rows.min_samples = 2;
+  all_rows.airborne_only = false;
+  EXPECT_NO_THROW(load_flight(table, {"A", "B", "C", "D"}, all_rows));
+  // asked for, each is the error at its first bad cell (the header is line 1)
+  expect_located(message_of<runtime::LogError>([&] { table.column("mode"); }), log, 2,
+                 "column 'mode': expected a number, got 'TAKEOFF'");
+  expect_located(message_of<runtime::LogError>([&] { table.values("note"); }), log, 5,
+                 "column 'note': expected a number, got ''");
+  expect_located(message_of<runtime::LogError>([&] { table.column("debug"); }), log, 2,
+                 "column 'debug' is not finite ('nan'; expected a finite number)");
+
+  // a mapping that reads the text column is refused at that column's line; one that does not is not
+  ColumnMapping reads_mode = parse_mapping("columns:\n  t: {source: t}\n  vbat: {source: mode}\n", "m.yaml");
+  expect_located(message_of<runtime::LogError>([&] { apply_mapping(table, reads_mode); }), log, 2, "column 'mode'");
+  ColumnMapping skips_mode = parse_mapping("columns:\n  t: {source: t}\n  p: {source: p}\n", "m.yaml");
+  EXPECT_EQ(apply_mapping(table, skips_mode).rows.size(), 30u);
+
+  // a gyro cell that is no number stops the fit that reads the gyro, at its line
+  std::string bad_gyro = kCanonicalHeader;
+  for (int k = 0; k < 30; ++k) bad_gyro += canonical_row(0.01 * k, k == 12 ? "n/a" : "0.01");
+  const std::string gyro = write("gyro.csv", bad_gyro);
+  const auto gyro_table = runtime::read_csv(gyro);
+  EXPECT_NO_THROW(runtime::validate_canonical(gyro_table, {"A", "B", "C", "D"}));  // t and u_* are fine
+  expect_located(message_of<runtime::LogError>([&] { load_flight(gyro_table, {"A", "B", "C", "D"}, all_rows); }), gyro, 14,
+                 "column 'p': expected a number, got 'n/a'");
+  // and a command column for a rotor the vehicle lacks is still an error when it holds text
+  const std::string stray = write("stray.csv", "t,u_A,u_E\n0,1,x\n1,1,1\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(stray), {"A"}); }),
+                 stray, 2, "column 'u_E'");
+
+  // a thrust stand: a comment column is ignored, a rotor speed that is text is not
+  std::string stand = std::string(kStandHeader);
+  stand.insert(stand.size() - 1, ",comment");
+  std::string rows = stand_rows(12), with_comment;
+  for (size_t start = 0, nl; (nl = rows.find('\n', start)) != std::string::npos; start = nl + 1)
+    with_comment += rows.substr(start, nl - start) + ",steady\n";
+  EXPECT_EQ(read_thrust_stand(write("comment_stand.csv", stand + with_comment)).size(), 12u);
+  const std::string text_rpm =
+      write("text_rpm.csv", std::string(kStandHeader) + stand_rows(12) + "1,3000,3.9,1,1,off,1\n");
+  expect_located(message_of<FitError>([&] { read_thrust_stand(text_rpm); }), text_rpm, 14,
+                 "column 'rpm3': expected a number, got 'off'");
 }
 
 // Defect 4: what is not a regular file is refused at once (a FIFO would block, /dev/zero
