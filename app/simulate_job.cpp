@@ -11,6 +11,7 @@
 #include "runtime/flight_log.hpp"
 #include "derive/geometry.hpp"
 #include "fit/log_reader.hpp"
+#include "runtime/ground_contact.hpp"
 #include "runtime/integrator.hpp"
 #include "app/model_registry.hpp"
 #include "derive/runtime_view.hpp"
@@ -173,12 +174,27 @@ void start_rotor_speeds(const OpenLoop& k, const InputFunction& inputs, std::vec
   }
 }
 
+// The ground's height when the job asks for one: the start's, or the one given, which the
+// start may not be below.
+std::optional<double> ground_height(const SimulateJob& a, const std::vector<double>& x0) {
+  const double z0 = x0[rigid_body::kPosition + 2];
+  if (a.ground_at_start) return z0;
+  if (a.ground_height && z0 < *a.ground_height - 1e-9) {
+    std::ostringstream os;
+    os << "--ground " << *a.ground_height << " m: the " << (a.scenario.empty() ? "log's first pose" : "scenario")
+       << " starts below it (z = " << z0 << " m); give the ground's height in the log's frame, or --ground start";
+    throw std::invalid_argument(os.str());
+  }
+  return a.ground_height;
+}
+
 // The trajectory at the output rate: dopri5 stops at the output times, rk4 keeps every
 // step that falls on one.
 Trajectory integrate(const SimulateJob& a, DynamicModel& m, const std::vector<double>& x0, const InputFunction& inputs,
                      Stats& stats) {
   IntegratorOptions io;
   io.step = a.step;
+  if (const auto ground = ground_height(a, x0)) io.constrain = GroundContact{*ground};
   std::vector<double> out_times;
   const long n_out = std::lround(a.duration * a.rate);
   for (long k = 0; k <= n_out; ++k) out_times.push_back(a.duration * static_cast<double>(k) / static_cast<double>(n_out));
@@ -254,6 +270,8 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
                    param(vehicle, "vbat_ref").nominal,
                    even_share,
                    hover_thrusts(vehicle, model)};
+  if (a.closed_loop && (a.ground_at_start || a.ground_height))
+    throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
 
   std::vector<double> x0(m.num_states(), 0.0);
@@ -264,6 +282,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   Stats stats;
   std::ostringstream starting;
   starting << "simulating " << a.duration << " s of " << vehicle.name << " with " << a.integrator;
+  if (const auto ground = ground_height(a, x0)) starting << " on a ground at z = " << *ground << " m";
   a.progress.say(starting.str());
   const Trajectory tr = integrate(a, m, x0, inputs, stats);
 

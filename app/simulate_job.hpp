@@ -3,6 +3,7 @@
 // flown by a controller that believes the nominal base model. Returns the trajectory in the
 // canonical flight-log layout and the plot's panels; the caller writes them.
 #pragma once
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,6 +26,11 @@ struct SimulateJob {
   double step = 1e-3;       // s, RK4
   double rate = 100;        // Hz, output rows
   std::string interpolation = "hold";  // replayed commands between samples: hold or linear
+  // A ground the vehicle rests on (runtime/ground_contact.hpp), for a scenario or a replay:
+  // none by default; at the start's height (the log's first z; 0 for a scenario) with
+  // ground_at_start, else at ground_height [m, world z of the body origin standing on it].
+  bool ground_at_start = false;
+  std::optional<double> ground_height;
   // Closed loop: the flight generator's seed, trajectory, noise and disturbances, with its
   // defaults (its own duration is replaced by `duration`), and the true model's parameter
   // overrides.

@@ -17,6 +17,7 @@ struct SimulateArgs {
   app::SimulateJob job;          // the flags land here
   std::string out;
   std::vector<std::string> set;  // NAME=VALUE overrides of the true model's parameters, parsed into job.set
+  std::string ground;            // "start" or a height [m], parsed into job.ground_*; "": none
 };
 
 void add_simulate(CLI::App& app, SimulateArgs& args);

@@ -79,6 +79,17 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--rate", a.job.rate, "output rate [Hz]")->check(finite_range(1e-3, 1e6))->excludes(cl);
   c->add_option("--interpolation", a.job.interpolation, "inputs between samples: hold or linear")
       ->check(CLI::IsMember({"hold", "linear"}))->needs(in);
+  c->add_option("--ground", a.ground,
+                "a ground the vehicle stands on and cannot fall through: 'start' (at the start's height, the log's "
+                "first z) or a world height [m] of the body origin standing on it; none by default")
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            double v = 0;
+            if (s == "start" || (parse_finite(s, &v) && std::fabs(v) <= 1e4)) return {};
+            return "'" + s + "': expected 'start' or a height in [-10000, 10000] m";
+          },
+          "start|HEIGHT"))
+      ->excludes(cl);
   c->add_flag("--no-size-limit", a.job.no_size_limit,
               "run even when the estimated work exceeds the limits (1e7 integration steps or output rows)");
 }
@@ -114,6 +125,9 @@ std::pair<std::string, double> parse_setting(const std::string& kv) {
 int run_simulate(const SimulateArgs& a) {
   app::SimulateJob job = a.job;
   for (const std::string& kv : a.set) job.set.push_back(parse_setting(kv));
+  double height = 0;
+  job.ground_at_start = a.ground == "start";
+  if (!job.ground_at_start && parse_finite(a.ground, &height)) job.ground_height = height;
   job.progress = output::terminal_progress();
   output::OutputFiles out = output_for(a);  // refused before the work, not after
   const app::SimulateJobResult r = app::run_simulate_job(job);

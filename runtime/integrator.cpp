@@ -12,9 +12,11 @@ namespace {
 
 using Vec = std::vector<double>;
 
-// The state's quaternion at offset q (none: q < 0).
-void normalize_quaternion_at(Vec& x, int q) {
-  if (q >= 0) runtime::normalize_quaternion(&x[q]);
+// After a step from `before`: the state's quaternion (at opt.quaternion_offset, none if < 0)
+// back on the unit sphere, then the options' constraint.
+void finish_step(const Vec& before, Vec& x, const IntegratorOptions& opt) {
+  if (opt.quaternion_offset >= 0) runtime::normalize_quaternion(&x[opt.quaternion_offset]);
+  if (opt.constrain) opt.constrain(before, x);
 }
 
 struct Rhs {
@@ -69,8 +71,9 @@ Trajectory integrate_rk4(const DynamicModel& m, Vec x, const InputFunction& u, d
   const double h = (t1 - t0) / static_cast<double>(steps);
   for (long s = 0; s < steps; ++s) {
     const double t = t0 + static_cast<double>(s) * h;
+    const Vec before = opt.constrain ? x : Vec();
     rk4_step(f, t, x, h);
-    normalize_quaternion_at(x, opt.quaternion_offset);
+    finish_step(before, x, opt);
     check_finite(m, x, t + h, opt.divergence_bound);
     if (stats) ++stats->accepted_steps;
     tr.t.push_back(t0 + static_cast<double>(s + 1) * h);
@@ -141,17 +144,17 @@ Trajectory integrate_dopri5(const DynamicModel& m, Vec x, const InputFunction& u
           const double r5 = h * (d1 * k1[i] + d3 * k3[i] + d4 * k4[i] + d5 * k5[i] + d6 * k6[i] + d7 * k7[i]);
           xo[i] = r1 + th * (ydiff + th1 * (bspl + th * ((ydiff - h * k7[i] - bspl) + th1 * r5)));
         }
-        normalize_quaternion_at(xo, opt.quaternion_offset);
+        finish_step(x, xo, opt);
         tr.t.push_back(out_t[next_out]);
         tr.x.push_back(xo);
         ++next_out;
       }
       t += h;
-      x = y;
-      normalize_quaternion_at(x, opt.quaternion_offset);
+      std::swap(x, y);  // y holds the step's start until the constraint has seen it
+      finish_step(y, x, opt);
       check_finite(m, x, t, opt.divergence_bound);
       k1 = k7;
-      if (opt.quaternion_offset >= 0) f(t, x, k1);  // x changed by normalisation
+      if (opt.quaternion_offset >= 0 || opt.constrain) f(t, x, k1);  // x changed by normalisation or the constraint
       if (stats) ++stats->accepted_steps;
     } else if (stats) {
       ++stats->rejected_steps;

@@ -32,6 +32,11 @@ struct IntegratorOptions {
   double min_step = 1e-10;
   int quaternion_offset = 6;    // index of qw in the state, or -1
   double divergence_bound = 1e6;  // |x_i| beyond this counts as divergence
+  // Applied to the state x after every RK4 step and every accepted DOPRI5 step (and to the
+  // DOPRI5 dense output), after the quaternion is normalised, with the state the step began
+  // from: a constraint the model's equations do not hold, such as a ground the vehicle rests
+  // on (runtime/ground_contact.hpp). Not applied by the sensitivity integrator. None when empty.
+  std::function<void(const std::vector<double>& before, std::vector<double>& x)> constrain;
 };
 
 struct Stats {

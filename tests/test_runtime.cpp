@@ -745,6 +745,73 @@ TEST(Simulate, ReplaysALogOfAnotherLayoutThroughAMapping) {
   std::filesystem::remove_all(dir);
 }
 
+// A replay that starts on the floor with the motors off but one: with --ground start the vehicle
+// stands at its first logged height and attitude, still, until the thrust lifts it, then climbs as the
+// model says (both integrators); without a ground it falls as g says; a ground above the
+// start and a ground for the closed loop are refused.
+TEST(Simulate, AGroundHoldsTheVehicleUntilTheThrustLiftsIt) {
+  const std::string dir = testing::TempDir() + "quadgen_sim_ground_" + std::to_string(::getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream log(dir + "/floor.csv");
+    log << "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz\n";
+    for (int i = 0; i <= 100; ++i) {
+      // one motor idling for 0.5 s (a torque, too little thrust to lift), then all well above hover
+      const double u = i < 50 ? 0.0 : 0.9, idle = i < 50 ? 0.2 : 0.9;
+      log << 0.01 * i << "," << idle << "," << u << "," << u << "," << u << ",0.2,-0.1,0.03,1,0,0,0\n";
+    }
+  }
+  const std::string simulate = std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                               " --duration 1 --inputs " + dir + "/floor.csv";
+  const auto run = [&](const std::string& args, const std::string& out) {
+    return std::system((simulate + " " + args + " --out " + dir + "/" + out + " > /dev/null 2> " + dir + "/err.txt").c_str());
+  };
+  for (const std::string integrator : {"rk4", "dopri5"}) {
+    ASSERT_EQ(run("--ground start --integrator " + integrator, integrator + ".csv"), 0) << integrator;
+    const CsvTable tr = read_csv(dir + "/" + integrator + ".csv");
+    const int t = tr.column("t"), x = tr.column("x"), z = tr.column("z"), vz = tr.column("vz"), p = tr.column("p");
+    double lowest = 1e9;
+    for (const auto& row : tr.rows) {
+      lowest = std::min(lowest, row[z]);
+      if (row[t] < 0.5) {  // standing: exactly where it stood, at rest
+        EXPECT_EQ(row[z], 0.03) << integrator << " t = " << row[t];
+        EXPECT_EQ(row[vz], 0.0) << integrator << " t = " << row[t];
+        EXPECT_EQ(row[p], 0.0) << integrator << " t = " << row[t];
+        EXPECT_EQ(row[x], 0.2) << integrator << " t = " << row[t];
+        for (const char* q : {"qx", "qy", "qz"}) EXPECT_EQ(row[tr.column(q)], 0.0) << q << " t = " << row[t];
+      }
+    }
+    EXPECT_EQ(lowest, 0.03) << integrator;
+    EXPECT_GT(tr.rows.back()[z], 1.0) << integrator;  // lifted off and climbed
+    EXPECT_GT(tr.rows.back()[vz], 5.0) << integrator;
+  }
+  ASSERT_EQ(run("", "falls.csv"), 0);
+  const CsvTable falls = read_csv(dir + "/falls.csv");
+  const auto at_half = std::find_if(falls.rows.begin(), falls.rows.end(), [&](const auto& r) { return r[0] >= 0.5 - 1e-9; });
+  ASSERT_NE(at_half, falls.rows.end());
+  // nearly free fall for 0.5 s (1.23 m; air drag takes a few cm of it)
+  EXPECT_LT((*at_half)[falls.column("z")], 0.03 - 0.9 * 0.5 * 9.81 * 0.25);
+  EXPECT_GT((*at_half)[falls.column("z")], 0.03 - 0.5 * 9.81 * 0.25);
+  const auto error = [&] {
+    std::ifstream in(dir + "/err.txt");
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  EXPECT_NE(run("--ground 0.1", "above.csv"), 0);
+  EXPECT_NE(error().find("starts below it (z = 0.03 m)"), std::string::npos) << error();
+  EXPECT_FALSE(std::filesystem::exists(dir + "/above.csv"));
+  EXPECT_EQ(run("--ground 0.02", "below.csv"), 0);  // a ground under the start: it falls onto it
+  const CsvTable below = read_csv(dir + "/below.csv");
+  EXPECT_EQ(below.rows[40][below.column("z")], 0.02);
+  EXPECT_NE(std::system((std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                         " --closed-loop --duration 1 --ground start --out " + dir + "/cl.csv > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  EXPECT_NE(run("--ground floor", "word.csv"), 0);
+  EXPECT_NE(error().find("expected 'start' or a height"), std::string::npos) << error();
+  std::filesystem::remove_all(dir);
+}
+
 // The closed-loop generator: tracks its reference, is reproducible by seed, and its
 // integrators compensate a weak motor with a larger command (what the thesis saw as
 // motor signals offset from each other).
