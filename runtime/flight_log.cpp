@@ -71,22 +71,66 @@ std::string quoted_cell(const std::string& cell) {
   return "'" + shown + (cell.size() > 40 ? "...'" : "'");
 }
 
-std::vector<std::string> split_header(const std::string& s) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream ss(s);
-  while (std::getline(ss, cell, ',')) cells.push_back(cell);
-  if (!s.empty() && s.back() == ',') cells.push_back("");
-  return cells;
+// The cells of one line as RFC 4180 reads them: a cell in double quotes may hold commas, and
+// "" in it is one quote (a spreadsheet or pandas quotes a cell that holds a comma or a quote;
+// some exporters quote every cell). A quote inside an unquoted cell is kept as it is. A quoted
+// cell ends at its closing quote, which a comma or the line's end must follow; a line break
+// inside quotes is not read (each line is one row).
+void split_cells(const std::string& line, const std::string& path, int lineno, std::vector<std::string>& cells) {
+  cells.clear();
+  size_t i = 0;
+  for (;;) {
+    std::string cell;
+    if (i < line.size() && line[i] == '"') {
+      const size_t open = i++;
+      for (;; ++i) {
+        if (i >= line.size())
+          fail_at(path, lineno, "the quote opened at character " + std::to_string(open + 1) +
+                                    " is not closed on this line (a line break inside a quoted cell is not read)");
+        if (line[i] != '"') cell += line[i];
+        else if (i + 1 < line.size() && line[i + 1] == '"') cell += line[i++];
+        else break;
+      }
+      ++i;  // past the closing quote
+      if (i < line.size() && line[i] != ',')
+        fail_at(path, lineno, "character " + std::to_string(i + 1) +
+                                  " follows a closing quote; expected a comma or the end of the line");
+    } else {
+      const size_t comma = std::min(line.find(',', i), line.size());
+      cell.assign(line, i, comma - i);
+      i = comma;
+    }
+    cells.push_back(std::move(cell));
+    if (i >= line.size()) return;
+    ++i;  // past the comma; a comma at the end leaves one empty cell after it
+  }
 }
 
-// One data line into `row`. Each cell must be a finite number in full: strtod alone would
-// accept "1\0junk" (it stops at the NUL) and turn "1e400" into inf. A cell that is not is
-// NaN in `row`, and the first such cell of each column is kept in `unreadable` (its
-// column's index; the column is left out of the table at the end).
+// Cell i of a row: its number, or NaN with the column's first bad cell kept in `unreadable`.
+// The whole cell must be a finite number: strtod alone would accept "1\0junk" (it stops at
+// the NUL) and turn "1e400" into inf.
+double cell_value(const std::string& cell, const CsvTable& t, size_t i, int lineno,
+                  std::vector<UnreadableColumn>& unreadable) {
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  const bool number = !cell.empty() && end == cell.c_str() + cell.size();
+  if (number && std::isfinite(v)) return v;
+  if (unreadable[i].line == 0)
+    unreadable[i] = {t.columns[i], lineno,
+                     number ? " is not finite (" + quoted_cell(cell) + "; expected a finite number)"
+                            : ": expected a number, got " + quoted_cell(cell)};
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// One data line into `row`. A cell that is no finite number is NaN in `row`, and the first
+// such cell of each column is kept in `unreadable` (the column is left out of the table at
+// the end). A line without quotes (every log quadgen writes, and most others) is cut at its
+// commas in place; one with quotes goes through split_cells.
 void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vector<double>& row,
-               std::vector<UnreadableColumn>& unreadable) {
-  const size_t n = static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+               std::vector<UnreadableColumn>& unreadable, std::vector<std::string>& cells) {
+  const bool quoted = line.find('"') != std::string::npos;
+  if (quoted) split_cells(line, t.path, lineno, cells);
+  const size_t n = quoted ? cells.size() : static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
   if (n != t.columns.size())
     fail_at(t.path, lineno, "expected " + std::to_string(t.columns.size()) + " values, got " + std::to_string(n));
   row.clear();
@@ -94,22 +138,13 @@ void parse_row(const std::string& line, const CsvTable& t, int lineno, std::vect
   std::string cell;
   size_t start = 0;
   for (size_t i = 0; i < n; ++i) {
-    const size_t comma = line.find(',', start);
-    const size_t stop = comma == std::string::npos ? line.size() : comma;
-    cell.assign(line, start, stop - start);
-    start = stop + 1;
-    char* end = nullptr;
-    const double v = std::strtod(cell.c_str(), &end);
-    const bool number = !cell.empty() && end == cell.c_str() + cell.size();
-    if (!number || !std::isfinite(v)) {
-      if (unreadable[i].line == 0)
-        unreadable[i] = {t.columns[i], lineno,
-                         number ? " is not finite (" + quoted_cell(cell) + "; expected a finite number)"
-                                : ": expected a number, got " + quoted_cell(cell)};
-      row.push_back(std::numeric_limits<double>::quiet_NaN());
-      continue;
+    if (!quoted) {
+      const size_t comma = line.find(',', start);
+      const size_t stop = comma == std::string::npos ? line.size() : comma;
+      cell.assign(line, start, stop - start);
+      start = stop + 1;
     }
-    row.push_back(v);
+    row.push_back(cell_value(quoted ? cells[i] : cell, t, i, lineno, unreadable));
   }
 }
 
@@ -140,6 +175,7 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
   std::string line;
   std::vector<double> row;
   std::vector<UnreadableColumn> unreadable;  // per column; line 0 while every cell read
+  std::vector<std::string> cells;            // a quoted line's cells
   int lineno = 0;
   while (next_line(line)) {
     if (lineno == std::numeric_limits<int>::max()) fail_at(path, lineno, "too many lines (line numbers are int)");
@@ -157,14 +193,14 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
       if (line.find(',') == std::string::npos || line[0] == '#')
         fail_at(path, lineno, "no CSV header: the first line is " + quoted_cell(line) +
                                   "; expected comma-separated column names such as t,u_M1,... (is this a flight log?)");
-      t.columns = split_header(line);
+      split_cells(line, path, lineno, t.columns);
       std::set<std::string> seen;
       for (const auto& c : t.columns)
         if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column '" + c + "'");
       unreadable.resize(t.columns.size());
       continue;
     }
-    parse_row(line, t, lineno, row, unreadable);
+    parse_row(line, t, lineno, row, unreadable, cells);
     try {
       if (t.rows.empty() && size_hint > 0) {
         const size_t estimate = static_cast<size_t>(size_hint / (line.size() + 1)) + 16;

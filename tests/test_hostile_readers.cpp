@@ -448,6 +448,39 @@ TEST_F(Hostile, ColumnsNothingReadsMayHoldTextAndColumnsReadMayNot) {
                  "column 'rpm3': expected a number, got 'off'");
 }
 
+// Quoted cells as RFC 4180 has them (a spreadsheet's or pandas' export): a comma inside quotes
+// is no separator, "" is one quote, a quoted number is a number; a quote left open on its line
+// or followed by more than a comma is the error at its line.
+TEST_F(Hostile, QuotedCellsAreReadAsSpreadsheetsWriteThem) {
+  const std::string log = write("quoted.csv",
+                                "\"t\",\"u_A\",mode\n"
+                                "0,\"0.5\",\"HOVER, low\"\n"
+                                "0.1,0.25,\"say \"\"hi\"\"\"\n"
+                                "0.2,\"\",x\n");
+  const auto t = runtime::read_csv(log);
+  ASSERT_EQ(t.columns, (std::vector<std::string>{"t"}));  // mode holds text; u_A an empty cell
+  ASSERT_EQ(t.unreadable.size(), 2u);
+  expect_located(message_of<runtime::LogError>([&] { t.column("mode"); }), log, 2,
+                 "column 'mode': expected a number, got 'HOVER, low'");
+  expect_located(message_of<runtime::LogError>([&] { t.column("u_A"); }), log, 4, "column 'u_A': expected a number, got ''");
+  const auto numbers = runtime::read_csv(write("numbers.csv", "t,\"u_A\"\n0,\"0.5\"\n\"0.1\",0.25\n"));
+  EXPECT_EQ(numbers.values("u_A"), (std::vector<double>{0.5, 0.25}));
+  EXPECT_EQ(numbers.values("t"), (std::vector<double>{0, 0.1}));
+  // a quote inside an unquoted cell is kept: the cell is no number
+  const auto inner = runtime::read_csv(write("inner.csv", "t,u_A\n0,1\"2\n"));
+  expect_located(message_of<runtime::LogError>([&] { inner.column("u_A"); }), (dir_ / "inner.csv").string(), 2,
+                 "got '1\"2'");
+
+  const std::string open = write("open.csv", "t,u_A\n0,1\n0.1,\"1\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(open); }), open, 3,
+                 "the quote opened at character 5 is not closed on this line");
+  const std::string after = write("after.csv", "t,u_A\n0,\"1\"2\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(after); }), after, 2,
+                 "character 6 follows a closing quote; expected a comma or the end of the line");
+  const std::string count = write("count.csv", "t,u_A\n0,\"1,2\",3\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::read_csv(count); }), count, 2, "expected 2 values, got 3");
+}
+
 // Defect 4: what is not a regular file is refused at once (a FIFO would block, /dev/zero
 // never ends), and so is a file above the size limit.
 TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
