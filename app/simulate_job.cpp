@@ -132,13 +132,11 @@ std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vect
 // has one, as fit, diagnose and predict read logs; x0 takes the log's first pose where it has one.
 InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector<double>& x0) {
   const CsvTable log = fit::read_log(a.inputs, a.mapping, 0);
-  try {
-    validate_canonical(log, k.rotors);
-  } catch (const LogError& e) {  // what a user may not guess: a log of another layout needs a mapping
-    throw LogError(std::string(e.what()) + (a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout "
-                                                                "(t, u_<rotor>; docs/formats.md), or another through --mapping"
-                                                              : ""));
-  }
+  // What a user may not guess when a column is missing: a log of another layout needs a mapping.
+  validate_canonical(log, k.rotors,
+                     a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout (t, u_<rotor>; "
+                                         "docs/formats.md), or another through --mapping"
+                                       : "");
   const std::vector<double> t = log.values("t");
   if (a.duration > t.back() - t.front() + 1e-9)
     throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
@@ -153,8 +151,13 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
   const auto commands = std::make_shared<InputSignal>(t, u, a.interpolation == "linear" ? Interpolation::linear : Interpolation::hold);
   const auto vbat = battery_signal(log, t);
   if (k.m.input_index("vbat") >= 0 && !vbat) throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
-  for (int i = 0; i < rigid_body::kNumStates; ++i)  // start from the logged pose where the log has one
+  for (int i = 0; i < rigid_body::kNumStates; ++i)  // start from the logged state where the log has it
     if (log.column(rigid_body::kStateNames[i]) >= 0) x0[i] = log.rows.front()[log.column(rigid_body::kStateNames[i])];
+  if (const auto form = fit::attitude_columns(log); form != fit::AttitudeColumns::kNone) {  // or as Euler angles
+    const auto q = fit::logged_attitude(log, form, 0);
+    std::copy(q.begin(), q.end(), x0.begin() + rigid_body::kAttitude);
+    normalize_quaternion(&x0[rigid_body::kAttitude]);
+  }
   const double t0 = t.front();
   return [&k, commands, vbat, t0](double tt, double* uu) {
     commands->at(t0 + tt, uu, k.delay_s());
@@ -181,8 +184,10 @@ std::optional<double> ground_height(const SimulateJob& a, const std::vector<doub
   if (a.ground_at_start) return z0;
   if (a.ground_height && z0 < *a.ground_height - 1e-9) {
     std::ostringstream os;
-    os << "--ground " << *a.ground_height << " m: the " << (a.scenario.empty() ? "log's first pose" : "scenario")
-       << " starts below it (z = " << z0 << " m); give the ground's height in the log's frame, or --ground start";
+    os << "--ground " << *a.ground_height << " m: the " << (a.scenario.empty() ? "replay" : "scenario")
+       << " starts below it (z = " << z0 << " m"
+       << (a.scenario.empty() ? "" : ": scenarios start at 0") << "); give the ground's height in the frame of "
+       << (a.scenario.empty() ? "the log's positions (without one the start is z = 0)" : "the world") << ", or --ground start";
     throw std::invalid_argument(os.str());
   }
   return a.ground_height;

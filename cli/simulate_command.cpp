@@ -80,8 +80,8 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--interpolation", a.job.interpolation, "inputs between samples: hold or linear")
       ->check(CLI::IsMember({"hold", "linear"}))->needs(in);
   c->add_option("--ground", a.ground,
-                "a ground the vehicle stands on and cannot fall through: 'start' (at the start's height, the log's "
-                "first z) or a world height [m] of the body origin standing on it; none by default")
+                "a ground the vehicle stands on and cannot fall through: 'start' (at the start's height: the log's "
+                "first z, 0 without one) or a world height [m] of the body origin standing on it; none by default")
       ->check(CLI::Validator(
           [](std::string& s) -> std::string {
             double v = 0;

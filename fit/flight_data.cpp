@@ -308,6 +308,7 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   out.columns = log.columns;
   out.named_by = log.named_by;
   out.name_lines = log.name_lines;
+  out.unreadable = log.unreadable;  // asking for one stays the error at its line
   size_t i = 0;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;
@@ -457,8 +458,7 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   auto has = [&](std::initializer_list<const char*> cs) {
     return std::all_of(cs.begin(), cs.end(), [&](const char* c) { return log.column(c) >= 0; });
   };
-  // The attitude as a quaternion or as Z-Y-X Euler angles (the quaternion where both are logged).
-  f.has_pose = has({"x", "y", "z"}) && (has({"qw", "qx", "qy", "qz"}) || has({"phi", "theta", "psi"}));
+  f.has_pose = has({"x", "y", "z"}) && attitude_columns(log) != AttitudeColumns::kNone;
   f.has_gyro = has({"p", "q", "r"});
   f.has_accelerometer = has({"ax", "ay", "az"});
   f.has_vbat = has({"vbat"});
@@ -487,13 +487,11 @@ FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::
   auto col = [&](const char* name) { return log.column(name) >= 0 ? log.values(name) : std::vector<double>(t.size(), 0.0); };
   for (const char* n : kStateNames) c.states.push_back(col(n));
   if (!f.has_pose) c.states[kAttitude].assign(t.size(), 1.0);
-  if (f.has_pose && log.column("qw") < 0) {  // the attitude logged as Euler angles
-    const auto phi = log.values("phi"), theta = log.values("theta"), psi = log.values("psi");
+  if (f.has_pose && attitude_columns(log) == AttitudeColumns::kEuler)
     for (size_t k = 0; k < t.size(); ++k) {
-      const auto q = runtime::quaternion_from_euler_zyx(phi[k], theta[k], psi[k]);
+      const auto q = logged_attitude(log, AttitudeColumns::kEuler, k);
       for (int i = 0; i < 4; ++i) c.states[kAttitude + i][k] = q[i];
     }
-  }
   const bool has_velocity = log.column("vx") >= 0 && log.column("vy") >= 0 && log.column("vz") >= 0;
   if (f.has_pose && !has_velocity)
     for (int i = 0; i < 3; ++i) c.states[kVelocity + i] = smoothed_derivative(c.t, c.states[kPosition + i], o.derivative_window);
@@ -542,12 +540,37 @@ bool kept(const FlightSample& fs, const Flight& f, double duration, const Flight
 }
 }  // namespace
 
+AttitudeColumns attitude_columns(const runtime::CsvTable& log) {
+  const auto has = [&](std::initializer_list<const char*> cs) {
+    return std::all_of(cs.begin(), cs.end(), [&](const char* c) { return log.column(c) >= 0; });
+  };
+  if (has({"qw", "qx", "qy", "qz"})) return AttitudeColumns::kQuaternion;
+  if (has({"phi", "theta", "psi"})) return AttitudeColumns::kEuler;
+  return AttitudeColumns::kNone;
+}
+
+std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row) {
+  const auto at = [&](const char* c) { return log.rows[row][log.column(c)]; };
+  switch (form) {
+    case AttitudeColumns::kQuaternion: return {at("qw"), at("qx"), at("qy"), at("qz")};
+    case AttitudeColumns::kEuler: return runtime::quaternion_from_euler_zyx(at("phi"), at("theta"), at("psi"));
+    case AttitudeColumns::kNone: break;
+  }
+  return {1, 0, 0, 0};
+}
+
+void require_known_columns_readable(const runtime::CsvTable& log) {
+  for (const auto& u : log.unreadable)
+    if (!canonical_unit(u.name).empty()) log.column(u.name);  // throws, naming the line
+}
+
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {
   // The likeliest cause of a missing column in a log read without a mapping: it needs one.
   runtime::validate_canonical(log, rotors,
                               log.named_by.empty() ? "; a log in another layout is read with --mapping M.yaml "
                                                      "(docs/formats.md, \"Column mapping\")"
                                                    : "");
+  require_known_columns_readable(log);
   Flight f;
   f.source = log.path;
   if (static_cast<double>(log.rows.size()) < o.min_samples)

@@ -3,6 +3,7 @@
 // attitude normalised, accelerations estimated where the log has none, and the flight
 // split by time into a training and a validation part.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,19 @@ runtime::CsvTable read_measurement_csv(const std::string& path);
 // Column `name` of such a file, -1 if absent; one with a cell that is no finite number is a
 // FitError naming that cell's line (columns the layout does not read may hold anything).
 int measurement_column(const runtime::CsvTable& t, const std::string& name);
+
+// How a log gives its attitude: a complete quaternion qw..qz, else complete Z-Y-X Euler
+// angles phi, theta, psi (docs/formats.md), else not at all.
+enum class AttitudeColumns { kNone, kQuaternion, kEuler };
+AttitudeColumns attitude_columns(const runtime::CsvTable& log);
+// Row `row`'s attitude as a quaternion (scalar first, body to world; not normalised), the
+// identity for kNone.
+std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row);
+
+// Every canonical column (docs/formats.md's table) the log has must hold a finite number in
+// every row, whether or not this command reads it: throws the reader's LogError naming the
+// first bad cell's line. Columns quadgen does not know may hold anything.
+void require_known_columns_readable(const runtime::CsvTable& log);
 
 ColumnMapping load_mapping(const std::string& path);  // throws FitError with file:line
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);

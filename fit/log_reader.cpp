@@ -147,6 +147,7 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
   }
   runtime::CsvTable log = runtime::read_csv(path);
   if (mapping) log = apply_mapping(log, *mapping);
+  require_known_columns_readable(log);
   if (resample_hz > 0) log = resample(log, resample_hz);
   return log;
 }

@@ -385,6 +385,13 @@ TEST(FitData, EulerAnglesGiveTheAttitudeOfTheirRotations) {
   all_rows.edge_trim = 0;
   const Flight from_q = load_flight(runtime::parse_csv(quaternion, "q.csv"), {"A", "B", "C", "D"}, all_rows);
   const Flight from_e = load_flight(runtime::parse_csv(euler, "e.csv"), {"A", "B", "C", "D"}, all_rows);
+  // a quaternion that is not complete (qw alone) does not hide complete Euler angles
+  std::string qw_and_euler;
+  std::istringstream lines(euler);
+  for (std::string line; std::getline(lines, line);) qw_and_euler += line + (qw_and_euler.empty() ? ",qw\n" : ",0.3\n");
+  const Flight from_qw_e = load_flight(runtime::parse_csv(qw_and_euler, "qe.csv"), {"A", "B", "C", "D"}, all_rows);
+  for (size_t k = 0; k < expected.size(); ++k)
+    EXPECT_NEAR(from_qw_e.samples[k].x[runtime::rigid_body::kAttitude + 3], expected[k].z(), 1e-12) << k;
   ASSERT_TRUE(from_e.has_pose);
   ASSERT_EQ(from_e.samples.size(), expected.size());
   for (size_t k = 0; k < expected.size(); ++k) {

@@ -416,6 +416,9 @@ TEST_F(Hostile, ColumnsNothingReadsMayHoldTextAndColumnsReadMayNot) {
   expect_located(message_of<runtime::LogError>([&] { table.column("debug"); }), log, 2,
                  "column 'debug' is not finite ('nan'; expected a finite number)");
 
+  // resampled, each stays the error at its line (not a column that is simply absent)
+  expect_located(message_of<runtime::LogError>([&] { resample(table, 50.0).column("note"); }), log, 5, "column 'note'");
+
   // a mapping that reads the text column is refused at that column's line; one that does not is not
   ColumnMapping reads_mode = parse_mapping("columns:\n  t: {source: t}\n  vbat: {source: mode}\n", "m.yaml");
   expect_located(message_of<runtime::LogError>([&] { apply_mapping(table, reads_mode); }), log, 2, "column 'mode'");
@@ -430,6 +433,20 @@ TEST_F(Hostile, ColumnsNothingReadsMayHoldTextAndColumnsReadMayNot) {
   EXPECT_NO_THROW(runtime::validate_canonical(gyro_table, {"A", "B", "C", "D"}));  // t and u_* are fine
   expect_located(message_of<runtime::LogError>([&] { load_flight(gyro_table, {"A", "B", "C", "D"}, all_rows); }), gyro, 14,
                  "column 'p': expected a number, got 'n/a'");
+  // so through read_log with --resample, and a canonical column nothing reads (w_A) stops it too
+  // (every column of the canonical table must be numbers), an unknown one does not
+  expect_located(message_of<runtime::LogError>([&] { read_log(gyro, "", 100.0); }), gyro, 14, "column 'p'");
+  std::string with_speed = "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz,p,q,r,w_A\n";
+  for (int k = 0; k < 30; ++k) {
+    const std::string row = canonical_row(0.01 * k);
+    with_speed += row.substr(0, row.size() - 1) + (k == 20 ? ",-\n" : ",1000\n");
+  }
+  const std::string speed = write("speed.csv", with_speed);
+  expect_located(message_of<runtime::LogError>([&] { read_log(speed, "", 0); }), speed, 22, "column 'w_A'");
+  expect_located(message_of<runtime::LogError>([&] { load_flight(runtime::read_csv(speed), {"A", "B", "C", "D"}, all_rows); }),
+                 speed, 22, "column 'w_A'");
+  EXPECT_EQ(read_log(log, "", 0).unreadable.size(), 3u);  // mode, note, debug: not quadgen's
+
   // and a command column for a rotor the vehicle lacks is still an error when it holds text
   const std::string stray = write("stray.csv", "t,u_A,u_E\n0,1,x\n1,1,1\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(stray), {"A"}); }),

@@ -12,6 +12,8 @@
 #include <set>
 #include <tuple>
 
+#include <Eigen/Geometry>
+
 #include "runtime/attitude.hpp"
 #include "runtime/dynamic_model.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -807,6 +809,24 @@ TEST(Simulate, AGroundHoldsTheVehicleUntilTheThrustLiftsIt) {
                          " --closed-loop --duration 1 --ground start --out " + dir + "/cl.csv > /dev/null 2>&1")
                             .c_str()),
             0);
+  // a log whose attitude is Euler angles starts from that attitude (Rz(psi) Ry(theta) Rx(phi))
+  {
+    std::ofstream log(dir + "/tilt.csv");
+    log << "t,u_A,u_B,u_C,u_D,x,y,z,phi,theta,psi\n0,0,0,0,0,0,0,0.03,0.5,0.2,0.9\n1,0,0,0,0,0,0,0.03,0.5,0.2,0.9\n";
+  }
+  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                         " --duration 0.1 --ground start --inputs " + dir + "/tilt.csv --out " + dir + "/tilt_out.csv > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  const CsvTable tilt = read_csv(dir + "/tilt_out.csv");
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(0.9, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX());
+  for (const auto& row : {tilt.rows.front(), tilt.rows.back()}) {
+    EXPECT_NEAR(row[tilt.column("qw")], q.w(), 1e-9);
+    EXPECT_NEAR(row[tilt.column("qx")], q.x(), 1e-9);
+    EXPECT_NEAR(row[tilt.column("qy")], q.y(), 1e-9);
+    EXPECT_NEAR(row[tilt.column("qz")], q.z(), 1e-9);
+  }
   EXPECT_NE(run("--ground floor", "word.csv"), 0);
   EXPECT_NE(error().find("expected 'start' or a height"), std::string::npos) << error();
   std::filesystem::remove_all(dir);
