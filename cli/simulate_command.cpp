@@ -81,7 +81,7 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
       ->check(CLI::IsMember({"hold", "linear"}))->needs(in);
   c->add_option("--ground", a.ground,
                 "a ground the vehicle stands on and cannot fall through: 'start' (at the start's height: the log's "
-                "first z, 0 without one) or a world height [m] of the body origin standing on it; none by default")
+                "first z, 0 without one) or H, the world z [m] of the body origin when it stands on the ground; none by default")
       ->check(CLI::Validator(
           [](std::string& s) -> std::string {
             double v = 0;

@@ -113,16 +113,12 @@ double unit_scale(const std::string& path, const YAML::Node& at, const std::stri
   return u.scale / want.scale;
 }
 
-const char* const kCanonicalColumns =
-    "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>, "
-    "phi_ref, theta_ref";
-
 ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key, const YAML::Node& value) {
   ColumnMapping::Entry e;
   e.target = scalar_text(path, key, "column name");
   e.line = key.Mark().line + 1;
   if (canonical_unit(e.target).empty())
-    mapping_error(path, key, "'" + e.target + "' is not a canonical column (expected one of " + kCanonicalColumns + ")");
+    mapping_error(path, key, "'" + e.target + "' is not a canonical column (expected one of " + runtime::kCanonicalColumns + ")");
   const std::string where = "column '" + e.target + "'";
   if (!value.IsMap()) mapping_error(path, key, where + ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}");
   const auto f = checked_keys(path, value, where, {"source", "scale", "offset", "unit"});
@@ -138,20 +134,6 @@ ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key,
 }
 
 }  // namespace
-
-std::string canonical_unit(const std::string& c) {
-  static const std::map<std::string, std::string> units = {
-      {"t", "s"},       {"x", "m"},       {"y", "m"},         {"z", "m"},       {"vx", "m/s"},    {"vy", "m/s"},
-      {"vz", "m/s"},    {"qw", "1"},      {"qx", "1"},        {"qy", "1"},      {"qz", "1"},      {"phi", "rad"},
-      {"theta", "rad"}, {"psi", "rad"},   {"p", "rad/s"},     {"q", "rad/s"},   {"r", "rad/s"},   {"ax", "m/s^2"},
-      {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},     {"phi_ref", "rad"}, {"theta_ref", "rad"},
-  };
-  const auto it = units.find(c);
-  if (it != units.end()) return it->second;
-  if (c.size() > 2 && c.rfind("u_", 0) == 0) return "1";
-  if (c.size() > 2 && c.rfind("w_", 0) == 0) return "rad/s";
-  return "";
-}
 
 ColumnMapping load_mapping(const std::string& path) {
   std::string text;

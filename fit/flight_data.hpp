@@ -54,9 +54,7 @@ ColumnMapping load_mapping(const std::string& path);  // throws FitError with fi
 ColumnMapping parse_mapping(const std::string& yaml_text, const std::string& source_name);
 runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMapping& m);
 
-// The SI unit of a canonical column (docs/formats.md "Flight log"): "s", "m", "m/s", "rad/s", "m/s^2",
-// "1", "rad", "V"; empty for a name that is no canonical column.
-std::string canonical_unit(const std::string& column);
+using runtime::canonical_unit;  // the canonical columns' units live with the layout (runtime/flight_log.hpp)
 
 // One time-aligned sample of a flight in canonical units.
 struct FlightSample {

@@ -12,8 +12,8 @@ inline std::array<double, 3> euler_zyx(double w, double x, double y, double z) {
           std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))};
 }
 
-// The unit quaternion (w, x, y, z) of Z-Y-X Euler angles, q = q_z(psi) ⊗ q_y(theta) ⊗ q_x(phi),
-// with w >= 0 for |phi|, |theta|, |psi| <= pi: the inverse of euler_zyx, for logs that give
+// The unit quaternion (w, x, y, z) of Z-Y-X Euler angles, q = q_z(psi) ⊗ q_y(theta) ⊗ q_x(phi)
+// (one of q and -q, which are one attitude): the inverse of euler_zyx, for logs that give
 // their attitude as angles.
 inline std::array<double, 4> quaternion_from_euler_zyx(double phi, double theta, double psi) {
   const double cr = std::cos(phi / 2), sr = std::sin(phi / 2), cp = std::cos(theta / 2), sp = std::sin(theta / 2),

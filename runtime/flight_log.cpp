@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <new>
 #include <set>
 #include <sstream>
@@ -288,6 +289,20 @@ CsvTable read_csv(const std::string& path) {
   return parse_lines(lines, path, file.size());
 }
 
+std::string canonical_unit(const std::string& c) {
+  static const std::map<std::string, std::string> units = {
+      {"t", "s"},       {"x", "m"},       {"y", "m"},         {"z", "m"},       {"vx", "m/s"},    {"vy", "m/s"},
+      {"vz", "m/s"},    {"qw", "1"},      {"qx", "1"},        {"qy", "1"},      {"qz", "1"},      {"phi", "rad"},
+      {"theta", "rad"}, {"psi", "rad"},   {"p", "rad/s"},     {"q", "rad/s"},   {"r", "rad/s"},   {"ax", "m/s^2"},
+      {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},     {"phi_ref", "rad"}, {"theta_ref", "rad"},
+  };
+  const auto it = units.find(c);
+  if (it != units.end()) return it->second;
+  if (c.size() > 2 && c.rfind("u_", 0) == 0) return "1";
+  if (c.size() > 2 && c.rfind("w_", 0) == 0) return "rad/s";
+  return "";
+}
+
 void check_values(const CsvTable& log) {
   const int tc = log.column("t");
   // Motor commands are throttle fractions: a percentage or a raw PWM count would run the model
@@ -300,8 +315,11 @@ void check_values(const CsvTable& log) {
   // A battery voltage is positive: battery_sag scales thrust by a power of it and its
   // derivatives take its logarithm, so 0 (a logger before its first reading) would be NaN.
   const int vbat = log.column("vbat");
+  std::vector<size_t> canonical;
+  for (size_t c = 0; c < log.columns.size(); ++c)
+    if (!canonical_unit(log.columns[c]).empty()) canonical.push_back(c);
   for (size_t i = 0; i < log.rows.size(); ++i)
-    for (size_t c = 0; c < log.columns.size(); ++c) {
+    for (size_t c : canonical) {
       const double v = log.rows[i][c];
       if (!std::isfinite(v)) fail_at(log.path, log.line_of(i), "column '" + log.columns[c] + "' is not finite");
       const double bound = static_cast<int>(c) == tc ? kMaxAbsTime : kMaxAbsValue;

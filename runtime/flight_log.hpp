@@ -45,6 +45,14 @@ struct CsvTable {
   std::string where_named() const;       // the file that names the columns, "log.csv:1" or "mapping.yaml"
 };
 
+// The SI unit of a canonical column (docs/formats.md "Flight log"): "s", "m", "m/s", "rad/s", "m/s^2",
+// "1", "rad", "V"; empty for a name that is no canonical column.
+std::string canonical_unit(const std::string& column);
+// Their names, for messages.
+inline const char* const kCanonicalColumns =
+    "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>, "
+    "phi_ref, theta_ref";
+
 // Sanity bounds on numbers in logs: a value beyond them is a corrupt or mis-scaled log,
 // and letting it through overflows the fit (squares of 1e160 are inf). In canonical SI
 // units every column satisfies |v| <= kMaxAbsValue, except t, which may be a Unix time
@@ -66,8 +74,9 @@ unsigned long long max_input_bytes();  // throws LogError for a malformed variab
 CsvTable read_csv(const std::string& path);
 CsvTable parse_csv(const std::string& text, const std::string& path);
 
-// Every value finite and within the sanity bounds above (a column named t against
-// kMaxAbsTime); throws LogError "path:line: ..." naming the column.
+// Every value of a canonical column finite and within the sanity bounds above (t against
+// kMaxAbsTime); throws LogError "path:line: ..." naming the column. Other columns are not
+// read, so an epoch time in seconds or a counter beside the canonical ones is let be.
 void check_values(const CsvTable& log);
 
 // Canonical columns a log lacks, and how to say so: what they are ("the body rates (gyro)"),

@@ -447,6 +447,14 @@ TEST_F(Hostile, ColumnsNothingReadsMayHoldTextAndColumnsReadMayNot) {
                  speed, 22, "column 'w_A'");
   EXPECT_EQ(read_log(log, "", 0).unreadable.size(), 3u);  // mode, note, debug: not quadgen's
 
+  // a number beyond the sanity bound in a column quadgen does not know (a Unix time) is let be;
+  // in a canonical one it is not
+  const std::string epoch = write("epoch.csv", "t,u_A,unix_time\n0,0.5,1715000000\n0.01,0.5,1715000000.01\n");
+  EXPECT_NO_THROW(runtime::validate_canonical(runtime::read_csv(epoch), {"A"}));
+  const std::string epoch_p = write("epoch_p.csv", "t,u_A,p\n0,0.5,1715000000\n0.01,0.5,0\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(epoch_p), {"A"}); }),
+                 epoch_p, 2, "column 'p' is 1.715e+09, beyond the sanity bound");
+
   // and a command column for a rotor the vehicle lacks is still an error when it holds text
   const std::string stray = write("stray.csv", "t,u_A,u_E\n0,1,x\n1,1,1\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(stray), {"A"}); }),
