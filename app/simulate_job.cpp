@@ -152,8 +152,14 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
   const auto vbat = battery_signal(log, t);
   if (k.m.input_index("vbat") >= 0 && !vbat) throw std::invalid_argument(a.inputs + ": battery_sag needs a 'vbat' column");
   for (int i = 0; i < rigid_body::kNumStates; ++i)  // start from the logged state where the log has it
-    if (log.column(rigid_body::kStateNames[i]) >= 0) x0[i] = log.rows.front()[log.column(rigid_body::kStateNames[i])];
-  if (const auto form = fit::attitude_columns(log); form != fit::AttitudeColumns::kNone) {  // or as Euler angles
+    if ((i < rigid_body::kAttitude || i >= rigid_body::kAttitude + 4) && log.column(rigid_body::kStateNames[i]) >= 0)
+      x0[i] = log.rows.front()[log.column(rigid_body::kStateNames[i])];
+  // The attitude as a whole, as a quaternion or as Euler angles; part of one is a mistake
+  // (a lone qw copied in would start from a rotation that is none), not a level start.
+  if (const std::string partial = fit::incomplete_attitude(log); !partial.empty())
+    throw LogError(log.where_named() + ": the start attitude needs qw, qx, qy, qz or phi, theta, psi; " + partial +
+                   (a.mapping.empty() ? " (a log in another layout is read with --mapping)" : ""));
+  if (const auto form = fit::attitude_columns(log); form != fit::AttitudeColumns::kNone) {
     const auto q = fit::logged_attitude(log, form, 0);
     std::copy(q.begin(), q.end(), x0.begin() + rigid_body::kAttitude);
     normalize_quaternion(&x0[rigid_body::kAttitude]);

@@ -447,8 +447,11 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   f.has_attitude_ref = has({"phi_ref", "theta_ref"});
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
-  if (!f.has_pose && !f.has_accelerometer)
-    throw FitError(log.path + ":1: need a pose (x, y, z and qw..qz or phi, theta, psi) or an accelerometer (ax, ay, az)");
+  if (!f.has_pose && !f.has_accelerometer) {
+    const std::string partial = incomplete_attitude(log);
+    throw FitError(log.where_named() + ": need a pose (x, y, z and qw..qz or phi, theta, psi) or an accelerometer (ax, ay, az)" +
+                   (partial.empty() ? "" : "; " + partial));
+  }
 }
 
 // The log's columns as the samples take them: time from the first row, the states (velocities
@@ -531,6 +534,20 @@ AttitudeColumns attitude_columns(const runtime::CsvTable& log) {
   return AttitudeColumns::kNone;
 }
 
+std::string incomplete_attitude(const runtime::CsvTable& log) {
+  if (attitude_columns(log) != AttitudeColumns::kNone) return "";
+  const std::vector<std::string> quaternion{"qw", "qx", "qy", "qz"}, euler{"phi", "theta", "psi"};
+  std::vector<std::string> has_q, has_e, lacks_q, lacks_e;
+  for (const auto& c : quaternion) (log.column(c) >= 0 ? has_q : lacks_q).push_back(c);
+  for (const auto& c : euler) (log.column(c) >= 0 ? has_e : lacks_e).push_back(c);
+  if (has_q.empty() && has_e.empty()) return "";
+  // The form the log comes nearer to is the one it meant.
+  const bool meant_euler = has_e.size() * 4 > has_q.size() * 3;
+  std::vector<std::string> has = has_q;
+  has.insert(has.end(), has_e.begin(), has_e.end());
+  return "it has " + output::joined(has) + " but not " + output::joined(meant_euler ? lacks_e : lacks_q);
+}
+
 std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row) {
   const auto at = [&](const char* c) { return log.rows[row][log.column(c)]; };
   switch (form) {
@@ -542,8 +559,7 @@ std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColu
 }
 
 void require_known_columns_readable(const runtime::CsvTable& log) {
-  for (const auto& u : log.unreadable)
-    if (!canonical_unit(u.name).empty()) log.column(u.name);  // throws, naming the line
+  log.require_readable([](const std::string& name) { return !canonical_unit(name).empty(); });
 }
 
 Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const FlightOptions& o) {

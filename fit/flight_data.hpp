@@ -41,6 +41,10 @@ int measurement_column(const runtime::CsvTable& t, const std::string& name);
 // angles phi, theta, psi (docs/formats.md), else not at all.
 enum class AttitudeColumns { kNone, kQuaternion, kEuler };
 AttitudeColumns attitude_columns(const runtime::CsvTable& log);
+// Said when a log has some attitude columns but neither form complete (a misnamed or
+// unmapped column, which would otherwise be read as no attitude at all): "it has phi, theta
+// but not psi". Empty when a form is complete or the log has no attitude column.
+std::string incomplete_attitude(const runtime::CsvTable& log);
 // Row `row`'s attitude as a quaternion (scalar first, body to world; not normalised), the
 // identity for kNone.
 std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row);

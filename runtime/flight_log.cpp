@@ -364,8 +364,7 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   const std::string list = output::joined(rotors);
   // A command column for a rotor the vehicle lacks first: a misspelt rotor is why its own
   // column is then missing. One with a cell that is no number is that error (column() says it).
-  for (const auto& u : log.unreadable)
-    if (u.name.rfind("u_", 0) == 0) log.column(u.name);
+  log.require_readable([](const std::string& name) { return name.rfind("u_", 0) == 0; });
   for (size_t c = 0; c < log.columns.size(); ++c) {
     const std::string& name = log.columns[c];
     if (name.rfind("u_", 0) == 0 && !known.count(name.substr(2)))

@@ -35,6 +35,13 @@ struct CsvTable {
   // asks for, so a column nothing asks for may hold anything.
   int column(const std::string& name) const;
   std::vector<UnreadableColumn> unreadable;
+  // column()'s error for the first unreadable column `reads(name)` says a command reads
+  // (the rotor commands for a replay, every canonical column for a fit); nothing otherwise.
+  template <typename Reads>
+  void require_readable(Reads reads) const {
+    for (const auto& u : unreadable)
+      if (reads(u.name)) column(u.name);  // throws, naming the line
+  }
   std::vector<double> values(const std::string& name) const;
   int line_of(size_t row) const;  // lines[row], or row + 2 where no line was recorded
   // Where the column names come from: the header of `path` when empty; a column mapping's

@@ -402,6 +402,32 @@ TEST(FitData, EulerAnglesGiveTheAttitudeOfTheirRotations) {
   }
 }
 
+// Part of an attitude (a yaw under another name, a quaternion missing a component) is said,
+// not read as no attitude at all: the message names what the log has and what it lacks.
+TEST(FitData, AnIncompleteAttitudeIsSaidWithWhatItLacks) {
+  const auto log = [](const std::string& attitude_columns, const std::string& attitude_cells) {
+    std::string text = "t,u_A,u_B,u_C,u_D,x,y,z," + attitude_columns + ",p,q,r\n";
+    for (int k = 0; k < 40; ++k)
+      text += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5,0,0,1," + attitude_cells + ",0,0,0\n";
+    return runtime::parse_csv(text, "log.csv");
+  };
+  EXPECT_EQ(incomplete_attitude(log("phi,theta,yaw", "0.1,0.2,0.3")), "it has phi, theta but not psi");
+  EXPECT_EQ(incomplete_attitude(log("qw,qx,qy", "1,0,0")), "it has qw, qx, qy but not qz");
+  EXPECT_EQ(incomplete_attitude(log("qw,phi,theta,psi", "1,0,0,0")), "");  // the Euler angles are complete
+  EXPECT_EQ(incomplete_attitude(log("roll,pitch,yaw", "0,0,0")), "");     // no attitude column at all
+  FlightOptions all_rows;
+  all_rows.airborne_only = false;
+  all_rows.edge_trim = 0;
+  try {
+    load_flight(log("phi,theta,yaw", "0.1,0.2,0.3"), {"A", "B", "C", "D"}, all_rows);
+    ADD_FAILURE() << "a log without a whole attitude or an accelerometer was loaded";
+  } catch (const FitError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("log.csv:1: need a pose"), std::string::npos) << what;
+    EXPECT_NE(what.find("; it has phi, theta but not psi"), std::string::npos) << what;
+  }
+}
+
 // A bound is hit when the value is within 1e-9 of the bounds' span of it, on either side.
 TEST(Fit, OnBoundSeesBothBoundsAndNothingInside) {
   FitParameter p;

@@ -827,6 +827,24 @@ TEST(Simulate, AGroundHoldsTheVehicleUntilTheThrustLiftsIt) {
     EXPECT_NEAR(row[tilt.column("qy")], q.y(), 1e-9);
     EXPECT_NEAR(row[tilt.column("qz")], q.z(), 1e-9);
   }
+  // part of an attitude is refused, not a level start (nor a lone qw copied in as a rotation)
+  for (const auto& [columns, cells, said] :
+       std::vector<std::array<std::string, 3>>{{"phi,theta,yaw", "0.5,0.2,0.9", "it has phi, theta but not psi"},
+                                               {"qw", "0.6", "it has qw but not qx, qy, qz"}}) {
+    {
+      std::ofstream log(dir + "/part.csv");
+      log << "t,u_A,u_B,u_C,u_D,x,y,z," << columns << "\n0,0,0,0,0,0,0,0.03," << cells << "\n1,0,0,0,0,0,0,0.03," << cells << "\n";
+    }
+    EXPECT_NE(std::system((std::string(QUADGEN_BINARY) + " simulate " + test::source_path("vehicles/finken3.yaml") +
+                           " --duration 0.1 --inputs " + dir + "/part.csv --out " + dir + "/part_out.csv > /dev/null 2> " + dir +
+                           "/err.txt")
+                              .c_str()),
+              0)
+        << columns;
+    EXPECT_NE(error().find("part.csv:1: the start attitude needs qw, qx, qy, qz or phi, theta, psi; " + said), std::string::npos)
+        << error();
+    EXPECT_FALSE(std::filesystem::exists(dir + "/part_out.csv"));
+  }
   EXPECT_NE(run("--ground floor", "word.csv"), 0);
   EXPECT_NE(error().find("expected 'start' or a height"), std::string::npos) << error();
   std::filesystem::remove_all(dir);
