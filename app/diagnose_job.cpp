@@ -183,6 +183,7 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
   DiagnoseJobResult r;
+  for (const auto& f : flights) r.notes.insert(r.notes.end(), f.notes.begin(), f.notes.end());
   if (plots.empty()) r.notes.push_back("no plots: " + err);
   r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, diagnosed))},
              {"report.html", diagnose::diagnosis_html(d, diagnosed, plots)},

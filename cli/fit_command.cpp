@@ -115,7 +115,7 @@ int run_fit(const FitArgs& a) {
   for (const auto& err : result.plot_errors) std::cerr << "no plot " << output::printable_lines(err) << "\n";
   commit_and_say(out, "fit");
   std::cout << output::printable_lines(result.summary);
-  for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << w << "\n";
+  for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << output::printable(w) << "\n";
   return 0;
 }
 

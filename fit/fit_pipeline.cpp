@@ -275,6 +275,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   o.progress("[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples");
   const auto before = channel_rms(*valid_m, params), after = channel_rms(*valid_m, best.parameters);
   FitOutputs out;
+  out.warnings = flight.notes;
   auto& j = out.json = fit_json(best, profiles);
   j["kind"] = shooting ? "flight_multiple_shooting" : "flight_equation_error";
   j["vehicle"] = v.name;

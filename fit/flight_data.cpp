@@ -447,8 +447,11 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   f.has_attitude_ref = has({"phi_ref", "theta_ref"});
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
+  const std::string partial = incomplete_attitude(log);
+  if (!f.has_pose && f.has_accelerometer && (has({"x", "y", "z"}) || !partial.empty()))
+    f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs x, y, z and qw..qz or phi, "
+                      "theta, psi" + (partial.empty() ? std::string(", and the log has no attitude") : "; " + partial));
   if (!f.has_pose && !f.has_accelerometer) {
-    const std::string partial = incomplete_attitude(log);
     throw FitError(log.where_named() + ": need a pose (x, y, z and qw..qz or phi, theta, psi) or an accelerometer (ax, ay, az)" +
                    (partial.empty() ? "" : "; " + partial));
   }

@@ -79,6 +79,9 @@ struct Flight {
   std::vector<FlightSample> samples;
   bool has_accelerometer = false, has_gyro = false, has_pose = false, has_vbat = false;
   bool has_attitude_ref = false;  // phi_ref and theta_ref logged
+  // What the log holds but the loader could not read, for the user ("log.csv:1: no pose is
+  // read: ..."); the commands pass them on (fit's warnings, diagnose's and predict's notes).
+  std::vector<std::string> notes;
 };
 
 struct FlightOptions {

@@ -426,6 +426,18 @@ TEST(FitData, AnIncompleteAttitudeIsSaidWithWhatItLacks) {
     EXPECT_NE(what.find("log.csv:1: need a pose"), std::string::npos) << what;
     EXPECT_NE(what.find("; it has phi, theta but not psi"), std::string::npos) << what;
   }
+  // with an accelerometer the flight loads without a pose, and says why in its notes
+  const Flight with_imu = load_flight(log("phi,theta,yaw,ax,ay,az", "0.1,0.2,0.3,0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
+  EXPECT_FALSE(with_imu.has_pose);
+  ASSERT_EQ(with_imu.notes.size(), 1u);
+  EXPECT_EQ(with_imu.notes[0], "log.csv:1: no pose is read, only the accelerometer: a pose needs x, y, z and qw..qz or phi, "
+                               "theta, psi; it has phi, theta but not psi");
+  const Flight no_attitude = load_flight(log("ax,ay,az", "0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
+  ASSERT_EQ(no_attitude.notes.size(), 1u);
+  EXPECT_NE(no_attitude.notes[0].find("and the log has no attitude"), std::string::npos) << no_attitude.notes[0];
+  const Flight whole = load_flight(log("phi,theta,psi,ax,ay,az", "0.1,0.2,0.3,0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
+  EXPECT_TRUE(whole.has_pose);
+  EXPECT_TRUE(whole.notes.empty());
 }
 
 // A bound is hit when the value is within 1e-9 of the bounds' span of it, on either side.
