@@ -163,6 +163,8 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
 
   const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
+  for (const auto& f : flights)  // said before the long work, not after it
+    for (const auto& note : f.notes) o.progress.say("[diagnose] " + note);
   const std::string diagnosed = logs_label(job.logs);  // what the outputs say was diagnosed
   size_t samples = 0;
   for (const auto& f : flights) samples += f.samples.size();
@@ -183,7 +185,6 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   std::vector<std::pair<std::string, std::string>> plot_data;
   const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
   DiagnoseJobResult r;
-  for (const auto& f : flights) r.notes.insert(r.notes.end(), f.notes.begin(), f.notes.end());
   if (plots.empty()) r.notes.push_back("no plots: " + err);
   r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, diagnosed))},
              {"report.html", diagnose::diagnosis_html(d, diagnosed, plots)},

@@ -157,7 +157,7 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
   // The attitude as a whole, as a quaternion or as Euler angles; part of one is a mistake
   // (a lone qw copied in would start from a rotation that is none), not a level start.
   if (const std::string partial = fit::incomplete_attitude(log); !partial.empty())
-    throw LogError(log.where_named() + ": the start attitude needs qw, qx, qy, qz or phi, theta, psi; " + partial +
+    throw LogError(log.where_named() + ": the start attitude needs " + fit::kAttitudeColumnSets + "; " + partial +
                    (a.mapping.empty() ? " (a log in another layout is read with --mapping)" : ""));
   if (const auto form = fit::attitude_columns(log); form != fit::AttitudeColumns::kNone) {
     const auto q = fit::logged_attitude(log, form, 0);

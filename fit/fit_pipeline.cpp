@@ -305,7 +305,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
   // by design; their reports say so.)
   for (const std::string& name : best.at_bound)
-    out.warnings.push_back(output::printable(name) +
+    out.warnings.push_back(name +
                            " ended on a bound of the fit, so its value is not an estimate (check the log's units and "
                            "scales, and the vehicle file's bounds)");
   return out;

@@ -52,7 +52,7 @@ struct FitOutputs {
   std::vector<std::pair<std::string, std::string>> plots;
   std::vector<std::string> plot_errors;
   std::string summary;
-  std::vector<std::string> warnings;  // what the user should look at before trusting the result
+  std::vector<std::string> warnings;  // what the user should look at before trusting the result (raw: made printable where printed)
 };
 
 FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o);

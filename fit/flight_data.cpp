@@ -447,14 +447,14 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   f.has_attitude_ref = has({"phi_ref", "theta_ref"});
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
-  const std::string partial = incomplete_attitude(log);
-  if (!f.has_pose && f.has_accelerometer && (has({"x", "y", "z"}) || !partial.empty()))
-    f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs x, y, z and qw..qz or phi, "
-                      "theta, psi" + (partial.empty() ? std::string(", and the log has no attitude") : "; " + partial));
-  if (!f.has_pose && !f.has_accelerometer) {
-    throw FitError(log.where_named() + ": need a pose (x, y, z and qw..qz or phi, theta, psi) or an accelerometer (ax, ay, az)" +
-                   (partial.empty() ? "" : "; " + partial));
-  }
+  if (f.has_pose) return;
+  const std::string lacks = pose_lacks(log);
+  if (!f.has_accelerometer)
+    throw FitError(log.where_named() + ": need a pose (" + kPoseColumns + ") or an accelerometer (ax, ay, az)" +
+                   (lacks.empty() ? "" : "; " + lacks));
+  // Part of a pose logged: the user may expect it read.
+  if (!lacks.empty())
+    f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs " + kPoseColumns + "; " + lacks);
 }
 
 // The log's columns as the samples take them: time from the first row, the states (velocities
@@ -528,27 +528,46 @@ bool kept(const FlightSample& fs, const Flight& f, double duration, const Flight
 }
 }  // namespace
 
+namespace {
+const std::array<std::string, 4> kQuaternionColumns{"qw", "qx", "qy", "qz"};
+const std::array<std::string, 3> kEulerColumns{"phi", "theta", "psi"};
+}  // namespace
+
 AttitudeColumns attitude_columns(const runtime::CsvTable& log) {
-  const auto has = [&](std::initializer_list<const char*> cs) {
-    return std::all_of(cs.begin(), cs.end(), [&](const char* c) { return log.column(c) >= 0; });
+  const auto has = [&](const auto& cs) {
+    return std::all_of(cs.begin(), cs.end(), [&](const std::string& c) { return log.column(c) >= 0; });
   };
-  if (has({"qw", "qx", "qy", "qz"})) return AttitudeColumns::kQuaternion;
-  if (has({"phi", "theta", "psi"})) return AttitudeColumns::kEuler;
+  if (has(kQuaternionColumns)) return AttitudeColumns::kQuaternion;
+  if (has(kEulerColumns)) return AttitudeColumns::kEuler;
   return AttitudeColumns::kNone;
 }
 
 std::string incomplete_attitude(const runtime::CsvTable& log) {
   if (attitude_columns(log) != AttitudeColumns::kNone) return "";
-  const std::vector<std::string> quaternion{"qw", "qx", "qy", "qz"}, euler{"phi", "theta", "psi"};
   std::vector<std::string> has_q, has_e, lacks_q, lacks_e;
-  for (const auto& c : quaternion) (log.column(c) >= 0 ? has_q : lacks_q).push_back(c);
-  for (const auto& c : euler) (log.column(c) >= 0 ? has_e : lacks_e).push_back(c);
+  for (const auto& c : kQuaternionColumns) (log.column(c) >= 0 ? has_q : lacks_q).push_back(c);
+  for (const auto& c : kEulerColumns) (log.column(c) >= 0 ? has_e : lacks_e).push_back(c);
   if (has_q.empty() && has_e.empty()) return "";
   // The form the log comes nearer to is the one it meant.
   const bool meant_euler = has_e.size() * 4 > has_q.size() * 3;
   std::vector<std::string> has = has_q;
   has.insert(has.end(), has_e.begin(), has_e.end());
   return "it has " + output::joined(has) + " but not " + output::joined(meant_euler ? lacks_e : lacks_q);
+}
+
+std::string pose_lacks(const runtime::CsvTable& log) {
+  std::vector<std::string> positions;
+  for (const char* c : {"x", "y", "z"})
+    if (log.column(c) < 0) positions.push_back(c);
+  const bool attitude = attitude_columns(log) != AttitudeColumns::kNone;
+  const std::string partial = incomplete_attitude(log);
+  const bool none_of_it = positions.size() == 3 && !attitude && partial.empty();
+  if (none_of_it || (positions.empty() && attitude)) return "";
+  std::vector<std::string> said;
+  if (!positions.empty()) said.push_back("it lacks " + output::joined(positions));
+  if (!partial.empty()) said.push_back(partial);
+  else if (!attitude) said.push_back("it has no attitude");
+  return output::joined(said, "; ");
 }
 
 std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row) {

@@ -45,6 +45,12 @@ AttitudeColumns attitude_columns(const runtime::CsvTable& log);
 // unmapped column, which would otherwise be read as no attitude at all): "it has phi, theta
 // but not psi". Empty when a form is complete or the log has no attitude column.
 std::string incomplete_attitude(const runtime::CsvTable& log);
+// A pose's columns, for messages.
+inline constexpr const char* kPoseColumns = "x, y, z and qw, qx, qy, qz or phi, theta, psi";
+inline constexpr const char* kAttitudeColumnSets = "qw, qx, qy, qz or phi, theta, psi";
+// What keeps a log that has part of a pose from having one ("it lacks z; it has phi, theta
+// but not psi"; "it has no attitude"): empty when it has a pose or none of its columns.
+std::string pose_lacks(const runtime::CsvTable& log);
 // Row `row`'s attitude as a quaternion (scalar first, body to world; not normalised), the
 // identity for kNone.
 std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColumns form, size_t row);

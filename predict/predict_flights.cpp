@@ -20,8 +20,10 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   const std::vector<std::string> rotors = rotor_names(v);
   const runtime::CsvTable log = fit::read_log(path, o.mapping ? &*o.mapping : nullptr, o.resample);
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
-  for (const auto& note : flight.notes) o.progress.say(note);
-  if (!flight.has_pose) o.progress.say(path + ": no pose logged: one-step errors only (rollouts need a measured state)");
+  for (const auto& note : flight.notes) o.progress.say(note);  // why a logged pose is not read
+  if (!flight.has_pose)
+    o.progress.say(path + (flight.notes.empty() ? ": no pose logged" : "") +
+                   ": one-step errors only (rollouts need a measured state)");
   if (!o.set_point_controller.empty() && !flight.has_attitude_ref)
     throw fit::FitError(path + ":1: --controller " + o.set_point_controller +
                         " flies the log's attitude set points, but it has no phi_ref and theta_ref columns "

@@ -51,7 +51,9 @@ std::string CsvTable::where_named(int c) const {
   return k < name_lines.size() ? named_by + ":" + std::to_string(name_lines[k]) : named_by;
 }
 
-std::string CsvTable::where_named() const { return named_by.empty() ? path + ":1" : named_by; }
+std::string CsvTable::where_named() const {
+  return named_by.empty() ? path + ":1" : path + " (columns named by " + named_by + ")";
+}
 
 namespace {
 

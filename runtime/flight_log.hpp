@@ -49,7 +49,9 @@ struct CsvTable {
   std::string named_by;
   std::vector<int> name_lines;
   std::string where_named(int c) const;  // "log.csv:1" or "mapping.yaml:12"
-  std::string where_named() const;       // the file that names the columns, "log.csv:1" or "mapping.yaml"
+  // The columns as a whole, for a message about what the log has: "log.csv:1", or
+  // "log.csv (columns named by mapping.yaml)" (several logs may share one mapping).
+  std::string where_named() const;
 };
 
 // The SI unit of a canonical column (docs/formats.md "Flight log"): "s", "m", "m/s", "rad/s", "m/s^2",

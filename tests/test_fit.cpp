@@ -2,6 +2,7 @@
 // non-identifiability of mass and thrust coefficient, and bad data at the command line.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -255,6 +256,29 @@ TEST(FitCli, BadDataFailsClearlyWithoutOutput) {
   }
 }
 
+// Part of a pose in a log the accelerometer carries is said as the fit's warning, the log's
+// name made printable where it is printed (a control character in it shows as \x1B).
+TEST(FitCli, APoseThatCannotBeReadIsAWarning) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fit_part_pose";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string text = "t,u_M1,u_M2,u_M3,u_M4,x,y,z,phi,theta,yaw,p,q,r,ax,ay,az\n";
+  for (int k = 0; k < 200; ++k) {
+    const double u = 0.6 + 0.05 * std::sin(0.2 * k);
+    text += std::to_string(0.01 * k) + "," + std::to_string(u) + "," + std::to_string(u) + "," + std::to_string(u) + "," +
+            std::to_string(u) + ",0,0,1,0,0,0,0,0,0,0,0," + std::to_string(9.81 * u / 0.6) + "\n";
+  }
+  const fs::path log = dir / "flight\x1b[31m.csv";
+  std::ofstream(log) << text;
+  const CliRun r = run_fit(test::source_path("vehicles/crazyflie21.yaml"), "'" + log.string() + "'", (dir / "out").string());
+  EXPECT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.err.find("quadgen: warning: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("flight\\x1B[31m.csv:1: no pose is read, only the accelerometer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("it has phi, theta but not psi"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "a raw escape reached the terminal";
+  fs::remove_all(dir);
+}
+
 TEST(FitCli, MotorStepsOfTheThesis) {
   const fs::path out = fs::temp_directory_path() / "quadgen_fit_steps";
   fs::remove_all(out);
@@ -430,11 +454,28 @@ TEST(FitData, AnIncompleteAttitudeIsSaidWithWhatItLacks) {
   const Flight with_imu = load_flight(log("phi,theta,yaw,ax,ay,az", "0.1,0.2,0.3,0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
   EXPECT_FALSE(with_imu.has_pose);
   ASSERT_EQ(with_imu.notes.size(), 1u);
-  EXPECT_EQ(with_imu.notes[0], "log.csv:1: no pose is read, only the accelerometer: a pose needs x, y, z and qw..qz or phi, "
-                               "theta, psi; it has phi, theta but not psi");
+  EXPECT_EQ(with_imu.notes[0], "log.csv:1: no pose is read, only the accelerometer: a pose needs x, y, z and qw, qx, qy, qz "
+                               "or phi, theta, psi; it has phi, theta but not psi");
   const Flight no_attitude = load_flight(log("ax,ay,az", "0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
   ASSERT_EQ(no_attitude.notes.size(), 1u);
-  EXPECT_NE(no_attitude.notes[0].find("and the log has no attitude"), std::string::npos) << no_attitude.notes[0];
+  EXPECT_NE(no_attitude.notes[0].find("; it has no attitude"), std::string::npos) << no_attitude.notes[0];
+  // the log's name stays in the message when a mapping names its columns
+  runtime::CsvTable mapped = log("phi,theta,yaw,ax,ay,az", "0.1,0.2,0.3,0,0,9.81");
+  mapped.named_by = "map.yaml";
+  ASSERT_EQ(load_flight(mapped, {"A", "B", "C", "D"}, all_rows).notes.size(), 1u);
+  EXPECT_EQ(load_flight(mapped, {"A", "B", "C", "D"}, all_rows).notes[0].rfind("log.csv (columns named by map.yaml): no pose", 0), 0u);
+  // positions without all three axes
+  const Flight no_z = load_flight(runtime::parse_csv("t,u_A,u_B,u_C,u_D,x,y,qw,qx,qy,qz,p,q,r,ax,ay,az\n" +
+                                                         [] {
+                                                           std::string rows;
+                                                           for (int k = 0; k < 40; ++k)
+                                                             rows += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5,0,0,1,0,0,0,0,0,0,0,0,9.81\n";
+                                                           return rows;
+                                                         }(),
+                                                     "noz.csv"),
+                                  {"A", "B", "C", "D"}, all_rows);
+  ASSERT_EQ(no_z.notes.size(), 1u);
+  EXPECT_NE(no_z.notes[0].find("; it lacks z"), std::string::npos) << no_z.notes[0];
   const Flight whole = load_flight(log("phi,theta,psi,ax,ay,az", "0.1,0.2,0.3,0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
   EXPECT_TRUE(whole.has_pose);
   EXPECT_TRUE(whole.notes.empty());

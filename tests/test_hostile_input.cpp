@@ -1329,22 +1329,35 @@ TEST(Cli, PredictRefusesALogTooShortForOneRollout) {
   // A log without a pose has no rollouts at all, whatever its length: its one-step errors are
   // measured, and that is no refusal (the ARPL log is one).
   const quadgen::runtime::CsvTable flight = quadgen::runtime::read_csv(tmp / "f.csv");
-  std::vector<int> kept;
-  for (size_t c = 0; c < flight.columns.size(); ++c)
-    for (const char* name : {"t", "u_A", "u_B", "u_C", "u_D", "p", "q", "r", "ax", "ay", "az", "vbat"})
-      if (flight.columns[c] == name) kept.push_back(static_cast<int>(c));
-  std::ostringstream imu;
-  imu.precision(17);
-  for (size_t i = 0; i < kept.size(); ++i) imu << (i ? "," : "") << flight.columns[kept[i]];
-  for (const auto& row : flight.rows) {
-    imu << "\n";
-    for (size_t i = 0; i < kept.size(); ++i) imu << (i ? "," : "") << row[kept[i]];
-  }
-  write(tmp / "imu.csv", imu.str() + "\n");
-  ASSERT_EQ(kept.size(), 12u);
+  const auto write_columns = [&](const std::string& path, const std::vector<std::string>& names) {
+    std::vector<int> kept;
+    for (const auto& name : names) kept.push_back(flight.column(name));
+    ASSERT_EQ(std::count(kept.begin(), kept.end(), -1), 0);
+    std::ostringstream out;
+    out.precision(17);
+    for (size_t i = 0; i < kept.size(); ++i) out << (i ? "," : "") << names[i];
+    for (const auto& row : flight.rows) {
+      out << "\n";
+      for (size_t i = 0; i < kept.size(); ++i) out << (i ? "," : "") << row[kept[i]];
+    }
+    write(path, out.str() + "\n");
+  };
+  const std::vector<std::string> imu{"t", "u_A", "u_B", "u_C", "u_D", "p", "q", "r", "ax", "ay", "az", "vbat"};
+  write_columns(tmp / "imu.csv", imu);
   const CliResult r_imu = run_quadgen({"predict", vehicle, tmp / "imu.csv", "--out", tmp / "i"}, tmp.dir);
   EXPECT_EQ(r_imu.rc, 0) << r_imu.err;
   EXPECT_NE(r_imu.err.find("no pose logged: one-step errors only"), std::string::npos) << r_imu.err;
+  // Part of a pose (positions and a lone qw) is read as none, and said before the work.
+  std::vector<std::string> part = imu;
+  part.insert(part.end(), {"x", "y", "z", "qw"});
+  write_columns(tmp / "part.csv", part);
+  const CliResult r_part = run_quadgen({"predict", vehicle, tmp / "part.csv", "--out", tmp / "j"}, tmp.dir);
+  EXPECT_EQ(r_part.rc, 0) << r_part.err;
+  EXPECT_NE(r_part.err.find("part.csv:1: no pose is read, only the accelerometer: a pose needs x, y, z and qw, qx, qy, qz or "
+                            "phi, theta, psi; it has qw but not qx, qy, qz\n"),
+            std::string::npos)
+      << r_part.err;
+  EXPECT_NE(r_part.err.find("part.csv: one-step errors only"), std::string::npos) << r_part.err;
 }
 
 // ---- options -------------------------------------------------------------------------------
