@@ -764,6 +764,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
                    " candidates");
   name_the_causes(d, search, held_out_gain, all, train_ee, so);
+  if (const std::string note = held_out_gain.short_folds_note(d.search.final_fit); !note.empty()) d.notes.push_back(note);
 
   // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
   if (joint) {

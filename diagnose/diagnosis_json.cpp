@@ -523,6 +523,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   json at_bounds = json::array();
   for (const auto& p : d.at_bounds) at_bounds.push_back(p.name);
   j["parameters_at_bounds"] = at_bounds;
+  j["notes"] = d.notes;
   j["gain"] = {{"metric", d.metric},
                {"before", number_or_null(d.metric_before)},
                {"after", number_or_null(d.metric_after)},

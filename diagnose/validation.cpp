@@ -27,7 +27,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   // Sums of squared errors over every scored sample.
   struct Sums {
     double pos = 0, vel = 0, att = 0, rate = 0;
-    size_t count = 0;
+    size_t count = 0, windows = 0, cut_short = 0;
   };
   // One window from sample k0: integrates until `window` seconds or a gap, scores each
   // sample into `sums` and, with `trace`, appends it to the plotted trace.
@@ -55,6 +55,9 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       out.e_att.push_back(angle);
       out.e_rate.push_back(std::sqrt(w2));
     }
+    ++sums.windows;
+    const bool ended_early = k + 1 >= S.size() || S[k + 1].t - S[k].t > predict::Rollout::kMaxGap;
+    if (ended_early && S[k].t - S[k0].t < window - 1e-9) ++sums.cut_short;
     return {k, false};
   };
   const double inf = std::numeric_limits<double>::infinity();
@@ -103,6 +106,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   out.velocity_rmse = std::sqrt(scored.vel / samples);
   out.attitude_rmse = std::sqrt(scored.att / samples);
   out.rate_rmse = std::sqrt(scored.rate / samples);
+  out.windows = scored.windows, out.cut_short = scored.cut_short;
   return out;
 }
 

@@ -27,6 +27,9 @@ struct WindowedSimulation {
   std::vector<double> t, x, y, z;  // simulated positions (NaN between windows) for plots
   // Error norms at the same times: position, velocity, attitude angle, body rates.
   std::vector<double> e_pos, e_vel, e_att, e_rate;
+  // The scored windows, and of them those cut short by the part's end or a gap before they
+  // ran `window` seconds (a part not much longer than a window scores mostly short ones).
+  size_t windows = 0, cut_short = 0;
 };
 
 // Whether simulate_windows scores overlapping windows for this stride.

@@ -1134,6 +1134,30 @@ TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
   EXPECT_EQ(w.position_rmse, 0.0);
 }
 
+// A held-out part barely longer than its window (a 10 s flight: 3 s held out, four folds of
+// 0.75 s against 1 s windows) scores only windows cut short at a fold's end, so the per-fold
+// gains that accept a finding judge shorter horizons than the headline before -> after (on
+// such a flight they disagreed in sign): the diagnosis says so, and says nothing for a flight
+// long enough.
+TEST(Validation, FoldsTooShortForTheirWindowsAreSaid) {
+  HiddenCase c;
+  c.name = "short_folds";
+  c.effects = "motor_gain";
+  c.truth = {{"motor_gain.C", -0.08}};
+  for (const auto& [duration, said] : std::vector<std::pair<double, bool>>{{10.0, true}, {45.0, false}}) {
+    const fs::path dir = fresh_directory("quadgen_short_folds_" + std::to_string(static_cast<int>(duration)));
+    const json j = diagnose_log(vehicle_file(c), fly(c, dir, "f.csv", duration), dir);
+    ASSERT_TRUE(j.contains("notes")) << duration;
+    std::string notes;
+    for (const auto& n : j["notes"]) notes += n.get<std::string>() + "\n";
+    EXPECT_EQ(notes.find("end at a fold's end before 1 s") != std::string::npos, said) << duration << " s: " << notes;
+    std::ifstream summary(dir / "diagnose.log");
+    const std::string printed((std::istreambuf_iterator<char>(summary)), {});
+    EXPECT_EQ(printed.find("caution: the held-out part spans") != std::string::npos, said) << printed;
+    fs::remove_all(dir);
+  }
+}
+
 // The acceptance takes out one failed effect at a time, the one the held-out part speaks most
 // clearly against: a stand-in whose gain is negative beyond its spread before a cause whose
 // gain is merely within its spread (which may pay once the stand-in is gone), and before one
