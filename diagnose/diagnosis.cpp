@@ -21,6 +21,7 @@
 #include "runtime/tape.hpp"
 #include "runtime/thrust_law.hpp"
 #include "codegen/tape_builder.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "runtime/rigid_body_state.hpp"
 
@@ -666,6 +667,21 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
   return parts;
 }
 
+// A finding accepted by its open-loop gain per fold while the whole held-out part's
+// before -> after says the opposite (a held-out part not much longer than four windows: its
+// folds score windows cut short at a fold's end, shorter horizons than the whole part's):
+// said beside the finding, with how the folds' windows end, so that neither number is read
+// alone.
+void note_gains_that_disagree(Diagnosis& d, const HeldOutGain& held_out_gain) {
+  std::vector<std::string> disagreeing;
+  for (const auto& f : d.findings)
+    if (f.accepted_by == Finding::kByOpenLoopPosition && f.gain_mean > 0 && f.after > f.before) disagreeing.push_back(f.effect);
+  if (disagreeing.empty()) return;
+  d.notes.push_back(output::joined(disagreeing) + (disagreeing.size() > 1 ? ": each accepted" : ": accepted") +
+                    " on its open-loop gain per held-out fold, while its before -> after over the whole held-out part rose; " + held_out_gain.fold_windows_text(d.search.final_fit) +
+                    ", so the folds judge shorter horizons; a longer flight or a larger --validation judges more surely");
+}
+
 // From what the search named to what the diagnosis names: each candidate tested on held-out
 // data, the look-alike checks after acceptance (an absorbed look-alike, a suspect the named
 // values need), the net for refinements, and findings beyond their physics set apart.
@@ -764,7 +780,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
                    " candidates");
   name_the_causes(d, search, held_out_gain, all, train_ee, so);
-  if (const std::string note = held_out_gain.short_folds_note(d.search.final_fit); !note.empty()) d.notes.push_back(note);
+  note_gains_that_disagree(d, held_out_gain);
 
   // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
   if (joint) {

@@ -99,20 +99,17 @@ std::vector<double> HeldOutGain::rollout_metrics(const std::vector<fit::FitParam
   return m;
 }
 
-std::string HeldOutGain::short_folds_note(const std::vector<fit::FitParameter>& ps) const {
+std::string HeldOutGain::fold_windows_text(const std::vector<fit::FitParameter>& ps) const {
   if (!pose_ || folds_.empty()) return "";
   size_t windows = 0, cut_short = 0;
   for (const auto& f : folds_) {
     const WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false);
     windows += w.windows, cut_short += w.cut_short;
   }
-  if (windows == 0 || 2 * cut_short <= windows) return "";
   const double span = valid_.samples.back().t - valid_.samples.front().t;
-  return "the held-out part spans " + output::short_number(span) + " s: of the " + std::to_string(windows) +
-         " windows its " + std::to_string(folds_.size()) + " folds score, " + std::to_string(cut_short) +
-         " end at a fold's end before " + output::short_number(window_) +
-         " s, so the per-fold gains that accept a finding judge shorter horizons than the metric's before -> after "
-         "(the two may disagree); a longer flight or a larger --validation judges more surely";
+  return "of the " + std::to_string(windows) + " windows the " + std::to_string(folds_.size()) + " folds score, " +
+         std::to_string(cut_short) + " end at a fold's end before " + output::short_number(window_) +
+         " s (the held-out part spans " + output::short_number(span) + " s)";
 }
 
 HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const {

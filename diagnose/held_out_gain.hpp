@@ -50,10 +50,10 @@ class HeldOutGain {
   const std::string& metric_name() const { return metric_name_; }
   // The folds (empty of windows without a pose: the metric is then one-step already).
   const std::vector<fit::Flight>& folds() const { return folds_; }
-  // Said when most of the windows the folds score for parameter set `ps` are cut short by a
-  // fold's end (a held-out part not much longer than four windows): the per-fold gains that
-  // accept a finding then judge shorter horizons than the whole part's metric. Empty otherwise.
-  std::string short_folds_note(const std::vector<fit::FitParameter>& ps) const;
+  // How the folds' windows for parameter set `ps` end: "of the 18 windows the 4 folds score,
+  // 18 end at a fold's end before 1 s (the held-out part spans 2.96 s)". Where most are cut
+  // short, the per-fold gains judge shorter horizons than the whole part's metric.
+  std::string fold_windows_text(const std::vector<fit::FitParameter>& ps) const;
 
   // Effect `e` of the search's final model, against the model fitted without it under its
   // own weights (CandidateSearch::fit_as_own_model). Where a score is weighted (the one-step

@@ -1136,24 +1136,36 @@ TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
 
 // A held-out part barely longer than its window (a 10 s flight: 3 s held out, four folds of
 // 0.75 s against 1 s windows) scores only windows cut short at a fold's end, so the per-fold
-// gains that accept a finding judge shorter horizons than the headline before -> after (on
-// such a flight they disagreed in sign): the diagnosis says so, and says nothing for a flight
-// long enough.
+// gains that accept a finding judge shorter horizons than the headline before -> after; on
+// this flight (found by a contract audit) they disagree in sign, and the diagnosis says so
+// beside the finding. On a 45 s flight of the same kind they agree, and nothing is said.
 TEST(Validation, FoldsTooShortForTheirWindowsAreSaid) {
   HiddenCase c;
   c.name = "short_folds";
   c.effects = "motor_gain";
   c.truth = {{"motor_gain.C", -0.08}};
+  c.flight_flags = "--excitation 1";  // rate steps: the open loop diverges within a window
   for (const auto& [duration, said] : std::vector<std::pair<double, bool>>{{10.0, true}, {45.0, false}}) {
     const fs::path dir = fresh_directory("quadgen_short_folds_" + std::to_string(static_cast<int>(duration)));
     const json j = diagnose_log(vehicle_file(c), fly(c, dir, "f.csv", duration), dir);
     ASSERT_TRUE(j.contains("notes")) << duration;
     std::string notes;
     for (const auto& n : j["notes"]) notes += n.get<std::string>() + "\n";
-    EXPECT_EQ(notes.find("end at a fold's end before 1 s") != std::string::npos, said) << duration << " s: " << notes;
+    EXPECT_EQ(notes.find("motor_gain: accepted on its open-loop gain per held-out fold, while its before -> after over the "
+                         "whole held-out part rose; of the ") != std::string::npos,
+              said)
+        << duration << " s: " << notes;
+    EXPECT_EQ(notes.find("end at a fold's end before 1 s (the held-out part spans") != std::string::npos, said) << notes;
     std::ifstream summary(dir / "diagnose.log");
     const std::string printed((std::istreambuf_iterator<char>(summary)), {});
-    EXPECT_EQ(printed.find("caution: the held-out part spans") != std::string::npos, said) << printed;
+    EXPECT_EQ(printed.find("caution: motor_gain: accepted on its open-loop gain") != std::string::npos, said) << printed;
+    // the note stands beside a finding whose two numbers disagree, and only there
+    for (const auto& f : j["findings"]) {
+      const auto& g = f["gain"];
+      const bool disagree = f["accepted_by"] == "open-loop position" && g["gain_mean"].get<double>() > 0 &&
+                            g["after"].get<double>() > g["before"].get<double>();
+      EXPECT_EQ(disagree, said) << f.dump(1);
+    }
     fs::remove_all(dir);
   }
 }
