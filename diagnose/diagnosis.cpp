@@ -670,16 +670,17 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
 // A finding accepted by its open-loop gain per fold while the whole held-out part's
 // before -> after says the opposite (a held-out part not much longer than four windows: its
 // folds score windows cut short at a fold's end, shorter horizons than the whole part's):
-// said beside the finding, with how the folds' windows end, so that neither number is read
-// alone.
+// said above the findings, with how the folds' windows end, so that neither number is read
+// alone. (An accepted gain is positive: held_out_test asks it beyond its spread.)
 void note_gains_that_disagree(Diagnosis& d, const HeldOutGain& held_out_gain) {
   std::vector<std::string> disagreeing;
   for (const auto& f : d.findings)
-    if (f.accepted_by == Finding::kByOpenLoopPosition && f.gain_mean > 0 && f.after > f.before) disagreeing.push_back(f.effect);
+    if (f.accepted_by == Finding::kByOpenLoopPosition && f.after > f.before) disagreeing.push_back(f.effect);
   if (disagreeing.empty()) return;
   d.notes.push_back(output::joined(disagreeing) + (disagreeing.size() > 1 ? ": each accepted" : ": accepted") +
-                    " on its open-loop gain per held-out fold, while its before -> after over the whole held-out part rose; " + held_out_gain.fold_windows_text(d.search.final_fit) +
-                    ", so the folds judge shorter horizons; a longer flight or a larger --validation judges more surely");
+                    " on its open-loop gain per held-out fold, while its before -> after over the whole held-out part rose; " +
+                    held_out_gain.fold_windows_text(d.search.final_fit) +
+                    "; a longer flight or a larger --validation judges more surely");
 }
 
 // From what the search named to what the diagnosis names: each candidate tested on held-out

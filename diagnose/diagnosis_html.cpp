@@ -255,7 +255,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
 
 void findings_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>Findings</h2>\n";
-  for (const auto& note : d.notes) h << "<p class=\"caution\">Caution: " << esc(note) << ".</p>\n";
+  for (const auto& note : d.notes) h << "<p class=\"warn\">Caution: " << esc(note) << ".</p>\n";
   if (d.findings.empty()) h << "<p>None.</p>\n";
   if (!d.per_flight_effects.empty()) {
     h << "<p>One value per flight for ";

@@ -100,16 +100,25 @@ std::vector<double> HeldOutGain::rollout_metrics(const std::vector<fit::FitParam
 }
 
 std::string HeldOutGain::fold_windows_text(const std::vector<fit::FitParameter>& ps) const {
-  if (!pose_ || folds_.empty()) return "";
   size_t windows = 0, cut_short = 0;
+  bool diverged = false;
   for (const auto& f : folds_) {
     const WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false);
     windows += w.windows, cut_short += w.cut_short;
+    diverged = diverged || !std::isfinite(w.position_rmse);
   }
-  const double span = valid_.samples.back().t - valid_.samples.front().t;
+  // The held-out time itself: a joint diagnosis's parts lie apart on the joined clock.
+  double held_out = 0;
+  for (size_t k = 1; k < valid_.samples.size(); ++k) {
+    const double dt = valid_.samples[k].t - valid_.samples[k - 1].t;
+    if (dt <= predict::Rollout::kMaxGap) held_out += dt;
+  }
+  const bool mostly_short = 2 * cut_short > windows;
   return "of the " + std::to_string(windows) + " windows the " + std::to_string(folds_.size()) + " folds score, " +
-         std::to_string(cut_short) + " end at a fold's end before " + output::short_number(window_) +
-         " s (the held-out part spans " + output::short_number(span) + " s)";
+         std::to_string(cut_short) + " end early (at a fold's end or a gap) before " + output::short_number(window_) +
+         " s (" + output::short_number(held_out) + " s held out" + (diverged ? "; a fold's windows diverged" : "") + ")" +
+         (mostly_short ? ", so the folds judge shorter horizons than the whole part"
+                       : ", so the folds and the whole part weigh the windows differently");
 }
 
 HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const {

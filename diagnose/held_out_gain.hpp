@@ -50,9 +50,10 @@ class HeldOutGain {
   const std::string& metric_name() const { return metric_name_; }
   // The folds (empty of windows without a pose: the metric is then one-step already).
   const std::vector<fit::Flight>& folds() const { return folds_; }
-  // How the folds' windows for parameter set `ps` end: "of the 18 windows the 4 folds score,
-  // 18 end at a fold's end before 1 s (the held-out part spans 2.96 s)". Where most are cut
-  // short, the per-fold gains judge shorter horizons than the whole part's metric.
+  // How the folds' windows for parameter set `ps` end, and what that means for the per-fold
+  // gains against the whole part's metric: "of the 18 windows the 4 folds score, 18 end
+  // early (at a fold's end or a gap) before 1 s (2.96 s held out), so the folds judge
+  // shorter horizons than the whole part". With a pose only.
   std::string fold_windows_text(const std::vector<fit::FitParameter>& ps) const;
 
   // Effect `e` of the search's final model, against the model fitted without it under its

@@ -55,6 +55,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
       out.e_att.push_back(angle);
       out.e_rate.push_back(std::sqrt(w2));
     }
+    if (k == k0) return {k, false};  // scored nothing (a start just before a gap or the end)
     ++sums.windows;
     const bool ended_early = k + 1 >= S.size() || S[k + 1].t - S[k].t > predict::Rollout::kMaxGap;
     if (ended_early && S[k].t - S[k0].t < window - 1e-9) ++sums.cut_short;

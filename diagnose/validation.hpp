@@ -27,8 +27,9 @@ struct WindowedSimulation {
   std::vector<double> t, x, y, z;  // simulated positions (NaN between windows) for plots
   // Error norms at the same times: position, velocity, attitude angle, body rates.
   std::vector<double> e_pos, e_vel, e_att, e_rate;
-  // The scored windows, and of them those cut short by the part's end or a gap before they
-  // ran `window` seconds (a part not much longer than a window scores mostly short ones).
+  // The scored windows (those that scored a sample), and of them those cut short by the
+  // part's end or a gap before they ran `window` seconds (a part not much longer than a
+  // window scores mostly short ones). Zero where the windows diverged.
   size_t windows = 0, cut_short = 0;
 };
 
