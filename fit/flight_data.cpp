@@ -448,13 +448,13 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
   if (f.has_pose) return;
-  const std::string lacks = pose_lacks(log);
+  const std::string lacks = pose_lacks(log), pose = std::string("x, y, z and ") + kAttitudeColumnSets;
   if (!f.has_accelerometer)
-    throw FitError(log.where_named() + ": need a pose (" + kPoseColumns + ") or an accelerometer (ax, ay, az)" +
+    throw FitError(log.where_named() + ": need a pose (" + pose + ") or an accelerometer (ax, ay, az)" +
                    (lacks.empty() ? "" : "; " + lacks));
   // Part of a pose logged: the user may expect it read.
   if (!lacks.empty())
-    f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs " + kPoseColumns + "; " + lacks);
+    f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs " + pose + "; " + lacks);
 }
 
 // The log's columns as the samples take them: time from the first row, the states (velocities

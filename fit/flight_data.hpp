@@ -45,8 +45,7 @@ AttitudeColumns attitude_columns(const runtime::CsvTable& log);
 // unmapped column, which would otherwise be read as no attitude at all): "it has phi, theta
 // but not psi". Empty when a form is complete or the log has no attitude column.
 std::string incomplete_attitude(const runtime::CsvTable& log);
-// A pose's columns, for messages.
-inline constexpr const char* kPoseColumns = "x, y, z and qw, qx, qy, qz or phi, theta, psi";
+// An attitude's columns, for messages (a pose is x, y, z and these).
 inline constexpr const char* kAttitudeColumnSets = "qw, qx, qy, qz or phi, theta, psi";
 // What keeps a log that has part of a pose from having one ("it lacks z; it has phi, theta
 // but not psi"; "it has no attitude"): empty when it has a pose or none of its columns.
