@@ -429,10 +429,12 @@ TEST(FitData, EulerAnglesGiveTheAttitudeOfTheirRotations) {
 // Part of an attitude (a yaw under another name, a quaternion missing a component) is said,
 // not read as no attitude at all: the message names what the log has and what it lacks.
 TEST(FitData, AnIncompleteAttitudeIsSaidWithWhatItLacks) {
-  const auto log = [](const std::string& attitude_columns, const std::string& attitude_cells) {
-    std::string text = "t,u_A,u_B,u_C,u_D,x,y,z," + attitude_columns + ",p,q,r\n";
+  // A log with positions x, y, z (or the `positions` given) and these columns.
+  const auto log = [](const std::string& columns, const std::string& cells, const std::string& positions = "x,y,z",
+                      const std::string& position_cells = "0,0,1") {
+    std::string text = "t,u_A,u_B,u_C,u_D," + positions + "," + columns + ",p,q,r\n";
     for (int k = 0; k < 40; ++k)
-      text += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5,0,0,1," + attitude_cells + ",0,0,0\n";
+      text += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5," + position_cells + "," + cells + ",0,0,0\n";
     return runtime::parse_csv(text, "log.csv");
   };
   EXPECT_EQ(incomplete_attitude(log("phi,theta,yaw", "0.1,0.2,0.3")), "it has phi, theta but not psi");
@@ -462,18 +464,11 @@ TEST(FitData, AnIncompleteAttitudeIsSaidWithWhatItLacks) {
   // the log's name stays in the message when a mapping names its columns
   runtime::CsvTable mapped = log("phi,theta,yaw,ax,ay,az", "0.1,0.2,0.3,0,0,9.81");
   mapped.named_by = "map.yaml";
-  ASSERT_EQ(load_flight(mapped, {"A", "B", "C", "D"}, all_rows).notes.size(), 1u);
-  EXPECT_EQ(load_flight(mapped, {"A", "B", "C", "D"}, all_rows).notes[0].rfind("log.csv (columns named by map.yaml): no pose", 0), 0u);
+  const Flight from_mapped = load_flight(mapped, {"A", "B", "C", "D"}, all_rows);
+  ASSERT_EQ(from_mapped.notes.size(), 1u);
+  EXPECT_EQ(from_mapped.notes[0].rfind("log.csv (columns named by map.yaml): no pose", 0), 0u);
   // positions without all three axes
-  const Flight no_z = load_flight(runtime::parse_csv("t,u_A,u_B,u_C,u_D,x,y,qw,qx,qy,qz,p,q,r,ax,ay,az\n" +
-                                                         [] {
-                                                           std::string rows;
-                                                           for (int k = 0; k < 40; ++k)
-                                                             rows += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5,0,0,1,0,0,0,0,0,0,0,0,9.81\n";
-                                                           return rows;
-                                                         }(),
-                                                     "noz.csv"),
-                                  {"A", "B", "C", "D"}, all_rows);
+  const Flight no_z = load_flight(log("qw,qx,qy,qz,ax,ay,az", "1,0,0,0,0,0,9.81", "x,y", "0,0"), {"A", "B", "C", "D"}, all_rows);
   ASSERT_EQ(no_z.notes.size(), 1u);
   EXPECT_NE(no_z.notes[0].find("; it lacks z"), std::string::npos) << no_z.notes[0];
   const Flight whole = load_flight(log("phi,theta,psi,ax,ay,az", "0.1,0.2,0.3,0,0,9.81"), {"A", "B", "C", "D"}, all_rows);
