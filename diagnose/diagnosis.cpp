@@ -204,15 +204,15 @@ DraftSignatureInput draft_signature_input(const Diagnosis& d, const fit::Flight&
 namespace {
 
 // What the proposed terms buy in a simulation, like an effect: the full-catalogue model with
-// the terms added is derived and taped, and the held-out folds are simulated with the final
-// fit's values and the terms' coefficients, then with the coefficients at zero. No folds (no
-// pose): not measured.
+// the terms added is derived and taped, and the held-out part's windows are simulated with
+// the final fit's values and the terms' coefficients, then with the coefficients at zero,
+// each fold scored by the windows starting in it. No pose: not measured.
 Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, const std::vector<AddedTerm>& terms,
                                 const std::vector<double>& later_starts, const std::vector<std::string>& per_flight,
-                                const std::vector<fit::FitParameter>& final_fit, const std::vector<fit::Flight>& folds,
-                                double window, double window_stride) {
+                                const std::vector<fit::FitParameter>& final_fit, const fit::Flight& valid,
+                                const std::vector<double>& fold_starts, double window, double window_stride) {
   Diagnosis::TermsGain g;
-  if (folds.empty()) {
+  if (!valid.has_pose) {
     g.note = "no pose logged: no open-loop rollouts; the gain is the channel's held-out equation-error RMS";
     return g;
   }
@@ -239,14 +239,13 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   g.measured = true;
   g.metric = "position RMSE of " + output::short_number(window) + " s open-loop windows on the held-out part" +
              stride_clause(window, window_stride) + " [m]";
-  double sum_before = 0, sum_after = 0;
-  for (const auto& f : folds) {
-    const double b = simulate_windows(*model, without, f, window, window_stride, false).position_rmse;
-    const double a = simulate_windows(*model, with, f, window, window_stride, false).position_rmse;
-    sum_before += b / static_cast<double>(folds.size()), sum_after += a / static_cast<double>(folds.size());
-    g.fold_gains.push_back(b - a);
-  }
-  g.before = sum_before, g.after = sum_after;
+  WindowOptions windows;
+  windows.seconds = window, windows.start_stride = window_stride, windows.keep_trace = false;
+  windows.fold_starts = fold_starts;
+  const WindowedSimulation b = simulate_windows(*model, without, valid, windows);
+  const WindowedSimulation a = simulate_windows(*model, with, valid, windows);
+  for (size_t k = 0; k < a.folds.size(); ++k) g.fold_gains.push_back(b.folds[k].position_rmse - a.folds[k].position_rmse);
+  g.before = b.position_rmse, g.after = a.position_rmse;
   mean_and_standard_error(g.fold_gains, &g.gain_mean, &g.gain_standard_error);
   return g;
 }
@@ -667,20 +666,25 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
   return parts;
 }
 
-// A finding accepted by its open-loop gain per fold while the whole held-out part's
-// before -> after says the opposite (a held-out part not much longer than four windows: its
-// folds score windows cut short at a fold's end, shorter horizons than the whole part's):
-// said above the findings, with how the folds' windows end, so that neither number is read
-// alone. (An accepted gain is positive: held_out_test asks it beyond its spread.)
-void note_gains_that_disagree(Diagnosis& d, const HeldOutGain& held_out_gain) {
+}  // namespace
+
+std::string gains_that_disagree_note(const std::vector<Finding>& findings,
+                                     const std::function<std::string()>& how_windows_end) {
   std::vector<std::string> disagreeing;
-  for (const auto& f : d.findings)
+  for (const auto& f : findings)
     if (f.accepted_by == Finding::kByOpenLoopPosition && f.after > f.before) disagreeing.push_back(f.effect);
-  if (disagreeing.empty()) return;
-  d.notes.push_back(output::joined(disagreeing) + (disagreeing.size() > 1 ? ": each accepted" : ": accepted") +
-                    " on its open-loop gain per held-out fold, while its before -> after over the whole held-out part rose; " +
-                    held_out_gain.fold_windows_text(d.search.final_fit) +
-                    "; a longer flight or a larger --validation judges more surely");
+  if (disagreeing.empty()) return "";
+  return output::joined(disagreeing) + (disagreeing.size() > 1 ? ": each accepted" : ": accepted") +
+         " on its open-loop gain per held-out fold, while its before -> after over the whole held-out part rose; " +
+         how_windows_end() + "; a longer flight or a larger --validation judges more surely";
+}
+
+namespace {
+
+void note_gains_that_disagree(Diagnosis& d, const HeldOutGain& held_out_gain) {
+  const std::string note =
+      gains_that_disagree_note(d.findings, [&] { return held_out_gain.fold_windows_text(d.search.final_fit); });
+  if (!note.empty()) d.notes.push_back(note);
 }
 
 // From what the search named to what the diagnosis names: each candidate tested on held-out
@@ -821,8 +825,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (!proposed_terms(d.discovered).empty()) {
     opt.progress.say(progress() + "the proposed terms regenerated into the model and simulated on the held-out part");
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), fm.later_starts, fm.per_flight_names,
-                              s.final_fit, flight.has_pose ? held_out_gain.folds() : std::vector<fit::Flight>{},
-                              opt.window, opt.window_stride);
+                              s.final_fit, valid, held_out_gain.fold_starts(), opt.window, opt.window_stride);
   }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);

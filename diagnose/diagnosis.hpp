@@ -3,6 +3,7 @@
 // report is diagnosis_report's job; the command line is cli/diagnose_command.cpp.
 #pragma once
 #include <optional>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -234,6 +235,16 @@ struct Diagnosis {
 // spread, with the one-step cost lower beyond its spread and neither the translational nor
 // the rotational channels worse beyond theirs.
 std::string held_out_test(const Finding& f);
+
+// The caution where a finding accepted by its open-loop gain per fold has its before -> after
+// over the whole held-out part rising ("" where none has): the folds and the whole part
+// score the same windows, but the mean of the folds' gains weighs each fold alike while the
+// whole part pools their squared errors, so a fold with larger errors can turn it. Said
+// above the findings so that neither number is read alone, with `how_windows_end` (called
+// only then: it simulates). (An accepted gain is positive: held_out_test asks it beyond its
+// spread.)
+std::string gains_that_disagree_note(const std::vector<Finding>& findings,
+                                     const std::function<std::string()>& how_windows_end);
 
 // Of the effects that failed a round of acceptance (each with why), the one to take out
 // first: the one whose held-out gain speaks most clearly against it (the lowest gain over

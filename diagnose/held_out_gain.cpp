@@ -64,6 +64,7 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
       window_(window),
       window_stride_(window_stride),
       folds_(validation_folds(valid, 4)) {
+  for (const auto& f : folds_) fold_starts_.push_back(f.samples.front().t);
   // Every point of a window is scored (0 to `window` s ahead): less than the error at the
   // window's end, which predict reports; the wording keeps the two apart.
   metric_name_ = pose_ ? "validation position RMSE (" + std::to_string(window).substr(0, 3) +
@@ -85,48 +86,51 @@ double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, const std::
   return pose_ ? open_loop_rmse(ps, sim) : CandidateSearch::cost(valid_ee_, ps, weights);
 }
 
+WindowedSimulation HeldOutGain::windows(const std::vector<fit::FitParameter>& ps, predict::Replay replay,
+                                        bool keep_trace) const {
+  WindowOptions o;
+  o.seconds = window_, o.start_stride = window_stride_, o.keep_trace = keep_trace, o.replay = replay;
+  o.fold_starts = fold_starts_;
+  return simulate_windows(model_, fit::parameter_values(ps), valid_, o);
+}
+
 double HeldOutGain::open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const {
-  WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), valid_, window_, window_stride_, sim != nullptr);
+  WindowedSimulation w = windows(ps, predict::Replay::kNothing, sim != nullptr);
   if (sim) *sim = w;
   return w.position_rmse;
 }
 
-std::vector<double> HeldOutGain::rollout_metrics(const std::vector<fit::FitParameter>& ps,
-                                                 predict::Replay replay) const {
+std::vector<double> HeldOutGain::fold_rmses(const WindowedSimulation& w) {
   std::vector<double> m;
-  for (const auto& f : folds_)
-    m.push_back(simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false, replay).position_rmse);
+  for (const auto& fold : w.folds) m.push_back(fold.position_rmse);
   return m;
 }
 
 std::string HeldOutGain::fold_windows_text(const std::vector<fit::FitParameter>& ps) const {
-  size_t windows = 0, cut_short = 0;
-  bool diverged = false;
-  for (const auto& f : folds_) {
-    const WindowedSimulation w = simulate_windows(model_, fit::parameter_values(ps), f, window_, window_stride_, false);
-    windows += w.windows, cut_short += w.cut_short;
-    diverged = diverged || !std::isfinite(w.position_rmse);
-  }
+  const WindowedSimulation w = windows(ps, predict::Replay::kNothing, false);
   // The held-out time itself: a joint diagnosis's parts lie apart on the joined clock.
   double held_out = 0;
   for (size_t k = 1; k < valid_.samples.size(); ++k) {
     const double dt = valid_.samples[k].t - valid_.samples[k - 1].t;
     if (dt <= predict::Rollout::kMaxGap) held_out += dt;
   }
-  const bool mostly_short = 2 * cut_short > windows;
-  return "of the " + std::to_string(windows) + " windows the " + std::to_string(folds_.size()) + " folds score, " +
-         std::to_string(cut_short) + " end early (at a fold's end or a gap) before " + output::short_number(window_) +
-         " s (" + output::short_number(held_out) + " s held out" + (diverged ? "; a fold's windows diverged" : "") + ")" +
-         (mostly_short ? ", so the folds judge shorter horizons than the whole part"
-                       : ", so the folds and the whole part weigh the windows differently");
+  const bool diverged = !std::isfinite(w.position_rmse);
+  return "of the " + std::to_string(w.windows) + " windows the " + std::to_string(fold_starts_.size()) +
+         " folds score, " + std::to_string(w.cut_short) + " end early (at the held-out part's end or a gap) before " +
+         output::short_number(window_) + " s (" + output::short_number(held_out) + " s held out" +
+         (diverged ? "; the windows diverged" : "") +
+         "); the whole part pools the folds' squared errors, so a fold with larger errors weighs more in it than in "
+         "the mean of the folds' gains";
 }
 
 HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const {
   Scores out;
   if (pose_) {
-    out.metric = open_loop_rmse(ps, nullptr);
-    out.fold_metrics = rollout_metrics(ps, predict::Replay::kNothing);
-    if (force_alone) out.force_alone = rollout_metrics(ps, predict::Replay::kAttitude);
+    // One simulation of the part scores the whole and each fold (its windows start in it).
+    const WindowedSimulation w = windows(ps, predict::Replay::kNothing, false);
+    out.metric = w.position_rmse;
+    out.fold_metrics = fold_rmses(w);
+    if (force_alone) out.force_alone = fold_rmses(windows(ps, predict::Replay::kAttitude, false));
   }
   for (const auto& fold : fold_problems_) {
     out.fit_groups.push_back(channel_group_squares(*fold.fit, ps));
@@ -152,7 +156,7 @@ const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool
     cached_values_ = values;
     cached_force_alone_ = force_alone;
   } else if (force_alone && !cached_force_alone_ && pose_) {
-    cached_.force_alone = rollout_metrics(s.final_fit, predict::Replay::kAttitude);
+    cached_.force_alone = fold_rmses(windows(s.final_fit, predict::Replay::kAttitude, false));
     cached_force_alone_ = true;
   }
   return cached_;

@@ -1,8 +1,9 @@
 // What one named effect buys on data the fit did not see: the search's final model against
 // the model fitted without the effect (under its own weights), on four consecutive folds of
 // the validation part. Measured three ways (Finding in diagnosis.hpp holds them):
-//  - the report's metric per fold: the position RMSE of open-loop windows with a pose, else
-//    the held-out equation-error cost;
+//  - the report's metric per fold: the position RMSE of the open-loop windows that start in
+//    the fold (each runs its whole horizon, across the fold's end) with a pose, else the
+//    held-out equation-error cost;
 //  - one step at a time, per kind of channel: the weighted cost, and the sums of squares of
 //    the translational (the accelerometer's where one is logged and the fit differentiates
 //    the pose), horizontal, vertical, rotational, roll/pitch and yaw channels;
@@ -48,12 +49,13 @@ class HeldOutGain {
   double metric(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
                 WindowedSimulation* sim) const;
   const std::string& metric_name() const { return metric_name_; }
-  // The folds (empty of windows without a pose: the metric is then one-step already).
-  const std::vector<fit::Flight>& folds() const { return folds_; }
-  // How the folds' windows for parameter set `ps` end, and what that means for the per-fold
-  // gains against the whole part's metric: "of the 18 windows the 4 folds score, 18 end
-  // early (at a fold's end or a gap) before 1 s (2.96 s held out), so the folds judge
-  // shorter horizons than the whole part". With a pose only.
+  // The times the folds begin (WindowOptions::fold_starts): the open-loop windows of the
+  // whole held-out part count toward the fold their start lies in.
+  const std::vector<double>& fold_starts() const { return fold_starts_; }
+  // How the windows for parameter set `ps` end, and why the per-fold gains and the whole
+  // part's metric can disagree: "of the 18 windows the 4 folds score, 5 end early (at the
+  // held-out part's end or a gap) before 1 s (2.96 s held out); the whole part pools the
+  // folds' squared errors, ...". With a pose only.
   std::string fold_windows_text(const std::vector<fit::FitParameter>& ps) const;
 
   // Effect `e` of the search's final model, against the model fitted without it under its
@@ -92,9 +94,11 @@ class HeldOutGain {
   // The final model's unweighted scores: every finding of one acceptance round compares with
   // the same final model, which is simulated once per round, not once per finding.
   const Scores& final_scores(const SearchResult& s, bool force_alone) const;
-  // The open-loop windows' position RMSE over the whole held-out part (with a pose).
+  // The open-loop windows of the whole held-out part, scored per fold too (with a pose).
+  WindowedSimulation windows(const std::vector<fit::FitParameter>& ps, predict::Replay replay, bool keep_trace) const;
+  // Their position RMSE over the whole part; with `sim`, the windows' trace is kept there.
   double open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const;
-  std::vector<double> rollout_metrics(const std::vector<fit::FitParameter>& ps, predict::Replay replay) const;
+  static std::vector<double> fold_rmses(const WindowedSimulation& w);
   static ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m,
                                                    const std::vector<fit::FitParameter>& ps);
   static Finding::OneStep one_step(const Scores& without, const Scores& with);
@@ -114,7 +118,8 @@ class HeldOutGain {
   const bool pose_;
   const double window_, window_stride_;
   std::string metric_name_;
-  std::vector<fit::Flight> folds_;
+  std::vector<fit::Flight> folds_;  // the one-step problems' folds
+  std::vector<double> fold_starts_;
   std::vector<FoldProblems> fold_problems_;  // with a pose; a fold without rows is skipped
   // final_scores' cache, keyed on the final model's values.
   mutable std::vector<double> cached_values_;

@@ -15,27 +15,48 @@ std::string stride_clause(double window, double start_stride) {
   return overlapping_windows(window, start_stride) ? ", started every " + output::short_number(start_stride) + " s" : "";
 }
 
+namespace {
+
+// Sums of squared errors over the scored samples of some windows.
+struct Sums {
+  double pos = 0, vel = 0, att = 0, rate = 0;
+  size_t count = 0, windows = 0, cut_short = 0;
+  Sums& operator+=(const Sums& o) {
+    pos += o.pos, vel += o.vel, att += o.att, rate += o.rate;
+    count += o.count, windows += o.windows, cut_short += o.cut_short;
+    return *this;
+  }
+  double rms(double squares) const { return std::sqrt(squares / static_cast<double>(std::max<size_t>(count, 1))); }
+};
+
+// The fold a window starting at `t` counts toward: the last fold begun by then (the first
+// before any).
+size_t fold_of(double t, const std::vector<double>& fold_starts) {
+  const auto after = std::upper_bound(fold_starts.begin(), fold_starts.end(), t + 1e-9);
+  return after == fold_starts.begin() ? 0 : static_cast<size_t>(after - fold_starts.begin()) - 1;
+}
+
+}  // namespace
+
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& f, double window, double start_stride, bool keep_trace,
-                                    predict::Replay replay) {
+                                    const fit::Flight& f, const WindowOptions& o) {
   if (f.samples.size() < 2) return {};  // no window to simulate
+  const double window = o.seconds;
+  const predict::Replay replay = o.replay;
   const std::vector<double> sim_params = runtime::simulation_params(model, params);
   model.set_params(sim_params);
   predict::Rollout roll(model, f, sim_params);  // the prediction's rollout
   WindowedSimulation out;
   const auto& S = f.samples;
-  // Sums of squared errors over every scored sample.
-  struct Sums {
-    double pos = 0, vel = 0, att = 0, rate = 0;
-    size_t count = 0, windows = 0, cut_short = 0;
-  };
+  const size_t n_folds = std::max<size_t>(o.fold_starts.size(), 1);
   // One window from sample k0: integrates until `window` seconds or a gap, scores each
-  // sample into `sums` and, with `trace`, appends it to the plotted trace.
+  // sample into its fold's sums and, with `trace`, appends it to the plotted trace.
   struct WindowEnd {
     size_t last;    // the window's last sample scored (k0 if none)
     bool diverged;  // the simulation left the finite numbers after `last`
   };
-  auto run_window = [&](size_t k0, Sums& sums, bool trace) -> WindowEnd {
+  auto run_window = [&](size_t k0, std::vector<Sums>& folds, bool trace) -> WindowEnd {
+    Sums& sums = folds[fold_of(S[k0].t, o.fold_starts)];
     auto [e, x] = roll.start_at(k0, replay);
     size_t k = k0;
     for (; k + 1 < S.size() && S[k + 1].t - S[k0].t <= window + 1e-9; ++k) {
@@ -64,6 +85,7 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   const double inf = std::numeric_limits<double>::infinity();
   auto diverged = [&] {  // no error measure is meaningful (diagnosis.json shows null)
     out.position_rmse = out.velocity_rmse = out.attitude_rmse = out.rate_rmse = inf;
+    out.folds.assign(n_folds, WindowedSimulation::Fold{inf, 0, 0});
     return out;
   };
   // The plotted trace: consecutive windows, NaN between them. A window starts only where the
@@ -71,18 +93,18 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   // Divergence is decided by the windows that are scored: when the scores come from the
   // overlapping windows, a diverging trace window just ends there (so that the scores do not
   // depend on whether a trace is kept).
-  const bool overlapping = overlapping_windows(window, start_stride);
-  Sums consecutive;
-  for (size_t k0 = 0; k0 + 1 < S.size() && (keep_trace || !overlapping);) {
+  const bool overlapping = overlapping_windows(window, o.start_stride);
+  std::vector<Sums> consecutive(n_folds);
+  for (size_t k0 = 0; k0 + 1 < S.size() && (o.keep_trace || !overlapping);) {
     if (!roll.may_start_at(k0)) {
       ++k0;
       continue;
     }
     const size_t trace_before = out.t.size();
-    const auto [k, window_diverged] = run_window(k0, consecutive, keep_trace);
+    const auto [k, window_diverged] = run_window(k0, consecutive, o.keep_trace);
     if (window_diverged && !overlapping) return diverged();
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (keep_trace) {
+    if (o.keep_trace) {
       if (window_diverged)  // its points up to the bound would only stretch the plot's axes
         for (auto* v : {&out.t, &out.x, &out.y, &out.z, &out.e_pos, &out.e_vel, &out.e_att, &out.e_rate}) v->resize(trace_before);
       out.t.push_back(S[k].t);
@@ -92,22 +114,26 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
   }
   // The scores: from the consecutive windows, or from windows started every `start_stride`
   // seconds (overlapping; each sample is scored at several horizons).
-  Sums scored = consecutive;
+  std::vector<Sums> scored = consecutive;
   if (overlapping) {
-    scored = {};
+    scored.assign(n_folds, Sums{});
     double next_start = S.front().t;
     for (size_t k0 = 0; k0 + 1 < S.size(); ++k0) {
       if (S[k0].t + 1e-9 < next_start || !roll.may_start_at(k0)) continue;
-      next_start = S[k0].t + start_stride;
+      next_start = S[k0].t + o.start_stride;
       if (run_window(k0, scored, false).diverged) return diverged();
     }
   }
-  const double samples = static_cast<double>(std::max<size_t>(scored.count, 1));
-  out.position_rmse = std::sqrt(scored.pos / samples);
-  out.velocity_rmse = std::sqrt(scored.vel / samples);
-  out.attitude_rmse = std::sqrt(scored.att / samples);
-  out.rate_rmse = std::sqrt(scored.rate / samples);
-  out.windows = scored.windows, out.cut_short = scored.cut_short;
+  Sums all;
+  for (const Sums& fold : scored) {
+    all += fold;
+    out.folds.push_back({fold.rms(fold.pos), fold.windows, fold.cut_short});
+  }
+  out.position_rmse = all.rms(all.pos);
+  out.velocity_rmse = all.rms(all.vel);
+  out.attitude_rmse = all.rms(all.att);
+  out.rate_rmse = all.rms(all.rate);
+  out.windows = all.windows, out.cut_short = all.cut_short;
   return out;
 }
 

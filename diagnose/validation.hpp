@@ -31,6 +31,27 @@ struct WindowedSimulation {
   // part's end or a gap before they ran `window` seconds (a part not much longer than a
   // window scores mostly short ones). Zero where the windows diverged.
   size_t windows = 0, cut_short = 0;
+  // Per held-out fold (WindowOptions::fold_starts): the same scores of the windows that
+  // start in that fold. The whole part's numbers pool the folds' squares.
+  struct Fold {
+    double position_rmse = 0;  // m; 0 where no window starts in the fold
+    size_t windows = 0, cut_short = 0;
+  };
+  std::vector<Fold> folds;
+};
+
+// How simulate_windows cuts a part into windows and what it keeps.
+struct WindowOptions {
+  double seconds = 1.0;     // each window's horizon
+  double start_stride = 0;  // windows started this often (overlapping_windows), else consecutive
+  bool keep_trace = true;   // keep the plotted trace (consecutive windows, NaN between them)
+  predict::Replay replay = predict::Replay::kNothing;  // what the windows take from the log
+  // The times at which the held-out folds begin. A window counts toward the fold its start
+  // lies in and runs its whole horizon across the fold's end, so the folds judge the same
+  // horizon as the whole part (folds scored as parts of their own cut most of their windows
+  // short at their ends: 0.75 s folds under 1 s windows judged shorter horizons than the
+  // whole part's metric). Empty: one fold, the whole part.
+  std::vector<double> fold_starts;
 };
 
 // Whether simulate_windows scores overlapping windows for this stride.
@@ -49,7 +70,6 @@ std::string stride_clause(double window, double start_stride);
 // depend on keep_trace. With `replay` the windows take that part of the state from the log
 // (predict::Replay::kAttitude: the force model alone).
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
-                                    const fit::Flight& flight, double window_seconds, double start_stride = 0,
-                                    bool keep_trace = true, predict::Replay replay = predict::Replay::kNothing);
+                                    const fit::Flight& flight, const WindowOptions& options);
 
 }  // namespace quadgen::diagnose

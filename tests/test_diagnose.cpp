@@ -1129,7 +1129,7 @@ TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
   quadgen::runtime::CompiledModel<quadgen_generated::finken3::Model> model;
   const std::vector<double> p = model.params();
   const quadgen::fit::Flight empty;
-  const auto w = quadgen::diagnose::simulate_windows(model, p, empty, 1.0);
+  const auto w = quadgen::diagnose::simulate_windows(model, p, empty, {1.0, 0, true});
   EXPECT_TRUE(w.t.empty());
   EXPECT_EQ(w.position_rmse, 0.0);
 }
@@ -1150,61 +1150,105 @@ TEST(Validation, WindowsCutShortByTheEndOrAGapAreCounted) {
     return quadgen::fit::load_flight(quadgen::runtime::parse_csv(text, "w.csv"), {"A", "B", "C", "D"}, all_rows);
   };
   // consecutive windows from 0.3 s (the rotor speeds settle first): 0.3-1.3, 1.3-2.3, 2.3-3.3
-  const auto whole = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), 1.0, 0, false);
+  const auto whole = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0, false});
   EXPECT_EQ(whole.windows, 3u);
   EXPECT_EQ(whole.cut_short, 0u);
-  const auto end = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.0, 9, 9), 1.0, 0, false);
+  const auto end = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.0, 9, 9), {1.0, 0, false});
   EXPECT_EQ(end.windows, 3u);  // the last one, 2.3-3.0, cut by the end
   EXPECT_EQ(end.cut_short, 1u);
   // a 0.2 s gap after 1.9 s: 0.3-1.3, 1.3-1.9 (cut by the gap), 2.1-3.1 (the rotors carried
   // across so short a gap), 3.1-3.3 (cut by the end); the start at 1.9 s scores nothing
-  const auto gap = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 1.9, 2.1), 1.0, 0, false);
+  const auto gap = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 1.9, 2.1), {1.0, 0, false});
   EXPECT_EQ(gap.windows, 4u);
   EXPECT_EQ(gap.cut_short, 2u);
+  // Held-out folds from 0, 1 and 2 s, windows started every 0.5 s: 0.3 and 0.8 count toward
+  // the first fold, 1.3 and 1.8 the second, 2.3 and 2.8 the third. The window from 0.8 s runs
+  // on to 1.8 s across the first fold's end, whole; only the last (2.8-3.3) is cut short.
+  quadgen::diagnose::WindowOptions folded{1.0, 0.5, false};
+  folded.fold_starts = {0.0, 1.0, 2.0};
+  const auto folds = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), folded);
+  ASSERT_EQ(folds.folds.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) EXPECT_EQ(folds.folds[k].windows, 2u) << k;
+  EXPECT_EQ(folds.folds[0].cut_short + folds.folds[1].cut_short, 0u);
+  EXPECT_EQ(folds.folds[2].cut_short, 1u);
+  // The whole part is the folds' windows pooled: the same as without folds.
+  const auto unfolded = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0.5, false});
+  EXPECT_EQ(unfolded.windows, 6u);
+  EXPECT_NEAR(folds.position_rmse, unfolded.position_rmse, 1e-12 * unfolded.position_rmse);
+  double lowest = folds.folds[0].position_rmse, highest = lowest;
+  for (const auto& f : folds.folds) lowest = std::min(lowest, f.position_rmse), highest = std::max(highest, f.position_rmse);
+  EXPECT_GT(highest, lowest);  // the vehicle drifts off: later windows start further from hover
+  EXPECT_GE(folds.position_rmse, lowest);
+  EXPECT_LE(folds.position_rmse, highest);
 }
 
-// A held-out part barely longer than its window (a 10 s flight: 3 s held out, four folds of
-// 0.75 s against 1 s windows) scores only windows cut short at a fold's end, so the per-fold
-// gains that accept a finding judge shorter horizons than the whole part's before -> after;
-// on this flight (rate steps; found by a contract audit) the two disagree in sign for a true
-// motor trim, and the diagnosis says so. On a 45 s flight of the same kind they agree, and
-// nothing is said. Either way the caution names exactly the findings whose numbers disagree.
-TEST(Validation, AFindingWhosePerFoldGainAndBeforeAfterDisagreeIsCautioned) {
+// The folds and the whole part judge the same windows (each fold those starting in it, run
+// their whole second), so a finding's per-fold gain and its before -> after agree. Until
+// they did, a contract audit's flight (10 s with rate steps: 3 s held out, four folds of
+// 0.75 s against 1 s windows, each fold's windows cut short at its end) named a true motor
+// trim on per-fold gains of +0.018 m while its before -> after rose 0.94 -> 0.97 m. Now
+// its 1 s windows do not show the trim there: it is reported, with its value, as suspected;
+// on a 45 s flight of the same kind it is named by its open-loop gain. Nothing is cautioned.
+TEST(Validation, PerFoldGainsAndTheWholePartJudgeTheSameWindows) {
   HiddenCase c;
   c.name = "short_folds";
   c.effects = "motor_gain";
   c.truth = {{"motor_gain.C", -0.08}};
   c.flight_flags = "--excitation 1";  // rate steps: the open loop departs within a window
-  for (const auto& [duration, said] : std::vector<std::pair<double, bool>>{{10.0, true}, {45.0, false}}) {
+  for (const double duration : {10.0, 45.0}) {
     const fs::path dir = fresh_directory("quadgen_short_folds_" + std::to_string(static_cast<int>(duration)));
     const json j = diagnose_log(vehicle_file(c), fly(c, dir, "f.csv", duration), dir);
     ASSERT_TRUE(j.contains("notes")) << duration;
-    std::string notes;
-    for (const auto& n : j["notes"]) notes += n.get<std::string>() + "\n";
-    std::vector<std::string> disagreeing;
+    EXPECT_TRUE(j["notes"].empty()) << duration << " s: " << j["notes"].dump(1);
     bool trim_by_open_loop = false;
     for (const auto& f : j["findings"]) {
       const auto& g = f["gain"];
-      const bool open_loop = f["accepted_by"] == "open-loop position";
-      trim_by_open_loop = trim_by_open_loop || (f["effect"] == "motor_gain" && open_loop);
-      // an `after` that diverged is null in the JSON, and a rise too
-      if (open_loop && g["before"].is_number() && (!g["after"].is_number() || g["after"].get<double>() > g["before"].get<double>()))
-        disagreeing.push_back(f["effect"]);
+      if (f["accepted_by"] != "open-loop position") continue;
+      trim_by_open_loop = trim_by_open_loop || f["effect"] == "motor_gain";
+      ASSERT_TRUE(g["before"].is_number() && g["after"].is_number()) << duration << " s: " << f.dump(1);
+      EXPECT_LT(g["after"].get<double>(), g["before"].get<double>()) << duration << " s: " << f["effect"];
     }
-    ASSERT_TRUE(trim_by_open_loop) << duration << " s: the trim is not named by its open-loop gain: " << j["findings"].dump(1);
-    EXPECT_EQ(std::find(disagreeing.begin(), disagreeing.end(), "motor_gain") != disagreeing.end(), said) << duration;
-    EXPECT_EQ(j["notes"].empty(), disagreeing.empty()) << duration << " s: " << notes;
-    for (const auto& e : disagreeing)
-      EXPECT_NE(notes.find(e + ": accepted on its open-loop gain per held-out fold, while its before -> after over the whole "
-                               "held-out part rose; of the "),
-                std::string::npos)
-          << notes;
-    if (said) EXPECT_NE(notes.find("end early (at a fold's end or a gap) before 1 s"), std::string::npos) << notes;
+    // On either flight the trim is reported with its value, named or suspected.
+    const json* trim = nullptr;
+    for (const char* list : {"findings", "suspected"})
+      for (const auto& f : j[list])
+        if (f["effect"] == "motor_gain") trim = &f;
+    ASSERT_NE(trim, nullptr) << duration << " s: " << j["suspected"].dump(1);
+    EXPECT_NEAR((*trim)["parameters"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.005) << duration;
+    if (duration > 40) EXPECT_TRUE(trim_by_open_loop) << j["findings"].dump(1);
     std::ifstream summary(dir / "diagnose.log");
     const std::string printed((std::istreambuf_iterator<char>(summary)), {});
-    EXPECT_EQ(printed.find("caution: motor_gain: accepted on its open-loop gain") != std::string::npos, said) << printed;
+    EXPECT_EQ(printed.find("caution:"), std::string::npos) << printed;
     fs::remove_all(dir);
   }
+}
+
+// The caution, where it is still due: a finding accepted by its per-fold gain whose whole
+// part's before -> after rose (the whole part pools the folds' squares, the mean of the
+// gains weighs each fold alike). It names exactly those findings, asks how the windows end
+// only then, and is empty otherwise.
+TEST(Validation, TheCautionNamesTheFindingsWhoseTwoNumbersDisagree) {
+  using quadgen::diagnose::Finding;
+  const auto finding = [](const std::string& effect, const std::string& accepted_by, double before, double after) {
+    Finding f;
+    f.effect = effect, f.accepted_by = accepted_by, f.before = before, f.after = after;
+    return f;
+  };
+  int asked = 0;
+  const auto windows = [&] { return ++asked, std::string("WINDOWS"); };
+  std::vector<Finding> findings = {finding("rotor_drag", Finding::kByOpenLoopPosition, 0.30, 0.25),
+                                   finding("motor_gain", Finding::kByOpenLoopPosition, 0.94, 0.97),
+                                   finding("wind", Finding::kByForceModelAlone, 0.30, 0.31)};
+  EXPECT_EQ(quadgen::diagnose::gains_that_disagree_note(findings, windows),
+            "motor_gain: accepted on its open-loop gain per held-out fold, while its before -> after over the whole "
+            "held-out part rose; WINDOWS; a longer flight or a larger --validation judges more surely");
+  findings.push_back(finding("input_delay", Finding::kByOpenLoopPosition, 0.25, 0.26));
+  EXPECT_EQ(quadgen::diagnose::gains_that_disagree_note(findings, windows).rfind("motor_gain, input_delay: each accepted", 0),
+            0u);
+  EXPECT_EQ(asked, 2);
+  findings.erase(findings.begin() + 1), findings.pop_back();
+  EXPECT_EQ(quadgen::diagnose::gains_that_disagree_note(findings, windows), "");
+  EXPECT_EQ(asked, 2);
 }
 
 // The acceptance takes out one failed effect at a time, the one the held-out part speaks most
