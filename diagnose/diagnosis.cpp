@@ -244,7 +244,7 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   windows.fold_starts = fold_starts;
   const WindowedSimulation b = simulate_windows(*model, without, valid, windows);
   const WindowedSimulation a = simulate_windows(*model, with, valid, windows);
-  for (size_t k = 0; k < a.folds.size(); ++k) g.fold_gains.push_back(b.folds[k].position_rmse - a.folds[k].position_rmse);
+  g.fold_gains = fold_gains(fold_position_rmses(b), fold_position_rmses(a));
   g.before = b.position_rmse, g.after = a.position_rmse;
   mean_and_standard_error(g.fold_gains, &g.gain_mean, &g.gain_standard_error);
   return g;

@@ -2,8 +2,8 @@
 // extend the model, measure the gain): flight in, Diagnosis out. Writing files and the
 // report is diagnosis_report's job; the command line is cli/diagnose_command.cpp.
 #pragma once
-#include <optional>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>

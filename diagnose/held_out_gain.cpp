@@ -100,12 +100,6 @@ double HeldOutGain::open_loop_rmse(const std::vector<fit::FitParameter>& ps, Win
   return w.position_rmse;
 }
 
-std::vector<double> HeldOutGain::fold_rmses(const WindowedSimulation& w) {
-  std::vector<double> m;
-  for (const auto& fold : w.folds) m.push_back(fold.position_rmse);
-  return m;
-}
-
 std::string HeldOutGain::fold_windows_text(const std::vector<fit::FitParameter>& ps) const {
   const WindowedSimulation w = windows(ps, predict::Replay::kNothing, false);
   // The held-out time itself: a joint diagnosis's parts lie apart on the joined clock.
@@ -129,8 +123,8 @@ HeldOutGain::Scores HeldOutGain::unweighted_scores(const std::vector<fit::FitPar
     // One simulation of the part scores the whole and each fold (its windows start in it).
     const WindowedSimulation w = windows(ps, predict::Replay::kNothing, false);
     out.metric = w.position_rmse;
-    out.fold_metrics = fold_rmses(w);
-    if (force_alone) out.force_alone = fold_rmses(windows(ps, predict::Replay::kAttitude, false));
+    out.fold_metrics = fold_position_rmses(w);
+    if (force_alone) out.force_alone = fold_position_rmses(windows(ps, predict::Replay::kAttitude, false));
   }
   for (const auto& fold : fold_problems_) {
     out.fit_groups.push_back(channel_group_squares(*fold.fit, ps));
@@ -156,7 +150,7 @@ const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool
     cached_values_ = values;
     cached_force_alone_ = force_alone;
   } else if (force_alone && !cached_force_alone_ && pose_) {
-    cached_.force_alone = fold_rmses(windows(s.final_fit, predict::Replay::kAttitude, false));
+    cached_.force_alone = fold_position_rmses(windows(s.final_fit, predict::Replay::kAttitude, false));
     cached_force_alone_ = true;
   }
   return cached_;
@@ -218,11 +212,11 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   f.metric = metric_name_;
   f.before = b.metric;
   f.after = a.metric;
-  for (size_t k = 0; k < a.fold_metrics.size(); ++k) f.fold_gains.push_back(b.fold_metrics[k] - a.fold_metrics[k]);
+  f.fold_gains = fold_gains(b.fold_metrics, a.fold_metrics);
   mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
   f.one_step = one_step(b, a);
   if (force_alone) {
-    for (size_t k = 0; k < a.force_alone.size(); ++k) f.force_alone.per_fold.push_back(b.force_alone[k] - a.force_alone[k]);
+    f.force_alone.per_fold = fold_gains(b.force_alone, a.force_alone);
     summarise(f.force_alone);
   }
   f.accepted_by = held_out_test(f);

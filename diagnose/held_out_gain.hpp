@@ -85,7 +85,9 @@ class HeldOutGain {
     double metric = 0;
     std::vector<double> fold_metrics;  // the open-loop windows per fold (one cost without a pose)
     std::vector<double> force_alone;   // the same with the measured attitude replayed (when asked)
-    std::vector<ChannelGroupSquares> fit_groups, translational_groups;  // per fold; the latter as the guard reads it
+    // Per one-step fold (a fold without a row to differentiate has none, so these can be
+    // fewer than the open-loop folds; the two families are never indexed together).
+    std::vector<ChannelGroupSquares> fit_groups, translational_groups;  // the latter as the guard reads it
     // Weighted (weigh): the one-step cost per fold; without a pose the metric and fold_metrics.
     std::vector<double> fold_costs;
   };
@@ -98,7 +100,6 @@ class HeldOutGain {
   WindowedSimulation windows(const std::vector<fit::FitParameter>& ps, predict::Replay replay, bool keep_trace) const;
   // Their position RMSE over the whole part; with `sim`, the windows' trace is kept there.
   double open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const;
-  static std::vector<double> fold_rmses(const WindowedSimulation& w);
   static ChannelGroupSquares channel_group_squares(const fit::EquationErrorModel& m,
                                                    const std::vector<fit::FitParameter>& ps);
   static Finding::OneStep one_step(const Scores& without, const Scores& with);

@@ -31,10 +31,12 @@ struct WindowedSimulation {
   // part's end or a gap before they ran `window` seconds (a part not much longer than a
   // window scores mostly short ones). Zero where the windows diverged.
   size_t windows = 0, cut_short = 0;
-  // Per held-out fold (WindowOptions::fold_starts): the same scores of the windows that
-  // start in that fold. The whole part's numbers pool the folds' squares.
+  // Per held-out fold (WindowOptions::fold_starts): the position RMSE of the windows that
+  // start in that fold, NaN where none does (fold_gains leaves it out) and infinite where
+  // one of them diverged (the whole part's RMSEs are then infinite too). The whole part's
+  // numbers pool the folds' squares.
   struct Fold {
-    double position_rmse = 0;  // m; 0 where no window starts in the fold
+    double position_rmse = 0;  // m
     size_t windows = 0, cut_short = 0;
   };
   std::vector<Fold> folds;
@@ -48,9 +50,7 @@ struct WindowOptions {
   predict::Replay replay = predict::Replay::kNothing;  // what the windows take from the log
   // The times at which the held-out folds begin. A window counts toward the fold its start
   // lies in and runs its whole horizon across the fold's end, so the folds judge the same
-  // horizon as the whole part (folds scored as parts of their own cut most of their windows
-  // short at their ends: 0.75 s folds under 1 s windows judged shorter horizons than the
-  // whole part's metric). Empty: one fold, the whole part.
+  // windows as the whole part. Empty: one fold, the whole part.
   std::vector<double> fold_starts;
 };
 
@@ -62,14 +62,19 @@ std::string stride_clause(double window, double start_stride);
 
 // `model` must be the full-catalogue model with `params` (effects off at their neutral values).
 // The RMSEs come from windows started every `start_stride` seconds (overlapping: see
-// overlapping_windows), or else from the consecutive windows of the plotted trace. Without
-// `keep_trace` the trace is left empty, and with overlapping windows not simulated at all
-// (about a tenth of the work at the default 0.1 s stride of 1 s windows). A scored window
-// that diverges makes every RMSE infinite; with overlapping windows a diverging window of
-// the trace only ends that window (and is left out of the plot), so that the scores do not
-// depend on keep_trace. With `replay` the windows take that part of the state from the log
+// overlapping_windows), or else from the consecutive windows of the plotted trace; each
+// fold's from the windows that start in it. Without `keep_trace` the trace is left empty,
+// and with overlapping windows not simulated at all. A scored window that diverges makes
+// every RMSE of the whole part, and its fold's, infinite; a diverging window of the trace is
+// left out of the plot. With `replay` the windows take that part of the state from the log
 // (predict::Replay::kAttitude: the force model alone).
 WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vector<double>& params,
                                     const fit::Flight& flight, const WindowOptions& options);
+
+// The folds' position RMSEs of a simulation, in fold order.
+std::vector<double> fold_position_rmses(const WindowedSimulation& w);
+// Per fold, `before` - `after` (m): the gain a finding or a proposed term buys, over the
+// folds both score (a fold no window starts in, NaN, is left out).
+std::vector<double> fold_gains(const std::vector<double>& before, const std::vector<double>& after);
 
 }  // namespace quadgen::diagnose

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <random>
 #include <memory>
@@ -1129,7 +1130,7 @@ TEST(Validation, AFlightWithoutAWindowSimulatesNothing) {
   quadgen::runtime::CompiledModel<quadgen_generated::finken3::Model> model;
   const std::vector<double> p = model.params();
   const quadgen::fit::Flight empty;
-  const auto w = quadgen::diagnose::simulate_windows(model, p, empty, {1.0, 0, true});
+  const auto w = quadgen::diagnose::simulate_windows(model, p, empty, {1.0, 0, /*keep_trace=*/true});
   EXPECT_TRUE(w.t.empty());
   EXPECT_EQ(w.position_rmse, 0.0);
 }
@@ -1150,21 +1151,21 @@ TEST(Validation, WindowsCutShortByTheEndOrAGapAreCounted) {
     return quadgen::fit::load_flight(quadgen::runtime::parse_csv(text, "w.csv"), {"A", "B", "C", "D"}, all_rows);
   };
   // consecutive windows from 0.3 s (the rotor speeds settle first): 0.3-1.3, 1.3-2.3, 2.3-3.3
-  const auto whole = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0, false});
+  const auto whole = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0, /*keep_trace=*/false});
   EXPECT_EQ(whole.windows, 3u);
   EXPECT_EQ(whole.cut_short, 0u);
-  const auto end = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.0, 9, 9), {1.0, 0, false});
+  const auto end = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.0, 9, 9), {1.0, 0, /*keep_trace=*/false});
   EXPECT_EQ(end.windows, 3u);  // the last one, 2.3-3.0, cut by the end
   EXPECT_EQ(end.cut_short, 1u);
   // a 0.2 s gap after 1.9 s: 0.3-1.3, 1.3-1.9 (cut by the gap), 2.1-3.1 (the rotors carried
   // across so short a gap), 3.1-3.3 (cut by the end); the start at 1.9 s scores nothing
-  const auto gap = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 1.9, 2.1), {1.0, 0, false});
+  const auto gap = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 1.9, 2.1), {1.0, 0, /*keep_trace=*/false});
   EXPECT_EQ(gap.windows, 4u);
   EXPECT_EQ(gap.cut_short, 2u);
   // Held-out folds from 0, 1 and 2 s, windows started every 0.5 s: 0.3 and 0.8 count toward
   // the first fold, 1.3 and 1.8 the second, 2.3 and 2.8 the third. The window from 0.8 s runs
   // on to 1.8 s across the first fold's end, whole; only the last (2.8-3.3) is cut short.
-  quadgen::diagnose::WindowOptions folded{1.0, 0.5, false};
+  quadgen::diagnose::WindowOptions folded{1.0, 0.5, /*keep_trace=*/false};
   folded.fold_starts = {0.0, 1.0, 2.0};
   const auto folds = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), folded);
   ASSERT_EQ(folds.folds.size(), 3u);
@@ -1172,7 +1173,7 @@ TEST(Validation, WindowsCutShortByTheEndOrAGapAreCounted) {
   EXPECT_EQ(folds.folds[0].cut_short + folds.folds[1].cut_short, 0u);
   EXPECT_EQ(folds.folds[2].cut_short, 1u);
   // The whole part is the folds' windows pooled: the same as without folds.
-  const auto unfolded = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0.5, false});
+  const auto unfolded = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), {1.0, 0.5, /*keep_trace=*/false});
   EXPECT_EQ(unfolded.windows, 6u);
   EXPECT_NEAR(folds.position_rmse, unfolded.position_rmse, 1e-12 * unfolded.position_rmse);
   double lowest = folds.folds[0].position_rmse, highest = lowest;
@@ -1180,6 +1181,22 @@ TEST(Validation, WindowsCutShortByTheEndOrAGapAreCounted) {
   EXPECT_GT(highest, lowest);  // the vehicle drifts off: later windows start further from hover
   EXPECT_GE(folds.position_rmse, lowest);
   EXPECT_LE(folds.position_rmse, highest);
+  // Consecutive windows (0.3, 1.3, 2.3 s) under folds from 0, 0.75, 1.3 and 1.5 s: the
+  // window from 1.3 s starts exactly at its fold's start; no window starts in the second
+  // fold, which has no score and no gain.
+  quadgen::diagnose::WindowOptions consecutive{1.0, 0, /*keep_trace=*/false};
+  consecutive.fold_starts = {0.0, 0.75, 1.3, 1.5};
+  const auto sparse = quadgen::diagnose::simulate_windows(model, model.params(), flight(3.3, 9, 9), consecutive);
+  ASSERT_EQ(sparse.folds.size(), 4u);
+  for (size_t k : {0, 2, 3}) EXPECT_EQ(sparse.folds[k].windows, 1u) << k;
+  EXPECT_EQ(sparse.folds[1].windows, 0u);
+  EXPECT_TRUE(std::isnan(sparse.folds[1].position_rmse));
+  const auto rmses = quadgen::diagnose::fold_position_rmses(sparse);
+  std::vector<double> lower = rmses;
+  for (double& x : lower) x *= 0.5;
+  const auto gains = quadgen::diagnose::fold_gains(rmses, lower);
+  ASSERT_EQ(gains.size(), 3u);
+  EXPECT_DOUBLE_EQ(gains[1], 0.5 * rmses[2]);
 }
 
 // The folds and the whole part judge the same windows (each fold those starting in it, run
@@ -1199,11 +1216,14 @@ TEST(Validation, PerFoldGainsAndTheWholePartJudgeTheSameWindows) {
     const fs::path dir = fresh_directory("quadgen_short_folds_" + std::to_string(static_cast<int>(duration)));
     const json j = diagnose_log(vehicle_file(c), fly(c, dir, "f.csv", duration), dir);
     ASSERT_TRUE(j.contains("notes")) << duration;
-    EXPECT_TRUE(j["notes"].empty()) << duration << " s: " << j["notes"].dump(1);
+    for (const auto& n : j["notes"])
+      EXPECT_EQ(n.get<std::string>().find("accepted on its open-loop gain per held-out fold"), std::string::npos) << n;
     bool trim_by_open_loop = false;
+    int judged = 0;  // findings accepted by their open-loop gain, whose two numbers are compared
     for (const auto& f : j["findings"]) {
       const auto& g = f["gain"];
       if (f["accepted_by"] != "open-loop position") continue;
+      ++judged;
       trim_by_open_loop = trim_by_open_loop || f["effect"] == "motor_gain";
       ASSERT_TRUE(g["before"].is_number() && g["after"].is_number()) << duration << " s: " << f.dump(1);
       EXPECT_LT(g["after"].get<double>(), g["before"].get<double>()) << duration << " s: " << f["effect"];
@@ -1215,18 +1235,18 @@ TEST(Validation, PerFoldGainsAndTheWholePartJudgeTheSameWindows) {
         if (f["effect"] == "motor_gain") trim = &f;
     ASSERT_NE(trim, nullptr) << duration << " s: " << j["suspected"].dump(1);
     EXPECT_NEAR((*trim)["parameters"]["motor_gain.C"]["value"].get<double>(), -0.08, 0.005) << duration;
-    if (duration > 40) EXPECT_TRUE(trim_by_open_loop) << j["findings"].dump(1);
+    if (duration > 40) EXPECT_TRUE(trim_by_open_loop && judged > 0) << j["findings"].dump(1);
     std::ifstream summary(dir / "diagnose.log");
     const std::string printed((std::istreambuf_iterator<char>(summary)), {});
-    EXPECT_EQ(printed.find("caution:"), std::string::npos) << printed;
+    EXPECT_EQ(printed.find("caution: motor_gain"), std::string::npos) << printed;
     fs::remove_all(dir);
   }
 }
 
 // The caution, where it is still due: a finding accepted by its per-fold gain whose whole
 // part's before -> after rose (the whole part pools the folds' squares, the mean of the
-// gains weighs each fold alike). It names exactly those findings, asks how the windows end
-// only then, and is empty otherwise.
+// gains weighs each fold alike), or diverged. It names exactly those findings, asks how the
+// windows end only then, and is empty otherwise.
 TEST(Validation, TheCautionNamesTheFindingsWhoseTwoNumbersDisagree) {
   using quadgen::diagnose::Finding;
   const auto finding = [](const std::string& effect, const std::string& accepted_by, double before, double after) {
@@ -1242,7 +1262,7 @@ TEST(Validation, TheCautionNamesTheFindingsWhoseTwoNumbersDisagree) {
   EXPECT_EQ(quadgen::diagnose::gains_that_disagree_note(findings, windows),
             "motor_gain: accepted on its open-loop gain per held-out fold, while its before -> after over the whole "
             "held-out part rose; WINDOWS; a longer flight or a larger --validation judges more surely");
-  findings.push_back(finding("input_delay", Finding::kByOpenLoopPosition, 0.25, 0.26));
+  findings.push_back(finding("input_delay", Finding::kByOpenLoopPosition, 0.25, std::numeric_limits<double>::infinity()));
   EXPECT_EQ(quadgen::diagnose::gains_that_disagree_note(findings, windows).rfind("motor_gain, input_delay: each accepted", 0),
             0u);
   EXPECT_EQ(asked, 2);

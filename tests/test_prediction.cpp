@@ -150,12 +150,12 @@ TEST(Prediction, LaggedAndDelayedRotorsStartWhereTheyWereInEveryRollout) {
     EXPECT_LT(h.position.mean(), 0.03 * h.horizon) << h.horizon;
   }
   for (double stride : {0.0, 0.1}) {
-    const auto w = quadgen::diagnose::simulate_windows(m, params, g.flight, {1.0, stride, true});
+    const auto w = quadgen::diagnose::simulate_windows(m, params, g.flight, {1.0, stride, /*keep_trace=*/true});
     EXPECT_LT(w.rate_rmse, 0.03) << stride;
     EXPECT_LT(w.position_rmse, 0.02) << stride;
     // Without the plotted trace the scores are the same (the trace is not simulated when the
     // overlapping windows score).
-    const auto scores_only = quadgen::diagnose::simulate_windows(m, params, g.flight, {1.0, stride, false});
+    const auto scores_only = quadgen::diagnose::simulate_windows(m, params, g.flight, {1.0, stride, /*keep_trace=*/false});
     EXPECT_EQ(scores_only.position_rmse, w.position_rmse) << stride;
     EXPECT_EQ(scores_only.rate_rmse, w.rate_rmse) << stride;
     EXPECT_TRUE(scores_only.t.empty() && scores_only.e_pos.empty()) << stride;
@@ -176,14 +176,22 @@ TEST(Prediction, ADivergingTraceWindowDoesNotDecideTheScores) {
   size_t second = first;  // where the first 1 s trace window ends and the second starts
   while (S[second + 1].t - S[first].t <= 1.0 + 1e-9) ++second;
   f.samples[second].x[3] = 1e7;  // m/s
-  const auto with_trace = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.3, true});
-  const auto scores_only = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.3, false});
+  const auto with_trace = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.3, /*keep_trace=*/true});
+  const auto scores_only = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.3, /*keep_trace=*/false});
   EXPECT_TRUE(std::isfinite(scores_only.position_rmse));
   EXPECT_EQ(with_trace.position_rmse, scores_only.position_rmse);
   EXPECT_GT(with_trace.t.size(), 100u);  // the trace goes on after the diverged window
   EXPECT_GT(with_trace.t.back(), S[second].t + 1.0);
-  // Consecutive windows are what is scored there: the diverged window decides.
-  EXPECT_TRUE(std::isinf(quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.0, true}).position_rmse));
+  // Consecutive windows are what is scored there: the diverged window decides the whole
+  // part, and of two folds (split at the diverged window's start) the second only.
+  quadgen::diagnose::WindowOptions consecutive{1.0, 0.0, /*keep_trace=*/true};
+  consecutive.fold_starts = {S.front().t, S[second].t};
+  const auto diverged = quadgen::diagnose::simulate_windows(m, m.params(), f, consecutive);
+  EXPECT_TRUE(std::isinf(diverged.position_rmse));
+  ASSERT_EQ(diverged.folds.size(), 2u);
+  EXPECT_TRUE(std::isfinite(diverged.folds[0].position_rmse));
+  EXPECT_TRUE(std::isinf(diverged.folds[1].position_rmse));
+  EXPECT_GT(diverged.t.back(), S[second].t + 1.0);  // the trace goes on after it
 }
 
 // Holding the past disturbance, with gravity 0.2 m/s^2 too strong in the model: the model's
@@ -288,8 +296,8 @@ TEST(Prediction, ValidationWindowsWithTheAttitudeReplayedAreTheForceModelAlone) 
   std::vector<double> tilted = m.params();
   tilted[m.param_index("attitude_bias.roll")] = 0.03;
   using quadgen::predict::Replay;
-  const auto own = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.1, false, Replay::kAttitude});
-  const auto wrong = quadgen::diagnose::simulate_windows(m, tilted, f, {1.0, 0.1, false, Replay::kAttitude});
+  const auto own = quadgen::diagnose::simulate_windows(m, m.params(), f, {1.0, 0.1, /*keep_trace=*/false, Replay::kAttitude});
+  const auto wrong = quadgen::diagnose::simulate_windows(m, tilted, f, {1.0, 0.1, /*keep_trace=*/false, Replay::kAttitude});
   EXPECT_LT(own.attitude_rmse, 1e-6);
   EXPECT_LT(wrong.attitude_rmse, 1e-6);
   EXPECT_LT(own.position_rmse, 3e-3);
@@ -297,7 +305,7 @@ TEST(Prediction, ValidationWindowsWithTheAttitudeReplayedAreTheForceModelAlone) 
   EXPECT_NEAR(wrong.position_rmse, expected, 0.25 * expected);
   // Open loop the same tilt starts every window tilted and the moments carry it on: not the
   // same number.
-  EXPECT_NE(quadgen::diagnose::simulate_windows(m, tilted, f, {1.0, 0.1, false}).position_rmse, wrong.position_rmse);
+  EXPECT_NE(quadgen::diagnose::simulate_windows(m, tilted, f, {1.0, 0.1, /*keep_trace=*/false}).position_rmse, wrong.position_rmse);
 }
 
 TEST(Prediction, ThrustTooStrongGivesTheClosedFormError) {
