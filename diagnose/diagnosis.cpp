@@ -210,7 +210,7 @@ namespace {
 Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, const std::vector<AddedTerm>& terms,
                                 const std::vector<double>& later_starts, const std::vector<std::string>& per_flight,
                                 const std::vector<fit::FitParameter>& final_fit, const fit::Flight& valid,
-                                const std::vector<double>& fold_starts, double window, double window_stride) {
+                                const WindowOptions& windows) {
   Diagnosis::TermsGain g;
   if (!valid.has_pose) {
     g.note = "no pose logged: no open-loop rollouts; the gain is the channel's held-out equation-error RMS";
@@ -237,11 +237,8 @@ Diagnosis::TermsGain terms_gain(const Vehicle& v, const SymbolicModel& all, cons
   };
   const auto without = values(false), with = values(true);
   g.measured = true;
-  g.metric = "position RMSE of " + output::short_number(window) + " s open-loop windows on the held-out part" +
-             stride_clause(window, window_stride) + " [m]";
-  WindowOptions windows;
-  windows.seconds = window, windows.start_stride = window_stride, windows.keep_trace = false;
-  windows.fold_starts = fold_starts;
+  g.metric = "position RMSE of " + output::short_number(windows.seconds) + " s open-loop windows on the held-out part" +
+             stride_clause(windows.seconds, windows.start_stride) + " [m]";
   const WindowedSimulation b = simulate_windows(*model, without, valid, windows);
   const WindowedSimulation a = simulate_windows(*model, with, valid, windows);
   g.fold_gains = fold_gains(fold_position_rmses(b), fold_position_rmses(a));
@@ -825,7 +822,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (!proposed_terms(d.discovered).empty()) {
     opt.progress.say(progress() + "the proposed terms regenerated into the model and simulated on the held-out part");
     d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), fm.later_starts, fm.per_flight_names,
-                              s.final_fit, valid, held_out_gain.fold_starts(), opt.window, opt.window_stride);
+                              s.final_fit, valid, held_out_gain.window_options());
   }
   for (const auto& p : s.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);

@@ -86,12 +86,16 @@ double HeldOutGain::metric(const std::vector<fit::FitParameter>& ps, const std::
   return pose_ ? open_loop_rmse(ps, sim) : CandidateSearch::cost(valid_ee_, ps, weights);
 }
 
-WindowedSimulation HeldOutGain::windows(const std::vector<fit::FitParameter>& ps, predict::Replay replay,
-                                        bool keep_trace) const {
+WindowOptions HeldOutGain::window_options(predict::Replay replay, bool keep_trace) const {
   WindowOptions o;
   o.seconds = window_, o.start_stride = window_stride_, o.keep_trace = keep_trace, o.replay = replay;
   o.fold_starts = fold_starts_;
-  return simulate_windows(model_, fit::parameter_values(ps), valid_, o);
+  return o;
+}
+
+WindowedSimulation HeldOutGain::windows(const std::vector<fit::FitParameter>& ps, predict::Replay replay,
+                                        bool keep_trace) const {
+  return simulate_windows(model_, fit::parameter_values(ps), valid_, window_options(replay, keep_trace));
 }
 
 double HeldOutGain::open_loop_rmse(const std::vector<fit::FitParameter>& ps, WindowedSimulation* sim) const {

@@ -49,9 +49,9 @@ class HeldOutGain {
   double metric(const std::vector<fit::FitParameter>& ps, const std::vector<double>& weights,
                 WindowedSimulation* sim) const;
   const std::string& metric_name() const { return metric_name_; }
-  // The times the folds begin (WindowOptions::fold_starts): the open-loop windows of the
-  // whole held-out part count toward the fold their start lies in.
-  const std::vector<double>& fold_starts() const { return fold_starts_; }
+  // How the held-out part's open-loop windows are cut and scored: the diagnosis's window and
+  // stride, and the folds' start times (the windows count toward the fold they start in).
+  WindowOptions window_options(predict::Replay replay = predict::Replay::kNothing, bool keep_trace = false) const;
   // How the windows for parameter set `ps` end, and why the per-fold gains and the whole
   // part's metric can disagree: "of the 18 windows the 4 folds score, 5 end early (at the
   // held-out part's end or a gap) before 1 s (2.96 s held out); the whole part pools the
