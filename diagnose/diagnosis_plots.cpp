@@ -31,59 +31,42 @@ runtime::Series series(const std::string& label, const std::vector<double>& x, c
   return s;
 }
 
-}  // namespace
-
-std::vector<std::pair<std::string, std::string>> diagnosis_plots(
-    const Diagnosis& d, const fit::Flight& valid, std::string* error,
-    std::vector<std::pair<std::string, std::string>>* data) {
-  std::vector<std::pair<std::string, std::string>> out;
-  // One colour per model in every plot: measured black, base model red, extended model blue.
-  const std::map<std::string, std::string> colours = {{"measured", "#000000"},
-                                                       {"base model", "#d62728"},
-                                                       {"extended model", "#1f77b4"},
-                                                       {"95 % white-noise band", "#7f7f7f"},
-                                                       {"", "#7f7f7f"}};
-  auto render = [&](const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
-    for (auto& p : panels)
-      for (auto& s : p.series)
-        for (const auto& [model, colour] : colours)  // "base model, tilt" is the base model's too
-          if (!model.empty() && (s.label == model || s.label.rfind(model + ",", 0) == 0)) s.color = colour;
-    if (data) data->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
-    std::string svg;
-    if (runtime::render_svg(title, panels, &svg, error)) out.emplace_back(name, svg);
-  };
-  const size_t stride = std::max<size_t>(1, d.t.size() / 3000);
-  // Measured vs simulated positions on the validation part.
-  if (!d.sim_before.t.empty()) {
-    std::vector<runtime::Panel> panels;
-    const char* axes[3] = {"x", "y", "z"};
-    for (int a = 0; a < 3; ++a) {
-      std::vector<double> tm, ym;
-      for (const auto& s : valid.samples) tm.push_back(s.t), ym.push_back(s.x[a]);
-      const auto& yb = a == 0 ? d.sim_before.x : a == 1 ? d.sim_before.y : d.sim_before.z;
-      const auto& ya = a == 0 ? d.sim_after.x : a == 1 ? d.sim_after.y : d.sim_after.z;
-      panels.push_back({std::string("position ") + axes[a] + " (validation, open-loop windows)", "t [s]", "m",
-                        {series("measured", tm, ym, 1, true), series("base model", d.sim_before.t, yb),
-                         series("extended model", d.sim_after.t, ya)}});
-    }
-    render("validation.svg", d.vehicle + ": measured vs simulated, before and after", panels);
-    // The simulation's error over time, per quantity.
-    const struct {
-      const char* title;
-      const char* unit;
-      std::vector<double> WindowedSimulation::*err;
-    } quantities[] = {{"position error", "m", &WindowedSimulation::e_pos},
-                      {"velocity error", "m/s", &WindowedSimulation::e_vel},
-                      {"attitude error (rotation angle)", "rad", &WindowedSimulation::e_att},
-                      {"body-rate error", "rad/s", &WindowedSimulation::e_rate}};
-    std::vector<runtime::Panel> errs;
-    for (const auto& q : quantities)
-      errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", q.unit,
-                      {series("base model", d.sim_before.t, d.sim_before.*q.err),
-                       series("extended model", d.sim_after.t, d.sim_after.*q.err)}});
-    render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", errs);
+// Measured vs simulated positions in the open-loop windows of the validation part.
+std::vector<runtime::Panel> validation_panels(const Diagnosis& d, const fit::Flight& valid) {
+  std::vector<runtime::Panel> panels;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> tm, ym;
+    for (const auto& s : valid.samples) tm.push_back(s.t), ym.push_back(s.x[a]);
+    const auto& yb = a == 0 ? d.sim_before.x : a == 1 ? d.sim_before.y : d.sim_before.z;
+    const auto& ya = a == 0 ? d.sim_after.x : a == 1 ? d.sim_after.y : d.sim_after.z;
+    panels.push_back({std::string("position ") + axes[a] + " (validation, open-loop windows)", "t [s]", "m",
+                      {series("measured", tm, ym, 1, true), series("base model", d.sim_before.t, yb),
+                       series("extended model", d.sim_after.t, ya)}});
   }
-  // Residuals over time.
+  return panels;
+}
+
+// The simulation's error over time, per quantity.
+std::vector<runtime::Panel> simulation_error_panels(const Diagnosis& d) {
+  const struct {
+    const char* title;
+    const char* unit;
+    std::vector<double> WindowedSimulation::*err;
+  } quantities[] = {{"position error", "m", &WindowedSimulation::e_pos},
+                    {"velocity error", "m/s", &WindowedSimulation::e_vel},
+                    {"attitude error (rotation angle)", "rad", &WindowedSimulation::e_att},
+                    {"body-rate error", "rad/s", &WindowedSimulation::e_rate}};
+  std::vector<runtime::Panel> errs;
+  for (const auto& q : quantities)
+    errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", q.unit,
+                    {series("base model", d.sim_before.t, d.sim_before.*q.err),
+                     series("extended model", d.sim_after.t, d.sim_after.*q.err)}});
+  return errs;
+}
+
+// Equation-error residuals over time, every `stride`-th sample (a plot of 3000 points reads as well).
+std::vector<runtime::Panel> residual_panels(const Diagnosis& d, size_t stride) {
   std::vector<runtime::Panel> res;
   for (int c = 0; c < 6; ++c) {
     std::vector<double> rb, ra;
@@ -92,12 +75,18 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
                    d.channel_units[c], {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)},
                    d.validation_starts});
   }
-  render("residuals.svg",
-         d.vehicle + ": equation-error residuals (" +
-             (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
-                                   : "validation from t = " + std::to_string(d.t_split).substr(0, 5) + " s") + ")",
-         res);
-  // Autocorrelation with the white-noise band.
+  return res;
+}
+
+std::string residuals_title(const Diagnosis& d) {
+  return d.vehicle + ": equation-error residuals (" +
+         (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
+                               : "validation from t = " + std::to_string(d.t_split).substr(0, 5) + " s") +
+         ")";
+}
+
+// Autocorrelation of each channel's residual with the white-noise band.
+std::vector<runtime::Panel> autocorrelation_panels(const Diagnosis& d) {
   std::vector<runtime::Panel> acf;
   for (size_t c = 0; c < d.before.channels.size(); ++c) {
     const auto& b = d.before.channels[c];
@@ -109,8 +98,11 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
                    {series("base model", lag, b.acf), series("extended model", lag, a.acf), series("95 % white-noise band", lag, band),
                     series("", lag, nband)}});
   }
-  render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", acf);
-  // The answer to the commands, band by band: one series per flight, 1 where the model is right.
+  return acf;
+}
+
+// The answer to the commands, band by band: one series per flight, 1 where the model is right.
+std::vector<runtime::Panel> command_gain_panels(const Diagnosis& d) {
   std::vector<std::pair<std::string, const CommandGain*>> gains;
   for (const auto& [flight, g] : command_gains_by_flight(d))
     gains.emplace_back(flight.empty() ? "this flight" : std::filesystem::path(flight).stem().string(), g);
@@ -130,13 +122,57 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     panel.series.push_back(series("the model", hz, std::vector<double>(hz.size(), 1.0)));
     gain_panels.push_back(panel);
   }
-  if (!gain_panels.empty()) render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
+  return gain_panels;
+}
+
+// Renders panels as SVG (and, where asked, their data as CSV), one colour per model in every
+// plot: measured black, base model red, extended model blue.
+class PlotRenderer {
+ public:
+  PlotRenderer(std::string* error, std::vector<std::pair<std::string, std::string>>* data) : error_(error), data_(data) {}
+
+  void render(const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
+    for (auto& p : panels)
+      for (auto& s : p.series)
+        for (const auto& [model, colour] : kColours)  // "base model, tilt" is the base model's too
+          if (!model.empty() && (s.label == model || s.label.rfind(model + ",", 0) == 0)) s.color = colour;
+    if (data_) data_->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
+    std::string svg;
+    if (runtime::render_svg(title, panels, &svg, error_)) svgs_.emplace_back(name, svg);
+  }
+  std::vector<std::pair<std::string, std::string>> svgs() && { return std::move(svgs_); }
+
+ private:
+  inline static const std::map<std::string, std::string> kColours = {{"measured", "#000000"},
+                                                                     {"base model", "#d62728"},
+                                                                     {"extended model", "#1f77b4"},
+                                                                     {"95 % white-noise band", "#7f7f7f"},
+                                                                     {"", "#7f7f7f"}};
+  std::string* error_;
+  std::vector<std::pair<std::string, std::string>>* data_;
+  std::vector<std::pair<std::string, std::string>> svgs_;
+};
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> diagnosis_plots(
+    const Diagnosis& d, const fit::Flight& valid, std::string* error,
+    std::vector<std::pair<std::string, std::string>>* data) {
+  PlotRenderer plots(error, data);
+  if (!d.sim_before.t.empty()) {
+    plots.render("validation.svg", d.vehicle + ": measured vs simulated, before and after", validation_panels(d, valid));
+    plots.render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", simulation_error_panels(d));
+  }
+  plots.render("residuals.svg", residuals_title(d), residual_panels(d, std::max<size_t>(1, d.t.size() / 3000)));
+  plots.render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", autocorrelation_panels(d));
+  const auto gain_panels = command_gain_panels(d);
+  if (!gain_panels.empty()) plots.render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
   if (d.has_prediction)
-    render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
-           predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
+    plots.render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
+                 predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
   if (!d.search.profiles.empty())
-    render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", fit::profile_panels(d.search.profiles));
-  return out;
+    plots.render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", fit::profile_panels(d.search.profiles));
+  return std::move(plots).svgs();
 }
 
 }  // namespace quadgen::diagnose

@@ -88,6 +88,88 @@ SignalSet physical_signals(const fit::Flight& f, const std::vector<std::string>&
   return s;
 }
 
+namespace {
+
+// Slow structure: the residual's means over 1 s windows against what the high-passed noise
+// would give them (a chi-squared test of the means), the worst window, and how much of the
+// autocorrelation beyond the noise's correlation length lies outside the white-noise band.
+// Needs three windows; fewer leave the fields at their defaults.
+void analyse_slow_structure(ChannelAnalysis& a, const std::vector<double>& x, const std::vector<double>& t, double dt) {
+  const size_t ns = x.size();
+  const size_t w = std::max<size_t>(10, static_cast<size_t>(std::lround(1.0 / dt)));
+  std::vector<double> means, highpass;
+  std::vector<size_t> starts;
+  for (size_t k0 = 0; k0 + w <= ns; k0 += w) {
+    double m = 0;
+    for (size_t k = k0; k < k0 + w; ++k) m += x[k];
+    m /= static_cast<double>(w);
+    means.push_back(m);
+    starts.push_back(k0);
+    for (size_t k = k0; k < k0 + w; ++k) highpass.push_back(x[k] - m);
+  }
+  if (means.size() < 3) return;
+  // The noise's correlation length, read from the high-passed residual's short lags.
+  auto hp_acf = autocorrelation(highpass, static_cast<int>(std::min<size_t>(w / 2, highpass.size() / 4)));
+  const double tau = tau_from_acf(hp_acf);
+  double hv = 0;
+  for (double v : highpass) hv += v * v;
+  // Within-window variance is biased low by 1 - tau/w; undo it.
+  hv = hv / static_cast<double>(highpass.size()) / std::max(0.05, 1.0 - tau / static_cast<double>(w));
+  const double var_mean = hv * tau / static_cast<double>(w);
+  double S = 0, worst = 0;
+  for (size_t j = 0; j < means.size(); ++j) {
+    S += means[j] * means[j] / var_mean;
+    if (std::abs(means[j]) > std::abs(worst)) {
+      worst = means[j];
+      a.worst_window_t0 = t[starts[j]];
+      a.worst_window_t1 = t[starts[j] + w - 1];
+    }
+  }
+  double ms = 0;
+  for (double m : means) ms += m * m;
+  a.slow_rms = std::sqrt(ms / static_cast<double>(means.size()));
+  a.worst_window_mean = worst;
+  const double J = static_cast<double>(means.size());
+  a.slow_ratio = S / J;
+  a.slow_p_value = boost::math::cdf(boost::math::complement(boost::math::chi_squared(J), S));
+  int outside = 0, counted = 0;
+  for (size_t k = static_cast<size_t>(std::ceil(tau)) + 1; k < a.acf.size(); ++k, ++counted)
+    if (std::abs(a.acf[k]) > a.acf_band) ++outside;
+  a.acf_outside = counted ? static_cast<double>(outside) / counted : 0.0;
+}
+
+// Correlations of the residual with each signal, strongest first; the effective n by
+// Bartlett's formula for two autocorrelated series, n / (1 + 2 sum rho_x rho_y).
+std::vector<Correlation> correlations_with(const ChannelAnalysis& a, const std::vector<double>& x, const SignalSet& signals,
+                                           const std::vector<std::vector<double>>& signal_acf, int lag) {
+  const size_t ns = x.size();
+  const double sx = a.sigma;
+  std::vector<Correlation> out;
+  for (size_t s = 0; s < signals.names.size(); ++s) {
+    const auto& y = signals.values[s];
+    const double my = mean(y);
+    double sy = 0, cxy = 0;
+    for (size_t k = 0; k < ns; ++k) {
+      sy += (y[k] - my) * (y[k] - my);
+      cxy += (x[k] - a.bias) * (y[k] - my);
+    }
+    sy = std::sqrt(sy / static_cast<double>(ns));
+    if (sx <= 0 || sy <= 0) continue;
+    Correlation cr;
+    cr.signal = signals.names[s];
+    cr.r = cxy / static_cast<double>(ns) / (sx * sy);
+    const double n_eff = bartlett_effective_n(a.acf, signal_acf[s], ns, lag);
+    const double r2 = std::min(cr.r * cr.r, 1 - 1e-12);
+    const double tstat = std::abs(cr.r) * std::sqrt((n_eff - 2) / (1 - r2));
+    cr.p_value = 2 * boost::math::cdf(boost::math::complement(boost::math::students_t(n_eff - 2), tstat));
+    out.push_back(cr);
+  }
+  std::sort(out.begin(), out.end(), [](const Correlation& p, const Correlation& q) { return std::abs(p.r) > std::abs(q.r); });
+  return out;
+}
+
+}  // namespace
+
 ResidualAnalysis analyse_residuals(const std::vector<double>& r6, const std::vector<std::string>& names,
                                    const std::vector<std::string>& units, const std::vector<double>& t,
                                    const SignalSet& signals) {
@@ -113,72 +195,8 @@ ResidualAnalysis analyse_residuals(const std::vector<double>& r6, const std::vec
     a.acf = autocorrelation(x, lag);
     a.tau_int = tau_from_acf(a.acf);
     a.acf_band = 1.96 / std::sqrt(static_cast<double>(std::max<size_t>(ns, 1)));
-    // Slow structure: 1 s window means against the high-passed noise.
-    const size_t w = std::max<size_t>(10, static_cast<size_t>(std::lround(1.0 / dt)));
-    std::vector<double> means, highpass;
-    std::vector<size_t> starts;
-    for (size_t k0 = 0; k0 + w <= ns; k0 += w) {
-      double m = 0;
-      for (size_t k = k0; k < k0 + w; ++k) m += x[k];
-      m /= static_cast<double>(w);
-      means.push_back(m);
-      starts.push_back(k0);
-      for (size_t k = k0; k < k0 + w; ++k) highpass.push_back(x[k] - m);
-    }
-    if (means.size() >= 3) {
-      // The noise's correlation length, read from the high-passed residual's short lags.
-      auto hp_acf = autocorrelation(highpass, static_cast<int>(std::min<size_t>(w / 2, highpass.size() / 4)));
-      const double tau = tau_from_acf(hp_acf);
-      double hv = 0;
-      for (double v : highpass) hv += v * v;
-      // Within-window variance is biased low by 1 - tau/w; undo it.
-      hv = hv / static_cast<double>(highpass.size()) / std::max(0.05, 1.0 - tau / static_cast<double>(w));
-      const double var_mean = hv * tau / static_cast<double>(w);
-      double S = 0, worst = 0;
-      for (size_t j = 0; j < means.size(); ++j) {
-        S += means[j] * means[j] / var_mean;
-        if (std::abs(means[j]) > std::abs(worst)) {
-          worst = means[j];
-          a.worst_window_t0 = t[starts[j]];
-          a.worst_window_t1 = t[starts[j] + w - 1];
-        }
-      }
-      double ms = 0;
-      for (double m : means) ms += m * m;
-      a.slow_rms = std::sqrt(ms / static_cast<double>(means.size()));
-      a.worst_window_mean = worst;
-      const double J = static_cast<double>(means.size());
-      a.slow_ratio = S / J;
-      a.slow_p_value = boost::math::cdf(boost::math::complement(boost::math::chi_squared(J), S));
-      int outside = 0, counted = 0;
-      for (size_t k = static_cast<size_t>(std::ceil(tau)) + 1; k < a.acf.size(); ++k, ++counted)
-        if (std::abs(a.acf[k]) > a.acf_band) ++outside;
-      a.acf_outside = counted ? static_cast<double>(outside) / counted : 0.0;
-    }
-    // Correlations with the signals; effective n by Bartlett's formula for two
-    // autocorrelated series, n / (1 + 2 sum rho_x rho_y).
-    const double sx = a.sigma;
-    for (size_t s = 0; s < signals.names.size(); ++s) {
-      const auto& y = signals.values[s];
-      const double my = mean(y);
-      double sy = 0, cxy = 0;
-      for (size_t k = 0; k < ns; ++k) {
-        sy += (y[k] - my) * (y[k] - my);
-        cxy += (x[k] - a.bias) * (y[k] - my);
-      }
-      sy = std::sqrt(sy / static_cast<double>(ns));
-      if (sx <= 0 || sy <= 0) continue;
-      Correlation cr;
-      cr.signal = signals.names[s];
-      cr.r = cxy / static_cast<double>(ns) / (sx * sy);
-      const double n_eff = bartlett_effective_n(a.acf, signal_acf[s], ns, lag);
-      const double r2 = std::min(cr.r * cr.r, 1 - 1e-12);
-      const double tstat = std::abs(cr.r) * std::sqrt((n_eff - 2) / (1 - r2));
-      cr.p_value = 2 * boost::math::cdf(boost::math::complement(boost::math::students_t(n_eff - 2), tstat));
-      a.correlations.push_back(cr);
-    }
-    std::sort(a.correlations.begin(), a.correlations.end(),
-              [](const Correlation& p, const Correlation& q) { return std::abs(p.r) > std::abs(q.r); });
+    analyse_slow_structure(a, x, t, dt);
+    a.correlations = correlations_with(a, x, signals, signal_acf, lag);
     out.channels.push_back(std::move(a));
   }
   return out;

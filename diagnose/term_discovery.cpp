@@ -239,6 +239,145 @@ std::string DiscoveredTerm::expression() const {
   return os.str();
 }
 
+namespace {
+
+// The library's columns that carry information on the training part, each scaled to unit RMS
+// there (the thresholds compare coefficients in these units), evaluated on both parts.
+struct ScaledDesign {
+  std::vector<size_t> used;  // library column of each design column
+  std::vector<double> scale;
+  Matrix train, valid;
+};
+
+ScaledDesign scaled_design(const RegressorLibrary& lt, const RegressorLibrary& lv) {
+  const size_t nt = lt.columns.front().size(), nv = lv.columns.front().size();
+  ScaledDesign d;
+  for (size_t j = 0; j < lt.columns.size(); ++j) {
+    double ss = 0, s = 0;
+    for (double x : lt.columns[j]) ss += x * x, s += x;
+    const double rms = std::sqrt(ss / static_cast<double>(nt)), mean = s / static_cast<double>(nt);
+    const double spread = std::sqrt(std::max(0.0, rms * rms - mean * mean));
+    if (j == 0 || spread > 1e-9 * std::max(1.0, rms)) d.used.push_back(j), d.scale.push_back(rms > 0 ? rms : 1.0);
+  }
+  const auto k = static_cast<Eigen::Index>(d.used.size());
+  d.train.resize(static_cast<Eigen::Index>(nt), k), d.valid.resize(static_cast<Eigen::Index>(nv), k);
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (size_t r = 0; r < nt; ++r) d.train(static_cast<Eigen::Index>(r), c) = lt.columns[d.used[c]][r] / d.scale[c];
+    for (size_t r = 0; r < nv; ++r) d.valid(static_cast<Eigen::Index>(r), c) = lv.columns[d.used[c]][r] / d.scale[c];
+  }
+  return d;
+}
+
+struct SignificantFit {
+  Vector xi, se;  // coefficients and standard errors in scaled columns; zero where dropped
+};
+
+// Intervals on the chosen support by ordinary least squares with a covariance that holds for
+// autocorrelated residuals (Newey-West). A term stays only if it is significant after
+// Bonferroni's correction for the size of the library searched (|t| > 3.2 for 36
+// regressors): the least significant is dropped and the rest refitted until all are.
+SignificantFit keep_significant(const Matrix& X, const Vector& y, const Vector& support) {
+  const Eigen::Index k = X.cols();
+  const double z_keep = boost::math::quantile(boost::math::complement(boost::math::normal(), 0.025 / static_cast<double>(k)));
+  std::vector<bool> active(static_cast<size_t>(k));
+  for (Eigen::Index j = 0; j < k; ++j) active[static_cast<size_t>(j)] = support(j) != 0;
+  SignificantFit f{Vector::Zero(k), Vector::Zero(k)};
+  for (int pass = 0; pass < 10; ++pass) {
+    std::vector<Eigen::Index> idx;
+    for (Eigen::Index j = 0; j < k; ++j)
+      if (active[static_cast<size_t>(j)]) idx.push_back(j);
+    f.xi.setZero(), f.se.setZero();
+    if (idx.empty()) break;
+    Matrix A(X.rows(), static_cast<Eigen::Index>(idx.size()));
+    for (size_t i = 0; i < idx.size(); ++i) A.col(static_cast<Eigen::Index>(i)) = X.col(idx[i]);
+    const Eigen::ColPivHouseholderQR<Matrix> qr(A);
+    const Vector sol = qr.solve(y);
+    const Matrix cov = hac_covariance(A, y - A * sol);
+    for (size_t i = 0; i < idx.size(); ++i) {
+      f.xi(idx[i]) = sol(static_cast<Eigen::Index>(i));
+      f.se(idx[i]) = std::sqrt(std::max(0.0, cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i))));
+    }
+    // Drop the least significant term, one at a time.
+    Eigen::Index worst = -1;
+    double worst_t = z_keep;
+    for (Eigen::Index j : idx) {
+      const double t = std::abs(f.xi(j)) / std::max(f.se(j), 1e-300);
+      if (t < worst_t) worst_t = t, worst = j;
+    }
+    if (worst < 0) break;
+    active[static_cast<size_t>(worst)] = false;
+  }
+  return f;
+}
+
+// The held-out gain and its spread over consecutive blocks of the held-out part, and the
+// verdict that follows from them.
+void judge_held_out(DiscoveredTerm& d, const Vector& before_rows, const Vector& after_rows, int validation_folds) {
+  const size_t nv = static_cast<size_t>(before_rows.size());
+  const size_t nb = static_cast<size_t>(std::max(1, validation_folds));
+  std::vector<double> before(nb, 0), after(nb, 0), count(nb, 0);
+  for (size_t r = 0; r < nv; ++r) {
+    const size_t b = r * nb / nv;
+    before[b] += before_rows(static_cast<Eigen::Index>(r)) * before_rows(static_cast<Eigen::Index>(r));
+    after[b] += after_rows(static_cast<Eigen::Index>(r)) * after_rows(static_cast<Eigen::Index>(r));
+    count[b] += 1;
+  }
+  for (size_t b = 0; b < nb; ++b)
+    if (count[b] > 0) d.fold_gains.push_back(std::sqrt(before[b] / count[b]) - std::sqrt(after[b] / count[b]));
+  const double n = static_cast<double>(d.fold_gains.size());
+  for (double g : d.fold_gains) d.gain_mean += g / n;
+  double ss = 0;
+  for (double g : d.fold_gains) ss += (g - d.gain_mean) * (g - d.gain_mean);
+  d.gain_standard_error = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+  const std::string held = "held-out RMS " + output::short_number(d.valid_rms_before) + " -> " + output::short_number(d.valid_rms_after) + " " +
+                           d.unit + " (gain " + output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) +
+                           " over " + std::to_string(d.fold_gains.size()) + " blocks)";
+  d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
+  d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;
+}
+
+// One channel: the cross-validated sparsity level, the significant coefficients on it (in the
+// library's units) and their held-out gain. `yt`, `yv`: what the model lacks on each part.
+DiscoveredTerm discover_channel(DiscoveredTerm d, const ScaledDesign& x, const RegressorLibrary& lt, const Vector& yt,
+                                const Vector& yv, const std::vector<std::vector<size_t>>& folds, const DiscoveryOptions& opt) {
+  const auto nt = static_cast<double>(yt.size()), nv = static_cast<double>(yv.size());
+  std::vector<Normal> fold_normals;
+  for (const auto& f : folds) fold_normals.push_back(normal_of(x.train, yt, f));
+  const Chosen chosen = choose_threshold(fold_normals, opt.thresholds, opt.max_terms);
+  d.cv_error = chosen.cv_error;
+  d.threshold = chosen.threshold;
+  d.train_rms_before = d.train_rms_after = std::sqrt(yt.squaredNorm() / nt);
+  d.valid_rms_before = d.valid_rms_after = std::sqrt(yv.squaredNorm() / nv);
+  if (chosen.threshold == 0) {
+    d.verdict = "no term: cross-validation (" + d.cross_validation + ") finds no combination of at most " +
+                std::to_string(opt.max_terms) + " regressors that predicts left-out residual better than none";
+    return d;
+  }
+  std::vector<size_t> all_rows(static_cast<size_t>(yt.size()));
+  for (size_t r = 0; r < all_rows.size(); ++r) all_rows[r] = r;
+  const SignificantFit fit = keep_significant(x.train, yt, stlsq(normal_of(x.train, yt, all_rows), chosen.threshold));
+  for (Eigen::Index j = 0; j < fit.xi.size(); ++j) {
+    if (fit.xi(j) == 0) continue;
+    const size_t col = x.used[static_cast<size_t>(j)];
+    const double s = x.scale[static_cast<size_t>(j)];
+    const std::string& ru = lt.units[col];
+    d.coefficients.push_back({lt.names[col], ru.empty() || ru == "1" ? d.unit : d.unit + "/(" + ru + ")", fit.xi(j) / s,
+                              (fit.xi(j) - fit::kZ95 * fit.se(j)) / s, (fit.xi(j) + fit::kZ95 * fit.se(j)) / s});
+  }
+  if (d.coefficients.empty()) {
+    d.verdict = "no term: no selected coefficient is significant once corrected for the " + std::to_string(fit.xi.size()) +
+                " regressors searched";
+    return d;
+  }
+  const Vector et = yt - x.train * fit.xi, ev = yv - x.valid * fit.xi;
+  d.train_rms_after = std::sqrt(et.squaredNorm() / nt);
+  d.valid_rms_after = std::sqrt(ev.squaredNorm() / nv);
+  judge_held_out(d, yv, ev, opt.validation_folds);
+  return d;
+}
+
+}  // namespace
+
 std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::vector<double>& residual_train,
                                            const fit::Flight& valid, const std::vector<double>& residual_valid,
                                            const std::vector<std::string>& channels,
@@ -248,26 +387,9 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
   std::vector<DiscoveredTerm> out;
   if (nt < 50 || nv < 20 || residual_train.size() != nt * nc || residual_valid.size() != nv * nc) return out;
   const RegressorLibrary lt = physical_regressors(train), lv = physical_regressors(valid, lt.centres);
-  // Columns that carry information on the training part, scaled to unit RMS there.
-  std::vector<size_t> used;
-  std::vector<double> scale;
-  for (size_t j = 0; j < lt.columns.size(); ++j) {
-    double ss = 0, s = 0;
-    for (double x : lt.columns[j]) ss += x * x, s += x;
-    const double rms = std::sqrt(ss / static_cast<double>(nt)), mean = s / static_cast<double>(nt);
-    const double spread = std::sqrt(std::max(0.0, rms * rms - mean * mean));
-    if (j == 0 || spread > 1e-9 * std::max(1.0, rms)) used.push_back(j), scale.push_back(rms > 0 ? rms : 1.0);
-  }
-  const auto k = static_cast<Eigen::Index>(used.size());
-  Matrix Xt(static_cast<Eigen::Index>(nt), k), Xv(static_cast<Eigen::Index>(nv), k);
-  for (Eigen::Index c = 0; c < k; ++c) {
-    for (size_t r = 0; r < nt; ++r) Xt(static_cast<Eigen::Index>(r), c) = lt.columns[used[c]][r] / scale[c];
-    for (size_t r = 0; r < nv; ++r) Xv(static_cast<Eigen::Index>(r), c) = lv.columns[used[c]][r] / scale[c];
-  }
+  const ScaledDesign x = scaled_design(lt, lv);
   std::string how;
   const auto folds = cv_folds(train, flight_starts, opt.time_folds, &how);
-  std::vector<size_t> all_rows(nt);
-  for (size_t r = 0; r < nt; ++r) all_rows[r] = r;
   for (size_t ch = 0; ch < nc; ++ch) {
     DiscoveredTerm d;
     d.channel = channels[ch], d.unit = units[ch], d.cross_validation = how, d.centres = lt.centres;
@@ -275,93 +397,7 @@ std::vector<DiscoveredTerm> discover_terms(const fit::Flight& train, const std::
     Vector yt(static_cast<Eigen::Index>(nt)), yv(static_cast<Eigen::Index>(nv));
     for (size_t r = 0; r < nt; ++r) yt(static_cast<Eigen::Index>(r)) = -residual_train[r * nc + ch];
     for (size_t r = 0; r < nv; ++r) yv(static_cast<Eigen::Index>(r)) = -residual_valid[r * nc + ch];
-    std::vector<Normal> fold_normals;
-    for (const auto& f : folds) fold_normals.push_back(normal_of(Xt, yt, f));
-    const Chosen chosen = choose_threshold(fold_normals, opt.thresholds, opt.max_terms);
-    d.cv_error = chosen.cv_error;
-    d.threshold = chosen.threshold;
-    d.train_rms_before = d.train_rms_after = std::sqrt(yt.squaredNorm() / static_cast<double>(nt));
-    d.valid_rms_before = d.valid_rms_after = std::sqrt(yv.squaredNorm() / static_cast<double>(nv));
-    if (chosen.threshold == 0) {
-      d.verdict = "no term: cross-validation (" + how + ") finds no combination of at most " +
-                  std::to_string(opt.max_terms) + " regressors that predicts left-out residual better than none";
-      out.push_back(d);
-      continue;
-    }
-    Vector xi = stlsq(normal_of(Xt, yt, all_rows), chosen.threshold);
-    // Intervals on the chosen support by ordinary least squares with a covariance that
-    // holds for autocorrelated residuals (Newey-West). A term stays only if it is significant after
-    // Bonferroni's correction for the size of the library searched (|t| > 3.2 for 36
-    // regressors): the least significant is dropped and the rest refitted until all are.
-    const double z_keep = boost::math::quantile(boost::math::complement(boost::math::normal(), 0.025 / static_cast<double>(k)));
-    std::vector<bool> active(static_cast<size_t>(k));
-    for (Eigen::Index j = 0; j < k; ++j) active[static_cast<size_t>(j)] = xi(j) != 0;
-    Vector se = Vector::Zero(k);
-    for (int pass = 0; pass < 10; ++pass) {
-      std::vector<Eigen::Index> idx;
-      for (Eigen::Index j = 0; j < k; ++j)
-        if (active[static_cast<size_t>(j)]) idx.push_back(j);
-      xi.setZero(), se.setZero();
-      if (idx.empty()) break;
-      Matrix A(static_cast<Eigen::Index>(nt), static_cast<Eigen::Index>(idx.size()));
-      for (size_t i = 0; i < idx.size(); ++i) A.col(static_cast<Eigen::Index>(i)) = Xt.col(idx[i]);
-      const Eigen::ColPivHouseholderQR<Matrix> qr(A);
-      const Vector sol = qr.solve(yt);
-      const Vector e = yt - A * sol;
-      const Matrix cov = hac_covariance(A, e);
-      bool dropped = false;
-      for (size_t i = 0; i < idx.size(); ++i) {
-        xi(idx[i]) = sol(static_cast<Eigen::Index>(i));
-        se(idx[i]) = std::sqrt(std::max(0.0, cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i))));
-      }
-      // Drop the least significant term, one at a time.
-      Eigen::Index worst = -1;
-      double worst_t = z_keep;
-      for (Eigen::Index j : idx) {
-        const double t = std::abs(xi(j)) / std::max(se(j), 1e-300);
-        if (t < worst_t) worst_t = t, worst = j;
-      }
-      if (worst >= 0) active[static_cast<size_t>(worst)] = false, dropped = true;
-      if (!dropped) break;
-    }
-    for (Eigen::Index j = 0; j < k; ++j) {
-      if (xi(j) == 0) continue;
-      const size_t col = used[static_cast<size_t>(j)];
-      const double s = scale[static_cast<size_t>(j)];
-      const std::string& ru = lt.units[col];
-      d.coefficients.push_back({lt.names[col], ru.empty() || ru == "1" ? units[ch] : units[ch] + "/(" + ru + ")",
-                                xi(j) / s, (xi(j) - fit::kZ95 * se(j)) / s, (xi(j) + fit::kZ95 * se(j)) / s});
-    }
-    if (d.coefficients.empty()) {
-      d.verdict = "no term: no selected coefficient is significant once corrected for the " + std::to_string(k) + " regressors searched";
-      out.push_back(d);
-      continue;
-    }
-    const Vector et = yt - Xt * xi, ev = yv - Xv * xi;
-    d.train_rms_after = std::sqrt(et.squaredNorm() / static_cast<double>(nt));
-    d.valid_rms_after = std::sqrt(ev.squaredNorm() / static_cast<double>(nv));
-    // The gain's spread over consecutive blocks of the held-out part.
-    const size_t nb = static_cast<size_t>(std::max(1, opt.validation_folds));
-    std::vector<double> before(nb, 0), after(nb, 0), count(nb, 0);
-    for (size_t r = 0; r < nv; ++r) {
-      const size_t b = r * nb / nv;
-      before[b] += yv(static_cast<Eigen::Index>(r)) * yv(static_cast<Eigen::Index>(r));
-      after[b] += ev(static_cast<Eigen::Index>(r)) * ev(static_cast<Eigen::Index>(r));
-      count[b] += 1;
-    }
-    for (size_t b = 0; b < nb; ++b)
-      if (count[b] > 0) d.fold_gains.push_back(std::sqrt(before[b] / count[b]) - std::sqrt(after[b] / count[b]));
-    const double n = static_cast<double>(d.fold_gains.size());
-    for (double g : d.fold_gains) d.gain_mean += g / n;
-    double ss = 0;
-    for (double g : d.fold_gains) ss += (g - d.gain_mean) * (g - d.gain_mean);
-    d.gain_standard_error = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
-    const std::string held = "held-out RMS " + output::short_number(d.valid_rms_before) + " -> " + output::short_number(d.valid_rms_after) + " " +
-                             d.unit + " (gain " + output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) +
-                             " over " + std::to_string(d.fold_gains.size()) + " blocks)";
-    d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
-    d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;
-    out.push_back(d);
+    out.push_back(discover_channel(std::move(d), x, lt, yt, yv, folds, opt));
   }
   return out;
 }

@@ -159,42 +159,8 @@ double solve_scale(const FitParameter& p) {
   return std::max(std::fabs(p.value), 1e-3 * size);
 }
 
-}  // namespace
-
-double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
-                      const FitOptions& opt, bool* converged, std::string* report) {
-  const int n = static_cast<int>(params.size());
-  const std::vector<double> x = parameter_values(params);
-  const std::vector<bool> free = free_mask(params);
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
-  ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
-  std::vector<double> xf, scale;  // the free values in units of their scale: Ceres' parameter block
-  for (int i = 0; i < n; ++i)
-    if (free[i]) {
-      scale.push_back(solve_scale(params[i]));
-      xf.push_back(x[i] / scale.back());
-    }
-  if (xf.empty()) {
-    std::vector<double> all = x;
-    problem.AddResidualBlock(new WeightedCost(model, n, w, free), loss, all.data());
-    double cost = 0;
-    if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr) || !std::isfinite(cost))
-      throw FitError("least squares: a residual is not finite at " + values_text(params));
-    if (converged) *converged = true;
-    return 2 * cost;
-  }
-  auto* cost_function = new FreeSubsetCost(model, x, w, free, scale);
-  problem.AddResidualBlock(cost_function, loss, xf.data());
-  for (int i = 0, k = 0; i < n; ++i) {
-    if (!free[i]) continue;
-    if (params[i].lower < params[i].upper) {
-      problem.SetParameterLowerBound(xf.data(), k, params[i].lower / scale[k]);
-      problem.SetParameterUpperBound(xf.data(), k, params[i].upper / scale[k]);
-    }
-    ++k;
-  }
+// The solver's settings: each says why it is what it is.
+ceres::Solver::Options solver_options(const FitOptions& opt) {
   ceres::Solver::Options so;
   // Normal equations: the Jacobians are tall and thin (a joint diagnosis has 77 000 rows and
   // a few dozen free columns), where Householder QR of J costs twice the flops of forming
@@ -214,6 +180,57 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   so.line_search_interpolation_type = ceres::QUADRATIC;
   so.minimizer_progress_to_stdout = opt.verbose;
   so.num_threads = 1;
+  return so;
+}
+
+// Twice the cost of a fit with no free parameter, evaluated where the parameters are.
+double cost_without_free_parameters(const ResidualModel& model, const std::vector<FitParameter>& params,
+                                    const std::vector<double>& w, const FitOptions& opt) {
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  std::vector<double> all = parameter_values(params);
+  const int n = static_cast<int>(params.size());
+  problem.AddResidualBlock(new WeightedCost(model, n, w, free_mask(params)), opt.robust ? new ceres::HuberLoss(1.0) : nullptr,
+                           all.data());
+  double cost = 0;
+  if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr) || !std::isfinite(cost))
+    throw FitError("least squares: a residual is not finite at " + values_text(params));
+  return 2 * cost;
+}
+
+}  // namespace
+
+double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& params, const std::vector<double>& w,
+                      const FitOptions& opt, bool* converged, std::string* report) {
+  const int n = static_cast<int>(params.size());
+  const std::vector<double> x = parameter_values(params);
+  const std::vector<bool> free = free_mask(params);
+  std::vector<double> xf, scale;  // the free values in units of their scale: Ceres' parameter block
+  for (int i = 0; i < n; ++i)
+    if (free[i]) {
+      scale.push_back(solve_scale(params[i]));
+      xf.push_back(x[i] / scale.back());
+    }
+  if (xf.empty()) {
+    if (converged) *converged = true;
+    return cost_without_free_parameters(model, params, w, opt);
+  }
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  ceres::LossFunction* loss = opt.robust ? new ceres::HuberLoss(1.0) : nullptr;
+  auto* cost_function = new FreeSubsetCost(model, x, w, free, scale);
+  problem.AddResidualBlock(cost_function, loss, xf.data());
+  for (int i = 0, k = 0; i < n; ++i) {
+    if (!free[i]) continue;
+    if (params[i].lower < params[i].upper) {
+      problem.SetParameterLowerBound(xf.data(), k, params[i].lower / scale[k]);
+      problem.SetParameterUpperBound(xf.data(), k, params[i].upper / scale[k]);
+    }
+    ++k;
+  }
+  const ceres::Solver::Options so = solver_options(opt);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   // FAILURE is an evaluation or linear-solver error, most often a residual or Jacobian

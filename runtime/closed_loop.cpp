@@ -400,6 +400,50 @@ struct UnmodelledForces {
   }
 };
 
+// The commands the motors act on: those sent `delay` seconds ago. The delay is whole control
+// periods and a rest within one (below 1 us counts as none: 0.03 / 0.01 is
+// 2.9999999999999996 in floating point); with a rest, the command acting switches that far
+// into each period.
+class DelayedCommands {
+ public:
+  DelayedCommands(double delay, double dt) : whole_(static_cast<long>(std::floor(delay / dt + 1e-6))) {
+    rest_ = delay - static_cast<double>(whole_) * dt;
+    if (rest_ < 1e-6) rest_ = 0;
+  }
+  void send(const std::vector<double>& u) { sent_.push_back(u); }
+  double rest() const { return rest_; }
+  // In control period k: acting before the switch, after it, and at the period's start.
+  // (References into the record: valid until the next send.)
+  const std::vector<double>& before_switch(long k) const { return sent_at(k - whole_ - 1); }
+  const std::vector<double>& after_switch(long k) const { return sent_at(k - whole_); }
+  const std::vector<double>& at_start(long k) const { return rest_ > 0 ? before_switch(k) : after_switch(k); }
+
+ private:
+  const std::vector<double>& sent_at(long i) const { return sent_[static_cast<size_t>(std::max(0L, i))]; }
+  long whole_;
+  double rest_ = 0;
+  std::vector<std::vector<double>> sent_;  // commands of every control step
+};
+
+// The true model over control period k (from t0, dt long), the rotor commands held as the
+// delay has them; the extra inputs (battery voltage, wind...) follow the clock.
+void fly_one_period(const DynamicModel& truth, std::vector<double>& x, const DelayedCommands& commands, long k,
+                    const ExtraInputs& extra, int nr, double t0, double dt, double vbat, const IntegratorOptions& io) {
+  bool before_switch = false;
+  auto inputs = [&](double tt, double* uu) {
+    const std::vector<double>& held = before_switch ? commands.before_switch(k) : commands.after_switch(k);
+    for (int i = 0; i < nr; ++i) uu[i] = held[i];
+    extra.fill(t0 + tt, vbat, uu);
+  };
+  // Integrate up to the switch and on from it, so that no RK4 step straddles it.
+  if (commands.rest() > 0) {
+    before_switch = true;
+    x = integrate_rk4(truth, x, inputs, 0.0, commands.rest(), io).x.back();
+    before_switch = false;
+  }
+  x = integrate_rk4(truth, x, inputs, commands.rest(), dt, io).x.back();
+}
+
 }  // namespace
 
 GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel& b,
@@ -423,15 +467,9 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   // logs is the model's measurement h(x) (q ⊗ q_bias under attitude_bias; it flies on that
   // estimate), and the motors act on the commands of `delay` seconds ago.
   const int delay_param = truth.input_delay_param();
-  const double delay = delay_param >= 0 ? truth.params()[delay_param] : 0.0;
+  DelayedCommands commands(delay_param >= 0 ? truth.params()[delay_param] : 0.0, dt);
   std::vector<double> logged(truth.num_outputs());
   const int logged_q = truth.num_outputs() - 4;  // h = (position, quaternion)
-  // Whole control periods of delay, and the rest (below 1 us counts as none: 0.03 / 0.01
-  // is 2.9999999999999996 in floating point).
-  const long delay_steps = static_cast<long>(std::floor(delay / dt + 1e-6));
-  double delay_rest = delay - static_cast<double>(delay_steps) * dt;
-  if (delay_rest < 1e-6) delay_rest = 0;
-  std::vector<std::vector<double>> sent;  // commands of every control step
   std::vector<double> u(truth.num_inputs(), 0.0), f(truth.num_states());
   IntegratorOptions io;
   io.step = o.sim_step;
@@ -449,32 +487,15 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
         Eigen::Quaterniond(logged[logged_q], logged[logged_q + 1], logged[logged_q + 2], logged[logged_q + 3]).normalized();
     commands_for(b, controller.thrusts(t, dt, r, x, q_est.toRotationMatrix()), o.command_levels, u);
     extra.fill(t, vbat, u.data());
-    sent.push_back(u);
-    auto sent_at = [&](long i) -> const std::vector<double>& { return sent[static_cast<size_t>(std::max(0L, i))]; };
-    const std::vector<double>& early = sent_at(k - delay_steps - 1);
-    const std::vector<double>& late = sent_at(k - delay_steps);
+    commands.send(u);
     // --- log: noisy sensors (the accelerometer feels the commands in effect now) ---
     std::vector<double> acting = u;
-    for (int i = 0; i < nr; ++i) acting[i] = (delay_rest > 0 ? early : late)[i];
+    for (int i = 0; i < nr; ++i) acting[i] = commands.at_start(k)[i];
     truth.rhs(x.data(), acting.data(), f.data(), nullptr, nullptr, nullptr);
     out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, controller.desired(), rng, gauss));
     if (k == steps) break;
-    // --- plant: the true model over one control period, commands held ---
-    const double t0 = t;
-    bool before_switch = false;
-    auto inputs = [&](double tt, double* uu) {
-      const std::vector<double>& held = before_switch ? early : late;
-      for (int i = 0; i < nr; ++i) uu[i] = held[i];
-      extra.fill(t0 + tt, vbat, uu);
-    };
-    // The delayed command switches at delay_rest into the period: integrate up to the
-    // switch and on from it, so that no RK4 step straddles it.
-    if (delay_rest > 0) {
-      before_switch = true;
-      x = integrate_rk4(truth, x, inputs, 0.0, delay_rest, io).x.back();
-      before_switch = false;
-    }
-    x = integrate_rk4(truth, x, inputs, delay_rest, dt, io).x.back();
+    // --- plant: the true model over one control period ---
+    fly_one_period(truth, x, commands, k, extra, nr, t, dt, vbat, io);
     unmodelled.apply(x, ref, gauss);
     if (x[kPosition + 2] < -5 || (p_at_t - r.position()).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
