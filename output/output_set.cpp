@@ -80,15 +80,17 @@ void fsync_path(const fs::path& p, int flags) {
   if (rc != 0) fail(p, "cannot sync to disk: " + errno_text());
 }
 
-// The absolute, normalised form of a path named on the command line (symbolic links of an
-// existing path resolved, a trailing '/' dropped).
+// The absolute form of a path named on the command line, resolved as the kernel resolves it:
+// symbolic links in its existing part followed before a '..' after them is applied (so that
+// `link/../x` is x beside the link's target, where the file system puts it, not beside the
+// link), a trailing '/' dropped.
 fs::path resolved(const std::string& name) {
   if (name.empty()) throw OutputError("an output path is empty");
   std::error_code ec;
-  fs::path p = fs::absolute(fs::path(name), ec).lexically_normal();
+  fs::path p = fs::absolute(fs::path(name), ec);
   if (!p.has_filename()) p = p.parent_path();
-  if (fs::exists(p, ec)) p = fs::canonical(p, ec);
-  return p;
+  const fs::path r = fs::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal() : r;
 }
 
 // A file path named on the command line: its folder resolved, the file itself not (so that a
@@ -96,11 +98,10 @@ fs::path resolved(const std::string& name) {
 fs::path resolved_file(const std::string& name) {
   if (name.empty()) throw OutputError("an output path is empty");
   std::error_code ec;
-  const fs::path p = fs::absolute(fs::path(name), ec).lexically_normal();
-  if (!p.has_filename()) fail(p, "names a directory; expected a file name");
-  fs::path parent = p.parent_path();
-  if (fs::exists(parent, ec)) parent = fs::canonical(parent, ec);
-  return parent / p.filename();
+  const fs::path p = fs::absolute(fs::path(name), ec);
+  if (!p.has_filename() || p.filename() == "." || p.filename() == "..") fail(p, "names a directory; expected a file name");
+  const fs::path parent = fs::weakly_canonical(p.parent_path(), ec);
+  return (ec ? p.parent_path().lexically_normal() : parent) / p.filename();
 }
 
 bool inside(const fs::path& child, const fs::path& parent) {

@@ -807,6 +807,29 @@ TEST(DataLoss, SimulateRefusesToWriteOverItsInputs) {
   EXPECT_FALSE(fs::exists(tmp / "x.svg"));
 }
 
+// `link/../x` is x beside the link's target for the kernel; an output path resolved
+// lexically first (the '..' dropping the link) wrote beside the link instead, so the files
+// were not where the path the user gave (and the one quadgen printed) leads.
+TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
+  Scratch tmp;
+  const std::string vehicle = tmp / "v.yaml";
+  fs::copy_file(source_path("vehicles/finken3.yaml"), vehicle);
+  fs::create_directories(tmp.dir / "far/dir");
+  fs::create_directory_symlink(tmp.dir / "far/dir", tmp.dir / "lnk");
+  const CliResult sim =
+      run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", "lnk/../z.csv"}, tmp.dir);
+  ASSERT_EQ(sim.rc, 0) << sim.err;
+  EXPECT_TRUE(fs::exists(tmp.dir / "far/z.csv"));
+  EXPECT_FALSE(fs::exists(tmp.dir / "z.csv"));
+  const CliResult der = run_quadgen({"derive", vehicle, "--out", "lnk/../zz"}, tmp.dir);
+  ASSERT_EQ(der.rc, 0) << der.err;
+  EXPECT_TRUE(fs::exists(tmp.dir / "far/zz/model.hpp"));
+  EXPECT_FALSE(fs::exists(tmp.dir / "zz"));
+  // A file name that is a directory's is refused as before.
+  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", "lnk/.."}, tmp.dir),
+                        "expected a .csv file name", "lnk/..");
+}
+
 TEST(DataLoss, OutputDirectoriesHoldingOtherFilesOrInputsAreRefused) {
   Scratch tmp;
   const std::string vehicle = tmp / "v.yaml";
