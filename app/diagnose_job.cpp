@@ -143,6 +143,7 @@ std::string logs_label(const std::vector<std::string>& paths) {
 DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   std::string error;
   if (!job.IsValid(&error)) throw std::invalid_argument("diagnose: " + error);
+  runtime::refuse_repeated_files(job.logs, "flight log");
   const Vehicle v = load_vehicle(job.vehicle);
   const fit::ColumnMapping mapping = job.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(job.mapping);
   diagnose::DiagnoseOptions o = job.options;

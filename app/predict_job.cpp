@@ -10,6 +10,7 @@
 #include "fit/flight_data.hpp"
 #include "output/json_document.hpp"
 #include "output/numbers.hpp"
+#include "runtime/log_file.hpp"
 #include "runtime/plot.hpp"
 
 namespace quadgen::app {
@@ -88,6 +89,7 @@ void check_something_measured(const predict::Prediction& pooled, const PredictJo
 }  // namespace
 
 PredictJobResult run_predict_job(const PredictJob& job_in, const Vehicle& v) {
+  runtime::refuse_repeated_files(job_in.logs, "flight log");
   PredictJobResult r;
   PredictJob job = job_in;
   if (!job.mapping.empty()) job.options.mapping = fit::load_mapping(job.mapping);  // read once, for every log

@@ -6,6 +6,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <map>
+#include <utility>
 
 #include "runtime/flight_log.hpp"
 
@@ -44,6 +46,19 @@ LogFile::LogFile(const std::string& path, const std::string& expected) : path_(p
 }
 
 LogFile::~LogFile() { ::close(fd_); }
+
+void refuse_repeated_files(const std::vector<std::string>& paths, const std::string& what) {
+  std::map<std::pair<dev_t, ino_t>, const std::string*> seen;
+  for (const auto& p : paths) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) != 0) continue;
+    const auto [at, inserted] = seen.emplace(std::make_pair(st.st_dev, st.st_ino), &p);
+    if (!inserted)
+      throw LogError(p + ": the same file as " + *at->second +
+                     (p == *at->second ? " (named twice)" : " (a link to it, or it to this)") + ": give each " + what +
+                     " once");
+  }
+}
 
 std::string read_head(const std::string& path, std::size_t n) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -5,6 +5,7 @@
 #pragma once
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace quadgen::runtime {
 
@@ -33,5 +34,11 @@ class LogFile {
   int fd_ = -1;
   unsigned long long size_ = 0, limit_ = 0;
 };
+
+// Refuses a file named twice among `paths`, by its name or by what it is (a hard or symbolic
+// link to one named before): one flight counted twice doubles its weight in a fit, and a joint
+// diagnosis would compare it with itself. A path that cannot be looked at is left to its
+// reader, which says why. Throws LogError naming both paths.
+void refuse_repeated_files(const std::vector<std::string>& paths, const std::string& what);
 
 }  // namespace quadgen::runtime

@@ -830,6 +830,23 @@ TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
                         "expected a .csv file name", "lnk/..");
 }
 
+// One flight named twice (or through a hard or symbolic link) doubled its weight in the fit
+// and had a joint diagnosis compare the flight with itself.
+TEST(DataLoss, ALogNamedTwiceIsRefused) {
+  Scratch tmp;
+  const std::string vehicle = tmp / "v.yaml";
+  fs::copy_file(source_path("vehicles/finken3.yaml"), vehicle);
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.2", "--out", "a.csv"}, tmp.dir).rc, 0);
+  fs::create_hard_link(tmp.dir / "a.csv", tmp.dir / "hard.csv");
+  fs::create_symlink("a.csv", tmp.dir / "sym.csv");
+  for (const std::string& second : {"a.csv", "hard.csv", "sym.csv"})
+    for (const std::string& command : {"diagnose", "predict"}) {
+      const CliResult r = run_quadgen({command, vehicle, "a.csv", second, "--out", "out"}, tmp.dir);
+      expect_one_line_error(r, second + ": the same file as a.csv", command + " a.csv " + second);
+      EXPECT_FALSE(fs::exists(tmp.dir / "out")) << command << " " << second;
+    }
+}
+
 TEST(DataLoss, OutputDirectoriesHoldingOtherFilesOrInputsAreRefused) {
   Scratch tmp;
   const std::string vehicle = tmp / "v.yaml";
