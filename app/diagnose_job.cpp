@@ -193,7 +193,14 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
              {"extended_model.json", ext.model_json},
              {"extended_derivation.md", ext.derivation_markdown},
              {"fitted_parameters.yaml", ext.fitted_parameters_yaml}};
-  if (!ext.fitted_vehicle_yaml.empty()) r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
+  if (!ext.fitted_vehicle_yaml.empty())
+    r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
+  else
+    r.notes.push_back(std::string("note: no fitted_vehicle.yaml: ") +
+                      (v.fitted_line > 0 ? "the vehicle file has a fitted: section already"
+                                         : "a fitted: section cannot be added to this vehicle file's YAML (a flow-style "
+                                           "or indented top level)") +
+                      "; fitted_parameters.yaml holds the values (quadgen derive VEHICLE --params it)");
   if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
     const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to, true);
     r.files.push_back({"discovered_model.hpp", disc.header});

@@ -1,7 +1,6 @@
 #include "app/extended_model.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <iterator>
 #include <sstream>
 #include <vector>
@@ -36,14 +35,11 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
   return y.str();
 }
 
-// The vehicle file as the user wrote it (comments kept), with the fitted values appended as
-// its `fitted:` section: `quadgen derive` on it builds the fitted model. Empty when the file
-// has a `fitted:` section already, or is not a block map a key can be appended to.
+}  // namespace
+
 std::string fitted_vehicle_yaml(const Vehicle& v, const std::string& fitted_parameters) {
   if (v.fitted_line > 0) return "";
-  std::ifstream in(v.source_path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), {});
-  if (!in.good() && !in.eof()) return "";
+  std::string text = v.source_text;
   if (!text.empty() && text.back() != '\n') text += '\n';
   std::ostringstream y;
   y << text << "\n# Written by quadgen diagnose: the effects it named and the values it fitted. `quadgen derive`\n"
@@ -58,8 +54,6 @@ std::string fitted_vehicle_yaml(const Vehicle& v, const std::string& fitted_para
   }
   return y.str();
 }
-
-}  // namespace
 
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
                                   const std::string& vehicle_file, const std::string& logs_label,

@@ -273,6 +273,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (root["fitted"]) v.fitted_line = root["fitted"].Mark().line + 1;
   v.source_path = path;
   v.content_hash = sha256_hex(content);
+  v.source_text = content;
   const YAML::Node name = r.need(root, "name", "the vehicle file");
   v.name = r.name(name, "vehicle name");
   if (const auto problem = output::vehicle_name_problem(v.name)) r.fail(name, "vehicle name '" + v.name + "': " + *problem);

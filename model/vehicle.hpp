@@ -73,6 +73,9 @@ struct Vehicle {
   std::string name;
   std::string source_path;
   std::string content_hash;  // SHA-256 of the file bytes, hex (model/sha256.hpp: why not FNV-1a)
+  // The bytes parsed and hashed: a copy of the file quadgen writes (fitted_vehicle.yaml) starts
+  // from these, never from a second read, which could find the file edited since.
+  std::string source_text;
   std::string description;
   std::vector<Block> blocks;
   std::vector<Rotor> rotors;

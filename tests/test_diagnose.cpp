@@ -30,6 +30,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/diagnose_job.hpp"
+#include "app/extended_model.hpp"
 #include "app/model_registry.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
@@ -1739,4 +1740,30 @@ TEST(ReportWords, TheMotorGainSentenceNamesOnlyGainsToldApartFromTheReference) {
   f.parameters[0].lower = 0.002;
   f.parameters[2].lower = 0.001;
   EXPECT_EQ(words::headline(f), "Motor M2 gives 1.2 % more thrust than motor M1; motor M3 8.0 % less; motor M4 0.20 % more.");
+}
+
+// fitted_vehicle.yaml is the vehicle file as the diagnosis read it, with the fitted values
+// appended: read again at the end, a file edited (or swapped) during a diagnosis of minutes
+// mixed another vehicle's text with this one's values (hostile-input audit, 2026-12-03).
+TEST(FittedVehicle, IsTheFileAsItWasReadNotAsItIsNow) {
+  const fs::path dir = fs::temp_directory_path() / "quadgen_fitted_vehicle_as_read";
+  fs::create_directories(dir);
+  const fs::path file = dir / "v.yaml";
+  fs::copy_file(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml", file, fs::copy_options::overwrite_existing);
+  const quadgen::Vehicle v = quadgen::load_vehicle(file.string());
+  std::ifstream in(file);
+  const std::string as_read((std::istreambuf_iterator<char>(in)), {});
+  { std::ofstream(file) << "name: another\n"; }
+  const std::string fitted = "effects: [motor_gain]\nparameters:\n  motor_gain.C: {value: -0.08, unit: \"1\"}\n";
+  const std::string y = quadgen::diagnose::fitted_vehicle_yaml(v, fitted);
+  ASSERT_FALSE(y.empty());
+  EXPECT_EQ(y.substr(0, as_read.size()), as_read);
+  EXPECT_EQ(y.find("name: another"), std::string::npos);
+  EXPECT_NE(y.find("\nfitted:\n  effects: [motor_gain]"), std::string::npos) << y;
+  // A top level indented as a whole is valid YAML, but a `fitted:` key cannot be appended to it.
+  std::string indented;
+  std::istringstream lines(as_read);
+  for (std::string line; std::getline(lines, line);) indented += (line.empty() ? "" : "  ") + line + "\n";
+  EXPECT_EQ(quadgen::diagnose::fitted_vehicle_yaml(quadgen::parse_vehicle(indented, "indented.yaml"), fitted), "");
+  fs::remove_all(dir);
 }
