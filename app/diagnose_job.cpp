@@ -14,6 +14,7 @@
 #include "app/extended_model.hpp"
 #include "derive/geometry.hpp"
 #include "output/joined.hpp"
+#include "output/numbers.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "fit/log_reader.hpp"
@@ -113,19 +114,30 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
   for (const auto& f : j["findings"]) {
     const std::string effect = f.value("effect", "");
     if (effect.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
+    const auto& catalogue = effect_catalogue();
+    if (std::none_of(catalogue.begin(), catalogue.end(), [&](const Effect& c) { return c.name == effect; }))
+      throw airframe_error(path, "findings: unknown effect '" + output::printable(effect) + "'");
     if (find_effect(effect).per_flight) continue;  // a flight's state, freed above
     diagnose::AirframeReference::Effect e{effect, {}, {}, {}, {}};
     for (const auto& [name, p] : f["parameters"].items()) {
       if (p.value("reference", false)) continue;
       known(name);
       const double v = number(p.value("value", nlohmann::json()), name);
+      // Compared with this flight's estimate: a value outside the parameter's bounds is no
+      // estimate quadgen could have written, and an infinite one broke the comparison's test.
+      const auto& bounds = all.params[all.param_index(name)];
+      if (!(v >= bounds.lower && v <= bounds.upper))
+        throw airframe_error(path, "findings: " + output::printable(name) + " = " + output::short_number(v) +
+                                       " lies outside its bounds [" + output::short_number(bounds.lower) + ", " +
+                                       output::short_number(bounds.upper) + "]");
       double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
+      if (!std::isfinite(se)) se = NAN;
       if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
           p["ci95"][1].is_number())
         se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * fit::kZ95);
       e.parameters.push_back(name);
       e.value.push_back(v);
-      e.standard_error.push_back(se > 0 ? se : 0.0);
+      e.standard_error.push_back(se > 0 && std::isfinite(se) ? se : 0.0);
       e.off.push_back(diagnose::neutral_value(all.params[all.param_index(name)]));
     }
     if (!e.parameters.empty()) ref.effects.push_back(e);
