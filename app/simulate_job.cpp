@@ -49,6 +49,8 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   for (const auto& [name, value] : a.set) {
     const int i = truth.param_index(name);
     if (i < 0) throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model (add its effect with --effects)");
+    const std::string problem = runtime::value_problem(truth.parameters()[static_cast<size_t>(i)], value, false);
+    if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
   }
   truth.set_params(p);

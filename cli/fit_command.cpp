@@ -1,5 +1,6 @@
 // quadgen fit VEHICLE.yaml LOG --out DIR: flags to options; the fits are fit/fit_pipeline.
 // The kind of fit follows the log's layout; an option that kind does not use is refused.
+#include <algorithm>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -52,21 +53,27 @@ void add_fit(CLI::App& app, FitArgs& a) {
 
 namespace {
 
-std::vector<std::string> split_list(const std::string& s) {
+// A comma-separated option value; a name given twice is refused (a channel listed twice was
+// weighted twice in the fit), as --candidates and --effects refuse one.
+std::vector<std::string> split_list(const std::string& s, const std::string& option) {
   std::vector<std::string> out;
   std::stringstream ss(s);
   std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
+  while (std::getline(ss, item, ',')) {
+    if (item.empty()) continue;
+    if (std::find(out.begin(), out.end(), item) != out.end())
+      throw std::invalid_argument(option + ": '" + output::printable(item) + "' is given twice");
+    out.push_back(item);
+  }
   return out;
 }
 
 FitJobOptions job_options(const FitArgs& a) {
   FitJobOptions o = a.options;
   o.profile_all_free = a.profiles != "none";
-  if (a.profiles != "all" && a.profiles != "none") o.profiles = split_list(a.profiles);
-  o.channels = split_list(a.channels);
-  o.free = split_list(a.free);
+  if (a.profiles != "all" && a.profiles != "none") o.profiles = split_list(a.profiles, "--profiles");
+  o.channels = split_list(a.channels, "--channels");
+  o.free = split_list(a.free, "--free");
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   return o;
 }

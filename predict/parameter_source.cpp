@@ -66,12 +66,16 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
 
 void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::json& entries, const char* key,
                           std::vector<double>& p) const {
+  const std::vector<runtime::Parameter> declared = model.parameters();
   for (const auto& [name, entry] : entries.items()) {
     if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
       throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " has no numeric value");
     const int i = model.param_index(name);
     if (i >= 0) {
-      p[static_cast<size_t>(i)] = entry["value"].get<double>();
+      const double value = entry["value"].get<double>();
+      const std::string problem = runtime::value_problem(declared[static_cast<size_t>(i)], value, true);
+      if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
+      p[static_cast<size_t>(i)] = value;
       continue;
     }
     // Another flight's copy (name@k, k = 2 .. the number of flights) of a per-flight
@@ -86,6 +90,9 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
     if (k < 2 || (!flights_.empty() && k > static_cast<int>(flights_.size())))
       throw std::invalid_argument(path_ + ": '" + output::printable(name) + "': a flight's copy is name@k with k from 2 to " +
                                   std::to_string(flights_.size()) + ", the number of flights");
+    const std::string problem = runtime::value_problem(declared[static_cast<size_t>(model.param_index(name.substr(0, at)))],
+                                                       entry["value"].get<double>(), true);
+    if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
   }
 }
 

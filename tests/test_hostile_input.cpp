@@ -1298,6 +1298,43 @@ TEST(Cli, PredictExitsNonZeroWhenTheModelLeavesItsRange) {
   EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", tmp / "good.json", "--out", tmp / "q"}, tmp.dir).rc, 0);
 }
 
+// Values from outside the vehicle file (predict --params, simulate --set) that no model can
+// run with were taken as they were: a negative mass predicted and flew with exit 0, a zero
+// inertia ended in "state x = nan" naming neither the file nor the option. Refused with the
+// parameter named; predict also holds a value to its bounds, as derive --params does.
+TEST(Cli, ParameterValuesFromOutsideAreChecked) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "2", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  const auto params = [&](const std::string& name, const std::string& entries) {
+    write(tmp / name, R"({"vehicle": "finken3", "estimates": {)" + entries + "}}");
+    return tmp / name;
+  };
+  const auto predict = [&](const std::string& file) {
+    return run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", file, "--out", tmp / "p"}, tmp.dir);
+  };
+  expect_one_line_error(predict(params("negative.json", R"("mass": {"value": -1})")),
+                        "negative.json: estimates.mass = -1 is outside its bounds", "mass -1");
+  expect_one_line_error(predict(params("zero.json", R"("J_zz": {"value": 0})")),
+                        "zero.json: estimates.J_zz = 0: a mass and a principal moment of inertia must be positive", "J_zz 0");
+  expect_one_line_error(predict(params("lag.json", R"("motor_lag.tau": {"value": 5})")),
+                        "lag.json: estimates.motor_lag.tau = 5 is outside its bounds", "tau 5");
+  EXPECT_FALSE(fs::exists(tmp / "p"));
+  const auto simulate = [&](const std::string& setting) {
+    return run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "1", "--set", setting, "--out", tmp / "s.csv"},
+                       tmp.dir);
+  };
+  expect_one_line_error(simulate("mass=-1"), "--set: mass = -1: a mass and a principal moment of inertia must be positive",
+                        "--set mass=-1");
+  expect_one_line_error(simulate("J_xx=0"), "--set: J_xx = 0: a mass", "--set J_xx=0");
+  expect_one_line_error(simulate("c_t=nan"), "'nan' is not a finite number", "--set c_t=nan");  // the command line's own check
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
+  // A channel listed twice was weighted twice.
+  expect_one_line_error(run_quadgen({"fit", vehicle, tmp / "f.csv", "--channels", "ax,qdot,ax", "--out", tmp / "o"}, tmp.dir),
+                        "--channels: 'ax' is given twice", "--channels ax,qdot,ax");
+  EXPECT_FALSE(fs::exists(tmp / "o"));
+}
+
 // A newcomer's likely mistakes (a review that used the tool as a new user would): each gets one
 // line that names the word, the file or the missing piece, and what would work.
 TEST(Cli, NewcomerMistakesAreNamed) {
