@@ -15,6 +15,8 @@
 #include "output/joined.hpp"
 #include "output/sinks.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/flight_log.hpp"
+#include "runtime/log_file.hpp"
 
 namespace quadgen {
 
@@ -54,19 +56,15 @@ struct YamlReader {
     throw VehicleError(os.str());
   }
 
-  // The file's text; `what` names it in the error ("vehicle file").
+  // The file's text; `what` names it in the error ("vehicle file"). Opened as every log is
+  // (runtime::LogFile): a FIFO or a directory refused at once, checked on what was opened,
+  // at most max_input_bytes(), and a read cut short is an error, never taken as the file.
   std::string read_file(const std::string& what) const {
-    // A directory reads as empty and a FIFO blocks: refuse what is not a regular file.
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (std::filesystem::is_directory(status)) throw VehicleError(path + ": a directory; expected a " + what);
-    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
-      throw VehicleError(path + ": not a regular file (a FIFO or a device); expected a " + what);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw VehicleError(path + ": cannot open " + what);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    try {
+      return runtime::LogFile(path, "a " + what).read_all();
+    } catch (const runtime::LogError& e) {
+      throw VehicleError(e.what());
+    }
   }
 
   YAML::Node parse(const std::string& content) const {

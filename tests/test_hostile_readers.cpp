@@ -521,8 +521,9 @@ TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
       std::string::npos);
   // The YAML inputs beside the log: a mapping, a vehicle file.
   EXPECT_NE(message_of<FitError>([&] { load_mapping(fifo); }).find(fifo + ": a FIFO, not a regular file"), std::string::npos);
-  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(fifo); }).find(fifo + ": not a regular file"), std::string::npos);
-  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(dir_.string()); }).find(": a directory; expected a vehicle file"),
+  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(fifo); }).find(fifo + ": a FIFO, not a regular file (expected a vehicle file)"),
+            std::string::npos);
+  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(dir_.string()); }).find(": a directory, not a regular file (expected a vehicle file)"),
             std::string::npos);
   EXPECT_NE(message_of<runtime::LogError>([&] {
               runtime::read_csv(dir_.string());
@@ -536,6 +537,12 @@ TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
   EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(path); })
                 .find(path + ": " + std::to_string(text.size()) +
                       " bytes, above the limit of 100 bytes (set QUADGEN_MAX_INPUT_BYTES"),
+            std::string::npos);
+  // A vehicle file is held to the same limit (it had none, and a read cut short by memory
+  // was taken as the whole file).
+  const std::string big = "name: big\n" + std::string(200, '#') + "\n", vehicle = write("big.yaml", big);
+  EXPECT_NE(message_of<VehicleError>([&] { load_vehicle(vehicle); })
+                .find(vehicle + ": " + std::to_string(big.size()) + " bytes, above the limit of 100 bytes"),
             std::string::npos);
   ::setenv("QUADGEN_MAX_INPUT_BYTES", "lots", 1);
   EXPECT_NE(message_of<runtime::LogError>([&] { runtime::read_csv(path); }).find("QUADGEN_MAX_INPUT_BYTES='lots'"),
