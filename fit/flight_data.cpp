@@ -447,6 +447,13 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
   f.has_attitude_ref = has({"phi_ref", "theta_ref"});
   if (!f.has_gyro)
     throw FitError(runtime::missing_columns_message(log, {"p", "q", "r"}, {"the body rates (gyro)", "rad/s", ""}));
+  // Part of the accelerometer logged (a header misspelt, or spelt with a look-alike letter):
+  // the fit would change its formulation without a word.
+  std::vector<std::string> accel_has, accel_lacks;
+  for (const char* c : {"ax", "ay", "az"}) (log.column(c) >= 0 ? accel_has : accel_lacks).push_back(c);
+  if (!accel_has.empty() && !accel_lacks.empty())
+    f.notes.push_back(log.where_named() + ": the accelerometer is not read: it has " + output::joined(accel_has) +
+                      " but not " + output::joined(accel_lacks));
   if (f.has_pose) return;
   const std::string lacks = pose_lacks(log), pose = std::string("x, y, z and ") + kAttitudeColumnSets;
   if (!f.has_accelerometer)

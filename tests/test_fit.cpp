@@ -276,6 +276,18 @@ TEST(FitCli, APoseThatCannotBeReadIsAWarning) {
   EXPECT_NE(r.err.find("flight\\x1B[31m.csv:1: no pose is read, only the accelerometer"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("it has phi, theta but not psi"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "a raw escape reached the terminal";
+  // A whole pose and part of the accelerometer (ay spelt with a Cyrillic a): the fit leaves the
+  // accelerometer out and says so, where it changed its formulation without a word.
+  std::string posed = text;
+  posed.replace(posed.find("phi,theta,yaw"), 13, "qw,qx,qy,qz");
+  posed.replace(posed.find(",ay,"), 4, ",\xd0\xb0y,");
+  for (size_t at = posed.find("\n"); at != std::string::npos && at + 1 < posed.size(); at = posed.find("\n", at + 1))
+    posed.replace(posed.find(",0,0,0,0,0,0,", at), 13, ",1,0,0,0,0,0,0,");  // level: qw = 1
+  const fs::path mixed = dir / "mixed.csv";
+  std::ofstream(mixed) << posed;
+  const CliRun m = run_fit(test::source_path("vehicles/crazyflie21.yaml"), mixed.string(), (dir / "out2").string());
+  EXPECT_EQ(m.rc, 0) << m.err;
+  EXPECT_NE(m.err.find("mixed.csv:1: the accelerometer is not read: it has ax, az but not ay"), std::string::npos) << m.err;
   fs::remove_all(dir);
 }
 
