@@ -104,8 +104,12 @@ std::vector<runtime::Panel> autocorrelation_panels(const Diagnosis& d) {
 // The answer to the commands, band by band: one series per flight, 1 where the model is right.
 std::vector<runtime::Panel> command_gain_panels(const Diagnosis& d) {
   std::vector<std::pair<std::string, const CommandGain*>> gains;
-  for (const auto& [flight, g] : command_gains_by_flight(d))
-    gains.emplace_back(flight.empty() ? "this flight" : std::filesystem::path(flight).stem().string(), g);
+  const auto by_flight = command_gains_by_flight(d);
+  std::vector<std::string> paths;
+  for (const auto& [flight, g] : by_flight) paths.push_back(flight);
+  const std::vector<std::string> labels = short_flight_labels(paths);
+  for (size_t i = 0; i < by_flight.size(); ++i)
+    gains.emplace_back(by_flight[i].first.empty() ? "this flight" : labels[i], by_flight[i].second);
   std::vector<runtime::Panel> gain_panels;
   for (size_t a = 0; a < 3; ++a) {
     runtime::Panel panel{"", "band centre [Hz]", "gain (1: as the model)", {}};

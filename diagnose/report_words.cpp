@@ -1,6 +1,8 @@
 #include "diagnose/report_words.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -176,6 +178,17 @@ std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(
   if (d.command_gain_per_flight.empty()) out.emplace_back("", &d.command_gain);
   for (size_t i = 0; i < d.command_gain_per_flight.size() && i < d.flights.size(); ++i)
     out.emplace_back(d.flights[i], &d.command_gain_per_flight[i]);
+  return out;
+}
+
+std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths) {
+  std::vector<std::string> stems;
+  for (const auto& p : paths) stems.push_back(std::filesystem::path(p).stem().string());
+  std::vector<std::string> out;
+  for (size_t i = 0; i < stems.size(); ++i) {
+    const bool shared = std::count(stems.begin(), stems.end(), stems[i]) > 1;
+    out.push_back(shared ? "flight " + std::to_string(i + 1) + " (" + stems[i] + ")" : stems[i]);
+  }
   return out;
 }
 

@@ -31,6 +31,11 @@ std::string point_of_action_headline(const PointOfAction& p);
 // The command-gain check per flight of a joint diagnosis (the flight's log), or the one
 // flight's (named "").
 std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(const Diagnosis& d);
+
+// Short names of flights for a plot's legend: each log's file name without its folder and
+// extension, and where two share one (day1/log.csv, day2/log.csv) "flight k (log)" for each
+// of those, so that no two series carry one name.
+std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths);
 // What the screening says in words: flights left out, or a caution on an unusable flight
 // diagnosed anyway (the flight's path made printable: these go to a terminal too).
 std::vector<std::string> screening_notes(const Diagnosis& d);

@@ -1767,3 +1767,12 @@ TEST(FittedVehicle, IsTheFileAsItWasReadNotAsItIsNow) {
   EXPECT_EQ(quadgen::diagnose::fitted_vehicle_yaml(quadgen::parse_vehicle(indented, "indented.yaml"), fitted), "");
   fs::remove_all(dir);
 }
+
+// A plot's legend names each flight by its file; two logs of one name in two folders shared
+// one series name in the command-gain plot (hostile-input audit, 2026-12-03).
+TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {
+  using quadgen::diagnose::words::short_flight_labels;
+  EXPECT_EQ(short_flight_labels({"data/B2.csv", "B3.csv"}), (std::vector<std::string>{"B2", "B3"}));
+  EXPECT_EQ(short_flight_labels({"day1/log.csv", "B3.csv", "day2/log.csv"}),
+            (std::vector<std::string>{"flight 1 (log)", "B3", "flight 3 (log)"}));
+}
