@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include "output/joined.hpp"
@@ -70,6 +71,9 @@ struct YamlReader {
   YAML::Node parse(const std::string& content) const {
     try {
       return YAML::Load(content);
+    } catch (const YAML::DeepRecursion& e) {  // its own message reads "bad file"
+      fail_at(e.mark, "malformed YAML: nested more deeply than the reader follows (" + std::to_string(e.depth()) +
+                          " levels of lists or mappings)");
     } catch (const YAML::ParserException& e) {
       fail_at(e.mark, "malformed YAML: " + e.msg + yaml_slip(content, e.mark.line, e.msg));
     }

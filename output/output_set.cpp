@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -102,6 +103,15 @@ fs::path resolved_file(const std::string& name) {
   if (!p.has_filename() || p.filename() == "." || p.filename() == "..") fail(p, "names a directory; expected a file name");
   const fs::path parent = fs::weakly_canonical(p.parent_path(), ec);
   return (ec ? p.parent_path().lexically_normal() : parent) / p.filename();
+}
+
+// A name longer than a file system takes (NAME_MAX, 255 bytes on Linux's) failed only at the
+// end, when the finished output was moved into place: refused before the work instead.
+void check_name_lengths(const fs::path& p) {
+  for (const auto& part : p)
+    if (part.string().size() > NAME_MAX)
+      fail(p, "has a name of " + std::to_string(part.string().size()) + " bytes, longer than the " +
+                  std::to_string(NAME_MAX) + " a file system takes; choose a shorter one");
 }
 
 bool inside(const fs::path& child, const fs::path& parent) {
@@ -619,6 +629,7 @@ OutputDirectory::OutputDirectory(const std::string& dir, const std::string& comm
     : command_(command), inputs_(inputs) {
   const fs::path target = resolved(dir);
   dir_ = target.string();
+  check_name_lengths(target);
   check_not_above_working_directory(target);
   check_not_input(target, inputs_);
   check_replaceable(target, command_);
@@ -674,6 +685,7 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   std::error_code ec;
   for (const auto& name : paths) {
     const fs::path p = resolved_file(name);
+    check_name_lengths(p);
     if (!plain_file_name(p.filename().string()))
       fail(p, "cannot be an output file name (a control character or line break in it, a blank at its start or end, "
               "or a name beginning '.quadgen'); choose another");

@@ -825,6 +825,13 @@ TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
   ASSERT_EQ(der.rc, 0) << der.err;
   EXPECT_TRUE(fs::exists(tmp.dir / "far/zz/model.hpp"));
   EXPECT_FALSE(fs::exists(tmp.dir / "zz"));
+  // A name longer than the file system takes is refused before the work, not when the output
+  // is moved into place at the end.
+  const std::string long_name(300, 'n');
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", long_name}, tmp.dir), "has a name of 300 bytes", "--out 300");
+  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", long_name + ".csv"},
+                                    tmp.dir),
+                        "has a name of 304 bytes", "--out 300.csv");
   // A file name that is a directory's is refused as before.
   expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", "lnk/.."}, tmp.dir),
                         "expected a .csv file name", "lnk/..");
@@ -1377,6 +1384,10 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   expect_error({"diagnose", cf, f3, "--out", tmp / "o"}, 2, "finken3.yaml:1: no CSV header");
   // A stray comma in an effect list; a thrust-stand fit given as a flight model's values.
   expect_error({"derive", f3, "--effects", "motor_lag,", "--out", tmp / "o"}, 2, "has an empty name");
+  expect_error({"derive", f3, "--effects", "all,wind", "--out", tmp / "o"}, 2, "'all' stands alone");
+  // Lists nested past the YAML reader's depth guard: said as such, not as its "bad file".
+  write(tmp / "deep.yaml", "name: deep\nblocks: " + std::string(600, '[') + std::string(600, ']') + "\n");
+  expect_error({"derive", tmp / "deep.yaml", "--out", tmp / "o"}, 2, "deep.yaml:2: malformed YAML: nested more deeply than");
   write(tmp / "stand.json", R"({"kind": "thrust_stand", "summary": {}, "thrust_vs_speed": {"estimates": {}}})");
   expect_error({"predict", cf, tmp / "f.csv", "--params", tmp / "stand.json", "--out", tmp / "o"}, 2,
                "a thrust-stand fit describes the motors");

@@ -159,6 +159,8 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
+    if (item == "all")
+      throw std::invalid_argument("effect list '" + text + "': 'all' stands alone (it is every effect); name effects or write all");
     if (!known.count(item)) {
       throw std::invalid_argument("unknown effect '" + item + "' (known: " + catalogue_names() + ", or all)");
     }
