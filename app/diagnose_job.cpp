@@ -14,13 +14,13 @@
 #include "app/extended_model.hpp"
 #include "derive/geometry.hpp"
 #include "output/joined.hpp"
-#include "output/numbers.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "fit/log_reader.hpp"
 #include "app/model_registry.hpp"
 #include "model/vehicle.hpp"
 #include "runtime/log_file.hpp"
+#include "runtime/parameter.hpp"
 
 namespace quadgen::app {
 
@@ -125,11 +125,10 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
       const double v = number(p.value("value", nlohmann::json()), name);
       // Compared with this flight's estimate: a value outside the parameter's bounds is no
       // estimate quadgen could have written, and an infinite one broke the comparison's test.
-      const auto& bounds = all.params[all.param_index(name)];
-      if (!(v >= bounds.lower && v <= bounds.upper))
-        throw airframe_error(path, "findings: " + output::printable(name) + " = " + output::short_number(v) +
-                                       " lies outside its bounds [" + output::short_number(bounds.lower) + ", " +
-                                       output::short_number(bounds.upper) + "]");
+      const auto& declared = all.params[all.param_index(name)];
+      const std::string problem =
+          runtime::value_problem({declared.name, declared.unit, declared.nominal, declared.lower, declared.upper}, v, true);
+      if (!problem.empty()) throw airframe_error(path, "findings: " + output::printable(name) + " " + problem);
       double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
       if (!std::isfinite(se)) se = NAN;
       if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
@@ -208,11 +207,13 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   if (!ext.fitted_vehicle_yaml.empty())
     r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
   else
-    r.notes.push_back(std::string("note: no fitted_vehicle.yaml: ") +
-                      (v.fitted_line > 0 ? "the vehicle file has a fitted: section already"
-                                         : "a fitted: section cannot be added to this vehicle file's YAML (a flow-style "
-                                           "or indented top level)") +
-                      "; fitted_parameters.yaml holds the values (quadgen derive VEHICLE --params it)");
+    r.notes.push_back(v.fitted_line > 0
+                          ? "note: no fitted_vehicle.yaml: the vehicle file has a fitted: section already; to build "
+                            "this fitted model, put fitted_parameters.yaml's lines in its place (or remove it and "
+                            "run quadgen derive VEHICLE --params fitted_parameters.yaml)"
+                          : "note: no fitted_vehicle.yaml: a fitted: section cannot be added to this vehicle file's "
+                            "YAML (a flow-style or indented top level); fitted_parameters.yaml holds the values "
+                            "(quadgen derive VEHICLE --params fitted_parameters.yaml)");
   if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
     const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to, true);
     r.files.push_back({"discovered_model.hpp", disc.header});

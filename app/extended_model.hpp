@@ -19,15 +19,15 @@ struct ExtendedModelFiles {
   std::string fitted_vehicle_yaml;      // fitted_vehicle.yaml: the vehicle file plus `fitted:` ("": not written)
 };
 
-// `vehicle_file` and `logs_label` say in the header where the model and its values came from.
-// With `with_proposed_terms`, the terms proposed beyond the catalogue are added too (written
-// as discovered_model.hpp: a lead, not the named causes' model).
 // The vehicle file as it was read (v.source_text, comments kept; not read again, so a file
 // edited during the diagnosis does not mix into it), with the fitted values appended as its
 // `fitted:` section: `quadgen derive` on it builds the fitted model. Empty when the file has
 // a `fitted:` section already, or is not a block map a key can be appended to.
 std::string fitted_vehicle_yaml(const Vehicle& v, const std::string& fitted_parameters);
 
+// `vehicle_file` and `logs_label` say in the header where the model and its values came from.
+// With `with_proposed_terms`, the terms proposed beyond the catalogue are added too (written
+// as discovered_model.hpp: a lead, not the named causes' model).
 ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, const Diagnosis& d,
                                   const std::string& vehicle_file, const std::string& logs_label,
                                   bool with_proposed_terms = false);

@@ -1,17 +1,17 @@
 #include "derive/fitted_parameters.hpp"
 
 #include <algorithm>
-#include <sstream>
 
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/sinks.hpp"
 #include "model/yaml_reader.hpp"
+#include "runtime/parameter.hpp"
 
 namespace quadgen {
 
 FittedParameters load_fitted_parameters(const std::string& path) {
   const YamlReader r{path};
-  const YAML::Node file = r.parse(r.read_file("fitted parameters"));
+  const YAML::Node file = r.parse(r.read_file("fitted-parameters file"));
   if (!file.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
   // The other files a user may hand over by mistake (YAML reads JSON too): name the one expected.
   if (file["final_fit"] || file["estimates"] || file["findings"])
@@ -68,11 +68,8 @@ void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitte
       if (q.name == v.name) p = &q;
     if (!p) throw VehicleError(where + "no parameter '" + v.name + "' in this model (effects: " + model.effect_list(", ") + ")");
     if (v.unit != p->unit) throw VehicleError(where + v.name + " is in " + p->unit + ", the file says " + v.unit);
-    if (p->lower < p->upper && (v.value < p->lower || v.value > p->upper)) {
-      std::ostringstream os;
-      os << where << v.name << " = " << v.value << " is outside its bounds [" << p->lower << ", " << p->upper << "]";
-      throw VehicleError(os.str());
-    }
+    const std::string problem = runtime::value_problem({p->name, p->unit, p->nominal, p->lower, p->upper}, v.value, true);
+    if (!problem.empty()) throw VehicleError(where + v.name + " " + problem);
     p->nominal = v.value;
   }
 }

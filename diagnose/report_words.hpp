@@ -36,6 +36,7 @@ std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(
 // extension, and where two share one (day1/log.csv, day2/log.csv) "flight k (log)" for each
 // of those, so that no two series carry one name.
 std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths);
+
 // What the screening says in words: flights left out, or a caution on an unusable flight
 // diagnosed anyway (the flight's path made printable: these go to a terminal too).
 std::vector<std::string> screening_notes(const Diagnosis& d);

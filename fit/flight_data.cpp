@@ -150,8 +150,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg +
-                   yaml_slip(text, e.mark.line, e.msg));
+    throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": " + malformed_yaml(e, text));
   }
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;

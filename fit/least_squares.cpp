@@ -213,8 +213,9 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
       xf.push_back(x[i] / scale.back());
     }
   if (xf.empty()) {
+    const double cost = cost_without_free_parameters(model, params, w, opt);
     if (converged) *converged = true;
-    return cost_without_free_parameters(model, params, w, opt);
+    return cost;
   }
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;

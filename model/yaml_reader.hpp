@@ -4,8 +4,6 @@
 // silently).
 #pragma once
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -41,6 +39,15 @@ inline std::string yaml_slip(const std::string& text, int line, const std::strin
   return "";
 }
 
+// "malformed YAML: ..." for a parser error in `text`, with the likely slip; yaml-cpp's depth
+// guard (lists or mappings nested past it) says "bad file", so it is said in words here.
+inline std::string malformed_yaml(const YAML::ParserException& e, const std::string& text) {
+  if (const auto* deep = dynamic_cast<const YAML::DeepRecursion*>(&e))
+    return "malformed YAML: nested more deeply than the reader follows (" + std::to_string(deep->depth()) +
+           " levels of lists or mappings)";
+  return "malformed YAML: " + e.msg + yaml_slip(text, e.mark.line, e.msg);
+}
+
 struct YamlReader {
   std::string path;
 
@@ -71,11 +78,8 @@ struct YamlReader {
   YAML::Node parse(const std::string& content) const {
     try {
       return YAML::Load(content);
-    } catch (const YAML::DeepRecursion& e) {  // its own message reads "bad file"
-      fail_at(e.mark, "malformed YAML: nested more deeply than the reader follows (" + std::to_string(e.depth()) +
-                          " levels of lists or mappings)");
     } catch (const YAML::ParserException& e) {
-      fail_at(e.mark, "malformed YAML: " + e.msg + yaml_slip(content, e.mark.line, e.msg));
+      fail_at(e.mark, malformed_yaml(e, content));
     }
   }
 

@@ -81,17 +81,18 @@ void fsync_path(const fs::path& p, int flags) {
   if (rc != 0) fail(p, "cannot sync to disk: " + errno_text());
 }
 
-// The absolute form of a path named on the command line, resolved as the kernel resolves it:
-// symbolic links in its existing part followed before a '..' after them is applied (so that
-// `link/../x` is x beside the link's target, where the file system puts it, not beside the
-// link), a trailing '/' dropped.
+// The absolute form of a path named on the command line: symbolic links in its existing part
+// followed before a '..' after them is applied, as the file system does (so that `link/../x`
+// is x beside the link's target, not beside the link); the part that does not exist yet taken
+// as written, normalised; no trailing '/' (`new/.` is `new`).
 fs::path resolved(const std::string& name) {
   if (name.empty()) throw OutputError("an output path is empty");
   std::error_code ec;
-  fs::path p = fs::absolute(fs::path(name), ec);
-  if (!p.has_filename()) p = p.parent_path();
-  const fs::path r = fs::weakly_canonical(p, ec);
-  return ec ? p.lexically_normal() : r;
+  const fs::path p = fs::absolute(fs::path(name), ec);
+  fs::path r = fs::weakly_canonical(p, ec);
+  if (ec) r = p.lexically_normal();
+  while (!r.has_filename() && r.has_relative_path()) r = r.parent_path();
+  return r;
 }
 
 // A file path named on the command line: its folder resolved, the file itself not (so that a

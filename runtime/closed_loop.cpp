@@ -4,6 +4,7 @@
 #include <limits>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -406,7 +407,12 @@ struct UnmodelledForces {
 // into each period.
 class DelayedCommands {
  public:
-  DelayedCommands(double delay, double dt) : whole_(static_cast<long>(std::floor(delay / dt + 1e-6))) {
+  DelayedCommands(double delay, double dt, double duration) {
+    // A negative delay would read commands not yet sent, one beyond the flight none sent.
+    if (!(delay >= 0 && delay <= duration))
+      throw std::invalid_argument("input_delay.seconds = " + std::to_string(delay) + ": expected 0 to the flight's " +
+                                  std::to_string(duration) + " s");
+    whole_ = static_cast<long>(std::floor(delay / dt + 1e-6));
     rest_ = delay - static_cast<double>(whole_) * dt;
     if (rest_ < 1e-6) rest_ = 0;
   }
@@ -420,20 +426,27 @@ class DelayedCommands {
 
  private:
   const std::vector<double>& sent_at(long i) const { return sent_[static_cast<size_t>(std::max(0L, i))]; }
-  long whole_;
+  long whole_ = 0;
   double rest_ = 0;
   std::vector<std::vector<double>> sent_;  // commands of every control step
 };
 
-// The true model over control period k (from t0, dt long), the rotor commands held as the
-// delay has them; the extra inputs (battery voltage, wind...) follow the clock.
-void fly_one_period(const DynamicModel& truth, std::vector<double>& x, const DelayedCommands& commands, long k,
-                    const ExtraInputs& extra, int nr, double t0, double dt, double vbat, const IntegratorOptions& io) {
+// One control period: its number, start [s], length [s] and the battery voltage in it [V].
+struct ControlPeriod {
+  long k;
+  double t0, dt, vbat;
+};
+
+// The true model over one control period, the rotor commands (the first `nr` inputs) held as
+// the delay has them; the extra inputs (battery voltage, wind...) follow the clock.
+void fly_one_period(const DynamicModel& truth, std::vector<double>& x, const DelayedCommands& commands,
+                    const ExtraInputs& extra, int nr, const ControlPeriod& period, const IntegratorOptions& io) {
   bool before_switch = false;
   auto inputs = [&](double tt, double* uu) {
-    const std::vector<double>& held = before_switch ? commands.before_switch(k) : commands.after_switch(k);
+    const std::vector<double>& held =
+        before_switch ? commands.before_switch(period.k) : commands.after_switch(period.k);
     for (int i = 0; i < nr; ++i) uu[i] = held[i];
-    extra.fill(t0 + tt, vbat, uu);
+    extra.fill(period.t0 + tt, period.vbat, uu);
   };
   // Integrate up to the switch and on from it, so that no RK4 step straddles it.
   if (commands.rest() > 0) {
@@ -441,7 +454,7 @@ void fly_one_period(const DynamicModel& truth, std::vector<double>& x, const Del
     x = integrate_rk4(truth, x, inputs, 0.0, commands.rest(), io).x.back();
     before_switch = false;
   }
-  x = integrate_rk4(truth, x, inputs, commands.rest(), dt, io).x.back();
+  x = integrate_rk4(truth, x, inputs, commands.rest(), period.dt, io).x.back();
 }
 
 }  // namespace
@@ -467,7 +480,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
   // logs is the model's measurement h(x) (q ⊗ q_bias under attitude_bias; it flies on that
   // estimate), and the motors act on the commands of `delay` seconds ago.
   const int delay_param = truth.input_delay_param();
-  DelayedCommands commands(delay_param >= 0 ? truth.params()[delay_param] : 0.0, dt);
+  DelayedCommands commands(delay_param >= 0 ? truth.params()[delay_param] : 0.0, dt, o.duration);
   std::vector<double> logged(truth.num_outputs());
   const int logged_q = truth.num_outputs() - 4;  // h = (position, quaternion)
   std::vector<double> u(truth.num_inputs(), 0.0), f(truth.num_states());
@@ -495,7 +508,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, controller.desired(), rng, gauss));
     if (k == steps) break;
     // --- plant: the true model over one control period ---
-    fly_one_period(truth, x, commands, k, extra, nr, t, dt, vbat, io);
+    fly_one_period(truth, x, commands, extra, nr, {k, t, dt, vbat}, io);
     unmodelled.apply(x, ref, gauss);
     if (x[kPosition + 2] < -5 || (p_at_t - r.position()).norm() > 20)
       throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");

@@ -4,8 +4,6 @@
 // tape carry all of it, so a fit needs no symbolic derivation when a compiled header matches.
 // fit::FitParameter is this record.
 #pragma once
-#include <cmath>
-#include <sstream>
 #include <string>
 
 namespace quadgen::runtime {
@@ -16,21 +14,12 @@ struct Parameter {
   bool free = true;
 };
 
-// Why `value` cannot be given to `p` from outside (predict --params, simulate --set), or ""
-// when it can: not finite; with `within_bounds`, outside p's bounds where it has any (lower <
-// upper; `derive --params` holds values to the same); the rigid body's mass and principal
-// moments of inertia not positive, which the model would integrate without a word (a test
-// flight's truth may lie outside what a fit searches, so simulate checks no bounds).
-inline std::string value_problem(const Parameter& p, double value, bool within_bounds) {
-  std::ostringstream os;
-  if (!std::isfinite(value)) {
-    os << "is not finite";
-  } else if (within_bounds && p.lower < p.upper && (value < p.lower || value > p.upper)) {
-    os << "= " << value << " is outside its bounds [" << p.lower << ", " << p.upper << "]";
-  } else if ((p.name == "mass" || p.name == "J_xx" || p.name == "J_yy" || p.name == "J_zz") && !(value > 0)) {
-    os << "= " << value << ": a mass and a principal moment of inertia must be positive";
-  }
-  return os.str();
-}
+// Why `value` cannot be given to `p` from outside (predict --params, derive --params, a
+// diagnosis read by --airframe, simulate --set), or "" when it can: not finite; with
+// `within_bounds`, outside p's bounds where it has any (lower < upper; equal bounds hold a
+// parameter fixed, and any value may replace it); the rigid body's mass and principal moments
+// of inertia not positive, which the model would integrate without a word. (A test flight's
+// truth may lie outside what a fit searches, so simulate checks no bounds.)
+std::string value_problem(const Parameter& p, double value, bool within_bounds);
 
 }  // namespace quadgen::runtime

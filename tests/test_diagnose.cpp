@@ -1764,7 +1764,8 @@ TEST(FittedVehicle, IsTheFileAsItWasReadNotAsItIsNow) {
   std::string indented;
   std::istringstream lines(as_read);
   for (std::string line; std::getline(lines, line);) indented += (line.empty() ? "" : "  ") + line + "\n";
-  EXPECT_EQ(quadgen::diagnose::fitted_vehicle_yaml(quadgen::parse_vehicle(indented, "indented.yaml"), fitted), "");
+  { std::ofstream(dir / "indented.yaml") << indented; }
+  EXPECT_EQ(quadgen::diagnose::fitted_vehicle_yaml(quadgen::load_vehicle((dir / "indented.yaml").string()), fitted), "");
   fs::remove_all(dir);
 }
 

@@ -279,10 +279,15 @@ TEST(FitCli, APoseThatCannotBeReadIsAWarning) {
   // A whole pose and part of the accelerometer (ay spelt with a Cyrillic a): the fit leaves the
   // accelerometer out and says so, where it changed its formulation without a word.
   std::string posed = text;
+  ASSERT_NE(posed.find("phi,theta,yaw"), std::string::npos);
   posed.replace(posed.find("phi,theta,yaw"), 13, "qw,qx,qy,qz");
+  ASSERT_NE(posed.find(",ay,"), std::string::npos);
   posed.replace(posed.find(",ay,"), 4, ",\xd0\xb0y,");
-  for (size_t at = posed.find("\n"); at != std::string::npos && at + 1 < posed.size(); at = posed.find("\n", at + 1))
-    posed.replace(posed.find(",0,0,0,0,0,0,", at), 13, ",1,0,0,0,0,0,0,");  // level: qw = 1
+  for (size_t at = posed.find("\n"); at != std::string::npos && at + 1 < posed.size(); at = posed.find("\n", at + 1)) {
+    const size_t zeros = posed.find(",0,0,0,0,0,0,", at);
+    ASSERT_NE(zeros, std::string::npos);
+    posed.replace(zeros, 13, ",1,0,0,0,0,0,0,");  // level: qw = 1
+  }
   const fs::path mixed = dir / "mixed.csv";
   std::ofstream(mixed) << posed;
   const CliRun m = run_fit(test::source_path("vehicles/crazyflie21.yaml"), mixed.string(), (dir / "out2").string());

@@ -832,9 +832,15 @@ TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
   expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", long_name + ".csv"},
                                     tmp.dir),
                         "has a name of 304 bytes", "--out 300.csv");
-  // A file name that is a directory's is refused as before.
-  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", "lnk/.."}, tmp.dir),
-                        "expected a .csv file name", "lnk/..");
+  // A folder named with a '.' or '..' at its end, not there yet: the folder itself (resolved
+  // with a trailing '/', it was made as the staging folder's parent and the finished output
+  // could not move onto it).
+  const CliResult dot = run_quadgen({"derive", vehicle, "--out", "new/."}, tmp.dir);
+  ASSERT_EQ(dot.rc, 0) << dot.err;
+  EXPECT_TRUE(fs::exists(tmp.dir / "new/model.hpp"));
+  const CliResult up = run_quadgen({"derive", vehicle, "--out", "made/sub/.."}, tmp.dir);
+  ASSERT_EQ(up.rc, 0) << up.err;
+  EXPECT_TRUE(fs::exists(tmp.dir / "made/model.hpp"));
 }
 
 // One flight named twice (or through a hard or symbolic link) doubled its weight in the fit
@@ -1335,6 +1341,11 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                         "--set mass=-1");
   expect_one_line_error(simulate("J_xx=0"), "--set: J_xx = 0: a mass", "--set J_xx=0");
   expect_one_line_error(simulate("c_t=nan"), "'nan' is not a finite number", "--set c_t=nan");  // the command line's own check
+  // A negative delay read commands not yet sent (beyond the end of the record).
+  const CliResult delay = run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "1", "--effects", "input_delay", "--set",
+                                       "input_delay.seconds=-0.05", "--out", tmp / "s.csv"},
+                                      tmp.dir);
+  expect_one_line_error(delay, "input_delay.seconds = -0.05", "--set input_delay.seconds=-0.05");
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   // A channel listed twice was weighted twice.
   expect_one_line_error(run_quadgen({"fit", vehicle, tmp / "f.csv", "--channels", "ax,qdot,ax", "--out", tmp / "o"}, tmp.dir),
@@ -1407,9 +1418,9 @@ TEST(Cli, NewcomerMistakesAreNamed) {
     return tmp / name;
   };
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("huge.json", "motor_lag", "1e308"), "--out", tmp / "o"},
-               2, "huge.json: findings: motor_lag.tau = 1e+308 lies outside its bounds");
+               2, "huge.json: findings: motor_lag.tau = 1e+308 is outside its bounds");
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("negative.json", "motor_lag", "-5"), "--out", tmp / "o"},
-               2, "negative.json: findings: motor_lag.tau = -5 lies outside its bounds");
+               2, "negative.json: findings: motor_lag.tau = -5 is outside its bounds");
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("unknown.json", "wind2", "0.05"), "--out", tmp / "o"},
                2, "unknown.json: findings: unknown effect 'wind2'");
 }

@@ -1,0 +1,21 @@
+#include "runtime/parameter.hpp"
+
+#include <cmath>
+
+#include "output/numbers.hpp"
+
+namespace quadgen::runtime {
+
+std::string value_problem(const Parameter& p, double value, bool within_bounds) {
+  using output::short_number;
+  if (!std::isfinite(value)) return "is not finite";
+  if (within_bounds && p.lower < p.upper && (value < p.lower || value > p.upper))
+    return "= " + short_number(value) + " is outside its bounds [" + short_number(p.lower) + ", " + short_number(p.upper) + "]";
+  // The names the vehicle file's derived section gives them (model/vehicle.hpp).
+  const bool must_be_positive = p.name == "mass" || p.name == "J_xx" || p.name == "J_yy" || p.name == "J_zz";
+  if (must_be_positive && !(value > 0))
+    return "= " + short_number(value) + ": a mass and a principal moment of inertia must be positive";
+  return "";
+}
+
+}  // namespace quadgen::runtime
