@@ -114,10 +114,13 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
   for (const auto& f : j["findings"]) {
     const std::string effect = f.value("effect", "");
     if (effect.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
-    const auto& catalogue = effect_catalogue();
-    if (std::none_of(catalogue.begin(), catalogue.end(), [&](const Effect& c) { return c.name == effect; }))
+    const Effect* described = nullptr;
+    try {
+      described = &find_effect(effect);
+    } catch (const std::invalid_argument&) {
       throw airframe_error(path, "findings: unknown effect '" + output::printable(effect) + "'");
-    if (find_effect(effect).per_flight) continue;  // a flight's state, freed above
+    }
+    if (described->per_flight) continue;  // a flight's state, freed above
     diagnose::AirframeReference::Effect e{effect, {}, {}, {}, {}};
     for (const auto& [name, p] : f["parameters"].items()) {
       if (p.value("reference", false)) continue;
@@ -137,7 +140,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
       e.parameters.push_back(name);
       e.value.push_back(v);
       e.standard_error.push_back(se > 0 && std::isfinite(se) ? se : 0.0);
-      e.off.push_back(diagnose::neutral_value(all.params[all.param_index(name)]));
+      e.off.push_back(diagnose::neutral_value(declared));
     }
     if (!e.parameters.empty()) ref.effects.push_back(e);
   }

@@ -67,15 +67,19 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
 void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::json& entries, const char* key,
                           std::vector<double>& p) const {
   const std::vector<runtime::Parameter> declared = model.parameters();
+  // The value an entry gives the model's parameter `index` (its own, or one flight's copy).
+  const auto checked = [&](const std::string& name, const nlohmann::json& entry, int index) {
+    const double value = entry["value"].get<double>();
+    const std::string problem = runtime::value_problem(declared[static_cast<size_t>(index)], value, true);
+    if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
+    return value;
+  };
   for (const auto& [name, entry] : entries.items()) {
     if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
       throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " has no numeric value");
     const int i = model.param_index(name);
     if (i >= 0) {
-      const double value = entry["value"].get<double>();
-      const std::string problem = runtime::value_problem(declared[static_cast<size_t>(i)], value, true);
-      if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
-      p[static_cast<size_t>(i)] = value;
+      p[static_cast<size_t>(i)] = checked(name, entry, i);
       continue;
     }
     // Another flight's copy (name@k, k = 2 .. the number of flights) of a per-flight
@@ -90,9 +94,7 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
     if (k < 2 || (!flights_.empty() && k > static_cast<int>(flights_.size())))
       throw std::invalid_argument(path_ + ": '" + output::printable(name) + "': a flight's copy is name@k with k from 2 to " +
                                   std::to_string(flights_.size()) + ", the number of flights");
-    const std::string problem = runtime::value_problem(declared[static_cast<size_t>(model.param_index(name.substr(0, at)))],
-                                                       entry["value"].get<double>(), true);
-    if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
+    checked(name, entry, model.param_index(name.substr(0, at)));  // applied by for_log
   }
 }
 

@@ -503,7 +503,8 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     commands.send(u);
     // --- log: noisy sensors (the accelerometer feels the commands in effect now) ---
     std::vector<double> acting = u;
-    for (int i = 0; i < nr; ++i) acting[i] = commands.at_start(k)[i];
+    const std::vector<double>& in_effect = commands.at_start(k);
+    for (int i = 0; i < nr; ++i) acting[i] = in_effect[i];
     truth.rhs(x.data(), acting.data(), f.data(), nullptr, nullptr, nullptr);
     out.rows.push_back(sensors.row(t, u, nr, x, q_est, q_true.toRotationMatrix(), f, vbat, r, controller.desired(), rng, gauss));
     if (k == steps) break;
