@@ -99,8 +99,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
   ref.source = path;
   ref.flights = j.contains("flights") && j["flights"].is_array() ? j["flights"].size() : 0;
   for (const auto& p : all.params)
-    ref.values.push_back({p.name, p.unit, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, p.lower,
-                          p.upper, false});
+    ref.values.push_back(runtime_parameter(p, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, false));
   for (const auto& [name, e] : j["airframe_fit"].items()) {
     known(name);
     for (auto& p : ref.values)
@@ -129,8 +128,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
       // Compared with this flight's estimate: a value outside the parameter's bounds is no
       // estimate quadgen could have written, and an infinite one broke the comparison's test.
       const auto& declared = all.params[all.param_index(name)];
-      const std::string problem =
-          runtime::value_problem({declared.name, declared.unit, declared.nominal, declared.lower, declared.upper}, v, true);
+      const std::string problem = runtime::value_problem(runtime_parameter(declared), v, true);
       if (!problem.empty()) throw airframe_error(path, "findings: " + output::printable(name) + " " + problem);
       double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
       if (!std::isfinite(se)) se = NAN;

@@ -68,7 +68,7 @@ void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitte
       if (q.name == v.name) p = &q;
     if (!p) throw VehicleError(where + "no parameter '" + v.name + "' in this model (effects: " + model.effect_list(", ") + ")");
     if (v.unit != p->unit) throw VehicleError(where + v.name + " is in " + p->unit + ", the file says " + v.unit);
-    const std::string problem = runtime::value_problem({p->name, p->unit, p->nominal, p->lower, p->upper}, v.value, true);
+    const std::string problem = runtime::value_problem(runtime_parameter(*p), v.value, true);
     if (!problem.empty()) throw VehicleError(where + v.name + " " + problem);
     p->nominal = v.value;
   }

@@ -116,10 +116,7 @@ CandidateSearch::CandidateSearch(const SymbolicModel& all, runtime::DynamicModel
 
 std::vector<FitParameter> CandidateSearch::initial_parameters() const {
   std::vector<FitParameter> ps;
-  for (const auto& p : all_.params) {
-    const bool effect_param = is_effect_parameter(p.name);
-    ps.push_back({p.name, p.unit, neutral_value(p), p.lower, p.upper, p.fit && !effect_param});
-  }
+  for (const auto& p : all_.params) ps.push_back(runtime_parameter(p, neutral_value(p), p.fit && !is_effect_parameter(p.name)));
   return ps;
 }
 

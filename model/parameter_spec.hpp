@@ -7,6 +7,7 @@
 #include <string>
 
 #include "model/units.hpp"
+#include "runtime/parameter.hpp"
 
 namespace quadgen {
 
@@ -19,5 +20,13 @@ struct ParameterSpec {
   bool fit = false;
   std::string doc;  // what it is
 };
+
+// The run-time record of `p` (the one conversion): at `value`, freed by a fit or not.
+inline runtime::Parameter runtime_parameter(const ParameterSpec& p, double value, bool free) {
+  return {p.name, p.unit, value, p.lower, p.upper, free};
+}
+
+// ... at its nominal value, freed as the vehicle file says.
+inline runtime::Parameter runtime_parameter(const ParameterSpec& p) { return runtime_parameter(p, p.nominal, p.fit); }
 
 }  // namespace quadgen

@@ -45,7 +45,9 @@ inline std::string malformed_yaml(const YAML::ParserException& e, const std::str
   if (const auto* deep = dynamic_cast<const YAML::DeepRecursion*>(&e))
     return "malformed YAML: nested more deeply than the reader follows (" + std::to_string(deep->depth()) +
            " levels of lists or mappings)";
-  return "malformed YAML: " + e.msg + yaml_slip(text, e.mark.line, e.msg);
+  // yaml-cpp's message may quote a byte of the file ("unknown escape character: " and a NUL,
+  // which cut the whole error short where it became a C string): shown, as every name is.
+  return "malformed YAML: " + output::printable(e.msg) + yaml_slip(text, e.mark.line, e.msg);
 }
 
 struct YamlReader {

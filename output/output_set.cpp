@@ -273,6 +273,11 @@ std::string first_names(const std::vector<std::string>& names) {
 // manifest that names only plain files, and nothing else.
 void check_replaceable(const fs::path& dir, const std::string& command) {
   std::error_code ec;
+  // A symbolic link that leads nowhere: the finished output could not move onto it ("Not a
+  // directory" once the work was done), and quadgen does not make folders a link points to.
+  if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
+    fail(dir, "is a symbolic link to " + printable(fs::read_symlink(dir, ec).string()) +
+                  ", which does not exist; create that directory or choose another --out");
   if (!fs::exists(dir, ec)) return;
   if (!fs::is_directory(dir, ec)) fail(dir, "exists and is not a directory");
   const Manifest m = read_manifest(dir);

@@ -193,6 +193,24 @@ std::string gnuplot_string(const std::string& s) {
   return out + "'";
 }
 
+std::string gnuplot_svg_tooltips_mended(const std::string& svg) {
+  static const std::string open = "<title>", close = "</title>", wrong = "&amp;#x26;", right = "&amp;";
+  std::string out;
+  out.reserve(svg.size());
+  size_t done = 0;
+  for (size_t at = svg.find(open); at != std::string::npos; at = svg.find(open, done)) {
+    const size_t text = at + open.size(), end = svg.find(close, text);
+    if (end == std::string::npos) break;
+    out.append(svg, done, text - done);
+    for (size_t i = text; i < end;) {
+      if (svg.compare(i, wrong.size(), wrong) == 0) out += right, i += wrong.size();
+      else out += svg[i++];
+    }
+    done = end;
+  }
+  return out.append(svg, done, std::string::npos);
+}
+
 namespace {
 std::string html_escaped(const std::string& s, bool keep_lines) {
   std::string out;

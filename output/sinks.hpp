@@ -36,6 +36,12 @@ const std::string& checked_cpp_identifier(const std::string& s, const std::strin
 // are set `noenhanced`, so _ ^ @ { } stay literal.
 std::string gnuplot_string(const std::string& s);
 
+// The SVG gnuplot wrote from gnuplot_string labels, its tooltips mended: gnuplot escapes every
+// & of a <title> element (the tooltip a browser shows), the "&#x" of drawn text it does not, so
+// the &#x26; written for drawn text shows in the tooltip as "&#x26;". Inside <title> elements
+// "&amp;#x26;" becomes "&amp;" (each such sequence there is one gnuplot_string wrote).
+std::string gnuplot_svg_tooltips_mended(const std::string& svg);
+
 // HTML text or attribute value: & < > " ' as entities, control characters dropped, the
 // bidirectional controls shown as \xNN (as printable does) instead of reordering the text.
 std::string html_text(const std::string& s);

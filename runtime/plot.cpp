@@ -298,7 +298,7 @@ bool render_svg(const std::string& title, const std::vector<Panel>& panels, std:
     if (error) *error = why;
     return false;
   }
-  *svg = run.out;
+  *svg = output::gnuplot_svg_tooltips_mended(run.out);
   return true;
 }
 

@@ -702,6 +702,11 @@ TEST(Sinks, GnuplotStringShowsBidiControls) {
   EXPECT_EQ(svg.find("&#x202E;"), std::string::npos);
   EXPECT_EQ(svg.find("&#x0;"), std::string::npos);
   EXPECT_NE(svg.find("x&#x26;#x202E;vsc.gol"), std::string::npos) << svg.substr(0, 2000);
+  // The series' tooltip (a <title> element, where gnuplot escapes every &) shows the name too.
+  EXPECT_NE(svg.find("<title>x&amp;#x202E;vsc.gol</title>"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find("&amp;#x26;"), std::string::npos);
+  EXPECT_EQ(out::gnuplot_svg_tooltips_mended("<text>a&#x26;#x1;</text><title>a&amp;#x26;#x1; &amp;#x26;</title>&amp;#x26;<title>"),
+            "<text>a&#x26;#x1;</text><title>a&amp;#x1; &amp;</title>&amp;#x26;<title>");
 }
 
 TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
@@ -841,6 +846,14 @@ TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
   const CliResult up = run_quadgen({"derive", vehicle, "--out", "made/sub/.."}, tmp.dir);
   ASSERT_EQ(up.rc, 0) << up.err;
   EXPECT_TRUE(fs::exists(tmp.dir / "made/model.hpp"));
+  // A symbolic link that leads nowhere is refused before the work (it failed with "Not a
+  // directory" when the output was moved into place), and nothing is made where it points.
+  fs::create_directory_symlink(tmp.dir / "gone/sub", tmp.dir / "dangling");
+  const CliResult dangling = run_quadgen({"derive", vehicle, "--out", "dangling"}, tmp.dir);
+  expect_one_line_error(dangling, "is a symbolic link to " + (tmp.dir / "gone/sub").string() + ", which does not exist",
+                        "--out dangling");
+  EXPECT_EQ(dangling.err.find("generating C++"), std::string::npos) << dangling.err;
+  EXPECT_FALSE(fs::exists(tmp.dir / "gone"));
 }
 
 // One flight named twice (or through a hard or symbolic link) doubled its weight in the fit
@@ -1399,6 +1412,9 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // Lists nested past the YAML reader's depth guard: said as such, not as its "bad file".
   write(tmp / "deep.yaml", "name: deep\nblocks: " + std::string(600, '[') + std::string(600, ']') + "\n");
   expect_error({"derive", tmp / "deep.yaml", "--out", tmp / "o"}, 2, "deep.yaml:2: malformed YAML: nested more deeply than");
+  // A NUL after a backslash: the parser's message quotes it, and the error ended there.
+  write(tmp / "nul.yaml", std::string("name: \"fin\\\0ken\"\n", 17));
+  expect_error({"derive", tmp / "nul.yaml", "--out", tmp / "o"}, 2, "nul.yaml:1: malformed YAML: unknown escape character: \\x00");
   write(tmp / "stand.json", R"({"kind": "thrust_stand", "summary": {}, "thrust_vs_speed": {"estimates": {}}})");
   expect_error({"predict", cf, tmp / "f.csv", "--params", tmp / "stand.json", "--out", tmp / "o"}, 2,
                "a thrust-stand fit describes the motors");
