@@ -152,12 +152,10 @@ std::string logs_label(const std::vector<std::string>& paths) {
   return output::joined(paths, ", ", [](const std::string& p) { return output::shell_path(p); });
 }
 
-DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
-  std::string error;
-  if (!job.IsValid(&error)) throw std::invalid_argument("diagnose: " + error);
-  runtime::refuse_repeated_files(job.logs, "flight log");
-  const Vehicle v = load_vehicle(job.vehicle);
-  const fit::ColumnMapping mapping = job.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(job.mapping);
+namespace {
+
+// The options the job's flags give beyond its DiagnoseOptions: the candidates, the environment.
+diagnose::DiagnoseOptions options_of(const DiagnoseJob& job, const fit::ColumnMapping& mapping) {
   diagnose::DiagnoseOptions o = job.options;
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);
   for (const auto& e : refinements_without_their_effect(o.search.candidates)) {  // only ever tested beside it
@@ -166,32 +164,26 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
                                 refined + " too");
   }
   o.search.environment = parse_environment(job.environment.empty() ? mapping.environment : job.environment);
-  // The model and the airframe first: a wrong --airframe file is said before the logs are read.
-  if (const std::string note = fitted_section_note(v, "diagnose"); !note.empty()) o.progress.say("[diagnose] " + note);
-  o.progress.say("[diagnose] deriving the full-catalogue model's equations (its parameters, units and structure)");
-  const MassProperties mp = derive_mass_properties(v);
-  DeriveOptions all_opt;
-  all_opt.effects = parse_effect_list("all");
-  const SymbolicModel all = derive_model(v, mp, all_opt);
-  if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
+  return o;
+}
 
-  const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
-  for (const auto& f : flights)  // said before the long work, not after it
-    for (const auto& note : f.notes) o.progress.say("[diagnose] " + note);
+// Why a diagnosis writes no fitted_vehicle.yaml, and what to do instead.
+std::string no_fitted_vehicle_note(const Vehicle& v) {
+  return v.fitted_line > 0
+             ? "note: no fitted_vehicle.yaml: the vehicle file has a fitted: section already; to build "
+               "this fitted model, put fitted_parameters.yaml's lines in its place (or remove it and "
+               "run quadgen derive VEHICLE --params fitted_parameters.yaml)"
+             : "note: no fitted_vehicle.yaml: a fitted: section cannot be added to this vehicle file's "
+               "YAML (a flow-style or indented top level); fitted_parameters.yaml holds the values "
+               "(quadgen derive VEHICLE --params fitted_parameters.yaml)";
+}
+
+// What a diagnosis writes: the report, the extended model (and the model with the proposed
+// terms), the plots and their data.
+DiagnoseJobResult diagnosis_files(const DiagnoseJob& job, const Vehicle& v, const MassProperties& mp,
+                                  const diagnose::Diagnosis& d, const fit::Flight& valid, const output::Progress& progress) {
+  progress.say("[diagnose] generating the extended model");
   const std::string diagnosed = logs_label(job.logs);  // what the outputs say was diagnosed
-  size_t samples = 0;
-  for (const auto& f : flights) samples += f.samples.size();
-  o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
-                 (flights.size() > 1 ? " logs (diagnosed jointly)" : " log"));
-  bool compiled = false;
-  const auto model = make_model(all, &compiled);
-  o.progress.say(std::string("[diagnose] evaluating it with ") +
-                 (compiled ? "the compiled header in generated/, derived from the same equations"
-                           : "an interpreted tape of the equations (no compiled header matches this vehicle)"));
-  fit::Flight valid;
-  const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
-
-  o.progress.say("[diagnose] generating the extended model");
   const std::string fitted_to = logs_label(d.flights);  // a left-out log is not one of them
   const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to);
   std::string err;
@@ -205,16 +197,8 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
              {"extended_model.json", ext.model_json},
              {"extended_derivation.md", ext.derivation_markdown},
              {"fitted_parameters.yaml", ext.fitted_parameters_yaml}};
-  if (!ext.fitted_vehicle_yaml.empty())
-    r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
-  else
-    r.notes.push_back(v.fitted_line > 0
-                          ? "note: no fitted_vehicle.yaml: the vehicle file has a fitted: section already; to build "
-                            "this fitted model, put fitted_parameters.yaml's lines in its place (or remove it and "
-                            "run quadgen derive VEHICLE --params fitted_parameters.yaml)"
-                          : "note: no fitted_vehicle.yaml: a fitted: section cannot be added to this vehicle file's "
-                            "YAML (a flow-style or indented top level); fitted_parameters.yaml holds the values "
-                            "(quadgen derive VEHICLE --params fitted_parameters.yaml)");
+  if (!ext.fitted_vehicle_yaml.empty()) r.files.push_back({"fitted_vehicle.yaml", ext.fitted_vehicle_yaml});
+  else r.notes.push_back(no_fitted_vehicle_note(v));
   if (!diagnose::proposed_terms(d.discovered).empty()) {  // the extended model plus the proposed terms
     const diagnose::ExtendedModelFiles disc = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to, true);
     r.files.push_back({"discovered_model.hpp", disc.header});
@@ -226,6 +210,41 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   summary << diagnose::diagnosis_summary(d) << "diagnosed in " << d.seconds << " s";
   r.summary = summary.str();
   return r;
+}
+
+}  // namespace
+
+DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
+  std::string error;
+  if (!job.IsValid(&error)) throw std::invalid_argument("diagnose: " + error);
+  runtime::refuse_repeated_files(job.logs, "flight log");
+  const Vehicle v = load_vehicle(job.vehicle);
+  const fit::ColumnMapping mapping = job.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(job.mapping);
+  diagnose::DiagnoseOptions o = options_of(job, mapping);
+  // The model and the airframe first: a wrong --airframe file is said before the logs are read.
+  if (const std::string note = fitted_section_note(v, "diagnose"); !note.empty()) o.progress.say("[diagnose] " + note);
+  o.progress.say("[diagnose] deriving the full-catalogue model's equations (its parameters, units and structure)");
+  const MassProperties mp = derive_mass_properties(v);
+  DeriveOptions all_opt;
+  all_opt.effects = parse_effect_list("all");
+  const SymbolicModel all = derive_model(v, mp, all_opt);
+  if (!job.airframe.empty()) o.airframe = load_airframe(job.airframe, all);
+
+  const std::vector<fit::Flight> flights = load_flights(job, v, mapping);
+  for (const auto& f : flights)  // said before the long work, not after it
+    for (const auto& note : f.notes) o.progress.say("[diagnose] " + note);
+  size_t samples = 0;
+  for (const auto& f : flights) samples += f.samples.size();
+  o.progress.say("[diagnose] " + std::to_string(samples) + " airborne samples in " + std::to_string(flights.size()) +
+                 (flights.size() > 1 ? " logs (diagnosed jointly)" : " log"));
+  bool compiled = false;
+  const auto model = make_model(all, &compiled);
+  o.progress.say(std::string("[diagnose] evaluating it with ") +
+                 (compiled ? "the compiled header in generated/, derived from the same equations"
+                           : "an interpreted tape of the equations (no compiled header matches this vehicle)"));
+  fit::Flight valid;
+  const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
+  return diagnosis_files(job, v, mp, d, valid, o.progress);
 }
 
 }  // namespace quadgen::app

@@ -740,12 +740,63 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// "[diagnose] 212 s: ..." - where a long diagnosis spends its time.
+struct StageClock {
+  const output::Progress& progress;
+  Clock::time_point start = Clock::now();
+  void say(const std::string& what) const {
+    progress.say("[diagnose] " + std::to_string(static_cast<int>(seconds_since(start))) + " s: " + what);
+  }
+  // "... (12 s)": how long the stage begun at `since` took.
+  static std::string took(Clock::time_point since) {
+    return " (" + std::to_string(static_cast<int>(seconds_since(since))) + " s)";
+  }
+};
+
+// Step 3: do the joined flights agree, or does this one flight show an airframe diagnosed before?
+void compare_flights(Diagnosis& d, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
+                     const std::vector<fit::Flight>& flights, const FlightModels& fm, const fit::Flight& train,
+                     bool accel, const DiagnoseOptions& opt, const StageClock& clock) {
+  const auto start = Clock::now();
+  if (flights.size() > 1) {
+    d.agreement = per_flight_agreement(
+        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names));
+    clock.say("agreement: " + std::to_string(d.agreement.size()) + " parameters on " + std::to_string(flights.size()) +
+              " flights" + StageClock::took(start));
+  } else if (opt.airframe) {
+    d.airframe_source = opt.airframe->source;
+    d.airframe_flights = opt.airframe->flights;
+    d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
+    clock.say("against the airframe of " + opt.airframe->source + ": " + std::to_string(d.airframe_check.size()) +
+              " parameters" + StageClock::took(start));
+  }
+}
+
+// Step 5: a term proposed from what the final model leaves, regenerated into the model and
+// scored on the held-out part like any effect.
+void look_beyond_the_catalogue(Diagnosis& d, const Vehicle& v, const SymbolicModel& all_in, const FlightModels& fm,
+                               const fit::Flight& train, const fit::EquationErrorModel& train_ee,
+                               const fit::Flight& valid, const fit::EquationErrorModel& valid_ee,
+                               const std::vector<double>& flight_starts, const HeldOutGain& held_out_gain,
+                               const StageClock& clock) {
+  clock.say("beyond the catalogue: sparse regression on what the final model leaves");
+  const SearchResult& s = d.search;
+  d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
+                                valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units, flight_starts);
+  if (proposed_terms(d.discovered).empty()) return;
+  clock.say("the proposed terms regenerated into the model and simulated on the held-out part");
+  d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), fm.later_starts, fm.per_flight_names, s.final_fit,
+                            valid, held_out_gain.window_options());
+}
+
+}  // namespace
+
 Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {
-  const auto clock0 = Clock::now();
-  // "[diagnose] 212 s: " - where a long diagnosis spends its time.
-  const auto progress = [&]() { return "[diagnose] " + std::to_string(static_cast<int>(seconds_since(clock0))) + " s: "; };
+  const StageClock clock{opt_in.progress};
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
@@ -779,55 +830,29 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   // 2. Which of them are causes: held-out data, look-alikes, plausibility.
   const HeldOutGain held_out_gain(model, search, valid, valid_ee, accel, opt.window, opt.window_stride);
   d.metric = held_out_gain.metric_name();
-  opt.progress.say(progress() + "acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) +
-                   " candidates");
+  clock.say("acceptance: held-out gain and intervals of " + std::to_string(d.search.named().size()) + " candidates");
   name_the_causes(d, search, held_out_gain, all, train_ee, so);
   note_gains_that_disagree(d, held_out_gain);
 
   // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
-  if (joint) {
-    const auto start = Clock::now();
-    d.agreement = per_flight_agreement(
-        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names));
-    opt.progress.say(progress() + "agreement: " + std::to_string(d.agreement.size()) + " parameters on " +
-                     std::to_string(flights.size()) + " flights (" +
-                     std::to_string(static_cast<int>(seconds_since(start))) + " s)");
-  }
-  if (!joint && opt.airframe) {
-    const auto start = Clock::now();
-    d.airframe_source = opt.airframe->source;
-    d.airframe_flights = opt.airframe->flights;
-    d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
-    opt.progress.say(progress() + "against the airframe of " + opt.airframe->source + ": " +
-                     std::to_string(d.airframe_check.size()) + " parameters (" +
-                     std::to_string(static_cast<int>(seconds_since(start))) + " s)");
-  }
+  compare_flights(d, all_in, model_in, flights, fm, train, accel, opt, clock);
   add_suspects_of_the_search(d);
 
   // 4. What the extended model still gets wrong, and what it gains on the held-out part.
   const fit::Flight used = rows_of(flight, all_ee);
   analyse_what_is_wrong(v, used, all_ee, d);
-  opt.progress.say(progress() + "validation of the base and the extended model; prediction error at horizons");
+  clock.say("validation of the base and the extended model; prediction error at horizons");
   measure_held_out(d, held_out_gain, model, valid, valid_ee);
   d.unexplained = unexplained(d.after, opt);
   const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
 
   // 5. Beyond the catalogue: a term proposed from what is left, regenerated and tested.
-  opt.progress.say(progress() + "beyond the catalogue: sparse regression on what the final model leaves");
-  const SearchResult& s = d.search;
-  d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
-                                valid_ee.all_channels(s.final_fit), d.channel_names, d.channel_units,
-                                flight_starts);
-  if (!proposed_terms(d.discovered).empty()) {
-    opt.progress.say(progress() + "the proposed terms regenerated into the model and simulated on the held-out part");
-    d.terms_gain = terms_gain(v, all_in, proposed_terms(d.discovered), fm.later_starts, fm.per_flight_names,
-                              s.final_fit, valid, held_out_gain.window_options());
-  }
-  for (const auto& p : s.final_fit)
+  look_beyond_the_catalogue(d, v, all_in, fm, train, train_ee, valid, valid_ee, flight_starts, held_out_gain, clock);
+  for (const auto& p : d.search.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
-  d.airframe_fit = airframe_values(s.final_fit);
-  d.seconds = seconds_since(clock0);
+  d.airframe_fit = airframe_values(d.search.final_fit);
+  d.seconds = seconds_since(clock.start);
   return d;
 }
 
