@@ -155,6 +155,7 @@ std::string logs_label(const std::vector<std::string>& paths) {
 namespace {
 
 // The options the job's flags give beyond its DiagnoseOptions: the candidates, the environment.
+// A refinement among the candidates without the effect it refines is refused here.
 diagnose::DiagnoseOptions options_of(const DiagnoseJob& job, const fit::ColumnMapping& mapping) {
   diagnose::DiagnoseOptions o = job.options;
   if (!job.candidates.empty()) o.search.candidates = parse_effect_list(job.candidates);

@@ -742,7 +742,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
 
 namespace {
 
-// "[diagnose] 212 s: ..." - where a long diagnosis spends its time.
+// "[diagnose] 212 s: ..." - where a long diagnosis spends its time, counted from its start
+// (output::PhaseTimer counts each phase from the last one's end instead: "... (12 s)").
 struct StageClock {
   const output::Progress& progress;
   Clock::time_point start = Clock::now();
@@ -756,11 +757,11 @@ struct StageClock {
 };
 
 // Step 3: do the joined flights agree, or does this one flight show an airframe diagnosed before?
-void compare_flights(Diagnosis& d, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
+void compare_flights(Diagnosis& d, bool joint, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                      const std::vector<fit::Flight>& flights, const FlightModels& fm, const fit::Flight& train,
                      bool accel, const DiagnoseOptions& opt, const StageClock& clock) {
   const auto start = Clock::now();
-  if (flights.size() > 1) {
+  if (joint) {
     d.agreement = per_flight_agreement(
         agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names));
     clock.say("agreement: " + std::to_string(d.agreement.size()) + " parameters on " + std::to_string(flights.size()) +
@@ -835,7 +836,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   note_gains_that_disagree(d, held_out_gain);
 
   // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
-  compare_flights(d, all_in, model_in, flights, fm, train, accel, opt, clock);
+  compare_flights(d, joint, all_in, model_in, flights, fm, train, accel, opt, clock);
   add_suspects_of_the_search(d);
 
   // 4. What the extended model still gets wrong, and what it gains on the held-out part.

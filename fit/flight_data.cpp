@@ -118,7 +118,8 @@ ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key,
   e.target = scalar_text(path, key, "column name");
   e.line = key.Mark().line + 1;
   if (canonical_unit(e.target).empty())
-    mapping_error(path, key, "'" + e.target + "' is not a canonical column (expected one of " + runtime::kCanonicalColumns + ")");
+    mapping_error(path, key, "'" + output::printable(e.target) + "' is not a canonical column (expected one of " +
+                                 runtime::kCanonicalColumns + ")");
   const std::string where = "column '" + e.target + "'";
   if (!value.IsMap()) mapping_error(path, key, where + ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}");
   const auto f = checked_keys(path, value, where, {"source", "scale", "offset", "unit"});
@@ -174,11 +175,12 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
     for (const auto& kv : top.at("columns")) {
       ColumnMapping::Entry e = parse_entry(path, kv.first, kv.second);
       if (!targets.insert(e.target).second)
-        mapping_error(path, kv.first, "columns: duplicate key '" + e.target + "' (each canonical column at most once)");
+        mapping_error(path, kv.first,
+                      "columns: duplicate key '" + output::printable(e.target) + "' (each canonical column at most once)");
       m.entries.push_back(std::move(e));
     }
   } catch (const YAML::Exception& e) {
-    throw FitError(path + ":" + std::to_string(e.mark.line >= 0 ? e.mark.line + 1 : 1) + ": " + e.msg +
+    throw FitError(path + ":" + std::to_string(e.mark.line >= 0 ? e.mark.line + 1 : 1) + ": " + output::printable(e.msg) +
                    " (expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT})");
   }
   return m;

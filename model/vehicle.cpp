@@ -176,7 +176,8 @@ Vehicle parse_vehicle(const std::string& content, const std::string& path) {
   try {
     return parse_vehicle_checked(content, path);
   } catch (const YAML::Exception& e) {
-    throw VehicleError(path + ":" + std::to_string(e.mark.line + 1) + ": unexpected YAML structure: " + e.msg);
+    throw VehicleError(path + ":" + std::to_string(e.mark.line + 1) +
+                       ": unexpected YAML structure: " + output::printable(e.msg));
   }
 }
 

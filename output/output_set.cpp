@@ -84,7 +84,9 @@ void fsync_path(const fs::path& p, int flags) {
 // The absolute form of a path named on the command line: symbolic links in its existing part
 // followed before a '..' after them is applied, as the file system does (so that `link/../x`
 // is x beside the link's target, not beside the link); the part that does not exist yet taken
-// as written, normalised; no trailing '/' (`new/.` is `new`).
+// as written, normalised; no trailing '/' (`new/.` is `new`). A '..' after a link that leads
+// nowhere is applied as written (`dangling/..` is the link's folder, where the kernel finds no
+// path): such a folder holds the link, which no run replaces.
 fs::path resolved(const std::string& name) {
   if (name.empty()) throw OutputError("an output path is empty");
   std::error_code ec;
@@ -268,16 +270,33 @@ std::string first_names(const std::vector<std::string>& names) {
   return names.size() > 3 ? out + ", ..." : out;
 }
 
+// A symbolic link on the way to an output that cannot be followed: the path itself, or the
+// nearest part of it that exists (`--out dangling/sub`). The finished output could not move
+// onto it ("Not a directory" once the work was done), nor could the folders below it be made
+// ("File exists"); quadgen does not make the folders a link points to. Refused before the work.
+void refuse_links_that_lead_nowhere(const fs::path& target) {
+  std::error_code ec;
+  fs::path p = target;
+  while (!fs::exists(fs::symlink_status(p, ec)) && p.has_relative_path()) p = p.parent_path();
+  if (!fs::is_symlink(fs::symlink_status(p, ec))) return;
+  const fs::file_status followed = fs::status(p, ec);
+  if (fs::exists(followed)) return;
+  std::error_code read_ec;
+  const fs::path to = fs::read_symlink(p, read_ec);
+  const std::string where = read_ec ? "" : " to " + printable((to.is_absolute() ? to : p.parent_path() / to).lexically_normal().string());
+  if (ec == std::errc::too_many_symbolic_link_levels)
+    fail(p, "is a symbolic link that loops (it leads back to itself through links); choose another output path");
+  if (followed.type() == fs::file_type::not_found)
+    fail(p, "is a symbolic link" + where + ", which leads nowhere (it does not exist); create that directory or choose "
+            "another output path");
+  fail(p, "is a symbolic link" + where + " that cannot be followed (" + ec.message() + "); choose another output path");
+}
+
 // Refuses to replace a directory unless it holds exactly what an earlier run of the same
 // command wrote: every file listed in its manifest and unchanged since (size and hash), a
 // manifest that names only plain files, and nothing else.
 void check_replaceable(const fs::path& dir, const std::string& command) {
   std::error_code ec;
-  // A symbolic link that leads nowhere: the finished output could not move onto it ("Not a
-  // directory" once the work was done), and quadgen does not make folders a link points to.
-  if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
-    fail(dir, "is a symbolic link to " + printable(fs::read_symlink(dir, ec).string()) +
-                  ", which does not exist; create that directory or choose another --out");
   if (!fs::exists(dir, ec)) return;
   if (!fs::is_directory(dir, ec)) fail(dir, "exists and is not a directory");
   const Manifest m = read_manifest(dir);
@@ -638,6 +657,7 @@ OutputDirectory::OutputDirectory(const std::string& dir, const std::string& comm
   check_name_lengths(target);
   check_not_above_working_directory(target);
   check_not_input(target, inputs_);
+  refuse_links_that_lead_nowhere(target);
   check_replaceable(target, command_);
   created_.create(target.parent_path());
   staging_ = std::make_unique<StagingDirectory>(target.parent_path(), target.filename().string());
@@ -703,6 +723,7 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
     paths_.push_back(p.string());
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();
+  refuse_links_that_lead_nowhere(parent);
   std::error_code manifest_ec;
   if (fs::exists(fs::symlink_status(parent / kManifestName, manifest_ec)))
     fail(parent, "is the output directory of another quadgen run (it holds " + std::string(kManifestName) +

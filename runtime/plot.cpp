@@ -289,16 +289,20 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
 
 bool render_svg(const std::string& title, const std::vector<Panel>& panels, std::string* svg, std::string* error) {
   const GnuplotRun run = run_gnuplot(gnuplot_script(title, panels));
-  std::string why;
+  std::string why, mended;
   if (!run.failure.empty()) why = run.failure;
   else if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0)
     why = "gnuplot failed: " + output::printable(run.err.substr(0, 300));
-  else if (!whole_inert_svg(run.out)) why = "gnuplot returned no complete SVG document, or one with script in a tag";
+  else {
+    mended = output::gnuplot_svg_tooltips_mended(run.out);
+    if (!whole_inert_svg(mended))  // checked as it is written
+      why = "gnuplot returned no complete SVG document, or one with script in a tag";
+  }
   if (!why.empty()) {
     if (error) *error = why;
     return false;
   }
-  *svg = output::gnuplot_svg_tooltips_mended(run.out);
+  *svg = std::move(mended);
   return true;
 }
 

@@ -707,6 +707,14 @@ TEST(Sinks, GnuplotStringShowsBidiControls) {
   EXPECT_EQ(svg.find("&amp;#x26;"), std::string::npos);
   EXPECT_EQ(out::gnuplot_svg_tooltips_mended("<text>a&#x26;#x1;</text><title>a&amp;#x26;#x1; &amp;#x26;</title>&amp;#x26;<title>"),
             "<text>a&#x26;#x1;</text><title>a&amp;#x1; &amp;</title>&amp;#x26;<title>");
+  // Names that hold the workaround's own text keep it, drawn and in their tooltips.
+  quadgen::runtime::Panel own;
+  own.series.push_back({"p&#x26;q", t, t});
+  own.series.push_back({"r&amp;#x26;s", t, {2, 1, 0}});
+  ASSERT_TRUE(quadgen::runtime::render_svg("own", {own}, &svg, &error)) << error;
+  EXPECT_NE(svg.find("<title>p&amp;#x26;q</title>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("<title>r&amp;amp;#x26;s</title>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("p&#x26;#x26;q"), std::string::npos);  // drawn: p&#x26;q
 }
 
 TEST(Sinks, HtmlShowsBidiControlsAndPreformattedTextKeepsItsLines) {
@@ -848,11 +856,24 @@ TEST(DataLoss, AnOutputPathIsResolvedAsTheFileSystemResolvesIt) {
   EXPECT_TRUE(fs::exists(tmp.dir / "made/model.hpp"));
   // A symbolic link that leads nowhere is refused before the work (it failed with "Not a
   // directory" when the output was moved into place), and nothing is made where it points.
+  // The same for a link on the way to the output, one that loops, and the simulation's
+  // folder; a relative link's target is said from the working directory.
   fs::create_directory_symlink(tmp.dir / "gone/sub", tmp.dir / "dangling");
-  const CliResult dangling = run_quadgen({"derive", vehicle, "--out", "dangling"}, tmp.dir);
-  expect_one_line_error(dangling, "is a symbolic link to " + (tmp.dir / "gone/sub").string() + ", which does not exist",
-                        "--out dangling");
-  EXPECT_EQ(dangling.err.find("generating C++"), std::string::npos) << dangling.err;
+  fs::create_symlink("loop", tmp.dir / "loop");
+  fs::create_symlink("gone/rel", tmp.dir / "relative");
+  const std::string nowhere = "is a symbolic link to " + (tmp.dir / "gone/sub").string() + ", which leads nowhere";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"derive", vehicle, "--out", "dangling"}, nowhere},
+      {{"derive", vehicle, "--out", "dangling/deeper/still"}, nowhere},
+      {{"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out", "dangling/t.csv"}, nowhere},
+      {{"derive", vehicle, "--out", "relative"}, "is a symbolic link to " + (tmp.dir / "gone/rel").string() + ", which"},
+      {{"derive", vehicle, "--out", "loop"}, "is a symbolic link that loops"},
+  };
+  for (const auto& [args, message] : cases) {
+    const CliResult r = run_quadgen(args, tmp.dir);
+    expect_one_line_error(r, message, args.back());
+    EXPECT_EQ(r.err.find("generating C++"), std::string::npos) << r.err;
+  }
   EXPECT_FALSE(fs::exists(tmp.dir / "gone"));
 }
 
