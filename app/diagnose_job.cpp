@@ -53,7 +53,86 @@ std::runtime_error airframe_error(const std::string& path, const std::string& wh
   return std::runtime_error(output::printable(path) + ": " + what);
 }
 
-diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::string& path, const SymbolicModel& all);
+// Names and numbers of an airframe's diagnosis.json, each refused where it is not what
+// quadgen writes for this vehicle.
+struct AirframeReader {
+  const std::string& path;
+  const SymbolicModel& all;
+
+  void known(const std::string& name) const {
+    for (const auto& p : all.params)
+      if (p.name == name) return;
+    throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model");
+  }
+  double number(const nlohmann::json& v, const std::string& what) const {
+    if (!v.is_number()) throw airframe_error(path, what + ": expected a number");
+    return v.get<double>();
+  }
+  // A parameter's standard error: as written, else from its 95 % interval; 0 where neither is.
+  static double standard_error(const nlohmann::json& p) {
+    double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
+    if (!std::isfinite(se)) se = NAN;
+    if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
+        p["ci95"][1].is_number())
+      se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * fit::kZ95);
+    return se > 0 && std::isfinite(se) ? se : 0.0;
+  }
+  // A finding's airframe effect with its values (no parameters: a flight's state, or only the
+  // reference rotor's).
+  diagnose::AirframeReference::Effect effect(const nlohmann::json& f) const {
+    const std::string name = f.value("effect", "");
+    if (name.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
+    const Effect* described = nullptr;
+    try {
+      described = &find_effect(name);
+    } catch (const std::invalid_argument&) {
+      throw airframe_error(path, "findings: unknown effect '" + output::printable(name) + "'");
+    }
+    diagnose::AirframeReference::Effect e{name, {}, {}, {}, {}};
+    if (described->per_flight) return e;  // a flight's state, freed by read_airframe
+    for (const auto& [parameter, p] : f["parameters"].items()) {
+      if (p.value("reference", false)) continue;
+      known(parameter);
+      const double v = number(p.value("value", nlohmann::json()), parameter);
+      // Compared with this flight's estimate: a value outside the parameter's bounds is no
+      // estimate quadgen could have written, and an infinite one broke the comparison's test.
+      const auto& declared = all.params[all.param_index(parameter)];
+      const std::string problem = runtime::value_problem(runtime_parameter(declared), v, true);
+      if (!problem.empty()) throw airframe_error(path, "findings: " + output::printable(parameter) + " " + problem);
+      e.parameters.push_back(parameter);
+      e.value.push_back(v);
+      e.standard_error.push_back(standard_error(p));
+      e.off.push_back(diagnose::neutral_value(declared));
+    }
+    return e;
+  }
+};
+
+diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::string& path, const SymbolicModel& all) {
+  if (!j.is_object() || !j.contains("airframe_fit") || !j.contains("findings") || !j.contains("flight_parameters"))
+    throw airframe_error(path, "not a diagnosis.json of quadgen (expected airframe_fit, findings, flight_parameters)");
+  const AirframeReader read{path, all};
+  diagnose::AirframeReference ref;
+  ref.source = path;
+  ref.flights = j.contains("flights") && j["flights"].is_array() ? j["flights"].size() : 0;
+  for (const auto& p : all.params)
+    ref.values.push_back(runtime_parameter(p, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, false));
+  for (const auto& [name, e] : j["airframe_fit"].items()) {
+    read.known(name);
+    for (auto& p : ref.values)
+      if (p.name == name) p.value = std::clamp(read.number(e.value("value", nlohmann::json()), name), p.lower, p.upper);
+  }
+  for (const auto& n : j["flight_parameters"]) {
+    if (!n.is_string()) throw airframe_error(path, "flight_parameters: expected names");
+    read.known(n.get<std::string>());
+    ref.flight_parameters.push_back(n.get<std::string>());
+  }
+  for (const auto& f : j["findings"]) {
+    diagnose::AirframeReference::Effect e = read.effect(f);
+    if (!e.parameters.empty()) ref.effects.push_back(std::move(e));
+  }
+  return ref;
+}
 
 // The airframe an earlier diagnosis found, from its diagnosis.json: its fitted values
 // (airframe_fit; parameters it did not fit at the model's nominal or "off" values), the
@@ -81,68 +160,6 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
     throw airframe_error(path, "not the diagnosis.json layout quadgen writes (" +
                                    output::printable(bracket == std::string::npos ? what : what.substr(bracket + 2)) + ")");
   }
-}
-
-diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::string& path, const SymbolicModel& all) {
-  if (!j.is_object() || !j.contains("airframe_fit") || !j.contains("findings") || !j.contains("flight_parameters"))
-    throw airframe_error(path, "not a diagnosis.json of quadgen (expected airframe_fit, findings, flight_parameters)");
-  const auto known = [&](const std::string& name) {
-    for (const auto& p : all.params)
-      if (p.name == name) return;
-    throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model");
-  };
-  const auto number = [&](const nlohmann::json& v, const std::string& what) {
-    if (!v.is_number()) throw airframe_error(path, what + ": expected a number");
-    return v.get<double>();
-  };
-  diagnose::AirframeReference ref;
-  ref.source = path;
-  ref.flights = j.contains("flights") && j["flights"].is_array() ? j["flights"].size() : 0;
-  for (const auto& p : all.params)
-    ref.values.push_back(runtime_parameter(p, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, false));
-  for (const auto& [name, e] : j["airframe_fit"].items()) {
-    known(name);
-    for (auto& p : ref.values)
-      if (p.name == name) p.value = std::clamp(number(e.value("value", nlohmann::json()), name), p.lower, p.upper);
-  }
-  for (const auto& n : j["flight_parameters"]) {
-    if (!n.is_string()) throw airframe_error(path, "flight_parameters: expected names");
-    known(n.get<std::string>());
-    ref.flight_parameters.push_back(n.get<std::string>());
-  }
-  for (const auto& f : j["findings"]) {
-    const std::string effect = f.value("effect", "");
-    if (effect.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
-    const Effect* described = nullptr;
-    try {
-      described = &find_effect(effect);
-    } catch (const std::invalid_argument&) {
-      throw airframe_error(path, "findings: unknown effect '" + output::printable(effect) + "'");
-    }
-    if (described->per_flight) continue;  // a flight's state, freed above
-    diagnose::AirframeReference::Effect e{effect, {}, {}, {}, {}};
-    for (const auto& [name, p] : f["parameters"].items()) {
-      if (p.value("reference", false)) continue;
-      known(name);
-      const double v = number(p.value("value", nlohmann::json()), name);
-      // Compared with this flight's estimate: a value outside the parameter's bounds is no
-      // estimate quadgen could have written, and an infinite one broke the comparison's test.
-      const auto& declared = all.params[all.param_index(name)];
-      const std::string problem = runtime::value_problem(runtime_parameter(declared), v, true);
-      if (!problem.empty()) throw airframe_error(path, "findings: " + output::printable(name) + " " + problem);
-      double se = p.contains("standard_error") && p["standard_error"].is_number() ? p["standard_error"].get<double>() : NAN;
-      if (!std::isfinite(se)) se = NAN;
-      if (!(se > 0) && p.contains("ci95") && p["ci95"].is_array() && p["ci95"].size() == 2 && p["ci95"][0].is_number() &&
-          p["ci95"][1].is_number())
-        se = (p["ci95"][1].get<double>() - p["ci95"][0].get<double>()) / (2 * fit::kZ95);
-      e.parameters.push_back(name);
-      e.value.push_back(v);
-      e.standard_error.push_back(se > 0 && std::isfinite(se) ? se : 0.0);
-      e.off.push_back(diagnose::neutral_value(declared));
-    }
-    if (!e.parameters.empty()) ref.effects.push_back(e);
-  }
-  return ref;
 }
 
 }  // namespace

@@ -287,7 +287,13 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     // samples the linear interpolation is their average over the interval).
     inputs_at(s, s.t - e.delay, u);
   }
-  if (speed_states_.empty()) return;
+  if (!speed_states_.empty()) filter_rotor_speeds(X, U, span);
+}
+
+void EquationErrorModel::filter_rotor_speeds(std::vector<double>& X, const std::vector<double>& U, SampleSpan span) const {
+  const int n = model_->num_states(), nu = model_->num_inputs();
+  const size_t ns = flight_.samples.size(), nr = speed_states_.size();
+  const std::vector<double>& tau = scratch_.tau;
   // Rotor speeds: the commanded speed (the model's dw/dt at w = 0, times tau) through the
   // first-order lag, started in steady state; the commands are held between samples, for
   // which the discretisation is exact. The mean over each interval (what its mid-interval

@@ -146,6 +146,9 @@ class EquationErrorModel : public ResidualModel {
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
   // Only the samples in `span` are filled (the others stay zero).
   void prepare(const double* p, std::vector<double>& X, std::vector<double>& U, SampleSpan span) const;
+  // prepare()'s rotor-speed states (motor_lag): the commands' speeds through each rotor's lag
+  // (scratch_.tau), and their means over each interval into scratch_.mean_speed.
+  void filter_rotor_speeds(std::vector<double>& X, const std::vector<double>& U, SampleSpan span) const;
   void commands_at(double t, double* u) const;  // rotor commands interpolated at t
   // The model's inputs at sample s with the commands logged at command_time (s.t less a
   // delay): the rotor commands, and the time and battery voltage where the model has them.

@@ -244,6 +244,44 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
 
 }  // namespace
 
+namespace {
+
+// The training and the validation part's residual models of the chosen formulation.
+struct FlightResiduals {
+  std::unique_ptr<ResidualModel> train, valid;
+};
+FlightResiduals flight_residuals(runtime::DynamicModel& model, const Flight& train, const Flight& valid, bool accel,
+                                 const FitJobOptions& o) {
+  if (o.formulation == "multiple_shooting")
+    return {std::make_unique<MultipleShootingModel>(model, train, o.window),
+            std::make_unique<MultipleShootingModel>(model, valid, o.window)};
+  return {std::make_unique<EquationErrorModel>(model, train, accel, o.channels),
+          std::make_unique<EquationErrorModel>(model, valid, accel)};
+}
+
+// fit.json's "validation": each channel's RMS on the held-out part, nominal and fitted.
+nlohmann::ordered_json validation_json(const ResidualModel& valid_m, const std::vector<FitParameter>& nominal,
+                                       const FitResult& best, double fraction, size_t samples) {
+  const auto before = channel_rms(valid_m, nominal), after = channel_rms(valid_m, best.parameters);
+  nlohmann::ordered_json val = nlohmann::ordered_json::array();
+  const auto ch = valid_m.channels();
+  for (size_t c = 0; c < ch.size(); ++c)
+    val.push_back({{"channel", ch[c]}, {"rms_nominal", before[c]}, {"rms_fitted", after[c]},
+                   {"reduction_percent", before[c] > 0 ? 100 * (before[c] - after[c]) / before[c] : 0.0}});
+  return {{"fraction", fraction}, {"samples", samples}, {"channels", val}};
+}
+
+// One line a profiled parameter: "name = value [lower, upper] verdict".
+std::string profile_summary(const FitResult& best, const std::vector<Profile>& profiles) {
+  std::ostringstream s;
+  for (const auto& pr : profiles)
+    s << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
+      << side(pr.upper, pr.upper_open) << "] " << pr.verdict << "\n";
+  return s.str();
+}
+
+}  // namespace
+
 FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
   std::string error;
   if (!o.IsValid(&error)) throw std::invalid_argument("fit: " + error);
@@ -253,27 +291,19 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
   const bool accel = flight.has_accelerometer;
   const bool shooting = o.formulation == "multiple_shooting";
-  std::unique_ptr<ResidualModel> train_m, valid_m;
-  if (shooting) {
-    train_m = std::make_unique<MultipleShootingModel>(model, train, o.window);
-    valid_m = std::make_unique<MultipleShootingModel>(model, valid, o.window);
-  } else {
-    train_m = std::make_unique<EquationErrorModel>(model, train, accel, o.channels);
-    valid_m = std::make_unique<EquationErrorModel>(model, valid, accel);
-  }
+  const FlightResiduals m = flight_residuals(model, train, valid, accel, o);
   const FitOptions fo = fit_options(o);
   o.progress("[1/3] " + o.formulation + " fit on " + std::to_string(train.samples.size()) + " samples (" +
-             std::to_string(train_m->num_residuals()) + " residuals), " +
+             std::to_string(m.train->num_residuals()) + " residuals), " +
              std::to_string(std::count_if(params.begin(), params.end(), [](auto& p) { return p.free; })) + " free parameters");
   auto clock0 = std::chrono::steady_clock::now();
-  const FitResult best = fit_least_squares(*train_m, params, fo);
+  const FitResult best = fit_least_squares(*m.train, params, fo);
   const double fit_seconds = seconds_since(clock0);
   o.progress("[2/3] profile likelihood (fit took " + std::to_string(fit_seconds) + " s)");
   clock0 = std::chrono::steady_clock::now();
-  const auto profiles = run_profiles(o, *train_m, best, fo);
+  const auto profiles = run_profiles(o, *m.train, best, fo);
   const double profile_seconds = seconds_since(clock0);
   o.progress("[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples");
-  const auto before = channel_rms(*valid_m, params), after = channel_rms(*valid_m, best.parameters);
   FitOutputs out;
   out.warnings = flight.notes;
   auto& j = out.json = fit_json(best, profiles);
@@ -284,23 +314,14 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   j["formulation"] = shooting ? "multiple shooting: " + std::to_string(o.window) + " s windows from measured states, pose residuals"
                      : accel  ? "equation error: accelerometer specific force and gyro derivative"
                               : "equation error: differentiated velocity and gyro derivative";
-  nlohmann::ordered_json val = nlohmann::ordered_json::array();
-  const auto ch = valid_m->channels();
-  for (size_t c = 0; c < ch.size(); ++c)
-    val.push_back({{"channel", ch[c]}, {"rms_nominal", before[c]}, {"rms_fitted", after[c]},
-                   {"reduction_percent", before[c] > 0 ? 100 * (before[c] - after[c]) / before[c] : 0.0}});
-  j["validation"] = {{"fraction", o.validation}, {"samples", valid.samples.size()}, {"channels", val}};
-  j["fitted_channels"] = train_m->channels();
+  j["validation"] = validation_json(*m.valid, params, best, o.validation, valid.samples.size());
+  j["fitted_channels"] = m.train->channels();
   j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
   add_profile_plot(out, v.name + ": profile likelihood", profiles);
   const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
   add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
            flight_panels(model, flight, parameter_values(best.parameters)));
-  std::ostringstream s;
-  for (const auto& pr : profiles)
-    s << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
-      << side(pr.upper, pr.upper_open) << "] " << pr.verdict << "\n";
-  out.summary = s.str();
+  out.summary = profile_summary(best, profiles);
   // A model parameter on its bound is not an estimate: on a flight log most often the log's
   // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
   // by design; their reports say so.)

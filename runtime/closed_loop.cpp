@@ -127,63 +127,83 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
 }
 }  // namespace
 
+namespace {
+
+// The hover trim's problem: thrusts F (one per rotor) with A F = (weight, 0, 0, 0), each
+// between the least a rotor gives (its thrust at command 0: a motor map with a0 > 0 idles
+// above 0 N) and the most (at command 1).
+struct TrimProblem {
+  explicit TrimProblem(const ControllerModel& b) : A(allocation_matrix(b)), least(A.cols()), most(A.cols()) {
+    weight = b.mass * b.g;
+    w = Eigen::Vector4d(weight, 0, 0, 0);
+    for (Eigen::Index i = 0; i < A.cols(); ++i) {
+      const ThrustLaw& l = b.thrust_laws[static_cast<size_t>(i)];
+      least(i) = l.thrust_at_speed(std::max(l.speed_at(0.0), 0.0));
+      most(i) = l.thrust_at_speed(std::max(l.speed_at(1.0), 0.0));
+    }
+  }
+  bool balances(const Eigen::VectorXd& F) const { return (A * F - w).norm() <= 1e-6 * weight; }
+  bool above_least(const Eigen::VectorXd& F) const { return balances(F) && (F - least).minCoeff() >= -1e-12 * weight; }
+  bool within_reach(const Eigen::VectorXd& F) const { return above_least(F) && (most - F).minCoeff() >= -1e-12 * weight; }
+  Eigen::VectorXd trim(const std::vector<bool>& free) const { return trim_with(A, free, least, w); }
+
+  Eigen::MatrixXd A;
+  Eigen::VectorXd least, most;
+  Eigen::Vector4d w;
+  double weight = 0;
+};
+
+// Every set of rotors held at their least in turn, the others trimmed with least norm: of
+// those trims, the least-norm one with every rotor within reach (commands 0 to 1). That is
+// the least-norm trim within reach where only command 0 binds (a KKT point of the least-norm
+// problem holds its active rotors at their least); where command 1 binds too, a trim within
+// reach is still found if holding rotors at command 0 gives one. (2^n - 1 small solves; a
+// greedy choice of the set missed trims.) F and free are left as they are where none is.
+void search_held_sets(const TrimProblem& P, Eigen::VectorXd& F, std::vector<bool>& free) {
+  const size_t n = free.size();
+  double best = std::numeric_limits<double>::infinity();
+  for (unsigned held = 1; held < (1u << n); ++held) {
+    std::vector<bool> f(n);
+    for (size_t i = 0; i < n; ++i) f[i] = !(held >> i & 1u);
+    const Eigen::VectorXd candidate = P.trim(f);
+    if (P.within_reach(candidate) && candidate.squaredNorm() < best) best = candidate.squaredNorm(), F = candidate, free = f;
+  }
+}
+
+// Holds the rotor furthest below its least at its least, and trims the others again, until
+// every rotor is above its least (or no free rotor is left below it).
+void hold_shortfalls(const TrimProblem& P, Eigen::VectorXd& F, std::vector<bool>& free) {
+  Eigen::Index short_most = 0;
+  while (P.balances(F) && (F - P.least).minCoeff(&short_most) < -1e-12 * P.weight && free[static_cast<size_t>(short_most)]) {
+    free[static_cast<size_t>(short_most)] = false;
+    F = P.trim(free);
+  }
+}
+
+}  // namespace
+
 HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names) {
-  const Eigen::MatrixXd A = allocation_matrix(b);
-  const size_t n = static_cast<size_t>(A.cols());
-  const double weight = b.mass * b.g, even = weight / static_cast<double>(n);
-  const Eigen::Vector4d w(weight, 0, 0, 0);
-  const auto balances = [&](const Eigen::VectorXd& F) { return (A * F - w).norm() <= 1e-6 * weight; };
-  // The least a rotor gives: its thrust at command 0 (a motor map with a0 > 0 idles above 0 N);
-  // the most: its thrust at command 1.
-  Eigen::VectorXd least(A.cols()), most(A.cols());
-  for (size_t i = 0; i < n; ++i) {
-    const ThrustLaw& l = b.thrust_laws[i];
-    least(static_cast<Eigen::Index>(i)) = l.thrust_at_speed(std::max(l.speed_at(0.0), 0.0));
-    most(static_cast<Eigen::Index>(i)) = l.thrust_at_speed(std::max(l.speed_at(1.0), 0.0));
-  }
+  const TrimProblem P(b);
+  const size_t n = static_cast<size_t>(P.A.cols());
+  const double even = P.weight / static_cast<double>(n);
   std::vector<bool> free(n, true);
-  const Eigen::VectorXd least_norm = trim_with(A, free, least, w);
-  const auto above_least = [&](const Eigen::VectorXd& F) {
-    return balances(F) && (F - least).minCoeff() >= -1e-12 * weight;
-  };
-  const auto within_reach = [&](const Eigen::VectorXd& F) {
-    return above_least(F) && (most - F).minCoeff() >= -1e-12 * weight;
-  };
+  const Eigen::VectorXd least_norm = P.trim(free);
   Eigen::VectorXd F = least_norm;
-  if (!within_reach(F) && n <= kExactTrimRotors) {
-    // Every set of rotors held at their least in turn, the others trimmed with least norm:
-    // of those trims, the least-norm one with every rotor within reach (commands 0 to 1).
-    // That is the least-norm trim within reach where only command 0 binds (a KKT point of
-    // the least-norm problem holds its active rotors at their least); where command 1 binds
-    // too, a trim within reach is still found if holding rotors at command 0 gives one.
-    // (2^n - 1 small solves; a greedy choice of the set missed trims.)
-    double best = std::numeric_limits<double>::infinity();
-    for (unsigned held = 1; held < (1u << n); ++held) {
-      std::vector<bool> f(n);
-      for (size_t i = 0; i < n; ++i) f[i] = !(held >> i & 1u);
-      const Eigen::VectorXd candidate = trim_with(A, f, least, w);
-      if (within_reach(candidate) && candidate.squaredNorm() < best)
-        best = candidate.squaredNorm(), F = candidate, free = f;
-    }
-  } else if (!above_least(F)) {
-    Eigen::Index short_most = 0;
-    while (balances(F) && (F - least).minCoeff(&short_most) < -1e-12 * weight &&
-           free[static_cast<size_t>(short_most)]) {  // hold the rotor furthest below its least at its least
-      free[static_cast<size_t>(short_most)] = false;
-      F = trim_with(A, free, least, w);
-    }
-  }
+  if (!P.within_reach(F) && n <= kExactTrimRotors)
+    search_held_sets(P, F, free);
+  else if (!P.above_least(F))
+    hold_shortfalls(P, F, free);
   HoverTrim t;
   // Where no trim is within reach but the least-norm one is above every least, the rotor
   // beyond its command 1 is named below (command_for), as before the search.
-  const bool reachable_below = above_least(F);
+  const bool reachable_below = P.above_least(F);
   if (!reachable_below) F = least_norm;
   t.thrusts.assign(F.data(), F.data() + F.size());
   if ((F.array() - even).abs().maxCoeff() <= 1e-9 * even) t.thrusts.assign(n, even);  // symmetric: exact
-  if (!balances(least_norm)) {
+  if (!P.balances(least_norm)) {
     t.why_not = "no thrusts balance the weight without a moment";
   } else if (!reachable_below) {
-    t.why_not = why_no_trim_above_least(least_norm, least, rotor_names, weight);
+    t.why_not = why_no_trim_above_least(least_norm, P.least, rotor_names, P.weight);
   }
   for (size_t i = 0; t.found() && i < n; ++i) try {
       t.commands.push_back(free[i] ? b.thrust_laws[i].command_for(t.thrusts[i]) : 0.0);  // held: command 0
