@@ -1,5 +1,6 @@
 #include "app/simulate_job.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -40,20 +41,46 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 }
 
 
+// The --set values, each checked, in the model the simulation flies.
+void apply_settings(const SimulateJob& a, DynamicModel& m) {
+  std::vector<double> p = m.params();
+  for (const auto& [name, value] : a.set) {
+    const int i = m.param_index(name);
+    if (i < 0)
+      throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model" +
+                                  output::printable(missing_parameter_hint(name, m.param_names())));
+    const std::string problem = runtime::value_problem(m.parameters()[static_cast<size_t>(i)], value, false);
+    if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
+    p[i] = value;
+  }
+  m.set_params(p);
+}
+
+// Said when the controller ran out of authority: a motor command at 0 or 1 in more than 1 %
+// of the samples. Such samples fit poorly (an idle rotor is not in the model; diagnose and fit
+// leave samples with a command at or below 0.05 out), so the flight tells less than it seems.
+std::string saturation_note(const GeneratedFlight& flight, const std::vector<std::string>& rotors) {
+  std::vector<int> columns;
+  for (const auto& r : rotors) columns.push_back(index_in(flight.columns, "u_" + r));
+  size_t at_limit = 0;
+  for (const auto& row : flight.rows)
+    if (std::any_of(columns.begin(), columns.end(), [&](int c) { return row[c] <= 1e-3 || row[c] >= 1 - 1e-3; }))
+      ++at_limit;
+  const double share = flight.rows.empty() ? 0.0 : static_cast<double>(at_limit) / static_cast<double>(flight.rows.size());
+  if (share <= 0.01) return "";
+  std::ostringstream os;
+  os.precision(3);
+  os << "note: a motor command is at its limit (0 or 1) in " << 100 * share
+     << " % of the samples: the controller ran out of authority there (a smaller --excitation, --amplitude or "
+        "disturbance keeps it within reach); fit and diagnose leave out samples with a command at or below 0.05";
+  return os.str();
+}
+
 // A closed-loop test flight: the true model (effects and --set values) flown by a
 // controller that believes the nominal base model.
 SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, const SymbolicModel& model,
                                   DynamicModel& truth) {
   SimulateJobResult result;
-  std::vector<double> p = truth.params();
-  for (const auto& [name, value] : a.set) {
-    const int i = truth.param_index(name);
-    if (i < 0) throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model (add its effect with --effects)");
-    const std::string problem = runtime::value_problem(truth.parameters()[static_cast<size_t>(i)], value, false);
-    if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
-    p[i] = value;
-  }
-  truth.set_params(p);
   const ControllerModel belief = nominal_controller_belief(vehicle, model);
   const std::vector<std::string> rotors = rotor_names(vehicle);
   ClosedLoopOptions o = a.flight;
@@ -80,6 +107,7 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   std::ostringstream summary;
   summary << "flew " << a.duration << " s closed loop";
   result.summary = summary.str();
+  if (const std::string note = saturation_note(flight, rotors); !note.empty()) result.notes.push_back(note);
   return result;
 }
 
@@ -139,6 +167,7 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
                      a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout (t, u_<rotor>; "
                                          "docs/formats.md), or another through --mapping"
                                        : "");
+  fit::check_log_conventions(log);
   const std::vector<double> t = log.values("t");
   if (a.duration > t.back() - t.front() + 1e-9)
     throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
@@ -265,6 +294,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
   const Vehicle vehicle = load_vehicle(a.vehicle);
+  if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
   if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
   else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
   DeriveOptions opt;
@@ -272,6 +302,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
+  apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
   const double even_share =
       m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
   const OpenLoop k{m,

@@ -45,6 +45,7 @@ struct SimulateJobResult {
   std::string plot_title;
   std::vector<runtime::Panel> plot;    // translation, rotation, thrust; or position and commands
   std::string summary;                 // what the command prints
+  std::vector<std::string> notes;      // what the user should know about the flight (its commands' limits)
 };
 
 // Throws std::invalid_argument for contradicting or oversized requests before any work, and

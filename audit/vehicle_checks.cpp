@@ -83,14 +83,20 @@ AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b)
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
   std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(b.mass * b.g) + " N)";
-  if (trim.found()) {
-    const Eigen::VectorXd u =
-        Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
-    detail += ", commands " + numbers(u, "");
-  } else {
-    detail += ": " + trim.why_not;
-  }
-  return advisory("a hover trim exists within the motors' reach", trim.found(), detail);
+  if (!trim.found()) return advisory("a hover trim exists within the motors' reach", false, detail + ": " + trim.why_not);
+  const Eigen::VectorXd u =
+      Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
+  detail += ", commands " + numbers(u, "");
+  // Hover at the very bottom of the map is no design: most often a map in rpm written without
+  // its unit (read as rad/s, 9.5 times too fast). Below 0.05 fit and diagnose take a rotor
+  // for idle and leave the sample out.
+  constexpr double kLowestHoverCommand = 0.1;
+  const bool low = u.maxCoeff() < kLowestHoverCommand;
+  if (low)
+    detail += ": hover needs less than " + std::to_string(kLowestHoverCommand).substr(0, 3) +
+              " of the command range (a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too "
+              "fast; below 0.05 fit and diagnose take a rotor for idle)";
+  return advisory("a hover trim exists within the motors' reach", !low, detail);
 }
 
 // No two rotor discs cut through each other: hubs in one plane (within a quarter of the

@@ -26,7 +26,8 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", j.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", j.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5));
+      ->check(finite_range(0.1, 1e5))
+      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_option("--validation", o.validation_fraction, "fraction of the flight (at its end) held out")
       ->check(finite_range(0.1, 0.6));
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
@@ -37,7 +38,8 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);
-  c->add_option("--translational", o.translational, "translational channels: auto, pose or accelerometer")
+  c->add_option("--translational", o.translational, "translational channels: the differentiated velocity of the pose, or the accelerometer's specific "
+                "force; auto: the pose where the log has one, else the accelerometer")
       ->check(CLI::IsMember({"auto", "pose", "accelerometer"}));
   c->add_option("--environment", j.environment,
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "

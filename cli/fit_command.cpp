@@ -27,7 +27,9 @@ void add_fit(CLI::App& app, FitArgs& a) {
                                   "), motor steps or a thrust stand (CSV)")
       ->required();
   c->add_option("--out", a.out, "output directory")->required();
-  c->add_flag("--robust", a.options.robust, "Huber loss instead of squares");
+  c->add_flag("--robust", a.options.robust,
+              "Huber loss instead of squares (quadratic up to 1 in the weighted residuals, about one noise "
+              "standard deviation of each channel; linear beyond)");
   c->add_option("--mapping", a.options.mapping, "column mapping (YAML) for logs not in the canonical layout, e.g. data/mappings/nanobench.yaml");
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
@@ -37,8 +39,14 @@ void add_fit(CLI::App& app, FitArgs& a) {
       ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
   c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(0.01, 100));
   c->add_option("--resample", a.options.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5));
+      ->check(finite_range(0.1, 1e5))
+      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
+  c->add_option("--translational", a.options.translational,
+                "equation error: ax, ay, az from the accelerometer (body specific force at each sample) or from the "
+                "pose (world acceleration, the differentiated velocity, exact for commands held between samples)")
+      ->check(CLI::IsMember({"pose", "accelerometer"}))
+      ->default_str("the accelerometer where logged, else the pose");
   c->add_option("--free", a.free,
                 std::string("parameters to fit (comma-separated), overriding the vehicle file's fit flags: ") +
                     parameter_names_help());
@@ -91,6 +99,8 @@ void refuse_options(const FitArgs& a, const std::string& kind, const std::set<st
 void check_flight_options(const FitArgs& a) {
   const bool shooting = a.options.formulation == "multiple_shooting";
   if (a.given.count("--window") && !shooting) throw std::invalid_argument("--window: only with --formulation multiple_shooting");
+  if (a.given.count("--translational") && shooting)
+    throw std::invalid_argument("--translational: only with --formulation equation_error (multiple shooting fits the pose)");
   if (a.given.count("--channels") && shooting)
     throw std::invalid_argument("--channels: only with --formulation equation_error (multiple shooting fits the pose)");
 }

@@ -25,7 +25,8 @@ void add_predict(CLI::App& app, PredictArgs& a) {
                 "fraction of each flight (at its end) evaluated; 1 for flights no fit has seen")
       ->check(finite_range(0.05, 1.0));
   c->add_option("--resample", a.options.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5));
+      ->check(finite_range(0.1, 1e5))
+      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (c_t, motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");

@@ -34,15 +34,16 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--mapping", a.job.mapping, "column mapping (YAML) for an --inputs log not in the canonical layout (a CSV, a PX4 ULog, a Crazyflie uSD log)")
       ->needs(in);
   auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
-                         "fly a smooth random trajectory under a cascaded controller (test flights)");
+                         "fly a smooth random trajectory under a cascaded controller (test flights); the controller runs and the "
+                         "log is written at 100 Hz (--rate and --integrator are for scenarios and replays)");
   sc->excludes(in);
   cl->excludes(sc)->excludes(in);
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
   c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
   c->add_option("--set", a.set,
-                std::string("closed loop: NAME=VALUE for a parameter of the true model (repeatable); names: ") +
-                    parameter_names_help())
-      ->needs(cl);
+                std::string("NAME=VALUE for a parameter of the simulated model (repeatable; in a closed loop the true "
+                            "model, which the controller does not know); names: ") +
+                    parameter_names_help());
   c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
   c->add_option("--gyro-bias", a.job.flight.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
@@ -72,7 +73,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
       ->required();
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
-  c->add_option("--effects", a.job.effects, "comma-separated effects to add, or 'all': " + effect_names);
+  c->add_option("--effects", a.job.effects,
+                "comma-separated effects to add, or 'all' (each at its neutral value, no change, until --set gives "
+                "its parameters values): " + effect_names);
   c->add_option("--integrator", a.job.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
       ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);
   c->add_option("--step", a.job.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
@@ -136,6 +139,7 @@ int run_simulate(const SimulateArgs& a) {
   if (render_svg(r.plot_title, r.plot, &svg, &err)) out.set(1, svg);
   else std::cerr << "no plot: " << err << "\n";
   out.commit();
+  for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "\n";
   return 0;
 }

@@ -93,8 +93,11 @@ void spread_under_agreement(ParameterAgreement& a) {
   a.spread_p_value = std::clamp(1 - range_cdf(sd, a.spread * scale), 0.0, 1.0);
 }
 
+
+}  // namespace
+
 // Pooled value, Cochran's Q, spread and the verdict from the flights' estimates.
-void summarise(ParameterAgreement& a) {
+void summarise_agreement(ParameterAgreement& a) {
   double sw = 0, swk = 0, lo = INFINITY, hi = -INFINITY;
   for (const auto& f : a.flights) {
     lo = std::min(lo, f.value), hi = std::max(hi, f.value);
@@ -117,10 +120,9 @@ void summarise(ParameterAgreement& a) {
   a.q_p_value = chi2_upper(a.q, counted - 1.0);
   a.spread = a.joint_value != 0 ? (hi - lo) / std::abs(a.joint_value) : INFINITY;
   a.agree = within && a.spread < 0.3;
+  a.within_errors = within;
   spread_under_agreement(a);
 }
-
-}  // namespace
 
 double range_cdf(const std::vector<double>& sd, double r) {
   if (!(r > 0)) return 0.0;
@@ -160,7 +162,7 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) 
         if (p.name == a.parameter) a.unit = p.unit;
       a.joint_value = e.start[j];
       for (const auto& f : per_flight) a.flights.push_back(f.at(a.parameter));
-      summarise(a);
+      summarise_agreement(a);
       out.push_back(a);
     }
   return out;
@@ -203,7 +205,8 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
       a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
       a.q_p_value = chi2_upper(a.q, 1.0);
       a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
-      a.agree = a.q < kZ95 * kZ95 && a.spread < 0.3;
+      a.within_errors = a.q < kZ95 * kZ95;
+      a.agree = a.within_errors && a.spread < 0.3;
       out.push_back(a);
     }
   return out;

@@ -44,7 +44,17 @@ struct ParameterAgreement {
   // Every flight's interval contains the pooled value or the heterogeneity test does not
   // reject at 1 %; and the spread is below 30 %.
   bool agree = false;
+  // Within the errors (every interval holds the pooled value; against an airframe, the
+  // difference within 1.96 standard errors) though not agreeing: only the 30 % is not met,
+  // and the values may well be one, measured too loosely to show it.
+  bool within_errors = false;
 };
+
+// The verdict in a word: "agree", "too uncertain" (within the errors, apart by 30 % or more)
+// or "disagree".
+inline const char* agreement_verdict(const ParameterAgreement& a) {
+  return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
+}
 
 struct AgreementInputs {
   runtime::DynamicModel* model = nullptr;   // the single-flight model (shared parameter names)
@@ -69,6 +79,10 @@ struct AgreementInputs {
 };
 
 std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
+
+// Pooled value, Cochran's Q, spread, the spread under agreement and the verdict of `a`, from
+// its flights' estimates and joint value.
+void summarise_agreement(ParameterAgreement& a);
 
 // P(max - min <= r) for independent normals with standard deviations `sd` (their means
 // equal): sum over which one is the smallest, integrated over its value.

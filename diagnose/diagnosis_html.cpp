@@ -59,7 +59,11 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
   if (!first) return;
   h << "<h2>The answer to the commands</h2>\n<p>Gain of the measured on the base model's accelerations, band by band "
        "(1: the motor map's slope at the operating point is right), with the correlation and the delay of the model "
-       "that correlates best. The lowest band carries the controller's answer to slow disturbances.</p>\n"
+       "that correlates best. The lowest band carries the controller's answer to slow disturbances. A band whose "
+       "correlation is below " << num(CommandGain::kMinR, 2) << " shows no gain: there the commands explain too "
+       "little of the measured (a closed loop that only answers disturbances, no excitation) for the gain to mean "
+       "the slope. Even well correlated, a closed loop reads low in band (generated flights with an exact map: "
+       "0.55-0.8 at 4-8 Hz), so a gain below 1 is a lead, not a measurement of the map.</p>\n"
        "<table><tr>"
     << (d.command_gain_per_flight.empty() ? "" : "<th>flight</th>") << "<th>axis</th>";
   for (const auto& b : first->axes.front().bands) h << "<th>" << num(b.low_hz, 2) << "&ndash;" << num(b.high_hz, 2) << " Hz</th>";
@@ -69,7 +73,8 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
     for (const auto& a : g->axes) {
       h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td>" + esc(flight) + "</td>") << "<td>" << esc(a.name) << "</td>";
       for (const auto& b : a.bands)
-        h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
+        if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << num(b.r, 2) << ")</td>";
+        else h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
       h << "</tr>\n";
     }
   }
@@ -151,7 +156,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
-      << ": <span class=\"" << (a.agree ? "ok\">agree" : "warn\">disagree") << "</span></h3>\n<p>"
+      << ": <span class=\"" << (a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a) << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
@@ -177,7 +182,8 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<h2>Against the airframe</h2>\n<p>The named effects of the airframe in " << esc(d.airframe_source)
       << " refitted on this flight's training part (the airframe's other values held, this flight's own thrust "
          "constant and trims free). The flight agrees with the airframe when the difference is within 1.96 of its "
-         "standard error (both estimates' errors) and below 30 %. Line: the airframe's value.</p>\n";
+         "standard error (both estimates' errors) and below 30 %; within the errors but 30 % or more apart it is \"too "
+         "uncertain\" to agree. Line: the airframe's value.</p>\n";
     if (!words::airframe_from_one_flight(d).empty())
       h << "<p class=\"warn\">Note: " << esc(words::airframe_from_one_flight(d)) << ".</p>\n";
     agreement_table_html(h, d.airframe_check, d.flights, "airframe");
@@ -191,7 +197,8 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "value and the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
        "median spread the flights would show if each measured the pooled value with its own standard error, and the "
        "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
-       "wider, however well they agree.</p>\n";
+       "wider, however well they agree: where every interval holds it and only the 30 % is missed, the verdict is "
+       "\"too uncertain\", not \"disagree\".</p>\n";
   agreement_table_html(h, d.agreement, d.flights, "joint");
 }
 

@@ -250,6 +250,7 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
                    {"cochran_q", number_or_null(a.q)},
                    {"q_p_value", a.q_p_value},
                    {"agree", a.agree},
+                   {"verdict", agreement_verdict(a)},
                    {"flights", per_flight}});
   }
   return out;

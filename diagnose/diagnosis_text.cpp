@@ -41,7 +41,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
 // Whether the flights of a joint diagnosis agree, or this flight with an airframe found before.
 void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.agreement) {
-    os << "flights " << (a.agree ? "agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+    os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q p = " << num(a.q_p_value, 2) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
@@ -50,10 +50,11 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())
     os << "note: " << words::airframe_from_one_flight(d) << "\n";
   for (const auto& a : d.airframe_check)
-    os << "this flight " << (a.agree ? "agrees" : "disagrees") << " with the airframe on " << a.parameter << ": "
+    os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
+       << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
        << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
        << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
-       << ")\n";
+       << (a.within_errors && !a.agree ? ": within the errors, but 30 % or more apart" : "") << ")\n";
 }
 
 // What was not named and why: look-alikes, stand-ins, suspects, what the backward pass

@@ -13,6 +13,10 @@
 
 #include <Eigen/Dense>
 
+#include "output/joined.hpp"
+#include "output/nearest_word.hpp"
+#include "output/sinks.hpp"
+
 namespace quadgen::fit {
 
 using namespace runtime::rigid_body;
@@ -25,7 +29,11 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   if (use.empty()) use = names;
   for (const auto& u : use) {
     const int c = runtime::index_in(names, u);
-    if (c < 0) throw FitError("unknown residual channel '" + u + "'");
+    if (c < 0) {
+      const std::string near = output::nearest_word(u, names);
+      throw FitError("unknown residual channel '" + output::printable(u) + "' (channels: " + output::joined(names) + ")" +
+                     (near.empty() ? "" : "; did you mean '" + near + "'?"));
+    }
     used_.push_back(c);
   }
   speed_states_ = model.rotor_speed_states();

@@ -88,6 +88,24 @@ std::string side(double v, bool open) {
 
 // A plot's data always joins the outputs as CSV beside it (fit.csv for fit.svg); the plot
 // itself when gnuplot can draw it, and without one the fit still counts.
+// The motor map's three terms as the vehicle file's motor_map section takes them (values
+// with their unit, to copy), with their intervals; `where`: at which command scale and voltage.
+std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vector<Profile>& profiles,
+                            const std::string& where) {
+  std::ostringstream s;
+  s << "motor_map (for the vehicle file; " << where << "):\n";
+  for (const char* term : {"a0", "a1", "a2"}) {
+    const auto p = std::find_if(ps.begin(), ps.end(), [&](const FitParameter& q) { return q.name == term; });
+    if (p == ps.end()) continue;
+    s << "  " << term << ": {value: " << p->value << ", unit: " << p->unit << "}";
+    for (const auto& pr : profiles)
+      if (pr.parameter == term)
+        s << "  # [" << side(pr.lower, pr.lower_open) << ", " << side(pr.upper, pr.upper_open) << "] " << pr.verdict;
+    s << "\n";
+  }
+  return s.str();
+}
+
 void add_plot(FitOutputs& out, const std::string& file, const std::string& title, const std::vector<runtime::Panel>& panels) {
   out.plots.emplace_back(file.substr(0, file.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
   std::string svg, err;
@@ -147,6 +165,8 @@ bool FitJobOptions::IsValid(std::string* error) const {
   if (formulation != "equation_error" && formulation != "multiple_shooting")
     return fail("formulation: equation_error or multiple_shooting");
   if (!(window >= 0.01 && window <= 100)) return fail("window: 0.01 to 100 s");
+  if (!translational.empty() && translational != "pose" && translational != "accelerometer")
+    return fail("translational: pose or accelerometer (empty: the accelerometer where logged)");
   return true;
 }
 
@@ -188,7 +208,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
     s << ", 95 % profile interval [" << side(tau->lower, tau->lower_open) << ", " << side(tau->upper, tau->upper_open) << "] ("
       << tau->verdict << ")";
   if (thesis) s << "; thesis: " << kThesisMotorTau << " s";
-  s << "\n";
+  s << "\n" << motor_map_lines(best.parameters, profiles, "the steps' command scale");
   out.summary = s.str();
   return out;
 }
@@ -201,7 +221,8 @@ std::vector<FitParameter> starting_parameters(const runtime::DynamicModel& model
   std::vector<FitParameter> params = model.parameters();
   for (const auto& name : o.free)
     if (std::none_of(params.begin(), params.end(), [&](const auto& p) { return p.name == name; }))
-      throw std::invalid_argument("--free: no parameter '" + output::printable(name) + "' in the model");
+      throw std::invalid_argument("--free: no parameter '" + output::printable(name) + "' in the model" +
+                                  output::printable(missing_parameter_hint(name, model.param_names())));
   if (!o.free.empty()) {
     for (auto& p : params) p.free = std::find(o.free.begin(), o.free.end(), p.name) != o.free.end();
     return params;
@@ -271,6 +292,40 @@ nlohmann::ordered_json validation_json(const ResidualModel& valid_m, const std::
   return {{"fraction", fraction}, {"samples", samples}, {"channels", val}};
 }
 
+// Whether the translational channels come from the accelerometer (FitJobOptions::translational).
+bool uses_accelerometer(const Flight& flight, const FitJobOptions& o) {
+  if (o.translational == "accelerometer" && !flight.has_accelerometer)
+    throw std::invalid_argument("--translational accelerometer: " + output::printable(flight.source) +
+                                " has no accelerometer columns ax, ay, az");
+  if (o.translational == "pose" && !flight.has_pose)
+    throw std::invalid_argument("--translational pose: " + output::printable(flight.source) + " has no pose");
+  return o.translational == "accelerometer" || (o.translational.empty() && flight.has_accelerometer);
+}
+
+// An input delay fitted to the accelerometer's samples: between samples the model
+// interpolates the logged commands, while commands held between samples (a generated flight;
+// a logger that repeats its last value) change the force once per interval. A delay that is
+// no whole number of sample intervals can then come out at the nearest whole one, its
+// interval far too narrow. The differentiated velocity averages over each interval and has
+// no such preference.
+std::string delay_resolution_warning(const Flight& flight, const FitResult& best, bool pointwise) {
+  const auto it = std::find_if(best.parameters.begin(), best.parameters.end(),
+                               [](const FitParameter& p) { return p.name == "input_delay.seconds" && p.free; });
+  if (!pointwise || it == best.parameters.end() || flight.samples.size() < 2) return "";
+  std::vector<double> dts;
+  for (size_t k = 1; k < flight.samples.size(); ++k) dts.push_back(flight.samples[k].t - flight.samples[k - 1].t);
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  const double dt = dts[dts.size() / 2], intervals = it->value / dt;
+  if (!(dt > 0) || std::fabs(intervals - std::round(intervals)) > 0.05) return "";  // not stuck at a whole one
+  std::ostringstream os;
+  os.precision(3);
+  os << "input_delay.seconds = " << it->value << " s is a whole number of the accelerometer's sample intervals ("
+     << dt * 1e3 << " ms), to which it was fitted: with commands held between samples, a delay between two whole "
+        "numbers comes out at one, its interval too narrow; --translational pose fits the differentiated velocity, "
+        "which resolves it within an interval";
+  return os.str();
+}
+
 // One line a profiled parameter: "name = value [lower, upper] verdict".
 std::string profile_summary(const FitResult& best, const std::vector<Profile>& profiles) {
   std::ostringstream s;
@@ -289,7 +344,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
   const std::vector<FitParameter> params = starting_parameters(model, o);
   const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
-  const bool accel = flight.has_accelerometer;
+  const bool accel = uses_accelerometer(flight, o);
   const bool shooting = o.formulation == "multiple_shooting";
   const FlightResiduals m = flight_residuals(model, train, valid, accel, o);
   const FitOptions fo = fit_options(o);
@@ -325,6 +380,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   // A model parameter on its bound is not an estimate: on a flight log most often the log's
   // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
   // by design; their reports say so.)
+  if (const std::string w = delay_resolution_warning(flight, best, accel && !shooting); !w.empty()) out.warnings.push_back(w);
   for (const std::string& name : best.at_bound)
     out.warnings.push_back(name +
                            " ended on a bound of the fit, so its value is not an estimate (check the log's units and "
@@ -418,6 +474,11 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   s << "c_t = " << ct << "; ";
   if (f.voltage_exponent_identified) s << "speed ~ vbat^" << f.speed.parameters[3].value << "\n";
   else s << f.voltage_reason << "\n";
+  std::ostringstream where;
+  where << "over the command pwm / 65535, ";
+  if (f.voltage_exponent_identified) where << "at vbat_ref = " << vref << " V";
+  else where << "at the stand's voltage at each command";
+  s << motor_map_lines(f.speed.parameters, f.speed_profiles, where.str());
   out.summary = s.str();
   return out;
 }

@@ -38,6 +38,11 @@ struct FitJobOptions {
   std::string formulation = "equation_error";  // flights: or multiple_shooting
   double window = 0.5;                 // multiple shooting: window length [s]
   std::vector<std::string> channels;   // equation error: residual channels fitted (empty: all)
+  // Equation error: the translational channels from the accelerometer (its specific force at
+  // each sample) or from the pose (the differentiated velocity, exact for commands held
+  // between samples); empty: the accelerometer where the log has one, else the pose. (Not
+  // diagnose's "auto", which takes the pose first: fit keeps the sensor it has always used.)
+  std::string translational;
   std::vector<std::string> free;       // parameters fitted, overriding the vehicle file's flags
   std::function<void(const std::string&)> progress = [](const std::string&) {};  // one line per step
 

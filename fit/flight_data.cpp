@@ -354,7 +354,8 @@ namespace {
 // flight, where it is near 9.8). Judged on airborne samples, only where the data can tell.
 // Over windows of up to 0.2 s: whether the attitude turns as far as the gyro says (a gyro in
 // deg/s declared rad/s turns it 57 times too little).
-void check_gyro_against_attitude(const std::string& path, const Flight& f) {
+// `euler`: the log's attitude is given as Euler angles (which may be in degrees).
+void check_gyro_against_attitude(const std::string& path, const Flight& f, bool euler) {
   const auto& S = f.samples;
   if (f.has_pose && f.has_gyro && S.size() > 10) {
     // Over windows of up to 0.2 s: the attitude's turn A (rotation vector of q_a^-1 q_b, body
@@ -397,7 +398,9 @@ void check_gyro_against_attitude(const std::string& path, const Flight& f) {
         os << path << ": the logged attitude turns " << slope << " times as far as the gyro's rates say (+- " << se
            << ", over " << n << " windows of up to 0.2 s): "
            << (near(per_degree)       ? "deg/s read as rad/s? (in the mapping, unit: deg/s)"
-               : near(1 / per_degree) ? "rad/s read as deg/s?"
+               : near(1 / per_degree) ? (euler ? "attitude angles in degrees read as radians (in the mapping, unit: deg), "
+                                                 "or a gyro in rad/s read as deg/s?"
+                                               : "rad/s read as deg/s?")
                                       : "the attitude and the gyro disagree in convention or axes: a world-to-body "
                                         "quaternion (in the mapping, scale: -1 on qx, qy, qz), or gyro axes of another "
                                         "frame (frame: ned_frd)?");
@@ -537,6 +540,27 @@ bool kept(const FlightSample& fs, const Flight& f, double duration, const Flight
 }  // namespace
 
 namespace {
+// Samples high in the air with a motor command at or below min_command: left out as not
+// airborne, which is right for take-off and landing but hides a controller out of authority
+// (a rotor stopped in flight) or a throttle cut. Said when more than 1 % of the samples in
+// the air are left out so.
+struct IdleInTheAir {
+  size_t in_the_air = 0, idle = 0;
+  void count(const FlightSample& fs, const Flight& f, const FlightOptions& o) {
+    if (!f.has_pose || !o.airborne_only || !(fs.x[2] > o.min_height)) return;
+    ++in_the_air;
+    if (std::any_of(fs.u.begin(), fs.u.end(), [&](double uc) { return !(uc > o.min_command); })) ++idle;
+  }
+  std::string note(const std::string& where, const FlightOptions& o) const {
+    if (in_the_air == 0 || static_cast<double>(idle) <= 0.01 * static_cast<double>(in_the_air)) return "";
+    std::ostringstream os;
+    os << where << ": " << idle << " of the " << in_the_air << " samples above " << o.min_height
+       << " m have a motor command at or below " << o.min_command
+       << " and are left out (a rotor at idle is not in the model): a controller out of authority, or a throttle cut?";
+    return os.str();
+  }
+};
+
 const std::array<std::string, 4> kQuaternionColumns{"qw", "qx", "qy", "qz"};
 const std::array<std::string, 3> kEulerColumns{"phi", "theta", "psi"};
 }  // namespace
@@ -588,6 +612,55 @@ std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColu
   return {1, 0, 0, 0};
 }
 
+namespace {
+// Z-Y-X Euler angles in degrees read as radians make a random attitude that no later check
+// reliably catches (the gyro check's windows turn less than pi; these turn tens of radians):
+// a roll beyond +-pi or a pitch beyond +-pi/2 is no Z-Y-X angle in radians. The yaw may be
+// logged unwrapped, so it is not judged.
+void check_euler_range(const runtime::CsvTable& log) {
+  if (attitude_columns(log) != AttitudeColumns::kEuler) return;
+  struct Range {
+    const char* column;
+    double limit;  // rad
+    const char* said;
+  };
+  for (const Range& r : {Range{"phi", M_PI, "+-pi (180 deg)"}, Range{"theta", M_PI / 2, "+-pi/2 (90 deg)"}}) {
+    const int c = log.column(r.column);
+    for (size_t k = 0; k < log.rows.size(); ++k) {
+      const double v = log.rows[k][static_cast<size_t>(c)];
+      if (!(std::fabs(v) > r.limit + 1e-3)) continue;  // NaN is judged where values are read
+      std::ostringstream os;
+      os << log.path << ":" << log.line_of(k) << ": " << r.column << " = " << v
+         << " rad lies outside the range of a Z-Y-X Euler angle, " << r.said
+         << ": angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)";
+      throw FitError(os.str());
+    }
+  }
+}
+
+// Time in milliseconds read as seconds: samples seconds apart. A flight log holds tens to
+// thousands of samples a second; a median interval of half a second or more is no such log.
+void check_time_unit(const runtime::CsvTable& log) {
+  const int c = log.column("t");
+  if (c < 0 || log.rows.size() < 3) return;
+  std::vector<double> dts;
+  for (size_t k = 1; k < log.rows.size(); ++k) dts.push_back(log.rows[k][static_cast<size_t>(c)] - log.rows[k - 1][static_cast<size_t>(c)]);
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  const double median = dts[dts.size() / 2];
+  if (!(median >= 0.5)) return;
+  std::ostringstream os;
+  os << log.where_named() << ": its samples are " << median << " s apart (the median of " << log.rows.size()
+     << " samples): a flight log holds tens to thousands a second; is t in seconds? (milliseconds: in a mapping, "
+        "scale: 0.001 on t)";
+  throw FitError(os.str());
+}
+}  // namespace
+
+void check_log_conventions(const runtime::CsvTable& log) {
+  check_time_unit(log);
+  check_euler_range(log);
+}
+
 void require_known_columns_readable(const runtime::CsvTable& log) {
   log.require_readable([](const std::string& name) { return !canonical_unit(name).empty(); });
 }
@@ -599,6 +672,7 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
                                                      "(docs/formats.md, \"Column mapping\")"
                                                    : "");
   require_known_columns_readable(log);
+  check_log_conventions(log);
   Flight f;
   f.source = log.path;
   if (static_cast<double>(log.rows.size()) < o.min_samples)
@@ -606,12 +680,15 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
                    std::to_string(static_cast<int>(o.min_samples)) + ")");
   read_signals(log, f);
   const FlightColumns columns = read_columns(log, rotors, f, o);
+  IdleInTheAir idle;
   for (size_t k = 0; k < columns.t.size(); ++k) {
     FlightSample fs = sample_at(columns, k, log);
+    idle.count(fs, f, o);
     if (kept(fs, f, columns.t.back(), o)) f.samples.push_back(std::move(fs));
   }
   if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, columns.t, f, o);
-  check_gyro_against_attitude(log.path, f);
+  if (const std::string note = idle.note(log.where_named(), o); !note.empty()) f.notes.push_back(note);
+  check_gyro_against_attitude(log.path, f, attitude_columns(log) == AttitudeColumns::kEuler);
   check_accelerometer_unit(log.path, f);
   return f;
 }

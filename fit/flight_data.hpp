@@ -106,6 +106,11 @@ struct FlightOptions {
 // different rates and forward-filled, or irregular sample times).
 runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz);
 
+// Refuses a log whose time or attitude angles are plainly in another unit than the canonical
+// layout's (ms for s, degrees for rad), naming file, line and the likely fix. load_flight
+// runs it; a reader of a log's commands alone (simulate --inputs) runs it too.
+void check_log_conventions(const runtime::CsvTable& log);
+
 // Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
 Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);
 

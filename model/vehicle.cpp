@@ -295,6 +295,7 @@ std::string fitted_section_note(const Vehicle& v, const std::string& command) {
                      ": its `fitted:` section is read only by `quadgen derive`; " + command +
                      " uses the file's own values";
   if (command == "predict") note += " (to predict with a diagnosis' values, pass its diagnosis.json with --params)";
+  if (command == "simulate") note += " (to fly other values, give them with --set)";
   return note;
 }
 

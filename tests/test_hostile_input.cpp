@@ -1462,6 +1462,66 @@ TEST(Cli, NewcomerMistakesAreNamed) {
                2, "unknown.json: findings: unknown effect 'wind2'");
 }
 
+// A user trial of the less-trodden paths (helper-79, 2026-12-03): simulate ignored --effects
+// outside a closed loop (--set needed one), a --set name slip blamed a missing effect, fit
+// listed no channel names, a closed loop out of authority said nothing, and fit pulled a 25 ms
+// delay to 30 ms from the accelerometer's samples without a word.
+TEST(Cli, UserTrialFindingsAreSaid) {
+  Scratch tmp;
+  const std::string f3 = source_path("vehicles/finken3.yaml");
+  const auto slurp = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  // A scenario flies the values --set gives; an effect without one stays neutral.
+  const auto fly = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"simulate", f3, "--scenario", "hover", "--duration", "1", "--out", tmp / name};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CliResult r = run_quadgen(args, tmp.dir);
+    EXPECT_EQ(r.rc, 0) << r.err;
+    return slurp(tmp / name);
+  };
+  const std::string plain = fly("plain.csv", {}), neutral = fly("neutral.csv", {"--effects", "motor_gain"}),
+                    weak = fly("weak.csv", {"--effects", "motor_gain", "--set", "motor_gain.C=-0.1"});
+  EXPECT_EQ(plain.substr(plain.find('\n')), neutral.substr(neutral.find('\n')));  // the header names no effect
+  EXPECT_NE(neutral, weak);
+  // A slip in a --set name is named as one; a parameter of an effect not added names the effect.
+  expect_one_line_error(run_quadgen({"simulate", f3, "--scenario", "hover", "--duration", "1", "--effects", "motor_gain",
+                                     "--set", "motor_gain.c=-0.1", "--out", tmp / "x.csv"}, tmp.dir),
+                        "no parameter 'motor_gain.c' in the model; did you mean 'motor_gain.C'?", "--set motor_gain.c");
+  expect_one_line_error(run_quadgen({"simulate", f3, "--scenario", "hover", "--duration", "1", "--set",
+                                     "motor_gain.C=-0.1", "--out", tmp / "x.csv"}, tmp.dir),
+                        "(its effect motor_gain is not in the model: add it with --effects)", "--set without --effects");
+  // A closed loop that ran out of authority says so; one within reach does not.
+  const CliResult hard = run_quadgen({"simulate", f3, "--closed-loop", "--duration", "10", "--excitation", "1", "--out",
+                                      tmp / "hard.csv"}, tmp.dir);
+  EXPECT_EQ(hard.rc, 0) << hard.err;
+  EXPECT_NE(hard.err.find("note: a motor command is at its limit (0 or 1) in "), std::string::npos) << hard.err;
+  const CliResult easy = run_quadgen({"simulate", f3, "--closed-loop", "--duration", "20", "--effects", "input_delay",
+                                      "--set", "input_delay.seconds=0.025", "--out", tmp / "delay.csv"}, tmp.dir);
+  EXPECT_EQ(easy.rc, 0) << easy.err;
+  EXPECT_EQ(easy.err.find("at its limit"), std::string::npos) << easy.err;
+  // fit names its channels; with the accelerometer a delay between two sample intervals comes
+  // out at one, which fit says, and the differentiated velocity finds it.
+  expect_one_line_error(run_quadgen({"fit", f3, tmp / "delay.csv", "--channels", "ax,p_dot", "--out", tmp / "o"}, tmp.dir),
+                        "(channels: ax, ay, az, pdot, qdot, rdot); did you mean 'pdot'?", "--channels ax,p_dot");
+  const auto delay_fit = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"fit", f3, tmp / "delay.csv", "--effects", "input_delay", "--free",
+                                     "input_delay.seconds,c_t", "--profiles", "none", "--out", tmp / name};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CliResult r = run_quadgen(args, tmp.dir);
+    EXPECT_EQ(r.rc, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(tmp / name + "/fit.json"));
+    return std::make_pair(j["estimates"]["input_delay.seconds"]["value"].get<double>(), r.err);
+  };
+  const auto [from_accelerometer, said] = delay_fit("acc", {});
+  EXPECT_NEAR(from_accelerometer, 0.030, 5e-4);
+  EXPECT_NE(said.find("is a whole number of the accelerometer's sample intervals (10 ms)"), std::string::npos) << said;
+  const auto [from_pose, quiet] = delay_fit("pose", {"--translational", "pose"});
+  EXPECT_NEAR(from_pose, 0.025, 5e-4);
+  EXPECT_EQ(quiet.find("whole number"), std::string::npos) << quiet;
+}
+
 // A log whose evaluated part is too short for one rollout is the input's problem: refused with
 // what would work, nothing written (before, every horizon read NaN and predict blamed the model).
 TEST(Cli, PredictRefusesALogTooShortForOneRollout) {
@@ -1535,7 +1595,7 @@ TEST(Options, EveryNumberIsCheckedAndNothingIsSilentlyIgnored) {
       {{"simulate", f3, "--closed-loop", "--duration", "1", "--set", "c_t=abc", "--out", traj}, "--set"},
       {{"simulate", f3, "--closed-loop", "--duration", "1", "--set", "c_t=nan", "--out", traj}, "--set"},
       {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--seed", "3", "--out", traj}, "--seed"},
-      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--set", "c_t=1", "--out", traj}, "--set"},
+      {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--set", "mass=-1", "--out", traj}, "--set"},
       {{"simulate", f3, "--scenario", "hover", "--duration", "1", "--pose-noise", "0.1", "--out", traj}, "--pose-noise"},
       {{"simulate", f3, "--closed-loop", "--duration", "1", "--step", "0.01", "--out", traj}, "--step"},
       {{"simulate", f3, "--scenario", "hover", "--duration", "1e8", "--out", traj}, "--no-size-limit"},

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "fit/flight_data.hpp"
+#include "runtime/attitude.hpp"
 #include "runtime/flight_log.hpp"
 #include "fit/log_reader.hpp"
 #include "fit/least_squares.hpp"
@@ -331,6 +332,56 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
     at("p") = p + rate, at("q") = c * qr + s * r, at("r") = -s * qr + c * r;
   }
   EXPECT_NO_THROW(load_flight(flip, rotors, {}));
+}
+
+// A user trial (helper-79, 2026-12-03): Euler angles logged in degrees passed every check
+// (the gyro check's windows turn less than pi; these turned tens of radians) and predict
+// reported a tilt error of 1.4 rad; time in ms reached predict's rollouts, whose message named
+// no file and blamed the flight's length; and a controller out of authority (a motor at 0 in
+// a third of a flight) had those samples left out without a word.
+TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
+  const std::string log = (dir_ / "flight.csv").string();
+  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + std::string(QUADGEN_SOURCE_DIR) +
+                          "/vehicles/finken3.yaml --closed-loop --duration 10 --out " + log + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(sim.c_str()), 0);
+  const std::vector<std::string> rotors = {"A", "B", "C", "D"};
+  const runtime::CsvTable table = runtime::read_csv(log);
+  const auto col = [&](const runtime::CsvTable& t, const char* c) { return static_cast<size_t>(t.column(c)); };
+  // The attitude as Z-Y-X Euler angles in place of the quaternion, scaled by `factor`.
+  const auto euler = [&](double factor) {
+    runtime::CsvTable t = table;
+    for (const char* c : {"qw", "qx", "qy", "qz"}) t.columns[col(t, c)] = std::string("unused_") + c;
+    t.columns.insert(t.columns.end(), {"phi", "theta", "psi"});
+    for (auto& row : t.rows) {
+      const auto e = runtime::euler_zyx(row[col(table, "qw")], row[col(table, "qx")], row[col(table, "qy")], row[col(table, "qz")]);
+      for (double a : e) row.push_back(factor * a);
+    }
+    return t;
+  };
+  EXPECT_NO_THROW(load_flight(euler(1), rotors, {}));
+  const runtime::CsvTable degrees = euler(180 / M_PI);
+  const std::string said = message_of<FitError>([&] { load_flight(degrees, rotors, {}); });
+  EXPECT_NE(said.find(" rad lies outside the range of a Z-Y-X Euler angle"), std::string::npos) << said;
+  EXPECT_NE(said.find("angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)"), std::string::npos) << said;
+  EXPECT_EQ(said.rfind(log + ":", 0), 0u) << said;
+  // Time in milliseconds.
+  runtime::CsvTable ms = table;
+  for (auto& row : ms.rows) row[col(ms, "t")] *= 1000;
+  const std::string slow = message_of<FitError>([&] { load_flight(ms, rotors, {}); });
+  EXPECT_NE(slow.find("its samples are 10 s apart"), std::string::npos) << slow;
+  EXPECT_NE(slow.find("is t in seconds? (milliseconds: in a mapping, scale: 0.001 on t)"), std::string::npos) << slow;
+  // A rotor at idle in the air in a fifth of the flight: said, and the samples left out.
+  const auto idle_note = [](const Flight& f) {
+    for (const auto& n : f.notes)
+      if (n.find("have a motor command at or below 0.05 and are left out") != std::string::npos) return n;
+    return std::string();
+  };
+  EXPECT_EQ(idle_note(load_flight(table, rotors, {})), "");
+  runtime::CsvTable idle = table;
+  for (auto& row : idle.rows)
+    if (row[col(idle, "t")] > 4 && row[col(idle, "t")] <= 6) row[col(idle, "u_C")] = 0;
+  const Flight f = load_flight(idle, rotors, {});
+  EXPECT_NE(idle_note(f).find("200 of the "), std::string::npos) << idle_note(f);
 }
 
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,

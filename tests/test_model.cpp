@@ -1181,6 +1181,16 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_FALSE(c.at(apart).passed);
     EXPECT_NE(c.at(apart).detail.find("cannot set apart thrust and yaw"), std::string::npos) << c.at(apart).detail;
   }
+  {  // a motor map's term in rpm written without its unit (read as rad/s, 9.5 times too fast):
+     // hover at the very bottom of the range, where fit and diagnose take a rotor for idle
+    Vehicle v = good;
+    Parameter& a1 = v.params.at("a1");
+    a1.nominal = a1.lower = a1.upper = a1.nominal * 60 / (2 * M_PI);
+    const auto c = checks_of(v);
+    EXPECT_FALSE(c.at(trim).passed);
+    EXPECT_NE(c.at(trim).detail.find("written without `unit: rpm`"), std::string::npos) << c.at(trim).detail;
+    EXPECT_TRUE(c.at(map).passed);
+  }
   {  // a motor map copied with the wrong sign
     Vehicle v = good;
     Parameter& a1 = v.params.at("a1");

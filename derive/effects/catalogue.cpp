@@ -8,6 +8,7 @@
 
 #include "derive/effects/definitions.hpp"
 #include "output/joined.hpp"
+#include "output/nearest_word.hpp"
 
 namespace quadgen {
 
@@ -77,6 +78,20 @@ std::vector<std::string> effect_with_what_it_refines(const std::string& name) {
 std::string effect_of_parameter(const std::string& parameter) {
   const auto dot = parameter.find('.');
   return dot == std::string::npos ? std::string() : parameter.substr(0, dot);
+}
+
+std::string missing_parameter_hint(const std::string& name, const std::vector<std::string>& model_parameters) {
+  if (const std::string near = output::nearest_word(name, model_parameters); !near.empty())
+    return "; did you mean '" + near + "'?";
+  const std::string effect = effect_of_parameter(name);
+  const auto described = std::find_if(effect_catalogue().begin(), effect_catalogue().end(),
+                                      [&](const Effect& e) { return e.name == effect; });
+  if (described == effect_catalogue().end()) return "";
+  std::vector<std::string> its;
+  for (const auto& p : model_parameters)
+    if (effect_of_parameter(p) == effect) its.push_back(p);
+  if (its.empty()) return " (its effect " + effect + " is not in the model: add it with --effects)";
+  return "; " + effect + "'s parameters here: " + output::joined(its);
 }
 
 std::vector<std::string> reference_parameters(const std::vector<std::string>& names) {

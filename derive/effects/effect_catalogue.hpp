@@ -34,6 +34,12 @@ std::string effect_of_parameter(const std::string& parameter);
 // Whether a parameter belongs to an effect rather than to the vehicle file.
 inline bool is_effect_parameter(const std::string& parameter) { return !effect_of_parameter(parameter).empty(); }
 
+// What to say after "no parameter 'NAME' in the model": "; did you mean 'X'?" for a slip (a
+// rotor name's case), the effect to add with --effects where NAME is a catalogue effect's
+// parameter the model lacks, or the effect's parameters where it is in the model; else "".
+// `model_parameters`: the model's parameter names.
+std::string missing_parameter_hint(const std::string& name, const std::vector<std::string>& model_parameters);
+
 // Of these parameter names (in model order), those held at off whatever the fit flags
 // say: the first parameter of each effect identifiable only as ratios (motor_gain's first
 // rotor, when c_t is fitted beside the gains).
