@@ -41,7 +41,11 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 }
 
 
-// The --set values, each checked, in the model the simulation flies.
+// The --set values, each checked, in the model the simulation flies. A scenario's commands,
+// its start and its thrust plot come from the vehicle file's values (its hover trim, motor
+// map, c_t, vbat_ref), so there only an effect's parameters may be set: a base parameter set
+// there would be half applied. A closed loop's controller believes the file, and the truth
+// may differ in anything.
 void apply_settings(const SimulateJob& a, DynamicModel& m) {
   std::vector<double> p = m.params();
   for (const auto& [name, value] : a.set) {
@@ -49,6 +53,11 @@ void apply_settings(const SimulateJob& a, DynamicModel& m) {
     if (i < 0)
       throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model" +
                                   output::printable(missing_parameter_hint(name, m.param_names())));
+    if (!a.closed_loop && !is_effect_parameter(name))
+      throw std::invalid_argument("--set " + output::printable(name) +
+                                  ": a scenario or a replay takes its commands, start and plot from the vehicle "
+                                  "file's values, so only an effect's parameters may be set there (edit the file, or "
+                                  "fly --closed-loop)");
     const std::string problem = runtime::value_problem(m.parameters()[static_cast<size_t>(i)], value, false);
     if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
@@ -58,7 +67,8 @@ void apply_settings(const SimulateJob& a, DynamicModel& m) {
 
 // Said when the controller ran out of authority: a motor command at 0 or 1 in more than 1 %
 // of the samples. Such samples fit poorly (an idle rotor is not in the model; diagnose and fit
-// leave samples with a command at or below 0.05 out), so the flight tells less than it seems.
+// leave samples with a command at or below FlightOptions::min_command out), so the flight
+// tells less than it seems.
 std::string saturation_note(const GeneratedFlight& flight, const std::vector<std::string>& rotors) {
   std::vector<int> columns;
   for (const auto& r : rotors) columns.push_back(index_in(flight.columns, "u_" + r));
@@ -72,7 +82,8 @@ std::string saturation_note(const GeneratedFlight& flight, const std::vector<std
   os.precision(3);
   os << "note: a motor command is at its limit (0 or 1) in " << 100 * share
      << " % of the samples: the controller ran out of authority there (a smaller --excitation, --amplitude or "
-        "disturbance keeps it within reach); fit and diagnose leave out samples with a command at or below 0.05";
+        "disturbance keeps it within reach); fit and diagnose leave out samples with a command at or below "
+     << fit::FlightOptions{}.min_command;
   return os.str();
 }
 
@@ -167,7 +178,7 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
                      a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout (t, u_<rotor>; "
                                          "docs/formats.md), or another through --mapping"
                                        : "");
-  fit::check_log_conventions(log);
+  fit::check_euler_range(log);  // the start attitude; a command schedule may be sparse, so its time is not judged
   const std::vector<double> t = log.values("t");
   if (a.duration > t.back() - t.front() + 1e-9)
     throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +

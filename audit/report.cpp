@@ -216,7 +216,8 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   md << "## 7. Audit\n\n**" << (d.audit.all_passed() ? "All checks of the derivation passed." : "SOME CHECKS FAILED.") << "**";
   if (warnings)
     md << " **" << warnings << " warning" << (warnings > 1 ? "s" : "")
-       << " about the vehicle** (group `vehicle`: the derivation holds, but the vehicle as described cannot fly)";
+       << " about the vehicle** (group `vehicle`: the derivation holds, but the vehicle as described cannot fly, "
+          "or is most likely described wrongly)";
   md << "\n\n| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "

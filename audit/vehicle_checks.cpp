@@ -78,25 +78,34 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
 
 // A hover trim (runtime::hover_trim, which simulate's scenarios fly): every rotor pushing and
 // within its motor's reach.
-AuditCheck check_hover_trim(const Vehicle& v, const runtime::ControllerModel& b) {
-  const runtime::HoverTrim trim = runtime::hover_trim(b, rotor_names(v));
+AuditCheck check_hover_trim(const runtime::HoverTrim& trim, double weight) {
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
-  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(b.mass * b.g) + " N)";
-  if (!trim.found()) return advisory("a hover trim exists within the motors' reach", false, detail + ": " + trim.why_not);
-  const Eigen::VectorXd u =
-      Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
-  detail += ", commands " + numbers(u, "");
-  // Hover at the very bottom of the map is no design: most often a map in rpm written without
-  // its unit (read as rad/s, 9.5 times too fast). Below 0.05 fit and diagnose take a rotor
-  // for idle and leave the sample out.
+  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(weight) + " N)";
+  if (trim.found()) {
+    const Eigen::VectorXd u =
+        Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
+    detail += ", commands " + numbers(u, "");
+  } else {
+    detail += ": " + trim.why_not;
+  }
+  return advisory("a hover trim exists within the motors' reach", trim.found(), detail);
+}
+
+// Hover at the very bottom of the command range is no design: most often a motor map in rpm
+// written without its unit (read as rad/s, 9.5 times too fast). Near there fit and diagnose
+// take a rotor for idle and leave the sample out. Judged only where a trim exists.
+AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   constexpr double kLowestHoverCommand = 0.1;
-  const bool low = u.maxCoeff() < kLowestHoverCommand;
+  const double highest = trim.found() ? *std::max_element(trim.commands.begin(), trim.commands.end()) : 1.0;
+  const bool low = highest < kLowestHoverCommand;
+  std::ostringstream detail;
+  detail << "the highest hover command " << (trim.found() ? std::to_string(highest) : std::string("(no trim)"));
   if (low)
-    detail += ": hover needs less than " + std::to_string(kLowestHoverCommand).substr(0, 3) +
-              " of the command range (a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too "
-              "fast; below 0.05 fit and diagnose take a rotor for idle)";
-  return advisory("a hover trim exists within the motors' reach", !low, detail);
+    detail << ", below " << kLowestHoverCommand
+           << " of the command range: a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too "
+              "fast? (near the bottom of the range fit and diagnose take a rotor for idle)";
+  return advisory("hover needs a tenth of the command range or more", !low, detail.str());
 }
 
 // No two rotor discs cut through each other: hubs in one plane (within a quarter of the
@@ -259,10 +268,12 @@ AuditCheck check_one_scale(const Vehicle& v) {
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
   const Eigen::MatrixXd B = runtime::allocation_matrix(b);
+  const runtime::HoverTrim trim = runtime::hover_trim(b, rotor_names(v));
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
   return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
-          check_motor_map(b.thrust_laws), check_controllable(B),          check_hover_trim(v, b)};
+          check_motor_map(b.thrust_laws), check_controllable(B),          check_hover_trim(trim, b.mass * b.g),
+          check_hover_above_the_bottom(trim)};
 }
 
 }  // namespace quadgen

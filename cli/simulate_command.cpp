@@ -41,8 +41,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
   c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
   c->add_option("--set", a.set,
-                std::string("NAME=VALUE for a parameter of the simulated model (repeatable; in a closed loop the true "
-                            "model, which the controller does not know); names: ") +
+                std::string("NAME=VALUE for a parameter of the simulated model (repeatable): in a closed loop any "
+                            "of the true model, which the controller does not know; in a scenario or a replay an "
+                            "effect's only; names: ") +
                     parameter_names_help());
   c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);

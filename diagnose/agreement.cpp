@@ -107,10 +107,10 @@ void summarise_agreement(ParameterAgreement& a) {
   }
   a.pooled = sw > 0 ? swk / sw : a.joint_value;
   int counted = 0;
-  bool within = true;
+  bool every_flight_says = true, within = true;
   for (const auto& f : a.flights) {
     if (!(f.standard_error > 0)) {
-      within = false;  // a flight that cannot say: no agreement claimed
+      every_flight_says = false;  // a flight that cannot say: no agreement claimed, nor disagreement
       continue;
     }
     a.q += std::pow((f.value - a.pooled) / f.standard_error, 2);
@@ -119,7 +119,7 @@ void summarise_agreement(ParameterAgreement& a) {
   }
   a.q_p_value = chi2_upper(a.q, counted - 1.0);
   a.spread = a.joint_value != 0 ? (hi - lo) / std::abs(a.joint_value) : INFINITY;
-  a.agree = within && a.spread < 0.3;
+  a.agree = every_flight_says && within && a.spread < 0.3;
   a.within_errors = within;
   spread_under_agreement(a);
 }
@@ -205,8 +205,9 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
       a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
       a.q_p_value = chi2_upper(a.q, 1.0);
       a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
-      a.within_errors = a.q < kZ95 * kZ95;
-      a.agree = a.within_errors && a.spread < 0.3;
+      const bool says = f.standard_error > 0;  // a flight without one cannot disagree, nor agree
+      a.within_errors = !says || a.q < kZ95 * kZ95;
+      a.agree = says && a.q < kZ95 * kZ95 && a.spread < 0.3;
       out.push_back(a);
     }
   return out;

@@ -41,17 +41,17 @@ struct ParameterAgreement {
   // flight has no standard error.
   double spread_if_agree = std::numeric_limits<double>::quiet_NaN();
   double spread_p_value = std::numeric_limits<double>::quiet_NaN();
-  // Every flight's interval contains the pooled value or the heterogeneity test does not
-  // reject at 1 %; and the spread is below 30 %.
+  // Every flight has a standard error and an interval that holds the pooled value (against an
+  // airframe: the difference within 1.96 standard errors of both), and the spread is below 30 %.
   bool agree = false;
-  // Within the errors (every interval holds the pooled value; against an airframe, the
-  // difference within 1.96 standard errors) though not agreeing: only the 30 % is not met,
-  // and the values may well be one, measured too loosely to show it.
+  // Within the errors though perhaps not agreeing: every flight that has a standard error
+  // holds the pooled value (against an airframe, as above). Without `agree` only the 30 % is
+  // missed, or a flight cannot say: the values may well be one, measured too loosely to show it.
   bool within_errors = false;
 };
 
-// The verdict in a word: "agree", "too uncertain" (within the errors, apart by 30 % or more)
-// or "disagree".
+// The verdict in a word: "agree", "too uncertain" (within the errors, but apart by 30 % or
+// more, or a flight without a standard error) or "disagree".
 inline const char* agreement_verdict(const ParameterAgreement& a) {
   return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
 }

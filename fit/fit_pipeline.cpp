@@ -86,8 +86,6 @@ std::string side(double v, bool open) {
   return os.str();
 }
 
-// A plot's data always joins the outputs as CSV beside it (fit.csv for fit.svg); the plot
-// itself when gnuplot can draw it, and without one the fit still counts.
 // The motor map's three terms as the vehicle file's motor_map section takes them (values
 // with their unit, to copy), with their intervals; `where`: at which command scale and voltage.
 std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vector<Profile>& profiles,
@@ -106,6 +104,8 @@ std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vect
   return s.str();
 }
 
+// A plot's data always joins the outputs as CSV beside it (fit.csv for fit.svg); the plot
+// itself when gnuplot can draw it, and without one the fit still counts.
 void add_plot(FitOutputs& out, const std::string& file, const std::string& title, const std::vector<runtime::Panel>& panels) {
   out.plots.emplace_back(file.substr(0, file.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
   std::string svg, err;
@@ -304,25 +304,34 @@ bool uses_accelerometer(const Flight& flight, const FitJobOptions& o) {
 
 // An input delay fitted to the accelerometer's samples: between samples the model
 // interpolates the logged commands, while commands held between samples (a generated flight;
-// a logger that repeats its last value) change the force once per interval. A delay that is
-// no whole number of sample intervals can then come out at the nearest whole one, its
-// interval far too narrow. The differentiated velocity averages over each interval and has
-// no such preference.
-std::string delay_resolution_warning(const Flight& flight, const FitResult& best, bool pointwise) {
+// a logger that repeats its last value) change the force once per interval. A delay between
+// two whole numbers of intervals then comes out at one, with an interval far narrower than
+// the data can support. The differentiated velocity averages over each interval and has no
+// such preference. Said when the three signs meet: the accelerometer's channels fitted, the
+// delay within 5 % of a whole number (one or more) of intervals, and its 95 % interval (the
+// profile's, else 1.96 standard errors a side) within a tenth of an interval.
+std::string delay_resolution_warning(const Flight& flight, const FitResult& best, const std::vector<Profile>& profiles,
+                                     bool accelerometer_fitted) {
   const auto it = std::find_if(best.parameters.begin(), best.parameters.end(),
                                [](const FitParameter& p) { return p.name == "input_delay.seconds" && p.free; });
-  if (!pointwise || it == best.parameters.end() || flight.samples.size() < 2) return "";
+  if (!accelerometer_fitted || it == best.parameters.end() || flight.samples.size() < 3) return "";
   std::vector<double> dts;
   for (size_t k = 1; k < flight.samples.size(); ++k) dts.push_back(flight.samples[k].t - flight.samples[k - 1].t);
   std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
   const double dt = dts[dts.size() / 2], intervals = it->value / dt;
-  if (!(dt > 0) || std::fabs(intervals - std::round(intervals)) > 0.05) return "";  // not stuck at a whole one
+  if (!(dt > 0) || std::round(intervals) < 1 || std::fabs(intervals - std::round(intervals)) > 0.05) return "";
+  const size_t index = static_cast<size_t>(it - best.parameters.begin());
+  double width = 2 * 1.96 * (index < best.standard_errors.size() ? best.standard_errors[index] : NAN);
+  for (const auto& pr : profiles)
+    if (pr.parameter == it->name && std::isfinite(pr.lower) && std::isfinite(pr.upper)) width = pr.upper - pr.lower;
+  if (!(width < 0.1 * dt)) return "";
   std::ostringstream os;
   os.precision(3);
   os << "input_delay.seconds = " << it->value << " s is a whole number of the accelerometer's sample intervals ("
-     << dt * 1e3 << " ms), to which it was fitted: with commands held between samples, a delay between two whole "
-        "numbers comes out at one, its interval too narrow; --translational pose fits the differentiated velocity, "
-        "which resolves it within an interval";
+     << dt * 1e3 << " ms) with a 95 % interval " << width * 1e3
+     << " ms wide: with commands held between samples, a delay between two whole numbers comes out at one, its "
+        "interval too narrow; --translational pose fits the differentiated velocity, which resolves it within an "
+        "interval";
   return os.str();
 }
 
@@ -380,7 +389,12 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   // A model parameter on its bound is not an estimate: on a flight log most often the log's
   // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
   // by design; their reports say so.)
-  if (const std::string w = delay_resolution_warning(flight, best, accel && !shooting); !w.empty()) out.warnings.push_back(w);
+  const auto fitted = m.train->channels();
+  const bool accelerometer_fitted = accel && !shooting && std::any_of(fitted.begin(), fitted.end(), [](const std::string& c) {
+    return c == "ax" || c == "ay" || c == "az";
+  });
+  if (const std::string w = delay_resolution_warning(flight, best, profiles, accelerometer_fitted); !w.empty())
+    out.warnings.push_back(w);
   for (const std::string& name : best.at_bound)
     out.warnings.push_back(name +
                            " ended on a bound of the fit, so its value is not an estimate (check the log's units and "

@@ -540,22 +540,29 @@ bool kept(const FlightSample& fs, const Flight& f, double duration, const Flight
 }  // namespace
 
 namespace {
-// Samples high in the air with a motor command at or below min_command: left out as not
-// airborne, which is right for take-off and landing but hides a controller out of authority
-// (a rotor stopped in flight) or a throttle cut. Said when more than 1 % of the samples in
-// the air are left out so.
+// Samples in the air with a motor command at or below min_command, within the flight (between
+// the first and the last sample in the air with every rotor running): left out as not
+// airborne, which hides a controller out of authority (a rotor stopped in flight) or a
+// throttle cut. Take-off and landing lie outside that span (a Crazyflie cuts its motors at
+// about 0.12 m). Said when more than 1 % of the span's samples are left out so.
 struct IdleInTheAir {
-  size_t in_the_air = 0, idle = 0;
+  enum Kind : char { kOnTheGround, kRunning, kIdle };
+  std::vector<Kind> kinds;  // per row
   void count(const FlightSample& fs, const Flight& f, const FlightOptions& o) {
-    if (!f.has_pose || !o.airborne_only || !(fs.x[2] > o.min_height)) return;
-    ++in_the_air;
-    if (std::any_of(fs.u.begin(), fs.u.end(), [&](double uc) { return !(uc > o.min_command); })) ++idle;
+    if (!f.has_pose || !o.airborne_only || !(fs.x[2] > o.min_height)) return kinds.push_back(kOnTheGround);
+    const bool idle = std::any_of(fs.u.begin(), fs.u.end(), [&](double uc) { return !(uc > o.min_command); });
+    kinds.push_back(idle ? kIdle : kRunning);
   }
   std::string note(const std::string& where, const FlightOptions& o) const {
-    if (in_the_air == 0 || static_cast<double>(idle) <= 0.01 * static_cast<double>(in_the_air)) return "";
+    const auto first = std::find(kinds.begin(), kinds.end(), kRunning);
+    const auto last = std::find(kinds.rbegin(), kinds.rend(), kRunning).base();
+    if (first >= last) return "";
+    const auto idle = static_cast<size_t>(std::count(first, last, kIdle));
+    const auto in_the_air = idle + static_cast<size_t>(std::count(first, last, kRunning));
+    if (static_cast<double>(idle) <= 0.01 * static_cast<double>(in_the_air)) return "";
     std::ostringstream os;
     os << where << ": " << idle << " of the " << in_the_air << " samples above " << o.min_height
-       << " m have a motor command at or below " << o.min_command
+       << " m between take-off and landing have a motor command at or below " << o.min_command
        << " and are left out (a rotor at idle is not in the model): a controller out of authority, or a throttle cut?";
     return os.str();
   }
@@ -612,7 +619,6 @@ std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColu
   return {1, 0, 0, 0};
 }
 
-namespace {
 // Z-Y-X Euler angles in degrees read as radians make a random attitude that no later check
 // reliably catches (the gyro check's windows turn less than pi; these turn tens of radians):
 // a roll beyond +-pi or a pitch beyond +-pi/2 is no Z-Y-X angle in radians. The yaw may be
@@ -649,16 +655,10 @@ void check_time_unit(const runtime::CsvTable& log) {
   const double median = dts[dts.size() / 2];
   if (!(median >= 0.5)) return;
   std::ostringstream os;
-  os << log.where_named() << ": its samples are " << median << " s apart (the median of " << log.rows.size()
+  os << log.where_named() << ": its samples are " << median << " s apart (the median interval of " << log.rows.size()
      << " samples): a flight log holds tens to thousands a second; is t in seconds? (milliseconds: in a mapping, "
         "scale: 0.001 on t)";
   throw FitError(os.str());
-}
-}  // namespace
-
-void check_log_conventions(const runtime::CsvTable& log) {
-  check_time_unit(log);
-  check_euler_range(log);
 }
 
 void require_known_columns_readable(const runtime::CsvTable& log) {
@@ -672,7 +672,8 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
                                                      "(docs/formats.md, \"Column mapping\")"
                                                    : "");
   require_known_columns_readable(log);
-  check_log_conventions(log);
+  check_time_unit(log);
+  check_euler_range(log);
   Flight f;
   f.source = log.path;
   if (static_cast<double>(log.rows.size()) < o.min_samples)

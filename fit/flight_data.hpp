@@ -106,10 +106,14 @@ struct FlightOptions {
 // different rates and forward-filled, or irregular sample times).
 runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz);
 
-// Refuses a log whose time or attitude angles are plainly in another unit than the canonical
-// layout's (ms for s, degrees for rad), naming file, line and the likely fix. load_flight
-// runs it; a reader of a log's commands alone (simulate --inputs) runs it too.
-void check_log_conventions(const runtime::CsvTable& log);
+// Refuse a log whose time or attitude angles are plainly in another unit than the canonical
+// layout's, naming file, line and the likely fix; load_flight runs both. check_time_unit: a
+// median sample interval of 0.5 s or more (ms read as s; a flight log holds tens to
+// thousands of samples a second; a replay's command schedule may be sparse and is not
+// judged). check_euler_range: a roll beyond +-pi or a pitch beyond +-pi/2 (degrees read as
+// radians; simulate --inputs runs it for its start attitude).
+void check_time_unit(const runtime::CsvTable& log);
+void check_euler_range(const runtime::CsvTable& log);
 
 // Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
 Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);

@@ -1034,6 +1034,21 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(loose), "too uncertain");
   EXPECT_FALSE(loose.agree);  // the 30 % is still not met: nothing is named on it
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(apart), "disagree");
+  // A flight without a standard error cannot disagree.
+  ParameterAgreement unsure = judged(1.0, 1.02, 0.05);
+  unsure.flights[1].standard_error = NAN;
+  quadgen::diagnose::summarise_agreement(unsure);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(unsure), "too uncertain");
+  // The printout says it, and that an airframe's value was refitted on this flight.
+  quadgen::diagnose::Diagnosis d;
+  ParameterAgreement check = loose;
+  check.parameter = "rotor_drag.k";
+  d.airframe_check = {check};
+  const std::string said = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(said.find("this flight is too uncertain to agree with the airframe on rotor_drag.k (refitted here, the "
+                      "airframe's other values held)"),
+            std::string::npos)
+      << said;
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {

@@ -1485,6 +1485,10 @@ TEST(Cli, UserTrialFindingsAreSaid) {
                     weak = fly("weak.csv", {"--effects", "motor_gain", "--set", "motor_gain.C=-0.1"});
   EXPECT_EQ(plain.substr(plain.find('\n')), neutral.substr(neutral.find('\n')));  // the header names no effect
   EXPECT_NE(neutral, weak);
+  // A base parameter there would be half applied (the commands, start and plot are the file's).
+  expect_one_line_error(run_quadgen({"simulate", f3, "--scenario", "hover", "--duration", "1", "--set", "c_t=0.02",
+                                     "--out", tmp / "x.csv"}, tmp.dir),
+                        "only an effect's parameters may be set there", "--set c_t in a scenario");
   // A slip in a --set name is named as one; a parameter of an effect not added names the effect.
   expect_one_line_error(run_quadgen({"simulate", f3, "--scenario", "hover", "--duration", "1", "--effects", "motor_gain",
                                      "--set", "motor_gain.c=-0.1", "--out", tmp / "x.csv"}, tmp.dir),
@@ -1520,6 +1524,11 @@ TEST(Cli, UserTrialFindingsAreSaid) {
   const auto [from_pose, quiet] = delay_fit("pose", {"--translational", "pose"});
   EXPECT_NEAR(from_pose, 0.025, 5e-4);
   EXPECT_EQ(quiet.find("whole number"), std::string::npos) << quiet;
+  // No delay at all is no whole number of intervals to warn of.
+  ASSERT_EQ(run_quadgen({"simulate", f3, "--closed-loop", "--duration", "20", "--out", tmp / "delay.csv"}, tmp.dir).rc, 0);
+  const auto [none, none_said] = delay_fit("none", {});
+  EXPECT_LT(none, 1e-3);
+  EXPECT_EQ(none_said.find("whole number"), std::string::npos) << none_said;
 }
 
 // A log whose evaluated part is too short for one rollout is the input's problem: refused with

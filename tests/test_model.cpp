@@ -1151,7 +1151,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
                            "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 6u);
+    ASSERT_EQ(checks.size(), 7u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1187,8 +1187,10 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     Parameter& a1 = v.params.at("a1");
     a1.nominal = a1.lower = a1.upper = a1.nominal * 60 / (2 * M_PI);
     const auto c = checks_of(v);
-    EXPECT_FALSE(c.at(trim).passed);
-    EXPECT_NE(c.at(trim).detail.find("written without `unit: rpm`"), std::string::npos) << c.at(trim).detail;
+    const std::string low = "hover needs a tenth of the command range or more";
+    EXPECT_FALSE(c.at(low).passed);
+    EXPECT_NE(c.at(low).detail.find("written without `unit: rpm`"), std::string::npos) << c.at(low).detail;
+    EXPECT_TRUE(c.at(trim).passed);  // a trim exists: the vehicle can hover, at the bottom of its range
     EXPECT_TRUE(c.at(map).passed);
   }
   {  // a motor map copied with the wrong sign
