@@ -248,16 +248,20 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
     h << "</li>\n";
   }
   if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
-  if (!d.findings.empty())
+  if (!d.findings.empty()) {
+    // A finding accepted on another held-out test (one step, the force alone) may leave this
+    // metric worse: said as worse, not as a negative gain.
+    const double gain = reduction(d.metric_before, d.metric_after);
     h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
-      << num(reduction(d.metric_before, d.metric_after), 2) << " % better (" << esc(d.metric) << " "
+      << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
+  }
   // The command's own printout, for a reader who compares it with a terminal; the sections
   // below say the same in tables.
   h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
     << "</pre></details>\n";
   h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
-    << num(reduction(d.metric_before, d.metric_after), 3) << " % lower).</p>\n";
+    << lower_or_higher(d.metric_before, d.metric_after, 3) << ").</p>\n";
 }
 
 void findings_html(std::ostringstream& h, const Diagnosis& d) {
@@ -273,7 +277,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
-      << num(reduction(f.before, f.after), 3) << " % lower)" << esc(beside_gain_text(f)) << ".</p>\n";
+      << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
     if (per_flight) {

@@ -91,6 +91,11 @@ double reduction(double before, double after) {
   return before > 0 && std::isfinite(before) && std::isfinite(after) ? percent_lower(before, after) : 0.0;
 }
 
+std::string lower_or_higher(double before, double after, int digits) {
+  const double r = reduction(before, after);
+  return num(std::fabs(r), digits) + (r < 0 ? " % higher" : " % lower");
+}
+
 // The finding in one sentence (the effect's own words), from its values: a per-flight
 // parameter at its mean over the flights.
 // Where the first parameter is the reference (motor gains), one whose interval holds 0 on every

@@ -14,6 +14,9 @@ namespace quadgen::diagnose::words {
 
 // A reduction to show [%]: 0 where it is undefined (a diverged simulation, nothing before).
 double reduction(double before, double after);
+// The change from before to after in words, with `digits` significant digits: "75.5 % lower",
+// or "3.8 % higher" (a rise said as one, not as a negative reduction).
+std::string lower_or_higher(double before, double after, int digits);
 // A finding in one sentence ("Motor M4 gives 6.9 % less thrust than motor M1").
 std::string headline(const Finding& f);
 // Said where the airframe a flight is checked against came from one flight's diagnosis ("" else).

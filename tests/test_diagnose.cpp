@@ -1751,6 +1751,14 @@ TEST(ReportWords, ACommandGainTheCommandsDoNotExplainIsNotShown) {
   EXPECT_NE(html.find("<td>0.99 (r 0.91, 40 ms)</td>"), std::string::npos);
 }
 
+// A held-out metric that rose is said as a rise (a user trial read "-3.8 % better" in the
+// report's summary of a finding accepted on its one-step gain).
+TEST(ReportWords, AMetricThatRoseIsSaidAsARise) {
+  EXPECT_EQ(quadgen::diagnose::words::lower_or_higher(1.081, 0.2646, 3), "75.5 % lower");
+  EXPECT_EQ(quadgen::diagnose::words::lower_or_higher(0.5984, 0.6213, 3), "3.83 % higher");
+  EXPECT_EQ(quadgen::diagnose::words::lower_or_higher(0, 1, 3), "0 % lower");  // undefined: no claim
+}
+
 // An airframe from one flight's diagnosis is said to be that flight's values.
 TEST(ReportWords, AnAirframeOfOneFlightIsSaidToBeThatFlights) {
   quadgen::diagnose::Diagnosis d;
