@@ -82,12 +82,8 @@ struct AirframeReader {
   diagnose::AirframeReference::Effect effect(const nlohmann::json& f) const {
     const std::string name = f.value("effect", "");
     if (name.empty() || !f.contains("parameters")) throw airframe_error(path, "a finding without effect or parameters");
-    const Effect* described = nullptr;
-    try {
-      described = &find_effect(name);
-    } catch (const std::invalid_argument&) {
-      throw airframe_error(path, "findings: unknown effect '" + output::printable(name) + "'");
-    }
+    const Effect* described = effect_named(name);
+    if (!described) throw airframe_error(path, "findings: unknown effect '" + output::printable(name) + "'");
     diagnose::AirframeReference::Effect e{name, {}, {}, {}, {}};
     if (described->per_flight) return e;  // a flight's state, freed by read_airframe
     for (const auto& [parameter, p] : f["parameters"].items()) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "runtime/thrust_law.hpp"
+#include "runtime/data_side_effects.hpp"
 #include "runtime/dynamic_model.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/equation_error.hpp"
@@ -86,6 +87,11 @@ std::string side(double v, bool open) {
   return os.str();
 }
 
+// A profile's 95 % interval as printed: "[lower, upper]", an open side as side() says it.
+std::string interval_of(const Profile& pr) {
+  return "[" + side(pr.lower, pr.lower_open) + ", " + side(pr.upper, pr.upper_open) + "]";
+}
+
 // The motor map's three terms as the vehicle file's motor_map section takes them (values
 // with their unit, to copy), with their intervals; `where`: at which command scale and voltage.
 std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vector<Profile>& profiles,
@@ -98,7 +104,7 @@ std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vect
     s << "  " << term << ": {value: " << p->value << ", unit: " << p->unit << "}";
     for (const auto& pr : profiles)
       if (pr.parameter == term)
-        s << "  # [" << side(pr.lower, pr.lower_open) << ", " << side(pr.upper, pr.upper_open) << "] " << pr.verdict;
+        s << "  # " << interval_of(pr) << " " << pr.verdict;
     s << "\n";
   }
   return s.str();
@@ -205,8 +211,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   std::ostringstream s;
   s << "tau = " << tau_s << " s";
   if (tau)
-    s << ", 95 % profile interval [" << side(tau->lower, tau->lower_open) << ", " << side(tau->upper, tau->upper_open) << "] ("
-      << tau->verdict << ")";
+    s << ", 95 % profile interval " << interval_of(*tau) << " (" << tau->verdict << ")";
   if (thesis) s << "; thesis: " << kThesisMotorTau << " s";
   s << "\n" << motor_map_lines(best.parameters, profiles, "the steps' command scale");
   out.summary = s.str();
@@ -315,10 +320,9 @@ std::string delay_resolution_warning(const Flight& flight, const FitResult& best
   const auto it = std::find_if(best.parameters.begin(), best.parameters.end(),
                                [](const FitParameter& p) { return p.name == "input_delay.seconds" && p.free; });
   if (!accelerometer_fitted || it == best.parameters.end() || flight.samples.size() < 3) return "";
-  std::vector<double> dts;
-  for (size_t k = 1; k < flight.samples.size(); ++k) dts.push_back(flight.samples[k].t - flight.samples[k - 1].t);
-  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-  const double dt = dts[dts.size() / 2], intervals = it->value / dt;
+  std::vector<double> times;
+  for (const auto& s : flight.samples) times.push_back(s.t);
+  const double dt = runtime::median_interval(times), intervals = it->value / dt;
   if (!(dt > 0) || std::round(intervals) < 1 || std::fabs(intervals - std::round(intervals)) > 0.05) return "";
   const size_t index = static_cast<size_t>(it - best.parameters.begin());
   double width = 2 * 1.96 * (index < best.standard_errors.size() ? best.standard_errors[index] : NAN);
@@ -339,8 +343,7 @@ std::string delay_resolution_warning(const Flight& flight, const FitResult& best
 std::string profile_summary(const FitResult& best, const std::vector<Profile>& profiles) {
   std::ostringstream s;
   for (const auto& pr : profiles)
-    s << pr.parameter << " = " << best.parameters[pr.index].value << " [" << side(pr.lower, pr.lower_open) << ", "
-      << side(pr.upper, pr.upper_open) << "] " << pr.verdict << "\n";
+    s << pr.parameter << " = " << best.parameters[pr.index].value << " " << interval_of(pr) << " " << pr.verdict << "\n";
   return s.str();
 }
 
@@ -386,15 +389,15 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
            flight_panels(model, flight, parameter_values(best.parameters)));
   out.summary = profile_summary(best, profiles);
-  // A model parameter on its bound is not an estimate: on a flight log most often the log's
-  // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
-  // by design; their reports say so.)
   const auto fitted = m.train->channels();
   const bool accelerometer_fitted = accel && !shooting && std::any_of(fitted.begin(), fitted.end(), [](const std::string& c) {
     return c == "ax" || c == "ay" || c == "az";
   });
   if (const std::string w = delay_resolution_warning(flight, best, profiles, accelerometer_fitted); !w.empty())
     out.warnings.push_back(w);
+  // A model parameter on its bound is not an estimate: on a flight log most often the log's
+  // scale or units are off. (A motor-step or stand fit's nuisance timing may sit on its bound
+  // by design; their reports say so.)
   for (const std::string& name : best.at_bound)
     out.warnings.push_back(name +
                            " ended on a bound of the fit, so its value is not an estimate (check the log's units and "
@@ -478,8 +481,8 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
   std::ostringstream s;
   if (shared) {
-    s << "k = " << k << " N s^2 [" << side(kp->lower, kp->lower_open) << ", " << side(kp->upper, kp->upper_open) << "] ("
-      << kp->verdict << "), shared by all motors: " << f.coefficients_reason << "\n";
+    s << "k = " << k << " N s^2 " << interval_of(*kp) << " (" << kp->verdict << "), shared by all motors: "
+      << f.coefficients_reason << "\n";
   } else {
     s << "k per motor:";
     for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << f.thrust_profiles[i].verdict << ")";

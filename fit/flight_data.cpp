@@ -13,6 +13,7 @@
 #include "fit/least_squares.hpp"
 #include "model/yaml_reader.hpp"
 #include "output/joined.hpp"
+#include "runtime/data_side_effects.hpp"
 #include "output/nearest_word.hpp"
 #include "runtime/attitude.hpp"
 #include "runtime/log_file.hpp"
@@ -647,12 +648,8 @@ void check_euler_range(const runtime::CsvTable& log) {
 // Time in milliseconds read as seconds: samples seconds apart. A flight log holds tens to
 // thousands of samples a second; a median interval of half a second or more is no such log.
 void check_time_unit(const runtime::CsvTable& log) {
-  const int c = log.column("t");
-  if (c < 0 || log.rows.size() < 3) return;
-  std::vector<double> dts;
-  for (size_t k = 1; k < log.rows.size(); ++k) dts.push_back(log.rows[k][static_cast<size_t>(c)] - log.rows[k - 1][static_cast<size_t>(c)]);
-  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-  const double median = dts[dts.size() / 2];
+  if (log.column("t") < 0 || log.rows.size() < 3) return;
+  const double median = runtime::median_interval(log.values("t"));
   if (!(median >= 0.5)) return;
   std::ostringstream os;
   os << log.where_named() << ": its samples are " << median << " s apart (the median interval of " << log.rows.size()

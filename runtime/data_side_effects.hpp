@@ -76,17 +76,22 @@ inline std::vector<double> simulation_params(const DynamicModel& model, std::vec
   return p;
 }
 
-// The one gap rule of the pipeline: a sample interval longer than 1.5 times the log's median
-// interval is a gap (a joined flight's boundary, trimmed ground contact, a dropped sample).
-// No derivative, rotor-speed filter or delayed command lookup reaches across one. Relative
-// to the median so that it holds at any logging rate; 1.5 lets sampling jitter through.
-inline double gap_threshold(const std::vector<double>& times) {
+// The median of the intervals between consecutive times (the upper median of an even count;
+// 0 for fewer than two times): a log's sampling interval, which a dropped sample or a gap
+// does not move.
+inline double median_interval(const std::vector<double>& times) {
   std::vector<double> dts;
   for (size_t k = 1; k < times.size(); ++k) dts.push_back(times[k] - times[k - 1]);
   if (dts.empty()) return 0.0;
   std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-  return 1.5 * dts[dts.size() / 2];
+  return dts[dts.size() / 2];
 }
+
+// The one gap rule of the pipeline: a sample interval longer than 1.5 times the log's median
+// interval is a gap (a joined flight's boundary, trimmed ground contact, a dropped sample).
+// No derivative, rotor-speed filter or delayed command lookup reaches across one. Relative
+// to the median so that it holds at any logging rate; 1.5 lets sampling jitter through.
+inline double gap_threshold(const std::vector<double>& times) { return 1.5 * median_interval(times); }
 
 // Across a gap up to this long (a dropped sample; an in-flight motor dip trimmed as not
 // airborne, up to 0.3 s in the ARPL log) the rotors kept spinning: a rotor-speed filter

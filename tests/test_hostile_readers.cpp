@@ -50,6 +50,13 @@ class Hostile : public ::testing::Test {
     std::ofstream(dir_ / name, std::ios::binary) << text;
     return (dir_ / name).string();
   }
+  // A generated 10 s closed-loop flight of the FINken 3 (rotors A-D), written to `path` and read.
+  runtime::CsvTable generated_flight(const std::string& path) const {
+    const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + std::string(QUADGEN_SOURCE_DIR) +
+                            "/vehicles/finken3.yaml --closed-loop --duration 10 --out " + path + " > /dev/null 2>&1";
+    EXPECT_EQ(std::system(sim.c_str()), 0) << sim;
+    return runtime::read_csv(path);
+  }
   fs::path dir_;
 };
 
@@ -282,11 +289,9 @@ TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
 // with the hint; as generated it loads.
 TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   const std::string log = (dir_ / "flight.csv").string();
-  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + std::string(QUADGEN_SOURCE_DIR) +
-                          "/vehicles/finken3.yaml --closed-loop --duration 10 --out " + log + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(sim.c_str()), 0);
+  const runtime::CsvTable table = generated_flight(log);
+  ASSERT_FALSE(HasFailure());
   const std::vector<std::string> rotors = {"A", "B", "C", "D"};
-  const runtime::CsvTable table = runtime::read_csv(log);
   EXPECT_NO_THROW(load_flight(table, rotors, {}));
   const auto scaled = [&](std::initializer_list<const char*> columns, double factor) {
     runtime::CsvTable t = table;
@@ -341,11 +346,9 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
 // a third of a flight) had those samples left out without a word.
 TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
   const std::string log = (dir_ / "flight.csv").string();
-  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + std::string(QUADGEN_SOURCE_DIR) +
-                          "/vehicles/finken3.yaml --closed-loop --duration 10 --out " + log + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(sim.c_str()), 0);
+  const runtime::CsvTable table = generated_flight(log);
+  ASSERT_FALSE(HasFailure());
   const std::vector<std::string> rotors = {"A", "B", "C", "D"};
-  const runtime::CsvTable table = runtime::read_csv(log);
   const auto col = [&](const runtime::CsvTable& t, const char* c) { return static_cast<size_t>(t.column(c)); };
   // The attitude as Z-Y-X Euler angles in place of the quaternion, scaled by `factor`.
   const auto euler = [&](double factor) {

@@ -54,9 +54,14 @@ std::string catalogue_parameter_names() {
   return output::joined(effect_catalogue(), ", ", [](const Effect& e) { return e.parameter_names; });
 }
 
-const Effect& find_effect(const std::string& name) {
+const Effect* effect_named(const std::string& name) {
   for (const auto& e : effect_catalogue())
-    if (e.name == name) return e;
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+const Effect& find_effect(const std::string& name) {
+  if (const Effect* e = effect_named(name)) return *e;
   throw std::invalid_argument("unknown effect '" + name + "'");
 }
 
@@ -84,9 +89,7 @@ std::string missing_parameter_hint(const std::string& name, const std::vector<st
   if (const std::string near = output::nearest_word(name, model_parameters); !near.empty())
     return "; did you mean '" + near + "'?";
   const std::string effect = effect_of_parameter(name);
-  const auto described = std::find_if(effect_catalogue().begin(), effect_catalogue().end(),
-                                      [&](const Effect& e) { return e.name == effect; });
-  if (described == effect_catalogue().end()) return "";
+  if (!effect_named(effect)) return "";
   std::vector<std::string> its;
   for (const auto& p : model_parameters)
     if (effect_of_parameter(p) == effect) its.push_back(p);

@@ -21,6 +21,8 @@ std::string catalogue_parameter_names();
 
 // The catalogue entry of this name; std::invalid_argument if there is none.
 const Effect& find_effect(const std::string& name);
+// The same, or nullptr for a name that is no effect (for a caller that words its own error).
+const Effect* effect_named(const std::string& name);
 // The effect and the one it refines, in canonical order ({"motor_lag", "motor_lag_spread"}
 // for motor_lag_spread), or the effect alone: the smallest model it can be derived in.
 std::vector<std::string> effect_with_what_it_refines(const std::string& name);
