@@ -56,6 +56,15 @@ inline const char* agreement_verdict(const ParameterAgreement& a) {
   return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
 }
 
+// Why a verdict is "too uncertain" ("" for the other two): a flight that has no standard
+// error cannot say, else the values are within the errors but 30 % or more apart.
+inline const char* why_too_uncertain(const ParameterAgreement& a) {
+  if (a.agree || !a.within_errors) return "";
+  for (const auto& f : a.flights)
+    if (!(f.standard_error > 0)) return "a flight without a standard error cannot say";
+  return "within the errors, but 30 % or more apart";
+}
+
 struct AgreementInputs {
   runtime::DynamicModel* model = nullptr;   // the single-flight model (shared parameter names)
   std::vector<fit::Flight> training_parts;  // each flight's training part, in order

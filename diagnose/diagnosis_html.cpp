@@ -156,7 +156,8 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
-      << ": <span class=\"" << (a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a) << "</span></h3>\n<p>"
+      << ": <span class=\"" << (a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
+      << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"

@@ -54,7 +54,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
        << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
        << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
-       << (a.within_errors && !a.agree ? ": within the errors, but 30 % or more apart" : "") << ")\n";
+       << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }
 
 // What was not named and why: look-alikes, stand-ins, suspects, what the backward pass

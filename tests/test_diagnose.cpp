@@ -1039,6 +1039,10 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   unsure.flights[1].standard_error = NAN;
   quadgen::diagnose::summarise_agreement(unsure);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(unsure), "too uncertain");
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unsure), "a flight without a standard error cannot say");
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(loose), "within the errors, but 30 % or more apart");
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(close), "");
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(apart), "");
   // The printout says it, and that an airframe's value was refitted on this flight.
   quadgen::diagnose::Diagnosis d;
   ParameterAgreement check = loose;
@@ -1049,6 +1053,14 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
                       "airframe's other values held)"),
             std::string::npos)
       << said;
+  EXPECT_NE(said.find("p = 0.48: within the errors, but 30 % or more apart)"), std::string::npos) << said;
+  check.flights[0].standard_error = NAN;
+  d.airframe_check = {check};
+  const std::string unsaid = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(unsaid.find(": a flight without a standard error cannot say)"), std::string::npos) << unsaid;
+  EXPECT_EQ(unsaid.find("30 % or more apart"), std::string::npos) << unsaid;
+  const std::string page = quadgen::diagnose::diagnosis_html(d, "flight.csv", {});
+  EXPECT_NE(page.find("too uncertain (a flight without a standard error cannot say)</span>"), std::string::npos);
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
