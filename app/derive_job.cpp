@@ -7,10 +7,22 @@
 
 #include "app/derive_pipeline.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/joined.hpp"
 
 namespace quadgen::app {
 
 namespace {
+
+// Where the values said come from: " (the blocks')", " (the file's `derived:`)" where it gives
+// all of `names`, or " (the blocks', J_xy from the file's `derived:`)" where it gives some.
+std::string given(const Vehicle& v, const std::vector<std::string>& names) {
+  std::vector<std::string> from_file;
+  for (const auto& n : names)
+    if (v.derived_given.count(n)) from_file.push_back(n);
+  if (from_file.empty()) return " (the blocks')";
+  if (from_file.size() == names.size()) return " (the file's `derived:`)";
+  return " (the blocks', " + output::joined(from_file) + " from the file's `derived:`)";
+}
 
 // What a user checks first: the model's size and audit, the generated code's op counts, and
 // the mass properties against their scale and CAD (as the model uses them: from the blocks,
@@ -22,13 +34,18 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
   std::ostringstream os;
   os << "derived " << vehicle.name << ": " << model.states.size() << " states, " << model.inputs.size() << " inputs, "
      << model.params.size() << " parameters; audit " << (d.audit.all_passed() ? "passed" : "FAILED") << " ("
-     << d.audit.checks.size() << " checks); derived, audited and generated in " << std::setprecision(3) << seconds
+     << d.audit.checks.size() << " checks"
+     << (d.audit.warnings().empty() ? std::string()
+                                    : "; " + std::to_string(d.audit.warnings().size()) + " about the vehicle warn, below")
+     << "); derived, audited and generated in " << std::setprecision(3) << seconds
      << std::setprecision(6) << " s (writing the files not counted)\n"
      << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
      << " ops, f + Jacobians " << header.ops_before << " -> " << header.ops_after << " ops after CSE, "
-     << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n"
-     << "mass " << nominal("mass") << " kg; centre of gravity of the blocks (" << nominal("cog_x") << ", "
-     << nominal("cog_y") << ", " << nominal("cog_z") << ") m";
+     << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n";
+  // Values the file gives in `derived:` replace the blocks' (their tensor stays about the blocks'
+  // centre as given: the file's values are what the model uses), so the line says which.
+  os << "mass " << nominal("mass") << " kg" << given(vehicle, {"mass"}) << "; centre of gravity (" << nominal("cog_x")
+     << ", " << nominal("cog_y") << ", " << nominal("cog_z") << ") m" << given(vehicle, {"cog_x", "cog_y", "cog_z"});
   // A fitted CoG offset moves the point the thrust's moments act about; the blocks' centre
   // stays what the file describes, so both are said.
   const auto has = [&](const std::string& name) {
@@ -37,7 +54,7 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
   if (has("cog_offset.x") && (nominal("cog_offset.x") != 0 || nominal("cog_offset.y") != 0))
     os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
   os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
-     << " kg m^2\n";
+     << " kg m^2" << given(vehicle, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   return os.str();

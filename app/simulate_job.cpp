@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
+#include "runtime/allocation_matrix.hpp"
 #include "runtime/attitude.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -18,6 +20,7 @@
 #include "derive/runtime_view.hpp"
 #include "runtime/rigid_body_state.hpp"
 #include "runtime/scenarios.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::app {
@@ -45,20 +48,34 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 // its start and its thrust plot come from the vehicle file's values (its hover trim, motor
 // map, c_t, vbat_ref), so there only an effect's parameters may be set: a base parameter set
 // there would be half applied. A closed loop's controller believes the file, and the truth
-// may differ in anything.
+// may differ in anything. No bounds of a fit apply (a test flight's truth may lie beyond
+// them), but a value the physics cannot take is refused in every mode (Effect::domain), as is
+// a delay longer than the flight (no command would act) and a name given twice.
 void apply_settings(const SimulateJob& a, DynamicModel& m) {
   std::vector<double> p = m.params();
+  std::set<std::string> seen;
   for (const auto& [name, value] : a.set) {
     const int i = m.param_index(name);
-    if (i < 0)
+    if (i < 0) {
+      std::vector<std::string> settable;  // what the hint may offer: no name refused below
+      for (const auto& n : m.param_names())
+        if (a.closed_loop || is_effect_parameter(n)) settable.push_back(n);
       throw std::invalid_argument("--set: no parameter '" + output::printable(name) + "' in the model" +
-                                  output::printable(missing_parameter_hint(name, m.param_names())));
+                                  output::printable(missing_parameter_hint(name, settable)));
+    }
+    if (!seen.insert(name).second)
+      throw std::invalid_argument("--set: '" + output::printable(name) + "' is given twice");
     if (!a.closed_loop && !is_effect_parameter(name))
       throw std::invalid_argument("--set " + output::printable(name) +
                                   ": a scenario or a replay takes its commands, start and plot from the vehicle "
                                   "file's values, so only an effect's parameters may be set there (edit the file, or "
                                   "fly --closed-loop)");
-    const std::string problem = runtime::value_problem(m.parameters()[static_cast<size_t>(i)], value, false);
+    std::string problem = runtime::value_problem(m.parameters()[static_cast<size_t>(i)], value, false);
+    if (problem.empty() && !outside_physical_domain(name, value).empty())
+      problem = "= " + output::short_number(value) + " " + outside_physical_domain(name, value);
+    if (problem.empty() && name == "input_delay.seconds" && a.duration > 0 && value > a.duration)
+      problem = "= " + output::short_number(value) + " s is longer than the flight (--duration " +
+                output::short_number(a.duration) + " s): no command would act";
     if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
   }
@@ -122,6 +139,15 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
   return result;
 }
 
+// The allocation matrix of the vehicle's nominal model and its least-norm inverse (zero where
+// the rotors cannot set the four apart: the audit warns of that, and nothing is taken out).
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> allocation_and_inverse(const Vehicle& v, const SymbolicModel& model) {
+  const Eigen::MatrixXd A = runtime::allocation_matrix(nominal_controller_belief(v, model));
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  if (cod.rank() < 4) return {A, Eigen::MatrixXd::Zero(A.cols(), 4)};
+  return {A, cod.pseudoInverse()};
+}
+
 // Each rotor's hover thrust [N] (runtime::hover_trim: m g / n on a symmetric vehicle, a rotor
 // off the symmetric place carrying more or less). Hover must be within every motor's reach, or
 // no manoeuvre can be flown: said once, naming the vehicle file, instead of failing somewhere
@@ -144,19 +170,36 @@ struct OpenLoop {
   double vbat_ref;    // V, the battery voltage where the log holds none
   double hover;       // N per rotor, m g / n: the thesis' manoeuvres are fractions of it
   std::vector<double> hover_trim;  // N, each rotor's own hover thrust (hover_thrusts)
+  // The map from the rotors' thrusts to (thrust, roll, pitch, yaw) about the CoG, and its
+  // least-norm inverse: what takes a manoeuvre's turn about an axis it does not mean out.
+  Eigen::MatrixXd allocation, allocation_inverse;
 
   double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
 };
 
 // A thesis manoeuvre: the thrusts it asks for at each (delayed) time, scaled by each rotor's
-// own trim (1 on a symmetric vehicle), turned into commands by each rotor's law.
+// own trim (1 on a symmetric vehicle), turned into commands by each rotor's law. With uneven
+// trims the raised rotors' steps differ, and also turn the vehicle about axes the manoeuvre
+// does not mean (a user trial: the yaw manoeuvre rolled an H quad with its CoG off centre):
+// that part of the change is taken out, with the least change of the thrusts. On a symmetric
+// vehicle it is zero (to rounding, which leaves the thrusts' bits as they are).
 InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   return [&k, s](double t, double* u) {
     // About the even share m g / n; on a trimmed vehicle each rotor's thrust scaled by its trim,
     // so that a change of every rotor alike (climb) keeps the moments balanced.
     const auto F = s.thrust(t - k.delay_s(), k.hover, k.places);
-    for (size_t i = 0; i < k.rotors.size(); ++i)
-      u[i] = k.laws[i].command_for(k.hover_trim[i] == k.hover ? F[i] : F[i] * (k.hover_trim[i] / k.hover));
+    const auto n = static_cast<Eigen::Index>(k.rotors.size());
+    Eigen::VectorXd trimmed(n), step(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const size_t r = static_cast<size_t>(i);
+      trimmed(i) = k.hover_trim[r] == k.hover ? F[r] : F[r] * (k.hover_trim[r] / k.hover);
+      step(i) = trimmed(i) - k.hover_trim[r];
+    }
+    Eigen::Vector4d unmeant = k.allocation * step;
+    for (int axis = 0; axis < 4; ++axis)
+      if (s.changes[static_cast<size_t>(axis)]) unmeant(axis) = 0;
+    trimmed -= k.allocation_inverse * unmeant;
+    for (Eigen::Index i = 0; i < n; ++i) u[i] = k.laws[static_cast<size_t>(i)].command_for(trimmed(i));
     k.extra.fill(t, k.vbat_ref, u);
   };
 }
@@ -316,6 +359,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
   const double even_share =
       m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
+  const auto [allocation, allocation_inverse] = allocation_and_inverse(vehicle, model);
   const OpenLoop k{m,
                    nominal_thrust_laws(vehicle, model),
                    rotor_names(vehicle),
@@ -324,7 +368,9 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
                    m.input_delay_param(),
                    param(vehicle, "vbat_ref").nominal,
                    even_share,
-                   hover_thrusts(vehicle, model)};
+                   hover_thrusts(vehicle, model),
+                   allocation,
+                   allocation_inverse};
   if (a.closed_loop && (a.ground_at_start || a.ground_height))
     throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
   if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);

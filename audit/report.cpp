@@ -9,6 +9,7 @@
 
 #include "audit/tex_writer.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "derive/runtime_view.hpp"
 #include "output/joined.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
@@ -47,6 +48,22 @@ void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "\n";
 }
 
+// Values the vehicle file's `derived:` section gives (measured) in place of the blocks': the
+// model uses them, as they are (a given tensor is not moved to a given centre of gravity).
+void given_values(std::ostringstream& md, const Derivation& d) {
+  if (d.vehicle.derived_given.empty()) return;
+  md << "The vehicle file's `derived:` section gives measured values in place of the blocks', and the model "
+        "uses these (as given: a tensor is not moved to another centre of gravity; J_xy, J_xz, J_yz are tensor "
+        "entries, minus the products of inertia):";
+  const char* separator = " ";
+  for (const DerivedQuantity& q : kDerivedQuantities)
+    if (d.vehicle.derived_given.count(q.name)) {
+      md << separator << "`" << q.name << "` = " << num(d.vehicle.derived_overrides.at(q.name).nominal) << " " << q.unit;
+      separator = "; ";
+    }
+  md << ".\n\n";
+}
+
 void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
   const MassProperties& mp = d.mass;
   md << "## 2. Mass properties by exact integration\n\n"
@@ -81,6 +98,7 @@ void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
      << "These stay expressions in the block symbols ($m_i, a_i, b_i, c_i, x_i, y_i, z_i$): a changed "
         "vehicle file re-derives them. They enter the dynamics as parameters `mass`, `cog_*`, `J_*`, `A_*` "
         "with these nominal values, so that a fit may free them.\n\n";
+  given_values(md, d);
 }
 
 // An equation a reader can follow: up to this many nodes it is written out, beyond it named.
@@ -264,6 +282,20 @@ std::string derivation_markdown(const Derivation& d) {
   return md.str();
 }
 
+// The hover trim at full precision (a user trial, helper-82: the audit's text rounds it to
+// four digits, which leaves a compiled model's roll acceleration at 7e-3 rad/s^2 instead of
+// 1e-14): each rotor's thrust and command, as simulate's scenarios fly it; `why_not` says
+// why there is none (then the thrusts are the least-norm balance and there are no commands).
+static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
+  const runtime::HoverTrim trim = runtime::hover_trim(nominal_controller_belief(d.vehicle, d.model), rotor_names(d.vehicle));
+  nlohmann::ordered_json j;
+  j["rotors"] = rotor_names(d.vehicle);
+  j["thrust_N"] = trim.thrusts;
+  j["command"] = trim.commands;
+  j["why_not"] = trim.why_not;
+  return j;
+}
+
 std::string model_json(const Derivation& d) {
   using nlohmann::ordered_json;
   ordered_json j;
@@ -305,6 +337,7 @@ std::string model_json(const Derivation& d) {
   for (const auto& c : d.audit.checks)
     checks.push_back({{"group", c.group}, {"check", c.name}, {"passed", c.passed}, {"advisory", c.advisory}, {"detail", c.detail}});
   j["audit"] = {{"passed", d.audit.all_passed()}, {"checks", checks}};
+  j["hover_trim"] = hover_trim_json(d);
   ordered_json th = ordered_json::array();
   for (const auto& t : d.thesis)
     th.push_back({{"ref", t.ref}, {"topic", t.topic}, {"thesis", t.thesis}, {"derived", t.derived},

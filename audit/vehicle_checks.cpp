@@ -94,13 +94,21 @@ AuditCheck check_hover_trim(const runtime::HoverTrim& trim, double weight) {
 
 // Hover at the very bottom of the command range is no design: most often a motor map in rpm
 // written without its unit (read as rad/s, 9.5 times too fast). Near there fit and diagnose
-// take a rotor for idle and leave the sample out. Judged only where a trim exists.
+// take a rotor for idle and leave the sample out. Without a trim it fails where the rotors
+// at command 0 lift the weight (a motor map with a0 > 0 has no trim then), else it cannot say.
 AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   constexpr double kLowestHoverCommand = 0.1;
-  const double highest = trim.found() ? *std::max_element(trim.commands.begin(), trim.commands.end()) : 1.0;
+  if (!trim.found()) {
+    const bool low = trim.idle_lifts_weight;
+    return advisory("hover needs a tenth of the command range or more", !low,
+                    low ? "no trim: the rotors at command 0 lift the weight; a motor map in rpm written without "
+                          "`unit: rpm` reads as rad/s, 9.5 times too fast? (or c_t too large?)"
+                        : "not judged: no hover trim (see the trim's check)");
+  }
+  const double highest = *std::max_element(trim.commands.begin(), trim.commands.end());
   const bool low = highest < kLowestHoverCommand;
   std::ostringstream detail;
-  detail << "the highest hover command " << (trim.found() ? std::to_string(highest) : std::string("(no trim)"));
+  detail << "the highest hover command " << std::to_string(highest);
   if (low)
     detail << ", below " << kLowestHoverCommand
            << " of the command range: a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too "
@@ -235,7 +243,9 @@ AuditCheck check_discs_clear_of_blocks(const Vehicle& v) {
 // larger than its rotors' circle; the FINken 3's thrust-law area 0.13 of its disc), far
 // below the factor of 1000 of the mistake.
 AuditCheck check_one_scale(const Vehicle& v) {
-  double reach = 0, farthest = 0;  // m, of the blocks (corners) and of the rotors (hub and tip)
+  // m: a sphere about the origin holding every block (its centre's distance plus half its
+  // diagonal, a bound, not the farthest corner), and the rotors' farthest reach (hub and tip)
+  double reach = 0, farthest = 0;
   for (const Block& b : v.blocks)
     reach = std::max(reach, std::hypot(b.centre[0], b.centre[1], b.centre[2]) +
                                 0.5 * std::hypot(b.size[0], b.size[1], b.size[2]));
@@ -246,21 +256,44 @@ AuditCheck check_one_scale(const Vehicle& v) {
     farthest = std::max(farthest, out);
     if (out > 30 * reach)
       os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << " reaches " << out << " m from the origin, the blocks "
-         << reach << " m (a position or radius in mm read as m?)";
+         << "lie within " << reach << " m of it (a position or radius in mm read as m?)";
     const double disc = M_PI * r.radius * r.radius;
     if (r.disc_area > 1.01 * disc)
       os << (os.tellp() > 0 ? "; " : "") << "rotor " << r.name << ": disc_area " << r.disc_area
          << " m^2 is more than the disc its radius sweeps, pi r^2 = " << disc << " m^2 (an area in mm^2 or a diameter as the radius?)";
   }
   if (farthest > 0 && reach > 20 * farthest)
-    os << (os.tellp() > 0 ? "; " : "") << "the blocks reach " << reach << " m from the origin, the rotors " << farthest
+    os << (os.tellp() > 0 ? "; " : "") << "the blocks lie within " << reach << " m of the origin, the rotors reach " << farthest
        << " m (a block's size or centre in mm read as m?)";
   const std::string found = os.str();
   std::ostringstream fine;
   fine.precision(4);
-  fine << "the blocks reach " << reach << " m from the origin, the rotors " << farthest
+  fine << "the blocks lie within " << reach << " m of the origin, the rotors reach " << farthest
        << " m; every disc_area at most pi r^2";
   return advisory("rotors and blocks on one scale", found.empty(), found.empty() ? fine.str() : found);
+}
+
+// The inertia tensor the model flies with, the vehicle file's `derived:` values where it gives
+// them: the derivation's audit judges the blocks' tensor, which such values replace (a J_xy
+// given larger than J_xx and J_yy allow has a negative principal moment, and a closed loop
+// flown with it is lost without a word).
+AuditCheck check_inertia_used(const SymbolicModel& m) {
+  const auto value = [&](const char* name) {
+    for (const auto& p : m.params)
+      if (p.name == name) return p.nominal;
+    return 0.0;  // a model without the entry (products of inertia are always declared)
+  };
+  Eigen::Matrix3d J;
+  J << value("J_xx"), value("J_xy"), value("J_xz"), value("J_xy"), value("J_yy"), value("J_yz"), value("J_xz"),
+      value("J_yz"), value("J_zz");
+  const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(J).eigenvalues();
+  const bool positive = l.minCoeff() > 0;
+  const bool triangle = l(0) + l(1) >= l(2) * (1 - 1e-12);  // ascending: the others hold then
+  std::ostringstream detail;
+  detail << "principal moments of the model's J " << l(0) << ", " << l(1) << ", " << l(2) << " kg m^2";
+  if (!positive) detail << ": not positive definite (a product of inertia too large for the moments given, or its sign?)";
+  else if (!triangle) detail << ": the largest exceeds the sum of the other two, which no mass distribution gives";
+  return advisory("the inertia the model uses is a body's", positive && triangle, detail.str());
 }
 
 }  // namespace
@@ -272,8 +305,8 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
   return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
-          check_motor_map(b.thrust_laws), check_controllable(B),          check_hover_trim(trim, b.mass * b.g),
-          check_hover_above_the_bottom(trim)};
+          check_inertia_used(m),          check_motor_map(b.thrust_laws), check_controllable(B),
+          check_hover_trim(trim, b.mass * b.g), check_hover_above_the_bottom(trim)};
 }
 
 }  // namespace quadgen

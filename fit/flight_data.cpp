@@ -247,6 +247,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   runtime::CsvTable out;
   out.path = raw.path;
   out.lines = raw.lines;
+  out.resampled_hz = raw.resampled_hz;
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);
@@ -293,6 +294,7 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   out.named_by = log.named_by;
   out.name_lines = log.name_lines;
   out.unreadable = log.unreadable;  // asking for one stays the error at its line
+  out.resampled_hz = rate_hz;
   size_t i = 0;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;
@@ -514,7 +516,7 @@ FlightSample sample_at(const FlightColumns& c, size_t k, const runtime::CsvTable
   for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
   qn = std::sqrt(qn);
   if (!(qn > 0.5 && qn < 1.5))
-    throw FitError(log.path + ":" + std::to_string(log.line_of(k)) + ": attitude quaternion has norm " + std::to_string(qn));
+    throw FitError(log.where_row(k) + ": attitude quaternion has norm " + std::to_string(qn));
   for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
   for (const auto& uc : c.commands) fs.u.push_back(uc[k]);
   fs.vbat = c.vbat[k];
@@ -637,7 +639,7 @@ void check_euler_range(const runtime::CsvTable& log) {
       const double v = log.rows[k][static_cast<size_t>(c)];
       if (!(std::fabs(v) > r.limit + 1e-3)) continue;  // NaN is judged where values are read
       std::ostringstream os;
-      os << log.path << ":" << log.line_of(k) << ": " << r.column << " = " << v
+      os << log.where_row(k) << ": " << r.column << " = " << v
          << " rad lies outside the range of a Z-Y-X Euler angle, " << r.said
          << ": angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)";
       throw FitError(os.str());

@@ -115,6 +115,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
                    " Hz over the logged span is more than quadgen holds; lower --resample");
   runtime::CsvTable out;
   out.path = log.path;
+  out.resampled_hz = rate_hz;
   out.columns.push_back("t");
   for (const auto& s : signals) out.columns.push_back(s.source);
   // Grid points inside a gap of any signal are left out: the table then has a gap there too,

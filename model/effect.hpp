@@ -38,6 +38,17 @@ struct PlausibleRange {
   std::string why;  // the physical argument, with its source
 };
 
+// The values a parameter can take at all, whatever a fit searches: below `lower` (or at it,
+// where it is excluded) the physics breaks (a delay below zero acts on commands not yet sent,
+// a time constant of zero is no lag and the integration divides by it, a rotor at -100 % gives
+// no thrust). simulate --set refuses such values; any other may be a test flight's truth.
+struct PhysicalDomain {
+  std::string parameter;  // empty: every parameter of the effect
+  double lower = 0;
+  bool lower_included = true;
+  std::string why;
+};
+
 // One sentence in words for a person reading a report ("Motor C gives 8 % less thrust than
 // motor A"), from the fitted values by parameter name; `reference` is the parameter held at
 // off (first_parameter_is_reference), or empty.
@@ -85,6 +96,8 @@ struct Effect {
   std::string not_in_joint_diagnosis;
   // Plausible values of its parameters (none for a parameter: any value in its bounds).
   std::vector<PlausibleRange> plausible;
+  // Where its parameters' physics ends (none for a parameter: any finite value).
+  std::vector<PhysicalDomain> domain;
   std::vector<LookAlike> look_alikes;
   Headline headline;
 };

@@ -123,6 +123,11 @@ Block read_block(const Reader& r, const YAML::Node& n) {
 
 Rotor read_rotor(const Reader& r, const YAML::Node& n) {
   r.require_map(n, "a rotor");
+  // A block may be turned (orientation_deg), so a user may try it on a rotor: say why not.
+  for (const char* tilt : {"orientation_deg", "axis", "tilt", "tilt_deg"})
+    if (n[tilt])
+      r.fail(n[tilt], std::string("a rotor takes no '") + tilt +
+                          "': every rotor's thrust acts along body +z (tilted rotors are not modelled; README, Scope)");
   r.only_keys(n, {"name", "position", "spin", "radius", "disc_area", "source"}, "rotor");
   Rotor ro;
   ro.line = n.Mark().line + 1;

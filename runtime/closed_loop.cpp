@@ -116,6 +116,10 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
       pulls ? " would have to pull down " + newtons(-asked)
             : " would have to give " + newtons(asked) + ", less than its motor map gives at command 0 (" +
                   newtons(least(k)) + ")";
+  if (least.sum() >= weight)
+    return "rotor " + rotor_names[static_cast<size_t>(k)] + what + " (at command 0 the rotors give " +
+           newtons(least.sum()) + " in all, the weight is " + newtons(weight) +
+           ": a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too fast; or c_t too large?)";
   const std::string where =
       least_norm.size() > static_cast<Eigen::Index>(kExactTrimRotors)
           ? " (with more than " + std::to_string(kExactTrimRotors) +
@@ -194,6 +198,7 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   else if (!P.above_least(F))
     hold_shortfalls(P, F, free);
   HoverTrim t;
+  t.idle_lifts_weight = P.least.sum() >= P.weight;
   // Where no trim is within reach but the least-norm one is above every least, the rotor
   // beyond its command 1 is named below (command_for), as before the search.
   const bool reachable_below = P.above_least(F);
@@ -532,7 +537,11 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     fly_one_period(truth, x, commands, extra, nr, {k, t, dt, vbat}, io);
     unmodelled.apply(x, ref, gauss);
     if (x[kPosition + 2] < -5 || (p_at_t - r.position()).norm() > 20)
-      throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s");
+      throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s: " +
+                            (x[kPosition + 2] < -5 ? "fell below z = -5 m"
+                                                   : "more than 20 m from the reference (" +
+                                                         std::to_string((p_at_t - r.position()).norm()) + " m)") +
+                            "; does the vehicle file hold what flies (the audit's warnings), or the --set values?");
   }
   return out;
 }

@@ -47,6 +47,9 @@ struct HoverTrim {
   std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)
   std::vector<double> commands;  // each rotor's command for its thrust (0 where held); empty if none found
   std::string why_not;           // empty where a trim was found, else why not (names the rotor)
+  // The rotors at command 0 lift the weight or more: no trim can be lower (a motor map in rpm
+  // written without its unit reads 9.5 times too fast).
+  bool idle_lifts_weight = false;
   bool found() const { return why_not.empty(); }
 };
 HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names);

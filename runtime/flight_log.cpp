@@ -45,6 +45,16 @@ int CsvTable::line_of(size_t row) const {
   return row < lines.size() ? lines[row] : static_cast<int>(row) + 2;
 }
 
+std::string CsvTable::where_row(size_t row) const {
+  if (!(resampled_hz > 0)) return path + ":" + std::to_string(line_of(row));
+  const auto t = std::find(columns.begin(), columns.end(), "t");
+  std::ostringstream os;
+  os << path << " (the row";
+  if (t != columns.end() && row < rows.size()) os << " at t = " << rows[row][static_cast<size_t>(t - columns.begin())] << " s";
+  os << ", resampled at " << resampled_hz << " Hz)";
+  return os.str();
+}
+
 std::string CsvTable::where_named(int c) const {
   if (named_by.empty()) return path + ":1";
   const auto k = static_cast<size_t>(c);
@@ -59,6 +69,10 @@ namespace {
 
 [[noreturn]] void fail_at(const std::string& path, int line, const std::string& what) {
   throw LogError(path + ":" + std::to_string(line) + ": " + what);
+}
+
+[[noreturn]] void fail_at_row(const CsvTable& log, size_t row, const std::string& what) {
+  throw LogError(log.where_row(row) + ": " + what);
 }
 
 std::string number_text(double v) {
@@ -323,19 +337,19 @@ void check_values(const CsvTable& log) {
   for (size_t i = 0; i < log.rows.size(); ++i)
     for (size_t c : canonical) {
       const double v = log.rows[i][c];
-      if (!std::isfinite(v)) fail_at(log.path, log.line_of(i), "column '" + log.columns[c] + "' is not finite");
+      if (!std::isfinite(v)) fail_at_row(log, i, "column '" + log.columns[c] + "' is not finite");
       const double bound = static_cast<int>(c) == tc ? kMaxAbsTime : kMaxAbsValue;
       if (std::fabs(v) > bound)
-        fail_at(log.path, log.line_of(i),
+        fail_at_row(log, i,
                 "column '" + log.columns[c] + "' is " + number_text(v) + ", beyond the sanity bound |value| <= " +
                     number_text(bound) + " (canonical SI units)");
       if (static_cast<int>(c) == vbat && !(v > 0))
-        fail_at(log.path, log.line_of(i),
+        fail_at_row(log, i,
                 "column 'vbat' is " + number_text(v) +
                     " V; a battery voltage must be positive (a logger writes 0 before its first reading: drop those "
                     "rows, or the column where battery_sag is not wanted)");
       if (throttle[c] && v > kMaxThrottle)
-        fail_at(log.path, log.line_of(i),
+        fail_at_row(log, i,
                 "column '" + log.columns[c] + "' is " + number_text(v) +
                     "; expected a throttle fraction 0..1 (in a log mapping, a percentage takes scale: 0.01, a 16-bit PWM "
                     "count scale: 1.5259e-05)");
@@ -386,9 +400,8 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   if (log.rows.size() < 2) throw LogError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ")");
   check_values(log);
   for (size_t i = 0; i < log.rows.size(); ++i) {
-    const int line = log.line_of(i);
     if (i > 0 && !(log.rows[i][tc] > log.rows[i - 1][tc]))
-      fail_at(log.path, line, "time not strictly increasing (" + std::to_string(log.rows[i - 1][tc]) + " then " +
+      fail_at_row(log, i, "time not strictly increasing (" + std::to_string(log.rows[i - 1][tc]) + " then " +
                                   std::to_string(log.rows[i][tc]) + ")");
   }
 }

@@ -44,6 +44,12 @@ struct CsvTable {
   }
   std::vector<double> values(const std::string& name) const;
   int line_of(size_t row) const;  // lines[row], or row + 2 where no line was recorded
+  // Above 0 where the rows are not the file's lines but samples at this rate (a CSV log
+  // resampled, a ULog or uSD log's topics on a grid): a row is then named by its time.
+  double resampled_hz = 0;
+  // Where row `row` is, for a message: "log.csv:94", or "log.csv (the row at t = 2.49 s,
+  // resampled at 37 Hz)".
+  std::string where_row(size_t row) const;
   // Where the column names come from: the header of `path` when empty; a column mapping's
   // file when the table was mapped, with the line of each column's entry in name_lines.
   std::string named_by;

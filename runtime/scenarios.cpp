@@ -84,16 +84,19 @@ std::vector<double> new_height(double t, double h, const std::vector<RotorPlace>
 }  // namespace
 
 const std::vector<Scenario>& scenario_catalogue() {
+  // (thrust, roll, pitch, yaw) each manoeuvre means to change.
+  constexpr std::array<bool, 4> kNone{}, kThrust{true}, kThrustRoll{true, true}, kThrustPitch{true, false, true},
+      kThrustYaw{true, false, false, true};
   static const std::vector<Scenario> list = {
-      {"hover", "every rotor at its hover thrust (m g / n on a symmetric vehicle; thesis (60))", hover},
-      {"climb", "1.16 times hover thrust on every rotor (the thesis' 1.1 N; 2.3.1 b, (63)-(64))", climb},
+      {"hover", "every rotor at its hover thrust (m g / n on a symmetric vehicle; thesis (60))", hover, kNone},
+      {"climb", "1.16 times hover thrust on every rotor (the thesis' 1.1 N; 2.3.1 b, (63)-(64))", climb, kThrust},
       {"right", "the rotors on the -x side of the centre of gravity (A, D) raised 2.1 % of hover for 0.1 s, then "
-                "those on +x; reversed at 1.5 s (thesis 2.3.2 a): tilts towards +x", right},
+                "those on +x; reversed at 1.5 s (thesis 2.3.2 a): tilts towards +x", right, kThrustPitch},
       {"forward", "the rotors on the +y side (C, D) raised 2.1 % of hover for 0.1 s, then those on -y; reversed at "
-                  "1.5 s (thesis 2.3.2 b, its inputs for +y): tilts towards -y", forward},
-      {"yaw", "the ccw rotors (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw},
+                  "1.5 s (thesis 2.3.2 b, its inputs for +y): tilts towards -y", forward, kThrustRoll},
+      {"yaw", "the ccw rotors (A, C) raised 2.1 % of hover from 0.5 to 1.5 s (thesis 2.3.2 c)", yaw, kThrustYaw},
       {"new_height", "all rotors +10.5 % of hover from 0.5 to 1.0 s, -10.5 % from 2.0 to 2.5 s (thesis 2.3.2 d)",
-       new_height},
+       new_height, kThrust},
   };
   return list;
 }

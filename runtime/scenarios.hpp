@@ -1,6 +1,7 @@
 // The manoeuvres of the thesis, section 2.3, as per-rotor thrust profiles, turned into
 // motor commands through the inverse of the thrust law and motor map.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ struct Scenario {
   // listed: the thesis' rotor roles on the FINken 3 (A, D on -x; C, D on +y; A, C ccw), and
   // the same manoeuvre on any layout.
   std::vector<double> (*thrust)(double t, double hover, const std::vector<RotorPlace>& rotors);
+  // What the manoeuvre means to change of (thrust, roll, pitch, yaw), the rows of the
+  // allocation matrix. On a vehicle whose rotors carry different trims (a CoG off the centre)
+  // the raised rotors' steps also turn it about the other axes: simulate takes that part out.
+  std::array<bool, 4> changes{};
 };
 
 const std::vector<Scenario>& scenario_catalogue();

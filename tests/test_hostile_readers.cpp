@@ -367,6 +367,12 @@ TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
   EXPECT_NE(said.find(" rad lies outside the range of a Z-Y-X Euler angle"), std::string::npos) << said;
   EXPECT_NE(said.find("angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)"), std::string::npos) << said;
   EXPECT_EQ(said.rfind(log + ":", 0), 0u) << said;
+  // Resampled (a review, helper-81: --resample 37 named line 94, which held a valid angle), the
+  // rows are no lines of the file: the message names the row by its time.
+  const std::string resampled = message_of<FitError>([&] { load_flight(resample(degrees, 37), rotors, {}); });
+  EXPECT_EQ(resampled.rfind(log + " (the row at t = ", 0), 0u) << resampled;
+  EXPECT_NE(resampled.find(" s, resampled at 37 Hz): "), std::string::npos) << resampled;
+  EXPECT_NE(resampled.find("angles in degrees?"), std::string::npos) << resampled;
   // Time in milliseconds.
   runtime::CsvTable ms = table;
   for (auto& row : ms.rows) row[col(ms, "t")] *= 1000;

@@ -10,6 +10,7 @@
 #include <set>
 
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 
 #include "audit/audit.hpp"
 #include "audit/vehicle_checks.hpp"
@@ -1151,13 +1152,46 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
                            "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 7u);
+    ASSERT_EQ(checks.size(), 8u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
     }
   }
   const Vehicle good = test::finken3();
+  {  // a measured tensor given in `derived:` that no body has (a user trial, helper-82: a J_xy of
+     // 0.002 beside J_xx 0.00166 passed the audit, which judged the blocks' tensor, and a closed
+     // loop flown with it was lost); and one a body has (a small product of inertia)
+    const std::string text = good.source_text;
+    const auto with_j_xy = [&](const char* value) {
+      return parse_vehicle(text + "  J_xy: {value: " + value + ", unit: kg m^2}\n", "given.yaml");
+    };
+    const std::string inertia = "the inertia the model uses is a body's";
+    const auto bad = checks_of(with_j_xy("0.002"));
+    EXPECT_FALSE(bad.at(inertia).passed);
+    EXPECT_NE(bad.at(inertia).detail.find("not positive definite"), std::string::npos) << bad.at(inertia).detail;
+    EXPECT_TRUE(checks_of(with_j_xy("1e-5")).at(inertia).passed);
+    // derivation.md says the model uses the given value, not the blocks' it lists.
+    const Vehicle given = with_j_xy("1e-5");
+    const MassProperties mp = derive_mass_properties(given);
+    const SymbolicModel m = derive_model(given, mp, {});
+    const AuditResult no_audit;
+    const std::vector<ThesisItem> no_thesis;
+    const std::string md = derivation_markdown({given, mp, m, no_audit, no_thesis});
+    EXPECT_NE(md.find("The vehicle file's `derived:` section gives measured values in place of the blocks', and the "
+                      "model uses these"),
+              std::string::npos);
+    EXPECT_NE(md.find("minus the products of inertia): `J_xy` = 1e-05 kg m^2.\n"), std::string::npos);
+    EXPECT_EQ(derivation_markdown({good, derive_mass_properties(good), derive_model(good, derive_mass_properties(good), {}),
+                                   no_audit, no_thesis})
+                  .find("section gives measured values"),
+              std::string::npos);
+    // A prolate tensor beyond the triangle inequality: J_zz larger than J_xx + J_yy.
+    const auto flat = checks_of(parse_vehicle(text + "  J_zz: {value: 0.005, unit: kg m^2}\n", "flat.yaml"));
+    EXPECT_FALSE(flat.at(inertia).passed);
+    EXPECT_NE(flat.at(inertia).detail.find("the largest exceeds the sum of the other two"), std::string::npos)
+        << flat.at(inertia).detail;
+  }
   {  // masses in grams written as kilograms: hover beyond the motor map
     Vehicle v = good;
     for (auto& b : v.blocks) b.mass *= 1000;
@@ -1192,6 +1226,29 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_NE(c.at(low).detail.find("written without `unit: rpm`"), std::string::npos) << c.at(low).detail;
     EXPECT_TRUE(c.at(trim).passed);  // a trim exists: the vehicle can hover, at the bottom of its range
     EXPECT_TRUE(c.at(map).passed);
+  }
+  {  // the whole map in rpm without its unit, idling above 0 (a user trial, helper-82): command 0
+     // lifts the weight, so there is no trim; that was blamed on the centre of gravity and the
+     // check above passed on "(no trim)"
+    Vehicle v = good;
+    for (const char* term : {"a0", "a1", "a2"}) {
+      Parameter& a = v.params.at(term);
+      a.nominal = a.lower = a.upper = a.nominal * 60 / (2 * M_PI);
+    }
+    ASSERT_GT(v.params.at("a0").nominal, 0);
+    const auto c = checks_of(v);
+    const std::string low = "hover needs a tenth of the command range or more";
+    EXPECT_FALSE(c.at(trim).passed);
+    EXPECT_NE(c.at(trim).detail.find("at command 0 the rotors give "), std::string::npos) << c.at(trim).detail;
+    EXPECT_EQ(c.at(trim).detail.find("centre of gravity"), std::string::npos) << c.at(trim).detail;
+    EXPECT_FALSE(c.at(low).passed);
+    EXPECT_NE(c.at(low).detail.find("no trim: the rotors at command 0 lift the weight"), std::string::npos) << c.at(low).detail;
+  }
+  {  // no trim for another reason (the centre of gravity outside the rotors): not judged, not passed on nothing
+    Vehicle v = good;
+    for (auto& r : v.rotors) r.position[0] += 0.2;
+    const auto c = checks_of(v);
+    EXPECT_NE(c.at("hover needs a tenth of the command range or more").detail.find("not judged"), std::string::npos);
   }
   {  // a motor map copied with the wrong sign
     Vehicle v = good;
@@ -1298,4 +1355,36 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   EXPECT_EQ(r.warnings().size(), 1u);
   r.checks.push_back({"units", "dx/dt", false, ""});
   EXPECT_FALSE(r.all_passed());
+}
+
+// model.json carries the hover trim at full precision (a user trial, helper-82: the audit's
+// text rounds it to four digits, which left a roll acceleration of 7e-3 rad/s^2 at "hover" on
+// a vehicle with its CoG off the middle). Checked independently of the trim's own solver: the
+// symbolic model evaluated at those commands, level and at rest, accelerates by rounding only.
+TEST(Derive, ModelJsonHoldsTheHoverTrimAtFullPrecision) {
+  std::string text = test::finken3().source_text;
+  const std::string upper = "centre: [0, 0, 0.036]";
+  ASSERT_NE(text.find(upper), std::string::npos);
+  text.replace(text.find(upper), upper.size(), "centre: [0.02, 0.015, 0.036]");
+  const Vehicle v = parse_vehicle(text, "off_centre.yaml");
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive_model(v, mp, {});
+  const AuditResult no_audit;
+  const std::vector<ThesisItem> no_thesis;
+  const auto j = nlohmann::json::parse(model_json({v, mp, m, no_audit, no_thesis}));
+  const auto& trim = j.at("hover_trim");
+  EXPECT_EQ(trim.at("why_not"), "");
+  EXPECT_EQ(trim.at("rotors"), nlohmann::json({"A", "B", "C", "D"}));
+  const std::vector<double> u = trim.at("command").get<std::vector<double>>();
+  ASSERT_EQ(u.size(), 4u);
+  EXPECT_GT(*std::max_element(u.begin(), u.end()) - *std::min_element(u.begin(), u.end()), 0.01);  // uneven
+  const std::vector<double> x = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0};
+  const std::vector<double> f = test::eval_f(m, x, u);
+  for (int i = 3; i < 6; ++i) EXPECT_NEAR(f[i], 0.0, 1e-9) << "acceleration " << i;
+  for (int i = 10; i < 13; ++i) EXPECT_NEAR(f[i], 0.0, 1e-9) << "angular acceleration " << i;
+  // Rounded to four digits, as the audit's text gives it, the roll or pitch is off by far more.
+  std::vector<double> rounded = u;
+  for (double& c : rounded) c = std::round(c * 1e4) / 1e4;
+  const std::vector<double> g = test::eval_f(m, x, rounded);
+  EXPECT_GT(std::max(std::fabs(g[10]), std::fabs(g[11])), 1e-4);
 }

@@ -127,6 +127,13 @@ TEST(VehicleInput, MissingRotorModelOrFrameKey) {
 TEST(VehicleInput, UnknownKey) {
   expect_error(replace(finken_text(), "  c_w:", "  cw_typo: 1\n  c_w:"), "unknown key 'cw_typo'");
 }
+// A tilted rotor is said to be outside the model, not only an unknown key (a user trial: blocks
+// take orientation_deg, so a user tried it on a rotor).
+TEST(VehicleInput, TiltedRotorIsSaidToBeOutsideTheModel) {
+  expect_error(replace(finken_text(), "{name: B, position: [0.07465, -0.07465, 0],",
+                       "{name: B, orientation_deg: [0, 10, 0], position: [0.07465, -0.07465, 0],"),
+               "a rotor takes no 'orientation_deg': every rotor's thrust acts along body +z");
+}
 TEST(VehicleInput, NegativeMass) {
   expect_error(replace(finken_text(), "mass: 0.099", "mass: -0.099"), "expected a positive number for mass");
 }

@@ -8,6 +8,7 @@
 
 #include "derive/effects/definitions.hpp"
 #include "output/joined.hpp"
+#include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
 
 namespace quadgen {
@@ -161,6 +162,18 @@ VehicleScales vehicle_scales(const Vehicle& v) {
 bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,
                              double* lower, double* upper, std::string* why) {
   return plausible_range(parameter, where, scales, lower, upper, why) && !(value >= *lower && value <= *upper);
+}
+
+std::string outside_physical_domain(const std::string& parameter, double value) {
+  const Effect* e = effect_named(effect_of_parameter(parameter));
+  if (!e) return "";
+  for (const auto& d : e->domain) {
+    if (!d.parameter.empty() && d.parameter != parameter) continue;
+    if (d.lower_included ? value >= d.lower : value > d.lower) continue;
+    return std::string("must be ") + (d.lower_included ? "at least " : "above ") + output::short_number(d.lower) + ": " +
+           d.why;
+  }
+  return "";
 }
 
 std::vector<std::string> parse_effect_list(const std::string& text) {

@@ -74,6 +74,9 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
 // stand-ins. False inside the range or without one.
 bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,
                              double* lower, double* upper, std::string* why);
+// Why `value` lies outside the values `parameter` can physically take (Effect::domain:
+// "must be 0 or above: ..."), or "" when it can, or when it is no effect's parameter.
+std::string outside_physical_domain(const std::string& parameter, double value);
 // Parses "motor_gain,motor_lag" or "all"; rejects unknown or repeated names.
 std::vector<std::string> parse_effect_list(const std::string& text);
 // These effects in canonical order joined by commas: SymbolicModel::effect_list() of the model

@@ -41,6 +41,7 @@ Effect ground_effect() {
   e.parameter_names = "ground_effect.radius";  // as --help lists them
   e.needs = EffectNeeds::kPose;
   e.typical_start = {{"ground_effect.radius", 0.05}};
+  e.domain = {{"ground_effect.radius", 0.0, true, "a rotor radius is no negative length"}};
   e.plausible = {{"ground_effect.radius", 0.0, 3.0, PlausibleRange::Scale::kRotorRadius, Environment::kUnknown,
                   "the Cheeseman-Bennett law's R is the rotor radius; several rotors side by side act like a "
                   "somewhat larger one"}};

@@ -24,6 +24,7 @@ Effect input_delay() {
   e.parameter_names = "input_delay.seconds";  // as --help lists them
   e.acts_on = Effect::ActsOn::kCommands;
   e.typical_start = {{"input_delay.seconds", 0.015}};
+  e.domain = {{"input_delay.seconds", 0.0, true, "a delay below zero would act on commands not yet sent"}};
   e.plausible = {{"input_delay.seconds", 0.0, 0.1, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "logging and radio latencies are one to a few control periods (10-50 ms)"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {

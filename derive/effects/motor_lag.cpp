@@ -33,6 +33,7 @@ Effect motor_lag() {
   e.off_at_lower_bound = true;
   e.plausible = {{"motor_lag.tau", 0.0, 0.25, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "small electric motors respond in 20-100 ms (Crazyflie: 0.072 s, ARPL log authors)"}};
+  e.domain = {{"motor_lag.tau", 0.0, false, "a time constant of zero or below is no lag (the rotor speed's rate divides by it)"}};
   e.look_alikes = {{"input_delay", "fast throttle steps or chirps (1-10 Hz): a lag rounds and attenuates the response, a "
                                    "delay shifts it without changing its shape"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {

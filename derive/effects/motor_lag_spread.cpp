@@ -40,6 +40,7 @@ Effect motor_lag_spread() {
   e.refines = "motor_lag";
   // No published spread of one batch's time constants was found; the ARPL log's authors give
   // one time constant for all four motors of their Crazyflie (0.072 s).
+  e.domain = {{"", -1.0, false, "it scales the shared time constant by 1 + spread, which must stay above zero"}};
   e.plausible = {{"", -0.5, 1.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "motors and propellers of one type share their time constant (the ARPL authors give one, 0.072 s, "
                   "for all four); half or twice the others' is a damaged propeller or a failing motor, beyond that "

@@ -33,6 +33,7 @@ Effect rotor_drag() {
   e.meaning = "horizontal body force -k (sum of rotor speeds) v_body,xy";
   e.apply = terms;
   e.parameter_names = "rotor_drag.k";  // as --help lists them
+  e.domain = {{"rotor_drag.k", 0.0, true, "a negative drag would push the vehicle along its airspeed"}};
   e.look_alikes = {{"blade_flapping", "straight legs at several constant speeds: rotor drag slows the vehicle (a "
                                       "horizontal force), flapping only tilts it (a moment the attitude loop must hold)"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
