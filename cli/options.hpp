@@ -103,6 +103,14 @@ inline void commit_and_say(output::OutputDirectory& out, const std::string& comm
     std::cerr << "quadgen: note: replaced the earlier " << command << " output in " << output::printable(out.dir()) << "\n";
 }
 
+// ... and of a command that writes files, not a folder (simulate).
+inline void commit_and_say(output::OutputFiles& out, const std::string& command) {
+  out.commit();
+  if (out.replaced_earlier_run())
+    std::cerr << "quadgen: note: replaced the earlier " << command << " output " << output::printable(out.first_path())
+              << "\n";
+}
+
 // The long names of the options of `sub` that the command line gave.
 inline std::set<std::string> given_options(const CLI::App* sub) {
   std::set<std::string> given;

@@ -139,7 +139,7 @@ int run_simulate(const SimulateArgs& a) {
   std::string svg, err;  // the plot, when gnuplot can draw it
   if (render_svg(r.plot_title, r.plot, &svg, &err)) out.set(1, svg);
   else std::cerr << "no plot: " << err << "\n";
-  out.commit();
+  commit_and_say(out, "simulate");
   for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "\n";
   return 0;

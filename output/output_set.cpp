@@ -756,6 +756,11 @@ void OutputFiles::commit() {
   test_hook_die_before_commit();
   test_hook_signal("before-commit");
   std::error_code ec;
+  // The constructor let through only files this command wrote here, unchanged since.
+  replaced_ = std::any_of(paths_.begin(), paths_.end(), [](const std::string& p) {
+    std::error_code e;
+    return fs::exists(fs::symlink_status(p, e));
+  });
   for (size_t i = 1; i < paths_.size(); ++i) fs::remove(paths_[i], ec);  // no companion of another run
   for (size_t i = 0; i < paths_.size(); ++i) {
     if (!written_[i]) continue;

@@ -96,9 +96,13 @@ class OutputFiles {
   // Content of paths[i]; a path never set is not written, and a previous file there is removed.
   void set(size_t i, const std::string& content);
   void commit();
+  // Whether the commit replaced files an earlier run of the command wrote at these paths.
+  bool replaced_earlier_run() const { return replaced_; }
+  const std::string& first_path() const { return paths_.front(); }
 
  private:
   void update_record();
+  bool replaced_ = false;
   std::string command_;
   std::vector<std::string> paths_;
   std::vector<bool> written_;
