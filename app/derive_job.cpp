@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include "app/derive_pipeline.hpp"
@@ -13,21 +15,39 @@ namespace quadgen::app {
 
 namespace {
 
-// Where the values said come from: " (the blocks')", " (the file's `derived:`)" where it gives
-// all of `names`, or " (the blocks', J_xy from the file's `derived:`)" where it gives some.
-std::string given(const Vehicle& v, const std::vector<std::string>& names) {
-  std::vector<std::string> from_file;
-  for (const auto& n : names)
-    if (v.derived_given.count(n)) from_file.push_back(n);
-  if (from_file.empty()) return " (the blocks')";
-  if (from_file.size() == names.size()) return " (the file's `derived:`)";
-  return " (the blocks', " + output::joined(from_file) + " from the file's `derived:`)";
+// The blocks' value of a quantity of kDerivedQuantities the summary prints.
+double blocks_value(const MassProperties& mp, const std::string& name) {
+  if (name == "mass") return mp.mass_value;
+  if (name.rfind("cog_", 0) == 0) return mp.cog_value[static_cast<size_t>(name[4] - 'x')];
+  const auto axis = [&](char c) { return static_cast<size_t>(c - 'x'); };
+  return mp.inertia_cog_value[axis(name[2])][axis(name[3])];  // J_xy -> [x][y]
+}
+
+// Where the values said come from: " (the blocks')", " (the file's `derived:`)" or " (fitted)"
+// where all of `names` come from one place, else each place with its names, "(the blocks';
+// the file's `derived:`: J_xy)". Fitted values (--params, a `fitted:` section) replace the
+// blocks' as the model's nominal ones.
+std::string source_of(const Vehicle& v, const MassProperties& mp, const SymbolicModel& model,
+                      const std::vector<std::string>& names) {
+  std::map<std::string, std::vector<std::string>> by_source;
+  for (const auto& n : names) {
+    const double nominal = model.params[model.param_index(n)].nominal, blocks = blocks_value(mp, n);
+    const bool same = std::fabs(nominal - blocks) <= 1e-12 * std::max(std::fabs(blocks), 1e-300);
+    by_source[v.derived_given.count(n) ? "the file's `derived:`" : same ? "the blocks'" : "fitted"].push_back(n);
+  }
+  if (by_source.size() == 1) return " (" + by_source.begin()->first + ")";
+  std::string said;
+  for (const char* source : {"the blocks'", "the file's `derived:`", "fitted"})
+    if (by_source.count(source))
+      said += std::string(said.empty() ? "" : "; ") + source +
+              (std::string(source) == "the blocks'" ? "" : ": " + output::joined(by_source[source]));
+  return " (" + said + ")";
 }
 
 // What a user checks first: the model's size and audit, the generated code's op counts, and
 // the mass properties against their scale and CAD (as the model uses them: from the blocks,
 // or measured values the vehicle file gives in `derived:`).
-std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double seconds) {
+std::string summary_of(const Vehicle& vehicle, const MassProperties& mp, const DerivedModel& d, double seconds) {
   const SymbolicModel& model = d.model;
   const codegen::GeneratedHeader& header = d.header;
   const auto nominal = [&](const std::string& name) { return model.params[model.param_index(name)].nominal; };
@@ -36,7 +56,9 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
      << model.params.size() << " parameters; audit " << (d.audit.all_passed() ? "passed" : "FAILED") << " ("
      << d.audit.checks.size() << " checks"
      << (d.audit.warnings().empty() ? std::string()
-                                    : "; " + std::to_string(d.audit.warnings().size()) + " about the vehicle warn, below")
+                                    : "; " + std::to_string(d.audit.warnings().size()) +
+                                          (d.audit.warnings().size() == 1 ? " vehicle warning" : " vehicle warnings") +
+                                          " below")
      << "); derived, audited and generated in " << std::setprecision(3) << seconds
      << std::setprecision(6) << " s (writing the files not counted)\n"
      << "generated model.hpp (" << header.name << "): f " << header.ops_f_before << " -> " << header.ops_f_after
@@ -44,8 +66,8 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
      << header.pre_count << " precomputed values (" << header.pre_ops << " ops)\n";
   // Values the file gives in `derived:` replace the blocks' (their tensor stays about the blocks'
   // centre as given: the file's values are what the model uses), so the line says which.
-  os << "mass " << nominal("mass") << " kg" << given(vehicle, {"mass"}) << "; centre of gravity (" << nominal("cog_x")
-     << ", " << nominal("cog_y") << ", " << nominal("cog_z") << ") m" << given(vehicle, {"cog_x", "cog_y", "cog_z"});
+  os << "mass " << nominal("mass") << " kg" << source_of(vehicle, mp, model, {"mass"}) << "; centre of gravity (" << nominal("cog_x")
+     << ", " << nominal("cog_y") << ", " << nominal("cog_z") << ") m" << source_of(vehicle, mp, model, {"cog_x", "cog_y", "cog_z"});
   // A fitted CoG offset moves the point the thrust's moments act about; the blocks' centre
   // stays what the file describes, so both are said.
   const auto has = [&](const std::string& name) {
@@ -54,7 +76,7 @@ std::string summary_of(const Vehicle& vehicle, const DerivedModel& d, double sec
   if (has("cog_offset.x") && (nominal("cog_offset.x") != 0 || nominal("cog_offset.y") != 0))
     os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
   os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
-     << " kg m^2" << given(vehicle, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
+     << " kg m^2" << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   return os.str();
@@ -81,7 +103,7 @@ DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle) {
   r.files = {{"model.json", d.model_json}, {"derivation.md", d.derivation_md}, {"model.hpp", d.header.content}};
   r.audit_passed = d.audit.all_passed();
   r.note = note;
-  r.summary = summary_of(vehicle, d, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  r.summary = summary_of(vehicle, mass_properties, d, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return r;
 }
 

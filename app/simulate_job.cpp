@@ -50,7 +50,7 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 // there would be half applied. A closed loop's controller believes the file, and the truth
 // may differ in anything. No bounds of a fit apply (a test flight's truth may lie beyond
 // them), but a value the physics cannot take is refused in every mode (Effect::domain), as is
-// a delay longer than the flight (no command would act) and a name given twice.
+// a delay as long as the flight (no command would act) and a name given twice.
 void apply_settings(const SimulateJob& a, DynamicModel& m) {
   std::vector<double> p = m.params();
   std::set<std::string> seen;
@@ -71,10 +71,10 @@ void apply_settings(const SimulateJob& a, DynamicModel& m) {
                                   "file's values, so only an effect's parameters may be set there (edit the file, or "
                                   "fly --closed-loop)");
     std::string problem = runtime::value_problem(m.parameters()[static_cast<size_t>(i)], value, false);
-    if (problem.empty() && !outside_physical_domain(name, value).empty())
-      problem = "= " + output::short_number(value) + " " + outside_physical_domain(name, value);
-    if (problem.empty() && name == "input_delay.seconds" && a.duration > 0 && value > a.duration)
-      problem = "= " + output::short_number(value) + " s is longer than the flight (--duration " +
+    if (const std::string outside = outside_physical_domain(name, value); problem.empty() && !outside.empty())
+      problem = "= " + output::short_number(value) + " " + outside;
+    if (problem.empty() && name == "input_delay.seconds" && a.duration > 0 && value >= a.duration)
+      problem = "= " + output::short_number(value) + " s is as long as the flight or longer (--duration " +
                 output::short_number(a.duration) + " s): no command would act";
     if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
@@ -177,29 +177,42 @@ struct OpenLoop {
   double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
 };
 
+// `thrusts` less their change's part about the axes the manoeuvre does not mean (from the hover
+// trim), with the least change of every rotor's thrust. Left as they are where that would ask
+// a rotor for less than its command 0 gives or more than its command 1 (a rotor the trim holds
+// at idle).
+void take_out_unmeant_turn(const OpenLoop& k, const Scenario& s, Eigen::VectorXd& thrusts) {
+  const Eigen::VectorXd trim = Eigen::Map<const Eigen::VectorXd>(k.hover_trim.data(), thrusts.size());
+  Eigen::Vector4d unmeant = k.allocation * (thrusts - trim);
+  for (int axis = 0; axis < 4; ++axis)
+    if (s.changes[static_cast<size_t>(axis)]) unmeant(axis) = 0;
+  const Eigen::VectorXd balanced = thrusts - k.allocation_inverse * unmeant;
+  for (Eigen::Index i = 0; i < balanced.size(); ++i) {
+    const ThrustLaw& law = k.laws[static_cast<size_t>(i)];
+    const double least = law.thrust_at_speed(std::max(law.speed_at(0.0), 0.0));
+    const double most = law.thrust_at_speed(std::max(law.speed_at(1.0), 0.0));
+    if (!(balanced(i) >= least && balanced(i) <= most)) return;
+  }
+  thrusts = balanced;
+}
+
 // A thesis manoeuvre: the thrusts it asks for at each (delayed) time, scaled by each rotor's
-// own trim (1 on a symmetric vehicle), turned into commands by each rotor's law. With uneven
-// trims the raised rotors' steps differ, and also turn the vehicle about axes the manoeuvre
-// does not mean (a user trial: the yaw manoeuvre rolled an H quad with its CoG off centre):
-// that part of the change is taken out, with the least change of the thrusts. On a symmetric
-// vehicle it is zero (to rounding, which leaves the thrusts' bits as they are).
+// own trim (1 on a symmetric vehicle), turned into commands by each rotor's law. The rotors a
+// manoeuvre raises may also turn the vehicle about axes it does not mean: with uneven trims
+// (a user trial: `yaw` rolled an H quad with its CoG off centre), or where the rule raises
+// rotors of both spins (hexa_plus's `right` raises two ccw and one cw rotor, and yawed). That
+// part is taken out. Where the raised rotors balance about the other axes (the FINken 3, the
+// Crazyflie) it is zero, and the thrusts keep their bits.
 InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   return [&k, s](double t, double* u) {
     // About the even share m g / n; on a trimmed vehicle each rotor's thrust scaled by its trim,
     // so that a change of every rotor alike (climb) keeps the moments balanced.
     const auto F = s.thrust(t - k.delay_s(), k.hover, k.places);
-    const auto n = static_cast<Eigen::Index>(k.rotors.size());
-    Eigen::VectorXd trimmed(n), step(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const size_t r = static_cast<size_t>(i);
-      trimmed(i) = k.hover_trim[r] == k.hover ? F[r] : F[r] * (k.hover_trim[r] / k.hover);
-      step(i) = trimmed(i) - k.hover_trim[r];
-    }
-    Eigen::Vector4d unmeant = k.allocation * step;
-    for (int axis = 0; axis < 4; ++axis)
-      if (s.changes[static_cast<size_t>(axis)]) unmeant(axis) = 0;
-    trimmed -= k.allocation_inverse * unmeant;
-    for (Eigen::Index i = 0; i < n; ++i) u[i] = k.laws[static_cast<size_t>(i)].command_for(trimmed(i));
+    Eigen::VectorXd thrusts(static_cast<Eigen::Index>(F.size()));
+    for (size_t i = 0; i < F.size(); ++i)
+      thrusts(static_cast<Eigen::Index>(i)) = k.hover_trim[i] == k.hover ? F[i] : F[i] * (k.hover_trim[i] / k.hover);
+    take_out_unmeant_turn(k, s, thrusts);
+    for (size_t i = 0; i < F.size(); ++i) u[i] = k.laws[i].command_for(thrusts(static_cast<Eigen::Index>(i)));
     k.extra.fill(t, k.vbat_ref, u);
   };
 }

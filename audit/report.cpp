@@ -67,15 +67,17 @@ void given_values(std::ostringstream& md, const Derivation& d) {
 void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
   const MassProperties& mp = d.mass;
   md << "## 2. Mass properties by exact integration\n\n"
-     << "Each block is a cuboid of constant density $\\rho = m/(abc)$. In its own frame GiNaC "
-        "integrates the second moment $S = \\int \\xi\\xi^T\\,dm$ exactly over "
+     << "Each block is a cuboid of constant density $\\rho_i = m_i/(a_i b_i c_i)$. In its own frame GiNaC "
+        "integrates the second moment $S = \\int \\xi \\xi^T \\mathrm{d}m$ exactly over "
         "$[-a/2,a/2]\\times[-b/2,b/2]\\times[-c/2,c/2]$";
   if (!mp.blocks.empty()) {
     md << "; for block " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nS = " << tex.matrix(mp.blocks[0].local_second_moment)
        << "\n```\n\n";
   }
-  md << "It is rotated and moved into the body frame, $S_b = R S R^T + m\\,c\\,c^T$, and the inertia tensor "
-        "about the origin is $J_o = \\operatorname{tr}(S_b) I - S_b$.";
+  md << "It is rotated by the block's orientation, $R = R_z(\\mathrm{yaw}) R_y(\\mathrm{pitch}) R_x(\\mathrm{roll})$ "
+        "(Z-Y-X, as the vehicle file's `orientation_deg: [yaw, pitch, roll]`), and moved to its centre $c$ in the "
+        "body frame, $S_b = R S R^T + m c c^T$; the inertia tensor about the origin is "
+        "$J_o = \\operatorname{tr}(S_b) I - S_b$.";
   if (!mp.blocks.empty())
     md << " For " << output::markdown_code(mp.blocks[0].name) << ":\n\n```math\nJ_o = " << tex.matrix(mp.blocks[0].inertia_origin) << "\n```\n\n";
   md << "Contributions of every block about the body origin [kg m²] and projected areas [m²]:\n\n"
@@ -87,7 +89,8 @@ void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
        << " | " << num(b.areas_value[1]) << " | " << num(b.areas_value[2]) << " |\n";
   }
   const auto& Jc = mp.inertia_cog_value;
-  md << "\nTotals: $m = " << tex.tex(mp.mass) << "$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
+  // $`...`$: GitHub's Markdown would read the TeX's "\_" in $...$ as an escaped "_" (a subscript).
+  md << "\nTotals: $`m = " << tex.tex(mp.mass) << "`$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
      << "$c = \\frac{1}{m}\\sum m_i c_i$ = **(" << num(mp.cog_value[0]) << ", " << num(mp.cog_value[1]) << ", "
      << num(mp.cog_value[2]) << ") m**; exposed areas **(" << num(mp.areas_value[0]) << ", "
      << num(mp.areas_value[1]) << ", " << num(mp.areas_value[2]) << ") m²**.\n\n"
@@ -131,7 +134,7 @@ void section_kinematics(std::ostringstream& md) {
 // each written with the ones before it as symbols.
 void section_forces_and_torques(std::ostringstream& md, const SymbolicModel& m, TexWriter& tex) {
   md << "## 4. Forces and torques\n\n";
-  md << "The air velocity in body axes $v_a = R^T (v - v_{wind})$; each rotor's speed $\\omega_i$ and thrust "
+  md << "The air velocity in body axes $v_a = R^T (v - v_{wind})$ ($v_{wind}$ the wind effect's, zero without it); each rotor's speed $\\omega_i$ and thrust "
         "$F_i$ (along body $+z$ at its hub); the moment $\\tau_i$ of that thrust about the centre of gravity with "
         "the reaction moment of the spin (a counter-clockwise rotor, seen from above, turns the body with "
         "$-\\kappa F_i$ about $z$, a clockwise one with $+\\kappa F_i$); and the frame's drag on $v_a$, acting at "
@@ -171,7 +174,7 @@ void section_effect_terms(std::ostringstream& md, const SymbolicModel& m, TexWri
   if (m.effect_formulas.empty()) return;
   md << "### What each effect adds\n\nEach effect applied alone to the base model, in body axes ($R = I$; "
         "$v_a$ is the air velocity, in body axes unless said), with the quantity it changes: a rotor's thrust is "
-        "$s\\,c_t \\rho A_p r_p^2\\,\\omega(\\omega - \\omega_{\\mathrm{loss}})$, $\\Delta c$ moves the centre of "
+        "$s c_t \\rho A_p r_p^2 \\omega(\\omega - \\omega_{\\mathrm{loss}})$, $\\Delta c$ moves the centre of "
         "gravity, $\\Delta F_{body}$ and $\\Delta\\tau$ add to the body force and the moment about the centre of "
         "gravity.\n\n";
   for (const auto& f : m.effect_formulas) {
@@ -250,7 +253,8 @@ void section_thesis(std::ostringstream& md, const Derivation& d) {
         "them with the derived model at its nominal parameters. *Verdict from* says how each verdict was reached: "
         "computed from the derived model (its equations or an integration of them), computed by arithmetic on the "
         "quantities quadgen derives (mass, inertia, areas), or read from the equations' form (stated in "
-        "`thesis_reference.cpp`, not computed).\n\n"
+        "`thesis_reference.cpp`, not computed). Roll here is the turn about x (phi) and pitch about y "
+        "(theta); the thesis (2.2.4.1) names them the other way round, Nicken about x and Rollen about y.\n\n"
      << "| ref | topic | thesis | derived | verdict | verdict from | cause | size |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& t : d.thesis)
     md << "| " << output::markdown_text(t.ref) << " | " << output::markdown_text(t.topic) << " | " << output::markdown_text(t.thesis)

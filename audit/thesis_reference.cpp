@@ -97,7 +97,7 @@ void translation_items(std::vector<ThesisItem>& out, const Numbers& n) {
                  "with velocity in world axes, Newton's law has no ω x v term; it appears only for "
                  "velocity in body axes (and then with body rates, not Euler-angle rates)",
                  "|ω x v| = 1 m/s^2 for 1 rad/s and 1 m/s at right angles: the size of the "
-                 "thrust-induced acceleration of a 10 deg tilt",
+                 "thrust-induced acceleration of a 6 deg tilt (g sin 6 deg = 1.03 m/s^2)",
                  std::string(kFromReading) + ": the derived translation rows hold no ω x v term (section 5)"});
   const double k_thesis[3] = {0.5 * 0.7 * 7.985e-3 * 1.225, 0.5 * 0.7 * 7.575e-3 * 1.225,
                               0.5 * 0.7 * 1.2672e-2 * 1.225};
@@ -237,8 +237,9 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
                      fmt("about the CoG (the dynamics' J) diag(%.4g, %.4g, %.4g) kg m^2", n.Jxx, n.Jyy, n.Jzz) +
                      fmt(", J_xz = %.3g", mp.inertia_cog_value[0][2]),
                  std::fabs(d[0]) < 1 && std::fabs(d[1]) < 1 && std::fabs(d[2]) < 1,
-                 "besides the per-block causes: J_xx != J_yy although arms and motors are symmetric "
-                 "under a 90 deg turn; Table 1 sums to J_zz = 1.2645e-3 but (45) states 1.43e-3 "
+                 "besides the per-block causes: the thesis' arm and motor blocks give J_xx != J_yy although "
+                 "they are symmetric under a 90 deg turn (block 1: 4.079e-4 against 2.058e-4; the lower body "
+                 "alone makes the derived J_xx and J_yy differ, by 1.3e-5); Table 1 sums to J_zz = 1.2645e-3 but (45) states 1.43e-3 "
                  "(the x^2 term); the thesis' J is about the origin, the dynamics need it about the CoG",
                  fmt("J_xx %+.0f %%, J_yy %+.0f %%, J_zz %+.0f %% (thesis relative to derived, both about the origin)",
                      d[0], d[1], d[2]),
@@ -261,7 +262,7 @@ void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, cons
                  fmt("c = (%.3g, %.3g, %.3g) mm", n.cog[0] * 1e3, n.cog[1] * 1e3, n.cog[2] * 1e3),
                  std::fabs(n.cog[2] * 1e3 - 0.94) < 0.05 && std::hypot(n.cog[0], n.cog[1]) < 5e-5,
                  "quadgen keeps the CoG offset in the equations (torque arms, origin kinematics); "
-                 "the thesis' 0.94 mm cannot be reproduced from its own blocks and limits",
+                 "the thesis' 0.94 mm is not reproduced by its blocks and limits as read here",
                  fmt("c_z differs by %.2f mm; the offset enters the body origin's acceleration as dω/dt × c: ",
                      1e3 * n.cog[2] - 0.94) +
                      fmt("%.2g m/s^2 at the %.3g rad/s^2 of the fly-right case (65); a thrust along body z has no "
@@ -461,7 +462,8 @@ void evaluation_items(std::vector<ThesisItem>& out, const Numbers& n, const Flig
                  fmt("a_z(0) = %.3g m/s^2; z(1 s) = %.4g m with drag (0.5 a t^2 = ", a, z1) +
                      fmt("%.3g m without)", 0.5 * a),
                  std::fabs(a - 1.56) < 0.005 && std::fabs(z1 - 0.78) < 0.005, "",
-                 fmt("agrees; drag at the final 1.56 m/s lowers z(1 s) by %.2g mm", (0.5 * a - z1) * 1e3),
+                 fmt("agrees; drag (the speed staying below a t = %.3g m/s) lowers z(1 s) by ", a) +
+                     fmt("%.2g mm", (0.5 * a - z1) * 1e3),
                  flights ? std::string(kFromModel) + fmt(": z(1 s) by RK4 of the derived model, within 0.005 m of 0.78 m "
                                                          "(a 1-D integration by hand gives %.4g m); a_z(0) = 4.4 N / m - g "
                                                          "within 0.005 m/s^2",
@@ -476,7 +478,8 @@ void evaluation_items(std::vector<ThesisItem>& out, const Numbers& n, const Flig
                  near(theta_dd * 180 / M_PI, 15.648, 0.01),
                  "0.2 N x 0.07465 m / 9.541e-4 kg m^2 = 15.648 rad/s^2, not deg/s^2: a unit error. "
                  "The single-step evaluation then takes the tilt reached after 1 s as if present from "
-                 "the start; the true tilt after 1 s at this torque is 7.8 rad (the vehicle flips)",
+                 "the start; the true tilt after 1 s at this torque is 7.8 rad with the thesis' J_yy (8.6 "
+                 "with the derived one: the vehicle flips)",
                  fmt("factor 57.3 in the angular acceleration; at t = 0 the thrust is still vertical (the CoG's "
                      "a_x is 0; the body origin's is -(dω/dt × c)_x), and a_x reaches 1.48 m/s^2 after %.3g s, not 1 s",
                      std::sqrt(2 * 7.824 * M_PI / 180 / theta_dd)),

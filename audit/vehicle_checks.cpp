@@ -101,9 +101,9 @@ AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   if (!trim.found()) {
     const bool low = trim.idle_lifts_weight;
     return advisory("hover needs a tenth of the command range or more", !low,
-                    low ? "no trim: the rotors at command 0 lift the weight; a motor map in rpm written without "
-                          "`unit: rpm` reads as rad/s, 9.5 times too fast? (or c_t too large?)"
-                        : "not judged: no hover trim (see the trim's check)");
+                    low ? std::string("no trim: the rotors at command 0 lift the weight; ") + runtime::kRpmWithoutUnit +
+                              "? (or c_t too large?)"
+                        : std::string("not judged: no hover trim (see the trim's check)"));
   }
   const double highest = *std::max_element(trim.commands.begin(), trim.commands.end());
   const bool low = highest < kLowestHoverCommand;
@@ -111,8 +111,8 @@ AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   detail << "the highest hover command " << std::to_string(highest);
   if (low)
     detail << ", below " << kLowestHoverCommand
-           << " of the command range: a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too "
-              "fast? (near the bottom of the range fit and diagnose take a rotor for idle)";
+           << " of the command range: " << runtime::kRpmWithoutUnit
+           << "? (near the bottom of the range fit and diagnose take a rotor for idle)";
   return advisory("hover needs a tenth of the command range or more", !low, detail.str());
 }
 
@@ -233,7 +233,9 @@ AuditCheck check_discs_clear_of_blocks(const Vehicle& v) {
     }
   const std::string found = os.str();
   return advisory("no propeller sweeps through a block", found.empty(),
-                  found.empty() ? "every rotor's disc is clear of every block" : found);
+                  found.empty() ? "every rotor's disc is clear of every block (a block that only touches a disc's "
+                                  "plane, a hub on its motor's face, counts as clear)"
+                                : found);
 }
 
 // Rotors and blocks on one scale: a number without a unit is read as metres, so a position or

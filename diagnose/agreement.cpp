@@ -201,11 +201,14 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
       a.joint_value = a.pooled = e.value[j];
       const FlightEstimate& f = here.at(a.parameter);
       a.flights = {f};
-      const double se = std::hypot(f.standard_error, e.standard_error[j]);
+      // An airframe value without a standard error (a diagnosis that had none) cannot say either.
+      a.reference_without_error = std::isnan(e.standard_error[j]);
+      const double se = a.reference_without_error ? f.standard_error : std::hypot(f.standard_error, e.standard_error[j]);
       a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
       a.q_p_value = chi2_upper(a.q, 1.0);
       a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
-      const bool says = f.standard_error > 0;  // a flight without one cannot disagree, nor agree
+      // A flight without one cannot disagree, nor agree.
+      const bool says = f.standard_error > 0 && !a.reference_without_error;
       a.within_errors = !says || a.q < kZ95 * kZ95;
       a.agree = says && a.q < kZ95 * kZ95 && a.spread < 0.3;
       out.push_back(a);

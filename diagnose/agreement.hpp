@@ -48,6 +48,9 @@ struct ParameterAgreement {
   // holds the pooled value (against an airframe, as above). Without `agree` only the 30 % is
   // missed, or a flight cannot say: the values may well be one, measured too loosely to show it.
   bool within_errors = false;
+  // Against an airframe: its value came without a standard error, so the flight can neither
+  // agree nor disagree with it.
+  bool reference_without_error = false;
 };
 
 // The verdict in a word: "agree", "too uncertain" (within the errors, but apart by 30 % or
@@ -56,10 +59,11 @@ inline const char* agreement_verdict(const ParameterAgreement& a) {
   return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
 }
 
-// Why a verdict is "too uncertain" ("" for the other two): a flight that has no standard
-// error cannot say, else the values are within the errors but 30 % or more apart.
+// Why a verdict is "too uncertain" ("" for the other two): an airframe value or a flight that
+// has no standard error cannot say, else the values are within the errors but 30 % or more apart.
 inline const char* why_too_uncertain(const ParameterAgreement& a) {
   if (a.agree || !a.within_errors) return "";
+  if (a.reference_without_error) return "the airframe's value has no standard error";
   for (const auto& f : a.flights)
     if (!(f.standard_error > 0)) return "a flight without a standard error cannot say";
   return "within the errors, but 30 % or more apart";

@@ -248,6 +248,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   out.path = raw.path;
   out.lines = raw.lines;
   out.resampled_hz = raw.resampled_hz;
+  out.time_from_topics_start = raw.time_from_topics_start;
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);
@@ -295,6 +296,7 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   out.name_lines = log.name_lines;
   out.unreadable = log.unreadable;  // asking for one stays the error at its line
   out.resampled_hz = rate_hz;
+  out.time_from_topics_start = log.time_from_topics_start;
   size_t i = 0;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;

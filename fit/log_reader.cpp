@@ -116,6 +116,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   runtime::CsvTable out;
   out.path = log.path;
   out.resampled_hz = rate_hz;
+  out.time_from_topics_start = true;
   out.columns.push_back("t");
   for (const auto& s : signals) out.columns.push_back(s.source);
   // Grid points inside a gap of any signal are left out: the table then has a gap there too,

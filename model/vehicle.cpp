@@ -197,7 +197,7 @@ void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v
                {{"c_t", "1", true, "thrust coefficient of F = c_t rho A_p (omega r_p)^2"},
                 {"kappa", "m", true, "yaw torque per thrust, Q = kappa F"}});
   read_section(r, root, v, "motor_map",
-               {{"a0", "rad/s", true, "rotor speed at zero command"},
+               {{"a0", "rad/s", true, "the motor map's speed at command 0 (its constant term)"},
                 {"a1", "rad/s", true, "rotor speed per command"},
                 {"a2", "rad/s", true, "rotor speed per command squared"},
                 {"slope", "1", false, "slope of the rotor speed over the command at the pivot, relative to a0..a2's"},

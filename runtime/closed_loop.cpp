@@ -119,7 +119,7 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
   if (least.sum() >= weight)
     return "rotor " + rotor_names[static_cast<size_t>(k)] + what + " (at command 0 the rotors give " +
            newtons(least.sum()) + " in all, the weight is " + newtons(weight) +
-           ": a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too fast; or c_t too large?)";
+           ": " + kRpmWithoutUnit + "; or c_t too large?)";
   const std::string where =
       least_norm.size() > static_cast<Eigen::Index>(kExactTrimRotors)
           ? " (with more than " + std::to_string(kExactTrimRotors) +

@@ -43,6 +43,11 @@ std::vector<double> allocate(const ControllerModel& b, double thrust, const std:
 // to 1) taken; above, the rotor furthest below its least is held and the rest trimmed again,
 // greedily. One home for derive's vehicle check and simulate's scenarios.
 inline constexpr size_t kExactTrimRotors = 12;
+// The likeliest cause of hover at or below the bottom of the command range, said by the
+// trim's reason and by derive's check of it (one wording).
+inline constexpr const char* kRpmWithoutUnit =
+    "a motor map in rpm written without `unit: rpm` reads as rad/s, 9.5 times too fast";
+
 struct HoverTrim {
   std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)
   std::vector<double> commands;  // each rotor's command for its thrust (0 where held); empty if none found

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <iomanip>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,7 +51,12 @@ std::string CsvTable::where_row(size_t row) const {
   const auto t = std::find(columns.begin(), columns.end(), "t");
   std::ostringstream os;
   os << path << " (the row";
-  if (t != columns.end() && row < rows.size()) os << " at t = " << rows[row][static_cast<size_t>(t - columns.begin())] << " s";
+  if (t != columns.end() && row < rows.size()) {
+    // Fixed decimals fine enough to tell rows apart, also at a Unix time (1.7e9 s).
+    const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(resampled_hz))) + 1, 1, 9);
+    os << " at t = " << std::fixed << std::setprecision(decimals) << rows[row][static_cast<size_t>(t - columns.begin())]
+       << std::defaultfloat << std::setprecision(6) << " s" << (time_from_topics_start ? " after the mapped topics' common start" : "");
+  }
   os << ", resampled at " << resampled_hz << " Hz)";
   return os.str();
 }

@@ -1043,6 +1043,9 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(loose), "within the errors, but 30 % or more apart");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(close), "");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(apart), "");
+  ParameterAgreement against = loose;  // an airframe value without a standard error
+  against.reference_without_error = true;
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(against), "the airframe's value has no standard error");
   // The printout says it, and that an airframe's value was refitted on this flight.
   quadgen::diagnose::Diagnosis d;
   ParameterAgreement check = loose;

@@ -1399,10 +1399,13 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   expect_one_line_error(scenario("input_delay", {"input_delay.seconds=-0.05"}),
                         "--set: input_delay.seconds = -0.05 must be at least 0: a delay below zero", "scenario, delay -0.05");
   expect_one_line_error(scenario("input_delay", {"input_delay.seconds=5"}),
-                        "--set: input_delay.seconds = 5 s is longer than the flight (--duration 1 s)", "scenario, delay 5");
+                        "--set: input_delay.seconds = 5 s is as long as the flight or longer (--duration 1 s)",
+                        "scenario, delay 5");
+  expect_one_line_error(scenario("input_delay", {"input_delay.seconds=1"}), "is as long as the flight or longer",
+                        "scenario, delay 1 of 1 s");
   expect_one_line_error(scenario("motor_lag", {"motor_lag.tau=0"}), "--set: motor_lag.tau = 0 must be above 0: ",
                         "scenario, tau 0");
-  expect_one_line_error(scenario("motor_gain", {"motor_gain.C=-1.5"}), "--set: motor_gain.C = -1.5 must be above -1: ",
+  expect_one_line_error(scenario("motor_gain", {"motor_gain.C=-1.5"}), "--set: motor_gain.C = -1.5 must be at least -1: ",
                         "scenario, gain -150 %");
   expect_one_line_error(scenario("input_delay", {"input_delay.seconds=0.01", "input_delay.seconds=0.02"}),
                         "--set: 'input_delay.seconds' is given twice", "scenario, delay twice");
@@ -1411,8 +1414,10 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   expect_one_line_error(slip, "--set: no parameter 'Mass' in the model", "scenario, Mass");
   EXPECT_EQ(slip.err.find("did you mean 'mass'"), std::string::npos) << slip.err;
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
-  // A value beyond a fit's bounds but within the physics is flown (a test flight's truth).
+  // A value beyond a fit's bounds but within the physics is flown (a test flight's truth), as
+  // is a dead motor (a gain of -100 %: no thrust; the review of this change found it refused).
   EXPECT_EQ(scenario("input_delay", {"input_delay.seconds=0.5"}).rc, 0);
+  EXPECT_EQ(scenario("motor_gain", {"motor_gain.C=-1"}).rc, 0);
   fs::remove(tmp / "s.csv");
   fs::remove(tmp / "s.svg");
   // A channel listed twice was weighted twice.
@@ -1816,10 +1821,22 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
   EXPECT_NE(blocks.find("kg (the blocks'); centre of gravity ("), std::string::npos) << blocks;
   const auto [file_status, file] = derive(tmp / "given.yaml", "b");
   ASSERT_EQ(file_status, 0) << file;  // a vehicle's warning is no failed derivation
-  EXPECT_NE(file.find(" checks; 1 about the vehicle warn, below); derived"), std::string::npos) << file;
+  EXPECT_NE(file.find(" checks; 1 vehicle warning below); derived"), std::string::npos) << file;
   EXPECT_NE(file.find("mass 0.52 kg (the file's `derived:`); centre of gravity ("), std::string::npos) << file;
-  EXPECT_NE(file.find(" kg m^2 (the blocks', J_xy from the file's `derived:`)"), std::string::npos) << file;
+  EXPECT_NE(file.find(" kg m^2 (the blocks'; the file's `derived:`: J_xy)"), std::string::npos) << file;
   EXPECT_NE(file.find("the inertia the model uses is a body's: no"), std::string::npos) << file;
+  // A fitted value (--params) is said as fitted, not as the blocks'.
+  write(tmp.dir / "fitted.yaml", "vehicle: finken3\neffects: []\nparameters:\n  mass: {value: 0.4, unit: kg}\n");
+  FILE* p = ::popen((std::string(QUADGEN_BINARY) + " derive '" + source_path("vehicles/finken3.yaml") + "' --params '" +
+                     (tmp / "fitted.yaml") + "' --out '" + (tmp / "c") + "' 2>&1")
+                        .c_str(),
+                    "r");
+  ASSERT_NE(p, nullptr);
+  std::string fitted;
+  char buf[1024];
+  while (std::fgets(buf, sizeof buf, p)) fitted += buf;
+  EXPECT_EQ(::pclose(p), 0) << fitted;
+  EXPECT_NE(fitted.find("mass 0.4 kg (fitted); centre of gravity ("), std::string::npos) << fitted;
 }
 
 // A manoeuvre on a vehicle whose centre of gravity is off the rotors' centre (a user trial,
@@ -1849,10 +1866,36 @@ TEST(Cli, ManoeuvresTurnAnOffCentreVehicleOnlyAboutTheirAxis) {
   EXPECT_LT(yaw["psi"], -0.2);
   EXPECT_LT(std::hypot(yaw["phi"], yaw["theta"]), 0.15 * std::fabs(yaw["psi"])) << yaw["phi"] << " " << yaw["theta"];
   EXPECT_LT(std::hypot(yaw["x"], yaw["y"]), 0.1) << yaw["x"] << " " << yaw["y"];
+  // Guards the axis each tilt means (a roll flag for `right` would take its pitch out), not
+  // the fix: the raised rotors' own pitch dominates here.
   auto right = end_of("right");
   EXPECT_GT(right["x"], 0.2);
   EXPECT_LT(std::fabs(right["y"]), 0.05 * right["x"]);
   EXPECT_LT(std::fabs(right["psi"]), 0.01);
+  // Where the rule's rotors balance about the other axes the thrusts keep their bits: on the
+  // FINken 3 during `yaw`, B and D stay at the hover command exactly. hexa_plus's `right` raises
+  // two ccw and one cw rotor: the yaw that adds is taken out.
+  const fs::path yaw_csv = tmp / "f3_yaw.csv";
+  ASSERT_EQ(run_quadgen({"simulate", source_path("vehicles/finken3.yaml"), "--scenario", "yaw", "--duration", "2", "--out",
+                         yaw_csv},
+                        tmp.dir)
+                .rc,
+            0);
+  const quadgen::runtime::CsvTable f3 = quadgen::runtime::read_csv(yaw_csv);
+  const double u_hover = f3.rows.front()[f3.column("u_B")];
+  for (const auto& row : f3.rows) {
+    EXPECT_EQ(row[f3.column("u_B")], u_hover);
+    EXPECT_EQ(row[f3.column("u_D")], u_hover);
+  }
+  const fs::path hexa_csv = tmp / "hexa_right.csv";
+  ASSERT_EQ(run_quadgen({"simulate", source_path("vehicles/hexa_plus.yaml"), "--scenario", "right", "--duration", "2",
+                         "--out", hexa_csv},
+                        tmp.dir)
+                .rc,
+            0);
+  const quadgen::runtime::CsvTable hexa = quadgen::runtime::read_csv(hexa_csv);
+  EXPECT_LT(std::fabs(hexa.rows.back()[hexa.column("psi")]), 1e-9);
+  EXPECT_GT(hexa.rows.back()[hexa.column("x")], 0.05);
 }
 
 // Scenarios on other layouts: the tilt and yaw manoeuvres turn every vehicle the way they

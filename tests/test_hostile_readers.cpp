@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <regex>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -371,7 +372,20 @@ TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
   // rows are no lines of the file: the message names the row by its time.
   const std::string resampled = message_of<FitError>([&] { load_flight(resample(degrees, 37), rotors, {}); });
   EXPECT_EQ(resampled.rfind(log + " (the row at t = ", 0), 0u) << resampled;
-  EXPECT_NE(resampled.find(" s, resampled at 37 Hz): "), std::string::npos) << resampled;
+  EXPECT_TRUE(std::regex_search(resampled, std::regex(R"(the row at t = [0-9]+\.[0-9]{3} s, resampled at 37 Hz\): )")))
+      << resampled;
+  // At a Unix time the row is still told apart (not "1.7e+09 s"), and a ULog's or uSD log's
+  // grid says where its time counts from.
+  runtime::CsvTable unix_time;
+  unix_time.path = "log.ulg";
+  unix_time.columns = {"t", "phi"};
+  unix_time.rows = {{1700000000.01, 0.0}, {1700000000.02, 9.0}};
+  unix_time.resampled_hz = 100;
+  unix_time.time_from_topics_start = true;
+  EXPECT_EQ(unix_time.where_row(1), "log.ulg (the row at t = 1700000000.020 s after the mapped topics' common start, "
+                                    "resampled at 100 Hz)");
+  unix_time.resampled_hz = 0;
+  EXPECT_EQ(unix_time.where_row(1), "log.ulg:3");
   EXPECT_NE(resampled.find("angles in degrees?"), std::string::npos) << resampled;
   // Time in milliseconds.
   runtime::CsvTable ms = table;

@@ -1109,3 +1109,24 @@ TEST(Scenario, TiltsAndYawsChooseTheirRotorsByWhereTheySitNotByOrder) {
   EXPECT_EQ(raised("right", 0.55, hexa), (S{"R3", "R4", "R5"}));
   EXPECT_EQ(raised("forward", 0.55, hexa), (S{"R2", "R3"}));  // R1 and R4 sit on the x axis
 }
+
+#include "runtime/allocation_matrix.hpp"
+
+// Each manoeuvre's `changes` (the axes of (thrust, roll, pitch, yaw) it means) are the axes its
+// raised rotors turn the FINken 3 about, where the rule's rotors balance about the others: so a
+// scenario added without them, or with an axis swapped, fails here (simulate would take its
+// whole step out, or keep a turn it does not mean). Checked at a time each manoeuvre is on.
+TEST(Scenario, EachManoeuvreMeansTheAxesItsRotorsTurnASymmetricVehicleAbout) {
+  const Vehicle v = test::finken3();
+  const SymbolicModel m = derive_model(v, derive_mass_properties(v), {});
+  const Eigen::MatrixXd A = runtime::allocation_matrix(nominal_controller_belief(v, m));
+  const double hover = 1.0;
+  for (const auto& s : runtime::scenario_catalogue()) {
+    const std::vector<double> F = s.thrust(0.55, hover, rotor_places(v, m));
+    Eigen::VectorXd step(static_cast<Eigen::Index>(F.size()));
+    for (size_t i = 0; i < F.size(); ++i) step(static_cast<Eigen::Index>(i)) = F[i] - hover;
+    const Eigen::Vector4d turn = A * step;
+    for (int axis = 0; axis < 4; ++axis)
+      EXPECT_EQ(std::fabs(turn(axis)) > 1e-12, s.changes[static_cast<size_t>(axis)]) << s.name << " axis " << axis << ": " << turn(axis);
+  }
+}

@@ -35,7 +35,7 @@ Effect motor_gain() {
   // The NanoBench flights of one Crazyflie trim their motors differently on every flight
   // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).
   e.per_flight = true;
-  e.domain = {{"", -1.0, false, "at -1 (-100 %) a rotor gives no thrust, below it a thrust that pulls"}};
+  e.domain = {{"", -1.0, true, "at -1 (-100 %) a rotor gives no thrust (a dead motor), below it a thrust that pulls"}};
   e.plausible = {{"", -0.35, 0.35, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "motors of one type differ by up to ~20 % in thrust at one command, worn brushed motors by ~30 % "
                   "(the NanoBench trims reach a duty ratio of 1.2); beyond, a motor is broken or something else acts"}};

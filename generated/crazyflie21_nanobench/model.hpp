@@ -88,7 +88,7 @@ struct Param {
     c_w = 2,  // c_w [1] drag coefficient of the frame
     c_t = 3,  // c_t [1] thrust coefficient of F = c_t rho A_p (omega r_p)^2
     kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F
-    motor_a0 = 5,  // motor_a0 [rad/s] rotor speed at zero command
+    motor_a0 = 5,  // motor_a0 [rad/s] the motor map's speed at command 0 (its constant term)
     motor_a1 = 6,  // motor_a1 [rad/s] rotor speed per command
     motor_a2 = 7,  // motor_a2 [rad/s] rotor speed per command squared
     motor_slope = 8,  // motor_slope [1] slope of the rotor speed over the command at the pivot, relative to a0..a2's
