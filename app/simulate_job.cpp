@@ -299,6 +299,22 @@ std::optional<double> ground_height(const SimulateJob& a, const std::vector<doub
 
 // The trajectory at the output rate: dopri5 stops at the output times, rk4 keeps every
 // step that falls on one.
+// RK4 at the fixed step; where it diverges and the rotors lag faster than the step can follow
+// (a first-order lag leaves RK4's region of stability beyond step / tau = 2.78; a review: a
+// --set motor_lag.tau of 1e-4 s at 1 ms ended in "w_A = 5.8e6"), the message says so.
+Trajectory rk4_or_why_not(const SimulateJob& a, DynamicModel& m, const std::vector<double>& x0,
+                          const InputFunction& inputs, const IntegratorOptions& io, Stats& stats) {
+  try {
+    return integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
+  } catch (const DivergenceError& e) {
+    const int tau = m.param_index("motor_lag.tau");
+    if (tau < 0 || !(io.step > 2.5 * m.params()[static_cast<size_t>(tau)])) throw;
+    throw DivergenceError(std::string(e.what()) + "; motor_lag.tau = " + output::short_number(m.params()[static_cast<size_t>(tau)]) +
+                          " s is too fast for RK4 at --step " + output::short_number(io.step) +
+                          " s (stable to a step of about 2.5 tau): lower --step, or --integrator dopri5");
+  }
+}
+
 Trajectory integrate(const SimulateJob& a, DynamicModel& m, const std::vector<double>& x0, const InputFunction& inputs,
                      Stats& stats) {
   IntegratorOptions io;
@@ -308,7 +324,7 @@ Trajectory integrate(const SimulateJob& a, DynamicModel& m, const std::vector<do
   const long n_out = std::lround(a.duration * a.rate);
   for (long k = 0; k <= n_out; ++k) out_times.push_back(a.duration * static_cast<double>(k) / static_cast<double>(n_out));
   if (a.integrator == "dopri5") return integrate_dopri5(m, x0, inputs, out_times, io, &stats);
-  const Trajectory full = integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
+  const Trajectory full = rk4_or_why_not(a, m, x0, inputs, io, stats);
   Trajectory tr;
   const long every = std::max(1L, std::lround(1.0 / (a.rate * io.step)));
   for (size_t k = 0; k < full.t.size(); k += every) {

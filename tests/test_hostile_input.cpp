@@ -1418,6 +1418,11 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   // is a dead motor (a gain of -100 %: no thrust; the review of this change found it refused).
   EXPECT_EQ(scenario("input_delay", {"input_delay.seconds=0.5"}).rc, 0);
   EXPECT_EQ(scenario("motor_gain", {"motor_gain.C=-1"}).rc, 0);
+  // A time constant the physics allows but RK4's step cannot follow: the divergence says why.
+  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "yaw", "--duration", "1", "--effects", "motor_lag",
+                                     "--set", "motor_lag.tau=1e-4", "--out", tmp / "s.csv"},
+                                    tmp.dir),
+                        "motor_lag.tau = 0.0001 s is too fast for RK4 at --step 0.001 s", "tau 1e-4 at a 1 ms step");
   fs::remove(tmp / "s.csv");
   fs::remove(tmp / "s.svg");
   // A channel listed twice was weighted twice.
