@@ -22,6 +22,7 @@
 #include <set>
 #include <sstream>
 
+#include "output/file_identity.hpp"
 #include "output/fnv1a.hpp"
 #include "output/sinks.hpp"
 
@@ -125,18 +126,10 @@ bool inside(const fs::path& child, const fs::path& parent) {
   return true;
 }
 
-struct FileId {
-  dev_t dev;
-  ino_t ino;
-  bool operator<(const FileId& o) const { return dev != o.dev ? dev < o.dev : ino < o.ino; }
-};
-
 std::map<FileId, std::string> identities(const std::vector<std::string>& paths) {
   std::map<FileId, std::string> ids;
-  for (const auto& p : paths) {
-    struct stat st {};
-    if (::stat(p.c_str(), &st) == 0) ids[{st.st_dev, st.st_ino}] = p;
-  }
+  for (const auto& p : paths)
+    if (const auto id = file_id(p)) ids[*id] = p;
   return ids;
 }
 
@@ -332,11 +325,9 @@ void check_not_input(const fs::path& target, const std::vector<std::string>& inp
   }
   if (!fs::is_directory(target, ec)) return;
   const auto ids = identities(inputs);
-  for (const auto& e : fs::directory_iterator(target, ec)) {
-    struct stat st {};
-    if (::stat(e.path().c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
-      fail(target, "holds the input " + printable(ids.at({st.st_dev, st.st_ino})) + " (a link to it); write the output elsewhere");
-  }
+  for (const auto& e : fs::directory_iterator(target, ec))
+    if (const auto id = file_id(e.path().string()); id && ids.count(*id))
+      fail(target, "holds the input " + printable(ids.at(*id)) + " (a link to it); write the output elsewhere");
 }
 
 void check_not_above_working_directory(const fs::path& target) {
@@ -717,9 +708,8 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
               "or a name beginning '.quadgen'); choose another");
     if (!seen.insert(p).second) fail(p, "is named for two outputs of one run (the trajectory and its plot)");
     if (p.parent_path() != resolved_file(paths.front()).parent_path()) throw OutputError("internal: outputs in two folders");
-    struct stat st {};
-    if (::stat(p.c_str(), &st) == 0 && ids.count({st.st_dev, st.st_ino}))
-      fail(p, "is the input " + printable(ids.at({st.st_dev, st.st_ino})) + "; choose another output path");
+    if (const auto id = file_id(p.string()); id && ids.count(*id))
+      fail(p, "is the input " + printable(ids.at(*id)) + "; choose another output path");
     paths_.push_back(p.string());
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();

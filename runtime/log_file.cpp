@@ -1,5 +1,7 @@
 #include "runtime/log_file.hpp"
 
+#include "output/file_identity.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -48,11 +50,11 @@ LogFile::LogFile(const std::string& path, const std::string& expected) : path_(p
 LogFile::~LogFile() { ::close(fd_); }
 
 void refuse_repeated_files(const std::vector<std::string>& paths, const std::string& what) {
-  std::map<std::pair<dev_t, ino_t>, const std::string*> seen;
+  std::map<output::FileId, const std::string*> seen;
   for (const auto& p : paths) {
-    struct stat st {};
-    if (::stat(p.c_str(), &st) != 0) continue;
-    const auto [at, inserted] = seen.emplace(std::make_pair(st.st_dev, st.st_ino), &p);
+    const auto id = output::file_id(p);
+    if (!id) continue;
+    const auto [at, inserted] = seen.emplace(*id, &p);
     if (!inserted)
       throw LogError(p + ": the same file as " + *at->second +
                      (p == *at->second ? " (named twice)" : " (a link to it, or it to this)") + ": give each " + what +
