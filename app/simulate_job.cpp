@@ -189,9 +189,7 @@ void take_out_unmeant_turn(const OpenLoop& k, const Scenario& s, Eigen::VectorXd
   const Eigen::VectorXd balanced = thrusts - k.allocation_inverse * unmeant;
   for (Eigen::Index i = 0; i < balanced.size(); ++i) {
     const ThrustLaw& law = k.laws[static_cast<size_t>(i)];
-    const double least = law.thrust_at_speed(std::max(law.speed_at(0.0), 0.0));
-    const double most = law.thrust_at_speed(std::max(law.speed_at(1.0), 0.0));
-    if (!(balanced(i) >= least && balanced(i) <= most)) return;
+    if (!(balanced(i) >= law.thrust_at_command(0.0) && balanced(i) <= law.thrust_at_command(1.0))) return;
   }
   thrusts = balanced;
 }
@@ -297,8 +295,6 @@ std::optional<double> ground_height(const SimulateJob& a, const std::vector<doub
   return a.ground_height;
 }
 
-// The trajectory at the output rate: dopri5 stops at the output times, rk4 keeps every
-// step that falls on one.
 // RK4 at the fixed step; where it diverges and the rotors lag faster than the step can follow
 // (a first-order lag leaves RK4's region of stability beyond step / tau = 2.78; a review: a
 // --set motor_lag.tau of 1e-4 s at 1 ms ended in "w_A = 5.8e6"), the message says so.
@@ -315,6 +311,8 @@ Trajectory rk4_or_why_not(const SimulateJob& a, DynamicModel& m, const std::vect
   }
 }
 
+// The trajectory at the output rate: dopri5 stops at the output times, rk4 keeps every
+// step that falls on one.
 Trajectory integrate(const SimulateJob& a, DynamicModel& m, const std::vector<double>& x0, const InputFunction& inputs,
                      Stats& stats) {
   IntegratorOptions io;

@@ -142,8 +142,8 @@ struct TrimProblem {
     w = Eigen::Vector4d(weight, 0, 0, 0);
     for (Eigen::Index i = 0; i < A.cols(); ++i) {
       const ThrustLaw& l = b.thrust_laws[static_cast<size_t>(i)];
-      least(i) = l.thrust_at_speed(std::max(l.speed_at(0.0), 0.0));
-      most(i) = l.thrust_at_speed(std::max(l.speed_at(1.0), 0.0));
+      least(i) = l.thrust_at_command(0.0);
+      most(i) = l.thrust_at_command(1.0);
     }
   }
   bool balances(const Eigen::VectorXd& F) const { return (A * F - w).norm() <= 1e-6 * weight; }

@@ -33,6 +33,8 @@ struct ThrustLaw {
   double a0 = 0, a1 = 0, a2 = 0;
   double speed_at(double u) const { return motor_map(a0, a1, a2, u); }
   double thrust_at_speed(double w) const { return k * w * w; }
+  // The thrust command u gives (a map below 0 rad/s there gives none).
+  double thrust_at_command(double u) const { return thrust_at_speed(std::max(speed_at(u), 0.0)); }
   double command_for(double thrust) const;  // throws std::invalid_argument if unreachable for u in [0, 1]
 };
 
@@ -44,7 +46,7 @@ inline double ThrustLaw::command_for(double thrust) const {
     if (!(a1 > 0 && a1 + 2 * a2 > 0))
       return std::invalid_argument("the motor map's speed does not rise with the command over 0..1 (a1 = " +
                                    std::to_string(a1) + ", a2 = " + std::to_string(a2) + " rad/s)");
-    const double lowest = thrust_at_speed(std::max(speed_at(0.0), 0.0));
+    const double lowest = thrust_at_command(0.0);
     if (thrust < lowest)
       return std::invalid_argument("thrust " + std::to_string(thrust) + " N is below what the motor map gives at command 0 (" +
                                    std::to_string(lowest) + " N)");
