@@ -106,10 +106,9 @@ std::string saturation_note(const GeneratedFlight& flight, const std::vector<std
 
 // A closed-loop test flight: the true model (effects and --set values) flown by a
 // controller that believes the nominal base model.
-SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, const SymbolicModel& model,
+SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, const ControllerModel& belief,
                                   DynamicModel& truth) {
   SimulateJobResult result;
-  const ControllerModel belief = nominal_controller_belief(vehicle, model);
   const std::vector<std::string> rotors = rotor_names(vehicle);
   ClosedLoopOptions o = a.flight;
   o.duration = a.duration;
@@ -141,8 +140,8 @@ SimulateJobResult run_closed_loop(const SimulateJob& a, const Vehicle& vehicle, 
 
 // The allocation matrix of the vehicle's nominal model and its least-norm inverse (zero where
 // the rotors cannot set the four apart: the audit warns of that, and nothing is taken out).
-std::pair<Eigen::MatrixXd, Eigen::MatrixXd> allocation_and_inverse(const Vehicle& v, const SymbolicModel& model) {
-  const Eigen::MatrixXd A = runtime::allocation_matrix(nominal_controller_belief(v, model));
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> allocation_and_inverse(const ControllerModel& belief) {
+  const Eigen::MatrixXd A = runtime::allocation_matrix(belief);
   const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
   if (cod.rank() < 4) return {A, Eigen::MatrixXd::Zero(A.cols(), 4)};
   return {A, cod.pseudoInverse()};
@@ -152,8 +151,8 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> allocation_and_inverse(const Vehicle
 // off the symmetric place carrying more or less). Hover must be within every motor's reach, or
 // no manoeuvre can be flown: said once, naming the vehicle file, instead of failing somewhere
 // inside the flight.
-std::vector<double> hover_thrusts(const Vehicle& v, const SymbolicModel& model) {
-  const runtime::HoverTrim trim = runtime::hover_trim(nominal_controller_belief(v, model), rotor_names(v));
+std::vector<double> hover_thrusts(const Vehicle& v, const ControllerModel& belief) {
+  const runtime::HoverTrim trim = runtime::hover_trim(belief, rotor_names(v));
   if (!trim.found()) throw std::invalid_argument(v.source_path + ": the vehicle cannot hover: " + trim.why_not);
   return trim.thrusts;
 }
@@ -386,21 +385,24 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
   const double even_share =
       m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
-  const auto [allocation, allocation_inverse] = allocation_and_inverse(vehicle, model);
+  // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor
+  // places, trim and allocation, and the closed loop's controller, all from this one.
+  const ControllerModel belief = nominal_controller_belief(vehicle, model);
+  const auto [allocation, allocation_inverse] = allocation_and_inverse(belief);
   const OpenLoop k{m,
-                   nominal_thrust_laws(vehicle, model),
+                   belief.thrust_laws,
                    rotor_names(vehicle),
-                   rotor_places(vehicle, model),
+                   rotor_places(belief),
                    ExtraInputs(m),
                    m.input_delay_param(),
                    param(vehicle, "vbat_ref").nominal,
                    even_share,
-                   hover_thrusts(vehicle, model),
+                   hover_thrusts(vehicle, belief),
                    allocation,
                    allocation_inverse};
   if (a.closed_loop && (a.ground_at_start || a.ground_height))
     throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
-  if (a.closed_loop) return run_closed_loop(a, vehicle, model, m);
+  if (a.closed_loop) return run_closed_loop(a, vehicle, belief, m);
 
   std::vector<double> x0(m.num_states(), 0.0);
   x0[rigid_body::kAttitude] = 1.0;

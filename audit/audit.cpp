@@ -118,6 +118,22 @@ std::vector<AuditCheck> check_quaternion_norm(const SymbolicModel& m) {
                "q . dq/dt of the model's rows 7-10 expands to 0")};
 }
 
+}  // namespace
+
+PrincipalMoments principal_moments(const Mat3& J) {
+  Eigen::Matrix3d M;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) M(i, j) = J[static_cast<size_t>(i)][static_cast<size_t>(j)];
+  const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(M).eigenvalues();
+  PrincipalMoments pm;
+  pm.moments = {l(0), l(1), l(2)};
+  pm.positive = l.minCoeff() > 0;
+  pm.triangle = l(0) + l(1) >= l(2) * (1 - 1e-12);
+  return pm;
+}
+
+namespace {
+
 std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   std::vector<AuditCheck> out;
   bool sym = true;
@@ -126,16 +142,12 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
       if (!normal(mp.inertia_cog(i, j) - mp.inertia_cog(j, i)).is_zero()) sym = false;
   out.push_back(make("inertia", "symmetric", sym, "J_cg - J_cg^T = 0 symbolically"));
 
-  Eigen::Matrix3d J;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) J(i, j) = mp.inertia_cog_value[i][j];
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(J);
-  const Eigen::Vector3d l = es.eigenvalues();
+  const PrincipalMoments pm = principal_moments(mp.inertia_cog_value);
+  const auto& l = pm.moments;
   std::ostringstream os;
-  os << "principal moments " << l(0) << ", " << l(1) << ", " << l(2) << " kg m^2";
-  out.push_back(make("inertia", "positive definite", l.minCoeff() > 0, os.str()));
-  const bool tri = l(0) + l(1) >= l(2) * (1 - 1e-12) && l(0) + l(2) >= l(1) && l(1) + l(2) >= l(0);
-  out.push_back(make("inertia", "triangle inequalities of principal moments", tri,
+  os << "principal moments " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2";
+  out.push_back(make("inertia", "positive definite", pm.positive, os.str()));
+  out.push_back(make("inertia", "triangle inequalities of principal moments", pm.triangle,
                      "each principal moment <= sum of the other two"));
 
   bool closed = true;

@@ -1,6 +1,7 @@
 // The audit: independent checks that make the derivation trustworthy: units,
 // rotation properties, inertia validity and cross-checks, energy conservation.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -40,5 +41,16 @@ GiNaC::lst torque_free_substitutions(const SymbolicModel& m);
 // Closed-form inertia of a cuboid about its centre, m/12 diag(b^2+c^2, a^2+c^2, a^2+b^2),
 // rotated and moved to the origin with the parallel-axis theorem.
 GiNaC::matrix closed_form_block_inertia(const BlockSymbols& s);
+
+// Whether a symmetric 3x3 tensor can be a body's inertia: its principal moments (ascending)
+// are positive and each is at most the sum of the other two. One home for the test that the
+// derivation audit applies to the blocks' tensor and the vehicle checks to the tensor the
+// model uses (which a file's `derived:` may give).
+struct PrincipalMoments {
+  std::array<double, 3> moments{};  // kg m^2, ascending
+  bool positive = false;
+  bool triangle = false;    // l0 + l1 >= l2 (to a relative 1e-12); the others follow when ascending
+};
+PrincipalMoments principal_moments(const Mat3& J);
 
 }  // namespace quadgen

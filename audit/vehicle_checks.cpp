@@ -285,17 +285,16 @@ AuditCheck check_inertia_used(const SymbolicModel& m) {
       if (p.name == name) return p.nominal;
     return 0.0;  // a model without the entry (products of inertia are always declared)
   };
-  Eigen::Matrix3d J;
-  J << value("J_xx"), value("J_xy"), value("J_xz"), value("J_xy"), value("J_yy"), value("J_yz"), value("J_xz"),
-      value("J_yz"), value("J_zz");
-  const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(J).eigenvalues();
-  const bool positive = l.minCoeff() > 0;
-  const bool triangle = l(0) + l(1) >= l(2) * (1 - 1e-12);  // ascending: the others hold then
+  const Mat3 J{{{value("J_xx"), value("J_xy"), value("J_xz")},
+                {value("J_xy"), value("J_yy"), value("J_yz")},
+                {value("J_xz"), value("J_yz"), value("J_zz")}}};
+  const PrincipalMoments pm = principal_moments(J);
+  const auto& l = pm.moments;
   std::ostringstream detail;
-  detail << "principal moments of the model's J " << l(0) << ", " << l(1) << ", " << l(2) << " kg m^2";
-  if (!positive) detail << ": not positive definite (a product of inertia too large for the moments given, or its sign?)";
-  else if (!triangle) detail << ": the largest exceeds the sum of the other two, which no mass distribution gives";
-  return advisory("the inertia the model uses is a body's", positive && triangle, detail.str());
+  detail << "principal moments of the model's J " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2";
+  if (!pm.positive) detail << ": not positive definite (a product of inertia too large for the moments given, or its sign?)";
+  else if (!pm.triangle) detail << ": the largest exceeds the sum of the other two, which no mass distribution gives";
+  return advisory("the inertia the model uses is a body's", pm.positive && pm.triangle, detail.str());
 }
 
 }  // namespace

@@ -39,11 +39,14 @@ runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const Symbo
   return b;
 }
 
-std::vector<runtime::RotorPlace> rotor_places(const Vehicle& v, const SymbolicModel& m) {
-  const runtime::ControllerModel b = nominal_controller_belief(v, m);
+std::vector<runtime::RotorPlace> rotor_places(const runtime::ControllerModel& b) {
   std::vector<runtime::RotorPlace> out;
   for (size_t i = 0; i < b.rotor_x.size(); ++i) out.push_back({b.rotor_x[i], b.rotor_y[i], b.spin[i] > 0});
   return out;
+}
+
+std::vector<runtime::RotorPlace> rotor_places(const Vehicle& v, const SymbolicModel& m) {
+  return rotor_places(nominal_controller_belief(v, m));
 }
 
 }  // namespace quadgen

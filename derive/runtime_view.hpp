@@ -18,5 +18,7 @@ runtime::ControllerModel nominal_controller_belief(const Vehicle& v, const Symbo
 // Where each rotor sits relative to the nominal centre of gravity, and its spin: what the
 // thesis' tilt and yaw manoeuvres choose their rotors by (runtime/scenarios.hpp).
 std::vector<runtime::RotorPlace> rotor_places(const Vehicle& v, const SymbolicModel& m);
+// The same, from a belief already built (simulate builds one and reads everything from it).
+std::vector<runtime::RotorPlace> rotor_places(const runtime::ControllerModel& b);
 
 }  // namespace quadgen

@@ -102,7 +102,8 @@ namespace {
 // A thrust within rounding of 0 (a rotor the trim does not need: 1e-17 N either side) is 0,
 // not a pull.
 std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eigen::VectorXd& least,
-                                    const std::vector<std::string>& rotor_names, double weight) {
+                                    const std::vector<std::string>& rotor_names, double weight,
+                                    bool idle_lifts_weight) {
   Eigen::Index k = 0;
   (least_norm - least).minCoeff(&k);
   const bool pulls = least_norm(k) < -1e-9 * weight;
@@ -116,7 +117,7 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
       pulls ? " would have to pull down " + newtons(-asked)
             : " would have to give " + newtons(asked) + ", less than its motor map gives at command 0 (" +
                   newtons(least(k)) + ")";
-  if (least.sum() >= weight)
+  if (idle_lifts_weight)
     return "rotor " + rotor_names[static_cast<size_t>(k)] + what + " (at command 0 the rotors give " +
            newtons(least.sum()) + " in all, the weight is " + newtons(weight) +
            ": " + kRpmWithoutUnit + "; or c_t too large?)";
@@ -208,7 +209,7 @@ HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& r
   if (!P.balances(least_norm)) {
     t.why_not = "no thrusts balance the weight without a moment";
   } else if (!reachable_below) {
-    t.why_not = why_no_trim_above_least(least_norm, P.least, rotor_names, P.weight);
+    t.why_not = why_no_trim_above_least(least_norm, P.least, rotor_names, P.weight, t.idle_lifts_weight);
   }
   for (size_t i = 0; t.found() && i < n; ++i) try {
       t.commands.push_back(free[i] ? b.thrust_laws[i].command_for(t.thrusts[i]) : 0.0);  // held: command 0
