@@ -26,14 +26,19 @@ double blocks_value(const MassProperties& mp, const std::string& name) {
 // Where the values said come from: " (the blocks')", " (the file's `derived:`)" or " (fitted)"
 // where all of `names` come from one place, else each place with its names, "(the blocks';
 // the file's `derived:`: J_xy)". Fitted values (--params, a `fitted:` section) replace the
-// blocks' as the model's nominal ones.
+// blocks' and the `derived:` ones as the model's nominal ones: a value is the file's only
+// where the model holds it (a review found a fitted mass said to be the file's).
 std::string source_of(const Vehicle& v, const MassProperties& mp, const SymbolicModel& model,
                       const std::vector<std::string>& names) {
   std::map<std::string, std::vector<std::string>> by_source;
   for (const auto& n : names) {
-    const double nominal = model.params[model.param_index(n)].nominal, blocks = blocks_value(mp, n);
-    const bool same = std::fabs(nominal - blocks) <= 1e-12 * std::max(std::fabs(blocks), 1e-300);
-    by_source[v.derived_given.count(n) ? "the file's `derived:`" : same ? "the blocks'" : "fitted"].push_back(n);
+    const double nominal = model.params[model.param_index(n)].nominal;
+    const auto same = [&](double value) { return std::fabs(nominal - value) <= 1e-12 * std::max(std::fabs(value), 1e-300); };
+    const bool given = v.derived_given.count(n) > 0;
+    by_source[given && same(v.derived_overrides.at(n).nominal) ? "the file's `derived:`"
+              : !given && same(blocks_value(mp, n))            ? "the blocks'"
+                                                               : "fitted"]
+        .push_back(n);
   }
   if (by_source.size() == 1) return " (" + by_source.begin()->first + ")";
   std::string said;

@@ -39,14 +39,19 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.set_nominal) request.set_nominal(out.model);
   progress("audit");
   out.audit = audit(out.model, mass);
-  for (AuditCheck& c : check_vehicle_can_fly(vehicle, out.model)) out.audit.checks.push_back(std::move(c));
+  out.hover_trim = nominal_hover_trim(vehicle, out.model);
+  for (AuditCheck& c : check_vehicle_can_fly(vehicle, out.model, out.hover_trim)) out.audit.checks.push_back(std::move(c));
   if (request.thesis_comparison) out.thesis = compare_with_thesis(vehicle, out.model, mass);
   progress("generating C++");
   codegen::EmitOptions emit = request.emit;
   if (request.regenerate_flags_from_model)
     emit.regenerate_flags = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
+  for (const Rotor& r : vehicle.rotors) emit.rotor_spin.push_back(spin_sign(r));
+  emit.hover_command = out.hover_trim.commands;
+  emit.hover_thrust = out.hover_trim.thrusts;
+  emit.why_no_hover = out.hover_trim.why_not;
   out.header = codegen::generate_header(out.model, emit);
-  const Derivation d{vehicle, mass, out.model, out.audit, out.thesis};
+  const Derivation d{vehicle, mass, out.model, out.audit, out.thesis, out.hover_trim};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);
   return out;

@@ -14,6 +14,7 @@
 #include "derive/symbolic_model.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/closed_loop.hpp"
 
 namespace quadgen {
 
@@ -35,6 +36,7 @@ struct DerivedModel {
   SymbolicModel model;
   AuditResult audit;
   std::vector<ThesisItem> thesis;
+  runtime::HoverTrim hover_trim;  // at the nominal values: the vehicle checks, the header and model.json read it
   codegen::GeneratedHeader header;
   std::string model_json, derivation_md;
 };

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "audit/audit.hpp"
 #include "runtime/allocation_matrix.hpp"
 #include "runtime/attitude.hpp"
 #include "derive/dynamics.hpp"
@@ -44,6 +45,37 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 }
 
 
+// What only the --set values together with the others tell (a review): an inertia tensor no
+// body has (a J_xy too large for the moments: the closed loop flew it until it was lost), and
+// a thrust decay whose factor 1 - rate t reaches 0 within the flight (the rotors would pull).
+std::string settings_problem(const SimulateJob& a, const DynamicModel& m, const std::vector<double>& p) {
+  const auto value = [&](const char* name) {
+    const int i = m.param_index(name);
+    return i < 0 ? 0.0 : p[static_cast<size_t>(i)];
+  };
+  const bool inertia_set =
+      std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
+  if (inertia_set) {
+    const Mat3 J{{{value("J_xx"), value("J_xy"), value("J_xz")},
+                  {value("J_xy"), value("J_yy"), value("J_yz")},
+                  {value("J_xz"), value("J_yz"), value("J_zz")}}};
+    const PrincipalMoments pm = principal_moments(J);
+    if (!pm.positive || !pm.triangle) {
+      std::ostringstream os;
+      os << "--set: with these values the inertia tensor's principal moments are " << pm.moments[0] << ", "
+         << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
+         << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
+                         : "not positive definite (a product of inertia too large for the moments, or its sign?)");
+      return os.str();
+    }
+  }
+  const double rate = value("thrust_decay.rate");
+  if (a.duration > 0 && rate * a.duration >= 1)
+    return "--set: thrust_decay.rate = " + output::short_number(rate) + " /s: the thrust factor 1 - rate t reaches 0 at t = " +
+           output::short_number(1 / rate) + " s, within the flight (--duration " + output::short_number(a.duration) + " s)";
+  return "";
+}
+
 // The --set values, each checked, in the model the simulation flies. A scenario's commands,
 // its start and its thrust plot come from the vehicle file's values (its hover trim, motor
 // map, c_t, vbat_ref), so there only an effect's parameters may be set: a base parameter set
@@ -79,6 +111,7 @@ void apply_settings(const SimulateJob& a, DynamicModel& m) {
     if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
   }
+  if (const std::string problem = settings_problem(a, m, p); !problem.empty()) throw std::invalid_argument(problem);
   m.set_params(p);
 }
 
@@ -214,6 +247,18 @@ InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
   };
 }
 
+// A manoeuvre whose rule picks no rotor of this vehicle (none on the side it raises: rotors in
+// a line along x and `forward`) would fly as a hover and be written as the manoeuvre: refused
+// (a review). Its schedule is looked at over 10 s, longer than any manoeuvre's.
+void check_scenario_raises_a_rotor(const OpenLoop& k, const Scenario& s, const std::string& vehicle_path) {
+  if (std::none_of(s.changes.begin(), s.changes.end(), [](bool c) { return c; })) return;  // hover
+  for (double t = 0; t <= 10.0; t += 0.005)
+    for (double f : s.thrust(t, k.hover, k.places))
+      if (f != k.hover) return;
+  throw std::invalid_argument(vehicle_path + ": scenario '" + s.name + "' (" + s.description +
+                              ") changes no rotor of this vehicle: it would fly as a hover");
+}
+
 // The linearly interpolated battery voltage of a log, or nothing where it holds none.
 std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vector<double>& t) {
   if (log.column("vbat") < 0) return nullptr;
@@ -302,11 +347,22 @@ Trajectory rk4_or_why_not(const SimulateJob& a, DynamicModel& m, const std::vect
   try {
     return integrate_rk4(m, x0, inputs, 0.0, a.duration, io, &stats);
   } catch (const DivergenceError& e) {
-    const int tau = m.param_index("motor_lag.tau");
-    if (tau < 0 || !(io.step > 2.5 * m.params()[static_cast<size_t>(tau)])) throw;
-    throw DivergenceError(std::string(e.what()) + "; motor_lag.tau = " + output::short_number(m.params()[static_cast<size_t>(tau)]) +
+    // The fastest rotor's time constant: the shared one scaled by 1 + its spread (a review: a
+    // spread of -0.9999 diverged without this note).
+    const int tau_index = m.param_index("motor_lag.tau");
+    if (tau_index < 0) throw;
+    double fastest = m.params()[static_cast<size_t>(tau_index)];
+    const double shared = fastest;
+    for (size_t i = 0; i < m.param_names().size(); ++i)
+      if (m.param_names()[i].rfind("motor_lag_spread.", 0) == 0) fastest = std::min(fastest, shared * (1 + m.params()[i]));
+    if (!(io.step > 2.5 * fastest)) throw;
+    const std::string what = fastest < shared ? "the fastest rotor's time constant, motor_lag.tau (1 + spread), "
+                                              : "motor_lag.tau ";
+    throw DivergenceError(std::string(e.what()) + "; " + what + "= " + output::short_number(fastest) +
                           " s is too fast for RK4 at --step " + output::short_number(io.step) +
-                          " s (stable to a step of about 2.5 tau): lower --step, or --integrator dopri5");
+                          " s (stable to a step of about 2.5 tau): " +
+                          (2.5 * fastest >= kMinStep ? "lower --step, or --integrator dopri5"
+                                                     : "no step simulate takes follows it (a lag that short is none: leave motor_lag out)"));
   }
 }
 
@@ -404,6 +460,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
     throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
   if (a.closed_loop) return run_closed_loop(a, vehicle, belief, m);
 
+  if (!a.scenario.empty()) check_scenario_raises_a_rotor(k, find_scenario(a.scenario), vehicle.source_path);
   std::vector<double> x0(m.num_states(), 0.0);
   x0[rigid_body::kAttitude] = 1.0;
   const InputFunction inputs =

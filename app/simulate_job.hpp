@@ -14,6 +14,8 @@
 
 namespace quadgen::app {
 
+inline constexpr double kMinStep = 1e-7;  // s, the smallest RK4 --step taken
+
 struct SimulateJob {
   std::string vehicle;      // vehicle file (YAML)
   std::string scenario;     // one of the thesis' manoeuvres, or

@@ -1,6 +1,7 @@
 #include "audit/report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <sstream>
@@ -9,7 +10,6 @@
 
 #include "audit/tex_writer.hpp"
 #include "derive/effects/effect_catalogue.hpp"
-#include "derive/runtime_view.hpp"
 #include "output/joined.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
@@ -49,7 +49,8 @@ void section_vehicle(std::ostringstream& md, const Derivation& d) {
 }
 
 // Values the vehicle file's `derived:` section gives (measured) in place of the blocks': the
-// model uses them, as they are (a given tensor is not moved to a given centre of gravity).
+// model uses them, as they are (a given tensor is not moved to a given centre of gravity),
+// unless fitted values (--params, a `fitted:` section) replace them in turn: then said.
 void given_values(std::ostringstream& md, const Derivation& d) {
   if (d.vehicle.derived_given.empty()) return;
   md << "The vehicle file's `derived:` section gives measured values in place of the blocks', and the model "
@@ -58,7 +59,11 @@ void given_values(std::ostringstream& md, const Derivation& d) {
   const char* separator = " ";
   for (const DerivedQuantity& q : kDerivedQuantities)
     if (d.vehicle.derived_given.count(q.name)) {
-      md << separator << "`" << q.name << "` = " << num(d.vehicle.derived_overrides.at(q.name).nominal) << " " << q.unit;
+      const double given = d.vehicle.derived_overrides.at(q.name).nominal;
+      const double used = d.model.params[d.model.param_index(q.name)].nominal;
+      md << separator << "`" << q.name << "` = " << num(given) << " " << q.unit;
+      if (std::fabs(used - given) > 1e-12 * std::max(std::fabs(given), 1e-300))
+        md << " (replaced by the fitted " << num(used) << " " << q.unit << ")";
       separator = "; ";
     }
   md << ".\n\n";
@@ -291,7 +296,7 @@ std::string derivation_markdown(const Derivation& d) {
 // 1e-14): each rotor's thrust and command, as simulate's scenarios fly it; `why_not` says
 // why there is none (then the thrusts are the least-norm balance and there are no commands).
 static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
-  const runtime::HoverTrim trim = runtime::hover_trim(nominal_controller_belief(d.vehicle, d.model), rotor_names(d.vehicle));
+  const runtime::HoverTrim& trim = d.hover_trim;
   nlohmann::ordered_json j;
   j["rotors"] = rotor_names(d.vehicle);
   j["thrust_N"] = trim.thrusts;
@@ -307,11 +312,21 @@ std::string model_json(const Derivation& d) {
   j["vehicle"] = d.vehicle.name;
   j["vehicle_hash"] = d.vehicle.content_hash;
   j["effects"] = d.model.effects;
-  j["mass"] = d.mass.mass_value;
-  j["cog"] = d.mass.cog_value;
-  j["inertia"] = d.mass.inertia_cog_value;
+  // The mass properties the model uses (a review found the blocks' here beside a hover trim for
+  // the file's given mass): the blocks', or the file's `derived:` values, or fitted ones; the
+  // blocks' own are under "from_blocks".
+  const auto used = [&](const char* name) { return d.model.params[d.model.param_index(name)].nominal; };
+  j["mass"] = used("mass");
+  j["cog"] = {used("cog_x"), used("cog_y"), used("cog_z")};
+  j["inertia"] = {{used("J_xx"), used("J_xy"), used("J_xz")},
+                  {used("J_xy"), used("J_yy"), used("J_yz")},
+                  {used("J_xz"), used("J_yz"), used("J_zz")}};
+  j["from_blocks"] = {{"mass", d.mass.mass_value},
+                      {"cog", d.mass.cog_value},
+                      {"inertia", d.mass.inertia_cog_value},
+                      {"areas", d.mass.areas_value}};
   j["inertia_about_origin"] = d.mass.inertia_origin_value;
-  j["areas"] = d.mass.areas_value;
+  j["areas"] = {used("A_x"), used("A_y"), used("A_z")};
   auto vars = [](const std::vector<Variable>& vs, bool params) {
     ordered_json a = ordered_json::array();
     for (const auto& v : vs) {

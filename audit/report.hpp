@@ -9,6 +9,7 @@
 #include "derive/symbolic_model.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/closed_loop.hpp"
 
 namespace quadgen {
 
@@ -18,6 +19,7 @@ struct Derivation {
   const SymbolicModel& model;
   const AuditResult& audit;
   const std::vector<ThesisItem>& thesis;  // empty for vehicles other than the FINken 3
+  const runtime::HoverTrim& hover_trim;    // at the nominal values (nominal_hover_trim)
 };
 
 std::string derivation_markdown(const Derivation& d);

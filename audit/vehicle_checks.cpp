@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "derive/geometry.hpp"
+#include "output/numbers.hpp"
 #include "derive/runtime_view.hpp"
 #include "runtime/allocation_matrix.hpp"
 
@@ -81,7 +82,7 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
 AuditCheck check_hover_trim(const runtime::HoverTrim& trim, double weight) {
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
-  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + std::to_string(weight) + " N)";
+  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + output::short_number(weight) + " N)";
   if (trim.found()) {
     const Eigen::VectorXd u =
         Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
@@ -299,10 +300,17 @@ AuditCheck check_inertia_used(const SymbolicModel& m) {
 
 }  // namespace
 
+runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m) {
+  return runtime::hover_trim(nominal_controller_belief(v, m), rotor_names(v));
+}
+
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m) {
+  return check_vehicle_can_fly(v, m, nominal_hover_trim(v, m));
+}
+
+std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m, const runtime::HoverTrim& trim) {
   const runtime::ControllerModel b = nominal_controller_belief(v, m);
   const Eigen::MatrixXd B = runtime::allocation_matrix(b);
-  const runtime::HoverTrim trim = runtime::hover_trim(b, rotor_names(v));
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
   return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),

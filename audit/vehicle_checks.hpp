@@ -16,9 +16,17 @@
 #include "audit/audit.hpp"
 #include "derive/symbolic_model.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/closed_loop.hpp"
 
 namespace quadgen {
 
+// The hover trim of the vehicle at the model's nominal values (runtime::hover_trim of the
+// nominal controller belief): computed once per derivation, and read by the checks below, the
+// generated header's kHoverCommand and model.json's hover_trim.
+runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m);
+
+std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m, const runtime::HoverTrim& trim);
+// The same with the trim computed here (tests).
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m);
 
 }  // namespace quadgen

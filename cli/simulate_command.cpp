@@ -79,7 +79,7 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
                 "its parameters values): " + effect_names);
   c->add_option("--integrator", a.job.integrator, "rk4 (fixed step) or dopri5 (adaptive)")
       ->check(CLI::IsMember({"rk4", "dopri5"}))->excludes(cl);
-  c->add_option("--step", a.job.step, "RK4 step [s]")->check(finite_range(1e-7, 1.0))->excludes(cl);
+  c->add_option("--step", a.job.step, "RK4 step [s]")->check(finite_range(app::kMinStep, 1.0))->excludes(cl);
   c->add_option("--rate", a.job.rate, "output rate [Hz]")->check(finite_range(1e-3, 1e6))->excludes(cl);
   c->add_option("--interpolation", a.job.interpolation, "inputs between samples: hold or linear")
       ->check(CLI::IsMember({"hold", "linear"}))->needs(in);

@@ -1,9 +1,10 @@
 # quadgen_generate_model(TARGET <name> VEHICLE <vehicle.yaml> [EFFECTS e1,e2|all] [OUTPUT_DIR <dir>])
 #
 # Runs `quadgen derive <vehicle.yaml> --out <dir> [--effects ...]` at build time and creates
-# the INTERFACE library <name>, whose include directory is <dir>: link it and
+# the INTERFACE library <name>, whose include directories are <dir> and its parent: link it and
 # `#include "model.hpp"` (namespace quadgen_generated::<vehicle name>[_with_<effects>...] or
-# <vehicle name>_all_effects). The header is rebuilt when the vehicle file or the quadgen
+# <vehicle name>_all_effects), or, where one translation unit uses two models (each header is
+# named model.hpp), `#include "<name>/model.hpp"` for each (with the default <dir>). The header is rebuilt when the vehicle file or the quadgen
 # executable changes. <dir> (default: ${CMAKE_CURRENT_BINARY_DIR}/quadgen_models/<name>) is
 # quadgen's own output directory (model.hpp, model.json, derivation.md): put nothing else in it.
 # EFFECTS takes a comma-separated list, a CMake list, or `all`.
@@ -60,7 +61,7 @@ function(quadgen_generate_model)
     VERBATIM)
   add_custom_target(${QG_TARGET}_quadgen_derive DEPENDS "${out}/model.hpp")
   add_library(${QG_TARGET} INTERFACE)
-  target_include_directories(${QG_TARGET} INTERFACE "${out}")
+  target_include_directories(${QG_TARGET} INTERFACE "${out}" "${out_parent}")
   target_compile_features(${QG_TARGET} INTERFACE cxx_std_17)
   add_dependencies(${QG_TARGET} ${QG_TARGET}_quadgen_derive)
   set_target_properties(${QG_TARGET} PROPERTIES QUADGEN_MODEL_HEADER "${out}/model.hpp")

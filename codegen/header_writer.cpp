@@ -1,6 +1,8 @@
 #include "codegen/header_writer.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -151,6 +153,35 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("constant_values", table(m.constants, [](const Variable& v) { return number(v.nominal); }));
 }
 
+// A trim value to 12 significant digits: what holds hover to about 1e-10 m/s^2, and no last
+// bits that another machine's solver could round otherwise (CI compares generated/ byte for byte).
+std::string trim_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return number(std::strtod(buf, nullptr));
+}
+
+// The rotors' spins and the hover trim (EmitOptions), where the caller gives them.
+void set_rotor_facts(data& d, const EmitOptions& opt) {
+  const size_t n = opt.rotor_spin.size();
+  d.set("has_rotors", data(n > 0));
+  const bool trimmed = opt.hover_command.size() == n && opt.hover_thrust.size() == n && n > 0;
+  std::string spin = "{", command = "{", thrust = "{";
+  for (size_t i = 0; i < n; ++i) {
+    const std::string sep = i ? ", " : "";
+    spin += sep + std::to_string(opt.rotor_spin[i]);
+    command += sep + (trimmed ? trim_number(opt.hover_command[i]) : "0");
+    thrust += sep + (trimmed ? trim_number(opt.hover_thrust[i]) : "0");
+  }
+  d.set("n_rotors", std::to_string(n));
+  d.set("rotor_spin", spin + "}");
+  d.set("hover_command", command + "}");
+  d.set("hover_thrust", thrust + "}");
+  d.set("has_hover_trim", trimmed ? "true" : "false");
+  d.set("hover_trim_line", trimmed ? std::string()
+                                   : "// No hover trim: " + output::cpp_comment(opt.why_no_hover.empty() ? "not given" : opt.why_no_hover) + ".\n");
+}
+
 // Each Jacobian's sparsity pattern (row and column of every stored entry).
 void set_sparsity(data& d, const LoweredModel& lm) {
   list sparsity;
@@ -200,6 +231,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   set_counts(d, m, out);
   set_variable_tables(d, m);
   set_sparsity(d, lm);
+  set_rotor_facts(d, opt);
   d.set("precompute_body", pre.body);
   d.set("rhs_body", rhs_code.body);
   d.set("rhs_f_body", f_only.body);
@@ -207,7 +239,17 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("measurement_body", meas_code.body);
   mustache tmpl{std::string(kModelHeaderTemplate)};
   if (!tmpl.is_valid()) throw std::runtime_error("templates/model.hpp.mustache: " + tmpl.error_message());
-  out.content = tmpl.render(d);
+  // The inline namespace's name: a hash of the code (from the namespace on: not the comments,
+  // which name the path the vehicle file was read from), written in where it was held open.
+  const std::string placeholder = "model_code_tag_placeholder";
+  d.set("code_tag", placeholder);
+  std::string text = tmpl.render(d);
+  const size_t code = text.find("namespace quadgen_generated {");
+  if (code == std::string::npos) throw std::logic_error("templates/model.hpp.mustache: no namespace quadgen_generated");
+  const std::string tag = "model_" + output::fnv1a_hex(text.substr(code));
+  for (size_t at = text.find(placeholder); at != std::string::npos; at = text.find(placeholder, at + tag.size()))
+    text.replace(at, placeholder.size(), tag);
+  out.content = std::move(text);
   return out;
 }
 

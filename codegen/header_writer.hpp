@@ -1,6 +1,7 @@
 // Fills the file skeleton in templates/model.hpp.mustache with the emitted code.
 #pragma once
 #include <string>
+#include <vector>
 
 #include <kainjow/mustache.hpp>
 
@@ -15,6 +16,13 @@ struct EmitOptions {
   // diagnose to LOG"): said in the header's comment, since regenerating with derive gives
   // the vehicle file's values. Empty: the vehicle file's.
   std::string parameter_source;
+  // The rotors in input order (u_<rotor>): each one's spin seen from above (+1 counter-
+  // clockwise, -1 clockwise), and the hover trim at the nominal values (each rotor's command
+  // and thrust [N]; empty where the vehicle has none, `why_no_hover` then says why). A firmware
+  // mixer and a simulator's start need them, and the header is all such a user has.
+  std::vector<int> rotor_spin;
+  std::vector<double> hover_command, hover_thrust;
+  std::string why_no_hover;
 };
 
 struct GeneratedHeader {

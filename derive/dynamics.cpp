@@ -184,7 +184,7 @@ void declare_rotors(ModelContext& c) {
 void declare_base(ModelContext& c, const MassProperties& mp) {
   declare_rigid_body(c);
   for (const Rotor& r : c.vehicle.rotors)
-    c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction");
+    c.add_input("u_" + r.name, "1", "motor command of rotor " + r.name + ", throttle fraction 0 to 1 (not clamped here)");
   declare_parameters(c, mp);
   declare_rotors(c);
 }

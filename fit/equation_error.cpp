@@ -58,7 +58,8 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
       const auto& S = flight_.samples;
       os << flight_.source << ": no stretch of the log is long enough for the derivative window of " << window
          << " s (its samples are " << (S.size() > 1 ? (S.back().t - S.front().t) / static_cast<double>(S.size() - 1) : 0.0)
-         << " s apart on average, over " << (S.empty() ? 0.0 : S.back().t - S.front().t) << " s: is t in seconds?)";
+         << " s apart on average, over " << (S.empty() ? 0.0 : S.back().t - S.front().t)
+         << " s: is t in seconds, and a --resample rate, where one is given, high enough?)";
       throw FitError(os.str());
     }
   }

@@ -253,6 +253,12 @@ void read_derived(const Reader& r, const YAML::Node& d, Vehicle& v) {
     if (spec["value"]) {  // given: it replaces the blocks' value
       v.derived_overrides[key] = r.parameter(spec, key, derived_units.at(key), "");
       v.derived_given.insert(key);
+      // As --set and --params judge a value from outside (a mass of 0 passed the audit, and the
+      // trim blamed a motor map in rpm; a J_zz of 0 diverged in simulate).
+      const double value = v.derived_overrides[key].nominal;
+      if (const std::string problem = runtime::value_problem(runtime_parameter(v.derived_overrides[key]), value, false);
+          !problem.empty())
+        r.fail(spec["value"], "derived quantity " + key + " " + problem);
     } else {
       if (!spec["bounds"]) r.fail(spec, "derived quantity " + key + " needs bounds (or a value)");
       if (spec["unit"]) r.fail(spec["unit"], "derived quantity " + key + ": a unit belongs to a value");

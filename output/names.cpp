@@ -20,7 +20,7 @@ const std::set<std::string>& generated_header_names() {
       "kNumInputs", "kNumParams", "kNumOutputs", "kNumPrecomputed", "kNumRotorSpeedStates", "kRotorSpeedStates",
       "kVehicleHash", "kEffects", "kStateNames", "kInputNames", "kParamNames", "kOutputNames", "kNominalParams",
       "kInputDelayParam", "kParamUnits", "kParamLower", "kParamUpper", "kParamFit", "kNumConstants", "kConstantNames",
-      "kConstantValues"};
+      "kConstantValues", "kNumRotors", "kRotorSpin", "kHasHoverTrim", "kHoverCommand", "kHoverThrust"};
   return names;
 }
 
@@ -78,7 +78,10 @@ std::optional<std::string> name_problem(const std::string& name) {
       return "the name may hold only letters, digits and '_' (found a character outside them)";
   if (name.find("__") != std::string::npos || name.back() == '_')
     return "the name may not hold '__' or end in '_' (reserved in C++)";
-  if (is_cpp_keyword(name)) return "'" + name + "' is a C++ keyword";
+  if (is_cpp_keyword(name)) {
+    const bool macro = name == "assert" || name == "errno" || name == "NULL" || name == "EOF";  // the list's last four
+    return "'" + name + "' is a C++ keyword" + (macro ? std::string(" or standard macro") : std::string());
+  }
   if (is_library_macro(name)) return "'" + name + "' is a macro of the C library or the compiler";
   if (generated_header_names().count(name)) return "'" + name + "' is a name the generated header uses";
   return std::nullopt;

@@ -187,8 +187,22 @@ void hold_shortfalls(const TrimProblem& P, Eigen::VectorXd& F, std::vector<bool>
 
 }  // namespace
 
+namespace {
+std::string as_g(double v) {  // a number as %g: no 300 digits for 1e300
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
 HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names) {
   const TrimProblem P(b);
+  if (!std::isfinite(P.weight) || !std::isfinite(P.least.sum()) || !std::isfinite(P.most.sum())) {
+    HoverTrim t;  // a mass or motor map beyond a double (a review: 1.7e308 kg said "no thrusts balance")
+    t.why_not = !std::isfinite(P.weight) ? "the weight m g is not a finite number (mass " + as_g(b.mass) + " kg)"
+                                         : "a motor map's thrust at command 0 or 1 is not a finite number";
+    return t;
+  }
   const size_t n = static_cast<size_t>(P.A.cols());
   const double even = P.weight / static_cast<double>(n);
   std::vector<bool> free(n, true);

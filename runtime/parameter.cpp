@@ -15,6 +15,8 @@ std::string value_problem(const Parameter& p, double value, bool within_bounds) 
   const bool must_be_positive = p.name == "mass" || p.name == "J_xx" || p.name == "J_yy" || p.name == "J_zz";
   if (must_be_positive && !(value > 0))
     return "= " + short_number(value) + ": a mass and a principal moment of inertia must be positive";
+  const bool area = p.name == "A_x" || p.name == "A_y" || p.name == "A_z";
+  if (area && value < 0) return "= " + short_number(value) + ": an exposed area cannot be negative";
   return "";
 }
 

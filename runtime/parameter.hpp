@@ -18,7 +18,8 @@ struct Parameter {
 // diagnosis read by --airframe, simulate --set), or "" when it can: not finite; with
 // `within_bounds`, outside p's bounds where it has any (lower < upper; equal bounds hold a
 // parameter fixed, and any value may replace it); the rigid body's mass and principal moments
-// of inertia not positive, which the model would integrate without a word. (A test flight's
+// of inertia not positive, or an exposed area negative, which the model would integrate
+// without a word. (The vehicle file's `derived:` values are judged by it too.) (A test flight's
 // truth may lie outside what a fit searches, so simulate checks no bounds.)
 std::string value_problem(const Parameter& p, double value, bool within_bounds);
 

@@ -24,5 +24,6 @@ cmake -S examples/consumer -B "$tmp/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PR
 cmake --build "$tmp/build" -j2 >"$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; exit 1; }
 "$tmp/build/quadgen_consumer"
 "$tmp/build/quadgen_consumer_effects" || { echo "consumer_check: the model generated with EFFECTS failed" >&2; exit 1; }
+"$tmp/build/quadgen_consumer_two_models" || { echo "consumer_check: two models in one translation unit failed" >&2; exit 1; }
 "$tmp/build/readme_example" || { echo "consumer_check: the README example ran and failed" >&2; exit 1; }
 echo "consumer_check: installed package, quadgen_generate_model() and the generated header work"

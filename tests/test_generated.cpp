@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "app/derive_pipeline.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "tests/generated_models.hpp"
@@ -358,6 +359,90 @@ TEST(Generated, DerivationTablesHaveAsManyCellsAsTheirHeader) {
   }
 }
 
+// The hover trim a header declares (kHoverCommand, from the audit's trim of the nominal
+// controller belief: its allocation and thrust laws) holds the model's own f at rest: level,
+// still, 1 m up, every effect at its nominal value, rotor-speed states where the commands
+// put them, t = 0 and a battery at 4 V (neutral at nominal). Two computations that share no
+// code but the vehicle's numbers: the trim's least-norm solve, and the generated rows.
+template <class M>
+double hover_residual(double* thrust_sum = nullptr) {
+  double x[M::kNumStates] = {}, u[M::kNumInputs] = {}, f[M::kNumStates] = {};
+  x[2] = 1.0;
+  x[6] = 1.0;
+  for (int i = 0; i < M::kNumInputs; ++i) u[i] = std::string(M::kInputNames[i]) == "vbat" ? 4.0 : 0.0;
+  double sum = 0;
+  for (int i = 0; i < M::kNumRotors; ++i) u[i] = M::kHoverCommand[i], sum += M::kHoverThrust[i];
+  if (thrust_sum) *thrust_sum = sum;
+  typename M::template Precomputed<double> pre;
+  M::precompute(M::kNominalParams, &pre);
+  int tau = -1;
+  for (int i = 0; i < M::kNumParams; ++i)
+    if (std::string(M::kParamNames[i]) == "motor_lag.tau") tau = i;
+  for (int pass = 0; pass < 2 && M::kNumRotorSpeedStates > 0; ++pass) {  // each speed where its row is 0
+    M::rhs(x, u, M::kNominalParams, pre, f);
+    for (int k = 0; k < M::kNumRotorSpeedStates; ++k) x[M::kRotorSpeedStates[k]] += M::kNominalParams[tau] * f[M::kRotorSpeedStates[k]];
+  }
+  M::rhs(x, u, M::kNominalParams, pre, f);
+  double worst = 0;
+  for (double v : f) worst = std::max(worst, std::abs(v));
+  return worst;
+}
+
+TEST(Generated, TheHeadersHoverTrimHoldsItsOwnModel) {
+  const auto check = [](const char* name, double worst, double thrust_sum, double weight, bool trimmed, int rotors) {
+    EXPECT_TRUE(trimmed) << name;
+    EXPECT_EQ(rotors, 4) << name;
+    EXPECT_LT(worst, 1e-8) << name << ": |f| at the header's hover trim";
+    EXPECT_NEAR(thrust_sum, weight, 1e-9 * weight) << name << ": the trim's thrusts carry the weight";
+  };
+#define QUADGEN_HOVER_CASE(NS)                                                                          \
+  {                                                                                                     \
+    using M = gen::NS::Model;                                                                           \
+    double sum = 0;                                                                                     \
+    const double worst = hover_residual<M>(&sum);                                                       \
+    check(#NS, worst, sum, M::kNominalParams[gen::NS::Param::mass] * M::kNominalParams[gen::NS::Param::g], \
+          M::kHasHoverTrim, M::kNumRotors);                                                             \
+  }
+  QUADGEN_HOVER_CASE(finken3)
+  QUADGEN_HOVER_CASE(finken3_all_effects)
+  QUADGEN_HOVER_CASE(crazyflie21)
+  QUADGEN_HOVER_CASE(crazyflie21_all_effects)
+  QUADGEN_HOVER_CASE(crazyflie21_nanobench)
+  QUADGEN_HOVER_CASE(crazyflie21_nanobench_all_effects)
+#undef QUADGEN_HOVER_CASE
+  // A command off the trim by 1e-4 leaves far more than the bound above (the test can fail).
+  using M = gen::crazyflie21::Model;
+  double x[M::kNumStates] = {0, 0, 1, 0, 0, 0, 1}, u[M::kNumInputs], f[M::kNumStates];
+  for (int i = 0; i < M::kNumRotors; ++i) u[i] = M::kHoverCommand[i] + 1e-4;
+  M::Precomputed<double> pre;
+  M::precompute(M::kNominalParams, &pre);
+  M::rhs(x, u, M::kNominalParams, pre, f);
+  EXPECT_GT(std::abs(f[gen::crazyflie21::State::vz]), 1e-4);
+  // The spins as the vehicle file gives them (M1 and M3 counter-clockwise).
+  EXPECT_EQ(std::vector<int>(M::kRotorSpin, M::kRotorSpin + 4), (std::vector<int>{1, -1, 1, -1}));
+}
+
+// The header's inline namespace is named after its code: a vehicle file read from another
+// path gives the same name, one with another mass another (so an edited copy that kept the
+// vehicle's name links as a model of its own, not silently as the other one).
+TEST(Generated, TheInlineNamespaceNamesTheCodeNotThePath) {
+  const auto tag = [](const quadgen::Vehicle& v, const std::string& path) {
+    quadgen::DeriveRequest request;
+    request.emit.vehicle_file = path;
+    request.thesis_comparison = false;
+    const std::string h = quadgen::run_derive_pipeline(v, quadgen::derive_mass_properties(v), request).header.content;
+    const size_t at = h.find("inline namespace model_");
+    EXPECT_NE(at, std::string::npos);
+    return h.substr(at, h.find(' ', at + 17) - at);
+  };
+  quadgen::Vehicle v = quadgen::test::finken3();
+  const std::string stock = tag(v, "vehicles/finken3.yaml");
+  EXPECT_EQ(stock.size(), std::string("inline namespace model_").size() + 16) << stock;
+  EXPECT_EQ(tag(v, "/somewhere/else/finken3 copy.yaml"), stock);
+  v.blocks.front().mass *= 1.1;
+  EXPECT_NE(tag(v, "vehicles/finken3.yaml"), stock);
+}
+
 // Symbols created in a different order (which changes GiNaC's internal term order) and
 // a different process must not change a byte.
 TEST(Generated, IndependentOfSymbolCreationOrder) {
@@ -367,13 +452,12 @@ TEST(Generated, IndependentOfSymbolCreationOrder) {
   GiNaC::ex junk = 0;
   for (auto& s : noise) junk += s * s;  // touch them so they are really allocated first
   const quadgen::Vehicle v = quadgen::test::finken3();
-  quadgen::DeriveOptions o;
-  o.effects = quadgen::parse_effect_list("all");
-  const quadgen::SymbolicModel m = quadgen::derive_model(v, quadgen::derive_mass_properties(v), o);
-  quadgen::codegen::EmitOptions eo;
-  eo.vehicle_file = "vehicles/finken3.yaml";
-  eo.regenerate_flags = " --effects all";
-  const std::string text = quadgen::codegen::generate_header(m, eo).content;
+  quadgen::DeriveRequest request;  // as derive runs it (the header holds the audit's hover trim)
+  request.derive.effects = quadgen::parse_effect_list("all");
+  request.emit.vehicle_file = "vehicles/finken3.yaml";
+  request.emit.regenerate_flags = " --effects all";
+  request.thesis_comparison = false;
+  const std::string text = quadgen::run_derive_pipeline(v, quadgen::derive_mass_properties(v), request).header.content;
   EXPECT_TRUE(text == read(fs::path(QUADGEN_SOURCE_DIR) / "generated/finken3_all_effects/model.hpp"));
 }
 

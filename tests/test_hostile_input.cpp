@@ -602,7 +602,8 @@ TEST(Sinks, MarkdownAndLatexTextStayText) {
   const auto model = quadgen::derive_model(v, mp, {});
   const quadgen::AuditResult no_audit;
   const std::vector<quadgen::ThesisItem> no_thesis;
-  const quadgen::Derivation d{v, mp, model, no_audit, no_thesis};
+  const quadgen::runtime::HoverTrim no_trim;
+  const quadgen::Derivation d{v, mp, model, no_audit, no_thesis, no_trim};
   const std::string md = quadgen::derivation_markdown(d);
   EXPECT_EQ(md.find("<script>"), std::string::npos);
   EXPECT_NE(md.find("&lt;script&gt;"), std::string::npos);
@@ -1381,6 +1382,12 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                         "--set mass=-1");
   expect_one_line_error(simulate("J_xx=0"), "--set: J_xx = 0: a mass", "--set J_xx=0");
   expect_one_line_error(simulate("c_t=nan"), "'nan' is not a finite number", "--set c_t=nan");  // the command line's own check
+  // Values each within its own limits that together make no body (a sixth audit, helper-86: the
+  // closed loop flew J_xy = 0.01 until it was lost), and an exposed area below zero.
+  expect_one_line_error(simulate("J_xy=0.01"),
+                        "--set: with these values the inertia tensor's principal moments are ", "--set J_xy=0.01");
+  expect_one_line_error(simulate("A_x=-0.01"), "--set: A_x = -0.01: an exposed area cannot be negative", "--set A_x<0");
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   // A negative delay read commands not yet sent (beyond the end of the record).
   const CliResult delay = run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "1", "--effects", "input_delay", "--set",
                                        "input_delay.seconds=-0.05", "--out", tmp / "s.csv"},
@@ -1407,6 +1414,14 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                         "scenario, tau 0");
   expect_one_line_error(scenario("motor_gain", {"motor_gain.C=-1.5"}), "--set: motor_gain.C = -1.5 must be at least -1: ",
                         "scenario, gain -150 %");
+  // A decay whose factor 1 - rate t reaches 0 within the flight (the rotors would pull), and an
+  // inflow that raises the thrust as the rotor climbs (the same audit).
+  expect_one_line_error(scenario("thrust_decay", {"thrust_decay.rate=1"}),
+                        "--set: thrust_decay.rate = 1 /s: the thrust factor 1 - rate t reaches 0 at t = 1 s, within the "
+                        "flight (--duration 1 s)",
+                        "scenario, decay 1/s");
+  expect_one_line_error(scenario("inflow", {"inflow.k=-100"}), "--set: inflow.k = -100 must be at least 0: ",
+                        "scenario, inflow -100");
   expect_one_line_error(scenario("input_delay", {"input_delay.seconds=0.01", "input_delay.seconds=0.02"}),
                         "--set: 'input_delay.seconds' is given twice", "scenario, delay twice");
   // The hint offers no name the mode refuses (it had offered 'mass', then refused it).
@@ -1423,11 +1438,71 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                                      "--set", "motor_lag.tau=1e-4", "--out", tmp / "s.csv"},
                                     tmp.dir),
                         "motor_lag.tau = 0.0001 s is too fast for RK4 at --step 0.001 s", "tau 1e-4 at a 1 ms step");
+  // The fastest rotor's constant is the one that diverges (a spread of -0.9999 had no note),
+  // and a constant no step follows says so rather than "lower --step".
+  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "yaw", "--duration", "1", "--effects",
+                                     "motor_lag,motor_lag_spread", "--set", "motor_lag.tau=0.05", "--set",
+                                     "motor_lag_spread.A=-0.9999", "--out", tmp / "s.csv"},
+                                    tmp.dir),
+                        "the fastest rotor's time constant, motor_lag.tau (1 + spread), = 5e-06 s is too fast for RK4",
+                        "spread -0.9999");
+  expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "yaw", "--duration", "1", "--effects", "motor_lag",
+                                     "--set", "motor_lag.tau=1e-12", "--out", tmp / "s.csv"},
+                                    tmp.dir),
+                        "no step simulate takes follows it", "tau 1e-12");
   fs::remove(tmp / "s.csv");
   fs::remove(tmp / "s.svg");
   // A channel listed twice was weighted twice.
   expect_one_line_error(run_quadgen({"fit", vehicle, tmp / "f.csv", "--channels", "ax,qdot,ax", "--out", tmp / "o"}, tmp.dir),
                         "--channels: 'ax' is given twice", "--channels ax,qdot,ax");
+  EXPECT_FALSE(fs::exists(tmp / "o"));
+}
+
+// A manoeuvre whose rule picks no rotor of the vehicle flew as a hover and was written as the
+// manoeuvre, exit 0 (a sixth audit, helper-86: `forward` on four rotors in a line along x).
+TEST(Cli, AScenarioThatRaisesNoRotorIsRefused) {
+  Scratch tmp;
+  std::string text = read(source_path("vehicles/finken3.yaml"));
+  const std::pair<const char*, const char*> moves[] = {{"[-0.07465, -0.07465, 0]", "[-0.3, 0, 0]"},
+                                                        {"[0.07465, -0.07465, 0]", "[-0.1, 0, 0]"},
+                                                        {"[0.07465, 0.07465, 0]", "[0.1, 0, 0]"},
+                                                        {"[-0.07465, 0.07465, 0]", "[0.3, 0, 0]"}};
+  for (const auto& [from, to] : moves) {
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), std::string(from).size(), to);
+  }
+  text.replace(text.find("name: finken3"), std::string("name: finken3").size(), "name: in_line");
+  write(tmp / "line.yaml", text);
+  const auto fly = [&](const char* scenario) {
+    return run_quadgen({"simulate", tmp / "line.yaml", "--scenario", scenario, "--duration", "2", "--out", tmp / "s.csv"},
+                       tmp.dir);
+  };
+  expect_one_line_error(fly("forward"), "line.yaml: scenario 'forward' (", "forward on rotors in a line");
+  EXPECT_NE(fly("forward").err.find("changes no rotor of this vehicle: it would fly as a hover"), std::string::npos);
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
+  EXPECT_EQ(fly("right").rc, 0);  // the rotors on -x and +x: it raises some
+}
+
+// --resample judged only the pair of rows it interpolated between and walked past rows whose
+// time went back (a sixth audit, helper-86: 100 reversed rows were fitted without a word), and
+// a rate too low for a flight log was blamed on the log's time unit.
+TEST(Cli, ResampleJudgesEveryRowAndNamesItsRate) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "2", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
+  std::istringstream in(read(tmp / "f.csv"));
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_GT(lines.size(), 150u);
+  std::reverse(lines.begin() + 51, lines.begin() + 101);  // rows 50..99 (lines 52..101) backwards
+  std::string reversed;
+  for (const auto& l : lines) reversed += l + "\n";
+  write(tmp / "r.csv", reversed);
+  const auto fit = [&](const std::string& log, const char* rate) {
+    return run_quadgen({"fit", vehicle, tmp / log, "--resample", rate, "--profiles", "none", "--out", tmp / "o"}, tmp.dir);
+  };
+  expect_one_line_error(fit("r.csv", "100"), "r.csv:53: time not strictly increasing", "reversed rows, --resample 100");
+  expect_one_line_error(fit("f.csv", "1"), "f.csv: --resample 1 gives samples 1 s apart", "--resample 1");
   EXPECT_FALSE(fs::exists(tmp / "o"));
 }
 
@@ -1842,6 +1917,37 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
   while (std::fgets(buf, sizeof buf, p)) fitted += buf;
   EXPECT_EQ(::pclose(p), 0) << fitted;
   EXPECT_NE(fitted.find("mass 0.4 kg (fitted); centre of gravity ("), std::string::npos) << fitted;
+  // A fitted value replaces a `derived:` one too, and is said as fitted, in the summary, in
+  // derivation.md and in model.json's mass (a sixth audit, helper-86: all three said the file's).
+  const auto [both_status, both] = [&] {
+    FILE* q = ::popen((std::string(QUADGEN_BINARY) + " derive '" + (tmp / "given.yaml") + "' --params '" +
+                       (tmp / "fitted.yaml") + "' --out '" + (tmp / "d") + "' 2>&1")
+                          .c_str(),
+                      "r");
+    std::string said;
+    while (q && std::fgets(buf, sizeof buf, q)) said += buf;
+    return std::make_pair(q ? ::pclose(q) : -1, said);
+  }();
+  ASSERT_EQ(both_status, 0) << both;
+  EXPECT_NE(both.find("mass 0.4 kg (fitted); centre of gravity ("), std::string::npos) << both;
+  EXPECT_NE(read(tmp / "d/derivation.md").find("`mass` = 0.52 kg (replaced by the fitted 0.4 kg)"), std::string::npos);
+  const auto model = nlohmann::json::parse(read(tmp / "d/model.json"));
+  EXPECT_EQ(model.at("mass").get<double>(), 0.4);
+  EXPECT_NEAR(model.at("from_blocks").at("mass").get<double>(), 0.387, 1e-9);
+  EXPECT_EQ(model.at("inertia")[0][1].get<double>(), 0.002);  // the file's J_xy, not the blocks' 0
+  // A given mass or principal moment that no body has is refused at its line (it passed the
+  // audit, and the trim blamed a motor map in rpm).
+  std::string zero = text;
+  zero.replace(zero.find(mass), mass.size(), "  mass: {value: 0, unit: kg}\n");
+  write(tmp.dir / "zero.yaml", zero);
+  const size_t line = static_cast<size_t>(std::count(zero.begin(), zero.begin() + static_cast<long>(zero.find("  mass: {value: 0")), '\n')) + 1;
+  const auto [zero_status, zero_said] = derive(tmp / "zero.yaml", "e");
+  EXPECT_NE(zero_status, 0);
+  EXPECT_NE(zero_said.find("zero.yaml:" + std::to_string(line) + ":"), std::string::npos) << zero_said;
+  EXPECT_NE(zero_said.find("derived quantity mass = 0: a mass and a principal moment of inertia must be positive"),
+            std::string::npos)
+      << zero_said;
+  EXPECT_FALSE(fs::exists(tmp / "e"));
 }
 
 // A manoeuvre on a vehicle whose centre of gravity is off the rotors' centre (a user trial,

@@ -712,7 +712,7 @@ TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
     const SymbolicModel m = derive_model(v, mp, o);
     const AuditResult no_audit;
     const std::vector<ThesisItem> no_thesis;
-    return derivation_markdown({v, mp, m, no_audit, no_thesis});
+    return derivation_markdown({v, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
   };
   const std::string first = markdown();
   std::vector<symbol> noise;
@@ -940,7 +940,7 @@ TEST(Report, EachEffectHasItsOwnFormula) {
   const MassProperties mp = derive_mass_properties(v);
   const AuditResult checks = audit(m, mp);
   const std::vector<ThesisItem> no_thesis;
-  const std::string md = derivation_markdown({v, mp, m, checks, no_thesis});
+  const std::string md = derivation_markdown({v, mp, m, checks, no_thesis, runtime::HoverTrim{}});
   EXPECT_NE(md.find("### What each effect adds"), std::string::npos);
   EXPECT_NE(md.find("**blade\\_flapping**"), std::string::npos);
 }
@@ -1103,7 +1103,7 @@ TEST(Report, NamedEquationsComposeToTheModelsForcesAndTorque) {
   expect_named_chain_composes(derive(v, parse_effect_list("all")), false);
   const MassProperties mp = derive_mass_properties(v);
   const SymbolicModel m = derive(v);
-  const std::string md = derivation_markdown({v, mp, m, audit(m, mp), {}});
+  const std::string md = derivation_markdown({v, mp, m, audit(m, mp), {}, runtime::HoverTrim{}});
   EXPECT_NE(md.find("```math\nv_a = "), std::string::npos);
   EXPECT_NE(md.find("```math\n\\tau_{\\mathrm{A}} = "), std::string::npos);
   EXPECT_NE(md.find("```math\n\\tau = \\sum_i \\tau_i\n```"), std::string::npos);
@@ -1177,13 +1177,13 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     const SymbolicModel m = derive_model(given, mp, {});
     const AuditResult no_audit;
     const std::vector<ThesisItem> no_thesis;
-    const std::string md = derivation_markdown({given, mp, m, no_audit, no_thesis});
+    const std::string md = derivation_markdown({given, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
     EXPECT_NE(md.find("The vehicle file's `derived:` section gives measured values in place of the blocks', and the "
                       "model uses these"),
               std::string::npos);
     EXPECT_NE(md.find("minus the products of inertia): `J_xy` = 1e-05 kg m^2.\n"), std::string::npos);
     EXPECT_EQ(derivation_markdown({good, derive_mass_properties(good), derive_model(good, derive_mass_properties(good), {}),
-                                   no_audit, no_thesis})
+                                   no_audit, no_thesis, runtime::HoverTrim{}})
                   .find("section gives measured values"),
               std::string::npos);
     // A prolate tensor beyond the triangle inequality: J_zz larger than J_xx + J_yy.
@@ -1371,7 +1371,7 @@ TEST(Derive, ModelJsonHoldsTheHoverTrimAtFullPrecision) {
   const SymbolicModel m = derive_model(v, mp, {});
   const AuditResult no_audit;
   const std::vector<ThesisItem> no_thesis;
-  const auto j = nlohmann::json::parse(model_json({v, mp, m, no_audit, no_thesis}));
+  const auto j = nlohmann::json::parse(model_json({v, mp, m, no_audit, no_thesis, nominal_hover_trim(v, m)}));
   const auto& trim = j.at("hover_trim");
   EXPECT_EQ(trim.at("why_not"), "");
   EXPECT_EQ(trim.at("rotors"), nlohmann::json({"A", "B", "C", "D"}));

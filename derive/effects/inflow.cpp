@@ -37,6 +37,7 @@ Effect inflow() {
   e.meaning = "thrust lowered by k (climb speed of each rotor through the air) / (tip speed)";
   e.apply = terms;
   e.parameter_names = "inflow.k";  // as --help lists them
+  e.domain = {{"inflow.k", 0.0, true, "a negative k would raise the thrust as the rotor climbs (positive feedback)"}};
   e.plausible = {{"inflow.k", 0.0, 8.0, PlausibleRange::Scale::kSI, Environment::kUnknown,
                   "blade-element theory with momentum inflow gives 1 / (lambda_h + 16 lambda_h^2 / (sigma a)): "
                   "about 1-6 for small rotors; negative would mean thrust grows with climb"}};

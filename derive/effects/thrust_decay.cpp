@@ -13,7 +13,9 @@ namespace {
 
 void terms(ModelContext& c) {
   const ex rate = c.add_param("thrust_decay.rate", "1/s", 0.0, -0.05, 0.05, true, "relative thrust loss per second");
-  const ex t = c.add_input("t", "s", "time since the start of the log");
+  const ex t = c.add_input("t", "s",
+                              "time since the start of the log (the factor 1 - rate t is linear, meant for a flight's "
+                              "minutes: it reaches 0 at t = 1/rate)");
   for (ex& s : c.thrust_scale) s = s * (1 - rate * t);
 }
 

@@ -37,8 +37,9 @@ void hover_state(double* x) {
   x[m::State::qw] = 1;
 }
 
-// The common command that holds the hover (vertical acceleration zero), by bisection.
-double hover_command(const Simulation<double>& sim) {
+// The common command that holds the hover (vertical acceleration zero), by bisection: a check
+// of the header's kHoverCommand (the FINken 3 is symmetric, so every rotor's is the same).
+double hover_command_by_bisection(const Simulation<double>& sim) {
   double x[m::kNumStates], u[m::kNumInputs], f[m::kNumStates];
   hover_state(x);
   double lo = 0, hi = 1;
@@ -71,7 +72,12 @@ int adapter_mismatches(const Simulation<double>& sim, double u_hover) {
 int main() {
   const Simulation<double> sd;
   const Simulation<float> sf;
-  const double u_hover = hover_command(sd);
+  const double u_hover = m::kHoverCommand[0];  // the header's trim: each rotor's command
+  const double bisected = hover_command_by_bisection(sd);
+  if (!(m::kHasHoverTrim && std::fabs(bisected - u_hover) < 1e-9)) {
+    std::printf("the header's hover command %.12f differs from bisection's %.12f\n", u_hover, bisected);
+    return 1;
+  }
 
   double xd[m::kNumStates], ud[m::kNumInputs];
   float xf[m::kNumStates], uf[m::kNumInputs];

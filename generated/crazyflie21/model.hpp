@@ -17,8 +17,10 @@
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
 // World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
-// below twice the thrust closer to it). Inputs named vbat (a battery voltage) must be
-// positive; the measurement h is indexed by Output, not State.
+// below twice the thrust closer to it); f holds no contact force, so a simulation that lands
+// adds its own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as
+// given: clamp them to 0..1 first. Inputs named vbat (a battery voltage) must be positive;
+// the measurement h is indexed by Output, not State.
 #pragma once
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
@@ -35,6 +37,12 @@
 
 namespace quadgen_generated {
 namespace crazyflie21 {
+// Everything below sits in an inline namespace, named after a hash of this header's code: two
+// different models under one name in one program (an edited copy of a vehicle file that kept
+// its name) then link as two, where otherwise one would silently take the other's functions
+// (the one-definition rule; found in a user trial). Code names them as before,
+// quadgen_generated::crazyflie21::rhs; both in one translation unit are ambiguous, an error.
+inline namespace model_32796f5188ece58a {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -55,6 +63,16 @@ inline constexpr const char* kEffects = "";
 inline constexpr int kNumConstants = 20;
 inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"M1.A_p", "M1.r_p", "M1.x", "M1.y", "M1.z", "M2.A_p", "M2.r_p", "M2.x", "M2.y", "M2.z", "M3.A_p", "M3.r_p", "M3.x", "M3.y", "M3.z", "M4.A_p", "M4.r_p", "M4.x", "M4.y", "M4.z"};
 inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.0015904, 0.0225, 0.0325, -0.0325, 0.008, 0.0015904, 0.0225, -0.0325, -0.0325, 0.008, 0.0015904, 0.0225, -0.0325, 0.0325, 0.008, 0.0015904, 0.0225, 0.0325, 0.0325, 0.008};
+// The rotors in input order (u_<rotor>), for a mixer and a simulation's start: each one's spin
+// seen from above (+1 counter-clockwise, -1 clockwise), and the hover trim at kNominalParams,
+// each rotor's command (0 to 1) and thrust [N] that hold the vehicle level and still: f = 0
+// to about 1e-10 with every effect at its neutral value (the catalogue's nominal 0; rotor-speed
+// states at the speeds the commands ask). Effect values fitted away from 0 move it.
+inline constexpr int kNumRotors = 4;
+inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
+inline constexpr bool kHasHoverTrim = true;
+inline constexpr double kHoverCommand[kNumRotors] = {0.665545326649, 0.665545326649, 0.665545326649, 0.665545326649};
+inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
 
 struct State {
   enum : int {
@@ -75,10 +93,10 @@ struct State {
 };
 struct Input {
   enum : int {
-    u_M1 = 0,  // u_M1 [1] motor command of rotor M1, throttle fraction
-    u_M2 = 1,  // u_M2 [1] motor command of rotor M2, throttle fraction
-    u_M3 = 2,  // u_M3 [1] motor command of rotor M3, throttle fraction
-    u_M4 = 3,  // u_M4 [1] motor command of rotor M4, throttle fraction
+    u_M1 = 0,  // u_M1 [1] motor command of rotor M1, throttle fraction 0 to 1 (not clamped here)
+    u_M2 = 1,  // u_M2 [1] motor command of rotor M2, throttle fraction 0 to 1 (not clamped here)
+    u_M3 = 2,  // u_M3 [1] motor command of rotor M3, throttle fraction 0 to 1 (not clamped here)
+    u_M4 = 3,  // u_M4 [1] motor command of rotor M4, throttle fraction 0 to 1 (not clamped here)
   };
 };
 struct Param {
@@ -1442,6 +1460,11 @@ struct Model {
   static constexpr const char* kVehicleHash = crazyflie21::kVehicleHash;
   static constexpr const char* kEffects = crazyflie21::kEffects;
   static constexpr int kNumConstants = crazyflie21::kNumConstants;
+  static constexpr int kNumRotors = crazyflie21::kNumRotors;
+  static constexpr const int* kRotorSpin = crazyflie21::kRotorSpin;
+  static constexpr bool kHasHoverTrim = crazyflie21::kHasHoverTrim;
+  static constexpr const double* kHoverCommand = crazyflie21::kHoverCommand;
+  static constexpr const double* kHoverThrust = crazyflie21::kHoverThrust;
   static constexpr const char* const* kConstantNames = crazyflie21::kConstantNames;
   static constexpr const double* kConstantValues = crazyflie21::kConstantValues;
   template <typename Scalar>
@@ -1472,5 +1495,6 @@ struct Model {
   }
 };
 
+}  // inline namespace model_32796f5188ece58a
 }  // namespace crazyflie21
 }  // namespace quadgen_generated

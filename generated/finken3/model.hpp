@@ -17,8 +17,10 @@
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
 // World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
-// below twice the thrust closer to it). Inputs named vbat (a battery voltage) must be
-// positive; the measurement h is indexed by Output, not State.
+// below twice the thrust closer to it); f holds no contact force, so a simulation that lands
+// adds its own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as
+// given: clamp them to 0..1 first. Inputs named vbat (a battery voltage) must be positive;
+// the measurement h is indexed by Output, not State.
 #pragma once
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
@@ -35,6 +37,12 @@
 
 namespace quadgen_generated {
 namespace finken3 {
+// Everything below sits in an inline namespace, named after a hash of this header's code: two
+// different models under one name in one program (an edited copy of a vehicle file that kept
+// its name) then link as two, where otherwise one would silently take the other's functions
+// (the one-definition rule; found in a user trial). Code names them as before,
+// quadgen_generated::finken3::rhs; both in one translation unit are ambiguous, an error.
+inline namespace model_7016485bc1dc6682 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -55,6 +63,16 @@ inline constexpr const char* kEffects = "";
 inline constexpr int kNumConstants = 20;
 inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"A.A_p", "A.r_p", "A.x", "A.y", "A.z", "B.A_p", "B.r_p", "B.x", "B.y", "B.z", "C.A_p", "C.r_p", "C.x", "C.y", "C.z", "D.A_p", "D.r_p", "D.x", "D.y", "D.z"};
 inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.001646, 0.0635, -0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, 0.07465, 0, 0.001646, 0.0635, -0.07465, 0.07465, 0};
+// The rotors in input order (u_<rotor>), for a mixer and a simulation's start: each one's spin
+// seen from above (+1 counter-clockwise, -1 clockwise), and the hover trim at kNominalParams,
+// each rotor's command (0 to 1) and thrust [N] that hold the vehicle level and still: f = 0
+// to about 1e-10 with every effect at its neutral value (the catalogue's nominal 0; rotor-speed
+// states at the speeds the commands ask). Effect values fitted away from 0 move it.
+inline constexpr int kNumRotors = 4;
+inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
+inline constexpr bool kHasHoverTrim = true;
+inline constexpr double kHoverCommand[kNumRotors] = {0.350006028447, 0.350006028447, 0.350006028447, 0.350006028447};
+inline constexpr double kHoverThrust[kNumRotors] = {0.9491175, 0.9491175, 0.9491175, 0.9491175};
 
 struct State {
   enum : int {
@@ -75,10 +93,10 @@ struct State {
 };
 struct Input {
   enum : int {
-    u_A = 0,  // u_A [1] motor command of rotor A, throttle fraction
-    u_B = 1,  // u_B [1] motor command of rotor B, throttle fraction
-    u_C = 2,  // u_C [1] motor command of rotor C, throttle fraction
-    u_D = 3,  // u_D [1] motor command of rotor D, throttle fraction
+    u_A = 0,  // u_A [1] motor command of rotor A, throttle fraction 0 to 1 (not clamped here)
+    u_B = 1,  // u_B [1] motor command of rotor B, throttle fraction 0 to 1 (not clamped here)
+    u_C = 2,  // u_C [1] motor command of rotor C, throttle fraction 0 to 1 (not clamped here)
+    u_D = 3,  // u_D [1] motor command of rotor D, throttle fraction 0 to 1 (not clamped here)
   };
 };
 struct Param {
@@ -1444,6 +1462,11 @@ struct Model {
   static constexpr const char* kVehicleHash = finken3::kVehicleHash;
   static constexpr const char* kEffects = finken3::kEffects;
   static constexpr int kNumConstants = finken3::kNumConstants;
+  static constexpr int kNumRotors = finken3::kNumRotors;
+  static constexpr const int* kRotorSpin = finken3::kRotorSpin;
+  static constexpr bool kHasHoverTrim = finken3::kHasHoverTrim;
+  static constexpr const double* kHoverCommand = finken3::kHoverCommand;
+  static constexpr const double* kHoverThrust = finken3::kHoverThrust;
   static constexpr const char* const* kConstantNames = finken3::kConstantNames;
   static constexpr const double* kConstantValues = finken3::kConstantValues;
   template <typename Scalar>
@@ -1474,5 +1497,6 @@ struct Model {
   }
 };
 
+}  // inline namespace model_7016485bc1dc6682
 }  // namespace finken3
 }  // namespace quadgen_generated

@@ -17,8 +17,10 @@
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
 // World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
-// below twice the thrust closer to it). Inputs named vbat (a battery voltage) must be
-// positive; the measurement h is indexed by Output, not State.
+// below twice the thrust closer to it); f holds no contact force, so a simulation that lands
+// adds its own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as
+// given: clamp them to 0..1 first. Inputs named vbat (a battery voltage) must be positive;
+// the measurement h is indexed by Output, not State.
 #pragma once
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
@@ -35,6 +37,12 @@
 
 namespace quadgen_generated {
 namespace finken3_all_effects {
+// Everything below sits in an inline namespace, named after a hash of this header's code: two
+// different models under one name in one program (an edited copy of a vehicle file that kept
+// its name) then link as two, where otherwise one would silently take the other's functions
+// (the one-definition rule; found in a user trial). Code names them as before,
+// quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
+inline namespace model_9e1e2d3bd1f9e6b0 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -55,6 +63,16 @@ inline constexpr const char* kEffects = "motor_gain,motor_lag_spread,motor_lag,i
 inline constexpr int kNumConstants = 22;
 inline constexpr const char* kConstantNames[kNumConstants > 0 ? kNumConstants : 1] = {"A.A_p", "A.r_p", "A.x", "A.y", "A.z", "B.A_p", "B.r_p", "B.x", "B.y", "B.z", "C.A_p", "C.r_p", "C.x", "C.y", "C.z", "D.A_p", "D.r_p", "D.x", "D.y", "D.z", "ground_effect.floor", "ground_effect.x_max"};
 inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] = {0.001646, 0.0635, -0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, -0.07465, 0, 0.001646, 0.0635, 0.07465, 0.07465, 0, 0.001646, 0.0635, -0.07465, 0.07465, 0, 0.001, 0.5};
+// The rotors in input order (u_<rotor>), for a mixer and a simulation's start: each one's spin
+// seen from above (+1 counter-clockwise, -1 clockwise), and the hover trim at kNominalParams,
+// each rotor's command (0 to 1) and thrust [N] that hold the vehicle level and still: f = 0
+// to about 1e-10 with every effect at its neutral value (the catalogue's nominal 0; rotor-speed
+// states at the speeds the commands ask). Effect values fitted away from 0 move it.
+inline constexpr int kNumRotors = 4;
+inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
+inline constexpr bool kHasHoverTrim = true;
+inline constexpr double kHoverCommand[kNumRotors] = {0.350006028447, 0.350006028447, 0.350006028447, 0.350006028447};
+inline constexpr double kHoverThrust[kNumRotors] = {0.9491175, 0.9491175, 0.9491175, 0.9491175};
 
 struct State {
   enum : int {
@@ -79,11 +97,11 @@ struct State {
 };
 struct Input {
   enum : int {
-    u_A = 0,  // u_A [1] motor command of rotor A, throttle fraction
-    u_B = 1,  // u_B [1] motor command of rotor B, throttle fraction
-    u_C = 2,  // u_C [1] motor command of rotor C, throttle fraction
-    u_D = 3,  // u_D [1] motor command of rotor D, throttle fraction
-    t = 4,  // t [s] time since the start of the log
+    u_A = 0,  // u_A [1] motor command of rotor A, throttle fraction 0 to 1 (not clamped here)
+    u_B = 1,  // u_B [1] motor command of rotor B, throttle fraction 0 to 1 (not clamped here)
+    u_C = 2,  // u_C [1] motor command of rotor C, throttle fraction 0 to 1 (not clamped here)
+    u_D = 3,  // u_D [1] motor command of rotor D, throttle fraction 0 to 1 (not clamped here)
+    t = 4,  // t [s] time since the start of the log (the factor 1 - rate t is linear, meant for a flight's minutes: it reaches 0 at t = 1/rate)
     vbat = 5,  // vbat [V] battery voltage
   };
 };
@@ -2168,6 +2186,11 @@ struct Model {
   static constexpr const char* kVehicleHash = finken3_all_effects::kVehicleHash;
   static constexpr const char* kEffects = finken3_all_effects::kEffects;
   static constexpr int kNumConstants = finken3_all_effects::kNumConstants;
+  static constexpr int kNumRotors = finken3_all_effects::kNumRotors;
+  static constexpr const int* kRotorSpin = finken3_all_effects::kRotorSpin;
+  static constexpr bool kHasHoverTrim = finken3_all_effects::kHasHoverTrim;
+  static constexpr const double* kHoverCommand = finken3_all_effects::kHoverCommand;
+  static constexpr const double* kHoverThrust = finken3_all_effects::kHoverThrust;
   static constexpr const char* const* kConstantNames = finken3_all_effects::kConstantNames;
   static constexpr const double* kConstantValues = finken3_all_effects::kConstantValues;
   template <typename Scalar>
@@ -2198,5 +2221,6 @@ struct Model {
   }
 };
 
+}  // inline namespace model_9e1e2d3bd1f9e6b0
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
