@@ -6,6 +6,7 @@
 #include "audit/report.hpp"
 #include "audit/vehicle_checks.hpp"
 #include "derive/fitted_parameters.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen {
@@ -50,8 +51,19 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   emit.hover_command = out.hover_trim.commands;
   emit.hover_thrust = out.hover_trim.thrusts;
   emit.why_no_hover = out.hover_trim.why_not;
+  if (out.hover_trim.found()) {
+    // The trim is the base model's; a header whose effect values were fitted away from neutral
+    // does not hover at it, and says so rather than declare a trim that does not hold.
+    out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
+    if (!(out.hover_residual <= DerivedModel::kHoverHolds)) {
+      emit.hover_command.clear();
+      emit.why_no_hover = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
+                          output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
+                          output::short_number(out.hover_residual) + " there";
+    }
+  }
   out.header = codegen::generate_header(out.model, emit);
-  const Derivation d{vehicle, mass, out.model, out.audit, out.thesis, out.hover_trim};
+  const Derivation d{vehicle, mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);
   return out;

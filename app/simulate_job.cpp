@@ -46,28 +46,28 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 
 
 // What only the --set values together with the others tell (a review): an inertia tensor no
-// body has (a J_xy too large for the moments: the closed loop flew it until it was lost), and
+// body has (a J_xy too large for the moments: the closed loop flew it until it was lost; the
+// vehicle file's own too), and
 // a thrust decay whose factor 1 - rate t reaches 0 within the flight (the rotors would pull).
 std::string settings_problem(const SimulateJob& a, const DynamicModel& m, const std::vector<double>& p) {
   const auto value = [&](const char* name) {
     const int i = m.param_index(name);
     return i < 0 ? 0.0 : p[static_cast<size_t>(i)];
   };
-  const bool inertia_set =
-      std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
-  if (inertia_set) {
-    const Mat3 J{{{value("J_xx"), value("J_xy"), value("J_xz")},
-                  {value("J_xy"), value("J_yy"), value("J_yz")},
-                  {value("J_xz"), value("J_yz"), value("J_zz")}}};
-    const PrincipalMoments pm = principal_moments(J);
-    if (!pm.positive || !pm.triangle) {
-      std::ostringstream os;
-      os << "--set: with these values the inertia tensor's principal moments are " << pm.moments[0] << ", "
-         << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
-         << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
-                         : "not positive definite (a product of inertia too large for the moments, or its sign?)");
-      return os.str();
-    }
+  // Judged whether or not --set touched it: a tensor the vehicle file's `derived:` gives is
+  // only a warning in derive, and a closed loop flew it until it was lost (a review).
+  const Mat3 J{{{value("J_xx"), value("J_xy"), value("J_xz")},
+                {value("J_xy"), value("J_yy"), value("J_yz")},
+                {value("J_xz"), value("J_yz"), value("J_zz")}}};
+  const PrincipalMoments pm = principal_moments(J);
+  if (!pm.positive || !pm.triangle) {
+    const bool set = std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
+    std::ostringstream os;
+    os << (set ? "--set: with these values the inertia tensor's" : output::printable(a.vehicle) + ": the inertia tensor's")
+       << " principal moments are " << pm.moments[0] << ", " << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
+       << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
+                       : "not positive definite (a product of inertia too large for the moments, or its sign?)");
+    return os.str();
   }
   const double rate = value("thrust_decay.rate");
   if (a.duration > 0 && rate * a.duration >= 1)
@@ -255,7 +255,7 @@ void check_scenario_raises_a_rotor(const OpenLoop& k, const Scenario& s, const s
   for (double t = 0; t <= 10.0; t += 0.005)
     for (double f : s.thrust(t, k.hover, k.places))
       if (f != k.hover) return;
-  throw std::invalid_argument(vehicle_path + ": scenario '" + s.name + "' (" + s.description +
+  throw std::invalid_argument(output::printable(vehicle_path) + ": scenario '" + s.name + "' (" + s.description +
                               ") changes no rotor of this vehicle: it would fly as a hover");
 }
 
@@ -356,9 +356,9 @@ Trajectory rk4_or_why_not(const SimulateJob& a, DynamicModel& m, const std::vect
     for (size_t i = 0; i < m.param_names().size(); ++i)
       if (m.param_names()[i].rfind("motor_lag_spread.", 0) == 0) fastest = std::min(fastest, shared * (1 + m.params()[i]));
     if (!(io.step > 2.5 * fastest)) throw;
-    const std::string what = fastest < shared ? "the fastest rotor's time constant, motor_lag.tau (1 + spread), "
-                                              : "motor_lag.tau ";
-    throw DivergenceError(std::string(e.what()) + "; " + what + "= " + output::short_number(fastest) +
+    const std::string what =
+        fastest < shared ? "the fastest rotor's time constant (motor_lag.tau times 1 + its spread) = " : "motor_lag.tau = ";
+    throw DivergenceError(std::string(e.what()) + "; " + what + output::short_number(fastest) +
                           " s is too fast for RK4 at --step " + output::short_number(io.step) +
                           " s (stable to a step of about 2.5 tau): " +
                           (2.5 * fastest >= kMinStep ? "lower --step, or --integrator dopri5"

@@ -302,6 +302,9 @@ static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   j["thrust_N"] = trim.thrusts;
   j["command"] = trim.commands;
   j["why_not"] = trim.why_not;
+  // Where effect values fitted away from neutral move the hover, the base trim does not hold
+  // this model (the header then declares none): how far it is off.
+  j["largest_f_at_trim"] = d.hover_residual;
   return j;
 }
 
@@ -324,8 +327,8 @@ std::string model_json(const Derivation& d) {
   j["from_blocks"] = {{"mass", d.mass.mass_value},
                       {"cog", d.mass.cog_value},
                       {"inertia", d.mass.inertia_cog_value},
-                      {"areas", d.mass.areas_value}};
-  j["inertia_about_origin"] = d.mass.inertia_origin_value;
+                      {"areas", d.mass.areas_value},
+                      {"inertia_about_origin", d.mass.inertia_origin_value}};
   j["areas"] = {used("A_x"), used("A_y"), used("A_z")};
   auto vars = [](const std::vector<Variable>& vs, bool params) {
     ordered_json a = ordered_json::array();

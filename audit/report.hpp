@@ -20,6 +20,7 @@ struct Derivation {
   const AuditResult& audit;
   const std::vector<ThesisItem>& thesis;  // empty for vehicles other than the FINken 3
   const runtime::HoverTrim& hover_trim;    // at the nominal values (nominal_hover_trim)
+  double hover_residual = 0;               // the largest |f| of the model there (hover_residual)
 };
 
 std::string derivation_markdown(const Derivation& d);

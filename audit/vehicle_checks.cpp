@@ -14,6 +14,7 @@
 #include "output/numbers.hpp"
 #include "derive/runtime_view.hpp"
 #include "runtime/allocation_matrix.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen {
 
@@ -82,7 +83,7 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
 AuditCheck check_hover_trim(const runtime::HoverTrim& trim, double weight) {
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
-  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + output::short_number(weight) + " N)";
+  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + output::six_digits(weight) + " N)";
   if (trim.found()) {
     const Eigen::VectorXd u =
         Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
@@ -299,6 +300,35 @@ AuditCheck check_inertia_used(const SymbolicModel& m) {
 }
 
 }  // namespace
+
+double hover_residual(const SymbolicModel& m, const std::vector<double>& commands) {
+  using namespace runtime::rigid_body;
+  GiNaC::lst s = m.constant_substitution();
+  double vbat_ref = 0;
+  for (const Variable& p : m.params) {
+    s.append(p.sym == p.nominal);
+    if (p.name == "vbat_ref") vbat_ref = p.nominal;
+  }
+  for (size_t i = 0; i < m.inputs.size(); ++i)
+    s.append(m.inputs[i].sym == (i < commands.size() ? commands[i] : m.inputs[i].name == "vbat" ? vbat_ref : 0.0));
+  std::vector<double> x(m.states.size(), 0.0);
+  x[kPosition + 2] = 100.0;
+  x[kAttitude] = 1.0;
+  const auto row = [&](size_t i, const std::vector<double>& at) {
+    GiNaC::lst all = s;
+    for (size_t k = 0; k < m.states.size(); ++k) all.append(m.states[k].sym == at[k]);
+    return to_double(m.f(static_cast<unsigned>(i), 0).subs(all));
+  };
+  for (size_t k : m.rotor_speed_states) {  // each row is linear in its own speed: its zero
+    std::vector<double> one = x;
+    one[k] = 1.0;
+    const double at_zero = row(k, x), at_one = row(k, one);
+    if (at_zero != at_one) x[k] = at_zero / (at_zero - at_one);
+  }
+  double worst = 0;
+  for (size_t i = 0; i < m.states.size(); ++i) worst = std::max(worst, std::fabs(row(i, x)));
+  return worst;
+}
 
 runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m) {
   return runtime::hover_trim(nominal_controller_belief(v, m), rotor_names(v));

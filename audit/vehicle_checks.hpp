@@ -25,6 +25,15 @@ namespace quadgen {
 // generated header's kHoverCommand and model.json's hover_trim.
 runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m);
 
+// The largest |f| (every row; at rest only the accelerations and rotor-speed rates can be
+// nonzero) of the model's own symbolic right-hand side at its nominal values with the rotors
+// at `commands`: level and still 100 m up (clear of any ground effect), each rotor-speed state
+// where its row is zero, t = 0 and a battery at vbat_ref (each effect's input where it is
+// neutral). The trim comes from the base model's numbers; effect values fitted away from
+// neutral (a motor gain, a wind, a CoG offset in a diagnosis' extended model) move the hover,
+// and this says by how much (a review: the header's kHoverCommand did not hold such a model).
+double hover_residual(const SymbolicModel& m, const std::vector<double>& commands);
+
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m, const runtime::HoverTrim& trim);
 // The same with the trim computed here (tests).
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m);

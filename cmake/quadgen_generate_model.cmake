@@ -4,7 +4,8 @@
 # the INTERFACE library <name>, whose include directories are <dir> and its parent: link it and
 # `#include "model.hpp"` (namespace quadgen_generated::<vehicle name>[_with_<effects>...] or
 # <vehicle name>_all_effects), or, where one translation unit uses two models (each header is
-# named model.hpp), `#include "<name>/model.hpp"` for each (with the default <dir>). The header is rebuilt when the vehicle file or the quadgen
+# named model.hpp), `#include "<name>/model.hpp"` for each (with the default <dir>; a given
+# OUTPUT_DIR's parent is not put on the include path, which could be a whole source tree). The header is rebuilt when the vehicle file or the quadgen
 # executable changes. <dir> (default: ${CMAKE_CURRENT_BINARY_DIR}/quadgen_models/<name>) is
 # quadgen's own output directory (model.hpp, model.json, derivation.md): put nothing else in it.
 # EFFECTS takes a comma-separated list, a CMake list, or `all`.
@@ -61,7 +62,10 @@ function(quadgen_generate_model)
     VERBATIM)
   add_custom_target(${QG_TARGET}_quadgen_derive DEPENDS "${out}/model.hpp")
   add_library(${QG_TARGET} INTERFACE)
-  target_include_directories(${QG_TARGET} INTERFACE "${out}" "${out_parent}")
+  target_include_directories(${QG_TARGET} INTERFACE "${out}")
+  if(NOT QG_OUTPUT_DIR)  # quadgen_models/: only quadgen's folders, so "<name>/model.hpp" is safe to offer
+    target_include_directories(${QG_TARGET} INTERFACE "${out_parent}")
+  endif()
   target_compile_features(${QG_TARGET} INTERFACE cxx_std_17)
   add_dependencies(${QG_TARGET} ${QG_TARGET}_quadgen_derive)
   set_target_properties(${QG_TARGET} PROPERTIES QUADGEN_MODEL_HEADER "${out}/model.hpp")

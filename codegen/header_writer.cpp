@@ -239,17 +239,15 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   d.set("measurement_body", meas_code.body);
   mustache tmpl{std::string(kModelHeaderTemplate)};
   if (!tmpl.is_valid()) throw std::runtime_error("templates/model.hpp.mustache: " + tmpl.error_message());
-  // The inline namespace's name: a hash of the code (from the namespace on: not the comments,
-  // which name the path the vehicle file was read from), written in where it was held open.
-  const std::string placeholder = "model_code_tag_placeholder";
-  d.set("code_tag", placeholder);
-  std::string text = tmpl.render(d);
-  const size_t code = text.find("namespace quadgen_generated {");
+  // The inline namespace's name: a hash of the code (from the namespace on: not the opening
+  // comment block, which names the path the vehicle file was read from). Rendered once without
+  // it to hash, then with it (a text replacement would also hit a vehicle's or rotor's name).
+  d.set("code_tag", std::string());
+  const std::string untagged = tmpl.render(d);
+  const size_t code = untagged.find("namespace quadgen_generated {");
   if (code == std::string::npos) throw std::logic_error("templates/model.hpp.mustache: no namespace quadgen_generated");
-  const std::string tag = "model_" + output::fnv1a_hex(text.substr(code));
-  for (size_t at = text.find(placeholder); at != std::string::npos; at = text.find(placeholder, at + tag.size()))
-    text.replace(at, placeholder.size(), tag);
-  out.content = std::move(text);
+  d.set("code_tag", "model_" + output::fnv1a_hex(untagged.substr(code)));
+  out.content = tmpl.render(d);
   return out;
 }
 

@@ -45,6 +45,10 @@ bool is_library_macro(const std::string& w) {
   return false;
 }
 
+// Standard macros a header must not redefine, refused with the keywords (a name the generated
+// code declares must be neither) and named as macros.
+bool is_standard_macro(const std::string& w) { return w == "assert" || w == "errno" || w == "NULL" || w == "EOF"; }
+
 }  // namespace
 
 bool is_cpp_keyword(const std::string& w) {
@@ -59,9 +63,9 @@ bool is_cpp_keyword(const std::string& w) {
       "short", "signed", "sizeof", "static", "static_assert", "static_cast", "struct", "switch",
       "template", "this", "thread_local", "throw", "true", "try", "typedef", "typeid", "typename",
       "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t", "while", "xor", "xor_eq",
-      // Predefined macros and identifiers with special meaning that a header must not redefine.
-      "final", "override", "import", "module", "assert", "errno", "NULL", "EOF"};
-  return keywords.count(w) > 0;
+      // Identifiers with special meaning that a header must not redefine.
+      "final", "override", "import", "module"};
+  return keywords.count(w) > 0 || is_standard_macro(w);
 }
 
 const char* name_rule() {
@@ -78,10 +82,8 @@ std::optional<std::string> name_problem(const std::string& name) {
       return "the name may hold only letters, digits and '_' (found a character outside them)";
   if (name.find("__") != std::string::npos || name.back() == '_')
     return "the name may not hold '__' or end in '_' (reserved in C++)";
-  if (is_cpp_keyword(name)) {
-    const bool macro = name == "assert" || name == "errno" || name == "NULL" || name == "EOF";  // the list's last four
-    return "'" + name + "' is a C++ keyword" + (macro ? std::string(" or standard macro") : std::string());
-  }
+  if (is_standard_macro(name)) return "'" + name + "' is a standard macro";
+  if (is_cpp_keyword(name)) return "'" + name + "' is a C++ keyword";
   if (is_library_macro(name)) return "'" + name + "' is a macro of the C library or the compiler";
   if (generated_header_names().count(name)) return "'" + name + "' is a name the generated header uses";
   return std::nullopt;

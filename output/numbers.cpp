@@ -11,4 +11,11 @@ std::string short_number(double v) {
   return os.str();
 }
 
+std::string six_digits(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
 }  // namespace quadgen::output

@@ -8,5 +8,8 @@ namespace quadgen::output {
 
 // Three significant digits ("0.0524", "1.32e-06", "208").
 std::string short_number(double v);
+// Six significant digits ("0.265851", "1.7e+308"): where a reader adds numbers up by eye (a
+// weight beside the thrusts that carry it), and never hundreds of digits.
+std::string six_digits(double v);
 
 }  // namespace quadgen::output

@@ -9,6 +9,7 @@
 
 #include <Eigen/Dense>
 
+#include "output/numbers.hpp"
 #include "runtime/allocation_matrix.hpp"
 #include "runtime/attitude.hpp"
 #include "runtime/integrator.hpp"
@@ -187,19 +188,12 @@ void hold_shortfalls(const TrimProblem& P, Eigen::VectorXd& F, std::vector<bool>
 
 }  // namespace
 
-namespace {
-std::string as_g(double v) {  // a number as %g: no 300 digits for 1e300
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-}  // namespace
 
 HoverTrim hover_trim(const ControllerModel& b, const std::vector<std::string>& rotor_names) {
   const TrimProblem P(b);
   if (!std::isfinite(P.weight) || !std::isfinite(P.least.sum()) || !std::isfinite(P.most.sum())) {
     HoverTrim t;  // a mass or motor map beyond a double (a review: 1.7e308 kg said "no thrusts balance")
-    t.why_not = !std::isfinite(P.weight) ? "the weight m g is not a finite number (mass " + as_g(b.mass) + " kg)"
+    t.why_not = !std::isfinite(P.weight) ? "the weight m g is not a finite number (mass " + output::six_digits(b.mass) + " kg)"
                                          : "a motor map's thrust at command 0 or 1 is not a finite number";
     return t;
   }

@@ -422,6 +422,53 @@ TEST(Generated, TheHeadersHoverTrimHoldsItsOwnModel) {
   EXPECT_EQ(std::vector<int>(M::kRotorSpin, M::kRotorSpin + 4), (std::vector<int>{1, -1, 1, -1}));
 }
 
+// One of the header's constant arrays over the rotors, as numbers.
+std::vector<double> header_rotor_array(const std::string& header, const std::string& name) {
+  const std::string opening = "inline constexpr double " + name + "[kNumRotors] = {";
+  const size_t at = header.find(opening);
+  std::vector<double> values;
+  if (at == std::string::npos) return values;
+  std::istringstream in(header.substr(at + opening.size(), header.find('}', at) - at - opening.size()));
+  for (std::string item; std::getline(in, item, ',');) values.push_back(std::stod(item));
+  return values;
+}
+
+// The trim on a vehicle whose rotors carry different thrusts (its CoG off the middle: the
+// checked-in headers are all symmetric, where a permuted trim would pass), against the symbolic
+// f evaluated by the tests' own helper; a vehicle with no trim, and a model whose fitted effect
+// values move the hover, declare none and say why (a review of the change).
+TEST(Generated, TheHeadersHoverTrimHoldsAnOffCentreVehicleAndSaysWhenThereIsNone) {
+  quadgen::DeriveRequest request;
+  request.thesis_comparison = false;
+  quadgen::Vehicle off = quadgen::test::finken3();
+  off.blocks.front().centre[0] += 0.03;  // the upper body towards +x
+  const auto derived = quadgen::run_derive_pipeline(off, quadgen::derive_mass_properties(off), request);
+  const std::vector<double> u = header_rotor_array(derived.header.content, "kHoverCommand");
+  ASSERT_EQ(u.size(), 4u);
+  EXPECT_GT(*std::max_element(u.begin(), u.end()) - *std::min_element(u.begin(), u.end()), 1e-3) << "not off centre";
+  std::vector<double> x(13, 0.0);
+  x[2] = 1, x[6] = 1;
+  for (double fi : quadgen::test::eval_f(derived.model, x, u)) EXPECT_LT(std::abs(fi), 1e-8);
+  EXPECT_LT(derived.hover_residual, 1e-8);
+
+  quadgen::Vehicle heavy = quadgen::test::finken3();
+  for (auto& b : heavy.blocks) b.mass *= 10;
+  heavy.derived_overrides.at("mass").upper = 10;  // its bounds in the file end at 0.8 kg
+  const std::string none = quadgen::run_derive_pipeline(heavy, quadgen::derive_mass_properties(heavy), request).header.content;
+  EXPECT_NE(none.find("inline constexpr bool kHasHoverTrim = false;"), std::string::npos);
+  EXPECT_NE(none.find("// No hover trim: rotor "), std::string::npos);
+  EXPECT_EQ(header_rotor_array(none, "kHoverCommand"), std::vector<double>(4, 0.0));
+
+  request.derive.effects = quadgen::parse_effect_list("motor_gain");
+  request.set_nominal = [](quadgen::SymbolicModel& m) { m.params[m.param_index("motor_gain.A")].nominal = -0.1; };
+  const quadgen::Vehicle stock = quadgen::test::finken3();
+  const auto fitted = quadgen::run_derive_pipeline(stock, quadgen::derive_mass_properties(stock), request);
+  EXPECT_GT(fitted.hover_residual, 1e-3);
+  EXPECT_NE(fitted.header.content.find("inline constexpr bool kHasHoverTrim = false;"), std::string::npos);
+  EXPECT_NE(fitted.header.content.find("move the hover: the base model's trim"), std::string::npos);
+  EXPECT_NE(fitted.model_json.find("\"largest_f_at_trim\""), std::string::npos);
+}
+
 // The header's inline namespace is named after its code: a vehicle file read from another
 // path gives the same name, one with another mass another (so an edited copy that kept the
 // vehicle's name links as a model of its own, not silently as the other one).

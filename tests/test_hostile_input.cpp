@@ -243,6 +243,9 @@ TEST(NameRule, AcceptsIdentifiersAndRefusesEverythingElse) {
     EXPECT_TRUE(out::name_problem(bad)) << bad;
   EXPECT_TRUE(out::name_problem(std::string(65, 'a')));
   for (const auto& s : hostile_strings()) EXPECT_TRUE(out::name_problem(s)) << out::printable(s);
+  // Named for what they are (a user trial: errno was called a keyword).
+  for (const char* macro : {"errno", "assert", "NULL", "EOF"}) EXPECT_EQ(*out::name_problem(macro), "'" + std::string(macro) + "' is a standard macro");
+  EXPECT_EQ(*out::name_problem("class"), "'class' is a C++ keyword");
 }
 
 // Terminal output (every error message goes through output::printable): nothing a terminal
@@ -1444,7 +1447,7 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                                      "motor_lag,motor_lag_spread", "--set", "motor_lag.tau=0.05", "--set",
                                      "motor_lag_spread.A=-0.9999", "--out", tmp / "s.csv"},
                                     tmp.dir),
-                        "the fastest rotor's time constant, motor_lag.tau (1 + spread), = 5e-06 s is too fast for RK4",
+                        "the fastest rotor's time constant (motor_lag.tau times 1 + its spread) = 5e-06 s is too fast for RK4",
                         "spread -0.9999");
   expect_one_line_error(run_quadgen({"simulate", vehicle, "--scenario", "yaw", "--duration", "1", "--effects", "motor_lag",
                                      "--set", "motor_lag.tau=1e-12", "--out", tmp / "s.csv"},

@@ -1055,6 +1055,18 @@ TEST(HoverTrim, FindsTheTrimAGreedySearchMissedOnAnIrregularHexacopter) {
 // search's did: 7.89 N, and the vehicle was refused as beyond the motor map); with rotors R1
 // and R4 held at their idle the rest trim within every motor map. (Found by helper-50's
 // review: the search looked at command 0 alone.)
+// A weight beyond a double (a sixth audit: 1.7e308 kg was answered "no thrusts balance the
+// weight without a moment") is said as what it is.
+TEST(HoverTrim, AWeightThatIsNoFiniteNumberIsSaid) {
+  const double rows[6][4] = {{-0.0749, -0.2935, -1, 0.6},  {0.0872, -0.2098, +1, 192.9}, {-0.3169, 0.1564, +1, 243.8},
+                             {0.1430, 0.0598, +1, 182.3},  {-0.1304, -0.1915, +1, 467.4}, {0.0089, 0.0807, -1, 267.7}};
+  ControllerModel b = hexacopter(rows, 600);
+  b.mass = 1.7e308;
+  const HoverTrim trim = hover_trim(b, kHexaNames);
+  EXPECT_FALSE(trim.found());
+  EXPECT_EQ(trim.why_not, "the weight m g is not a finite number (mass 1.7e+308 kg)");
+}
+
 TEST(HoverTrim, HoldingRotorsAtIdleKeepsEveryOneBelowCommandOne) {
   const double rows[6][4] = {{-0.0749, -0.2935, -1, 0.6},  {0.0872, -0.2098, +1, 192.9}, {-0.3169, 0.1564, +1, 243.8},
                              {0.1430, 0.0598, +1, 182.3},  {-0.1304, -0.1915, +1, 467.4}, {0.0089, 0.0807, -1, 267.7}};

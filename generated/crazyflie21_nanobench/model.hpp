@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_f06896822db85a9f {
+inline namespace model_d1b11114f35a7cd1 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -66,8 +66,10 @@ inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] =
 // The rotors in input order (u_<rotor>), for a mixer and a simulation's start: each one's spin
 // seen from above (+1 counter-clockwise, -1 clockwise), and the hover trim at kNominalParams,
 // each rotor's command (0 to 1) and thrust [N] that hold the vehicle level and still: f = 0
-// to about 1e-10 with every effect at its neutral value (the catalogue's nominal 0; rotor-speed
-// states at the speeds the commands ask). Effect values fitted away from 0 move it.
+// to about 1e-10 with the effects' inputs where they are neutral (t = 0, vbat at vbat_ref, clear
+// of the ground) and rotor-speed states at the speeds the commands ask. Where the vehicle cannot
+// hover, or effect values fitted away from neutral move the hover, kHasHoverTrim is false, the
+// arrays hold 0 and the line below says why.
 inline constexpr int kNumRotors = 4;
 inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
@@ -1583,6 +1585,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_f06896822db85a9f
+}  // inline namespace model_d1b11114f35a7cd1
 }  // namespace crazyflie21_nanobench
 }  // namespace quadgen_generated
