@@ -84,6 +84,7 @@ std::string summary_of(const Vehicle& vehicle, const MassProperties& mp, const D
      << " kg m^2" << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
+  if (!d.why_trim_does_not_hold.empty()) os << "note: the header declares no hover trim: " << d.why_trim_does_not_hold << "\n";
   return os.str();
 }
 

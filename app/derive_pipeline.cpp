@@ -56,14 +56,17 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
     // does not hover at it, and says so rather than declare a trim that does not hold.
     out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
     if (!(out.hover_residual <= DerivedModel::kHoverHolds)) {
+      out.why_trim_does_not_hold =
+          "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
+          output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
+          output::short_number(out.hover_residual) + " there";
       emit.hover_command.clear();
-      emit.why_no_hover = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
-                          output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
-                          output::short_number(out.hover_residual) + " there";
+      emit.why_no_hover = out.why_trim_does_not_hold;
     }
   }
   out.header = codegen::generate_header(out.model, emit);
-  const Derivation d{vehicle, mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual};
+  const Derivation d{vehicle,        mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual,
+                     out.why_trim_does_not_hold};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);
   return out;

@@ -41,6 +41,7 @@ struct DerivedModel {
   // most that still counts as holding: the trim's 12 digits leave about 1e-10.
   double hover_residual = 0;
   static constexpr double kHoverHolds = 1e-6;
+  std::string why_trim_does_not_hold;  // empty where it holds (or there is none)
   codegen::GeneratedHeader header;
   std::string model_json, derivation_md;
 };

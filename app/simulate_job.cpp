@@ -186,7 +186,7 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> allocation_and_inverse(const Control
 // inside the flight.
 std::vector<double> hover_thrusts(const Vehicle& v, const ControllerModel& belief) {
   const runtime::HoverTrim trim = runtime::hover_trim(belief, rotor_names(v));
-  if (!trim.found()) throw std::invalid_argument(v.source_path + ": the vehicle cannot hover: " + trim.why_not);
+  if (!trim.found()) throw std::invalid_argument(output::printable(v.source_path) + ": the vehicle cannot hover: " + trim.why_not);
   return trim.thrusts;
 }
 
@@ -208,6 +208,24 @@ struct OpenLoop {
 
   double delay_s() const { return delay >= 0 ? m.params()[delay] : 0.0; }
 };
+
+// The open-loop context of this vehicle, from the model flown and the controller's belief.
+OpenLoop open_loop_context(DynamicModel& m, const Vehicle& vehicle, const ControllerModel& belief) {
+  const double even_share =
+      m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
+  const auto [allocation, allocation_inverse] = allocation_and_inverse(belief);
+  return OpenLoop{m,
+                  belief.thrust_laws,
+                  rotor_names(vehicle),
+                  rotor_places(belief),
+                  ExtraInputs(m),
+                  m.input_delay_param(),
+                  param(vehicle, "vbat_ref").nominal,
+                  even_share,
+                  hover_thrusts(vehicle, belief),
+                  allocation,
+                  allocation_inverse};
+}
 
 // `thrusts` less their change's part about the axes the manoeuvre does not mean (from the hover
 // trim), with the least change of every rotor's thrust. Left as they are where that would ask
@@ -249,14 +267,25 @@ InputFunction scenario_inputs(const OpenLoop& k, const Scenario& s) {
 
 // A manoeuvre whose rule picks no rotor of this vehicle (none on the side it raises: rotors in
 // a line along x and `forward`) would fly as a hover and be written as the manoeuvre: refused
-// (a review). Its schedule is looked at over 10 s, longer than any manoeuvre's.
-void check_scenario_raises_a_rotor(const OpenLoop& k, const Scenario& s, const std::string& vehicle_path) {
+// (a review). Its schedule is looked at over 10 s, longer than any manoeuvre's. So is a flight
+// that ends before the manoeuvre's first change (its input delay included).
+void check_scenario_changes_a_rotor(const OpenLoop& k, const Scenario& s, const SimulateJob& a,
+                                    const std::string& vehicle_path) {
   if (std::none_of(s.changes.begin(), s.changes.end(), [](bool c) { return c; })) return;  // hover
-  for (double t = 0; t <= 10.0; t += 0.005)
-    for (double f : s.thrust(t, k.hover, k.places))
-      if (f != k.hover) return;
-  throw std::invalid_argument(output::printable(vehicle_path) + ": scenario '" + s.name + "' (" + s.description +
-                              ") changes no rotor of this vehicle: it would fly as a hover");
+  const std::string what = "scenario '" + s.name + "' (" + s.description + ")";
+  for (int i = 0; i <= 2000; ++i) {
+    const double t = i / 200.0;  // s, in exact steps of 5 ms
+    const auto F = s.thrust(t, k.hover, k.places);
+    if (std::all_of(F.begin(), F.end(), [&](double f) { return f == k.hover; })) continue;
+    const double first = t + k.delay_s();
+    if (first < a.duration) return;
+    throw std::invalid_argument("--duration " + output::short_number(a.duration) + " s ends before " + what +
+                                " first changes a rotor, at " + output::short_number(first) + " s" +
+                                (k.delay_s() > 0 ? " (its input delay included)" : "") +
+                                ": it would fly as a hover; give a longer --duration");
+  }
+  throw std::invalid_argument(output::printable(vehicle_path) + ": " + what +
+                              " changes no rotor of this vehicle: it would fly as a hover");
 }
 
 // The linearly interpolated battery voltage of a log, or nothing where it holds none.
@@ -423,44 +452,10 @@ std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, cons
   return {trans, rot, thrust};
 }
 
-}  // namespace
-
-SimulateJobResult run_simulate_job(const SimulateJob& a) {
-  if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
-    throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
-  if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
-  const Vehicle vehicle = load_vehicle(a.vehicle);
-  if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
-  if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
-  else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
-  DeriveOptions opt;
-  opt.effects = parse_effect_list(a.effects);
-  const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
-  const auto model_ptr = make_model(model);
-  DynamicModel& m = *model_ptr;
-  apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
-  const double even_share =
-      m.params()[m.param_index("mass")] * m.params()[m.param_index("g")] / static_cast<double>(vehicle.rotors.size());
-  // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor
-  // places, trim and allocation, and the closed loop's controller, all from this one.
-  const ControllerModel belief = nominal_controller_belief(vehicle, model);
-  const auto [allocation, allocation_inverse] = allocation_and_inverse(belief);
-  const OpenLoop k{m,
-                   belief.thrust_laws,
-                   rotor_names(vehicle),
-                   rotor_places(belief),
-                   ExtraInputs(m),
-                   m.input_delay_param(),
-                   param(vehicle, "vbat_ref").nominal,
-                   even_share,
-                   hover_thrusts(vehicle, belief),
-                   allocation,
-                   allocation_inverse};
-  if (a.closed_loop && (a.ground_at_start || a.ground_height))
-    throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
-  if (a.closed_loop) return run_closed_loop(a, vehicle, belief, m);
-
-  if (!a.scenario.empty()) check_scenario_raises_a_rotor(k, find_scenario(a.scenario), vehicle.source_path);
+// A scenario's or a replay's flight, open loop.
+SimulateJobResult run_open_loop(const SimulateJob& a, const Vehicle& vehicle, const OpenLoop& k) {
+  DynamicModel& m = k.m;
+  if (!a.scenario.empty()) check_scenario_changes_a_rotor(k, find_scenario(a.scenario), a, vehicle.source_path);
   std::vector<double> x0(m.num_states(), 0.0);
   x0[rigid_body::kAttitude] = 1.0;
   const InputFunction inputs =
@@ -485,6 +480,53 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
           << ") m";
   result.summary = summary.str();
   return result;
+}
+
+// What a divergence may come from that the state it ends in cannot name: a --set value far
+// beyond what its effect's physics produces (a review: wind.x = 1e300 ended in "state x = -nan").
+std::string implausible_settings(const SimulateJob& a, const Vehicle& vehicle) {
+  std::string out;
+  for (const auto& [name, value] : a.set) {
+    double lower = 0, upper = 0;
+    std::string why;
+    if (!outside_plausible_range(name, value, Environment::kUnknown, vehicle_scales(vehicle), &lower, &upper, &why))
+      continue;
+    out += (out.empty() ? "; outside its plausible range, --set " : ", ") + output::printable(name) + " = " +
+           output::short_number(value) + " (plausible " + output::short_number(lower) + " to " +
+           output::short_number(upper) + ": " + why + ")";
+  }
+  return out;
+}
+
+}  // namespace
+
+SimulateJobResult run_simulate_job(const SimulateJob& a) {
+  if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
+    throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
+  if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
+  const Vehicle vehicle = load_vehicle(a.vehicle);
+  if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
+  if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
+  else check_size(a, a.integrator == "rk4" ? a.duration / a.step : 0, a.duration * a.rate);
+  DeriveOptions opt;
+  opt.effects = parse_effect_list(a.effects);
+  const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
+  const auto model_ptr = make_model(model);
+  DynamicModel& m = *model_ptr;
+  apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
+  // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor
+  // places, trim and allocation, and the closed loop's controller, all from this one.
+  const ControllerModel belief = nominal_controller_belief(vehicle, model);
+  const OpenLoop k = open_loop_context(m, vehicle, belief);  // also where a vehicle that cannot hover is said
+  if (a.closed_loop && (a.ground_at_start || a.ground_height))
+    throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
+  try {
+    return a.closed_loop ? run_closed_loop(a, vehicle, belief, m) : run_open_loop(a, vehicle, k);
+  } catch (const DivergenceError& e) {
+    const std::string cause = implausible_settings(a, vehicle);
+    if (cause.empty()) throw;
+    throw DivergenceError(e.what() + cause);
+  }
 }
 
 }  // namespace quadgen::app

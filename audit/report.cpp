@@ -249,6 +249,9 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "
        << (c.passed ? "pass" : c.advisory ? "**warning**" : "**FAIL**") << " | " << output::markdown_text(c.detail) << " |\n";
   md << "\n";
+  if (!d.why_trim_does_not_hold.empty())
+    md << "**The hover trim above is the base model's and does not hold this model:** "
+       << output::markdown_text(d.why_trim_does_not_hold) << ". The header declares none (`kHasHoverTrim = false`).\n\n";
 }
 
 void section_thesis(std::ostringstream& md, const Derivation& d) {
@@ -300,24 +303,22 @@ static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   nlohmann::ordered_json j;
   j["rotors"] = rotor_names(d.vehicle);
   j["thrust_N"] = trim.thrusts;
-  j["command"] = trim.commands;
-  j["why_not"] = trim.why_not;
+  // Where it does not hold the model (a review, helper-88: a consumer that read an empty
+  // why_not took commands that left |f| = 8.4), no commands and the reason, as in the header.
+  const bool holds = d.why_trim_does_not_hold.empty();
+  j["command"] = holds ? trim.commands : std::vector<double>{};
+  j["why_not"] = holds ? trim.why_not : d.why_trim_does_not_hold;
+  if (!holds) j["base_model_command"] = trim.commands;
   // Where effect values fitted away from neutral move the hover, the base trim does not hold
   // this model (the header then declares none): how far it is off.
   j["largest_f_at_trim"] = d.hover_residual;
   return j;
 }
 
-std::string model_json(const Derivation& d) {
-  using nlohmann::ordered_json;
-  ordered_json j;
-  j["quadgen_version"] = QUADGEN_VERSION;
-  j["vehicle"] = d.vehicle.name;
-  j["vehicle_hash"] = d.vehicle.content_hash;
-  j["effects"] = d.model.effects;
-  // The mass properties the model uses (a review found the blocks' here beside a hover trim for
-  // the file's given mass): the blocks', or the file's `derived:` values, or fitted ones; the
-  // blocks' own are under "from_blocks".
+// The mass properties the model uses (a review found the blocks' here beside a hover trim for
+// the file's given mass): the blocks', or the file's `derived:` values, or fitted ones; the
+// blocks' own are under "from_blocks".
+static void add_mass_properties(nlohmann::ordered_json& j, const Derivation& d) {
   const auto used = [&](const char* name) { return d.model.params[d.model.param_index(name)].nominal; };
   j["mass"] = used("mass");
   j["cog"] = {used("cog_x"), used("cog_y"), used("cog_z")};
@@ -330,41 +331,61 @@ std::string model_json(const Derivation& d) {
                       {"areas", d.mass.areas_value},
                       {"inertia_about_origin", d.mass.inertia_origin_value}};
   j["areas"] = {used("A_x"), used("A_y"), used("A_z")};
-  auto vars = [](const std::vector<Variable>& vs, bool params) {
-    ordered_json a = ordered_json::array();
-    for (const auto& v : vs) {
-      ordered_json o;
-      o["name"] = v.name;
-      if (params) o["value"] = v.nominal;
-      o["unit"] = v.unit;
-      if (params) {
-        o["lower"] = v.lower;
-        o["upper"] = v.upper;
-        o["fit"] = v.fit;
-      }
-      o["meaning"] = v.doc;
-      a.push_back(o);
+}
+
+// States, inputs, parameters or outputs: name, unit, meaning; a parameter's value, bounds and
+// whether fits estimate it.
+static nlohmann::ordered_json variables_json(const std::vector<Variable>& vs, bool params) {
+  nlohmann::ordered_json a = nlohmann::ordered_json::array();
+  for (const auto& v : vs) {
+    nlohmann::ordered_json o;
+    o["name"] = v.name;
+    if (params) o["value"] = v.nominal;
+    o["unit"] = v.unit;
+    if (params) {
+      o["lower"] = v.lower;
+      o["upper"] = v.upper;
+      o["fit"] = v.fit;
     }
-    return a;
-  };
-  j["states"] = vars(d.model.states, false);
-  j["inputs"] = vars(d.model.inputs, false);
-  j["parameters"] = vars(d.model.params, true);
-  j["outputs"] = vars(d.model.outputs, false);
-  ordered_json blocks = ordered_json::array();
-  for (const auto& b : d.mass.blocks)
-    blocks.push_back({{"name", b.name}, {"inertia_about_origin", b.inertia_origin_value}, {"areas", b.areas_value}});
-  j["blocks"] = blocks;
-  ordered_json checks = ordered_json::array();
+    o["meaning"] = v.doc;
+    a.push_back(o);
+  }
+  return a;
+}
+
+static nlohmann::ordered_json audit_json(const Derivation& d) {
+  nlohmann::ordered_json checks = nlohmann::ordered_json::array();
   for (const auto& c : d.audit.checks)
     checks.push_back({{"group", c.group}, {"check", c.name}, {"passed", c.passed}, {"advisory", c.advisory}, {"detail", c.detail}});
-  j["audit"] = {{"passed", d.audit.all_passed()}, {"checks", checks}};
-  j["hover_trim"] = hover_trim_json(d);
-  ordered_json th = ordered_json::array();
+  return {{"passed", d.audit.all_passed()}, {"checks", checks}};
+}
+
+static nlohmann::ordered_json thesis_json(const Derivation& d) {
+  nlohmann::ordered_json th = nlohmann::ordered_json::array();
   for (const auto& t : d.thesis)
     th.push_back({{"ref", t.ref}, {"topic", t.topic}, {"thesis", t.thesis}, {"derived", t.derived},
                   {"agrees", t.agrees}, {"basis", t.basis}, {"cause", t.cause}, {"size", t.size}});
-  j["thesis_comparison"] = th;
+  return th;
+}
+
+std::string model_json(const Derivation& d) {
+  nlohmann::ordered_json j;
+  j["quadgen_version"] = QUADGEN_VERSION;
+  j["vehicle"] = d.vehicle.name;
+  j["vehicle_hash"] = d.vehicle.content_hash;
+  j["effects"] = d.model.effects;
+  add_mass_properties(j, d);
+  j["states"] = variables_json(d.model.states, false);
+  j["inputs"] = variables_json(d.model.inputs, false);
+  j["parameters"] = variables_json(d.model.params, true);
+  j["outputs"] = variables_json(d.model.outputs, false);
+  nlohmann::ordered_json blocks = nlohmann::ordered_json::array();
+  for (const auto& b : d.mass.blocks)
+    blocks.push_back({{"name", b.name}, {"inertia_about_origin", b.inertia_origin_value}, {"areas", b.areas_value}});
+  j["blocks"] = blocks;
+  j["audit"] = audit_json(d);
+  j["hover_trim"] = hover_trim_json(d);
+  j["thesis_comparison"] = thesis_json(d);
   return output::json_document(j);
 }
 

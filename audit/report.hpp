@@ -21,6 +21,9 @@ struct Derivation {
   const std::vector<ThesisItem>& thesis;  // empty for vehicles other than the FINken 3
   const runtime::HoverTrim& hover_trim;    // at the nominal values (nominal_hover_trim)
   double hover_residual = 0;               // the largest |f| of the model there (hover_residual)
+  // Why that trim does not hold this model (fitted effect values move the hover), or empty:
+  // then the header declares none, and model.json and derivation.md say so too.
+  std::string why_trim_does_not_hold;
 };
 
 std::string derivation_markdown(const Derivation& d);

@@ -106,9 +106,11 @@ inline void commit_and_say(output::OutputDirectory& out, const std::string& comm
 // ... and of a command that writes files, not a folder (simulate).
 inline void commit_and_say(output::OutputFiles& out, const std::string& command) {
   out.commit();
-  if (out.replaced_earlier_run())
-    std::cerr << "quadgen: note: replaced the earlier " << command << " output " << output::printable(out.first_path())
-              << "\n";
+  if (!out.replaced_earlier_run()) return;
+  std::cerr << "quadgen: note: replaced the earlier " << command << " output";
+  for (size_t i = 0; i < out.replaced_files().size(); ++i)
+    std::cerr << (i == 0 ? " " : " and ") << output::printable(out.replaced_files()[i]);
+  std::cerr << "\n";
 }
 
 // The long names of the options of `sub` that the command line gave.

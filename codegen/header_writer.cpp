@@ -244,7 +244,9 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   // it to hash, then with it (a text replacement would also hit a vehicle's or rotor's name).
   d.set("code_tag", std::string());
   const std::string untagged = tmpl.render(d);
-  const size_t code = untagged.find("namespace quadgen_generated {");
+  // At a line's start: a vehicle file's path in the regenerate comment may hold the words too
+  // (a review, helper-88).
+  const size_t code = untagged.find("\nnamespace quadgen_generated {");
   if (code == std::string::npos) throw std::logic_error("templates/model.hpp.mustache: no namespace quadgen_generated");
   d.set("code_tag", "model_" + output::fnv1a_hex(untagged.substr(code)));
   out.content = tmpl.render(d);

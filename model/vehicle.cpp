@@ -165,6 +165,11 @@ void read_section(const Reader& r, const YAML::Node& root, Vehicle& v, const std
       continue;
     }
     v.params[sp.key] = r.parameter(s[sp.key], sp.key, sp.unit, sp.doc);
+    // Judged as --set and --params judge a value from outside (a review, helper-88: a vbat_ref
+    // of 0 ended in GiNaC's "division by zero" without a line).
+    const auto& p = v.params[sp.key];
+    if (const std::string problem = runtime::value_problem(runtime_parameter(p), p.nominal, false); !problem.empty())
+      r.fail(s[sp.key].IsMap() && s[sp.key]["value"] ? s[sp.key]["value"] : s[sp.key], sp.key + " " + problem);
   }
 }
 

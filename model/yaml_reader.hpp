@@ -126,6 +126,11 @@ struct YamlReader {
       fail(n, "expected a number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
     }
     if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
+    // yaml-cpp reads 1e-400 as 0 without a word (the notes of the forty-second session).
+    const std::string mantissa = n.Scalar().substr(0, n.Scalar().find_first_of("eE"));
+    if (v == 0 && mantissa.find_first_of("123456789") != std::string::npos)
+      fail(n, "'" + output::printable(n.Scalar()) + "' for " + what +
+                  " is below the smallest number a double holds (it would read as 0)");
     return v;
   }
 

@@ -18,4 +18,11 @@ std::string six_digits(double v) {
   return os.str();
 }
 
+std::string full_number(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
 }  // namespace quadgen::output

@@ -711,6 +711,7 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
     if (const auto id = file_id(p.string()); id && ids.count(*id))
       fail(p, "is the input " + printable(ids.at(*id)) + "; choose another output path");
     paths_.push_back(p.string());
+    named_.push_back(name);
   }
   const fs::path parent = fs::path(paths_.front()).parent_path();
   refuse_links_that_lead_nowhere(parent);
@@ -747,10 +748,8 @@ void OutputFiles::commit() {
   test_hook_signal("before-commit");
   std::error_code ec;
   // The constructor let through only files this command wrote here, unchanged since.
-  replaced_ = std::any_of(paths_.begin(), paths_.end(), [](const std::string& p) {
-    std::error_code e;
-    return fs::exists(fs::symlink_status(p, e));
-  });
+  for (size_t i = 0; i < paths_.size(); ++i)
+    if (std::error_code e; fs::exists(fs::symlink_status(paths_[i], e))) replaced_.push_back(named_[i]);
   for (size_t i = 1; i < paths_.size(); ++i) fs::remove(paths_[i], ec);  // no companion of another run
   for (size_t i = 0; i < paths_.size(); ++i) {
     if (!written_[i]) continue;

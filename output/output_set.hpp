@@ -96,15 +96,18 @@ class OutputFiles {
   // Content of paths[i]; a path never set is not written, and a previous file there is removed.
   void set(size_t i, const std::string& content);
   void commit();
-  // Whether the commit replaced files an earlier run of the command wrote at these paths.
-  bool replaced_earlier_run() const { return replaced_; }
-  const std::string& first_path() const { return paths_.front(); }
+  // Whether the commit replaced files an earlier run of the command wrote at these paths, and
+  // which, as the caller named them (a review: the note named the trajectory, by its absolute
+  // path, where only the earlier plot had been left).
+  bool replaced_earlier_run() const { return !replaced_.empty(); }
+  const std::vector<std::string>& replaced_files() const { return replaced_; }
 
  private:
   void update_record();
-  bool replaced_ = false;
+  std::vector<std::string> replaced_;
   std::string command_;
   std::vector<std::string> paths_;
+  std::vector<std::string> named_;  // paths_ as the caller gave them
   std::vector<bool> written_;
   CreatedFolders created_;  // destroyed after the staging directory inside them
   std::unique_ptr<StagingDirectory> staging_;

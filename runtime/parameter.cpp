@@ -17,6 +17,10 @@ std::string value_problem(const Parameter& p, double value, bool within_bounds) 
     return "= " + short_number(value) + ": a mass and a principal moment of inertia must be positive";
   const bool area = p.name == "A_x" || p.name == "A_y" || p.name == "A_z";
   if (area && value < 0) return "= " + short_number(value) + ": an exposed area cannot be negative";
+  // Battery sag scales the thrust by (vbat / vbat_ref)^exponent (a review, helper-88: 0 divided
+  // by zero in derive's hover check, -3 was flown).
+  if (p.name == "vbat_ref" && !(value > 0))
+    return "= " + short_number(value) + ": a battery voltage must be positive (the thrust scales with vbat / vbat_ref)";
   return "";
 }
 

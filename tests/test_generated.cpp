@@ -467,6 +467,13 @@ TEST(Generated, TheHeadersHoverTrimHoldsAnOffCentreVehicleAndSaysWhenThereIsNone
   EXPECT_NE(fitted.header.content.find("inline constexpr bool kHasHoverTrim = false;"), std::string::npos);
   EXPECT_NE(fitted.header.content.find("move the hover: the base model's trim"), std::string::npos);
   EXPECT_NE(fitted.model_json.find("\"largest_f_at_trim\""), std::string::npos);
+  // model.json and derivation.md say the same as the header (a review, helper-88: model.json
+  // held the base trim's commands beside an empty why_not).
+  EXPECT_EQ(fitted.why_trim_does_not_hold.rfind("the model's effect values (fitted away from neutral) move the hover", 0), 0u);
+  EXPECT_NE(fitted.model_json.find("\"command\": []"), std::string::npos);
+  EXPECT_NE(fitted.model_json.find("\"why_not\": \"the model's effect values"), std::string::npos);
+  EXPECT_NE(fitted.model_json.find("\"base_model_command\""), std::string::npos);
+  EXPECT_NE(fitted.derivation_md.find("does not hold this model:** the model"), std::string::npos);
 }
 
 // The header's inline namespace is named after its code: a vehicle file read from another

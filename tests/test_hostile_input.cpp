@@ -1045,6 +1045,12 @@ TEST(DataLoss, SimulateReplacesOnlyItsOwnTrajectoryAndPlot) {
   EXPECT_NE(again.err.find("quadgen: note: replaced the earlier simulate output " + (tmp / "run.csv")), std::string::npos)
       << again.err;
   EXPECT_EQ(read(tmp / "run.csv").substr(0, 2), "t,");
+  // Where only the earlier plot is left, the note names the plot, not the trajectory.
+  fs::remove(tmp / "run.csv");
+  const CliResult plot_left = run_quadgen(with_out(tmp / "run.csv"), tmp.dir);
+  ASSERT_EQ(plot_left.rc, 0);
+  EXPECT_NE(plot_left.err.find("replaced the earlier simulate output " + (tmp / "run.svg") + "\n"), std::string::npos)
+      << plot_left.err;
   write(tmp / "run.csv", read(tmp / "run.csv") + "my last row\n");
   expect_one_line_error(run_quadgen(with_out(tmp / "run.csv"), tmp.dir), "or it was changed since", "an edited trajectory");
   // Not into another run's output directory, which would then refuse its next run.
@@ -1484,6 +1490,34 @@ TEST(Cli, AScenarioThatRaisesNoRotorIsRefused) {
   EXPECT_NE(fly("forward").err.find("changes no rotor of this vehicle: it would fly as a hover"), std::string::npos);
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   EXPECT_EQ(fly("right").rc, 0);  // the rotors on -x and +x: it raises some
+}
+
+// A flight that ended before its manoeuvre's first change flew as a hover and was written as the
+// manoeuvre, and a divergence from a --set value far beyond its physics named only the state it
+// ended in, "x = -nan" (notes of the forty-second session).
+TEST(Cli, AFlightEndingBeforeItsManoeuvreAndAnImplausibleValueAreSaid) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/crazyflie21.yaml");
+  const auto fly = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"simulate", vehicle, "--out", tmp / "s.csv"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_quadgen(args, tmp.dir);
+  };
+  const CliResult short_flight = fly({"--scenario", "right", "--duration", "0.3"});
+  expect_one_line_error(short_flight, "--duration 0.3 s ends before scenario 'right' (", "right for 0.3 s");
+  EXPECT_NE(short_flight.err.find("first changes a rotor, at 0.5 s: it would fly as a hover"), std::string::npos)
+      << short_flight.err;
+  expect_one_line_error(fly({"--scenario", "right", "--duration", "0.6", "--effects", "input_delay", "--set",
+                             "input_delay.seconds=0.2"}),
+                        "first changes a rotor, at 0.7 s (its input delay included)", "right for 0.6 s, delayed 0.2 s");
+  const CliResult gale = fly({"--scenario", "hover", "--duration", "1", "--effects", "wind", "--set", "wind.x=1e300"});
+  expect_one_line_error(gale, "simulation diverged at t = ", "wind 1e300");
+  EXPECT_NE(gale.err.find("; outside its plausible range, --set wind.x = 1e+300 (plausible -15 to 15: "), std::string::npos)
+      << gale.err;
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
+  EXPECT_EQ(fly({"--scenario", "right", "--duration", "0.6"}).rc, 0);
+  EXPECT_EQ(fly({"--scenario", "climb", "--duration", "0.1"}).rc, 0);  // it climbs from the start
+  EXPECT_EQ(fly({"--scenario", "hover", "--duration", "0.1"}).rc, 0);
 }
 
 // --resample judged only the pair of rows it interpolated between and walked past rows whose

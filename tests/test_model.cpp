@@ -6,6 +6,7 @@
 #include "cli/options.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -625,6 +626,20 @@ TEST(Effects, PlausibleRangesDependOnWhereAndOnTheVehicle) {
   EXPECT_FALSE(outside_plausible_range("blade_flapping.k", 1.0, Environment::kIndoor, cf, &lo, &hi, &why));  // none
   EXPECT_EQ(parse_environment("indoor"), Environment::kIndoor);
   EXPECT_THROW(parse_environment("cave"), std::invalid_argument);
+}
+
+// A value just beyond a bound printed as the bound ("motor_gain.C = -1 must be at least -1"):
+// its every digit is given where three would not tell them apart.
+TEST(Effects, APhysicalDomainSaysAValueThatPrintsAsItsBoundInFull) {
+  EXPECT_EQ(outside_physical_domain("motor_gain.C", -1.0), "");
+  EXPECT_EQ(outside_physical_domain("motor_gain.C", std::nextafter(-1.0, 0.0)), "");
+  const std::string below = outside_physical_domain("motor_gain.C", std::nextafter(-1.0, -2.0));
+  EXPECT_EQ(below.rfind("must be at least -1 (-1.0000000000000002 is below it): ", 0), 0u) << below;
+  const std::string far = outside_physical_domain("motor_gain.C", -1.5);
+  EXPECT_EQ(far.rfind("must be at least -1: ", 0), 0u) << far;
+  // At an excluded bound the value is the bound: nothing to add.
+  EXPECT_EQ(outside_physical_domain("motor_lag.tau", 0.0).rfind("must be above 0: ", 0), 0u);
+  EXPECT_EQ(outside_physical_domain("mass", -1.0), "");  // no effect's: value_problem judges it
 }
 
 TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {

@@ -264,6 +264,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {head + "  motor_gain.C: {value: -0.9, unit: \"1\"}\n", ":4: motor_gain.C = -0.9 is outside its bounds"},
       {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
       {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: expected a finite number for c_w"},
+      {head + "  c_w: {value: 1e-400, unit: \"1\"}\n", ":4: '1e-400' for c_w is below the smallest number a double holds"},
       {head + "  c_t: {value: 0.2, unit: \"1\"}\n", ":4: key 'c_t' given twice in parameters"},
       {head + "  c_w: {value: 1, unit: \"1\", bounds: [0, 2]}\n", ":4: unknown key 'bounds' in parameter c_w"},
       {"effects: [motor_gain]\neffects: []\nparameters: {}\n", ":2: key 'effects' given twice"},
@@ -320,6 +321,21 @@ TEST(VehicleInput, MotorSlopeNeedsItsPivot) {
                "'slope' and its lower bound must be positive");
   expect_error(replace(finken_text(), a2, a2 + "\n  slope: {value: 0.5, unit: \"1\"}\n  pivot: {value: 1.5, unit: \"1\"}"),
                "'pivot' is a command, expected 0..1");
+}
+
+// A battery voltage of 0 ended in GiNaC's "division by zero" in derive's hover check, without a
+// file or line, and -3 was flown (a review, helper-88): refused at its line.
+TEST(VehicleInput, ABatteryVoltageThatIsNoVoltageIsRefusedAtItsLine) {
+  std::ifstream in(test::source_path("vehicles/crazyflie21.yaml"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string cf = ss.str();
+  const std::string given = "vbat_ref: {value: 3.15, unit: V}";
+  ASSERT_NE(cf.find(given), std::string::npos);
+  for (const char* bad : {"0", "-3"})
+    expect_error(replace(cf, given, std::string("vbat_ref: {value: ") + bad + ", unit: V}"),
+                 std::string("vbat_ref = ") + bad + ": a battery voltage must be positive");
+  EXPECT_NO_THROW(parse_vehicle(cf, "cf.yaml"));
 }
 
 // A derived quantity given a value (measured apart, e.g. an inertia from a pendulum test or

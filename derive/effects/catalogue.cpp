@@ -170,8 +170,12 @@ std::string outside_physical_domain(const std::string& parameter, double value) 
   for (const auto& d : e->domain) {
     if (!d.parameter.empty() && d.parameter != parameter) continue;
     if (d.lower_included ? value >= d.lower : value > d.lower) continue;
-    return std::string("must be ") + (d.lower_included ? "at least " : "above ") + output::short_number(d.lower) + ": " +
-           d.why;
+    // A value that prints as the bound (-1.0000000000000002 as -1) is given in full.
+    const std::string full = value != d.lower && output::short_number(value) == output::short_number(d.lower)
+                                 ? " (" + output::full_number(value) + " is below it)"
+                                 : "";
+    return std::string("must be ") + (d.lower_included ? "at least " : "above ") + output::short_number(d.lower) + full +
+           ": " + d.why;
   }
   return "";
 }

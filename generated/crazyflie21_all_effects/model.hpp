@@ -42,7 +42,7 @@ namespace crazyflie21_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_1154a186c450f9e6 {
+inline namespace model_e79108bd11dd521e {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2223,6 +2223,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_1154a186c450f9e6
+}  // inline namespace model_e79108bd11dd521e
 }  // namespace crazyflie21_all_effects
 }  // namespace quadgen_generated
