@@ -30,6 +30,18 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
          vehicle.name + "'; its values are applied by parameter name";
 }
 
+// The trim is the base model's; a model whose effect values were fitted away from neutral does
+// not hover at it: how far it misses (hover_residual) and, above kHoverHolds, why it does not
+// hold, which the header, model.json and derivation.md then say instead of declaring it.
+static void judge_hover_trim(DerivedModel& out) {
+  if (!out.hover_trim.found()) return;
+  out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
+  if (out.hover_residual <= DerivedModel::kHoverHolds) return;
+  out.why_trim_does_not_hold = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
+                               output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
+                               output::short_number(out.hover_residual) + " there";
+}
+
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
   auto progress = [&](const char* step) {
     if (request.progress) request.progress(step);
@@ -48,22 +60,10 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.regenerate_flags_from_model)
     emit.regenerate_flags = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
   for (const Rotor& r : vehicle.rotors) emit.rotor_spin.push_back(spin_sign(r));
-  emit.hover_command = out.hover_trim.commands;
+  judge_hover_trim(out);
+  emit.hover_command = out.why_trim_does_not_hold.empty() ? out.hover_trim.commands : std::vector<double>{};
   emit.hover_thrust = out.hover_trim.thrusts;
-  emit.why_no_hover = out.hover_trim.why_not;
-  if (out.hover_trim.found()) {
-    // The trim is the base model's; a header whose effect values were fitted away from neutral
-    // does not hover at it, and says so rather than declare a trim that does not hold.
-    out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
-    if (!(out.hover_residual <= DerivedModel::kHoverHolds)) {
-      out.why_trim_does_not_hold =
-          "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
-          output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
-          output::short_number(out.hover_residual) + " there";
-      emit.hover_command.clear();
-      emit.why_no_hover = out.why_trim_does_not_hold;
-    }
-  }
+  emit.why_no_hover = out.why_trim_does_not_hold.empty() ? out.hover_trim.why_not : out.why_trim_does_not_hold;
   out.header = codegen::generate_header(out.model, emit);
   const Derivation d{vehicle,        mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual,
                      out.why_trim_does_not_hold};
