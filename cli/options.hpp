@@ -16,6 +16,7 @@
 
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
 #include "output/sinks.hpp"
@@ -67,14 +68,18 @@ inline std::string parameter_names_help() {
          catalogue_parameter_names() + ")";
 }
 
-// A finite number of the whole text, or nothing.
+// A finite number of the whole text, or nothing (output/numbers.hpp: the rule of the vehicle
+// file and the log cells).
 inline bool parse_finite(const std::string& text, double* value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || !std::isfinite(v)) return false;
-  *value = v;
-  return true;
+  return output::read_number(text, value) == output::NumberText::finite;
+}
+
+// Why `text` is no finite number, for a message after it: "is not a finite number", or that it
+// is below a double's smallest and would read as 0 (1e-400).
+inline std::string why_not_finite(const std::string& text) {
+  double v = 0;
+  const output::NumberText kind = output::read_number(text, &v);
+  return kind == output::NumberText::underflow ? output::number_text_problem(kind) : "is not a finite number";
 }
 
 inline std::string range_text(double lo, double hi) {
@@ -88,7 +93,7 @@ inline CLI::Validator finite_range(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& s) -> std::string {
         double v = 0;
-        if (!parse_finite(s, &v)) return "'" + s + "' is not a finite number (accepted: " + range_text(lo, hi) + ")";
+        if (!parse_finite(s, &v)) return "'" + s + "' " + why_not_finite(s) + " (accepted: " + range_text(lo, hi) + ")";
         if (v < lo || v > hi) return s + " is outside the accepted range " + range_text(lo, hi);
         return {};
       },

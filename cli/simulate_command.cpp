@@ -120,7 +120,7 @@ std::pair<std::string, double> parse_setting(const std::string& kv) {
   if (eq == std::string::npos) throw std::invalid_argument("--set expects NAME=VALUE, got '" + output::printable(kv) + "'");
   double value = 0;
   if (!parse_finite(kv.substr(eq + 1), &value))
-    throw std::invalid_argument("--set " + output::printable(kv) + ": '" + output::printable(kv.substr(eq + 1)) + "' is not a finite number");
+    throw std::invalid_argument("--set " + output::printable(kv) + ": '" + output::printable(kv.substr(eq + 1)) + "' " + why_not_finite(kv.substr(eq + 1)));
   return {kv.substr(0, eq), value};
 }
 

@@ -14,6 +14,7 @@
 #include "output/names.hpp"
 #include "output/sinks.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "model/sha256.hpp"
 #include "model/vehicle.hpp"
 #include "output/fnv1a.hpp"
 
@@ -248,7 +249,10 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   // (a review, helper-88).
   const size_t code = untagged.find("\nnamespace quadgen_generated {");
   if (code == std::string::npos) throw std::logic_error("templates/model.hpp.mustache: no namespace quadgen_generated");
-  d.set("code_tag", "model_" + output::fnv1a_hex(untagged.substr(code)));
+  // SHA-256 cut to 128 bits, not FNV-1a: an edited copy made to collide with another model's
+  // tag (about 2^32 tries of a comment with a 64-bit FNV) would link as that model (a review,
+  // helper-88).
+  d.set("code_tag", "model_" + sha256_hex(untagged.substr(code)).substr(0, 32));
   out.content = tmpl.render(d);
   return out;
 }

@@ -3,6 +3,7 @@
 // refuses unknown and repeated keys the same way (yaml-cpp keeps the first of two equal keys
 // silently).
 #pragma once
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "output/joined.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "model/vehicle.hpp"
 #include "runtime/flight_log.hpp"
@@ -117,20 +119,27 @@ struct YamlReader {
     return n;
   }
 
+  // YAML's own words for them (.inf, -.Inf, .NaN), which are numbers, just not finite ones.
+  static bool yaml_infinity_or_nan(std::string text) {
+    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return text == ".inf" || text == "+.inf" || text == "-.inf" || text == ".nan";
+  }
+
+  // By the rule the log cells and the command line follow (output/numbers.hpp): yaml-cpp's
+  // own conversion read 1e-400 as 0 without a word.
   double number(const YAML::Node& n, const std::string& what) const {
     if (!n.IsScalar()) fail(n, "expected a number for " + what);
-    double v;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(n, "expected a number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
+    const std::string shown = output::printable(n.Scalar());
+    double v = 0;
+    output::NumberText kind = output::read_number(n.Scalar(), &v);
+    if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(n.Scalar())) kind = output::NumberText::not_finite;
+    switch (kind) {
+      case output::NumberText::finite: return v;
+      case output::NumberText::not_a_number: fail(n, "expected a number for " + what + ", got '" + shown + "'");
+      case output::NumberText::not_finite: fail(n, "expected a finite number for " + what + ", got '" + shown + "'");
+      case output::NumberText::underflow:
+        fail(n, "'" + shown + "' for " + what + " " + output::number_text_problem(output::NumberText::underflow));
     }
-    if (!std::isfinite(v)) fail(n, "expected a finite number for " + what + ", got '" + output::printable(n.Scalar()) + "'");
-    // yaml-cpp reads 1e-400 as 0 without a word (the notes of the forty-second session).
-    const std::string mantissa = n.Scalar().substr(0, n.Scalar().find_first_of("eE"));
-    if (v == 0 && mantissa.find_first_of("123456789") != std::string::npos)
-      fail(n, "'" + output::printable(n.Scalar()) + "' for " + what +
-                  " is below the smallest number a double holds (it would read as 0)");
     return v;
   }
 

@@ -15,4 +15,21 @@ std::string six_digits(double v);
 // compared with only beyond six ("-1.0000000000000002" below a bound of -1).
 std::string full_number(double v);
 
+// Reading a number from text: one rule for the vehicle file, the log cells and the command
+// line (three readers once judged text each their own way: 1e-400 was refused in a vehicle
+// file and read as 0 from the command line and a log).
+enum class NumberText {
+  finite,        // a finite decimal number, the whole text
+  not_a_number,  // no number, trailing text, or hexadecimal ("0x10")
+  not_finite,    // inf, nan or beyond a double's range (1e400)
+  underflow,     // a number too small for a double, which would read as 0 (1e-400)
+};
+// Reads the whole of `text` (blanks before it allowed, as strtod allows them) into `value`,
+// which is set only when the text is a finite number. Hexadecimal is refused: strtod reads
+// "0x1p3" as 8, which no log or vehicle file means.
+NumberText read_number(const std::string& text, double* value);
+// What is wrong with text that is not finite or underflows, for a message after the text:
+// "is not finite", "is below the smallest number a double holds, so it would read as 0".
+std::string number_text_problem(NumberText kind);
+
 }  // namespace quadgen::output

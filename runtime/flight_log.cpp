@@ -4,6 +4,7 @@
 
 #include "runtime/attitude.hpp"
 #include "runtime/rigid_body_state.hpp"
+#include "output/numbers.hpp"
 #include "output/joined.hpp"
 
 #include <fcntl.h>
@@ -130,18 +131,19 @@ void split_cells(const std::string& line, const std::string& path, int lineno, s
 }
 
 // Cell i of a row: its number, or NaN with the column's first bad cell kept in `unreadable`.
-// The whole cell must be a finite number: strtod alone would accept "1\0junk" (it stops at
-// the NUL) and turn "1e400" into inf.
+// The whole cell must be a finite number (output/numbers.hpp, the rule of the vehicle file and
+// the command line): strtod alone would accept "1\0junk" (it stops at the NUL), turn "1e400"
+// into inf and "1e-400" into 0.
 double cell_value(const std::string& cell, const CsvTable& t, size_t i, int lineno,
                   std::vector<UnreadableColumn>& unreadable) {
-  char* end = nullptr;
-  const double v = std::strtod(cell.c_str(), &end);
-  const bool number = !cell.empty() && end == cell.c_str() + cell.size();
-  if (number && std::isfinite(v)) return v;
+  double v = 0;
+  const output::NumberText kind = output::read_number(cell, &v);
+  if (kind == output::NumberText::finite) return v;
   if (unreadable[i].line == 0)
     unreadable[i] = {t.columns[i], lineno,
-                     number ? " is not finite (" + quoted_cell(cell) + "; expected a finite number)"
-                            : ": expected a number, got " + quoted_cell(cell)};
+                     kind == output::NumberText::not_a_number
+                         ? ": expected a number, got " + quoted_cell(cell)
+                         : " " + output::number_text_problem(kind) + " (" + quoted_cell(cell) + "; expected a finite number)"};
   return std::numeric_limits<double>::quiet_NaN();
 }
 

@@ -491,7 +491,7 @@ TEST(Generated, TheInlineNamespaceNamesTheCodeNotThePath) {
   };
   quadgen::Vehicle v = quadgen::test::finken3();
   const std::string stock = tag(v, "vehicles/finken3.yaml");
-  EXPECT_EQ(stock.size(), std::string("inline namespace model_").size() + 16) << stock;
+  EXPECT_EQ(stock.size(), std::string("inline namespace model_").size() + 32) << stock;
   EXPECT_EQ(tag(v, "/somewhere/else/finken3 copy.yaml"), stock);
   v.blocks.front().mass *= 1.1;
   EXPECT_NE(tag(v, "vehicles/finken3.yaml"), stock);

@@ -1391,6 +1391,10 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                         "--set mass=-1");
   expect_one_line_error(simulate("J_xx=0"), "--set: J_xx = 0: a mass", "--set J_xx=0");
   expect_one_line_error(simulate("c_t=nan"), "'nan' is not a finite number", "--set c_t=nan");  // the command line's own check
+  // The vehicle file's rule (output/numbers.hpp): 1e-400 read as 0 here, and 0x10 as 16.
+  expect_one_line_error(simulate("J_xy=1e-400"), "'1e-400' is below the smallest number a double holds, so it would read as 0",
+                        "--set J_xy=1e-400");
+  expect_one_line_error(simulate("c_t=0x10"), "'0x10' is not a finite number", "--set c_t=0x10");
   // Values each within its own limits that together make no body (a sixth audit, helper-86: the
   // closed loop flew J_xy = 0.01 until it was lost), and an exposed area below zero.
   expect_one_line_error(simulate("J_xy=0.01"),

@@ -25,6 +25,7 @@
 #include "fit/motor_steps.hpp"
 #include "fit/thrust_stand.hpp"
 #include "model/vehicle.hpp"
+#include "output/numbers.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;
@@ -467,6 +468,42 @@ TEST_F(Hostile, FlightLogLinesBomAndCrlf) {
   const std::string over = write("over.csv", "t,u_A\n0,1\n0.1,1e400\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(over), {"A"}); }),
                  over, 3, "column 'u_A' is not finite ('1e400'; expected a finite number)");
+  // below a double's smallest (strtod alone gives 0) and hexadecimal (strtod alone gives 16)
+  const std::string under = write("under.csv", "t,u_A\n0,1\n0.1,1e-400\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(under), {"A"}); }),
+                 under, 3, "column 'u_A' is below the smallest number a double holds, so it would read as 0 ('1e-400'");
+  const std::string hex = write("hex.csv", "t,u_A\n0,1\n0.1,0x10\n");
+  expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(hex), {"A"}); }),
+                 hex, 3, "column 'u_A': expected a number, got '0x10'");
+}
+
+// One rule reads a number in a vehicle file, a log cell and on the command line.
+TEST(NumberText, AWholeFiniteDecimalNumberAndNothingElse) {
+  namespace out = quadgen::output;
+  const auto kind = [](const std::string& text) {
+    double v = -7;
+    const out::NumberText k = out::read_number(text, &v);
+    if (k != out::NumberText::finite) EXPECT_EQ(v, -7) << "the value is set only for a number: " << text;
+    return k;
+  };
+  const auto value = [](const std::string& text) {
+    double v = -7;
+    EXPECT_EQ(out::read_number(text, &v), out::NumberText::finite) << text;
+    return v;
+  };
+  EXPECT_EQ(value("1.5"), 1.5);
+  EXPECT_EQ(value(" -2e3"), -2000);  // blanks before it, as in "t, x" logs
+  EXPECT_EQ(value("0e-400"), 0);     // a zero is a zero however it is written
+  EXPECT_EQ(value("0.000"), 0);
+  EXPECT_GT(value("1e-310"), 0);     // subnormal, still not 0
+  EXPECT_EQ(value(".5"), 0.5);
+  for (const char* text : {"", " ", "1 ", "1,5", "abc", "0x10", "0X1P3", "1e", "--1"})
+    EXPECT_EQ(kind(text), out::NumberText::not_a_number) << text;
+  EXPECT_EQ(kind(std::string("1\0junk", 6)), out::NumberText::not_a_number);
+  for (const char* text : {"inf", "-infinity", "nan", "1e400", "-1.8e308"})
+    EXPECT_EQ(kind(text), out::NumberText::not_finite) << text;
+  for (const char* text : {"1e-400", "-1e-400", "0.00001e-320", "5e-325"})
+    EXPECT_EQ(kind(text), out::NumberText::underflow) << text;
 }
 
 // A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as

@@ -42,7 +42,7 @@ namespace crazyflie21 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_b9e66714fa00ca6c {
+inline namespace model_c229fe44ae1076c709c63ab36a8d084a {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1497,6 +1497,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_b9e66714fa00ca6c
+}  // inline namespace model_c229fe44ae1076c709c63ab36a8d084a
 }  // namespace crazyflie21
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace crazyflie21_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_e79108bd11dd521e {
+inline namespace model_0b27641f8449e12a5a09a77ad3489e2b {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2223,6 +2223,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_e79108bd11dd521e
+}  // inline namespace model_0b27641f8449e12a5a09a77ad3489e2b
 }  // namespace crazyflie21_all_effects
 }  // namespace quadgen_generated

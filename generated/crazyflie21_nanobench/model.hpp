@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_baab0b14ec38bac9 {
+inline namespace model_3d1dd0b957e3f7505eaf32568a907698 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1585,6 +1585,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_baab0b14ec38bac9
+}  // inline namespace model_3d1dd0b957e3f7505eaf32568a907698
 }  // namespace crazyflie21_nanobench
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_355687119638f713 {
+inline namespace model_252994b40ebb8ab21f09e3ac64bb934d {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2270,6 +2270,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_355687119638f713
+}  // inline namespace model_252994b40ebb8ab21f09e3ac64bb934d
 }  // namespace crazyflie21_nanobench_all_effects
 }  // namespace quadgen_generated

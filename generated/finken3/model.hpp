@@ -42,7 +42,7 @@ namespace finken3 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_18b3279eee6d8d20 {
+inline namespace model_869e96bd1f7d7c84e8b3c20ea057608b {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1499,6 +1499,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_18b3279eee6d8d20
+}  // inline namespace model_869e96bd1f7d7c84e8b3c20ea057608b
 }  // namespace finken3
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_f5c3df8a80891b6e {
+inline namespace model_185b7d3e8b4a88d5c78af6795711f7f4 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2223,6 +2223,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_f5c3df8a80891b6e
+}  // inline namespace model_185b7d3e8b4a88d5c78af6795711f7f4
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
