@@ -118,6 +118,24 @@ AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   return advisory("hover needs a tenth of the command range or more", !low, detail.str());
 }
 
+// Hover near the top of the command range leaves nothing to steer or climb with: the trim
+// check passes up to command 1 exactly (a review, helper-88), where any roll needs a rotor
+// above full. A tenth of the range kept back is a floor, not a design margin (multirotors are
+// built to hover near half their thrust).
+AuditCheck check_hover_below_the_top(const runtime::HoverTrim& trim) {
+  constexpr double kHighestHoverCommand = 0.9;
+  const std::string name = "hover leaves a tenth of the command range to steer";
+  if (!trim.found()) return advisory(name, true, "not judged: no hover trim (see the trim's check)");
+  const double highest = *std::max_element(trim.commands.begin(), trim.commands.end());
+  const bool high = highest > kHighestHoverCommand;
+  std::string detail = "the highest hover command " + output::six_digits(highest);
+  if (high)
+    detail += ", above " + output::six_digits(kHighestHoverCommand) +
+              " of the command range: too little is left to steer and climb (a vehicle too heavy for its motors, "
+              "or a motor map of other motors?)";
+  return advisory(name, !high, detail);
+}
+
 // No two rotor discs cut through each other: hubs in one plane (within a quarter of the
 // smaller radius in z) closer than the sum of the radii. A coaxial pair (same place in x and
 // y, apart in z, as on a Y6) is a design, not a mistake.
@@ -345,7 +363,7 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   // them explains the flight checks after it, which fail with it.
   return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
           check_inertia_used(m),          check_motor_map(b.thrust_laws), check_controllable(B),
-          check_hover_trim(trim, b.mass * b.g), check_hover_above_the_bottom(trim)};
+          check_hover_trim(trim, b.mass * b.g), check_hover_above_the_bottom(trim), check_hover_below_the_top(trim)};
 }
 
 }  // namespace quadgen

@@ -12,6 +12,7 @@
 
 #include "fit/least_squares.hpp"
 #include "model/yaml_reader.hpp"
+#include "output/numbers.hpp"
 #include "output/joined.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "output/nearest_word.hpp"
@@ -285,8 +286,8 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   // 100 reversed rows were resampled without a word).
   for (size_t i = 1; i < log.rows.size(); ++i)
     if (!(log.rows[i][tc] > log.rows[i - 1][tc]))
-      throw FitError(log.where_row(i) + ": time not strictly increasing (" + std::to_string(log.rows[i - 1][tc]) +
-                     " then " + std::to_string(log.rows[i][tc]) + ")");
+      throw FitError(log.where_row(i) + ": time not strictly increasing (" +
+                     output::one_then_other(log.rows[i - 1][tc], log.rows[i][tc]) + ")");
   const double t0 = log.rows.front()[tc], t1 = log.rows.back()[tc];
   if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw FitError("resample: rate must be a positive number of Hz");
   // A bound on the resampled table's size, so that a high rate ends in a message rather

@@ -27,6 +27,17 @@ std::string full_number(double v) {
   return os.str();
 }
 
+std::string one_then_other(double a, double b) {
+  for (int digits = 6;; ++digits) {
+    std::ostringstream x, y;
+    x.precision(digits);
+    y.precision(digits);
+    x << a;
+    y << b;
+    if (x.str() != y.str() || a == b || digits >= 17) return x.str() + " then " + y.str();
+  }
+}
+
 NumberText read_number(const std::string& text, double* value) {
   if (text.find_first_of("xX") != std::string::npos) return NumberText::not_a_number;
   char* end = nullptr;

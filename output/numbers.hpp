@@ -14,6 +14,9 @@ std::string six_digits(double v);
 // Every digit a double holds (17 significant): where a value differs from the one it is
 // compared with only beyond six ("-1.0000000000000002" below a bound of -1).
 std::string full_number(double v);
+// "a then b" with six significant digits, or as many more as tell them apart: a log whose time
+// goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
+std::string one_then_other(double a, double b);
 
 // Reading a number from text: one rule for the vehicle file, the log cells and the command
 // line (three readers once judged text each their own way: 1e-400 was refused in a vehicle

@@ -409,8 +409,8 @@ void validate_canonical(const CsvTable& log, const std::vector<std::string>& rot
   check_values(log);
   for (size_t i = 0; i < log.rows.size(); ++i) {
     if (i > 0 && !(log.rows[i][tc] > log.rows[i - 1][tc]))
-      fail_at_row(log, i, "time not strictly increasing (" + std::to_string(log.rows[i - 1][tc]) + " then " +
-                                  std::to_string(log.rows[i][tc]) + ")");
+      fail_at_row(log, i, "time not strictly increasing (" +
+                                  output::one_then_other(log.rows[i - 1][tc], log.rows[i][tc]) + ")");
   }
 }
 

@@ -1185,7 +1185,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
                            "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 8u);
+    ASSERT_EQ(checks.size(), 9u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1276,6 +1276,20 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_EQ(c.at(trim).detail.find("centre of gravity"), std::string::npos) << c.at(trim).detail;
     EXPECT_FALSE(c.at(low).passed);
     EXPECT_NE(c.at(low).detail.find("no trim: the rotors at command 0 lift the weight"), std::string::npos) << c.at(low).detail;
+  }
+  {  // a rotor five times weaker: hover at command 0.97, which passed the trim's check with nothing
+     // left to steer (a review, helper-88)
+    Vehicle v = good;
+    Parameter& c_t = v.params.at("c_t");
+    c_t.nominal = c_t.lower = c_t.upper = c_t.nominal * 0.2;
+    const auto c = checks_of(v);
+    const std::string high = "hover leaves a tenth of the command range to steer";
+    EXPECT_TRUE(c.at(trim).passed);
+    EXPECT_FALSE(c.at(high).passed);
+    EXPECT_NE(c.at(high).detail.find("the highest hover command 0.97"), std::string::npos) << c.at(high).detail;
+    EXPECT_NE(c.at(high).detail.find("too little is left to steer and climb"), std::string::npos) << c.at(high).detail;
+    c_t.nominal = c_t.lower = c_t.upper = good.params.at("c_t").nominal * 0.3;  // hover at 0.77
+    EXPECT_TRUE(checks_of(v).at(high).passed) << checks_of(v).at(high).detail;
   }
   {  // no trim for another reason (the centre of gravity outside the rotors): not judged, not passed on nothing
     Vehicle v = good;
