@@ -49,7 +49,18 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 // body has (a J_xy too large for the moments: the closed loop flew it until it was lost; the
 // vehicle file's own too), and
 // a thrust decay whose factor 1 - rate t reaches 0 within the flight (the rotors would pull).
-std::string settings_problem(const SimulateJob& a, const DynamicModel& m, const std::vector<double>& p) {
+// Where the vehicle file gives the tensor a body cannot have: the line of a product of inertia
+// it gives (the usual culprit, a J_xy too large or of the wrong sign), else of a moment.
+std::string where_file_gives_inertia(const Vehicle& v) {
+  for (const char* name : {"J_xy", "J_xz", "J_yz", "J_xx", "J_yy", "J_zz"}) {
+    const auto it = v.derived_overrides.find(name);
+    if (v.derived_given.count(name) && it != v.derived_overrides.end() && it->second.line > 0)
+      return output::printable(v.source_path) + ":" + std::to_string(it->second.line);
+  }
+  return output::printable(v.source_path);
+}
+
+std::string settings_problem(const SimulateJob& a, const Vehicle& v, const DynamicModel& m, const std::vector<double>& p) {
   const auto value = [&](const char* name) {
     const int i = m.param_index(name);
     return i < 0 ? 0.0 : p[static_cast<size_t>(i)];
@@ -63,7 +74,7 @@ std::string settings_problem(const SimulateJob& a, const DynamicModel& m, const 
   if (!pm.positive || !pm.triangle) {
     const bool set = std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
     std::ostringstream os;
-    os << (set ? "--set: with these values the inertia tensor's" : output::printable(a.vehicle) + ": the inertia tensor's")
+    os << (set ? "--set: with these values the inertia tensor's" : where_file_gives_inertia(v) + ": the inertia tensor's")
        << " principal moments are " << pm.moments[0] << ", " << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
        << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
                        : "not positive definite (a product of inertia too large for the moments, or its sign?)");
@@ -83,7 +94,7 @@ std::string settings_problem(const SimulateJob& a, const DynamicModel& m, const 
 // may differ in anything. No bounds of a fit apply (a test flight's truth may lie beyond
 // them), but a value the physics cannot take is refused in every mode (Effect::domain), as is
 // a delay as long as the flight (no command would act) and a name given twice.
-void apply_settings(const SimulateJob& a, DynamicModel& m) {
+void apply_settings(const SimulateJob& a, const Vehicle& v, DynamicModel& m) {
   std::vector<double> p = m.params();
   std::set<std::string> seen;
   for (const auto& [name, value] : a.set) {
@@ -111,7 +122,7 @@ void apply_settings(const SimulateJob& a, DynamicModel& m) {
     if (!problem.empty()) throw std::invalid_argument("--set: " + output::printable(name) + " " + problem);
     p[i] = value;
   }
-  if (const std::string problem = settings_problem(a, m, p); !problem.empty()) throw std::invalid_argument(problem);
+  if (const std::string problem = settings_problem(a, v, m, p); !problem.empty()) throw std::invalid_argument(problem);
   m.set_params(p);
 }
 
@@ -513,7 +524,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const SymbolicModel model = derive_model(vehicle, derive_mass_properties(vehicle), opt);
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
-  apply_settings(a, m);  // before anything reads the parameters (the scenario's delay)
+  apply_settings(a, vehicle, m);  // before anything reads the parameters (the scenario's delay)
   // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor
   // places, trim and allocation, and the closed loop's controller, all from this one.
   const ControllerModel belief = nominal_controller_belief(vehicle, model);

@@ -1946,6 +1946,15 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
   EXPECT_NE(file.find("mass 0.52 kg (the file's `derived:`); centre of gravity ("), std::string::npos) << file;
   EXPECT_NE(file.find(" kg m^2 (the blocks'; the file's `derived:`: J_xy)"), std::string::npos) << file;
   EXPECT_NE(file.find("the inertia the model uses is a body's: no"), std::string::npos) << file;
+  // simulate refuses that tensor at the line that gives it (it named the file alone; helper-88)
+  const auto j_line = std::count(given.begin(), given.begin() + static_cast<long>(given.find("  J_xy: {value: 0.002")), '\n') + 1;
+  const auto flown =
+      run_quadgen({"simulate", tmp / "given.yaml", "--closed-loop", "--duration", "1", "--out", tmp / "s.csv"}, tmp.dir);
+  EXPECT_NE(flown.rc, 0);
+  EXPECT_NE(flown.err.find("given.yaml:" + std::to_string(j_line) + ": the inertia tensor's principal moments are "),
+            std::string::npos)
+      << flown.err;
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   // A fitted value (--params) is said as fitted, not as the blocks'.
   write(tmp.dir / "fitted.yaml", "vehicle: finken3\neffects: []\nparameters:\n  mass: {value: 0.4, unit: kg}\n");
   FILE* p = ::popen((std::string(QUADGEN_BINARY) + " derive '" + source_path("vehicles/finken3.yaml") + "' --params '" +
