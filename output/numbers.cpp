@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 namespace quadgen::output {
 
 std::string short_number(double v) {
@@ -60,6 +62,39 @@ std::string number_text_problem(NumberText kind) {
     case NumberText::underflow: return "is below the smallest number a double holds, so it would read as 0";
   }
   return "is not a number";
+}
+
+namespace {
+
+// Walks JSON text and keeps the first floating-point number's text that underflows; a SAX pass
+// sees each number as written, which the parsed document no longer does.
+struct UnderflowFinder : nlohmann::json::json_sax_t {
+  std::string found;
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t& text) override {
+    double v = 0;
+    if (read_number(text, &v) == NumberText::underflow) found = text;
+    return found.empty();  // stop at the first
+  }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::json::exception&) override { return false; }
+};
+
+}  // namespace
+
+std::string json_number_below_a_double(const std::string& json_text) {
+  UnderflowFinder finder;
+  nlohmann::json::sax_parse(json_text, &finder);
+  return finder.found;
 }
 
 }  // namespace quadgen::output

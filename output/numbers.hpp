@@ -34,5 +34,9 @@ NumberText read_number(const std::string& text, double* value);
 // What is wrong with text that is not finite or underflows, for a message after the text:
 // "is not finite", "is below the smallest number a double holds, so it would read as 0".
 std::string number_text_problem(NumberText kind);
+// The first number in JSON text (a --params or --airframe file) that reads as 0 only because a
+// double cannot hold it (1e-400): nlohmann's parser takes it as 0 without a word. Empty when
+// there is none, or the text is no JSON (the parse that follows says so).
+std::string json_number_below_a_double(const std::string& json_text);
 
 }  // namespace quadgen::output

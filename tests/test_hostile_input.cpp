@@ -1382,6 +1382,10 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
                         "zero.json: estimates.J_zz = 0: a mass and a principal moment of inertia must be positive", "J_zz 0");
   expect_one_line_error(predict(params("lag.json", R"("motor_lag.tau": {"value": 5})")),
                         "lag.json: estimates.motor_lag.tau = 5 is outside its bounds", "tau 5");
+  // read as 0 by the JSON parser, without a word (one rule for numbers, output/numbers.hpp)
+  expect_one_line_error(predict(params("tiny.json", R"("J_xy": {"value": 1e-400})")),
+                        "tiny.json: the number 1e-400 is below the smallest number a double holds, so it would read as 0",
+                        "J_xy 1e-400");
   EXPECT_FALSE(fs::exists(tmp / "p"));
   const auto simulate = [&](const std::string& setting) {
     return run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "1", "--set", setting, "--out", tmp / "s.csv"},

@@ -504,6 +504,10 @@ TEST(NumberText, AWholeFiniteDecimalNumberAndNothingElse) {
     EXPECT_EQ(kind(text), out::NumberText::not_finite) << text;
   for (const char* text : {"1e-400", "-1e-400", "0.00001e-320", "5e-325"})
     EXPECT_EQ(kind(text), out::NumberText::underflow) << text;
+  // in JSON, where the parser reads it as 0 (the first such number, as written)
+  EXPECT_EQ(out::json_number_below_a_double(R"({"a": [1, 2.5, -1E-400, 3e-500], "b": 1e-400})"), "-1E-400");
+  EXPECT_EQ(out::json_number_below_a_double(R"({"a": 0e-400, "b": 1e-310, "c": "1e-400"})"), "");
+  EXPECT_EQ(out::json_number_below_a_double("not JSON 1e-400"), "");
 }
 
 // A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as
