@@ -148,7 +148,9 @@ struct TrimProblem {
       most(i) = l.thrust_at_command(1.0);
     }
   }
-  bool balances(const Eigen::VectorXd& F) const { return (A * F - w).norm() <= 1e-6 * weight; }
+  // stableNorm: a weight of 1e300 N squared overflows, and norm() then said no thrusts balance
+  // it (a review, helper-88).
+  bool balances(const Eigen::VectorXd& F) const { return (A * F - w).stableNorm() <= 1e-6 * weight; }
   bool above_least(const Eigen::VectorXd& F) const { return balances(F) && (F - least).minCoeff() >= -1e-12 * weight; }
   bool within_reach(const Eigen::VectorXd& F) const { return above_least(F) && (most - F).minCoeff() >= -1e-12 * weight; }
   Eigen::VectorXd trim(const std::vector<bool>& free) const { return trim_with(A, free, least, w); }
@@ -172,7 +174,7 @@ void search_held_sets(const TrimProblem& P, Eigen::VectorXd& F, std::vector<bool
     std::vector<bool> f(n);
     for (size_t i = 0; i < n; ++i) f[i] = !(held >> i & 1u);
     const Eigen::VectorXd candidate = P.trim(f);
-    if (P.within_reach(candidate) && candidate.squaredNorm() < best) best = candidate.squaredNorm(), F = candidate, free = f;
+    if (P.within_reach(candidate) && candidate.stableNorm() < best) best = candidate.stableNorm(), F = candidate, free = f;
   }
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -39,7 +40,13 @@ struct ThrustLaw {
 };
 
 inline double ThrustLaw::command_for(double thrust) const {
-  if (!(thrust >= 0)) throw std::invalid_argument("thrust " + std::to_string(thrust) + " N requested of a rotor");
+  // Six significant digits: std::to_string wrote a thrust of 1.6e299 N with 300 digits.
+  const auto newtons = [](double f) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g N", f);
+    return std::string(buf);
+  };
+  if (!(thrust >= 0)) throw std::invalid_argument("thrust " + newtons(thrust) + " requested of a rotor");
   // Why no command gives it: a map that does not rise over 0..1, or a thrust below what
   // command 0 gives, or above what command 1 gives.
   const auto unreachable = [&] {
@@ -48,10 +55,10 @@ inline double ThrustLaw::command_for(double thrust) const {
                                    std::to_string(a1) + ", a2 = " + std::to_string(a2) + " rad/s)");
     const double lowest = thrust_at_command(0.0);
     if (thrust < lowest)
-      return std::invalid_argument("thrust " + std::to_string(thrust) + " N is below what the motor map gives at command 0 (" +
-                                   std::to_string(lowest) + " N)");
-    return std::invalid_argument("thrust " + std::to_string(thrust) + " N is beyond the motor map (at most " +
-                                 std::to_string(thrust_at_speed(speed_at(1.0))) + " N at command 1)");
+      return std::invalid_argument("thrust " + newtons(thrust) + " is below what the motor map gives at command 0 (" +
+                                   newtons(lowest) + ")");
+    return std::invalid_argument("thrust " + newtons(thrust) + " is beyond the motor map (at most " +
+                                 newtons(thrust_at_speed(speed_at(1.0))) + " at command 1)");
   };
   const double w = std::sqrt(thrust / k);
   // Solve a2 u^2 + a1 u + (a0 - w) = 0 for the root in [0, 1].

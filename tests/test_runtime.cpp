@@ -1072,6 +1072,14 @@ TEST(HoverTrim, AWeightThatIsNoFiniteNumberIsSaid) {
   const HoverTrim trim = hover_trim(b, kHexaNames);
   EXPECT_FALSE(trim.found());
   EXPECT_EQ(trim.why_not, "the weight m g is not a finite number (mass 1.7e+308 kg)");
+  // Finite but beyond any motor: said as that, in six digits (the least-norm check squared the
+  // weight into an overflow and said no thrusts balance it; a thrust had 300 digits).
+  b.mass = 1e300;
+  const HoverTrim heavy = hover_trim(b, kHexaNames);
+  EXPECT_FALSE(heavy.found());
+  EXPECT_NE(heavy.why_not.find("is beyond the motor map (at most "), std::string::npos) << heavy.why_not;
+  EXPECT_EQ(heavy.why_not.find("balance"), std::string::npos) << heavy.why_not;
+  EXPECT_LT(heavy.why_not.size(), 200u) << heavy.why_not;
 }
 
 TEST(HoverTrim, HoldingRotorsAtIdleKeepsEveryOneBelowCommandOne) {
