@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -45,21 +46,27 @@ void check_size(const SimulateJob& a, double steps, double rows) {
 }
 
 
+// Where the vehicle file gives the tensor a body cannot have: for a tensor not positive
+// definite the line of a product of inertia it gives (the usual culprit, a J_xy too large or
+// of the wrong sign), for moments that break the triangle rule the line of a moment; else the
+// other kind's line.
+std::string where_file_gives_inertia(const Vehicle& v, bool moments_first) {
+  const auto line_of_first = [&](std::initializer_list<const char*> names) {
+    for (const char* name : names) {
+      const auto it = v.derived_overrides.find(name);
+      if (v.derived_given.count(name) && it != v.derived_overrides.end() && it->second.line > 0) return it->second.line;
+    }
+    return 0;
+  };
+  const int products = line_of_first({"J_xy", "J_xz", "J_yz"}), moments = line_of_first({"J_xx", "J_yy", "J_zz"});
+  const int line = moments_first ? (moments ? moments : products) : (products ? products : moments);
+  return output::printable(v.source_path) + (line ? ":" + std::to_string(line) : "");
+}
+
 // What only the --set values together with the others tell (a review): an inertia tensor no
 // body has (a J_xy too large for the moments: the closed loop flew it until it was lost; the
 // vehicle file's own too), and
 // a thrust decay whose factor 1 - rate t reaches 0 within the flight (the rotors would pull).
-// Where the vehicle file gives the tensor a body cannot have: the line of a product of inertia
-// it gives (the usual culprit, a J_xy too large or of the wrong sign), else of a moment.
-std::string where_file_gives_inertia(const Vehicle& v) {
-  for (const char* name : {"J_xy", "J_xz", "J_yz", "J_xx", "J_yy", "J_zz"}) {
-    const auto it = v.derived_overrides.find(name);
-    if (v.derived_given.count(name) && it != v.derived_overrides.end() && it->second.line > 0)
-      return output::printable(v.source_path) + ":" + std::to_string(it->second.line);
-  }
-  return output::printable(v.source_path);
-}
-
 std::string settings_problem(const SimulateJob& a, const Vehicle& v, const DynamicModel& m, const std::vector<double>& p) {
   const auto value = [&](const char* name) {
     const int i = m.param_index(name);
@@ -74,7 +81,7 @@ std::string settings_problem(const SimulateJob& a, const Vehicle& v, const Dynam
   if (!pm.positive || !pm.triangle) {
     const bool set = std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
     std::ostringstream os;
-    os << (set ? "--set: with these values the inertia tensor's" : where_file_gives_inertia(v) + ": the inertia tensor's")
+    os << (set ? "--set: with these values the inertia tensor's" : where_file_gives_inertia(v, pm.positive) + ": the inertia tensor's")
        << " principal moments are " << pm.moments[0] << ", " << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
        << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
                        : "not positive definite (a product of inertia too large for the moments, or its sign?)");

@@ -132,6 +132,12 @@ struct YamlReader {
     const std::string shown = output::printable(n.Scalar());
     double v = 0;
     output::NumberText kind = output::read_number(n.Scalar(), &v);
+    // A quoted or block scalar keeps its blanks: "1 " and a block's final newline were read by
+    // yaml-cpp, " 1" was not; none is a number here (a review, helper-89).
+    const std::string& text = n.Scalar();
+    if (!text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
+                          std::isspace(static_cast<unsigned char>(text.back()))))
+      kind = output::NumberText::not_a_number;
     if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(n.Scalar())) kind = output::NumberText::not_finite;
     switch (kind) {
       case output::NumberText::finite: return v;

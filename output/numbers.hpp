@@ -27,6 +27,8 @@ enum class NumberText {
   not_finite,    // inf, nan or beyond a double's range (1e400)
   underflow,     // a number too small for a double, which would read as 0 (1e-400)
 };
+// strtod takes its decimal point from the C locale: quadgen never calls setlocale, and must not
+// (a "1.5" would read as 1 under a German locale, and the files would be misread, not refused).
 // Reads the whole of `text` (blanks before it allowed, as strtod allows them) into `value`,
 // which is set only when the text is a finite number. Hexadecimal is refused: strtod reads
 // "0x1p3" as 8, which no log or vehicle file means.

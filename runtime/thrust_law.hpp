@@ -40,19 +40,21 @@ struct ThrustLaw {
 };
 
 inline double ThrustLaw::command_for(double thrust) const {
-  // Six significant digits: std::to_string wrote a thrust of 1.6e299 N with 300 digits.
-  const auto newtons = [](double f) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g N", f);
+  // Six significant digits: std::to_string wrote a thrust of 1.6e299 N with 300 digits, and
+  // an a1 of -1e-9 rad/s as -0.000000.
+  const auto six = [](double v, const char* unit) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.6g %s", v, unit);
     return std::string(buf);
   };
+  const auto newtons = [&](double f) { return six(f, "N"); };
   if (!(thrust >= 0)) throw std::invalid_argument("thrust " + newtons(thrust) + " requested of a rotor");
   // Why no command gives it: a map that does not rise over 0..1, or a thrust below what
   // command 0 gives, or above what command 1 gives.
   const auto unreachable = [&] {
     if (!(a1 > 0 && a1 + 2 * a2 > 0))
       return std::invalid_argument("the motor map's speed does not rise with the command over 0..1 (a1 = " +
-                                   std::to_string(a1) + ", a2 = " + std::to_string(a2) + " rad/s)");
+                                   six(a1, "rad/s") + ", a2 = " + six(a2, "rad/s") + ")");
     const double lowest = thrust_at_command(0.0);
     if (thrust < lowest)
       return std::invalid_argument("thrust " + newtons(thrust) + " is below what the motor map gives at command 0 (" +

@@ -1959,6 +1959,21 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
             std::string::npos)
       << flown.err;
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
+  // A moment too large for the other two (the triangle rule) is a moment's line, not that of a
+  // harmless product of inertia the file also gives (a review, helper-89).
+  std::string lopsided = text;
+  lopsided.replace(lopsided.find(mass), mass.size(), "  J_xy: {value: 0, unit: kg m^2}\n  J_zz: {value: 0.1, unit: kg m^2}\n");
+  write(tmp.dir / "lopsided.yaml", lopsided);
+  const auto zz_line =
+      std::count(lopsided.begin(), lopsided.begin() + static_cast<long>(lopsided.find("  J_zz: {value: 0.1")), '\n') + 1;
+  const auto lopsided_flown =
+      run_quadgen({"simulate", tmp / "lopsided.yaml", "--closed-loop", "--duration", "1", "--out", tmp / "s.csv"}, tmp.dir);
+  EXPECT_NE(lopsided_flown.rc, 0);
+  EXPECT_NE(lopsided_flown.err.find("lopsided.yaml:" + std::to_string(zz_line) + ": the inertia tensor's principal moments are "),
+            std::string::npos)
+      << lopsided_flown.err;
+  EXPECT_NE(lopsided_flown.err.find("the largest exceeds the sum of the other two"), std::string::npos) << lopsided_flown.err;
+  EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   // A fitted value (--params) is said as fitted, not as the blocks'.
   write(tmp.dir / "fitted.yaml", "vehicle: finken3\neffects: []\nparameters:\n  mass: {value: 0.4, unit: kg}\n");
   FILE* p = ::popen((std::string(QUADGEN_BINARY) + " derive '" + source_path("vehicles/finken3.yaml") + "' --params '" +

@@ -471,7 +471,7 @@ TEST_F(Hostile, FlightLogLinesBomAndCrlf) {
   // below a double's smallest (strtod alone gives 0) and hexadecimal (strtod alone gives 16)
   const std::string under = write("under.csv", "t,u_A\n0,1\n0.1,1e-400\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(under), {"A"}); }),
-                 under, 3, "column 'u_A' is below the smallest number a double holds, so it would read as 0 ('1e-400'");
+                 under, 3, "column 'u_A' is below the smallest number a double holds, so it would read as 0 ('1e-400')");
   const std::string hex = write("hex.csv", "t,u_A\n0,1\n0.1,0x10\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(hex), {"A"}); }),
                  hex, 3, "column 'u_A': expected a number, got '0x10'");
