@@ -149,9 +149,8 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
     throw airframe_error(path, "not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
                                    "); expected the diagnosis.json of an earlier diagnose run");
   }
-  if (const std::string tiny = output::json_number_below_a_double(text); !tiny.empty())
-    throw airframe_error(path, "the number " + output::printable(tiny) + " " +
-                                   output::number_text_problem(output::NumberText::underflow));
+  if (const std::string problem = output::json_number_problem(text); !problem.empty())
+    throw airframe_error(path, problem);
   try {
     return read_airframe(j, path, all);
   } catch (const nlohmann::json::exception& e) {  // an entry of another type than quadgen writes

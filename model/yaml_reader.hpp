@@ -129,16 +129,15 @@ struct YamlReader {
   // own conversion read 1e-400 as 0 without a word.
   double number(const YAML::Node& n, const std::string& what) const {
     if (!n.IsScalar()) fail(n, "expected a number for " + what);
-    const std::string shown = output::printable(n.Scalar());
-    double v = 0;
-    output::NumberText kind = output::read_number(n.Scalar(), &v);
+    const std::string& text = n.Scalar();
+    const std::string shown = output::printable(text);
     // A quoted or block scalar keeps its blanks: "1 " and a block's final newline were read by
     // yaml-cpp, " 1" was not; none is a number here (a review, helper-89).
-    const std::string& text = n.Scalar();
-    if (!text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
-                          std::isspace(static_cast<unsigned char>(text.back()))))
-      kind = output::NumberText::not_a_number;
-    if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(n.Scalar())) kind = output::NumberText::not_finite;
+    const bool blank_around = !text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
+                                                std::isspace(static_cast<unsigned char>(text.back())));
+    double v = 0;
+    output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, &v);
+    if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(text)) kind = output::NumberText::not_finite;
     switch (kind) {
       case output::NumberText::finite: return v;
       case output::NumberText::not_a_number: fail(n, "expected a number for " + what + ", got '" + shown + "'");

@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "output/sinks.hpp"
+
 namespace quadgen::output {
 
 std::string short_number(double v) {
@@ -95,6 +97,11 @@ std::string json_number_below_a_double(const std::string& json_text) {
   UnderflowFinder finder;
   nlohmann::json::sax_parse(json_text, &finder);
   return finder.found;
+}
+
+std::string json_number_problem(const std::string& json_text) {
+  const std::string tiny = json_number_below_a_double(json_text);
+  return tiny.empty() ? "" : "the number " + printable(tiny) + " " + number_text_problem(NumberText::underflow);
 }
 
 }  // namespace quadgen::output

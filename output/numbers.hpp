@@ -40,5 +40,7 @@ std::string number_text_problem(NumberText kind);
 // double cannot hold it (1e-400): nlohmann's parser takes it as 0 without a word. Empty when
 // there is none, or the text is no JSON (the parse that follows says so).
 std::string json_number_below_a_double(const std::string& json_text);
+// What a reader of JSON says of such a number ("the number 1e-400 is below ..."), or nothing.
+std::string json_number_problem(const std::string& json_text);
 
 }  // namespace quadgen::output

@@ -39,9 +39,8 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
                                 "); --params takes the diagnosis.json or fit.json a diagnose or fit run writes (the "
                                 "fitted_parameters.yaml beside it is for derive --params)");
   }
-  if (const std::string tiny = output::json_number_below_a_double(text); !tiny.empty())
-    throw std::invalid_argument(path + ": the number " + output::printable(tiny) + " " +
-                                output::number_text_problem(output::NumberText::underflow));
+  if (const std::string problem = output::json_number_problem(text); !problem.empty())
+    throw std::invalid_argument(path + ": " + problem);
   if (!json_.is_object()) throw std::invalid_argument(path + ": expected a diagnosis.json or fit.json object");
   if (json_.value("kind", nlohmann::json()) == "thrust_stand")
     throw std::invalid_argument(path + ": a thrust-stand fit describes the motors (thrust_vs_speed, speed_vs_command), "
