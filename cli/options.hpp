@@ -74,12 +74,14 @@ inline bool parse_finite(const std::string& text, double* value) {
   return output::read_number(text, value) == output::NumberText::finite;
 }
 
-// Why `text` is no finite number, for a message after it: "is not a finite number", or that it
-// is below a double's smallest and would read as 0 (1e-400).
+// Why `text` is no finite number, for a message after it: "is not a finite number" (with a
+// word on hexadecimal where it is that), or that it is below a double's smallest and would read
+// as 0 (1e-400).
 inline std::string why_not_finite(const std::string& text) {
   double v = 0;
   const output::NumberText kind = output::read_number(text, &v);
-  return kind == output::NumberText::underflow ? output::number_text_problem(kind) : "is not a finite number";
+  return kind == output::NumberText::underflow ? output::number_text_problem(kind)
+                                               : "is not a finite number" + output::hexadecimal_hint(text);
 }
 
 inline std::string range_text(double lo, double hi) {

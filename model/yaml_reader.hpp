@@ -140,7 +140,8 @@ struct YamlReader {
     if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(text)) kind = output::NumberText::not_finite;
     switch (kind) {
       case output::NumberText::finite: return v;
-      case output::NumberText::not_a_number: fail(n, "expected a number for " + what + ", got '" + shown + "'");
+      case output::NumberText::not_a_number:
+        fail(n, "expected a number for " + what + ", got '" + shown + "'" + output::hexadecimal_hint(text));
       case output::NumberText::not_finite: fail(n, "expected a finite number for " + what + ", got '" + shown + "'");
       case output::NumberText::underflow:
         fail(n, "'" + shown + "' for " + what + " " + output::number_text_problem(output::NumberText::underflow));

@@ -56,6 +56,14 @@ NumberText read_number(const std::string& text, double* value) {
   return NumberText::finite;
 }
 
+std::string hexadecimal_hint(const std::string& text) {
+  size_t i = text.find_first_not_of(" \t\n\v\f\r");
+  if (i != std::string::npos && (text[i] == '+' || text[i] == '-')) ++i;
+  const bool hexadecimal = i != std::string::npos && i + 1 < text.size() && text[i] == '0' &&
+                           (text[i + 1] == 'x' || text[i + 1] == 'X');
+  return hexadecimal ? "; hexadecimal is not read, write it in decimal" : "";
+}
+
 std::string number_text_problem(NumberText kind) {
   switch (kind) {
     case NumberText::finite: return "is a finite number";

@@ -33,6 +33,10 @@ enum class NumberText {
 // which is set only when the text is a finite number. Hexadecimal is refused: strtod reads
 // "0x1p3" as 8, which no log or vehicle file means.
 NumberText read_number(const std::string& text, double* value);
+// After "is not a number": "; hexadecimal is not read, write it in decimal" for text such as
+// "0x10" or "-0X1p3", which strtod would have taken; otherwise nothing. A person who wrote 0x10
+// meant a number, and "expected a number, got '0x10'" alone leaves them guessing why.
+std::string hexadecimal_hint(const std::string& text);
 // What is wrong with text that is not finite or underflows, for a message after the text:
 // "is not finite", "is below the smallest number a double holds, so it would read as 0".
 std::string number_text_problem(NumberText kind);

@@ -142,7 +142,7 @@ double cell_value(const std::string& cell, const CsvTable& t, size_t i, int line
   if (unreadable[i].line == 0)
     unreadable[i] = {t.columns[i], lineno,
                      kind == output::NumberText::not_a_number
-                         ? ": expected a number, got " + quoted_cell(cell)
+                         ? ": expected a number, got " + quoted_cell(cell) + output::hexadecimal_hint(cell)
                          : " " + output::number_text_problem(kind) + " (" + quoted_cell(cell) +
                                (kind == output::NumberText::underflow ? ")" : "; expected a finite number)")};
   return std::numeric_limits<double>::quiet_NaN();

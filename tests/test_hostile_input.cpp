@@ -1398,7 +1398,8 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   // The vehicle file's rule (output/numbers.hpp): 1e-400 read as 0 here, and 0x10 as 16.
   expect_one_line_error(simulate("J_xy=1e-400"), "'1e-400' is below the smallest number a double holds, so it would read as 0",
                         "--set J_xy=1e-400");
-  expect_one_line_error(simulate("c_t=0x10"), "'0x10' is not a finite number", "--set c_t=0x10");
+  expect_one_line_error(simulate("c_t=0x10"), "'0x10' is not a finite number; hexadecimal is not read, write it in decimal",
+                        "--set c_t=0x10");
   // Values each within its own limits that together make no body (a sixth audit, helper-86: the
   // closed loop flew J_xy = 0.01 until it was lost), and an exposed area below zero.
   expect_one_line_error(simulate("J_xy=0.01"),
@@ -1624,6 +1625,9 @@ TEST(Cli, NewcomerMistakesAreNamed) {
                2, "negative.json: findings: motor_lag.tau = -5 is outside its bounds");
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("unknown.json", "wind2", "0.05"), "--out", tmp / "o"},
                2, "unknown.json: findings: unknown effect 'wind2'");
+  // A value too small for a double, which the JSON parser alone reads as 0 (as --params' test).
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("tiny.json", "motor_lag", "1e-400"), "--out", tmp / "o"},
+               2, "tiny.json: the number 1e-400 is below the smallest number a double holds, so it would read as 0");
 }
 
 // A user trial of the less-trodden paths (helper-79, 2026-12-03): simulate ignored --effects

@@ -474,7 +474,7 @@ TEST_F(Hostile, FlightLogLinesBomAndCrlf) {
                  under, 3, "column 'u_A' is below the smallest number a double holds, so it would read as 0 ('1e-400')");
   const std::string hex = write("hex.csv", "t,u_A\n0,1\n0.1,0x10\n");
   expect_located(message_of<runtime::LogError>([&] { runtime::validate_canonical(runtime::read_csv(hex), {"A"}); }),
-                 hex, 3, "column 'u_A': expected a number, got '0x10'");
+                 hex, 3, "column 'u_A': expected a number, got '0x10'; hexadecimal is not read, write it in decimal");
 }
 
 // One rule reads a number in a vehicle file, a log cell and on the command line.
@@ -500,6 +500,10 @@ TEST(NumberText, AWholeFiniteDecimalNumberAndNothingElse) {
   for (const char* text : {"", " ", "1 ", "1,5", "abc", "0x10", "0X1P3", "1e", "--1"})
     EXPECT_EQ(kind(text), out::NumberText::not_a_number) << text;
   EXPECT_EQ(kind(std::string("1\0junk", 6)), out::NumberText::not_a_number);
+  // hexadecimal is said as such (strtod would read it), other text that is no number is not
+  for (const char* text : {"0x10", "0X1P3", " -0x1", "+0xg"})
+    EXPECT_EQ(out::hexadecimal_hint(text), "; hexadecimal is not read, write it in decimal") << text;
+  for (const char* text : {"", "0", "x10", "10x", "1e0x", "-", "abc", "0 x1"}) EXPECT_EQ(out::hexadecimal_hint(text), "") << text;
   for (const char* text : {"inf", "-infinity", "nan", "1e400", "-1.8e308"})
     EXPECT_EQ(kind(text), out::NumberText::not_finite) << text;
   for (const char* text : {"1e-400", "-1e-400", "0.00001e-320", "5e-325"})

@@ -265,7 +265,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
       {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: expected a finite number for c_w"},
       {head + "  c_w: {value: 1e-400, unit: \"1\"}\n", ":4: '1e-400' for c_w is below the smallest number a double holds"},
-      {head + "  c_w: {value: 0x10, unit: \"1\"}\n", ":4: expected a number for c_w, got '0x10'"},
+      {head + "  c_w: {value: 0x10, unit: \"1\"}\n", ":4: expected a number for c_w, got '0x10'; hexadecimal is not read"},
       {head + "  c_w: {value: \"1 \", unit: \"1\"}\n", ":4: expected a number for c_w, got '1 '"},
       {head + "  c_t: {value: 0.2, unit: \"1\"}\n", ":4: key 'c_t' given twice in parameters"},
       {head + "  c_w: {value: 1, unit: \"1\", bounds: [0, 2]}\n", ":4: unknown key 'bounds' in parameter c_w"},
