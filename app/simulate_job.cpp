@@ -532,6 +532,10 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const auto model_ptr = make_model(model);
   DynamicModel& m = *model_ptr;
   apply_settings(a, vehicle, m);  // before anything reads the parameters (the scenario's delay)
+  // Flown as set (a test flight may mean it), but said before the flight rather than only after
+  // a divergence: motor_gain.M3=0.93 meant as "93 %" flew a rotor 93 % strong (a user trial).
+  if (const std::string outside = implausible_settings(a, vehicle); !outside.empty())
+    a.progress.say("note: flown as set, though" + outside.substr(1));
   // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor
   // places, trim and allocation, and the closed loop's controller, all from this one.
   const ControllerModel belief = nominal_controller_belief(vehicle, model);

@@ -43,7 +43,8 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--set", a.set,
                 std::string("NAME=VALUE for a parameter of the simulated model (repeatable): in a closed loop any "
                             "of the true model, which the controller does not know; in a scenario or a replay an "
-                            "effect's only; names: ") +
+                            "effect's only; an effect's values are as docs/effects.md gives them (motor_gain.<rotor> "
+                            "is a relative change: thrust x (1 + value), 0 for none); names: ") +
                     parameter_names_help());
   c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);

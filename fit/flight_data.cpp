@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 #include <yaml-cpp/yaml.h>
 
+#include "fit/grid_mean.hpp"
 #include "fit/least_squares.hpp"
 #include "model/yaml_reader.hpp"
 #include "output/numbers.hpp"
@@ -305,16 +306,17 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   out.unreadable = log.unreadable;  // asking for one stays the error at its line
   out.resampled_hz = rate_hz;
   out.time_from_topics_start = log.time_from_topics_start;
-  size_t i = 0;
+  // Each column's mean over the grid interval around each grid point, not its value there
+  // (fit/grid_mean.hpp): a log faster than the grid would fold its fast content into the rest.
+  std::vector<std::vector<double>> columns(log.columns.size(), std::vector<double>(log.rows.size()));
+  for (size_t i = 0; i < log.rows.size(); ++i)
+    for (size_t c = 0; c < columns.size(); ++c) columns[c][i] = log.rows[i][c];
+  const size_t last = log.rows.size() - 1;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;
     if (t > t1) break;
-    while (i + 2 < log.rows.size() && log.rows[i + 1][tc] <= t) ++i;
-    const auto& a = log.rows[i];
-    const auto& b = log.rows[i + 1];
-    const double w = std::clamp((t - a[tc]) / (b[tc] - a[tc]), 0.0, 1.0);
-    std::vector<double> row(a.size());
-    for (size_t c = 0; c < a.size(); ++c) row[c] = (1 - w) * a[c] + w * b[c];
+    std::vector<double> row(columns.size());
+    for (size_t c = 0; c < columns.size(); ++c) row[c] = grid_mean(columns[tc], columns[c], 0, last, t, 0.5 / rate_hz);
     row[tc] = t;
     out.rows.push_back(row);
   }
@@ -359,6 +361,22 @@ namespace {
 }
 }  // namespace
 
+std::string gyro_disagreement_hint(double slope, double se, bool euler) {
+  // A unit's hint only where the slope is that unit's factor and the data tell the factor from
+  // zero (a mapping with p and q swapped gave -0.13 +- 0.058, and was told "deg/s read as
+  // rad/s?": a user trial, helper-91); any other disagreement is one of convention or axes.
+  const double per_degree = M_PI / 180;
+  const auto near = [&](double factor) {
+    return slope > 0 && 3 * se < factor && std::fabs(slope - factor) < 3 * se + 0.25 * factor;
+  };
+  if (near(per_degree)) return "deg/s read as rad/s? (in the mapping, unit: deg/s)";
+  if (near(1 / per_degree))
+    return euler ? "attitude angles in degrees read as radians (in the mapping, unit: deg), or a gyro in rad/s read as deg/s?"
+                 : "rad/s read as deg/s?";
+  return "the attitude and the gyro disagree in convention or axes: a world-to-body quaternion (in the mapping, scale: "
+         "-1 on qx, qy, qz), gyro axes of another frame (frame: ned_frd), or gyro columns mapped to the wrong axes?";
+}
+
 namespace {
 // Two unit mistakes a mapping can make that no dimension check sees, because the unit is
 // right and the number is not: a gyro in deg/s declared rad/s (57 times the rates the
@@ -402,20 +420,9 @@ void check_gyro_against_attitude(const std::string& path, const Flight& f, bool 
       const double slope = ag / gg;
       const double se = std::sqrt(std::max(0.0, aa - slope * ag) / static_cast<double>(3 * n - 1) / gg);
       if ((slope + 3 * se < 0.2 || slope - 3 * se > 5) && se < 0.1 * std::max(1.0, std::fabs(slope))) {
-        // The hint only where the slope is the unit's factor; any other disagreement is one of
-        // convention or axes.
-        const double per_degree = M_PI / 180;
-        const auto near = [&](double factor) { return std::fabs(slope - factor) < 3 * se + 0.25 * factor; };
         std::ostringstream os;
         os << path << ": the logged attitude turns " << slope << " times as far as the gyro's rates say (+- " << se
-           << ", over " << n << " windows of up to 0.2 s): "
-           << (near(per_degree)       ? "deg/s read as rad/s? (in the mapping, unit: deg/s)"
-               : near(1 / per_degree) ? (euler ? "attitude angles in degrees read as radians (in the mapping, unit: deg), "
-                                                 "or a gyro in rad/s read as deg/s?"
-                                               : "rad/s read as deg/s?")
-                                      : "the attitude and the gyro disagree in convention or axes: a world-to-body "
-                                        "quaternion (in the mapping, scale: -1 on qx, qy, qz), or gyro axes of another "
-                                        "frame (frame: ned_frd)?");
+           << ", over " << n << " windows of up to 0.2 s): " << gyro_disagreement_hint(slope, se, euler);
         throw FitError(os.str());
       }
     }

@@ -106,6 +106,13 @@ struct FlightOptions {
 // different rates and forward-filled, or irregular sample times).
 runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz);
 
+// What a gyro that disagrees with the attitude's turns most likely means, from the slope of
+// the attitude's turn on the gyro's integral and its standard error (1 where they agree): a
+// unit's factor (deg/s read as rad/s gives 1/57) only where the slope is that factor and the
+// data tell it from zero; otherwise a convention or axes. `euler`: the attitude is logged as
+// Euler angles (which may be in degrees).
+std::string gyro_disagreement_hint(double slope, double se, bool euler);
+
 // Refuse a log whose time or attitude angles are plainly in another unit than the canonical
 // layout's, naming file, line and the likely fix; load_flight runs both. check_time_unit: a
 // median sample interval of 0.5 s or more (ms read as s; a flight log holds tens to

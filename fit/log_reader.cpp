@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fit/grid_mean.hpp"
 #include "fit/least_squares.hpp"  // FitError
 #include "runtime/log_file.hpp"
 #include "output/joined.hpp"
@@ -18,12 +19,14 @@ bool is_topic_log(const std::string& path) { return is_ulog(path) || runtime::is
 
 namespace {
 
-// One mapped signal: its topic's timestamps (s) and finite values, and the longest interval
-// between them that still counts as continuous.
+// One mapped signal: its topic's timestamps (s) and finite values, the longest interval
+// between them that still counts as continuous, and the samples after which a longer one
+// (a gap) follows.
 struct Signal {
   std::string source, target;
   std::vector<double> t, v;
   double gap = 0;
+  std::vector<size_t> breaks;
 };
 
 const runtime::LogTopic& find_topic(const runtime::TopicLog& log, const std::string& topic, const std::string& source) {
@@ -42,7 +45,7 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
     throw FitError(log.path + ": topic '" + topic + "' has no field for '" + e.source + "' (fields: " +
                    output::joined(tp.fields) + ")");
   }
-  Signal s{e.source, e.target, {}, {}, 0};
+  Signal s{e.source, e.target, {}, {}, 0, {}};
   for (const auto& row : tp.rows) {
     const double t = row[0] * 1e-6;
     if (!std::isfinite(row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
@@ -54,6 +57,8 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   for (size_t k = 1; k < s.t.size(); ++k) dt.push_back(s.t[k] - s.t[k - 1]);
   std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
   s.gap = std::max(3 * dt[dt.size() / 2], 0.1);  // a dropout or a paused topic beyond this
+  for (size_t k = 0; k + 1 < s.t.size(); ++k)
+    if (s.t[k + 1] - s.t[k] > s.gap) s.breaks.push_back(k);
   return s;
 }
 
@@ -75,18 +80,18 @@ void align_quaternion_signs(std::vector<Signal>& signals) {
   }
 }
 
-// The value at t, or false when t falls in a gap of the signal (or outside it).
-bool interpolate(const Signal& s, double t, double* v) {
+// The grid value at t: the signal's mean over the grid interval around t, within its stretch
+// without a gap (fit/grid_mean.hpp), or false when t falls in a gap of the signal (or outside it).
+bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
   const auto it = std::upper_bound(s.t.begin(), s.t.end(), t);
-  if (it == s.t.end()) {
-    *v = s.v.back();
-    return t - s.t.back() <= 1e-9;
-  }
   if (it == s.t.begin()) return false;
-  const size_t k = static_cast<size_t>(it - s.t.begin());
-  if (s.t[k] - s.t[k - 1] > s.gap) return false;
-  const double w = (t - s.t[k - 1]) / (s.t[k] - s.t[k - 1]);
-  *v = s.v[k - 1] + w * (s.v[k] - s.v[k - 1]);
+  if (it == s.t.end() && t - s.t.back() > 1e-9) return false;
+  const size_t k = static_cast<size_t>(it - s.t.begin()) - 1;  // the last sample at or before t
+  if (it != s.t.end() && s.t[k + 1] - s.t[k] > s.gap) return false;
+  const auto next_break = std::lower_bound(s.breaks.begin(), s.breaks.end(), k);
+  const size_t last = next_break == s.breaks.end() ? s.t.size() - 1 : *next_break;
+  const size_t first = next_break == s.breaks.begin() ? 0 : *(next_break - 1) + 1;
+  *v = grid_mean(s.t, s.v, first, last, std::min(t, s.t[last]), half_step);
   return true;
 }
 
@@ -127,7 +132,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
     bool inside = true;
     for (const auto& s : signals) {
       double v = 0;
-      inside = inside && interpolate(s, t, &v);
+      inside = inside && value_on_grid(s, t, 0.5 * step, &v);
       row.push_back(v);
     }
     if (inside) out.rows.push_back(std::move(row));

@@ -34,7 +34,10 @@ kg m^2, vehicles/crazyflie21.yaml and Foerster 2015), before the 0.62-0.75 answe
 commands the diagnoses measure. Given DIAGNOSIS_DIRs (single-flight diagnoses of the
 NanoBench flights, residuals.csv unthinned), the slow band of the extended model's own roll
 and pitch residual is printed beside each flight, and the correlation across the flights
-between it and the folded estimate.
+between it and the folded estimate. Last, the folded estimates as the model's slow moment
+(the pipeline's share undone, the answer applied) and as a 1 s rollout error (the ARPL log's
+drift per rad/s^2 of slow band, scaled by the 0.49-0.58 ratio of measured rollouts to the
+linearised drift, docs/history.md's twenty-seventh session).
 
 Usage: command_aliasing.py [--data DIR] [DIAGNOSIS_DIR ...]
   DIR holds arpl/log10.csv and nanobench/B*.csv (default: ../shared/data/crazyflie)"""
@@ -57,6 +60,8 @@ G, MASS, ARM = 9.80665, 0.0271, 0.0325
 INERTIA = {"roll": 1.395e-5, "pitch": 1.436e-5}
 AXES = ("roll", "pitch")
 MOTOR_LAG = 0.062  # s: quadgen's fit of the ARPL log (the authors give 0.072 s)
+ANSWER = (0.62, 0.75)  # NanoBench: roll/pitch answer to the commands against the stock file (README)
+ROLLOUT_RATIO = (0.49, 0.58)  # a measured rollout over the linearised drift (docs/history.md, 27th session)
 SATURATED = {"B6_linear_ramp_rep1"}  # motor 4 at full command on most airborne rows
 LOST = 0.2  # the share of motor samples lost over the radio on NanoBench (about 18 %)
 
@@ -349,18 +354,21 @@ def arpl(path):
               f"{rms(o['kept']):.2f} ({min(o['kept']):.2f}-{max(o['kept']):.2f}), refitted {rms(o['refitted']):.2f} "
               f"({min(o['refitted']):.2f}-{max(o['refitted']):.2f}); the moment error the holding makes "
               f"{rms(o['error']):.2f}")
-    print(f"  that moment error alone over 1 s (linearised, no damping): {sum(drift) / len(drift):.3f} m "
+    mean_drift = sum(drift) / len(drift)
+    print(f"  that moment error alone over 1 s (linearised, no damping): {mean_drift:.3f} m "
           f"(phases {min(drift):.3f}-{max(drift):.3f})")
-    return ratio
+    error_slow = rms([v for axis in AXES for v in out[axis]["error"]])
+    return ratio, check, mean_drift / error_slow, piece_ratio
 
 
 # ---- 2. the NanoBench flights ----
 
 def nanobench(folder, ratio, residual_slow):
+    """Prints each flight's line; returns the folded estimates of the unsaturated flights."""
     print("NanoBench flights, 100 Hz: fraction of the mean command [nominal rad/s^2]")
     print("  flight, axis: slow band of the logged commands | top band | folded into the slow band, "
           "estimated with the ARPL ratio" + (" | the extended model's residual, slow band" if residual_slow else ""))
-    pairs = []
+    pairs, unsaturated = [], []
     for path in sorted(glob.glob(os.path.join(folder, "B*.csv"))):
         with open(path, newline="") as f:
             commands = [[float(r[f"motor_motor_m{i}"]) for i in range(1, 5)] for r in csv.DictReader(f)]
@@ -370,6 +378,8 @@ def nanobench(folder, ratio, residual_slow):
         for axis, x in differential(commands[first:last]).items():
             s, t = slow([x]), top([x])
             folded = ratio[axis] * t
+            if not mark:
+                unsaturated.append((axis, folded))
             line = (f"  {name + mark:36s} {axis:5s} {s:.4f} [{rad_s2(s, axis):.2f}] | {t:.4f} | "
                     f"{folded:.4f} [{rad_s2(folded, axis):.2f}]")
             if name in residual_slow and residual_slow[name][axis] is None:
@@ -382,6 +392,23 @@ def nanobench(folder, ratio, residual_slow):
     if len(pairs) >= 3:
         print(f"  across the unsaturated flights and axes ({len(pairs)}), the folded estimate and the residual's "
               f"slow band correlate at {correlation([f for f, _ in pairs], [r for _, r in pairs]):+.2f}")
+    return unsaturated
+
+
+def as_a_rollout(unsaturated, check, metres_per_slow, piece_ratio, ratio):
+    """The folded estimates of the unsaturated flights as rad/s^2 of the model's moment (the
+    estimate's share found through NanoBench's pipeline undone, the answer to the commands
+    applied) and as a 1 s rollout error, linearised and scaled by the rollouts' ratio."""
+    low = min(rad_s2(f, a) / check[a] for a, f in unsaturated) * ANSWER[0]
+    high = max(rad_s2(f, a) / check[a] for a, f in unsaturated) * ANSWER[1]
+    spread = (min(min(piece_ratio[a]) / ratio[a] for a in AXES), max(max(piece_ratio[a]) / ratio[a] for a in AXES))
+    print(f"  the folded slow moment on the unsaturated flights, the pipeline's share undone and through the "
+          f"{ANSWER[0]}-{ANSWER[1]} answer: {low:.2f}-{high:.2f} rad/s^2; at the ARPL log's {metres_per_slow:.2f} m "
+          f"per rad/s^2 of slow band, linearised {low * metres_per_slow:.2f}-{high * metres_per_slow:.2f} m at 1 s, "
+          f"scaled by the rollouts' {ROLLOUT_RATIO[0]}-{ROLLOUT_RATIO[1]}: "
+          f"{low * metres_per_slow * ROLLOUT_RATIO[0]:.2f}-{high * metres_per_slow * ROLLOUT_RATIO[1]:.2f} m "
+          f"({low * metres_per_slow * ROLLOUT_RATIO[0] * spread[0]:.2f}-"
+          f"{high * metres_per_slow * ROLLOUT_RATIO[1] * spread[1]:.2f} m with the ratio's spread between the ARPL pieces)")
 
 
 def residuals_slow_band(diagnoses):
@@ -425,8 +452,9 @@ def main(argv):
     if any(a.startswith("-") for a in argv):
         sys.exit(__doc__)
     residual_slow = residuals_slow_band(argv)
-    ratio = arpl(os.path.join(data, "arpl", "log10.csv"))
-    nanobench(os.path.join(data, "nanobench"), ratio, residual_slow)
+    ratio, check, metres_per_slow, piece_ratio = arpl(os.path.join(data, "arpl", "log10.csv"))
+    unsaturated = nanobench(os.path.join(data, "nanobench"), ratio, residual_slow)
+    as_a_rollout(unsaturated, check, metres_per_slow, piece_ratio, ratio)
 
 
 if __name__ == "__main__":

@@ -386,17 +386,39 @@ TEST(Fit, MultipleShootingRecoversParametersFromPose) {
   }
 }
 
-TEST(FitData, ResampleInterpolatesOntoAUniformGrid) {
+// Each grid value is the mean over the grid interval around it of the log drawn as straight
+// lines between its rows (fit/grid_mean.hpp): a straight line keeps its value, a step is
+// averaged (by hand: b steps from 5 at t = 0.3 to 6 at t = 0.4, so the window [0.25, 0.35]
+// holds 5 for its first half and 5 to 5.5 for its second, a mean of 5.125).
+TEST(FitData, ResampleTakesEachGridIntervalsMean) {
   const auto t = runtime::parse_csv("t,a,b\n0,0,5\n0.3,3,5\n0.4,4,6\n1.0,10,6\n", "x.csv");
   const auto r = resample(t, 10.0);
   ASSERT_EQ(r.rows.size(), 11u);
   for (size_t k = 0; k < r.rows.size(); ++k) {
     EXPECT_NEAR(r.rows[k][0], 0.1 * k, 1e-12);
-    EXPECT_NEAR(r.rows[k][1], 10 * 0.1 * k, 1e-9);  // a = 10 t, linear throughout
+    EXPECT_NEAR(r.rows[k][1], 10 * 0.1 * k, 1e-9);  // a = 10 t, linear throughout, ends included
   }
-  EXPECT_NEAR(r.rows[3][2], 5.0, 1e-12);
-  EXPECT_NEAR(r.rows[4][2], 6.0, 1e-12);
   EXPECT_NEAR(r.rows[2][2], 5.0, 1e-12);
+  EXPECT_NEAR(r.rows[3][2], 5.125, 1e-12);
+  EXPECT_NEAR(r.rows[4][2], 5.875, 1e-12);
+  EXPECT_NEAR(r.rows[10][2], 6.0, 1e-12);  // the last row: the window shrinks to the point
+}
+
+// A log faster than the grid does not fold its fast content into the slow band: 1 kHz rows of
+// a slow sine plus one at 403 Hz, resampled at 100 Hz. Read at the grid points alone, the
+// 403 Hz sine comes back as a 3 Hz one of its full size; a grid interval's mean leaves 1 %.
+TEST(FitData, ResamplingALogFasterThanTheGridFoldsNothingIntoTheSlowBand) {
+  std::string text = "t,u\n";
+  const auto slow = [](double s) { return std::sin(2 * M_PI * 0.3 * s); };
+  for (int k = 0; k <= 3000; ++k) {
+    const double s = 0.001 * k;
+    text += std::to_string(s) + "," + std::to_string(slow(s) + std::sin(2 * M_PI * 403 * s)) + "\n";
+  }
+  const auto r = resample(runtime::parse_csv(text, "fast.csv"), 100.0);
+  ASSERT_EQ(r.rows.size(), 301u);
+  double worst = 0;
+  for (size_t k = 5; k + 5 < r.rows.size(); ++k) worst = std::max(worst, std::abs(r.rows[k][1] - slow(r.rows[k][0])));
+  EXPECT_LT(worst, 0.02);
 }
 
 // A log may give its attitude as Z-Y-X Euler angles instead of a quaternion (docs/formats.md):

@@ -1524,6 +1524,13 @@ TEST(Cli, AFlightEndingBeforeItsManoeuvreAndAnImplausibleValueAreSaid) {
   EXPECT_NE(gale.err.find("; outside its plausible range, --set wind.x = 1e+300 (plausible -15 to 15: "), std::string::npos)
       << gale.err;
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
+  // A value beyond its plausible range is flown, and said before the flight (a user trial:
+  // motor_gain.M3=0.93, meant as 93 %, flew a rotor 93 % strong without a word).
+  const CliResult strong = fly({"--scenario", "hover", "--duration", "0.1", "--effects", "motor_gain", "--set", "motor_gain.M3=0.93"});
+  EXPECT_EQ(strong.rc, 0) << strong.err;
+  EXPECT_NE(strong.err.find("note: flown as set, though outside its plausible range, --set motor_gain.M3 = 0.93 (plausible "),
+            std::string::npos)
+      << strong.err;
   EXPECT_EQ(fly({"--scenario", "right", "--duration", "0.6"}).rc, 0);
   EXPECT_EQ(fly({"--scenario", "climb", "--duration", "0.1"}).rc, 0);  // it climbs from the start
   EXPECT_EQ(fly({"--scenario", "hover", "--duration", "0.1"}).rc, 0);

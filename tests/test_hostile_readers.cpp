@@ -303,6 +303,12 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   };
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"p", "q", "r"}, 180 / M_PI), rotors, {}); }).find("deg/s read as rad/s?"),
             std::string::npos);
+  // The hint names a unit only where the slope is its factor: -0.13 +- 0.058 (p and q swapped
+  // in a user trial's mapping) was told "deg/s read as rad/s?".
+  EXPECT_EQ(gyro_disagreement_hint(1 / 57.3, 0.001, false), "deg/s read as rad/s? (in the mapping, unit: deg/s)");
+  EXPECT_EQ(gyro_disagreement_hint(57.3, 2, false), "rad/s read as deg/s?");
+  for (const double slope : {-0.13, 0.03, -1.0})
+    EXPECT_NE(gyro_disagreement_hint(slope, 0.058, false).find("disagree in convention or axes"), std::string::npos) << slope;
   // A world-to-body quaternion turns the other way: refused, with the convention named.
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"qx", "qy", "qz"}, -1), rotors, {}); })
                 .find("disagree in convention or axes: a world-to-body quaternion"),

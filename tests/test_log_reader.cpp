@@ -165,6 +165,29 @@ TEST(LogReader, UnsetValuesAreSkippedGapsStayGapsQuaternionSignsAligned) {
   EXPECT_TRUE(gap);
 }
 
+// A topic logged faster than the grid (a motor command at 1 kHz, read at 100 Hz) does not fold
+// its fast content into the slow band: each grid value is the topic's mean over the grid
+// interval around it (fit/grid_mean.hpp). Read at the grid points alone, the 403 Hz sine
+// below came back as a 3 Hz one of its full size.
+TEST(LogReader, ATopicFasterThanTheGridFoldsNothingIntoTheSlowBand) {
+  Writer w;
+  w.flag_bits().format("m:uint64_t timestamp;float u;");
+  w.add(0, 0, "m");
+  const auto slow = [](double s) { return 0.5 + 0.2 * std::sin(2 * M_PI * 0.3 * s); };
+  for (int k = 0; k <= 3000; ++k) {
+    const double s = 0.001 * k;
+    w.data(0, le(1000000 + 1000 * static_cast<std::uint64_t>(k), 8) + f32(static_cast<float>(slow(s) + 0.2 * std::sin(2 * M_PI * 403 * s))));
+  }
+  const std::string log = write_file("quadgen_fast_topic.ulg", w.bytes());
+  const std::string mapping = write_file("quadgen_fast_topic.yaml", "name: fast\ncolumns:\n  t: {source: t}\n  u_A: {source: m.u}\n");
+  const runtime::CsvTable t = fit::read_log(log, mapping, 100.0);
+  ASSERT_GT(t.rows.size(), 290u);
+  double worst = 0;
+  const int u = t.column("u_A"), time = t.column("t");
+  for (size_t k = 5; k + 5 < t.rows.size(); ++k) worst = std::max(worst, std::abs(t.rows[k][u] - slow(t.rows[k][time])));
+  EXPECT_LT(worst, 0.005);  // 0.2 folded back whole at the grid points alone
+}
+
 TEST(LogReader, MissingTopicsAndFieldsAreNamedWithWhatTheLogHas) {
   const std::string log = write_file("quadgen_px4_missing.ulg", px4_log());
   const auto error = [&](const std::string& mapping_text) {
