@@ -533,7 +533,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   DynamicModel& m = *model_ptr;
   apply_settings(a, vehicle, m);  // before anything reads the parameters (the scenario's delay)
   // Flown as set (a test flight may mean it), but said before the flight rather than only after
-  // a divergence: motor_gain.M3=0.93 meant as "93 %" flew a rotor 93 % strong (a user trial).
+  // a divergence: motor_gain.M3=0.93 meant as "93 %" flew a rotor at 193 % (a user trial).
   if (const std::string outside = implausible_settings(a, vehicle); !outside.empty())
     a.progress.say("note: flown as set, though" + outside.substr(1));
   // The nominal base model as a controller believes it: the scenarios' thrust laws, rotor

@@ -1,6 +1,7 @@
 #include "fit/flight_data.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -275,16 +276,45 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   return out;
 }
 
+namespace {
+
+// The columns resample averages from a prepared copy rather than as logged, by index: the
+// quaternion's four components sign-aligned row to row, the Euler roll and yaw unwrapped.
+std::map<size_t, std::vector<double>> columns_to_average(const runtime::CsvTable& log) {
+  std::map<size_t, std::vector<double>> out;
+  const auto column = [&](const char* name) {
+    std::vector<double> v;
+    const int c = log.column(name);
+    if (c >= 0)
+      for (const auto& row : log.rows) v.push_back(row[static_cast<size_t>(c)]);
+    return std::make_pair(c, v);
+  };
+  for (const char* angle : {"phi", "psi"})
+    if (auto [c, v] = column(angle); c >= 0) out[static_cast<size_t>(c)] = unwrapped(v, 2 * M_PI);
+  std::array<std::pair<int, std::vector<double>>, 4> q{column("qw"), column("qx"), column("qy"), column("qz")};
+  if (std::any_of(q.begin(), q.end(), [](const auto& c) { return c.first < 0; })) return out;
+  for (size_t k = 1; k < log.rows.size(); ++k) {
+    double dot = 0;
+    for (const auto& [c, v] : q) dot += v[k] * v[k - 1];
+    if (dot < 0)
+      for (auto& [c, v] : q) v[k] = -v[k];
+  }
+  for (auto& [c, v] : q) out[static_cast<size_t>(c)] = std::move(v);
+  return out;
+}
+
+}  // namespace
+
 runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   const int tc = log.column("t");
   if (tc < 0) throw FitError(log.path + ":1: missing column 't'");
   if (log.rows.size() < 2) throw FitError(log.path + ": too few samples to resample");
-  // Checked here, where the rows still have their lines: interpolation would spread a
-  // bad value over its neighbours and the error would name a resampled row.
+  // Checked here, where the rows still have their lines: averaging would spread a bad value
+  // over its neighbours and the error would name a resampled row.
   runtime::check_values(log);
-  // Every row's time after the one before, checked before interpolating: the loop below only
-  // sees the pair it interpolates between and walked past rows whose time went back (a review:
-  // 100 reversed rows were resampled without a word).
+  // Every row's time after the one before, checked before resampling: the interpolating loop
+  // this replaced saw only the pair it interpolated between and walked past rows whose time
+  // went back (a review: 100 reversed rows were resampled without a word).
   for (size_t i = 1; i < log.rows.size(); ++i)
     if (!(log.rows[i][tc] > log.rows[i - 1][tc]))
       throw FitError(log.where_row(i) + ": time not strictly increasing (" +
@@ -308,17 +338,27 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   out.time_from_topics_start = log.time_from_topics_start;
   // Each column's mean over the grid interval around each grid point, not its value there
   // (fit/grid_mean.hpp): a log faster than the grid would fold its fast content into the rest.
-  std::vector<std::vector<double>> columns(log.columns.size(), std::vector<double>(log.rows.size()));
-  for (size_t i = 0; i < log.rows.size(); ++i)
-    for (size_t c = 0; c < columns.size(); ++c) columns[c][i] = log.rows[i][c];
-  const size_t last = log.rows.size() - 1;
+  // Columns that must not be averaged as logged are averaged from a copy: the quaternion's
+  // components sign-aligned row to row (q and -q are one attitude), the Euler roll and yaw
+  // unwrapped.
+  const std::map<size_t, std::vector<double>> prepared = columns_to_average(log);
+  std::vector<double> times(log.rows.size());
+  for (size_t i = 0; i < times.size(); ++i) times[i] = log.rows[i][tc];
+  std::vector<const std::vector<double>*> from_copy(log.columns.size(), nullptr);
+  for (const auto& [c, v] : prepared) from_copy[c] = &v;
+  const int phi = log.column("phi");
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;
     if (t > t1) break;
-    std::vector<double> row(columns.size());
-    for (size_t c = 0; c < columns.size(); ++c) row[c] = grid_mean(columns[tc], columns[c], 0, last, t, 0.5 / rate_hz);
+    const GridWeights g = grid_weights(times, 0, times.size() - 1, t, 0.5 / rate_hz);
+    std::vector<double> row(log.columns.size(), 0.0);
+    for (size_t i = 0; i < g.weight.size(); ++i) {
+      const size_t r = g.first_sample + i;
+      for (size_t c = 0; c < row.size(); ++c) row[c] += g.weight[i] * (from_copy[c] ? (*from_copy[c])[r] : log.rows[r][c]);
+    }
     row[tc] = t;
-    out.rows.push_back(row);
+    if (phi >= 0) row[static_cast<size_t>(phi)] = wrapped_to_pi(row[static_cast<size_t>(phi)]);
+    out.rows.push_back(std::move(row));
   }
   return out;
 }
@@ -369,12 +409,16 @@ std::string gyro_disagreement_hint(double slope, double se, bool euler) {
   const auto near = [&](double factor) {
     return slope > 0 && 3 * se < factor && std::fabs(slope - factor) < 3 * se + 0.25 * factor;
   };
+  const std::string convention =
+      "the attitude and the gyro disagree in convention or axes: a world-to-body quaternion (in the mapping, scale: "
+      "-1 on qx, qy, qz), gyro axes of another frame (frame: ned_frd), or gyro columns mapped to the wrong axes?";
   if (near(per_degree)) return "deg/s read as rad/s? (in the mapping, unit: deg/s)";
   if (near(1 / per_degree))
     return euler ? "attitude angles in degrees read as radians (in the mapping, unit: deg), or a gyro in rad/s read as deg/s?"
                  : "rad/s read as deg/s?";
-  return "the attitude and the gyro disagree in convention or axes: a world-to-body quaternion (in the mapping, scale: "
-         "-1 on qx, qy, qz), gyro axes of another frame (frame: ned_frd), or gyro columns mapped to the wrong axes?";
+  // Turning far less than the gyro says, on data too noisy to tell 1/57 from zero: both.
+  if (slope > 0 && slope < 0.2) return "deg/s read as rad/s (in the mapping, unit: deg/s)? Or " + convention;
+  return convention;
 }
 
 namespace {

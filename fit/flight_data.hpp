@@ -102,8 +102,10 @@ struct FlightOptions {
   double edge_trim = 0.1;
 };
 
-// Linear interpolation of every column onto a uniform grid at `rate_hz` (streams logged at
-// different rates and forward-filled, or irregular sample times).
+// Every column onto a uniform grid at `rate_hz` (streams logged at different rates and
+// forward-filled, or irregular sample times), each grid value the column's mean over the grid
+// interval around it (fit/grid_mean.hpp: a faster log folds nothing into the slow band); the
+// quaternion sign-aligned and the Euler roll and yaw unwrapped before averaging.
 runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz);
 
 // What a gyro that disagrees with the attitude's turns most likely means, from the slope of

@@ -91,8 +91,23 @@ bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
   const auto next_break = std::lower_bound(s.breaks.begin(), s.breaks.end(), k);
   const size_t last = next_break == s.breaks.end() ? s.t.size() - 1 : *next_break;
   const size_t first = next_break == s.breaks.begin() ? 0 : *(next_break - 1) + 1;
-  *v = grid_mean(s.t, s.v, first, last, std::min(t, s.t[last]), half_step);
+  *v = grid_weights(s.t, first, last, std::min(t, s.t[last]), half_step).apply(s.v);
   return true;
+}
+
+// An Euler angle mapped from a topic is averaged unwrapped (fit/grid_mean.hpp), its period in
+// the source's unit from the mapping's scale and unit (360 for degrees).
+void unwrap_if_angle(Signal& s, const ColumnMapping::Entry& e) {
+  const double to_radians = std::fabs(e.scale * e.unit_scale);
+  if ((e.target == "phi" || e.target == "psi") && to_radians > 0) s.v = unwrapped(s.v, 2 * M_PI / to_radians);
+}
+
+// The roll back into (-pi, pi] after averaging (the reading checks refuse a roll beyond it;
+// a yaw may stay unwrapped).
+void wrap_roll(runtime::CsvTable& t) {
+  const int c = t.column("phi");
+  if (c >= 0)
+    for (auto& row : t.rows) row[static_cast<size_t>(c)] = wrapped_to_pi(row[static_cast<size_t>(c)]);
 }
 
 // A cap on the table a few bytes of timestamps could ask for: 2^28 cells (2 GiB of doubles).
@@ -107,6 +122,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   for (const auto& e : m.entries) {
     if (e.source == "t") continue;  // the time base this function makes
     signals.push_back(find_signal(log, e));
+    unwrap_if_angle(signals.back(), e);
     t0 = std::max(t0, signals.back().t.front());
     t1 = std::min(t1, signals.back().t.back());
   }
@@ -150,7 +166,9 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
     const double rate = resample_hz > 0 ? resample_hz : 100.0;
     const runtime::CsvTable table = ulog ? topic_table(runtime::read_ulog(path), *mapping, rate)
                                          : topic_table(runtime::read_usd_log(path), *mapping, rate);
-    return apply_mapping(table, *mapping);
+    runtime::CsvTable mapped = apply_mapping(table, *mapping);
+    wrap_roll(mapped);
+    return mapped;
   }
   runtime::CsvTable log = runtime::read_csv(path);
   if (mapping) log = apply_mapping(log, *mapping);

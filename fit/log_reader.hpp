@@ -4,8 +4,9 @@
 //    of several topics. The mapping names a signal as "topic.field" (ULog array elements
 //    "topic.field[i]", instance 0 of a topic; uSD "fixedFrequency.acc.x", the event type's
 //    name and the log variable). Every topic keeps its own rate: the
-//    signals the mapping uses are interpolated linearly onto one uniform time base (column
-//    "t", seconds) over the span all of them cover. Samples a topic logs as NaN (not set yet)
+//    signals the mapping uses are put onto one uniform time base (column "t", seconds) over
+//    the span all of them cover, each grid value a signal's mean over the grid interval around
+//    it (fit/grid_mean.hpp), an Euler angle averaged unwrapped. Samples a topic logs as NaN (not set yet)
 //    are left out; where any signal has a gap (a dropout, a paused topic: longer than three
 //    of its median intervals and 0.1 s) the table has a gap too, rather than a line drawn
 //    across it. Quaternion components are sign-aligned sample to sample first.

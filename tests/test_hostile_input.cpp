@@ -1525,7 +1525,7 @@ TEST(Cli, AFlightEndingBeforeItsManoeuvreAndAnImplausibleValueAreSaid) {
       << gale.err;
   EXPECT_FALSE(fs::exists(tmp / "s.csv"));
   // A value beyond its plausible range is flown, and said before the flight (a user trial:
-  // motor_gain.M3=0.93, meant as 93 %, flew a rotor 93 % strong without a word).
+  // motor_gain.M3=0.93, meant as 93 %, flew a rotor at 193 % without a word).
   const CliResult strong = fly({"--scenario", "hover", "--duration", "0.1", "--effects", "motor_gain", "--set", "motor_gain.M3=0.93"});
   EXPECT_EQ(strong.rc, 0) << strong.err;
   EXPECT_NE(strong.err.find("note: flown as set, though outside its plausible range, --set motor_gain.M3 = 0.93 (plausible "),

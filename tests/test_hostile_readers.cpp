@@ -309,6 +309,9 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   EXPECT_EQ(gyro_disagreement_hint(57.3, 2, false), "rad/s read as deg/s?");
   for (const double slope : {-0.13, 0.03, -1.0})
     EXPECT_NE(gyro_disagreement_hint(slope, 0.058, false).find("disagree in convention or axes"), std::string::npos) << slope;
+  // turning far less than the gyro says on noisy data: both readings are offered
+  EXPECT_EQ(gyro_disagreement_hint(0.03, 0.058, false).rfind("deg/s read as rad/s (in the mapping, unit: deg/s)? Or ", 0), 0u);
+  EXPECT_EQ(gyro_disagreement_hint(-0.13, 0.058, false).find("deg/s"), std::string::npos);
   // A world-to-body quaternion turns the other way: refused, with the convention named.
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"qx", "qy", "qz"}, -1), rotors, {}); })
                 .find("disagree in convention or axes: a world-to-body quaternion"),

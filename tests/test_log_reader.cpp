@@ -188,6 +188,28 @@ TEST(LogReader, ATopicFasterThanTheGridFoldsNothingIntoTheSlowBand) {
   EXPECT_LT(worst, 0.005);  // 0.2 folded back whole at the grid points alone
 }
 
+// A grid window never reaches across a gap: each stretch of a paused topic holds its own
+// constant, and every grid value is its stretch's (a window averaged across the pause would
+// mix two). The earlier gap test's signal was a line, which reads the same either way (a
+// review, helper-92).
+TEST(LogReader, AGridWindowStaysWithinItsStretch) {
+  Writer w;
+  w.flag_bits().format("a:uint64_t timestamp;float v;");
+  w.add(0, 0, "a");
+  const auto level = [](double s) { return s < 1.0 ? 1.0 : s < 2.0 ? 5.0 : 9.0; };
+  for (int k = 0; k <= 3000; ++k) {
+    const double s = 0.001 * k;
+    if ((s > 0.8 + 1e-9 && s < 1.0 - 1e-9) || (s > 1.7 + 1e-9 && s < 2.0 - 1e-9)) continue;  // two pauses
+    w.data(0, le(1000000 + 1000 * static_cast<std::uint64_t>(k), 8) + f32(static_cast<float>(level(s))));
+  }
+  const std::string log = write_file("quadgen_stretches.ulg", w.bytes());
+  const std::string mapping = write_file("quadgen_stretches.yaml", "name: s\ncolumns:\n  t: {source: t}\n  vbat: {source: a.v}\n");
+  const runtime::CsvTable t = fit::read_log(log, mapping, 100.0);
+  ASSERT_GT(t.rows.size(), 200u);
+  const int v = t.column("vbat"), time = t.column("t");
+  for (const auto& row : t.rows) EXPECT_NEAR(row[v], level(row[time]), 1e-9) << row[time];
+}
+
 TEST(LogReader, MissingTopicsAndFieldsAreNamedWithWhatTheLogHas) {
   const std::string log = write_file("quadgen_px4_missing.ulg", px4_log());
   const auto error = [&](const std::string& mapping_text) {
