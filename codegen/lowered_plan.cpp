@@ -127,7 +127,16 @@ LoweredPlan::Mono LoweredPlan::convert(int gid) {
     case Op::mul:
       for (int a : n.args) m = times(m, convert(a));
       break;
-    case Op::div: m = times(convert(n.args[0]), convert(n.args[1]), -1); break;
+    case Op::div: {
+      // The denominator first, written out: the order in which nodes are numbered decides
+      // signs and operand order in the emitted code (make_sum), and C++ leaves the order of a
+      // call's arguments to the compiler (GCC converted the second first, Clang the first:
+      // the headers differed by compiler). The checked-in headers were generated in GCC's order.
+      const Mono den = convert(n.args[1]);
+      const Mono num = convert(n.args[0]);
+      m = times(num, den, -1);
+      break;
+    }
     case Op::ipow: m = times(m, convert(n.args[0]), static_cast<int>(n.exponent)); break;
     case Op::add: {
       std::vector<Mono> terms;

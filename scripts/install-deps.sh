@@ -14,7 +14,7 @@ packages=(
   libkainjow-mustache-dev               # text templates for generated code
   gnuplot-nox                           # plots (SVG) of simulations and fits
   cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown
-  clang libclang-rt-14-dev              # libFuzzer targets (scripts/fuzz.sh)
+  clang libclang-rt-14-dev              # CI's sanitizer build (.ci/sanitize) and libFuzzer (scripts/fuzz.sh)
 )
 missing=()
 for p in "${packages[@]}"; do
