@@ -118,7 +118,14 @@ class FunctionLowering {
         for (int d : divisors) acc = emit(TapeOp::div, acc, d);
         return acc;
       }
-      case Kind::recip: return emit(TapeOp::div, regs_.of_constant(1.0), value(n.args[0]));
+      case Kind::recip: {
+        // Operands first, each in a statement of its own (and in GCC's order, which the
+        // arguments of one call had): a call's argument order is the compiler's, and it
+        // numbers registers and orders instructions.
+        const int divisor = value(n.args[0]);
+        const int one = regs_.of_constant(1.0);
+        return emit(TapeOp::div, one, divisor);
+      }
       case Kind::call: return call(n);
       case Kind::leaf: break;
     }
@@ -126,7 +133,11 @@ class FunctionLowering {
   }
 
   int call(const LoweredPlan::Node& n) {
-    if (n.text == "pow") return emit(TapeOp::pow, value(n.args[0]), value(n.args[1]));
+    if (n.text == "pow") {
+      const int exponent = value(n.args[1]);  // GCC's order, as at Kind::recip
+      const int base = value(n.args[0]);
+      return emit(TapeOp::pow, base, exponent);
+    }
     static const std::map<std::string, TapeOp> unary = {{"sin", TapeOp::sin},       {"cos", TapeOp::cos},
                                                         {"log", TapeOp::log},       {"abs_value", TapeOp::abs},
                                                         {"sign_of", TapeOp::sign}};

@@ -461,7 +461,9 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
   ModelContext c{v, scratch};
   declare_base(c, mp);
   c.R = matrix(3, 3, lst{1, 0, 0, 0, 1, 0, 0, 0, 1});
-  c.air_velocity_world = vec3(symbol("v_ax", "v_{a,x}"), symbol("v_ay", "v_{a,y}"), symbol("v_az", "v_{a,z}"));
+  // One statement each (a call's argument order is the compiler's; GCC created z first).
+  const symbol v_az("v_az", "v_{a,z}"), v_ay("v_ay", "v_{a,y}"), v_ax("v_ax", "v_{a,x}");
+  c.air_velocity_world = vec3(v_ax, v_ay, v_az);
   // Rotor speeds as symbols rather than the motor map, and a level vehicle (q = 1), so that
   // an attitude bias shows as the rotation it applies.
   for (size_t i = 0; i < v.rotors.size(); ++i) {

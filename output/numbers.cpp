@@ -10,24 +10,30 @@
 
 namespace quadgen::output {
 
+namespace {
+// -0 (a vehicle file's "-0", a product of 0 and a negative number) is printed as 0: "-0" in a
+// message or a report reads as a sign that matters, and nothing here tells the two apart.
+double printed(double v) { return v == 0 ? 0.0 : v; }
+}  // namespace
+
 std::string short_number(double v) {
   std::ostringstream os;
   os.precision(3);
-  os << v;
+  os << printed(v);
   return os.str();
 }
 
 std::string six_digits(double v) {
   std::ostringstream os;
   os.precision(6);
-  os << v;
+  os << printed(v);
   return os.str();
 }
 
 std::string full_number(double v) {
   std::ostringstream os;
   os.precision(17);
-  os << v;
+  os << printed(v);
   return os.str();
 }
 
@@ -36,8 +42,8 @@ std::string one_then_other(double a, double b) {
     std::ostringstream x, y;
     x.precision(digits);
     y.precision(digits);
-    x << a;
-    y << b;
+    x << printed(a);
+    y << printed(b);
     if (x.str() != y.str() || a == b || digits >= 17) return x.str() + " then " + y.str();
   }
 }

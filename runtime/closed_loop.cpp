@@ -387,7 +387,10 @@ struct Sensors {
     std::vector<double> row{t};
     for (int i = 0; i < nr; ++i) row.push_back(u[i]);
     const double an = o.pose_noise;
-    const Eigen::Quaterniond dq(1, 0.5 * an * gauss(rng), 0.5 * an * gauss(rng), 0.5 * an * gauss(rng));
+    // One draw per declarator, z first: as a constructor's three arguments their order was the
+    // compiler's (GCC drew z first, clang x: the flights differed by compiler).
+    const double dz = gauss(rng), dy = gauss(rng), dx = gauss(rng);
+    const Eigen::Quaterniond dq(1, 0.5 * an * dx, 0.5 * an * dy, 0.5 * an * dz);
     const Eigen::Quaterniond q = (q_estimated * dq).normalized();
     for (int i = 0; i < 3; ++i) row.push_back(x[kPosition + i] + an * gauss(rng));
     for (double c : {q.w(), q.x(), q.y(), q.z()}) row.push_back(c);

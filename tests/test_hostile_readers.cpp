@@ -523,6 +523,20 @@ TEST(NumberText, AWholeFiniteDecimalNumberAndNothingElse) {
   EXPECT_EQ(out::json_number_below_a_double("not JSON 1e-400"), "");
 }
 
+// A negative zero is printed as 0 by every number printer (a "-0" reads as a sign that matters).
+TEST(NumberText, ANegativeZeroIsPrintedAsZero) {
+  namespace out = quadgen::output;
+  double v = 1;
+  ASSERT_EQ(out::read_number("-0", &v), out::NumberText::finite);
+  ASSERT_TRUE(std::signbit(v));  // what the reader gives: the printers are what is tested
+  EXPECT_EQ(out::short_number(v), "0");
+  EXPECT_EQ(out::six_digits(v), "0");
+  EXPECT_EQ(out::full_number(v), "0");
+  EXPECT_EQ(out::one_then_other(v, 0.5), "0 then 0.5");
+  EXPECT_EQ(out::short_number(-0.25), "-0.25");  // a negative number keeps its sign
+  EXPECT_EQ(out::full_number(-0.1), "-0.10000000000000001");
+}
+
 // A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as
 // an empty cell, nan): it is left out, and only asking for it is the error, at the line of
 // its first bad cell. Before, any such cell stopped every command.
