@@ -28,7 +28,7 @@ size_t tree_size(const ex& e, size_t limit) {
 
 std::string num(double v) {
   char b[64];
-  std::snprintf(b, sizeof b, "%.6g", v);
+  std::snprintf(b, sizeof b, "%.6g", v == 0 ? 0.0 : v);  // -0 as 0 (output/numbers.cpp says why)
   return b;
 }
 

@@ -461,7 +461,7 @@ SymbolicModel::EffectFormula effect_formula(const Vehicle& v, const MassProperti
   ModelContext c{v, scratch};
   declare_base(c, mp);
   c.R = matrix(3, 3, lst{1, 0, 0, 0, 1, 0, 0, 0, 1});
-  // One statement each (a call's argument order is the compiler's; GCC created z first).
+  // One declarator each (a call's argument order is the compiler's; GCC created z first).
   const symbol v_az("v_az", "v_{a,z}"), v_ay("v_ay", "v_{a,y}"), v_ax("v_ax", "v_{a,x}");
   c.air_velocity_world = vec3(v_ax, v_ay, v_az);
   // Rotor speeds as symbols rather than the motor map, and a level vehicle (q = 1), so that

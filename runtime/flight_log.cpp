@@ -84,7 +84,7 @@ namespace {
 
 std::string number_text(double v) {
   std::ostringstream os;
-  os << v;
+  os << (v == 0 ? 0.0 : v);  // -0 as 0 (output/numbers.cpp says why)
   return os.str();
 }
 

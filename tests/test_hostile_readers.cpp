@@ -523,7 +523,8 @@ TEST(NumberText, AWholeFiniteDecimalNumberAndNothingElse) {
   EXPECT_EQ(out::json_number_below_a_double("not JSON 1e-400"), "");
 }
 
-// A negative zero is printed as 0 by every number printer (a "-0" reads as a sign that matters).
+// A negative zero is printed as 0 by output/numbers' printers (a "-0" reads as a sign that
+// matters; the log reader's and the report's own printers do the same; JSON keeps -0.0).
 TEST(NumberText, ANegativeZeroIsPrintedAsZero) {
   namespace out = quadgen::output;
   double v = 1;
