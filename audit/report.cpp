@@ -12,6 +12,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/joined.hpp"
 #include "output/json_document.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen {
@@ -26,11 +27,7 @@ size_t tree_size(const ex& e, size_t limit) {
   return n;
 }
 
-std::string num(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.6g", v == 0 ? 0.0 : v);  // -0 as 0 (output/numbers.cpp says why)
-  return b;
-}
+std::string num(double v) { return output::six_digits(v); }
 
 void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "## 1. Vehicle\n\n" << output::markdown_text(d.vehicle.description) << "\n\n";

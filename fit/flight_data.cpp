@@ -293,12 +293,7 @@ std::map<size_t, std::vector<double>> columns_to_average(const runtime::CsvTable
     if (auto [c, v] = column(angle); c >= 0) out[static_cast<size_t>(c)] = unwrapped(v, 2 * M_PI);
   std::array<std::pair<int, std::vector<double>>, 4> q{column("qw"), column("qx"), column("qy"), column("qz")};
   if (std::any_of(q.begin(), q.end(), [](const auto& c) { return c.first < 0; })) return out;
-  for (size_t k = 1; k < log.rows.size(); ++k) {
-    double dot = 0;
-    for (const auto& [c, v] : q) dot += v[k] * v[k - 1];
-    if (dot < 0)
-      for (auto& [c, v] : q) v[k] = -v[k];
-  }
+  align_quaternion_signs({&q[0].second, &q[1].second, &q[2].second, &q[3].second});
   for (auto& [c, v] : q) out[static_cast<size_t>(c)] = std::move(v);
   return out;
 }

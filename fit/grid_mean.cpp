@@ -60,6 +60,15 @@ std::vector<double> unwrapped(const std::vector<double>& angles, double period) 
   return out;
 }
 
+void align_quaternion_signs(const std::array<std::vector<double>*, 4>& q) {
+  for (size_t k = 1; k < q[0]->size(); ++k) {
+    double dot = 0;
+    for (const auto* c : q) dot += (*c)[k] * (*c)[k - 1];
+    if (dot < 0)
+      for (auto* c : q) (*c)[k] = -(*c)[k];
+  }
+}
+
 double wrapped_to_pi(double radians) {
   const double r = std::remainder(radians, 2 * M_PI);  // in [-pi, pi]
   return r <= -M_PI ? r + 2 * M_PI : r;

@@ -7,6 +7,7 @@
 // signal slower than the grid keeps its values but for the corners at its samples (a window
 // holding a sample moves by at most a quarter of the window times the change of slope there).
 #pragma once
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -31,5 +32,10 @@ GridWeights grid_weights(const std::vector<double>& times, size_t first, size_t 
 // in the log's unit), and a roll is wrapped back into (-pi, pi] after (a review, helper-92).
 std::vector<double> unwrapped(const std::vector<double>& angles, double period);
 double wrapped_to_pi(double radians);
+
+// q and -q are one attitude, so a quaternion's component averaged or interpolated across a
+// sign flip would pass through zero: each sample is negated where its dot product with the one
+// before is negative. The four vectors are one quaternion's components (w, x, y, z) on one clock.
+void align_quaternion_signs(const std::array<std::vector<double>*, 4>& components);
 
 }  // namespace quadgen::fit

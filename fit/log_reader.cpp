@@ -62,9 +62,9 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   return s;
 }
 
-// The four quaternion components from one topic: q and -q are one attitude, so a component
-// interpolated across a sign flip would pass through zero. Consecutive samples are aligned.
-void align_quaternion_signs(std::vector<Signal>& signals) {
+// The four quaternion components from one topic, sign-aligned sample to sample
+// (fit/grid_mean.hpp says why).
+void align_mapped_quaternion(std::vector<Signal>& signals) {
   Signal* q[4] = {};
   const char* names[4] = {"qw", "qx", "qy", "qz"};
   for (auto& s : signals)
@@ -72,12 +72,7 @@ void align_quaternion_signs(std::vector<Signal>& signals) {
       if (s.target == names[i]) q[i] = &s;
   for (int i = 0; i < 4; ++i)
     if (!q[i] || q[i]->t != q[0]->t) return;  // not four components on one clock
-  for (size_t k = 1; k < q[0]->t.size(); ++k) {
-    double dot = 0;
-    for (int i = 0; i < 4; ++i) dot += q[i]->v[k] * q[i]->v[k - 1];
-    if (dot < 0)
-      for (int i = 0; i < 4; ++i) q[i]->v[k] = -q[i]->v[k];
-  }
+  align_quaternion_signs({&q[0]->v, &q[1]->v, &q[2]->v, &q[3]->v});
 }
 
 // The grid value at t: the signal's mean over the grid interval around t, within its stretch
@@ -128,7 +123,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   }
   if (signals.empty()) throw FitError(m.name + ": maps no signal of the log's topics (sources are topic.field)");
   if (!(t1 > t0)) throw FitError(log.path + ": the mapped topics do not overlap in time");
-  align_quaternion_signs(signals);
+  align_mapped_quaternion(signals);
   const double step = 1.0 / rate_hz, rows = std::floor((t1 - t0) / step) + 1;
   if (rows * static_cast<double>(signals.size() + 1) > kMaxCells)
     throw FitError(log.path + ": " + std::to_string(static_cast<long long>(rows)) + " rows of " +

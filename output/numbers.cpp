@@ -11,40 +11,27 @@
 namespace quadgen::output {
 
 namespace {
-// -0 (a vehicle file's "-0", a product of 0 and a negative number) is printed as 0: "-0" in a
-// message or a report reads as a sign that matters, and nothing here tells the two apart.
-double printed(double v) { return v == 0 ? 0.0 : v; }
+// v with `digits` significant digits (as %g). -0 (a vehicle file's "-0", a product of 0 and a
+// negative number) is printed as 0: "-0" in a message or a report reads as a sign that
+// matters, and nothing here tells the two apart.
+std::string with_digits(double v, int digits) {
+  std::ostringstream os;
+  os.precision(digits);
+  os << (v == 0 ? 0.0 : v);
+  return os.str();
+}
 }  // namespace
 
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << printed(v);
-  return os.str();
-}
+std::string short_number(double v) { return with_digits(v, 3); }
 
-std::string six_digits(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << printed(v);
-  return os.str();
-}
+std::string six_digits(double v) { return with_digits(v, 6); }
 
-std::string full_number(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << printed(v);
-  return os.str();
-}
+std::string full_number(double v) { return with_digits(v, 17); }
 
 std::string one_then_other(double a, double b) {
   for (int digits = 6;; ++digits) {
-    std::ostringstream x, y;
-    x.precision(digits);
-    y.precision(digits);
-    x << printed(a);
-    y << printed(b);
-    if (x.str() != y.str() || a == b || digits >= 17) return x.str() + " then " + y.str();
+    const std::string x = with_digits(a, digits), y = with_digits(b, digits);
+    if (x != y || a == b || digits >= 17) return x + " then " + y;
   }
 }
 

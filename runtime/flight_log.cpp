@@ -82,12 +82,6 @@ namespace {
   throw LogError(log.where_row(row) + ": " + what);
 }
 
-std::string number_text(double v) {
-  std::ostringstream os;
-  os << (v == 0 ? 0.0 : v);  // -0 as 0 (output/numbers.cpp says why)
-  return os.str();
-}
-
 // A cell as it may appear in a one-line message: long or binary junk is cut short.
 std::string quoted_cell(const std::string& cell) {
   std::string shown;
@@ -350,16 +344,16 @@ void check_values(const CsvTable& log) {
       const double bound = static_cast<int>(c) == tc ? kMaxAbsTime : kMaxAbsValue;
       if (std::fabs(v) > bound)
         fail_at_row(log, i,
-                "column '" + log.columns[c] + "' is " + number_text(v) + ", beyond the sanity bound |value| <= " +
-                    number_text(bound) + " (canonical SI units)");
+                "column '" + log.columns[c] + "' is " + output::six_digits(v) + ", beyond the sanity bound |value| <= " +
+                    output::six_digits(bound) + " (canonical SI units)");
       if (static_cast<int>(c) == vbat && !(v > 0))
         fail_at_row(log, i,
-                "column 'vbat' is " + number_text(v) +
+                "column 'vbat' is " + output::six_digits(v) +
                     " V; a battery voltage must be positive (a logger writes 0 before its first reading: drop those "
                     "rows, or the column where battery_sag is not wanted)");
       if (throttle[c] && v > kMaxThrottle)
         fail_at_row(log, i,
-                "column '" + log.columns[c] + "' is " + number_text(v) +
+                "column '" + log.columns[c] + "' is " + output::six_digits(v) +
                     "; expected a throttle fraction 0..1 (in a log mapping, a percentage takes scale: 0.01, a 16-bit PWM "
                     "count scale: 1.5259e-05)");
     }
