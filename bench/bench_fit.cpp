@@ -12,6 +12,7 @@
 #include "fit/multiple_shooting.hpp"
 #include "generated/finken3/model.hpp"
 #include "fit/profile_likelihood.hpp"
+#include "runtime/portable_random.hpp"
 
 using namespace quadgen;
 using namespace quadgen::fit;
@@ -26,8 +27,8 @@ struct Setup {
   Setup() {
     truth = model.params();
     std::mt19937 rng(1);
-    std::normal_distribution<double> n(0, 1);
-    std::uniform_real_distribution<double> u(0.3, 0.5);
+    quadgen::runtime::Normal n(0, 1);
+    quadgen::runtime::UniformReal u(0.3, 0.5);
     flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
     for (int k = 0; k < 6000; ++k) {
       FlightSample s;

@@ -288,7 +288,9 @@ LoweredPlan::Mono LoweredPlan::make_sum(std::vector<Mono> in) {
     for (const auto& t : statics) kept.push_back(t);
   }
   for (const auto& t : kept) mat.push_back(materialize(t));
-  std::sort(mat.begin(), mat.end(), [](const Signed& a, const Signed& b) { return a.id < b.id; });
+  // Stable: should two terms ever materialise as one node, the outer sign is the first one's,
+  // not whichever std::sort happened to put first.
+  std::stable_sort(mat.begin(), mat.end(), [](const Signed& a, const Signed& b) { return a.id < b.id; });
   const int outer = mat.front().sign;
   std::vector<std::pair<int, int>> st;
   for (const auto& s : mat) st.push_back({s.id, s.sign * outer});

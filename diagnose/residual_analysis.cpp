@@ -164,7 +164,10 @@ std::vector<Correlation> correlations_with(const ChannelAnalysis& a, const std::
     cr.p_value = 2 * boost::math::cdf(boost::math::complement(boost::math::students_t(n_eff - 2), tstat));
     out.push_back(cr);
   }
-  std::sort(out.begin(), out.end(), [](const Correlation& p, const Correlation& q) { return std::abs(p.r) > std::abs(q.r); });
+  // Stable: signals of equal |r| keep the signal set's order, not the sort's (which the
+  // standard leaves open, so another library could print them the other way round).
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Correlation& p, const Correlation& q) { return std::abs(p.r) > std::abs(q.r); });
   return out;
 }
 

@@ -131,7 +131,9 @@ Profile assemble(const FitResult& best, int k, const ProfileOptions& po, const S
   pr.points.push_back({p.value, 0.0, best_vals});
   for (const auto& q : left) pr.points.push_back(q);
   for (const auto& q : right) pr.points.push_back(q);
-  std::sort(pr.points.begin(), pr.points.end(), [](const auto& a, const auto& b) { return a.value < b.value; });
+  // Stable: two steps that land on one value keep the order they were taken in (std::sort
+  // leaves ties in the library's order).
+  std::stable_sort(pr.points.begin(), pr.points.end(), [](const auto& a, const auto& b) { return a.value < b.value; });
   if (!pr.lower_open && !pr.upper_open) {
     pr.verdict = "identifiable";
   } else if (interior >= 3 && max_delta < 1e-3 * pr.threshold_pointwise) {

@@ -13,6 +13,7 @@
 #include "runtime/allocation_matrix.hpp"
 #include "runtime/attitude.hpp"
 #include "runtime/integrator.hpp"
+#include "runtime/portable_random.hpp"
 #include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::runtime {
@@ -34,7 +35,7 @@ struct Reference {
   std::vector<Wave> axis[4];  // x, y, z, yaw
   double offset[4] = {0, 0, 0, 0};
   Reference(const ClosedLoopOptions& o, std::mt19937& rng) {
-    std::uniform_real_distribution<double> freq(0.08, 0.35), ph(0, 2 * M_PI);
+    const UniformReal freq(0.08, 0.35), ph(0, 2 * M_PI);
     const double amp[4] = {o.amplitude, o.amplitude, o.height_amplitude, o.yaw_amplitude};
     offset[2] = o.height;
     for (int a = 0; a < 4; ++a)
@@ -249,7 +250,7 @@ namespace {
 class Multisine {
  public:
   explicit Multisine(std::mt19937& rng) {
-    std::uniform_real_distribution<double> uphase(0, 2 * M_PI);
+    const UniformReal uphase(0, 2 * M_PI);
     for (auto& ch : phase_)
       for (double& p : ch) p = uphase(rng);
   }
@@ -383,7 +384,7 @@ struct Sensors {
   std::vector<double> row(double t, const std::vector<double>& u, int nr, const std::vector<double>& x,
                           const Eigen::Quaterniond& q_estimated, const M3& R_true, const std::vector<double>& f,
                           double vbat, const ReferenceAt& r, const M3& desired, std::mt19937& rng,
-                          std::normal_distribution<double>& gauss) const {
+                          Normal& gauss) const {
     std::vector<double> row{t};
     for (int i = 0; i < nr; ++i) row.push_back(u[i]);
     const double an = o.pose_noise;
@@ -410,7 +411,7 @@ struct Sensors {
 // Forces outside the effect catalogue, as impulses over one control period: a tether pulling
 // back to the start, a random roll and pitch disturbance, a yaw moment in proportion to the
 // forward speed. The disturbance has an engine of its own but draws through the sensors'
-// normal distribution, whose cached second value it may take: a flight without it is the
+// Normal (portable_random.hpp), whose kept second value it may take: a flight without it is the
 // same as before it existed, one with it does not share the sensor noise of the same seed
 // without it. (Kept so, since the flights generated with it are referred to as they are.)
 struct UnmodelledForces {
@@ -422,7 +423,7 @@ struct UnmodelledForces {
   UnmodelledForces(const ClosedLoopOptions& options, double m, double period)
       : o(options), mass(m), dt(period), rng(options.seed + 7919), pole(std::exp(-2 * M_PI * 10.0 * period)),
         gain(options.angular_disturbance * std::sqrt(1 - pole * pole)) {}
-  void apply(std::vector<double>& x, const Reference& ref, std::normal_distribution<double>& gauss) {
+  void apply(std::vector<double>& x, const Reference& ref, Normal& gauss) {
     if (o.tether_stiffness > 0) {
       const ReferenceAt start(ref, 0.0);
       for (int a = 0; a < 2; ++a)
@@ -502,7 +503,7 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
                                 const std::vector<std::string>& rotors, const ClosedLoopOptions& o) {
   std::mt19937 rng(o.seed);
   const Reference ref(o, rng);
-  std::normal_distribution<double> gauss(0, 1);
+  Normal gauss(0, 1);
   const Multisine excitation(rng);
   const int nr = static_cast<int>(rotors.size());
   const ExtraInputs extra(truth);

@@ -14,6 +14,7 @@
 #include "generated/crazyflie21_nanobench_all_effects/model.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
+#include "runtime/portable_random.hpp"
 
 namespace gen = quadgen_generated;
 
@@ -73,7 +74,7 @@ int index_of_param(const std::string& name) {
 template <class M>
 Point<M> random_point(std::mt19937& rng) {
   Point<M> pt;
-  std::uniform_real_distribution<double> d(-1, 1);
+  quadgen::runtime::UniformReal d(-1, 1);
   double n = 0;
   for (int i = 0; i < M::kNumStates; ++i) pt.x[i] = d(rng);
   pt.x[2] = 0.5 + std::fabs(pt.x[2]);  // above the ground (ground effect)

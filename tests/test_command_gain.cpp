@@ -16,6 +16,7 @@
 #include "runtime/dynamic_model.hpp"
 #include "runtime/flight_log.hpp"
 #include "tests/test_helpers.hpp"
+#include "runtime/portable_random.hpp"
 
 using namespace quadgen;
 using namespace quadgen::diagnose;
@@ -27,7 +28,7 @@ namespace {
 // vertical carry a multisine (1-15 Hz) and a slow swing; the measured ones are `gain` times
 // the model's `delay` earlier plus a slow disturbance of their own and white noise.
 CommandGainInput synthetic(double gain, double delay, double seconds, std::mt19937& rng) {
-  std::normal_distribution<double> noise(0, 0.3);
+  quadgen::runtime::Normal noise(0, 0.3);
   CommandGainInput in;
   in.rotors = 4, in.vertical_offset = 9.81;
   const auto drive = [](double t, int axis) {

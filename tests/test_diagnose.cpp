@@ -47,6 +47,7 @@
 #include "runtime/dynamic_model.hpp"
 #include "tests/estimate_shape.hpp"
 #include "tests/shared_data.hpp"
+#include "runtime/portable_random.hpp"
 
 namespace {
 
@@ -603,7 +604,7 @@ TEST(Acceptance, CauseOnlyInTheTrainingPartIsSuspectedNotNamed) {
 // tau = 1 + 2 sum rho^k = (1 + rho) / (1 - rho), 9 for rho = 0.8; white noise has 1.
 TEST(Acceptance, AutocorrelationTimeOfAnAr1SeriesIsItsClosedForm) {
   std::mt19937 rng(11);
-  std::normal_distribution<double> e(0.0, 1.0);
+  quadgen::runtime::Normal e(0.0, 1.0);
   const size_t n = 200000;
   std::vector<double> ar(n), white(n);
   double x = 0;
@@ -940,7 +941,7 @@ TEST(MultiFlight, TheSpreadOfAgreeingFlightsIsTheRangeOfTheirNormals) {
   }
   const std::vector<double> sd = {0.5, 1.0, 1.5, 1.0, 2.0};
   std::mt19937_64 rng(7);
-  std::normal_distribution<double> z;
+  quadgen::runtime::Normal z(0.0, 1.0);
   constexpr int kDraws = 200000;
   std::vector<double> ranges;
   for (int n = 0; n < kDraws; ++n) {

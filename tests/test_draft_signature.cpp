@@ -14,6 +14,7 @@
 #include "diagnose/draft_signature.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "diagnose/report_words.hpp"
+#include "runtime/portable_random.hpp"
 
 namespace {
 
@@ -26,7 +27,7 @@ constexpr double kd = 1.32e-6, kf = 2.9e-8, mass = 0.0271, Jxx = 1.43e-5, Jyy = 
 
 // A slowly wandering air speed component [m/s]: AR(1) with a 2 s time constant, about 0.2 m/s RMS.
 std::vector<double> wandering(std::mt19937& rng, size_t n) {
-  std::normal_distribution<double> step(0.0, 0.02);
+  quadgen::runtime::Normal step(0.0, 0.02);
   std::vector<double> w(n, 0.0);
   for (size_t k = 1; k < n; ++k) w[k] = 0.995 * w[k - 1] + step(rng);
   return w;
@@ -48,7 +49,7 @@ DraftSignatureInput flight_with_draft(Force force, unsigned seed, bool accelerom
   std::mt19937 rng(seed);
   const size_t n = 6000;
   const auto wx = wandering(rng, n), wy = wandering(rng, n), ox = wandering(rng, n), oy = wandering(rng, n);
-  std::normal_distribution<double> moment_noise(0.0, 3.0), force_noise(0.0, 0.1);
+  quadgen::runtime::Normal moment_noise(0.0, 3.0), force_noise(0.0, 0.1);
   DraftSignatureInput in;
   in.rotor_drag_k = kd, in.blade_flapping_k = kf, in.mass = mass, in.J_xx = Jxx, in.J_yy = Jyy;
   in.hover_speeds_sum = S;

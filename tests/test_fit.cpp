@@ -38,7 +38,7 @@ namespace {
 std::vector<MotorStep> synthetic_steps(const std::vector<MotorStep>& layout, const std::vector<double>& truth,
                                        double sigma, std::mt19937& rng) {
   MotorStepModel m(layout);
-  std::normal_distribution<double> noise(0, sigma);
+  quadgen::runtime::Normal noise(0, sigma);
   std::vector<MotorStep> out = layout;
   for (size_t k = 0; k < out.size(); ++k)
     for (size_t i = 0; i < out[k].t.size(); ++i) out[k].rpm[i] = m.predict(truth.data(), k, out[k].t[i]) + noise(rng);
@@ -49,8 +49,8 @@ std::vector<MotorStep> synthetic_steps(const std::vector<MotorStep>& layout, con
 // [0.3, 0.5], the model's accelerations plus Gaussian noise (0.05). At rest with equal
 // commands, velocities and rates are zero and all four rotors get the same command.
 Flight synthetic_flight(const runtime::DynamicModel& model, std::mt19937& rng, bool at_rest_equal_commands) {
-  std::normal_distribution<double> noise(0, 0.05);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  quadgen::runtime::Normal noise(0, 0.05);
+  quadgen::runtime::UniformReal cmd(0.3, 0.5);
   Flight flight;
   flight.has_pose = flight.has_gyro = flight.has_accelerometer = true;
   for (int k = 0; k < 300; ++k) {
@@ -77,7 +77,7 @@ Flight synthetic_flight(const runtime::DynamicModel& model, std::mt19937& rng, b
 // `flights` stretches of 200 samples each (flight k from t = 10 k s, so a joined log has a gap
 // between them) of random states and commands in [0.3, 0.5], vbat 3.9 V, pose and gyro logged.
 Flight random_command_flights(std::mt19937& rng, int flights) {
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
+  quadgen::runtime::UniformReal cmd(0.3, 0.5);
   Flight out;
   out.has_pose = out.has_gyro = true;
   for (int flight = 0; flight < flights; ++flight)
@@ -146,7 +146,7 @@ TEST(Fit, ProfileIntervalsCoverTheTruth) {
   truth[0] = 1600, truth[1] = 21500, truth[2] = -3200, truth[3] = 0.09;
   std::mt19937 rng(2024);
   for (size_t k = 0; k < layout.size(); ++k) {
-    std::uniform_real_distribution<double> d(0.0, layout[k].t_first - layout[k].t_before);
+    quadgen::runtime::UniformReal d(0.0, layout[k].t_first - layout[k].t_before);
     truth[4 + k] = d(rng);
   }
   int covered = 0, inside = 0, closed = 0;
@@ -351,7 +351,7 @@ TEST(Fit, MultipleShootingRecoversParametersFromPose) {
   o.step = 0.01;
   const auto tr = runtime::integrate_rk4(model, x0, u, 0.0, 4.0, o);
   std::mt19937 rng(3);
-  std::normal_distribution<double> pos(0, 5e-4), ang(0, 1e-3);
+  quadgen::runtime::Normal pos(0, 5e-4), ang(0, 1e-3);
   Flight f;
   f.has_pose = f.has_gyro = true;
   for (size_t k = 0; k < tr.t.size(); ++k) {
@@ -410,7 +410,7 @@ TEST(FitData, ResampleTakesEachGridIntervalsMean) {
 // draws below). A constant reads as itself wherever the window sits.
 TEST(FitData, AGridWindowAtAStretchsStartReadsTheStretch) {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> start(0.0, 0.003), into(0.0, 1.0);
+  quadgen::runtime::UniformReal start(0.0, 0.003), into(0.0, 1.0);
   int checked = 0;
   for (int n = 0; n < 2000; ++n) {
     const double s = start(rng);
@@ -628,6 +628,7 @@ TEST(Fit, ParallelProfilesEqualSequentialOnes) {
 }
 
 #include "fit/thrust_stand.hpp"
+#include "runtime/portable_random.hpp"
 namespace {
 // A synthetic stand run: thrust sum k w_i^2 + tare with noise; each motor's speed is the
 // common speed times its own factor, varied per sample by `independent`; the battery
@@ -635,8 +636,8 @@ namespace {
 std::vector<StandSample> synthetic_stand(double independent, bool voltage_varies, std::mt19937& rng,
                                         size_t motors = 4, double k = 2e-8, double speed_scale = 1,
                                         double thrust_sd = 0.002) {
-  std::uniform_real_distribution<double> cmd(0.1, 1.0), indep(-independent, independent), volt(3.0, 4.1);
-  std::normal_distribution<double> thrust_noise(0, thrust_sd), speed_noise(0, 1);
+  quadgen::runtime::UniformReal cmd(0.1, 1.0), indep(-independent, independent), volt(3.0, 4.1);
+  quadgen::runtime::Normal thrust_noise(0, thrust_sd), speed_noise(0, 1);
   const double tare = 0.01, vref = 3.7, e = 0.5;
   const double ratio[6] = {1.03, 0.98, 1.01, 0.98, 1.02, 0.99};
   std::vector<StandSample> out;
@@ -795,8 +796,8 @@ TEST(Fit, EachFlightKeepsItsOwnAttitudeBias) {
   runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
   const double roll[2] = {0.03, -0.02}, pitch[2] = {-0.01, 0.025};
   std::mt19937 rng(21);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  std::normal_distribution<double> noise(0, 0.01);
+  quadgen::runtime::UniformReal cmd(0.3, 0.5);
+  quadgen::runtime::Normal noise(0, 0.01);
   Flight joined;
   joined.has_pose = joined.has_gyro = true;
   const int n = inner.num_states();
@@ -1027,8 +1028,8 @@ TEST(Fit, RotorSpeedsAreCarriedAcrossShortGaps) {
   truth[lag] = 0.06;
   model.set_params(truth);
   std::mt19937 rng(8);
-  std::uniform_real_distribution<double> cmd(0.3, 0.5);
-  std::normal_distribution<double> noise(0, 0.01);
+  quadgen::runtime::UniformReal cmd(0.3, 0.5);
+  quadgen::runtime::Normal noise(0, 0.01);
   const auto in_gap = [](double t) { return (t >= 1.0 && t < 1.2) || (t >= 2.5 && t < 2.8) || (t >= 4.0 && t < 4.1); };
   Flight flight;
   flight.has_pose = flight.has_gyro = true;
@@ -1088,7 +1089,7 @@ class LinearModel : public ResidualModel {
  public:
   LinearModel() {
     std::mt19937 rng(7);
-    std::normal_distribution<double> n(0.0, 1.0);
+    quadgen::runtime::Normal n(0.0, 1.0);
     A_ = Eigen::MatrixXd(40, 4);
     b_ = Eigen::VectorXd(40);
     for (int i = 0; i < 40; ++i) {
@@ -1199,7 +1200,7 @@ class CollinearMixedScaleModel : public ResidualModel {
  public:
   CollinearMixedScaleModel() {
     std::mt19937 rng(11);
-    std::normal_distribution<double> n(0.0, 1.0);
+    quadgen::runtime::Normal n(0.0, 1.0);
     A_ = Eigen::MatrixXd(200, 2);
     b_ = Eigen::VectorXd(200);
     for (int i = 0; i < 200; ++i) {

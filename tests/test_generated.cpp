@@ -158,7 +158,7 @@ void check_f_against_symbolic_model(const char* vehicle_file, int trials, unsign
   for (int i = 0; i < M::kNumInputs; ++i) ASSERT_EQ(m.inputs[i].name, M::input_names[i]);
   for (int i = 0; i < M::kNumParams; ++i) ASSERT_EQ(m.params[i].name, M::param_names[i]);
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> unit(0, 1);
+  quadgen::runtime::UniformReal unit(0, 1);
   int effect_params = 0;
   for (int t = 0; t < trials; ++t) {
     Point<M> pt = random_point<M>(rng);
@@ -519,6 +519,7 @@ TEST(Generated, IndependentOfSymbolCreationOrder) {
 // same physics; it must agree with the generated f everywhere, products of inertia and
 // CoG offsets included.
 #include "bench/reference_model.hpp"
+#include "runtime/portable_random.hpp"
 TEST(Generated, AgreesWithHandWrittenReferenceModel) {
   std::mt19937 rng(21);
   const auto layout = quadgen::reference::finken3_layout();

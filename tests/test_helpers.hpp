@@ -9,6 +9,7 @@
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/portable_random.hpp"
 
 namespace quadgen::test {
 
@@ -31,7 +32,7 @@ inline std::vector<double> eval_f(const SymbolicModel& m, const std::vector<doub
 
 // A random flight state: position, velocity, unit quaternion, body rates.
 inline std::vector<double> random_state(std::mt19937& rng) {
-  std::uniform_real_distribution<double> d(-1, 1);
+  quadgen::runtime::UniformReal d(-1, 1);
   std::vector<double> x(13);
   for (int i = 0; i < 6; ++i) x[i] = 2 * d(rng);
   x[2] = 1.0 + std::fabs(x[2]);  // above the ground

@@ -45,6 +45,7 @@
 #include "output/sinks.hpp"
 #include "tests/test_helpers.hpp"
 #include "model/vehicle.hpp"
+#include "runtime/portable_random.hpp"
 
 namespace fs = std::filesystem;
 using quadgen::test::source_path;
@@ -1311,7 +1312,7 @@ TEST(DataLoss, SigkillAtRandomMomentsLeavesOneCompleteRun) {
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   std::mt19937 rng(20261123);
-  std::uniform_real_distribution<double> fraction(0.0, 1.2);
+  quadgen::runtime::UniformReal fraction(0.0, 1.2);
   for (int k = 0; k < 12; ++k) {
     const size_t which = static_cast<size_t>(k) % runs.size();
     run_quadgen(runs[which], tmp.dir, {fraction(rng) * seconds[which]});

@@ -6,6 +6,7 @@
 #include "audit/audit.hpp"
 #include "derive/kinematics.hpp"
 #include "tests/test_helpers.hpp"
+#include "runtime/portable_random.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;
@@ -35,9 +36,10 @@ TEST(Kinematics, ReduceTrigDetectsANonRotation) {
 
 TEST(Kinematics, QuaternionMatrixMatchesEigen) {
   std::mt19937 rng(7);
-  std::normal_distribution<double> d;
+  quadgen::runtime::Normal d(0.0, 1.0);
   for (int k = 0; k < 20; ++k) {
-    Eigen::Quaterniond q(d(rng), d(rng), d(rng), d(rng));
+    const double w = d(rng), x = d(rng), y = d(rng), z = d(rng);  // in this order, whatever the compiler
+    Eigen::Quaterniond q(w, x, y, z);
     q.normalize();
     const matrix R = rotation_from_quaternion(quaternion(q.w(), q.x(), q.y(), q.z()));
     const Eigen::Matrix3d E = q.toRotationMatrix();

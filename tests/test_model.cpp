@@ -24,6 +24,7 @@
 #include "audit/thesis_reference.hpp"
 #include "model/units.hpp"
 #include "runtime/rigid_body_state.hpp"
+#include "runtime/portable_random.hpp"
 
 using namespace quadgen;
 using namespace GiNaC;
@@ -199,7 +200,7 @@ TEST(Model, EveryEffectAtNominalValuesReproducesTheBaseModel) {
   const Vehicle v = test::finken3();
   const SymbolicModel base = derive(v);
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> cmd(0.2, 0.8);
+  quadgen::runtime::UniformReal cmd(0.2, 0.8);
   for (const Effect& e : effect_catalogue()) {
     const SymbolicModel ext = derive(v, effect_with_what_it_refines(e.name));
     for (int trial = 0; trial < 3; ++trial) {

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -24,6 +25,7 @@
 #include "generated/finken3_all_effects/model.hpp"
 #include "runtime/integrator.hpp"
 #include "runtime/per_flight_model.hpp"
+#include "runtime/portable_random.hpp"
 #include "codegen/tape_builder.hpp"
 #include "tests/test_helpers.hpp"
 
@@ -760,8 +762,8 @@ TEST(Simulate, ReplaysALogOfAnotherLayoutThroughAMapping) {
 // optimisation: the checked-in 2 s flight (tests/golden/, written by scripts/regenerate.sh) is
 // flown byte for byte. CI flies it built with GCC and, instrumented, with clang; under clang the
 // attitude noise once came out permuted (a constructor's three draws, in the compiler's order).
-// The file also pins what the flight is computed with: libstdc++'s random distributions,
-// glibc's sin/cos/exp and no fused multiply-add (CMakeLists.txt). After an upgrade of those,
+// The file also pins what the flight is computed with: the random distributions written out in
+// runtime/portable_random.hpp, glibc's sin/cos/exp/log and no fused multiply-add (CMakeLists.txt). After an upgrade of those,
 // or an intended change to the simulator, look at the first differing line the test prints
 // (last-digit noise, or a real change?), then run scripts/regenerate.sh.
 TEST(Simulate, TheCheckedInClosedLoopFlightIsFlownByteForByte) {
@@ -791,6 +793,47 @@ TEST(Simulate, TheCheckedInClosedLoopFlightIsFlownByteForByte) {
   }
   EXPECT_TRUE(flown.str() == golden.str()) << "the same lines, other bytes (a line ending?)";
   std::filesystem::remove_all(dir);
+}
+
+// The simulator's distributions (runtime/portable_random.hpp) were written from libstdc++'s so
+// that the flights generated before them stay the same: where libstdc++ is the standard library,
+// they give its numbers bit for bit, uniform and normal draws interleaved on one engine and the
+// normal's kept second value taken by a draw on another engine (as the closed loop's
+// disturbance does). Elsewhere the golden flight above is the check.
+TEST(PortableRandom, GivesTheNumbersOfTheLibstdcxxAlgorithmsItWasWrittenFrom) {
+#ifndef __GLIBCXX__
+  GTEST_SKIP() << "the reference algorithms are libstdc++'s";
+#else
+  std::mt19937 mine_a(11), mine_b(12), theirs_a(11), theirs_b(12);
+  UniformReal mine_uniform(-0.3, 2.5);
+  std::uniform_real_distribution<double> theirs_uniform(-0.3, 2.5);
+  Normal mine_normal(0.7, 1.9);
+  std::normal_distribution<double> theirs_normal(0.7, 1.9);
+  double sum = 0, sum_sq = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const bool other_engine = i % 7 == 0;
+    std::mt19937& mine = other_engine ? mine_b : mine_a;
+    std::mt19937& theirs = other_engine ? theirs_b : theirs_a;
+    if (i % 3 == 0) {
+      const double u = mine_uniform(mine);
+      ASSERT_EQ(u, theirs_uniform(theirs)) << "draw " << i;
+      ASSERT_TRUE(u >= -0.3 && u < 2.5) << u;
+    } else {
+      const double z = mine_normal(mine);
+      ASSERT_EQ(z, theirs_normal(theirs)) << "draw " << i;
+      sum += z, sum_sq += z * z;
+    }
+  }
+  EXPECT_EQ(mine_a(), theirs_a());  // both left the engines at the same place
+  std::mt19937_64 mine_64(13), theirs_64(13);  // a 64-bit engine: one draw per double
+  for (int i = 0; i < 20000; ++i)
+    ASSERT_EQ(i % 2 ? mine_uniform(mine_64) : mine_normal(mine_64),
+              i % 2 ? theirs_uniform(theirs_64) : theirs_normal(theirs_64)) << "draw " << i;
+  // Not only the same as libstdc++, also what was asked for (n = 133333: 5 standard errors).
+  const double n = 133333, mean = sum / n, sd = std::sqrt(sum_sq / n - mean * mean);
+  EXPECT_NEAR(mean, 0.7, 5 * 1.9 / std::sqrt(n));
+  EXPECT_NEAR(sd, 1.9, 5 * 1.9 / std::sqrt(2 * n));
+#endif
 }
 
 // A replay that starts on the floor with the motors off but one: with --ground start the vehicle

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "diagnose/term_discovery.hpp"
+#include "runtime/portable_random.hpp"
 
 using namespace quadgen;
 using namespace quadgen::diagnose;
@@ -39,7 +40,7 @@ fit::Flight manoeuvre(double t0, double seconds, double phase) {
 // smoothed derivative), plus on `channel` the negative of a term the model lacks.
 std::vector<double> residuals(const fit::Flight& f, std::mt19937& rng, int channel,
                               double (*lacks)(const fit::FlightSample&)) {
-  std::normal_distribution<double> n(0, 1);
+  quadgen::runtime::Normal n(0, 1);
   std::vector<double> r(f.samples.size() * 6), state(6, 0.0);
   for (size_t k = 0; k < f.samples.size(); ++k)
     for (int c = 0; c < 6; ++c) {
