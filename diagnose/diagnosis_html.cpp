@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <map>
 #include <optional>
@@ -142,6 +143,13 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   h << "</table>\n";
 }
 
+// A flight's log by its file name: the full paths are listed once at the top of the report
+// (and on hover), where in every table row they pushed the numbers and the plot aside.
+std::string file_name_of(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  return name.empty() ? path : name;
+}
+
 // Each named airframe parameter per flight as a forest plot in the table: the flight's 95 %
 // interval as a bar, its value as a dot, the joint value as a vertical line; agreeing
 // flights' bars all cross the line.
@@ -164,7 +172,8 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
          "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
-      h << "<tr><td>" << k + 1 << ". " << esc(k < flights.size() ? flights[k] : std::string()) << "</td><td>"
+      const std::string path = k < flights.size() ? flights[k] : std::string();
+      h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
         << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
         << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
         << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Detection rate against effect size and noise level (README "Calibration"):
+# Detection rate against effect size and noise level (docs/validation.md, "Calibration"):
 #   scripts/calibrate.sh [OUT_DIR] [SEEDS]
 # For each effect, size and noise level, closed-loop flights over the seeds are diagnosed;
 # "named" counts flights where the hidden effect is named and nothing else, "detected"
