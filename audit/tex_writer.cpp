@@ -29,7 +29,7 @@ ex negated_sum(const ex& sum) {
 }  // namespace
 
 void TexWriter::sort(std::vector<Written>& v) {
-  std::sort(v.begin(), v.end(), [](const Written& a, const Written& b) {
+  std::stable_sort(v.begin(), v.end(), [](const Written& a, const Written& b) {  // ties only between equal texts
     if (term_order::before(a.support, b.support)) return true;
     if (term_order::before(b.support, a.support)) return false;
     return a.text < b.text;

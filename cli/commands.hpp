@@ -1,4 +1,4 @@
-// Subcommands of the quadgen executable (README "What each command writes").
+// Subcommands of the quadgen executable (docs/formats.md, "What each command writes").
 #pragma once
 #include <set>
 #include <string>

@@ -154,7 +154,7 @@ std::vector<Correlation> correlations_with(const ChannelAnalysis& a, const std::
       cxy += (x[k] - a.bias) * (y[k] - my);
     }
     sy = std::sqrt(sy / static_cast<double>(ns));
-    if (sx <= 0 || sy <= 0) continue;
+    if (!(sx > 0 && sy > 0)) continue;  // also a NaN, which would break the sort below
     Correlation cr;
     cr.signal = signals.names[s];
     cr.r = cxy / static_cast<double>(ns) / (sx * sy);

@@ -32,6 +32,7 @@
 #include "app/diagnose_job.hpp"
 #include "app/extended_model.hpp"
 #include "app/model_registry.hpp"
+#include "output/sinks.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
 #include "fit/log_reader.hpp"
@@ -981,7 +982,7 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
     std::ifstream in(fs::temp_directory_path() / "quadgen_agree" / "out" / "report.html");
     const std::string html((std::istreambuf_iterator<char>(in)), {});
     const std::string whole = (fs::temp_directory_path() / "quadgen_agree" / "b.csv").string();
-    EXPECT_NE(html.find("<td title=\"" + whole + "\">2. b.csv</td>"), std::string::npos)
+    EXPECT_NE(html.find("<td title=\"" + quadgen::output::html_text(whole) + "\">2. b.csv</td>"), std::string::npos)
         << html.substr(html.find("Do the flights agree?"), 3000);
   }
 

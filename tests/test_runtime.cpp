@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
@@ -833,6 +835,28 @@ TEST(PortableRandom, GivesTheNumbersOfTheLibstdcxxAlgorithmsItWasWrittenFrom) {
   const double n = 133333, mean = sum / n, sd = std::sqrt(sum_sq / n - mean * mean);
   EXPECT_NEAR(mean, 0.7, 5 * 1.9 / std::sqrt(n));
   EXPECT_NEAR(sd, 1.9, 5 * 1.9 / std::sqrt(2 * n));
+#endif
+}
+
+// The one branch the draws above cannot reach: an engine at its largest value, whose double
+// would round up to 1, gives the largest double below 1 instead (as libstdc++ does).
+template <class Int>
+struct EngineAtItsTop {
+  using result_type = Int;
+  static constexpr Int min() { return 0; }
+  static constexpr Int max() { return std::numeric_limits<Int>::max(); }
+  Int operator()() { return max(); }
+};
+
+TEST(PortableRandom, AnEngineAtItsTopGivesTheLargestDoubleBelowOne) {
+  const double below_one = std::nextafter(1.0, 0.0);
+  EngineAtItsTop<std::uint32_t> top32;
+  EngineAtItsTop<std::uint64_t> top64;
+  EXPECT_EQ(canonical_double(top32), below_one);
+  EXPECT_EQ(canonical_double(top64), below_one);
+#ifdef __GLIBCXX__
+  EXPECT_EQ(canonical_double(top32), (std::generate_canonical<double, 53>(top32)));
+  EXPECT_EQ(canonical_double(top64), (std::generate_canonical<double, 53>(top64)));
 #endif
 }
 
