@@ -15,7 +15,6 @@ packages=(
   gnuplot-nox                           # plots (SVG) of simulations and fits
   cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown
   clang libclang-rt-14-dev              # CI's sanitizer build (.ci/sanitize) and libFuzzer (scripts/fuzz.sh)
-  libc++-14-dev libc++abi-14-dev        # test: the simulator's random numbers the same with LLVM's standard library
 )
 missing=()
 for p in "${packages[@]}"; do
