@@ -26,16 +26,18 @@ int main(int argc, char** argv) {
   for (unsigned seed : {1u, 3u, 5489u}) {
     std::mt19937 engine32(seed);
     std::mt19937_64 engine64(seed);
+    const auto on_both_engines = [&](auto& uniform, auto& gaussian) {
+      print_draws(engine32, uniform, gaussian, count);
+      print_draws(engine64, uniform, gaussian, count);
+    };
     if (standard) {
       std::uniform_real_distribution<double> uniform(-0.3, 2.5);
       std::normal_distribution<double> gaussian(0.7, 1.9);
-      print_draws(engine32, uniform, gaussian, count);
-      print_draws(engine64, uniform, gaussian, count);
+      on_both_engines(uniform, gaussian);
     } else {
       const quadgen::runtime::UniformReal uniform(-0.3, 2.5);
       quadgen::runtime::Normal gaussian(0.7, 1.9);
-      print_draws(engine32, uniform, gaussian, count);
-      print_draws(engine64, uniform, gaussian, count);
+      on_both_engines(uniform, gaussian);
     }
   }
   return 0;

@@ -978,17 +978,17 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
   EXPECT_LT((*a)["spread"].get<double>(), 0.3);
   EXPECT_GT((*a)["spread_if_agree"].get<double>(), 0.0);  // two flights with standard errors
   EXPECT_GT((*a)["spread_p_value"].get<double>(), 0.01) << "agreeing flights whose spread looks unusual";
+  const fs::path dir = fs::temp_directory_path() / "quadgen_agree";
   {  // the report's agreement table names each flight by its file, the whole path on hover
-    std::ifstream in(fs::temp_directory_path() / "quadgen_agree" / "out" / "report.html");
+    std::ifstream in(dir / "out" / "report.html");
     const std::string html((std::istreambuf_iterator<char>(in)), {});
-    const std::string whole = (fs::temp_directory_path() / "quadgen_agree" / "b.csv").string();
+    const std::string whole = (dir / "b.csv").string();
     EXPECT_NE(html.find("<td title=\"" + quadgen::output::html_text(whole) + "\">2. b.csv</td>"), std::string::npos)
         << html.substr(html.find("Do the flights agree?"), 3000);
   }
 
   // Flights no fit saw, checked against that airframe (diagnose LOG --airframe): one with the
   // same rotor drag and a trim of its own agrees, one with 2.5 times the drag does not.
-  const fs::path dir = fs::temp_directory_path() / "quadgen_agree";
   const fs::path airframe = dir / "out" / "diagnosis.json";
   const auto check = [&](const std::string& name, double k, unsigned seed) {
     const HiddenCase c{name, "rotor_drag,motor_gain", {{"rotor_drag.k", k}, {"motor_gain.D", -0.06}}, {}, "", seed};
