@@ -194,22 +194,51 @@ std::vector<std::string> EquationErrorModel::channels() const {
   return out;
 }
 
+namespace {
+
+// The Jacobian columns a mask asks for: its free parameters, or all of them when none is
+// marked (as restrict_param_jacobian reads an empty list).
+std::vector<int> jacobian_columns(const std::vector<bool>& free, int num_params) {
+  std::vector<int> columns = runtime::free_columns(free);
+  if (columns.empty())
+    for (int c = 0; c < num_params; ++c) columns.push_back(c);
+  return columns;
+}
+
+}  // namespace
+
 void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
   if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
-  if (used_.size() == 6) return evaluate6(p, r, J, free);
   const int np = model_->num_params();
-  const size_t ns = rows_.size();
+  const std::vector<int> columns = jacobian_columns(free, np);
+  if (!J) return evaluate_packed(p, r, nullptr, columns);
+  const size_t nr = static_cast<size_t>(num_residuals()), nc = columns.size();
+  std::vector<double>& packed = scratch_.packed;
+  packed.resize(nr * nc);
+  evaluate_packed(p, r, packed.data(), columns);
+  for (size_t i = 0; i < nr; ++i)
+    for (size_t k = 0; k < nc; ++k) J[i * np + columns[k]] = packed[i * nc + k];
+}
+
+void EquationErrorModel::evaluate_columns(const std::vector<double>& p, double* r, double* J,
+                                          const std::vector<int>& columns) const {
+  if (J) model_->restrict_param_jacobian(columns);
+  evaluate_packed(p.data(), r, J, columns);
+}
+
+void EquationErrorModel::evaluate_packed(const double* p, double* r, double* J, const std::vector<int>& columns) const {
+  if (used_.size() == 6) return evaluate6(p, r, J, columns);
+  const size_t ns = rows_.size(), nc = columns.size(), nu = used_.size();
   std::vector<double>& r6 = scratch_.r6;
   std::vector<double>& J6 = scratch_.J6;
-  r6.assign(ns * 6, 0.0);
-  J6.assign(J ? ns * 6 * np : 0, 0.0);
-  evaluate6(p, r6.data(), J ? J6.data() : nullptr, free);
-  const size_t nu = used_.size();
+  r6.resize(ns * 6);  // evaluate6 writes every entry
+  J6.resize(J ? ns * 6 * nc : 0);
+  evaluate6(p, r6.data(), J ? J6.data() : nullptr, columns);
   for (size_t k = 0; k < ns; ++k)
     for (size_t c = 0; c < nu; ++c) {
       r[k * nu + c] = r6[k * 6 + used_[c]];
       if (J)
-        for (int j = 0; j < np; ++j) J[(k * nu + c) * np + j] = J6[(k * 6 + used_[c]) * np + j];
+        for (size_t q = 0; q < nc; ++q) J[(k * nu + c) * nc + q] = J6[(k * 6 + used_[c]) * nc + q];
     }
 }
 
@@ -238,14 +267,39 @@ std::vector<double> EquationErrorModel::measured_channels() const {
   return m;
 }
 
-void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, double* u) const {
-  commands_at(command_time, u);
+void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, double* u, size_t* cursor) const {
+  commands_at(command_time, u, cursor);
   extra_.fill(s.t, s.vbat, u);
 }
 
-void EquationErrorModel::commands_at(double t, double* u) const {
+namespace {
+
+// The first sample at or after t, as std::lower_bound finds it. With a cursor (the answer of
+// the previous lookup) it searches on from there when t has not gone back: the times a pass
+// looks up rise, so that is a step or two, where the binary search over the whole flight
+// was a twentieth of a diagnosis' time.
+std::vector<FlightSample>::const_iterator first_at_or_after(const std::vector<FlightSample>& S, double t,
+                                                            size_t* cursor) {
+  const auto before = [](const FlightSample& s, double v) { return s.t < v; };
+  auto it = S.begin();
+  bool found = false;
+  if (cursor && *cursor <= S.size() && (*cursor == 0 || S[*cursor - 1].t < t)) {
+    it += static_cast<std::ptrdiff_t>(*cursor);
+    for (int step = 0; step < 4 && !found; ++step) {
+      found = it == S.end() || !(it->t < t);
+      if (!found) ++it;
+    }
+  }
+  if (!found) it = std::lower_bound(it, S.end(), t, before);
+  if (cursor) *cursor = static_cast<size_t>(it - S.begin());
+  return it;
+}
+
+}  // namespace
+
+void EquationErrorModel::commands_at(double t, double* u, size_t* cursor) const {
   const auto& S = flight_.samples;
-  const auto it = std::lower_bound(S.begin(), S.end(), t, [](const FlightSample& s, double v) { return s.t < v; });
+  const auto it = first_at_or_after(S, t, cursor);
   if (it == S.begin() || it == S.end()) {
     const FlightSample& s = it == S.end() ? S.back() : S.front();
     std::copy(s.u.begin(), s.u.end(), u);
@@ -279,6 +333,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
   // their bits change (-0 and +0 kept apart, so results stay bit for bit).
   bool have_bias = false;
   double bias_roll = 0, bias_pitch = 0, conj_q_bias[4] = {1, 0, 0, 0};
+  size_t command_cursor = 0;
   for (size_t k = span.lo; k < span.hi; ++k) {
     const FlightSample& s = flight_.samples[k];
     const runtime::DataSideEffects e = data_side_.at(*model_, p, s.t);
@@ -294,7 +349,7 @@ void EquationErrorModel::prepare(const double* p, std::vector<double>& X, std::v
     runtime::quaternion_product(&s.x[kAttitude], conj_q_bias, x + kAttitude);
     // The commands logged at t_k - d act now (held until the next sample; between
     // samples the linear interpolation is their average over the interval).
-    inputs_at(s, s.t - e.delay, u);
+    inputs_at(s, s.t - e.delay, u, &command_cursor);
   }
   if (!speed_states_.empty()) filter_rotor_speeds(X, U, span);
 }
@@ -336,19 +391,19 @@ void EquationErrorModel::filter_rotor_speeds(std::vector<double>& X, const std::
   }
 }
 
-void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const {
+void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const std::vector<int>& columns) const {
   const int np = model_->num_params();
-  std::vector<int> columns = runtime::free_columns(free);
-  if (columns.empty())
-    for (int c = 0; c < np; ++c) columns.push_back(c);
   residuals(p, r, J, all_samples(), columns);
   if (!J) return;
   // Columns of the parameters applied to the data: central differences over the rows each
   // column can change (zero elsewhere).
+  const size_t nc = columns.size();
   std::vector<double> pp(p, p + np), rp, rm;
   for (size_t d = 0; d < data_side_columns_.size(); ++d) {
     const int c = data_side_columns_[d];
-    if (!free.empty() && !free[c]) continue;
+    const auto at = std::find(columns.begin(), columns.end(), c);
+    if (at == columns.end()) continue;
+    const size_t q = static_cast<size_t>(at - columns.begin());
     const auto [row_lo, row_hi] = rows_in(data_side_spans_[d]);
     rp.resize((row_hi - row_lo) * 6);
     rm.resize(rp.size());
@@ -358,8 +413,8 @@ void EquationErrorModel::evaluate6(const double* p, double* r, double* J, const 
     pp[c] = p[c] - h;
     residuals(pp.data(), rm.data(), nullptr, data_side_spans_[d], {});
     pp[c] = p[c];
-    for (size_t i = 0; i < rows_.size() * 6; ++i) J[i * np + c] = 0.0;
-    for (size_t i = 0; i < rp.size(); ++i) J[(row_lo * 6 + i) * np + c] = (rp[i] - rm[i]) / (2 * h);
+    for (size_t i = 0; i < rows_.size() * 6; ++i) J[i * nc + q] = 0.0;
+    for (size_t i = 0; i < rp.size(); ++i) J[(row_lo * 6 + i) * nc + q] = (rp[i] - rm[i]) / (2 * h);
   }
   model_->set_params(pp);
 }
@@ -401,7 +456,7 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
                                                 const std::vector<double>& U, std::vector<double>& F,
                                                 std::vector<double>* Bm, SampleSpan span,
                                                 const std::vector<int>& columns) const {
-  const int n = model_->num_states(), np = model_->num_params(), nu = model_->num_inputs();
+  const int n = model_->num_states(), nu = model_->num_inputs();
   const int t_in = extra_.t, v_in = extra_.vbat;
   const size_t ns = flight_.samples.size(), nc = columns.size();
   F.assign(ns * 6, 0.0);
@@ -410,9 +465,13 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
   if (Bm) Bm->assign(ns * 6 * nc, 0.0);
   // The residual rows: linear acceleration (world) and angular acceleration (body).
   static const int kRows[6] = {kVelocity, kVelocity + 1, kVelocity + 2, kBodyRate, kBodyRate + 1, kBodyRate + 2};
+  // Their df/dp in the columns asked for, straight from the model (a helper thread's copy
+  // of it reads the same block).
+  const runtime::DynamicModel::ParamBlock block =
+      Bm ? model_->param_block(std::vector<int>(kRows, kRows + 6), columns) : runtime::DynamicModel::ParamBlock{};
   // Intervals k_lo .. k_hi - 1; each writes its own rows of F and Bm only.
   const auto part = [&](const runtime::DynamicModel& model, size_t k_lo, size_t k_hi) {
-    std::vector<double> xm(n), um(nu), f(n), B(Bm ? n * np : 0);
+    std::vector<double> xm(n), um(nu), f(n), B(Bm ? 6 * nc : 0);
     for (size_t k = k_lo; k < k_hi; ++k) {
       if (!interval_ok_[k]) continue;
       for (int i = 0; i < n; ++i) xm[i] = 0.5 * (X[k * n + i] + X[(k + 1) * n + i]);
@@ -422,12 +481,11 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
       if (t_in >= 0) um[t_in] = 0.5 * (U[k * nu + t_in] + U[(k + 1) * nu + t_in]);
       if (v_in >= 0) um[v_in] = 0.5 * (U[k * nu + v_in] + U[(k + 1) * nu + v_in]);
       if (quadrature_ == Quadrature::kMidpoint) {
-        model.rhs(xm.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
-        for (int c = 0; c < 6; ++c) {
-          F[k * 6 + c] = f[kRows[c]];
-          if (Bm)
-            for (size_t qi = 0; qi < nc; ++qi) (*Bm)[(k * 6 + c) * nc + qi] = B[kRows[c] * np + columns[qi]];
-        }
+        if (Bm)
+          model.rhs_block(xm.data(), um.data(), f.data(), block, &(*Bm)[k * 6 * nc]);
+        else
+          model.rhs(xm.data(), um.data(), f.data(), nullptr, nullptr, nullptr);
+        for (int c = 0; c < 6; ++c) F[k * 6 + c] = f[kRows[c]];
         continue;
       }
       // Trapezoid: the rigid-body state at both ends, the held command and the interval's
@@ -435,11 +493,14 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
       for (size_t end = k; end <= k + 1; ++end) {
         std::vector<double> xe(&X[end * n], &X[end * n] + n);
         for (size_t i = 0; i < speed_states_.size(); ++i) xe[speed_states_[i]] = xm[speed_states_[i]];
-        model.rhs(xe.data(), um.data(), f.data(), nullptr, Bm ? B.data() : nullptr, nullptr);
+        if (Bm)
+          model.rhs_block(xe.data(), um.data(), f.data(), block, B.data());
+        else
+          model.rhs(xe.data(), um.data(), f.data(), nullptr, nullptr, nullptr);
         for (int c = 0; c < 6; ++c) {
           F[k * 6 + c] += 0.5 * f[kRows[c]];
           if (Bm)
-            for (size_t qi = 0; qi < nc; ++qi) (*Bm)[(k * 6 + c) * nc + qi] += 0.5 * B[kRows[c] * np + columns[qi]];
+            for (size_t qi = 0; qi < nc; ++qi) (*Bm)[(k * 6 + c) * nc + qi] += 0.5 * B[c * nc + qi];
         }
       }
     }
@@ -469,11 +530,40 @@ void EquationErrorModel::residuals(const double* p, double* r, double* J, Sample
     s.Ba6.assign(J ? 6 * columns.size() : 0, 0.0);
     for (size_t row = from_row; row < to_row; ++row) {
       row_accelerations(model, e, row, s);
-      row_residuals(e, row, s, r + 6 * (row - row_lo), J ? J + 6 * (row - row_lo) * np : nullptr);
+      row_residuals(e, row, s, r + 6 * (row - row_lo), J ? J + 6 * (row - row_lo) * columns.size() : nullptr);
     }
   };
   split_over_cores(row_lo, row_hi, p, J ? &columns : nullptr, part);
 }
+
+namespace {
+
+// to[c * nc + q] = sum over j of W[j] * from[(j * 6 + c) * nc + q]: the window sums of the
+// interval accelerations' df/dp columns. Four columns at a time are summed in registers;
+// added to memory, each sum went out and back once per interval of the window. Every sum
+// is still taken in the order of j from 0, so the result is the same to the bit.
+void window_sums(const std::vector<double>& W, const double* from, size_t nc, double* to) {
+  const size_t stride = 6 * nc;
+  for (size_t c = 0; c < 6; ++c) {
+    const double* b = from + c * nc;
+    size_t q = 0;
+    for (; q + 4 <= nc; q += 4) {
+      double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+      for (size_t j = 0; j < W.size(); ++j) {
+        const double* x = b + j * stride + q;
+        a0 += W[j] * x[0], a1 += W[j] * x[1], a2 += W[j] * x[2], a3 += W[j] * x[3];
+      }
+      to[c * nc + q] = a0, to[c * nc + q + 1] = a1, to[c * nc + q + 2] = a2, to[c * nc + q + 3] = a3;
+    }
+    for (; q < nc; ++q) {
+      double a = 0;
+      for (size_t j = 0; j < W.size(); ++j) a += W[j] * b[j * stride + q];
+      to[c * nc + q] = a;
+    }
+  }
+}
+
+}  // namespace
 
 // The model's six accelerations seen by the measurement at this row (and their df/dp
 // columns): the filtered derivatives' window sums of the interval accelerations, or the rows
@@ -486,18 +576,15 @@ void EquationErrorModel::row_accelerations(const runtime::DynamicModel& model, c
   if (!filtered || accel_)  // the specific force needs f at the sample itself
     model.rhs(&e.X[k * n], &e.U[k * nu], s.f.data(), nullptr, e.jacobian ? s.B.data() : nullptr, nullptr);
   if (filtered) {
-    std::fill(s.a6.begin(), s.a6.end(), 0.0);
-    std::fill(s.Ba6.begin(), s.Ba6.end(), 0.0);
     const auto& W = interval_weights_[row];
     const size_t lo = window_start_[row];
+    // Summed in a local array: through s.a6 every addition went to memory and back, as the
+    // compiler cannot rule out that it overlaps e.F (a seventh of a diagnosis' time).
+    double a6[6] = {0, 0, 0, 0, 0, 0};
     for (size_t j = 0; j < W.size(); ++j)
-      for (int c = 0; c < 6; ++c) {
-        s.a6[c] += W[j] * e.F[(lo + j) * 6 + c];
-        if (!e.jacobian) continue;
-        const double* from = &e.Bm[((lo + j) * 6 + c) * nc];
-        double* to = &s.Ba6[c * nc];
-        for (size_t qi = 0; qi < nc; ++qi) to[qi] += W[j] * from[qi];
-      }
+      for (int c = 0; c < 6; ++c) a6[c] += W[j] * e.F[(lo + j) * 6 + c];
+    std::copy(a6, a6 + 6, s.a6.begin());
+    if (e.jacobian) window_sums(W, &e.Bm[lo * 6 * nc], nc, s.Ba6.data());
     for (int c = 0; c < 6; ++c) s.measured[c] = measured_[row][c];
     return;
   }
@@ -516,7 +603,7 @@ void EquationErrorModel::row_accelerations(const runtime::DynamicModel& model, c
 }
 
 // The row's six residuals at rk (model minus measurement) and, when Jk is given, their
-// derivatives in the columns asked for. With an accelerometer the translation residual is
+// derivatives in the columns asked for (packed: Jk[i * columns + k]). With an accelerometer the translation residual is
 // the specific force in body axes at the sample, R^T (a + g e_z), against the measured one.
 void EquationErrorModel::row_residuals(const Evaluation& e, size_t row, const RowScratch& s, double* rk,
                                        double* Jk) const {
@@ -545,8 +632,8 @@ void EquationErrorModel::row_residuals(const Evaluation& e, size_t row, const Ro
         d = 0;
         for (int j = 0; j < 3; ++j) d += R[j][i] * (s.B[(3 + j) * np + c] + (j == 2 && c == g_index_ ? 1.0 : 0.0));
       }
-      Jk[i * np + c] = d;
-      Jk[(3 + i) * np + c] = s.Ba6[(3 + i) * nc + qi];
+      Jk[i * nc + qi] = d;
+      Jk[(3 + i) * nc + qi] = s.Ba6[(3 + i) * nc + qi];
     }
   }
 }

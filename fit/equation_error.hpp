@@ -50,6 +50,8 @@ class EquationErrorModel : public ResidualModel {
   const std::vector<size_t>& rows() const { return rows_; }
   void evaluate(const double* p, double* r, double* J) const override { evaluate_free(p, r, J, {}); }
   void evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const override;
+  void evaluate_columns(const std::vector<double>& p, double* r, double* J,
+                        const std::vector<int>& columns) const override;
   int channel_of(int i) const override { return i % static_cast<int>(used_.size()); }
   std::vector<std::string> channels() const override;
   std::unique_ptr<ResidualModel> clone() const override;  // with its own copy of the dynamic model
@@ -108,7 +110,8 @@ class EquationErrorModel : public ResidualModel {
     std::vector<double> X, U;    // prepare(): states and inputs of every sample
     std::vector<double> tau;     // prepare(): each rotor's lag at every sample
     std::vector<double> F, Bm;   // interval_accelerations()
-    std::vector<double> r6, J6;  // evaluate_free() of fewer than six channels
+    std::vector<double> r6, J6;  // evaluate_packed() of fewer than six channels
+    std::vector<double> packed;  // evaluate_free(): the packed Jacobian before it is spread out
     std::vector<double> mean_speed;  // prepare(): rotor speeds averaged over each interval (motor_lag)
     Scratch() = default;
     Scratch(const Scratch&) {}
@@ -142,22 +145,27 @@ class EquationErrorModel : public ResidualModel {
   void split_over_cores(size_t lo, size_t hi, const double* p, const std::vector<int>* columns,
                         const Part& part) const;
   std::vector<std::string> all_names() const;
-  void evaluate6(const double* p, double* r, double* J, const std::vector<bool>& free) const;
+  // The used channels (evaluate_packed) or all six (evaluate6) of every row, the Jacobian
+  // packed to `columns`.
+  void evaluate_packed(const double* p, double* r, double* J, const std::vector<int>& columns) const;
+  void evaluate6(const double* p, double* r, double* J, const std::vector<int>& columns) const;
   // Full model state and inputs of every sample (states row-major ns x n, inputs ns x nu).
   // Only the samples in `span` are filled (the others stay zero).
   void prepare(const double* p, std::vector<double>& X, std::vector<double>& U, SampleSpan span) const;
   // prepare()'s rotor-speed states (motor_lag): the commands' speeds through each rotor's lag
   // (scratch_.tau), and their means over each interval into scratch_.mean_speed.
   void filter_rotor_speeds(std::vector<double>& X, const std::vector<double>& U, SampleSpan span) const;
-  void commands_at(double t, double* u) const;  // rotor commands interpolated at t
+  // Rotor commands interpolated at t; `cursor` (optional) carries the search's position
+  // from one lookup to the next of a pass in time order.
+  void commands_at(double t, double* u, size_t* cursor = nullptr) const;
   // The model's inputs at sample s with the commands logged at command_time (s.t less a
   // delay): the rotor commands, and the time and battery voltage where the model has them.
-  void inputs_at(const FlightSample& s, double command_time, double* u) const;
+  void inputs_at(const FlightSample& s, double command_time, double* u, size_t* cursor = nullptr) const;
   SampleSpan all_samples() const { return {0, flight_.samples.size()}; }
   // First and one-past-last residual row whose sample lies in `span`.
   std::pair<size_t, size_t> rows_in(SampleSpan span) const;
-  // Residuals (and the df/dp columns in `columns`, the others left unwritten) of the rows in
-  // `span`: row i of that range at r + 6 i. A search step frees a few of the 30-80
+  // Residuals (and the df/dp columns in `columns`, packed) of the rows in `span`: row i of
+  // that range at r + 6 i, its Jacobian rows at J + 6 i columns.size(). A search step frees a few of the 30-80
   // parameters of a per-flight model; the Jacobian work follows the free ones.
   void residuals(const double* p, double* r, double* J, SampleSpan span, const std::vector<int>& columns) const;
   void interval_accelerations(const double* p, const std::vector<double>& X, const std::vector<double>& U,

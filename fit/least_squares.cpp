@@ -13,6 +13,18 @@
 
 namespace quadgen::fit {
 
+void ResidualModel::evaluate_columns(const std::vector<double>& p, double* r, double* J,
+                                     const std::vector<int>& columns) const {
+  if (!J) return evaluate(p.data(), r, nullptr);
+  const size_t n = p.size(), nc = columns.size(), nr = static_cast<size_t>(num_residuals());
+  std::vector<bool> free(n, false);
+  for (int c : columns) free[static_cast<size_t>(c)] = true;
+  std::vector<double> full(nr * n);
+  evaluate_free(p.data(), r, full.data(), free);
+  for (size_t i = 0; i < nr; ++i)
+    for (size_t k = 0; k < nc; ++k) J[i * nc + k] = full[i * n + static_cast<size_t>(columns[k])];
+}
+
 namespace {
 
 // All parameters in one block; the residual model's Jacobian is passed through, each row
@@ -71,9 +83,9 @@ class WeightedCost : public ceres::CostFunction {
 // same relative precision. (The trust region is scaled per column already: Jacobi scaling.)
 class FreeSubsetCost : public ceres::CostFunction {
  public:
-  FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, std::vector<bool> free,
+  FreeSubsetCost(const ResidualModel& m, std::vector<double> all, const std::vector<double>& w, const std::vector<bool>& free,
                  std::vector<double> scale)
-      : m_(m), all_(std::move(all)), w_(w), free_(std::move(free)), columns_(runtime::free_columns(free_)),
+      : m_(m), all_(std::move(all)), w_(w), columns_(runtime::free_columns(free)),
         scale_(std::move(scale)) {
     set_num_residuals(m.num_residuals());
     mutable_parameter_block_sizes()->push_back(static_cast<int>(columns_.size()));
@@ -86,11 +98,11 @@ class FreeSubsetCost : public ceres::CostFunction {
   }
   bool Evaluate(double const* const* x, double* r, double** J) const override {
     const std::vector<double> p = expand(x[0]);
-    const int nr = m_.num_residuals(), n = static_cast<int>(all_.size()), nf = static_cast<int>(columns_.size());
+    const int nr = m_.num_residuals(), nf = static_cast<int>(columns_.size());
     const bool jacobian = J && J[0];
     if (jacobian) {
-      full_.resize(static_cast<size_t>(nr) * n);
-      m_.evaluate_free(p.data(), r, full_.data(), free_);
+      packed_.resize(static_cast<size_t>(nr) * nf);
+      m_.evaluate_columns(p, r, packed_.data(), columns_);
     } else {
       m_.evaluate(p.data(), r, nullptr);
     }
@@ -99,10 +111,10 @@ class FreeSubsetCost : public ceres::CostFunction {
       r[i] *= w;
       if (!std::isfinite(r[i])) return false;
       if (!jacobian) continue;
-      const double* in = full_.data() + static_cast<size_t>(i) * n;
+      const double* in = packed_.data() + static_cast<size_t>(i) * nf;
       double* out = J[0] + static_cast<size_t>(i) * nf;
       for (int k = 0; k < nf; ++k) {
-        out[k] = in[columns_[k]] * w * scale_[k];
+        out[k] = in[k] * w * scale_[k];
         if (!std::isfinite(out[k])) return false;
       }
     }
@@ -113,10 +125,9 @@ class FreeSubsetCost : public ceres::CostFunction {
   const ResidualModel& m_;
   std::vector<double> all_;
   std::vector<double> w_;
-  std::vector<bool> free_;
   std::vector<int> columns_;
   std::vector<double> scale_;  // per free column
-  mutable std::vector<double> full_;  // the model's Jacobian over all parameters, reused
+  mutable std::vector<double> packed_;  // the model's Jacobian in the free columns, reused
 };
 
 std::vector<bool> free_mask(const std::vector<FitParameter>& ps) {

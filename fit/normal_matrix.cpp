@@ -7,21 +7,18 @@ namespace quadgen::fit {
 
 Eigen::MatrixXd weighted_free_jacobian(const ResidualModel& model, const std::vector<FitParameter>& params,
                                        const std::vector<double>& channel_weights) {
-  const size_t n = params.size(), nr = static_cast<size_t>(model.num_residuals());
-  std::vector<bool> free;
-  std::vector<size_t> free_idx;
-  for (size_t i = 0; i < n; ++i) {
-    free.push_back(params[i].free);
-    if (params[i].free) free_idx.push_back(i);
-  }
-  const std::vector<double> x = parameter_values(params);
-  std::vector<double> r(nr), J(nr * n);
-  model.evaluate_free(x.data(), r.data(), J.data(), free);  // the free columns only
-  Eigen::MatrixXd Jw(static_cast<Eigen::Index>(nr), static_cast<Eigen::Index>(free_idx.size()));
+  const size_t nr = static_cast<size_t>(model.num_residuals());
+  std::vector<int> free;
+  for (size_t i = 0; i < params.size(); ++i)
+    if (params[i].free) free.push_back(static_cast<int>(i));
+  const size_t nf = free.size();
+  std::vector<double> r(nr), J(nr * nf);
+  if (nf > 0) model.evaluate_columns(parameter_values(params), r.data(), J.data(), free);
+  Eigen::MatrixXd Jw(static_cast<Eigen::Index>(nr), static_cast<Eigen::Index>(nf));
   for (size_t i = 0; i < nr; ++i)
-    for (size_t k = 0; k < free_idx.size(); ++k)
+    for (size_t k = 0; k < nf; ++k)
       Jw(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) =
-          J[i * n + free_idx[k]] * channel_weights[model.channel_of(static_cast<int>(i))];
+          J[i * nf + k] * channel_weights[model.channel_of(static_cast<int>(i))];
   return Jw;
 }
 

@@ -32,6 +32,26 @@ class DynamicModel {
   // unwritten), equal to rhs()'s bit for bit. For a caller that needs a few rates at every sample (the rotor speeds'
   // commanded values): a TapeModel then runs only the instructions those rows need.
   virtual void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const;
+  // df/dp in a block of rows and columns (each list without repeats), packed:
+  // block[i * columns.size() + k] is df[rows[i]] / dp[columns[k]]. A caller that needs a few rows of B in a fit's free columns
+  // at every sample (the equation error's six accelerations) prepares the block once with
+  // param_block() and passes it to rhs_block() at each sample: B is n x 60 and more and
+  // mostly zero, and clearing and filling it at every call took a tenth of a diagnosis.
+  struct ParamBlock {
+    std::vector<int> rows, columns;
+    // The model's own preparation, opaque to callers. A generated model: where each nonzero
+    // of its df/dp goes in the block (-1: outside it). A per-flight model: each flight's
+    // block of the inner model and where its columns go in this one.
+    std::vector<int> slot;
+    std::vector<ParamBlock> inner;
+    std::vector<std::vector<int>> place;
+  };
+  virtual ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const {
+    return {std::move(rows), std::move(columns), {}, {}, {}};
+  }
+  // f (all rows) and the block of df/dp, equal to rhs()'s bit for bit. The default takes them
+  // from rhs()'s dense df/dp.
+  virtual void rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const;
   // The rotor-speed states (motor_lag's w_<rotor>), in rotor order; empty without a motor lag.
   // Where the model is derived they are the rotors' speed symbols among the states
   // (SymbolicModel::rotor_speed_states); every runtime user takes them from here, so the
@@ -76,6 +96,15 @@ inline void DynamicModel::rhs_rows(const double* x, const double* u, const std::
   std::vector<double> all(num_states());
   rhs(x, u, all.data(), nullptr, nullptr, nullptr);
   for (int i : rows) f[i] = all[i];
+}
+inline void DynamicModel::rhs_block(const double* x, const double* u, double* f, const ParamBlock& block,
+                                    double* B) const {
+  const size_t np = static_cast<size_t>(num_params()), nc = block.columns.size();
+  thread_local std::vector<double> dense;  // one per thread: rhs() is called from several
+  dense.resize(static_cast<size_t>(num_states()) * np);
+  rhs(x, u, f, nullptr, dense.data(), nullptr);
+  for (size_t i = 0; i < block.rows.size(); ++i)
+    for (size_t k = 0; k < nc; ++k) B[i * nc + k] = dense[static_cast<size_t>(block.rows[i]) * np + static_cast<size_t>(block.columns[k])];
 }
 inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
 inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
@@ -127,6 +156,27 @@ class CompiledModel : public DynamicModel {
     if (A) scatter(A, n, sx, M::kDfdxNnz, M::kDfdxRow, M::kDfdxCol);
     if (B) scatter(B, M::kNumParams, sp, M::kDfdpNnz, M::kDfdpRow, M::kDfdpCol);
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
+  }
+  ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const override {
+    ParamBlock b{std::move(rows), std::move(columns), std::vector<int>(M::kDfdpNnz, -1), {}, {}};
+    std::vector<int> row_at(M::kNumStates, -1), column_at(M::kNumParams, -1);
+    for (size_t i = 0; i < b.rows.size(); ++i) row_at.at(static_cast<size_t>(b.rows[i])) = static_cast<int>(i);
+    for (size_t q = 0; q < b.columns.size(); ++q) column_at.at(static_cast<size_t>(b.columns[q])) = static_cast<int>(q);
+    for (int k = 0; k < M::kDfdpNnz; ++k) {
+      const int i = row_at[M::kDfdpRow[k]], q = column_at[M::kDfdpCol[k]];
+      if (i >= 0 && q >= 0) b.slot[k] = i * static_cast<int>(b.columns.size()) + q;
+    }
+    return b;
+  }
+  // The nonzeros go straight to their places in the block (a later duplicate wins, as in scatter()).
+  void rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const override {
+    if (block.slot.size() != static_cast<size_t>(M::kDfdpNnz)) return DynamicModel::rhs_block(x, u, f, block, B);
+    double sp[M::kDfdpNnz + 1];
+    double* none = nullptr;
+    M::rhs(x, u, p_.data(), pre_, f, none, none, sp);
+    std::fill(B, B + block.rows.size() * block.columns.size(), 0.0);
+    for (int k = 0; k < M::kDfdpNnz; ++k)
+      if (block.slot[k] >= 0) B[block.slot[k]] = sp[k];
   }
   // The rotor speeds' rows have a generated function of their own; other rows take rhs().
   void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override {

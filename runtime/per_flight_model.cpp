@@ -98,6 +98,38 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
     for (int j = 0; j < np_inner; ++j) B[i * np + column[j]] = inner_B_[i * np_inner + j];
 }
 
+// Each flight's block holds the inner columns whose copy for that flight is asked for;
+// place[k][q] is where the flight's q-th inner column goes in the block asked for. The other
+// columns of the block (another flight's copies) are zero for this flight, as in rhs().
+DynamicModel::ParamBlock PerFlightModel::param_block(std::vector<int> rows, std::vector<int> columns) const {
+  ParamBlock b{std::move(rows), std::move(columns), {}, {}, {}};
+  for (size_t k = 0; k < flights_.size(); ++k) {
+    std::vector<int> inner, place;
+    for (size_t q = 0; q < b.columns.size(); ++q)
+      for (size_t j = 0; j < column_[k].size(); ++j)
+        if (column_[k][j] == b.columns[q]) {
+          inner.push_back(static_cast<int>(j));
+          place.push_back(static_cast<int>(q));
+        }
+    b.inner.push_back(flights_[k]->param_block(b.rows, inner));
+    b.place.push_back(std::move(place));
+  }
+  return b;
+}
+
+void PerFlightModel::rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const {
+  if (block.inner.size() != flights_.size()) return DynamicModel::rhs_block(x, u, f, block, B);
+  const int k = flight_at(u[t_input_]);
+  const ParamBlock& in = block.inner[static_cast<size_t>(k)];
+  const size_t rows = block.rows.size(), nc = block.columns.size(), nc_inner = in.columns.size();
+  inner_B_.resize(rows * nc_inner);
+  flights_[static_cast<size_t>(k)]->rhs_block(x, u, f, in, inner_B_.data());
+  std::fill(B, B + rows * nc, 0.0);
+  const auto& place = block.place[static_cast<size_t>(k)];
+  for (size_t i = 0; i < rows; ++i)
+    for (size_t q = 0; q < nc_inner; ++q) B[i * nc + static_cast<size_t>(place[q])] = inner_B_[i * nc_inner + q];
+}
+
 std::vector<Parameter> PerFlightModel::parameters() const {
   const std::vector<Parameter> inner = flights_[0]->parameters();
   std::vector<Parameter> out(names_.size());

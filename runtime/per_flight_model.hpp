@@ -50,6 +50,8 @@ class PerFlightModel : public DynamicModel {
   const std::vector<double>& params() const override { return p_; }
   void set_params(const std::vector<double>& p) override;
   void rhs(const double* x, const double* u, double* f, double* A, double* B, double* Bu) const override;
+  ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const override;
+  void rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const override;
   void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const override {
     flights_[flight_at(u[t_input_])]->rhs_rows(x, u, rows, f);
   }

@@ -197,6 +197,70 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
   }
 }
 
+// rhs_block: the rows and columns of df/dp a fit asks for at every sample (the equation
+// error's six accelerations in its free columns) are rhs()'s dense df/dp bit for bit, from
+// a compiled header (its nonzeros placed directly), a tape (the default gather) and joint
+// models over either (each flight's columns, zero in another flight's copies). The columns
+// are out of order and include a per-flight copy and a parameter the rows do not depend
+// on; a copy of each model evaluates the block its original prepared.
+TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
+  using Compiled = CompiledModel<quadgen_generated::finken3_all_effects::Model>;
+  TapeModel tape = finken3_tape(parse_effect_list("all"));
+  Compiled compiled;
+  std::vector<double> p = tape.params();
+  p[tape.param_index("motor_lag.tau")] = 0.03;
+  p[tape.param_index("rotor_drag.k")] = 2e-5;
+  p[tape.param_index("wind.x")] = 0.4;
+  tape.set_params(p);
+  compiled.set_params(p);
+  PerFlightModel joint_compiled(compiled, {10.0}, {"wind.x", "motor_gain.C"});
+  PerFlightModel joint_tape(tape, {10.0}, {"wind.x", "motor_gain.C"});
+  const int n = tape.num_states(), nu = tape.num_inputs(), np = tape.num_params();
+  std::vector<double> pj = p;
+  pj.push_back(-0.7), pj.push_back(0.05);  // wind.x@2, motor_gain.C@2
+  joint_compiled.set_params(pj);
+  joint_tape.set_params(pj);
+  const std::vector<int> rows = {3, 4, 5, 10, 11, 12};
+  const std::vector<int> columns = {tape.param_index("wind.x"), np, tape.param_index("c_t"),
+                                    tape.param_index("motor_gain.C"), np + 1, tape.param_index("rotor_drag.k"),
+                                    tape.param_index("g")};
+  std::mt19937 rng(7);
+  for (DynamicModel* m : std::vector<DynamicModel*>{&tape, &compiled, &joint_compiled, &joint_tape}) {
+    std::vector<int> asked;  // the per-flight copies where the model has them
+    for (int c : columns)
+      if (c < m->num_params()) asked.push_back(c);
+    const DynamicModel::ParamBlock block = m->param_block(rows, asked);
+    const std::unique_ptr<DynamicModel> copy = m->clone();
+    for (int k = 0; k < 8; ++k) {
+      std::vector<double> x = test::random_state(rng);
+      x[2] = 0.5 + std::fabs(x[2]);
+      x.resize(n, 900.0 + 10.0 * k);
+      std::vector<double> u{0.3 + 0.01 * k, 0.4, 0.5, 0.6};
+      while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
+      u[tape.input_index("t")] = k % 2 == 0 ? 4.0 : 14.0;  // a joint model's first and second flight
+      u[tape.input_index("vbat")] = 3.9;
+      const size_t npm = static_cast<size_t>(m->num_params()), nc = asked.size();
+      std::vector<double> f(n), dense(n * npm), f_block(n), B(rows.size() * nc, -7.5), f_copy(n),
+          B_copy(rows.size() * nc, -7.5);
+      m->rhs(x.data(), u.data(), f.data(), nullptr, dense.data(), nullptr);
+      m->rhs_block(x.data(), u.data(), f_block.data(), block, B.data());
+      copy->rhs_block(x.data(), u.data(), f_copy.data(), block, B_copy.data());
+      EXPECT_EQ(std::memcmp(f.data(), f_block.data(), sizeof(double) * n), 0);
+      EXPECT_EQ(B, B_copy);
+      EXPECT_EQ(f_block, f_copy);
+      bool some_nonzero = false;
+      for (size_t i = 0; i < rows.size(); ++i)
+        for (size_t q = 0; q < nc; ++q) {
+          const double want = dense[static_cast<size_t>(rows[i]) * npm + static_cast<size_t>(asked[q])];
+          EXPECT_EQ(std::memcmp(&B[i * nc + q], &want, sizeof(double)), 0)
+              << m->param_names()[asked[q]] << " row " << rows[i] << " point " << k;
+          some_nonzero = some_nonzero || want != 0.0;
+        }
+      EXPECT_TRUE(some_nonzero);
+    }
+  }
+}
+
 // The tape's schedule (runtime::schedule_by_level) only moves independent instructions: the
 // scheduled code is the lowered code's instructions, each operand written before it is read
 // (or an input, parameter or constant), and the runs cover the code with one operation each.
