@@ -35,8 +35,9 @@ class DynamicModel {
   // df/dp in a block of rows and columns (each list without repeats), packed:
   // block[i * columns.size() + k] is df[rows[i]] / dp[columns[k]]. A caller that needs a few rows of B in a fit's free columns
   // at every sample (the equation error's six accelerations) prepares the block once with
-  // param_block() and passes it to rhs_block() at each sample: B is n x 60 and more and
-  // mostly zero, and clearing and filling it at every call took a tenth of a diagnosis.
+  // param_block() and passes it to rhs_block() at each sample: B is n x 45 and more (a joint
+  // model's, n x 100 and more), mostly zero, and clearing and filling it at every call took
+  // a tenth of a diagnosis.
   struct ParamBlock {
     std::vector<int> rows, columns;
     // The model's own preparation, opaque to callers. A generated model: where each nonzero
