@@ -196,11 +196,11 @@ std::vector<std::string> EquationErrorModel::channels() const {
 
 namespace {
 
-// The Jacobian columns a mask asks for: its free parameters, or all of them when none is
-// marked (as restrict_param_jacobian reads an empty list).
+// The Jacobian columns a mask asks for: its free parameters, or all of them for an empty
+// mask (as restrict_param_jacobian reads an empty list); none for a mask of only fixed ones.
 std::vector<int> jacobian_columns(const std::vector<bool>& free, int num_params) {
   std::vector<int> columns = runtime::free_columns(free);
-  if (columns.empty())
+  if (free.empty())
     for (int c = 0; c < num_params; ++c) columns.push_back(c);
   return columns;
 }
@@ -211,7 +211,7 @@ void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, co
   if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
   const int np = model_->num_params();
   const std::vector<int> columns = jacobian_columns(free, np);
-  if (!J) return evaluate_packed(p, r, nullptr, columns);
+  if (!J || columns.empty()) return evaluate_packed(p, r, nullptr, columns);
   const size_t nr = static_cast<size_t>(num_residuals()), nc = columns.size();
   std::vector<double>& packed = scratch_.packed;
   packed.resize(nr * nc);
@@ -222,6 +222,8 @@ void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, co
 
 void EquationErrorModel::evaluate_columns(const std::vector<double>& p, double* r, double* J,
                                           const std::vector<int>& columns) const {
+  check_columns(columns, static_cast<size_t>(model_->num_params()));
+  if (columns.empty()) J = nullptr;  // r alone
   if (J) model_->restrict_param_jacobian(columns);
   evaluate_packed(p.data(), r, J, columns);
 }
@@ -272,12 +274,6 @@ void EquationErrorModel::inputs_at(const FlightSample& s, double command_time, d
   extra_.fill(s.t, s.vbat, u);
 }
 
-namespace {
-
-// The first sample at or after t, as std::lower_bound finds it. With a cursor (the answer of
-// the previous lookup) it searches on from there when t has not gone back: the times a pass
-// looks up rise, so that is a step or two, where the binary search over the whole flight
-// was a twentieth of a diagnosis' time.
 std::vector<FlightSample>::const_iterator first_at_or_after(const std::vector<FlightSample>& S, double t,
                                                             size_t* cursor) {
   const auto before = [](const FlightSample& s, double v) { return s.t < v; };
@@ -294,8 +290,6 @@ std::vector<FlightSample>::const_iterator first_at_or_after(const std::vector<Fl
   if (cursor) *cursor = static_cast<size_t>(it - S.begin());
   return it;
 }
-
-}  // namespace
 
 void EquationErrorModel::commands_at(double t, double* u, size_t* cursor) const {
   const auto& S = flight_.samples;
@@ -461,7 +455,7 @@ void EquationErrorModel::interval_accelerations(const double* p, const std::vect
   const size_t ns = flight_.samples.size(), nc = columns.size();
   F.assign(ns * 6, 0.0);
   // Only the columns asked for, packed: a search step frees a few of a per-flight model's
-  // 28 and more parameters, and the window sums in residuals() then run over contiguous memory.
+  // 45 and more parameters, and the window sums (window_sums()) then run over contiguous memory.
   if (Bm) Bm->assign(ns * 6 * nc, 0.0);
   // The residual rows: linear acceleration (world) and angular acceleration (body).
   static const int kRows[6] = {kVelocity, kVelocity + 1, kVelocity + 2, kBodyRate, kBodyRate + 1, kBodyRate + 2};
@@ -603,8 +597,9 @@ void EquationErrorModel::row_accelerations(const runtime::DynamicModel& model, c
 }
 
 // The row's six residuals at rk (model minus measurement) and, when Jk is given, their
-// derivatives in the columns asked for (packed: Jk[i * columns + k]). With an accelerometer the translation residual is
-// the specific force in body axes at the sample, R^T (a + g e_z), against the measured one.
+// derivatives in the columns asked for (packed: residual i's column qi at Jk[i * nc + qi]).
+// With an accelerometer the translation residual is the specific force in body axes at the
+// sample, R^T (a + g e_z), against the measured one.
 void EquationErrorModel::row_residuals(const Evaluation& e, size_t row, const RowScratch& s, double* rk,
                                        double* Jk) const {
   const int n = model_->num_states(), np = model_->num_params();

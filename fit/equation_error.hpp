@@ -23,6 +23,13 @@
 
 namespace quadgen::fit {
 
+// The first sample at or after t of samples in time order, as std::lower_bound finds it.
+// With a cursor (the answer of the previous lookup) it searches on from there when t has not
+// gone back: the times a pass looks up rise, so that is a step or two, where the binary
+// search over the whole flight was a twentieth of a diagnosis' time.
+std::vector<FlightSample>::const_iterator first_at_or_after(const std::vector<FlightSample>& samples, double t,
+                                                            size_t* cursor = nullptr);
+
 class EquationErrorModel : public ResidualModel {
  public:
   // The model's parameters are the fit parameters; `use_accelerometer` picks specific

@@ -13,13 +13,28 @@
 
 namespace quadgen::fit {
 
+void check_columns(const std::vector<int>& columns, size_t num_params) {
+  std::vector<bool> seen(num_params, false);
+  for (int c : columns) {
+    if (c < 0 || static_cast<size_t>(c) >= num_params || seen[static_cast<size_t>(c)])
+      throw FitError("Jacobian columns: " + std::to_string(c) + (c >= 0 && static_cast<size_t>(c) < num_params
+                                                                     ? " asked for twice"
+                                                                     : " is no parameter index"));
+    seen[static_cast<size_t>(c)] = true;
+  }
+}
+
 void ResidualModel::evaluate_columns(const std::vector<double>& p, double* r, double* J,
                                      const std::vector<int>& columns) const {
-  if (!J) return evaluate(p.data(), r, nullptr);
+  check_columns(columns, p.size());
+  if (!J || columns.empty()) return evaluate(p.data(), r, nullptr);
   const size_t n = p.size(), nc = columns.size(), nr = static_cast<size_t>(num_residuals());
   std::vector<bool> free(n, false);
   for (int c : columns) free[static_cast<size_t>(c)] = true;
-  std::vector<double> full(nr * n);
+  // Reused: a fit evaluates thousands of times, and an array of nr x n allocated afresh
+  // each time costs page faults and zero-filling (one per thread: fits run on several).
+  thread_local std::vector<double> full;
+  full.resize(nr * n);
   evaluate_free(p.data(), r, full.data(), free);
   for (size_t i = 0; i < nr; ++i)
     for (size_t k = 0; k < nc; ++k) J[i * nc + k] = full[i * n + static_cast<size_t>(columns[k])];

@@ -2,7 +2,9 @@
 // non-identifiability of mass and thrust coefficient, and bad data at the command line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -1014,6 +1016,98 @@ TEST(Fit, AFreeMaskDoesNotOutliveItsEvaluation) {
     for (int i = 0; i < nr; ++i) data_side_nonzero += after[static_cast<size_t>(i) * np + c] != 0.0;
   }
   EXPECT_GT(data_side_nonzero, nr / 2);
+}
+
+// evaluate_columns (what every fit's solver calls, the Jacobian packed to its free columns)
+// gives evaluate()'s residuals and the listed columns of its full Jacobian bit for bit, on
+// every path the packing touches: midpoint and trapezoid quadrature, accelerometer or not,
+// all six channels or three, a compiled model and a joint one. The columns are out of order,
+// with data-side ones (central differences) after the first place and a second flight's copy.
+// An empty list gives the residuals alone; a repeated or unknown column is refused.
+TEST(Fit, PackedJacobianColumnsAreTheFullJacobiansBitForBit) {
+  runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
+  runtime::PerFlightModel joint(inner, {10.0}, {"input_delay.seconds", "wind.x"});
+  std::mt19937 rng(13);
+  Flight flight = random_command_flights(rng, 2);
+  flight.has_accelerometer = true;
+  quadgen::runtime::Normal n(0, 1);
+  for (auto& s : flight.samples)
+    for (int a = 0; a < 3; ++a) s.specific_force[a] = (a == 2 ? 9.8 : 0.0) + n(rng);
+  for (runtime::DynamicModel* model : std::vector<runtime::DynamicModel*>{&inner, &joint}) {
+    std::vector<double> p = model->params();
+    p[model->param_index("attitude_bias.roll")] = 0.02;
+    p[model->param_index("motor_lag.tau")] = 0.03;
+    p[model->param_index("input_delay.seconds")] = 0.013;
+    p[model->param_index("rotor_drag.k")] = 2e-5;
+    std::vector<int> columns = {model->param_index("mass"), model->param_index("input_delay.seconds"),
+                                model->param_index("c_t"), model->param_index("attitude_bias.roll"),
+                                model->param_index("rotor_drag.k"), model->param_index("motor_lag.tau")};
+    if (model == &joint) {
+      p[joint.param_index("input_delay.seconds@2")] = 0.027;
+      columns.insert(columns.begin() + 1, joint.param_index("input_delay.seconds@2"));
+    }
+    const size_t np = p.size(), nc = columns.size();
+    for (const bool accel : {false, true})
+      for (const std::vector<std::string>& use : {std::vector<std::string>{}, std::vector<std::string>{"ax", "qdot", "rdot"}})
+        for (const auto quadrature : {EquationErrorModel::Quadrature::kMidpoint, EquationErrorModel::Quadrature::kTrapezoid}) {
+          EquationErrorModel m(*model, flight, accel, use);
+          m.set_quadrature(quadrature);
+          const size_t nr = static_cast<size_t>(m.num_residuals());
+          std::vector<double> r(nr), full(nr * np), r_packed(nr), packed(nr * nc, -7.5);
+          m.evaluate(p.data(), r.data(), full.data());
+          m.evaluate_columns(p, r_packed.data(), packed.data(), columns);
+          const std::string where = std::string(model == &joint ? "joint" : "compiled") + (accel ? ", accelerometer" : "") +
+                                    ", " + std::to_string(m.channels().size()) + " channels" +
+                                    (quadrature == EquationErrorModel::Quadrature::kTrapezoid ? ", trapezoid" : "");
+          ASSERT_EQ(std::memcmp(r.data(), r_packed.data(), nr * sizeof(double)), 0) << where;
+          size_t nonzero = 0;
+          for (size_t i = 0; i < nr; ++i)
+            for (size_t q = 0; q < nc; ++q) {
+              const double want = full[i * np + static_cast<size_t>(columns[q])];
+              ASSERT_EQ(std::memcmp(&packed[i * nc + q], &want, sizeof(double)), 0)
+                  << where << ": " << model->param_names()[columns[q]] << ", residual " << i;
+              nonzero += want != 0.0;
+            }
+          EXPECT_GT(nonzero, nr) << where;  // more than one column's worth compared
+        }
+    EquationErrorModel m(*model, flight, false);
+    const size_t nr = static_cast<size_t>(m.num_residuals());
+    std::vector<double> r(nr), r_alone(nr), untouched(4, -7.5);
+    m.evaluate(p.data(), r.data(), nullptr);
+    m.evaluate_columns(p, r_alone.data(), untouched.data(), {});
+    EXPECT_EQ(r, r_alone);
+    EXPECT_EQ(untouched, std::vector<double>(4, -7.5));
+    std::vector<double> J(nr * 2);
+    EXPECT_THROW(m.evaluate_columns(p, r.data(), J.data(), {columns[0], columns[0]}), FitError);
+    EXPECT_THROW(m.evaluate_columns(p, r.data(), J.data(), {0, static_cast<int>(np)}), FitError);
+  }
+}
+
+// first_at_or_after is std::lower_bound over the sample times, whatever its cursor holds:
+// the previous answer (times rising, by small and large steps), a stale one ahead of t, one
+// past the end, none; times before the first sample and after the last; equal to a sample's.
+TEST(Fit, TheCommandLookupsCursorFindsWhatABinarySearchFinds) {
+  std::mt19937 rng(17);
+  std::vector<FlightSample> samples(300);
+  double t = 0;
+  for (auto& s : samples) s.t = t += (rng() % 3 == 0 ? 0.02 : 0.01);
+  const auto lower_bound = [&](double v) {
+    return std::lower_bound(samples.begin(), samples.end(), v, [](const FlightSample& s, double x) { return s.t < x; });
+  };
+  quadgen::runtime::UniformReal anywhere(-0.5, t + 0.5), step(0.0, 0.03);
+  size_t cursor = 0;
+  double v = -0.1;
+  for (int k = 0; k < 5000; ++k) {
+    if (k % 97 == 0) v = anywhere(rng);                          // a jump, either way
+    else if (k % 13 == 0) v = samples[rng() % samples.size()].t;  // a sample's own time
+    else v += step(rng);                                          // rising, as in a pass
+    if (k % 251 == 0) cursor = samples.size() + rng() % 3;        // past the end
+    if (k % 331 == 0) cursor = rng() % samples.size();            // stale: anywhere
+    const auto want = lower_bound(v);
+    ASSERT_EQ(first_at_or_after(samples, v, &cursor), want) << "t = " << v;
+    EXPECT_EQ(cursor, static_cast<size_t>(want - samples.begin()));
+    EXPECT_EQ(first_at_or_after(samples, v), want);
+  }
 }
 
 // Across a short gap (an in-flight motor dip trimmed as not airborne, a dropped sample) the
