@@ -194,23 +194,10 @@ std::vector<std::string> EquationErrorModel::channels() const {
   return out;
 }
 
-namespace {
-
-// The Jacobian columns a mask asks for: its free parameters, or all of them for an empty
-// mask (as restrict_param_jacobian reads an empty list); none for a mask of only fixed ones.
-std::vector<int> jacobian_columns(const std::vector<bool>& free, int num_params) {
-  std::vector<int> columns = runtime::free_columns(free);
-  if (free.empty())
-    for (int c = 0; c < num_params; ++c) columns.push_back(c);
-  return columns;
-}
-
-}  // namespace
-
 void EquationErrorModel::evaluate_free(const double* p, double* r, double* J, const std::vector<bool>& free) const {
   if (J) model_->restrict_param_jacobian(runtime::free_columns(free));
   const int np = model_->num_params();
-  const std::vector<int> columns = jacobian_columns(free, np);
+  const std::vector<int> columns = runtime::jacobian_columns(free, np);
   if (!J || columns.empty()) return evaluate_packed(p, r, nullptr, columns);
   const size_t nr = static_cast<size_t>(num_residuals()), nc = columns.size();
   std::vector<double>& packed = scratch_.packed;

@@ -36,8 +36,7 @@ void MultipleShootingModel::evaluate_free(const double* p, double* r, double* J,
   std::vector<int> free_;
   if (J) {
     model_->restrict_param_jacobian(runtime::free_columns(free));
-    for (int j = 0; j < np; ++j)
-      if (free.empty() || free[j]) free_.push_back(j);
+    free_ = runtime::jacobian_columns(free, np);
   }
   const int nf = static_cast<int>(free_.size()), cols = n + nf;
   model_->set_params(std::vector<double>(p, p + np));

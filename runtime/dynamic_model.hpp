@@ -33,11 +33,11 @@ class DynamicModel {
   // commanded values): a TapeModel then runs only the instructions those rows need.
   virtual void rhs_rows(const double* x, const double* u, const std::vector<int>& rows, double* f) const;
   // df/dp in a block of rows and columns (each list without repeats), packed:
-  // block[i * columns.size() + k] is df[rows[i]] / dp[columns[k]]. A caller that needs a few rows of B in a fit's free columns
-  // at every sample (the equation error's six accelerations) prepares the block once with
-  // param_block() and passes it to rhs_block() at each sample: B is n x 45 and more (a joint
-  // model's, n x 100 and more), mostly zero, and clearing and filling it at every call took
-  // a tenth of a diagnosis.
+  // block[i * columns.size() + k] is df[rows[i]] / dp[columns[k]]. A caller that needs a few
+  // rows of B in a fit's free columns at every sample (the equation error's six
+  // accelerations) prepares the block once with param_block() and passes it to rhs_block()
+  // at each sample: B is n x 45 and more (a joint model's, n x 100 and more), mostly zero,
+  // and clearing and filling it at every call took a tenth of a diagnosis.
   struct ParamBlock {
     std::vector<int> rows, columns;
     // The model's own preparation, opaque to callers. A generated model: where each nonzero
@@ -105,7 +105,8 @@ inline void DynamicModel::rhs_block(const double* x, const double* u, double* f,
   dense.resize(static_cast<size_t>(num_states()) * np);
   rhs(x, u, f, nullptr, dense.data(), nullptr);
   for (size_t i = 0; i < block.rows.size(); ++i)
-    for (size_t k = 0; k < nc; ++k) B[i * nc + k] = dense[static_cast<size_t>(block.rows[i]) * np + static_cast<size_t>(block.columns[k])];
+    for (size_t k = 0; k < nc; ++k)
+      B[i * nc + k] = dense[static_cast<size_t>(block.rows[i]) * np + static_cast<size_t>(block.columns[k])];
 }
 inline int DynamicModel::state_index(const std::string& n) const { return index_in(state_names(), n); }
 inline int DynamicModel::input_index(const std::string& n) const { return index_in(input_names(), n); }
@@ -219,6 +220,15 @@ inline std::vector<int> free_columns(const std::vector<bool>& free) {
   std::vector<int> cols;
   for (size_t j = 0; j < free.size(); ++j)
     if (free[j]) cols.push_back(static_cast<int>(j));
+  return cols;
+}
+
+// The Jacobian columns a mask asks for: its free parameters, or all num_params of them for an
+// empty mask (as restrict_param_jacobian reads an empty list); none for a mask of only fixed ones.
+inline std::vector<int> jacobian_columns(const std::vector<bool>& free, int num_params) {
+  std::vector<int> cols = free_columns(free);
+  if (free.empty())
+    for (int c = 0; c < num_params; ++c) cols.push_back(c);
   return cols;
 }
 

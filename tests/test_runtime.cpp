@@ -201,8 +201,8 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
 // error's six accelerations in its free columns) are rhs()'s dense df/dp bit for bit, from
 // a compiled header (its nonzeros placed directly), a tape (the default gather) and joint
 // models over either (each flight's columns, zero in another flight's copies). The columns
-// are out of order and include a per-flight copy and a parameter the rows do not depend
-// on; a copy of each model evaluates the block its original prepared.
+// are out of order and include a per-flight copy and g, on which only the vertical row
+// depends; a copy of each model evaluates the block its original prepared.
 TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
   using Compiled = CompiledModel<quadgen_generated::finken3_all_effects::Model>;
   TapeModel tape = finken3_tape(parse_effect_list("all"));
