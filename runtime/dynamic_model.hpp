@@ -46,9 +46,14 @@ class DynamicModel {
     std::vector<int> slot;
     std::vector<ParamBlock> inner;
     std::vector<std::vector<int>> place;
+    // Who prepared it: a token that a model shares with its clones (a generated model's
+    // type; a per-flight model's layout of parameters). A model uses the preparation only of
+    // a block that carries its own token; any other block takes the default path, which
+    // reads nothing but rows and columns and so is right for every model.
+    const void* prepared_by = nullptr;
   };
   virtual ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const {
-    return {std::move(rows), std::move(columns), {}, {}, {}};
+    return {std::move(rows), std::move(columns), {}, {}, {}, nullptr};
   }
   // f (all rows) and the block of df/dp, equal to rhs()'s bit for bit. The default takes them
   // from rhs()'s dense df/dp.
@@ -160,7 +165,7 @@ class CompiledModel : public DynamicModel {
     if (Bu) scatter(Bu, M::kNumInputs, su, M::kDfduNnz, M::kDfduRow, M::kDfduCol);
   }
   ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const override {
-    ParamBlock b{std::move(rows), std::move(columns), std::vector<int>(M::kDfdpNnz, -1), {}, {}};
+    ParamBlock b{std::move(rows), std::move(columns), std::vector<int>(M::kDfdpNnz, -1), {}, {}, block_token()};
     std::vector<int> row_at(M::kNumStates, -1), column_at(M::kNumParams, -1);
     for (size_t i = 0; i < b.rows.size(); ++i) row_at.at(static_cast<size_t>(b.rows[i])) = static_cast<int>(i);
     for (size_t q = 0; q < b.columns.size(); ++q) column_at.at(static_cast<size_t>(b.columns[q])) = static_cast<int>(q);
@@ -172,7 +177,7 @@ class CompiledModel : public DynamicModel {
   }
   // The nonzeros go straight to their places in the block (a later duplicate wins, as in scatter()).
   void rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const override {
-    if (block.slot.size() != static_cast<size_t>(M::kDfdpNnz)) return DynamicModel::rhs_block(x, u, f, block, B);
+    if (block.prepared_by != block_token()) return DynamicModel::rhs_block(x, u, f, block, B);
     double sp[M::kDfdpNnz + 1];
     double* none = nullptr;
     M::rhs(x, u, p_.data(), pre_, f, none, none, sp);
@@ -203,6 +208,12 @@ class CompiledModel : public DynamicModel {
   std::unique_ptr<DynamicModel> clone() const override { return std::make_unique<CompiledModel>(*this); }
 
  private:
+  // One per generated model type (a function's static in a class template: one per M), so a
+  // block prepared by another generated model is not read as this one's.
+  static const void* block_token() {
+    static const char token = 0;
+    return &token;
+  }
   static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col,
                       int rows = M::kNumStates) {
     for (int i = 0; i < rows * cols; ++i) dense[i] = 0;

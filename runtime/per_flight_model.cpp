@@ -62,7 +62,7 @@ PerFlightModel::PerFlightModel(const DynamicModel& inner, std::vector<double> fl
 
 PerFlightModel::PerFlightModel(const PerFlightModel& o)
     : DynamicModel(o), starts_(o.starts_), t_input_(o.t_input_), names_(o.names_), p_(o.p_), column_(o.column_),
-      restricted_to_(o.restricted_to_) {  // the inner copies keep their restriction: so does the record of it
+      restricted_to_(o.restricted_to_), layout_token_(o.layout_token_) {  // the inner copies keep their restriction: so does the record of it
   for (const auto& m : o.flights_) flights_.push_back(m->clone());
 }
 
@@ -102,7 +102,7 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
 // place[k][q] is where the flight's q-th inner column goes in the block asked for. The other
 // columns of the block (another flight's copies) are zero for this flight, as in rhs().
 DynamicModel::ParamBlock PerFlightModel::param_block(std::vector<int> rows, std::vector<int> columns) const {
-  ParamBlock b{std::move(rows), std::move(columns), {}, {}, {}};
+  ParamBlock b{std::move(rows), std::move(columns), {}, {}, {}, layout_token_.get()};
   for (size_t k = 0; k < flights_.size(); ++k) {
     std::vector<int> inner, place;
     for (size_t q = 0; q < b.columns.size(); ++q)
@@ -118,7 +118,7 @@ DynamicModel::ParamBlock PerFlightModel::param_block(std::vector<int> rows, std:
 }
 
 void PerFlightModel::rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const {
-  if (block.inner.size() != flights_.size()) return DynamicModel::rhs_block(x, u, f, block, B);
+  if (block.prepared_by != layout_token_.get()) return DynamicModel::rhs_block(x, u, f, block, B);
   const int k = flight_at(u[t_input_]);
   const ParamBlock& in = block.inner[static_cast<size_t>(k)];
   const size_t rows = block.rows.size(), nc = block.columns.size(), nc_inner = in.columns.size();

@@ -74,6 +74,10 @@ class PerFlightModel : public DynamicModel {
   std::vector<std::vector<int>> column_;
   mutable std::vector<double> inner_B_;
   std::vector<int> restricted_to_;  // the columns of the last restrict_param_jacobian (empty: all)
+  // What a ParamBlock of this model carries (prepared_by): made with the layout of columns,
+  // shared by the copies, so a block of another per-flight model of the same size is not
+  // read with this one's columns.
+  std::shared_ptr<const char> layout_token_ = std::make_shared<const char>(0);
 };
 
 }  // namespace quadgen::runtime

@@ -25,6 +25,7 @@
 #include "runtime/flight_log.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
+#include "generated/crazyflie21_all_effects/model.hpp"
 #include "runtime/integrator.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/portable_random.hpp"
@@ -257,6 +258,61 @@ TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
           some_nonzero = some_nonzero || want != 0.0;
         }
       EXPECT_TRUE(some_nonzero);
+    }
+  }
+}
+
+// A block is read with the preparation of the model that made it only: a per-flight model of
+// the same size but other per-flight parameters (or a generated model of another vehicle)
+// takes the default path and still gives its own df/dp, while a model's copies share its
+// preparation (else each helper thread would lose the fast path, silently).
+TEST(Runtime, ABlockPreparedByAnotherModelIsNotReadAsThisOnes) {
+  using Compiled = CompiledModel<quadgen_generated::finken3_all_effects::Model>;
+  Compiled compiled;
+  std::vector<double> p = compiled.params();
+  p[compiled.param_index("rotor_drag.k")] = 2e-5;
+  p[compiled.param_index("wind.x")] = 0.4;
+  compiled.set_params(p);
+  // The same shape: one copy of one parameter for the second flight, different parameters.
+  PerFlightModel wind_per_flight(compiled, {10.0}, {"wind.x"});
+  PerFlightModel gain_per_flight(compiled, {10.0}, {"motor_gain.C"});
+  std::vector<double> pj = p;
+  pj.push_back(-0.7);
+  wind_per_flight.set_params(pj);
+  pj.back() = 0.05;
+  gain_per_flight.set_params(pj);
+  CompiledModel<quadgen_generated::crazyflie21_all_effects::Model> other_vehicle;
+  const int np = compiled.num_params();
+  const std::vector<int> rows = {3, 4, 5, 10, 11, 12};
+  const std::vector<int> columns = {compiled.param_index("wind.x"), np, compiled.param_index("motor_gain.C"),
+                                    compiled.param_index("rotor_drag.k")};
+  const DynamicModel::ParamBlock foreign = wind_per_flight.param_block(rows, columns);
+  const DynamicModel::ParamBlock foreign_vehicle = other_vehicle.param_block(rows, {0, 1, 2, 3});
+  EXPECT_EQ(gain_per_flight.clone()->param_block(rows, columns).prepared_by,
+            gain_per_flight.param_block(rows, columns).prepared_by);
+  EXPECT_EQ(compiled.clone()->param_block(rows, {0, 1}).prepared_by, compiled.param_block(rows, {2}).prepared_by);
+  EXPECT_NE(foreign.prepared_by, gain_per_flight.param_block(rows, columns).prepared_by);
+  const int n = compiled.num_states(), nu = compiled.num_inputs();
+  std::mt19937 rng(11);
+  for (int k = 0; k < 4; ++k) {
+    std::vector<double> x = test::random_state(rng);
+    x[2] = 0.5 + std::fabs(x[2]);
+    x.resize(n, 900.0 + 10.0 * k);
+    std::vector<double> u{0.3 + 0.01 * k, 0.4, 0.5, 0.6};
+    while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
+    u[compiled.input_index("t")] = 14.0;  // the second flight, where the two layouts differ
+    u[compiled.input_index("vbat")] = 3.9;
+    for (const auto& [model, block] : std::vector<std::pair<DynamicModel*, const DynamicModel::ParamBlock*>>{
+             {&gain_per_flight, &foreign}, {&compiled, &foreign_vehicle}}) {
+      const size_t npm = static_cast<size_t>(model->num_params()), nc = block->columns.size();
+      std::vector<double> f(n), dense(n * npm), f_block(n), B(rows.size() * nc, -7.5);
+      model->rhs(x.data(), u.data(), f.data(), nullptr, dense.data(), nullptr);
+      model->rhs_block(x.data(), u.data(), f_block.data(), *block, B.data());
+      EXPECT_EQ(f, f_block);
+      for (size_t i = 0; i < rows.size(); ++i)
+        for (size_t q = 0; q < nc; ++q)
+          EXPECT_EQ(B[i * nc + q], dense[static_cast<size_t>(rows[i]) * npm + static_cast<size_t>(block->columns[q])])
+              << model->param_names()[block->columns[q]] << " row " << rows[i];
     }
   }
 }
