@@ -285,7 +285,8 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
          "<i>k</i>'s (flights numbered as under the title).</p>\n";
   }
   for (const auto& f : d.findings) {
-    h << "<h3>" << esc(f.effect) << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
+    h << "<h3>" << esc(f.effect) << (scope(f.effect) == "flight" ? " <small>(a property of the flight, not of the airframe)</small>" : "")
+      << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
       << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),

@@ -201,6 +201,7 @@ json finding_json(const Finding& f) {
     ps[e.name] = pj;
   }
   json fj = {{"effect", f.effect},
+             {"scope", scope(f.effect)},
              {"headline", headline(f)},
              {"parameters", ps},
              {"gain", {{"metric", f.metric},
@@ -542,6 +543,9 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["final_fit"] = parameters_json(d.search.final_fit);
   // For predicting other flights (quadgen predict): the airframe's values.
   j["airframe_fit"] = parameters_json(d.airframe_fit.empty() ? d.search.final_fit : d.airframe_fit);
+  json scopes = json::object();
+  for (const auto& e : d.candidates) scopes[e] = scope(e);
+  j["effect_scopes"] = scopes;
   j["flight_parameters"] = flight_parameters_json(d.search);
   j["residuals"] = {{"before", channels_json(d.before)}, {"after", channels_json(d.after)}};
   j["extended_model"] = extended_model_json(d);

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "derive/effects/effect_catalogue.hpp"
 #include "fit/fit_report.hpp"
 #include "output/estimate.hpp"
 #include "output/numbers.hpp"
@@ -144,6 +145,12 @@ std::string carried_suspect(const CarriedSuspect& c) {
   return "carried in the model, not named: " + c.beside + "'s values fitted without it (" + c.without +
          ") are rejected once it is held at its estimate (p = " + output::short_number(c.named_values_p) +
          "); beside it they are " + c.with;
+}
+
+// "" for a name that is no catalogue effect (a test's made-up finding): the sinks then say nothing.
+std::string scope(const std::string& effect) {
+  const Effect* e = effect_named(effect);
+  return !e ? "" : e->per_flight ? "flight" : "airframe";
 }
 
 // Where the rotor drag force acts, when the diagnosis names both halves of it: the force

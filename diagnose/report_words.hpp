@@ -23,6 +23,12 @@ std::string headline(const Finding& f);
 std::string airframe_from_one_flight(const Diagnosis& d);
 // A suspect carried for a named look-alike's sake, in one sentence.
 std::string carried_suspect(const CarriedSuspect& c);
+// What a catalogue effect describes, as its descriptor declares (`per_flight`): "airframe", a
+// property of the vehicle that every flight of it shares (compare it across flights), or
+// "flight", a condition of the one flight (motor trims, the marker frame, a wind) that may
+// differ on the next. Said beside every finding, so that diagnoses of several flights of one
+// vehicle can be read for what must agree.
+std::string scope(const std::string& effect);
 
 // Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
 struct PointOfAction {

@@ -78,6 +78,9 @@ def violations(f):
         out.append("every interval contains off")
     if not held_out_gain(f):
         out.append("no held-out gain beyond its standard error")
+    scope = "flight" if f["effect"] in PER_FLIGHT else "airframe"
+    if f.get("scope") != scope:
+        out.append(f"scope {f.get('scope')!r}, not {scope!r}")
     return out
 
 
@@ -174,7 +177,8 @@ def look_alike_classes(root):
     could not separate (diagnosis.json `ambiguous`) joined into one class: per flight whether
     the class is named (which member), in the model as an ambiguous pair, suspected, or absent.
     Which member of a pair a flight names is what the data cannot decide; that a member is in
-    the model is what the flights can be compared on. (A carried member of a pair is not
+    the model is what the flights can be compared on. "of the": whether the class describes the
+    airframe (every flight should carry it) or the flight (diagnosis.json `effect_scopes`). (A carried member of a pair is not
     tested on held-out data: acceptance judges named effects only.)"""
     singles = []
     for d in sorted(pathlib.Path(root).iterdir()):
@@ -203,9 +207,14 @@ def look_alike_classes(root):
         classes.setdefault(find(e), []).append(e)
     print("\nFlights diagnosed alone, look-alikes joined (named: which member; ambiguous: a pair the flight "
           "cannot separate, its stronger member carried; suspected; —: absent)\n")
-    print("| effect (or look-alikes) | " + " | ".join(cell(n) for n, _ in singles) + " | named, or carried as an ambiguous pair, on |")
-    print("|---|" + "---|" * len(singles) + "---|")
+    scopes = {}
+    for _, j in singles:
+        scopes.update(j.get("effect_scopes", {}))
+    print("| effect (or look-alikes) | of the | " + " | ".join(cell(n) for n, _ in singles) +
+          " | named, or carried as an ambiguous pair, on |")
+    print("|---|---|" + "---|" * len(singles) + "---|")
     for members in sorted(classes.values(), key=lambda m: m[0]):
+        of = " / ".join(sorted({scopes.get(m, "?") for m in members}))
         cells, in_model = [], 0
         for _, j in singles:
             named = [f["effect"] for f in j["findings"] if f["effect"] in members]
@@ -215,7 +224,7 @@ def look_alike_classes(root):
                 in_model += 1
             cells.append(", ".join(named + [f"ambiguous ({p})" for p in pairs]) or
                          (f"suspected ({', '.join(suspected)})" if suspected else "—"))
-        print(f"| {' / '.join(members)} | " + " | ".join(cells) + f" | {in_model} of {len(singles)} |")
+        print(f"| {' / '.join(members)} | {of} | " + " | ".join(cells) + f" | {in_model} of {len(singles)} |")
 
 
 def agreement_tables(root):

@@ -34,6 +34,7 @@
 #include "app/model_registry.hpp"
 #include "output/sinks.hpp"
 #include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "derive/geometry.hpp"
 #include "fit/log_reader.hpp"
 #include "diagnose/candidate_search.hpp"
@@ -1165,6 +1166,43 @@ TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
   EXPECT_NE(html.find("[0.03, open]"), std::string::npos);
   EXPECT_EQ(html.find("nan"), std::string::npos);
+}
+
+// Each finding says whether it describes the airframe or the flight, as its catalogue entry
+// declares (`per_flight`), in diagnosis.json, the terminal summary and the report: diagnoses of
+// several flights of one vehicle must agree on the first kind, not on the second.
+TEST(DiagnosisReport, EachFindingSaysWhetherItIsTheAirframesOrTheFlights) {
+  quadgen::diagnose::Diagnosis d;
+  d.metric = "position RMSE [m]";
+  for (const std::string e : {"blade_flapping", "motor_gain", "attitude_bias", "cog_offset", "wind"}) {
+    quadgen::diagnose::Finding f;
+    f.effect = e, f.metric = d.metric, f.before = 0.3, f.after = 0.2;
+    d.findings.push_back(f);
+    d.candidates.push_back(e);
+  }
+  const auto j = quadgen::diagnose::diagnosis_json(d, "log.csv");
+  const std::string summary = quadgen::diagnose::diagnosis_summary(d);
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
+  const std::string tag = "(a property of the flight, not of the airframe)";
+  for (size_t i = 0; i < d.findings.size(); ++i) {
+    const std::string& e = d.findings[i].effect;
+    const std::string expected = quadgen::find_effect(e).per_flight ? "flight" : "airframe";
+    EXPECT_EQ(j["findings"][i]["scope"], expected) << e;
+    EXPECT_EQ(j["effect_scopes"][e], expected) << e;
+    const bool tagged = summary.find("found " + e + " " + tag + ":") != std::string::npos;
+    EXPECT_EQ(tagged, expected == "flight") << summary;
+    const size_t h3 = html.find("<h3>" + e);
+    ASSERT_NE(h3, std::string::npos) << e;
+    const std::string tagged_heading = "<h3>" + e + " <small>" + tag;
+    EXPECT_EQ(html.compare(h3, tagged_heading.size(), tagged_heading) == 0, expected == "flight") << e;
+  }
+  // The catalogue's own declarations, written down independently: trims, the marker frame
+  // and a wind belong to the flight; blade flapping and a CoG offset to the airframe.
+  EXPECT_EQ(j["effect_scopes"]["motor_gain"], "flight");
+  EXPECT_EQ(j["effect_scopes"]["attitude_bias"], "flight");
+  EXPECT_EQ(j["effect_scopes"]["wind"], "flight");
+  EXPECT_EQ(j["effect_scopes"]["blade_flapping"], "airframe");
+  EXPECT_EQ(j["effect_scopes"]["cog_offset"], "airframe");
 }
 
 // A cause named jointly that the flights alone disagree on is flagged where it is named (the
