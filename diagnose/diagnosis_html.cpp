@@ -248,7 +248,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) {
-    h << "<li>" << esc(headline(f));
+    h << "<li>" << esc(headline(f)) << (scope(f.effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "");
     // A cause named jointly that the flights alone do not agree on is not one value of the
     // airframe: said here, not only in the agreement table further down.
     for (const auto& a : d.agreement)
@@ -281,11 +281,11 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.per_flight_effects.empty()) {
     h << "<p>One value per flight for ";
     for (size_t i = 0; i < d.per_flight_effects.size(); ++i) h << (i ? ", " : "") << esc(d.per_flight_effects[i]);
-    h << " (a property of the flight, not of the airframe): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
+    h << " (" << esc(flights_own(d)) << "): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
          "<i>k</i>'s (flights numbered as under the title).</p>\n";
   }
   for (const auto& f : d.findings) {
-    h << "<h3>" << esc(f.effect) << (scope(f.effect) == "flight" ? " <small>(a property of the flight, not of the airframe)</small>" : "")
+    h << "<h3>" << esc(f.effect) << (scope(f.effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "")
       << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
       << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";

@@ -27,7 +27,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   // The held-out measure is said once; a finding judged by another says its own.
   os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
   for (const auto& f : d.findings) {
-    os << "found " << f.effect << (scope(f.effect) == "flight" ? " (a property of the flight, not of the airframe)" : "") << ":";
+    os << "found " << f.effect << (scope(f.effect) == "flight" ? " (" + flights_own(d) + ")" : "") << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)

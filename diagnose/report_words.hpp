@@ -29,6 +29,8 @@ std::string carried_suspect(const CarriedSuspect& c);
 // differ on the next. Said beside every finding, so that diagnoses of several flights of one
 // vehicle can be read for what must agree.
 std::string scope(const std::string& effect);
+// Said beside a finding whose scope is "flight" ("... of each flight ..." in a joint diagnosis).
+std::string flights_own(const Diagnosis& d);
 
 // Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
 struct PointOfAction {

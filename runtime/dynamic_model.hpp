@@ -47,10 +47,11 @@ class DynamicModel {
     std::vector<ParamBlock> inner;
     std::vector<std::vector<int>> place;
     // Who prepared it: a token that a model shares with its clones (a generated model's
-    // type; a per-flight model's layout of parameters). A model uses the preparation only of
-    // a block that carries its own token; any other block takes the default path, which
-    // reads nothing but rows and columns and so is right for every model.
-    const void* prepared_by = nullptr;
+    // type; a per-flight model's layout of parameters), held by the block so that no later
+    // model is given its address. A model uses the preparation only of a block that carries
+    // its own token (and has its shape); any other block takes the default path, which reads
+    // nothing but rows and columns and so is right for every model.
+    std::shared_ptr<const void> prepared_by;
   };
   virtual ParamBlock param_block(std::vector<int> rows, std::vector<int> columns) const {
     return {std::move(rows), std::move(columns), {}, {}, {}, nullptr};
@@ -177,7 +178,8 @@ class CompiledModel : public DynamicModel {
   }
   // The nonzeros go straight to their places in the block (a later duplicate wins, as in scatter()).
   void rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const override {
-    if (block.prepared_by != block_token()) return DynamicModel::rhs_block(x, u, f, block, B);
+    if (block.prepared_by != block_token() || block.slot.size() != static_cast<size_t>(M::kDfdpNnz))
+      return DynamicModel::rhs_block(x, u, f, block, B);
     double sp[M::kDfdpNnz + 1];
     double* none = nullptr;
     M::rhs(x, u, p_.data(), pre_, f, none, none, sp);
@@ -209,10 +211,13 @@ class CompiledModel : public DynamicModel {
 
  private:
   // One per generated model type (a function's static in a class template: one per M), so a
-  // block prepared by another generated model is not read as this one's.
-  static const void* block_token() {
-    static const char token = 0;
-    return &token;
+  // block prepared by another generated model is not read as this one's. Writable, so that no
+  // linker folds the tokens of two types into one address; not owned (it lives as long as
+  // the program).
+  static const std::shared_ptr<const void>& block_token() {
+    static char token = 0;
+    static const std::shared_ptr<const void> shared(std::shared_ptr<const void>(), &token);
+    return shared;
   }
   static void scatter(double* dense, int cols, const double* v, int nnz, const int* row, const int* col,
                       int rows = M::kNumStates) {

@@ -102,7 +102,7 @@ void PerFlightModel::rhs(const double* x, const double* u, double* f, double* A,
 // place[k][q] is where the flight's q-th inner column goes in the block asked for. The other
 // columns of the block (another flight's copies) are zero for this flight, as in rhs().
 DynamicModel::ParamBlock PerFlightModel::param_block(std::vector<int> rows, std::vector<int> columns) const {
-  ParamBlock b{std::move(rows), std::move(columns), {}, {}, {}, layout_token_.get()};
+  ParamBlock b{std::move(rows), std::move(columns), {}, {}, {}, layout_token_};
   for (size_t k = 0; k < flights_.size(); ++k) {
     std::vector<int> inner, place;
     for (size_t q = 0; q < b.columns.size(); ++q)
@@ -118,7 +118,8 @@ DynamicModel::ParamBlock PerFlightModel::param_block(std::vector<int> rows, std:
 }
 
 void PerFlightModel::rhs_block(const double* x, const double* u, double* f, const ParamBlock& block, double* B) const {
-  if (block.prepared_by != layout_token_.get()) return DynamicModel::rhs_block(x, u, f, block, B);
+  if (block.prepared_by != layout_token_ || block.inner.size() != flights_.size())
+    return DynamicModel::rhs_block(x, u, f, block, B);
   const int k = flight_at(u[t_input_]);
   const ParamBlock& in = block.inner[static_cast<size_t>(k)];
   const size_t rows = block.rows.size(), nc = block.columns.size(), nc_inner = in.columns.size();

@@ -75,9 +75,9 @@ class PerFlightModel : public DynamicModel {
   mutable std::vector<double> inner_B_;
   std::vector<int> restricted_to_;  // the columns of the last restrict_param_jacobian (empty: all)
   // What a ParamBlock of this model carries (prepared_by): made with the layout of columns,
-  // shared by the copies, so a block of another per-flight model of the same size is not
-  // read with this one's columns.
-  std::shared_ptr<const char> layout_token_ = std::make_shared<const char>(0);
+  // shared by the copies and the blocks, so a block of another per-flight model of the same
+  // size is not read with this one's columns.
+  std::shared_ptr<const void> layout_token_ = std::make_shared<const char>(0);
 };
 
 }  // namespace quadgen::runtime

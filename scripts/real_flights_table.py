@@ -6,7 +6,9 @@ standard error (open-loop position; or one-step equation error with neither the 
 gain nor any channel group's one-step gain — translational, horizontal, rotational, yaw — below
 minus its standard error; or, for a flight's own quantity acting on the force, the force
 model alone — position with the measured attitude replayed — with the one-step gain above and
-no channel group below its spread). Exit status 1 on a violation."""
+no channel group below its spread); and every `scope` diagnosis.json gives (findings, suspects,
+stand-ins, `effect_scopes`) against this script's own list of the flight's own effects. Exit
+status 1 on a violation."""
 import json
 import math
 import pathlib
@@ -78,10 +80,26 @@ def violations(f):
         out.append("every interval contains off")
     if not held_out_gain(f):
         out.append("no held-out gain beyond its standard error")
-    scope = "flight" if f["effect"] in PER_FLIGHT else "airframe"
-    if f.get("scope") != scope:
-        out.append(f"scope {f.get('scope')!r}, not {scope!r}")
-    return out
+    return out + wrong_scope(f["effect"], f.get("scope"))
+
+
+def scope_of(effect):
+    return "flight" if effect in PER_FLIGHT else "airframe"
+
+
+def wrong_scope(effect, said):
+    """A scope diagnosis.json gives an effect against this script's own list."""
+    return [] if said == scope_of(effect) else [f"{effect}: scope {said!r}, not {scope_of(effect)!r}"]
+
+
+def scope_violations(j):
+    """The scopes of the entries besides findings: suspects, stand-ins and every candidate."""
+    out = []
+    for e in j.get("suspected", []) + j.get("stand_ins", []):
+        out += wrong_scope(e["effect"], e.get("scope"))
+    for effect, said in j.get("effect_scopes", {}).items():
+        out += wrong_scope(effect, said)
+    return out + [f"no scope for {e}" for e in j.get("candidates_considered", []) if e not in j.get("effect_scopes", {})]
 
 
 # The symmetric SI plausible ranges of the catalogue (docs/effects.md; motor_lag and
@@ -141,6 +159,10 @@ def main(root):
             v = violations(f) + implausible(f, j.get("environment", "unknown"))
             bad += len(v)
             named.append(finding_text(f) + (" ⚠ " + ", ".join(v) if v else ""))
+        scopes = scope_violations(j)
+        bad += len(scopes)
+        if scopes:
+            named.append("⚠ " + ", ".join(scopes))
         suspected = [f"{s['effect']} ({s['failed'].split(' (')[0]})" for s in j["suspected"]]
         groups = [" or ".join(a["effects"]) for a in j.get("ambiguous", [])]
         stand_ins = [f"{s['effect']} ({s['parameter']} = {s['value']:.3g} {s['unit']})" for s in j.get("stand_ins", [])]
@@ -178,7 +200,8 @@ def look_alike_classes(root):
     the class is named (which member), in the model as an ambiguous pair, suspected, or absent.
     Which member of a pair a flight names is what the data cannot decide; that a member is in
     the model is what the flights can be compared on. "of the": whether the class describes the
-    airframe (every flight should carry it) or the flight (diagnosis.json `effect_scopes`). (A carried member of a pair is not
+    airframe (every flight should carry it) or the flight (PER_FLIGHT; diagnosis.json's own
+    `scope` fields are checked against it in main()). (A carried member of a pair is not
     tested on held-out data: acceptance judges named effects only.)"""
     singles = []
     for d in sorted(pathlib.Path(root).iterdir()):
@@ -207,14 +230,11 @@ def look_alike_classes(root):
         classes.setdefault(find(e), []).append(e)
     print("\nFlights diagnosed alone, look-alikes joined (named: which member; ambiguous: a pair the flight "
           "cannot separate, its stronger member carried; suspected; —: absent)\n")
-    scopes = {}
-    for _, j in singles:
-        scopes.update(j.get("effect_scopes", {}))
     print("| effect (or look-alikes) | of the | " + " | ".join(cell(n) for n, _ in singles) +
           " | named, or carried as an ambiguous pair, on |")
     print("|---|---|" + "---|" * len(singles) + "---|")
     for members in sorted(classes.values(), key=lambda m: m[0]):
-        of = " / ".join(sorted({scopes.get(m, "?") for m in members}))
+        of = " / ".join(sorted({scope_of(m) for m in members}))
         cells, in_model = [], 0
         for _, j in singles:
             named = [f["effect"] for f in j["findings"] if f["effect"] in members]

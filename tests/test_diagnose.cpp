@@ -1196,6 +1196,15 @@ TEST(DiagnosisReport, EachFindingSaysWhetherItIsTheAirframesOrTheFlights) {
     const std::string tagged_heading = "<h3>" + e + " <small>" + tag;
     EXPECT_EQ(html.compare(h3, tagged_heading.size(), tagged_heading) == 0, expected == "flight") << e;
   }
+  // Said in "In short" and in the finding's heading, for each of the three flight's own.
+  size_t tags = 0;
+  for (size_t at = html.find("<small>" + tag + "</small>"); at != std::string::npos;
+       at = html.find("<small>" + tag + "</small>", at + 1))
+    ++tags;
+  EXPECT_EQ(tags, 6u) << html;
+  d.flights = {"a.csv", "b.csv"};  // jointly: each flight has its own value
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("found wind (a property of each flight, not of the airframe):"),
+            std::string::npos);
   // The catalogue's own declarations, written down independently: trims, the marker frame
   // and a wind belong to the flight; blade flapping and a CoG offset to the airframe.
   EXPECT_EQ(j["effect_scopes"]["motor_gain"], "flight");

@@ -25,7 +25,6 @@
 #include "runtime/flight_log.hpp"
 #include "generated/finken3/model.hpp"
 #include "generated/finken3_all_effects/model.hpp"
-#include "generated/crazyflie21_all_effects/model.hpp"
 #include "runtime/integrator.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/portable_random.hpp"
@@ -263,9 +262,10 @@ TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
 }
 
 // A block is read with the preparation of the model that made it only: a per-flight model of
-// the same size but other per-flight parameters (or a generated model of another vehicle)
-// takes the default path and still gives its own df/dp, while a model's copies share its
-// preparation (else each helper thread would lose the fast path, silently).
+// the same size but other per-flight parameters takes the default path and still gives its own
+// df/dp. A model's copies and a per-flight model's inner blocks share the preparation, and a
+// model's own block is read through it (seen by spoiling its slots: else every helper thread
+// could lose the fast path with nothing to show it, the two paths giving the same numbers).
 TEST(Runtime, ABlockPreparedByAnotherModelIsNotReadAsThisOnes) {
   using Compiled = CompiledModel<quadgen_generated::finken3_all_effects::Model>;
   Compiled compiled;
@@ -281,17 +281,23 @@ TEST(Runtime, ABlockPreparedByAnotherModelIsNotReadAsThisOnes) {
   wind_per_flight.set_params(pj);
   pj.back() = 0.05;
   gain_per_flight.set_params(pj);
-  CompiledModel<quadgen_generated::crazyflie21_all_effects::Model> other_vehicle;
   const int np = compiled.num_params();
   const std::vector<int> rows = {3, 4, 5, 10, 11, 12};
   const std::vector<int> columns = {compiled.param_index("wind.x"), np, compiled.param_index("motor_gain.C"),
                                     compiled.param_index("rotor_drag.k")};
   const DynamicModel::ParamBlock foreign = wind_per_flight.param_block(rows, columns);
-  const DynamicModel::ParamBlock foreign_vehicle = other_vehicle.param_block(rows, {0, 1, 2, 3});
-  EXPECT_EQ(gain_per_flight.clone()->param_block(rows, columns).prepared_by,
-            gain_per_flight.param_block(rows, columns).prepared_by);
-  EXPECT_EQ(compiled.clone()->param_block(rows, {0, 1}).prepared_by, compiled.param_block(rows, {2}).prepared_by);
-  EXPECT_NE(foreign.prepared_by, gain_per_flight.param_block(rows, columns).prepared_by);
+  const DynamicModel::ParamBlock own = gain_per_flight.param_block(rows, columns);
+  EXPECT_EQ(gain_per_flight.clone()->param_block(rows, columns).prepared_by, own.prepared_by);
+  EXPECT_NE(foreign.prepared_by, own.prepared_by);
+  const DynamicModel::ParamBlock compiled_own = compiled.param_block(
+      rows, {compiled.param_index("c_t"), compiled.param_index("rotor_drag.k"), compiled.param_index("wind.x")});
+  ASSERT_NE(compiled_own.prepared_by, nullptr);
+  EXPECT_EQ(compiled.clone()->param_block(rows, {0, 1}).prepared_by, compiled_own.prepared_by);
+  for (const auto& inner : own.inner) EXPECT_EQ(inner.prepared_by, compiled_own.prepared_by);
+  DynamicModel::ParamBlock spoiled = compiled_own;  // every nonzero placed outside the block
+  std::fill(spoiled.slot.begin(), spoiled.slot.end(), -1);
+  DynamicModel::ParamBlock anonymous = spoiled;  // the same, but no model's
+  anonymous.prepared_by = nullptr;
   const int n = compiled.num_states(), nu = compiled.num_inputs();
   std::mt19937 rng(11);
   for (int k = 0; k < 4; ++k) {
@@ -302,18 +308,26 @@ TEST(Runtime, ABlockPreparedByAnotherModelIsNotReadAsThisOnes) {
     while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
     u[compiled.input_index("t")] = 14.0;  // the second flight, where the two layouts differ
     u[compiled.input_index("vbat")] = 3.9;
-    for (const auto& [model, block] : std::vector<std::pair<DynamicModel*, const DynamicModel::ParamBlock*>>{
-             {&gain_per_flight, &foreign}, {&compiled, &foreign_vehicle}}) {
-      const size_t npm = static_cast<size_t>(model->num_params()), nc = block->columns.size();
+    // Read through the model's own preparation or the default path: its own df/dp either way,
+    // except for the spoiled block of its own, which the fast path reads as all zero.
+    const auto expect_block = [&](DynamicModel& model, const DynamicModel::ParamBlock& block, bool all_zero) {
+      const size_t npm = static_cast<size_t>(model.num_params()), nc = block.columns.size();
       std::vector<double> f(n), dense(n * npm), f_block(n), B(rows.size() * nc, -7.5);
-      model->rhs(x.data(), u.data(), f.data(), nullptr, dense.data(), nullptr);
-      model->rhs_block(x.data(), u.data(), f_block.data(), *block, B.data());
+      model.rhs(x.data(), u.data(), f.data(), nullptr, dense.data(), nullptr);
+      model.rhs_block(x.data(), u.data(), f_block.data(), block, B.data());
       EXPECT_EQ(f, f_block);
+      bool some_nonzero = false;
       for (size_t i = 0; i < rows.size(); ++i)
-        for (size_t q = 0; q < nc; ++q)
-          EXPECT_EQ(B[i * nc + q], dense[static_cast<size_t>(rows[i]) * npm + static_cast<size_t>(block->columns[q])])
-              << model->param_names()[block->columns[q]] << " row " << rows[i];
-    }
+        for (size_t q = 0; q < nc; ++q) {
+          const double want = dense[static_cast<size_t>(rows[i]) * npm + static_cast<size_t>(block.columns[q])];
+          EXPECT_EQ(B[i * nc + q], all_zero ? 0.0 : want) << model.param_names()[block.columns[q]] << " row " << rows[i];
+          some_nonzero = some_nonzero || want != 0.0;
+        }
+      EXPECT_TRUE(some_nonzero);
+    };
+    expect_block(gain_per_flight, foreign, false);
+    expect_block(compiled, spoiled, true);
+    expect_block(compiled, anonymous, false);
   }
 }
 
