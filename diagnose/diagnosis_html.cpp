@@ -220,7 +220,7 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
-       ".headline{font-size:1.1em}</style></head><body>\n";
+       ".headline{font-size:1.1em}h1,li{overflow-wrap:anywhere}</style></head><body>\n";  // long paths wrap
   // Several flights: their count in the title (their paths, a wall of text there, numbered
   // below it: the per-flight values refer to these numbers).
   const std::string subject = d.flights.size() > 1    ? std::to_string(d.flights.size()) + " flights"
