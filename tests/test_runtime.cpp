@@ -62,6 +62,22 @@ double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
   return d;
 }
 
+// A point to evaluate an all-effects model at: a random rigid-body state above the ground,
+// every further state (the rotor speeds) at `speed`; unequal rotor commands that change with
+// `k`, the log time `t` (which flight of a joint model) and a battery voltage.
+struct EvaluationPoint {
+  std::vector<double> x, u;
+};
+EvaluationPoint evaluation_point(std::mt19937& rng, const DynamicModel& m, int k, double speed, double t) {
+  EvaluationPoint p{test::random_state(rng), {0.3 + 0.01 * k, 0.4, 0.5, 0.6}};
+  p.x[2] = 0.5 + std::fabs(p.x[2]);
+  p.x.resize(static_cast<size_t>(m.num_states()), speed);
+  while (static_cast<int>(p.u.size()) < m.num_inputs()) p.u.push_back(0.0);
+  p.u[static_cast<size_t>(m.input_index("t"))] = t;
+  p.u[static_cast<size_t>(m.input_index("vbat"))] = 3.9;
+  return p;
+}
+
 }  // namespace
 
 // Bit for bit: the tape is lowered from the plan the header was printed from, so it
@@ -160,7 +176,7 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
   PerFlightModel joint(tape, {10.0}, {"motor_lag.tau"});
   p.push_back(0.05);  // motor_lag.tau@2
   joint.set_params(p);
-  const int n = tape.num_states(), nu = tape.num_inputs();
+  const int n = tape.num_states();
   const std::vector<int> speeds = tape.rotor_speed_states();
   using M = quadgen_generated::finken3_all_effects::Model;
   ASSERT_EQ(speeds, std::vector<int>(M::kRotorSpeedStates, M::kRotorSpeedStates + M::kNumRotorSpeedStates))
@@ -170,14 +186,11 @@ TEST(Runtime, AFewRowsOfTheRightHandSideAreTheFullEvaluationsBitForBit) {
   std::unique_ptr<DynamicModel> tape_copy;
   for (const std::vector<int>& rows : {speeds, others, speeds}) {
     for (int k = 0; k < 10; ++k) {
-      std::vector<double> x = test::random_state(rng);
-      x[2] = 0.5 + std::fabs(x[2]);
-      x.resize(n, 0.0);
+      // The joint model's first and second flight.
+      EvaluationPoint at = evaluation_point(rng, tape, k, 0.0, k < 5 ? 4.0 : 14.0);
+      std::vector<double>& x = at.x;
+      const std::vector<double>& u = at.u;
       for (size_t i = 0; i < speeds.size(); ++i) x[speeds[i]] = 1000.0 + 137.0 * i + k;
-      std::vector<double> u{0.3 + 0.01 * k, 0.4, 0.5, 0.6};
-      while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
-      u[tape.input_index("t")] = k < 5 ? 4.0 : 14.0;  // the joint model's first and second flight
-      u[tape.input_index("vbat")] = 3.9;
       std::vector<const DynamicModel*> models = {&tape, &compiled, &joint};
       if (tape_copy) models.push_back(tape_copy.get());
       for (const DynamicModel* m : models) {
@@ -215,7 +228,7 @@ TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
   compiled.set_params(p);
   PerFlightModel joint_compiled(compiled, {10.0}, {"wind.x", "motor_gain.C"});
   PerFlightModel joint_tape(tape, {10.0}, {"wind.x", "motor_gain.C"});
-  const int n = tape.num_states(), nu = tape.num_inputs(), np = tape.num_params();
+  const int n = tape.num_states(), np = tape.num_params();
   std::vector<double> pj = p;
   pj.push_back(-0.7), pj.push_back(0.05);  // wind.x@2, motor_gain.C@2
   joint_compiled.set_params(pj);
@@ -232,13 +245,10 @@ TEST(Runtime, ABlockOfTheParameterJacobianIsTheDenseOnesBitForBit) {
     const DynamicModel::ParamBlock block = m->param_block(rows, asked);
     const std::unique_ptr<DynamicModel> copy = m->clone();
     for (int k = 0; k < 8; ++k) {
-      std::vector<double> x = test::random_state(rng);
-      x[2] = 0.5 + std::fabs(x[2]);
-      x.resize(n, 900.0 + 10.0 * k);
-      std::vector<double> u{0.3 + 0.01 * k, 0.4, 0.5, 0.6};
-      while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
-      u[tape.input_index("t")] = k % 2 == 0 ? 4.0 : 14.0;  // a joint model's first and second flight
-      u[tape.input_index("vbat")] = 3.9;
+      // A joint model's first and second flight.
+      const EvaluationPoint at = evaluation_point(rng, tape, k, 900.0 + 10.0 * k, k % 2 == 0 ? 4.0 : 14.0);
+      const std::vector<double>& x = at.x;
+      const std::vector<double>& u = at.u;
       const size_t npm = static_cast<size_t>(m->num_params()), nc = asked.size();
       std::vector<double> f(n), dense(n * npm), f_block(n), B(rows.size() * nc, -7.5), f_copy(n),
           B_copy(rows.size() * nc, -7.5);
@@ -298,16 +308,13 @@ TEST(Runtime, ABlockPreparedByAnotherModelIsNotReadAsThisOnes) {
   std::fill(spoiled.slot.begin(), spoiled.slot.end(), -1);
   DynamicModel::ParamBlock anonymous = spoiled;  // the same, but no model's
   anonymous.prepared_by = nullptr;
-  const int n = compiled.num_states(), nu = compiled.num_inputs();
+  const int n = compiled.num_states();
   std::mt19937 rng(11);
   for (int k = 0; k < 4; ++k) {
-    std::vector<double> x = test::random_state(rng);
-    x[2] = 0.5 + std::fabs(x[2]);
-    x.resize(n, 900.0 + 10.0 * k);
-    std::vector<double> u{0.3 + 0.01 * k, 0.4, 0.5, 0.6};
-    while (static_cast<int>(u.size()) < nu) u.push_back(0.0);
-    u[compiled.input_index("t")] = 14.0;  // the second flight, where the two layouts differ
-    u[compiled.input_index("vbat")] = 3.9;
+    // The second flight, where the two layouts differ.
+    const EvaluationPoint at = evaluation_point(rng, compiled, k, 900.0 + 10.0 * k, 14.0);
+    const std::vector<double>& x = at.x;
+    const std::vector<double>& u = at.u;
     // Read through the model's own preparation or the default path: its own df/dp either way,
     // except for the spoiled block of its own, which the fast path reads as all zero.
     const auto expect_block = [&](DynamicModel& model, const DynamicModel::ParamBlock& block, bool all_zero) {
