@@ -24,6 +24,11 @@ namespace {
 
 std::string esc(const std::string& s) { return output::html_text(s); }
 
+// Beside a finding of the flight's own (its scope "flight"), in "In short" and its heading.
+std::string flights_own_tag(const Diagnosis& d, const std::string& effect) {
+  return scope(effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "";
+}
+
 // A discovered term's verdict for the report: "proposed" in bold, said once (the verdict
 // text may already begin with it).
 std::string verdict_cell(const DiscoveredTerm& t) {
@@ -248,7 +253,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) {
-    h << "<li>" << esc(headline(f)) << (scope(f.effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "");
+    h << "<li>" << esc(headline(f)) << flights_own_tag(d, f.effect);
     // A cause named jointly that the flights alone do not agree on is not one value of the
     // airframe: said here, not only in the agreement table further down.
     for (const auto& a : d.agreement)
@@ -285,7 +290,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
          "<i>k</i>'s (flights numbered as under the title).</p>\n";
   }
   for (const auto& f : d.findings) {
-    h << "<h3>" << esc(f.effect) << (scope(f.effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "")
+    h << "<h3>" << esc(f.effect) << flights_own_tag(d, f.effect)
       << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
       << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";

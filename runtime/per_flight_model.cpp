@@ -61,8 +61,10 @@ PerFlightModel::PerFlightModel(const DynamicModel& inner, std::vector<double> fl
 }
 
 PerFlightModel::PerFlightModel(const PerFlightModel& o)
+    // The inner copies keep their restriction: so does the record of it. The copy shares the
+    // layout, so blocks prepared by either serve both.
     : DynamicModel(o), starts_(o.starts_), t_input_(o.t_input_), names_(o.names_), p_(o.p_), column_(o.column_),
-      restricted_to_(o.restricted_to_), layout_token_(o.layout_token_) {  // the inner copies keep their restriction: so does the record of it
+      restricted_to_(o.restricted_to_), layout_token_(o.layout_token_) {
   for (const auto& m : o.flights_) flights_.push_back(m->clone());
 }
 
