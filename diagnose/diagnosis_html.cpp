@@ -322,7 +322,7 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
          "extended model and is not named.</p>\n<table><tr><th>effect</th><th>value</th><th>plausible</th><th>why</th>"
          "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
     for (const auto& st : d.stand_ins) {
-      h << "<tr><td>" << esc(st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
+      h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
         << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
         << esc(st.why) << "</td><td>";
       for (size_t c = 0; c < st.channels.size(); ++c)
@@ -341,7 +341,7 @@ void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<h2>Ambiguous</h2>\n";
     for (const auto& x : d.suspected)
       if (x.carried)
-        h << "<p class=\"warn\"><b>" << esc(x.candidate.effect) << "</b> (suspected: " << esc(x.failed) << ") is "
+        h << "<p class=\"warn\"><b>" << esc(x.candidate.effect) << "</b>" << flights_own_tag(d, x.candidate.effect) << " (suspected: " << esc(x.failed) << ") is "
           << esc(words::carried_suspect(*x.carried)) << ".</p>\n";
     for (const auto& a : d.search.unresolved)
       if (a.absorbed)

@@ -27,7 +27,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   // The held-out measure is said once; a finding judged by another says its own.
   os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
   for (const auto& f : d.findings) {
-    os << "found " << f.effect << (scope(f.effect) == "flight" ? " (" + flights_own(d) + ")" : "") << ":";
+    os << "found " << f.effect << flights_own_note(d, f.effect) << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
@@ -64,12 +64,14 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
     os << "ambiguous: " << a.a << " or " << a.b << " (the data cannot tell them apart; the model carries " << a.a
        << "); to separate them: " << a.manoeuvre << "\n";
   for (const auto& st : d.stand_ins)
-    os << "stands in for missing physics, not named: " << st.candidate.effect << " (" << st.parameter << " = "
+    os << "stands in for missing physics, not named: " << st.candidate.effect << flights_own_note(d, st.candidate.effect)
+       << " (" << st.parameter << " = "
        << num(st.value) << " " << st.unit << " lies outside [" << num(st.plausible_lower) << ", "
        << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
   for (const auto& x : d.suspected) {
-    os << "suspected, not named: " << x.candidate.effect << " (" << x.failed << ")";
+    os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect) << " (" << x.failed
+       << ")";
     if (x.carried) os << "; " << words::carried_suspect(*x.carried);
     os << "\n";
   }

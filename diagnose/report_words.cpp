@@ -157,6 +157,10 @@ std::string flights_own(const Diagnosis& d) {
   return d.flights.size() > 1 ? "a property of each flight, not of the airframe" : "a property of the flight, not of the airframe";
 }
 
+std::string flights_own_note(const Diagnosis& d, const std::string& effect) {
+  return scope(effect) == "flight" ? " (" + flights_own(d) + ")" : "";
+}
+
 // Where the rotor drag force acts, when the diagnosis names both halves of it: the force
 // (rotor_drag, at the CoG) and its forward-flight moment (blade_flapping) have coefficients of
 // their own, and a force at height h above the CoG gives exactly blade_flapping.k =

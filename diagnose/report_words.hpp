@@ -31,6 +31,9 @@ std::string carried_suspect(const CarriedSuspect& c);
 std::string scope(const std::string& effect);
 // Said beside a finding whose scope is "flight" ("... of each flight ..." in a joint diagnosis).
 std::string flights_own(const Diagnosis& d);
+// " (a property of the flight, not of the airframe)" after a flight's own effect, else "":
+// the terminal summary says it beside each finding, stand-in and suspect.
+std::string flights_own_note(const Diagnosis& d, const std::string& effect);
 
 // Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
 struct PointOfAction {

@@ -1214,6 +1214,34 @@ TEST(DiagnosisReport, EachFindingSaysWhetherItIsTheAirframesOrTheFlights) {
   EXPECT_EQ(j["effect_scopes"]["cog_offset"], "airframe");
 }
 
+// A suspect or a stand-in that is the flight's own says so too, in the summary and the
+// report (a wind standing in indoors is the flight's; a suspected rotor drag the airframe's).
+TEST(DiagnosisReport, SuspectsAndStandInsSayWhetherTheyAreTheFlightsOwn) {
+  quadgen::diagnose::Diagnosis d;
+  d.metric = "position RMSE [m]";
+  quadgen::diagnose::StandIn wind;
+  wind.candidate.effect = "wind", wind.parameter = "wind.v_x", wind.unit = "m/s", wind.value = 2.5;
+  wind.plausible_lower = -0.3, wind.plausible_upper = 0.3, wind.why = "indoors";
+  d.stand_ins.push_back(wind);
+  for (const std::string e : {"rotor_drag", "motor_gain"}) {
+    quadgen::diagnose::Suspected x;
+    x.candidate.effect = e, x.failed = "no held-out gain";
+    d.suspected.push_back(x);
+  }
+  quadgen::diagnose::CarriedSuspect carried;
+  carried.effect = "motor_gain", carried.beside = "cog_offset";
+  d.suspected.back().carried = carried;  // the trims, carried: shown in the report's "Ambiguous"
+  const std::string tag = " (a property of the flight, not of the airframe)";
+  const std::string summary = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(summary.find("not named: wind" + tag + " (wind.v_x"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("suspected, not named: motor_gain" + tag + " (no held-out gain)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("suspected, not named: rotor_drag (no held-out gain)"), std::string::npos) << summary;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
+  const std::string small = " <small>(a property of the flight, not of the airframe)</small>";
+  EXPECT_NE(html.find("<td>wind" + small + "</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<b>motor_gain</b>" + small + " (suspected"), std::string::npos) << html;
+}
+
 // A cause named jointly that the flights alone disagree on is flagged where it is named (the
 // summary's line and the report's "In short"), not only in the agreement table; one they
 // agree on is not.
