@@ -644,15 +644,6 @@ std::string CandidateSearch::values_in_words(const std::string& effect, const st
   return os.str();
 }
 
-// Whether either of two effects declares the other a look-alike.
-static bool declared_look_alikes(const std::string& x, const std::string& y) {
-  for (const auto& l : find_effect(x).look_alikes)
-    if (l.effect == y) return true;
-  for (const auto& l : find_effect(y).look_alikes)
-    if (l.effect == x) return true;
-  return false;
-}
-
 // The three fits both look-alike checks below rest on, for a look-alike E of the named F
 // with E's values in `start` (the rest at the final model's): E held there and the rest
 // refitted (held); E and F's values both held (kept); E free beside the final model
@@ -718,7 +709,7 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
   const double level = opt_.alpha / static_cast<double>(candidates_.size());
   for (const std::string& f : r.named()) {
     for (const std::string& e : candidates_) {
-      if (base.count(e) || !declared_look_alikes(f, e)) continue;
+      if (base.count(e) || !are_look_alikes(f, e)) continue;
       const CandidateEvidence* own = nullptr;  // its strongest showing on its own
       double f_statistic = 0;
       for (const auto& step : r.steps)
@@ -776,7 +767,7 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
   for (const auto& [e, estimate] : suspects) {
     if (std::find(r.selected.begin(), r.selected.end(), e) != r.selected.end()) continue;
     for (const std::string& f : r.named()) {
-      if (!declared_look_alikes(f, e)) continue;
+      if (!are_look_alikes(f, e)) continue;
       std::vector<FitParameter> start = r.final_fit;
       for (int i : effect_params_.at(e))
         if (estimate.count(start[i].name)) start[i].value = estimate.at(start[i].name);

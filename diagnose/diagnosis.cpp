@@ -254,6 +254,12 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   Finding f;
   f.effect = effect;
   f.evidence = evidence;
+  // Its values in the fit with it, without an interval (a suspect is not profiled): without
+  // them its headline read zeros ("the centre of gravity sits 0.00 mm ahead", a review).
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& p : evidence.parameters)
+    if (p.free && effect_of_parameter(p.name) == effect)
+      f.parameters.push_back({p.name, p.unit, p.value, none, none, none, 0, "not profiled (suspected)", "none", false});
   f.metric = "validation equation-error cost (weighted)";
   f.before = cost_without;
   f.after = cost_with;

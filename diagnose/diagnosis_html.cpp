@@ -245,6 +245,7 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
     h << " validation samples from t = " << num(d.t_split, 4) << " s";
   h << "; " << num(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
+  if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
 }
 
 // One line per named cause and the held-out gain, then the command's own printout (for a
@@ -271,6 +272,9 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
       << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
   }
+  if (d.has_prediction)
+    if (const std::string against = predict::open_loop_against_no_model(d.prediction_after); !against.empty())
+      h << "<li>" << esc(against) << "</li>\n";
   // The command's own printout, for a reader who compares it with a terminal; the sections
   // below say the same in tables.
   h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
@@ -294,6 +298,8 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
       << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
       << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";
+    if (const std::string caveat = one_flight_caveat(d, f.effect); !caveat.empty())
+      h << "<p class=\"warn\">" << esc(caveat) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
                                                               f.effect) != d.per_flight_effects.end();
     if (per_flight) {
@@ -313,6 +319,14 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ".</p>\n";
   }
+}
+
+void next_steps_html(std::ostringstream& h, const Diagnosis& d) {
+  const auto steps = next_steps(d);
+  if (steps.empty()) return;
+  h << "<h2>What to do next</h2>\n<ul>\n";
+  for (const auto& step : steps) h << "<li>" << esc(step) << "</li>\n";
+  h << "</ul>\n";
 }
 
 void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
@@ -440,9 +454,11 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
     const auto& st = d.search.steps[s];
     h << "<h3>Step " << s + 1 << " (model: base";
     for (const auto& e : st.base_effects) h << " + " << esc(e);
-    h << ")</h3>\n<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
+    h << ")</h3>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
+      << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic.</p>\n"
+      << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
     for (const auto& c : st.candidates)
-      h << "<tr><td>" << esc(c.effect) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
+      h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
         << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not))
         << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
@@ -478,6 +494,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   std::ostringstream h;
   head_html(h, d, log_path);
   in_short_html(h, d);
+  next_steps_html(h, d);
   findings_html(h, d);
   agreement_html(h, d);
   stand_ins_html(h, d);

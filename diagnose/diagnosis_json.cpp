@@ -506,7 +506,10 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["formulation"] = d.formulation;
   j["samples"] = {{"training", d.train_samples}, {"validation", d.valid_samples}, {"validation_from_s", d.t_split}};
   json findings = json::array();
-  for (const auto& f : d.findings) findings.push_back(finding_json(f));
+  for (const auto& f : d.findings) {
+    findings.push_back(finding_json(f));
+    findings.back()["flights_own_look_alikes"] = flights_own_look_alikes_named_alone(d, f.effect);
+  }
   j["findings"] = findings;
   j["suspected"] = suspected_json(d);
   j["environment"] = d.environment;

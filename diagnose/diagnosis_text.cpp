@@ -35,6 +35,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
     for (const auto& a : d.agreement)
       if (a.effect == f.effect && !a.agree) os << "; the flights disagree on " << a.parameter << " (below)";
     os << "\n  " << headline(f) << "\n";
+    if (const std::string caveat = one_flight_caveat(d, f.effect); !caveat.empty()) os << "  " << caveat << "\n";
   }
 }
 
@@ -70,8 +71,12 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
        << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
   for (const auto& x : d.suspected) {
-    os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect) << " (" << x.failed
-       << ")";
+    os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
+    for (size_t k = 0; k < x.candidate.parameters.size(); ++k) {
+      const auto& p = x.candidate.parameters[k];
+      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit);
+    }
+    os << " (" << x.failed << ")";
     if (x.carried) os << "; " << words::carried_suspect(*x.carried);
     os << "\n";
   }
@@ -84,7 +89,15 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
       os << (k ? ", " : " ") << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible")
          << ")";
     }
-    os << "\n";
+    // What a larger limit would do next: an implausible candidate ranks last, so when only
+    // those are left the next step adds a stand-in; a plausible one might be named.
+    const bool only_implausible =
+        std::all_of(d.search.left_at_limit.begin(), d.search.left_at_limit.end(),
+                    [](const CandidateEvidence& ev) { return !ev.implausible.empty(); });
+    os << (only_implausible ? "; a larger --max-effects would next add an implausible effect: a stand-in for missing "
+                              "physics, not a cause"
+                            : "; a larger --max-effects may name more (each further effect must pass the same tests)")
+       << "\n";
   }
 }
 
@@ -124,12 +137,14 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
 std::string diagnosis_summary(const Diagnosis& d) {
   std::ostringstream os;
   for (const auto& note : screening_notes(d)) os << note << "\n";
+  if (const std::string note = environment_note(d); !note.empty()) os << note << "\n";
   if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
     os << "no significant discrepancy: the base model explains the flight\n";
   write_findings(os, d);
   write_agreement(os, d);
   write_not_named(os, d);
   write_what_is_left(os, d);
+  for (const auto& step : next_steps(d)) os << "next: " << step << "\n";
   return os.str();
 }
 

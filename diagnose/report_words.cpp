@@ -10,6 +10,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/fit_report.hpp"
 #include "output/estimate.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
@@ -130,7 +131,9 @@ std::string headline(const Finding& f) {
   std::string s = e.headline(values, reference);
   if (values.size() < named.size()) s += " (mean over the flights; each flight's values below)";
   if (dropped > 0) s += " The others are within their intervals of the reference.";
-  else if (e.first_parameter_is_reference && apart.empty() && !values.empty())
+  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() &&
+           std::all_of(f.parameters.begin(), f.parameters.end(),
+                       [](const EffectEstimate& p) { return std::isfinite(p.lower) && std::isfinite(p.upper); }))
     s += " Each interval holds 0: the values are significant only together.";
   return s;
 }
@@ -159,6 +162,23 @@ std::string flights_own(const Diagnosis& d) {
 
 std::string flights_own_note(const Diagnosis& d, const std::string& effect) {
   return scope(effect) == "flight" ? " (" + flights_own(d) + ")" : "";
+}
+
+std::vector<std::string> flights_own_look_alikes_named_alone(const Diagnosis& d, const std::string& effect) {
+  if (d.flights.size() > 1 || !effect_named(effect)) return {};
+  return flights_own_look_alikes(effect);
+}
+
+// B3 rep 1 named a CoG offset alone; the three flights of its day, diagnosed together, carried
+// each flight's own trims instead (docs/validation.md): the finding needed this sentence. Not
+// "cannot tell": a flight with the look-alike's separating manoeuvre may (the catalogue's).
+std::string one_flight_caveat(const Diagnosis& d, const std::string& effect) {
+  const auto others = flights_own_look_alikes_named_alone(d, effect);
+  if (others.empty()) return "";
+  return "named on one flight: " + output::joined(others, " or ") + ", " +
+         (others.size() > 1 ? "properties" : "a property") + " of the flight, can give the same residual; " +
+         "several flights of the vehicle diagnosed together (quadgen diagnose VEHICLE LOG1 LOG2 ...) show whether " +
+         "it is the airframe's, whose value is the same on each flight";
 }
 
 // Where the rotor drag force acts, when the diagnosis names both halves of it: the force
@@ -224,6 +244,59 @@ std::vector<std::string> screening_notes(const Diagnosis& d) {
                              : "caution: " + source + ": " + s.reason +
                                    "; the commands there do not tell the thrust, and what is found may stand in for that");
   }
+  return out;
+}
+
+std::string environment_note(const Diagnosis& d) {
+  if (d.environment != "unknown") return "";
+  const auto range = [](const PlausibleRange& r) {
+    return "[" + output::short_number(r.lower) + ", " + output::short_number(r.upper) + "]";
+  };
+  for (const auto& c : d.candidates) {
+    const Effect* e = effect_named(c);
+    if (!e) continue;
+    for (const auto& indoor : e->plausible) {
+      if (indoor.only_in != Environment::kIndoor || indoor.scale != PlausibleRange::Scale::kSI) continue;
+      std::string anywhere = "its bounds";
+      for (const auto& r : e->plausible)
+        if (r.only_in == Environment::kUnknown && r.parameter == indoor.parameter && r.scale == indoor.scale)
+          anywhere = range(r);
+      return "note: where the flights were flown is not declared (--environment, or `environment:` in the mapping), so " +
+             (indoor.parameter.empty() ? c : indoor.parameter) + " counts as plausible within " + anywhere +
+             "; indoors only " + range(indoor) + " would, and a value beyond it would be a stand-in for missing physics, "
+             "not a cause (--environment indoor)";
+    }
+  }
+  return "";
+}
+
+std::vector<std::string> next_steps(const Diagnosis& d) {
+  std::vector<std::string> out;
+  for (const auto& a : d.search.unresolved)
+    out.push_back("fly this to tell " + a.a + " from " + a.b + ", and diagnose that flight with this one: " + a.manoeuvre);
+  bool airframe_named = false;
+  for (const auto& f : d.findings) airframe_named = airframe_named || scope(f.effect) == "airframe";
+  if (airframe_named && d.flights.size() <= 1)
+    out.push_back("diagnose this flight with other flights of the vehicle (quadgen diagnose VEHICLE LOG1 LOG2 ...): "
+                  "an airframe's cause holds on each of them, with the same value");
+  for (const auto& x : d.suspected)
+    if (!x.carried)
+      out.push_back("do not put " + x.candidate.effect + " in the vehicle file: the held-out part does not support it; a "
+                    "longer flight, or the same manoeuvre repeated, decides");
+  for (const auto& st : d.stand_ins)
+    out.push_back("do not believe " + st.parameter + ": the model lacks something " + st.candidate.effect +
+                  " absorbs; the channels it changes say where");
+  for (const auto& p : d.at_bounds)
+    out.push_back("check the units and the number of " + p.name + " in the vehicle file before widening its bounds");
+  if (!d.search.left_at_limit.empty())
+    out.push_back("rerun with --max-effects " + std::to_string(d.search.steps.size() + d.search.left_at_limit.size()) +
+                  " to see what is left tested (this run's limit, " + std::to_string(d.search.steps.size()) + ", binds)");
+  if (d.findings.empty() && !d.unexplained.empty())
+    out.push_back("the cause may lie outside the catalogue: read the proposed terms and the hypotheses; a flight of "
+                  "another kind (speed, height, payload) separates causes");
+  if (!d.findings.empty())
+    out.push_back("the fitted model: quadgen derive VEHICLE --params fitted_parameters.yaml (this folder) --out "
+                  "FOLDER, or extended_model.hpp as it is");
   return out;
 }
 

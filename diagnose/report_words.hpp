@@ -34,6 +34,13 @@ std::string flights_own(const Diagnosis& d);
 // " (a property of the flight, not of the airframe)" after a flight's own effect, else "":
 // the terminal summary says it beside each finding, stand-in and suspect.
 std::string flights_own_note(const Diagnosis& d, const std::string& effect);
+// The flight's own look-alikes of an airframe's effect named on one flight (catalogue's
+// flights_own_look_alikes): they may give the same residual on one flight; several flights
+// diagnosed together tell them apart.
+// Empty in a joint diagnosis, where the airframe's value is shared and the flight's own are not.
+std::vector<std::string> flights_own_look_alikes_named_alone(const Diagnosis& d, const std::string& effect);
+// The sentence said beside such a finding, or "".
+std::string one_flight_caveat(const Diagnosis& d, const std::string& effect);
 
 // Where the rotor drag force acts: blade_flapping.k / rotor_drag.k, with a delta-method interval.
 struct PointOfAction {
@@ -54,6 +61,15 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
 // What the screening says in words: flights left out, or a caution on an unusable flight
 // diagnosed anyway (the flight's path made printable: these go to a terminal too).
 std::vector<std::string> screening_notes(const Diagnosis& d);
+// Where no environment was declared and some candidate's plausible range depends on it (a
+// steady wind): what counted as plausible, and how to say "indoor". "" otherwise. A user's
+// own mapping may lack the key, and a wind indoors would then be named, not a stand-in.
+std::string environment_note(const Diagnosis& d);
+// What to do next, one line per outcome the diagnosis has (docs/diagnosis.md, "What to do
+// next", keyed to this diagnosis): fly the manoeuvre that separates a pair, confirm an
+// airframe's finding on a second flight, distrust a stand-in's value, ... Said at the end of
+// the summary and as the report's last section, so a reader is not left at the numbers.
+std::vector<std::string> next_steps(const Diagnosis& d);
 
 // A number with `prec` significant digits ("–" where it is not finite); a 95 % interval,
 // "open" on a side its profile never closed.

@@ -326,6 +326,19 @@ std::string against_constant_velocity(const Prediction& p) {
 
 }  // namespace
 
+std::string open_loop_against_no_model(const Prediction& p) {
+  if (p.open_loop.empty() || p.constant_velocity.size() != p.open_loop.size()) return "";
+  const auto by_horizon = [](const HorizonErrors& a, const HorizonErrors& b) { return a.horizon < b.horizon; };
+  const size_t i = static_cast<size_t>(std::max_element(p.open_loop.begin(), p.open_loop.end(), by_horizon) -
+                                       p.open_loop.begin());
+  const double model = p.open_loop[i].position.mean(), none = p.constant_velocity[i].position.mean();
+  if (!std::isfinite(model) || !std::isfinite(none)) return "";
+  return "Open loop, " + output::short_number(p.open_loop[i].horizon) + " s ahead of a measured state, the model is " +
+         output::short_number(model) + " m off; extrapolating the measured velocity with no model is " +
+         output::short_number(none) + " m off" +
+         (model <= none ? ": the model is the closer." : ": at that horizon no model is the closer.");
+}
+
 // m: below this at the longest horizon a model predicts the log exactly (its own flights).
 constexpr double kNegligiblePositionError = 1e-3;
 

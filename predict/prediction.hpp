@@ -148,6 +148,10 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 // translation; and how much of the error at the longest horizon holding the past
 // disturbance removes.
 std::string what_limits_prediction(const Prediction& p);
+// One sentence for a report's summary: the open loop at the longest horizon against
+// extrapolating the measured velocity with no model, and which is the closer ("" without
+// those views). A gain over the base model alone can hide that no model does better.
+std::string open_loop_against_no_model(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
 // translation_replayed, open_loop_past_disturbance, disturbance_window_s, body_rates_held,

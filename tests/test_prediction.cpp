@@ -586,6 +586,14 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   p.constant_velocity = {row(1.0, 2.0, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);
   EXPECT_NE(s.find("is 2 m off: the model predicts better at this horizon."), std::string::npos) << s;
+  // The report's one line against no model, at the longest horizon (the rows in any order).
+  EXPECT_EQ(quadgen::predict::open_loop_against_no_model(p),
+            "Open loop, 1 s ahead of a measured state, the model is 1 m off; extrapolating the measured velocity with no "
+            "model is 2 m off: the model is the closer.");
+  p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.05, 0)};
+  EXPECT_NE(quadgen::predict::open_loop_against_no_model(p).find("is 0.4 m off: at that horizon no model is the closer."),
+            std::string::npos);
+  p.constant_velocity = {row(1.0, 2.0, 0), row(0.5, 0.05, 0)};
   EXPECT_EQ(s.find("Without the moment model"), std::string::npos) << s;  // that view not run
   p.body_rates_held = {row(1.0, 0.3, 0), row(0.5, 0.05, 0)};
   s = quadgen::predict::what_limits_prediction(p);

@@ -66,6 +66,22 @@ const Effect& find_effect(const std::string& name) {
   throw std::invalid_argument("unknown effect '" + name + "'");
 }
 
+bool are_look_alikes(const std::string& x, const std::string& y) {
+  for (const auto& l : find_effect(x).look_alikes)
+    if (l.effect == y) return true;
+  for (const auto& l : find_effect(y).look_alikes)
+    if (l.effect == x) return true;
+  return false;
+}
+
+std::vector<std::string> flights_own_look_alikes(const std::string& effect) {
+  std::vector<std::string> out;
+  if (find_effect(effect).per_flight) return out;
+  for (const Effect& e : effect_catalogue())
+    if (e.per_flight && are_look_alikes(effect, e.name)) out.push_back(e.name);
+  return out;
+}
+
 std::vector<std::string> refinements_without_their_effect(const std::vector<std::string>& effects) {
   std::vector<std::string> out;
   for (const auto& e : effects) {

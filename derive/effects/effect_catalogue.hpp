@@ -23,6 +23,13 @@ std::string catalogue_parameter_names();
 const Effect& find_effect(const std::string& name);
 // The same, or nullptr for a name that is no effect (for a caller that words its own error).
 const Effect* effect_named(const std::string& name);
+// Whether either of two effects declares the other a look-alike (Effect::look_alikes).
+bool are_look_alikes(const std::string& x, const std::string& y);
+// The flight's own effects (Effect::per_flight) that look like this effect of the airframe's:
+// a single flight cannot say which of them it saw (motor trims that leave the yaw alone give a
+// CoG offset's moments at every thrust); several flights can, since the airframe's value is
+// the same on each. Empty for an effect that is itself the flight's own.
+std::vector<std::string> flights_own_look_alikes(const std::string& effect);
 // The effect and the one it refines, in canonical order ({"motor_lag", "motor_lag_spread"}
 // for motor_lag_spread), or the effect alone: the smallest model it can be derived in.
 std::vector<std::string> effect_with_what_it_refines(const std::string& name);
