@@ -34,7 +34,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
       ->check(finite_range(1e-9, 0.2));
   c->add_option("--max-effects", o.search.max_effects,
                 "forward-selection steps at most (each adds one effect; later tests may turn it down)")
-      ->check(CLI::Range(1, 10));
+      ->check(CLI::Range(1, static_cast<int>(diagnose::kMaxEffectsAllowed)));
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);

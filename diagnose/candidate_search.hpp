@@ -42,6 +42,10 @@
 
 namespace quadgen::diagnose {
 
+// The largest forward search a diagnosis runs (--max-effects, DiagnoseOptions::IsValid): each
+// step refits every remaining candidate, and on the real flights five already bind.
+constexpr size_t kMaxEffectsAllowed = 10;
+
 struct SearchOptions {
   double alpha = 0.01;   // family-wise level of one selection step
   // Forward-selection steps at most. On real logs every step finds something significant on
@@ -49,7 +53,7 @@ struct SearchOptions {
   // ended the search on all six NanoBench flights before an airframe effect the others show
   // was tried (a stand-in and a trim took the slots); 5 leaves room for those and for the
   // per-flight nuisances (docs/validation.md, 2026-11-25).
-  int max_effects = 5;
+  int max_effects = 5;  // at most kMaxEffectsAllowed
   double ambiguity_ratio = 0.5;  // runner-up statistic / winner's above which both are tested together
   std::vector<std::string> candidates;  // effects to consider (default: all that the log supports)
   output::Progress progress;  // steps, counters, profiles; nowhere by default

@@ -259,7 +259,8 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   const double none = std::numeric_limits<double>::quiet_NaN();
   for (const auto& p : evidence.parameters)
     if (p.free && effect_of_parameter(p.name) == effect)
-      f.parameters.push_back({p.name, p.unit, p.value, none, none, none, 0, "not profiled (suspected)", "none", false});
+      f.parameters.push_back({p.name, p.unit, p.value, none, none, none, 0, "", "none",
+                              fit::on_bound(p)});
   f.metric = "validation equation-error cost (weighted)";
   f.before = cost_without;
   f.after = cost_with;
@@ -740,7 +741,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (translational != "auto" && translational != "pose" && translational != "accelerometer")
     return fail("translational channels: auto, pose or accelerometer");
   if (!(search.alpha > 0 && search.alpha <= 0.2)) return fail("alpha: above 0, at most 0.2");
-  if (search.max_effects < 1 || search.max_effects > 10) return fail("max effects: 1 to 10");
+  if (search.max_effects < 1 || search.max_effects > static_cast<int>(kMaxEffectsAllowed))
+    return fail("max effects: 1 to " + std::to_string(kMaxEffectsAllowed));
   if (!(unexplained_ratio > 1) || !(unexplained_p > 0 && unexplained_p < 1))
     return fail("unexplained: a ratio above 1 and a p-value in (0, 1)");
   return true;

@@ -74,7 +74,8 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
     os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
     for (size_t k = 0; k < x.candidate.parameters.size(); ++k) {
       const auto& p = x.candidate.parameters[k];
-      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit);
+      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit)
+         << (p.at_bound ? " (on its bound)" : "");
     }
     os << " (" << x.failed << ")";
     if (x.carried) os << "; " << words::carried_suspect(*x.carried);
@@ -89,15 +90,17 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
       os << (k ? ", " : " ") << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible")
          << ")";
     }
-    // What a larger limit would do next: an implausible candidate ranks last, so when only
-    // those are left the next step adds a stand-in; a plausible one might be named.
+    // What a larger limit would do: an implausible candidate ranks last, so where only those
+    // are left a further step would take a stand-in (the step tests every candidate again,
+    // so this is what the data say now, not a promise).
     const bool only_implausible =
         std::all_of(d.search.left_at_limit.begin(), d.search.left_at_limit.end(),
                     [](const CandidateEvidence& ev) { return !ev.implausible.empty(); });
-    os << (only_implausible ? "; a larger --max-effects would next add an implausible effect: a stand-in for missing "
-                              "physics, not a cause"
-                            : "; a larger --max-effects may name more (each further effect must pass the same tests)")
-       << "\n";
+    if (d.search.steps.size() >= kMaxEffectsAllowed) os << "; --max-effects is at its largest";
+    else if (only_implausible) os << "; what is still significant is implausible here: taken in a further step it would be "
+                                     "a stand-in for missing physics, not a cause";
+    else os << "; a larger --max-effects may name more (each further effect must pass the same tests)";
+    os << "\n";
   }
 }
 

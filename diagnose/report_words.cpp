@@ -164,6 +164,9 @@ std::string flights_own_note(const Diagnosis& d, const std::string& effect) {
   return scope(effect) == "flight" ? " (" + flights_own(d) + ")" : "";
 }
 
+// The command a reader types to diagnose several flights of one vehicle together.
+const std::string kJointDiagnosis = "quadgen diagnose VEHICLE LOG1 LOG2 ...";
+
 std::vector<std::string> flights_own_look_alikes_named_alone(const Diagnosis& d, const std::string& effect) {
   if (d.flights.size() > 1 || !effect_named(effect)) return {};
   return flights_own_look_alikes(effect);
@@ -177,7 +180,7 @@ std::string one_flight_caveat(const Diagnosis& d, const std::string& effect) {
   if (others.empty()) return "";
   return "named on one flight: " + output::joined(others, " or ") + ", " +
          (others.size() > 1 ? "properties" : "a property") + " of the flight, can give the same residual; " +
-         "several flights of the vehicle diagnosed together (quadgen diagnose VEHICLE LOG1 LOG2 ...) show whether " +
+         "several flights of the vehicle diagnosed together (" + kJointDiagnosis + ") show whether " +
          "it is the airframe's, whose value is the same on each flight";
 }
 
@@ -261,7 +264,8 @@ std::string environment_note(const Diagnosis& d) {
       for (const auto& r : e->plausible)
         if (r.only_in == Environment::kUnknown && r.parameter == indoor.parameter && r.scale == indoor.scale)
           anywhere = range(r);
-      return "note: where the flights were flown is not declared (--environment, or `environment:` in the mapping), so " +
+      return "note: where the flights were flown is unknown (not declared, or declared so: --environment, or "
+             "`environment:` in the mapping), so " +
              (indoor.parameter.empty() ? c : indoor.parameter) + " counts as plausible within " + anywhere +
              "; indoors only " + range(indoor) + " would, and a value beyond it would be a stand-in for missing physics, "
              "not a cause (--environment indoor)";
@@ -277,20 +281,23 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   bool airframe_named = false;
   for (const auto& f : d.findings) airframe_named = airframe_named || scope(f.effect) == "airframe";
   if (airframe_named && d.flights.size() <= 1)
-    out.push_back("diagnose this flight with other flights of the vehicle (quadgen diagnose VEHICLE LOG1 LOG2 ...): "
-                  "an airframe's cause holds on each of them, with the same value");
+    out.push_back("diagnose this flight with other flights of the vehicle (" + kJointDiagnosis +
+                  "): an airframe's cause holds on each of them, with the same value");
   for (const auto& x : d.suspected)
     if (!x.carried)
-      out.push_back("do not put " + x.candidate.effect + " in the vehicle file: the held-out part does not support it; a "
-                    "longer flight, or the same manoeuvre repeated, decides");
+      out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")");
   for (const auto& st : d.stand_ins)
     out.push_back("do not believe " + st.parameter + ": the model lacks something " + st.candidate.effect +
                   " absorbs; the channels it changes say where");
   for (const auto& p : d.at_bounds)
-    out.push_back("check the units and the number of " + p.name + " in the vehicle file before widening its bounds");
-  if (!d.search.left_at_limit.empty())
-    out.push_back("rerun with --max-effects " + std::to_string(d.search.steps.size() + d.search.left_at_limit.size()) +
-                  " to see what is left tested (this run's limit, " + std::to_string(d.search.steps.size()) + ", binds)");
+    out.push_back("check the units and the number of " + p.name + " before widening its bounds (the vehicle file's, or "
+                  "the effect's own)");
+  if (!d.search.left_at_limit.empty()) {
+    const size_t limit = d.search.steps.size(), wider = std::min(limit + d.search.left_at_limit.size(), kMaxEffectsAllowed);
+    out.push_back(wider > limit ? "rerun with --max-effects " + std::to_string(wider) + " to see what is left tested (this "
+                                  "run's limit, " + std::to_string(limit) + ", binds)"
+                                : "what is left untested stays so: --max-effects is at its largest, " + std::to_string(limit));
+  }
   if (d.findings.empty() && !d.unexplained.empty())
     out.push_back("the cause may lie outside the catalogue: read the proposed terms and the hypotheses; a flight of "
                   "another kind (speed, height, payload) separates causes");

@@ -1,6 +1,7 @@
 #include "predict/prediction.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -305,17 +306,31 @@ const HorizonErrors& nearest(const std::vector<HorizonErrors>& rows, double h) {
   });
 }
 
+// The open loop's and no model's (extrapolating at the measured start velocity) mean position
+// errors at the longest horizon; nothing without the no-model view or where either is not finite.
+struct AtLongestHorizon {
+  double horizon = 0, model = 0, none = 0;
+};
+std::optional<AtLongestHorizon> open_loop_and_no_model_at_longest(const Prediction& p) {
+  if (p.open_loop.empty() || p.constant_velocity.size() != p.open_loop.size()) return std::nullopt;
+  const auto by_horizon = [](const HorizonErrors& a, const HorizonErrors& b) { return a.horizon < b.horizon; };
+  const size_t i = static_cast<size_t>(std::max_element(p.open_loop.begin(), p.open_loop.end(), by_horizon) -
+                                       p.open_loop.begin());
+  const AtLongestHorizon at{p.open_loop[i].horizon, p.open_loop[i].position.mean(), p.constant_velocity[i].position.mean()};
+  if (!std::isfinite(at.model) || !std::isfinite(at.none)) return std::nullopt;
+  return at;
+}
+
 // The open loop against extrapolating at the measured start velocity (no model), in words: at
 // the longest horizon, and at which horizons the model is the closer ("" without that view).
 std::string against_constant_velocity(const Prediction& p) {
-  if (p.constant_velocity.size() != p.open_loop.size()) return "";
+  const auto at = open_loop_and_no_model_at_longest(p);
+  if (!at) return "";
+  std::string s = " Extrapolating at the measured start velocity, with no model, is " + output::short_number(at->none) + " m off";
+  if (at->model <= at->none) return s + ": the model predicts better at this horizon.";
   std::vector<size_t> order(p.open_loop.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return p.open_loop[a].horizon < p.open_loop[b].horizon; });
-  const double model = p.open_loop[order.back()].position.mean(), none = p.constant_velocity[order.back()].position.mean();
-  if (!std::isfinite(model) || !std::isfinite(none)) return "";
-  std::string s = " Extrapolating at the measured start velocity, with no model, is " + output::short_number(none) + " m off";
-  if (model <= none) return s + ": the model predicts better at this horizon.";
   std::vector<std::string> closer;  // the horizons at which the model is at least as close
   for (size_t i : order)
     if (p.open_loop[i].position.mean() <= p.constant_velocity[i].position.mean())
@@ -327,16 +342,12 @@ std::string against_constant_velocity(const Prediction& p) {
 }  // namespace
 
 std::string open_loop_against_no_model(const Prediction& p) {
-  if (p.open_loop.empty() || p.constant_velocity.size() != p.open_loop.size()) return "";
-  const auto by_horizon = [](const HorizonErrors& a, const HorizonErrors& b) { return a.horizon < b.horizon; };
-  const size_t i = static_cast<size_t>(std::max_element(p.open_loop.begin(), p.open_loop.end(), by_horizon) -
-                                       p.open_loop.begin());
-  const double model = p.open_loop[i].position.mean(), none = p.constant_velocity[i].position.mean();
-  if (!std::isfinite(model) || !std::isfinite(none)) return "";
-  return "Open loop, " + output::short_number(p.open_loop[i].horizon) + " s ahead of a measured state, the model is " +
-         output::short_number(model) + " m off; extrapolating the measured velocity with no model is " +
-         output::short_number(none) + " m off" +
-         (model <= none ? ": the model is the closer." : ": at that horizon no model is the closer.");
+  const auto at = open_loop_and_no_model_at_longest(p);
+  if (!at) return "";
+  return "Open loop, " + output::short_number(at->horizon) + " s ahead of a measured state, the model is " +
+         output::short_number(at->model) + " m off; extrapolating the measured velocity with no model is " +
+         output::short_number(at->none) + " m off" +
+         (at->model <= at->none ? ": the model is the closer." : ": at that horizon no model is the closer.");
 }
 
 // m: below this at the longest horizon a model predicts the log exactly (its own flights).
