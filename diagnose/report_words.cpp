@@ -277,7 +277,8 @@ std::string environment_note(const Diagnosis& d) {
 std::vector<std::string> next_steps(const Diagnosis& d) {
   std::vector<std::string> out;
   for (const auto& a : d.search.unresolved)
-    out.push_back("fly this to tell " + a.a + " from " + a.b + ", and diagnose that flight with this one: " + a.manoeuvre);
+    out.push_back("fly this to tell " + a.a + " from " + a.b + ", and diagnose that flight with " +
+                  (d.flights.size() > 1 ? "these" : "this one") + ": " + a.manoeuvre);
   bool airframe_named = false;
   for (const auto& f : d.findings) airframe_named = airframe_named || scope(f.effect) == "airframe";
   if (airframe_named && d.flights.size() <= 1)
