@@ -845,6 +845,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
 
   // 3. Do the flights agree (joint), or does this flight show an airframe diagnosed before?
   compare_flights(d, joint, all_in, model_in, flights, fm, train, accel, opt, clock);
+  // After the agreement and the carried suspects: these suspects' values are not profiled
+  // (no interval), and neither step may read them as if they were.
   add_suspects_of_the_search(d);
 
   // 4. What the extended model still gets wrong, and what it gains on the held-out part.

@@ -281,7 +281,8 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
                   (d.flights.size() > 1 ? "these" : "this one") + ": " + a.manoeuvre);
   bool airframe_named = false;
   for (const auto& f : d.findings) airframe_named = airframe_named || scope(f.effect) == "airframe";
-  if (airframe_named && d.flights.size() <= 1)
+  // Not after --airframe with a joint diagnosis' airframe: this flight was checked against it.
+  if (airframe_named && d.flights.size() <= 1 && !(d.airframe_flights > 1))
     out.push_back("diagnose this flight with other flights of the vehicle (" + kJointDiagnosis +
                   "): an airframe's cause holds on each of them, with the same value");
   for (const auto& x : d.suspected)

@@ -1352,6 +1352,11 @@ TEST(DiagnosisReport, WhatToDoNextFollowsTheOutcomes) {
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
   EXPECT_NE(html.find("<h2>What to do next</h2>\n<ul>\n<li>fly this to tell input_delay from motor_lag"), std::string::npos)
       << html;
+  d.airframe_source = "joint/diagnosis.json", d.airframe_flights = 5;  // checked against a joint airframe already
+  EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find("with other flights of the vehicle"), std::string::npos);
+  d.airframe_flights = 1;  // an airframe from one flight's diagnosis: still worth a joint one
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("with other flights of the vehicle"), std::string::npos);
+  d.airframe_source.clear(), d.airframe_flights = 0;
   d.flights = {"a.csv", "b.csv"};  // jointly: the airframe's findings already hold across flights
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find("with other flights of the vehicle"), std::string::npos);
   // The limit suggested is one --max-effects accepts (at most 10), and at 10 none is.
