@@ -123,7 +123,8 @@ void write_equation(std::ostringstream& md, const std::string& lhs, const std::s
 
 void section_kinematics(std::ostringstream& md) {
   md << "## 3. Kinematics\n\n"
-     << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton). Its rotation "
+     << "Attitude is the unit quaternion $q = (q_w, q_x, q_y, q_z)$, body → world (Hamilton); the state "
+        "named `q` in section 6 is not it but the body rate about y, $\\omega = (p, q, r)$. Its rotation "
         "matrix and rate:\n\n"
      << "```math\nR(q) = \\begin{pmatrix} 1-2(q_y^2+q_z^2) & 2(q_xq_y-q_wq_z) & 2(q_xq_z+q_wq_y) \\\\ "
         "2(q_xq_y+q_wq_z) & 1-2(q_x^2+q_z^2) & 2(q_yq_z-q_wq_x) \\\\ 2(q_xq_z-q_wq_y) & 2(q_yq_z+q_wq_x) & "
@@ -229,7 +230,8 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
     if (params)
       md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
          << " | " << (v.fit ? "yes" : "no") << " | ";
-    md << output::markdown_text(v.doc) << " |\n";
+    md << output::markdown_text(v.doc)
+       << (v.as_written.empty() ? "" : " (the vehicle file: " + output::markdown_text(v.as_written) + ")") << " |\n";
   }
   md << "\n";
 }
@@ -241,6 +243,10 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
     md << " **" << warnings << " warning" << (warnings > 1 ? "s" : "")
        << " about the vehicle** (group `vehicle`: the derivation holds, but the vehicle as described cannot fly, "
           "or is most likely described wrongly)";
+  // What the units checks cannot see (a reviewer's trial, helper-103).
+  md << "\n\nThe units checks count an angle as dimensionless (rad = 1, as SI does): they cannot tell degrees "
+        "from radians or rev/s from rad/s. Such a slip shows only in numbers against a reference"
+     << (d.thesis.empty() ? "" : " (section 8 finds two in the thesis so)") << ".";
   md << "\n\n| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "
@@ -254,7 +260,8 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
 void section_thesis(std::ostringstream& md, const Derivation& d) {
   if (d.thesis.empty()) return;
   md << "## 8. Comparison with the thesis\n\n"
-     << "The thesis' equations and numbers are encoded in `audit/thesis_reference.cpp`; each row compares "
+     << "The thesis: " << output::markdown_text(kThesisCitation) << " (equation and section numbers below are its own). "
+     << "Its equations and numbers are encoded in quadgen's `audit/thesis_reference.cpp`; each row compares "
         "them with the derived model at its nominal parameters. *Verdict from* says how each verdict was reached: "
         "computed from the derived model (its equations or an integration of them), computed by arithmetic on the "
         "quantities quadgen derives (mass, inertia, areas), or read from the equations' form (stated in "

@@ -27,6 +27,12 @@ inline constexpr const char* kFromModel = "computed from the model";
 inline constexpr const char* kFromArithmetic = "computed by arithmetic";
 inline constexpr const char* kFromReading = "reading of the equations";
 
+// The thesis, as a reader cites it (derivation.md's comparison names it; vehicles/finken3.yaml
+// says the same in its header).
+inline constexpr const char* kThesisCitation =
+    "A. Heckert, \"Entwicklung eines dynamischen Modells und Parameterschätzung für den FINken 3 Quadkopter\", "
+    "bachelor thesis, Otto-von-Guericke-Universität Magdeburg, 2016";
+
 // Whether a model is of the thesis' vehicle (model/vehicle.hpp decides it by name).
 bool is_thesis_vehicle(const SymbolicModel& m);
 

@@ -285,21 +285,44 @@ AuditCheck check_one_scale(const Vehicle& v) {
          << " m^2 is more than the disc its radius sweeps, pi r^2 = " << disc << " m^2 (an area in mm^2 or a diameter as the radius?)";
   }
   if (farthest > 0 && reach > 20 * farthest)
-    os << (os.tellp() > 0 ? "; " : "") << "the blocks lie within " << reach << " m of the origin, the rotors reach " << farthest
+    os << (os.tellp() > 0 ? "; " : "") << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach " << farthest
        << " m (a block's size or centre in mm read as m?)";
   const std::string found = os.str();
   std::ostringstream fine;
   fine.precision(4);
-  fine << "the blocks lie within " << reach << " m of the origin, the rotors reach " << farthest
+  fine << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach " << farthest
        << " m; every disc_area at most pi r^2";
   return advisory("rotors and blocks on one scale", found.empty(), found.empty() ? fine.str() : found);
+}
+
+// Block orientations in radians typed into orientation_deg: 0.785 for an arm at 45 deg turns it
+// by 0.785 deg, and every check above still passes (a reviewer's trial, helper-103). A value
+// that is a round angle in radians (a multiple of pi/12 within 0.5 %) and not a whole number of
+// degrees is most likely one; a real tilt of 0.785 deg is rarely written so.
+AuditCheck check_orientations_in_degrees(const Vehicle& v) {
+  const char* axes[3] = {"yaw", "pitch", "roll"};
+  std::ostringstream os;
+  os.precision(4);
+  for (const Block& b : v.blocks)
+    for (int k = 0; k < 3; ++k) {
+      const double a = b.yaw_pitch_roll_deg[k], steps = std::round(std::fabs(a) / (M_PI / 12));
+      if (a == std::round(a) || steps < 1 || steps > 24) continue;
+      if (std::fabs(std::fabs(a) - steps * M_PI / 12) > 0.005 * std::fabs(a)) continue;
+      os << (os.tellp() > 0 ? "; " : "") << "block " << b.name << ": " << axes[k] << " " << a << " deg is "
+         << (a < 0 ? "-" : "") << steps << " pi/12 in radians (" << (a < 0 ? -15 : 15) * steps
+         << " deg): orientation_deg takes degrees";
+    }
+  const std::string found = os.str();
+  return advisory("block orientations are in degrees", found.empty(),
+                  found.empty() ? "no block's yaw, pitch or roll reads as a round angle in radians (a multiple of pi/12)"
+                                : found);
 }
 
 // The inertia tensor the model flies with, the vehicle file's `derived:` values where it gives
 // them: the derivation's audit judges the blocks' tensor, which such values replace (a J_xy
 // given larger than J_xx and J_yy allow has a negative principal moment, and a closed loop
 // flown with it is lost without a word).
-AuditCheck check_inertia_used(const SymbolicModel& m) {
+AuditCheck check_inertia_used(const Vehicle& v, const SymbolicModel& m) {
   const auto value = [&](const char* name) {
     for (const auto& p : m.params)
       if (p.name == name) return p.nominal;
@@ -310,8 +333,14 @@ AuditCheck check_inertia_used(const SymbolicModel& m) {
                 {value("J_xz"), value("J_yz"), value("J_zz")}}};
   const PrincipalMoments pm = principal_moments(J);
   const auto& l = pm.moments;
+  // Where the file gives none of J, this is the blocks' tensor the inertia group judged: say
+  // so, rather than repeat its numbers as if they were a second finding (helper-103).
+  bool given = false;
+  for (const char* name : {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) given = given || v.derived_given.count(name);
   std::ostringstream detail;
-  detail << "principal moments of the model's J " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2";
+  detail << "principal moments of the model's J " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2"
+         << (given ? " (with the vehicle file's `derived:` values)"
+                   : " (the blocks' tensor, as in the inertia checks: the file gives no J in `derived:`)");
   if (!pm.positive) detail << ": not positive definite (a product of inertia too large for the moments given, or its sign?)";
   else if (!pm.triangle) detail << ": the largest exceeds the sum of the other two, which no mass distribution gives";
   return advisory("the inertia the model uses is a body's", pm.positive && pm.triangle, detail.str());
@@ -362,7 +391,7 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
   return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
-          check_inertia_used(m),          check_motor_map(b.thrust_laws), check_controllable(B),
+          check_orientations_in_degrees(v), check_inertia_used(v, m),          check_motor_map(b.thrust_laws), check_controllable(B),
           check_hover_trim(trim, b.mass * b.g), check_hover_above_the_bottom(trim), check_hover_below_the_top(trim)};
 }
 

@@ -363,7 +363,7 @@ symbol ModelContext::add_param(const ParameterSpec& spec) {
 }
 symbol ModelContext::add_param(const std::string& name, const std::string& unit, double nominal,
                                double lower, double upper, bool fit, const std::string& doc) {
-  return add_param(ParameterSpec{name, unit, parse_unit(unit).dim, nominal, lower, upper, fit, doc});
+  return add_param(ParameterSpec{name, unit, parse_unit(unit).dim, nominal, lower, upper, fit, doc, ""});
 }
 symbol ModelContext::add_state(const std::string& name, const std::string& unit, const std::string& doc) {
   model.states.push_back(make_variable(name, unit, doc));

@@ -358,8 +358,7 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
     if (!p.free ||
         !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
-    const std::string unit = p.unit.empty() || p.unit == "1" ? "" : " " + p.unit;
-    return p.name + " = " + output::short_number(p.value) + unit + " outside [" + output::short_number(lo) + ", " + output::short_number(hi) + "]";
+    return p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" + output::short_number(lo) + ", " + output::short_number(hi) + "]";
   }
   return "";
 }
@@ -640,7 +639,7 @@ std::string CandidateSearch::values_in_words(const std::string& effect, const st
   for (int i : effect_params_.at(effect))
     if (ps[i].free)
       os << (os.tellp() > 0 ? ", " : "") << ps[i].name << " = " << output::short_number(ps[i].value)
-         << (ps[i].unit.empty() || ps[i].unit == "1" ? "" : " " + ps[i].unit);
+         << output::unit_after_number(ps[i].unit);
   return os.str();
 }
 

@@ -11,6 +11,7 @@
 #include "diagnose/report_words.hpp"
 #include "fit/fit_report.hpp"
 #include "output/estimate.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/plot.hpp"
@@ -67,14 +68,14 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   for (const auto& st : d.stand_ins)
     os << "stands in for missing physics, not named: " << st.candidate.effect << flights_own_note(d, st.candidate.effect)
        << " (" << st.parameter << " = "
-       << num(st.value) << " " << st.unit << " lies outside [" << num(st.plausible_lower) << ", "
+       << num(st.value) << output::unit_after_number(st.unit) << " lies outside [" << num(st.plausible_lower) << ", "
        << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
   for (const auto& x : d.suspected) {
     os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
     for (size_t k = 0; k < x.candidate.parameters.size(); ++k) {
       const auto& p = x.candidate.parameters[k];
-      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit)
+      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << output::unit_after_number(p.unit)
          << (p.at_bound ? " (on its bound)" : "");
     }
     os << " (" << x.failed << ")";
@@ -109,7 +110,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
 void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& note : d.notes) os << "caution: " << note << "\n";
   for (const auto& p : d.at_bounds)
-    os << "caution: " << p.name << " = " << num(p.value) << (p.unit == "1" ? "" : " " + p.unit)
+    os << "caution: " << p.name << " = " << num(p.value) << output::unit_after_number(p.unit)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)

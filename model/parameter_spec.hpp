@@ -19,6 +19,9 @@ struct ParameterSpec {
   double lower = 0, upper = 0;  // bounds in SI; equal: held at the nominal value
   bool fit = false;
   std::string doc;  // what it is
+  // The value as the vehicle file wrote it where its unit is not the SI one ("1674 rpm"), for a
+  // reviewer who compares the derivation with the file; empty otherwise.
+  std::string as_written;
 };
 
 // The run-time record of `p` (the one conversion): at `value`, freed by a fit or not.

@@ -24,12 +24,22 @@ struct Reader : YamlReader {
     return v;
   }
 
+  // Each entry's error says which of the three it is: a list on one line has one line number.
   Vec3 vec3(const YAML::Node& n, const std::string& what, bool must_be_positive = false) const {
     if (!n.IsSequence() || n.size() != 3) fail(n, "expected a list of 3 numbers for " + what);
     Vec3 v;
-    for (int i = 0; i < 3; ++i)
-      v[i] = must_be_positive ? positive(n[i], what) : number(n[i], what);
+    for (int i = 0; i < 3; ++i) {
+      const std::string entry = what + ", entry " + std::to_string(i + 1) + " of 3";
+      v[i] = must_be_positive ? positive(n[i], entry) : number(n[i], entry);
+    }
     return v;
+  }
+
+  // "block 'motor_C'" where the item's name can be read, for an error found before the name
+  // is judged (an unknown key); "block" otherwise.
+  static std::string item_where(const YAML::Node& n, const std::string& kind) {
+    const YAML::Node name = n["name"];
+    return name && name.IsScalar() ? kind + " '" + output::printable(name.Scalar()) + "'" : kind;
   }
 
   // A name that becomes a C++ identifier, a CSV column, a plot label and report text: one
@@ -71,6 +81,7 @@ struct Reader : YamlReader {
         scale = u.scale / si.scale;
       }
       p.nominal = number(need(n, "value", "parameter " + name), name) * scale;
+      if (scale != 1.0) p.as_written = n["value"].Scalar() + " " + n["unit"].Scalar();
       if (n["bounds"]) {
         const YAML::Node b = n["bounds"];
         if (!b.IsSequence() || b.size() != 2) fail(b, "expected bounds [lower, upper] for " + name);
@@ -108,7 +119,7 @@ struct Reader : YamlReader {
 
 Block read_block(const Reader& r, const YAML::Node& n) {
   r.require_map(n, "a block");
-  r.only_keys(n, {"name", "mass", "size", "centre", "orientation_deg", "source"}, "block");
+  r.only_keys(n, {"name", "mass", "size", "centre", "orientation_deg", "source"}, Reader::item_where(n, "block"));
   Block b;
   b.line = n.Mark().line + 1;
   b.name = r.name(r.need(n, "name", "block"), "block name");
@@ -128,7 +139,7 @@ Rotor read_rotor(const Reader& r, const YAML::Node& n) {
     if (n[tilt])
       r.fail(n[tilt], std::string("a rotor takes no '") + tilt +
                           "': every rotor's thrust acts along body +z (tilted rotors are not modelled; README, Scope)");
-  r.only_keys(n, {"name", "position", "spin", "radius", "disc_area", "source"}, "rotor");
+  r.only_keys(n, {"name", "position", "spin", "radius", "disc_area", "source"}, Reader::item_where(n, "rotor"));
   Rotor ro;
   ro.line = n.Mark().line + 1;
   ro.name = r.name(r.need(n, "name", "rotor"), "rotor name");  // also the CSV column u_<name>
@@ -222,7 +233,7 @@ void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v
     read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});
   else
     v.params["vbat_ref"] = Parameter{{"vbat_ref", "V", parse_unit("V").dim, 4.0, 4.0, 4.0, false,
-                                      "reference battery voltage"}};
+                                      "reference battery voltage", ""}};
 }
 
 // A non-empty list of blocks or rotors (`what`), each read by `read` and named once.

@@ -28,6 +28,8 @@ std::string six_digits(double v) { return with_digits(v, 6); }
 
 std::string full_number(double v) { return with_digits(v, 17); }
 
+std::string unit_after_number(const std::string& unit) { return unit.empty() || unit == "1" ? "" : " " + unit; }
+
 std::string one_then_other(double a, double b) {
   for (int digits = 6;; ++digits) {
     const std::string x = with_digits(a, digits), y = with_digits(b, digits);

@@ -17,6 +17,9 @@ std::string full_number(double v);
 // "a then b" with six significant digits, or as many more as tell them apart: a log whose time
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
 std::string one_then_other(double a, double b);
+// What follows a number in a sentence: " m/s" for a unit, nothing for a dimensionless one ("1",
+// as the symbols declare it, or none), so that "motor_gain.A = 0.08" never reads "0.08 1".
+std::string unit_after_number(const std::string& unit);
 
 // Reading a number from text: one rule for the vehicle file, the log cells and the command
 // line (three readers once judged text each their own way: 1e-400 was refused in a vehicle

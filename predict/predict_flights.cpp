@@ -68,7 +68,7 @@ nlohmann::ordered_json implausible_calibration(const Vehicle& v, const runtime::
     double lower = 0, upper = 0;
     std::string why;
     if (!outside_plausible_range(name, values[k], o.environment, vehicle_scales(v), &lower, &upper, &why)) continue;
-    const std::string unit = bounds[k].unit.empty() ? "" : " " + bounds[k].unit;
+    const std::string unit = output::unit_after_number(bounds[k].unit);
     o.progress.say("  note: calibrated " + name + " = " + output::short_number(values[k]) + unit +
                    " lies outside what is plausible " + where_words(o.environment) + " (" +
                    output::short_number(lower) + " to " + output::short_number(upper) + unit + ": " + why +

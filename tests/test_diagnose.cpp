@@ -32,6 +32,7 @@
 #include "app/diagnose_job.hpp"
 #include "app/extended_model.hpp"
 #include "app/model_registry.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -1267,6 +1268,29 @@ TEST(DiagnosisReport, SuspectsAndStandInsSayWhetherTheyAreTheFlightsOwn) {
   const std::string small = " <small>(a property of the flight, not of the airframe)</small>";
   EXPECT_NE(html.find("<td>wind" + small + "</td>"), std::string::npos) << html;
   EXPECT_NE(html.find("<b>motor_gain</b>" + small + " (suspected"), std::string::npos) << html;
+}
+
+// A dimensionless value ("1", as the symbols declare it) is said without a unit in every
+// sentence: a stand-in, a suspect and a parameter at its bound once read "0.45 1".
+TEST(DiagnosisReport, ADimensionlessValueIsSaidWithoutAUnit) {
+  EXPECT_EQ(quadgen::output::unit_after_number("1"), "");
+  EXPECT_EQ(quadgen::output::unit_after_number(""), "");
+  EXPECT_EQ(quadgen::output::unit_after_number("m/s"), " m/s");
+  quadgen::diagnose::Diagnosis d;
+  quadgen::diagnose::StandIn gain;
+  gain.candidate.effect = "motor_gain", gain.parameter = "motor_gain.A", gain.unit = "1", gain.value = 0.45;
+  gain.plausible_lower = -0.35, gain.plausible_upper = 0.35, gain.why = "a rotor's spread";
+  d.stand_ins.push_back(gain);
+  quadgen::diagnose::Suspected x;
+  x.candidate.effect = "motor_gain", x.failed = "no held-out gain";
+  x.candidate.parameters.push_back({"motor_gain.B", "1", -0.125});
+  d.suspected.push_back(x);
+  d.at_bounds.push_back({"motor_lag_spread.A", "1", -0.5});
+  d.at_bounds.back().lower = -0.5, d.at_bounds.back().upper = 1;
+  const std::string summary = quadgen::diagnose::diagnosis_summary(d);
+  EXPECT_NE(summary.find("(motor_gain.A = 0.45 lies outside [-0.35, 0.35]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("at motor_gain.B = -0.125 (no held-out gain)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("caution: motor_lag_spread.A = -0.5 (lower bound)"), std::string::npos) << summary;
 }
 
 // An airframe's effect named on one flight, with a look-alike that is the flight's own (a CoG

@@ -184,7 +184,7 @@ TEST(Geometry, ThousandBlockGridMatchesParallelAxisSums) {
 namespace {
 
 Parameter derived_bounds(const std::string& name, const std::string& unit, double lower, double upper) {
-  return Parameter{{name, unit, parse_unit(unit).dim, lower, lower, upper, false, ""}};
+  return Parameter{{name, unit, parse_unit(unit).dim, lower, lower, upper, false, "", ""}};
 }
 
 std::string derive_error(const Vehicle& v) {

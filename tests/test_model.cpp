@@ -737,6 +737,23 @@ TEST(Model, ALagSpreadNeedsTheLagAndGivesEachRotorItsOwnTimeConstant) {
 // GiNaC happens to keep operands in (symbol serial numbers, i.e. the process). The same
 // model derived after other symbols were created prints byte for byte the same, in math
 // blocks that GitHub renders.
+// A reviewer compares section 6 with the vehicle file: a parameter the file gives in another
+// unit than the SI one shows it as written (a reviewer's trial, helper-103: 1674 rpm appeared
+// only as 175.301 rad/s); one given in SI shows nothing more. Section 8 cites the thesis.
+TEST(Report, AParameterShowsTheFilesValueWhereItsUnitWasConverted) {
+  const Vehicle v = test::finken3();
+  EXPECT_EQ(v.params.at("a0").as_written, "1674.0 rpm");
+  EXPECT_EQ(v.params.at("c_w").as_written, "");  // a bare number, in SI
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive_model(v, mp, {});
+  const AuditResult no_audit;
+  const std::string md =
+      derivation_markdown({v, mp, m, no_audit, compare_with_thesis(v, m, mp), runtime::HoverTrim{}});
+  EXPECT_NE(md.find(" (the vehicle file: 1674.0 rpm) |\n"), std::string::npos);
+  EXPECT_EQ(md.find("(the vehicle file: 0.7"), std::string::npos);
+  EXPECT_NE(md.find("The thesis: A. Heckert, "), std::string::npos);
+}
+
 TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
   const Vehicle v = test::finken3();
   const auto markdown = [&] {
@@ -1186,7 +1203,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   for (const char* file : {"vehicles/finken3.yaml", "vehicles/crazyflie21.yaml", "vehicles/crazyflie21_nanobench.yaml",
                            "vehicles/hexa_plus.yaml"}) {
     const auto checks = checks_of(load_vehicle(test::source_path(file)));
-    ASSERT_EQ(checks.size(), 9u);
+    ASSERT_EQ(checks.size(), 10u);
     for (const auto& [name, c] : checks) {
       EXPECT_TRUE(c.passed) << file << ": " << c.name << ": " << c.detail;
       EXPECT_TRUE(c.advisory);
@@ -1205,6 +1222,9 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_FALSE(bad.at(inertia).passed);
     EXPECT_NE(bad.at(inertia).detail.find("not positive definite"), std::string::npos) << bad.at(inertia).detail;
     EXPECT_TRUE(checks_of(with_j_xy("1e-5")).at(inertia).passed);
+    EXPECT_NE(checks_of(with_j_xy("1e-5")).at(inertia).detail.find("(with the vehicle file's `derived:` values)"),
+              std::string::npos);
+    EXPECT_NE(checks_of(good).at(inertia).detail.find("(the blocks' tensor, as in the inertia checks"), std::string::npos);
     // derivation.md says the model uses the given value, not the blocks' it lists.
     const Vehicle given = with_j_xy("1e-5");
     const MassProperties mp = derive_mass_properties(given);
@@ -1373,6 +1393,22 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_TRUE(checks_of(v).at(clear).passed) << checks_of(v).at(clear).detail;
     v.blocks.back().centre[0] -= 0.002;  // and 2 mm into the disc
     EXPECT_FALSE(checks_of(v).at(clear).passed);
+  }
+  const std::string degrees = "block orientations are in degrees";
+  {  // radians typed into orientation_deg (a reviewer's trial, helper-103: passed without a word);
+     // whole degrees and a small tilt that is no round angle in radians pass
+    Vehicle v = good;
+    ASSERT_EQ(v.blocks[4].name, "arm_C");
+    v.blocks[4].yaw_pitch_roll_deg = {0.785, 0, 0};
+    auto c = checks_of(v).at(degrees);
+    EXPECT_FALSE(c.passed);
+    EXPECT_NE(c.detail.find("block arm_C: yaw 0.785 deg is 3 pi/12 in radians (45 deg)"), std::string::npos) << c.detail;
+    v.blocks[4].yaw_pitch_roll_deg = {45, 0, -1.5708};
+    c = checks_of(v).at(degrees);
+    EXPECT_NE(c.detail.find("block arm_C: roll -1.571 deg is -6 pi/12 in radians (-90 deg)"), std::string::npos) << c.detail;
+    EXPECT_EQ(c.detail.find("yaw"), std::string::npos) << c.detail;  // 45 is whole degrees
+    v.blocks[4].yaw_pitch_roll_deg = {45, 2.5, 0.3};  // a small tilt
+    EXPECT_TRUE(checks_of(v).at(degrees).passed) << checks_of(v).at(degrees).detail;
   }
   const std::string scale = "rotors and blocks on one scale";
   {  // numbers copied in millimetres where the file reads metres: one at a time

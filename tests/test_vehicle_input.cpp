@@ -126,6 +126,10 @@ TEST(VehicleInput, MissingRotorModelOrFrameKey) {
 }
 TEST(VehicleInput, UnknownKey) {
   expect_error(replace(finken_text(), "  c_w:", "  cw_typo: 1\n  c_w:"), "unknown key 'cw_typo'");
+  // in a block or a rotor, with its name (a reviewer's trial, helper-103: only "in block")
+  expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "sise: [0.056, 0.056, 0.072]"),
+               "unknown key 'sise' in block 'upper_body' (expected one of:");
+  expect_error(replace(finken_text(), "{name: B, position", "{name: B, positon"), "unknown key 'positon' in rotor 'B'");
 }
 // A tilted rotor is said to be outside the model, not only an unknown key (a user trial: blocks
 // take orientation_deg, so a user tried it on a rotor).
@@ -139,7 +143,7 @@ TEST(VehicleInput, NegativeMass) {
 }
 TEST(VehicleInput, ZeroSize) {
   expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "size: [0.056, 0, 0.072]"),
-               "expected a positive number for size");
+               "expected a positive number for size of block 'upper_body' [m], entry 2 of 3, got 0");
 }
 TEST(VehicleInput, DuplicateRotor) {
   expect_error(replace(finken_text(), "{name: B, position", "{name: A, position"), "duplicate rotor name 'A'");
