@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -297,24 +298,29 @@ AuditCheck check_one_scale(const Vehicle& v) {
 
 // Block orientations in radians typed into orientation_deg: 0.785 for an arm at 45 deg turns it
 // by 0.785 deg, and every check above still passes (a reviewer's trial, helper-103). A value
-// that is a round angle in radians (a multiple of pi/12 within 0.5 %) and not a whole number of
-// degrees is most likely one; a real tilt of 0.785 deg is rarely written so.
+// within 0.0051 of a multiple of pi/6 or pi/4 (what radians written to two decimals allow:
+// 0.79, 0.52, 1.57, 3.14) is most likely one, unless it is a whole or half degree (1.5, 5.5),
+// as a real tilt is usually written.
 AuditCheck check_orientations_in_degrees(const Vehicle& v) {
   const char* axes[3] = {"yaw", "pitch", "roll"};
   std::ostringstream os;
   os.precision(4);
   for (const Block& b : v.blocks)
     for (int k = 0; k < 3; ++k) {
-      const double a = b.yaw_pitch_roll_deg[k], steps = std::round(std::fabs(a) / (M_PI / 12));
-      if (a == std::round(a) || steps < 1 || steps > 24) continue;
-      if (std::fabs(std::fabs(a) - steps * M_PI / 12) > 0.005 * std::fabs(a)) continue;
+      const double a = b.yaw_pitch_roll_deg[k], twelfths = std::round(std::fabs(a) / (M_PI / 12));
+      const bool round_in_radians = static_cast<int>(twelfths) % 2 == 0 || static_cast<int>(twelfths) % 3 == 0;
+      if (2 * a == std::round(2 * a) || twelfths < 1 || twelfths > 24 || !round_in_radians) continue;
+      if (std::fabs(std::fabs(a) - twelfths * M_PI / 12) > 0.0051) continue;
+      const int t = static_cast<int>(twelfths), common = std::gcd(t, 12), num = t / common, den = 12 / common;
       os << (os.tellp() > 0 ? "; " : "") << "block " << b.name << ": " << axes[k] << " " << a << " deg is "
-         << (a < 0 ? "-" : "") << steps << " pi/12 in radians (" << (a < 0 ? -15 : 15) * steps
+         << (a < 0 ? "-" : "") << (num == 1 ? "" : std::to_string(num) + " ") << "pi"
+         << (den == 1 ? "" : "/" + std::to_string(den)) << " in radians (" << (a < 0 ? -15 : 15) * t
          << " deg): orientation_deg takes degrees";
     }
   const std::string found = os.str();
   return advisory("block orientations are in degrees", found.empty(),
-                  found.empty() ? "no block's yaw, pitch or roll reads as a round angle in radians (a multiple of pi/12)"
+                  found.empty() ? "no block's yaw, pitch or roll reads as a round angle in radians (a multiple of pi/6 "
+                                  "or pi/4)"
                                 : found);
 }
 

@@ -1287,10 +1287,13 @@ TEST(DiagnosisReport, ADimensionlessValueIsSaidWithoutAUnit) {
   d.suspected.push_back(x);
   d.at_bounds.push_back({"motor_lag_spread.A", "1", -0.5});
   d.at_bounds.back().lower = -0.5, d.at_bounds.back().upper = 1;
+  d.at_bounds.push_back({"thrust_decay.rate", "", 0.005});  // no unit at all: no double blank
+  d.at_bounds.back().lower = -1e-4, d.at_bounds.back().upper = 0.005;
   const std::string summary = quadgen::diagnose::diagnosis_summary(d);
   EXPECT_NE(summary.find("(motor_gain.A = 0.45 lies outside [-0.35, 0.35]"), std::string::npos) << summary;
   EXPECT_NE(summary.find("at motor_gain.B = -0.125 (no held-out gain)"), std::string::npos) << summary;
   EXPECT_NE(summary.find("caution: motor_lag_spread.A = -0.5 (lower bound)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("caution: thrust_decay.rate = 0.005 (upper bound)"), std::string::npos) << summary;
 }
 
 // An airframe's effect named on one flight, with a look-alike that is the flight's own (a CoG

@@ -16,6 +16,7 @@
 #include "audit/audit.hpp"
 #include "audit/vehicle_checks.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "derive/fitted_parameters.hpp"
 #include "audit/report.hpp"
 #include "audit/tex_writer.hpp"
 #include "codegen/cpp_printer.hpp"
@@ -733,17 +734,13 @@ TEST(Model, ALagSpreadNeedsTheLagAndGivesEachRotorItsOwnTimeConstant) {
   }
 }
 
-// A reviewer diffs derivation.md after a vehicle change: it must not depend on the order
-// GiNaC happens to keep operands in (symbol serial numbers, i.e. the process). The same
-// model derived after other symbols were created prints byte for byte the same, in math
-// blocks that GitHub renders.
 // A reviewer compares section 6 with the vehicle file: a parameter the file gives in another
 // unit than the SI one shows it as written (a reviewer's trial, helper-103: 1674 rpm appeared
 // only as 175.301 rad/s); one given in SI shows nothing more. Section 8 cites the thesis.
 TEST(Report, AParameterShowsTheFilesValueWhereItsUnitWasConverted) {
   const Vehicle v = test::finken3();
   EXPECT_EQ(v.params.at("a0").as_written, "1674.0 rpm");
-  EXPECT_EQ(v.params.at("c_w").as_written, "");  // a bare number, in SI
+  EXPECT_EQ(v.params.at("c_w").as_written, "");  // written in its SI unit, "1"
   const MassProperties mp = derive_mass_properties(v);
   const SymbolicModel m = derive_model(v, mp, {});
   const AuditResult no_audit;
@@ -752,8 +749,19 @@ TEST(Report, AParameterShowsTheFilesValueWhereItsUnitWasConverted) {
   EXPECT_NE(md.find(" (the vehicle file: 1674.0 rpm) |\n"), std::string::npos);
   EXPECT_EQ(md.find("(the vehicle file: 0.7"), std::string::npos);
   EXPECT_NE(md.find("The thesis: A. Heckert, "), std::string::npos);
+  // A fitted value replaces the nominal one: the file's value is no longer shown beside it.
+  SymbolicModel fitted = m;
+  FittedParameters values;
+  values.path = "fitted.yaml";
+  values.values.push_back({"motor_a0", "rad/s", 180.0, 1});
+  apply_fitted_parameters(fitted, values);
+  EXPECT_EQ(fitted.params[fitted.param_index("motor_a0")].as_written, "");
 }
 
+// A reviewer diffs derivation.md after a vehicle change: it must not depend on the order
+// GiNaC happens to keep operands in (symbol serial numbers, i.e. the process). The same
+// model derived after other symbols were created prints byte for byte the same, in math
+// blocks that GitHub renders.
 TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
   const Vehicle v = test::finken3();
   const auto markdown = [&] {
@@ -795,6 +803,30 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   EXPECT_TRUE(verdict.at("(63), (64)"));       // climb
   EXPECT_FALSE(verdict.at("(65), (67), (68)"));  // rad vs deg
   EXPECT_FALSE(verdict.at("(73), (76)"));        // c_t: rad/s vs rev/s
+  // The causes are computed: (65) with the thesis' own J_yy, which gives its number in rad/s^2;
+  // Table 1's axis-aligned blocks are the thesis' cuboids in this file, and not where a block
+  // is changed (a review, helper-104: the sentence was fixed text).
+  std::map<std::string, std::string> cause;
+  for (const auto& t : items) cause[t.ref] = t.cause;
+  EXPECT_NE(cause.at("(65), (67), (68)").find("/ 0.0009541 kg m^2 = 15.648 rad/s^2, not deg/s^2: a unit error"),
+            std::string::npos)
+      << cause.at("(65), (67), (68)");
+  EXPECT_NE(cause.at("Table 1").find("block 3 (lower_body) J_yy by 137 %; block 4 (upper_body) J_zz by 4 %, where a "
+                                     "cuboid with the thesis' limits (2.2.4.3) and mass (appendix A) gives the derived value"),
+            std::string::npos)
+      << cause.at("Table 1");
+  Vehicle heavier = v;
+  for (auto& b : heavier.blocks)
+    if (b.name == "lower_body") b.mass = 0.2;
+  const MassProperties mp2 = derive_mass_properties(heavier);
+  for (const auto& t : compare_with_thesis(heavier, derive_model(heavier, mp2, {}), mp2))
+    if (t.ref == "Table 1") {
+      EXPECT_NE(t.cause.find("block 3 (lower_body) J_xx by 34 %, J_yy by 56 %, J_zz by 34 % (the vehicle file's block is "
+                             "not the thesis' cuboid)"),
+                std::string::npos)
+          << t.cause;
+      EXPECT_EQ(t.cause.find("gives the derived value"), std::string::npos) << t.cause;
+    }
   realsymbol a("a"), b("b"), c("c");
   EXPECT_TRUE(reduce_trig(thesis_transformation(a, b, c).determinant() + 1, {a, b, c}).is_zero());
   EXPECT_TRUE(reduce_trig(thesis_rotation_about_y(b).determinant() + 1, {b}).is_zero());
@@ -1402,13 +1434,22 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     v.blocks[4].yaw_pitch_roll_deg = {0.785, 0, 0};
     auto c = checks_of(v).at(degrees);
     EXPECT_FALSE(c.passed);
-    EXPECT_NE(c.detail.find("block arm_C: yaw 0.785 deg is 3 pi/12 in radians (45 deg)"), std::string::npos) << c.detail;
+    EXPECT_NE(c.detail.find("block arm_C: yaw 0.785 deg is pi/4 in radians (45 deg)"), std::string::npos) << c.detail;
     v.blocks[4].yaw_pitch_roll_deg = {45, 0, -1.5708};
     c = checks_of(v).at(degrees);
-    EXPECT_NE(c.detail.find("block arm_C: roll -1.571 deg is -6 pi/12 in radians (-90 deg)"), std::string::npos) << c.detail;
+    EXPECT_NE(c.detail.find("block arm_C: roll -1.571 deg is -pi/2 in radians (-90 deg)"), std::string::npos) << c.detail;
     EXPECT_EQ(c.detail.find("yaw"), std::string::npos) << c.detail;  // 45 is whole degrees
-    v.blocks[4].yaw_pitch_roll_deg = {45, 2.5, 0.3};  // a small tilt
-    EXPECT_TRUE(checks_of(v).at(degrees).passed) << checks_of(v).at(degrees).detail;
+    // radians to two decimals (a review, helper-104: 0.79 and 0.52 passed a relative tolerance)
+    for (double typed : {0.79, 0.52, 2.36, 3.14}) {
+      v.blocks[4].yaw_pitch_roll_deg = {typed, 0, 0};
+      EXPECT_FALSE(checks_of(v).at(degrees).passed) << typed;
+    }
+    // small tilts as degrees are written: whole and half degrees, and one-decimal values that are
+    // no multiple of pi/6 or pi/4 within two decimals' rounding (2.1 is 0.0056 from 2 pi/3)
+    for (double tilt : {2.5, 0.3, 1.5, 5.5, 2.1, 3.4, 4.7, 6.3, 22.5, 7.5}) {
+      v.blocks[4].yaw_pitch_roll_deg = {45, tilt, 0};
+      EXPECT_TRUE(checks_of(v).at(degrees).passed) << tilt << ": " << checks_of(v).at(degrees).detail;
+    }
   }
   const std::string scale = "rotors and blocks on one scale";
   {  // numbers copied in millimetres where the file reads metres: one at a time
