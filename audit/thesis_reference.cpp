@@ -218,8 +218,9 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
   // largest difference, 137 %, is the lower body's J_yy, and the cause named only the others).
   // Whether such a block is the thesis' cuboid is computed from the thesis' own numbers (limits
   // x3, y9, z3 and x4, y10, z4 of 2.2.4.3; masses of appendix A), not taken from the file.
-  const std::array<double, 3> thesis_cuboid[2] = {cuboid_about_origin(0.132, {-0.0275, -0.0325, -0.041}, {0.0275, 0.0325, 0}),
-                                                  cuboid_about_origin(0.099, {-0.028, -0.028, 0}, {0.028, 0.028, 0.072})};
+  const std::array<double, 3> thesis_cuboid[2] = {
+      cuboid_about_origin(0.132, {-0.0275, -0.0325, -0.041}, {0.0275, 0.0325, 0}),  // lower body
+      cuboid_about_origin(0.099, {-0.028, -0.028, 0}, {0.028, 0.028, 0.072})};      // upper body
   std::string aligned_differ;
   bool aligned_are_the_theses = true;
   for (int g = 0; g < 6; ++g) {

@@ -286,13 +286,14 @@ AuditCheck check_one_scale(const Vehicle& v) {
          << " m^2 is more than the disc its radius sweeps, pi r^2 = " << disc << " m^2 (an area in mm^2 or a diameter as the radius?)";
   }
   if (farthest > 0 && reach > 20 * farthest)
-    os << (os.tellp() > 0 ? "; " : "") << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach " << farthest
+    os << (os.tellp() > 0 ? "; " : "") << "the blocks lie within " << reach
+       << " m of the origin (a bound: centre plus half diagonal), the rotors reach " << farthest
        << " m (a block's size or centre in mm read as m?)";
   const std::string found = os.str();
   std::ostringstream fine;
   fine.precision(4);
-  fine << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach " << farthest
-       << " m; every disc_area at most pi r^2";
+  fine << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach "
+       << farthest << " m; every disc_area at most pi r^2";
   return advisory("rotors and blocks on one scale", found.empty(), found.empty() ? fine.str() : found);
 }
 
@@ -396,9 +397,16 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
   const Eigen::MatrixXd B = runtime::allocation_matrix(b);
   // The slips of the file first (a copied rotor line, millimetres read as metres): one of
   // them explains the flight checks after it, which fail with it.
-  return {check_discs_apart(v),          check_discs_clear_of_blocks(v), check_one_scale(v),
-          check_orientations_in_degrees(v), check_inertia_used(v, m),          check_motor_map(b.thrust_laws), check_controllable(B),
-          check_hover_trim(trim, b.mass * b.g), check_hover_above_the_bottom(trim), check_hover_below_the_top(trim)};
+  return {check_discs_apart(v),
+          check_discs_clear_of_blocks(v),
+          check_one_scale(v),
+          check_orientations_in_degrees(v),
+          check_inertia_used(v, m),
+          check_motor_map(b.thrust_laws),
+          check_controllable(B),
+          check_hover_trim(trim, b.mass * b.g),
+          check_hover_above_the_bottom(trim),
+          check_hover_below_the_top(trim)};
 }
 
 }  // namespace quadgen

@@ -358,7 +358,8 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
     if (!p.free ||
         !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
-    return p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" + output::short_number(lo) + ", " + output::short_number(hi) + "]";
+    return p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" +
+           output::short_number(lo) + ", " + output::short_number(hi) + "]";
   }
   return "";
 }
