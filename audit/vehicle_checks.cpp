@@ -308,11 +308,11 @@ AuditCheck check_orientations_in_degrees(const Vehicle& v) {
   os.precision(4);
   for (const Block& b : v.blocks)
     for (int k = 0; k < 3; ++k) {
-      const double a = b.yaw_pitch_roll_deg[k], twelfths = std::round(std::fabs(a) / (M_PI / 12));
-      const bool round_in_radians = static_cast<int>(twelfths) % 2 == 0 || static_cast<int>(twelfths) % 3 == 0;
-      if (2 * a == std::round(2 * a) || twelfths < 1 || twelfths > 24 || !round_in_radians) continue;
-      if (std::fabs(std::fabs(a) - twelfths * M_PI / 12) > 0.0051) continue;
-      const int t = static_cast<int>(twelfths), common = std::gcd(t, 12), num = t / common, den = 12 / common;
+      const double a = b.yaw_pitch_roll_deg[k];
+      if (2 * a == std::round(2 * a) || std::fabs(a) > 10 * M_PI) continue;  // whole or half degrees, or far out
+      const int t = static_cast<int>(std::round(std::fabs(a) / (M_PI / 12)));  // twelfths of pi
+      if (t < 1 || t > 24 || (t % 2 != 0 && t % 3 != 0) || std::fabs(std::fabs(a) - t * M_PI / 12) > 0.0051) continue;
+      const int common = std::gcd(t, 12), num = t / common, den = 12 / common;
       os << (os.tellp() > 0 ? "; " : "") << "block " << b.name << ": " << axes[k] << " " << a << " deg is "
          << (a < 0 ? "-" : "") << (num == 1 ? "" : std::to_string(num) + " ") << "pi"
          << (den == 1 ? "" : "/" + std::to_string(den)) << " in radians (" << (a < 0 ? -15 : 15) * t
