@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "app/derive_pipeline.hpp"
+#include "derive/fitted_parameters.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::diagnose {
@@ -63,7 +64,7 @@ ExtendedModelFiles extended_model(const Vehicle& v, const MassProperties& mass, 
   if (with_proposed_terms) request.derive.terms = proposed_terms(d.discovered);
   request.set_nominal = [&](SymbolicModel& ext) {  // the header's nominal values are the estimates
     for (const auto& p : d.airframe_fit)
-      if (p.free) ext.params[ext.param_index(p.name)].nominal = p.value;
+      if (p.free) set_fitted_nominal(ext.params[ext.param_index(p.name)], p.value);
   };
   request.thesis_comparison = false;  // the thesis comparison belongs to the FINken 3's own derivation
   request.emit.vehicle_file = vehicle_file;

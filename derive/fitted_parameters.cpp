@@ -70,8 +70,7 @@ void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitte
     if (v.unit != p->unit) throw VehicleError(where + v.name + " is in " + p->unit + ", the file says " + v.unit);
     const std::string problem = runtime::value_problem(runtime_parameter(*p), v.value, true);
     if (!problem.empty()) throw VehicleError(where + v.name + " " + problem);
-    p->nominal = v.value;
-    p->as_written.clear();  // the vehicle file's value is no longer this one's (helper-104)
+    set_fitted_nominal(*p, v.value);
   }
 }
 

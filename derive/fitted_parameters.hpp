@@ -27,6 +27,13 @@ struct FittedParameters {
 // "path:line: ...".
 FittedParameters load_fitted_parameters(const std::string& path);
 
+// Gives `p` a value fitted to data: the vehicle file's value as written (`as_written`, shown in
+// derivation.md beside the nominal) no longer describes it, so it goes (helper-104, helper-105).
+inline void set_fitted_nominal(Variable& p, double value) {
+  p.nominal = value;
+  p.as_written.clear();
+}
+
 // Sets the model's nominal values to the fitted ones. Each must name a parameter of the
 // model, in its unit, within its bounds; otherwise VehicleError "path:line: ...".
 void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitted);

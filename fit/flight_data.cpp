@@ -307,6 +307,9 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   // Checked here, where the rows still have their lines: averaging would spread a bad value
   // over its neighbours and the error would name a resampled row.
   runtime::check_values(log);
+  // The range of the Euler angles too: the resampled roll is wrapped into (-pi, pi], where a
+  // roll in degrees read as radians would pass (hostile-input audit, helper-105).
+  check_euler_range(log);
   // Every row's time after the one before, checked before resampling: the interpolating loop
   // this replaced saw only the pair it interpolated between and walked past rows whose time
   // went back (a review: 100 reversed rows were resampled without a word).
@@ -681,23 +684,25 @@ std::array<double, 4> logged_attitude(const runtime::CsvTable& log, AttitudeColu
 // reliably catches (the gyro check's windows turn less than pi; these turn tens of radians):
 // a roll beyond +-pi or a pitch beyond +-pi/2 is no Z-Y-X angle in radians. The yaw may be
 // logged unwrapped, so it is not judged.
+std::string euler_range_problem(const std::string& column, double value_rad) {
+  const bool roll = column == "phi";
+  if (!roll && column != "theta") return "";
+  const double limit = roll ? M_PI : M_PI / 2;
+  if (!(std::fabs(value_rad) > limit + 1e-3)) return "";  // NaN is judged where values are read
+  std::ostringstream os;
+  os << column << " = " << value_rad << " rad lies outside the range of a Z-Y-X Euler angle, "
+     << (roll ? "+-pi (180 deg)" : "+-pi/2 (90 deg)")
+     << ": angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)";
+  return os.str();
+}
+
 void check_euler_range(const runtime::CsvTable& log) {
   if (attitude_columns(log) != AttitudeColumns::kEuler) return;
-  struct Range {
-    const char* column;
-    double limit;  // rad
-    const char* said;
-  };
-  for (const Range& r : {Range{"phi", M_PI, "+-pi (180 deg)"}, Range{"theta", M_PI / 2, "+-pi/2 (90 deg)"}}) {
-    const int c = log.column(r.column);
+  for (const char* column : {"phi", "theta"}) {
+    const int c = log.column(column);
     for (size_t k = 0; k < log.rows.size(); ++k) {
-      const double v = log.rows[k][static_cast<size_t>(c)];
-      if (!(std::fabs(v) > r.limit + 1e-3)) continue;  // NaN is judged where values are read
-      std::ostringstream os;
-      os << log.where_row(k) << ": " << r.column << " = " << v
-         << " rad lies outside the range of a Z-Y-X Euler angle, " << r.said
-         << ": angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)";
-      throw FitError(os.str());
+      const std::string problem = euler_range_problem(column, log.rows[k][static_cast<size_t>(c)]);
+      if (!problem.empty()) throw FitError(log.where_row(k) + ": " + problem);
     }
   }
 }

@@ -123,6 +123,9 @@ std::string gyro_disagreement_hint(double slope, double se, bool euler);
 // radians; simulate --inputs runs it for its start attitude).
 void check_time_unit(const runtime::CsvTable& log);
 void check_euler_range(const runtime::CsvTable& log);
+// The rule behind check_euler_range for one value of column "phi" or "theta" (any other column
+// passes): "" or what is wrong, without the place (a mapped topic log judges its samples).
+std::string euler_range_problem(const std::string& column, double value_rad);
 
 // Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
 Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);

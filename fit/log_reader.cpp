@@ -8,6 +8,7 @@
 #include "fit/least_squares.hpp"  // FitError
 #include "runtime/log_file.hpp"
 #include "output/joined.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::fit {
 
@@ -92,8 +93,16 @@ bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
 
 // An Euler angle mapped from a topic is averaged unwrapped (fit/grid_mean.hpp), its period in
 // the source's unit from the mapping's scale and unit (360 for degrees).
-void unwrap_if_angle(Signal& s, const ColumnMapping::Entry& e) {
+// Judged as logged, before the roll is unwrapped, averaged and wrapped again: a roll in
+// degrees read as radians would pass once wrapped (hostile-input audit, helper-105).
+void unwrap_if_angle(Signal& s, const ColumnMapping::Entry& e, const std::string& path) {
   const double to_radians = std::fabs(e.scale * e.unit_scale);
+  for (size_t k = 0; k < s.v.size(); ++k) {
+    const std::string problem = euler_range_problem(e.target, s.v[k] * e.scale * e.unit_scale);
+    if (!problem.empty())
+      throw FitError(path + " ('" + e.source + "' at t = " + output::six_digits(s.t[k]) + " s of the log's clock): " +
+                     problem);
+  }
   if ((e.target == "phi" || e.target == "psi") && to_radians > 0) s.v = unwrapped(s.v, 2 * M_PI / to_radians);
 }
 
@@ -117,7 +126,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   for (const auto& e : m.entries) {
     if (e.source == "t") continue;  // the time base this function makes
     signals.push_back(find_signal(log, e));
-    unwrap_if_angle(signals.back(), e);
+    unwrap_if_angle(signals.back(), e, log.path);
     t0 = std::max(t0, signals.back().t.front());
     t1 = std::min(t1, signals.back().t.back());
   }

@@ -50,6 +50,7 @@ import random
 import sys
 
 import disturbance_floor
+from markdown_cell import terminal_text  # file names printed as text
 import moment_residuals
 
 SLOW = (0.35, 2.0)  # Hz: at 2.56 s windows the bins 0.39-1.95 Hz
@@ -369,11 +370,11 @@ def nanobench(folder, ratio, residual_slow):
     print("  flight, axis: slow band of the logged commands | top band | folded into the slow band, "
           "estimated with the ARPL ratio" + (" | the extended model's residual, slow band" if residual_slow else ""))
     pairs, unsaturated = [], []
-    for path in sorted(glob.glob(os.path.join(folder, "B*.csv"))):
+    for path in sorted(glob.glob(os.path.join(glob.escape(folder), "B*.csv"))):  # "[1]" in a folder is no pattern
         with open(path, newline="") as f:
             commands = [[float(r[f"motor_motor_m{i}"]) for i in range(1, 5)] for r in csv.DictReader(f)]
         first, last = airborne_stretch(commands, 300)
-        name = os.path.splitext(os.path.basename(path))[0]
+        name = terminal_text(os.path.splitext(os.path.basename(path))[0])
         mark = " (saturated)" if name in SATURATED else ""
         for axis, x in differential(commands[first:last]).items():
             s, t = slow([x]), top([x])
@@ -392,6 +393,8 @@ def nanobench(folder, ratio, residual_slow):
     if len(pairs) >= 3:
         print(f"  across the unsaturated flights and axes ({len(pairs)}), the folded estimate and the residual's "
               f"slow band correlate at {correlation([f for f, _ in pairs], [r for _, r in pairs]):+.2f}")
+    if not unsaturated:  # said here, not as min() of nothing further on (helper-105)
+        sys.exit(f"{terminal_text(folder)}: no unsaturated NanoBench flight (B*.csv) to estimate the folding on")
     return unsaturated
 
 

@@ -14,8 +14,9 @@ measured on the airframe). Prints one table: the slope, the residuals, their rat
   scripts/held_out_slope.py [OUT_DIR]      (default out/held_out_slope)
 
 SLOPES="B2_circle_medium_rep1:0.586 ..." takes those slopes instead of measuring them (another
-measure's); QUADGEN=BINARY selects the quadgen binary (default build/quadgen). A flight whose
-OUT_DIR/NAME/diagnosis/diagnosis.json exists is not diagnosed again. About 3-5 minutes on 2
+measure's; each NAME one of the five flights); QUADGEN=BINARY selects the quadgen binary
+(default build/quadgen). A flight whose OUT_DIR/NAME/diagnosis_slope_S/diagnosis.json exists for
+its slope S is not diagnosed again (another slope gets a folder of its own). About 3-5 minutes on 2
 cores: the copied file is no compiled-in model, so each diagnosis runs on the expression tape.
 Needs the build (./setup.sh --no-run) and ../shared/data beside the clone; standard library
 and PyYAML only (as motor_map_slope.py)."""
@@ -59,7 +60,9 @@ def vehicle_with_slope(slope, folder):
     if count != 1:
         sys.exit(f"{VEHICLE}: expected one 'slope: {{value: 0.6, ...}}' line, found {count}")
     path = folder / f"crazyflie21_nanobench_slope_{slope}.yaml"
-    path.write_text(changed)
+    partial = path.with_name(path.name + ".partial")  # a run cut short leaves no half file
+    partial.write_text(changed)
+    os.replace(partial, path)
     return path
 
 
@@ -74,14 +77,17 @@ def one_flight(quadgen, name, slope, out):
     folder = out / name
     folder.mkdir(parents=True, exist_ok=True)
     flight = mms.DATA / f"{name}.csv"
-    if not (folder / "diagnosis" / "diagnosis.json").exists():
+    # One folder per slope: a second run with other slopes into the same OUT_DIR printed the
+    # first run's diagnosis beside the new slope (hostile-input audit, helper-105).
+    diagnosed = folder / f"diagnosis_slope_{slope}"
+    if not (diagnosed / "diagnosis.json").exists():
         vehicle = vehicle_with_slope(slope, folder)
-        run(quadgen, ["diagnose", vehicle, flight, "--mapping", MAPPING, "--out", folder / "diagnosis"],
-            folder / "diagnosis.log")
+        run(quadgen, ["diagnose", vehicle, flight, "--mapping", MAPPING, "--out", diagnosed],
+            folder / f"diagnosis_slope_{slope}.log")
     if not (folder / "nominal" / "prediction.json").exists():
         run(quadgen, ["predict", NOMINAL, flight, "--mapping", MAPPING, "--out", folder / "nominal"],
             folder / "nominal.log")
-    diagnosis = json.loads((folder / "diagnosis" / "diagnosis.json").read_text())
+    diagnosis = json.loads((diagnosed / "diagnosis.json").read_text())
     nominal = json.loads((folder / "nominal" / "prediction.json").read_text())
     return diagnosis, nominal
 
@@ -96,11 +102,28 @@ def row(name, slope, diagnosis, nominal):
             f"{nom['x'] / ext['x']:.1f} / {nom['y'] / ext['y']:.1f} | {open_loop} | {effects} |")
 
 
+def given_slopes(text):
+    """SLOPES="NAME:SLOPE ...": each NAME a flight of motor_map_slope.FLIGHTS (a name is a
+    folder under OUT_DIR: a path in its place would write elsewhere), each SLOPE a number."""
+    slopes = {}
+    for pair in text.split():
+        name, colon, number = pair.rpartition(":")
+        try:
+            slope = float(number)
+        except ValueError:
+            slope = float("nan")
+        if not colon or name not in mms.FLIGHTS or not 0 < slope < 10 or name in slopes:
+            sys.exit(f"SLOPES: {pair!r} is not NAME:SLOPE with NAME one of {', '.join(mms.FLIGHTS)} "
+                     "(each once) and SLOPE a positive number")
+        slopes[name] = slope
+    return slopes
+
+
 def main():
     out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ROOT / "out" / "held_out_slope").resolve()
     quadgen = str((ROOT / os.environ.get("QUADGEN", "build/quadgen")).resolve())
     if os.environ.get("SLOPES"):
-        slopes = {k: float(v) for k, v in (pair.split(":") for pair in os.environ["SLOPES"].split())}
+        slopes = given_slopes(os.environ["SLOPES"])
         source = "given (SLOPES)"
     else:
         gains = measured_gains()

@@ -27,10 +27,10 @@ def finding_text(f):
         if p.get("reference"):
             continue
         lo, hi = p["ci95"]
-        parts.append(f"{name} = {fmt(p['value'])} [{fmt(lo)}, {fmt(hi)}]")
+        parts.append(f"{cell(name)} = {fmt(p['value'])} [{fmt(lo)}, {fmt(hi)}]")
     how = {"one-step equation error": " (held out: one step)",
            "force model alone (attitude replayed)": " (held out: force model alone)"}.get(f.get("accepted_by"), "")
-    return f"**{f['effect']}**{how} " + "; ".join(parts)
+    return f"**{cell(f['effect'])}**{how} " + "; ".join(parts)
 
 
 # The catalogue's per-flight effects (docs/effects.md), written down again like PLAUSIBLE below,
@@ -89,7 +89,7 @@ def scope_of(effect):
 
 def wrong_scope(effect, said):
     """A scope diagnosis.json gives an effect against this script's own list."""
-    return [] if said == scope_of(effect) else [f"{effect}: scope {said!r}, not {scope_of(effect)!r}"]
+    return [] if said == scope_of(effect) else [f"{cell(effect)}: scope {cell(repr(said))}, not {scope_of(effect)!r}"]
 
 
 def scope_violations(j):
@@ -99,7 +99,7 @@ def scope_violations(j):
         out += wrong_scope(e["effect"], e.get("scope"))
     for effect, said in j.get("effect_scopes", {}).items():
         out += wrong_scope(effect, said)
-    return out + [f"no scope for {e}" for e in j.get("candidates_considered", []) if e not in j.get("effect_scopes", {})]
+    return out + [f"no scope for {cell(e)}" for e in j.get("candidates_considered", []) if e not in j.get("effect_scopes", {})]
 
 
 # The symmetric SI plausible ranges of the catalogue (docs/effects.md; motor_lag and
@@ -116,7 +116,7 @@ def implausible(f, environment):
         limit = limit.get(environment, 15.0)
     if limit is None:
         return []
-    return [f"{n} = {p['value']:.3g} beyond ±{limit}" for n, p in f["parameters"].items()
+    return [f"{cell(n)} = {p['value']:.3g} beyond ±{limit}" for n, p in f["parameters"].items()
             if abs(p["value"]) > limit + 1e-12]
 
 
@@ -134,7 +134,7 @@ def per_flight_verdict(check, one):
 def draft_verdict(j):
     """The draft check's verdict (diagnose/draft_signature.hpp): the axes showing a draft's
     signature on both parts, "not measured" without rotor drag and blade flapping."""
-    return per_flight_verdict(j.get("draft_signature"), lambda d: ", ".join(d.get("axes_showing_it", [])) or "none")
+    return per_flight_verdict(j.get("draft_signature"), lambda d: ", ".join(cell(a) for a in d.get("axes_showing_it", [])) or "none")
 
 
 def command_gain_verdict(j):
@@ -163,12 +163,11 @@ def main(root):
         bad += len(scopes)
         if scopes:
             named.append("⚠ " + ", ".join(scopes))
-        suspected = [f"{s['effect']} ({s['failed'].split(' (')[0]})" for s in j["suspected"]]
-        groups = [" or ".join(a["effects"]) for a in j.get("ambiguous", [])]
-        stand_ins = [f"{s['effect']} ({s['parameter']} = {s['value']:.3g} {s['unit']})" for s in j.get("stand_ins", [])]
-        removed = [r["effect"] for r in j.get("removed_by_backward_pass", [])]
+        suspected = [f"{cell(s['effect'])} ({cell(s['failed'].split(' (')[0])})" for s in j["suspected"]]
+        groups = [" or ".join(map(cell, a["effects"])) for a in j.get("ambiguous", [])]
+        stand_ins = [f"{cell(s['effect'])} ({cell(s['parameter'])} = {s['value']:.3g} {cell(s['unit'])})" for s in j.get("stand_ins", [])]
         # Beyond the catalogue: proposed terms with their held-out RMS before -> after.
-        proposed = [f"{t['expression']} ({fmt(t['held_out_rms'][0])} → {fmt(t['held_out_rms'][1])} {t['unit']})"
+        proposed = [f"{cell(t['expression'])} ({fmt(t['held_out_rms'][0])} → {fmt(t['held_out_rms'][1])} {cell(t['unit'])})"
                     for t in j.get("discovered_terms", []) if t.get("proposed")]
         pb, pa = j.get("prediction", {}).get("before", {}), j.get("prediction", {}).get("after", {})
 
@@ -237,14 +236,14 @@ def look_alike_classes(root):
         of = " / ".join(sorted({scope_of(m) for m in members}))
         cells, in_model = [], 0
         for _, j in singles:
-            named = [f["effect"] for f in j["findings"] if f["effect"] in members]
-            pairs = [" or ".join(a["effects"]) for a in j.get("ambiguous", []) if set(a["effects"]) & set(members)]
-            suspected = [s["effect"] for s in j["suspected"] if s["effect"] in members]
+            named = [cell(f["effect"]) for f in j["findings"] if f["effect"] in members]
+            pairs = [" or ".join(map(cell, a["effects"])) for a in j.get("ambiguous", []) if set(a["effects"]) & set(members)]
+            suspected = [cell(s["effect"]) for s in j["suspected"] if s["effect"] in members]
             if named or pairs:
                 in_model += 1
             cells.append(", ".join(named + [f"ambiguous ({p})" for p in pairs]) or
                          (f"suspected ({', '.join(suspected)})" if suspected else "—"))
-        print(f"| {' / '.join(members)} | {of} | " + " | ".join(cells) + f" | {in_model} of {len(singles)} |")
+        print(f"| {' / '.join(map(cell, members))} | {of} | " + " | ".join(cells) + f" | {in_model} of {len(singles)} |")
 
 
 def agreement_tables(root):
@@ -257,7 +256,7 @@ def agreement_tables(root):
         for a in json.loads(j_path.read_text()).get("agreement", []):
             state = "agree" if a["agree"] else "disagree"
             named = "named" if a["named"] else "suspected"
-            print(f"\n{cell(d.name)}: **{a['parameter']}** [{a['unit']}] ({named}) — flights {state}: joint "
+            print(f"\n{cell(d.name)}: **{cell(a['parameter'])}** [{cell(a['unit'])}] ({named}) — flights {state}: joint "
                   f"{fmt(a['joint_value'])}, pooled {fmt(a['pooled'])}, spread {fmt(100 * a['spread'] if a['spread'] is not None else None)} %"
                   + (f" (if they agree: median {fmt(100 * a['spread_if_agree'], 2)} %, p = {fmt(a['spread_p_value'], 2)})"
                      if a.get("spread_if_agree") is not None else "") + ", "

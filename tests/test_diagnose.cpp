@@ -2127,6 +2127,22 @@ TEST(FittedVehicle, IsTheFileAsItWasReadNotAsItIsNow) {
   fs::remove_all(dir);
 }
 
+// The extended model's derivation shows the value the diagnosis fitted; the vehicle file's
+// value as written ("1674.0 rpm") stays only beside a parameter the fit held (hostile-input
+// audit, helper-105: a fitted 6 mm kappa read "(the vehicle file: 9 mm)").
+TEST(ExtendedModel, AFittedValueIsNotShownBesideTheFilesValue) {
+  const quadgen::Vehicle v = quadgen::load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml");
+  const quadgen::MassProperties mp = quadgen::derive_mass_properties(v);
+  quadgen::diagnose::Diagnosis d;
+  d.airframe_fit.push_back({"motor_a0", "rad/s", 180.0, 0.0, 1000.0, false});
+  const std::string held = quadgen::diagnose::extended_model(v, mp, d, "finken3.yaml", "log.csv").derivation_markdown;
+  EXPECT_NE(held.find(" (the vehicle file: 1674.0 rpm) |\n"), std::string::npos);
+  d.airframe_fit.back().free = true;
+  const std::string fitted = quadgen::diagnose::extended_model(v, mp, d, "finken3.yaml", "log.csv").derivation_markdown;
+  EXPECT_EQ(fitted.find("(the vehicle file: 1674.0 rpm)"), std::string::npos);
+  EXPECT_NE(fitted.find("| `motor_a0` | rad/s | 180 |"), std::string::npos);
+}
+
 // A plot's legend names each flight by its file; two logs of one name in two folders shared
 // one series name in the command-gain plot (hostile-input audit, 2026-12-03).
 TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {

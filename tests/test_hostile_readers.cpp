@@ -378,12 +378,16 @@ TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
   EXPECT_NE(said.find(" rad lies outside the range of a Z-Y-X Euler angle"), std::string::npos) << said;
   EXPECT_NE(said.find("angles in degrees? (the canonical log takes radians; in a mapping, unit: deg)"), std::string::npos) << said;
   EXPECT_EQ(said.rfind(log + ":", 0), 0u) << said;
-  // Resampled (a review, helper-81: --resample 37 named line 94, which held a valid angle), the
-  // rows are no lines of the file: the message names the row by its time.
+  // Resampled, the range is judged before the averaging, at the file's line (a review,
+  // helper-81: --resample 37 named line 94, which held a valid angle); a roll shifted by 2 pi
+  // alone, which the resampled table's wrapped roll hid, is refused too (helper-105).
   const std::string resampled = message_of<FitError>([&] { load_flight(resample(degrees, 37), rotors, {}); });
-  EXPECT_EQ(resampled.rfind(log + " (the row at t = ", 0), 0u) << resampled;
-  EXPECT_TRUE(std::regex_search(resampled, std::regex(R"(the row at t = [0-9]+\.[0-9]{3} s, resampled at 37 Hz\): )")))
-      << resampled;
+  EXPECT_EQ(resampled.rfind(log + ":", 0), 0u) << resampled;
+  runtime::CsvTable roll_shifted = euler(1);
+  roll_shifted.rows[93][col(roll_shifted, "phi")] += 2 * M_PI;
+  const std::string shifted = message_of<FitError>([&] { load_flight(roll_shifted, rotors, {}); });
+  EXPECT_EQ(shifted.rfind(log + ":95: phi = ", 0), 0u) << shifted;
+  EXPECT_EQ(message_of<FitError>([&] { load_flight(resample(roll_shifted, 37), rotors, {}); }), shifted);
   // At a Unix time the row is still told apart (not "1.7e+09 s"), and a ULog's or uSD log's
   // grid says where its time counts from.
   runtime::CsvTable unix_time;

@@ -165,6 +165,33 @@ TEST(LogReader, UnsetValuesAreSkippedGapsStayGapsQuaternionSignsAligned) {
   EXPECT_TRUE(gap);
 }
 
+// A roll logged in degrees and mapped as radians is refused at the sample, as logged: the
+// table's roll is averaged unwrapped and wrapped into (-pi, pi] again, where 30 "rad" passed
+// (hostile-input audit, helper-105). The same roll mapped with `unit: deg` is read.
+TEST(LogReader, AMappedRollInDegreesIsRefusedBeforeItIsWrapped) {
+  Writer w;
+  w.flag_bits().format("att:uint64_t timestamp;float roll;float pitch;");
+  w.add(0, 0, "att");
+  for (int k = 0; k <= 100; ++k)
+    w.data(0, le(1000000 + 10000 * static_cast<std::uint64_t>(k), 8) + f32(static_cast<float>(0.3 * k)) + f32(1.0f));
+  const std::string log = write_file("quadgen_roll_degrees.ulg", w.bytes());
+  const auto mapping = [](const char* unit) {
+    return write_file("quadgen_roll_degrees.yaml", std::string("name: roll\ncolumns:\n  t: {source: t}\n") +
+                                                       "  phi: {source: att.roll, unit: " + unit + "}\n" +
+                                                       "  theta: {source: att.pitch, unit: " + unit + "}\n");
+  };
+  std::string said;
+  try {
+    fit::read_log(log, mapping("rad"), 100.0);
+  } catch (const fit::FitError& e) {
+    said = e.what();
+  }
+  EXPECT_EQ(said.rfind(log + " ('att.roll' at t = 1.11 s of the log's clock): phi = 3.3", 0), 0u) << said;
+  EXPECT_NE(said.find("angles in degrees?"), std::string::npos) << said;
+  const runtime::CsvTable t = fit::read_log(log, mapping("deg"), 100.0);
+  EXPECT_NEAR(t.rows[50][t.column("phi")], 15.0 * M_PI / 180, 1e-6);
+}
+
 // A topic logged faster than the grid (a motor command at 1 kHz, read at 100 Hz) does not fold
 // its fast content into the slow band: each grid value is the topic's mean over the grid
 // interval around it (fit/grid_mean.hpp). Read at the grid points alone, the 403 Hz sine

@@ -648,6 +648,37 @@ TEST(Thesis, AFinken3TooHeavyForTheManoeuvresIsComparedWithoutThem) {
   for (const auto& t : compare_with_thesis(v, stock, mp)) EXPECT_NE(t.ref, "2.3");
 }
 
+// Table 1 compares the file's blocks by the thesis' names: a body renamed is said to be missing,
+// not compared as a block of nothing ("block 3 (lower_body) J_xx by inf %"), and a block made
+// nearly massless gives a percentage of three digits, not of 300 (hostile-input audit, helper-105).
+TEST(Thesis, Table1SaysABlockTheFileDoesNotHaveAndKeepsPercentagesShort) {
+  const auto table1 = [](const Vehicle& v) {
+    const MassProperties mp = derive_mass_properties(v);
+    for (const auto& t : compare_with_thesis(v, derive(v, {}), mp))
+      if (t.ref == "Table 1") return t;
+    ADD_FAILURE() << "no Table 1 row";
+    return ThesisItem{};
+  };
+  Vehicle renamed = test::finken3();
+  for (auto& b : renamed.blocks)
+    if (b.name == "lower_body") b.name = "lower_body_x";
+  const ThesisItem r = table1(renamed);
+  EXPECT_FALSE(r.agrees);
+  EXPECT_EQ(r.derived.find("inf"), std::string::npos) << r.derived;
+  EXPECT_NE(r.derived.find("3: -; "), std::string::npos) << r.derived;
+  EXPECT_NE(r.cause.find("the vehicle file has no block named lower_body, so those are not compared"), std::string::npos)
+      << r.cause;
+  EXPECT_NE(r.size.find("; blocks not in the file: lower_body"), std::string::npos) << r.size;
+  Vehicle light = test::finken3();
+  for (auto& b : light.blocks)
+    if (b.name == "lower_body") b.mass = 1e-300;
+  const ThesisItem l = table1(light);
+  EXPECT_LT(l.cause.size() + l.size.size(), 2000u) << l.cause << l.size;
+  // about 1e-4 kg m^2 of the thesis against 1e-300 kg times a few 1e-3 m^2: near 1e300 times
+  EXPECT_TRUE(std::regex_search(l.size, std::regex(R"(^largest per-entry difference [1-9]\.[0-9]{2}e\+30[0-9] % \(block 3, J_)")))
+      << l.size;
+}
+
 // A value just beyond a bound printed as the bound ("motor_gain.C = -1 must be at least -1"):
 // its every digit is given where three would not tell them apart.
 TEST(Effects, APhysicalDomainSaysAValueThatPrintsAsItsBoundInFull) {
