@@ -224,7 +224,7 @@ DiagnoseJobResult diagnosis_files(const DiagnoseJob& job, const Vehicle& v, cons
   for (const auto& [name, svg] : plots) r.files.push_back({name, svg});
   for (const auto& [name, csv] : plot_data) r.files.push_back({name, csv});  // every plotted series, for Python or MATLAB
   std::ostringstream summary;
-  summary << diagnose::diagnosis_summary(d) << "diagnosed in " << d.seconds << " s";
+  summary << diagnose::diagnosis_summary(d) << "diagnosed in " << output::short_number(d.seconds) << " s";
   r.summary = summary.str();
   return r;
 }

@@ -758,10 +758,9 @@ struct StageClock {
   void say(const std::string& what) const {
     progress.say("[diagnose] " + std::to_string(static_cast<int>(seconds_since(start))) + " s: " + what);
   }
-  // "... (12 s)": how long the stage begun at `since` took.
-  static std::string took(Clock::time_point since) {
-    return " (" + std::to_string(static_cast<int>(seconds_since(since))) + " s)";
-  }
+  // "... (12.3 s)", "(0.41 s)": how long the stage begun at `since` took (whole seconds read
+  // "(0 s)" for every step of a short flight: a user trial, helper-106).
+  static std::string took(Clock::time_point since) { return " (" + output::short_number(seconds_since(since)) + " s)"; }
 };
 
 // Step 3: do the joined flights agree, or does this one flight show an airframe diagnosed before?

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <optional>
@@ -11,7 +12,9 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "diagnose/report_words.hpp"
 #include "fit/fit_report.hpp"
+#include "fit/least_squares.hpp"  // on_bound
 #include "output/estimate.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/plot.hpp"
@@ -23,6 +26,13 @@ using namespace words;
 namespace {
 
 std::string esc(const std::string& s) { return output::html_text(s); }
+
+// A flight's log by its file name: the full paths are listed once at the top of the report
+// (and on hover), where in every table row they pushed the numbers and the plot aside.
+std::string file_name_of(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  return name.empty() ? path : name;
+}
 
 // Beside a finding of the flight's own (its scope "flight"), in "In short" and its heading.
 std::string flights_own_tag(const Diagnosis& d, const std::string& effect) {
@@ -36,13 +46,6 @@ std::string verdict_cell(const DiscoveredTerm& t) {
   const bool begins = t.verdict.rfind(said, 0) == 0;
   const std::string rest = begins ? t.verdict.substr(said.size()) : ": " + t.verdict;
   return (t.proposed ? "<b>proposed</b>" : said) + output::html_text(rest);
-}
-
-// The unit of a residual channel, as the diagnosis names its channels.
-std::string channel_unit(const Diagnosis& d, const std::string& channel) {
-  for (size_t c = 0; c < d.channel_names.size() && c < d.channel_units.size(); ++c)
-    if (d.channel_names[c] == channel) return d.channel_units[c];
-  return "";
 }
 
 // A check's leads: each claim once, the numbers of each source that shows it below.
@@ -77,7 +80,8 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
   for (const auto& [flight, g] : rows) {
     if (!g->measured) continue;
     for (const auto& a : g->axes) {
-      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td>" + esc(flight) + "</td>") << "<td>" << esc(a.name) << "</td>";
+      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td title=\"" + esc(flight) + "\">" + esc(file_name_of(flight)) + "</td>")
+        << "<td>" << esc(a.name) << "</td>";
       for (const auto& b : a.bands)
         if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << num(b.r, 2) << ")</td>";
         else h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
@@ -148,28 +152,34 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   h << "</table>\n";
 }
 
-// A flight's log by its file name: the full paths are listed once at the top of the report
-// (and on hover), where in every table row they pushed the numbers and the plot aside.
-std::string file_name_of(const std::string& path) {
-  const std::string name = std::filesystem::path(path).filename().string();
-  return name.empty() ? path : name;
-}
-
 // Each named airframe parameter per flight as a forest plot in the table: the flight's 95 %
 // interval as a bar, its value as a dot, the joint value as a vertical line; agreeing
 // flights' bars all cross the line.
+// The joint fit's 95 % interval of `parameter` among the findings (NaN, NaN where none has it).
+std::pair<double, double> joint_interval(const std::vector<Finding>& findings, const std::string& parameter) {
+  for (const auto& f : findings)
+    for (const auto& p : f.parameters)
+      if (p.name == parameter) return {p.lower, p.upper};
+  return {NAN, NAN};
+}
+
+// `joint`: the findings whose intervals are drawn as the reference's band (none against an
+// airframe, whose interval this diagnosis does not have).
 void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgreement>& list,
-                          const std::vector<std::string>& flights, const std::string& reference_name) {
+                          const std::vector<std::string>& flights, const std::string& reference_name,
+                          const std::vector<Finding>& joint = {}) {
   for (const auto& a : list) {
+    const auto [band_lo, band_hi] = joint_interval(joint, a.parameter);
     double lo = a.joint_value, hi = a.joint_value;
     for (const auto& f : a.flights)
-      for (double v : {f.value, f.lower, f.upper})
+      for (double v : {f.value, f.lower, f.upper, band_lo, band_hi})
         if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
     const double pad = 0.05 * (hi - lo) + 1e-300;
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
+    // A suspect's agreement in grey: green read as an endorsement of what is not named.
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
-      << ": <span class=\"" << (a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
+      << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
@@ -180,14 +190,22 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
         << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
-        << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">"
-        << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
+        << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">";
+      if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind
+        h << "<div style=\"position:absolute;left:" << at(band_lo) << ";width:calc(" << at(band_hi) << " - " << at(band_lo)
+          << ");top:0;bottom:0;background:#f4d6d6\"></div>";
+      h << "<div style=\"position:absolute;left:" << at(a.joint_value) << ";top:0;bottom:0;border-left:1px solid #c00\"></div>";
       if (std::isfinite(f.lower) && std::isfinite(f.upper))
         h << "<div style=\"position:absolute;left:" << at(f.lower) << ";width:calc(" << at(f.upper) << " - " << at(f.lower)
           << ");top:5px;height:4px;background:#357\"></div>";
       h << "<div style=\"position:absolute;left:calc(" << at(f.value) << " - 4px);top:3px;width:8px;height:8px;"
         << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
     }
+    // The strips' scale (a user trial, helper-106: bars without an axis).
+    h << "<tr><td colspan=\"4\"><small>scale of the bars" << esc(output::unit_after_number(a.unit) == "" ? "" : " [" + a.unit + "]")
+      << (std::isfinite(band_lo) && std::isfinite(band_hi) ? "; shaded: the joint fit's 95 % interval" : "")
+      << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << num(lo, 3)
+      << "</small><small>" << num(hi, 3) << "</small></div></td></tr>\n";
     h << "</table>\n";
   }
 }
@@ -214,7 +232,7 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
        "wider, however well they agree: where every interval holds it and only the 30 % is missed, the verdict is "
        "\"too uncertain\", not \"disagree\".</p>\n";
-  agreement_table_html(h, d.agreement, d.flights, "joint");
+  agreement_table_html(h, d.agreement, d.flights, "joint", d.findings);
 }
 
 // The page's head, the title (the flights numbered: per-flight values refer to these
@@ -222,16 +240,19 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
 void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log_path) {
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>quadgen diagnosis: " << esc(d.vehicle)
     << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
-       "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+       "table{border-collapse:collapse;margin:1em 0;display:block;max-width:100%;overflow-x:auto}"  // narrow screens scroll a table
+       "table.glance td,table.glance th{text-align:left;vertical-align:top}.path{color:#555;overflow-wrap:anywhere}"
+       "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
        ".headline{font-size:1.1em}h1,li{overflow-wrap:anywhere}</style></head><body>\n";  // long paths wrap
   // Several flights: their count in the title (their paths, a wall of text there, numbered
   // below it: the per-flight values refer to these numbers).
-  const std::string subject = d.flights.size() > 1    ? std::to_string(d.flights.size()) + " flights"
-                              : d.flights.size() == 1 ? d.flights[0]  // the others left out, said below
-                                                      : log_path;
+  // One flight: its file name, and the path below it (a path broke the title mid-word).
+  const std::string one = d.flights.size() == 1 ? d.flights[0] : log_path;  // the others left out, said below
+  const std::string subject = d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights" : file_name_of(one);
   h << "<h1>Diagnosis of " << esc(subject) << " (" << esc(d.vehicle) << ")</h1>\n";
+  if (d.flights.size() <= 1 && subject != one) h << "<p class=\"path\">" << esc(one) << "</p>\n";
   if (d.flights.size() > 1) {
     h << "<ol>\n";
     for (const auto& f : d.flights) h << "<li>" << esc(f) << "</li>\n";
@@ -246,6 +267,97 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
   h << "; " << num(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
   if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
+}
+
+// "name = value unit" for up to four of an effect's values, then how many more: the glance
+// table's cells stay a few lines high where a joint diagnosis has one value per flight.
+template <class Value>
+std::string values_cell(const std::vector<Value>& values, const std::function<std::string(const Value&)>& one) {
+  constexpr size_t kShown = 4;
+  std::string cell;
+  for (size_t i = 0; i < values.size() && i < kShown; ++i) cell += (i ? "<br>" : "") + one(values[i]);
+  if (values.size() > kShown) cell += "<br>&hellip; " + std::to_string(values.size() - kShown) + " more (below)";
+  return cell.empty() ? "&ndash;" : cell;
+}
+
+std::string estimate_text(const EffectEstimate& p) {
+  return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit)) + " " + interval(p.lower, p.upper, 3);
+}
+
+// The values the extended model carries for an effect it does not name (its estimate in the
+// final fit; no interval: the values are not claimed).
+std::string carried_values(const Diagnosis& d, const std::string& effect) {
+  std::vector<fit::FitParameter> values;
+  for (const auto& p : d.airframe_fit)
+    if (p.free && p.name.rfind(effect + ".", 0) == 0) values.push_back(p);
+  return values_cell<fit::FitParameter>(values, [](const fit::FitParameter& p) {
+    return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit));
+  });
+}
+
+struct GlanceRow {
+  std::string effect, css, verdict, values, held_out;
+};
+
+// Every effect the diagnosis has a verdict on, in one table at the top (a user trial,
+// helper-106: how sure, what was rejected and what the model carries unnamed were spread
+// over five sections, one of them folded): named, in the model but not named (an ambiguous
+// pair's carried member, a stand-in, a carried suspect), and suspected.
+std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
+  std::vector<GlanceRow> rows;
+  std::vector<std::string> said;
+  for (const auto& f : d.findings) {
+    std::string verdict = "named";
+    for (const auto& a : d.agreement)
+      if (a.effect == f.effect && !a.agree) verdict += "; the flights disagree on " + esc(a.parameter);
+    rows.push_back({f.effect, verdict == "named" ? "ok" : "warn", verdict,
+                    values_cell<EffectEstimate>(f.parameters, estimate_text),
+                    num(f.before, 3) + " &rarr; " + num(f.after, 3) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
+                        (f.metric == d.metric ? "" : "<br><small>" + esc(f.metric) + "</small>")});
+    said.push_back(f.effect);
+  }
+  for (const auto& st : d.stand_ins) {
+    rows.push_back({st.candidate.effect, "warn",
+                    "in the model, not named: a stand-in for missing physics (" + esc(st.parameter) + " outside [" +
+                        num(st.plausible_lower, 3) + ", " + num(st.plausible_upper, 3) + "])",
+                    carried_values(d, st.candidate.effect), "&ndash;"});
+    said.push_back(st.candidate.effect);
+  }
+  for (const auto& a : d.search.unresolved) {
+    rows.push_back({a.a, "warn", "in the model, not named: the data cannot tell it from " + esc(a.b),
+                    carried_values(d, a.a), "&ndash;"});
+    said.push_back(a.a);
+  }
+  for (const auto& x : d.suspected) {
+    rows.push_back({x.candidate.effect, x.carried ? "warn" : "no",
+                    std::string(x.carried ? "suspected, carried in the model for a named look-alike's values"
+                                          : "suspected, not in the model") +
+                        ": " + esc(x.failed),
+                    x.carried ? carried_values(d, x.candidate.effect)
+                              : values_cell<EffectEstimate>(x.candidate.parameters, [](const EffectEstimate& p) {
+                                  return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit));
+                                }),
+                    "&ndash;"});
+    said.push_back(x.candidate.effect);
+  }
+  for (const auto& e : d.search.selected)  // anything else the model carries
+    if (std::find(said.begin(), said.end(), e) == said.end())
+      rows.push_back({e, "warn", "in the model, not named", carried_values(d, e), "&ndash;"});
+  return rows;
+}
+
+void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
+  const auto rows = glance_rows(d);
+  if (rows.empty()) return;
+  h << "<table class=\"glance\"><tr><th>effect</th><th>verdict</th><th>values, 95 % interval where named</th>"
+       "<th>held out: the final model without it &rarr; with it</th><th>of the</th></tr>\n";
+  for (const auto& r : rows)
+    h << "<tr><td><b>" << esc(r.effect) << "</b></td><td class=\"" << r.css << "\">" << r.verdict << "</td><td>"
+      << r.values << "</td><td>" << r.held_out << "</td><td>" << esc(scope(r.effect)) << "</td></tr>\n";
+  h << "</table>\n<p><small>Held out: " << esc(d.metric)
+    << ". Each effect's figure is the final model with and without it, not its share of the whole gain: effects "
+       "overlap. \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight. Words: "
+       "<a href=\"#words\">at the end</a>.</small></p>\n";
 }
 
 // One line per named cause and the held-out gain, then the command's own printout (for a
@@ -275,12 +387,16 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   if (d.has_prediction)
     if (const std::string against = predict::open_loop_against_no_model(d.prediction_after); !against.empty())
       h << "<li>" << esc(against) << "</li>\n";
+  // Where the extended model is worse, said beside the gain (a user trial, helper-106: a
+  // channel 44 % worse was only in a table near the end).
+  if (const std::string worse = worse_channels(d); !worse.empty())
+    h << "<li class=\"warn\">Worse with the extended model on the held-out part: " << esc(worse) << ".</li>\n";
+  h << "</ul>\n";
+  at_a_glance_html(h, d);
   // The command's own printout, for a reader who compares it with a terminal; the sections
   // below say the same in tables.
-  h << "</ul>\n<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
+  h << "<details><summary>Verdict as the command printed it</summary>\n<pre>" << output::html_preformatted(diagnosis_summary(d))
     << "</pre></details>\n";
-  h << "<p>Overall gain: " << esc(d.metric) << " " << num(d.metric_before) << " &rarr; " << num(d.metric_after) << " ("
-    << lower_or_higher(d.metric_before, d.metric_after, 3) << ").</p>\n";
 }
 
 void findings_html(std::ostringstream& h, const Diagnosis& d) {
@@ -319,6 +435,24 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
       << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ".</p>\n";
   }
+}
+
+// The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...), as the
+// extended model carries them, with those on a bound marked (a user trial, helper-106: the
+// baseline every gain is measured against was not shown, and its c_w sat on a bound). A joint
+// diagnosis' per-flight copies ("c_t@2") are one row each.
+void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
+  std::vector<const fit::FitParameter*> base;
+  for (const auto& p : d.airframe_fit)
+    if (p.free && runtime::shared_name(p.name).find('.') == std::string::npos) base.push_back(&p);
+  if (base.empty()) return;
+  h << "<h2>The vehicle's own parameters, as fitted</h2>\n<p>The vehicle file's parameters the fit freed, at their "
+       "values in the extended model. One on its bound was held there: the model is strained, and a finding may stand "
+       "in for what it lacks.</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
+  for (const auto* p : base)
+    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value) << "</td><td>" << esc(p->unit) << "</td><td>"
+      << interval(p->lower, p->upper) << "</td><td" << (fit::on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
+  h << "</table>\n";
 }
 
 void next_steps_html(std::ostringstream& h, const Diagnosis& d) {
@@ -430,7 +564,8 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
     h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
-      << "</td><td>" << num(c.after) << "</td><td>" << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
+      << "</td><td>" << num(c.after) << "</td><td" << (reduction(c.before, c.after) < -1 ? " class=\"warn\"" : "") << ">"
+      << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
   h << "</table>\n";
 }
 
@@ -472,10 +607,47 @@ void plots_html(std::ostringstream& h, const std::vector<std::pair<std::string, 
   for (const auto& [name, svg] : plots) {
     const size_t at = svg.find("<svg");
     const std::string stem = name.substr(0, name.rfind('.'));
-    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>" << esc(name);
+    const std::string look_for = what_to_look_for(name);
+    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>"
+      << (look_for.empty() ? "" : "<b>What to look for:</b> " + esc(look_for) + ". ") << esc(name);
     h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
     h << "</figcaption></figure>\n";
   }
+}
+
+// The words a reader meets in this page, each in a line (a user trial, helper-106: LR
+// statistic, carried, stand-in, x noise were used undefined). docs/diagnosis.md, "Reading the
+// output", has the longer table.
+void words_html(std::ostringstream& h) {
+  static const std::pair<const char*, const char*> kWords[] = {
+      {"training part, held-out part", "the first 70 % of each flight, which the fit sees, and the last 30 %, which "
+                                       "only judges (also called the validation part)"},
+      {"equation error, one step", "the model's accelerations against the measured ones, sample by sample, no "
+                                   "simulation: what the fit minimises"},
+      {"open loop", "the model run forward from a measured state, fed only the logged commands"},
+      {"named", "significant on the training part, better on the held-out part, its interval closed and excluding "
+                "\"off\", its value plausible: a cause"},
+      {"suspected", "significant on the training part, but it failed a later test (the reason is given); not named"},
+      {"ambiguous, carried", "two effects the flight cannot tell apart: neither is named, the stronger stays in the "
+                             "extended model (carried, its values not claimed); the manoeuvre that separates them is "
+                             "given"},
+      {"stand-in", "passed every test, but its value is beyond what its physics gives here (a steady wind indoors): "
+                   "it absorbs something the model lacks; carried, not named"},
+      {"of the airframe, of the flight", "a property every flight of the vehicle shares, or a condition of this "
+                                         "flight (motor trims, the marker frame, a wind)"},
+      {"LR statistic, p, level", "how much adding the effect lowers the noise-weighted residual (likelihood ratio), "
+                                 "its p-value, and the level it must beat (corrected for the candidates tried)"},
+      {"&Delta;BIC, &Delta;AIC", "the change of the Bayesian and Akaike information criteria with the effect: "
+                                 "negative favours it"},
+      {"identifiable", "its profile likelihood closes on both sides: the data decide its value"},
+      {"slow RMS, x noise", "the RMS of a residual's slow part, and how many times what white noise of the same "
+                            "size would leave there"},
+      {"Wald interval, Cochran's Q", "value plus or minus 1.96 standard errors; a test of whether the flights' "
+                                     "values are one (a small p: they differ beyond their errors)"},
+  };
+  h << "<h2 id=\"words\">Words used here</h2>\n<table class=\"glance\">\n";
+  for (const auto& [word, meaning] : kWords) h << "<tr><td><b>" << word << "</b></td><td>" << meaning << "</td></tr>\n";
+  h << "</table>\n";
 }
 
 void method_html(std::ostringstream& h) {
@@ -496,6 +668,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   in_short_html(h, d);
   next_steps_html(h, d);
   findings_html(h, d);
+  base_parameters_html(h, d);
   agreement_html(h, d);
   stand_ins_html(h, d);
   ambiguous_html(h, d);
@@ -507,6 +680,7 @@ std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
   base_residuals_html(h, d);
   candidates_html(h, d);
   plots_html(h, plots);
+  words_html(h);
   method_html(h);
   return h.str();
 }

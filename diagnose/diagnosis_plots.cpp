@@ -94,11 +94,25 @@ std::vector<runtime::Panel> autocorrelation_panels(const Diagnosis& d) {
     std::vector<double> lag, band, nband;
     const double dt = d.t.size() > 1 ? (d.t.back() - d.t.front()) / static_cast<double>(d.t.size() - 1) : 0.01;
     for (size_t k = 0; k < b.acf.size(); ++k) lag.push_back(static_cast<double>(k) * dt), band.push_back(b.acf_band), nband.push_back(-b.acf_band);
-    acf.push_back({b.name + " autocorrelation", "lag [s]", "1",
-                   {series("base model", lag, b.acf), series("extended model", lag, a.acf), series("95 % white-noise band", lag, band),
-                    series("", lag, nband)}});
+    // The band's two lines in one colour, the legend's (the lower one had gnuplot's next).
+    runtime::Series upper = series("95 % white-noise band", lag, band), lower = series("", lag, nband);
+    upper.color = lower.color = "#7f7f7f";
+    acf.push_back({b.name + " autocorrelation", "lag [s]", "correlation",
+                   {series("base model", lag, b.acf), series("extended model", lag, a.acf), upper, lower}});
   }
   return acf;
+}
+
+// The found parameters' profiles, each axis with its parameter's unit (the profiles carry
+// names only; the final fit carries units).
+std::vector<runtime::Panel> profile_panels(const Diagnosis& d) {
+  std::vector<runtime::Panel> panels = fit::profile_panels(d.search.profiles);
+  for (auto& panel : panels) {
+    for (const auto& p : d.airframe_fit)  // the final fit's parameters: named and carried
+      if (p.name == panel.xlabel && !p.unit.empty() && p.unit != "1") panel.xlabel += " [" + p.unit + "]";
+    panel.ylabel = "cost rise (delta chi2)";
+  }
+  return panels;
 }
 
 // The answer to the commands, band by band: one series per flight, 1 where the model is right.
@@ -149,15 +163,46 @@ class PlotRenderer {
  private:
   inline static const std::map<std::string, std::string> kColours = {{"measured", "#000000"},
                                                                      {"base model", "#d62728"},
-                                                                     {"extended model", "#1f77b4"},
-                                                                     {"95 % white-noise band", "#7f7f7f"},
-                                                                     {"", "#7f7f7f"}};
+                                                                     {"extended model", "#1f77b4"}};
   std::string* error_;
   std::vector<std::pair<std::string, std::string>>* data_;
   std::vector<std::pair<std::string, std::string>> svgs_;
 };
 
 }  // namespace
+
+std::string what_to_look_for(const std::string& plot_name) {
+  // Beside each render call below, in the order they are made (a user trial, helper-106:
+  // every caption was the file name alone).
+  static const std::map<std::string, std::string> kLookFor = {
+      {"validation.svg",
+       "the held-out part: the measured position (black dots) against the base model (red) and the extended model "
+       "(blue), each simulated open loop from measured states in windows; the closer a model's line stays on the "
+       "dots, the better it predicts"},
+      {"simulation_errors.svg",
+       "how far each model's simulation has drifted within each window of the held-out part: the extended model's "
+       "error (blue) should stay below the base model's (red)"},
+      {"residuals.svg",
+       "what each model gets wrong sample by sample (the equation error) over the whole flight: structure left in "
+       "the extended model's residual (blue) is what it still lacks; dashed: where the held-out part starts"},
+      {"autocorrelation.svg",
+       "how long each residual stays correlated with itself: a model that explains the flight leaves white noise, "
+       "inside the grey band after a few samples; a slow decay is structure the model does not explain"},
+      {"command_gain.svg",
+       "how strongly the vehicle answered a change of command, band by band, over the base model's answer: 1 where "
+       "the motor map's slope is right (a closed loop reads low in band, so below 1 is a lead, not a measurement)"},
+      {"prediction.svg",
+       "position and attitude error against the prediction horizon, mean over start points on the held-out part, "
+       "for each model and the baselines; lower is better. A tilt or heading error is an angle, at most pi: a "
+       "model that has turned over can read lower at a longer horizon"},
+      {"profiles.svg",
+       "each named parameter's profile likelihood: the 95 % interval is where the curve stays below the pointwise "
+       "line; a flat curve means the data barely decide the value"},
+  };
+  const auto it = kLookFor.find(plot_name);
+  return it == kLookFor.end() ? "" : it->second;
+}
+
 
 std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     const Diagnosis& d, const fit::Flight& valid, std::string* error,
@@ -175,7 +220,7 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     plots.render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
                  predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
   if (!d.search.profiles.empty())
-    plots.render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", fit::profile_panels(d.search.profiles));
+    plots.render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", profile_panels(d));
   return std::move(plots).svgs();
 }
 

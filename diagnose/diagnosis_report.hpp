@@ -22,6 +22,10 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     const Diagnosis& d, const fit::Flight& validation, std::string* error,
     std::vector<std::pair<std::string, std::string>>* data = nullptr);
 
+// What a reader should look for in one of diagnosis_plots' plots, by its file name ("" for
+// one it does not make): the report's caption under the plot.
+std::string what_to_look_for(const std::string& plot_name);
+
 std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
                            const std::vector<std::pair<std::string, std::string>>& plots);
 

@@ -145,6 +145,13 @@ std::string diagnosis_summary(const Diagnosis& d) {
   if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
     os << "no significant discrepancy: the base model explains the flight\n";
   write_findings(os, d);
+  // The whole gain, and where it is paid for (a user trial, helper-106: only report.html said
+  // either).
+  if (!d.search.selected.empty())
+    os << "held out, the extended model against the base model: " << d.metric << " " << num(d.metric_before) << " -> "
+       << num(d.metric_after) << " (" << lower_or_higher(d.metric_before, d.metric_after, 3) << ")\n";
+  if (const std::string worse = worse_channels(d); !worse.empty())
+    os << "worse with the extended model on the held-out part: " << worse << "\n";
   write_agreement(os, d);
   write_not_named(os, d);
   write_what_is_left(os, d);

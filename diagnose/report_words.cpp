@@ -285,6 +285,13 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   if (airframe_named && d.flights.size() <= 1 && !(d.airframe_flights > 1))
     out.push_back("diagnose this flight with other flights of the vehicle (" + kJointDiagnosis +
                   "): an airframe's cause holds on each of them, with the same value");
+  // A named cause the flights disagree on (a user trial, helper-106: the report named it and
+  // said the disagreement, but gave nothing to do about it).
+  for (const auto& a : d.agreement)
+    if (a.named && !a.agree && !a.within_errors)
+      out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
+                    "differs between the flights that lie apart (speed, battery, payload, the day) and diagnose them " +
+                    "apart, or together without the odd one");
   for (const auto& x : d.suspected)
     if (!x.carried)
       out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")");
@@ -362,6 +369,22 @@ std::string spread_context(const ParameterAgreement& a) {
 }
 
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
+std::string channel_unit(const Diagnosis& d, const std::string& channel) {
+  for (size_t c = 0; c < d.channel_names.size() && c < d.channel_units.size(); ++c)
+    if (d.channel_names[c] == channel) return d.channel_units[c];
+  return "";
+}
+
+std::string worse_channels(const Diagnosis& d) {
+  constexpr double kNegligiblePercent = 1;  // as the acceptance's negligible change
+  std::string out;
+  for (const auto& c : d.channel_gain)
+    if (reduction(c.before, c.after) < -kNegligiblePercent)
+      out += (out.empty() ? "" : "; ") + c.channel + " " + num(c.before) + " -> " + num(c.after) +
+             output::unit_after_number(channel_unit(d, c.channel)) + " (" + lower_or_higher(c.before, c.after, 3) + ")";
+  return out;
+}
+
 std::string interval(double lower, double upper, int prec) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
   return "[" + side(lower) + ", " + side(upper) + "]";

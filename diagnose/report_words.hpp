@@ -65,6 +65,13 @@ std::vector<std::string> screening_notes(const Diagnosis& d);
 // steady wind): what counted as plausible, and how to say "indoor". "" otherwise. A user's
 // own mapping may lack the key, and a wind indoors would then be named, not a stand-in.
 std::string environment_note(const Diagnosis& d);
+// The unit of a residual channel, as the diagnosis names its channels ("" for none).
+std::string channel_unit(const Diagnosis& d, const std::string& channel);
+// The held-out channels the extended model gets more than 1 % worse than the base model
+// ("az_world 0.2575 -> 0.371 m/s^2 (44.1 % higher)", joined by "; "), "" where none is: said
+// beside the overall gain, which averages over them.
+std::string worse_channels(const Diagnosis& d);
+
 // What to do next, one line per outcome the diagnosis has (docs/diagnosis.md, "What to do
 // next", keyed to this diagnosis): fly the manoeuvre that separates a pair, confirm an
 // airframe's finding on a second flight, distrust a stand-in's value, ... Said at the end of

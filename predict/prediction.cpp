@@ -537,23 +537,25 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   runtime::Panel open{"open loop: mean position error at a horizon", "horizon [s]", "m", {}};
   runtime::Panel reduced{"without the moment model, and with no model: mean position error", "horizon [s]", "m", {}};
   runtime::Panel replay{"attitude replayed (force model alone): mean position error", "horizon [s]", "m", {}};
-  runtime::Panel tilt{"open loop: mean tilt and heading error", "horizon [s]", "rad", {}};
+  runtime::Panel tilt{"open loop: mean tilt and heading error (angles: at most pi)", "horizon [s]", "rad", {}};
   runtime::Panel moments{"translation replayed (moment model alone): mean tilt error", "horizon [s]", "rad", {}};
-  // One series of a view's mean errors (of `quantity`); markers where `points`. Empty views
-  // (not run) add nothing.
+  // One series of a view's mean errors (of `quantity`); markers of type `marker` where
+  // `points`, so that one model's views keep its colour and still differ. Empty views (not
+  // run) add nothing.
+  enum Marker { kCircle = 7, kSquare = 5, kTriangle = 9, kDiamond = 13, kStar = 3 };
   const auto add = [](runtime::Panel& panel, const std::string& label, const std::vector<HorizonErrors>& rows,
-                      ErrorStats HorizonErrors::*quantity, bool points) {
-    runtime::Series s{label, {}, {}, points};
+                      ErrorStats HorizonErrors::*quantity, bool points, int marker = kCircle) {
+    runtime::Series s{label, {}, {}, points, {}, marker};
     for (const auto& h : rows) s.x.push_back(h.horizon), s.y.push_back((h.*quantity).mean());
     if (!s.x.empty()) panel.series.push_back(s);
   };
   for (const auto& [label, p] : predictions) {
     add(open, label, p->open_loop, &HorizonErrors::position, false);
     add(open, label + ", past disturbance held", p->open_loop_past_disturbance, &HorizonErrors::position, true);
-    add(open, label + ", set points flown", p->set_points_flown, &HorizonErrors::position, true);
+    add(open, label + ", set points flown", p->set_points_flown, &HorizonErrors::position, true, kSquare);
     add(reduced, label + ", open loop", p->open_loop, &HorizonErrors::position, false);
-    add(reduced, label + ", body rates held", p->body_rates_held, &HorizonErrors::position, true);
-    add(reduced, label + ", attitude held", p->attitude_held, &HorizonErrors::position, true);
+    add(reduced, label + ", body rates held", p->body_rates_held, &HorizonErrors::position, true, kTriangle);
+    add(reduced, label + ", attitude held", p->attitude_held, &HorizonErrors::position, true, kSquare);
     add(replay, label, p->attitude_replayed, &HorizonErrors::position, false);
     // Heading as markers, so that it keeps its model's colour beside the tilt's line.
     add(tilt, label + ", tilt", p->open_loop, &HorizonErrors::tilt, false);
@@ -562,10 +564,14 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   }
   // No model: the same for every model of the same log, drawn once.
   if (!predictions.empty())
-    add(reduced, "constant velocity (no model)", predictions.front().second->constant_velocity, &HorizonErrors::position, true);
+    add(reduced, "constant velocity (no model)", predictions.front().second->constant_velocity, &HorizonErrors::position, true,
+        kDiamond);
+  if (!reduced.series.empty() && reduced.series.back().label == "constant velocity (no model)")
+    reduced.series.back().color = "#555555";
   // Published for the Crazyflie only; drawn for every vehicle as the scale of the state of the
   // art, and labelled with the vehicle they are of.
-  runtime::Series published{"published for the Crazyflie (IDSIA, NanoBench)", {}, {}, true};
+  // One colour and marker in every panel and plot (gnuplot's next colour differed by panel).
+  runtime::Series published{"published for the Crazyflie (IDSIA, NanoBench)", {}, {}, true, "#ff7f0e", kStar};
   for (const auto& pt : published_position_errors()) published.x.push_back(pt.horizon_s), published.y.push_back(pt.position_m);
   open.series.push_back(published);
   reduced.series.push_back(published);

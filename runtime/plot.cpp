@@ -247,7 +247,10 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
   script << "set encoding utf8\n"
          << "set terminal svg size 900," << height << " dynamic noenhanced font 'sans,11'\n"
          << "set multiplot layout " << panels.size() << ",1 title " << gnuplot_string(title) << " noenhanced\n"
-         << "set grid\nset key outside right noenhanced\n";
+         << "set grid\nset key outside right noenhanced\n"
+         // Four significant digits on the ticks: gnuplot's default wrote 1.05e-6 and 1.1e-6 both
+         // as 0.0000011 (a user trial, helper-106).
+         << "set format x '%.4g'\nset format y '%.4g'\n";
   int block = 0;
   for (const Panel& p : panels) {
     script << "set title " << gnuplot_string(p.title) << " noenhanced\n"
@@ -267,7 +270,7 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
       }
       script << "EOD\n";
       plot << (plot.tellp() > 0 ? ", " : "") << name << " using 1:2 with "
-           << (s.points ? "points pt 7 ps 0.5" : "lines lw 1.5");
+           << (s.points ? "points pt " + std::to_string(std::clamp(s.marker, 1, 15)) + " ps 0.5" : std::string("lines lw 1.5"));
       if (is_rgb(s.color)) plot << " lc rgb '" << s.color << "'";
       plot << " title " << gnuplot_string(s.label) << " noenhanced";
     }

@@ -13,6 +13,9 @@ struct Series {
   std::vector<double> x, y;
   bool points = false;  // markers instead of a line (measurements)
   std::string color = {};  // "#rrggbb", so that one model has one colour in every plot; empty: gnuplot's
+  // gnuplot's point type for markers (7 a filled circle, 5 a square, 9 a triangle, 13 a
+  // diamond, 3 a star): two series of one colour stay two (a user trial, helper-106).
+  int marker = 7;
 };
 
 struct Panel {

@@ -1439,6 +1439,79 @@ TEST(DiagnosisReport, AJointCauseTheFlightsDisagreeOnIsFlaggedWhereItIsNamed) {
   EXPECT_EQ(quadgen::diagnose::diagnosis_html(d, "log.csv", {}).find(says_html), std::string::npos);
 }
 
+// What a reader needs within the first screen (a user trial, helper-106): every verdict in one
+// table (named with its interval and held-out figures, carried unnamed with its values, a
+// stand-in, a suspect), the channels the extended model made worse, and the whole gain in
+// the terminal summary too; the words and plots explained; the base model's freed parameters
+// with the one on its bound marked; a named cause the flights disagree on gets a next step.
+TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
+  namespace dg = quadgen::diagnose;
+  const auto estimate = [](const std::string& name, const std::string& unit, double value, double lower, double upper) {
+    dg::EffectEstimate e;
+    e.name = name, e.unit = unit, e.value = value, e.lower = lower, e.upper = upper;
+    return e;
+  };
+  dg::Diagnosis d;
+  d.metric = "position RMSE [m]", d.metric_before = 1.2, d.metric_after = 0.45;
+  dg::Finding f;
+  f.effect = "rotor_drag", f.metric = d.metric, f.before = 0.48, f.after = 0.45;
+  f.parameters.push_back(estimate("rotor_drag.k", "N s^2/m", 1.28e-6, 1.11e-6, 1.35e-6));
+  d.findings.push_back(f);
+  dg::Ambiguity a;
+  a.a = "wind", a.b = "attitude_bias";
+  d.search.unresolved.push_back(a);
+  dg::Suspected x;
+  x.candidate.effect = "motor_gain", x.failed = "improves the training data (p = 1e-9) but not the held-out part";
+  x.candidate.parameters.push_back(estimate("motor_gain.M2", "1", 0.027, NAN, NAN));
+  d.suspected.push_back(x);
+  d.search.selected = {"rotor_drag", "wind"};
+  d.airframe_fit = {{"wind.x", "m/s", -0.296, -5, 5, true}, {"c_w", "1", 3.0, 0, 3, true}, {"mass", "kg", 0.03, 0, 0, false}};
+  d.channel_names = {"az_world"}, d.channel_units = {"m/s^2"};
+  d.channel_gain = {{"az_world", 0.2575, 0.371}};
+  const std::string html = dg::diagnosis_html(d, "dir/B3.csv", {{"validation.svg", "<svg></svg>"}});
+  const size_t glance = html.find("<table class=\"glance\">"), findings = html.find("<h2>Findings</h2>");
+  ASSERT_NE(glance, std::string::npos);
+  EXPECT_LT(glance, findings);
+  const std::string table = html.substr(glance, html.find("</table>", glance) - glance);
+  EXPECT_NE(table.find("<td><b>rotor_drag</b></td><td class=\"ok\">named</td><td>rotor_drag.k = 1.28e-06 N s^2/m "
+                       "[1.11e-06, 1.35e-06]</td><td>0.48 &rarr; 0.45 (6.25 % lower)</td><td>airframe</td>"),
+            std::string::npos) << table;
+  EXPECT_NE(table.find("<td><b>wind</b></td><td class=\"warn\">in the model, not named: the data cannot tell it from "
+                       "attitude_bias</td><td>wind.x = -0.296 m/s</td>"),
+            std::string::npos) << table;
+  EXPECT_NE(table.find("<td class=\"no\">suspected, not in the model: improves the training data (p = 1e-9) but not the "
+                       "held-out part</td><td>motor_gain.M2 = 0.027</td>"),
+            std::string::npos) << table;
+  EXPECT_NE(html.find("Worse with the extended model on the held-out part: az_world 0.2575 -&gt; 0.371 m/s^2 (44.1 % higher)"),
+            std::string::npos);
+  EXPECT_EQ(html.find("Overall gain"), std::string::npos);  // said once, in "In short"
+  EXPECT_NE(html.find("<h1>Diagnosis of B3.csv ("), std::string::npos);
+  EXPECT_NE(html.find("<p class=\"path\">dir/B3.csv</p>"), std::string::npos);
+  EXPECT_NE(html.find("<h2 id=\"words\">Words used here</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<figcaption><b>What to look for:</b> the held-out part"), std::string::npos);
+  const size_t base = html.find("<h2>The vehicle's own parameters, as fitted</h2>");
+  ASSERT_NE(base, std::string::npos);
+  EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on its bound</td></tr>", base),
+            std::string::npos);
+  EXPECT_EQ(html.find("<tr><td>mass</td>", base), std::string::npos);  // held, not fitted
+  const std::string summary = dg::diagnosis_summary(d);
+  EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
+                         "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s^2 (44.1 % higher)\n"),
+            std::string::npos) << summary;
+  // A named cause the flights disagree on: a next step; one too uncertain to agree: none.
+  dg::ParameterAgreement disagree;
+  disagree.parameter = "rotor_drag.k", disagree.effect = "rotor_drag", disagree.named = true;
+  d.agreement.push_back(disagree);
+  const auto steps = dg::words::next_steps(d);
+  EXPECT_TRUE(std::any_of(steps.begin(), steps.end(), [](const std::string& s) {
+    return s.rfind("the flights disagree on rotor_drag.k: its joint value is no one airframe's", 0) == 0;
+  }));
+  d.agreement.back().within_errors = true;
+  const auto uncertain = dg::words::next_steps(d);
+  EXPECT_TRUE(std::none_of(uncertain.begin(), uncertain.end(),
+                           [](const std::string& s) { return s.find("the flights disagree") != std::string::npos; }));
+}
+
 // Joined flights hold their held-out parts apart in time, so a block of equal duration may
 // hold no sample; simulating such a flight gives no windows (it read the first sample of an
 // empty flight, and a two-flight diagnosis crashed).
