@@ -35,8 +35,11 @@ std::string fmt(const char* f, Numbers... numbers) {
 double pct(double ours, double theirs) { return 100.0 * (theirs - ours) / ours; }
 // A percentage in a sentence: whole per cent, three digits beyond 1000 % (a block of 1e-300 kg
 // gave 300 digits: hostile-input audit, helper-105).
-std::string percent(double d) { return std::fabs(d) < 1000 ? fmt("%.0f %%", d) : fmt("%.3g %%", d); }
-std::string signed_percent(double d) { return std::fabs(d) < 1000 ? fmt("%+.0f %%", d) : fmt("%+.3g %%", d); }
+// A difference from a derived value of 0 (a block whose inertia underflows) has no percentage.
+std::string percent(double d) {
+  return !std::isfinite(d) ? "unbounded (the derived value is 0)" : std::fabs(d) < 1000 ? fmt("%.0f %%", d) : fmt("%.3g %%", d);
+}
+std::string signed_percent(double d) { return std::isfinite(d) && d < 0 ? "-" + percent(-d) : std::isfinite(d) ? "+" + percent(d) : percent(d); }
 
 // The thesis' J about the origin, (42), (43), (45) [kg m^2]: compared in (41)-(45), and its
 // J_yy is the one (65) divides by.
@@ -220,6 +223,7 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
   const char* entry[3] = {"J_xx", "J_yy", "J_zz"};
   std::ostringstream thesis, ours;
   double worst = 0;
+  bool compared = false;  // some thesis block had the file's blocks to compare with
   int worst_block = 0, worst_entry = 0;
   // Blocks 3 and 4 are axis-aligned cuboids: the thesis' parallelograms do not touch them, so
   // a difference there has a cause the audit does not know (a reviewer's trial, helper-103: the
@@ -233,10 +237,10 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
   bool aligned_are_the_theses = true;
   for (int g = 0; g < 6; ++g) {
     double J[4] = {0, 0, 0, 0};
-    int found = 0;
+    bool found[2] = {false, !*groups[g][1]};  // each of the group's names, once (two blocks of one name are one)
     for (const auto& bc : mp.blocks)
       if (bc.name == groups[g][0] || bc.name == groups[g][1]) {
-        ++found;
+        found[bc.name == groups[g][0] ? 0 : 1] = true;
         J[0] += bc.inertia_origin_value[0][0];
         J[1] += bc.inertia_origin_value[1][1];
         J[2] += bc.inertia_origin_value[2][2];
@@ -244,12 +248,13 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
       }
     // A file whose blocks are named otherwise has no such thesis block to compare (a renamed
     // body read "block 3 (lower_body) J_xx by inf %": helper-105).
-    if (found < (*groups[g][1] ? 2 : 1)) {
+    if (!found[0] || !found[1]) {
       missing += std::string(missing.empty() ? "" : ", ") + groups[g][0] + (*groups[g][1] ? std::string("/") + groups[g][1] : "");
       thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[g][0], t1[g][1]) << fmt("%.4g, %.3g; ", t1[g][2], t1[g][3]);
       ours << fmt("%.0f: -; ", g + 1);
       continue;
     }
+    compared = true;
     thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[g][0], t1[g][1]) << fmt("%.4g, %.3g; ", t1[g][2], t1[g][3]);
     ours << fmt("%.0f: %.4g, %.4g, ", g + 1, J[0], J[1]) << fmt("%.4g, %.3g; ", J[2], J[3]);
     const bool aligned = g == 2 || g == 3;
@@ -279,8 +284,10 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
                                                           "(appendix A) gives the derived value"
                                                         : "")) +
                      (missing.empty() ? "" : "; the vehicle file has no block named " + missing + ", so those are not compared"),
-                 "largest per-entry difference " + percent(worst) + fmt(" (block %.0f, ", worst_block + 1) + entry[worst_entry] +
-                     ")" + (missing.empty() ? "" : "; blocks not in the file: " + missing),
+                 (compared ? "largest per-entry difference " + percent(worst) + fmt(" (block %.0f, ", worst_block + 1) +
+                                 entry[worst_entry] + ")"
+                           : std::string("no block compared")) +
+                     (missing.empty() ? "" : "; blocks not in the file: " + missing),
                  std::string(kFromArithmetic) + ": the blocks' integrated tensors about the origin, summed per "
                                                 "thesis block, every diagonal entry within 1 % (J_xz shown, not judged)"});
   // The thesis' J is about the origin: compared with the blocks' tensor about the origin, like

@@ -59,6 +59,10 @@ inline const char* agreement_verdict(const ParameterAgreement& a) {
   return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
 }
 
+// The flights' values differ beyond their errors (not merely "too uncertain"): said beside a
+// named cause wherever it is named, and given a next step.
+inline bool flights_disagree(const ParameterAgreement& a) { return !a.agree && !a.within_errors; }
+
 // Why a verdict is "too uncertain" ("" for the other two): an airframe value or a flight that
 // has no standard error cannot say, else the values are within the errors but 30 % or more apart.
 inline const char* why_too_uncertain(const ParameterAgreement& a) {

@@ -66,13 +66,12 @@ bool beyond_spread(double mean, double standard_error) { return mean > 0 && mean
 bool not_worse_beyond_spread(double mean, double standard_error) { return mean >= -standard_error; }
 
 // A kind of channel pays for a gain when its error gets worse beyond its spread and by more
-// than kNegligibleChange per cent: a refit moves a channel its effect does not act on by
+// than kNegligibleChangePercent: a refit moves a channel its effect does not act on by
 // hundredths of a per cent, alike in every fold, so that the spread is tinier still (the yaw
 // of B3 rep 2's marker frame, -0.05 % +- 0.02 %, refused the marker frame on the helix in a
 // run with fewer candidates).
-constexpr double kNegligibleChange = 1.0;  // per cent of the group's sum of squares
-bool pays_for_it(const Finding::FoldGains& g) {
-  return !not_worse_beyond_spread(g.mean, g.standard_error) && g.mean < -kNegligibleChange;
+bool pays_for_it(const Finding::FoldGains& g) {  // g in per cent of the group's sum of squares
+  return !not_worse_beyond_spread(g.mean, g.standard_error) && g.mean < -kNegligibleChangePercent;
 }
 
 // Which kinds of channel a held-out gain was bought with ("" when none is worse beyond its

@@ -23,6 +23,11 @@
 
 namespace quadgen::diagnose {
 
+// A change smaller than this, in per cent, is no change worth a word: a refit moves a channel
+// its effect does not act on by hundredths of a per cent. Used where a gain is said to be paid
+// for by a kind of channel, and where the report says which held-out channels got worse.
+inline constexpr double kNegligibleChangePercent = 1.0;
+
 struct DiagnoseOptions {
   double validation_fraction = 0.3;  // end of the flight, held out
   double window = 1.0;               // s, validation simulation windows

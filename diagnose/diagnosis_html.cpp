@@ -12,7 +12,6 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "diagnose/report_words.hpp"
 #include "fit/fit_report.hpp"
-#include "fit/least_squares.hpp"  // on_bound
 #include "output/estimate.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
@@ -269,79 +268,82 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
   if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
 }
 
-// "name = value unit" for up to four of an effect's values, then how many more: the glance
-// table's cells stay a few lines high where a joint diagnosis has one value per flight.
-template <class Value>
-std::string values_cell(const std::vector<Value>& values, const std::function<std::string(const Value&)>& one) {
+// Up to four of an effect's values, one per line, then how many more: the glance table's
+// cells stay a few lines high where a joint diagnosis has one value per flight.
+std::string values_cell(const std::vector<std::string>& values) {
   constexpr size_t kShown = 4;
   std::string cell;
-  for (size_t i = 0; i < values.size() && i < kShown; ++i) cell += (i ? "<br>" : "") + one(values[i]);
+  for (size_t i = 0; i < values.size() && i < kShown; ++i) cell += (i ? "<br>" : "") + values[i];
   if (values.size() > kShown) cell += "<br>&hellip; " + std::to_string(values.size() - kShown) + " more (below)";
   return cell.empty() ? "&ndash;" : cell;
 }
 
-std::string estimate_text(const EffectEstimate& p) {
-  return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit)) + " " + interval(p.lower, p.upper, 3);
+// An effect's estimates as HTML, each with its 95 % interval where `with_interval`.
+std::string estimates_cell(const std::vector<EffectEstimate>& ps, bool with_interval) {
+  std::vector<std::string> values;
+  for (const auto& p : ps)
+    values.push_back(esc(name_value(p.name, p.value, p.unit, 3)) + (with_interval ? " " + interval(p.lower, p.upper, 3) : ""));
+  return values_cell(values);
 }
 
-// The values the extended model carries for an effect it does not name (its estimate in the
-// final fit; no interval: the values are not claimed).
+// The values the extended model carries for an effect it does not name: the final fit's, a
+// joint diagnosis' per-flight copies by their own names ("wind.x@2"; the plain name is flight
+// 1's), no interval (the values are not claimed).
 std::string carried_values(const Diagnosis& d, const std::string& effect) {
-  std::vector<fit::FitParameter> values;
-  for (const auto& p : d.airframe_fit)
-    if (p.free && p.name.rfind(effect + ".", 0) == 0) values.push_back(p);
-  return values_cell<fit::FitParameter>(values, [](const fit::FitParameter& p) {
-    return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit));
-  });
+  std::vector<std::string> values;
+  for (const auto& p : d.search.final_fit)
+    if (p.free && p.name.rfind(effect + ".", 0) == 0) values.push_back(esc(name_value(p.name, p.value, p.unit, 3)));
+  return values_cell(values);
 }
 
 struct GlanceRow {
-  std::string effect, css, verdict, values, held_out;
+  std::string effect, css, verdict, values, held_out;  // verdict, values and held_out: HTML
 };
+
+GlanceRow named_row(const Diagnosis& d, const Finding& f) {
+  std::string verdict = "named", css = "ok";
+  for (const auto& a : d.agreement)
+    if (a.effect == f.effect && !a.agree) {
+      verdict += std::string("; the flights ") + (flights_disagree(a) ? "disagree on " : "are too uncertain to agree on ") +
+                 esc(a.parameter);
+      css = "warn";
+    }
+  return {f.effect, css, verdict, estimates_cell(f.parameters, true),
+          num(f.before, 3) + " &rarr; " + num(f.after, 3) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
+              (f.metric == d.metric ? "" : "<br><small>" + esc(f.metric) + "</small>")};
+}
 
 // Every effect the diagnosis has a verdict on, in one table at the top (a user trial,
 // helper-106: how sure, what was rejected and what the model carries unnamed were spread
-// over five sections, one of them folded): named, in the model but not named (an ambiguous
-// pair's carried member, a stand-in, a carried suspect), and suspected.
+// over five sections, one of them folded): named; in the model but not named (a stand-in,
+// an ambiguous pair's carried member, a carried suspect); suspected; still significant
+// where the search stopped; dropped by the backward pass.
 std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
   std::vector<GlanceRow> rows;
-  std::vector<std::string> said;
-  for (const auto& f : d.findings) {
-    std::string verdict = "named";
-    for (const auto& a : d.agreement)
-      if (a.effect == f.effect && !a.agree) verdict += "; the flights disagree on " + esc(a.parameter);
-    rows.push_back({f.effect, verdict == "named" ? "ok" : "warn", verdict,
-                    values_cell<EffectEstimate>(f.parameters, estimate_text),
-                    num(f.before, 3) + " &rarr; " + num(f.after, 3) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
-                        (f.metric == d.metric ? "" : "<br><small>" + esc(f.metric) + "</small>")});
-    said.push_back(f.effect);
-  }
-  for (const auto& st : d.stand_ins) {
+  for (const auto& f : d.findings) rows.push_back(named_row(d, f));
+  for (const auto& st : d.stand_ins)
     rows.push_back({st.candidate.effect, "warn",
                     "in the model, not named: a stand-in for missing physics (" + esc(st.parameter) + " outside [" +
                         num(st.plausible_lower, 3) + ", " + num(st.plausible_upper, 3) + "])",
                     carried_values(d, st.candidate.effect), "&ndash;"});
-    said.push_back(st.candidate.effect);
-  }
-  for (const auto& a : d.search.unresolved) {
+  for (const auto& a : d.search.unresolved)
     rows.push_back({a.a, "warn", "in the model, not named: the data cannot tell it from " + esc(a.b),
                     carried_values(d, a.a), "&ndash;"});
-    said.push_back(a.a);
-  }
-  for (const auto& x : d.suspected) {
+  for (const auto& x : d.suspected)
     rows.push_back({x.candidate.effect, x.carried ? "warn" : "no",
                     std::string(x.carried ? "suspected, carried in the model for a named look-alike's values"
-                                          : "suspected, not in the model") +
-                        ": " + esc(x.failed),
-                    x.carried ? carried_values(d, x.candidate.effect)
-                              : values_cell<EffectEstimate>(x.candidate.parameters, [](const EffectEstimate& p) {
-                                  return esc(p.name) + " = " + num(p.value, 3) + esc(output::unit_after_number(p.unit));
-                                }),
+                                          : "suspected, not in the model") + ": " + esc(x.failed),
+                    x.carried ? carried_values(d, x.candidate.effect) : estimates_cell(x.candidate.parameters, false),
                     "&ndash;"});
-    said.push_back(x.candidate.effect);
-  }
+  for (const auto& e : d.search.left_at_limit)
+    rows.push_back({e.effect, "no",
+                    "not tested: still significant where the search stopped (p = " + num(e.p_value, 2) +
+                        (e.implausible.empty() ? "" : "; implausible here: " + esc(e.implausible)) + ")",
+                    "&ndash;", "&ndash;"});
+  for (const auto& r : d.search.removed)
+    rows.push_back({r.effect, "no", "dropped by the backward pass: " + esc(r.reason), "&ndash;", "&ndash;"});
   for (const auto& e : d.search.selected)  // anything else the model carries
-    if (std::find(said.begin(), said.end(), e) == said.end())
+    if (std::none_of(rows.begin(), rows.end(), [&](const GlanceRow& r) { return r.effect == e; }))
       rows.push_back({e, "warn", "in the model, not named", carried_values(d, e), "&ndash;"});
   return rows;
 }
@@ -356,8 +358,9 @@ void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
       << r.values << "</td><td>" << r.held_out << "</td><td>" << esc(scope(r.effect)) << "</td></tr>\n";
   h << "</table>\n<p><small>Held out: " << esc(d.metric)
     << ". Each effect's figure is the final model with and without it, not its share of the whole gain: effects "
-       "overlap. \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight. Words: "
-       "<a href=\"#words\">at the end</a>.</small></p>\n";
+       "overlap. \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
+    << (d.flights.size() > 1 ? "; a value name@k is flight k's, a plain name flight 1's" : "")
+    << ". Words: <a href=\"#words\">at the end</a>.</small></p>\n";
 }
 
 // One line per named cause and the held-out gain, then the command's own printout (for a
@@ -370,17 +373,18 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
     // A cause named jointly that the flights alone do not agree on is not one value of the
     // airframe: said here, not only in the agreement table further down.
     for (const auto& a : d.agreement)
-      if (a.effect == f.effect && !a.agree)
+      if (a.effect == f.effect && flights_disagree(a))
         h << " <span class=\"warn\">The flights disagree on " << esc(a.parameter) << " (Cochran's Q p = "
           << num(a.q_p_value, 2) << "; see <i>Do the flights agree?</i>).</span>";
     h << "</li>\n";
   }
   if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
-  if (!d.findings.empty()) {
+  if (!d.search.selected.empty()) {  // the extended model differs from the base model
     // A finding accepted on another held-out test (one step, the force alone) may leave this
     // metric worse: said as worse, not as a negative gain.
     const double gain = reduction(d.metric_before, d.metric_after);
-    h << "<li>With " << (d.findings.size() > 1 ? "them" : "it") << ", the model predicts the held-out part "
+    h << "<li>With " << (d.findings.empty() ? "what it carries unnamed (below)" : d.findings.size() > 1 ? "them" : "it")
+      << ", the model predicts the held-out part "
       << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
   }
@@ -438,20 +442,24 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
 }
 
 // The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...), as the
-// extended model carries them, with those on a bound marked (a user trial, helper-106: the
-// baseline every gain is measured against was not shown, and its c_w sat on a bound). A joint
-// diagnosis' per-flight copies ("c_t@2") are one row each.
+// final fit has them, with those on a bound marked as the summary's caution marks them (a
+// user trial, helper-106: the baseline every gain is measured against was not shown, and its
+// c_w sat on a bound). A joint diagnosis' per-flight copies ("c_t@2") are one row each.
 void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
   std::vector<const fit::FitParameter*> base;
-  for (const auto& p : d.airframe_fit)
+  for (const auto& p : d.search.final_fit)
     if (p.free && runtime::shared_name(p.name).find('.') == std::string::npos) base.push_back(&p);
+  const auto on_bound = [&](const fit::FitParameter& p) {
+    return std::any_of(d.at_bounds.begin(), d.at_bounds.end(), [&](const fit::FitParameter& b) { return b.name == p.name; });
+  };
   if (base.empty()) return;
   h << "<h2>The vehicle's own parameters, as fitted</h2>\n<p>The vehicle file's parameters the fit freed, at their "
-       "values in the extended model. One on its bound was held there: the model is strained, and a finding may stand "
+       "values in the final fit (jointly diagnosed, each flight's own copy: name@k; the extended model's header "
+       "carries their mean). One on its bound was held there: the model is strained, and a finding may stand "
        "in for what it lacks.</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
   for (const auto* p : base)
     h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value) << "</td><td>" << esc(p->unit) << "</td><td>"
-      << interval(p->lower, p->upper) << "</td><td" << (fit::on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
+      << interval(p->lower, p->upper) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
   h << "</table>\n";
 }
 
@@ -564,7 +572,7 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
     h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
-      << "</td><td>" << num(c.after) << "</td><td" << (reduction(c.before, c.after) < -1 ? " class=\"warn\"" : "") << ">"
+      << "</td><td>" << num(c.after) << "</td><td" << (reduction(c.before, c.after) < -kNegligibleChangePercent ? " class=\"warn\"" : "") << ">"
       << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
   h << "</table>\n";
 }
@@ -595,7 +603,8 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
     for (const auto& c : st.candidates)
       h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
-        << "</td><td class=\"" << (c.significant ? "ok\">significant" : "no\">" + esc(c.why_not))
+        // significant but implausible in orange: a stand-in, not a cause (a user trial, helper-106)
+        << "</td><td class=\"" << (!c.significant ? "no\">" + esc(c.why_not) : c.implausible.empty() ? "ok\">significant" : "warn\">significant")
         << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
     h << "</table>\n";
   }
@@ -620,17 +629,19 @@ void plots_html(std::ostringstream& h, const std::vector<std::pair<std::string, 
 // output", has the longer table.
 void words_html(std::ostringstream& h) {
   static const std::pair<const char*, const char*> kWords[] = {
-      {"training part, held-out part", "the first 70 % of each flight, which the fit sees, and the last 30 %, which "
-                                       "only judges (also called the validation part)"},
+      {"training part, held-out part", "the first part of each flight, which the fit sees, and the rest, which only "
+                                       "judges (also called the validation part): 70 % and 30 % unless --validation "
+                                       "says otherwise"},
       {"equation error, one step", "the model's accelerations against the measured ones, sample by sample, no "
                                    "simulation: what the fit minimises"},
       {"open loop", "the model run forward from a measured state, fed only the logged commands"},
       {"named", "significant on the training part, better on the held-out part, its interval closed and excluding "
                 "\"off\", its value plausible: a cause"},
       {"suspected", "significant on the training part, but it failed a later test (the reason is given); not named"},
-      {"ambiguous, carried", "two effects the flight cannot tell apart: neither is named, the stronger stays in the "
-                             "extended model (carried, its values not claimed); the manoeuvre that separates them is "
-                             "given"},
+      {"ambiguous", "two effects the flight cannot tell apart: neither is named, one of them stays in the extended "
+                    "model, and the manoeuvre that separates them is given"},
+      {"carried", "in the extended model, its values fitted but not claimed: an ambiguous pair's member, a stand-in, "
+                  "or a suspect a named effect's values need"},
       {"stand-in", "passed every test, but its value is beyond what its physics gives here (a steady wind indoors): "
                    "it absorbs something the model lacks; carried, not named"},
       {"of the airframe, of the flight", "a property every flight of the vehicle shares, or a condition of this "

@@ -31,6 +31,21 @@ runtime::Series series(const std::string& label, const std::vector<double>& x, c
   return s;
 }
 
+// Joined flights on one clock: each flight's held-out part marked where it starts and labelled
+// with the flight's short name (a user trial, helper-106: three flights end to end could not
+// be told apart; where a panel holds whole flights, `before` says the label marks the held-out
+// part, not the flight's start). One flight: as given.
+void mark_flights(const Diagnosis& d, std::vector<runtime::Panel>& panels, const std::string& before = "") {
+  if (d.flights.size() < 2) return;
+  const std::vector<std::string> names = short_flight_labels(d.flights);
+  for (auto& panel : panels) {
+    panel.marks = d.validation_starts;
+    panel.labels.clear();
+    for (size_t k = 0; k < d.validation_starts.size() && k < names.size(); ++k)
+      panel.labels.emplace_back(d.validation_starts[k], before + names[k]);
+  }
+}
+
 // Measured vs simulated positions in the open-loop windows of the validation part.
 std::vector<runtime::Panel> validation_panels(const Diagnosis& d, const fit::Flight& valid) {
   std::vector<runtime::Panel> panels;
@@ -172,8 +187,9 @@ class PlotRenderer {
 }  // namespace
 
 std::string what_to_look_for(const std::string& plot_name) {
-  // Beside each render call below, in the order they are made (a user trial, helper-106:
-  // every caption was the file name alone).
+  // One entry per plot diagnosis_plots renders, by the name it renders it under (a user trial,
+  // helper-106: every caption was the file name alone); a test asks each plot a diagnosis
+  // writes for its caption.
   static const std::map<std::string, std::string> kLookFor = {
       {"validation.svg",
        "the held-out part: the measured position (black dots) against the base model (red) and the extended model "
@@ -196,8 +212,9 @@ std::string what_to_look_for(const std::string& plot_name) {
        "for each model and the baselines; lower is better. A tilt or heading error is an angle, at most pi: a "
        "model that has turned over can read lower at a longer horizon"},
       {"profiles.svg",
-       "each named parameter's profile likelihood: the 95 % interval is where the curve stays below the pointwise "
-       "line; a flat curve means the data barely decide the value"},
+       "the profile likelihood of each parameter of the extended model's effects, named or carried (a joint "
+       "diagnosis' per-flight copies have Wald intervals instead): the 95 % interval is where the curve stays "
+       "below the pointwise line; a flat curve means the data barely decide the value"},
   };
   const auto it = kLookFor.find(plot_name);
   return it == kLookFor.end() ? "" : it->second;
@@ -209,10 +226,15 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     std::vector<std::pair<std::string, std::string>>* data) {
   PlotRenderer plots(error, data);
   if (!d.sim_before.t.empty()) {
-    plots.render("validation.svg", d.vehicle + ": measured vs simulated, before and after", validation_panels(d, valid));
-    plots.render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", simulation_error_panels(d));
+    auto validation = validation_panels(d, valid), errors = simulation_error_panels(d);
+    mark_flights(d, validation);
+    mark_flights(d, errors);
+    plots.render("validation.svg", d.vehicle + ": measured vs simulated, before and after", validation);
+    plots.render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", errors);
   }
-  plots.render("residuals.svg", residuals_title(d), residual_panels(d, std::max<size_t>(1, d.t.size() / 3000)));
+  auto residuals = residual_panels(d, std::max<size_t>(1, d.t.size() / 3000));
+  mark_flights(d, residuals, "held out: ");
+  plots.render("residuals.svg", residuals_title(d), residuals);
   plots.render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", autocorrelation_panels(d));
   const auto gain_panels = command_gain_panels(d);
   if (!gain_panels.empty()) plots.render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);

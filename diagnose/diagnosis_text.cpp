@@ -34,7 +34,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
        << beside_gain_text(f);
     for (const auto& a : d.agreement)
-      if (a.effect == f.effect && !a.agree) os << "; the flights disagree on " << a.parameter << " (below)";
+      if (a.effect == f.effect && flights_disagree(a)) os << "; the flights disagree on " << a.parameter << " (below)";
     os << "\n  " << headline(f) << "\n";
     if (const std::string caveat = one_flight_caveat(d, f.effect); !caveat.empty()) os << "  " << caveat << "\n";
   }
@@ -142,7 +142,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
   std::ostringstream os;
   for (const auto& note : screening_notes(d)) os << note << "\n";
   if (const std::string note = environment_note(d); !note.empty()) os << note << "\n";
-  if (d.findings.empty() && d.search.unresolved.empty() && d.unexplained.empty())
+  if (d.search.selected.empty() && d.unexplained.empty())  // the base model is the final one
     os << "no significant discrepancy: the base model explains the flight\n";
   write_findings(os, d);
   // The whole gain, and where it is paid for (a user trial, helper-106: only report.html said

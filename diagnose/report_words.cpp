@@ -288,7 +288,7 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   // A named cause the flights disagree on (a user trial, helper-106: the report named it and
   // said the disagreement, but gave nothing to do about it).
   for (const auto& a : d.agreement)
-    if (a.named && !a.agree && !a.within_errors)
+    if (a.named && flights_disagree(a))
       out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
                     "differs between the flights that lie apart (speed, battery, payload, the day) and diagnose them " +
                     "apart, or together without the odd one");
@@ -363,12 +363,15 @@ std::string terms_gain_verdict(double gain_mean, double gain_standard_error) {
 
 // What spread agreeing flights would show, beside the one seen: " (if they agree: median
 // 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
+std::string name_value(const std::string& name, double value, const std::string& unit, int prec) {
+  return name + " = " + num(value, prec) + output::unit_after_number(unit);
+}
+
 std::string spread_context(const ParameterAgreement& a) {
   if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
   return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, p = " + num(a.spread_p_value, 2) + ")";
 }
 
-// A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
 std::string channel_unit(const Diagnosis& d, const std::string& channel) {
   for (size_t c = 0; c < d.channel_names.size() && c < d.channel_units.size(); ++c)
     if (d.channel_names[c] == channel) return d.channel_units[c];
@@ -376,15 +379,15 @@ std::string channel_unit(const Diagnosis& d, const std::string& channel) {
 }
 
 std::string worse_channels(const Diagnosis& d) {
-  constexpr double kNegligiblePercent = 1;  // as the acceptance's negligible change
   std::string out;
   for (const auto& c : d.channel_gain)
-    if (reduction(c.before, c.after) < -kNegligiblePercent)
+    if (reduction(c.before, c.after) < -kNegligibleChangePercent)
       out += (out.empty() ? "" : "; ") + c.channel + " " + num(c.before) + " -> " + num(c.after) +
              output::unit_after_number(channel_unit(d, c.channel)) + " (" + lower_or_higher(c.before, c.after, 3) + ")";
   return out;
 }
 
+// A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
 std::string interval(double lower, double upper, int prec) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
   return "[" + side(lower) + ", " + side(upper) + "]";

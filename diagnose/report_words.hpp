@@ -65,6 +65,9 @@ std::vector<std::string> screening_notes(const Diagnosis& d);
 // steady wind): what counted as plausible, and how to say "indoor". "" otherwise. A user's
 // own mapping may lack the key, and a wind indoors would then be named, not a stand-in.
 std::string environment_note(const Diagnosis& d);
+// "wind.x = -0.296 m/s", "motor_gain.M2 = 0.027" (no unit for a dimensionless value), with
+// `prec` significant digits: a value in a sentence or a cell.
+std::string name_value(const std::string& name, double value, const std::string& unit, int prec = 4);
 // The unit of a residual channel, as the diagnosis names its channels ("" for none).
 std::string channel_unit(const Diagnosis& d, const std::string& channel);
 // The held-out channels the extended model gets more than 1 % worse than the base model

@@ -544,8 +544,8 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   // run) add nothing.
   enum Marker { kCircle = 7, kSquare = 5, kTriangle = 9, kDiamond = 13, kStar = 3 };
   const auto add = [](runtime::Panel& panel, const std::string& label, const std::vector<HorizonErrors>& rows,
-                      ErrorStats HorizonErrors::*quantity, bool points, int marker = kCircle) {
-    runtime::Series s{label, {}, {}, points, {}, marker};
+                      ErrorStats HorizonErrors::*quantity, bool points, int marker = kCircle, const std::string& colour = "") {
+    runtime::Series s{label, {}, {}, points, colour, marker};
     for (const auto& h : rows) s.x.push_back(h.horizon), s.y.push_back((h.*quantity).mean());
     if (!s.x.empty()) panel.series.push_back(s);
   };
@@ -565,9 +565,7 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   // No model: the same for every model of the same log, drawn once.
   if (!predictions.empty())
     add(reduced, "constant velocity (no model)", predictions.front().second->constant_velocity, &HorizonErrors::position, true,
-        kDiamond);
-  if (!reduced.series.empty() && reduced.series.back().label == "constant velocity (no model)")
-    reduced.series.back().color = "#555555";
+        kDiamond, "#555555");
   // Published for the Crazyflie only; drawn for every vehicle as the scale of the state of the
   // art, and labelled with the vehicle they are of.
   // One colour and marker in every panel and plot (gnuplot's next colour differed by panel).

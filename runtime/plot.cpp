@@ -212,7 +212,9 @@ bool whole_inert_svg(const std::string& svg) {
 Series decimated(const Series& s) {
   const size_t n = std::min(s.x.size(), s.y.size());
   if (n <= kMaxPlotPointsPerSeries) return s;
-  Series d{s.label, {}, {}, s.points};
+  Series d = s;  // its label, style, colour and marker (a thinned series lost its colour: helper-107)
+  d.x.clear();
+  d.y.clear();
   const size_t buckets = kMaxPlotPointsPerSeries / 2;
   for (size_t b = 0; b < buckets; ++b) {
     const size_t lo = b * n / buckets, hi = (b + 1) * n / buckets;
@@ -274,7 +276,13 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
       if (is_rgb(s.color)) plot << " lc rgb '" << s.color << "'";
       plot << " title " << gnuplot_string(s.label) << " noenhanced";
     }
-    script << "unset arrow\n";
+    script << "unset arrow\nunset label\n";
+    for (const auto& [x, text] : p.labels)
+      if (std::isfinite(x)) {
+        script << "set label " << gnuplot_string(text) << " at first ";
+        write_number(script, x);
+        script << ", graph 0.93 offset 0.5,0 noenhanced front font ',9'\n";
+      }
     for (double m : p.marks)
       if (std::isfinite(m)) {
         script << "set arrow from ";

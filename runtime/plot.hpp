@@ -4,6 +4,7 @@
 // the script, and every label is passed as an escaped, non-enhanced string (output/sinks.hpp).
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace quadgen::runtime {
@@ -22,6 +23,9 @@ struct Panel {
   std::string title, xlabel, ylabel;
   std::vector<Series> series;
   std::vector<double> marks = {};  // x values marked by a dashed vertical line (e.g. where validation starts)
+  // Text written at the top of the panel from an x value on (e.g. which flight a stretch of
+  // joined flights is); escaped like every label.
+  std::vector<std::pair<double, std::string>> labels = {};
 };
 
 // At most this many points of one series reach gnuplot; longer series are thinned to the

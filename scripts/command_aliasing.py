@@ -374,14 +374,14 @@ def nanobench(folder, ratio, residual_slow):
         with open(path, newline="") as f:
             commands = [[float(r[f"motor_motor_m{i}"]) for i in range(1, 5)] for r in csv.DictReader(f)]
         first, last = airborne_stretch(commands, 300)
-        name = terminal_text(os.path.splitext(os.path.basename(path))[0])
+        name = os.path.splitext(os.path.basename(path))[0]
         mark = " (saturated)" if name in SATURATED else ""
         for axis, x in differential(commands[first:last]).items():
             s, t = slow([x]), top([x])
             folded = ratio[axis] * t
             if not mark:
                 unsaturated.append((axis, folded))
-            line = (f"  {name + mark:36s} {axis:5s} {s:.4f} [{rad_s2(s, axis):.2f}] | {t:.4f} | "
+            line = (f"  {terminal_text(name) + mark:36s} {axis:5s} {s:.4f} [{rad_s2(s, axis):.2f}] | {t:.4f} | "
                     f"{folded:.4f} [{rad_s2(folded, axis):.2f}]")
             if name in residual_slow and residual_slow[name][axis] is None:
                 line += " | (no 3 s without a gap)"
@@ -420,14 +420,14 @@ def residuals_slow_band(diagnoses):
     out = {}
     for folder in diagnoses:
         if not os.path.isfile(os.path.join(folder, "residuals.csv")):
-            sys.exit(f"{folder}: no diagnosis folder (no residuals.csv in it)")
+            sys.exit(f"{terminal_text(folder)}: no diagnosis folder (no residuals.csv in it)")
         series, meta = moment_residuals.read(folder)
         flights = meta.get("flights", [])
         if len(flights) != 1:
-            sys.exit(f"{folder}: give a single-flight diagnosis")
+            sys.exit(f"{terminal_text(folder)}: give a single-flight diagnosis")
         samples = meta["samples"]["training"] + meta["samples"]["validation"]
         if len(series["pdot"]) < 0.9 * samples:
-            sys.exit(f"{folder}: residuals.csv holds {len(series['pdot'])} residuals of {samples} samples: thinned "
+            sys.exit(f"{terminal_text(folder)}: residuals.csv holds {len(series['pdot'])} residuals of {samples} samples: thinned "
                      "for its plot, too coarse for a spectrum")
         name = os.path.splitext(os.path.basename(flights[0]))[0]
         out[name] = {}

@@ -149,8 +149,11 @@ json diagnose_log(const std::string& vehicle, const fs::path& log, const fs::pat
   int tables = 0;
   for (const auto& e : fs::directory_iterator(dir / "out")) {
     if (e.path().extension() == ".csv") ++tables;
-    if (e.path().extension() == ".svg")
+    if (e.path().extension() == ".svg") {
       EXPECT_TRUE(fs::exists(fs::path(e.path()).replace_extension(".csv"))) << e.path() << " has no CSV beside it";
+      // and a caption in the report that says what to look for in it
+      EXPECT_NE(quadgen::diagnose::what_to_look_for(e.path().filename().string()), "") << e.path();
+    }
   }
   EXPECT_GE(tables, 3);
   expect_evidence_holds_together(j);
@@ -1412,6 +1415,9 @@ TEST(DiagnosisReport, EachStepSaysWhichCandidateItTook) {
   EXPECT_NE(html.find("<p>Taken: <b>blade_flapping</b>. Ranked: the significant first"), std::string::npos) << html;
   EXPECT_NE(html.find("<tr><td><b>blade_flapping</b> (taken)</td>"), std::string::npos) << html;
   EXPECT_NE(html.find("<tr><td>wind</td>"), std::string::npos) << html;
+  // significant but implausible: not in a cause's green (a user trial, helper-106)
+  EXPECT_NE(html.find("<td class=\"warn\">significant; implausible here: wind.x = 2 m/s outside [-0.5, 0.5]</td>"),
+            std::string::npos) << html;
 }
 
 // A cause named jointly that the flights alone disagree on is flagged where it is named (the
@@ -1465,7 +1471,11 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   x.candidate.parameters.push_back(estimate("motor_gain.M2", "1", 0.027, NAN, NAN));
   d.suspected.push_back(x);
   d.search.selected = {"rotor_drag", "wind"};
-  d.airframe_fit = {{"wind.x", "m/s", -0.296, -5, 5, true}, {"c_w", "1", 3.0, 0, 3, true}, {"mass", "kg", 0.03, 0, 0, false}};
+  // a joint fit's copies by their own names: the plain name is flight 1's
+  d.flights = {"dir/B3.csv"};
+  d.search.final_fit = {{"wind.x", "m/s", -0.296, -5, 5, true}, {"wind.x@2", "m/s", 0.1, -5, 5, true},
+                        {"c_w", "1", 3.0, 0, 3, true}, {"mass", "kg", 0.03, 0, 0, false}};
+  d.at_bounds = {d.search.final_fit[2]};
   d.channel_names = {"az_world"}, d.channel_units = {"m/s^2"};
   d.channel_gain = {{"az_world", 0.2575, 0.371}};
   const std::string html = dg::diagnosis_html(d, "dir/B3.csv", {{"validation.svg", "<svg></svg>"}});
@@ -1477,7 +1487,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
                        "[1.11e-06, 1.35e-06]</td><td>0.48 &rarr; 0.45 (6.25 % lower)</td><td>airframe</td>"),
             std::string::npos) << table;
   EXPECT_NE(table.find("<td><b>wind</b></td><td class=\"warn\">in the model, not named: the data cannot tell it from "
-                       "attitude_bias</td><td>wind.x = -0.296 m/s</td>"),
+                       "attitude_bias</td><td>wind.x = -0.296 m/s<br>wind.x@2 = 0.1 m/s</td>"),
             std::string::npos) << table;
   EXPECT_NE(table.find("<td class=\"no\">suspected, not in the model: improves the training data (p = 1e-9) but not the "
                        "held-out part</td><td>motor_gain.M2 = 0.027</td>"),
@@ -1498,6 +1508,42 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
                          "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s^2 (44.1 % higher)\n"),
             std::string::npos) << summary;
+  // A stand-in, what the search's limit left and the backward pass dropped have rows too;
+  // a hostile name in a reason arrives as text.
+  dg::StandIn st;
+  st.candidate.effect = "attitude_bias", st.parameter = "attitude_bias.roll", st.plausible_lower = -0.05,
+  st.plausible_upper = 0.05;
+  d.stand_ins.push_back(st);
+  dg::CandidateEvidence left;
+  left.effect = "inflow", left.p_value = 1e-3, left.implausible = "<b>x</b>";
+  d.search.left_at_limit.push_back(left);
+  d.search.removed.push_back({"ground_effect", "its held-out gain <script> vanished", 0.5, 0});
+  const std::string more = dg::diagnosis_html(d, "dir/B3.csv", {});
+  EXPECT_NE(more.find("<td><b>attitude_bias</b></td><td class=\"warn\">in the model, not named: a stand-in for missing "
+                      "physics (attitude_bias.roll outside [-0.05, 0.05])</td>"),
+            std::string::npos);
+  EXPECT_NE(more.find("<td><b>inflow</b></td><td class=\"no\">not tested: still significant where the search stopped "
+                      "(p = 0.001; implausible here: &lt;b&gt;x&lt;/b&gt;)</td>"),
+            std::string::npos);
+  EXPECT_NE(more.find("dropped by the backward pass: its held-out gain &lt;script&gt; vanished"), std::string::npos);
+  EXPECT_EQ(more.find("<script>"), std::string::npos);
+  // No cause named, an effect carried: the whole gain is still said, and the summary does
+  // not call the base model enough.
+  dg::Diagnosis carried = d;
+  carried.findings.clear();
+  const std::string unnamed = dg::diagnosis_html(carried, "dir/B3.csv", {});
+  EXPECT_NE(unnamed.find("<li>With what it carries unnamed (below), the model predicts the held-out part "),
+            std::string::npos);
+  EXPECT_EQ(dg::diagnosis_summary(carried).find("no significant discrepancy"), std::string::npos);
+  // A named cause the flights are too uncertain to agree on is said so, not "disagree".
+  dg::ParameterAgreement loose;
+  loose.parameter = "rotor_drag.k", loose.effect = "rotor_drag", loose.named = true, loose.within_errors = true;
+  dg::Diagnosis uncertain_flights = d;
+  uncertain_flights.agreement.push_back(loose);
+  const std::string loose_html = dg::diagnosis_html(uncertain_flights, "dir/B3.csv", {});
+  EXPECT_NE(loose_html.find("<td class=\"warn\">named; the flights are too uncertain to agree on rotor_drag.k</td>"),
+            std::string::npos);
+  EXPECT_EQ(loose_html.find("disagree on rotor_drag.k"), std::string::npos);
   // A named cause the flights disagree on: a next step; one too uncertain to agree: none.
   dg::ParameterAgreement disagree;
   disagree.parameter = "rotor_drag.k", disagree.effect = "rotor_drag", disagree.named = true;

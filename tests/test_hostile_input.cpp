@@ -431,7 +431,7 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
   } restore{fs::current_path()};
   fs::current_path(tmp.dir);  // a `system "touch PWNED"` would create the file here
   for (const auto& s : hostile_strings()) {
-    quadgen::runtime::Panel p{s, s, s, {{s, {0, 1, 2}, {1, 0, 1}}, {s, {0, 1}, {0, 1}, true}}};
+    quadgen::runtime::Panel p{s, s, s, {{s, {0, 1, 2}, {1, 0, 1}}, {s, {0, 1}, {0, 1}, true}}, {1}, {{1.0, s}}};
     std::string svg, err;
     const bool drawn = quadgen::runtime::render_svg(s, {p}, &svg, &err);
     // setup.sh installs gnuplot: without it this test would prove nothing, so it fails.
@@ -787,14 +787,21 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << out::printable(r.err);
 }
 
+// ... and their colour and marker (a review, helper-107: a thinned series was drawn in
+// gnuplot's next colour, not its model's).
 TEST(Sinks, LongSeriesAreThinnedKeepingTheirExtremes) {
-  quadgen::runtime::Series s{"long", {}, {}};
+  quadgen::runtime::Series s{"long", {}, {}, true, "#1f77b4", 9};
   for (int i = 0; i < 1000000; ++i) s.x.push_back(i), s.y.push_back(i == 123457 ? 50.0 : std::sin(i * 1e-3));
   const auto d = quadgen::runtime::decimated(s);
   EXPECT_LE(d.x.size(), quadgen::runtime::kMaxPlotPointsPerSeries);
   EXPECT_EQ(*std::max_element(d.y.begin(), d.y.end()), 50.0);
   EXPECT_TRUE(std::is_sorted(d.x.begin(), d.x.end()));
-  EXPECT_LT(quadgen::runtime::gnuplot_script("t", {{"p", "x", "y", {s}}}).size(), 200000u);
+  EXPECT_EQ(d.color, "#1f77b4");
+  EXPECT_EQ(d.marker, 9);
+  EXPECT_TRUE(d.points);
+  const std::string script = quadgen::runtime::gnuplot_script("t", {{"p", "x", "y", {s}}});
+  EXPECT_LT(script.size(), 200000u);
+  EXPECT_NE(script.find("points pt 9 ps 0.5 lc rgb '#1f77b4'"), std::string::npos);
 }
 
 // ---- data loss -----------------------------------------------------------------------------
