@@ -85,6 +85,9 @@ struct ErrorStats {
 struct HorizonErrors {
   double horizon = 0;  // s
   ErrorStats position, velocity, tilt, heading, body_rates;  // m, m/s, rad, rad, rad/s
+  // The angle of the whole rotation between simulated and measured attitude (geodesic, rad):
+  // the attitude error as the IDSIA benchmark reports it, beside tilt and heading apart.
+  ErrorStats attitude;
   size_t diverged = 0;  // rollouts that left any bound (counted in no statistic)
 };
 
@@ -162,11 +165,14 @@ nlohmann::ordered_json prediction_json(const Prediction& p);
 // One row per view, horizon and quantity: view,horizon_s,quantity,unit,mean,rms,count.
 std::string prediction_csv(const Prediction& p);
 
-// Published results this measure is comparable with (mean position error at a horizon).
+// Position errors at a horizon reported by others for a Crazyflie, drawn beside ours as the
+// scale of what learned and physical models reach; none is measured on our split, and the
+// caveat says how each differs (docs/validation.md, "Published anchors").
 struct PublishedPoint {
   std::string source;
   double horizon_s, position_m;
   std::string caveat;
+  bool benchmark_statistic;  // a mean over a test set; false: a single rollout a repository printed
 };
 const std::vector<PublishedPoint>& published_position_errors();
 

@@ -356,6 +356,10 @@ TEST(Prediction, TranslationReplayedIsTheMomentModelAlone) {
     EXPECT_NEAR(h.body_rates.mean(), expected, 0.2 * expected) << "horizon " << h.horizon;
     EXPECT_NEAR(h.tilt.mean(), p.open_loop[i].tilt.mean(), 0.05 * p.open_loop[i].tilt.mean() + 1e-4) << h.horizon;
     if (h.horizon >= 0.5) EXPECT_GT(h.tilt.mean(), 1e-3) << h.horizon;  // a drift to compare
+    // The whole rotation's angle (geodesic) turns the body z axis by no more than itself: never
+    // below the tilt, per start and so in the mean.
+    EXPECT_GE(h.attitude.mean(), h.tilt.mean() - 1e-12) << h.horizon;
+    EXPECT_EQ(h.attitude.count, h.tilt.count);
     // Position and velocity are the log's at every step, so they carry no error at all.
     EXPECT_LT(h.position.mean(), 1e-9) << h.horizon;
     EXPECT_LT(h.velocity.mean(), 1e-9) << h.horizon;
@@ -497,7 +501,7 @@ TEST(Prediction, EveryViewReachesTheJsonAndTheCsv) {
     for (size_t i = 0; i < rows->size(); ++i) {
       const auto& h = (*rows)[i];
       EXPECT_EQ(j[name][i]["horizon_s"].get<double>(), h.horizon) << name;
-      for (const char* q : {"position_m", "velocity_m_s", "tilt_rad", "heading_rad", "body_rates_rad_s"})
+      for (const char* q : {"position_m", "velocity_m_s", "tilt_rad", "heading_rad", "attitude_rad", "body_rates_rad_s"})
         EXPECT_TRUE(j[name][i].contains(q)) << name << " " << q;
       EXPECT_EQ(j[name][i]["position_m"]["count"].get<size_t>(), h.position.count) << name;
       EXPECT_DOUBLE_EQ(j[name][i]["position_m"]["mean"].get<double>(), h.position.mean()) << name;
@@ -509,11 +513,11 @@ TEST(Prediction, EveryViewReachesTheJsonAndTheCsv) {
       ASSERT_NE(at, std::string::npos) << key.str();
       EXPECT_NEAR(std::stod(csv.substr(at + key.str().size())), h.position.mean(), 1e-5 * h.position.mean()) << name;
     }
-    expected_rows += 5 * rows->size();
+    expected_rows += 6 * rows->size();
   }
   EXPECT_FALSE(j.contains("set_points_flown"));
   EXPECT_EQ(csv.find("set_points_flown"), std::string::npos);
-  expected_rows += 2 * p.attitude_replayed.size() + 3 * p.translation_replayed.size() + 7;  // + one step
+  expected_rows += 2 * p.attitude_replayed.size() + 4 * p.translation_replayed.size() + 7;  // + one step
   EXPECT_EQ(static_cast<size_t>(std::count(csv.begin(), csv.end(), '\n')), expected_rows);
 }
 
