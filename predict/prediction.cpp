@@ -97,7 +97,11 @@ template <class Begin, class Advance>
 std::vector<HorizonErrors> score_from_starts(const Rollout& roll, const fit::Flight& f, const PredictionOptions& o,
                                              size_t* starts, Begin begin, Advance advance) {
   std::vector<HorizonErrors> rows;
-  for (double h : o.horizons) rows.push_back({h, {}, {}, {}, {}, {}, 0});
+  for (double h : o.horizons) {
+    HorizonErrors row;
+    row.horizon = h;
+    rows.push_back(row);
+  }
   const auto& S = f.samples;
   const double dt = median_spacing(f), longest = *std::max_element(o.horizons.begin(), o.horizons.end());
   double next_start = S.empty() ? 0 : S.front().t;
@@ -474,7 +478,8 @@ nlohmann::ordered_json prediction_json(const Prediction& p) {
           {"definition",
            "error at each horizon after a start from the measured state, averaged over start points; "
            "tilt = angle between body z axes, heading = yaw difference, attitude = angle of the whole rotation between "
-           "them (geodesic)"}};
+           "the simulated and the measured attitude (geodesic; the measured one corrected by a fitted marker-frame "
+           "offset)"}};
   if (!p.set_points_flown.empty()) out["set_points_flown"] = full_rows(p.set_points_flown);
   if (p.one_step_corrected) {
     out["one_step_linear_correction"] = one_step_json(*p.one_step_corrected);
@@ -555,7 +560,7 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   // One series of a view's mean errors (of `quantity`); markers of type `marker` where
   // `points`, so that one model's views keep its colour and still differ. Empty views (not
   // run) add nothing.
-  enum Marker { kCircle = 7, kSquare = 5, kTriangle = 9, kDiamond = 13, kStar = 3 };
+  enum Marker { kCircle = 7, kSquare = 5, kTriangle = 9, kDiamond = 13, kStar = 3, kPentagon = 15 };
   const auto add = [](runtime::Panel& panel, const std::string& label, const std::vector<HorizonErrors>& rows,
                       ErrorStats HorizonErrors::*quantity, bool points, int marker = kCircle, const std::string& colour = "") {
     runtime::Series s{label, {}, {}, points, colour, marker};
@@ -583,8 +588,11 @@ std::vector<runtime::Panel> horizon_panels(const std::vector<std::pair<std::stri
   // art, and labelled with the vehicle they are of.
   // One colour and marker in every panel and plot (gnuplot's next colour differed by panel);
   // a benchmark's means apart from a single rollout a repository printed.
-  runtime::Series benchmark{"IDSIA benchmark, Crazyflie 2.1 Brushless (mean)", {}, {}, true, "#ff7f0e", kStar},
-      single{"NanoBench MLP, one rollout", {}, {}, true, "#9467bd", kTriangle};
+  // (a marker and colour no model's view uses: helper-109)
+  // Short labels: the legend shares the figure's width with the plot (the vehicles and how each
+  // is made: docs/validation.md, "Published anchors").
+  runtime::Series benchmark{"IDSIA benchmark, best (mean)", {}, {}, true, "#ff7f0e", kStar},
+      single{"NanoBench MLP, one rollout", {}, {}, true, "#8c564b", kPentagon};
   for (const auto& pt : published_position_errors()) {
     runtime::Series& s = pt.benchmark_statistic ? benchmark : single;
     s.x.push_back(pt.horizon_s), s.y.push_back(pt.position_m);

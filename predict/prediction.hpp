@@ -25,7 +25,7 @@
 //    acceleration as zero (the rates stay those measured at the start, the attitude turns at
 //    them; the structure of the IDSIA benchmark code's physics baseline); attitude held keeps
 //    the attitude measured at the start as well, so the force model acts along it. They are
-//    open-loop predictions in the published sense (no measurement after the start is read) of
+//    open-loop predictions (nothing measured after the start is read but the logged commands) of
 //    a model without moments: against the open loop they say whether the moment model helps
 //    the prediction or harms it at a horizon.
 //  - constant velocity: no model. From the same start states, the position moves on at the
