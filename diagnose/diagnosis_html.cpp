@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <iomanip>
 #include <map>
 #include <optional>
@@ -201,7 +200,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
         << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
     }
     // The strips' scale (a user trial, helper-106: bars without an axis).
-    h << "<tr><td colspan=\"4\"><small>scale of the bars" << esc(output::unit_after_number(a.unit) == "" ? "" : " [" + a.unit + "]")
+    h << "<tr><td colspan=\"4\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + esc(a.unit) + "]")
       << (std::isfinite(band_lo) && std::isfinite(band_hi) ? "; shaded: the joint fit's 95 % interval" : "")
       << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << num(lo, 3)
       << "</small><small>" << num(hi, 3) << "</small></div></td></tr>\n";
@@ -572,7 +571,7 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
     h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
-      << "</td><td>" << num(c.after) << "</td><td" << (reduction(c.before, c.after) < -kNegligibleChangePercent ? " class=\"warn\"" : "") << ">"
+      << "</td><td>" << num(c.after) << "</td><td" << (got_worse(c) ? " class=\"warn\"" : "") << ">"
       << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
   h << "</table>\n";
 }

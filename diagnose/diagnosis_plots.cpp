@@ -123,7 +123,7 @@ std::vector<runtime::Panel> autocorrelation_panels(const Diagnosis& d) {
 std::vector<runtime::Panel> profile_panels(const Diagnosis& d) {
   std::vector<runtime::Panel> panels = fit::profile_panels(d.search.profiles);
   for (auto& panel : panels) {
-    for (const auto& p : d.airframe_fit)  // the final fit's parameters: named and carried
+    for (const auto& p : d.search.final_fit)  // named and carried
       if (p.name == panel.xlabel && !p.unit.empty() && p.unit != "1") panel.xlabel += " [" + p.unit + "]";
     panel.ylabel = "cost rise (delta chi2)";
   }

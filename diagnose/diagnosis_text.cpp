@@ -75,7 +75,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
     os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
     for (size_t k = 0; k < x.candidate.parameters.size(); ++k) {
       const auto& p = x.candidate.parameters[k];
-      os << (k ? ", " : " at ") << p.name << " = " << num(p.value) << output::unit_after_number(p.unit)
+      os << (k ? ", " : " at ") << name_value(p.name, p.value, p.unit)
          << (p.at_bound ? " (on its bound)" : "");
     }
     os << " (" << x.failed << ")";
@@ -110,7 +110,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
 void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& note : d.notes) os << "caution: " << note << "\n";
   for (const auto& p : d.at_bounds)
-    os << "caution: " << p.name << " = " << num(p.value) << output::unit_after_number(p.unit)
+    os << "caution: " << name_value(p.name, p.value, p.unit)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)

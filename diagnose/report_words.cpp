@@ -378,10 +378,12 @@ std::string channel_unit(const Diagnosis& d, const std::string& channel) {
   return "";
 }
 
+bool got_worse(const ChannelGain& c) { return reduction(c.before, c.after) < -kNegligibleChangePercent; }
+
 std::string worse_channels(const Diagnosis& d) {
   std::string out;
   for (const auto& c : d.channel_gain)
-    if (reduction(c.before, c.after) < -kNegligibleChangePercent)
+    if (got_worse(c))
       out += (out.empty() ? "" : "; ") + c.channel + " " + num(c.before) + " -> " + num(c.after) +
              output::unit_after_number(channel_unit(d, c.channel)) + " (" + lower_or_higher(c.before, c.after, 3) + ")";
   return out;

@@ -74,6 +74,8 @@ std::string channel_unit(const Diagnosis& d, const std::string& channel);
 // ("az_world 0.2575 -> 0.371 m/s^2 (44.1 % higher)", joined by "; "), "" where none is: said
 // beside the overall gain, which averages over them.
 std::string worse_channels(const Diagnosis& d);
+// Whether the extended model is worse on this held-out channel by more than a negligible change.
+bool got_worse(const ChannelGain& c);
 
 // What to do next, one line per outcome the diagnosis has (docs/diagnosis.md, "What to do
 // next", keyed to this diagnosis): fly the manoeuvre that separates a pair, confirm an
