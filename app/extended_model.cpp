@@ -9,6 +9,7 @@
 
 #include "app/derive_pipeline.hpp"
 #include "derive/fitted_parameters.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::diagnose {
@@ -21,7 +22,6 @@ bool selected(const Diagnosis& d, const std::string& effect) {
 
 std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
   std::ostringstream y;
-  y.precision(17);  // round-trips: derive --params regenerates the same values
   y << "# Parameters of " << output::printable(v.name) << " fitted by quadgen diagnose; effects: ";
   for (const auto& e : d.search.selected) y << e << " ";
   for (const auto& e : d.per_flight_effects)
@@ -32,7 +32,9 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
   for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
   y << "]\nparameters:\n";
   for (const auto& p : d.airframe_fit)
-    if (p.free) y << "  " << p.name << ": {value: " << p.value << ", unit: \"" << p.unit << "\"}\n";
+    // The shortest text that reads back as the same double: derive --params regenerates the
+    // same values, and a fitted 0.05 reads "0.05".
+    if (p.free) y << "  " << p.name << ": {value: " << output::full_number(p.value) << ", unit: \"" << p.unit << "\"}\n";
   return y.str();
 }
 

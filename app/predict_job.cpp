@@ -41,6 +41,17 @@ std::string summary_of(const predict::Prediction& pooled) {
   positions("attitude held (no moment model)", pooled.attitude_held);
   positions("constant velocity (no model)", pooled.constant_velocity);
   if (const std::string limits = predict::what_limits_prediction(pooled); !limits.empty()) os << limits << "\n";
+  // The one-step errors, and with --linear-correction the corrected ones beside them (a review,
+  // helper-111: they reached prediction.json only).
+  const auto one_step = [&os](const char* what, const predict::OneStepErrors& e) {
+    if (e.vertical_acceleration_world.count == 0) return;
+    os << what << ", RMS: world vertical acceleration " << output::short_number(e.vertical_acceleration_world.rms())
+       << " m/s^2, roll / pitch / yaw acceleration " << output::short_number(e.angular_acceleration[0].rms()) << " / "
+       << output::short_number(e.angular_acceleration[1].rms()) << " / "
+       << output::short_number(e.angular_acceleration[2].rms()) << " rad/s^2\n";
+  };
+  one_step("one step", pooled.one_step);
+  if (pooled.one_step_corrected) one_step("one step with the linear correction", *pooled.one_step_corrected);
   for (const auto& h : pooled.set_points_flown)  // --controller: not the open loop, said so
     if (h.position.count > 0)
       os << "set points flown by the attitude loop's replica (not the open loop), " << h.horizon << " s: position "

@@ -41,7 +41,7 @@ void check_size(const SimulateJob& a, double steps, double rows) {
   if (steps > kMaxSteps) os << "about " << steps << " integration steps (limit " << kMaxSteps << ")";
   else if (rows > kMaxRows) os << "about " << rows << " output rows (limit " << kMaxRows << ")";
   else return;
-  throw std::invalid_argument("--duration " + std::to_string(a.duration) + ": " + os.str() +
+  throw std::invalid_argument("--duration " + output::six_digits(a.duration) + ": " + os.str() +
                               "; shorten it, raise --step or lower --rate, or pass --no-size-limit");
 }
 
@@ -326,8 +326,8 @@ InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector
   fit::check_euler_range(log);  // the start attitude; a command schedule may be sparse, so its time is not judged
   const std::vector<double> t = log.values("t");
   if (a.duration > t.back() - t.front() + 1e-9)
-    throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
-                                std::to_string(t.back() - t.front()) +
+    throw std::invalid_argument("--duration " + output::six_digits(a.duration) + " s: " + output::printable(a.inputs) + " holds " +
+                                output::six_digits(t.back() - t.front()) +
                                 " s of commands; a longer replay would hold the last command for the rest");
   const size_t nr = k.rotors.size();
   std::vector<std::vector<double>> u(t.size(), std::vector<double>(nr));

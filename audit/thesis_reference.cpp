@@ -271,8 +271,13 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
     aligned_differ += std::string(aligned_differ.empty() ? "" : ";") + fmt(" block %.0f (", g + 1) + groups[g][0] + ")" +
                       entries + (is_the_theses ? "" : " (the vehicle file's block is not the thesis' cuboid)");
   }
-  out.push_back({"Table 1", "inertia per block (J_xx, J_yy, J_zz, J_xz about the origin, kg m^2)", thesis.str(),
-                 ours.str(), worst < 1 && missing.empty(),
+  // The blocks joined by "; ", none after the last (a review, helper-111).
+  const auto joined_blocks = [](const std::ostringstream& os) {
+    std::string s = os.str();
+    return s.size() >= 2 && s.compare(s.size() - 2, 2, "; ") == 0 ? s.substr(0, s.size() - 2) : s;
+  };
+  out.push_back({"Table 1", "inertia per block (J_xx, J_yy, J_zz, J_xz about the origin, kg m^2)", joined_blocks(thesis),
+                 joined_blocks(ours), worst < 1 && missing.empty(),
                  std::string("blocks 1, 2, 5, 6: the thesis integrates motor blocks and arms over parallelograms "
                              "between y = ±x ± w (2.2.4.3) instead of rotated cuboids, and leaves the integration "
                              "variable x in the result (J_xx = 0.0932 x^2 + 7.309e-4, then x := 0.07465 m): a definite "

@@ -111,7 +111,7 @@ AuditCheck check_hover_above_the_bottom(const runtime::HoverTrim& trim) {
   const double highest = *std::max_element(trim.commands.begin(), trim.commands.end());
   const bool low = highest < kLowestHoverCommand;
   std::ostringstream detail;
-  detail << "the highest hover command " << std::to_string(highest);
+  detail << "the highest hover command " << output::six_digits(highest);
   if (low)
     detail << ", below " << kLowestHoverCommand
            << " of the command range: " << runtime::kRpmWithoutUnit

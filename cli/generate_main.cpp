@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   try {
     return quadgen::cli::run_derive(derive);
   } catch (const std::exception& e) {
-    std::cerr << "quadgen: error: " << quadgen::output::printable(e.what()) << "\n";
+    std::cerr << "quadgen: error: " << quadgen::output::printable_error(e.what()) << "\n";
     return 2;
   }
 }

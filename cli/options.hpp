@@ -48,9 +48,9 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
       if (const std::string near = nearest_option(*command, word); !near.empty() && near != word)
         suggestions += std::string(suggestions.empty() ? "" : ", ") + "'" + near + "' for '" + word + "'";
     }
-  std::cerr << "quadgen: error: " << output::printable(e.what());
+  std::cerr << "quadgen: error: " << output::printable_error(e.what());
   if (!not_understood.empty() && dynamic_cast<const CLI::RequiredError*>(&e))
-    std::cerr << " (not understood: " << output::printable(not_understood) << ")";
+    std::cerr << " (not understood: " << output::printable_error(not_understood) << ")";
   if (!suggestions.empty()) std::cerr << "; did you mean " << output::printable(suggestions) << "?";
   std::cerr << "\nRun with --help for more information.\n";
   return e.get_exit_code();

@@ -68,8 +68,9 @@ int main(int argc, char** argv) {
     std::cerr << "quadgen: error: out of memory: the input or the requested work is too large for this machine\n";
     return 2;
   } catch (const std::exception& e) {
-    // One line, whatever the message quotes from a hostile input (newlines, escape sequences).
-    std::cerr << "quadgen: error: " << quadgen::output::printable(e.what()) << "\n";
+    // One line of a readable length, whatever the message quotes from a hostile input
+    // (newlines, escape sequences, a name of 200 kB).
+    std::cerr << "quadgen: error: " << quadgen::output::printable_error(e.what()) << "\n";
     return 2;
   }
   return 1;

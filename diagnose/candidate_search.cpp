@@ -304,7 +304,7 @@ CandidateEvidence CandidateSearch::evaluate(const std::string& effect, const std
   const bool relevant = ev.size_translation >= opt_.negligible_fraction || ev.size_rotation >= opt_.negligible_fraction;
   static const std::string kNoHeldOutGain = "no gain on the validation part";
   const auto gate = [&] {
-    if (!(ev.p_value < ev.level)) return "not significant (p = " + std::to_string(ev.p_value) + ")";
+    if (!(ev.p_value < ev.level)) return "not significant (" + output::p_is(ev.p_value) + ")";
     if (!(ev.delta_bic < 0)) return std::string("BIC does not improve");
     if (!(ev.validation_cost_after < ev.validation_cost_before)) return kNoHeldOutGain;
     if (!relevant) return std::string("physically negligible size");
@@ -612,7 +612,7 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       if (p < level) continue;
       const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
       const double gain = percent_lower(cost(valid_, smaller), cost(valid_, current));
-      r.removed.push_back({e, "no longer significant" + beside + " (p = " + std::to_string(p) + ")", p, gain});
+      r.removed.push_back({e, "no longer significant" + beside + " (" + output::p_is(p) + ")", p, gain});
       for (const auto& g : going(e)) {
         if (g != e) r.removed.push_back({g, "taken out with " + e + ", whose terms it scales", p, gain});
         r.selected.erase(std::find(r.selected.begin(), r.selected.end(), g));
@@ -722,9 +722,9 @@ std::vector<std::string> CandidateSearch::check_absorbed_look_alikes(SearchResul
       std::vector<FitParameter> start = current;
       for (int i : effect_params_.at(e)) start[i].value = own->parameters[i].value;
       const LookAlikeTest t = test_look_alike(r, e, f, start, ws);
-      opt_.progress.say("[diagnose] " + e + " beside " + f + ": off p = " + output::short_number(t.p_off) +
-                        ", at its own estimate p = " + output::short_number(t.p_own) + ", " + f +
-                        "'s values kept then p = " + output::short_number(t.p_named));
+      opt_.progress.say("[diagnose] " + e + " beside " + f + ": off " + output::p_is(t.p_off) +
+                        ", at its own estimate " + output::p_is(t.p_own) + ", " + f +
+                        "'s values kept then " + output::p_is(t.p_named));
       if (t.p_off < level || t.p_own < level || t.p_named >= level) continue;
       std::set<std::string> without_f = base;
       without_f.erase(f);
@@ -772,9 +772,9 @@ std::vector<CarriedSuspect> CandidateSearch::carry_suspects_the_named_values_nee
       for (int i : effect_params_.at(e))
         if (estimate.count(start[i].name)) start[i].value = estimate.at(start[i].name);
       const LookAlikeTest t = test_look_alike(r, e, f, start, ws);
-      opt_.progress.say("[diagnose] suspected " + e + " beside " + f + ": off p = " + output::short_number(t.p_off) +
-                        ", at its estimate p = " + output::short_number(t.p_own) + ", " + f +
-                        "'s values kept then p = " + output::short_number(t.p_named));
+      opt_.progress.say("[diagnose] suspected " + e + " beside " + f + ": off " + output::p_is(t.p_off) +
+                        ", at its estimate " + output::p_is(t.p_own) + ", " + f +
+                        "'s values kept then " + output::p_is(t.p_named));
       if (t.p_off >= level || t.p_own < level || t.p_named >= level) continue;
       // Beside it the pair must stay physical: on a quad the trims and a CoG offset fitted
       // together can trade wildly (the NanoBench B3 figure-8 made trims of -42 % beside a

@@ -164,8 +164,8 @@ std::string acceptance_failure(const Finding& f, const SymbolicModel& all, bool 
     return "held-out rollouts " + output::short_number(f.gain_mean) + " +- " + output::short_number(f.gain_standard_error) +
            " better, but the held-out one-step cost is higher with it (" + output::short_number(f.one_step.cost.mean) +
            " % +- " + output::short_number(f.one_step.cost.standard_error) + " % lower per fold)";
-  return "held-out gain " + std::to_string(f.gain_mean) + " is not above its uncertainty (standard error " +
-         std::to_string(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) +
+  return "held-out gain " + output::short_number(f.gain_mean) + " is not above its uncertainty (standard error " +
+         output::short_number(f.gain_standard_error) + " over " + std::to_string(f.fold_gains.size()) +
          " validation folds)" + one_step_summary(f);
 }
 
@@ -577,7 +577,7 @@ void add_suspects_of_the_search(Diagnosis& d) {
   // Significant on the training data but no held-out gain in the search itself: suspected.
   for (const auto& ev : d.search.training_only)
     d.suspected.push_back(held_out_suspect(ev.effect, ev, ev.validation_cost_before, ev.validation_cost_after,
-                                           "improves the training data (p = " + output::short_number(ev.p_value) +
+                                           "improves the training data (" + output::p_is(ev.p_value) +
                                                ") but not the held-out part (its equation-error cost rises by " +
                                                output::short_number(-ev.validation_gain_percent) + " %)"));
 }
@@ -660,7 +660,7 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
                      : fit::split_by_time(flight, 1.0 - validation_fraction);
   const fit::Flight &train = parts.first, &valid = parts.second;
   if (train.samples.size() < 50 || valid.samples.size() < 50)
-    throw fit::FitError(flight.source + ": too short to hold out " + std::to_string(validation_fraction) +
+    throw fit::FitError(flight.source + ": too short to hold out " + output::short_number(validation_fraction) +
                         " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples)");
   d.train_samples = train.samples.size();
   d.valid_samples = valid.samples.size();

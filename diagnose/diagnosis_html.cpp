@@ -4,9 +4,11 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include "derive/effects/effect_catalogue.hpp"
 #include "diagnose/report_words.hpp"
@@ -24,6 +26,46 @@ using namespace words;
 namespace {
 
 std::string esc(const std::string& s) { return output::html_text(s); }
+
+// The plots, each beside the section whose numbers it draws (a user trial, helper-106: the
+// held-out comparison sat at the page's end, below every candidate's table). A plot no section
+// shows (its section is not on this page, or a name this page does not know) goes under "More
+// plots" at the end, so that none is lost.
+class Figures {
+ public:
+  explicit Figures(const std::vector<std::pair<std::string, std::string>>& plots)
+      : plots_(plots), shown_(plots.size(), false) {}
+
+  // Those of `names` that were drawn, in that order.
+  void show(std::ostream& h, std::initializer_list<std::string_view> names) {
+    for (const std::string_view name : names)
+      for (size_t i = 0; i < plots_.size(); ++i)
+        if (!shown_[i] && plots_[i].first == name) figure(h, i);
+  }
+
+  void show_rest(std::ostream& h) {
+    if (plots_.empty()) h << "<h2>Plots</h2>\n<p>No plots (gnuplot unavailable).</p>\n";
+    if (std::find(shown_.begin(), shown_.end(), false) != shown_.end()) h << "<h2>More plots</h2>\n";
+    for (size_t i = 0; i < plots_.size(); ++i)
+      if (!shown_[i]) figure(h, i);
+  }
+
+ private:
+  void figure(std::ostream& h, size_t i) {
+    shown_[i] = true;
+    const auto& [name, svg] = plots_[i];
+    const size_t at = svg.find("<svg");
+    const std::string stem = name.substr(0, name.rfind('.'));
+    const std::string look_for = what_to_look_for(name);
+    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>"
+      << (look_for.empty() ? "" : "<b>What to look for:</b> " + esc(look_for) + ". ") << esc(name);
+    h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
+    h << "</figcaption></figure>\n";
+  }
+
+  const std::vector<std::pair<std::string, std::string>>& plots_;
+  std::vector<bool> shown_;
+};
 
 // A flight's log by its file name: the full paths are listed once at the top of the report
 // (and on hover), where in every table row they pushed the numbers and the plot aside.
@@ -58,7 +100,7 @@ void lead_html(std::ostream& h, const std::vector<Lead>& leads, const std::strin
 
 // The command-gain check as a table: per flight (or the one flight) and axis, the gain,
 // correlation and delay in each band; the leads below it.
-void command_gain_html(std::ostream& h, const Diagnosis& d) {
+void command_gain_html(std::ostream& h, const Diagnosis& d, Figures& figures) {
   const auto rows = command_gains_by_flight(d);
   const CommandGain* first = nullptr;
   for (const auto& [flight, g] : rows)
@@ -87,6 +129,7 @@ void command_gain_html(std::ostream& h, const Diagnosis& d) {
     }
   }
   h << "</table>\n";
+  figures.show(h, {"command_gain.svg"});
   lead_html(h, command_gain_leads(d), "warn");
 }
 
@@ -180,7 +223,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
-      << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (p = " << num(a.q_p_value, 2)
+      << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
          "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
@@ -188,7 +231,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
         << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
-        << num(f.p_value, 2) << "</td><td><div style=\"position:relative;height:14px\">";
+        << esc(output::p_value_cell(f.p_value)) << "</td><td><div style=\"position:relative;height:14px\">";
       if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind
         h << "<div style=\"position:absolute;left:" << at(band_lo) << ";width:calc(" << at(band_hi) << " - " << at(band_lo)
           << ");top:0;bottom:0;background:#f4d6d6\"></div>";
@@ -262,18 +305,23 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
       << "vehicle parameters)";
   else
     h << " validation samples from t = " << num(d.t_split, 4) << " s";
-  h << "; " << num(d.seconds, 3) << " s.</p>\n";
+  h << "; diagnosed in " << num(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
   if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
 }
 
-// Up to four of an effect's values, one per line, then how many more: the glance table's
-// cells stay a few lines high where a joint diagnosis has one value per flight.
+// Up to four of an effect's values, one per line, the rest folded: the glance table's cells
+// stay a few lines high where a joint diagnosis has one value per flight, and every value is
+// on the page (a review, helper-111: "2 more (below)" pointed at values shown nowhere).
 std::string values_cell(const std::vector<std::string>& values) {
   constexpr size_t kShown = 4;
   std::string cell;
   for (size_t i = 0; i < values.size() && i < kShown; ++i) cell += (i ? "<br>" : "") + values[i];
-  if (values.size() > kShown) cell += "<br>&hellip; " + std::to_string(values.size() - kShown) + " more (below)";
+  if (values.size() > kShown) {
+    cell += "<details><summary>" + std::to_string(values.size() - kShown) + " more</summary>";
+    for (size_t i = kShown; i < values.size(); ++i) cell += (i > kShown ? "<br>" : "") + values[i];
+    cell += "</details>";
+  }
   return cell.empty() ? "&ndash;" : cell;
 }
 
@@ -336,7 +384,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
                     "&ndash;"});
   for (const auto& e : d.search.left_at_limit)
     rows.push_back({e.effect, "no",
-                    "not tested: still significant where the search stopped (p = " + num(e.p_value, 2) +
+                    "not tested: still significant where the search stopped (" + esc(output::p_is(e.p_value)) +
                         (e.implausible.empty() ? "" : "; implausible here: " + esc(e.implausible)) + ")",
                     "&ndash;", "&ndash;"});
   for (const auto& r : d.search.removed)
@@ -368,13 +416,16 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>In short</h2>\n<ul class=\"headline\">\n";
   if (d.findings.empty()) h << "<li>No cause named.</li>\n";
   for (const auto& f : d.findings) {
-    h << "<li>" << esc(headline(f)) << flights_own_tag(d, f.effect);
+    // The flight's own tag inside the sentence, before its full stop (a review, helper-111).
+    const std::string said = headline(f);
+    const bool stop = !said.empty() && said.back() == '.';
+    h << "<li>" << esc(stop ? said.substr(0, said.size() - 1) : said) << flights_own_tag(d, f.effect) << (stop ? "." : "");
     // A cause named jointly that the flights alone do not agree on is not one value of the
     // airframe: said here, not only in the agreement table further down.
     for (const auto& a : d.agreement)
       if (a.effect == f.effect && flights_disagree(a))
-        h << " <span class=\"warn\">The flights disagree on " << esc(a.parameter) << " (Cochran's Q p = "
-          << num(a.q_p_value, 2) << "; see <i>Do the flights agree?</i>).</span>";
+        h << " <span class=\"warn\">The flights disagree on " << esc(a.parameter) << " (Cochran's Q "
+          << esc(output::p_is(a.q_p_value)) << "; see <i>Do the flights agree?</i>).</span>";
     h << "</li>\n";
   }
   if (const auto p = point_of_action(d)) h << "<li>" << esc(point_of_action_headline(*p)) << "</li>\n";
@@ -402,7 +453,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
     << "</pre></details>\n";
 }
 
-void findings_html(std::ostringstream& h, const Diagnosis& d) {
+void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) {
   h << "<h2>Findings</h2>\n";
   for (const auto& note : d.notes) h << "<p class=\"warn\">Caution: " << esc(note) << ".</p>\n";
   if (d.findings.empty()) h << "<p>None.</p>\n";
@@ -434,10 +485,11 @@ void findings_html(std::ostringstream& h, const Diagnosis& d) {
           << "</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
       h << "</table>\n";
     }
-    h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, p = "
-      << num(f.evidence.p_value, 3) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
+    h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, "
+      << esc(output::p_is(f.evidence.p_value)) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
       << ".</p>\n";
   }
+  figures.show(h, {"profiles.svg"});
 }
 
 // The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...), as the
@@ -452,10 +504,16 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     return std::any_of(d.at_bounds.begin(), d.at_bounds.end(), [&](const fit::FitParameter& b) { return b.name == p.name; });
   };
   if (base.empty()) return;
+  // Each sentence only where it applies (a review, helper-111: a single flight's page spoke of
+  // per-flight copies, and of a bound no row was on).
   h << "<h2>The vehicle's own parameters, as fitted</h2>\n<p>The vehicle file's parameters the fit freed, at their "
-       "values in the final fit (jointly diagnosed, each flight's own copy: name@k; the extended model's header "
-       "carries their mean). One on its bound was held there: the model is strained, and a finding may stand "
-       "in for what it lacks.</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
+       "values in the final fit"
+    << (d.flights.size() > 1 ? " (each flight's own copy: name@k; the extended model's header carries their mean)" : "")
+    << "."
+    << (std::any_of(base.begin(), base.end(), [&](const fit::FitParameter* p) { return on_bound(*p); })
+            ? " One on its bound was held there: the model is strained, and a finding may stand in for what it lacks."
+            : "")
+    << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
   for (const auto* p : base)
     h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value) << "</td><td>" << esc(p->unit) << "</td><td>"
       << interval(p->lower, p->upper) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
@@ -502,15 +560,16 @@ void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
       if (a.absorbed)
         h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b) << "</b>: " << esc(a.b)
           << " explains the discrepancy on its own (" << esc(a.b_own_estimate) << ") and adds nothing beside " << esc(a.a)
-          << " (p = " << num(a.b_given_a_p, 3) << "), and the model fits as well with it held there (p = "
-          << num(a.b_at_own_estimate_p, 3) << "): " << esc(a.a) << " can reproduce it, so how much of the discrepancy is "
+          << " (" << esc(output::p_is(a.b_given_a_p)) << "), and the model fits as well with it held there ("
+          << esc(output::p_is(a.b_at_own_estimate_p)) << "): " << esc(a.a) << " can reproduce it, so how much of the discrepancy is "
           << esc(a.b) << " the data cannot say (with it held there: " << esc(a.a_with_b_held) << "). " << esc(a.a)
           << " is carried, its values not named. To separate them: "
           << esc(a.manoeuvre) << ".</p>\n";
       else
         h << "<p class=\"warn\"><b>" << esc(a.a) << "</b> or <b>" << esc(a.b)
-          << "</b>: both explain the discrepancy and neither adds anything significant to the other (p = "
-          << num(a.b_given_a_p, 3) << ", " << num(a.a_given_b_p, 3) << "). Not named. To separate them: " << esc(a.manoeuvre)
+          << "</b>: both explain the discrepancy and neither adds anything significant to the other ("
+          << esc(a.b) << " beside " << esc(a.a) << ": " << esc(output::p_is(a.b_given_a_p)) << "; " << esc(a.a) << " beside "
+          << esc(a.b) << ": " << esc(output::p_is(a.a_given_b_p)) << "). Not named. To separate them: " << esc(a.manoeuvre)
           << ".</p>\n";
   }
 }
@@ -528,42 +587,53 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
   lead_html(h, draft_leads(d), "");
 }
 
-void prediction_html(std::ostringstream& h, const Diagnosis& d) {
-  if (d.has_prediction) {
-    // Comparable with published models: the error AT a horizon, averaged over start points.
-    h << "<h2>Prediction on the validation part</h2>\n";
-    if (d.prediction_after.open_loop.empty())
-      h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state); one-step errors only.</p>\n";
-    h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
-         "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
-         "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
-         "<th>position, past disturbance held, extended [m]</th><th>position, body rates held, extended [m]</th>"
-         "<th>position, attitude held, extended [m]</th><th>position, constant velocity (no model) [m]</th></tr>\n";
-    const auto& b = d.prediction_before;
-    const auto& a = d.prediction_after;
-    // The mean of `quantity` at the i-th horizon of a view, "–" where the view has no such row.
-    const auto mean_at = [](const std::vector<predict::HorizonErrors>& rows, size_t i,
-                            predict::ErrorStats predict::HorizonErrors::*quantity) -> std::string {
-      return i < rows.size() ? num((rows[i].*quantity).mean()) : "–";
-    };
-    using H = predict::HorizonErrors;
-    for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
-      h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << mean_at(b.open_loop, i, &H::position) << "</td><td>"
-        << mean_at(a.open_loop, i, &H::position) << "</td><td>" << mean_at(a.open_loop, i, &H::tilt) << "</td><td>"
-        << mean_at(a.open_loop, i, &H::heading) << "</td><td>" << mean_at(a.attitude_replayed, i, &H::position)
-        << "</td><td>" << mean_at(a.translation_replayed, i, &H::tilt) << "</td><td>"
-        << mean_at(a.open_loop_past_disturbance, i, &H::position) << "</td><td>" << mean_at(a.body_rates_held, i, &H::position)
-        << "</td><td>" << mean_at(a.attitude_held, i, &H::position) << "</td><td>"
-        << mean_at(a.constant_velocity, i, &H::position) << "</td></tr>\n";
-    h << "</table>\n<p>Means over " << a.start_points << " start points; one step (extended model), RMS: body specific force "
-      << num(a.one_step.specific_force[0].rms(), 3) << " / " << num(a.one_step.specific_force[1].rms(), 3) << " / "
-      << num(a.one_step.specific_force[2].rms(), 3) << " m/s², angular acceleration "
-      << num(a.one_step.angular_acceleration[0].rms(), 3) << " / " << num(a.one_step.angular_acceleration[1].rms(), 3) << " / "
-      << num(a.one_step.angular_acceleration[2].rms(), 3) << " rad/s², world vertical acceleration "
-      << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
-    if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
-      h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
+// The open-loop errors per horizon, base and extended model, beside the extended model's views
+// that say where its error comes from.
+void horizon_table_html(std::ostringstream& h, const Diagnosis& d) {
+  h << "<table><tr><th>horizon [s]</th><th>position, base [m]</th>"
+       "<th>position, extended [m]</th><th>tilt, extended [rad]</th><th>heading, extended [rad]</th>"
+       "<th>position, attitude replayed [m]</th><th>tilt, translation replayed [rad]</th>"
+       "<th>position, past disturbance held, extended [m]</th><th>position, body rates held, extended [m]</th>"
+       "<th>position, attitude held, extended [m]</th><th>position, constant velocity (no model) [m]</th></tr>\n";
+  const auto& b = d.prediction_before;
+  const auto& a = d.prediction_after;
+  // The mean of `quantity` at the i-th horizon of a view, "–" where the view has no such row.
+  const auto mean_at = [](const std::vector<predict::HorizonErrors>& rows, size_t i,
+                          predict::ErrorStats predict::HorizonErrors::*quantity) -> std::string {
+    return i < rows.size() ? num((rows[i].*quantity).mean()) : "–";
+  };
+  using H = predict::HorizonErrors;
+  for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
+    h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << mean_at(b.open_loop, i, &H::position) << "</td><td>"
+      << mean_at(a.open_loop, i, &H::position) << "</td><td>" << mean_at(a.open_loop, i, &H::tilt) << "</td><td>"
+      << mean_at(a.open_loop, i, &H::heading) << "</td><td>" << mean_at(a.attitude_replayed, i, &H::position)
+      << "</td><td>" << mean_at(a.translation_replayed, i, &H::tilt) << "</td><td>"
+      << mean_at(a.open_loop_past_disturbance, i, &H::position) << "</td><td>" << mean_at(a.body_rates_held, i, &H::position)
+      << "</td><td>" << mean_at(a.attitude_held, i, &H::position) << "</td><td>"
+      << mean_at(a.constant_velocity, i, &H::position) << "</td></tr>\n";
+  h << "</table>\n";
+}
+
+void prediction_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) {
+  if (!d.has_prediction) return;
+  // Comparable with published models: the error AT a horizon, averaged over start points.
+  const auto& a = d.prediction_after;
+  h << "<h2>Prediction on the validation part</h2>\n";
+  // Without a pose no rollout starts (each starts from a measured state): no empty table
+  // (a review, helper-111: an ARPL report showed one, "over 0 start points").
+  if (a.open_loop.empty()) h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state). ";
+  else {
+    horizon_table_html(h, d);
+    h << "<p>Means over " << a.start_points << " start points. ";
   }
+  h << "One step (extended model), RMS: body specific force " << num(a.one_step.specific_force[0].rms(), 3) << " / "
+    << num(a.one_step.specific_force[1].rms(), 3) << " / " << num(a.one_step.specific_force[2].rms(), 3)
+    << " m/s², angular acceleration " << num(a.one_step.angular_acceleration[0].rms(), 3) << " / "
+    << num(a.one_step.angular_acceleration[1].rms(), 3) << " / " << num(a.one_step.angular_acceleration[2].rms(), 3)
+    << " rad/s², world vertical acceleration " << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
+  if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
+    h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
+  figures.show(h, {"validation.svg", "simulation_errors.svg", "prediction.svg"});
 }
 
 void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
@@ -576,7 +646,7 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
   h << "</table>\n";
 }
 
-void base_residuals_html(std::ostringstream& h, const Diagnosis& d) {
+void base_residuals_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) {
   h << "<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
        "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
   for (const auto& c : d.before.channels) {
@@ -588,38 +658,28 @@ void base_residuals_html(std::ostringstream& h, const Diagnosis& d) {
     h << "</td></tr>\n";
   }
   h << "</table>\n";
+  figures.show(h, {"residuals.svg", "autocorrelation.svg"});
 }
 
 void candidates_html(std::ostringstream& h, const Diagnosis& d) {
-  h << "<h2>Candidates</h2>\n";
+  // Folded: the verdicts are at the top; these tables are for a reader who asks why (a user
+  // trial, helper-106: they filled screens between the findings and the plots).
+  h << "<h2>Candidates</h2>\n<p>Every effect the search tried at each step, with its evidence; open a step to "
+       "read its table.</p>\n";
   for (size_t s = 0; s < d.search.steps.size(); ++s) {
     const auto& st = d.search.steps[s];
-    h << "<h3>Step " << s + 1 << " (model: base";
+    h << "<details><summary>Step " << s + 1 << " (model: base";
     for (const auto& e : st.base_effects) h << " + " << esc(e);
-    h << ")</h3>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
+    h << "): " << (st.selected.empty() ? "nothing taken" : "took " + esc(st.selected)) << "</summary>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
       << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic.</p>\n"
       << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
     for (const auto& c : st.candidates)
-      h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << num(c.p_value, 3)
+      h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << esc(output::p_value_cell(c.p_value))
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
         // significant but implausible in orange: a stand-in, not a cause (a user trial, helper-106)
         << "</td><td class=\"" << (!c.significant ? "no\">" + esc(c.why_not) : c.implausible.empty() ? "ok\">significant" : "warn\">significant")
         << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";
-    h << "</table>\n";
-  }
-}
-
-void plots_html(std::ostringstream& h, const std::vector<std::pair<std::string, std::string>>& plots) {
-  h << "<h2>Plots</h2>\n";
-  if (plots.empty()) h << "<p>No plots (gnuplot unavailable).</p>\n";
-  for (const auto& [name, svg] : plots) {
-    const size_t at = svg.find("<svg");
-    const std::string stem = name.substr(0, name.rfind('.'));
-    const std::string look_for = what_to_look_for(name);
-    h << "<figure>" << (at == std::string::npos ? "" : svg.substr(at)) << "<figcaption>"
-      << (look_for.empty() ? "" : "<b>What to look for:</b> " + esc(look_for) + ". ") << esc(name);
-    h << " (data: <a href=\"" << esc(stem) << ".csv\">" << esc(stem) << ".csv</a>)";
-    h << "</figcaption></figure>\n";
+    h << "</table>\n</details>\n";
   }
 }
 
@@ -673,23 +733,26 @@ void method_html(std::ostringstream& h) {
 
 std::string diagnosis_html(const Diagnosis& d, const std::string& log_path,
                            const std::vector<std::pair<std::string, std::string>>& plots) {
+  // In the order a reader asks: what was found, does it predict better on data the fit did not
+  // see, do the flights agree, what is not a cause, what is still wrong, then the evidence.
   std::ostringstream h;
+  Figures figures(plots);
   head_html(h, d, log_path);
   in_short_html(h, d);
   next_steps_html(h, d);
-  findings_html(h, d);
-  base_parameters_html(h, d);
+  findings_html(h, d, figures);
+  prediction_html(h, d, figures);
+  validation_channels_html(h, d);
   agreement_html(h, d);
   stand_ins_html(h, d);
   ambiguous_html(h, d);
+  base_parameters_html(h, d);
   unexplained_html(h, d);
-  command_gain_html(h, d);
+  base_residuals_html(h, d, figures);
+  command_gain_html(h, d, figures);
   discovered_terms_html(h, d);
-  prediction_html(h, d);
-  validation_channels_html(h, d);
-  base_residuals_html(h, d);
   candidates_html(h, d);
-  plots_html(h, plots);
+  figures.show_rest(h);
   words_html(h);
   method_html(h);
   return h.str();

@@ -96,7 +96,7 @@ std::vector<runtime::Panel> residual_panels(const Diagnosis& d, size_t stride) {
 std::string residuals_title(const Diagnosis& d) {
   return d.vehicle + ": equation-error residuals (" +
          (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
-                               : "validation from t = " + std::to_string(d.t_split).substr(0, 5) + " s") +
+                               : "validation from t = " + num(d.t_split, 4) + " s") +
          ")";
 }
 
@@ -238,7 +238,7 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   plots.render("autocorrelation.svg", d.vehicle + ": residual autocorrelation", autocorrelation_panels(d));
   const auto gain_panels = command_gain_panels(d);
   if (!gain_panels.empty()) plots.render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
-  if (d.has_prediction)
+  if (d.has_prediction && !d.prediction_after.open_loop.empty())  // no pose logged: no rollout to draw
     plots.render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
                  predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
   if (!d.search.profiles.empty())

@@ -26,9 +26,11 @@ namespace {
 void write_findings(std::ostream& os, const Diagnosis& d) {
   if (d.findings.empty()) return;
   // The held-out measure is said once; a finding judged by another says its own.
-  os << "held out: " << d.metric << ", for each effect found the final model without it -> with it\n";
+  // "named", as the report and its words table call a cause (a review, helper-111: the
+  // terminal said "found" where the page beside it said "named").
+  os << "held out: " << d.metric << ", for each effect named the final model without it -> with it\n";
   for (const auto& f : d.findings) {
-    os << "found " << f.effect << flights_own_note(d, f.effect) << ":";
+    os << "named " << f.effect << flights_own_note(d, f.effect) << ":";
     for (const auto& p : f.parameters)
       os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
@@ -44,7 +46,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
 void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.agreement) {
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
-       << " %" << spread_context(a) << ", Cochran's Q p = " << num(a.q_p_value, 2) << "):";
+       << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
     os << "\n";
@@ -55,7 +57,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
        << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
-       << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, p = " << num(a.q_p_value, 2)
+       << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }
 
@@ -88,7 +90,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
        << (d.search.steps.size() == 1 ? " effect" : " effects") << " (--max-effects); still significant in its last step:";
     for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
       const auto& ev = d.search.left_at_limit[k];
-      os << (k ? ", " : " ") << ev.effect << " (p = " << num(ev.p_value, 2) << (ev.implausible.empty() ? "" : ", implausible")
+      os << (k ? ", " : " ") << ev.effect << " (" << output::p_is(ev.p_value) << (ev.implausible.empty() ? "" : ", implausible")
          << ")";
     }
     // What a larger limit would do: an implausible candidate ranks last, so where only those

@@ -67,7 +67,7 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
   for (const auto& f : folds_) fold_starts_.push_back(f.samples.front().t);
   // Every point of a window is scored (0 to `window` s ahead): less than the error at the
   // window's end, which predict reports; the wording keeps the two apart.
-  metric_name_ = pose_ ? "validation position RMSE (" + std::to_string(window).substr(0, 3) +
+  metric_name_ = pose_ ? "validation position RMSE (" + output::short_number(window) +
                              " s open-loop windows from measured states" + stride_clause(window, window_stride) +
                              "; every point of a window scored) [m]"
                        : "validation equation-error cost (weighted, no pose logged)";

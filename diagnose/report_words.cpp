@@ -39,8 +39,8 @@ OneLead draft_lead(const DraftSignature& d) {
     numbers += (numbers.empty() ? "" : "; ") + p.name;
     for (const auto& axis : axes) {
       const auto& pair = axis == "y (roll)" ? p.y_roll : p.x_pitch;
-      numbers += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", p = " +
-                 num(pair.p, 2) + ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
+      numbers += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", " +
+                 output::p_is(pair.p) + ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
     }
     if (p.implied_speed > 0) numbers += ", draft at most " + num(p.implied_speed, 2) + " m/s";
   }
@@ -146,7 +146,7 @@ std::string airframe_from_one_flight(const Diagnosis& d) {
 
 std::string carried_suspect(const CarriedSuspect& c) {
   return "carried in the model, not named: " + c.beside + "'s values fitted without it (" + c.without +
-         ") are rejected once it is held at its estimate (p = " + output::short_number(c.named_values_p) +
+         ") are rejected once it is held at its estimate (" + output::p_is(c.named_values_p) +
          "); beside it they are " + c.with;
 }
 
@@ -210,7 +210,7 @@ std::optional<PointOfAction> point_of_action(const Diagnosis& d) {
 std::string point_of_action_headline(const PointOfAction& p) {
   std::ostringstream os;
   os << "The rotor drag force acts " << std::fixed << std::setprecision(0) << std::fabs(1000 * p.height) << " mm "
-     << (p.height >= 0 ? "above" : "below") << " the centre of gravity (blade_flapping.k / rotor_drag.k)";
+     << (p.height >= 0 ? "above" : "below") << " the centre of gravity (blade_flapping.k / rotor_drag.k).";
   return os.str();
 }
 
@@ -252,19 +252,28 @@ std::vector<std::string> screening_notes(const Diagnosis& d) {
 
 std::string environment_note(const Diagnosis& d) {
   if (d.environment != "unknown") return "";
-  const auto range = [](const PlausibleRange& r) {
-    return "[" + output::short_number(r.lower) + ", " + output::short_number(r.upper) + "]";
-  };
   for (const auto& c : d.candidates) {
     const Effect* e = effect_named(c);
     if (!e) continue;
     for (const auto& indoor : e->plausible) {
       if (indoor.only_in != Environment::kIndoor || indoor.scale != PlausibleRange::Scale::kSI) continue;
+      // The ranges with their unit (a review, helper-111: "within [-15, 15]" said no m/s).
+      std::string unit;
+      for (const auto& p : d.search.final_fit)
+        if (p.name == indoor.parameter || (indoor.parameter.empty() && p.name.rfind(c + ".", 0) == 0)) {
+          unit = p.unit;
+          break;
+        }
+      const auto range = [&](const PlausibleRange& r) {
+        return "[" + output::short_number(r.lower) + ", " + output::short_number(r.upper) + "]" +
+               output::unit_after_number(unit);
+      };
       std::string anywhere = "its bounds";
       for (const auto& r : e->plausible)
         if (r.only_in == Environment::kUnknown && r.parameter == indoor.parameter && r.scale == indoor.scale)
           anywhere = range(r);
-      return "note: where the flights were flown is unknown (not declared, or declared so: --environment, or "
+      return "note: where " + std::string(d.flights.size() > 1 ? "the flights were" : "the flight was") +
+             " flown is unknown (not declared, or declared so: --environment, or "
              "`environment:` in the mapping), so " +
              (indoor.parameter.empty() ? c : indoor.parameter) + " counts as plausible within " + anywhere +
              "; indoors only " + range(indoor) + " would, and a value beyond it would be a stand-in for missing physics, "
@@ -369,7 +378,7 @@ std::string name_value(const std::string& name, double value, const std::string&
 
 std::string spread_context(const ParameterAgreement& a) {
   if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
-  return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, p = " + num(a.spread_p_value, 2) + ")";
+  return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, " + output::p_is(a.spread_p_value) + ")";
 }
 
 std::string channel_unit(const Diagnosis& d, const std::string& channel) {

@@ -16,6 +16,7 @@
 #include "fit/motor_steps.hpp"
 #include "fit/multiple_shooting.hpp"
 #include "runtime/plot.hpp"
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "fit/thrust_stand.hpp"
 
@@ -366,7 +367,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   auto clock0 = std::chrono::steady_clock::now();
   const FitResult best = fit_least_squares(*m.train, params, fo);
   const double fit_seconds = seconds_since(clock0);
-  o.progress("[2/3] profile likelihood (fit took " + std::to_string(fit_seconds) + " s)");
+  o.progress("[2/3] profile likelihood (fit took " + output::short_number(fit_seconds) + " s)");
   clock0 = std::chrono::steady_clock::now();
   const auto profiles = run_profiles(o, *m.train, best, fo);
   const double profile_seconds = seconds_since(clock0);
@@ -378,7 +379,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   j["vehicle"] = v.name;
   j["log"] = path;
   j["mapping"] = o.mapping;
-  j["formulation"] = shooting ? "multiple shooting: " + std::to_string(o.window) + " s windows from measured states, pose residuals"
+  j["formulation"] = shooting ? "multiple shooting: " + output::short_number(o.window) + " s windows from measured states, pose residuals"
                      : accel  ? "equation error: accelerometer specific force and gyro derivative"
                               : "equation error: differentiated velocity and gyro derivative";
   j["validation"] = validation_json(*m.valid, params, best, o.validation, valid.samples.size());
@@ -386,7 +387,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
   add_profile_plot(out, v.name + ": profile likelihood", profiles);
   const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
-  add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + std::to_string(cut).substr(0, 5) + " s)",
+  add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + output::six_digits(cut) + " s)",
            flight_panels(model, flight, parameter_values(best.parameters)));
   out.summary = profile_summary(best, profiles);
   const auto fitted = m.train->channels();

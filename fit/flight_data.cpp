@@ -323,7 +323,7 @@ runtime::CsvTable resample(const runtime::CsvTable& log, double rate_hz) {
   // than in std::bad_alloc: 1e8 values (800 MB).
   const double n_out = std::floor(std::max(0.0, t1 - t0) * rate_hz) + 1;
   if (n_out * static_cast<double>(log.columns.size()) > 1e8)
-    throw FitError(log.path + ": resampling " + std::to_string(t1 - t0) + " s at " + std::to_string(rate_hz) + " Hz gives " +
+    throw FitError(log.path + ": resampling " + output::six_digits(t1 - t0) + " s at " + output::six_digits(rate_hz) + " Hz gives " +
                    std::to_string(static_cast<long long>(std::min(n_out, 1e18))) + " samples of " +
                    std::to_string(log.columns.size()) + " columns, above the limit of 1e8 values");
   runtime::CsvTable out;
@@ -392,7 +392,7 @@ namespace {
   std::ostringstream os;
   os << path << ": too few airborne samples (" << f.samples.size() << " of " << trel.size() << "; need "
      << static_cast<int>(o.min_samples) << "): a sample counts when every motor command is above " << o.min_command
-     << (f.has_pose ? " and z above " + std::to_string(o.min_height) + " m" : std::string()) << ", more than "
+     << (f.has_pose ? " and z above " + output::short_number(o.min_height) + " m" : std::string()) << ", more than "
      << o.edge_trim << " s from either end; the log spans " << trel.back() << " s with a median sample interval of "
      << dt[dt.size() / 2] << " s (is t in seconds?)";
   throw FitError(os.str());
@@ -574,7 +574,7 @@ FlightSample sample_at(const FlightColumns& c, size_t k, const runtime::CsvTable
   for (int i = kAttitude; i < kAttitude + 4; ++i) qn += fs.x[i] * fs.x[i];
   qn = std::sqrt(qn);
   if (!(qn > 0.5 && qn < 1.5))
-    throw FitError(log.where_row(k) + ": attitude quaternion has norm " + std::to_string(qn));
+    throw FitError(log.where_row(k) + ": attitude quaternion has norm " + output::six_digits(qn));
   for (int i = kAttitude; i < kAttitude + 4; ++i) fs.x[i] /= qn;
   for (const auto& uc : c.commands) fs.u.push_back(uc[k]);
   fs.vbat = c.vbat[k];

@@ -91,18 +91,21 @@ bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
   return true;
 }
 
-// An Euler angle mapped from a topic is averaged unwrapped (fit/grid_mean.hpp), its period in
-// the source's unit from the mapping's scale and unit (360 for degrees).
-// Judged as logged, before the roll is unwrapped, averaged and wrapped again: a roll in
-// degrees read as radians would pass once wrapped (hostile-input audit, helper-105).
-void unwrap_if_angle(Signal& s, const ColumnMapping::Entry& e, const std::string& path) {
-  const double to_radians = std::fabs(e.scale * e.unit_scale);
+// An Euler angle judged as logged, before the roll is unwrapped, averaged and wrapped again: a
+// roll in degrees read as radians would pass once wrapped (hostile-input audit, helper-105).
+void check_euler_range(const Signal& s, const ColumnMapping::Entry& e, const std::string& path) {
   for (size_t k = 0; k < s.v.size(); ++k) {
     const std::string problem = euler_range_problem(e.target, s.v[k] * e.scale * e.unit_scale);
     if (!problem.empty())
       throw FitError(path + " ('" + e.source + "' at t = " + output::six_digits(s.t[k]) + " s of the log's clock): " +
                      problem);
   }
+}
+
+// An Euler angle mapped from a topic is averaged unwrapped (fit/grid_mean.hpp), its period in
+// the source's unit from the mapping's scale and unit (360 for degrees).
+void unwrap_if_angle(Signal& s, const ColumnMapping::Entry& e) {
+  const double to_radians = std::fabs(e.scale * e.unit_scale);
   if ((e.target == "phi" || e.target == "psi") && to_radians > 0) s.v = unwrapped(s.v, 2 * M_PI / to_radians);
 }
 
@@ -126,7 +129,8 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   for (const auto& e : m.entries) {
     if (e.source == "t") continue;  // the time base this function makes
     signals.push_back(find_signal(log, e));
-    unwrap_if_angle(signals.back(), e, log.path);
+    check_euler_range(signals.back(), e, log.path);
+    unwrap_if_angle(signals.back(), e);
     t0 = std::max(t0, signals.back().t.front());
     t1 = std::min(t1, signals.back().t.back());
   }
@@ -136,7 +140,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   const double step = 1.0 / rate_hz, rows = std::floor((t1 - t0) / step) + 1;
   if (rows * static_cast<double>(signals.size() + 1) > kMaxCells)
     throw FitError(log.path + ": " + std::to_string(static_cast<long long>(rows)) + " rows of " +
-                   std::to_string(signals.size() + 1) + " columns at " + std::to_string(rate_hz) +
+                   std::to_string(signals.size() + 1) + " columns at " + output::six_digits(rate_hz) +
                    " Hz over the logged span is more than quadgen holds; lower --resample");
   runtime::CsvTable out;
   out.path = log.path;

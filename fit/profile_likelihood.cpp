@@ -1,5 +1,6 @@
 #include "fit/profile_likelihood.hpp"
 #include "fit/evaluation_threads.hpp"
+#include "output/numbers.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -64,7 +65,7 @@ Side walk(const ResidualModel& model, const FitResult& best, int k, double dir, 
     try {
       c = solve_weighted(model, ps, best.weights, fo);
     } catch (const FitError& e) {  // say which profile point could not be fitted
-      throw FitError("profile of " + ps[k].name + " at " + std::to_string(next) + ": " + e.what());
+      throw FitError("profile of " + ps[k].name + " at " + output::six_digits(next) + ": " + e.what());
     }
     std::vector<double> vals;
     for (const auto& p : ps) vals.push_back(p.value);

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "output/names.hpp"
+#include "output/numbers.hpp"
 #include "model/sha256.hpp"
 #include "model/yaml_reader.hpp"
 #include "output/sinks.hpp"
@@ -227,7 +228,7 @@ void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v
                                          "as the command rises)");
     const double pivot = v.params.at("pivot").nominal;
     if (!(pivot >= 0 && pivot <= 1))
-      r.fail(root["motor_map"]["pivot"], "motor_map: 'pivot' is a command, expected 0..1, got " + std::to_string(pivot));
+      r.fail(root["motor_map"]["pivot"], "motor_map: 'pivot' is a command, expected 0..1, got " + output::six_digits(pivot));
   }
   if (root["battery"])
     read_section(r, root, v, "battery", {{"vbat_ref", "V", true, "reference battery voltage"}});

@@ -26,7 +26,27 @@ std::string short_number(double v) { return with_digits(v, 3); }
 
 std::string six_digits(double v) { return with_digits(v, 6); }
 
-std::string full_number(double v) { return with_digits(v, 17); }
+namespace {
+constexpr double kSmallestPrintedP = 1e-300;
+}  // namespace
+
+std::string p_value_cell(double p) {
+  if (!std::isfinite(p)) return "–";
+  return p >= 0 && p < kSmallestPrintedP ? "< " + short_number(kSmallestPrintedP) : short_number(p);
+}
+
+std::string p_is(double p) {
+  const std::string value = p_value_cell(p);
+  return value[0] == '<' ? "p " + value : "p = " + value;
+}
+
+std::string full_number(double v) {
+  for (int digits = 1; digits < 17; ++digits) {
+    const std::string s = with_digits(v, digits);
+    if (std::strtod(s.c_str(), nullptr) == v) return s;
+  }
+  return with_digits(v, 17);
+}
 
 std::string unit_after_number(const std::string& unit) { return unit.empty() || unit == "1" ? "" : " " + unit; }
 

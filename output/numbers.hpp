@@ -8,11 +8,18 @@ namespace quadgen::output {
 
 // Three significant digits ("0.0524", "1.32e-06", "208").
 std::string short_number(double v);
+// A p-value in a sentence, "p = 0.00288", or "p < 1e-300" where it is below what a double
+// holds well (a likelihood-ratio statistic of thousands on a real flight gives 0, and "p = 0"
+// claims certainty no test gives); and the same without "p" for a table's cell.
+std::string p_is(double p);
+std::string p_value_cell(double p);
 // Six significant digits ("0.265851", "1.7e+308"): where a reader adds numbers up by eye (a
 // weight beside the thrusts that carry it), and never hundreds of digits.
 std::string six_digits(double v);
-// Every digit a double holds (17 significant): where a value differs from the one it is
-// compared with only beyond six ("-1.0000000000000002" below a bound of -1).
+// As many digits as read back as the same double, and no more (the shortest round trip, at
+// most 17 significant): where a value differs from the one it is compared with only beyond
+// six ("-1.0000000000000002" below a bound of -1), and where a file is read again (a fitted
+// 0.05 is "0.05", not "0.050000000000000003").
 std::string full_number(double v);
 // "a then b" with six significant digits, or as many more as tell them apart: a log whose time
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).

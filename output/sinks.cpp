@@ -82,6 +82,22 @@ std::string printable(const std::string& s) {
   return out;
 }
 
+namespace {
+constexpr size_t kErrorHead = 1000, kErrorTail = 600;
+bool utf8_continuation(const std::string& s, size_t i) {
+  return i < s.size() && (static_cast<unsigned char>(s[i]) & 0xC0) == 0x80;
+}
+}  // namespace
+
+std::string printable_error(const std::string& message) {
+  if (message.size() <= kErrorHead + kErrorTail + 100) return printable(message);
+  size_t head = kErrorHead, tail = message.size() - kErrorTail;
+  while (head > 0 && utf8_continuation(message, head)) --head;  // whole characters on both sides
+  while (utf8_continuation(message, tail)) ++tail;
+  return printable(message.substr(0, head)) + " [... " + std::to_string(tail - head) + " bytes left out ...] " +
+         printable(message.substr(tail));
+}
+
 std::string printable_lines(const std::string& text) {
   std::string out;
   size_t start = 0;

@@ -12,6 +12,10 @@ namespace quadgen::output {
 // controls and the bidirectional overrides in their UTF-8 form too) become \xNN, invalid
 // UTF-8 becomes '?'.
 std::string printable(const std::string& s);
+// An error message for a terminal, as printable makes it, in at most about 1.7 kB: a message
+// quoting a 200 kB name (a vehicle file's block, a log's column) keeps its head (where and
+// what) and its tail (what was expected), and says how many bytes it left out between them.
+std::string printable_error(const std::string& message);
 // Several lines for a terminal (a command's summary): each line as printable makes it, the
 // line breaks kept. Summaries quote log paths, which may carry escape sequences.
 std::string printable_lines(const std::string& text);

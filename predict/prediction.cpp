@@ -352,7 +352,7 @@ std::string open_loop_against_no_model(const Prediction& p) {
   return "Open loop, " + output::short_number(at->horizon) + " s ahead of a measured state, the model is " +
          output::short_number(at->model) + " m off; extrapolating the measured velocity with no model is " +
          output::short_number(at->none) + " m off" +
-         (at->model <= at->none ? ": the model is the closer." : ": at that horizon no model is the closer.");
+         (at->model <= at->none ? ": the model is the closer." : ": at that horizon the velocity alone comes closer than the model.");
 }
 
 // m: below this at the longest horizon a model predicts the log exactly (its own flights).

@@ -450,8 +450,8 @@ class DelayedCommands {
   DelayedCommands(double delay, double dt, double duration) {
     // A negative delay would read commands not yet sent, one beyond the flight none sent.
     if (!(delay >= 0 && delay <= duration))
-      throw std::invalid_argument("input_delay.seconds = " + std::to_string(delay) + ": expected 0 to the flight's " +
-                                  std::to_string(duration) + " s");
+      throw std::invalid_argument("input_delay.seconds = " + output::six_digits(delay) + ": expected 0 to the flight's " +
+                                  output::six_digits(duration) + " s");
     whole_ = static_cast<long>(std::floor(delay / dt + 1e-6));
     rest_ = delay - static_cast<double>(whole_) * dt;
     if (rest_ < 1e-6) rest_ = 0;
@@ -552,10 +552,10 @@ GeneratedFlight fly_closed_loop(const DynamicModel& truth, const ControllerModel
     fly_one_period(truth, x, commands, extra, nr, {k, t, dt, vbat}, io);
     unmodelled.apply(x, ref, gauss);
     if (x[kPosition + 2] < -5 || (p_at_t - r.position()).norm() > 20)
-      throw DivergenceError("closed-loop flight lost at t = " + std::to_string(t) + " s: " +
+      throw DivergenceError("closed-loop flight lost at t = " + output::six_digits(t) + " s: " +
                             (x[kPosition + 2] < -5 ? "fell below z = -5 m"
                                                    : "more than 20 m from the reference (" +
-                                                         std::to_string((p_at_t - r.position()).norm()) + " m)") +
+                                                         output::short_number((p_at_t - r.position()).norm()) + " m)") +
                             "; does the vehicle file hold what flies (the audit's warnings), or the --set values?");
   }
   return out;

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
 extern char** environ;
@@ -319,12 +320,8 @@ bool render_svg(const std::string& title, const std::vector<Panel>& panels, std:
 
 std::string panels_csv(const std::string& title, const std::vector<Panel>& panels) {
   std::string out = "plot,panel,x_label,y_label,series,x,y\n";
-  char number[32];
-  const auto field = [&](double v) {
-    if (!std::isfinite(v)) return std::string();
-    std::snprintf(number, sizeof number, "%.17g", v);
-    return std::string(number);
-  };
+  // Each number as the shortest text that reads back as it (0.1, not 0.10000000000000001).
+  const auto field = [&](double v) { return std::isfinite(v) ? output::full_number(v) : std::string(); };
   const std::string plot = output::csv_field(title);
   for (const auto& p : panels) {
     const std::string prefix = plot + "," + output::csv_field(p.title) + "," + output::csv_field(p.xlabel) + "," +

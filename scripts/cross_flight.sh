@@ -56,5 +56,5 @@ for n in "$unseen" $extra_checks; do
       > "$out/check_$n.log" 2>&1 || echo "check of $n failed: see $out/check_$n.log" >&2
   fi
   echo; echo "$n against the airframe of the four flights:"
-  grep -E '^(this flight|found|suspected)' "$out/check_$n.log" | cut -c1-300 || true
+  grep -E '^(this flight|named|suspected)' "$out/check_$n.log" | cut -c1-300 || true
 done

@@ -438,7 +438,7 @@ TEST(TwoEffects, WhatTheLimitLeftOutIsReported) {
   const std::string text((std::istreambuf_iterator<char>(printed)), {});
   const size_t line = text.find("the search stopped at its limit of 1 effect (--max-effects); still significant in its last step:");
   ASSERT_NE(line, std::string::npos) << text;
-  EXPECT_NE(text.substr(line, text.find('\n', line) - line).find(" " + other + " (p = "), std::string::npos) << text;
+  EXPECT_NE(text.substr(line, text.find('\n', line) - line).find(" " + other + " (p "), std::string::npos) << text;
   // Without the limit nothing is left over.
   const fs::path dir2 = fresh_directory("quadgen_two_limit_none");
   EXPECT_TRUE(diagnose_log(vehicle_file(c), log, dir2)["left_at_max_effects"].empty());
@@ -1216,7 +1216,7 @@ TEST(DiagnosisReport, EachFindingSaysWhetherItIsTheAirframesOrTheFlights) {
     const std::string expected = quadgen::find_effect(e).per_flight ? "flight" : "airframe";
     EXPECT_EQ(j["findings"][i]["scope"], expected) << e;
     EXPECT_EQ(j["effect_scopes"][e], expected) << e;
-    const bool tagged = summary.find("found " + e + " " + tag + ":") != std::string::npos;
+    const bool tagged = summary.find("named " + e + " " + tag + ":") != std::string::npos;
     EXPECT_EQ(tagged, expected == "flight") << summary;
     const size_t h3 = html.find("<h3>" + e);
     ASSERT_NE(h3, std::string::npos) << e;
@@ -1230,7 +1230,7 @@ TEST(DiagnosisReport, EachFindingSaysWhetherItIsTheAirframesOrTheFlights) {
     ++tags;
   EXPECT_EQ(tags, 6u) << html;
   d.flights = {"a.csv", "b.csv"};  // jointly: each flight has its own value
-  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("found wind (a property of each flight, not of the airframe):"),
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(d).find("named wind (a property of each flight, not of the airframe):"),
             std::string::npos);
   // The catalogue's own declarations, written down independently: trims, the marker frame
   // and a wind belong to the flight; blade flapping and a CoG offset to the airframe.
@@ -1315,7 +1315,7 @@ TEST(DiagnosisReport, AnAirframesCauseWithAFlightsOwnLookAlikeNamedOnOneFlightSa
   EXPECT_EQ(j["findings"][0]["flights_own_look_alikes"].dump(), "[\"motor_gain\"]");
   EXPECT_EQ(j["findings"][1]["flights_own_look_alikes"].dump(), "[]");
   std::string summary = quadgen::diagnose::diagnosis_summary(d);
-  const size_t cog = summary.find("found cog_offset"), flapping = summary.find("found blade_flapping");
+  const size_t cog = summary.find("named cog_offset"), flapping = summary.find("named blade_flapping");
   ASSERT_TRUE(cog != std::string::npos && flapping != std::string::npos) << summary;
   const size_t said = summary.find(caveat);
   EXPECT_TRUE(said > cog && said < flapping) << summary;  // beside the CoG offset's finding
@@ -1339,11 +1339,17 @@ TEST(DiagnosisReport, AnUndeclaredEnvironmentIsSaidWithTheWindItAllows) {
   quadgen::diagnose::Diagnosis d;
   d.environment = "unknown";
   d.candidates = {"motor_gain", "wind"};
+  d.flights = {"a.csv", "b.csv"};
+  d.search.final_fit = {{"wind.x", "m/s", 0.1, -20, 20, true}};
   const std::string note = "note: where the flights were flown is unknown";
   const std::string summary = quadgen::diagnose::diagnosis_summary(d);
   EXPECT_NE(summary.find(note), std::string::npos) << summary;
-  EXPECT_NE(summary.find("wind counts as plausible within [-15, 15]; indoors only [-0.5, 0.5] would"), std::string::npos)
+  EXPECT_NE(summary.find("wind counts as plausible within [-15, 15] m/s; indoors only [-0.5, 0.5] m/s would"),
+            std::string::npos)
       << summary;
+  quadgen::diagnose::Diagnosis one = d;
+  one.flights = {"a.csv"};
+  EXPECT_NE(quadgen::diagnose::diagnosis_summary(one).find("note: where the flight was flown is unknown"), std::string::npos);
   EXPECT_NE(quadgen::diagnose::diagnosis_html(d, "log.csv", {}).find("<p class=\"warn\">" + note), std::string::npos);
   d.environment = "indoor";
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find(note), std::string::npos);
@@ -1443,6 +1449,49 @@ TEST(DiagnosisReport, AJointCauseTheFlightsDisagreeOnIsFlaggedWhereItIsNamed) {
   d.agreement.front().agree = true;
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find(says), std::string::npos);
   EXPECT_EQ(quadgen::diagnose::diagnosis_html(d, "log.csv", {}).find(says_html), std::string::npos);
+}
+
+// Each plot beside the section whose numbers it draws, the candidates' tables folded, and a p
+// below a double's reach never printed as 0 (a user trial, helper-106; a real flight's finding
+// read "p = 0" and its candidates "p = 0.500000" beside "p = 0.5").
+TEST(DiagnosisReport, EachPlotIsBesideItsSectionAndTheCandidatesAreFolded) {
+  namespace dg = quadgen::diagnose;
+  dg::Diagnosis d;
+  d.has_prediction = true;
+  dg::Finding f;
+  f.effect = "rotor_drag", f.evidence.p_value = 0;
+  d.findings.push_back(f);
+  dg::CandidateEvidence tried;
+  tried.effect = "rotor_drag", tried.p_value = 0, tried.significant = true;
+  dg::SelectionStep step;
+  step.candidates = {tried}, step.selected = "rotor_drag", step.outcome = "selected";
+  d.search.steps.push_back(step);
+  const std::string html = dg::diagnosis_html(
+      d, "f.csv", {{"residuals.svg", "<svg>R</svg>"}, {"profiles.svg", "<svg>P</svg>"}, {"new.svg", "<svg>N</svg>"},
+                   {"validation.svg", "<svg>V</svg>"}});
+  const auto at = [&](const std::string& s) { return html.find(s); };
+  const size_t findings = at("<h2>Findings</h2>"), prediction = at("<h2>Prediction on the validation part</h2>"),
+               channels = at("<h2>Validation per channel</h2>"), base = at("<h2>What the base model gets wrong</h2>"),
+               candidates = at("<h2>Candidates</h2>"), more = at("<h2>More plots</h2>");
+  ASSERT_TRUE(findings < prediction && prediction < channels && channels < base && base < candidates && candidates < more &&
+              more != std::string::npos) << html;
+  EXPECT_TRUE(at("<svg>P</svg>") > findings && at("<svg>P</svg>") < prediction);
+  EXPECT_TRUE(at("<svg>V</svg>") > prediction && at("<svg>V</svg>") < channels);
+  EXPECT_TRUE(at("<svg>R</svg>") > base && at("<svg>R</svg>") < candidates);
+  EXPECT_GT(at("<svg>N</svg>"), more);  // a plot no section knows is not lost
+  EXPECT_EQ(html.find("<svg>V</svg>", at("<svg>V</svg>") + 1), std::string::npos);  // each once
+  EXPECT_NE(html.find("<details><summary>Step 1 (model: base): took rotor_drag</summary>", candidates), std::string::npos);
+  EXPECT_NE(html.find("dof, p &lt; 1e-300 (level"), std::string::npos);
+  EXPECT_NE(html.find("<td>&lt; 1e-300</td>", candidates), std::string::npos);
+  const std::string none = dg::diagnosis_html(d, "f.csv", {});
+  EXPECT_NE(none.find("<h2>Plots</h2>\n<p>No plots (gnuplot unavailable).</p>"), std::string::npos);
+  EXPECT_EQ(none.find("More plots"), std::string::npos);
+  namespace out = quadgen::output;
+  EXPECT_EQ(out::p_is(0.0028751), "p = 0.00288");
+  EXPECT_EQ(out::p_is(0.5), "p = 0.5");
+  EXPECT_EQ(out::p_is(1e-310), "p < 1e-300");
+  EXPECT_EQ(out::p_value_cell(1.08e-143), "1.08e-143");
+  EXPECT_EQ(out::p_value_cell(NAN), "–");
 }
 
 // What a reader needs within the first screen (a user trial, helper-106): every verdict in one

@@ -787,6 +787,34 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << out::printable(r.err);
 }
 
+// A name of 200 kB is refused in a line a person can read: its head (where, what) and its tail
+// (what was expected), the bytes between them counted, not printed (a review of the eighth
+// audit: a 200 kB block name gave a 200 kB error line); a cut never splits a UTF-8 character.
+TEST(Cli, AHugeNameGivesAnErrorLineOfReadableLength) {
+  Scratch tmp;
+  std::string text = read(source_path("vehicles/finken3.yaml"));
+  const std::string block = "{name: upper_body,";
+  ASSERT_NE(text.find(block), std::string::npos);
+  text.replace(text.find(block), block.size(), "{name: " + std::string(200000, 'a') + ",");
+  write(tmp.dir / "huge.yaml", text);
+  const CliResult r = run_quadgen({"derive", tmp / "huge.yaml", "--out", tmp / "o"}, tmp.dir);
+  EXPECT_NE(r.rc, 0);
+  EXPECT_LT(r.err.size(), 2000u) << r.err.substr(0, 300);
+  EXPECT_EQ(r.err.rfind("quadgen: error: ", 0), 0u) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find("huge.yaml:43"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find(" bytes left out ...] aaa"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(std::string("(allowed: ") + out::name_rule() + ")\n"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp / "o"));
+  const std::string accents = out::printable_error(std::string(1500, 'x') + "\xc3\xa9" + std::string(3000, 'x'));
+  for (size_t n = 1; n < 5000; n += 997) {  // wherever the cut falls among two-byte characters
+    std::string e;
+    for (size_t i = 0; i < n + 2000; ++i) e += "\xc3\xa9";
+    EXPECT_EQ(out::printable_error(e).find('?'), std::string::npos) << n;
+  }
+  EXPECT_EQ(out::printable_error("short\n"), "short\\x0A");
+  EXPECT_NE(accents.find("bytes left out"), std::string::npos);
+}
+
 // ... and their colour and marker (a review, helper-107: a thinned series was drawn in
 // gnuplot's next colour, not its model's).
 TEST(Sinks, LongSeriesAreThinnedKeepingTheirExtremes) {

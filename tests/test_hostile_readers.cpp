@@ -539,7 +539,10 @@ TEST(NumberText, ANegativeZeroIsPrintedAsZero) {
   EXPECT_EQ(out::full_number(v), "0");
   EXPECT_EQ(out::one_then_other(v, 0.5), "0 then 0.5");
   EXPECT_EQ(out::short_number(-0.25), "-0.25");  // a negative number keeps its sign
-  EXPECT_EQ(out::full_number(-0.1), "-0.10000000000000001");
+  EXPECT_EQ(out::full_number(-0.1), "-0.1");  // the shortest text that reads back as the same double
+  EXPECT_EQ(out::full_number(1 + 0x1p-52), "1.0000000000000002");
+  EXPECT_EQ(out::full_number(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(out::full_number(1e-300), "1e-300");
 }
 
 // A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as
