@@ -27,6 +27,15 @@ namespace {
 
 std::string esc(const std::string& s) { return output::html_text(s); }
 
+// A sentence the terminal shares, for the page: its ASCII arrow and plus-minus as the page's
+// tables write them (a review, helper-111: "0.294 -> 0.312" beside "0.401 &rarr; 0.353").
+std::string prose(const std::string& s) {
+  std::string out = esc(s);
+  for (const auto& [ascii, html] : {std::pair<std::string, std::string>{" -&gt; ", " &rarr; "}, {" +- ", " &plusmn; "}})
+    for (size_t at = 0; (at = out.find(ascii, at)) != std::string::npos; at += html.size()) out.replace(at, ascii.size(), html);
+  return out;
+}
+
 // The plots, each beside the section whose numbers it draws (a user trial, helper-106: the
 // held-out comparison sat at the page's end, below every candidate's table). A plot no section
 // shows (its section is not on this page, or a name this page does not know) goes under "More
@@ -85,7 +94,7 @@ std::string verdict_cell(const DiscoveredTerm& t) {
   const std::string said = t.proposed ? "proposed" : "not proposed";
   const bool begins = t.verdict.rfind(said, 0) == 0;
   const std::string rest = begins ? t.verdict.substr(said.size()) : ": " + t.verdict;
-  return (t.proposed ? "<b>proposed</b>" : said) + output::html_text(rest);
+  return (t.proposed ? "<b>proposed</b>" : said) + prose(rest);
 }
 
 // A check's leads: each claim once, the numbers of each source that shows it below.
@@ -356,7 +365,7 @@ GlanceRow named_row(const Diagnosis& d, const Finding& f) {
       css = "warn";
     }
   return {f.effect, css, verdict, estimates_cell(f.parameters, true),
-          num(f.before, 3) + " &rarr; " + num(f.after, 3) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
+          num(f.before) + " &rarr; " + num(f.after) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
               (f.metric == d.metric ? "" : "<br><small>" + esc(f.metric) + "</small>")};
 }
 
@@ -405,7 +414,7 @@ void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
       << r.values << "</td><td>" << r.held_out << "</td><td>" << esc(scope(r.effect)) << "</td></tr>\n";
   h << "</table>\n<p><small>Held out: " << esc(d.metric)
     << ". Each effect's figure is the final model with and without it, not its share of the whole gain: effects "
-       "overlap. \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
+       "overlap" << (own_weights_note(d).empty() ? "" : "; " + esc(own_weights_note(d))) << ". \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
     << (d.flights.size() > 1 ? "; a value name@k is flight k's, a plain name flight 1's" : "")
     << ". Words: <a href=\"#words\">at the end</a>.</small></p>\n";
 }
@@ -444,7 +453,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   // Where the extended model is worse, said beside the gain (a user trial, helper-106: a
   // channel 44 % worse was only in a table near the end).
   if (const std::string worse = worse_channels(d); !worse.empty())
-    h << "<li class=\"warn\">Worse with the extended model on the held-out part: " << esc(worse) << ".</li>\n";
+    h << "<li class=\"warn\">Worse with the extended model on the held-out part: " << prose(worse) << ".</li>\n";
   h << "</ul>\n";
   at_a_glance_html(h, d);
   // The command's own printout, for a reader who compares it with a terminal; the sections

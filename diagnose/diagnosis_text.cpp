@@ -28,11 +28,13 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   // The held-out measure is said once; a finding judged by another says its own.
   // "named", as the report and its words table call a cause (a review, helper-111: the
   // terminal said "found" where the page beside it said "named").
-  os << "held out: " << d.metric << ", for each effect named the final model without it -> with it\n";
+  const std::string own_weights = words::own_weights_note(d);
+  os << "held out: " << d.metric << ", for each effect named the final model without it -> with it"
+     << (own_weights.empty() ? "" : "; " + own_weights) << "\n";
   for (const auto& f : d.findings) {
     os << "named " << f.effect << flights_own_note(d, f.effect) << ":";
-    for (const auto& p : f.parameters)
-      os << " " << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
+    for (const auto& p : f.parameters)  // a list, comma-separated (a review, helper-111)
+      os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
        << beside_gain_text(f);
     for (const auto& a : d.agreement)
@@ -48,7 +50,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
-      os << " " << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
+      os << (k ? ", " : " ") << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
     os << "\n";
   }
   if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())
@@ -84,7 +86,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
     if (x.carried) os << "; " << words::carried_suspect(*x.carried);
     os << "\n";
   }
-  for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << " (" << r.reason << ")\n";
+  for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << ": " << r.reason << "\n";
   if (!d.search.left_at_limit.empty()) {
     os << "the search stopped at its limit of " << d.search.steps.size()
        << (d.search.steps.size() == 1 ? " effect" : " effects") << " (--max-effects); still significant in its last step:";

@@ -363,6 +363,14 @@ std::string beside_gain_text(const Finding& f) {
   return judged_by_text(f) + unsettled;
 }
 
+std::string own_weights_note(const Diagnosis& d) {
+  const auto differs = [&](const Finding& f) {
+    return f.metric == d.metric && std::fabs(f.after - d.findings.front().after) > 1e-9 * std::fabs(f.after);
+  };
+  if (d.findings.empty() || std::none_of(d.findings.begin(), d.findings.end(), differs)) return "";
+  return "each line's costs are weighted by its own comparison's refit, so they compare within a line, not across lines";
+}
+
 std::string terms_gain_verdict(double gain_mean, double gain_standard_error) {
   return gain_mean > 0 && gain_mean > gain_standard_error
              ? ": a gain beyond its spread"

@@ -106,6 +106,11 @@ std::vector<Lead> command_gain_leads(const Diagnosis& d);
 // alone), and that text with a note on unsettled weights: said beside the gain.
 std::string judged_by_text(const Finding& f);
 std::string beside_gain_text(const Finding& f);
+// Where the findings' "with it" figures differ (a weighted cost, without a pose: each
+// comparison refits under its own residual weights), the sentence that says they compare only
+// within a line; else nothing (a review, helper-111: the ARPL report gave one final model three
+// scores).
+std::string own_weights_note(const Diagnosis& d);
 // Whether the proposed terms, regenerated into the model, gain on held-out data beyond the
 // spread of their per-fold gains, as an effect must: ": a gain beyond its spread" or why not.
 std::string terms_gain_verdict(double gain_mean, double gain_standard_error);

@@ -1494,6 +1494,26 @@ TEST(DiagnosisReport, EachPlotIsBesideItsSectionAndTheCandidatesAreFolded) {
   EXPECT_EQ(out::p_value_cell(NAN), "–");
 }
 
+// One final model, two findings, two different "with it" costs (no pose: each comparison is
+// refitted under its own weights): the summary and the page say the lines do not compare
+// across; where the figures are one (a position RMSE) nothing is said.
+TEST(DiagnosisReport, CostsUnderEachComparisonsOwnWeightsAreSaidSo) {
+  namespace dg = quadgen::diagnose;
+  dg::Diagnosis d;
+  d.metric = "validation equation-error cost (weighted, no pose logged)";
+  dg::Finding a, b;
+  a.effect = "motor_gain", a.metric = d.metric, a.before = 1162, a.after = 1087;
+  b.effect = "motor_lag", b.metric = d.metric, b.before = 1554, b.after = 1303;
+  d.findings = {a, b};
+  const std::string said = "each line's costs are weighted by its own comparison's refit";
+  EXPECT_NE(dg::diagnosis_summary(d).find("without it -> with it; " + said), std::string::npos) << dg::diagnosis_summary(d);
+  const std::string said_html = "each line&#39;s costs are weighted by its own comparison&#39;s refit";
+  EXPECT_NE(dg::diagnosis_html(d, "f.csv", {}).find("effects overlap; " + said_html), std::string::npos);
+  d.findings[1].after = 1087;
+  EXPECT_EQ(dg::diagnosis_summary(d).find(said), std::string::npos);
+  EXPECT_EQ(dg::diagnosis_html(d, "f.csv", {}).find(said_html), std::string::npos);
+}
+
 // What a reader needs within the first screen (a user trial, helper-106): every verdict in one
 // table (named with its interval and held-out figures, carried unnamed with its values, a
 // stand-in, a suspect), the channels the extended model made worse, and the whole gain in
@@ -1541,7 +1561,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(table.find("<td class=\"no\">suspected, not in the model: improves the training data (p = 1e-9) but not the "
                        "held-out part</td><td>motor_gain.M2 = 0.027</td>"),
             std::string::npos) << table;
-  EXPECT_NE(html.find("Worse with the extended model on the held-out part: az_world 0.2575 -&gt; 0.371 m/s^2 (44.1 % higher)"),
+  EXPECT_NE(html.find("Worse with the extended model on the held-out part: az_world 0.2575 &rarr; 0.371 m/s^2 (44.1 % higher)"),
             std::string::npos);
   EXPECT_EQ(html.find("Overall gain"), std::string::npos);  // said once, in "In short"
   EXPECT_NE(html.find("<h1>Diagnosis of B3.csv ("), std::string::npos);
