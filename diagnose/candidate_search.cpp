@@ -170,9 +170,9 @@ std::vector<FitParameter> CandidateSearch::fit_as_own_model(const std::set<std::
     // to a fixed point can run away.
     if (refit + 1 == kMaxRefits) {
       std::ostringstream note;
-      note << "[diagnose] note: the model with {";
+      note << "[diagnose] note: the " << (effects.empty() ? "base model" : "model with ");
       for (const auto& e : effects) note << (e == *effects.begin() ? "" : ", ") << e;
-      note << "} did not settle its weights in " << kMaxRefits << " refits (last change "
+      note << " did not settle its weights in " << kMaxRefits << " refits (last change "
            << std::round(1000 * change) / 10 << " %); it is compared as it stands";
       opt_.progress.say(note.str());
       break;

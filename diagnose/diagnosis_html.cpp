@@ -168,7 +168,7 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
   if (g.measured)
     h << "<p>With the proposed terms regenerated into the model (<code>discovered_model.hpp</code>) and simulated like an "
          "effect: "
-      << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per validation fold "
+      << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per held-out fold "
       << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ")"
       << esc(terms_gain_verdict(g.gain_mean, g.gain_standard_error)) << ".</p>\n";
   else if (!g.note.empty())
@@ -310,10 +310,10 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
   }
   h << "<p>" << esc(d.formulation) << "; " << d.train_samples << " training samples, " << d.valid_samples;
   if (d.flights.size() > 1)
-    h << " validation samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
+    h << " held-out samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
       << "vehicle parameters)";
   else
-    h << " validation samples from t = " << num(d.t_split, 4) << " s";
+    h << " held-out samples from t = " << num(d.t_split, 4) << " s";
   h << "; diagnosed in " << num(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
   if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
@@ -388,7 +388,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
   for (const auto& x : d.suspected)
     rows.push_back({x.candidate.effect, x.carried ? "warn" : "no",
                     std::string(x.carried ? "suspected, carried in the model for a named look-alike's values"
-                                          : "suspected, not in the model") + ": " + esc(x.failed),
+                                          : "suspected, not in the model") + ": " + prose(x.failed),
                     x.carried ? carried_values(d, x.candidate.effect) : estimates_cell(x.candidate.parameters, false),
                     "&ndash;"});
   for (const auto& e : d.search.left_at_limit)
@@ -397,7 +397,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
                         (e.implausible.empty() ? "" : "; implausible here: " + esc(e.implausible)) + ")",
                     "&ndash;", "&ndash;"});
   for (const auto& r : d.search.removed)
-    rows.push_back({r.effect, "no", "dropped by the backward pass: " + esc(r.reason), "&ndash;", "&ndash;"});
+    rows.push_back({r.effect, "no", "dropped by the backward pass: " + prose(r.reason), "&ndash;", "&ndash;"});
   for (const auto& e : d.search.selected)  // anything else the model carries
     if (std::none_of(rows.begin(), rows.end(), [&](const GlanceRow& r) { return r.effect == e; }))
       rows.push_back({e, "warn", "in the model, not named", carried_values(d, e), "&ndash;"});
@@ -476,7 +476,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
     h << "<h3>" << esc(f.effect) << flights_own_tag(d, f.effect)
       << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
       << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
-      << lower_or_higher(f.before, f.after, 3) << ")" << esc(beside_gain_text(f)) << ".</p>\n";
+      << lower_or_higher(f.before, f.after, 3) << ")" << prose(beside_gain_text(f)) << ".</p>\n";
     if (const std::string caveat = one_flight_caveat(d, f.effect); !caveat.empty())
       h << "<p class=\"warn\">" << esc(caveat) << ".</p>\n";
     const bool per_flight = d.flights.size() > 1 && std::find(d.per_flight_effects.begin(), d.per_flight_effects.end(),
@@ -546,7 +546,7 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
     for (const auto& st : d.stand_ins) {
       h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
         << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
-        << esc(st.why) << "</td><td>";
+        << prose(st.why) << "</td><td>";
       for (size_t c = 0; c < st.channels.size(); ++c)
         h << (c ? "; " : "") << esc(st.channels[c]) << " " << num(st.rms_without[c], 3) << " &rarr; "
           << num(st.rms_with[c], 3);
@@ -563,7 +563,7 @@ void ambiguous_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<h2>Ambiguous</h2>\n";
     for (const auto& x : d.suspected)
       if (x.carried)
-        h << "<p class=\"warn\"><b>" << esc(x.candidate.effect) << "</b>" << flights_own_tag(d, x.candidate.effect) << " (suspected: " << esc(x.failed) << ") is "
+        h << "<p class=\"warn\"><b>" << esc(x.candidate.effect) << "</b>" << flights_own_tag(d, x.candidate.effect) << " (suspected: " << prose(x.failed) << ") is "
           << esc(words::carried_suspect(*x.carried)) << ".</p>\n";
     for (const auto& a : d.search.unresolved)
       if (a.absorbed)
@@ -627,7 +627,7 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d, Figures& figures
   if (!d.has_prediction) return;
   // Comparable with published models: the error AT a horizon, averaged over start points.
   const auto& a = d.prediction_after;
-  h << "<h2>Prediction on the validation part</h2>\n";
+  h << "<h2>Prediction on the held-out part</h2>\n";
   // Without a pose no rollout starts (each starts from a measured state): no empty table
   // (a review, helper-111: an ARPL report showed one, "over 0 start points").
   if (a.open_loop.empty()) h << "<p>No pose logged: no open-loop rollouts (each starts from a measured state). ";
@@ -637,16 +637,16 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d, Figures& figures
   }
   h << "One step (extended model), RMS: body specific force " << num(a.one_step.specific_force[0].rms(), 3) << " / "
     << num(a.one_step.specific_force[1].rms(), 3) << " / " << num(a.one_step.specific_force[2].rms(), 3)
-    << " m/s², angular acceleration " << num(a.one_step.angular_acceleration[0].rms(), 3) << " / "
+    << " m/s^2, angular acceleration " << num(a.one_step.angular_acceleration[0].rms(), 3) << " / "
     << num(a.one_step.angular_acceleration[1].rms(), 3) << " / " << num(a.one_step.angular_acceleration[2].rms(), 3)
-    << " rad/s², world vertical acceleration " << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s².</p>\n";
+    << " rad/s^2, world vertical acceleration " << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s^2.</p>\n";
   if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
     h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
   figures.show(h, {"validation.svg", "simulation_errors.svg", "prediction.svg"});
 }
 
 void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
-  h << "<h2>Validation per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
+  h << "<h2>Held-out error per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
     h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
@@ -681,7 +681,7 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
     for (const auto& e : st.base_effects) h << " + " << esc(e);
     h << "): " << (st.selected.empty() ? "nothing taken" : "took " + esc(st.selected)) << "</summary>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
       << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic.</p>\n"
-      << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>validation gain %</th><th>verdict</th></tr>\n";
+      << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>held-out gain %</th><th>verdict</th></tr>\n";
     for (const auto& c : st.candidates)
       h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << esc(output::p_value_cell(c.p_value))
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
@@ -733,7 +733,7 @@ void method_html(std::ostringstream& h) {
   h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
        "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
        "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
-       "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the validation part. "
+       "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the held-out part. "
        "Intervals are profile-likelihood intervals with the same weights, widened on both sides by the change of the "
        "estimate when the interval accelerations use the trapezoid instead of the midpoint rule (discretisation error).</p>\n</body></html>\n";
 }

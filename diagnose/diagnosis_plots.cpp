@@ -230,7 +230,7 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
     mark_flights(d, validation);
     mark_flights(d, errors);
     plots.render("validation.svg", d.vehicle + ": measured vs simulated, before and after", validation);
-    plots.render("simulation_errors.svg", d.vehicle + ": simulation error over time (validation part)", errors);
+    plots.render("simulation_errors.svg", d.vehicle + ": simulation error over time (held-out part)", errors);
   }
   auto residuals = residual_panels(d, std::max<size_t>(1, d.t.size() / 3000));
   mark_flights(d, residuals, "held out: ");
@@ -239,10 +239,10 @@ std::vector<std::pair<std::string, std::string>> diagnosis_plots(
   const auto gain_panels = command_gain_panels(d);
   if (!gain_panels.empty()) plots.render("command_gain.svg", d.vehicle + ": the answer to the commands, band by band", gain_panels);
   if (d.has_prediction && !d.prediction_after.open_loop.empty())  // no pose logged: no rollout to draw
-    plots.render("prediction.svg", d.vehicle + ": prediction error against horizon (validation part)",
+    plots.render("prediction.svg", d.vehicle + ": prediction error against horizon (held-out part)",
                  predict::horizon_panels({{"base model", &d.prediction_before}, {"extended model", &d.prediction_after}}));
   if (!d.search.profiles.empty())
-    plots.render("profiles.svg", d.vehicle + ": profile likelihood of the found parameters", profile_panels(d));
+    plots.render("profiles.svg", d.vehicle + ": profile likelihood of the effects' parameters", profile_panels(d));
   return std::move(plots).svgs();
 }
 

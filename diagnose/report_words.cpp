@@ -364,10 +364,15 @@ std::string beside_gain_text(const Finding& f) {
 }
 
 std::string own_weights_note(const Diagnosis& d) {
+  // Compared with the first finding judged by the diagnosis' own measure (one judged by another
+  // says its own, beside it).
+  const auto judged_here = [&](const Finding& f) { return f.metric == d.metric; };
+  const auto first = std::find_if(d.findings.begin(), d.findings.end(), judged_here);
+  if (first == d.findings.end()) return "";
   const auto differs = [&](const Finding& f) {
-    return f.metric == d.metric && std::fabs(f.after - d.findings.front().after) > 1e-9 * std::fabs(f.after);
+    return judged_here(f) && std::fabs(f.after - first->after) > 1e-9 * std::fabs(f.after);
   };
-  if (d.findings.empty() || std::none_of(d.findings.begin(), d.findings.end(), differs)) return "";
+  if (std::none_of(d.findings.begin(), d.findings.end(), differs)) return "";
   return "each line's costs are weighted by its own comparison's refit, so they compare within a line, not across lines";
 }
 

@@ -150,7 +150,7 @@ std::vector<std::vector<size_t>> cv_folds(const fit::Flight& train, const std::v
   by_flight.erase(std::remove_if(by_flight.begin(), by_flight.end(), [](const auto& f) { return f.size() < 20; }),
                   by_flight.end());
   if (by_flight.size() >= 2) {
-    *how = "leave one flight out (" + std::to_string(by_flight.size()) + " flights)";
+    *how = "leave one flight out, " + std::to_string(by_flight.size()) + " flights";
     return by_flight;
   }
   std::vector<std::vector<size_t>> blocks(static_cast<size_t>(time_folds));
@@ -329,9 +329,14 @@ void judge_held_out(DiscoveredTerm& d, const Vector& before_rows, const Vector& 
   double ss = 0;
   for (double g : d.fold_gains) ss += (g - d.gain_mean) * (g - d.gain_mean);
   d.gain_standard_error = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
-  const std::string held = "held-out RMS " + output::short_number(d.valid_rms_before) + " -> " + output::short_number(d.valid_rms_after) + " " +
-                           d.unit + " (gain " + output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) +
-                           " over " + std::to_string(d.fold_gains.size()) + " blocks)";
+  // The gain with its unit, and its folds named as the held-out part's (a review, helper-111:
+  // "gain 0.0439" had no unit beside gains in per cent, and "blocks" read as the
+  // cross-validation's time blocks).
+  const std::string unit = output::unit_after_number(d.unit);
+  const std::string held = "held-out RMS " + output::short_number(d.valid_rms_before) + " -> " +
+                           output::short_number(d.valid_rms_after) + unit + " (RMS lower by " +
+                           output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) + unit +
+                           " per fold, over the held-out part's " + std::to_string(d.fold_gains.size()) + " folds)";
   d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
   d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;
 }

@@ -51,7 +51,7 @@ struct DiscoveredTerm {
   std::vector<TermCoefficient> coefficients;
   std::vector<std::pair<std::string, double>> centres;  // what dU and dvbat are taken about
   double threshold = 0;           // chosen sparsity level (0 when no term)
-  std::string cross_validation;   // "leave one flight out (5 flights)" or "5 time blocks"
+  std::string cross_validation;   // "leave one flight out, 5 flights" or "5 time blocks"
   std::vector<double> cv_error;   // per level tried, "no term" last: mean squared error
   double train_rms_before = 0, train_rms_after = 0;
   double valid_rms_before = 0, valid_rms_after = 0;

@@ -1,5 +1,6 @@
 #include "output/numbers.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -41,11 +42,13 @@ std::string p_is(double p) {
 }
 
 std::string full_number(double v) {
-  for (int digits = 1; digits < 17; ++digits) {
-    const std::string s = with_digits(v, digits);
-    if (std::strtod(s.c_str(), nullptr) == v) return s;
-  }
-  return with_digits(v, 17);
+  // std::to_chars without a format gives the shortest text that reads back as v, plain or
+  // scientific, whichever is shorter ("100", "0.1", "1e+22"); %g with the fewest digits
+  // that read back would give "1e+02" for 100 (a review, helper-112).
+  if (!std::isfinite(v)) return with_digits(v, 17);
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, v == 0 ? 0.0 : v);
+  return std::string(text, written.ptr);
 }
 
 std::string unit_after_number(const std::string& unit) { return unit.empty() || unit == "1" ? "" : " " + unit; }

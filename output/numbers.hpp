@@ -16,8 +16,8 @@ std::string p_value_cell(double p);
 // Six significant digits ("0.265851", "1.7e+308"): where a reader adds numbers up by eye (a
 // weight beside the thrusts that carry it), and never hundreds of digits.
 std::string six_digits(double v);
-// As many digits as read back as the same double, and no more (the shortest round trip, at
-// most 17 significant): where a value differs from the one it is compared with only beyond
+// The shortest text that reads back as the same double (std::to_chars: "100", "0.1",
+// "1e+22"): where a value differs from the one it is compared with only beyond
 // six ("-1.0000000000000002" below a bound of -1), and where a file is read again (a fitted
 // 0.05 is "0.05", not "0.050000000000000003").
 std::string full_number(double v);

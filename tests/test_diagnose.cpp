@@ -1468,18 +1468,22 @@ TEST(DiagnosisReport, EachPlotIsBesideItsSectionAndTheCandidatesAreFolded) {
   d.search.steps.push_back(step);
   const std::string html = dg::diagnosis_html(
       d, "f.csv", {{"residuals.svg", "<svg>R</svg>"}, {"profiles.svg", "<svg>P</svg>"}, {"new.svg", "<svg>N</svg>"},
-                   {"validation.svg", "<svg>V</svg>"}});
+                   {"prediction.svg", "<svg>Q</svg>"}, {"autocorrelation.svg", "<svg>A</svg>"},
+                   {"validation.svg", "<svg>V</svg>"}, {"simulation_errors.svg", "<svg>S</svg>"}});
   const auto at = [&](const std::string& s) { return html.find(s); };
-  const size_t findings = at("<h2>Findings</h2>"), prediction = at("<h2>Prediction on the validation part</h2>"),
-               channels = at("<h2>Validation per channel</h2>"), base = at("<h2>What the base model gets wrong</h2>"),
+  const size_t findings = at("<h2>Findings</h2>"), prediction = at("<h2>Prediction on the held-out part</h2>"),
+               channels = at("<h2>Held-out error per channel</h2>"), base = at("<h2>What the base model gets wrong</h2>"),
                candidates = at("<h2>Candidates</h2>"), more = at("<h2>More plots</h2>");
   ASSERT_TRUE(findings < prediction && prediction < channels && channels < base && base < candidates && candidates < more &&
               more != std::string::npos) << html;
   EXPECT_TRUE(at("<svg>P</svg>") > findings && at("<svg>P</svg>") < prediction);
-  EXPECT_TRUE(at("<svg>V</svg>") > prediction && at("<svg>V</svg>") < channels);
-  EXPECT_TRUE(at("<svg>R</svg>") > base && at("<svg>R</svg>") < candidates);
+  // the held-out comparison first, then its errors over time, then the error against horizon
+  EXPECT_TRUE(prediction < at("<svg>V</svg>") && at("<svg>V</svg>") < at("<svg>S</svg>") &&
+              at("<svg>S</svg>") < at("<svg>Q</svg>") && at("<svg>Q</svg>") < channels);
+  EXPECT_TRUE(base < at("<svg>R</svg>") && at("<svg>R</svg>") < at("<svg>A</svg>") && at("<svg>A</svg>") < candidates);
+  for (const char* svg : {"<svg>P</svg>", "<svg>V</svg>", "<svg>S</svg>", "<svg>Q</svg>", "<svg>R</svg>", "<svg>A</svg>", "<svg>N</svg>"})
+    EXPECT_EQ(html.find(svg, html.find(svg) + 1), std::string::npos) << svg;  // each once
   EXPECT_GT(at("<svg>N</svg>"), more);  // a plot no section knows is not lost
-  EXPECT_EQ(html.find("<svg>V</svg>", at("<svg>V</svg>") + 1), std::string::npos);  // each once
   EXPECT_NE(html.find("<details><summary>Step 1 (model: base): took rotor_drag</summary>", candidates), std::string::npos);
   EXPECT_NE(html.find("dof, p &lt; 1e-300 (level"), std::string::npos);
   EXPECT_NE(html.find("<td>&lt; 1e-300</td>", candidates), std::string::npos);
@@ -1510,6 +1514,10 @@ TEST(DiagnosisReport, CostsUnderEachComparisonsOwnWeightsAreSaidSo) {
   const std::string said_html = "each line&#39;s costs are weighted by its own comparison&#39;s refit";
   EXPECT_NE(dg::diagnosis_html(d, "f.csv", {}).find("effects overlap; " + said_html), std::string::npos);
   d.findings[1].after = 1087;
+  EXPECT_EQ(dg::diagnosis_summary(d).find(said), std::string::npos);
+  dg::Finding other = a;  // judged by its own measure, first: not what the others compare with
+  other.metric = "held-out equation-error cost (weighted), reduction per validation fold [%]", other.after = 3.5;
+  d.findings.insert(d.findings.begin(), other);
   EXPECT_EQ(dg::diagnosis_summary(d).find(said), std::string::npos);
   EXPECT_EQ(dg::diagnosis_html(d, "f.csv", {}).find(said_html), std::string::npos);
 }

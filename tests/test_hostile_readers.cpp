@@ -543,6 +543,9 @@ TEST(NumberText, ANegativeZeroIsPrintedAsZero) {
   EXPECT_EQ(out::full_number(1 + 0x1p-52), "1.0000000000000002");
   EXPECT_EQ(out::full_number(0.1 + 0.2), "0.30000000000000004");
   EXPECT_EQ(out::full_number(1e-300), "1e-300");
+  EXPECT_EQ(out::full_number(100), "100");  // not "1e+02" (a review, helper-112)
+  EXPECT_EQ(out::full_number(1500), "1500");
+  EXPECT_EQ(out::full_number(-2.5e-7), "-2.5e-07");
 }
 
 // A column nothing reads may hold anything (a flight mode as text, a sensor not yet read as

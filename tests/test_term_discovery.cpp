@@ -169,7 +169,7 @@ TEST(TermDiscovery, SeveralFlightsCrossValidateOneFlightAgainstTheOthers) {
   const auto terms = discover_terms(train, residuals(train, rng, 4, drag_moment), valid,
                                     residuals(valid, rng, 4, drag_moment), kChannels, kUnits, starts);
   ASSERT_EQ(terms.size(), 6u);
-  EXPECT_EQ(terms[4].cross_validation, "leave one flight out (3 flights)");
+  EXPECT_EQ(terms[4].cross_validation, "leave one flight out, 3 flights");
   ASSERT_TRUE(terms[4].proposed) << terms[4].verdict;
   ASSERT_EQ(terms[4].coefficients.size(), 2u);
   EXPECT_EQ(terms[4].coefficients[1].regressor, "v_bx*dU");

@@ -38,7 +38,7 @@ Effect blade_flapping() {
     const double k = headline::value_of(v, "blade_flapping.k");
     return std::string("Flying through the air ") + (k > 0 ? "pitches the nose up" : "pitches the nose down") +
            " (flapping moment k = " + headline::words(k) +
-           " N s²: N m per m/s of airspeed and per rad/s of summed rotor speed).";
+           " N s^2: N m per m/s of airspeed and per rad/s of summed rotor speed).";
   };
   return e;
 }

@@ -6,7 +6,9 @@
 
 namespace quadgen::headline {
 
-// Two significant digits (three at 100 and above), no exponent between 0.01 and 10,000.
+// A number for a sentence: between 0.01 and 10,000 with fixed decimals, none from 100 ("208"),
+// one from 1 ("37.5", "8.0"), two below 1 ("0.35", "0.05"); outside that range two significant
+// digits with an exponent ("1.4e-06").
 std::string words(double v);
 
 // The value of `name` among `values`; 0 when it is absent (an effect whose parameter the fit

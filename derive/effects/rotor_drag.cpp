@@ -38,7 +38,7 @@ Effect rotor_drag() {
                                       "horizontal force), flapping only tilts it (a moment the attitude loop must hold)"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
     return "The rotors drag the vehicle back against its airspeed (k = " +
-           headline::words(headline::value_of(v, "rotor_drag.k")) + " N s²/m: newtons of drag per m/s of airspeed and per rad/s of summed rotor speed).";
+           headline::words(headline::value_of(v, "rotor_drag.k")) + " N s^2/m: newtons of drag per m/s of airspeed and per rad/s of summed rotor speed).";
   };
   return e;
 }
