@@ -44,11 +44,7 @@ std::string summary_of(const predict::Prediction& pooled) {
   // The one-step errors, and with --linear-correction the corrected ones beside them (a review,
   // helper-111: they reached prediction.json only).
   const auto one_step = [&os](const char* what, const predict::OneStepErrors& e) {
-    if (e.vertical_acceleration_world.count == 0) return;
-    os << what << ", RMS: world vertical acceleration " << output::short_number(e.vertical_acceleration_world.rms())
-       << " m/s^2, roll / pitch / yaw acceleration " << output::short_number(e.angular_acceleration[0].rms()) << " / "
-       << output::short_number(e.angular_acceleration[1].rms()) << " / "
-       << output::short_number(e.angular_acceleration[2].rms()) << " rad/s^2\n";
+    if (e.vertical_acceleration_world.count > 0) os << what << ", RMS: " << predict::one_step_text(e) << "\n";
   };
   one_step("one step", pooled.one_step);
   if (pooled.one_step_corrected) one_step("one step with the linear correction", *pooled.one_step_corrected);

@@ -407,6 +407,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
 void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
   const auto rows = glance_rows(d);
   if (rows.empty()) return;
+  const std::string own_weights = own_weights_note(d);
   h << "<table class=\"glance\"><tr><th>effect</th><th>verdict</th><th>values, 95 % interval where named</th>"
        "<th>held out: the final model without it &rarr; with it</th><th>of the</th></tr>\n";
   for (const auto& r : rows)
@@ -414,7 +415,7 @@ void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
       << r.values << "</td><td>" << r.held_out << "</td><td>" << esc(scope(r.effect)) << "</td></tr>\n";
   h << "</table>\n<p><small>Held out: " << esc(d.metric)
     << ". Each effect's figure is the final model with and without it, not its share of the whole gain: effects "
-       "overlap" << (own_weights_note(d).empty() ? "" : "; " + esc(own_weights_note(d))) << ". \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
+       "overlap" << (own_weights.empty() ? "" : "; " + esc(own_weights)) << ". \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
     << (d.flights.size() > 1 ? "; a value name@k is flight k's, a plain name flight 1's" : "")
     << ". Words: <a href=\"#words\">at the end</a>.</small></p>\n";
 }
@@ -635,11 +636,7 @@ void prediction_html(std::ostringstream& h, const Diagnosis& d, Figures& figures
     horizon_table_html(h, d);
     h << "<p>Means over " << a.start_points << " start points. ";
   }
-  h << "One step (extended model), RMS: body specific force " << num(a.one_step.specific_force[0].rms(), 3) << " / "
-    << num(a.one_step.specific_force[1].rms(), 3) << " / " << num(a.one_step.specific_force[2].rms(), 3)
-    << " m/s^2, angular acceleration " << num(a.one_step.angular_acceleration[0].rms(), 3) << " / "
-    << num(a.one_step.angular_acceleration[1].rms(), 3) << " / " << num(a.one_step.angular_acceleration[2].rms(), 3)
-    << " rad/s^2, world vertical acceleration " << num(a.one_step.vertical_acceleration_world.rms(), 3) << " m/s^2.</p>\n";
+  h << "One step (extended model), RMS: " << esc(predict::one_step_text(a.one_step)) << ".</p>\n";
   if (const std::string limits = predict::what_limits_prediction(a); !limits.empty())
     h << "<p>What limits it (extended model): " << esc(limits) << "</p>\n";
   figures.show(h, {"validation.svg", "simulation_errors.svg", "prediction.svg"});

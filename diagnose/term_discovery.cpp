@@ -338,7 +338,7 @@ void judge_held_out(DiscoveredTerm& d, const Vector& before_rows, const Vector& 
                            output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) + unit +
                            " per fold, over the held-out part's " + std::to_string(d.fold_gains.size()) + " folds)";
   d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
-  d.verdict = (d.proposed ? "proposed: " : "not proposed, no held-out gain beyond its spread: ") + held;
+  d.verdict = (d.proposed ? std::string(kProposedVerdict) : "not proposed, no held-out gain beyond its spread: ") + held;
 }
 
 // One channel: the cross-validated sparsity level, the significant coefficients on it (in the

@@ -7,6 +7,7 @@
 // means physically is the user's call.
 #pragma once
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "derive/added_terms.hpp"
@@ -46,6 +47,9 @@ struct TermCoefficient {
 
 // The term proposed for one channel (added to the model's side: measured - model), or why
 // none is.
+// How a proposed term's verdict begins; a line that already says "proposed" prints the rest.
+inline constexpr std::string_view kProposedVerdict = "proposed: ";
+
 struct DiscoveredTerm {
   std::string channel, unit;
   std::vector<TermCoefficient> coefficients;
@@ -58,7 +62,7 @@ struct DiscoveredTerm {
   std::vector<double> fold_gains;  // held-out RMS before - after, per validation block
   double gain_mean = 0, gain_standard_error = 0;
   bool proposed = false;
-  std::string verdict;  // why it is proposed, or why not
+  std::string verdict;  // why it is proposed (after kProposedVerdict), or why not
   std::string expression() const;  // "pdot += 0.12 v_bx*U - 3.1 (1)" style, for reports
 };
 

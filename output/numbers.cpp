@@ -29,17 +29,15 @@ std::string six_digits(double v) { return with_digits(v, 6); }
 
 namespace {
 constexpr double kSmallestPrintedP = 1e-300;
+bool below_printed(double p) { return p >= 0 && p < kSmallestPrintedP; }
 }  // namespace
 
 std::string p_value_cell(double p) {
   if (!std::isfinite(p)) return "–";
-  return p >= 0 && p < kSmallestPrintedP ? "< " + short_number(kSmallestPrintedP) : short_number(p);
+  return below_printed(p) ? "< " + short_number(kSmallestPrintedP) : short_number(p);
 }
 
-std::string p_is(double p) {
-  const std::string value = p_value_cell(p);
-  return value[0] == '<' ? "p " + value : "p = " + value;
-}
+std::string p_is(double p) { return (below_printed(p) ? "p " : "p = ") + p_value_cell(p); }
 
 std::string full_number(double v) {
   // std::to_chars without a format gives the shortest text that reads back as v, plain or

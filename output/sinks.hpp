@@ -12,7 +12,8 @@ namespace quadgen::output {
 // controls and the bidirectional overrides in their UTF-8 form too) become \xNN, invalid
 // UTF-8 becomes '?'.
 std::string printable(const std::string& s);
-// An error message for a terminal, as printable makes it, in at most about 1.7 kB: a message
+// An error message for a terminal, as printable makes it, from at most about 1.7 kB of it (each
+// control character then shown as \xNN, four bytes): a message
 // quoting a 200 kB name (a vehicle file's block, a log's column) keeps its head (where and
 // what) and its tail (what was expected), and says how many bytes it left out between them.
 std::string printable_error(const std::string& message);

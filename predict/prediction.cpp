@@ -358,6 +358,16 @@ std::string open_loop_against_no_model(const Prediction& p) {
 // m: below this at the longest horizon a model predicts the log exactly (its own flights).
 constexpr double kNegligiblePositionError = 1e-3;
 
+std::string one_step_text(const OneStepErrors& e) {
+  const auto three = [](const ErrorStats (&axes)[3]) {
+    return output::short_number(axes[0].rms()) + " / " + output::short_number(axes[1].rms()) + " / " +
+           output::short_number(axes[2].rms());
+  };
+  return "body specific force " + three(e.specific_force) + " m/s^2, angular acceleration " +
+         three(e.angular_acceleration) + " rad/s^2, world vertical acceleration " +
+         output::short_number(e.vertical_acceleration_world.rms()) + " m/s^2";
+}
+
 std::string what_limits_prediction(const Prediction& p) {
   if (p.open_loop.empty() || p.attitude_replayed.size() != p.open_loop.size()) return "";
   // The views' rows are in the order of PredictionOptions::horizons, which need not be sorted.

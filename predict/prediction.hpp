@@ -151,6 +151,10 @@ OneStepErrors linearly_corrected_one_step(runtime::DynamicModel& model, const st
 // translation; and how much of the error at the longest horizon holding the past
 // disturbance removes.
 std::string what_limits_prediction(const Prediction& p);
+// The one-step RMS errors in words: "body specific force 0.1 / 0.2 / 0.3 m/s^2, angular
+// acceleration 4 / 5 / 6 rad/s^2, world vertical acceleration 0.2 m/s^2" (the report's
+// prediction section and predict's summary).
+std::string one_step_text(const OneStepErrors& e);
 // One sentence for a report's summary: the open loop at the longest horizon against
 // extrapolating the measured velocity with no model, and which is the closer ("" without
 // those views). A gain over the base model alone can hide that no model does better.
