@@ -134,55 +134,10 @@ void translation_items(std::vector<ThesisItem>& out, const Numbers& n) {
                      "reading"});
 }
 
-void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, const Numbers& n) {
-  // Torque (34) against the model's torque with the CoG at the origin and D_i = kappa F_i.
-  ex tau;
-  for (const auto& [name, e] : model.intermediates)
-    if (name == "\\tau") tau = e;
+// (35)/(36) against the model's own roll row: torques off, J diagonal, Euler-angle rates
+// equal to body rates (zero attitude, as the thesis' small angles have it).
+void gyroscopic_item(std::vector<ThesisItem>& out, const SymbolicModel& model, const Numbers& n) {
   auto P = [&](const char* s) { return model.params[model.param_index(s)].sym; };
-  lst at_origin{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
-  // Effects at their nominal (neutral) values: a model with effects is compared as the base.
-  lst neutral;
-  for (const auto& p : model.params)
-    if (!effect_of_parameter(p.name).empty()) neutral.append(p.sym == p.nominal);
-  tau = tau.subs(neutral);
-  bool torque_agrees = true;
-  if (is_thesis_vehicle(model)) {
-    ex F[4];
-    for (int i = 0; i < 4; ++i)
-      for (const auto& [name, e] : model.intermediates)
-        if (name == rotor_thrust_name(std::string(1, "ABCD"[i]))) F[i] = e.subs(neutral);
-    const ex kappa = P("kappa");
-    ex l;
-    for (const auto& c : model.constants)
-      if (c.name == "C.x") l = c.sym;  // the thesis' l, rotor C at (+l, +l)
-    const ex thesis[3] = {((F[2] + F[3]) - (F[0] + F[1])) * l, ((F[0] + F[3]) - (F[1] + F[2])) * l,
-                          kappa * (-F[0] + F[1] - F[2] + F[3])};
-    lst same_arm;  // the thesis' single l: every rotor at (±l, ±l, 0)
-    for (const auto& c : model.constants) {
-      const double v = c.nominal;
-      if (c.name.size() == 3 && (c.name[2] == 'x' || c.name[2] == 'y')) same_arm.append(c.sym == (v > 0 ? l : -l));
-      if (c.name.size() == 3 && c.name[2] == 'z') same_arm.append(c.sym == 0);
-    }
-    const matrix t = ex_to<matrix>(tau.subs(at_origin).subs(same_arm));
-    for (int i = 0; i < 3; ++i)
-      if (!normal(t(i, 0) - thesis[i]).is_zero()) torque_agrees = false;
-  }
-  out.push_back({"(34)", "torques from thrust and rotor drag",
-                 "M = (((F_C+F_D)-(F_A+F_B)) l, ((F_A+F_D)-(F_B+F_C)) l, -D_A+D_B-D_C+D_D)",
-                 "τ = Σ (r_i - c) × F_i e_z + Σ ∓kappa F_i e_z, symbolically", torque_agrees,
-                 torque_agrees ? "" : "torque differs",
-                 torque_agrees ? "identical when the CoG is at the origin and D_i = kappa F_i; a CoG offset along z "
-                                 "(c_z = " + fmt("%.2f mm", n.cog[2] * 1e3) +
-                                     ") leaves the moment of a thrust along body z unchanged, one in x or y would add to it"
-                               : "",
-                 std::string(kFromModel) +
-                     ": its torque with the CoG at the origin and every rotor at (±l, ±l, 0), symbolically. The "
-                     "rotor layout is the one vehicles/finken3.yaml reads from (34) itself (Figure 2, which shows "
-                     "it, is not in the thesis' text), so this checks the algebra, not the layout"});
-
-  // (35)/(36) against the model's own roll row: torques off, J diagonal, Euler-angle rates
-  // equal to body rates (zero attitude, as the thesis' small angles have it).
   const ex q = model.states[runtime::rigid_body::kBodyRate + 1].sym, r = model.states[runtime::rigid_body::kBodyRate + 2].sym;
   const lst diagonal{P("J_xy") == 0, P("J_xz") == 0, P("J_yz") == 0};
   const ex pdot = model.f(runtime::rigid_body::kBodyRate, 0).subs(torque_free_substitutions(model)).subs(diagonal);
@@ -203,6 +158,58 @@ void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, co
                                            "symbolically (the sign of ω × Jω is also audited: section 7)"});
 }
 
+// Torque (34) against the model's torque with the CoG at the origin and D_i = kappa F_i, every
+// effect at its nominal (neutral) value: a model with effects is compared as the base.
+bool torque_agrees_with_thesis(const SymbolicModel& model) {
+  if (!is_thesis_vehicle(model)) return true;
+  ex tau;
+  for (const auto& [name, e] : model.intermediates)
+    if (name == "\\tau") tau = e;
+  auto P = [&](const char* s) { return model.params[model.param_index(s)].sym; };
+  lst at_origin{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
+  lst neutral;
+  for (const auto& p : model.params)
+    if (!effect_of_parameter(p.name).empty()) neutral.append(p.sym == p.nominal);
+  tau = tau.subs(neutral);
+  ex F[4];
+  for (int i = 0; i < 4; ++i)
+    for (const auto& [name, e] : model.intermediates)
+      if (name == rotor_thrust_name(std::string(1, "ABCD"[i]))) F[i] = e.subs(neutral);
+  const ex kappa = P("kappa");
+  ex l;
+  for (const auto& c : model.constants)
+    if (c.name == "C.x") l = c.sym;  // the thesis' l, rotor C at (+l, +l)
+  const ex thesis[3] = {((F[2] + F[3]) - (F[0] + F[1])) * l, ((F[0] + F[3]) - (F[1] + F[2])) * l,
+                        kappa * (-F[0] + F[1] - F[2] + F[3])};
+  lst same_arm;  // the thesis' single l: every rotor at (±l, ±l, 0)
+  for (const auto& c : model.constants) {
+    const double v = c.nominal;
+    if (c.name.size() == 3 && (c.name[2] == 'x' || c.name[2] == 'y')) same_arm.append(c.sym == (v > 0 ? l : -l));
+    if (c.name.size() == 3 && c.name[2] == 'z') same_arm.append(c.sym == 0);
+  }
+  const matrix t = ex_to<matrix>(tau.subs(at_origin).subs(same_arm));
+  for (int i = 0; i < 3; ++i)
+    if (!normal(t(i, 0) - thesis[i]).is_zero()) return false;
+  return true;
+}
+
+void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, const Numbers& n) {
+  const bool torque_agrees = torque_agrees_with_thesis(model);
+  out.push_back({"(34)", "torques from thrust and rotor drag",
+                 "M = (((F_C+F_D)-(F_A+F_B)) l, ((F_A+F_D)-(F_B+F_C)) l, -D_A+D_B-D_C+D_D)",
+                 "τ = Σ (r_i - c) × F_i e_z + Σ ∓kappa F_i e_z, symbolically", torque_agrees,
+                 torque_agrees ? "" : "torque differs",
+                 torque_agrees ? "identical when the CoG is at the origin and D_i = kappa F_i; a CoG offset along z "
+                                 "(c_z = " + fmt("%.2f mm", n.cog[2] * 1e3) +
+                                     ") leaves the moment of a thrust along body z unchanged, one in x or y would add to it"
+                               : "",
+                 std::string(kFromModel) +
+                     ": its torque with the CoG at the origin and every rotor at (±l, ±l, 0), symbolically. The "
+                     "rotor layout is the one vehicles/finken3.yaml reads from (34) itself (Figure 2, which shows "
+                     "it, is not in the thesis' text), so this checks the algebra, not the layout"});
+  gyroscopic_item(out, model, n);
+}
+
 // The diagonal of a solid cuboid [lo, hi] (axis-aligned, mass m) about the origin: each entry
 // m times the mean of the squared coordinates across it, e.g. J_xx = m (<y^2> + <z^2>).
 std::array<double, 3> cuboid_about_origin(double m, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
@@ -212,91 +219,114 @@ std::array<double, 3> cuboid_about_origin(double m, const std::array<double, 3>&
   return {m * (mean_sq[1] + mean_sq[2]), m * (mean_sq[0] + mean_sq[2]), m * (mean_sq[0] + mean_sq[1])};
 }
 
-void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
-  // Table 1 per thesis block index, about the body origin: 1 = motor blocks at -x (A, D),
-  // 2 = arms at -x, 3 = lower block, 4 = upper block, 5 = arms at +x, 6 = motor blocks at +x.
-  const double t1[6][4] = {{4.079e-4, 2.058e-4, 4.033e-4, 0.144e-4}, {0.596e-4, 0.465e-4, 1.646e-4, 1.4e-8},
-                           {1.198e-4, 2.539e-4, 0.792e-4, 0},        {1.956e-4, 1.956e-4, 0.495e-4, 0},
-                           {0.596e-4, 0.465e-4, 1.646e-4, -1.4e-8},  {4.079e-4, 2.058e-4, 4.033e-4, -0.144e-4}};
-  const char* groups[6][2] = {{"motor_A", "motor_D"}, {"arm_A", "arm_D"}, {"lower_body", ""},
-                              {"upper_body", ""},     {"arm_B", "arm_C"}, {"motor_B", "motor_C"}};
-  const char* entry[3] = {"J_xx", "J_yy", "J_zz"};
+// Table 1 per thesis block index, about the body origin: 1 = motor blocks at -x (A, D),
+// 2 = arms at -x, 3 = lower block, 4 = upper block, 5 = arms at +x, 6 = motor blocks at +x.
+// Each row J_xx, J_yy, J_zz, J_xz [kg m^2]; each block's names in the vehicle file.
+constexpr double kTable1[6][4] = {{4.079e-4, 2.058e-4, 4.033e-4, 0.144e-4}, {0.596e-4, 0.465e-4, 1.646e-4, 1.4e-8},
+                                  {1.198e-4, 2.539e-4, 0.792e-4, 0},        {1.956e-4, 1.956e-4, 0.495e-4, 0},
+                                  {0.596e-4, 0.465e-4, 1.646e-4, -1.4e-8},  {4.079e-4, 2.058e-4, 4.033e-4, -0.144e-4}};
+constexpr const char* kTable1Blocks[6][2] = {{"motor_A", "motor_D"}, {"arm_A", "arm_D"}, {"lower_body", ""},
+                                             {"upper_body", ""},     {"arm_B", "arm_C"}, {"motor_B", "motor_C"}};
+constexpr const char* kDiagonalEntry[3] = {"J_xx", "J_yy", "J_zz"};
+
+// One thesis block's J_xx, J_yy, J_zz, J_xz summed over the file's blocks of its names; false
+// if the file lacks one of the names (two blocks of one name are one).
+bool sum_thesis_block(const MassProperties& mp, const char* const names[2], double J[4]) {
+  bool found[2] = {false, !*names[1]};
+  for (const auto& bc : mp.blocks)
+    if (bc.name == names[0] || bc.name == names[1]) {
+      found[bc.name == names[0] ? 0 : 1] = true;
+      J[0] += bc.inertia_origin_value[0][0];
+      J[1] += bc.inertia_origin_value[1][1];
+      J[2] += bc.inertia_origin_value[2][2];
+      J[3] += bc.inertia_origin_value[0][2];
+    }
+  return found[0] && found[1];
+}
+
+// What Table 1's comparison found, block by block.
+struct Table1Comparison {
   std::ostringstream thesis, ours;
   double worst = 0;
-  bool compared = false;  // some thesis block had the file's blocks to compare with
   int worst_block = 0, worst_entry = 0;
-  // Blocks 3 and 4 are axis-aligned cuboids: the thesis' parallelograms do not touch them, so
-  // a difference there has a cause the audit does not know (a reviewer's trial, helper-103: the
-  // largest difference, 137 %, is the lower body's J_yy, and the cause named only the others).
-  // Whether such a block is the thesis' cuboid is computed from the thesis' own numbers (limits
-  // x3, y9, z3 and x4, y10, z4 of 2.2.4.3; masses of appendix A), not taken from the file.
+  bool compared = false;  // some thesis block had the file's blocks to compare with
+  std::string aligned_differ, missing;
+  bool aligned_are_the_theses = true;
+};
+
+// Blocks 3 and 4 are axis-aligned cuboids: the thesis' parallelograms do not touch them, so
+// a difference there has a cause the audit does not know (a reviewer's trial, helper-103: the
+// largest difference, 137 %, is the lower body's J_yy, and the cause named only the others).
+// Whether such a block is the thesis' cuboid is computed from the thesis' own numbers (limits
+// x3, y9, z3 and x4, y10, z4 of 2.2.4.3; masses of appendix A), not taken from the file.
+void compare_aligned_block(Table1Comparison& c, int g, const double J[4], const std::string& entries) {
   const std::array<double, 3> thesis_cuboid[2] = {
       cuboid_about_origin(0.132, {-0.0275, -0.0325, -0.041}, {0.0275, 0.0325, 0}),  // lower body
       cuboid_about_origin(0.099, {-0.028, -0.028, 0}, {0.028, 0.028, 0.072})};      // upper body
-  std::string aligned_differ, missing;
-  bool aligned_are_the_theses = true;
-  for (int g = 0; g < 6; ++g) {
-    double J[4] = {0, 0, 0, 0};
-    bool found[2] = {false, !*groups[g][1]};  // each of the group's names, once (two blocks of one name are one)
-    for (const auto& bc : mp.blocks)
-      if (bc.name == groups[g][0] || bc.name == groups[g][1]) {
-        found[bc.name == groups[g][0] ? 0 : 1] = true;
-        J[0] += bc.inertia_origin_value[0][0];
-        J[1] += bc.inertia_origin_value[1][1];
-        J[2] += bc.inertia_origin_value[2][2];
-        J[3] += bc.inertia_origin_value[0][2];
-      }
-    // A file whose blocks are named otherwise has no such thesis block to compare (a renamed
-    // body read "block 3 (lower_body) J_xx by inf %": helper-105).
-    if (!found[0] || !found[1]) {
-      missing += std::string(missing.empty() ? "" : ", ") + groups[g][0] + (*groups[g][1] ? std::string("/") + groups[g][1] : "");
-      thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[g][0], t1[g][1]) << fmt("%.4g, %.3g; ", t1[g][2], t1[g][3]);
-      ours << fmt("%.0f: -; ", g + 1);
-      continue;
-    }
-    compared = true;
-    thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[g][0], t1[g][1]) << fmt("%.4g, %.3g; ", t1[g][2], t1[g][3]);
-    ours << fmt("%.0f: %.4g, %.4g, ", g + 1, J[0], J[1]) << fmt("%.4g, %.3g; ", J[2], J[3]);
-    const bool aligned = g == 2 || g == 3;
-    std::string entries;  // the axis-aligned block's entries that differ
-    for (int k = 0; k < 3; ++k) {
-      const double d = std::fabs(pct(J[k], t1[g][k]));
-      if (d > worst) worst = d, worst_block = g, worst_entry = k;
-      if (aligned && d >= 1) entries += std::string(entries.empty() ? " " : ", ") + entry[k] + " by " + percent(d);
-    }
-    if (entries.empty()) continue;
-    bool is_the_theses = true;
-    for (int k = 0; k < 3; ++k) is_the_theses = is_the_theses && std::fabs(pct(J[k], thesis_cuboid[g - 2][k])) < 1;
-    aligned_are_the_theses = aligned_are_the_theses && is_the_theses;
-    aligned_differ += std::string(aligned_differ.empty() ? "" : ";") + fmt(" block %.0f (", g + 1) + groups[g][0] + ")" +
-                      entries + (is_the_theses ? "" : " (the vehicle file's block is not the thesis' cuboid)");
+  bool is_the_theses = true;
+  for (int k = 0; k < 3; ++k) is_the_theses = is_the_theses && std::fabs(pct(J[k], thesis_cuboid[g - 2][k])) < 1;
+  c.aligned_are_the_theses = c.aligned_are_the_theses && is_the_theses;
+  c.aligned_differ += std::string(c.aligned_differ.empty() ? "" : ";") + fmt(" block %.0f (", g + 1) +
+                      kTable1Blocks[g][0] + ")" + entries +
+                      (is_the_theses ? "" : " (the vehicle file's block is not the thesis' cuboid)");
+}
+
+void compare_table1_block(Table1Comparison& c, const MassProperties& mp, int g) {
+  const double* t1 = kTable1[g];
+  const char* const* names = kTable1Blocks[g];
+  c.thesis << fmt("%.0f: %.4g, %.4g, ", g + 1, t1[0], t1[1]) << fmt("%.4g, %.3g; ", t1[2], t1[3]);
+  double J[4] = {0, 0, 0, 0};
+  // A file whose blocks are named otherwise has no such thesis block to compare (a renamed
+  // body read "block 3 (lower_body) J_xx by inf %": helper-105).
+  if (!sum_thesis_block(mp, names, J)) {
+    c.missing += std::string(c.missing.empty() ? "" : ", ") + names[0] + (*names[1] ? std::string("/") + names[1] : "");
+    c.ours << fmt("%.0f: -; ", g + 1);
+    return;
   }
+  c.compared = true;
+  c.ours << fmt("%.0f: %.4g, %.4g, ", g + 1, J[0], J[1]) << fmt("%.4g, %.3g; ", J[2], J[3]);
+  const bool aligned = g == 2 || g == 3;
+  std::string entries;  // the axis-aligned block's entries that differ
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::fabs(pct(J[k], t1[k]));
+    if (d > c.worst) c.worst = d, c.worst_block = g, c.worst_entry = k;
+    if (aligned && d >= 1) entries += std::string(entries.empty() ? " " : ", ") + kDiagonalEntry[k] + " by " + percent(d);
+  }
+  if (!entries.empty()) compare_aligned_block(c, g, J, entries);
+}
+
+void table1_item(std::vector<ThesisItem>& out, const MassProperties& mp) {
+  Table1Comparison c;
+  for (int g = 0; g < 6; ++g) compare_table1_block(c, mp, g);
   // The blocks joined by "; ", none after the last (a review, helper-111).
   const auto joined_blocks = [](const std::ostringstream& os) {
     std::string s = os.str();
     return s.size() >= 2 && s.compare(s.size() - 2, 2, "; ") == 0 ? s.substr(0, s.size() - 2) : s;
   };
-  out.push_back({"Table 1", "inertia per block (J_xx, J_yy, J_zz, J_xz about the origin, kg m^2)", joined_blocks(thesis),
-                 joined_blocks(ours), worst < 1 && missing.empty(),
+  out.push_back({"Table 1", "inertia per block (J_xx, J_yy, J_zz, J_xz about the origin, kg m^2)", joined_blocks(c.thesis),
+                 joined_blocks(c.ours), c.worst < 1 && c.missing.empty(),
                  std::string("blocks 1, 2, 5, 6: the thesis integrates motor blocks and arms over parallelograms "
                              "between y = ±x ± w (2.2.4.3) instead of rotated cuboids, and leaves the integration "
                              "variable x in the result (J_xx = 0.0932 x^2 + 7.309e-4, then x := 0.07465 m): a definite "
                              "integral cannot depend on its integration variable") +
-                     (aligned_differ.empty() ? ""
-                                             : "; not explained here, in the axis-aligned" + aligned_differ +
-                                                   (aligned_are_the_theses
-                                                        ? ", where a cuboid with the thesis' limits (2.2.4.3) and mass "
-                                                          "(appendix A) gives the derived value"
-                                                        : "")) +
-                     (missing.empty() ? "" : "; the vehicle file has no block named " + missing + ", so those are not compared"),
-                 (compared ? "largest per-entry difference " + percent(worst) + fmt(" (block %.0f, ", worst_block + 1) +
-                                 entry[worst_entry] + ")"
-                           : std::string("no block compared")) +
-                     (missing.empty() ? "" : "; blocks not in the file: " + missing),
+                     (c.aligned_differ.empty() ? ""
+                                               : "; not explained here, in the axis-aligned" + c.aligned_differ +
+                                                     (c.aligned_are_the_theses
+                                                          ? ", where a cuboid with the thesis' limits (2.2.4.3) and mass "
+                                                            "(appendix A) gives the derived value"
+                                                          : "")) +
+                     (c.missing.empty() ? "" : "; the vehicle file has no block named " + c.missing + ", so those are not compared"),
+                 (c.compared ? "largest per-entry difference " + percent(c.worst) + fmt(" (block %.0f, ", c.worst_block + 1) +
+                                   kDiagonalEntry[c.worst_entry] + ")"
+                             : std::string("no block compared")) +
+                     (c.missing.empty() ? "" : "; blocks not in the file: " + c.missing),
                  std::string(kFromArithmetic) + ": the blocks' integrated tensors about the origin, summed per "
                                                 "thesis block, every diagonal entry within 1 % (J_xz shown, not judged)"});
-  // The thesis' J is about the origin: compared with the blocks' tensor about the origin, like
-  // for like; the one about the CoG, which the dynamics use, is shown beside it.
+}
+
+// The thesis' J is about the origin: compared with the blocks' tensor about the origin, like
+// for like; the one about the CoG, which the dynamics use, is shown beside it.
+void inertia_tensor_item(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
   double origin_J[3] = {0, 0, 0};
   // Which block makes the derived J_xx and J_yy differ most (computed: a reviewer's trial,
   // helper-103, found this sentence fixed text that no longer held for an edited file).
@@ -327,6 +357,11 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
                  "J_xx " + signed_percent(d[0]) + ", J_yy " + signed_percent(d[1]) + ", J_zz " + signed_percent(d[2]) +
                      " (thesis relative to derived, both about the origin)",
                  std::string(kFromArithmetic) + ": the blocks' tensor about the origin, each diagonal entry within 1 %"});
+}
+
+void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
+  table1_item(out, mp);
+  inertia_tensor_item(out, mp, n);
 }
 
 void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
