@@ -727,7 +727,7 @@ void words_html(std::ostringstream& h) {
 }
 
 void method_html(std::ostringstream& h) {
-  h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already found) free; "
+  h << "<h2>Method</h2>\n<p>Each candidate is the full-catalogue model with only that effect (and those already taken) free; "
        "the statistic is the drop of the residual sum of squares per channel divided by the larger model's noise variance "
        "times its integrated autocorrelation time, compared with chi2 (chi-bar-square for a parameter whose neutral value "
        "is its bound) at a Bonferroni level; a candidate must also lower BIC and the cost on the held-out part. "
