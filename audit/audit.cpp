@@ -236,6 +236,33 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
           check_world_angular_momentum(m, J, off)};
 }
 
+// With J diagonal the body-rate rows must be Euler's equations, J_xx dp/dt = τ_x + (J_yy - J_zz) q r
+// and its cyclic permutations, written out here apart from the model's J^-1 (τ - ω × Jω). The
+// energy checks switch the torques off; this one tells how they enter (through J^-1, with the
+// moment about the CoG that the model names τ).
+AuditCheck check_euler_equations(const SymbolicModel& m) {
+  using namespace runtime::rigid_body;
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  const lst diagonal{P("J_xy") == 0, P("J_xz") == 0, P("J_yz") == 0};
+  ex tau;
+  for (const auto& [name, e] : m.intermediates)
+    if (name == "\\tau") tau = e;
+  const bool has_tau = is_a<matrix>(tau);
+  const ex J[3] = {P("J_xx"), P("J_yy"), P("J_zz")};
+  ex w[3];
+  for (int i = 0; i < 3; ++i) w[i] = m.states[kBodyRate + i].sym;
+  bool euler = has_tau;
+  for (int i = 0; i < 3 && euler; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const ex written_out = (ex_to<matrix>(tau)(i, 0) + (J[j] - J[k]) * w[j] * w[k]) / J[i];
+    euler = normal(m.f(kBodyRate + i, 0).subs(diagonal) - written_out.subs(diagonal)).is_zero();
+  }
+  return make("rotation", "body-rate rows are Euler's equations for a diagonal J", euler,
+              has_tau ? "with J_xy = J_xz = J_yz = 0 each row minus (τ_i + (J_jj - J_kk) ω_j ω_k) / J_ii, (i, j, k) cyclic, "
+                        "normalises to 0 (τ: the moment about the CoG of section 4)"
+                      : "the model names no moment τ to check the rows with");
+}
+
 }  // namespace
 
 // The substitutions that leave a model without torques: thrust (c_t = 0), gravity (g = 0),
@@ -346,6 +373,7 @@ AuditResult audit(const SymbolicModel& m, const MassProperties& mp) {
   add(check_mass_property_units(mp));
   add(check_rotation());
   add(check_quaternion_norm(m));
+  add({check_euler_equations(m)});
   add(check_inertia(mp));
   add(check_energy(m));
   return r;

@@ -154,6 +154,28 @@ TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
   EXPECT_FALSE(passed(world_rates, momentum));
   EXPECT_TRUE(passed(with_rates(gyro), energy));  // why the energy check alone is not enough
   EXPECT_TRUE(passed(with_rates(matrix(3, 1)), energy));
+
+  // How the moment enters: Euler's equations, written out in the audit for a diagonal J, hold
+  // for the derived rows and for J^-1 (τ - ω × Jω) written out again here; they fail for the
+  // thesis' sign (which the energy checks, torques off, cannot see) and for the moment entering
+  // without J^-1. (It takes the model's own τ: whether τ is the right moment is section 8's and
+  // the hover checks' question.)
+  const std::string euler = "body-rate rows are Euler's equations for a diagonal J";
+  matrix tau;
+  for (const auto& [name, e] : good.intermediates)
+    if (name == "\\tau") tau = ex_to<matrix>(e);
+  ASSERT_EQ(tau.rows(), 3u);
+  const matrix minus_gyro = gyro.mul_scalar(-1);
+  EXPECT_TRUE(passed(good, euler));
+  EXPECT_TRUE(passed(with_rates(tau.add(minus_gyro)), euler));
+  EXPECT_FALSE(passed(with_rates(tau.add(gyro)), euler));  // the thesis' sign
+  EXPECT_TRUE(passed(with_rates(tau.add(gyro)), energy));   // torques off, the energy check cannot tell
+  SymbolicModel no_inverse = good;  // dω/dt = τ - ω × Jω, J^-1 left out
+  {
+    const matrix wdot = tau.add(minus_gyro);
+    for (int i = 0; i < 3; ++i) no_inverse.f(kBodyRate + i, 0) = wdot(i, 0);
+  }
+  EXPECT_FALSE(passed(no_inverse, euler));
 }
 
 TEST(Model, HoverIsAnEquilibrium) {
