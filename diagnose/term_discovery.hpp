@@ -1,9 +1,10 @@
 // Beyond the catalogue: when the residual of the final model still has structure, propose a
 // term for it by sparse regression over physical regressors (sequentially thresholded least
 // squares, as in SINDy: Brunton, Proctor & Kutz, PNAS 113(15), 2016), with the sparsity
-// chosen by cross-validation across flights (or across time blocks of one flight) and the
-// gain measured on the held-out part that neither the catalogue search nor this regression
-// saw. The result is a proposal with its regressors, coefficients and intervals; what it
+// chosen by cross-validation across flights (or across time blocks of one flight) on the
+// training part, and the gain measured on the held-out part, which no fit saw but which also
+// decides whether the term is proposed (as it decides which catalogue effects are named): a
+// gate, so the gain it reports is not an untouched test score. The result is a proposal with its regressors, coefficients and intervals; what it
 // means physically is the user's call.
 #pragma once
 #include <string>

@@ -758,11 +758,17 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   return f;
 }
 
+double training_cut(const Flight& f, double train_fraction) {
+  if (f.samples.empty()) return 0;
+  const double front = f.samples.front().t, back = f.samples.back().t;
+  return front + train_fraction * (back - front);
+}
+
 std::pair<Flight, Flight> split_by_time(const Flight& f, double frac) {
   Flight a = f, b = f;
   a.samples.clear();
   b.samples.clear();
-  const double cut = f.samples.back().t * frac;
+  const double cut = training_cut(f, frac);
   for (const auto& s : f.samples) (s.t < cut ? a : b).samples.push_back(s);
   return {a, b};
 }
@@ -824,9 +830,8 @@ std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights,
   const auto offsets = join_offsets(flights, gap);
   Flight train = empty_join(flights), valid = empty_join(flights);
   for (size_t i = 0; i < flights.size(); ++i) {
-    const auto& S = flights[i].samples;
-    const double cut = S.front().t + train_fraction * (S.back().t - S.front().t);
-    for (FlightSample s : S) {
+    const double cut = training_cut(flights[i], train_fraction);
+    for (FlightSample s : flights[i].samples) {
       Flight& part = s.t < cut ? train : valid;
       s.t += offsets[i];
       part.samples.push_back(std::move(s));

@@ -130,7 +130,15 @@ std::string euler_range_problem(const std::string& column, double value_rad);
 // Reads a canonical log (or a raw log through a mapping), validates it for these rotors.
 Flight load_flight(const runtime::CsvTable& canonical, const std::vector<std::string>& rotors, const FlightOptions& o);
 
-// Samples with t - t0 < fraction * duration (training) and the rest (validation).
+// Where the held-out part begins: train_fraction of the flight's duration after its first
+// sample. The samples are the airborne ones (load_flight drops the rows before take-off), so
+// the fraction is of the flight, not of the log's clock: until 2026-12-05 split_by_time cut at
+// train_fraction times the last sample's time, counted from the log's first row, which held
+// out more than the fraction of a flight with ground time before it and did not match
+// split_each_by_time (a read-only audit, helper-114).
+double training_cut(const Flight& f, double train_fraction);
+
+// Samples before training_cut (training) and the rest (validation).
 std::pair<Flight, Flight> split_by_time(const Flight& f, double train_fraction);
 
 // Several flights of one vehicle as one log: each next flight's clock continues the

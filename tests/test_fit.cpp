@@ -1369,3 +1369,25 @@ TEST(Fit, MotorMapColumnsUnderALagMatchDifferences) {
     EXPECT_LE(check.worst, 1e-6 * check.scale) << name;
   }
 }
+
+// The held-out part is the end of the airborne flight: a log whose samples begin at take-off,
+// 3 s after its clock started, is cut at 70 % of those samples' duration (about 10 s), not at
+// 70 % of the clock's last time (9.1 s), which held out 39 % of the flight; a single
+// flight and the same flight inside a joint fit are cut at the same time (a leakage audit,
+// helper-114: predict on a joint diagnosis scored about 1 s of its training rows).
+TEST(Fit, TheHeldOutPartIsTheEndOfTheAirborneFlight) {
+  Flight flight;
+  for (int k = 0; k < 1000; ++k) {  // 3.005 ... 12.995 s, no sample near the cut
+    FlightSample s;
+    s.t = 3.005 + 0.01 * k;
+    flight.samples.push_back(s);
+  }
+  EXPECT_NEAR(training_cut(flight, 0.7), 3.005 + 0.7 * 9.99, 1e-12);
+  const auto [train, held_out] = split_by_time(flight, 0.7);
+  EXPECT_EQ(train.samples.size(), 700u);
+  EXPECT_EQ(held_out.samples.size(), 300u);
+  EXPECT_NEAR(held_out.samples.front().t, 10.005, 1e-9);
+  const auto [joint_train, joint_held_out] = split_each_by_time({flight}, 0.7);
+  EXPECT_EQ(joint_train.samples.size(), train.samples.size());
+  EXPECT_EQ(joint_held_out.samples.size(), held_out.samples.size());
+}
