@@ -64,7 +64,13 @@ def flight(path, delay):
                             -math.radians(rows[k - delay]["pid_controller_pitch"]), rows[k]["yaw"])
     measured = lambda k: (rows[k]["roll"], rows[k]["pitch"], rows[k]["yaw"])
     errors = {"set points": [], "measured attitude": []}
-    for start in range(int(0.7 * len(rows)), len(rows) - HORIZON, 5):
+    # The held-out part as quadgen cuts it (fit::training_cut): the last 30 % of the airborne
+    # flight, first to last airborne row (until 2026-12-05 this took the last 30 % of all rows,
+    # the ground before take-off and after landing included).
+    first = airborne.index(True)
+    last = len(airborne) - 1 - airborne[::-1].index(True)
+    cut = rows[first]["t"] + 0.7 * (rows[last]["t"] - rows[first]["t"])
+    for start in range(next(k for k, r in enumerate(rows) if r["t"] >= cut), len(rows) - HORIZON, 5):
         if not all(airborne[start - delay:start + HORIZON + 1]):
             continue
         errors["set points"].append(error_at_1s(rows, start, set_points))
