@@ -252,8 +252,7 @@ exmap generic_values(const SymbolicModel& m, double step, const lst& diagonal) {
 // and its cyclic permutations, written out here apart from the model's J^-1 (τ - ω × Jω). The
 // energy checks switch the torques off; this one tells how they enter (through J^-1, with the
 // moment about the CoG that the model names τ). Compared in numbers at two generic points, not
-// normalised: with every effect's τ, normal() doubled the audit's time (several minutes of
-// the sanitizer run in CI).
+// normalised: with every effect's τ, normal() doubled the audit's time.
 AuditCheck check_euler_equations(const SymbolicModel& m) {
   using namespace runtime::rigid_body;
   auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
@@ -266,9 +265,9 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
   ex w[3];
   for (int i = 0; i < 3; ++i) w[i] = m.states[kBodyRate + i].sym;
   bool euler = has_tau;
-  for (const double step : {0.6180339887498949, 0.4142135623730951})
+  for (const double step : {0.6180339887498949, 0.4142135623730951}) {
+    const exmap at = generic_values(m, step, diagonal);
     for (int i = 0; i < 3 && euler; ++i) {
-      const exmap at = generic_values(m, step, diagonal);
       const int j = (i + 1) % 3, k = (i + 2) % 3;
       const ex written_out = (ex_to<matrix>(tau)(i, 0) + (J[j] - J[k]) * w[j] * w[k]) / J[i];
       const ex row = evalf(m.f(kBodyRate + i, 0).subs(at)), euler_row = evalf(written_out.subs(at));
@@ -276,6 +275,7 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
               abs(ex_to<numeric>(row - euler_row)).to_double() <=
                   1e-12 * std::max({1.0, abs(ex_to<numeric>(row)).to_double(), abs(ex_to<numeric>(euler_row)).to_double()});
     }
+  }
   return make("rotation", "body-rate rows are Euler's equations for a diagonal J", euler,
               has_tau ? "with J_xy = J_xz = J_yz = 0 each row equals (τ_i + (J_jj - J_kk) ω_j ω_k) / J_ii, (i, j, k) cyclic, "
                         "to 1e-12 at two generic points of every state, input and parameter (τ: the moment about the "

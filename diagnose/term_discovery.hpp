@@ -4,8 +4,8 @@
 // chosen by cross-validation across flights (or across time blocks of one flight) on the
 // training part, and the gain measured on the held-out part, which no fit saw but which also
 // decides whether the term is proposed (as it decides which catalogue effects are named): a
-// gate, so the gain it reports is not an untouched test score. The result is a proposal with its regressors, coefficients and intervals; what it
-// means physically is the user's call.
+// gate, so the gain it reports is not an untouched test score. The result is a proposal with
+// its regressors, coefficients and intervals; what it means physically is the user's call.
 #pragma once
 #include <string>
 #include <string_view>
@@ -46,10 +46,11 @@ struct TermCoefficient {
   double value = 0, lower = 0, upper = 0;  // 95 % interval, widened for autocorrelated residuals
 };
 
-// The term proposed for one channel (added to the model's side: measured - model), or why
-// none is.
 // How a proposed term's verdict begins; a line that already says "proposed" prints the rest.
 inline constexpr std::string_view kProposedVerdict = "proposed: ";
+
+// The term proposed for one channel (added to the model's side: measured - model), or why
+// none is.
 
 struct DiscoveredTerm {
   std::string channel, unit;
