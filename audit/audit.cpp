@@ -257,10 +257,8 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
   using namespace runtime::rigid_body;
   auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
   const lst diagonal{P("J_xy") == 0, P("J_xz") == 0, P("J_yz") == 0};
-  ex tau;
-  for (const auto& [name, e] : m.intermediates)
-    if (name == "\\tau") tau = e;
-  const bool has_tau = is_a<matrix>(tau);
+  const ex& tau = m.intermediate("\\tau");
+  const bool has_tau = is_a<matrix>(tau) && tau.nops() == 3;
   const ex J[3] = {P("J_xx"), P("J_yy"), P("J_zz")};
   ex w[3];
   for (int i = 0; i < 3; ++i) w[i] = m.states[kBodyRate + i].sym;
@@ -280,7 +278,7 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
               has_tau ? "with J_xy = J_xz = J_yz = 0 each row equals (τ_i + (J_jj - J_kk) ω_j ω_k) / J_ii, (i, j, k) cyclic, "
                         "to 1e-12 at two generic points of every state, input and parameter (τ: the moment about the "
                         "CoG of section 4)"
-                      : "the model names no moment τ to check the rows with");
+                      : "the model's moment τ is not a 3-vector");
 }
 
 }  // namespace

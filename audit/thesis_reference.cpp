@@ -162,19 +162,14 @@ void gyroscopic_item(std::vector<ThesisItem>& out, const SymbolicModel& model, c
 // effect at its nominal (neutral) value: a model with effects is compared as the base.
 bool torque_agrees_with_thesis(const SymbolicModel& model) {
   if (!is_thesis_vehicle(model)) return true;
-  ex tau;
-  for (const auto& [name, e] : model.intermediates)
-    if (name == "\\tau") tau = e;
   auto P = [&](const char* s) { return model.params[model.param_index(s)].sym; };
   lst at_origin{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
   lst neutral;
   for (const auto& p : model.params)
     if (!effect_of_parameter(p.name).empty()) neutral.append(p.sym == p.nominal);
-  tau = tau.subs(neutral);
+  const ex tau = model.intermediate("\\tau").subs(neutral);
   ex F[4];
-  for (int i = 0; i < 4; ++i)
-    for (const auto& [name, e] : model.intermediates)
-      if (name == rotor_thrust_name(std::string(1, "ABCD"[i]))) F[i] = e.subs(neutral);
+  for (int i = 0; i < 4; ++i) F[i] = model.intermediate(rotor_thrust_name(std::string(1, "ABCD"[i]))).subs(neutral);
   const ex kappa = P("kappa");
   ex l;
   for (const auto& c : model.constants)

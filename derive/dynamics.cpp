@@ -403,6 +403,11 @@ size_t SymbolicModel::input_index(const std::string& n) const {
     if (inputs[i].name == n) return i;
   throw std::out_of_range("no input " + n);
 }
+const ex& SymbolicModel::intermediate(const std::string& n) const {
+  for (const auto& [name, e] : intermediates)
+    if (name == n) return e;
+  throw std::out_of_range("no intermediate " + n);
+}
 lst SymbolicModel::nominal_substitution() const {
   lst l;
   for (const auto& p : params) l.append(p.sym == exact(p.nominal));

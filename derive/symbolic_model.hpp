@@ -81,6 +81,9 @@ struct SymbolicModel {
   size_t state_index(const std::string& name) const;
   size_t param_index(const std::string& name) const;
   size_t input_index(const std::string& name) const;
+  // The entry of `intermediates` named `name` (TeX: "\\tau", "F_{drag}"); std::out_of_range
+  // when the model has none (every derived model has each rotor's thrust, drag, F_body and τ).
+  const GiNaC::ex& intermediate(const std::string& name) const;
   GiNaC::lst nominal_substitution() const;  // params == nominal values
   GiNaC::lst constant_substitution() const;  // constants == exact values
   // The effects in canonical order joined by `separator` ("motor_gain,motor_lag"): the

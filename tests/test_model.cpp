@@ -161,9 +161,7 @@ TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
   // without J^-1. (It takes the model's own τ: whether τ is the right moment is section 8's and
   // the hover checks' question.)
   const std::string euler = "body-rate rows are Euler's equations for a diagonal J";
-  matrix tau;
-  for (const auto& [name, e] : good.intermediates)
-    if (name == "\\tau") tau = ex_to<matrix>(e);
+  const matrix tau = ex_to<matrix>(good.intermediate("\\tau"));
   ASSERT_EQ(tau.rows(), 3u);
   const matrix minus_gyro = gyro.mul_scalar(-1);
   EXPECT_TRUE(passed(good, euler));
@@ -1113,12 +1111,6 @@ const SymbolicModel::NamedEquation& named(const SymbolicModel& m, const std::str
   throw std::runtime_error("no named equation " + lhs);
 }
 
-const ex& intermediate(const SymbolicModel& m, const std::string& name) {
-  for (const auto& [n, e] : m.intermediates)
-    if (n == name) return e;
-  throw std::runtime_error("no intermediate " + name);
-}
-
 // The report's chain of named quantities (rotor speed, thrust, moment per rotor, v_a, drag)
 // composed step by step equals the forces and torque the generated code is built from.
 void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
@@ -1132,7 +1124,7 @@ void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
     const std::string tex_name = "\\mathrm{" + std::string(r) + "}}";
     at[std::string("omega_") + r] = evaluate_by_name(named(m, "\\omega_{" + tex_name).rhs, at);
     const double thrust = evaluate_by_name(named(m, "F_{" + tex_name).rhs, at);
-    EXPECT_NEAR(thrust, evaluate_by_name(intermediate(m, "F_{" + tex_name), at), 1e-12 * std::fabs(thrust)) << r;
+    EXPECT_NEAR(thrust, evaluate_by_name(m.intermediate("F_{" + tex_name), at), 1e-12 * std::fabs(thrust)) << r;
     at[std::string("F_") + r] = thrust;
     thrust_sum += thrust;
     const matrix& tau_r = ex_to<matrix>(named(m, "\\tau_{" + tex_name).rhs);
@@ -1150,9 +1142,9 @@ void expect_named_chain_composes(const SymbolicModel& m, bool no_effect_terms) {
       for (int k = 0; k < 3; ++k) sum[k] += evaluate_by_name(ex_to<matrix>(rhs)(k, 0), at);
     }
   const matrix& drag_named = ex_to<matrix>(named(m, "F_{drag}").rhs);
-  const matrix& drag = ex_to<matrix>(intermediate(m, "F_{drag}"));
-  const matrix& force = ex_to<matrix>(intermediate(m, "F_{body}"));
-  const matrix& tau = ex_to<matrix>(intermediate(m, "\\tau"));
+  const matrix& drag = ex_to<matrix>(m.intermediate("F_{drag}"));
+  const matrix& force = ex_to<matrix>(m.intermediate("F_{body}"));
+  const matrix& tau = ex_to<matrix>(m.intermediate("\\tau"));
   for (int k = 0; k < 3; ++k) {
     const double d = evaluate_by_name(drag_named(k, 0), at);
     EXPECT_NEAR(d, evaluate_by_name(drag(k, 0), at), 1e-12 * (1 + std::fabs(d))) << axes[k];
