@@ -88,13 +88,9 @@ std::string flights_own_tag(const Diagnosis& d, const std::string& effect) {
   return scope(effect) == "flight" ? " <small>(" + esc(flights_own(d)) + ")</small>" : "";
 }
 
-// A discovered term's verdict for the report: "proposed" in bold, said once (the verdict
-// text may already begin with it).
+// A discovered term's verdict for the report: its label ("proposed" in bold), then why.
 std::string verdict_cell(const DiscoveredTerm& t) {
-  const std::string said = t.proposed ? "proposed" : "not proposed";
-  const bool begins = t.verdict.rfind(said, 0) == 0;
-  const std::string rest = begins ? t.verdict.substr(said.size()) : ": " + t.verdict;
-  return (t.proposed ? "<b>proposed</b>" : said) + prose(rest);
+  return (t.proposed ? "<b>proposed</b>" : esc(t.verdict_label)) + prose(": " + t.verdict_reason);
 }
 
 // A check's leads: each claim once, the numbers of each source that shows it below.

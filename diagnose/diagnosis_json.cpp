@@ -424,7 +424,7 @@ json discovered_terms_json(const Diagnosis& d) {
                     {"held_out_gain", {{"mean", number_or_null(t.gain_mean)},
                                        {"standard_error", number_or_null(t.gain_standard_error)},
                                        {"per_block", t.fold_gains}}},
-                    {"verdict", t.verdict}});
+                    {"verdict", t.verdict()}});
   }
   return disc;
 }

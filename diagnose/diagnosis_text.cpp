@@ -129,8 +129,7 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& t : d.discovered)
     if (t.proposed)
       os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
-         << (t.verdict.rfind(kProposedVerdict, 0) == 0 ? t.verdict.substr(kProposedVerdict.size()) : t.verdict)
-         << "\n";  // "proposed" once
+         << t.verdict_reason << "\n";
   if (d.terms_gain.measured)
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
        << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)

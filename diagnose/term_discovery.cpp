@@ -338,7 +338,8 @@ void judge_held_out(DiscoveredTerm& d, const Vector& before_rows, const Vector& 
                            output::short_number(d.gain_mean) + " +- " + output::short_number(d.gain_standard_error) + unit +
                            " per fold, over the held-out part's " + std::to_string(d.fold_gains.size()) + " folds)";
   d.proposed = d.gain_mean > 0 && d.gain_mean > d.gain_standard_error;
-  d.verdict = (d.proposed ? std::string(kProposedVerdict) : "not proposed, no held-out gain beyond its spread: ") + held;
+  d.verdict_label = d.proposed ? "proposed" : "not proposed";
+  d.verdict_reason = (d.proposed ? "" : "no held-out gain beyond its spread: ") + held;
 }
 
 // One channel: the cross-validated sparsity level, the significant coefficients on it (in the
@@ -354,8 +355,9 @@ DiscoveredTerm discover_channel(DiscoveredTerm d, const ScaledDesign& x, const R
   d.train_rms_before = d.train_rms_after = std::sqrt(yt.squaredNorm() / nt);
   d.valid_rms_before = d.valid_rms_after = std::sqrt(yv.squaredNorm() / nv);
   if (chosen.threshold == 0) {
-    d.verdict = "no term: cross-validation (" + d.cross_validation + ") finds no combination of at most " +
-                std::to_string(opt.max_terms) + " regressors that predicts left-out residual better than none";
+    d.verdict_label = "no term";
+    d.verdict_reason = "cross-validation (" + d.cross_validation + ") finds no combination of at most " +
+                       std::to_string(opt.max_terms) + " regressors that predicts left-out residual better than none";
     return d;
   }
   std::vector<size_t> all_rows(static_cast<size_t>(yt.size()));
@@ -370,8 +372,9 @@ DiscoveredTerm discover_channel(DiscoveredTerm d, const ScaledDesign& x, const R
                               (fit.xi(j) - fit::kZ95 * fit.se(j)) / s, (fit.xi(j) + fit::kZ95 * fit.se(j)) / s});
   }
   if (d.coefficients.empty()) {
-    d.verdict = "no term: no selected coefficient is significant once corrected for the " + std::to_string(fit.xi.size()) +
-                " regressors searched";
+    d.verdict_label = "no term";
+    d.verdict_reason = "no selected coefficient is significant once corrected for the " + std::to_string(fit.xi.size()) +
+                       " regressors searched";
     return d;
   }
   const Vector et = yt - x.train * fit.xi, ev = yv - x.valid * fit.xi;

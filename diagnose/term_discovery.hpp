@@ -46,9 +46,6 @@ struct TermCoefficient {
   double value = 0, lower = 0, upper = 0;  // 95 % interval, widened for autocorrelated residuals
 };
 
-// How a proposed term's verdict begins; a line that already says "proposed" prints the rest.
-inline constexpr std::string_view kProposedVerdict = "proposed: ";
-
 // The term proposed for one channel (added to the model's side: measured - model), or why
 // none is.
 
@@ -64,7 +61,10 @@ struct DiscoveredTerm {
   std::vector<double> fold_gains;  // held-out RMS before - after, per validation block
   double gain_mean = 0, gain_standard_error = 0;
   bool proposed = false;
-  std::string verdict;  // why it is proposed (after kProposedVerdict), or why not
+  // The verdict in two parts, so that each report says the label once, in its own way:
+  // "proposed", "not proposed" or "no term", and why (the held-out gain, or what the search found).
+  std::string verdict_label, verdict_reason;
+  std::string verdict() const { return verdict_label + ": " + verdict_reason; }  // diagnosis.json's words
   std::string expression() const;  // "pdot += 0.12 v_bx*U - 3.1 (1)" style, for reports
 };
 

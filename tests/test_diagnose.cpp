@@ -1195,6 +1195,40 @@ TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
   EXPECT_EQ(html.find("nan"), std::string::npos);
 }
 
+// A discovered term's verdict says its label once in each sink: "proposed" (bold in the
+// report) or "not proposed" or "no term", then why; diagnosis.json keeps label and reason in
+// one string. (The terminal and the report each stripped the label from that string their own
+// way, and the report wrote "not proposed: no term: ...".)
+TEST(DiagnosisReport, ADiscoveredTermsVerdictSaysItsLabelOnce) {
+  quadgen::diagnose::Diagnosis d;
+  const std::vector<std::pair<std::string, std::string>> verdicts{
+      {"proposed", "held-out RMS 2 -> 1"}, {"not proposed", "no held-out gain beyond its spread: held-out RMS 2 -> 2"},
+      {"no term", "cross-validation finds none"}};
+  for (const auto& [label, reason] : verdicts) {
+    quadgen::diagnose::DiscoveredTerm t;
+    t.channel = "pdot", t.unit = "rad/s^2", t.proposed = label == "proposed";
+    t.verdict_label = label, t.verdict_reason = reason;
+    if (t.proposed) t.coefficients.push_back({"v_bx", "rad/s^2/(m/s)", 0.5, 0.4, 0.6});
+    d.discovered.push_back(t);
+  }
+  const auto j = quadgen::diagnose::diagnosis_json(d, "log.csv");
+  ASSERT_EQ(j["discovered_terms"].size(), 3u);
+  EXPECT_EQ(j["discovered_terms"][0]["verdict"], "proposed: held-out RMS 2 -> 1");
+  EXPECT_EQ(j["discovered_terms"][2]["verdict"], "no term: cross-validation finds none");
+  const std::string summary = quadgen::diagnose::diagnosis_summary(d);
+  const size_t line = summary.find("proposed term");
+  ASSERT_NE(line, std::string::npos) << summary;
+  const std::string proposed_line = summary.substr(line, summary.find('\n', line) - line);
+  EXPECT_NE(proposed_line.find("]; held-out RMS 2 -> 1"), std::string::npos) << proposed_line;
+  EXPECT_EQ(proposed_line.find("proposed", 1), std::string::npos) << proposed_line;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
+  EXPECT_NE(html.find("<b>proposed</b>: held-out RMS 2 &rarr; 1"), std::string::npos);
+  EXPECT_NE(html.find(">not proposed: no held-out gain beyond its spread"), std::string::npos);
+  EXPECT_NE(html.find(">no term: cross-validation finds none"), std::string::npos);
+  EXPECT_EQ(html.find("proposed: no term"), std::string::npos);
+  EXPECT_EQ(html.find("proposed: proposed"), std::string::npos);
+}
+
 // Each finding says whether it describes the airframe or the flight, as its catalogue entry
 // declares (`per_flight`), in diagnosis.json, the terminal summary and the report: diagnoses of
 // several flights of one vehicle must agree on the first kind, not on the second.

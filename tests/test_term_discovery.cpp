@@ -110,7 +110,7 @@ TEST(TermDiscovery, HiddenDragMomentIsFoundWithItsCoefficientAndHeldOutGain) {
                                       residuals(valid, rng, 4, drag_moment), kChannels, kUnits, {0.0});
     ASSERT_EQ(terms.size(), 6u);
     for (const auto& t : terms) {
-      SCOPED_TRACE(t.channel + " seed " + std::to_string(seed) + ": " + t.expression() + "; " + t.verdict);
+      SCOPED_TRACE(t.channel + " seed " + std::to_string(seed) + ": " + t.expression() + "; " + t.verdict());
       if (t.channel != "qdot") {
         EXPECT_FALSE(t.proposed);
         continue;
@@ -144,7 +144,7 @@ TEST(TermDiscovery, AutocorrelatedNoiseAloneProposesNothing) {
     const fit::Flight train = manoeuvre(0, 40, 0.3 * seed), valid = manoeuvre(40, 15, 0.3 * seed);
     for (const auto& t : discover_terms(train, residuals(train, rng, -1, nullptr), valid,
                                         residuals(valid, rng, -1, nullptr), kChannels, kUnits, {0.0})) {
-      if (t.proposed) ADD_FAILURE() << "seed " << seed << ": " << t.expression() << "; " << t.verdict;
+      if (t.proposed) ADD_FAILURE() << "seed " << seed << ": " << t.expression() << "; " << t.verdict();
       proposed += t.proposed;
     }
   }
@@ -170,7 +170,7 @@ TEST(TermDiscovery, SeveralFlightsCrossValidateOneFlightAgainstTheOthers) {
                                     residuals(valid, rng, 4, drag_moment), kChannels, kUnits, starts);
   ASSERT_EQ(terms.size(), 6u);
   EXPECT_EQ(terms[4].cross_validation, "leave one flight out, 3 flights");
-  ASSERT_TRUE(terms[4].proposed) << terms[4].verdict;
+  ASSERT_TRUE(terms[4].proposed) << terms[4].verdict();
   ASSERT_EQ(terms[4].coefficients.size(), 2u);
   EXPECT_EQ(terms[4].coefficients[1].regressor, "v_bx*dU");
   EXPECT_LT(terms[4].coefficients[1].lower, -2.0);
