@@ -36,8 +36,9 @@ NanoBench flights, residuals.csv unthinned), the slow band of the extended model
 and pitch residual is printed beside each flight, and the correlation across the flights
 between it and the folded estimate. Last, the folded estimates as the model's slow moment
 (the pipeline's share undone, the answer applied) and as a 1 s rollout error (the ARPL log's
-drift per rad/s^2 of slow band, scaled by the 0.49-0.58 ratio of measured rollouts to the
-linearised drift, docs/history.md's twenty-seventh session).
+drift per rad/s^2 of slow band, scaled by the 0.50-0.59 ratio of measured rollouts to the
+linearised drift, docs/history.md's twenty-seventh session, remeasured with the corrected
+held-out part in the fifty-fifth).
 
 Usage: command_aliasing.py [--data DIR] [DIAGNOSIS_DIR ...]
   DIR holds arpl/log10.csv and nanobench/B*.csv (default: ../shared/data/crazyflie)"""
@@ -62,7 +63,7 @@ INERTIA = {"roll": 1.395e-5, "pitch": 1.436e-5}
 AXES = ("roll", "pitch")
 MOTOR_LAG = 0.062  # s: quadgen's fit of the ARPL log (the authors give 0.072 s)
 ANSWER = (0.62, 0.75)  # NanoBench: roll/pitch answer to the commands against the stock file (README)
-ROLLOUT_RATIO = (0.49, 0.58)  # a measured rollout over the linearised drift (docs/history.md, 27th session)
+ROLLOUT_RATIO = (0.50, 0.59)  # a measured rollout over the linearised drift (docs/history.md, 27th and 55th sessions)
 SATURATED = {"B6_linear_ramp_rep1"}  # motor 4 at full command on most airborne rows
 LOST = 0.2  # the share of motor samples lost over the radio on NanoBench (about 18 %)
 
@@ -408,7 +409,7 @@ def as_a_rollout(unsaturated, check, metres_per_slow, piece_ratio, ratio):
     print(f"  the folded slow moment on the unsaturated flights, the pipeline's share undone and through the "
           f"{ANSWER[0]}-{ANSWER[1]} answer: {low:.2f}-{high:.2f} rad/s^2; at the ARPL log's {metres_per_slow:.2f} m "
           f"per rad/s^2 of slow band, linearised {low * metres_per_slow:.2f}-{high * metres_per_slow:.2f} m at 1 s, "
-          f"scaled by the rollouts' {ROLLOUT_RATIO[0]}-{ROLLOUT_RATIO[1]}: "
+          f"scaled by the rollouts' {ROLLOUT_RATIO[0]:.2f}-{ROLLOUT_RATIO[1]:.2f}: "
           f"{low * metres_per_slow * ROLLOUT_RATIO[0]:.2f}-{high * metres_per_slow * ROLLOUT_RATIO[1]:.2f} m "
           f"({low * metres_per_slow * ROLLOUT_RATIO[0] * spread[0]:.2f}-"
           f"{high * metres_per_slow * ROLLOUT_RATIO[1] * spread[1]:.2f} m with the ratio's spread between the ARPL pieces)")
