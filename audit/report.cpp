@@ -29,6 +29,16 @@ size_t tree_size(const ex& e, size_t limit) {
 
 std::string num(double v) { return output::six_digits(v); }
 
+// A unit as the page's prose writes it ("kg m²" where the model declares "kg m^2", as the
+// generated code and diagnosis.json keep it): one page read "kg m²" above "kg m^2".
+std::string unit_for_reading(std::string unit) {
+  for (const auto& [ascii, raised] : {std::pair<std::string, std::string>{"^-1", "⁻¹"}, {"^-2", "⁻²"}, {"^2", "²"},
+                                      {"^3", "³"}, {"^4", "⁴"}})
+    for (size_t at = 0; (at = unit.find(ascii, at)) != std::string::npos; at += raised.size())
+      unit.replace(at, ascii.size(), raised);
+  return unit;
+}
+
 void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "## 1. Vehicle\n\n" << output::markdown_text(d.vehicle.description) << "\n\n";
   md << "| block | mass [kg] | size a × b × c [m] | centre [m] | yaw, pitch, roll [deg] |\n|---|---|---|---|---|\n";
@@ -58,9 +68,9 @@ void given_values(std::ostringstream& md, const Derivation& d) {
     if (d.vehicle.derived_given.count(q.name)) {
       const double given = d.vehicle.derived_overrides.at(q.name).nominal;
       const double used = d.model.params[d.model.param_index(q.name)].nominal;
-      md << separator << "`" << q.name << "` = " << num(given) << " " << q.unit;
+      md << separator << "`" << q.name << "` = " << num(given) << " " << unit_for_reading(q.unit);
       if (std::fabs(used - given) > 1e-12 * std::max(std::fabs(given), 1e-300))
-        md << " (replaced by the fitted " << num(used) << " " << q.unit << ")";
+        md << " (replaced by the fitted " << num(used) << " " << unit_for_reading(q.unit) << ")";
       separator = "; ";
     }
   md << ".\n\n";
@@ -231,7 +241,7 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
   else md << "| # | name | unit | meaning |\n|---|---|---|---|\n";
   for (size_t i = 0; i < vars.size(); ++i) {
     const auto& v = vars[i];
-    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(v.unit) << " | ";
+    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(unit_for_reading(v.unit)) << " | ";
     if (params)
       md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
          << " | " << (v.fit ? "yes" : "no") << " | ";
@@ -255,7 +265,8 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   md << "\n\n| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "
-       << (c.passed ? "pass" : c.advisory ? "**warning**" : "**FAIL**") << " | " << output::markdown_text(c.detail) << " |\n";
+       << (c.passed ? "pass" : c.advisory ? "**warning**" : "**FAIL**") << " | "
+       << output::markdown_text(c.group == "units" ? unit_for_reading(c.detail) : c.detail) << " |\n";
   md << "\n";
   if (!d.why_trim_does_not_hold.empty())
     md << "**The hover trim above is the base model's and does not hold this model:** "

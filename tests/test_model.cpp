@@ -1324,7 +1324,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_NE(md.find("The vehicle file's `derived:` section gives measured values in place of the blocks', and the "
                       "model uses these"),
               std::string::npos);
-    EXPECT_NE(md.find("minus the products of inertia): `J_xy` = 1e-05 kg m^2.\n"), std::string::npos);
+    EXPECT_NE(md.find("minus the products of inertia): `J_xy` = 1e-05 kg m².\n"), std::string::npos);
     EXPECT_EQ(derivation_markdown({good, derive_mass_properties(good), derive_model(good, derive_mass_properties(good), {}),
                                    no_audit, no_thesis, runtime::HoverTrim{}})
                   .find("section gives measured values"),
