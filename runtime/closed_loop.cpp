@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <limits>
-#include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <sstream>
@@ -110,11 +109,9 @@ std::string why_no_trim_above_least(const Eigen::VectorXd& least_norm, const Eig
   (least_norm - least).minCoeff(&k);
   const bool pulls = least_norm(k) < -1e-9 * weight;
   const double asked = pulls ? least_norm(k) : std::max(least_norm(k), 0.0);
-  const auto newtons = [](double f) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g N", f);
-    return std::string(buf);
-  };
+  // Six digits, as ThrustLaw::command_for's messages (which keep their own printer: that
+  // header is dependency-free): a reader adds the thrusts up against the weight by eye.
+  const auto newtons = [](double f) { return output::six_digits(f) + " N"; };
   const std::string what =
       pulls ? " would have to pull down " + newtons(-asked)
             : " would have to give " + newtons(asked) + ", less than its motor map gives at command 0 (" +
