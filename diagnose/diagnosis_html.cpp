@@ -154,7 +154,8 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       << "</td><td>";
     for (size_t i = 0; i < t.coefficients.size(); ++i) {
       const auto& c = t.coefficients[i];
-      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, 3) << " " << interval(c.lower, c.upper, 3) << " " << esc(c.unit);
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, kEstimateDigits) << " "
+        << interval(c.lower, c.upper, kEstimateDigits) << " " << esc(c.unit);
     }
     h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
       << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
@@ -190,7 +191,7 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
     h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
     for (const auto* p : row)
       if (p)
-        h << "<td>" << num(p->value, 3) << " " << interval(p->lower, p->upper, 3)
+        h << "<td>" << num(p->value, kEstimateDigits) << " " << interval(p->lower, p->upper, kEstimateDigits)
           << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
       else h << "<td>–</td>";
     h << "</tr>\n";
@@ -227,7 +228,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
-      << esc(reference_name) << " " << num(a.joint_value, 3) << ", pooled " << num(a.pooled, 3) << ", spread "
+      << esc(reference_name) << " " << num(a.joint_value, kEstimateDigits) << ", pooled " << num(a.pooled, kEstimateDigits) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
          "<th style=\"width:40%\">at a glance</th></tr>\n";
@@ -235,7 +236,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
-        << num(f.value, 3) << "</td><td>" << interval(f.lower, f.upper, 3) << "</td><td>"
+        << num(f.value, kEstimateDigits) << "</td><td>" << interval(f.lower, f.upper, kEstimateDigits) << "</td><td>"
         << esc(output::p_value_cell(f.p_value)) << "</td><td><div style=\"position:relative;height:14px\">";
       if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind
         h << "<div style=\"position:absolute;left:" << at(band_lo) << ";width:calc(" << at(band_hi) << " - " << at(band_lo)
@@ -334,7 +335,8 @@ std::string values_cell(const std::vector<std::string>& values) {
 std::string estimates_cell(const std::vector<EffectEstimate>& ps, bool with_interval) {
   std::vector<std::string> values;
   for (const auto& p : ps)
-    values.push_back(esc(name_value(p.name, p.value, p.unit, 3)) + (with_interval ? " " + interval(p.lower, p.upper, 3) : ""));
+    values.push_back(esc(name_value(p.name, p.value, p.unit, kEstimateDigits)) +
+                     (with_interval ? " " + interval(p.lower, p.upper, kEstimateDigits) : ""));
   return values_cell(values);
 }
 
@@ -344,7 +346,7 @@ std::string estimates_cell(const std::vector<EffectEstimate>& ps, bool with_inte
 std::string carried_values(const Diagnosis& d, const std::string& effect) {
   std::vector<std::string> values;
   for (const auto& p : d.search.final_fit)
-    if (p.free && p.name.rfind(effect + ".", 0) == 0) values.push_back(esc(name_value(p.name, p.value, p.unit, 3)));
+    if (p.free && p.name.rfind(effect + ".", 0) == 0) values.push_back(esc(name_value(p.name, p.value, p.unit, kEstimateDigits)));
   return values_cell(values);
 }
 
@@ -487,7 +489,8 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
     else {
       h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
       for (const auto& p : f.parameters)
-        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value) << "</td><td>" << interval(p.lower, p.upper)
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, kEstimateDigits) << "</td><td>"
+          << interval(p.lower, p.upper, kEstimateDigits)
           << "</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
       h << "</table>\n";
     }
@@ -521,7 +524,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
             : "")
     << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
   for (const auto* p : base)
-    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value) << "</td><td>" << esc(p->unit) << "</td><td>"
+    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << esc(p->unit) << "</td><td>"
       << interval(p->lower, p->upper) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
   h << "</table>\n";
 }
@@ -541,7 +544,7 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
          "extended model and is not named.</p>\n<table><tr><th>effect</th><th>value</th><th>plausible</th><th>why</th>"
          "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
     for (const auto& st : d.stand_ins) {
-      h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value) << " "
+      h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value, kEstimateDigits) << " "
         << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
         << prose(st.why) << "</td><td>";
       for (size_t c = 0; c < st.channels.size(); ++c)

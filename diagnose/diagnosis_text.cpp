@@ -34,7 +34,8 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   for (const auto& f : d.findings) {
     os << "named " << f.effect << flights_own_note(d, f.effect) << ":";
     for (const auto& p : f.parameters)  // a list, comma-separated (a review, helper-111)
-      os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << num(p.value) << " " << interval(p.lower, p.upper);
+      os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << num(p.value, kEstimateDigits) << " "
+         << interval(p.lower, p.upper, kEstimateDigits);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
        << beside_gain_text(f);
     for (const auto& a : d.agreement)
@@ -50,7 +51,8 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
-      os << (k ? ", " : " ") << k + 1 << ": " << num(a.flights[k].value, 3) << " " << interval(a.flights[k].lower, a.flights[k].upper, 3);
+      os << (k ? ", " : " ") << k + 1 << ": " << num(a.flights[k].value, kEstimateDigits) << " "
+         << interval(a.flights[k].lower, a.flights[k].upper, kEstimateDigits);
     os << "\n";
   }
   if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())
@@ -58,8 +60,9 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
-       << num(a.flights.front().value, 3) << " " << interval(a.flights.front().lower, a.flights.front().upper, 3)
-       << " against " << num(a.joint_value, 3) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
+       << num(a.flights.front().value, kEstimateDigits) << " "
+       << interval(a.flights.front().lower, a.flights.front().upper, kEstimateDigits) << " against "
+       << num(a.joint_value, kEstimateDigits) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }
 
@@ -72,14 +75,14 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   for (const auto& st : d.stand_ins)
     os << "stands in for missing physics, not named: " << st.candidate.effect << flights_own_note(d, st.candidate.effect)
        << " (" << st.parameter << " = "
-       << num(st.value) << output::unit_after_number(st.unit) << " lies outside [" << num(st.plausible_lower) << ", "
+       << num(st.value, kEstimateDigits) << output::unit_after_number(st.unit) << " lies outside [" << num(st.plausible_lower) << ", "
        << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
   for (const auto& x : d.suspected) {
     os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
     for (size_t k = 0; k < x.candidate.parameters.size(); ++k) {
       const auto& p = x.candidate.parameters[k];
-      os << (k ? ", " : " at ") << name_value(p.name, p.value, p.unit)
+      os << (k ? ", " : " at ") << name_value(p.name, p.value, p.unit, kEstimateDigits)
          << (p.at_bound ? " (on its bound)" : "");
     }
     os << " (" << x.failed << ")";

@@ -87,6 +87,11 @@ std::vector<std::string> next_steps(const Diagnosis& d);
 // "open" on a side its profile never closed.
 std::string num(double v, int prec = 4);
 std::string interval(double lower, double upper, int prec = 4);
+// The significant digits of an estimate and its interval wherever one is printed (the
+// terminal, the report's tables), so that a value reads the same in each: one page printed a
+// delay as 0.0409 [0.0377, 0.0439] in one table and 0.0409 [0.0377, 0.04395] in the next. A
+// sentence rounds further (headline::words); diagnosis.json keeps every digit.
+inline constexpr int kEstimateDigits = 3;
 
 // A check's lead: what it suggests, said once, and the numbers of each source that shows it
 // ("this flight" or "the flights together" for the diagnosis as a whole, "flight k (path)"
