@@ -146,7 +146,7 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   const PrincipalMoments pm = principal_moments(mp.inertia_cog_value);
   const auto& l = pm.moments;
   std::ostringstream os;
-  os << "principal moments " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2";
+  os << "principal moments " << l[0] << ", " << l[1] << ", " << l[2] << " kg m²";  // as derivation.md's units
   out.push_back(make("inertia", "positive definite", pm.positive, os.str()));
   out.push_back(make("inertia", "triangle inequalities of principal moments", pm.triangle,
                      "each principal moment <= sum of the other two"));
@@ -258,7 +258,7 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
   auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
   const lst diagonal{P("J_xy") == 0, P("J_xz") == 0, P("J_yz") == 0};
   const ex& tau = m.intermediate("\\tau");
-  const bool has_tau = is_a<matrix>(tau) && tau.nops() == 3;
+  const bool has_tau = is_a<matrix>(tau) && ex_to<matrix>(tau).rows() == 3 && ex_to<matrix>(tau).cols() == 1;
   const ex J[3] = {P("J_xx"), P("J_yy"), P("J_zz")};
   ex w[3];
   for (int i = 0; i < 3; ++i) w[i] = m.states[kBodyRate + i].sym;

@@ -29,15 +29,27 @@ size_t tree_size(const ex& e, size_t limit) {
 
 std::string num(double v) { return output::six_digits(v); }
 
-// A unit as the page's prose writes it ("kg m²" where the model declares "kg m^2", as the
-// generated code and diagnosis.json keep it): one page read "kg m²" above "kg m^2".
-std::string unit_for_reading(std::string unit) {
-  for (const auto& [ascii, raised] : {std::pair<std::string, std::string>{"^-1", "⁻¹"}, {"^-2", "⁻²"}, {"^2", "²"},
-                                      {"^3", "³"}, {"^4", "⁴"}})
-    for (size_t at = 0; (at = unit.find(ascii, at)) != std::string::npos; at += raised.size())
-      unit.replace(at, ascii.size(), raised);
-  return unit;
+}  // namespace
+
+std::string unit_for_reading(const std::string& unit) {
+  static const char* const kRaised[] = {"⁰", "¹", "²", "³", "⁴", "⁵", "⁶", "⁷", "⁸", "⁹"};
+  std::string out;
+  for (size_t at = 0; at < unit.size(); ++at) {
+    const size_t digits = at + 1 + (unit.compare(at + 1, 1, "-") == 0 ? 1 : 0);
+    size_t end = digits;
+    while (end < unit.size() && unit[end] >= '0' && unit[end] <= '9') ++end;
+    if (unit[at] != '^' || end == digits) {  // not a power: "^T", a '^' at the end, a name's '^'
+      out += unit[at];
+      continue;
+    }
+    if (digits > at + 1) out += "⁻";
+    for (size_t k = digits; k < end; ++k) out += kRaised[unit[k] - '0'];
+    at = end - 1;
+  }
+  return out;
 }
+
+namespace {
 
 void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "## 1. Vehicle\n\n" << output::markdown_text(d.vehicle.description) << "\n\n";

@@ -525,7 +525,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
   for (const auto* p : base)
     h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << esc(p->unit) << "</td><td>"
-      << interval(p->lower, p->upper) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
+      << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
   h << "</table>\n";
 }
 

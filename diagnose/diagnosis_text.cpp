@@ -117,7 +117,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
 void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& note : d.notes) os << "caution: " << note << "\n";
   for (const auto& p : d.at_bounds)
-    os << "caution: " << name_value(p.name, p.value, p.unit)
+    os << "caution: " << name_value(p.name, p.value, p.unit, kEstimateDigits)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)

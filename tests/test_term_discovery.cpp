@@ -171,6 +171,15 @@ TEST(TermDiscovery, SeveralFlightsCrossValidateOneFlightAgainstTheOthers) {
   ASSERT_EQ(terms.size(), 6u);
   EXPECT_EQ(terms[4].cross_validation, "leave one flight out, 3 flights");
   ASSERT_TRUE(terms[4].proposed) << terms[4].verdict();
+  // Each channel's verdict: a label of the three, and a reason that does not say it again
+  // (the report and the terminal print the label their own way).
+  for (const auto& t : terms) {
+    EXPECT_TRUE(t.verdict_label == (t.proposed ? "proposed" : "not proposed") ||
+                (!t.proposed && t.verdict_label == "no term")) << t.verdict();
+    EXPECT_FALSE(t.verdict_reason.empty()) << t.channel;
+    for (const char* label : {"proposed", "not proposed", "no term"})
+      EXPECT_NE(t.verdict_reason.rfind(label, 0), 0u) << t.verdict();
+  }
   ASSERT_EQ(terms[4].coefficients.size(), 2u);
   EXPECT_EQ(terms[4].coefficients[1].regressor, "v_bx*dU");
   EXPECT_LT(terms[4].coefficients[1].lower, -2.0);
