@@ -154,8 +154,7 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       << "</td><td>";
     for (size_t i = 0; i < t.coefficients.size(); ++i) {
       const auto& c = t.coefficients[i];
-      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << num(c.value, kEstimateDigits) << " "
-        << interval(c.lower, c.upper, kEstimateDigits) << " " << esc(c.unit);
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << estimate(c.value, c.lower, c.upper) << " " << esc(c.unit);
     }
     h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
       << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
@@ -191,7 +190,7 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
     h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
     for (const auto* p : row)
       if (p)
-        h << "<td>" << num(p->value, kEstimateDigits) << " " << interval(p->lower, p->upper, kEstimateDigits)
+        h << "<td>" << estimate(p->value, p->lower, p->upper)
           << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
       else h << "<td>–</td>";
     h << "</tr>\n";

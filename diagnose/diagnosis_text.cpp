@@ -34,8 +34,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   for (const auto& f : d.findings) {
     os << "named " << f.effect << flights_own_note(d, f.effect) << ":";
     for (const auto& p : f.parameters)  // a list, comma-separated (a review, helper-111)
-      os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << num(p.value, kEstimateDigits) << " "
-         << interval(p.lower, p.upper, kEstimateDigits);
+      os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << estimate(p.value, p.lower, p.upper);
     os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
        << beside_gain_text(f);
     for (const auto& a : d.agreement)
@@ -51,8 +50,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
-      os << (k ? ", " : " ") << k + 1 << ": " << num(a.flights[k].value, kEstimateDigits) << " "
-         << interval(a.flights[k].lower, a.flights[k].upper, kEstimateDigits);
+      os << (k ? ", " : " ") << k + 1 << ": " << estimate(a.flights[k].value, a.flights[k].lower, a.flights[k].upper);
     os << "\n";
   }
   if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())
@@ -60,8 +58,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
-       << num(a.flights.front().value, kEstimateDigits) << " "
-       << interval(a.flights.front().lower, a.flights.front().upper, kEstimateDigits) << " against "
+       << estimate(a.flights.front().value, a.flights.front().lower, a.flights.front().upper) << " against "
        << num(a.joint_value, kEstimateDigits) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }

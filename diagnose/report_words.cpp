@@ -412,6 +412,10 @@ std::string worse_channels(const Diagnosis& d) {
 }
 
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
+std::string estimate(double value, double lower, double upper) {
+  return num(value, kEstimateDigits) + " " + interval(lower, upper, kEstimateDigits);
+}
+
 std::string interval(double lower, double upper, int prec) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
   return "[" + side(lower) + ", " + side(upper) + "]";

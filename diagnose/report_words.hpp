@@ -92,6 +92,8 @@ std::string interval(double lower, double upper, int prec = 4);
 // delay as 0.0409 [0.0377, 0.0439] in one table and 0.0409 [0.0377, 0.04395] in the next. A
 // sentence rounds further (headline::words); diagnosis.json keeps every digit.
 inline constexpr int kEstimateDigits = 3;
+// An estimate and its interval at those digits: "0.0409 [0.0377, 0.0439]".
+std::string estimate(double value, double lower, double upper);
 
 // A check's lead: what it suggests, said once, and the numbers of each source that shows it
 // ("this flight" or "the flights together" for the diagnosis as a whole, "flight k (path)"

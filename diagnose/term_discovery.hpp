@@ -8,7 +8,6 @@
 // its regressors, coefficients and intervals; what it means physically is the user's call.
 #pragma once
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "derive/added_terms.hpp"
@@ -48,7 +47,6 @@ struct TermCoefficient {
 
 // The term proposed for one channel (added to the model's side: measured - model), or why
 // none is.
-
 struct DiscoveredTerm {
   std::string channel, unit;
   std::vector<TermCoefficient> coefficients;
