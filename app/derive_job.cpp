@@ -81,7 +81,7 @@ std::string summary_of(const Vehicle& vehicle, const MassProperties& mp, const D
   if (has("cog_offset.x") && (nominal("cog_offset.x") != 0 || nominal("cog_offset.y") != 0))
     os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
   os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
-     << " kg m^2" << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
+     << " kg m²" << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   if (!d.why_trim_does_not_hold.empty()) os << "note: the header declares no hover trim: " << d.why_trim_does_not_hold << "\n";

@@ -29,28 +29,6 @@ size_t tree_size(const ex& e, size_t limit) {
 
 std::string num(double v) { return output::six_digits(v); }
 
-}  // namespace
-
-std::string unit_for_reading(const std::string& unit) {
-  static const char* const kRaised[] = {"⁰", "¹", "²", "³", "⁴", "⁵", "⁶", "⁷", "⁸", "⁹"};
-  std::string out;
-  for (size_t at = 0; at < unit.size(); ++at) {
-    const size_t digits = at + 1 + (unit.compare(at + 1, 1, "-") == 0 ? 1 : 0);
-    size_t end = digits;
-    while (end < unit.size() && unit[end] >= '0' && unit[end] <= '9') ++end;
-    if (unit[at] != '^' || end == digits) {  // not a power: "^T", a '^' at the end, a name's '^'
-      out += unit[at];
-      continue;
-    }
-    if (digits > at + 1) out += "⁻";
-    for (size_t k = digits; k < end; ++k) out += kRaised[unit[k] - '0'];
-    at = end - 1;
-  }
-  return out;
-}
-
-namespace {
-
 void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "## 1. Vehicle\n\n" << output::markdown_text(d.vehicle.description) << "\n\n";
   md << "| block | mass [kg] | size a × b × c [m] | centre [m] | yaw, pitch, roll [deg] |\n|---|---|---|---|---|\n";
@@ -80,9 +58,9 @@ void given_values(std::ostringstream& md, const Derivation& d) {
     if (d.vehicle.derived_given.count(q.name)) {
       const double given = d.vehicle.derived_overrides.at(q.name).nominal;
       const double used = d.model.params[d.model.param_index(q.name)].nominal;
-      md << separator << "`" << q.name << "` = " << num(given) << " " << unit_for_reading(q.unit);
+      md << separator << "`" << q.name << "` = " << num(given) << " " << output::unit_for_reading(q.unit);
       if (std::fabs(used - given) > 1e-12 * std::max(std::fabs(given), 1e-300))
-        md << " (replaced by the fitted " << num(used) << " " << unit_for_reading(q.unit) << ")";
+        md << " (replaced by the fitted " << num(used) << " " << output::unit_for_reading(q.unit) << ")";
       separator = "; ";
     }
   md << ".\n\n";
@@ -253,7 +231,7 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
   else md << "| # | name | unit | meaning |\n|---|---|---|---|\n";
   for (size_t i = 0; i < vars.size(); ++i) {
     const auto& v = vars[i];
-    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(unit_for_reading(v.unit)) << " | ";
+    md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(output::unit_for_reading(v.unit)) << " | ";
     if (params)
       md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
          << " | " << (v.fit ? "yes" : "no") << " | ";
@@ -278,7 +256,7 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   for (const auto& c : d.audit.checks)
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "
        << (c.passed ? "pass" : c.advisory ? "**warning**" : "**FAIL**") << " | "
-       << output::markdown_text(c.group == "units" ? unit_for_reading(c.detail) : c.detail) << " |\n";
+       << output::markdown_text(c.group == "units" ? output::unit_for_reading(c.detail) : c.detail) << " |\n";
   md << "\n";
   if (!d.why_trim_does_not_hold.empty())
     md << "**The hover trim above is the base model's and does not hold this model:** "

@@ -27,10 +27,6 @@ struct Derivation {
 };
 
 std::string derivation_markdown(const Derivation& d);
-// A unit as derivation.md's prose writes it: each power raised ("kg m^2" -> "kg m²", "s^-12"
-// -> "s⁻¹²"), anything else as it is ("^T"); the generated code and the JSON files keep the
-// declared ASCII.
-std::string unit_for_reading(const std::string& unit);
 std::string model_json(const Derivation& d);
 
 }  // namespace quadgen

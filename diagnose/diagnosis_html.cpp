@@ -26,6 +26,8 @@ using namespace words;
 namespace {
 
 std::string esc(const std::string& s) { return output::html_text(s); }
+// A unit on the page as a person reads it ("m/s²"); diagnosis.json keeps the declared "m/s^2".
+std::string unit_html(const std::string& unit) { return esc(output::unit_for_reading(unit)); }
 
 // A sentence the terminal shares, for the page: its ASCII arrow and plus-minus as the page's
 // tables write them (a review, helper-111: "0.294 -> 0.312" beside "0.401 &rarr; 0.353").
@@ -154,9 +156,9 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       << "</td><td>";
     for (size_t i = 0; i < t.coefficients.size(); ++i) {
       const auto& c = t.coefficients[i];
-      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << estimate(c.value, c.lower, c.upper) << " " << esc(c.unit);
+      h << (i ? "<br>" : "") << esc(c.regressor) << ": " << estimate(c.value, c.lower, c.upper) << " " << unit_html(c.unit);
     }
-    h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << esc(t.unit)
+    h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << unit_html(t.unit)
       << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -224,7 +226,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
     // A suspect's agreement in grey: green read as an endorsement of what is not named.
-    h << "<h3>" << esc(a.parameter) << " [" << esc(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
+    h << "<h3>" << esc(a.parameter) << " [" << unit_html(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, kEstimateDigits) << ", pooled " << num(a.pooled, kEstimateDigits) << ", spread "
@@ -248,7 +250,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
         << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
     }
     // The strips' scale (a user trial, helper-106: bars without an axis).
-    h << "<tr><td colspan=\"4\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + esc(a.unit) + "]")
+    h << "<tr><td colspan=\"4\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + unit_html(a.unit) + "]")
       << (std::isfinite(band_lo) && std::isfinite(band_hi) ? "; shaded: the joint fit's 95 % interval" : "")
       << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << num(lo, 3)
       << "</small><small>" << num(hi, 3) << "</small></div></td></tr>\n";
@@ -490,7 +492,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
       for (const auto& p : f.parameters)
         h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, kEstimateDigits) << "</td><td>"
           << interval(p.lower, p.upper, kEstimateDigits)
-          << "</td><td>" << esc(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+          << "</td><td>" << unit_html(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
       h << "</table>\n";
     }
     h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, "
@@ -544,7 +546,7 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
          "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
     for (const auto& st : d.stand_ins) {
       h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value, kEstimateDigits) << " "
-        << esc(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
+        << unit_html(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
         << prose(st.why) << "</td><td>";
       for (size_t c = 0; c < st.channels.size(); ++c)
         h << (c ? "; " : "") << esc(st.channels[c]) << " " << num(st.rms_without[c], 3) << " &rarr; "
@@ -587,7 +589,7 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.unexplained.empty()) {
     h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
     for (const auto& u : d.unexplained)
-      h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << esc(u.unit) << "</td><td>" << num(u.ratio, 3)
+      h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << unit_html(u.unit) << "</td><td>" << num(u.ratio, 3)
         << "</td><td>" << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
         << "</td></tr>\n";
     h << "</table>\n";
@@ -644,7 +646,7 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>Held-out error per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
-    h << "<tr><td>" << esc(c.channel) << "</td><td>" << esc(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
+    h << "<tr><td>" << esc(c.channel) << "</td><td>" << unit_html(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
       << "</td><td>" << num(c.after) << "</td><td" << (got_worse(c) ? " class=\"warn\"" : "") << ">"
       << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
   h << "</table>\n";
@@ -654,7 +656,7 @@ void base_residuals_html(std::ostringstream& h, const Diagnosis& d, Figures& fig
   h << "<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
        "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
   for (const auto& c : d.before.channels) {
-    h << "<tr><td>" << esc(c.name) << "</td><td>" << esc(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
+    h << "<tr><td>" << esc(c.name) << "</td><td>" << unit_html(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
       << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
       << "</td><td>" << num(c.slow_ratio, 3) << "</td><td>";
     for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)

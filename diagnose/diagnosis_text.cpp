@@ -128,7 +128,7 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
     }
   for (const auto& t : d.discovered)
     if (t.proposed)
-      os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << t.unit << "]; "
+      os << "proposed term (beyond the catalogue, not a named cause): " << t.expression() << " [" << output::unit_for_reading(t.unit) << "]; "
          << t.verdict_reason << "\n";
   if (d.terms_gain.measured)
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "

@@ -265,8 +265,8 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
     pf.x.push_back(s.t);
     pf.y.push_back(s.rate_dot[0] + r[kChannels * row + kPdot]);
   }
-  return {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
-          {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}};
+  return {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s²", {meas, fitted}},
+          {"roll acceleration dp/dt", "t [s]", "rad/s²", {pm, pf}}};
 }
 
 }  // namespace
@@ -482,12 +482,12 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
   std::ostringstream s;
   if (shared) {
-    s << "k = " << k << " N s^2 " << interval_of(*kp) << " (" << kp->verdict << "), shared by all motors: "
+    s << "k = " << k << " N s² " << interval_of(*kp) << " (" << kp->verdict << "), shared by all motors: "
       << f.coefficients_reason << "\n";
   } else {
     s << "k per motor:";
     for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << f.thrust_profiles[i].verdict << ")";
-    s << "; mean " << k << " N s^2\n";
+    s << "; mean " << k << " N s²\n";
   }
   s << "c_t = " << ct << "; ";
   if (f.voltage_exponent_identified) s << "speed ~ vbat^" << f.speed.parameters[3].value << "\n";

@@ -49,7 +49,27 @@ std::string full_number(double v) {
   return std::string(text, written.ptr);
 }
 
-std::string unit_after_number(const std::string& unit) { return unit.empty() || unit == "1" ? "" : " " + unit; }
+std::string unit_for_reading(const std::string& unit) {
+  static const char* const kRaised[] = {"⁰", "¹", "²", "³", "⁴", "⁵", "⁶", "⁷", "⁸", "⁹"};
+  std::string out;
+  for (size_t at = 0; at < unit.size(); ++at) {
+    const size_t digits = at + 1 + (unit.compare(at + 1, 1, "-") == 0 ? 1 : 0);
+    size_t end = digits;
+    while (end < unit.size() && unit[end] >= '0' && unit[end] <= '9') ++end;
+    if (unit[at] != '^' || end == digits) {  // not a power: "^T", a '^' at the end, a name's '^'
+      out += unit[at];
+      continue;
+    }
+    if (digits > at + 1) out += "⁻";
+    for (size_t k = digits; k < end; ++k) out += kRaised[unit[k] - '0'];
+    at = end - 1;
+  }
+  return out;
+}
+
+std::string unit_after_number(const std::string& unit) {
+  return unit.empty() || unit == "1" ? "" : " " + unit_for_reading(unit);
+}
 
 std::string one_then_other(double a, double b) {
   for (int digits = 6;; ++digits) {

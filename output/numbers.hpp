@@ -24,8 +24,14 @@ std::string full_number(double v);
 // "a then b" with six significant digits, or as many more as tell them apart: a log whose time
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
 std::string one_then_other(double a, double b);
-// What follows a number in a sentence: " m/s" for a unit, nothing for a dimensionless one ("1",
-// as the symbols declare it, or none), so that "motor_gain.A = 0.08" never reads "0.08 1".
+// A unit as a person reads it: every power raised ("kg m^2" -> "kg m²", "s^-1" -> "s⁻¹"); a
+// '^' not followed by digits is kept ("R^T"). For prose, tables and plot labels; files that are
+// read again (diagnosis.json, model.json, a vehicle file) keep the unit as declared, which is
+// also what a user writes in a mapping.
+std::string unit_for_reading(const std::string& unit);
+// What follows a number in a sentence: " m/s²" for a unit (read as above), nothing for a
+// dimensionless one ("1", as the symbols declare it, or none), so that "motor_gain.A = 0.08"
+// never reads "0.08 1".
 std::string unit_after_number(const std::string& unit);
 
 // Reading a number from text: one rule for the vehicle file, the log cells and the command

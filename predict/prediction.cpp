@@ -363,9 +363,9 @@ std::string one_step_text(const OneStepErrors& e) {
     return output::short_number(axes[0].rms()) + " / " + output::short_number(axes[1].rms()) + " / " +
            output::short_number(axes[2].rms());
   };
-  return "body specific force " + three(e.specific_force) + " m/s^2, angular acceleration " +
-         three(e.angular_acceleration) + " rad/s^2, world vertical acceleration " +
-         output::short_number(e.vertical_acceleration_world.rms()) + " m/s^2";
+  return "body specific force " + three(e.specific_force) + " m/s², angular acceleration " +
+         three(e.angular_acceleration) + " rad/s², world vertical acceleration " +
+         output::short_number(e.vertical_acceleration_world.rms()) + " m/s²";
 }
 
 std::string what_limits_prediction(const Prediction& p) {

@@ -1298,7 +1298,7 @@ TEST(DiagnosisReport, SuspectsAndStandInsSayWhetherTheyAreTheFlightsOwn) {
   const std::string summary = quadgen::diagnose::diagnosis_summary(d);
   EXPECT_NE(summary.find("not named: wind" + tag + " (wind.v_x"), std::string::npos) << summary;
   EXPECT_NE(summary.find("suspected, not named: motor_gain" + tag + " (no held-out gain)"), std::string::npos) << summary;
-  EXPECT_NE(summary.find("suspected, not named: rotor_drag at rotor_drag.k = 1.25e-06 N s^2/m (on its bound) (no held-out gain)"),
+  EXPECT_NE(summary.find("suspected, not named: rotor_drag at rotor_drag.k = 1.25e-06 N s²/m (on its bound) (no held-out gain)"),
             std::string::npos)
       << summary;
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
@@ -1313,6 +1313,7 @@ TEST(DiagnosisReport, ADimensionlessValueIsSaidWithoutAUnit) {
   EXPECT_EQ(quadgen::output::unit_after_number("1"), "");
   EXPECT_EQ(quadgen::output::unit_after_number(""), "");
   EXPECT_EQ(quadgen::output::unit_after_number("m/s"), " m/s");
+  EXPECT_EQ(quadgen::output::unit_after_number("m/s^2"), " m/s²");  // as a person reads it
   quadgen::diagnose::Diagnosis d;
   quadgen::diagnose::StandIn gain;
   gain.candidate.effect = "motor_gain", gain.parameter = "motor_gain.A", gain.unit = "1", gain.value = 0.45;
@@ -1594,7 +1595,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   ASSERT_NE(glance, std::string::npos);
   EXPECT_LT(glance, findings);
   const std::string table = html.substr(glance, html.find("</table>", glance) - glance);
-  EXPECT_NE(table.find("<td><b>rotor_drag</b></td><td class=\"ok\">named</td><td>rotor_drag.k = 1.28e-06 N s^2/m "
+  EXPECT_NE(table.find("<td><b>rotor_drag</b></td><td class=\"ok\">named</td><td>rotor_drag.k = 1.28e-06 N s²/m "
                        "[1.11e-06, 1.35e-06]</td><td>0.48 &rarr; 0.45 (6.25 % lower)</td><td>airframe</td>"),
             std::string::npos) << table;
   EXPECT_NE(table.find("<td><b>wind</b></td><td class=\"warn\">in the model, not named: the data cannot tell it from "
@@ -1603,7 +1604,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(table.find("<td class=\"no\">suspected, not in the model: improves the training data (p = 1e-9) but not the "
                        "held-out part</td><td>motor_gain.M2 = 0.027</td>"),
             std::string::npos) << table;
-  EXPECT_NE(html.find("Worse with the extended model on the held-out part: az_world 0.2575 &rarr; 0.371 m/s^2 (44.1 % higher)"),
+  EXPECT_NE(html.find("Worse with the extended model on the held-out part: az_world 0.2575 &rarr; 0.371 m/s² (44.1 % higher)"),
             std::string::npos);
   EXPECT_EQ(html.find("Overall gain"), std::string::npos);  // said once, in "In short"
   EXPECT_NE(html.find("<h1>Diagnosis of B3.csv ("), std::string::npos);
@@ -1617,8 +1618,10 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_EQ(html.find("<tr><td>mass</td>", base), std::string::npos);  // held, not fitted
   const std::string summary = dg::diagnosis_summary(d);
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
-                         "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s^2 (44.1 % higher)\n"),
+                         "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s² (44.1 % higher)\n"),
             std::string::npos) << summary;
+  // The page and the console raise the unit's power (above); the file read again keeps it as declared.
+  EXPECT_EQ(dg::diagnosis_json(d, "dir/B3.csv")["findings"][0]["parameters"]["rotor_drag.k"]["unit"], "N s^2/m");
   // A stand-in, what the search's limit left and the backward pass dropped have rows too;
   // a hostile name in a reason arrives as text.
   dg::StandIn st;

@@ -1999,7 +1999,7 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
   ASSERT_EQ(file_status, 0) << file;  // a vehicle's warning is no failed derivation
   EXPECT_NE(file.find(" checks; 1 vehicle warning below); derived"), std::string::npos) << file;
   EXPECT_NE(file.find("mass 0.52 kg (the file's `derived:`); centre of gravity ("), std::string::npos) << file;
-  EXPECT_NE(file.find(" kg m^2 (the blocks'; the file's `derived:`: J_xy)"), std::string::npos) << file;
+  EXPECT_NE(file.find(" kg m² (the blocks'; the file's `derived:`: J_xy)"), std::string::npos) << file;
   EXPECT_NE(file.find("the inertia the model uses is a body's: no"), std::string::npos) << file;
   // simulate refuses such a tensor at the line that gives it (it named the file alone;
   // helper-88): the message a closed loop of `file` ends in, and the line of `given` in it.

@@ -24,6 +24,7 @@
 #include "tests/test_helpers.hpp"
 #include "audit/thesis_reference.hpp"
 #include "model/units.hpp"
+#include "output/numbers.hpp"
 #include "runtime/rigid_body_state.hpp"
 #include "runtime/portable_random.hpp"
 
@@ -1279,19 +1280,20 @@ TEST(Model, MotorSlopeTurnsTheMapAboutItsPivot) {
   }
 }
 
-// The vehicle advisories (audit/vehicle_checks.hpp) pass for the bundled vehicles and name
-// what a new vehicle's author most often gets wrong, each alone; the audit itself still passes.
-// derivation.md's units: every power raised, whatever its digits and sign (a first version
-// replaced "^-1" in "s^-12" and wrote "s⁻¹2"), anything else as it is.
+// Units as a person reads them (derivation.md, the diagnosis report, the console): every power
+// raised, whatever its digits and sign (a first version replaced "^-1" in "s^-12" and wrote
+// "s⁻¹2"), anything else as it is.
 TEST(DerivationReport, UnitsAreWrittenWithRaisedPowers) {
-  EXPECT_EQ(quadgen::unit_for_reading("kg m^2"), "kg m²");
-  EXPECT_EQ(quadgen::unit_for_reading("s^-12"), "s⁻¹²");
-  EXPECT_EQ(quadgen::unit_for_reading("m^2 kg s^-3 A^-1"), "m² kg s⁻³ A⁻¹");
-  EXPECT_EQ(quadgen::unit_for_reading("rad/s^2/(m/s)"), "rad/s²/(m/s)");
-  EXPECT_EQ(quadgen::unit_for_reading("N s^10"), "N s¹⁰");
-  EXPECT_EQ(quadgen::unit_for_reading("R^T, x^, y^-z, 1"), "R^T, x^, y^-z, 1");
+  EXPECT_EQ(quadgen::output::unit_for_reading("kg m^2"), "kg m²");
+  EXPECT_EQ(quadgen::output::unit_for_reading("s^-12"), "s⁻¹²");
+  EXPECT_EQ(quadgen::output::unit_for_reading("m^2 kg s^-3 A^-1"), "m² kg s⁻³ A⁻¹");
+  EXPECT_EQ(quadgen::output::unit_for_reading("rad/s^2/(m/s)"), "rad/s²/(m/s)");
+  EXPECT_EQ(quadgen::output::unit_for_reading("N s^10"), "N s¹⁰");
+  EXPECT_EQ(quadgen::output::unit_for_reading("R^T, x^, y^-z, 1"), "R^T, x^, y^-z, 1");
 }
 
+// The vehicle advisories (audit/vehicle_checks.hpp) pass for the bundled vehicles and name
+// what a new vehicle's author most often gets wrong, each alone; the audit itself still passes.
 TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
   auto checks_of = [](const Vehicle& v) {
     std::map<std::string, AuditCheck> by_name;

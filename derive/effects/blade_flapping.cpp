@@ -11,14 +11,17 @@
 #include "derive/dynamics.hpp"
 #include "derive/effects/headline_words.hpp"
 #include "derive/kinematics.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;
 
 namespace {
 
+constexpr const char* kUnit = "N s^2";  // N m per m/s of airspeed and per rad/s of rotor speed
+
 void terms(ModelContext& c) {
-  const ex k = c.add_param("blade_flapping.k", "N s^2", 0.0, -1e-4, 1e-4, true,
+  const ex k = c.add_param("blade_flapping.k", kUnit, 0.0, -1e-4, 1e-4, true,
                            "flapping moment per rotor speed sum and airspeed");
   const matrix vb = c.R.transpose().mul(c.air_velocity_world);
   ex speed_sum = 0;
@@ -38,7 +41,7 @@ Effect blade_flapping() {
     const double k = headline::value_of(v, "blade_flapping.k");
     return std::string("Flying through the air ") + (k > 0 ? "pitches the nose up" : "pitches the nose down") +
            " (flapping moment k = " + headline::words(k) +
-           " N s^2: N m per m/s of airspeed and per rad/s of summed rotor speed).";
+           output::unit_after_number(kUnit) + ": N m per m/s of airspeed and per rad/s of summed rotor speed).";
   };
   return e;
 }

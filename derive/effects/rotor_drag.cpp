@@ -11,14 +11,17 @@
 #include "derive/dynamics.hpp"
 #include "derive/effects/headline_words.hpp"
 #include "derive/kinematics.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::effects {
 using namespace GiNaC;
 
 namespace {
 
+constexpr const char* kUnit = "N s^2/m";  // newtons per m/s of airspeed and per rad/s of rotor speed
+
 void terms(ModelContext& c) {
-  const ex k = c.add_param("rotor_drag.k", "N s^2/m", 0.0, 0.0, 1e-3, true, "rotor drag per rotor speed sum");
+  const ex k = c.add_param("rotor_drag.k", kUnit, 0.0, 0.0, 1e-3, true, "rotor drag per rotor speed sum");
   const matrix vb = c.R.transpose().mul(c.air_velocity_world);
   ex speed_sum = 0;
   for (const ex& w : c.rotor_speed) speed_sum += w;
@@ -38,7 +41,7 @@ Effect rotor_drag() {
                                       "horizontal force), flapping only tilts it (a moment the attitude loop must hold)"}};
   e.headline = [](const std::map<std::string, double>& v, const std::string&) {
     return "The rotors drag the vehicle back against its airspeed (k = " +
-           headline::words(headline::value_of(v, "rotor_drag.k")) + " N s^2/m: newtons of drag per m/s of airspeed and per rad/s of summed rotor speed).";
+           headline::words(headline::value_of(v, "rotor_drag.k")) + output::unit_after_number(kUnit) + ": newtons of drag per m/s of airspeed and per rad/s of summed rotor speed).";
   };
   return e;
 }
