@@ -82,7 +82,7 @@ std::string settings_problem(const SimulateJob& a, const Vehicle& v, const Dynam
     const bool set = std::any_of(a.set.begin(), a.set.end(), [](const auto& s) { return s.first.rfind("J_", 0) == 0; });
     std::ostringstream os;
     os << (set ? "--set: with these values the inertia tensor's" : where_file_gives_inertia(v, pm.positive) + ": the inertia tensor's")
-       << " principal moments are " << pm.moments[0] << ", " << pm.moments[1] << ", " << pm.moments[2] << " kg m^2: "
+       << " principal moments are " << pm.moments[0] << ", " << pm.moments[1] << ", " << pm.moments[2] << " kg m²: "
        << (pm.positive ? "the largest exceeds the sum of the other two, which no mass distribution gives"
                        : "not positive definite (a product of inertia too large for the moments, or its sign?)");
     return os.str();

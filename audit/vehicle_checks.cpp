@@ -345,7 +345,7 @@ AuditCheck check_inertia_used(const Vehicle& v, const SymbolicModel& m) {
   bool given = false;
   for (const char* name : {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) given = given || v.derived_given.count(name);
   std::ostringstream detail;
-  detail << "principal moments of the model's J " << l[0] << ", " << l[1] << ", " << l[2] << " kg m^2"
+  detail << "principal moments of the model's J " << l[0] << ", " << l[1] << ", " << l[2] << " kg m²"
          << (given ? " (with the vehicle file's `derived:` values)"
                    : " (the blocks' tensor, as in the inertia checks: the file gives no J in `derived:`)");
   if (!pm.positive) detail << ": not positive definite (a product of inertia too large for the moments given, or its sign?)";

@@ -189,7 +189,7 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
   for (size_t k = 0; k < flights; ++k) h << "<th>flight " << k + 1 << "</th>";
   h << "</tr>\n";
   for (const auto& [name, row] : rows) {
-    h << "<tr><td>" << esc(name) << " [" << esc(units[name]) << "]</td>";
+    h << "<tr><td>" << esc(name) << " [" << unit_html(units[name]) << "]</td>";
     for (const auto* p : row)
       if (p)
         h << "<td>" << estimate(p->value, p->lower, p->upper)
@@ -525,7 +525,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
             : "")
     << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
   for (const auto* p : base)
-    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << esc(p->unit) << "</td><td>"
+    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << unit_html(p->unit) << "</td><td>"
       << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
   h << "</table>\n";
 }

@@ -11,7 +11,6 @@
 #include "diagnose/report_words.hpp"
 #include "fit/fit_report.hpp"
 #include "output/estimate.hpp"
-#include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "runtime/per_flight_model.hpp"
 #include "runtime/plot.hpp"
@@ -75,7 +74,7 @@ std::vector<runtime::Panel> simulation_error_panels(const Diagnosis& d) {
                     {"body-rate error", "rad/s", &WindowedSimulation::e_rate}};
   std::vector<runtime::Panel> errs;
   for (const auto& q : quantities)
-    errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", output::unit_for_reading(q.unit),
+    errs.push_back({std::string(q.title) + " in the open-loop windows", "t [s]", q.unit,
                     {series("base model", d.sim_before.t, d.sim_before.*q.err),
                      series("extended model", d.sim_after.t, d.sim_after.*q.err)}});
   return errs;
@@ -88,7 +87,7 @@ std::vector<runtime::Panel> residual_panels(const Diagnosis& d, size_t stride) {
     std::vector<double> rb, ra;
     for (size_t k = 0; k < d.t.size(); ++k) rb.push_back(d.residual_before[k * 6 + c]), ra.push_back(d.residual_after[k * 6 + c]);
     res.push_back({d.channel_names[c] + " residual (model - measured; dashed: held-out part starts)", "t [s]",
-                   output::unit_for_reading(d.channel_units[c]), {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)},
+                   d.channel_units[c], {series("base model", d.t, rb, stride), series("extended model", d.t, ra, stride)},
                    d.validation_starts});
   }
   return res;
@@ -125,7 +124,7 @@ std::vector<runtime::Panel> profile_panels(const Diagnosis& d) {
   std::vector<runtime::Panel> panels = fit::profile_panels(d.search.profiles);
   for (auto& panel : panels) {
     for (const auto& p : d.search.final_fit)  // named and carried
-      if (p.name == panel.xlabel && !p.unit.empty() && p.unit != "1") panel.xlabel += " [" + output::unit_for_reading(p.unit) + "]";
+      if (p.name == panel.xlabel && !p.unit.empty() && p.unit != "1") panel.xlabel += " [" + p.unit + "]";
     panel.ylabel = "cost rise (delta chi2)";
   }
   return panels;

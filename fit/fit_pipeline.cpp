@@ -265,8 +265,8 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
     pf.x.push_back(s.t);
     pf.y.push_back(s.rate_dot[0] + r[kChannels * row + kPdot]);
   }
-  return {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s²", {meas, fitted}},
-          {"roll acceleration dp/dt", "t [s]", "rad/s²", {pm, pf}}};
+  return {{accel ? "vertical specific force (body z)" : "vertical acceleration", "t [s]", "m/s^2", {meas, fitted}},
+          {"roll acceleration dp/dt", "t [s]", "rad/s^2", {pm, pf}}};
 }
 
 }  // namespace

@@ -53,10 +53,14 @@ std::string unit_for_reading(const std::string& unit) {
   static const char* const kRaised[] = {"⁰", "¹", "²", "³", "⁴", "⁵", "⁶", "⁷", "⁸", "⁹"};
   std::string out;
   for (size_t at = 0; at < unit.size(); ++at) {
+    if (unit[at] != '^') {
+      out += unit[at];
+      continue;
+    }
     const size_t digits = at + 1 + (unit.compare(at + 1, 1, "-") == 0 ? 1 : 0);
     size_t end = digits;
     while (end < unit.size() && unit[end] >= '0' && unit[end] <= '9') ++end;
-    if (unit[at] != '^' || end == digits) {  // not a power: "^T", a '^' at the end, a name's '^'
+    if (end == digits) {  // not a power: "^T", a '^' at the end, a name's '^'
       out += unit[at];
       continue;
     }

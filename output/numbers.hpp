@@ -25,9 +25,11 @@ std::string full_number(double v);
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
 std::string one_then_other(double a, double b);
 // A unit as a person reads it: every power raised ("kg m^2" -> "kg m²", "s^-1" -> "s⁻¹"); a
-// '^' not followed by digits is kept ("R^T"). For prose, tables and plot labels; files that are
-// read again (diagnosis.json, model.json, a vehicle file) keep the unit as declared, which is
-// also what a user writes in a mapping.
+// '^' not followed by digits is kept ("R^T"). For sentences, tables and plot axes (the SVG;
+// the CSV beside it keeps the label as declared). The fields a program reads keep the unit as
+// declared, which is also what a user writes in a vehicle file or a mapping: every `unit` of
+// diagnosis.json and model.json, the CSVs, a YAML snippet to paste. diagnosis.json's texts
+// (reasons, verdicts, headlines, values in words) are the report's sentences and read as it does.
 std::string unit_for_reading(const std::string& unit);
 // What follows a number in a sentence: " m/s²" for a unit (read as above), nothing for a
 // dimensionless one ("1", as the symbols declare it, or none), so that "motor_gain.A = 0.08"

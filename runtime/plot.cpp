@@ -257,8 +257,8 @@ std::string gnuplot_script(const std::string& title, const std::vector<Panel>& p
   int block = 0;
   for (const Panel& p : panels) {
     script << "set title " << gnuplot_string(p.title) << " noenhanced\n"
-           << "set xlabel " << gnuplot_string(p.xlabel) << " noenhanced\n"
-           << "set ylabel " << gnuplot_string(p.ylabel) << " noenhanced\n";
+           << "set xlabel " << gnuplot_string(output::unit_for_reading(p.xlabel)) << " noenhanced\n"
+           << "set ylabel " << gnuplot_string(output::unit_for_reading(p.ylabel)) << " noenhanced\n";
     std::ostringstream plot;
     for (const Series& full : p.series) {
       const Series s = decimated(full);

@@ -1220,10 +1220,11 @@ TEST(DiagnosisReport, ADiscoveredTermsVerdictSaysItsLabelOnce) {
   const size_t line = summary.find("proposed term");
   ASSERT_NE(line, std::string::npos) << summary;
   const std::string proposed_line = summary.substr(line, summary.find('\n', line) - line);
-  EXPECT_NE(proposed_line.find("]; held-out RMS 2 -> 1"), std::string::npos) << proposed_line;
+  EXPECT_NE(proposed_line.find(" [rad/s²]; held-out RMS 2 -> 1"), std::string::npos) << proposed_line;
   EXPECT_EQ(proposed_line.find("proposed", 1), std::string::npos) << proposed_line;
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
   EXPECT_NE(html.find("<b>proposed</b>: held-out RMS 2 &rarr; 1"), std::string::npos);
+  EXPECT_NE(html.find("v_bx: 0.5 [0.4, 0.6] rad/s²/(m/s)"), std::string::npos) << html;
   EXPECT_NE(html.find(">not proposed: no held-out gain beyond its spread"), std::string::npos);
   EXPECT_NE(html.find(">no term: cross-validation finds none"), std::string::npos);
   EXPECT_EQ(html.find("proposed: no term"), std::string::npos);
@@ -1586,7 +1587,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   // a joint fit's copies by their own names: the plain name is flight 1's
   d.flights = {"dir/B3.csv"};
   d.search.final_fit = {{"wind.x", "m/s", -0.296, -5, 5, true}, {"wind.x@2", "m/s", 0.1, -5, 5, true},
-                        {"c_w", "1", 3.0, 0, 3, true}, {"mass", "kg", 0.03, 0, 0, false}};
+                        {"c_w", "1", 3.0, 0, 3, true}, {"mass", "kg", 0.03, 0, 0, false}, {"kappa", "<b>m^2", 0.5, 0, 1, true}};
   d.at_bounds = {d.search.final_fit[2]};
   d.channel_names = {"az_world"}, d.channel_units = {"m/s^2"};
   d.channel_gain = {{"az_world", 0.2575, 0.371}};
@@ -1616,6 +1617,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on its bound</td></tr>", base),
             std::string::npos);
   EXPECT_EQ(html.find("<tr><td>mass</td>", base), std::string::npos);  // held, not fitted
+  EXPECT_NE(html.find("<tr><td>kappa</td><td>0.5</td><td>&lt;b&gt;m²</td>", base), std::string::npos);  // raised, then escaped
   const std::string summary = dg::diagnosis_summary(d);
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
                          "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s² (44.1 % higher)\n"),

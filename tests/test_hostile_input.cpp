@@ -1869,6 +1869,20 @@ TEST(Sinks, PlotColoursAndMarksAreDataNotScript) {
   EXPECT_NE(script.find("unset arrow", arrow), std::string::npos);  // cleared before the second panel
 }
 
+// A plot's axes read as a person reads a unit ("m/s²"), the CSV beside it keeps the label as
+// declared ("m/s^2", what a script compares), and a hostile label is still one gnuplot string.
+TEST(Sinks, APlotsAxesRaiseTheirPowersAndItsCsvKeepsThem) {
+  using quadgen::runtime::Panel;
+  using quadgen::runtime::Series;
+  const std::vector<Panel> panels{{"a", "k [N s^2]", "m/s^2'; system('touch PWNED')", {Series{"s", {0, 1}, {0, 1}}}}};
+  const std::string script = quadgen::runtime::gnuplot_script("t", panels);
+  EXPECT_NE(script.find("set xlabel 'k [N s²]' noenhanced"), std::string::npos) << script;
+  EXPECT_NE(script.find("set ylabel 'm/s²''; system(''touch PWNED'')' noenhanced"), std::string::npos) << script;
+  const std::string csv = quadgen::runtime::panels_csv("t", panels);
+  EXPECT_NE(csv.find("k [N s^2]"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find("²"), std::string::npos) << csv;
+}
+
 // gnuplot refuses a series whose every point is undefined ("all points y value undefined"):
 // such a series (a horizon no rollout reached) is left out, and the figure is drawn.
 TEST(Sinks, ASeriesWithoutOneFinitePointIsLeftOutOfThePlot) {
