@@ -236,8 +236,9 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
+      const int prec = estimate_digits(f.value, f.lower, f.upper);
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
-        << num(f.value, kEstimateDigits) << "</td><td>" << interval(f.lower, f.upper, kEstimateDigits) << "</td><td>"
+        << num(f.value, prec) << "</td><td>" << interval(f.lower, f.upper, prec) << "</td><td>"
         << esc(output::p_value_cell(f.p_value)) << "</td><td><div style=\"position:relative;height:14px\">";
       if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind
         h << "<div style=\"position:absolute;left:" << at(band_lo) << ";width:calc(" << at(band_hi) << " - " << at(band_lo)
@@ -335,9 +336,10 @@ std::string values_cell(const std::vector<std::string>& values) {
 // An effect's estimates as HTML, each with its 95 % interval where `with_interval`.
 std::string estimates_cell(const std::vector<EffectEstimate>& ps, bool with_interval) {
   std::vector<std::string> values;
-  for (const auto& p : ps)
-    values.push_back(esc(name_value(p.name, p.value, p.unit, kEstimateDigits)) +
-                     (with_interval ? " " + interval(p.lower, p.upper, kEstimateDigits) : ""));
+  for (const auto& p : ps) {
+    const int prec = with_interval ? estimate_digits(p.value, p.lower, p.upper) : kEstimateDigits;
+    values.push_back(esc(name_value(p.name, p.value, p.unit, prec)) + (with_interval ? " " + interval(p.lower, p.upper, prec) : ""));
+  }
   return values_cell(values);
 }
 
@@ -489,10 +491,11 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
     }
     else {
       h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
-      for (const auto& p : f.parameters)
-        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, kEstimateDigits) << "</td><td>"
-          << interval(p.lower, p.upper, kEstimateDigits)
+      for (const auto& p : f.parameters) {
+        const int prec = estimate_digits(p.value, p.lower, p.upper);
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, prec) << "</td><td>" << interval(p.lower, p.upper, prec)
           << "</td><td>" << unit_html(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+      }
       h << "</table>\n";
     }
     h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, "

@@ -412,8 +412,18 @@ std::string worse_channels(const Diagnosis& d) {
 }
 
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
+int estimate_digits(double value, double lower, double upper) {
+  const auto apart = [](double a, double b, int prec) {
+    return !std::isfinite(a) || !std::isfinite(b) || a == b || num(a, prec) != num(b, prec);
+  };
+  int prec = kEstimateDigits;
+  while (prec < 6 && !(apart(value, lower, prec) && apart(value, upper, prec) && apart(lower, upper, prec))) ++prec;
+  return prec;
+}
+
 std::string estimate(double value, double lower, double upper) {
-  return num(value, kEstimateDigits) + " " + interval(lower, upper, kEstimateDigits);
+  const int prec = estimate_digits(value, lower, upper);
+  return num(value, prec) + " " + interval(lower, upper, prec);
 }
 
 std::string interval(double lower, double upper, int prec) {
