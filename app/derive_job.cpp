@@ -85,6 +85,7 @@ std::string summary_of(const Vehicle& vehicle, const MassProperties& mp, const D
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   if (!d.why_trim_does_not_hold.empty()) os << "note: the header declares no hover trim: " << d.why_trim_does_not_hold << "\n";
+  if (!d.trim_moved_by_effects.empty()) os << "note: the header's hover trim: " << d.trim_moved_by_effects << "\n";
   return os.str();
 }
 

@@ -31,15 +31,29 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
 }
 
 // The trim is the base model's; a model whose effect values were fitted away from neutral does
-// not hover at it: how far it misses (hover_residual) and, above kHoverHolds, why it does not
-// hold, which the header, model.json and derivation.md then say instead of declaring it.
-static void judge_hover_trim(DerivedModel& out) {
+// not hover at it (hover_residual says how far it misses). Above kHoverHolds the model's own
+// trim is sought from it (model_hover_trim) and, where found, declared with a note of how it
+// moved; where none holds, why, which the header, model.json and derivation.md then say
+// instead of declaring one.
+static void judge_hover_trim(const Vehicle& vehicle, DerivedModel& out) {
   if (!out.hover_trim.found()) return;
   out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
   if (out.hover_residual <= DerivedModel::kHoverHolds) return;
-  out.why_trim_does_not_hold = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
-                               output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
-                               output::short_number(out.hover_residual) + " there";
+  const std::string moved = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
+                            output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
+                            output::short_number(out.hover_residual) + " there (in " +
+                            hover_residual_row(out.model, out.hover_trim.commands) + ")";
+  const runtime::HoverTrim own = model_hover_trim(vehicle, out.model, out.hover_trim.commands);
+  const double own_residual = own.found() ? hover_residual(out.model, own.commands) : 0;
+  if (own.found() && own_residual <= DerivedModel::kHoverHolds) {
+    out.base_trim_commands = out.hover_trim.commands;
+    out.hover_trim = own;
+    out.hover_residual = own_residual;
+    out.trim_moved_by_effects = moved + "; this trim is the model's own, with them";
+    return;
+  }
+  out.why_trim_does_not_hold = moved + ", and the model has no trim of its own: " +
+                               (own.found() ? "|f| = " + output::short_number(own_residual) + " at the nearest" : own.why_not);
 }
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
@@ -60,13 +74,14 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.regenerate_flags_from_model)
     emit.regenerate_flags = out.model.effects.empty() ? "" : " --effects " + out.model.effect_list();
   for (const Rotor& r : vehicle.rotors) emit.rotor_spin.push_back(spin_sign(r));
-  judge_hover_trim(out);
+  judge_hover_trim(vehicle, out);
   emit.hover_command = out.why_trim_does_not_hold.empty() ? out.hover_trim.commands : std::vector<double>{};
   emit.hover_thrust = out.hover_trim.thrusts;
   emit.why_no_hover = out.why_trim_does_not_hold.empty() ? out.hover_trim.why_not : out.why_trim_does_not_hold;
+  emit.hover_note = out.trim_moved_by_effects;
   out.header = codegen::generate_header(out.model, emit);
-  const Derivation d{vehicle,        mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual,
-                     out.why_trim_does_not_hold};
+  const Derivation d{vehicle,          mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual,
+                     out.why_trim_does_not_hold, out.trim_moved_by_effects, out.base_trim_commands};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);
   return out;

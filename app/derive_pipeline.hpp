@@ -42,6 +42,10 @@ struct DerivedModel {
   double hover_residual = 0;
   static constexpr double kHoverHolds = 1e-6;
   std::string why_trim_does_not_hold;  // empty where it holds (or there is none)
+  // Where the base model's trim missed and hover_trim is the model's own (model_hover_trim):
+  // how the hover moved, and the base trim's commands; empty otherwise.
+  std::string trim_moved_by_effects;
+  std::vector<double> base_trim_commands;
   codegen::GeneratedHeader header;
   std::string model_json, derivation_md;
 };

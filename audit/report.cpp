@@ -261,6 +261,13 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   if (!d.why_trim_does_not_hold.empty())
     md << "**The hover trim above is the base model's and does not hold this model:** "
        << output::markdown_text(d.why_trim_does_not_hold) << ". The header declares none (`kHasHoverTrim = false`).\n\n";
+  if (!d.trim_moved_by_effects.empty()) {
+    md << "**The hover trim above is the base model's; the header declares this model's own:** "
+       << output::markdown_text(d.trim_moved_by_effects) << ". Commands";
+    for (size_t i = 0; i < d.hover_trim.commands.size() && i < d.vehicle.rotors.size(); ++i)
+      md << (i ? ", " : " ") << output::markdown_text(d.vehicle.rotors[i].name) << " " << num(d.hover_trim.commands[i]);
+    md << "; |f| = " << output::short_number(d.hover_residual) << " there.\n\n";
+  }
 }
 
 void section_thesis(std::ostringstream& md, const Derivation& d) {
@@ -319,6 +326,12 @@ static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   j["command"] = holds ? trim.commands : std::vector<double>{};
   j["why_not"] = holds ? trim.why_not : d.why_trim_does_not_hold;
   if (!holds) j["base_model_command"] = trim.commands;
+  // Where it is the model's own (fitted effect values moved the base model's): how, and the
+  // base trim's commands.
+  if (!d.trim_moved_by_effects.empty()) {
+    j["moved_by_effects"] = d.trim_moved_by_effects;
+    j["base_model_command"] = d.base_trim_commands;
+  }
   // Where effect values fitted away from neutral move the hover, the base trim does not hold
   // this model (the header then declares none): how far it is off.
   j["largest_f_at_trim"] = d.hover_residual;

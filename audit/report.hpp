@@ -24,6 +24,10 @@ struct Derivation {
   // Why that trim does not hold this model (fitted effect values move the hover), or empty:
   // then the header declares none, and model.json and derivation.md say so too.
   std::string why_trim_does_not_hold;
+  // Where the base model's trim missed and hover_trim is the model's own (model_hover_trim):
+  // how the hover moved, and the base trim's commands; empty otherwise.
+  std::string trim_moved_by_effects;
+  std::vector<double> base_trim_commands;
 };
 
 std::string derivation_markdown(const Derivation& d);

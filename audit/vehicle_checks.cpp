@@ -11,6 +11,7 @@
 
 #include <Eigen/Dense>
 
+#include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
 #include "output/numbers.hpp"
 #include "derive/runtime_view.hpp"
@@ -355,33 +356,118 @@ AuditCheck check_inertia_used(const Vehicle& v, const SymbolicModel& m) {
 
 }  // namespace
 
-double hover_residual(const SymbolicModel& m, const std::vector<double>& commands) {
-  using namespace runtime::rigid_body;
-  GiNaC::lst s = m.constant_substitution();
-  double vbat_ref = 0;
-  for (const Variable& p : m.params) {
-    s.append(p.sym == p.nominal);
-    if (p.name == "vbat_ref") vbat_ref = p.nominal;
+namespace {
+
+// The model's f at hover_residual's point as a function of the commands, its parameters and
+// constants substituted once (a Gauss-Newton trim evaluates it some fifty times).
+class HoverPoint {
+ public:
+  explicit HoverPoint(const SymbolicModel& m) : m_(m) {
+    GiNaC::lst s = m.constant_substitution();
+    for (const Variable& p : m.params) {
+      s.append(p.sym == p.nominal);
+      if (p.name == "vbat_ref") vbat_ref_ = p.nominal;
+    }
+    constants_ = s;
+    f_ = GiNaC::ex_to<GiNaC::matrix>(GiNaC::ex(m.f).subs(s));
   }
-  for (size_t i = 0; i < m.inputs.size(); ++i)
-    s.append(m.inputs[i].sym == (i < commands.size() ? commands[i] : m.inputs[i].name == "vbat" ? vbat_ref : 0.0));
-  std::vector<double> x(m.states.size(), 0.0);
-  x[kPosition + 2] = 100.0;
-  x[kAttitude] = 1.0;
-  const auto row = [&](size_t i, const std::vector<double>& at) {
-    GiNaC::lst all = s;
-    for (size_t k = 0; k < m.states.size(); ++k) all.append(m.states[k].sym == at[k]);
-    return to_double(m.f(static_cast<unsigned>(i), 0).subs(all));
-  };
-  for (size_t k : m.rotor_speed_states) {  // each row is linear in its own speed: its zero
-    std::vector<double> one = x;
-    one[k] = 1.0;
-    const double at_zero = row(k, x), at_one = row(k, one);
-    if (at_zero != at_one) x[k] = at_zero / (at_zero - at_one);
+  // Level and still 100 m up, each rotor-speed state where its own row (linear in its speed)
+  // is zero.
+  std::vector<double> state(const std::vector<double>& commands) const {
+    using namespace runtime::rigid_body;
+    std::vector<double> x(m_.states.size(), 0.0);
+    x[kPosition + 2] = 100.0;
+    x[kAttitude] = 1.0;
+    for (size_t k : m_.rotor_speed_states) {
+      std::vector<double> one = x;
+      one[k] = 1.0;
+      const double at_zero = row(k, x, commands), at_one = row(k, one, commands);
+      if (at_zero != at_one) x[k] = at_zero / (at_zero - at_one);
+    }
+    return x;
   }
+  std::vector<double> rows(const std::vector<double>& commands) const {
+    const std::vector<double> x = state(commands);
+    std::vector<double> r(m_.states.size());
+    for (size_t i = 0; i < r.size(); ++i) r[i] = row(i, x, commands);
+    return r;
+  }
+  double value(const GiNaC::ex& e, const std::vector<double>& commands) const {
+    return to_double(e.subs(constants_).subs(point(state(commands), commands)));
+  }
+
+ private:
+  GiNaC::lst point(const std::vector<double>& x, const std::vector<double>& commands) const {
+    GiNaC::lst s;
+    for (size_t i = 0; i < m_.inputs.size(); ++i)
+      s.append(m_.inputs[i].sym == (i < commands.size() ? commands[i] : m_.inputs[i].name == "vbat" ? vbat_ref_ : 0.0));
+    for (size_t k = 0; k < m_.states.size(); ++k) s.append(m_.states[k].sym == x[k]);
+    return s;
+  }
+  double row(size_t i, const std::vector<double>& x, const std::vector<double>& commands) const {
+    return to_double(f_(static_cast<unsigned>(i), 0).subs(point(x, commands)));
+  }
+
+  const SymbolicModel& m_;
+  GiNaC::lst constants_;
+  GiNaC::matrix f_;
+  double vbat_ref_ = 0;
+};
+
+double largest(const std::vector<double>& r) {
   double worst = 0;
-  for (size_t i = 0; i < m.states.size(); ++i) worst = std::max(worst, std::fabs(row(i, x)));
+  for (double v : r) worst = std::max(worst, std::fabs(v));
   return worst;
+}
+
+}  // namespace
+
+double hover_residual(const SymbolicModel& m, const std::vector<double>& commands) {
+  return largest(HoverPoint(m).rows(commands));
+}
+
+std::string hover_residual_row(const SymbolicModel& m, const std::vector<double>& commands) {
+  const std::vector<double> r = HoverPoint(m).rows(commands);
+  size_t at = 0;
+  for (size_t i = 1; i < r.size(); ++i)
+    if (std::fabs(r[i]) > std::fabs(r[at])) at = i;
+  return r.empty() ? std::string() : "d" + m.states[at].name + "/dt";
+}
+
+runtime::HoverTrim model_hover_trim(const Vehicle& v, const SymbolicModel& m, const std::vector<double>& start) {
+  const HoverPoint hover(m);
+  runtime::HoverTrim trim;
+  std::vector<double> u = start;
+  std::vector<double> r = hover.rows(u);
+  const size_t n = u.size();
+  // f is smooth in the commands; ten steps from a trim off by a weak motor reach 1e-12.
+  for (int step = 0; step < 20 && largest(r) > 1e-12; ++step) {
+    Eigen::MatrixXd J(r.size(), n);
+    for (size_t k = 0; k < n; ++k) {
+      std::vector<double> moved = u;
+      const double h = 1e-7 * std::max(1.0, std::fabs(u[k]));
+      moved[k] += h;
+      const std::vector<double> rk = hover.rows(moved);
+      for (size_t i = 0; i < r.size(); ++i) J(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = (rk[i] - r[i]) / h;
+    }
+    // Least squares, least norm where rotors outnumber the conditions (a hexacopter).
+    const Eigen::VectorXd du = J.completeOrthogonalDecomposition().solve(-Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()));
+    for (size_t k = 0; k < n; ++k) u[k] += du(static_cast<Eigen::Index>(k));
+    r = hover.rows(u);
+  }
+  if (largest(r) > 1e-9) {
+    trim.why_not = "no commands hold this model level and still (|f| = " + output::short_number(largest(r)) +
+                   " at the nearest found): a force or a tilt no level hover holds";
+    return trim;
+  }
+  for (size_t k = 0; k < n; ++k)
+    if (u[k] < 0 || u[k] > 1) {
+      trim.why_not = "rotor " + v.rotors[k].name + " would need command " + output::short_number(u[k]) + ", outside 0 to 1";
+      return trim;
+    }
+  trim.commands = u;
+  for (const Rotor& rotor : v.rotors) trim.thrusts.push_back(hover.value(m.intermediate(rotor_thrust_name(rotor.name)), u));
+  return trim;
 }
 
 runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m) {

@@ -33,6 +33,17 @@ runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m);
 // neutral (a motor gain, a wind, a CoG offset in a diagnosis' extended model) move the hover,
 // and this says by how much (a review: the header's kHoverCommand did not hold such a model).
 double hover_residual(const SymbolicModel& m, const std::vector<double>& commands);
+// The row of f where that largest |f| is, as "dp/dt" (for a reader: |f| mixes units).
+std::string hover_residual_row(const SymbolicModel& m, const std::vector<double>& commands);
+
+// The hover trim of the model itself, at that same point: Gauss-Newton on the commands from
+// `start` (the base model's trim) until every row of f is zero. Where effect values fitted
+// away from neutral move the hover (a weak motor, a CoG offset), the base trim misses, and a
+// diagnosis' extended model or a header derived with --params would otherwise declare none (a
+// newcomer's trial, helper-118: the README's example program would then run at command 0).
+// Each rotor's thrust is the model's own at the trim. Not found (why_not says why) where no
+// commands within 0 to 1 zero f: a steady wind or a tilt, which no level hover holds.
+runtime::HoverTrim model_hover_trim(const Vehicle& v, const SymbolicModel& m, const std::vector<double>& start);
 
 std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicModel& m, const runtime::HoverTrim& trim);
 // The same with the trim computed here (tests).

@@ -179,8 +179,9 @@ void set_rotor_facts(data& d, const EmitOptions& opt) {
   d.set("hover_command", command + "}");
   d.set("hover_thrust", thrust + "}");
   d.set("has_hover_trim", trimmed ? "true" : "false");
-  d.set("hover_trim_line", trimmed ? std::string()
-                                   : "// No hover trim: " + output::cpp_comment(opt.why_no_hover.empty() ? "not given" : opt.why_no_hover) + ".\n");
+  d.set("hover_trim_line",
+        trimmed ? (opt.hover_note.empty() ? std::string() : "// Hover trim: " + output::cpp_comment(opt.hover_note) + ".\n")
+                : "// No hover trim: " + output::cpp_comment(opt.why_no_hover.empty() ? "not given" : opt.why_no_hover) + ".\n");
 }
 
 // Each Jacobian's sparsity pattern (row and column of every stored entry).

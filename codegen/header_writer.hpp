@@ -23,6 +23,9 @@ struct EmitOptions {
   std::vector<int> rotor_spin;
   std::vector<double> hover_command, hover_thrust;
   std::string why_no_hover;
+  // Where the trim is the model's own because fitted effect values moved the base model's:
+  // how, said on the line above the trim.
+  std::string hover_note;
 };
 
 struct GeneratedHeader {

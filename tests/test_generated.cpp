@@ -459,21 +459,49 @@ TEST(Generated, TheHeadersHoverTrimHoldsAnOffCentreVehicleAndSaysWhenThereIsNone
   EXPECT_NE(none.find("// No hover trim: rotor "), std::string::npos);
   EXPECT_EQ(header_rotor_array(none, "kHoverCommand"), std::vector<double>(4, 0.0));
 
+  // A weak motor (fitted effect values) moves the hover: the base model's trim misses it, and
+  // the header declares the model's own, which holds its f (a newcomer's trial, helper-118:
+  // the header of a fitted model had no trim, and the README's example would run at 0).
   request.derive.effects = quadgen::parse_effect_list("motor_gain");
   request.set_nominal = [](quadgen::SymbolicModel& m) { m.params[m.param_index("motor_gain.A")].nominal = -0.1; };
   const quadgen::Vehicle stock = quadgen::test::finken3();
   const auto fitted = quadgen::run_derive_pipeline(stock, quadgen::derive_mass_properties(stock), request);
-  EXPECT_GT(fitted.hover_residual, 1e-3);
-  EXPECT_NE(fitted.header.content.find("inline constexpr bool kHasHoverTrim = false;"), std::string::npos);
-  EXPECT_NE(fitted.header.content.find("move the hover: the base model's trim"), std::string::npos);
-  EXPECT_NE(fitted.model_json.find("\"largest_f_at_trim\""), std::string::npos);
-  // model.json and derivation.md say the same as the header (a review, helper-88: model.json
-  // held the base trim's commands beside an empty why_not).
-  EXPECT_EQ(fitted.why_trim_does_not_hold.rfind("the model's effect values (fitted away from neutral) move the hover", 0), 0u);
-  EXPECT_NE(fitted.model_json.find("\"command\": []"), std::string::npos);
-  EXPECT_NE(fitted.model_json.find("\"why_not\": \"the model's effect values"), std::string::npos);
+  EXPECT_TRUE(fitted.why_trim_does_not_hold.empty()) << fitted.why_trim_does_not_hold;
+  EXPECT_EQ(fitted.trim_moved_by_effects.rfind("the model's effect values (fitted away from neutral) move the hover", 0), 0u);
+  double base_miss = 0;
+  for (double fi : quadgen::test::eval_f(fitted.model, x, fitted.base_trim_commands)) base_miss = std::max(base_miss, std::abs(fi));
+  EXPECT_GT(base_miss, 1e-3);
+  EXPECT_NE(fitted.header.content.find("inline constexpr bool kHasHoverTrim = true;"), std::string::npos);
+  EXPECT_NE(fitted.header.content.find("// Hover trim: the model's effect values"), std::string::npos);
+  const std::vector<double> weak = header_rotor_array(fitted.header.content, "kHoverCommand");
+  ASSERT_EQ(weak.size(), 4u);
+  for (double fi : quadgen::test::eval_f(fitted.model, x, weak)) EXPECT_LT(std::abs(fi), 1e-8);
+  for (size_t i = 1; i < 4; ++i) EXPECT_GT(weak[0], weak[i] + 1e-3) << "motor A, 10 % weak, asks for more";
+  // The thrusts are the model's own at the trim: together they carry the weight.
+  const std::vector<double> thrust = header_rotor_array(fitted.header.content, "kHoverThrust");
+  ASSERT_EQ(thrust.size(), 4u);
+  const auto nominal = [&](const char* name) { return fitted.model.params[fitted.model.param_index(name)].nominal; };
+  EXPECT_NEAR(thrust[0] + thrust[1] + thrust[2] + thrust[3], nominal("mass") * nominal("g"), 1e-9);
+  EXPECT_NE(fitted.model_json.find("\"moved_by_effects\""), std::string::npos);
   EXPECT_NE(fitted.model_json.find("\"base_model_command\""), std::string::npos);
-  EXPECT_NE(fitted.derivation_md.find("does not hold this model:** the model"), std::string::npos);
+  EXPECT_NE(fitted.derivation_md.find("the header declares this model's own:** the model"), std::string::npos);
+
+  // A steady wind: no level hover holds the model, and the header declares none, as model.json
+  // and derivation.md say (a review, helper-88: model.json held the base trim's commands beside
+  // an empty why_not).
+  request.derive.effects = quadgen::parse_effect_list("wind");
+  request.set_nominal = [](quadgen::SymbolicModel& m) { m.params[m.param_index("wind.x")].nominal = 2.0; };
+  const auto windy = quadgen::run_derive_pipeline(stock, quadgen::derive_mass_properties(stock), request);
+  EXPECT_GT(windy.hover_residual, 1e-3);
+  EXPECT_NE(windy.header.content.find("inline constexpr bool kHasHoverTrim = false;"), std::string::npos);
+  EXPECT_NE(windy.header.content.find("move the hover: the base model's trim"), std::string::npos);
+  EXPECT_NE(windy.why_trim_does_not_hold.find("the model has no trim of its own: no commands hold this model level"),
+            std::string::npos) << windy.why_trim_does_not_hold;
+  EXPECT_NE(windy.model_json.find("\"largest_f_at_trim\""), std::string::npos);
+  EXPECT_NE(windy.model_json.find("\"command\": []"), std::string::npos);
+  EXPECT_NE(windy.model_json.find("\"why_not\": \"the model's effect values"), std::string::npos);
+  EXPECT_NE(windy.model_json.find("\"base_model_command\""), std::string::npos);
+  EXPECT_NE(windy.derivation_md.find("does not hold this model:** the model"), std::string::npos);
 }
 
 // The header's inline namespace is named after its code: a vehicle file read from another

@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_252994b40ebb8ab21f09e3ac64bb934d {
+inline namespace model_1fd4cc48319ba8b74624eb3439d3a75a {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -67,9 +67,10 @@ inline constexpr double kConstantValues[kNumConstants > 0 ? kNumConstants : 1] =
 // seen from above (+1 counter-clockwise, -1 clockwise), and the hover trim at kNominalParams,
 // each rotor's command (0 to 1) and thrust [N] that hold the vehicle level and still: f = 0
 // to about 1e-10 with the effects' inputs where they are neutral (t = 0, vbat at vbat_ref, clear
-// of the ground) and rotor-speed states at the speeds the commands ask. Where the vehicle cannot
-// hover, or effect values fitted away from neutral move the hover, kHasHoverTrim is false, the
-// arrays hold 0 and the line below says why.
+// of the ground) and rotor-speed states at the speeds the commands ask; with effect values fitted
+// away from neutral (a weak motor, a CoG offset) the trim is this model's own, and the line
+// below says how it moved. Where the vehicle cannot hover, or no level hover holds the model (a
+// steady wind), kHasHoverTrim is false, the arrays hold 0 and the line below says why.
 inline constexpr int kNumRotors = 4;
 inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
@@ -2270,6 +2271,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_252994b40ebb8ab21f09e3ac64bb934d
+}  // inline namespace model_1fd4cc48319ba8b74624eb3439d3a75a
 }  // namespace crazyflie21_nanobench_all_effects
 }  // namespace quadgen_generated
