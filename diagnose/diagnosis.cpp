@@ -659,9 +659,14 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
   auto parts = joint ? fit::split_each_by_time(flights, 1.0 - validation_fraction)
                      : fit::split_by_time(flight, 1.0 - validation_fraction);
   const fit::Flight &train = parts.first, &valid = parts.second;
-  if (train.samples.size() < 50 || valid.samples.size() < 50)
+  constexpr size_t kLeastPart = 50;  // samples a part needs to be fitted or judged
+  if (train.samples.size() < kLeastPart || valid.samples.size() < kLeastPart) {
+    const double smaller = std::min(validation_fraction, 1.0 - validation_fraction);
+    const auto needed = static_cast<size_t>(std::ceil(kLeastPart / std::max(smaller, 1e-9)));
     throw fit::FitError(flight.source + ": too short to hold out " + output::short_number(validation_fraction) +
-                        " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples)");
+                        " of it for validation (" + std::to_string(flight.samples.size()) + " airborne samples; each part needs " +
+                        std::to_string(kLeastPart) + ", about " + std::to_string(needed) + " airborne samples in all)");
+  }
   d.train_samples = train.samples.size();
   d.valid_samples = valid.samples.size();
   d.t_split = valid.samples.front().t;

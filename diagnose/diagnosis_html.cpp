@@ -410,13 +410,13 @@ void at_a_glance_html(std::ostringstream& h, const Diagnosis& d) {
   if (rows.empty()) return;
   const std::string own_weights = own_weights_note(d);
   h << "<table class=\"glance\"><tr><th>effect</th><th>verdict</th><th>values, 95 % interval where named</th>"
-       "<th>held out: the final model without it &rarr; with it</th><th>of the</th></tr>\n";
+       "<th>held out: the final model without it &rarr; with it</th><th>a cause of the</th></tr>\n";
   for (const auto& r : rows)
     h << "<tr><td><b>" << esc(r.effect) << "</b></td><td class=\"" << r.css << "\">" << r.verdict << "</td><td>"
       << r.values << "</td><td>" << r.held_out << "</td><td>" << esc(scope(r.effect)) << "</td></tr>\n";
   h << "</table>\n<p><small>Held out: " << esc(d.metric)
     << ". Each effect's figure is the final model with and without it, not its share of the whole gain: effects "
-       "overlap" << (own_weights.empty() ? "" : "; " + esc(own_weights)) << ". \"Of the\": a cause of the airframe (every flight of it should show it) or of this flight"
+       "overlap" << (own_weights.empty() ? "" : "; " + esc(own_weights)) << ". \"A cause of the\": the airframe (every flight of it should show it) or this flight"
     << (d.flights.size() > 1 ? "; a value name@k is flight k's, a plain name flight 1's" : "")
     << ". Words: <a href=\"#words\">at the end</a>.</small></p>\n";
 }

@@ -420,6 +420,16 @@ std::string gyro_disagreement_hint(double slope, double se, bool euler) {
 }
 
 namespace {
+// The log for a message about a column's unit, and where a mapping names that column: the fix
+// is in the mapping's entry, not the log (a newcomer's trial, helper-118: "mylog.csv: ...
+// deg/s read as rad/s?" left the mapping's line to be found). "log.csv (the gyro: its entry
+// for p at M.yaml:12)", or the log's path alone where it names its own columns.
+std::string log_and_entry(const runtime::CsvTable& log, const char* column, const char* what) {
+  const int c = log.column(column);
+  if (log.named_by.empty() || c < 0) return log.path;
+  return log.path + " (" + what + ": its entry for " + column + " at " + log.where_named(c) + ")";
+}
+
 // Two unit mistakes a mapping can make that no dimension check sees, because the unit is
 // right and the number is not: a gyro in deg/s declared rad/s (57 times the rates the
 // attitude shows) and an accelerometer in g declared m/s^2 (a specific force near 1 in
@@ -753,8 +763,8 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   }
   if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, columns.t, f, o);
   if (const std::string note = idle.note(log.where_named(), o); !note.empty()) f.notes.push_back(note);
-  check_gyro_against_attitude(log.path, f, attitude_columns(log) == AttitudeColumns::kEuler);
-  check_accelerometer_unit(log.path, f);
+  check_gyro_against_attitude(log_and_entry(log, "p", "the gyro"), f, attitude_columns(log) == AttitudeColumns::kEuler);
+  check_accelerometer_unit(log_and_entry(log, "az", "the accelerometer"), f);
   return f;
 }
 

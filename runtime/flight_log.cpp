@@ -353,9 +353,10 @@ void check_values(const CsvTable& log) {
                     "rows, or the column where battery_sag is not wanted)");
       if (throttle[c] && v > kMaxThrottle)
         fail_at_row(log, i,
-                "column '" + log.columns[c] + "' is " + output::six_digits(v) +
-                    "; expected a throttle fraction 0..1 (in a log mapping, a percentage takes scale: 0.01, a 16-bit PWM "
-                    "count scale: 1.5259e-05)");
+                "column '" + log.columns[c] + "' is " + output::six_digits(v) + "; expected a throttle fraction 0..1 (" +
+                    (log.named_by.empty() ? "" : "its entry at " + log.where_named(static_cast<int>(c)) + "; ") +
+                    "in a log mapping, a percentage takes scale: 0.01, a pulse width of 1000 to 2000 us scale: 0.001 "
+                    "and offset: -1, a 16-bit PWM count scale: 1.5259e-05)");
     }
 }
 

@@ -303,6 +303,12 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   };
   EXPECT_NE(message_of<FitError>([&] { load_flight(scaled({"p", "q", "r"}, 180 / M_PI), rotors, {}); }).find("deg/s read as rad/s?"),
             std::string::npos);
+  // Named by a mapping, the message names the entry to fix (its file and line), not the log alone.
+  runtime::CsvTable mapped = scaled({"p", "q", "r"}, 180 / M_PI);
+  mapped.named_by = "M.yaml";
+  for (size_t c = 0; c < mapped.columns.size(); ++c) mapped.name_lines.push_back(static_cast<int>(c) + 3);
+  const std::string entry = "flight.csv (the gyro: its entry for p at M.yaml:" + std::to_string(mapped.column("p") + 3) + "): ";
+  EXPECT_NE(message_of<FitError>([&] { load_flight(mapped, rotors, {}); }).find(entry), std::string::npos);
   // The hint names a unit only where the slope is its factor: -0.13 +- 0.058 (p and q swapped
   // in a user trial's mapping) was told "deg/s read as rad/s?".
   EXPECT_EQ(gyro_disagreement_hint(1 / 57.3, 0.001, false), "deg/s read as rad/s? (in the mapping, unit: deg/s)");
@@ -444,6 +450,23 @@ TEST_F(Hostile, NanobenchMappingValuesUnchanged) {
     const double want = 0.123456789012345 * m.entries[i].scale + m.entries[i].offset;
     EXPECT_EQ(std::memcmp(&out.rows[0][i], &want, sizeof want), 0) << m.entries[i].target;
   }
+}
+
+// A motor command out of range in a mapped log: the message names the mapping's entry to fix
+// (a newcomer's trial, helper-118: it named the log's row alone) and offers a pulse width's scale.
+TEST_F(Hostile, AThrottleOutOfRangeNamesItsMappingEntry) {
+  const std::string path = write("pwm.yaml",
+                                 "columns:\n  t: {source: time, unit: s}\n  u_A: {source: a, unit: \"1\"}\n"
+                                 "  u_B: {source: b, unit: \"1\"}\n  u_C: {source: c, unit: \"1\"}\n"
+                                 "  u_D: {source: pwm_d, unit: \"1\"}\n");
+  const auto raw = runtime::parse_csv("time,a,b,c,pwm_d\n0,0.5,0.5,0.5,0.5\n0.01,0.5,0.5,0.5,1493.5\n", "pulses.csv");
+  const runtime::CsvTable mapped = apply_mapping(raw, load_mapping(path));
+  const std::string message = message_of<runtime::LogError>([&] { runtime::validate_canonical(mapped, {"A", "B", "C", "D"}); });
+  EXPECT_NE(message.find("pulses.csv:3: column 'u_D' is 1493.5; expected a throttle fraction 0..1 (its entry at " + path +
+                         ":6; "),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("a pulse width of 1000 to 2000 us scale: 0.001 and offset: -1"), std::string::npos) << message;
 }
 
 // Defect 3: exponents beyond int (UB in the old std::stoi path) and Hz, through the

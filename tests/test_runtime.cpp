@@ -803,6 +803,8 @@ TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,x,1,1\n").find("log.csv:3: column 'u_B'"), std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,nan,1,1\n").find("not finite"), std::string::npos);
   // A percentage or a PWM count where a throttle fraction belongs: named at its line.
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,1500,1,1\n").find("a pulse width of 1000 to 2000 us scale: 0.001 and offset: -1"),
+            std::string::npos);
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,45,1,1\n").find("log.csv:3: column 'u_B' is 45; expected a throttle fraction 0..1"),
             std::string::npos);
   // Below 0 is a motor off (a disarmed PX4 output maps there): let through.
