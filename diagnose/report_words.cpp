@@ -417,7 +417,7 @@ int estimate_digits(double value, double lower, double upper) {
     return !std::isfinite(a) || !std::isfinite(b) || a == b || num(a, prec) != num(b, prec);
   };
   int prec = kEstimateDigits;
-  while (prec < 6 && !(apart(value, lower, prec) && apart(value, upper, prec) && apart(lower, upper, prec))) ++prec;
+  while (prec < 12 && !(apart(value, lower, prec) && apart(value, upper, prec) && apart(lower, upper, prec))) ++prec;
   return prec;
 }
 

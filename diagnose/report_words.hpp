@@ -92,10 +92,11 @@ std::string interval(double lower, double upper, int prec = 4);
 // delay as 0.0409 [0.0377, 0.0439] in one table and 0.0409 [0.0377, 0.04395] in the next. A
 // sentence rounds further (headline::words); diagnosis.json keeps every digit.
 inline constexpr int kEstimateDigits = 3;
-// The digits for an estimate and its interval: kEstimateDigits, or as many more (up to 6) as
+// The digits for an estimate and its interval: kEstimateDigits, or as many more (up to 12) as
 // print a side apart from the value or the other side where they differ. A weak motor fitted
 // to a generated flight read "-0.08 [-0.08, -0.08]", an interval of no width (a newcomer's
-// trial, helper-118); it reads "-0.08 [-0.08004, -0.07996]".
+// trial, helper-118); it reads "-0.08 [-0.08004, -0.07996]", on a noiseless flight
+// "-0.08 [-0.080000004, -0.079999996]".
 int estimate_digits(double value, double lower, double upper);
 // An estimate and its interval at those digits: "0.0409 [0.0377, 0.0439]".
 std::string estimate(double value, double lower, double upper);

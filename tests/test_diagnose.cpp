@@ -1309,14 +1309,16 @@ TEST(DiagnosisReport, SuspectsAndStandInsSayWhetherTheyAreTheFlightsOwn) {
 }
 
 // An estimate's interval is printed apart from its value: more digits where three would print
-// a side as the value (a weak motor read "-0.08 [-0.08, -0.08]"), never more than six, and no
-// more where a side is the value (an estimate at its bound).
+// a side as the value (a weak motor read "-0.08 [-0.08, -0.08]"), never more than twelve, and
+// no more where a side is the value (an estimate at its bound).
 TEST(DiagnosisReport, AnIntervalIsPrintedApartFromItsValue) {
   namespace words = quadgen::diagnose::words;
   EXPECT_EQ(words::estimate(0.0409, 0.0377, 0.0439), "0.0409 [0.0377, 0.0439]");
   EXPECT_EQ(words::estimate(-0.0800024, -0.080044, -0.07996), "-0.08 [-0.08004, -0.07996]");
   EXPECT_EQ(words::estimate(3.0, 2.5, 3.0), "3 [2.5, 3]");
-  EXPECT_EQ(words::estimate(1.0, 1.0 - 1e-12, 1.0 + 1e-12), "1 [1, 1]");
+  EXPECT_EQ(words::estimate(-0.07999999988112305, -0.08000000414517501, -0.07999999561707391),
+            "-0.08 [-0.080000004, -0.079999996]");  // a noiseless flight: 7 digits print -0.08 thrice
+  EXPECT_EQ(words::estimate(1.0, 1.0 - 1e-14, 1.0 + 1e-14), "1 [1, 1]");
   EXPECT_EQ(words::estimate(0.5, NAN, 0.7), "0.5 [open, 0.7]");
 }
 
