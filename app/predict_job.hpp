@@ -33,4 +33,8 @@ struct PredictJobResult {
 // with file and line) unchanged.
 PredictJobResult run_predict_job(const PredictJob& job, const Vehicle& vehicle);
 
+// What the command prints of a prediction (PredictJobResult::summary): the error at each
+// horizon, the views without a model's parts, what limits it, the one-step errors.
+std::string prediction_summary(const predict::Prediction& pooled);
+
 }  // namespace quadgen::app

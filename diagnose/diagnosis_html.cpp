@@ -680,8 +680,11 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<details><summary>Step " << s + 1 << " (model: base";
     for (const auto& e : st.base_effects) h << " + " << esc(e);
     h << "): " << (st.selected.empty() ? "nothing taken" : "took " + esc(st.selected)) << "</summary>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
-      << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic.</p>\n"
-      << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>held-out gain %</th><th>verdict</th></tr>\n";
+      << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic. "
+         "Held-out gain: how much lower the equation error (the one-step accelerations' weighted cost) is on the "
+         "held-out part with the candidate than without; not the open-loop position error of the findings above.</p>\n"
+      << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>held-out gain % "
+         "(equation error)</th><th>verdict</th></tr>\n";
     for (const auto& c : st.candidates)
       h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << esc(output::p_value_cell(c.p_value))
         << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
