@@ -47,13 +47,14 @@ static void judge_hover_trim(const Vehicle& vehicle, DerivedModel& out) {
   const double own_residual = own.found() ? hover_residual(out.model, own.commands) : 0;
   if (own.found() && own_residual <= DerivedModel::kHoverHolds) {
     out.base_trim_commands = out.hover_trim.commands;
+    out.base_trim_residual = out.hover_residual;
     out.hover_trim = own;
     out.hover_residual = own_residual;
     out.trim_moved_by_effects = moved + "; this trim is the model's own, with them";
     return;
   }
   out.why_trim_does_not_hold = moved + ", and the model has no trim of its own: " +
-                               (own.found() ? "|f| = " + output::short_number(own_residual) + " at the nearest" : own.why_not);
+                               (own.found() ? "|f| = " + output::short_number(own_residual) + " at the one found" : own.why_not);
 }
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
@@ -81,7 +82,7 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   emit.hover_note = out.trim_moved_by_effects;
   out.header = codegen::generate_header(out.model, emit);
   const Derivation d{vehicle,          mass, out.model, out.audit, out.thesis, out.hover_trim, out.hover_residual,
-                     out.why_trim_does_not_hold, out.trim_moved_by_effects, out.base_trim_commands};
+                     out.why_trim_does_not_hold, out.trim_moved_by_effects, out.base_trim_commands, out.base_trim_residual};
   out.model_json = model_json(d);
   out.derivation_md = derivation_markdown(d);
   return out;

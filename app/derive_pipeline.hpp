@@ -46,6 +46,7 @@ struct DerivedModel {
   // how the hover moved, and the base trim's commands; empty otherwise.
   std::string trim_moved_by_effects;
   std::vector<double> base_trim_commands;
+  double base_trim_residual = 0;  // the largest |f| at base_trim_commands
   codegen::GeneratedHeader header;
   std::string model_json, derivation_md;
 };

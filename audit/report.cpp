@@ -326,15 +326,16 @@ static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   j["command"] = holds ? trim.commands : std::vector<double>{};
   j["why_not"] = holds ? trim.why_not : d.why_trim_does_not_hold;
   if (!holds) j["base_model_command"] = trim.commands;
-  // Where it is the model's own (fitted effect values moved the base model's): how, and the
-  // base trim's commands.
+  // The largest |f| at the commands under "command" (or, where there are none, at the base
+  // model's trim, which then does not hold this model: how far it is off).
+  j["largest_f_at_trim"] = d.hover_residual;
+  // Where the trim is the model's own (fitted effect values moved the base model's): how, and
+  // the base trim's commands and how far they are off.
   if (!d.trim_moved_by_effects.empty()) {
     j["moved_by_effects"] = d.trim_moved_by_effects;
     j["base_model_command"] = d.base_trim_commands;
+    j["largest_f_at_base_model_command"] = d.base_trim_residual;
   }
-  // Where effect values fitted away from neutral move the hover, the base trim does not hold
-  // this model (the header then declares none): how far it is off.
-  j["largest_f_at_trim"] = d.hover_residual;
   return j;
 }
 

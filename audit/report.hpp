@@ -28,6 +28,7 @@ struct Derivation {
   // how the hover moved, and the base trim's commands; empty otherwise.
   std::string trim_moved_by_effects;
   std::vector<double> base_trim_commands;
+  double base_trim_residual = 0;  // the largest |f| at base_trim_commands
 };
 
 std::string derivation_markdown(const Derivation& d);

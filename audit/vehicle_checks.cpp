@@ -372,19 +372,26 @@ class HoverPoint {
     f_ = GiNaC::ex_to<GiNaC::matrix>(GiNaC::ex(m.f).subs(s));
   }
   // Level and still 100 m up, each rotor-speed state where its own row (linear in its speed)
-  // is zero.
+  // is zero. Its slope is taken over 1000 rad/s and the zero refined once: from speeds 0 and 1
+  // (a difference of 1/tau beside a row of omega/tau) a Crazyflie's speed came out some 1e-10
+  // off, and a motor lag's row 1e-8 from zero (a review, helper-119).
   std::vector<double> state(const std::vector<double>& commands) const {
     using namespace runtime::rigid_body;
     std::vector<double> x(m_.states.size(), 0.0);
     x[kPosition + 2] = 100.0;
     x[kAttitude] = 1.0;
     for (size_t k : m_.rotor_speed_states) {
-      std::vector<double> one = x;
-      one[k] = 1.0;
-      const double at_zero = row(k, x, commands), at_one = row(k, one, commands);
-      if (at_zero != at_one) x[k] = at_zero / (at_zero - at_one);
+      std::vector<double> far = x;
+      far[k] = 1000.0;
+      const double at_zero = row(k, x, commands), slope = (row(k, far, commands) - at_zero) / 1000.0;
+      if (slope == 0 || !std::isfinite(slope)) continue;
+      x[k] = -at_zero / slope;
+      x[k] -= row(k, x, commands) / slope;
     }
     return x;
+  }
+  bool is_rotor_speed(size_t row) const {
+    return std::find(m_.rotor_speed_states.begin(), m_.rotor_speed_states.end(), row) != m_.rotor_speed_states.end();
   }
   std::vector<double> rows(const std::vector<double>& commands) const {
     const std::vector<double> x = state(commands);
@@ -414,9 +421,13 @@ class HoverPoint {
   double vbat_ref_ = 0;
 };
 
+// The largest |r|; NaN where any is (std::max would pass it over, and a trim accept it).
 double largest(const std::vector<double>& r) {
   double worst = 0;
-  for (double v : r) worst = std::max(worst, std::fabs(v));
+  for (double v : r) {
+    if (std::isnan(v)) return v;
+    worst = std::max(worst, std::fabs(v));
+  }
   return worst;
 }
 
@@ -438,30 +449,37 @@ runtime::HoverTrim model_hover_trim(const Vehicle& v, const SymbolicModel& m, co
   const HoverPoint hover(m);
   runtime::HoverTrim trim;
   std::vector<double> u = start;
-  std::vector<double> r = hover.rows(u);
+  // The rows the commands must zero: the rotor-speed rows are zero by construction (state()).
+  const auto rows = [&](const std::vector<double>& commands) {
+    std::vector<double> r = hover.rows(commands);
+    for (size_t i = 0; i < r.size(); ++i)
+      if (hover.is_rotor_speed(i)) r[i] = 0;
+    return r;
+  };
+  std::vector<double> r = rows(u);
   const size_t n = u.size();
-  // f is smooth in the commands; ten steps from a trim off by a weak motor reach 1e-12.
-  for (int step = 0; step < 20 && largest(r) > 1e-12; ++step) {
+  // f is smooth in the commands; a few steps from a trim off by a weak motor reach 1e-12.
+  for (int step = 0; step < 20 && !(largest(r) <= 1e-12); ++step) {
     Eigen::MatrixXd J(r.size(), n);
     for (size_t k = 0; k < n; ++k) {
       std::vector<double> moved = u;
       const double h = 1e-7 * std::max(1.0, std::fabs(u[k]));
       moved[k] += h;
-      const std::vector<double> rk = hover.rows(moved);
+      const std::vector<double> rk = rows(moved);
       for (size_t i = 0; i < r.size(); ++i) J(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = (rk[i] - r[i]) / h;
     }
     // Least squares, least norm where rotors outnumber the conditions (a hexacopter).
     const Eigen::VectorXd du = J.completeOrthogonalDecomposition().solve(-Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()));
     for (size_t k = 0; k < n; ++k) u[k] += du(static_cast<Eigen::Index>(k));
-    r = hover.rows(u);
+    r = rows(u);
   }
-  if (largest(r) > 1e-9) {
+  if (!(largest(r) <= 1e-9)) {
     trim.why_not = "no commands hold this model level and still (|f| = " + output::short_number(largest(r)) +
                    " at the nearest found): a force or a tilt no level hover holds";
     return trim;
   }
   for (size_t k = 0; k < n; ++k)
-    if (u[k] < 0 || u[k] > 1) {
+    if (!(u[k] >= 0 && u[k] <= 1)) {
       trim.why_not = "rotor " + v.rotors[k].name + " would need command " + output::short_number(u[k]) + ", outside 0 to 1";
       return trim;
     }

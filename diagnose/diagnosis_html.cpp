@@ -225,18 +225,22 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     const double pad = 0.05 * (hi - lo) + 1e-300;
     lo -= pad, hi += pad;
     const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
+    // One precision for the table: each flight's value apart from its interval's sides, and
+    // the reference's apart from them too (a review, helper-119: "-0.08 against -0.08").
+    int prec = kEstimateDigits;
+    for (const auto& f : a.flights)
+      prec = std::max({prec, estimate_digits(f.value, f.lower, f.upper), estimate_digits(a.joint_value, f.lower, f.upper)});
     // A suspect's agreement in grey: green read as an endorsement of what is not named.
     h << "<h3>" << esc(a.parameter) << " [" << unit_html(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
-      << esc(reference_name) << " " << num(a.joint_value, kEstimateDigits) << ", pooled " << num(a.pooled, kEstimateDigits) << ", spread "
+      << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
          "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
-      const int prec = estimate_digits(f.value, f.lower, f.upper);
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
         << num(f.value, prec) << "</td><td>" << interval(f.lower, f.upper, prec) << "</td><td>"
         << esc(output::p_value_cell(f.p_value)) << "</td><td><div style=\"position:relative;height:14px\">";

@@ -58,8 +58,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
-       << estimate(a.flights.front().value, a.flights.front().lower, a.flights.front().upper) << " against "
-       << num(a.joint_value, kEstimateDigits) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
+       << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }
 

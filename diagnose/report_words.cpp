@@ -426,6 +426,11 @@ std::string estimate(double value, double lower, double upper) {
   return num(value, prec) + " " + interval(lower, upper, prec);
 }
 
+std::string estimate_against(double value, double lower, double upper, double other) {
+  const int prec = std::max(estimate_digits(value, lower, upper), estimate_digits(other, lower, upper));
+  return num(value, prec) + " " + interval(lower, upper, prec) + " against " + num(other, prec);
+}
+
 std::string interval(double lower, double upper, int prec) {
   const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
   return "[" + side(lower) + ", " + side(upper) + "]";

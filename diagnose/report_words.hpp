@@ -100,6 +100,9 @@ inline constexpr int kEstimateDigits = 3;
 int estimate_digits(double value, double lower, double upper);
 // An estimate and its interval at those digits: "0.0409 [0.0377, 0.0439]".
 std::string estimate(double value, double lower, double upper);
+// The same against a value it is compared with, printed apart from the interval's sides too:
+// "-0.08 [-0.08004, -0.07996] against -0.0802" (it read "against -0.08").
+std::string estimate_against(double value, double lower, double upper, double other);
 
 // A check's lead: what it suggests, said once, and the numbers of each source that shows it
 // ("this flight" or "the flights together" for the diagnosis as a whole, "flight k (path)"

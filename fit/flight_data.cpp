@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <set>
 #include <sstream>
@@ -420,14 +421,23 @@ std::string gyro_disagreement_hint(double slope, double se, bool euler) {
 }
 
 namespace {
-// The log for a message about a column's unit, and where a mapping names that column: the fix
-// is in the mapping's entry, not the log (a newcomer's trial, helper-118: "mylog.csv: ...
-// deg/s read as rad/s?" left the mapping's line to be found). "log.csv (the gyro: its entry
-// for p at M.yaml:12)", or the log's path alone where it names its own columns.
-std::string log_and_entry(const runtime::CsvTable& log, const char* column, const char* what) {
-  const int c = log.column(column);
-  if (log.named_by.empty() || c < 0) return log.path;
-  return log.path + " (" + what + ": its entry for " + column + " at " + log.where_named(c) + ")";
+// Where a message about the unit of a sensor's columns starts: at the mapping's entry for the
+// first of them, where the fix is, not at the log (a newcomer's trial, helper-118: "mylog.csv:
+// ... deg/s read as rad/s?" left the mapping's lines to be found). "M.yaml:12: the gyro's
+// entries (p, q, r: lines 12, 13, 14) for log.csv", or the log's path alone where it names its
+// own columns.
+std::string log_and_entries(const runtime::CsvTable& log, std::initializer_list<const char*> columns, const char* what) {
+  std::string names, lines;
+  int first = -1;
+  for (const char* name : columns) {
+    const int c = log.column(name);
+    if (c < 0 || static_cast<size_t>(c) >= log.name_lines.size()) continue;
+    if (first < 0) first = c;
+    names += (names.empty() ? "" : ", ") + std::string(name);
+    lines += (lines.empty() ? "" : ", ") + std::to_string(log.name_lines[static_cast<size_t>(c)]);
+  }
+  if (log.named_by.empty() || first < 0) return log.path;
+  return log.where_named(first) + ": " + what + "'s entries (" + names + ": lines " + lines + ") for " + log.path;
 }
 
 // Two unit mistakes a mapping can make that no dimension check sees, because the unit is
@@ -763,8 +773,9 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   }
   if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, columns.t, f, o);
   if (const std::string note = idle.note(log.where_named(), o); !note.empty()) f.notes.push_back(note);
-  check_gyro_against_attitude(log_and_entry(log, "p", "the gyro"), f, attitude_columns(log) == AttitudeColumns::kEuler);
-  check_accelerometer_unit(log_and_entry(log, "az", "the accelerometer"), f);
+  check_gyro_against_attitude(log_and_entries(log, {"p", "q", "r"}, "the gyro"), f,
+                              attitude_columns(log) == AttitudeColumns::kEuler);
+  check_accelerometer_unit(log_and_entries(log, {"ax", "ay", "az"}, "the accelerometer"), f);
   return f;
 }
 

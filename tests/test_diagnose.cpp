@@ -1320,6 +1320,9 @@ TEST(DiagnosisReport, AnIntervalIsPrintedApartFromItsValue) {
             "-0.08 [-0.080000004, -0.079999996]");  // a noiseless flight: 7 digits print -0.08 thrice
   EXPECT_EQ(words::estimate(1.0, 1.0 - 1e-14, 1.0 + 1e-14), "1 [1, 1]");
   EXPECT_EQ(words::estimate(0.5, NAN, 0.7), "0.5 [open, 0.7]");
+  // against a value it is compared with: that value apart from the sides too
+  EXPECT_EQ(words::estimate_against(-0.08, -0.08004, -0.07996, -0.0802), "-0.08 [-0.08004, -0.07996] against -0.0802");
+  EXPECT_EQ(words::estimate_against(0.0409, 0.0377, 0.0439, 0.04), "0.0409 [0.0377, 0.0439] against 0.04");
 }
 
 // A dimensionless value ("1", as the symbols declare it) is said without a unit in every

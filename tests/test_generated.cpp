@@ -504,6 +504,45 @@ TEST(Generated, TheHeadersHoverTrimHoldsAnOffCentreVehicleAndSaysWhenThereIsNone
   EXPECT_NE(windy.derivation_md.find("does not hold this model:** the model"), std::string::npos);
 }
 
+// With rotor-speed states (motor_lag) a fitted model's trim is its own too (a review,
+// helper-119: each speed computed from the row at speeds 0 and 1 left a Crazyflie's lag row
+// some 1e-8 from zero, above the trim's acceptance, and no trim would have been declared).
+// Checked by an evaluation of its own: each speed where its row is zero, then every row.
+TEST(Generated, AFittedModelWithRotorSpeedStatesHasItsOwnTrim) {
+  quadgen::DeriveRequest request;
+  request.thesis_comparison = false;
+  request.derive.effects = quadgen::parse_effect_list("motor_lag,motor_gain");
+  request.set_nominal = [](quadgen::SymbolicModel& m) {
+    m.params[m.param_index("motor_gain.M2")].nominal = -0.1;
+    m.params[m.param_index("motor_lag.tau")].nominal = 0.03;
+  };
+  const quadgen::Vehicle cf = quadgen::load_vehicle(quadgen::test::source_path("vehicles/crazyflie21.yaml"));
+  const auto fitted = quadgen::run_derive_pipeline(cf, quadgen::derive_mass_properties(cf), request);
+  ASSERT_TRUE(fitted.why_trim_does_not_hold.empty()) << fitted.why_trim_does_not_hold;
+  EXPECT_FALSE(fitted.trim_moved_by_effects.empty());
+  const quadgen::SymbolicModel& m = fitted.model;
+  ASSERT_EQ(m.rotor_speed_states.size(), 4u);
+  const std::vector<double> commands = header_rotor_array(fitted.header.content, "kHoverCommand");
+  ASSERT_EQ(commands.size(), 4u);
+  std::vector<double> u;
+  for (const auto& in : m.inputs)
+    u.push_back(in.name.rfind("u_", 0) == 0 ? commands[u.size()] : in.name == "vbat" ? m.params[m.param_index("vbat_ref")].nominal : 0.0);
+  std::vector<double> x(m.states.size(), 0.0);
+  x[2] = 1, x[6] = 1;
+  for (size_t k : m.rotor_speed_states) {
+    std::vector<double> far = x;
+    far[k] = 2000;
+    const double at_zero = quadgen::test::eval_f(m, x, u)[k], at_far = quadgen::test::eval_f(m, far, u)[k];
+    x[k] = -at_zero * 2000 / (at_far - at_zero);
+  }
+  const std::vector<double> f = quadgen::test::eval_f(m, x, u);
+  for (size_t i = 0; i < f.size(); ++i) {
+    const bool speed = std::find(m.rotor_speed_states.begin(), m.rotor_speed_states.end(), i) != m.rotor_speed_states.end();
+    EXPECT_LT(std::abs(f[i]), speed ? 1e-6 : 1e-8) << m.states[i].name;
+  }
+  EXPECT_GT(commands[1], commands[0] + 1e-3) << "M2, 10 % weak, asks for more";
+}
+
 // The header's inline namespace is named after its code: a vehicle file read from another
 // path gives the same name, one with another mass another (so an edited copy that kept the
 // vehicle's name links as a model of its own, not silently as the other one).

@@ -307,8 +307,11 @@ TEST_F(Hostile, GyroInDegreesAndAccelerometerInGAreCaught) {
   runtime::CsvTable mapped = scaled({"p", "q", "r"}, 180 / M_PI);
   mapped.named_by = "M.yaml";
   for (size_t c = 0; c < mapped.columns.size(); ++c) mapped.name_lines.push_back(static_cast<int>(c) + 3);
-  const std::string entry = "flight.csv (the gyro: its entry for p at M.yaml:" + std::to_string(mapped.column("p") + 3) + "): ";
-  EXPECT_NE(message_of<FitError>([&] { load_flight(mapped, rotors, {}); }).find(entry), std::string::npos);
+  const auto line = [&](const char* c) { return std::to_string(mapped.column(c) + 3); };
+  const std::string entry = "M.yaml:" + line("p") + ": the gyro's entries (p, q, r: lines " + line("p") + ", " + line("q") + ", " +
+                            line("r") + ") for " + log + ": the logged attitude turns ";
+  const std::string gyro = message_of<FitError>([&] { load_flight(mapped, rotors, {}); });
+  EXPECT_NE(gyro.find(entry), std::string::npos) << gyro;
   // The hint names a unit only where the slope is its factor: -0.13 +- 0.058 (p and q swapped
   // in a user trial's mapping) was told "deg/s read as rad/s?".
   EXPECT_EQ(gyro_disagreement_hint(1 / 57.3, 0.001, false), "deg/s read as rad/s? (in the mapping, unit: deg/s)");
