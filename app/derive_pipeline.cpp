@@ -31,20 +31,20 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
 }
 
 // The trim is the base model's; a model whose effect values were fitted away from neutral does
-// not hover at it (hover_residual says how far it misses). Above kHoverHolds the model's own
+// not hover at it (hover_miss says how far it misses). Above kHoverHolds the model's own
 // trim is sought from it (model_hover_trim) and, where found, declared with a note of how it
 // moved; where none holds, why, which the header, model.json and derivation.md then say
 // instead of declaring one.
 static void judge_hover_trim(const Vehicle& vehicle, DerivedModel& out) {
   if (!out.hover_trim.found()) return;
-  out.hover_residual = hover_residual(out.model, out.hover_trim.commands);
+  const HoverMiss base_miss = hover_miss(out.model, out.hover_trim.commands);
+  out.hover_residual = base_miss.largest;
   if (out.hover_residual <= DerivedModel::kHoverHolds) return;
   const std::string moved = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
                             output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
-                            output::short_number(out.hover_residual) + " there (in " +
-                            hover_residual_row(out.model, out.hover_trim.commands) + ")";
+                            output::short_number(out.hover_residual) + " there (in " + base_miss.row + ")";
   const runtime::HoverTrim own = model_hover_trim(vehicle, out.model, out.hover_trim.commands);
-  const double own_residual = own.found() ? hover_residual(out.model, own.commands) : 0;
+  const double own_residual = own.found() ? hover_miss(out.model, own.commands).largest : 0;
   if (own.found() && own_residual <= DerivedModel::kHoverHolds) {
     out.base_trim_commands = out.hover_trim.commands;
     out.base_trim_residual = out.hover_residual;

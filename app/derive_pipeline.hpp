@@ -37,7 +37,7 @@ struct DerivedModel {
   AuditResult audit;
   std::vector<ThesisItem> thesis;
   runtime::HoverTrim hover_trim;  // at the nominal values: the vehicle checks, the header and model.json read it
-  // The largest |f| of the model at that trim (hover_residual; 0 where there is none), and the
+  // The largest |f| of the model at that trim (hover_miss; 0 where there is none), and the
   // most that still counts as holding: the trim's 12 digits leave about 1e-10.
   double hover_residual = 0;
   static constexpr double kHoverHolds = 1e-6;

@@ -20,7 +20,7 @@ struct Derivation {
   const AuditResult& audit;
   const std::vector<ThesisItem>& thesis;  // empty for vehicles other than the FINken 3
   const runtime::HoverTrim& hover_trim;    // at the nominal values (nominal_hover_trim)
-  double hover_residual = 0;               // the largest |f| of the model there (hover_residual)
+  double hover_residual = 0;               // the largest |f| of the model there (hover_miss)
   // Why that trim does not hold this model (fitted effect values move the hover), or empty:
   // then the header declares none, and model.json and derivation.md say so too.
   std::string why_trim_does_not_hold;

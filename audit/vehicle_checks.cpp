@@ -421,28 +421,25 @@ class HoverPoint {
   double vbat_ref_ = 0;
 };
 
-// The largest |r|; NaN where any is (std::max would pass it over, and a trim accept it).
-double largest(const std::vector<double>& r) {
-  double worst = 0;
-  for (double v : r) {
-    if (std::isnan(v)) return v;
-    worst = std::max(worst, std::fabs(v));
+// Where the largest |r| is; a NaN's place where there is one (a larger |r| would pass it over,
+// and a trim accept it). 0 for none.
+size_t largest_at(const std::vector<double>& r) {
+  size_t at = 0;
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (std::isnan(r[i])) return i;
+    if (std::fabs(r[i]) > std::fabs(r[at])) at = i;
   }
-  return worst;
+  return at;
 }
+double largest(const std::vector<double>& r) { return r.empty() ? 0 : std::fabs(r[largest_at(r)]); }
 
 }  // namespace
 
-double hover_residual(const SymbolicModel& m, const std::vector<double>& commands) {
-  return largest(HoverPoint(m).rows(commands));
-}
-
-std::string hover_residual_row(const SymbolicModel& m, const std::vector<double>& commands) {
+HoverMiss hover_miss(const SymbolicModel& m, const std::vector<double>& commands) {
   const std::vector<double> r = HoverPoint(m).rows(commands);
-  size_t at = 0;
-  for (size_t i = 1; i < r.size(); ++i)
-    if (std::fabs(r[i]) > std::fabs(r[at])) at = i;
-  return r.empty() ? std::string() : "d" + m.states[at].name + "/dt";
+  if (r.empty()) return {};
+  const size_t at = largest_at(r);
+  return {std::fabs(r[at]), "d" + m.states[at].name + "/dt"};
 }
 
 runtime::HoverTrim model_hover_trim(const Vehicle& v, const SymbolicModel& m, const std::vector<double>& start) {

@@ -31,10 +31,13 @@ runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m);
 // where its row is zero, t = 0 and a battery at vbat_ref (each effect's input where it is
 // neutral). The trim comes from the base model's numbers; effect values fitted away from
 // neutral (a motor gain, a wind, a CoG offset in a diagnosis' extended model) move the hover,
-// and this says by how much (a review: the header's kHoverCommand did not hold such a model).
-double hover_residual(const SymbolicModel& m, const std::vector<double>& commands);
-// The row of f where that largest |f| is, as "dp/dt" (for a reader: |f| mixes units).
-std::string hover_residual_row(const SymbolicModel& m, const std::vector<double>& commands);
+// and this says by how much (a review: the header's kHoverCommand did not hold such a model),
+// and in which row, as "dp/dt" (for a reader: |f| mixes units). NaN where any row is.
+struct HoverMiss {
+  double largest = 0;
+  std::string row;
+};
+HoverMiss hover_miss(const SymbolicModel& m, const std::vector<double>& commands);
 
 // The hover trim of the model itself, at that same point: Gauss-Newton on the commands from
 // `start` (the base model's trim) until every row of f is zero. Where effect values fitted
