@@ -282,7 +282,9 @@ std::string markdown_text(const std::string& text) {
   // into a link, and a link is what a hostile description wants. So does it name@host, and
   // its e-mail autolinks see through an escaped '@' (the text is joined before they are
   // looked for): a word joiner (U+2060, invisible) follows the '@', and no domain starts there.
-  static const std::string punctuation = "\\`*_[]|$~";
+  // < > & too: escaped so, no raw HTML or entity comes of them, and the raw file reads as
+  // the text (a reviewer reads derivation.md in an editor too; "&lt;" and "&#39;" did not).
+  static const std::string punctuation = "\\`*_[]|$~<>&";
   const size_t opener = block_opener(s);
   const auto after_www = [&](size_t at) {
     if (at < 3) return false;
@@ -297,6 +299,7 @@ std::string markdown_text(const std::string& text) {
     const bool special = c.size() == 1 && (punctuation.find(c[0]) != std::string::npos || scheme || (c[0] == '.' && after_www(at)));
     if (c == "@") out += "\\@\xE2\x81\xA0";  // U+2060 WORD JOINER
     else if (special || at == opener) out += "\\" + c;
+    else if (c == "'" || c == "\"") out += c;  // text, not an attribute: nothing to escape
     else out += html_text(c);
     at += c.size();
   });

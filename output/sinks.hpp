@@ -54,8 +54,10 @@ std::string html_text(const std::string& s);
 // HTML text inside <pre>: as html_text, but line breaks stay.
 std::string html_preformatted(const std::string& s);
 
-// Markdown text on one line (table cells, headings): HTML-escaped, Markdown punctuation
-// backslash-escaped, line breaks become spaces; what would open a heading, a list or a rule
+// Markdown text on one line (table cells, headings): Markdown punctuation and the HTML
+// characters < > & backslash-escaped (CommonMark's escapes: the raw file reads as the text,
+// "a \< b" where an entity would read "a &lt; b"; quotes, which only an HTML attribute
+// needs escaped, stay as they are), control characters as html_text has them; what would open a heading, a list or a rule
 // at the start of a line (# - + = "1.") is escaped there, and blanks there dropped (four
 // would open a code block); no bare URL, www. address or e-mail address is left for GitHub
 // to turn into a link (the : of :// and the . after www escaped, @ escaped and followed by
