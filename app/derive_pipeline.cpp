@@ -37,18 +37,31 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
 // instead of declaring one.
 static void judge_hover_trim(const Vehicle& vehicle, DerivedModel& out) {
   if (!out.hover_trim.found()) return;
+  // Judged at the commands the header declares (and model.json gives), the rotor speeds found
+  // there: a motor lag's speed rows then hold at what a user reads (declared_trim_value).
+  const auto declared = [](std::vector<double> commands) {
+    for (double& c : commands) c = codegen::declared_trim_value(c);
+    return commands;
+  };
+  out.hover_trim.commands = declared(out.hover_trim.commands);
   const HoverMiss base_miss = hover_miss(out.model, out.hover_trim.commands);
   out.hover_residual = base_miss.largest;
-  if (out.hover_residual <= DerivedModel::kHoverHolds) return;
+  if (out.hover_residual <= DerivedModel::kHoverHolds) {
+    out.hover_trim.rotor_speeds = base_miss.rotor_speeds;
+    return;
+  }
   const std::string moved = "the model's effect values (fitted away from neutral) move the hover: the base model's trim (" +
                             output::short_number(out.hover_trim.commands.front()) + "...) leaves |f| = " +
                             output::short_number(out.hover_residual) + " there (in " + base_miss.row + ")";
-  const runtime::HoverTrim own = model_hover_trim(vehicle, out.model, out.hover_trim.commands);
-  const double own_residual = own.found() ? hover_miss(out.model, own.commands).largest : 0;
+  runtime::HoverTrim own = model_hover_trim(vehicle, out.model, out.hover_trim.commands);
+  own.commands = declared(own.commands);
+  const HoverMiss own_miss = own.found() ? hover_miss(out.model, own.commands) : HoverMiss{};
+  const double own_residual = own_miss.largest;
   if (own.found() && own_residual <= DerivedModel::kHoverHolds) {
     out.base_trim_commands = out.hover_trim.commands;
     out.base_trim_residual = out.hover_residual;
     out.hover_trim = own;
+    out.hover_trim.rotor_speeds = own_miss.rotor_speeds;
     out.hover_residual = own_residual;
     out.trim_moved_by_effects = moved + "; this trim is the model's own, with them";
     return;
@@ -78,6 +91,7 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   judge_hover_trim(vehicle, out);
   emit.hover_command = out.why_trim_does_not_hold.empty() ? out.hover_trim.commands : std::vector<double>{};
   emit.hover_thrust = out.hover_trim.thrusts;
+  emit.hover_rotor_speed = out.hover_trim.rotor_speeds;
   emit.why_no_hover = out.why_trim_does_not_hold.empty() ? out.hover_trim.why_not : out.why_trim_does_not_hold;
   emit.hover_note = out.trim_moved_by_effects;
   out.header = codegen::generate_header(out.model, emit);

@@ -311,9 +311,9 @@ std::string derivation_markdown(const Derivation& d) {
   return md.str();
 }
 
-// The hover trim at full precision (a user trial, helper-82: the audit's text rounds it to
-// four digits, which leaves a compiled model's roll acceleration at 7e-3 rad/s^2 instead of
-// 1e-14): each rotor's thrust and command, as simulate's scenarios fly it; `why_not` says
+// The hover trim as the header declares it, 12 digits (a user trial, helper-82: the audit's
+// text rounds it to four digits, which leaves a compiled model's roll acceleration at 7e-3
+// rad/s^2 instead of about 1e-10), a motor lag's rotor speeds there in full: each rotor's thrust and command, as simulate's scenarios fly it; `why_not` says
 // why there is none (then the thrusts are the least-norm balance and there are no commands).
 static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   const runtime::HoverTrim& trim = d.hover_trim;
@@ -326,6 +326,8 @@ static nlohmann::ordered_json hover_trim_json(const Derivation& d) {
   j["command"] = holds ? trim.commands : std::vector<double>{};
   j["why_not"] = holds ? trim.why_not : d.why_trim_does_not_hold;
   if (!holds) j["base_model_command"] = trim.commands;
+  // rad/s, a motor lag's rotor-speed states at the trim (the header's kHoverRotorSpeed).
+  if (holds && !trim.rotor_speeds.empty()) j["rotor_speed_rad_s"] = trim.rotor_speeds;
   // The largest |f| at the commands under "command" (or, where there are none, at the base
   // model's trim, which then does not hold this model: how far it is off).
   j["largest_f_at_trim"] = d.hover_residual;

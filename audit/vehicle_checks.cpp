@@ -393,8 +393,8 @@ class HoverPoint {
   bool is_rotor_speed(size_t row) const {
     return std::find(m_.rotor_speed_states.begin(), m_.rotor_speed_states.end(), row) != m_.rotor_speed_states.end();
   }
-  std::vector<double> rows(const std::vector<double>& commands) const {
-    const std::vector<double> x = state(commands);
+  std::vector<double> rows(const std::vector<double>& commands) const { return rows_at(state(commands), commands); }
+  std::vector<double> rows_at(const std::vector<double>& x, const std::vector<double>& commands) const {
     std::vector<double> r(m_.states.size());
     for (size_t i = 0; i < r.size(); ++i) r[i] = row(i, x, commands);
     return r;
@@ -436,10 +436,14 @@ double largest(const std::vector<double>& r) { return r.empty() ? 0 : std::fabs(
 }  // namespace
 
 HoverMiss hover_miss(const SymbolicModel& m, const std::vector<double>& commands) {
-  const std::vector<double> r = HoverPoint(m).rows(commands);
+  const HoverPoint hover(m);
+  const std::vector<double> x = hover.state(commands);
+  const std::vector<double> r = hover.rows_at(x, commands);
   if (r.empty()) return {};
   const size_t at = largest_at(r);
-  return {std::fabs(r[at]), "d" + m.states[at].name + "/dt"};
+  HoverMiss miss{std::fabs(r[at]), "d" + m.states[at].name + "/dt", {}};
+  for (size_t k : m.rotor_speed_states) miss.rotor_speeds.push_back(x[k]);
+  return miss;
 }
 
 runtime::HoverTrim model_hover_trim(const Vehicle& v, const SymbolicModel& m, const std::vector<double>& start) {

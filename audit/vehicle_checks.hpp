@@ -33,9 +33,12 @@ runtime::HoverTrim nominal_hover_trim(const Vehicle& v, const SymbolicModel& m);
 // neutral (a motor gain, a wind, a CoG offset in a diagnosis' extended model) move the hover,
 // and this says by how much (a review: the header's kHoverCommand did not hold such a model),
 // and in which row, as "dp/dt" (for a reader: |f| mixes units). NaN where any row is.
+// `rotor_speeds` [rad/s] are the rotor-speed states there, in the model's order of them (a
+// header declares them with its trim: a simulation of a motor lag starts its hover there).
 struct HoverMiss {
   double largest = 0;
   std::string row;
+  std::vector<double> rotor_speeds;
 };
 HoverMiss hover_miss(const SymbolicModel& m, const std::vector<double>& commands);
 

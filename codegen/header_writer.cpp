@@ -154,16 +154,10 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("constant_values", table(m.constants, [](const Variable& v) { return number(v.nominal); }));
 }
 
-// A trim value to 12 significant digits: what holds hover to about 1e-10 m/s^2, and no last
-// bits that another machine's solver could round otherwise (CI compares generated/ byte for byte).
-std::string trim_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return number(std::strtod(buf, nullptr));
-}
+std::string trim_number(double v) { return number(declared_trim_value(v)); }
 
 // The rotors' spins and the hover trim (EmitOptions), where the caller gives them.
-void set_rotor_facts(data& d, const EmitOptions& opt) {
+void set_rotor_facts(data& d, const EmitOptions& opt, size_t rotor_speed_states) {
   const size_t n = opt.rotor_spin.size();
   d.set("has_rotors", data(n > 0));
   const bool trimmed = opt.hover_command.size() == n && opt.hover_thrust.size() == n && n > 0;
@@ -179,6 +173,12 @@ void set_rotor_facts(data& d, const EmitOptions& opt) {
   d.set("hover_command", command + "}");
   d.set("hover_thrust", thrust + "}");
   d.set("has_hover_trim", trimmed ? "true" : "false");
+  // As many as the model has rotor-speed states (one unused 0 where it has none).
+  const bool speeds = trimmed && rotor_speed_states > 0 && opt.hover_rotor_speed.size() == rotor_speed_states;
+  std::string speed = "{";
+  for (size_t i = 0; i < std::max<size_t>(1, rotor_speed_states); ++i)
+    speed += (i ? ", " : "") + (speeds ? number(opt.hover_rotor_speed[i]) : "0");
+  d.set("hover_rotor_speed", speed + "}");
   d.set("hover_trim_line",
         trimmed ? (opt.hover_note.empty() ? std::string() : "// Hover trim: " + output::cpp_comment(opt.hover_note) + ".\n")
                 : "// No hover trim: " + output::cpp_comment(opt.why_no_hover.empty() ? "not given" : opt.why_no_hover) + ".\n");
@@ -202,6 +202,12 @@ void set_sparsity(data& d, const LoweredModel& lm) {
 }
 
 }  // namespace
+
+double declared_trim_value(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return std::strtod(buf, nullptr);
+}
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
   const LoweredModel lm = lower_model(m);
@@ -233,7 +239,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   set_counts(d, m, out);
   set_variable_tables(d, m);
   set_sparsity(d, lm);
-  set_rotor_facts(d, opt);
+  set_rotor_facts(d, opt, m.rotor_speed_states.size());
   d.set("precompute_body", pre.body);
   d.set("rhs_body", rhs_code.body);
   d.set("rhs_f_body", f_only.body);

@@ -22,6 +22,9 @@ struct EmitOptions {
   // mixer and a simulator's start need them, and the header is all such a user has.
   std::vector<int> rotor_spin;
   std::vector<double> hover_command, hover_thrust;
+  // rad/s: the rotor-speed states (motor_lag) at that trim's declared commands, in the
+  // model's order of them; declared in full (declared_trim_value).
+  std::vector<double> hover_rotor_speed;
   std::string why_no_hover;
   // Where the trim is the model's own because fitted effect values moved the base model's:
   // how, said on the line above the trim.
@@ -36,6 +39,13 @@ struct GeneratedHeader {
 };
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt);
+
+// A trim value (command, thrust) as the header declares it: 12 significant digits, which hold
+// hover to about 1e-10 m/s² and leave no last bits that another machine's solver could round
+// otherwise (CI compares generated/ byte for byte). The rotor speeds a motor lag has at the
+// trim are declared in full, found at these commands: a speed to 12 digits leaves its row
+// omega 1e-12 / tau off (5e-7 rad/s² at tau = 1 ms; the consumer check's example found it).
+double declared_trim_value(double v);
 
 // Where a header came from, as its comments and string constants tell it: text from a vehicle
 // file and a command line.

@@ -51,6 +51,9 @@ inline constexpr const char* kRpmWithoutUnit =
 struct HoverTrim {
   std::vector<double> thrusts;   // N, the trim found (the least-norm one where none pushes)
   std::vector<double> commands;  // each rotor's command for its thrust (0 where held); empty if none found
+  // rad/s: a model's rotor-speed states (motor_lag) at the commands, in its order of them,
+  // where a derivation found them (judge_hover_trim); empty for a model without such states.
+  std::vector<double> rotor_speeds;
   std::string why_not;           // empty where a trim was found, else why not (names the rotor)
   // The rotors at command 0 lift the weight or more: no trim can be lower (a motor map in rpm
   // written without its unit reads 9.5 times too fast).

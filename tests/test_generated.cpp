@@ -3,6 +3,7 @@
 // the symbolic model (every model, effects on) and a hand-written reference, independence
 // from symbol creation order.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstring>
@@ -382,6 +383,10 @@ double hover_residual(double* thrust_sum = nullptr) {
     M::rhs(x, u, M::kNominalParams, pre, f);
     for (int k = 0; k < M::kNumRotorSpeedStates; ++k) x[M::kRotorSpeedStates[k]] += M::kNominalParams[tau] * f[M::kRotorSpeedStates[k]];
   }
+  // The header declares those speeds with its trim (a firmware trial: a simulation of the lag
+  // had to find them itself); here each is found by the test's own two passes.
+  for (int k = 0; k < M::kNumRotorSpeedStates; ++k)
+    EXPECT_NEAR(M::kHoverRotorSpeed[k], x[M::kRotorSpeedStates[k]], 1e-9 * x[M::kRotorSpeedStates[k]]) << M::kStateNames[M::kRotorSpeedStates[k]];
   M::rhs(x, u, M::kNominalParams, pre, f);
   double worst = 0;
   for (double v : f) worst = std::max(worst, std::abs(v));
@@ -541,6 +546,19 @@ TEST(Generated, AFittedModelWithRotorSpeedStatesHasItsOwnTrim) {
     EXPECT_LT(std::abs(f[i]), speed ? 1e-6 : 1e-8) << m.states[i].name;
   }
   EXPECT_GT(commands[1], commands[0] + 1e-3) << "M2, 10 % weak, asks for more";
+  // The header's rotor speeds at its own trim are the speeds found here (M2's, weak, the
+  // highest) (the header's own table; model.json says the same).
+  const std::string opening = "inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {";
+  const std::string& h = fitted.header.content;
+  const size_t at = h.find(opening);
+  ASSERT_NE(at, std::string::npos);
+  std::istringstream in(h.substr(at + opening.size(), h.find('}', at) - at - opening.size()));
+  std::vector<double> speeds;
+  for (std::string item; std::getline(in, item, ',');) speeds.push_back(std::stod(item));
+  ASSERT_EQ(speeds.size(), 4u);
+  for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(speeds[k], x[m.rotor_speed_states[k]], 1e-6) << k;
+  EXPECT_GT(speeds[1], speeds[0] + 1);
+  EXPECT_EQ(nlohmann::json::parse(fitted.model_json)["hover_trim"]["rotor_speed_rad_s"].get<std::vector<double>>(), fitted.hover_trim.rotor_speeds);
 }
 
 // The header's inline namespace is named after its code: a vehicle file read from another

@@ -4,26 +4,20 @@
 // model. Exits non-zero unless both trims hold.
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 
 #include "finken3_lag_model/model.hpp"  // finken3 with motor_gain, motor_lag
 #include "finken3_model/model.hpp"      // finken3
 
 // The largest |f| at the model's hover trim (kHoverCommand): level and still at 1 m, the
-// rotor speeds (states where the model has motor_lag) where the commands put them.
+// rotor speeds (states where the model has motor_lag) at the trim's (kHoverRotorSpeed).
 template <class M>
 double hover_residual() {
   double x[M::kNumStates] = {}, u[M::kNumInputs] = {}, f[M::kNumStates];
-  x[2] = 1, x[6] = 1;  // z [m], qw
+  x[M::State::z] = 1, x[M::State::qw] = 1;
   for (int i = 0; i < M::kNumRotors; ++i) u[i] = M::kHoverCommand[i];
+  for (int k = 0; k < M::kNumRotorSpeedStates; ++k) x[M::kRotorSpeedStates[k]] = M::kHoverRotorSpeed[k];
   typename M::template Precomputed<double> pre;
   M::precompute(M::kNominalParams, &pre);
-  double tau = 0;
-  for (int i = 0; i < M::kNumParams; ++i)
-    if (std::strcmp(M::kParamNames[i], "motor_lag.tau") == 0) tau = M::kNominalParams[i];
-  M::rhs(x, u, M::kNominalParams, pre, f);
-  for (int k = 0; k < M::kNumRotorSpeedStates; ++k)  // dw/dt = (w_cmd - w) / tau, here at w = 0
-    x[M::kRotorSpeedStates[k]] = tau * f[M::kRotorSpeedStates[k]];
   M::rhs(x, u, M::kNominalParams, pre, f);
   double worst = 0;
   for (double v : f) worst = std::fmax(worst, std::fabs(v));

@@ -42,7 +42,7 @@ namespace crazyflie21 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_b29277e627f391ffa389622fd8cf6225 {
+inline namespace model_b57abec3e643e4a36e7aba6fab0c0df2 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -50,7 +50,9 @@ inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 257;
 // The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
-// their rows of f.
+// their rows of f. C++ has no empty array: a table with no entry here (no rotor-speed state,
+// no constant, a Jacobian without entries) holds one unused 0, so loop up to its count
+// (kNumRotorSpeedStates, kNumConstants, k...Nnz), not over the array (a firmware trial).
 inline constexpr int kNumRotorSpeedStates = 0;
 inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
@@ -76,6 +78,9 @@ inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
 inline constexpr double kHoverCommand[kNumRotors] = {0.665545326649, 0.665545326649, 0.665545326649, 0.665545326649};
 inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
+// The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
+// (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 
 struct State {
   enum : int {
@@ -1429,10 +1434,16 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
 
 // The model as one type, for code templated on the model (runtime/ integrators, fits).
 struct Model {
+  // The indices by name, for code written against any Model (x[M::State::z]).
+  using State = crazyflie21::State;
+  using Input = crazyflie21::Input;
+  using Param = crazyflie21::Param;
+  using Output = crazyflie21::Output;
   static constexpr int kNumStates = crazyflie21::kNumStates;
   static constexpr int kNumInputs = crazyflie21::kNumInputs;
   static constexpr int kNumParams = crazyflie21::kNumParams;
   static constexpr int kNumOutputs = crazyflie21::kNumOutputs;
+  static constexpr int kNumPrecomputed = crazyflie21::kNumPrecomputed;
   static constexpr int kInputDelayParam = crazyflie21::kInputDelayParam;
   static constexpr int kNumRotorSpeedStates = crazyflie21::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21::kRotorSpeedStates;
@@ -1468,6 +1479,7 @@ struct Model {
   static constexpr bool kHasHoverTrim = crazyflie21::kHasHoverTrim;
   static constexpr const double* kHoverCommand = crazyflie21::kHoverCommand;
   static constexpr const double* kHoverThrust = crazyflie21::kHoverThrust;
+  static constexpr const double* kHoverRotorSpeed = crazyflie21::kHoverRotorSpeed;
   static constexpr const char* const* kConstantNames = crazyflie21::kConstantNames;
   static constexpr const double* kConstantValues = crazyflie21::kConstantValues;
   template <typename Scalar>
@@ -1498,6 +1510,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_b29277e627f391ffa389622fd8cf6225
+}  // inline namespace model_b57abec3e643e4a36e7aba6fab0c0df2
 }  // namespace crazyflie21
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_89ed93872610e7270120dcab61894f50 {
+inline namespace model_b72b929a3c1437c05fc8160f426e0617 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -50,7 +50,9 @@ inline constexpr int kNumParams = 22;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 284;
 // The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
-// their rows of f.
+// their rows of f. C++ has no empty array: a table with no entry here (no rotor-speed state,
+// no constant, a Jacobian without entries) holds one unused 0, so loop up to its count
+// (kNumRotorSpeedStates, kNumConstants, k...Nnz), not over the array (a firmware trial).
 inline constexpr int kNumRotorSpeedStates = 0;
 inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
@@ -76,6 +78,9 @@ inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
 inline constexpr double kHoverCommand[kNumRotors] = {0.549295413174, 0.549295413174, 0.549295413174, 0.549295413174};
 inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
+// The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
+// (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 
 struct State {
   enum : int {
@@ -1517,10 +1522,16 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
 
 // The model as one type, for code templated on the model (runtime/ integrators, fits).
 struct Model {
+  // The indices by name, for code written against any Model (x[M::State::z]).
+  using State = crazyflie21_nanobench::State;
+  using Input = crazyflie21_nanobench::Input;
+  using Param = crazyflie21_nanobench::Param;
+  using Output = crazyflie21_nanobench::Output;
   static constexpr int kNumStates = crazyflie21_nanobench::kNumStates;
   static constexpr int kNumInputs = crazyflie21_nanobench::kNumInputs;
   static constexpr int kNumParams = crazyflie21_nanobench::kNumParams;
   static constexpr int kNumOutputs = crazyflie21_nanobench::kNumOutputs;
+  static constexpr int kNumPrecomputed = crazyflie21_nanobench::kNumPrecomputed;
   static constexpr int kInputDelayParam = crazyflie21_nanobench::kInputDelayParam;
   static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench::kRotorSpeedStates;
@@ -1556,6 +1567,7 @@ struct Model {
   static constexpr bool kHasHoverTrim = crazyflie21_nanobench::kHasHoverTrim;
   static constexpr const double* kHoverCommand = crazyflie21_nanobench::kHoverCommand;
   static constexpr const double* kHoverThrust = crazyflie21_nanobench::kHoverThrust;
+  static constexpr const double* kHoverRotorSpeed = crazyflie21_nanobench::kHoverRotorSpeed;
   static constexpr const char* const* kConstantNames = crazyflie21_nanobench::kConstantNames;
   static constexpr const double* kConstantValues = crazyflie21_nanobench::kConstantValues;
   template <typename Scalar>
@@ -1586,6 +1598,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_89ed93872610e7270120dcab61894f50
+}  // inline namespace model_b72b929a3c1437c05fc8160f426e0617
 }  // namespace crazyflie21_nanobench
 }  // namespace quadgen_generated

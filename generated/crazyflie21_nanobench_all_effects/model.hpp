@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_1fd4cc48319ba8b74624eb3439d3a75a {
+inline namespace model_ea277967855a4b8ebc68e90fc0911151 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -50,7 +50,9 @@ inline constexpr int kNumParams = 45;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 423;
 // The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
-// their rows of f.
+// their rows of f. C++ has no empty array: a table with no entry here (no rotor-speed state,
+// no constant, a Jacobian without entries) holds one unused 0, so loop up to its count
+// (kNumRotorSpeedStates, kNumConstants, k...Nnz), not over the array (a firmware trial).
 inline constexpr int kNumRotorSpeedStates = 4;
 inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {13, 14, 15, 16};
 // What this header was generated from: a runtime may use it only for the same vehicle
@@ -76,6 +78,9 @@ inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
 inline constexpr double kHoverCommand[kNumRotors] = {0.549295413174, 0.549295413174, 0.549295413174, 0.549295413174};
 inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
+// The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
+// (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {1868.796550643765, 1868.796550643765, 1868.796550643765, 1868.796550643765};
 
 struct State {
   enum : int {
@@ -2202,10 +2207,16 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
 
 // The model as one type, for code templated on the model (runtime/ integrators, fits).
 struct Model {
+  // The indices by name, for code written against any Model (x[M::State::z]).
+  using State = crazyflie21_nanobench_all_effects::State;
+  using Input = crazyflie21_nanobench_all_effects::Input;
+  using Param = crazyflie21_nanobench_all_effects::Param;
+  using Output = crazyflie21_nanobench_all_effects::Output;
   static constexpr int kNumStates = crazyflie21_nanobench_all_effects::kNumStates;
   static constexpr int kNumInputs = crazyflie21_nanobench_all_effects::kNumInputs;
   static constexpr int kNumParams = crazyflie21_nanobench_all_effects::kNumParams;
   static constexpr int kNumOutputs = crazyflie21_nanobench_all_effects::kNumOutputs;
+  static constexpr int kNumPrecomputed = crazyflie21_nanobench_all_effects::kNumPrecomputed;
   static constexpr int kInputDelayParam = crazyflie21_nanobench_all_effects::kInputDelayParam;
   static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench_all_effects::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench_all_effects::kRotorSpeedStates;
@@ -2241,6 +2252,7 @@ struct Model {
   static constexpr bool kHasHoverTrim = crazyflie21_nanobench_all_effects::kHasHoverTrim;
   static constexpr const double* kHoverCommand = crazyflie21_nanobench_all_effects::kHoverCommand;
   static constexpr const double* kHoverThrust = crazyflie21_nanobench_all_effects::kHoverThrust;
+  static constexpr const double* kHoverRotorSpeed = crazyflie21_nanobench_all_effects::kHoverRotorSpeed;
   static constexpr const char* const* kConstantNames = crazyflie21_nanobench_all_effects::kConstantNames;
   static constexpr const double* kConstantValues = crazyflie21_nanobench_all_effects::kConstantValues;
   template <typename Scalar>
@@ -2271,6 +2283,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_1fd4cc48319ba8b74624eb3439d3a75a
+}  // inline namespace model_ea277967855a4b8ebc68e90fc0911151
 }  // namespace crazyflie21_nanobench_all_effects
 }  // namespace quadgen_generated

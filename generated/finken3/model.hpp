@@ -42,7 +42,7 @@ namespace finken3 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_5ab7cc681f4a13240eb2e2acb5ff4ad2 {
+inline namespace model_8a60a2a775e8a0929929c7d30b062e76 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -50,7 +50,9 @@ inline constexpr int kNumParams = 21;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 257;
 // The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
-// their rows of f.
+// their rows of f. C++ has no empty array: a table with no entry here (no rotor-speed state,
+// no constant, a Jacobian without entries) holds one unused 0, so loop up to its count
+// (kNumRotorSpeedStates, kNumConstants, k...Nnz), not over the array (a firmware trial).
 inline constexpr int kNumRotorSpeedStates = 0;
 inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 // What this header was generated from: a runtime may use it only for the same vehicle
@@ -76,6 +78,9 @@ inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
 inline constexpr double kHoverCommand[kNumRotors] = {0.350006028447, 0.350006028447, 0.350006028447, 0.350006028447};
 inline constexpr double kHoverThrust[kNumRotors] = {0.9491175, 0.9491175, 0.9491175, 0.9491175};
+// The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
+// (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {0};
 
 struct State {
   enum : int {
@@ -1431,10 +1436,16 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
 
 // The model as one type, for code templated on the model (runtime/ integrators, fits).
 struct Model {
+  // The indices by name, for code written against any Model (x[M::State::z]).
+  using State = finken3::State;
+  using Input = finken3::Input;
+  using Param = finken3::Param;
+  using Output = finken3::Output;
   static constexpr int kNumStates = finken3::kNumStates;
   static constexpr int kNumInputs = finken3::kNumInputs;
   static constexpr int kNumParams = finken3::kNumParams;
   static constexpr int kNumOutputs = finken3::kNumOutputs;
+  static constexpr int kNumPrecomputed = finken3::kNumPrecomputed;
   static constexpr int kInputDelayParam = finken3::kInputDelayParam;
   static constexpr int kNumRotorSpeedStates = finken3::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = finken3::kRotorSpeedStates;
@@ -1470,6 +1481,7 @@ struct Model {
   static constexpr bool kHasHoverTrim = finken3::kHasHoverTrim;
   static constexpr const double* kHoverCommand = finken3::kHoverCommand;
   static constexpr const double* kHoverThrust = finken3::kHoverThrust;
+  static constexpr const double* kHoverRotorSpeed = finken3::kHoverRotorSpeed;
   static constexpr const char* const* kConstantNames = finken3::kConstantNames;
   static constexpr const double* kConstantValues = finken3::kConstantValues;
   template <typename Scalar>
@@ -1500,6 +1512,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_5ab7cc681f4a13240eb2e2acb5ff4ad2
+}  // inline namespace model_8a60a2a775e8a0929929c7d30b062e76
 }  // namespace finken3
 }  // namespace quadgen_generated

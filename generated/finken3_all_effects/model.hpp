@@ -42,7 +42,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_807dcda3aabffdfc590054b428cdd80c {
+inline namespace model_11c5c7c9931e2fabf52ea349b1235cb9 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -50,7 +50,9 @@ inline constexpr int kNumParams = 44;
 inline constexpr int kNumOutputs = 7;
 inline constexpr int kNumPrecomputed = 409;
 // The states that are rotor speeds (motor_lag), in rotor order; rotor_speed_rates() writes
-// their rows of f.
+// their rows of f. C++ has no empty array: a table with no entry here (no rotor-speed state,
+// no constant, a Jacobian without entries) holds one unused 0, so loop up to its count
+// (kNumRotorSpeedStates, kNumConstants, k...Nnz), not over the array (a firmware trial).
 inline constexpr int kNumRotorSpeedStates = 4;
 inline constexpr int kRotorSpeedStates[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {13, 14, 15, 16};
 // What this header was generated from: a runtime may use it only for the same vehicle
@@ -76,6 +78,9 @@ inline constexpr int kRotorSpin[kNumRotors] = {1, -1, 1, -1};
 inline constexpr bool kHasHoverTrim = true;
 inline constexpr double kHoverCommand[kNumRotors] = {0.350006028447, 0.350006028447, 0.350006028447, 0.350006028447};
 inline constexpr double kHoverThrust[kNumRotors] = {0.9491175, 0.9491175, 0.9491175, 0.9491175};
+// The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
+// (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {915.3317729375229, 915.3317729375229, 915.3317729375229, 915.3317729375229};
 
 struct State {
   enum : int {
@@ -2155,10 +2160,16 @@ inline void measurement(const Scalar* x, const Scalar* p, const Precomputed<Scal
 
 // The model as one type, for code templated on the model (runtime/ integrators, fits).
 struct Model {
+  // The indices by name, for code written against any Model (x[M::State::z]).
+  using State = finken3_all_effects::State;
+  using Input = finken3_all_effects::Input;
+  using Param = finken3_all_effects::Param;
+  using Output = finken3_all_effects::Output;
   static constexpr int kNumStates = finken3_all_effects::kNumStates;
   static constexpr int kNumInputs = finken3_all_effects::kNumInputs;
   static constexpr int kNumParams = finken3_all_effects::kNumParams;
   static constexpr int kNumOutputs = finken3_all_effects::kNumOutputs;
+  static constexpr int kNumPrecomputed = finken3_all_effects::kNumPrecomputed;
   static constexpr int kInputDelayParam = finken3_all_effects::kInputDelayParam;
   static constexpr int kNumRotorSpeedStates = finken3_all_effects::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = finken3_all_effects::kRotorSpeedStates;
@@ -2194,6 +2205,7 @@ struct Model {
   static constexpr bool kHasHoverTrim = finken3_all_effects::kHasHoverTrim;
   static constexpr const double* kHoverCommand = finken3_all_effects::kHoverCommand;
   static constexpr const double* kHoverThrust = finken3_all_effects::kHoverThrust;
+  static constexpr const double* kHoverRotorSpeed = finken3_all_effects::kHoverRotorSpeed;
   static constexpr const char* const* kConstantNames = finken3_all_effects::kConstantNames;
   static constexpr const double* kConstantValues = finken3_all_effects::kConstantValues;
   template <typename Scalar>
@@ -2224,6 +2236,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_807dcda3aabffdfc590054b428cdd80c
+}  // inline namespace model_11c5c7c9931e2fabf52ea349b1235cb9
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
