@@ -161,6 +161,15 @@ void declare_rotors(ModelContext& c) {
   for (size_t i = 0; i < c.vehicle.rotors.size(); ++i) {
     const Rotor& r = c.vehicle.rotors[i];
     const std::string n = r.name;
+    // A rotor's numbers are named "<rotor>.x" ..., an effect's parameters "<effect>.x": a rotor
+    // named after an effect would share names with its parameters (a red-team review: the
+    // derivation read cog_offset.y - cog_offset.y for a rotor's y and the CoG offset's, and
+    // `--set cog_offset.z` was answered for the wrong one). Refused with every model, so that
+    // no diagnosis stops when its search reaches the effect.
+    if (effect_named(n))
+      throw VehicleError(c.vehicle.source_path + (r.line > 0 ? ":" + std::to_string(r.line) : "") + ": rotor name '" + n +
+                         "' is the name of an effect, whose parameters are named '" + n +
+                         ".<name>' as the rotor's position is: rename the rotor (e.g. '" + n + "_rotor')");
     c.rotor_disc_area.push_back(c.add_constant(n + ".A_p", "m^2", r.disc_area, "thrust-law area of rotor " + n + " (its disc_area)"));
     c.rotor_radius.push_back(c.add_constant(n + ".r_p", "m", r.radius, "propeller radius of rotor " + n));
     // One statement each: the order of a call's arguments is unspecified, and it is the

@@ -20,7 +20,8 @@ const std::set<std::string>& generated_header_names() {
       "kNumInputs", "kNumParams", "kNumOutputs", "kNumPrecomputed", "kNumRotorSpeedStates", "kRotorSpeedStates",
       "kVehicleHash", "kEffects", "kStateNames", "kInputNames", "kParamNames", "kOutputNames", "kNominalParams",
       "kInputDelayParam", "kParamUnits", "kParamLower", "kParamUpper", "kParamFit", "kNumConstants", "kConstantNames",
-      "kConstantValues", "kNumRotors", "kRotorSpin", "kHasHoverTrim", "kHoverCommand", "kHoverThrust"};
+      "kConstantValues", "kNumRotors", "kRotorSpin", "kHasHoverTrim", "kHoverCommand", "kHoverThrust",
+      "kHoverRotorSpeed"};
   return names;
 }
 

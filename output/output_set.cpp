@@ -42,6 +42,12 @@ constexpr const char* kCommandKey = "command ";
 constexpr const char* kKeepMarker = ".quadgen-keep";
 // Beside the files OutputFiles writes (simulate's trajectory and plot): what it wrote there.
 constexpr const char* kFilesRecordName = ".quadgen-files";
+// The record of a commit under way: this run's files with their new hashes, in place before
+// the first file is moved and removed after the record is. A run killed between the moves
+// (SIGKILL, a power cut) leaves each file either as the record or as this says, and the next
+// run takes either as this command's (a red-team review: a simulate killed there left its
+// files beside the earlier record, and every later run to that path was refused).
+constexpr const char* kPendingRecordName = ".quadgen-files-pending";
 
 [[noreturn]] void fail(const fs::path& p, const std::string& what) {
   throw OutputError(printable(p.string()) + ": " + what);
@@ -723,13 +729,17 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   // wrote it there and it is unchanged since: a flight log of the user's looks like a
   // trajectory, a plot of theirs may be gnuplot's too.
   const Manifest record = read_files_record(parent / kFilesRecordName);
+  const Manifest pending = read_files_record(parent / kPendingRecordName);
+  const auto vouches = [&](const Manifest& m, const fs::path& p) {
+    const auto it = m.files.find(p.filename().string());
+    return m.command == command_ && it != m.files.end() && unchanged_since(p, it->second, m);
+  };
   for (const auto& path : paths_) {
     const fs::path p(path);
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) continue;
     if (!S_ISREG(st.st_mode)) fail(p, "exists and is not a regular file (a link or a directory); choose another path");
-    const auto it = record.files.find(p.filename().string());
-    if (record.command != command_ || it == record.files.end() || !unchanged_since(p, it->second, record))
+    if (!vouches(record, p) && !vouches(pending, p))
       fail(p, "exists and is not a file 'quadgen " + command_ + "' wrote there (or it was changed since); choose another path or remove it");
   }
   created_.create(parent);
@@ -750,13 +760,25 @@ void OutputFiles::commit() {
   // The constructor let through only files this command wrote here, unchanged since.
   for (size_t i = 0; i < paths_.size(); ++i)
     if (std::error_code e; fs::exists(fs::symlink_status(paths_[i], e))) replaced_.push_back(named_[i]);
+  const fs::path parent = fs::path(paths_.front()).parent_path();
+  std::map<std::string, std::string> moving;
+  for (size_t i = 0; i < paths_.size(); ++i) {
+    const std::string name = fs::path(paths_[i]).filename().string();
+    if (written_[i]) moving[name] = hash_and_size(staging_->path() / name);
+  }
+  staging_->write(kPendingRecordName, manifest_text(command_, moving));
+  const fs::path staged_pending = staging_->path() / kPendingRecordName;
+  if (::rename(staged_pending.c_str(), (parent / kPendingRecordName).c_str()) != 0)
+    fail(parent / kPendingRecordName, "cannot move into place: " + errno_text());
   for (size_t i = 1; i < paths_.size(); ++i) fs::remove(paths_[i], ec);  // no companion of another run
   for (size_t i = 0; i < paths_.size(); ++i) {
     if (!written_[i]) continue;
     const fs::path staged = staging_->path() / fs::path(paths_[i]).filename();
     if (::rename(staged.c_str(), paths_[i].c_str()) != 0) fail(paths_[i], "cannot move into place: " + errno_text());
+    test_hook_signal("after-a-file-moved");
   }
   update_record();
+  fs::remove(parent / kPendingRecordName, ec);
   created_.keep();
   fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
 }

@@ -1301,6 +1301,33 @@ TEST(DataLoss, ARunInterruptedWithItsFilesStagedLeavesNothingBehind) {
                                  tmp / "s/t/f.csv"}, tmp.dir, {}, {"QUADGEN_TEST_SIGNAL=before-commit:15"});
   EXPECT_EQ(traj.rc, 128 + SIGTERM) << traj.err;
   EXPECT_FALSE(fs::exists(tmp / "s"));
+
+  // Killed (SIGKILL: no handler runs) with its trajectory moved into place and its plot not
+  // yet, beside the earlier run's record: the next run to the path takes the files as
+  // simulate's (the commit's pending record vouches for them) and sweeps the dead run's
+  // staging folder (a red-team review: every later run was refused).
+  const auto flight = [&](const std::string& duration, std::vector<std::string> env) {
+    return run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", duration, "--out", tmp / "k/f.csv"},
+                       tmp.dir, {}, std::move(env));
+  };
+  ASSERT_EQ(flight("0.2", {}).rc, 0);
+  const std::string first = read(tmp / "k/f.csv");
+  const auto killed = flight("0.3", {"QUADGEN_TEST_SIGNAL=after-a-file-moved:9"});
+  EXPECT_EQ(killed.rc, 128 + SIGKILL) << killed.err;
+  EXPECT_NE(read(tmp / "k/f.csv"), first) << "the killed run's trajectory is in place";
+  const auto next = flight("0.25", {});
+  EXPECT_EQ(next.rc, 0) << next.err;
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(tmp / "k"))
+    if (e.path().filename().string().rfind(".quadgen-files", 0) != 0) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"f.csv", "f.svg"})) << "no staging folder left";
+  EXPECT_FALSE(fs::exists(tmp / "k/.quadgen-files-pending"));
+  // A file the record and the pending record know nothing of is still refused.
+  write(tmp / "k/f.csv", "t,x\n0,1\n");
+  const auto refused = flight("0.2", {});
+  EXPECT_NE(refused.rc, 0);
+  EXPECT_NE(refused.err.find("is not a file 'quadgen simulate' wrote there"), std::string::npos) << refused.err;
 }
 
 // motor_lag_spread scales motor_lag's time constant: asked for without it, derive and

@@ -138,6 +138,21 @@ TEST(VehicleInput, TiltedRotorIsSaidToBeOutsideTheModel) {
                        "{name: B, orientation_deg: [0, 10, 0], position: [0.07465, -0.07465, 0],"),
                "a rotor takes no 'orientation_deg': every rotor's thrust acts along body +z");
 }
+// A rotor named after an effect would share names with the effect's parameters (its position
+// "cog_offset.y" beside the CoG offset's): refused with every model, at the rotor's line.
+TEST(VehicleInput, ARotorNamedAfterAnEffectIsRefused) {
+  const quadgen::Vehicle v = quadgen::parse_vehicle(replace(finken_text(), "{name: B, position", "{name: cog_offset, position"), "r.yaml");
+  const quadgen::Vehicle ok = quadgen::parse_vehicle(replace(finken_text(), "{name: B, position", "{name: cog_offset_rotor, position"), "r.yaml");
+  EXPECT_NO_THROW(quadgen::derive_model(ok, quadgen::derive_mass_properties(ok), {}));
+  try {
+    quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});  // no effect asked for: refused all the same
+    ADD_FAILURE() << "a rotor named cog_offset was accepted";
+  } catch (const quadgen::VehicleError& e) {
+    const std::string msg = e.what();
+    EXPECT_TRUE(std::regex_search(msg, std::regex("^r\\.yaml:[0-9]+: rotor name 'cog_offset' is the name of an effect"))) << msg;
+    EXPECT_NE(msg.find("rename the rotor (e.g. 'cog_offset_rotor')"), std::string::npos) << msg;
+  }
+}
 TEST(VehicleInput, NegativeMass) {
   expect_error(replace(finken_text(), "mass: 0.099", "mass: -0.099"), "expected a positive number for mass");
 }
