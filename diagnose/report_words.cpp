@@ -225,11 +225,16 @@ std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(
 }
 
 std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths) {
-  std::vector<std::string> stems;
-  for (const auto& p : paths) stems.push_back(std::filesystem::path(p).stem().string());
+  std::vector<std::string> stems, seen;
+  for (const auto& p : paths) {
+    stems.push_back(std::filesystem::path(p).stem().string());
+    // As the sinks show them: "x y" and "x<tab>y" both read "x y" in a CSV and a legend (a
+    // red-team review: two flights were one series there), "flight" and "flight<U+200B>" alike.
+    seen.push_back(output::visible_skeleton(stems.back()));
+  }
   std::vector<std::string> out;
   for (size_t i = 0; i < stems.size(); ++i) {
-    const bool shared = std::count(stems.begin(), stems.end(), stems[i]) > 1;
+    const bool shared = std::count(seen.begin(), seen.end(), seen[i]) > 1;
     out.push_back(shared ? "flight " + std::to_string(i + 1) + " (" + stems[i] + ")" : stems[i]);
   }
   return out;

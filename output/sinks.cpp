@@ -168,6 +168,16 @@ bool blank_looking(const std::string& c) {
 }
 }  // namespace
 
+std::string visible_skeleton(const std::string& s) {
+  std::string out;
+  for_each_char(s, [&](const std::string& c) {
+    const bool unseen = (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) || invisible_control(c) ||
+                        blank_looking(c) || c == "\xE2\x80\x8C" || c == "\xE2\x80\x8D";  // and U+200C, U+200D joiners
+    if (!unseen) out += c;
+  });
+  return out;
+}
+
 std::string csv_field(const std::string& s) {
   // The text as the file will hold it: control characters as spaces, the invisible ones shown.
   std::vector<std::string> chars;

@@ -20,6 +20,11 @@ std::string printable_error(const std::string& message);
 // Several lines for a terminal (a command's summary): each line as printable makes it, the
 // line breaks kept. Summaries quote log paths, which may carry escape sequences.
 std::string printable_lines(const std::string& text);
+// What of `s` every sink shows alike: its characters without the control characters (a sink
+// shows them as spaces, or drops them), the invisible ones (bidirectional controls,
+// zero-width characters) and whatever looks blank. Two names with one skeleton may read the
+// same in some sink: a caller that must keep them apart (a plot's series) numbers them.
+std::string visible_skeleton(const std::string& s);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
 // trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);

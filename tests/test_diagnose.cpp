@@ -2402,4 +2402,15 @@ TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {
   EXPECT_EQ(short_flight_labels({"data/B2.csv", "B3.csv"}), (std::vector<std::string>{"B2", "B3"}));
   EXPECT_EQ(short_flight_labels({"day1/log.csv", "B3.csv", "day2/log.csv"}),
             (std::vector<std::string>{"flight 1 (log)", "B3", "flight 3 (log)"}));
+  // Names that differ only where a sink shows nothing or a blank (a tab where a space is, a
+  // zero-width space, a bidi mark) read the same there: numbered too (a red-team review:
+  // two flights were one series of command_gain.csv).
+  const auto labels = short_flight_labels({"x y.csv", "x\ty.csv", "flight.csv", "flight\xE2\x80\x8B.csv", "a.csv"});
+  EXPECT_EQ(labels[0].rfind("flight 1 (", 0), 0u) << labels[0];
+  EXPECT_EQ(labels[1].rfind("flight 2 (", 0), 0u) << labels[1];
+  EXPECT_EQ(labels[2].rfind("flight 3 (", 0), 0u) << labels[2];
+  EXPECT_EQ(labels[3].rfind("flight 4 (", 0), 0u) << labels[3];
+  EXPECT_EQ(labels[4], "a");
+  EXPECT_EQ(quadgen::output::visible_skeleton("a\xE2\x80\xAE b\x01\xC2\xA0" "c"), "abc");
+  EXPECT_EQ(quadgen::output::visible_skeleton("B3_rep2"), "B3_rep2");
 }
