@@ -156,6 +156,13 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
 
 std::string trim_number(double v) { return number(declared_trim_value(v)); }
 
+// A rotor speed at the trim to 15 significant digits (declared_trim_value says why).
+std::string speed_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  return number(std::strtod(buf, nullptr));
+}
+
 // The rotors' spins and the hover trim (EmitOptions), where the caller gives them.
 void set_rotor_facts(data& d, const EmitOptions& opt, size_t rotor_speed_states) {
   const size_t n = opt.rotor_spin.size();
@@ -177,7 +184,7 @@ void set_rotor_facts(data& d, const EmitOptions& opt, size_t rotor_speed_states)
   const bool speeds = trimmed && rotor_speed_states > 0 && opt.hover_rotor_speed.size() == rotor_speed_states;
   std::string speed = "{";
   for (size_t i = 0; i < std::max<size_t>(1, rotor_speed_states); ++i)
-    speed += (i ? ", " : "") + (speeds ? number(opt.hover_rotor_speed[i]) : "0");
+    speed += (i ? ", " : "") + (speeds ? speed_number(opt.hover_rotor_speed[i]) : "0");
   d.set("hover_rotor_speed", speed + "}");
   d.set("hover_trim_line",
         trimmed ? (opt.hover_note.empty() ? std::string() : "// Hover trim: " + output::cpp_comment(opt.hover_note) + ".\n")

@@ -23,7 +23,7 @@ struct EmitOptions {
   std::vector<int> rotor_spin;
   std::vector<double> hover_command, hover_thrust;
   // rad/s: the rotor-speed states (motor_lag) at that trim's declared commands, in the
-  // model's order of them; declared in full (declared_trim_value).
+  // model's order of them; declared to 15 digits (declared_trim_value).
   std::vector<double> hover_rotor_speed;
   std::string why_no_hover;
   // Where the trim is the model's own because fitted effect values moved the base model's:
@@ -43,8 +43,9 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt);
 // A trim value (command, thrust) as the header declares it: 12 significant digits, which hold
 // hover to about 1e-10 m/s² and leave no last bits that another machine's solver could round
 // otherwise (CI compares generated/ byte for byte). The rotor speeds a motor lag has at the
-// trim are declared in full, found at these commands: a speed to 12 digits leaves its row
-// omega 1e-12 / tau off (5e-7 rad/s² at tau = 1 ms; the consumer check's example found it).
+// trim are found at these commands and declared to 15 digits: to 12 a speed leaves its row
+// omega 1e-12 / tau off (5e-7 rad/s² at tau = 1 ms; the consumer check's example found it),
+// to 15 about 1e-9, and no last bit that the order of GiNaC's terms could set (a review).
 double declared_trim_value(double v);
 
 // Where a header came from, as its comments and string constants tell it: text from a vehicle

@@ -232,11 +232,18 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
     // red-team review: two flights were one series there), "flight" and "flight<U+200B>" alike.
     seen.push_back(output::visible_skeleton(stems.back()));
   }
+  const auto numbered = [&](size_t i) { return "flight " + std::to_string(i + 1) + " (" + stems[i] + ")"; };
   std::vector<std::string> out;
-  for (size_t i = 0; i < stems.size(); ++i) {
-    const bool shared = std::count(seen.begin(), seen.end(), seen[i]) > 1;
-    out.push_back(shared ? "flight " + std::to_string(i + 1) + " (" + stems[i] + ")" : stems[i]);
-  }
+  for (size_t i = 0; i < stems.size(); ++i)
+    out.push_back(std::count(seen.begin(), seen.end(), seen[i]) > 1 ? numbered(i) : stems[i]);
+  // A log may itself be named as a numbered label is ("flight 1 (x).csv" beside two x.csv, a
+  // review): then every flight is numbered, and the numbers differ.
+  std::set<std::string> labels;
+  for (const auto& l : out)
+    if (!labels.insert(output::visible_skeleton(l)).second) {
+      for (size_t i = 0; i < stems.size(); ++i) out[i] = numbered(i);
+      break;
+    }
   return out;
 }
 

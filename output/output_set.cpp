@@ -761,7 +761,10 @@ void OutputFiles::commit() {
   for (size_t i = 0; i < paths_.size(); ++i)
     if (std::error_code e; fs::exists(fs::symlink_status(paths_[i], e))) replaced_.push_back(named_[i]);
   const fs::path parent = fs::path(paths_.front()).parent_path();
-  std::map<std::string, std::string> moving;
+  // A pending record left by a run killed in its moves keeps vouching for its files until a
+  // record takes them over (a review: replacing it lost them when a run to another path in
+  // the folder committed).
+  std::map<std::string, std::string> moving = still_pending(parent);
   for (size_t i = 0; i < paths_.size(); ++i) {
     const std::string name = fs::path(paths_[i]).filename().string();
     if (written_[i]) moving[name] = hash_and_size(staging_->path() / name);
@@ -783,12 +786,25 @@ void OutputFiles::commit() {
   fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
+// The entries of the pending record beside the files (kPendingRecordName) whose files still
+// hold what it says: a run killed in its moves wrote them, as this command.
+std::map<std::string, std::string> OutputFiles::still_pending(const fs::path& parent) const {
+  const Manifest pending = read_files_record(parent / kPendingRecordName);
+  std::map<std::string, std::string> out;
+  if (pending.command != command_) return out;
+  for (const auto& [name, hash_size] : pending.files)
+    if (unchanged_since(parent / name, hash_size, pending)) out[name] = hash_size;
+  return out;
+}
+
 // The record beside the files: this run's files with their hashes, the entries of earlier
-// runs kept where their files are still there; replaced whole by a rename.
+// runs kept where their files are still there (and those a killed run's pending record
+// vouches for); replaced whole by a rename.
 void OutputFiles::update_record() {
   const fs::path parent = fs::path(paths_.front()).parent_path(), record_path = parent / kFilesRecordName;
   Manifest record = read_files_record(record_path);
   if (record.command != command_) record.files.clear();
+  for (const auto& [name, hash_size] : still_pending(parent)) record.files[name] = hash_size;  // a killed run's
   for (auto it = record.files.begin(); it != record.files.end();) {
     std::error_code ec;
     if (!fs::exists(fs::symlink_status(parent / it->first, ec))) {

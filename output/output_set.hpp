@@ -14,6 +14,7 @@
 // directory; a companion of the previous run is removed first, so a kill leaves a missing
 // plot, never a plot of another run.
 #pragma once
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -104,6 +105,7 @@ class OutputFiles {
 
  private:
   void update_record();
+  std::map<std::string, std::string> still_pending(const std::filesystem::path& parent) const;
   std::vector<std::string> replaced_;
   std::string command_;
   std::vector<std::string> paths_;

@@ -2411,6 +2411,9 @@ TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {
   EXPECT_EQ(labels[2].rfind("flight 3 (", 0), 0u) << labels[2];
   EXPECT_EQ(labels[3].rfind("flight 4 (", 0), 0u) << labels[3];
   EXPECT_EQ(labels[4], "a");
+  // A log named as a numbered label is: every flight numbered (a review).
+  EXPECT_EQ(short_flight_labels({"a/x.csv", "b/x.csv", "c/flight 1 (x).csv"}),
+            (std::vector<std::string>{"flight 1 (x)", "flight 2 (x)", "flight 3 (flight 1 (x))"}));
   EXPECT_EQ(quadgen::output::visible_skeleton("a\xE2\x80\xAE b\x01\xC2\xA0" "c"), "abc");
   EXPECT_EQ(quadgen::output::visible_skeleton("B3_rep2"), "B3_rep2");
 }

@@ -1323,6 +1323,13 @@ TEST(DataLoss, ARunInterruptedWithItsFilesStagedLeavesNothingBehind) {
   std::sort(left.begin(), left.end());
   EXPECT_EQ(left, (std::vector<std::string>{"f.csv", "f.svg"})) << "no staging folder left";
   EXPECT_FALSE(fs::exists(tmp / "k/.quadgen-files-pending"));
+  // Killed so again, and then another path in the folder committed first: the killed run's
+  // files are still vouched for (a review: the other run's pending record replaced the one
+  // that vouched for them, and the next run to f.csv was refused).
+  EXPECT_EQ(flight("0.3", {"QUADGEN_TEST_SIGNAL=after-a-file-moved:9"}).rc, 128 + SIGKILL);
+  ASSERT_EQ(run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.2", "--out", tmp / "k/g.csv"}, tmp.dir).rc, 0);
+  const auto after_other = flight("0.25", {});
+  EXPECT_EQ(after_other.rc, 0) << after_other.err;
   // A file the record and the pending record know nothing of is still refused.
   write(tmp / "k/f.csv", "t,x\n0,1\n");
   const auto refused = flight("0.2", {});

@@ -42,7 +42,7 @@ namespace crazyflie21_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_ac3a7b7bd5c396ab466a5290fc02f8db {
+inline namespace model_138f481375914999cadbac782c1395ba {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -80,7 +80,7 @@ inline constexpr double kHoverCommand[kNumRotors] = {0.665545326649, 0.665545326
 inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
 // The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
 // (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
-inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {1868.7965506439175, 1868.7965506439175, 1868.7965506439175, 1868.7965506439175};
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {1868.79655064392, 1868.79655064392, 1868.79655064392, 1868.79655064392};
 
 struct State {
   enum : int {
@@ -2236,6 +2236,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_ac3a7b7bd5c396ab466a5290fc02f8db
+}  // inline namespace model_138f481375914999cadbac782c1395ba
 }  // namespace crazyflie21_all_effects
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace crazyflie21_nanobench_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_ea277967855a4b8ebc68e90fc0911151 {
+inline namespace model_19ff9b94f6b51f06e8cf530df2667675 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -80,7 +80,7 @@ inline constexpr double kHoverCommand[kNumRotors] = {0.549295413174, 0.549295413
 inline constexpr double kHoverThrust[kNumRotors] = {0.06646275, 0.06646275, 0.06646275, 0.06646275};
 // The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
 // (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
-inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {1868.796550643765, 1868.796550643765, 1868.796550643765, 1868.796550643765};
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {1868.79655064376, 1868.79655064376, 1868.79655064376, 1868.79655064376};
 
 struct State {
   enum : int {
@@ -2283,6 +2283,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_ea277967855a4b8ebc68e90fc0911151
+}  // inline namespace model_19ff9b94f6b51f06e8cf530df2667675
 }  // namespace crazyflie21_nanobench_all_effects
 }  // namespace quadgen_generated

@@ -42,7 +42,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_11c5c7c9931e2fabf52ea349b1235cb9 {
+inline namespace model_b319ae727f27fc2cc3a56833e2461def {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -80,7 +80,7 @@ inline constexpr double kHoverCommand[kNumRotors] = {0.350006028447, 0.350006028
 inline constexpr double kHoverThrust[kNumRotors] = {0.9491175, 0.9491175, 0.9491175, 0.9491175};
 // The rotor-speed states (kRotorSpeedStates, rad/s) at the trim, where the model has them
 // (motor_lag): a simulation of the lag starts its hover there (0 where there is no trim).
-inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {915.3317729375229, 915.3317729375229, 915.3317729375229, 915.3317729375229};
+inline constexpr double kHoverRotorSpeed[kNumRotorSpeedStates > 0 ? kNumRotorSpeedStates : 1] = {915.331772937523, 915.331772937523, 915.331772937523, 915.331772937523};
 
 struct State {
   enum : int {
@@ -2236,6 +2236,6 @@ struct Model {
   }
 };
 
-}  // inline namespace model_11c5c7c9931e2fabf52ea349b1235cb9
+}  // inline namespace model_b319ae727f27fc2cc3a56833e2461def
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
