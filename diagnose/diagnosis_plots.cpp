@@ -136,7 +136,9 @@ std::vector<runtime::Panel> command_gain_panels(const Diagnosis& d) {
   const auto by_flight = command_gains_by_flight(d);
   std::vector<std::string> paths;
   for (const auto& [flight, g] : by_flight) paths.push_back(flight);
-  const std::vector<std::string> labels = short_flight_labels(paths);
+  // Not a name of the plot's other series, nor of a model's colour (a review: "the model.csv").
+  const std::vector<std::string> labels =
+      short_flight_labels(paths, {"the model", "this flight", "measured", "base model", "extended model"});
   for (size_t i = 0; i < by_flight.size(); ++i)
     gains.emplace_back(by_flight[i].first.empty() ? "this flight" : labels[i], by_flight[i].second);
   std::vector<runtime::Panel> gain_panels;

@@ -224,7 +224,7 @@ std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(
   return out;
 }
 
-std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths) {
+std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths, const std::vector<std::string>& taken) {
   std::vector<std::string> stems, seen;
   for (const auto& p : paths) {
     stems.push_back(std::filesystem::path(p).stem().string());
@@ -233,9 +233,16 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
     seen.push_back(output::visible_skeleton(stems.back()));
   }
   const auto numbered = [&](size_t i) { return "flight " + std::to_string(i + 1) + " (" + stems[i] + ")"; };
+  const auto takes_a_name = [&](const std::string& s) {
+    for (const auto& t : taken) {
+      const std::string name = output::visible_skeleton(t);
+      if (s == name || s.rfind(name + ",", 0) == 0) return true;
+    }
+    return false;
+  };
   std::vector<std::string> out;
   for (size_t i = 0; i < stems.size(); ++i)
-    out.push_back(std::count(seen.begin(), seen.end(), seen[i]) > 1 ? numbered(i) : stems[i]);
+    out.push_back(std::count(seen.begin(), seen.end(), seen[i]) > 1 || takes_a_name(seen[i]) ? numbered(i) : stems[i]);
   // A log may itself be named as a numbered label is ("flight 1 (x).csv" beside two x.csv, a
   // review): then every flight is numbered, and the numbers differ.
   std::set<std::string> labels;

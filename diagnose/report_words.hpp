@@ -55,8 +55,11 @@ std::vector<std::pair<std::string, const CommandGain*>> command_gains_by_flight(
 
 // Short names of flights for a plot's legend: each log's file name without its folder and
 // extension, and where two share one (day1/log.csv, day2/log.csv) "flight k (log)" for each
-// of those, so that no two series carry one name.
-std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths);
+// of those, so that no two series carry one name. A flight named as one of `taken` is (the
+// plot's other series: "the model"; a name that starts "base model," takes its colour), or
+// that name and a comma, is numbered too.
+std::vector<std::string> short_flight_labels(const std::vector<std::string>& paths,
+                                             const std::vector<std::string>& taken = {});
 
 // What the screening says in words: flights left out, or a caution on an unusable flight
 // diagnosed anyway (the flight's path made printable: these go to a terminal too).

@@ -168,12 +168,27 @@ bool blank_looking(const std::string& c) {
 }
 }  // namespace
 
+namespace {
+// Characters a font draws as nothing (beyond the blanks and controls): the zero-width joiners
+// U+200C, U+200D, the soft hyphen U+00AD, the combining grapheme joiner U+034F, the invisible
+// operators U+2061..U+2064, the variation selectors U+FE00..U+FE0F and the Hangul fillers
+// U+115F, U+3164 (a review of visible_skeleton).
+bool shows_as_nothing(const std::string& c) {
+  const auto b = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
+  if (c.size() == 2) return (b(0) == 0xC2 && b(1) == 0xAD) || (b(0) == 0xCD && b(1) == 0x8F);
+  if (c.size() != 3) return false;
+  return (b(0) == 0xE2 && b(1) == 0x80 && (b(2) == 0x8C || b(2) == 0x8D)) ||
+         (b(0) == 0xE2 && b(1) == 0x81 && b(2) >= 0xA1 && b(2) <= 0xA4) || (b(0) == 0xEF && b(1) == 0xB8 && b(2) <= 0x8F) ||
+         (b(0) == 0xE1 && b(1) == 0x85 && b(2) == 0x9F) || (b(0) == 0xE3 && b(1) == 0x85 && b(2) == 0xA4);
+}
+}  // namespace
+
 std::string visible_skeleton(const std::string& s) {
   std::string out;
   for_each_char(s, [&](const std::string& c) {
-    const bool unseen = (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) || invisible_control(c) ||
-                        blank_looking(c) || c == "\xE2\x80\x8C" || c == "\xE2\x80\x8D";  // and U+200C, U+200D joiners
-    if (!unseen) out += c;
+    if (!(c.size() == 1 && control(static_cast<unsigned char>(c[0]))) && !invisible_control(c) && !blank_looking(c) &&
+        !shows_as_nothing(c))
+      out += c;
   });
   return out;
 }

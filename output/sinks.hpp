@@ -22,7 +22,7 @@ std::string printable_error(const std::string& message);
 std::string printable_lines(const std::string& text);
 // What of `s` every sink shows alike: its characters without the control characters (a sink
 // shows them as spaces, or drops them), the invisible ones (bidirectional controls,
-// zero-width characters) and whatever looks blank. Two names with one skeleton may read the
+// zero-width characters, the soft hyphen, variation selectors) and whatever looks blank. Two names with one skeleton may read the
 // same in some sink: a caller that must keep them apart (a plot's series) numbers them.
 std::string visible_skeleton(const std::string& s);
 

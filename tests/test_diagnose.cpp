@@ -2414,6 +2414,11 @@ TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {
   // A log named as a numbered label is: every flight numbered (a review).
   EXPECT_EQ(short_flight_labels({"a/x.csv", "b/x.csv", "c/flight 1 (x).csv"}),
             (std::vector<std::string>{"flight 1 (x)", "flight 2 (x)", "flight 3 (flight 1 (x))"}));
+  // Nor a name of the plot's other series, or one that would take a model's colour.
+  EXPECT_EQ(short_flight_labels({"d/the model.csv", "base model, tilt.csv", "B3.csv"}, {"the model", "base model"}),
+            (std::vector<std::string>{"flight 1 (the model)", "flight 2 (base model, tilt)", "B3"}));
   EXPECT_EQ(quadgen::output::visible_skeleton("a\xE2\x80\xAE b\x01\xC2\xA0" "c"), "abc");
   EXPECT_EQ(quadgen::output::visible_skeleton("B3_rep2"), "B3_rep2");
+  EXPECT_EQ(quadgen::output::visible_skeleton("a\xC2\xAD" "b\xEF\xB8\x8F" "c\xE2\x81\xA2" "d\xE3\x85\xA4" "e"), "abcde");
+  EXPECT_EQ(quadgen::output::visible_skeleton("caf\xC3\xA9"), "caf\xC3\xA9");  // a letter stays
 }
