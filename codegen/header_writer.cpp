@@ -154,14 +154,17 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("constant_values", table(m.constants, [](const Variable& v) { return number(v.nominal); }));
 }
 
+// v rounded to `digits` significant digits, as printf's %g prints it.
+double to_significant_digits(double v, int digits) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return std::strtod(buf, nullptr);
+}
+
 std::string trim_number(double v) { return number(declared_trim_value(v)); }
 
 // A rotor speed at the trim to 15 significant digits (declared_trim_value says why).
-std::string speed_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.15g", v);
-  return number(std::strtod(buf, nullptr));
-}
+std::string speed_number(double v) { return number(to_significant_digits(v, 15)); }
 
 // The rotors' spins and the hover trim (EmitOptions), where the caller gives them.
 void set_rotor_facts(data& d, const EmitOptions& opt, size_t rotor_speed_states) {
@@ -210,11 +213,7 @@ void set_sparsity(data& d, const LoweredModel& lm) {
 
 }  // namespace
 
-double declared_trim_value(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return std::strtod(buf, nullptr);
-}
+double declared_trim_value(double v) { return to_significant_digits(v, 12); }
 
 GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) {
   const LoweredModel lm = lower_model(m);

@@ -729,17 +729,15 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   // wrote it there and it is unchanged since: a flight log of the user's looks like a
   // trajectory, a plot of theirs may be gnuplot's too.
   const Manifest record = read_files_record(parent / kFilesRecordName);
-  const Manifest pending = read_files_record(parent / kPendingRecordName);
-  const auto vouches = [&](const Manifest& m, const fs::path& p) {
-    const auto it = m.files.find(p.filename().string());
-    return m.command == command_ && it != m.files.end() && unchanged_since(p, it->second, m);
-  };
+  const std::map<std::string, std::string> pending = still_pending(parent);
   for (const auto& path : paths_) {
     const fs::path p(path);
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) continue;
     if (!S_ISREG(st.st_mode)) fail(p, "exists and is not a regular file (a link or a directory); choose another path");
-    if (!vouches(record, p) && !vouches(pending, p))
+    const auto it = record.files.find(p.filename().string());
+    const bool recorded = record.command == command_ && it != record.files.end() && unchanged_since(p, it->second, record);
+    if (!recorded && !pending.count(p.filename().string()))
       fail(p, "exists and is not a file 'quadgen " + command_ + "' wrote there (or it was changed since); choose another path or remove it");
   }
   created_.create(parent);
@@ -783,7 +781,7 @@ void OutputFiles::commit() {
   update_record();
   fs::remove(parent / kPendingRecordName, ec);
   created_.keep();
-  fsync_path(fs::path(paths_.front()).parent_path(), O_RDONLY | O_DIRECTORY);
+  fsync_path(parent, O_RDONLY | O_DIRECTORY);
 }
 
 // The entries of the pending record beside the files (kPendingRecordName) whose files still

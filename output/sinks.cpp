@@ -166,9 +166,7 @@ bool blank_looking(const std::string& c) {
   const auto u = [&](size_t i) { return static_cast<unsigned char>(c[i]); };
   return c.size() == 3 && u(0) == 0xE2 && u(1) == 0x80 && u(2) >= 0x80 && u(2) <= 0x8B;  // U+2000..U+200B
 }
-}  // namespace
 
-namespace {
 // Characters a font draws as nothing (beyond the blanks and controls): the zero-width joiners
 // U+200C, U+200D, the soft hyphen U+00AD, the combining grapheme joiner U+034F, the invisible
 // operators U+2061..U+2064, the variation selectors U+FE00..U+FE0F and the Hangul fillers
