@@ -64,10 +64,21 @@ DimensionChecker dimension_checker(const SymbolicModel& m) {
   return dc;
 }
 
-std::vector<AuditCheck> check_rotation() {
+std::vector<AuditCheck> check_quaternion_norm(const SymbolicModel& m) {
+  // d/dt |q|^2 = 2 q . dq/dt must vanish identically for the model's own quaternion rows.
+  ex s = 0;
+  for (int i = 0; i < 4; ++i) s += m.states[runtime::rigid_body::kAttitude + i].sym * m.f(runtime::rigid_body::kAttitude + i, 0);
+  const bool ok = expand(s).is_zero();
+  return {make("rotation", "quaternion kinematics preserve |q|", ok,
+               "q . dq/dt of the model's rows 7-10 expands to 0")};
+}
+
+}  // namespace
+
+std::vector<AuditCheck> check_rotation(const AttitudeForms& forms) {
   std::vector<AuditCheck> out;
   realsymbol phi("phi"), theta("theta"), psi("psi");
-  const matrix R = rotation_zyx(psi, theta, phi);
+  const matrix R = forms.zyx(psi, theta, phi);
   matrix RtR = R.transpose().mul(R);
   bool orth = true;
   for (int i = 0; i < 3; ++i)
@@ -81,7 +92,7 @@ std::vector<AuditCheck> check_rotation() {
 
   realsymbol qw("qw"), qx("qx"), qy("qy"), qz("qz");
   const matrix q = quaternion(qw, qx, qy, qz);
-  const matrix Rq = rotation_from_quaternion(q);
+  const matrix Rq = forms.from_quaternion(q);
   const matrix QtQ = Rq.transpose().mul(Rq);
   bool qorth = true;
   for (int i = 0; i < 3; ++i)
@@ -100,7 +111,7 @@ std::vector<AuditCheck> check_rotation() {
     half.append(sin(a) == 2 * sin(a / 2) * cos(a / 2));
     half.append(cos(a) == 1 - 2 * pow(sin(a / 2), 2));
   }
-  const matrix diff = rotation_from_quaternion(qzyx).sub(ex_to<matrix>(ex(R).subs(half)));
+  const matrix diff = forms.from_quaternion(qzyx).sub(ex_to<matrix>(ex(R).subs(half)));
   bool same = true;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -109,17 +120,6 @@ std::vector<AuditCheck> check_rotation() {
                      "R(q_z(psi) q_y(theta) q_x(phi)) - Rz Ry Rx reduces to 0 (half-angle identities)"));
   return out;
 }
-
-std::vector<AuditCheck> check_quaternion_norm(const SymbolicModel& m) {
-  // d/dt |q|^2 = 2 q . dq/dt must vanish identically for the model's own quaternion rows.
-  ex s = 0;
-  for (int i = 0; i < 4; ++i) s += m.states[runtime::rigid_body::kAttitude + i].sym * m.f(runtime::rigid_body::kAttitude + i, 0);
-  const bool ok = expand(s).is_zero();
-  return {make("rotation", "quaternion kinematics preserve |q|", ok,
-               "q . dq/dt of the model's rows 7-10 expands to 0")};
-}
-
-}  // namespace
 
 PrincipalMoments principal_moments(const Mat3& J) {
   Eigen::Matrix3d M;

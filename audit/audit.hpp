@@ -2,10 +2,12 @@
 // rotation properties, inertia validity and cross-checks, energy conservation.
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "derive/geometry.hpp"
+#include "derive/kinematics.hpp"
 #include "derive/symbolic_model.hpp"
 
 namespace quadgen {
@@ -28,6 +30,14 @@ struct AuditResult {
 AuditResult audit(const SymbolicModel& m, const MassProperties& mp);
 
 // Individual checks, exposed for tests.
+// The attitude forms the rotation checks judge: the derivation's own unless a test gives wrong
+// ones, to see each check fail (a check only ever seen to pass could be a constant).
+struct AttitudeForms {
+  std::function<GiNaC::matrix(const GiNaC::ex& psi, const GiNaC::ex& theta, const GiNaC::ex& phi)> zyx = rotation_zyx;
+  std::function<GiNaC::matrix(const GiNaC::matrix& q)> from_quaternion = rotation_from_quaternion;
+};
+// The Z-Y-X matrix and the quaternion matrix each orthogonal and proper, and the two agreeing.
+std::vector<AuditCheck> check_rotation(const AttitudeForms& forms = {});
 // Dimension of every f_i against state_i / s, and of every term of every sum.
 std::vector<AuditCheck> check_units(const SymbolicModel& m);
 // Reduces a polynomial in sin/cos of the given angles modulo sin^2 + cos^2 = 1.

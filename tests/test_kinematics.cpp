@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <set>
 
 #include "audit/audit.hpp"
 #include "derive/kinematics.hpp"
@@ -23,6 +24,48 @@ TEST(Kinematics, SymbolicRotationChecksPass) {
       EXPECT_TRUE(c.passed) << c.name << ": " << c.detail;
     }
   EXPECT_EQ(rotation_checks, 7);  // the Z-Y-X and quaternion matrices (5), |q| kept, Euler's equations
+}
+
+// Each rotation check, given a wrong attitude form, fails, and only the checks that form
+// breaks: a check seen only to pass could be a constant (a review of the tests, helper-123).
+TEST(Kinematics, EachRotationCheckFailsForAWrongAttitudeForm) {
+  const std::string zyx_orth = "Z-Y-X matrix orthogonal", zyx_proper = "Z-Y-X matrix proper (det = +1)",
+                    q_orth = "quaternion matrix orthogonal", q_proper = "quaternion matrix proper (det = +1)",
+                    agree = "quaternion and Z-Y-X matrix agree";
+  auto failed = [](const AttitudeForms& forms) {
+    std::set<std::string> out;
+    const auto checks = check_rotation(forms);
+    EXPECT_EQ(checks.size(), 5u);
+    for (const auto& c : checks)
+      if (!c.passed) out.insert(c.name);
+    return out;
+  };
+  using Set = std::set<std::string>;
+  EXPECT_EQ(failed({}), Set{});
+  const matrix flip_x(3, 3, lst{-1, 0, 0, 0, 1, 0, 0, 0, 1});
+  AttitudeForms reflected;  // the thesis' kind of error: a reflection, orthogonal but not proper
+  reflected.zyx = [&](const ex& psi, const ex& theta, const ex& phi) { return rotation_zyx(psi, theta, phi).mul(flip_x); };
+  EXPECT_EQ(failed(reflected), (Set{zyx_proper, agree}));
+  AttitudeForms slipped;  // one sign slipped in Rx: neither orthogonal nor proper
+  slipped.zyx = [](const ex& psi, const ex& theta, const ex& phi) {
+    const matrix bad_x(3, 3, lst{1, 0, 0, 0, cos(phi), -sin(phi), 0, -sin(phi), cos(phi)});
+    return rot_z(psi).mul(rot_y(theta)).mul(bad_x);
+  };
+  EXPECT_EQ(failed(slipped), (Set{zyx_orth, zyx_proper, agree}));
+  AttitudeForms world_to_body;  // the transpose: a rotation, but the other way round
+  world_to_body.from_quaternion = [](const matrix& q) { return rotation_from_quaternion(q).transpose(); };
+  EXPECT_EQ(failed(world_to_body), (Set{agree}));
+  AttitudeForms row_negated;  // orthogonal, det = -1
+  row_negated.from_quaternion = [&](const matrix& q) { return flip_x.mul(rotation_from_quaternion(q)); };
+  EXPECT_EQ(failed(row_negated), (Set{q_proper, agree}));
+  AttitudeForms entry_slipped;  // one entry's sign slipped
+  entry_slipped.from_quaternion = [](const matrix& q) {
+    matrix R = rotation_from_quaternion(q);
+    R(0, 1) = -R(0, 1);
+    return R;
+  };
+  EXPECT_EQ(failed(entry_slipped).count(q_orth), 1u);
+  EXPECT_EQ(failed(entry_slipped).count(agree), 1u);
 }
 
 TEST(Kinematics, ReduceTrigDetectsANonRotation) {

@@ -177,6 +177,52 @@ TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
   EXPECT_FALSE(passed(no_inverse, euler));
 }
 
+// The checks the derivation is only ever seen to pass, each fed a model or a tensor that breaks
+// what it checks (a review of the tests, helper-123): rates that feed energy in (k ω added to
+// J dω/dt, torques off) break both energy checks; a term ω × e_z, perpendicular to ω, keeps
+// the energy but not |Jω|; quaternion rows with k q added change |q|; an asymmetric J_cg.
+TEST(Model, EnergyNormAndSymmetryChecksFailWhereTheyShould) {
+  using namespace runtime::rigid_body;
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel good = derive(v);
+  auto P = [&](const char* n) { return good.params[good.param_index(n)].sym; };
+  const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
+                           P("J_xz"), P("J_yz"), P("J_zz")});
+  const matrix Jinv = J.inverse();
+  matrix w(3, 1);
+  for (int i = 0; i < 3; ++i) w(i, 0) = good.states[kBodyRate + i].sym;
+  auto with_added = [&](const matrix& Jwdot_added) {  // J dω/dt gains a term
+    SymbolicModel m = good;
+    const matrix wdot = Jinv.mul(Jwdot_added);
+    for (int i = 0; i < 3; ++i) m.f(kBodyRate + i, 0) += wdot(i, 0);
+    return m;
+  };
+  auto passed = [&](const SymbolicModel& m, const MassProperties& p, const std::string& check) {
+    for (const auto& c : audit(m, p).checks)
+      if (c.name == check) return c.passed;
+    ADD_FAILURE() << "no check " << check;
+    return false;
+  };
+  const std::string energy = "rotational kinetic energy conserved", magnitude = "angular momentum magnitude conserved",
+                    norm = "quaternion kinematics preserve |q|", symmetric = "symmetric";
+  for (const auto& name : {energy, magnitude, norm, symmetric}) EXPECT_TRUE(passed(good, mp, name)) << name;
+  const ex k = P("J_zz");  // any nonzero polynomial factor (the momentum check reduces polynomials)
+  const SymbolicModel feeding = with_added(w.mul_scalar(k));
+  EXPECT_FALSE(passed(feeding, mp, energy));
+  EXPECT_FALSE(passed(feeding, mp, magnitude));
+  const SymbolicModel turning = with_added(vec3(w(1, 0), -w(0, 0), 0));  // ω × e_z
+  EXPECT_TRUE(passed(turning, mp, energy));
+  EXPECT_FALSE(passed(turning, mp, magnitude));
+  SymbolicModel growing = good;
+  for (int i = 0; i < 4; ++i) growing.f(kAttitude + i, 0) += k * good.states[kAttitude + i].sym;
+  EXPECT_FALSE(passed(growing, mp, norm));
+  EXPECT_TRUE(passed(growing, mp, energy));  // the rates untouched
+  MassProperties lopsided = mp;
+  lopsided.inertia_cog(0, 1) = lopsided.inertia_cog(0, 1) + P("J_zz");
+  EXPECT_FALSE(passed(good, lopsided, symmetric));
+}
+
 TEST(Model, HoverIsAnEquilibrium) {
   // Level attitude, at rest, commands giving thrust m g: all accelerations vanish
   // when the CoG is on the thrust axis (it is, for the symmetric FINken 3).

@@ -826,6 +826,7 @@ namespace {
 
 using quadgen::runtime::AttitudeMixer;
 using quadgen::runtime::AttitudePid;
+using quadgen::runtime::AttitudePidOptions;
 
 AttitudeMixer mixer_of(const std::string& vehicle_file) {
   std::vector<std::array<double, 3>> positions;
@@ -878,6 +879,38 @@ TEST(FlyingSetPoints, TheMixerIsTheFirmwaresQuadXFromTheRotorPositions) {
 // Started from a window in which the loop tracked its set points (the means equal the
 // present values), the loop's next output is the window's mean output, but for one period of
 // the integrals (under 2 counts for a degree of error).
+// The replica's defaults are the firmware's CF2 values (platform_defaults_cf2.h and
+// attitude_pid_controller.c of bitcraze/crazyflie-firmware, as docs/simulation.md lists them;
+// the rate gains as an ETH course's exercise also reads them from the firmware), written here
+// as numbers, not read back from options(): the other tests take their expected values from
+// options() and would follow any change of a gain (a review of the tests, helper-123). Two
+// steps by hand with the firmware's PID step (integral first, then kp e + ki integral + kd
+// times the change of the error, here of the measured rate alone, at 500 Hz).
+TEST(FlyingSetPoints, TheDefaultsAreTheFirmwaresCf2Gains) {
+  const AttitudePidOptions o;
+  EXPECT_EQ(o.attitude.kp, 6.0);
+  EXPECT_EQ(o.attitude.ki, 3.0);
+  EXPECT_EQ(o.attitude.kd, 0.0);
+  EXPECT_EQ(o.attitude.integral_limit, 20.0);
+  EXPECT_EQ(o.rate.kp, 250.0);
+  EXPECT_EQ(o.rate.ki, 500.0);
+  EXPECT_EQ(o.rate.kd, 2.5);
+  EXPECT_EQ(o.rate.integral_limit, 33.3);
+  EXPECT_EQ(o.rate_hz, 500.0);
+  EXPECT_EQ(o.output_limit, 32767.0);
+  AttitudePid pid;
+  pid.start({0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0});
+  const double deg = M_PI / 180;
+  // A 2 degree set point, level and still: rate set point 6 * 2 + 3 * (2 * 0.002) deg/s.
+  const auto first = pid.update({0, 0}, {0, 0}, {2 * deg, 0});
+  EXPECT_NEAR(first[0], 250 * 12.012 + 500 * (12.012 * 0.002), 1e-9);
+  EXPECT_NEAR(first[1], 0, 1e-12);
+  // Then the rate measured at 10 deg/s: rate set point 12 + 3 * 0.008, its error 2.024, the
+  // rate integral 0.002 * (12.012 + 2.024), and kd times -10 deg/s over 2 ms.
+  const auto second = pid.update({0, 0}, {10 * deg, 0}, {2 * deg, 0});
+  EXPECT_NEAR(second[0], 250 * 2.024 + 500 * (0.002 * (12.012 + 2.024)) - 2.5 * 10 * 500, 1e-8);
+}
+
 TEST(FlyingSetPoints, TheControllerStartsWhereTheWindowBeforeLeftIt) {
   AttitudePid pid;
   const std::array<double, 2> angle = {0.10, -0.05}, rate = {0.3, -0.2}, ref = {0.11, -0.06}, output = {1500, -2500};
