@@ -61,6 +61,7 @@ TEST(CommandGain, RecoversAKnownGainAndDelay) {
   ASSERT_TRUE(g.measured) << g.why_not;
   EXPECT_NEAR(g.thrust_scale, 1.0, 0.02);  // the means of the swings over the rows used
   EXPECT_NEAR(g.hover_command, 0.6, 1e-12);
+  ASSERT_EQ(g.axes.size(), 3u);  // roll, pitch, collective: none may go unchecked
   for (const auto& axis : g.axes)
     for (size_t b = 0; b < 3; ++b) {  // the lowest band holds the slow disturbance too
       EXPECT_NEAR(axis.bands[b].gain, 0.6, 0.03) << axis.name << " band " << b;

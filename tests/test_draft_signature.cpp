@@ -94,6 +94,7 @@ TEST(DraftSignature, ADraftThroughTheRotorsShowsItsRatioOnBothAxesAndParts) {
       EXPECT_NEAR(p.y_roll.slope / p.y_roll.draft_slope, 1.0, 0.15) << seed << " " << p.name;
       EXPECT_NEAR(p.x_pitch.slope / p.x_pitch.draft_slope, 1.0, 0.15) << seed << " " << p.name;
       EXPECT_NEAR(p.y_roll.draft_slope, -kd * Jxx / (kf * mass), 1e-12);
+      EXPECT_NEAR(p.x_pitch.draft_slope, kd * Jyy / (kf * mass), 1e-12);  // J_yy, not J_xx (helper-123)
       EXPECT_GT(p.implied_speed, 0.1) << "the draft is about 0.2 m/s per axis";
       EXPECT_LT(p.implied_speed, 0.6);
     }

@@ -47,7 +47,12 @@ TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
     all.effects = parse_effect_list("all");
     for (const auto& opt : {DeriveOptions{}, all}) {
       const AuditResult r = audit(derive_model(v, mp, opt), mp);
-      for (const auto& c : r.checks) EXPECT_TRUE(c.passed) << file << ": " << c.group << " " << c.name << ": " << c.detail;
+      std::set<std::string> groups;
+      for (const auto& c : r.checks) {
+        EXPECT_TRUE(c.passed) << file << ": " << c.group << " " << c.name << ": " << c.detail;
+        groups.insert(c.group);
+      }
+      for (const char* g : {"units", "rotation", "inertia", "energy"}) EXPECT_EQ(groups.count(g), 1u) << file << ": no " << g << " check";
     }
   }
 }
@@ -104,8 +109,13 @@ TEST(Model, UnitCheckerRejectsInconsistentEquation) {
   EXPECT_TRUE(rejected);
   // ... and a right-hand side whose every term has the wrong unit.
   m.f(4, 0) = m.f(4, 0) * m.states[m.state_index("p")].sym;
+  bool found = false;
   for (const auto& c : check_units(m))
-    if (c.name == "dvy/dt") EXPECT_FALSE(c.passed);
+    if (c.name == "dvy/dt") {
+      EXPECT_FALSE(c.passed);
+      found = true;
+    }
+  EXPECT_TRUE(found) << "no check dvy/dt";
 }
 
 // The rotational rows are replaced by a wrong law for a general (not diagonal) J: the thesis'
@@ -929,14 +939,17 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   for (auto& b : heavier.blocks)
     if (b.name == "lower_body") b.mass = 0.2;
   const MassProperties mp2 = derive_mass_properties(heavier);
+  bool table_1 = false;
   for (const auto& t : compare_with_thesis(heavier, derive_model(heavier, mp2, {}), mp2))
     if (t.ref == "Table 1") {
+      table_1 = true;
       EXPECT_NE(t.cause.find("block 3 (lower_body) J_xx by 34 %, J_yy by 56 %, J_zz by 34 % (the vehicle file's block is "
                              "not the thesis' cuboid)"),
                 std::string::npos)
           << t.cause;
       EXPECT_EQ(t.cause.find("gives the derived value"), std::string::npos) << t.cause;
     }
+  EXPECT_TRUE(table_1) << "no Table 1 row";
   realsymbol a("a"), b("b"), c("c");
   EXPECT_TRUE(reduce_trig(thesis_transformation(a, b, c).determinant() + 1, {a, b, c}).is_zero());
   EXPECT_TRUE(reduce_trig(thesis_rotation_about_y(b).determinant() + 1, {b}).is_zero());

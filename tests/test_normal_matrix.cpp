@@ -25,6 +25,7 @@ TEST(NormalMatrix, ParametersOfVeryDifferentSizeAreAllDetermined) {
   J << 1, 0.5, 0, 0, 1, 0.2, 1, 0, 1, 0.3, 0.1, 0.4;
   const Eigen::MatrixXd H = normal_matrix(J, {1e-8, 1.0, 0.5});
   const auto a = analyse_normal_matrix(H);
+  ASSERT_EQ(a.confounded.size(), 3u);
   for (bool c : a.confounded) EXPECT_FALSE(c);
   const Eigen::MatrixXd inv = H.inverse();
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(a.covariance(i, i) / inv(i, i), 1.0, 1e-9) << i;
