@@ -1174,6 +1174,38 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   EXPECT_NEAR(column_mean(clean, "u_C", 500) - column_mean(clean, "u_A", 500), 0.0, 0.003);
 }
 
+// The Crazyflie's closed loop tracks its reference as the FINken 3's does (its golden flight
+// pins the bytes, not whether the flight is any good: a review of the tests, helper-123), on
+// every axis, with its own rotor names, and its commands stay inside [0, 1] without sitting
+// at a limit.
+TEST(ClosedLoop, TheCrazyflieTracksItsReferenceToo) {
+  const Vehicle v = load_vehicle(test::source_path("vehicles/crazyflie21.yaml"));
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel sm = derive_model(v, mp, {});
+  TapeModel truth(codegen::build_tape(sm));
+  const ControllerModel belief = nominal_controller_belief(v, sm);
+  std::vector<std::string> rotors;
+  for (const auto& r : v.rotors) rotors.push_back(r.name);
+  ClosedLoopOptions co;
+  co.duration = 20;
+  co.seed = 4;
+  const auto flight = fly_closed_loop(truth, belief, rotors, co);
+  ASSERT_GT(flight.rows.size(), 1000u);
+  for (const char* axis : {"x", "y", "z"}) {
+    const int a = index_in(flight.columns, axis), ar = index_in(flight.columns, std::string(axis) + "_ref");
+    double worst = 0;
+    for (size_t k = 500; k < flight.rows.size(); ++k) worst = std::max(worst, std::fabs(flight.rows[k][a] - flight.rows[k][ar]));
+    EXPECT_LT(worst, 0.15) << axis;
+  }
+  for (const auto& r : rotors) {
+    const int u = index_in(flight.columns, "u_" + r);
+    double low = 1, high = 0;
+    for (size_t k = 500; k < flight.rows.size(); ++k) low = std::min(low, flight.rows[k][u]), high = std::max(high, flight.rows[k][u]);
+    EXPECT_GT(low, 0.05) << r;
+    EXPECT_LT(high, 0.95) << r;
+  }
+}
+
 // The hover trim simulate flies and derive checks. A hexacopter whose centre of gravity lies
 // 12 cm toward rotor 0 (inside the rotors): the least-norm trim needs the far rotor to pull,
 // yet a trim with every rotor pushing exists (by hand: rotor 3 at zero, rotors 1 and 5 five
