@@ -57,12 +57,15 @@ void check_jacobians_against_finite_differences(int trials) {
           double an = 0;
           for (int k = 0; k < nnz; ++k)
             if (row[k] == i && col[k] == j) an = J[k];
-          // Central differences: truncation ~ h^2 f''' (relative to the entry) and rounding
-          // ~ eps |f| / h. The rounding bound with its own 1/h: a rotor-speed row's |f| of
-          // 1e4-7e4 rad/s^2 scaled the whole tolerance before, to a percent of its entries
-          // (a review of the tests, helper-123).
+          // Central differences: truncation ~ h^2 f''' and rounding ~ eps |f| / h (1e-13:
+          // about 450 eps). Beside 2e-5 of the entry, a floor of 2e-5 of the entry's natural size,
+          // (1 + |f|) / |v_j|: a floor of 2e-5 (1 + |f|) for every column checked the rotor-speed
+          // rows (|f| up to 7e4 rad/s^2) to a percent, and a floor of 2e-5 the columns of large
+          // variables (rotor speeds, the motor map's a0..a2) whose entries are small (reviews of
+          // the tests, helper-123, helper-125).
           const double rounding = 1e-13 * std::fabs(f[i]) / h;
-          EXPECT_NEAR(an, fd[i], 2e-5 * (1 + std::fabs(an)) + rounding) << what << " d f[" << i << "] / d " << j;
+          const double floor = 2e-5 * (1 + std::fabs(f[i])) / std::fmax(std::fabs(v[j]), 1.0);
+          EXPECT_NEAR(an, fd[i], 2e-5 * std::fabs(an) + floor + rounding) << what << " d f[" << i << "] / d " << j;
         }
       }
     };

@@ -876,16 +876,14 @@ TEST(FlyingSetPoints, TheMixerIsTheFirmwaresQuadXFromTheRotorPositions) {
     EXPECT_THROW(AttitudeMixer::quad_x(positions, spins), std::invalid_argument);
 }
 
-// Started from a window in which the loop tracked its set points (the means equal the
-// present values), the loop's next output is the window's mean output, but for one period of
-// the integrals (under 2 counts for a degree of error).
 // The replica's defaults are the firmware's CF2 values (platform_defaults_cf2.h and
 // attitude_pid_controller.c of bitcraze/crazyflie-firmware, as docs/simulation.md lists them;
 // the rate gains as an ETH course's exercise also reads them from the firmware), written here
 // as numbers, not read back from options(): the other tests take their expected values from
 // options() and would follow any change of a gain (a review of the tests, helper-123). Two
-// steps by hand with the firmware's PID step (integral first, then kp e + ki integral + kd
-// times the change of the error, here of the measured rate alone, at 500 Hz).
+// steps by hand with the firmware's PID step (pid.c since 2024: the integral first, then
+// kp e + ki integral + kd times minus the measured rate's change over the period, D on the
+// measurement; D on the error would give -11964.964 counts in the second step), at 500 Hz.
 TEST(FlyingSetPoints, TheDefaultsAreTheFirmwaresCf2Gains) {
   const AttitudePidOptions o;
   EXPECT_EQ(o.attitude.kp, 6.0);
@@ -898,18 +896,26 @@ TEST(FlyingSetPoints, TheDefaultsAreTheFirmwaresCf2Gains) {
   EXPECT_EQ(o.rate.integral_limit, 33.3);
   EXPECT_EQ(o.rate_hz, 500.0);
   EXPECT_EQ(o.output_limit, 32767.0);
+  EXPECT_EQ(o.counts_per_command, 65535.0);
   AttitudePid pid;
   pid.start({0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0});
   const double deg = M_PI / 180;
-  // A 2 degree set point, level and still: rate set point 6 * 2 + 3 * (2 * 0.002) deg/s.
-  const auto first = pid.update({0, 0}, {0, 0}, {2 * deg, 0});
-  EXPECT_NEAR(first[0], 250 * 12.012 + 500 * (12.012 * 0.002), 1e-9);
-  EXPECT_NEAR(first[1], 0, 1e-12);
-  // Then the rate measured at 10 deg/s: rate set point 12 + 3 * 0.008, its error 2.024, the
-  // rate integral 0.002 * (12.012 + 2.024), and kd times -10 deg/s over 2 ms.
-  const auto second = pid.update({0, 0}, {10 * deg, 0}, {2 * deg, 0});
+  // Set points of 2 degrees roll and -1 degree pitch, level and still: rate set points
+  // 6 * 2 + 3 * (2 * 0.002) and -(6 + 3 * 0.002) deg/s.
+  const auto first = pid.update({0, 0}, {0, 0}, {2 * deg, -1 * deg});
+  EXPECT_NEAR(first[0], 250 * 12.012 + 500 * (12.012 * 0.002), 1e-8);
+  EXPECT_NEAR(first[1], 250 * -6.006 + 500 * (-6.006 * 0.002), 1e-8);
+  // Then the roll rate measured at 10 deg/s: its rate set point 12 + 3 * 0.008, its error
+  // 2.024, the rate integral 0.002 * (12.012 + 2.024), and kd times -10 deg/s over 2 ms; the
+  // pitch still level and still: rate set point -6 - 3 * 0.004, integral 0.002 * (-6.006 - 6.012).
+  const auto second = pid.update({0, 0}, {10 * deg, 0}, {2 * deg, -1 * deg});
   EXPECT_NEAR(second[0], 250 * 2.024 + 500 * (0.002 * (12.012 + 2.024)) - 2.5 * 10 * 500, 1e-8);
+  EXPECT_NEAR(second[1], 250 * -6.012 + 500 * (0.002 * (-6.006 - 6.012)), 1e-8);
 }
+
+// Started from a window in which the loop tracked its set points (the means equal the
+// present values), the loop's next output is the window's mean output, but for one period of
+// the integrals (under 2 counts for a degree of error).
 
 TEST(FlyingSetPoints, TheControllerStartsWhereTheWindowBeforeLeftIt) {
   AttitudePid pid;

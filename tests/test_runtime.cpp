@@ -1147,6 +1147,7 @@ TEST(ClosedLoop, TracksReferenceAndCompensatesAWeakMotor) {
   // Tracking: position error small after the fade-in.
   double worst = 0;
   const int x = index_in(clean.columns, "x"), xr = index_in(clean.columns, "x_ref");
+  ASSERT_GE(std::min(x, xr), 0);
   for (size_t k = 500; k < clean.rows.size(); ++k) worst = std::max(worst, std::fabs(clean.rows[k][x] - clean.rows[k][xr]));
   EXPECT_LT(worst, 0.15);
   // Same seed, same flight, byte for byte.
@@ -1193,12 +1194,14 @@ TEST(ClosedLoop, TheCrazyflieTracksItsReferenceToo) {
   ASSERT_GT(flight.rows.size(), 1000u);
   for (const char* axis : {"x", "y", "z"}) {
     const int a = index_in(flight.columns, axis), ar = index_in(flight.columns, std::string(axis) + "_ref");
+    ASSERT_GE(std::min(a, ar), 0) << axis;
     double worst = 0;
     for (size_t k = 500; k < flight.rows.size(); ++k) worst = std::max(worst, std::fabs(flight.rows[k][a] - flight.rows[k][ar]));
     EXPECT_LT(worst, 0.15) << axis;
   }
   for (const auto& r : rotors) {
     const int u = index_in(flight.columns, "u_" + r);
+    ASSERT_GE(u, 0) << r;
     double low = 1, high = 0;
     for (size_t k = 500; k < flight.rows.size(); ++k) low = std::min(low, flight.rows[k][u]), high = std::max(high, flight.rows[k][u]);
     EXPECT_GT(low, 0.05) << r;
