@@ -877,6 +877,27 @@ TEST(DataLoss, SimulateRefusesToWriteOverItsInputs) {
   EXPECT_FALSE(fs::exists(tmp / "x.svg"));
 }
 
+// An output folder that holds an input, by its path or as a hard link to it, is refused for
+// that reason, before the folder's other files are judged (helper-126: the simulate cases
+// above are each refused by another check as well, so these two branches never decided).
+TEST(DataLoss, AnOutputFolderHoldingAnInputIsRefusedForThat) {
+  Scratch tmp;
+  fs::create_directories(tmp / "inside");
+  fs::create_directories(tmp / "linked");
+  const std::string inside = tmp / "inside/v.yaml", vehicle = tmp / "v.yaml";
+  fs::copy_file(source_path("vehicles/finken3.yaml"), inside);
+  fs::copy_file(source_path("vehicles/finken3.yaml"), vehicle);
+  fs::create_hard_link(vehicle, tmp / "linked/copy.yaml");
+  const std::string before = read(inside);
+  expect_one_line_error(run_quadgen({"derive", inside, "--out", tmp / "inside"}, tmp.dir), "is or contains the input",
+                        "an input inside the folder");
+  expect_one_line_error(run_quadgen({"derive", vehicle, "--out", tmp / "linked"}, tmp.dir), "(a link to it)",
+                        "a hard link to the input inside the folder");
+  EXPECT_EQ(read(inside), before);
+  EXPECT_EQ(read(vehicle), before);
+  EXPECT_EQ(fs::directory_iterator(tmp / "inside")->path().filename(), "v.yaml");
+}
+
 // `link/../x` is x beside the link's target for the kernel; an output path resolved
 // lexically first (the '..' dropping the link) wrote beside the link instead, so the files
 // were not where the path the user gave (and the one quadgen printed) leads.
@@ -1028,6 +1049,18 @@ TEST(DataLoss, ManifestAndFolderAreReadWithCare) {
   write(tmp / "d/.quadgen-manifest", current.substr(0, cmd) + current.substr(cmd + 15));
   expect_one_line_error(run_quadgen({"fit", vehicle, source_path("data/finken3_motor_steps.csv"), "--out", tmp / "d"}, tmp.dir),
                         "holds the output of 'quadgen derive'", "an older manifest");
+  EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
+  // What the kill tests' judge must also refuse (helper-126): a listed file missing, and a
+  // file the manifest does not list.
+  std::string why;
+  fs::rename(tmp / "d/model.json", tmp / "model.json.aside");
+  EXPECT_FALSE(out::complete_output_directory(tmp / "d", &why));
+  EXPECT_NE(why.find("missing"), std::string::npos) << why;
+  fs::rename(tmp / "model.json.aside", tmp / "d/model.json");
+  write(tmp / "d/extra.txt", "not quadgen's");
+  EXPECT_FALSE(out::complete_output_directory(tmp / "d", &why));
+  EXPECT_NE(why.find("extra.txt is not in the manifest"), std::string::npos) << why;
+  fs::remove(tmp / "d/extra.txt");
   EXPECT_TRUE(out::complete_output_directory(tmp / "d"));
 }
 

@@ -116,6 +116,7 @@ TEST(LogReader, Px4UlogInNedFrdBecomesTheCanonicalFlight) {
   EXPECT_NEAR(at(50, "r"), -0.3, 1e-6);
   EXPECT_NEAR(at(50, "az"), 9.7, 1e-5);
   EXPECT_NEAR(at(50, "ay"), 0.4, 1e-6);
+  EXPECT_NEAR(at(50, "ax"), 0.5, 1e-6);  // forward stays forward (helper-126: unchecked before)
   // attitude: R_enu<-flu = M R_ned<-frd F, M = [[0,1,0],[1,0,0],[0,0,-1]], F = diag(1,-1,-1)
   const double q[4] = {at(50, "qw"), at(50, "qx"), at(50, "qy"), at(50, "qz")};
   const runtime::Rotation got = runtime::rotation_matrix(q), ned = runtime::rotation_matrix(kQned);

@@ -257,8 +257,9 @@ TEST(Cli, DeriveWritesModelJsonAndReport) {
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_TRUE(fs::exists(out / "model.json"));
   EXPECT_TRUE(fs::exists(out / "derivation.md"));
-  for (const auto& e : fs::directory_iterator(out))
-    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << "left a temporary: " << e.path();
+  // No staging folder left beside it (.<out>.quadgen-tmp.<pid>.XXXXXX).
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_NE(e.path().filename().string().rfind(".quadgen_cli_ok.quadgen-tmp.", 0), 0u) << "left a staging folder: " << e.path();
 }
 
 // derive --params: a fitted_parameters.yaml is applied only when every value names a
