@@ -59,10 +59,10 @@ void check_jacobians_against_jets(int trials) {
 TEST(Generated, Finken3JacobiansMatchJets) { check_jacobians_against_jets<finken3_traits>(50); }
 TEST(Generated, AllEffectsJacobiansMatchJets) { check_jacobians_against_jets<finken3_all_effects_traits>(50); }
 TEST(Generated, CrazyflieJacobiansMatchJets) { check_jacobians_against_jets<crazyflie21_traits>(50); }
-// The NanoBench airframe's header with every effect: its motor map is turned about its pivot
-// by a parameter, and it holds every effect's terms with the Crazyflie's geometry (a review of
-// the tests, helper-123: the Crazyflie's effects had finite differences only). One header:
-// each costs the build seconds, twice in CI.
-TEST(Generated, CrazyflieNanobenchJacobiansMatchJets) {
+// The Crazyflie's headers with every effect, the NanoBench airframe's (its motor map turned
+// about its pivot by a parameter) and the stock one's (a review of the tests, helper-123: the
+// Crazyflie's effects had finite differences only). About 2 s of build each, twice in CI.
+TEST(Generated, CrazyflieEffectsJacobiansMatchJets) {
   check_jacobians_against_jets<crazyflie21_nanobench_all_effects_traits>(20);
+  check_jacobians_against_jets<crazyflie21_all_effects_traits>(20);
 }
