@@ -138,12 +138,21 @@ TEST(UsdLog, APowerCutKeepsEveryWholeRecord) {
   EXPECT_EQ(clean.topics[0].rows, all.topics[0].rows);
 }
 
+// A cut log that parses holds a prefix of the whole log's rows, value for value (a review of
+// the tests, helper-126: only the count was checked).
 TEST(UsdLog, EveryCutParsesAPrefixOrThrowsLogError) {
   const std::string full = two_event_log(5).bytes();
+  const UsdLog whole = parse_usd_log(full, "whole.bin");
+  ASSERT_EQ(whole.topics[0].rows.size(), 5u);
   for (std::size_t n = 0; n <= full.size(); ++n) {
     try {
       const UsdLog log = parse_usd_log(full.substr(0, n), "cut.bin");
-      EXPECT_LE(log.topics[0].rows.size(), 5u);
+      ASSERT_LE(log.topics.size(), whole.topics.size()) << n;
+      for (std::size_t t = 0; t < log.topics.size(); ++t) {
+        const auto& rows = log.topics[t].rows;
+        ASSERT_LE(rows.size(), whole.topics[t].rows.size()) << n;
+        for (std::size_t r = 0; r < rows.size(); ++r) EXPECT_EQ(rows[r], whole.topics[t].rows[r]) << "cut at " << n;
+      }
     } catch (const LogError& e) {
       EXPECT_NE(std::string(e.what()).find("cut.bin: byte "), std::string::npos) << e.what();
     }
