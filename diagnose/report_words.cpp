@@ -233,11 +233,11 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
     seen.push_back(output::visible_skeleton(stems.back()));
   }
   const auto numbered = [&](size_t i) { return "flight " + std::to_string(i + 1) + " (" + stems[i] + ")"; };
+  std::vector<std::string> taken_seen;
+  for (const auto& t : taken) taken_seen.push_back(output::visible_skeleton(t));
   const auto takes_a_name = [&](const std::string& s) {
-    for (const auto& t : taken) {
-      const std::string name = output::visible_skeleton(t);
+    for (const auto& name : taken_seen)
       if (s == name || s.rfind(name + ",", 0) == 0) return true;
-    }
     return false;
   };
   std::vector<std::string> out;

@@ -37,6 +37,25 @@ SymbolicModel derive(const Vehicle& v, std::vector<std::string> effects = {}) {
   o.effects = std::move(effects);
   return derive_model(v, derive_mass_properties(v), o);
 }
+
+// Whether the audit of m with mp passed its check `name` (a test failure where it has none).
+bool check_passed(const SymbolicModel& m, const MassProperties& mp, const std::string& name) {
+  for (const auto& c : audit(m, mp).checks)
+    if (c.name == name) return c.passed;
+  ADD_FAILURE() << "no check " << name;
+  return false;
+}
+
+// The model's inertia as a general symmetric J of its six parameters, and its body rates ω.
+matrix general_inertia(const SymbolicModel& m) {
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  return matrix(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"), P("J_xz"), P("J_yz"), P("J_zz")});
+}
+matrix body_rates(const SymbolicModel& m) {
+  matrix w(3, 1);
+  for (int i = 0; i < 3; ++i) w(i, 0) = m.states[runtime::rigid_body::kBodyRate + i].sym;
+  return w;
+}
 }  // namespace
 
 TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
@@ -67,10 +86,7 @@ TEST(Model, InertiaAuditHoldsForBlocksAtAnyAngle) {
   MassProperties mp = derive_mass_properties(v);
   const SymbolicModel m = derive_model(v, mp, DeriveOptions{});
   auto closed_form_ok = [&](const MassProperties& props) {
-    for (const auto& c : audit(m, props).checks)
-      if (c.name == "integrals match closed form + parallel axis") return c.passed;
-    ADD_FAILURE() << "no closed-form check";
-    return false;
+    return check_passed(m, props, "integrals match closed form + parallel axis");
   };
   EXPECT_TRUE(closed_form_ok(mp));
   // A tensor off by a part in a million of one product of inertia is caught.
@@ -127,13 +143,9 @@ TEST(Model, UnitCheckerRejectsInconsistentEquation) {
 TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
   using namespace runtime::rigid_body;
   const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
   const SymbolicModel good = derive(v);
-  auto P = [&](const char* n) { return good.params[good.param_index(n)].sym; };
-  const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
-                           P("J_xz"), P("J_yz"), P("J_zz")});
-  const matrix Jinv = J.inverse();
-  matrix w(3, 1);
-  for (int i = 0; i < 3; ++i) w(i, 0) = good.states[kBodyRate + i].sym;
+  const matrix J = general_inertia(good), Jinv = J.inverse(), w = body_rates(good);
   const matrix Jw = J.mul(w);
   const matrix gyro = vec3(w(1, 0) * Jw(2, 0) - w(2, 0) * Jw(1, 0), w(2, 0) * Jw(0, 0) - w(0, 0) * Jw(2, 0),
                            w(0, 0) * Jw(1, 0) - w(1, 0) * Jw(0, 0));  // ω × Jω
@@ -150,12 +162,7 @@ TEST(Model, AngularMomentumCheckCatchesAWrongGyroscopicTermOrKinematics) {
     const matrix qdot = quaternion_product(quaternion(0, w(0, 0), w(1, 0), w(2, 0)), q);
     for (int i = 0; i < 4; ++i) world_rates.f(kAttitude + i, 0) = qdot(i, 0) / 2;
   }
-  auto passed = [&](const SymbolicModel& m, const std::string& check) {
-    for (const auto& c : audit(m, derive_mass_properties(v)).checks)
-      if (c.name == check) return c.passed;
-    ADD_FAILURE() << "no check " << check;
-    return false;
-  };
+  auto passed = [&](const SymbolicModel& m, const std::string& check) { return check_passed(m, mp, check); };
   const std::string momentum = "angular momentum conserved in the world frame",
                     energy = "rotational kinetic energy conserved";
   EXPECT_TRUE(passed(good, momentum));
@@ -197,40 +204,30 @@ TEST(Model, EnergyNormAndSymmetryChecksFailWhereTheyShould) {
   const MassProperties mp = derive_mass_properties(v);
   const SymbolicModel good = derive(v);
   auto P = [&](const char* n) { return good.params[good.param_index(n)].sym; };
-  const matrix J(3, 3, lst{P("J_xx"), P("J_xy"), P("J_xz"), P("J_xy"), P("J_yy"), P("J_yz"),
-                           P("J_xz"), P("J_yz"), P("J_zz")});
-  const matrix Jinv = J.inverse();
-  matrix w(3, 1);
-  for (int i = 0; i < 3; ++i) w(i, 0) = good.states[kBodyRate + i].sym;
+  const matrix Jinv = general_inertia(good).inverse(), w = body_rates(good);
   auto with_added = [&](const matrix& Jwdot_added) {  // J dω/dt gains a term
     SymbolicModel m = good;
     const matrix wdot = Jinv.mul(Jwdot_added);
     for (int i = 0; i < 3; ++i) m.f(kBodyRate + i, 0) += wdot(i, 0);
     return m;
   };
-  auto passed = [&](const SymbolicModel& m, const MassProperties& p, const std::string& check) {
-    for (const auto& c : audit(m, p).checks)
-      if (c.name == check) return c.passed;
-    ADD_FAILURE() << "no check " << check;
-    return false;
-  };
   const std::string energy = "rotational kinetic energy conserved", magnitude = "angular momentum magnitude conserved",
                     norm = "quaternion kinematics preserve |q|", symmetric = "symmetric";
-  for (const auto& name : {energy, magnitude, norm, symmetric}) EXPECT_TRUE(passed(good, mp, name)) << name;
+  for (const auto& name : {energy, magnitude, norm, symmetric}) EXPECT_TRUE(check_passed(good, mp, name)) << name;
   const ex k = P("J_zz");  // any nonzero polynomial factor (the momentum check reduces polynomials)
   const SymbolicModel feeding = with_added(w.mul_scalar(k));
-  EXPECT_FALSE(passed(feeding, mp, energy));
-  EXPECT_FALSE(passed(feeding, mp, magnitude));
+  EXPECT_FALSE(check_passed(feeding, mp, energy));
+  EXPECT_FALSE(check_passed(feeding, mp, magnitude));
   const SymbolicModel turning = with_added(vec3(w(1, 0), -w(0, 0), 0));  // ω × e_z
-  EXPECT_TRUE(passed(turning, mp, energy));
-  EXPECT_FALSE(passed(turning, mp, magnitude));
+  EXPECT_TRUE(check_passed(turning, mp, energy));
+  EXPECT_FALSE(check_passed(turning, mp, magnitude));
   SymbolicModel growing = good;
   for (int i = 0; i < 4; ++i) growing.f(kAttitude + i, 0) += k * good.states[kAttitude + i].sym;
-  EXPECT_FALSE(passed(growing, mp, norm));
-  EXPECT_TRUE(passed(growing, mp, energy));  // the rates untouched
+  EXPECT_FALSE(check_passed(growing, mp, norm));
+  EXPECT_TRUE(check_passed(growing, mp, energy));  // the rates untouched
   MassProperties lopsided = mp;
   lopsided.inertia_cog(0, 1) = lopsided.inertia_cog(0, 1) + P("J_zz");
-  EXPECT_FALSE(passed(good, lopsided, symmetric));
+  EXPECT_FALSE(check_passed(good, lopsided, symmetric));
 }
 
 TEST(Model, HoverIsAnEquilibrium) {
