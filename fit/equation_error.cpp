@@ -418,6 +418,7 @@ void EquationErrorModel::split_over_cores(size_t lo, size_t hi, const double* p,
     helpers.push_back(std::move(h));
   }
   const size_t n = std::min(parts, helpers.size() + 1);
+  helpers_.last_parts = n;
   if (n <= 1) return part(*model_, lo, hi);
   const std::vector<double> params(p, p + model_->num_params());
   for (size_t i = 0; i + 1 < n; ++i) {  // before any thread starts: these may throw

@@ -71,6 +71,10 @@ class EquationErrorModel : public ResidualModel {
   // accelerations at p are all_channels(p) plus these.
   std::vector<double> measured_channels() const;
   const Flight& flight() const { return flight_; }
+  // Into how many parts, each on a thread of its own, the last split of an evaluation went
+  // (evaluation_threads.hpp; 0 before the first). For tests, which cannot otherwise tell a
+  // split evaluation from one that stayed on the calling thread: both give the same numbers.
+  size_t last_split_parts() const { return helpers_.last_parts; }
 
  private:
   runtime::DynamicModel* model_;  // the caller's, or owned_model_ in a clone
@@ -137,10 +141,12 @@ class EquationErrorModel : public ResidualModel {
   };
   struct Helpers {
     std::vector<Helper> list;
+    size_t last_parts = 0;
     Helpers() = default;
     Helpers(const Helpers&) {}
     Helpers& operator=(const Helpers&) {
       list.clear();
+      last_parts = 0;
       return *this;
     }
   };

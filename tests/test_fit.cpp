@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
+#include <thread>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -920,18 +922,20 @@ TEST(Fit, PerFlightDataSideColumnsMatchDifferencesOfTheWholeLog) {
   EXPECT_GT(second, 100);
 }
 
-// An evaluation split over threads (each part on its own copy of the model) gives the
-// residuals and Jacobian of one thread bit for bit: every row is computed by the same code
-// from the same prepared states. A joined two-flight log on a per-flight model with the
-// data-side effects at work, both quadratures, all columns and a free subset, and a part
-// boundary inside each flight (3 parts over 400 samples), after an evaluation elsewhere.
 // The one thread helper of the split evaluation, the candidate pool and the profiles: every
-// worker runs once, a failure reaches the caller after all threads are joined, and the other
-// workers see `stopped` and stop taking jobs from their queue.
+// worker runs once, worker 0 on the calling thread and each other one on a thread of its own
+// (this machine can start them), a failure reaches the caller after all threads are joined,
+// and the other workers see `stopped` and stop taking jobs from their queue.
 TEST(Threads, EveryWorkerRunsOnceAndTheFirstFailureReachesTheCaller) {
   std::vector<std::atomic<int>> runs(5);
-  fit::run_workers(5, [&](size_t w, const std::atomic<bool>&) { ++runs[w]; });
+  std::vector<std::thread::id> ran_on(5);
+  fit::run_workers(5, [&](size_t w, const std::atomic<bool>&) {
+    ++runs[w];
+    ran_on[w] = std::this_thread::get_id();
+  });
   for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
+  EXPECT_EQ(ran_on[0], std::this_thread::get_id());
+  EXPECT_EQ(std::set<std::thread::id>(ran_on.begin(), ran_on.end()).size(), 5u);
 
   // So many jobs that the others cannot run out of them while the failing worker is preempted
   // between its throw and setting `stopped` (with 1e5 this failed once in a loaded suite run);
@@ -948,6 +952,12 @@ TEST(Threads, EveryWorkerRunsOnceAndTheFirstFailureReachesTheCaller) {
   EXPECT_LT(taken.load(), jobs);  // the queue was left when one failed
 }
 
+// An evaluation split over threads (each part on its own copy of the model) gives the
+// residuals and Jacobian of one thread bit for bit: every row is computed by the same code
+// from the same prepared states. A joined two-flight log on a per-flight model with the
+// data-side effects at work, both quadratures, all columns and a free subset, and a part
+// boundary inside each flight (3 parts over 400 samples), after an evaluation elsewhere.
+// That it was split is read from the model (last_split_parts): the numbers cannot show it.
 TEST(Fit, ASplitEvaluationEqualsOneThread) {
   runtime::CompiledModel<quadgen_generated::finken3_all_effects::Model> inner;
   std::mt19937 rng(17);
@@ -972,12 +982,14 @@ TEST(Fit, ASplitEvaluationEqualsOneThread) {
       {
         EvaluationParts one(1);
         m.evaluate_free(p.data(), r1.data(), J1.data(), free);
+        EXPECT_EQ(m.last_split_parts(), 1u);
       }
       {
         EvaluationParts three(3);
         // First at other parameters: the helpers' copies must follow each evaluation's.
         m.evaluate_free(nominal.data(), r3.data(), J3.data(), free);
         m.evaluate_free(p.data(), r3.data(), J3.data(), free);
+        EXPECT_EQ(m.last_split_parts(), 3u);
       }
       EXPECT_EQ(r1, r3);
       EXPECT_EQ(J1, J3);
