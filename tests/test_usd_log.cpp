@@ -159,17 +159,45 @@ TEST(UsdLog, EveryCutParsesAPrefixOrThrowsLogError) {
   }
 }
 
+// A byte changed anywhere: the log is refused with a LogError, or it parses, its checksum is
+// found wrong (CRC-32 sees every change of one byte), and every record that lies wholly before
+// the changed byte is read as it was (the rows a cut there keeps lead each topic's rows).
+// A review of the tests (helper-126) found the first version checked only that nothing crashed.
 TEST(UsdLog, EveryCorruptedByteParsesOrThrowsLogError) {
   const std::string full = two_event_log(5).bytes();
+  int parsed = 0, refused = 0;
   for (std::size_t i = 0; i < full.size(); ++i)
     for (unsigned char v : {0x00, 0x01, 0x28, 0x7F, 0xBC, 0xFF}) {
+      if (static_cast<unsigned char>(full[i]) == v) continue;
       std::string b = full;
       b[i] = static_cast<char>(v);
+      UsdLog log;
       try {
-        parse_usd_log(b, "bad.bin");
+        log = parse_usd_log(b, "bad.bin");
+      } catch (const LogError& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.bin: byte "), std::string::npos) << e.what();
+        ++refused;
+        continue;
+      }
+      ++parsed;
+      EXPECT_FALSE(log.crc_valid) << "byte " << i << " set to " << int(v);
+      UsdLog kept;
+      try {
+        kept = parse_usd_log(full.substr(0, i), "cut.bin");
       } catch (const LogError&) {
+        continue;  // changed inside the header: no record lies before it
+      }
+      ASSERT_LE(kept.topics.size(), log.topics.size()) << i;
+      for (std::size_t t = 0; t < kept.topics.size(); ++t) {
+        const auto& before = kept.topics[t].rows;
+        const auto& rows = log.topics[t].rows;
+        ASSERT_LE(before.size(), rows.size()) << "byte " << i << " set to " << int(v);
+        for (std::size_t r = 0; r < before.size(); ++r) EXPECT_EQ(rows[r], before[r]) << "byte " << i;
       }
     }
+  // Both outcomes occur (the loop is not vacuous either way).
+  EXPECT_GT(parsed, 0);
+  EXPECT_GT(refused, 0);
 }
 
 TEST(UsdLog, MalformedLogsAreRefusedWithByteAndCause) {
