@@ -96,8 +96,29 @@ void spread_under_agreement(ParameterAgreement& a) {
 
 }  // namespace
 
-// Pooled value, Cochran's Q, spread and the verdict from the flights' estimates.
+ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airframe_value,
+                                          double airframe_standard_error) {
+  ParameterAgreement a;
+  a.joint_value = a.pooled = airframe_value;
+  a.flights = {f};
+  // An airframe value without a standard error (a diagnosis that had none) cannot say either.
+  a.reference_without_error = std::isnan(airframe_standard_error);
+  // A flight without one cannot disagree, nor agree, and has no z.
+  const bool measured = f.standard_error > 0 && std::isfinite(f.standard_error);
+  const bool says = measured && !a.reference_without_error;
+  const double se = a.reference_without_error ? f.standard_error : std::hypot(f.standard_error, airframe_standard_error);
+  a.q = measured ? std::pow((f.value - airframe_value) / se, 2) : std::numeric_limits<double>::quiet_NaN();
+  a.q_p_value = measured ? chi2_upper(a.q, 1.0) : std::numeric_limits<double>::quiet_NaN();
+  a.spread = airframe_value != 0 ? std::abs(f.value - airframe_value) / std::abs(airframe_value) : INFINITY;
+  a.within_errors = !says || a.q < kZ95 * kZ95;
+  a.agree = says && a.q < kZ95 * kZ95 && a.spread < 0.3;
+  return a;
+}
+
+// Pooled value, Cochran's Q, spread and the verdict from the flights' estimates (again from
+// nothing when called again: a second call doubled Q until the fifty-ninth session).
 void summarise_agreement(ParameterAgreement& a) {
+  a.q = 0;
   double sw = 0, swk = 0, lo = INFINITY, hi = -INFINITY;
   for (const auto& f : a.flights) {
     lo = std::min(lo, f.value), hi = std::max(hi, f.value);
@@ -192,25 +213,12 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
   const auto here = fit_one_flight(in, 1, named);
   for (const auto& e : airframe.effects)
     for (size_t j = 0; j < e.parameters.size(); ++j) {
-      ParameterAgreement a;
+      ParameterAgreement a = judge_against_airframe(here.at(e.parameters[j]), e.value[j], e.standard_error[j]);
       a.parameter = e.parameters[j];
       a.effect = e.name;
       a.named = true;
       for (const auto& p : airframe.values)
         if (p.name == a.parameter) a.unit = p.unit;
-      a.joint_value = a.pooled = e.value[j];
-      const FlightEstimate& f = here.at(a.parameter);
-      a.flights = {f};
-      // An airframe value without a standard error (a diagnosis that had none) cannot say either.
-      a.reference_without_error = std::isnan(e.standard_error[j]);
-      const double se = a.reference_without_error ? f.standard_error : std::hypot(f.standard_error, e.standard_error[j]);
-      a.q = se > 0 ? std::pow((f.value - e.value[j]) / se, 2) : INFINITY;
-      a.q_p_value = chi2_upper(a.q, 1.0);
-      a.spread = e.value[j] != 0 ? std::abs(f.value - e.value[j]) / std::abs(e.value[j]) : INFINITY;
-      // A flight without one cannot disagree, nor agree.
-      const bool says = f.standard_error > 0 && !a.reference_without_error;
-      a.within_errors = !says || a.q < kZ95 * kZ95;
-      a.agree = says && a.q < kZ95 * kZ95 && a.spread < 0.3;
       out.push_back(a);
     }
   return out;

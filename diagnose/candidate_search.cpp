@@ -838,7 +838,9 @@ fit::FitOptions refit_options() {
 }
 
 double chi2_upper(double x, double dof) {
+  if (std::isnan(x)) return x;            // nothing measured: no p-value (Boost would throw)
   if (x <= 0 || !(dof > 0)) return 1.0;  // no evidence, or nothing to test (one flight)
+  if (std::isinf(x)) return 0.0;
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
 }
 

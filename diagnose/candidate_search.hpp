@@ -212,7 +212,7 @@ std::string separating_manoeuvre(const std::string& a, const std::string& b);
 
 
 // P(chi2_dof > x): the p-value of a likelihood-ratio or heterogeneity statistic; 1 for x <= 0
-// or dof <= 0.
+// or dof <= 0, 0 for an infinite x, NaN for a NaN x.
 double chi2_upper(double x, double dof);
 
 // The solver settings of every refit a diagnosis makes (each step of the search, each flight

@@ -56,7 +56,7 @@ double rotation_scale(const Vehicle& v, const SymbolicModel& all) {
 // worse is not a better model, whatever a rollout dominated by the attitude drift shows. The
 // backward pass held this rule until the sixteenth session, judged with the smaller model
 // refitted under the final model's weights; here both models are fitted under their own
-// (HeldOutGain). Without one-step folds (no pose) the rollouts are the one-step cost.
+// (HeldOutGain). Without a pose the report's metric is the one-step cost, fold for fold.
 bool one_step_not_higher(const Finding& f) {
   return f.one_step.cost.per_fold.empty() || f.one_step.cost.mean >= 0;
 }

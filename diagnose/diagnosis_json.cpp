@@ -249,7 +249,7 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
                    {"spread_if_agree", number_or_null(a.spread_if_agree)},
                    {"spread_p_value", number_or_null(a.spread_p_value)},
                    {"cochran_q", number_or_null(a.q)},
-                   {"q_p_value", a.q_p_value},
+                   {"q_p_value", number_or_null(a.q_p_value)},
                    {"agree", a.agree},
                    {"verdict", agreement_verdict(a)},
                    {"flights", per_flight}});

@@ -38,9 +38,15 @@ void mean_and_standard_error(const std::vector<double>& x, double* mean, double*
 std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
   std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
   for (auto& f : folds) f.samples.clear();
-  const double t0 = valid.samples.front().t, span = valid.samples.back().t - t0 + 1e-9;
-  for (const auto& s : valid.samples)
-    folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>((s.t - t0) / span * k))].samples.push_back(s);
+  const auto& s = valid.samples;
+  std::vector<double> held_out(s.size(), 0.0);  // held-out time before each sample
+  for (size_t i = 1; i < s.size(); ++i) {
+    const double dt = s[i].t - s[i - 1].t;
+    held_out[i] = held_out[i - 1] + (dt <= predict::Rollout::kMaxGap ? dt : 0.0);
+  }
+  const double span = (s.empty() ? 0.0 : held_out.back()) + 1e-9;
+  for (size_t i = 0; i < s.size(); ++i)
+    folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>(held_out[i] / span * k))].samples.push_back(s[i]);
   folds.erase(std::remove_if(folds.begin(), folds.end(), [](const fit::Flight& f) { return f.samples.size() < 2; }),
               folds.end());
   return folds;
@@ -71,7 +77,8 @@ HeldOutGain::HeldOutGain(runtime::DynamicModel& model, const CandidateSearch& se
                              " s open-loop windows from measured states" + stride_clause(window, window_stride) +
                              "; every point of a window scored) [m]"
                        : "validation equation-error cost (weighted, no pose logged)";
-  if (!pose_) return;  // the metric already is one-step
+  // Without a pose the folds' one-step costs are the metric's folds too (until the
+  // fifty-ninth session such a part was one fold: a gain was judged by its sign alone).
   for (const auto& f : folds_)
     try {  // a fold of short stretches between gaps has no row to differentiate: skipped
       FoldProblems p{std::make_unique<fit::EquationErrorModel>(model, f, accelerometer), nullptr};
@@ -144,7 +151,7 @@ void HeldOutGain::weigh(Scores& s, const std::vector<fit::FitParameter>& ps, con
   for (const auto& fold : fold_problems_) s.fold_costs.push_back(CandidateSearch::cost(*fold.fit, ps, weights));
   if (pose_) return;
   s.metric = CandidateSearch::cost(valid_ee_, ps, weights);
-  s.fold_metrics = {s.metric};
+  s.fold_metrics = s.fold_costs.empty() ? std::vector<double>{s.metric} : s.fold_costs;
 }
 
 const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool force_alone) const {

@@ -1118,6 +1118,76 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_EQ(unsaid.find("30 % or more apart"), std::string::npos) << unsaid;
   const std::string page = quadgen::diagnose::diagnosis_html(d, "flight.csv", {});
   EXPECT_NE(page.find("too uncertain (a flight without a standard error cannot say)</span>"), std::string::npos);
+  // Summarised again, the same Q (a second call doubled it; a statistics review, helper-128).
+  ParameterAgreement twice = apart;
+  quadgen::diagnose::summarise_agreement(twice);
+  EXPECT_DOUBLE_EQ(twice.q, apart.q);
+  EXPECT_NEAR(apart.q, 2 * std::pow(0.25 / 0.05, 2), 1e-9);  // each value 0.25 from the pooled 1.25
+}
+
+// A flight checked against an airframe (diagnose --airframe): a flight without a standard
+// error (a confounded parameter: NaN; or 0) is "too uncertain" with no Q and no p-value. Such a
+// flight made Q infinite, and the p-value's Boost call threw and aborted the run (a
+// statistics review, helper-128).
+TEST(MultiFlight, AFlightWithoutAStandardErrorCannotSayAgainstAnAirframe) {
+  using quadgen::diagnose::judge_against_airframe;
+  quadgen::diagnose::FlightEstimate f;
+  f.value = 1.2, f.lower = NAN, f.upper = NAN;
+  for (double se : {std::numeric_limits<double>::quiet_NaN(), 0.0}) {
+    f.standard_error = se;
+    const auto a = judge_against_airframe(f, 1.0, 0.05);
+    EXPECT_STREQ(quadgen::diagnose::agreement_verdict(a), "too uncertain") << se;
+    EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(a), "a flight without a standard error cannot say");
+    EXPECT_TRUE(std::isnan(a.q) && std::isnan(a.q_p_value)) << a.q << " " << a.q_p_value;
+    EXPECT_NEAR(a.spread, 0.2, 1e-12);
+  }
+  f.standard_error = 0.05;  // z = 0.2 / hypot(0.05, 0.05)
+  const auto apart = judge_against_airframe(f, 1.0, 0.05);
+  EXPECT_NEAR(apart.q, 8.0, 1e-9);
+  EXPECT_NEAR(apart.q_p_value, boost::math::cdf(boost::math::complement(boost::math::chi_squared(1), 8.0)), 1e-15);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(apart), "disagree");
+  const auto no_reference = judge_against_airframe(f, 1.0, NAN);  // z on the flight's error alone
+  EXPECT_NEAR(no_reference.q, 16.0, 1e-9);
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(no_reference), "the airframe's value has no standard error");
+  f.value = 1.02;
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(judge_against_airframe(f, 1.0, 0.05)), "agree");
+  EXPECT_EQ(quadgen::diagnose::chi2_upper(INFINITY, 1.0), 0.0);
+  EXPECT_TRUE(std::isnan(quadgen::diagnose::chi2_upper(NAN, 1.0)));
+}
+
+// The held-out part is cut into four folds of equal held-out time. Two joined flights hold
+// theirs 42 s apart on the joined clock (the second's training part between): cut by that
+// clock, the folds were [1800, 0, 0, 1800] samples and two of them were dropped (a statistics
+// review, helper-128). A single contiguous part is cut as before, in equal durations.
+TEST(HeldOut, FoldsHoldEqualHeldOutTimeAcrossJoinedFlights) {
+  const auto part = [](std::vector<std::pair<double, double>> spans) {
+    quadgen::fit::Flight f;
+    for (const auto& [from, to] : spans)
+      for (int k = 0; from + 0.01 * k <= to + 1e-9; ++k) {
+        quadgen::fit::FlightSample s;
+        s.t = from + 0.01 * k;
+        f.samples.push_back(s);
+      }
+    return f;
+  };
+  const auto sizes = [](const std::vector<quadgen::fit::Flight>& folds) {
+    std::vector<size_t> n;
+    for (const auto& f : folds) n.push_back(f.samples.size());
+    return n;
+  };
+  const auto joined = quadgen::diagnose::validation_folds(part({{42, 60}, {102, 120}}), 4);
+  ASSERT_EQ(joined.size(), 4u);
+  for (size_t n : sizes(joined)) EXPECT_NEAR(static_cast<double>(n), 3602 / 4.0, 2.0) << ::testing::PrintToString(sizes(joined));
+  // Folds 1-2 the first flight's (the second's first sample, at the same held-out time as the
+  // first's last, may close fold 2), folds 3-4 the second's.
+  EXPECT_EQ(joined[0].samples.front().t, 42.0);
+  EXPECT_GE(joined[1].samples.back().t, 60.0);
+  EXPECT_LE(joined[1].samples.back().t, 102.0);
+  EXPECT_GE(joined[2].samples.front().t, 102.0);
+  EXPECT_EQ(joined[3].samples.back().t, 120.0);
+  const auto single = quadgen::diagnose::validation_folds(part({{42, 60}}), 4);
+  ASSERT_EQ(single.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) EXPECT_NEAR(single[i].samples.front().t, 42 + 4.5 * i, 0.011) << i;
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
@@ -2300,6 +2370,9 @@ TEST(RealData, ArplMotorLagIntervalContainsTheAuthorsValue) {
   ASSERT_NE(tau, nullptr) << "the motor lag is not named: " << named(j).size() << " findings";
   EXPECT_LE((*tau)["ci95"][0].get<double>(), 0.072);
   EXPECT_GE((*tau)["ci95"][1].get<double>(), 0.072);
+  // No pose: its held-out gain is judged on four folds of the one-step cost, as with a pose on
+  // four of the rollouts (until the fifty-ninth session on one, by its sign; helper-128).
+  for (const auto& f : j["findings"]) EXPECT_EQ(f["gain"]["fold_gains"].size(), 4u) << f["effect"];
 }
 
 // The command-gain table shows no gain where the commands explain too little of the measured
