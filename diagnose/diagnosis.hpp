@@ -107,6 +107,8 @@ struct Finding {
   static constexpr const char* kByOneStep = "one-step equation error";
   static constexpr const char* kByForceModelAlone = "force model alone (attitude replayed)";
   std::string accepted_by;
+  // False where no pose was logged: no rollouts, the held-out metric is the one-step cost.
+  bool rollouts = true;
   // How the model without the effect was fitted: under its own weights, settled or not, or
   // the base fit (a lone effect's). Unsettled weights make the comparison less certain than
   // its spread says; the report shows it. Empty for a suspect no held-out comparison judged

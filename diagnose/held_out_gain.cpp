@@ -221,6 +221,7 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   weigh(a, s.final_fit, between);
   weigh(b, without, between);
   f.metric = metric_name_;
+  f.rollouts = pose_;
   f.before = b.metric;
   f.after = a.metric;
   f.fold_gains = fold_gains(b.fold_metrics, a.fold_metrics);

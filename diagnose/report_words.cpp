@@ -369,7 +369,8 @@ std::string judged_by_text(const Finding& f) {
            " % lower, neither kind of channel worse (the open loop is dominated by the moment model's attitude drift)";
   if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
   return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
-         " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold, the rollouts unchanged within their spread";
+         " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold" +
+         (f.rollouts ? ", the rollouts unchanged within their spread" : " (no pose logged: no rollouts)");
 }
 
 std::string beside_gain_text(const Finding& f) {

@@ -2371,8 +2371,13 @@ TEST(RealData, ArplMotorLagIntervalContainsTheAuthorsValue) {
   EXPECT_LE((*tau)["ci95"][0].get<double>(), 0.072);
   EXPECT_GE((*tau)["ci95"][1].get<double>(), 0.072);
   // No pose: its held-out gain is judged on four folds of the one-step cost, as with a pose on
-  // four of the rollouts (until the fifty-ninth session on one, by its sign; helper-128).
+  // four of the rollouts (until the fifty-ninth session on one, by its sign; helper-128), and
+  // no line speaks of rollouts it has not got.
   for (const auto& f : j["findings"]) EXPECT_EQ(f["gain"]["fold_gains"].size(), 4u) << f["effect"];
+  std::ifstream said_in(dir / "diagnose.log");
+  const std::string said((std::istreambuf_iterator<char>(said_in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(said.find("lower per fold (no pose logged: no rollouts)"), std::string::npos) << said;
+  EXPECT_EQ(said.find("the rollouts unchanged"), std::string::npos) << said;
 }
 
 // The command-gain table shows no gain where the commands explain too little of the measured
