@@ -46,8 +46,9 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
   const fit::EquationErrorModel ee(*in.model, in.training_parts[static_cast<size_t>(k - 1)], in.use_accelerometer);
   const fit::FitOptions fo = refit_options();
   std::vector<fit::FitParameter> on = flight_start(in, k, named);
-  const double cost_on = fit::solve_weighted(ee, on, in.weights, fo);
-  const StandardErrors se = gauss_newton_standard_errors(ee, on, in.weights);
+  const std::vector<double> weights = in.weights.empty() ? channel_weights(ee, on) : in.weights;
+  const double cost_on = fit::solve_weighted(ee, on, weights, fo);
+  const StandardErrors se = gauss_newton_standard_errors(ee, on, weights);
   std::map<std::string, FlightEstimate> out;
   for (const auto& e : in.effects) {
     std::vector<fit::FitParameter> off = on;
@@ -56,7 +57,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
       off[i].value = e.off[j];
       off[i].free = false;
     }
-    const double cost_off = fit::solve_weighted(ee, off, in.weights, fo);
+    const double cost_off = fit::solve_weighted(ee, off, weights, fo);
     const double statistic = std::max(0.0, cost_off - cost_on);
     for (const auto& name : e.parameters) {
       const int i = in.model->param_index(name);

@@ -82,7 +82,11 @@ struct AgreementInputs {
   // The parameters each flight has its own value of (shared names: c_t, the trims); freed on
   // each flight where the joint fit freed them.
   std::vector<std::string> per_flight;
-  std::vector<double> weights;  // per channel, the joint search's final weights
+  // Per channel; empty: each flight's own, from its residuals where its fit starts (the
+  // joint fit's values). Under the joint search's weights a flight noisier than the others
+  // got standard errors too small and Cochran's Q too large (a statistics review,
+  // helper-128, fifty-ninth session). Against an airframe: the flight's own diagnosis's.
+  std::vector<double> weights;
   // Per airframe effect to check: its parameters (shared names), their values at "off" and
   // where each flight's fit starts (the joint estimate; for a suspected candidate, which the
   // joint fit no longer holds, its own).

@@ -259,7 +259,11 @@ std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>&
 }
 
 std::vector<double> CandidateSearch::weights_at(const std::vector<FitParameter>& ps, const Workspace& ws) const {
-  const ChannelNoise n = channel_noise(*ws.train, ps);
+  return channel_weights(*ws.train, ps);
+}
+
+std::vector<double> channel_weights(const fit::ResidualModel& m, const std::vector<FitParameter>& ps) {
+  const ChannelNoise n = channel_noise(m, ps);
   std::vector<double> w;
   for (double v : n.var_tau) w.push_back(1 / std::sqrt(v));
   return w;

@@ -215,6 +215,11 @@ std::string separating_manoeuvre(const std::string& a, const std::string& b);
 // or dof <= 0, 0 for an infinite x, NaN for a NaN x.
 double chi2_upper(double x, double dof);
 
+// Channel weights 1 / (sigma sqrt(tau_int)) from the residuals of `m` at `ps`: the weights
+// under which a weighted cost is -2 log-likelihood (each channel's noise and its
+// correlation time), as the search weighs its fits.
+std::vector<double> channel_weights(const fit::ResidualModel& m, const std::vector<fit::FitParameter>& ps);
+
 // The solver settings of every refit a diagnosis makes (each step of the search, each flight
 // alone in the agreement check), so that their costs compare.
 fit::FitOptions refit_options();

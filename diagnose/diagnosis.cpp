@@ -400,8 +400,7 @@ AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, r
   for (const auto& f : flights) in.training_parts.push_back(fit::split_by_time(f, 1.0 - validation_fraction).first);
   in.use_accelerometer = accelerometer;
   in.joint_fit = d.search.final_fit;
-  in.per_flight = per_flight_names;
-  in.weights = d.search.final_weights;
+  in.per_flight = per_flight_names;  // weights: each flight's own (AgreementInputs)
   const std::vector<std::string> references = reference_parameters(all);
   const auto check = [&](const Finding& f, bool named) {
     const Effect& effect = find_effect(f.effect);

@@ -1190,6 +1190,25 @@ TEST(HeldOut, FoldsHoldEqualHeldOutTimeAcrossJoinedFlights) {
   for (size_t i = 0; i < 4; ++i) EXPECT_NEAR(single[i].samples.front().t, 42 + 4.5 * i, 0.011) << i;
 }
 
+// Each flight is refitted alone under its own noise's weights: a flight with ten times the
+// marker noise measures the rotor drag (a horizontal force, read from the differentiated pose)
+// several times less precisely, and its standard error says so. Under the joint fit's
+// weights, as until the fifty-ninth session, the two errors came out alike (the same
+// manoeuvres), and Cochran's Q charged the noisy flight's scatter as disagreement (a
+// statistics review, helper-128).
+TEST(MultiFlight, EachFlightIsRefittedUnderItsOwnNoise) {
+  const fs::path dir = fresh_directory("quadgen_own_noise");
+  const HiddenCase a{"a", "rotor_drag,motor_gain", {{"rotor_drag.k", 2e-5}, {"motor_gain.C", -0.05}}, {}, "", 1};
+  const HiddenCase b{"b", "rotor_drag,motor_gain", {{"rotor_drag.k", 2e-5}, {"motor_gain.B", 0.04}}, {}, "--pose-noise 1e-2", 2};
+  const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
+  const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
+  const json* k = agreement_of(j, "rotor_drag.k");
+  ASSERT_NE(k, nullptr) << j["agreement"].dump(1);
+  ASSERT_EQ((*k)["flights"].size(), 2u);
+  const double quiet = (*k)["flights"][0]["standard_error"], noisy = (*k)["flights"][1]["standard_error"];
+  EXPECT_GT(noisy, 3 * quiet) << k->dump(1);
+}
+
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
   const json j = rotor_drag_on_two_flights("quadgen_disagree", 1e-5, 4e-5);
   // One joint value fits neither flight: named or suspected, it is checked flight by flight.
