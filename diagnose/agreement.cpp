@@ -59,6 +59,13 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     }
     const double cost_off = fit::solve_weighted(ee, off, weights, fo);
     const double statistic = std::max(0.0, cost_off - cost_on);
+    // "Off" on the bound of a lone parameter: the chi-bar-square null, as the search takes it
+    // (CandidateSearch::p_value_of; Self & Liang 1987). The plain chi2 doubled these p-values
+    // until the fifty-ninth session (a statistics review, helper-128).
+    const fit::FitParameter& first = on[static_cast<size_t>(in.model->param_index(e.parameters.front()))];
+    const bool off_on_bound = e.parameters.size() == 1 && e.off[0] <= first.lower + 0.01 * (first.upper - first.lower);
+    const double p_value = off_on_bound ? 0.5 * chi2_upper(statistic, 1.0)
+                                        : chi2_upper(statistic, static_cast<double>(e.parameters.size()));
     for (const auto& name : e.parameters) {
       const int i = in.model->param_index(name);
       FlightEstimate f;
@@ -68,7 +75,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
       f.lower = f.value - kZ95 * f.standard_error;
       f.upper = f.value + kZ95 * f.standard_error;
       f.statistic = statistic;
-      f.p_value = chi2_upper(statistic, static_cast<double>(e.parameters.size()));
+      f.p_value = p_value;
       out[name] = f;
     }
   }

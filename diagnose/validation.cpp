@@ -164,8 +164,11 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
 
 std::vector<double> fold_gains(const std::vector<double>& before, const std::vector<double>& after) {
   std::vector<double> gains;
+  // A fold where both diverged (inf - inf) says nothing of either: left out, as a NaN is
+  // (a statistics review, helper-128: its NaN gain made the mean NaN).
   for (size_t k = 0; k < std::min(before.size(), after.size()); ++k)
-    if (!std::isnan(before[k]) && !std::isnan(after[k])) gains.push_back(before[k] - after[k]);
+    if (!std::isnan(before[k]) && !std::isnan(after[k]) && (std::isfinite(before[k]) || std::isfinite(after[k])))
+      gains.push_back(before[k] - after[k]);
   return gains;
 }
 

@@ -74,7 +74,8 @@ WindowedSimulation simulate_windows(runtime::DynamicModel& model, const std::vec
 // The folds' position RMSEs of a simulation, in fold order.
 std::vector<double> fold_position_rmses(const WindowedSimulation& w);
 // Per fold, `before` - `after` (m): the gain a finding or a proposed term buys, over the
-// folds both score (a fold no window starts in, NaN, is left out).
+// folds both score (a fold no window starts in, NaN, is left out, and so is one where both
+// diverged; where one alone diverged the gain is infinite, for or against it).
 std::vector<double> fold_gains(const std::vector<double>& before, const std::vector<double>& after);
 
 }  // namespace quadgen::diagnose

@@ -1207,6 +1207,14 @@ TEST(MultiFlight, EachFlightIsRefittedUnderItsOwnNoise) {
   ASSERT_EQ((*k)["flights"].size(), 2u);
   const double quiet = (*k)["flights"][0]["standard_error"], noisy = (*k)["flights"][1]["standard_error"];
   EXPECT_GT(noisy, 3 * quiet) << k->dump(1);
+  // Each flight's own test against "off" (k = 0, its lower bound) takes the chi-bar-square
+  // null, as the search does: half the chi2_1 tail (it took the whole tail until the
+  // fifty-ninth session). Here the statistics are moderate (about 30), so the p-values are not 0.
+  for (const auto& f : (*k)["flights"]) {
+    const double statistic = f["alone"]["statistic"], p = f["alone"]["p_value"];
+    ASSERT_GT(p, 0.0) << f.dump();
+    EXPECT_NEAR(p / (0.5 * boost::math::cdf(boost::math::complement(boost::math::chi_squared(1), statistic))), 1.0, 1e-9);
+  }
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
@@ -1871,6 +1879,13 @@ TEST(Validation, WindowsCutShortByTheEndOrAGapAreCounted) {
   const auto gains = quadgen::diagnose::fold_gains(rmses, lower);
   ASSERT_EQ(gains.size(), 3u);
   EXPECT_DOUBLE_EQ(gains[1], 0.5 * rmses[2]);
+  // A fold where both models diverged says nothing (its inf - inf made every mean NaN); where
+  // one alone did, the gain is infinite for or against it.
+  const auto diverged = quadgen::diagnose::fold_gains({0.3, INFINITY, INFINITY, 0.2}, {0.1, INFINITY, 0.5, INFINITY});
+  ASSERT_EQ(diverged.size(), 3u);
+  EXPECT_DOUBLE_EQ(diverged[0], 0.2);
+  EXPECT_EQ(diverged[1], INFINITY);
+  EXPECT_EQ(diverged[2], -INFINITY);
 }
 
 // The folds and the whole part judge the same windows (each fold those starting in it, run
