@@ -64,7 +64,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     // until the fifty-ninth session (a statistics review, helper-128).
     const fit::FitParameter& first = on[static_cast<size_t>(in.model->param_index(e.parameters.front()))];
     const bool off_on_bound = e.parameters.size() == 1 && e.off[0] <= first.lower + 0.01 * (first.upper - first.lower);
-    const double p_value = off_on_bound ? 0.5 * chi2_upper(statistic, 1.0)
+    const double p_value = off_on_bound && statistic > 0 ? 0.5 * chi2_upper(statistic, 1.0)
                                         : chi2_upper(statistic, static_cast<double>(e.parameters.size()));
     for (const auto& name : e.parameters) {
       const int i = in.model->param_index(name);
@@ -110,7 +110,8 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
   a.joint_value = a.pooled = airframe_value;
   a.flights = {f};
   // An airframe value without a standard error (a diagnosis that had none) cannot say either.
-  a.reference_without_error = std::isnan(airframe_standard_error);
+  // (The reader of --airframe gives 0 where a diagnosis has none.)
+  a.reference_without_error = !(airframe_standard_error > 0 && std::isfinite(airframe_standard_error));
   // A flight without one cannot disagree, nor agree, and has no z.
   const bool measured = f.standard_error > 0 && std::isfinite(f.standard_error);
   const bool says = measured && !a.reference_without_error;

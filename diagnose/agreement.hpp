@@ -132,7 +132,7 @@ std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& mo
                                                        bool use_accelerometer, const std::vector<double>& weights,
                                                        const AirframeReference& airframe);
 
-// One flight's estimate `f` against an airframe's value and its standard error (NaN: none), as
+// One flight's estimate `f` against an airframe's value and its standard error (0 or NaN: none), as
 // check_against_airframe judges each parameter. Where either side has no standard error the
 // verdict is "too uncertain"; where the flight has none, q and its p-value are NaN too (until
 // the fifty-ninth session it made q infinite, and the p-value's Boost call aborted the run).

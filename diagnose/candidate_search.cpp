@@ -372,7 +372,8 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
 double CandidateSearch::p_value_of(const std::string& effect, double statistic, int dof) const {
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
   const bool boundary = dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
-  return boundary ? 0.5 * chi2_upper(statistic, 1) : chi2_upper(statistic, std::max(1, dof));
+  // P(T >= 0) is 1 under that null too (its half at 0 included): no evidence, p = 1.
+  return boundary && statistic > 0 ? 0.5 * chi2_upper(statistic, 1) : chi2_upper(statistic, std::max(1, dof));
 }
 
 void CandidateSearch::effect_size(const std::string& effect, const std::vector<FitParameter>& ps,

@@ -6,6 +6,7 @@
 
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/numbers.hpp"
+#include "runtime/data_side_effects.hpp"
 
 namespace quadgen::diagnose {
 
@@ -39,10 +40,15 @@ std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
   std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
   for (auto& f : folds) f.samples.clear();
   const auto& s = valid.samples;
+  std::vector<double> times;
+  for (const auto& x : s) times.push_back(x.t);
+  // A gap: longer than a rollout steps over, and than 1.5 of the log's median spacing (a log
+  // sampled at 10 Hz or slower would otherwise be all gaps, one fold).
+  const double gap = std::max(predict::Rollout::kMaxGap, s.size() > 1 ? runtime::gap_threshold(times) : 0.0);
   std::vector<double> held_out(s.size(), 0.0);  // held-out time before each sample
   for (size_t i = 1; i < s.size(); ++i) {
     const double dt = s[i].t - s[i - 1].t;
-    held_out[i] = held_out[i - 1] + (dt <= predict::Rollout::kMaxGap ? dt : 0.0);
+    held_out[i] = held_out[i - 1] + (dt > 0 && dt <= gap ? dt : 0.0);
   }
   const double span = (s.empty() ? 0.0 : held_out.back()) + 1e-9;
   for (size_t i = 0; i < s.size(); ++i)
@@ -224,9 +230,13 @@ Finding HeldOutGain::finding_for(const std::string& e, const SearchResult& s) co
   f.rollouts = pose_;
   f.before = b.metric;
   f.after = a.metric;
-  f.fold_gains = fold_gains(b.fold_metrics, a.fold_metrics);
-  mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
   f.one_step = one_step(b, a);
+  // Without a pose the metric is the one-step cost: its gain per fold is the one-step route's
+  // own, in per cent, so the two routes cannot disagree in sign (summed costs did: a
+  // fold with a larger cost weighs more in a difference than in a per cent).
+  f.fold_gains = pose_ || f.one_step.cost.per_fold.empty() ? fold_gains(b.fold_metrics, a.fold_metrics)
+                                                           : f.one_step.cost.per_fold;
+  mean_and_standard_error(f.fold_gains, &f.gain_mean, &f.gain_standard_error);
   if (force_alone) {
     f.force_alone.per_fold = fold_gains(b.force_alone, a.force_alone);
     summarise(f.force_alone);

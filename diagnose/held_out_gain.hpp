@@ -27,7 +27,7 @@ namespace quadgen::diagnose {
 
 // The validation part cut into `k` consecutive blocks of equal held-out time: the sample
 // intervals of its contiguous stretches count, a gap (longer than a rollout steps over,
-// predict::Rollout::kMaxGap) does not. Joined flights hold their validation parts apart on
+// predict::Rollout::kMaxGap, and than 1.5 median spacings) does not. Joined flights hold their validation parts apart on
 // the joined clock (each flight's training part lies between); cut by that clock, two
 // flights gave two blocks of four (a statistics review, helper-128). A block of fewer than
 // two samples is dropped.
