@@ -59,13 +59,11 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     }
     const double cost_off = fit::solve_weighted(ee, off, weights, fo);
     const double statistic = std::max(0.0, cost_off - cost_on);
-    // "Off" on the bound of a lone parameter: the chi-bar-square null, as the search takes it
-    // (CandidateSearch::p_value_of; Self & Liang 1987). The plain chi2 doubled these p-values
-    // until the fifty-ninth session (a statistics review, helper-128).
+    // Judged as the search judges (the plain chi2 doubled the p-values of "off" on a bound
+    // until the fifty-ninth session; a statistics review, helper-128).
     const fit::FitParameter& first = on[static_cast<size_t>(in.model->param_index(e.parameters.front()))];
-    const bool off_on_bound = e.parameters.size() == 1 && e.off[0] <= first.lower + 0.01 * (first.upper - first.lower);
-    const double p_value = off_on_bound && statistic > 0 ? 0.5 * chi2_upper(statistic, 1.0)
-                                        : chi2_upper(statistic, static_cast<double>(e.parameters.size()));
+    const double p_value =
+        lr_p_value(statistic, static_cast<int>(e.parameters.size()), e.off.front(), first.lower, first.upper);
     for (const auto& name : e.parameters) {
       const int i = in.model->param_index(name);
       FlightEstimate f;

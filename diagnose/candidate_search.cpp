@@ -368,12 +368,9 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
   return "";
 }
 
-// A parameter whose neutral value is its bound has a chi-bar-square null (Self & Liang 1987).
 double CandidateSearch::p_value_of(const std::string& effect, double statistic, int dof) const {
   const auto& p0 = all_.params[effect_params_.at(effect).front()];
-  const bool boundary = dof == 1 && neutral_value(p0) <= p0.lower + 0.01 * (p0.upper - p0.lower);
-  // P(T >= 0) is 1 under that null too (its half at 0 included): no evidence, p = 1.
-  return boundary && statistic > 0 ? 0.5 * chi2_upper(statistic, 1) : chi2_upper(statistic, std::max(1, dof));
+  return lr_p_value(statistic, dof, neutral_value(p0), p0.lower, p0.upper);
 }
 
 void CandidateSearch::effect_size(const std::string& effect, const std::vector<FitParameter>& ps,
@@ -847,6 +844,12 @@ double chi2_upper(double x, double dof) {
   if (x <= 0 || !(dof > 0)) return 1.0;  // no evidence, or nothing to test (one flight)
   if (std::isinf(x)) return 0.0;
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), x));
+}
+
+double lr_p_value(double statistic, int dof, double off, double lower, double upper) {
+  const bool boundary = dof == 1 && off <= lower + 0.01 * (upper - lower);
+  // P(T >= 0) is 1 under that null too (its half at 0 included): no evidence, p = 1.
+  return boundary && statistic > 0 ? 0.5 * chi2_upper(statistic, 1) : chi2_upper(statistic, std::max(1, dof));
 }
 
 StandardErrors gauss_newton_standard_errors(const fit::ResidualModel& m, const std::vector<FitParameter>& ps,

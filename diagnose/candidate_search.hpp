@@ -215,6 +215,13 @@ std::string separating_manoeuvre(const std::string& a, const std::string& b);
 // or dof <= 0, 0 for an infinite x, NaN for a NaN x.
 double chi2_upper(double x, double dof);
 
+// The p-value of a likelihood-ratio statistic of `dof` parameters against their "off" values.
+// Where a lone parameter's `off` lies on its lower bound (within 1 % of [lower, upper]) the
+// null is the chi-bar-square 0.5 chi2_0 + 0.5 chi2_1 (Self & Liang 1987): half the chi2_1
+// tail, and 1 for no evidence (a zero statistic). The search and the per-flight refits of
+// the agreement check both judge by it.
+double lr_p_value(double statistic, int dof, double off, double lower, double upper);
+
 // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals of `m` at `ps`: the weights
 // under which a weighted cost is -2 log-likelihood (each channel's noise and its
 // correlation time), as the search weighs its fits.
@@ -369,6 +376,7 @@ class CandidateSearch {
   std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;
   void effect_size(const std::string& effect, const std::vector<fit::FitParameter>& ps, CandidateEvidence& ev,
                    const Workspace& ws) const;
+  // lr_p_value at the effect's first parameter's neutral value and bounds.
   double p_value_of(const std::string& effect, double statistic, int dof) const;
   // with_profiles: profile likelihood for the airframe's parameters; else Wald for all.
   void estimate_intervals(SearchResult& r, bool with_profiles) const;

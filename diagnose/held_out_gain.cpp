@@ -14,6 +14,23 @@ namespace {
 
 void summarise(Finding::FoldGains& g) { mean_and_standard_error(g.per_fold, &g.mean, &g.standard_error); }
 
+// The held-out time before each sample of `valid`: its positive sample intervals up to a gap
+// count; a gap is longer than a rollout steps over (predict::Rollout::kMaxGap) and than 1.5
+// of the log's median spacing (a log sampled at 10 Hz or slower is no gap throughout). The
+// training parts between joined flights' held-out parts add nothing.
+std::vector<double> held_out_clock(const fit::Flight& valid) {
+  const auto& s = valid.samples;
+  std::vector<double> times;
+  for (const auto& x : s) times.push_back(x.t);
+  const double gap = std::max(predict::Rollout::kMaxGap, s.size() > 1 ? runtime::gap_threshold(times) : 0.0);
+  std::vector<double> clock(s.size(), 0.0);
+  for (size_t i = 1; i < s.size(); ++i) {
+    const double dt = s[i].t - s[i - 1].t;
+    clock[i] = clock[i - 1] + (dt > 0 && dt <= gap ? dt : 0.0);
+  }
+  return clock;
+}
+
 }  // namespace
 
 HeldOutGain::ChannelGroupSquares HeldOutGain::channel_group_squares(const fit::EquationErrorModel& m,
@@ -40,16 +57,7 @@ std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k) {
   std::vector<fit::Flight> folds(static_cast<size_t>(k), valid);
   for (auto& f : folds) f.samples.clear();
   const auto& s = valid.samples;
-  std::vector<double> times;
-  for (const auto& x : s) times.push_back(x.t);
-  // A gap: longer than a rollout steps over, and than 1.5 of the log's median spacing (a log
-  // sampled at 10 Hz or slower would otherwise be all gaps, one fold).
-  const double gap = std::max(predict::Rollout::kMaxGap, s.size() > 1 ? runtime::gap_threshold(times) : 0.0);
-  std::vector<double> held_out(s.size(), 0.0);  // held-out time before each sample
-  for (size_t i = 1; i < s.size(); ++i) {
-    const double dt = s[i].t - s[i - 1].t;
-    held_out[i] = held_out[i - 1] + (dt > 0 && dt <= gap ? dt : 0.0);
-  }
+  const std::vector<double> held_out = held_out_clock(valid);
   const double span = (s.empty() ? 0.0 : held_out.back()) + 1e-9;
   for (size_t i = 0; i < s.size(); ++i)
     folds[std::min<size_t>(static_cast<size_t>(k) - 1, static_cast<size_t>(held_out[i] / span * k))].samples.push_back(s[i]);
@@ -119,12 +127,10 @@ double HeldOutGain::open_loop_rmse(const std::vector<fit::FitParameter>& ps, Win
 
 std::string HeldOutGain::fold_windows_text(const std::vector<fit::FitParameter>& ps) const {
   const WindowedSimulation w = windows(ps, predict::Replay::kNothing, false);
-  // The held-out time itself: a joint diagnosis's parts lie apart on the joined clock.
-  double held_out = 0;
-  for (size_t k = 1; k < valid_.samples.size(); ++k) {
-    const double dt = valid_.samples[k].t - valid_.samples[k - 1].t;
-    if (dt <= predict::Rollout::kMaxGap) held_out += dt;
-  }
+  // The held-out time itself, as the folds cut it: a joint diagnosis's parts lie apart on
+  // the joined clock.
+  const std::vector<double> clock = held_out_clock(valid_);
+  const double held_out = clock.empty() ? 0.0 : clock.back();
   const bool diverged = !std::isfinite(w.position_rmse);
   return "of the " + std::to_string(w.windows) + " windows the " + std::to_string(fold_starts_.size()) +
          " folds score, " + std::to_string(w.cut_short) + " end early (at the held-out part's end or a gap) before " +
@@ -157,7 +163,7 @@ void HeldOutGain::weigh(Scores& s, const std::vector<fit::FitParameter>& ps, con
   for (const auto& fold : fold_problems_) s.fold_costs.push_back(CandidateSearch::cost(*fold.fit, ps, weights));
   if (pose_) return;
   s.metric = CandidateSearch::cost(valid_ee_, ps, weights);
-  s.fold_metrics = s.fold_costs.empty() ? std::vector<double>{s.metric} : s.fold_costs;
+  s.fold_metrics = {s.metric};  // read only where no fold problem could be built (finding_for)
 }
 
 const HeldOutGain::Scores& HeldOutGain::final_scores(const SearchResult& s, bool force_alone) const {

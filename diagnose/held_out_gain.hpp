@@ -27,10 +27,10 @@ namespace quadgen::diagnose {
 
 // The validation part cut into `k` consecutive blocks of equal held-out time: the sample
 // intervals of its contiguous stretches count, a gap (longer than a rollout steps over,
-// predict::Rollout::kMaxGap, and than 1.5 median spacings) does not. Joined flights hold their validation parts apart on
-// the joined clock (each flight's training part lies between); cut by that clock, two
-// flights gave two blocks of four (a statistics review, helper-128). A block of fewer than
-// two samples is dropped.
+// predict::Rollout::kMaxGap, and than 1.5 median spacings) does not. Joined flights hold
+// their validation parts apart on the joined clock (each flight's training part lies
+// between); cut by that clock, two flights gave two blocks of four (a statistics review,
+// helper-128). A block of fewer than two samples is dropped.
 std::vector<fit::Flight> validation_folds(const fit::Flight& valid, int k);
 
 // The mean of per-fold gains and its standard error (0 for one fold).
@@ -86,13 +86,13 @@ class HeldOutGain {
   struct Scores {
     // Unweighted: the open-loop rollouts (with a pose) and the channel groups.
     double metric = 0;
-    std::vector<double> fold_metrics;  // the open-loop windows per fold (without a pose: fold_costs)
+    std::vector<double> fold_metrics;  // the open-loop windows per fold (one cost without a pose)
     std::vector<double> force_alone;   // the same with the measured attitude replayed (when asked)
     // Per one-step fold (a fold without a row to differentiate has none, so these can be
     // fewer than the open-loop folds; the two families are never indexed together).
     std::vector<ChannelGroupSquares> fit_groups, translational_groups;  // the latter as the guard reads it
-    // Weighted (weigh): the one-step cost per fold; without a pose also the metric (the
-    // whole part's cost) and fold_metrics (these costs).
+    // Weighted (weigh): the one-step cost per fold; without a pose also the metric and
+    // fold_metrics (the whole part's cost; the folds' gains are then the one-step route's).
     std::vector<double> fold_costs;
   };
   Scores unweighted_scores(const std::vector<fit::FitParameter>& ps, bool force_alone) const;

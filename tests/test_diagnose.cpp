@@ -962,10 +962,11 @@ TEST(MultiFlight, OneCauseNamedOnceWithEachFlightsOwnTrim) {
 // value the joint fit gives (agreement), and a value that differs between the flights must be
 // reported as disagreement - the check that keeps a flight-to-flight stand-in from passing as a
 // property of the airframe.
-json rotor_drag_on_two_flights(const std::string& name, double k_a, double k_b) {
+// `b_flags`: the second flight's extra simulate flags (its marker noise, say).
+json rotor_drag_on_two_flights(const std::string& name, double k_a, double k_b, const std::string& b_flags = "") {
   const fs::path dir = fresh_directory(name);
   const HiddenCase a{"a", "rotor_drag,motor_gain", {{"rotor_drag.k", k_a}, {"motor_gain.C", -0.05}}, {}, "", 1};
-  const HiddenCase b{"b", "rotor_drag,motor_gain", {{"rotor_drag.k", k_b}, {"motor_gain.B", 0.04}}, {}, "", 2};
+  const HiddenCase b{"b", "rotor_drag,motor_gain", {{"rotor_drag.k", k_b}, {"motor_gain.B", 0.04}}, {}, b_flags, 2};
   const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
   return diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
 }
@@ -1219,11 +1220,7 @@ TEST(HeldOut, FoldsHoldEqualHeldOutTimeAcrossJoinedFlights) {
 // manoeuvres), and Cochran's Q charged the noisy flight's scatter as disagreement (a
 // statistics review, helper-128).
 TEST(MultiFlight, EachFlightIsRefittedUnderItsOwnNoise) {
-  const fs::path dir = fresh_directory("quadgen_own_noise");
-  const HiddenCase a{"a", "rotor_drag,motor_gain", {{"rotor_drag.k", 2e-5}, {"motor_gain.C", -0.05}}, {}, "", 1};
-  const HiddenCase b{"b", "rotor_drag,motor_gain", {{"rotor_drag.k", 2e-5}, {"motor_gain.B", 0.04}}, {}, "--pose-noise 1e-2", 2};
-  const fs::path fa = fly(a, dir, "a.csv", 40), fb = fly(b, dir, "b.csv", 40);
-  const json j = diagnose_log(vehicle_file(a), fs::path(fa.string() + " " + fb.string()), dir);
+  const json j = rotor_drag_on_two_flights("quadgen_own_noise", 2e-5, 2e-5, "--pose-noise 1e-2");
   const json* k = agreement_of(j, "rotor_drag.k");
   ASSERT_NE(k, nullptr) << j["agreement"].dump(1);
   ASSERT_EQ((*k)["flights"].size(), 2u);
