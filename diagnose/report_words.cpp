@@ -229,12 +229,14 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
   for (const auto& p : paths) {
     stems.push_back(std::filesystem::path(p).stem().string());
     // As the sinks show them: "x y" and "x<tab>y" both read "x y" in a CSV and a legend (a
-    // red-team review: two flights were one series there), "flight" and "flight<U+200B>" alike.
-    seen.push_back(output::visible_skeleton(stems.back()));
+    // red-team review: two flights were one series there), "flight" and "flight<U+200B>" alike;
+    // and as a reader sees them: "café" with its accent precomposed or combining, "flight a"
+    // with a Latin or a Cyrillic a (Unicode's confusables).
+    seen.push_back(output::lookalike_skeleton(stems.back()));
   }
   const auto numbered = [&](size_t i) { return "flight " + std::to_string(i + 1) + " (" + stems[i] + ")"; };
   std::vector<std::string> taken_seen;
-  for (const auto& t : taken) taken_seen.push_back(output::visible_skeleton(t));
+  for (const auto& t : taken) taken_seen.push_back(output::lookalike_skeleton(t));
   const auto takes_a_name = [&](const std::string& s) {
     for (const auto& name : taken_seen)
       if (s == name || s.rfind(name + ",", 0) == 0) return true;
@@ -247,7 +249,7 @@ std::vector<std::string> short_flight_labels(const std::vector<std::string>& pat
   // review): then every flight is numbered, and the numbers differ.
   std::set<std::string> labels;
   for (const auto& l : out)
-    if (!labels.insert(output::visible_skeleton(l)).second) {
+    if (!labels.insert(output::lookalike_skeleton(l)).second) {
       for (size_t i = 0; i < stems.size(); ++i) out[i] = numbered(i);
       break;
     }

@@ -1,8 +1,12 @@
 #include "output/sinks.hpp"
 
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
+
+#include <unicode/uspoof.h>
+#include <unicode/utypes.h>
 
 #include "output/names.hpp"
 
@@ -189,6 +193,40 @@ std::string visible_skeleton(const std::string& s) {
       out += c;
   });
   return out;
+}
+
+namespace {
+// One spoof checker for the process: configured once, then used read-only (ICU allows
+// concurrent use of a const checker).
+const USpoofChecker* confusable_checker() {
+  static const USpoofChecker* const checker = [] {
+    UErrorCode status = U_ZERO_ERROR;
+    USpoofChecker* sc = uspoof_open(&status);
+    if (U_SUCCESS(status)) uspoof_setChecks(sc, USPOOF_CONFUSABLE, &status);
+    if (U_FAILURE(status)) throw std::runtime_error(std::string("ICU spoof checker: ") + u_errorName(status));
+    return sc;
+  }();
+  return checker;
+}
+}  // namespace
+
+std::string lookalike_skeleton(const std::string& s) {
+  const std::string visible = visible_skeleton(s);  // valid UTF-8: invalid bytes are '?' there
+  if (visible.size() > static_cast<size_t>(INT32_MAX / 8)) return visible;
+  std::string out(visible.size() * 3 + 16, '\0');
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    UErrorCode status = U_ZERO_ERROR;
+    const int32_t n = uspoof_getSkeletonUTF8(confusable_checker(), 0, visible.data(), static_cast<int32_t>(visible.size()),
+                                             out.data(), static_cast<int32_t>(out.size()), &status);
+    if (status == U_BUFFER_OVERFLOW_ERROR) {
+      out.assign(static_cast<size_t>(n) + 1, '\0');
+      continue;
+    }
+    if (U_FAILURE(status)) return visible;  // no skeleton: the visible one still keeps most apart
+    out.resize(static_cast<size_t>(n));
+    return out;
+  }
+  return visible;
 }
 
 std::string csv_field(const std::string& s) {

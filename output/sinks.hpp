@@ -25,6 +25,12 @@ std::string printable_lines(const std::string& text);
 // zero-width characters, the soft hyphen, variation selectors) and whatever looks blank. Two names with one skeleton may read the
 // same in some sink: a caller that must keep them apart (a plot's series) numbers them.
 std::string visible_skeleton(const std::string& s);
+// visible_skeleton, then Unicode's confusable skeleton (UTS #39, by ICU's spoof checker): two
+// strings with one lookalike_skeleton may look the same to a reader even where every sink
+// shows their characters faithfully: "é" written as one character or as e and a combining
+// accent (NFC, NFD), a Latin "a" and a Cyrillic "а", "rn" and "m", "l" and "1". Coarser than
+// the visible skeleton: a caller numbering series that must be told apart uses this one.
+std::string lookalike_skeleton(const std::string& s);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
 // trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);

@@ -12,6 +12,7 @@ packages=(
   libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds
   libssl-dev                            # SHA-256 of vehicle files (which generated header is whose)
   libkainjow-mustache-dev               # text templates for generated code
+  libicu-dev                            # Unicode look-alike skeletons (flight labels that must not read alike)
   gnuplot-nox                           # plots (SVG) of simulations and fits
   cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown
   clang libclang-rt-14-dev              # CI's sanitizer build (.ci/sanitize) and libFuzzer (scripts/fuzz.sh)

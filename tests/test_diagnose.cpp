@@ -2609,3 +2609,29 @@ TEST(ReportWords, FlightsOfOneFileNameGetTheirNumber) {
   EXPECT_EQ(quadgen::output::visible_skeleton("a\xC2\xAD" "b\xEF\xB8\x8F" "c\xE2\x81\xA2" "d\xE3\x85\xA4" "e"), "abcde");
   EXPECT_EQ(quadgen::output::visible_skeleton("caf\xC3\xA9"), "caf\xC3\xA9");  // a letter stays
 }
+
+// Names whose every character a sink shows faithfully can still look alike to a reader: "é"
+// precomposed (NFC) and as e plus a combining accent (NFD), a Latin and a Cyrillic "a", "rn"
+// and "m". Left open by the label reviews of the forty-ninth and fifty-third sessions; two
+// such flights were two series with one legend.
+TEST(ReportWords, FlightsWhoseNamesLookAlikeGetTheirNumber) {
+  using quadgen::diagnose::words::short_flight_labels;
+  using quadgen::output::lookalike_skeleton;
+  const std::string nfc = "caf\xC3\xA9", nfd = "cafe\xCC\x81", cyrillic_a = "\xD0\xB0";
+  EXPECT_EQ(lookalike_skeleton(nfc), lookalike_skeleton(nfd));
+  EXPECT_EQ(lookalike_skeleton("flight a"), lookalike_skeleton("flight " + cyrillic_a));
+  EXPECT_EQ(lookalike_skeleton("modern"), lookalike_skeleton("modem"));
+  EXPECT_EQ(lookalike_skeleton("x\xE2\x80\x8By"), lookalike_skeleton("xy"));  // and what the visible one drops
+  EXPECT_NE(lookalike_skeleton("B3_rep1"), lookalike_skeleton("B3_rep2"));
+  EXPECT_NE(lookalike_skeleton("caf\xC3\xA9"), lookalike_skeleton("cafe"));  // an accent is seen
+  EXPECT_EQ(lookalike_skeleton("bad\xFF"), lookalike_skeleton("bad?"));  // invalid UTF-8 as the sinks show it
+
+  const auto labels = short_flight_labels({"a/" + nfc + ".csv", "b/" + nfd + ".csv", "flight a.csv",
+                                           "flight " + cyrillic_a + ".csv", "B3_rep1.csv", "B3_rep2.csv"});
+  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(labels[i].rfind("flight " + std::to_string(i + 1) + " (", 0), 0u) << labels[i];
+  EXPECT_EQ(labels[4], "B3_rep1");
+  EXPECT_EQ(labels[5], "B3_rep2");
+  // A series the plot names itself, spelt with a look-alike letter, is no flight's label either.
+  EXPECT_EQ(short_flight_labels({"the m" + std::string("\xD0\xBE") + "del.csv", "B3.csv"}, {"the model"}),
+            (std::vector<std::string>{"flight 1 (the m\xD0\xBE" "del)", "B3"}));
+}
