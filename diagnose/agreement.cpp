@@ -35,13 +35,15 @@ std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, co
     p.name = n;
     const bool of_effect = std::find(named.begin(), named.end(), n) != named.end();
     p.free = of_effect || (per_flight && p.free);
-    if (of_effect) p.value = std::clamp(start.at(n), p.lower, p.upper);
+    // A base parameter (base_parameter_agreement) starts where the joint fit left it.
+    if (of_effect && start.count(n)) p.value = std::clamp(start.at(n), p.lower, p.upper);
     ps.push_back(p);
   }
   return ps;
 }
 
-// One flight: its estimates of every named parameter and, per effect, the LR test against off.
+// One flight: its estimates of every named parameter and, per effect, the LR test against off
+// (a parameter of no effect in `in`, a base parameter, has no such test: statistic and p NaN).
 std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, int k, const std::vector<std::string>& named) {
   const fit::EquationErrorModel ee(*in.model, in.training_parts[static_cast<size_t>(k - 1)], in.use_accelerometer);
   const fit::FitOptions fo = refit_options();
@@ -50,6 +52,18 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
   const double cost_on = fit::solve_weighted(ee, on, weights, fo);
   const StandardErrors se = gauss_newton_standard_errors(ee, on, weights);
   std::map<std::string, FlightEstimate> out;
+  const auto estimate = [&](const std::string& name, double statistic, double p_value) {
+    const int i = in.model->param_index(name);
+    FlightEstimate f;
+    f.value = on[i].value;
+    const bool known = !se.confounded[i] && std::isfinite(se.value[i]) && se.value[i] > 0;
+    f.standard_error = known ? se.value[i] : std::numeric_limits<double>::quiet_NaN();
+    f.lower = f.value - kZ95 * f.standard_error;
+    f.upper = f.value + kZ95 * f.standard_error;
+    f.statistic = statistic;
+    f.p_value = p_value;
+    return f;
+  };
   for (const auto& e : in.effects) {
     std::vector<fit::FitParameter> off = on;
     for (size_t j = 0; j < e.parameters.size(); ++j) {
@@ -64,19 +78,11 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     const fit::FitParameter& first = on[static_cast<size_t>(in.model->param_index(e.parameters.front()))];
     const double p_value =
         lr_p_value(statistic, static_cast<int>(e.parameters.size()), e.off.front(), first.lower, first.upper);
-    for (const auto& name : e.parameters) {
-      const int i = in.model->param_index(name);
-      FlightEstimate f;
-      f.value = on[i].value;
-      const bool known = !se.confounded[i] && std::isfinite(se.value[i]) && se.value[i] > 0;
-      f.standard_error = known ? se.value[i] : std::numeric_limits<double>::quiet_NaN();
-      f.lower = f.value - kZ95 * f.standard_error;
-      f.upper = f.value + kZ95 * f.standard_error;
-      f.statistic = statistic;
-      f.p_value = p_value;
-      out[name] = f;
-    }
+    for (const auto& name : e.parameters) out[name] = estimate(name, statistic, p_value);
   }
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& name : named)
+    if (!out.count(name)) out[name] = estimate(name, none, none);
   return out;
 }
 
@@ -193,6 +199,26 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) 
       summarise_agreement(a);
       out.push_back(a);
     }
+  return out;
+}
+
+std::vector<ParameterAgreement> base_parameter_agreement(const AgreementInputs& in, const std::vector<std::string>& base) {
+  std::vector<ParameterAgreement> out;
+  if (base.empty() || in.training_parts.size() < 2) return out;
+  AgreementInputs held = in;
+  held.effects.clear();  // held at the joint fit: no effect refitted, none tested alone
+  std::vector<std::map<std::string, FlightEstimate>> per_flight;
+  for (size_t k = 1; k <= in.training_parts.size(); ++k) per_flight.push_back(fit_one_flight(held, static_cast<int>(k), base));
+  for (const auto& name : base) {
+    ParameterAgreement a;
+    a.parameter = name;
+    a.named = true;  // part of every model: no suspect
+    for (const auto& p : in.joint_fit)
+      if (p.name == name) a.unit = p.unit, a.joint_value = p.value;
+    for (const auto& f : per_flight) a.flights.push_back(f.at(name));
+    summarise_agreement(a);
+    out.push_back(a);
+  }
   return out;
 }
 

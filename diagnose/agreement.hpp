@@ -101,6 +101,15 @@ struct AgreementInputs {
 
 std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
 
+// The base model's parameters the flights share (`base`: the frame's drag coefficient, the
+// torque ratio; each free in the joint fit and no flight's own), refitted together on each
+// flight's training part with every effect held at the joint fit (the flight's own thrust
+// constant and trims free), judged as an effect's are. The brief's "vehicle properties must
+// agree across flights" covers these as much as the named causes: a drag coefficient that
+// each flight alone sends to another bound is not the airframe's. `effect` is empty and no
+// "alone" test is made (statistic and p NaN): the base model has no "off".
+std::vector<ParameterAgreement> base_parameter_agreement(const AgreementInputs& in, const std::vector<std::string>& base);
+
 // Pooled value, Cochran's Q, spread, the spread under agreement and the verdict of `a`, from
 // its flights' estimates and joint value.
 void summarise_agreement(ParameterAgreement& a);

@@ -766,16 +766,30 @@ struct StageClock {
   static std::string took(Clock::time_point since) { return " (" + output::short_number(seconds_since(since)) + " s)"; }
 };
 
+// The base model's parameters the joint fit fitted for all flights alike: free, no flight's
+// own copy, of no effect (c_w and kappa for the bundled vehicles; c_t is each flight's).
+std::vector<std::string> shared_base_parameters(const std::vector<fit::FitParameter>& joint_fit,
+                                                const std::vector<std::string>& per_flight_names) {
+  std::vector<std::string> out;
+  for (const auto& p : joint_fit)
+    if (p.free && p.name.find('@') == std::string::npos && !is_effect_parameter(p.name) &&
+        std::find(per_flight_names.begin(), per_flight_names.end(), p.name) == per_flight_names.end())
+      out.push_back(p.name);
+  return out;
+}
+
 // Step 3: do the joined flights agree, or does this one flight show an airframe diagnosed before?
 void compare_flights(Diagnosis& d, bool joint, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                      const std::vector<fit::Flight>& flights, const FlightModels& fm, const fit::Flight& train,
                      bool accel, const DiagnoseOptions& opt, const StageClock& clock) {
   const auto start = Clock::now();
   if (joint) {
-    d.agreement = per_flight_agreement(
-        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names));
-    clock.say("agreement: " + std::to_string(d.agreement.size()) + " parameters on " + std::to_string(flights.size()) +
-              " flights" + StageClock::took(start));
+    const AgreementInputs in =
+        agreement_inputs(d, all_in, model_in, flights, opt.validation_fraction, accel, fm.per_flight_names);
+    d.agreement = per_flight_agreement(in);
+    d.base_agreement = base_parameter_agreement(in, shared_base_parameters(d.search.final_fit, fm.per_flight_names));
+    clock.say("agreement: " + std::to_string(d.agreement.size() + d.base_agreement.size()) + " parameters on " +
+              std::to_string(flights.size()) + " flights" + StageClock::took(start));
   } else if (opt.airframe) {
     d.airframe_source = opt.airframe->source;
     d.airframe_flights = opt.airframe->flights;

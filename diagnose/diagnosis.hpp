@@ -177,6 +177,9 @@ struct Diagnosis {
   // Jointly diagnosed flights: each named airframe parameter refitted on each flight alone,
   // and whether the flights agree (agreement.hpp).
   std::vector<ParameterAgreement> agreement;
+  // And the base model's shared parameters (c_w, kappa where fitted), each flight refitted
+  // with the effects held (base_parameter_agreement).
+  std::vector<ParameterAgreement> base_agreement;
   // One flight diagnosed with an airframe: its named effects on this flight against it.
   std::string airframe_source;
   size_t airframe_flights = 0;  // the flights the airframe's diagnosis fitted (1: one flight's values; 0: not said)

@@ -263,6 +263,18 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
   }
 }
 
+// The base model's shared parameters per flight, after the effects' table (what is named comes first).
+void base_agreement_section(std::ostringstream& h, const Diagnosis& d) {
+  if (d.base_agreement.empty()) return;
+  h << "<h2>Do the flights agree on the base model?</h2>\n<p>The base model's parameters every flight shares "
+       "(the frame's drag coefficient, the torque ratio: those the joint fit fitted) refitted together on each "
+       "flight's training part alone, every named effect held at the joint fit (the flight's own trims and thrust "
+       "constant free). Bars, intervals and verdicts as for an effect's agreement; no \"alone\" test, since the base model has no "
+       "\"off\". Flights that disagree here are not one airframe's either: the parameter is carrying something "
+       "that differs between them.</p>\n";
+  agreement_table_html(h, d.base_agreement, d.flights, "joint");
+}
+
 void agreement_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.airframe_check.empty()) {
     h << "<h2>Against the airframe</h2>\n<p>The named effects of the airframe in " << esc(d.airframe_source)
@@ -274,7 +286,7 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
       h << "<p class=\"warn\">Note: " << esc(words::airframe_from_one_flight(d)) << ".</p>\n";
     agreement_table_html(h, d.airframe_check, d.flights, "airframe");
   }
-  if (d.agreement.empty()) return;
+  if (d.agreement.empty()) return base_agreement_section(h, d);
   h << "<h2>Do the flights agree?</h2>\n<p>Each named airframe effect refitted on each flight's training part alone "
        "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
        "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
@@ -286,6 +298,7 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "wider, however well they agree: where every interval holds it and only the 30 % is missed, the verdict is "
        "\"too uncertain\", not \"disagree\".</p>\n";
   agreement_table_html(h, d.agreement, d.flights, "joint", d.findings);
+  base_agreement_section(h, d);
 }
 
 // The page's head, the title (the flights numbered: per-flight values refer to these

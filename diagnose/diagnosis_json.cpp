@@ -236,7 +236,8 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
       json entry = output::estimate_json({f.value, a.unit, f.lower, f.upper, "", false});
       entry["flight"] = k < flights.size() ? flights[k] : std::string();
       entry["standard_error"] = number_or_null(f.standard_error);
-      entry["alone"] = {{"statistic", f.statistic}, {"p_value", f.p_value}};
+      // A base parameter has no test alone (no "off"): null.
+      entry["alone"] = std::isnan(f.statistic) ? json(nullptr) : json{{"statistic", f.statistic}, {"p_value", f.p_value}};
       per_flight.push_back(std::move(entry));
     }
     out.push_back({{"parameter", a.parameter},
@@ -518,6 +519,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["left_at_max_effects"] = left_at_limit_json(d.search);
   j["ambiguous"] = ambiguous_json(d.search);
   j["agreement"] = agreement_json(d.agreement, d.flights);
+  j["base_agreement"] = agreement_json(d.base_agreement, d.flights);
   j["airframe_check"] = airframe_check_json(d);
   j["point_of_action"] = point_of_action_json(d);  // null unless rotor_drag and blade_flapping are both named
   j["unexplained"] = unexplained_json(d);

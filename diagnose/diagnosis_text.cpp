@@ -46,8 +46,14 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
 
 // Whether the flights of a joint diagnosis agree, or this flight with an airframe found before.
 void write_agreement(std::ostream& os, const Diagnosis& d) {
-  for (const auto& a : d.agreement) {
-    os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on " << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+  std::vector<const ParameterAgreement*> all;
+  for (const auto& a : d.agreement) all.push_back(&a);
+  for (const auto& a : d.base_agreement) all.push_back(&a);
+  for (const ParameterAgreement* pa : all) {
+    const ParameterAgreement& a = *pa;
+    const bool base = a.effect.empty();
+    os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on "
+       << (base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << (k ? ", " : " ") << k + 1 << ": " << estimate(a.flights[k].value, a.flights[k].lower, a.flights[k].upper);

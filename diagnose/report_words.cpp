@@ -322,6 +322,11 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
       out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
                     "differs between the flights that lie apart (speed, battery, payload, the day) and diagnose them " +
                     "apart, or together without the odd one");
+  for (const auto& a : d.base_agreement)
+    if (flights_disagree(a))
+      out.push_back("the flights disagree on the base model's " + a.parameter + ": it carries something that differs " +
+                    "between them (for a drag coefficient: a drag the model lacks, or one the flights' speeds cannot " +
+                    "tell from rotor drag); read its values per flight before taking the joint value as the airframe's");
   for (const auto& x : d.suspected)
     if (!x.carried)
       out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")");

@@ -1024,6 +1024,23 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
   EXPECT_LT((*a)["spread"].get<double>(), 0.3);
   EXPECT_GT((*a)["spread_if_agree"].get<double>(), 0.0);  // two flights with standard errors
   EXPECT_GT((*a)["spread_p_value"].get<double>(), 0.01) << "agreeing flights whose spread looks unusual";
+  // The base model's shared parameter (the FINken 3 fits kappa; c_t is each flight's, c_w
+  // fixed) refitted on each flight with the effects held: each flight near the truth the
+  // flights were flown with, within its own interval's reach, and no test alone.
+  ASSERT_EQ(j["base_agreement"].size(), 1u) << j["base_agreement"].dump(1);
+  const json& kappa = j["base_agreement"][0];
+  EXPECT_EQ(kappa["parameter"], "kappa");
+  EXPECT_EQ(kappa["effect"], "");
+  EXPECT_NE(kappa["verdict"], "disagree") << kappa.dump(1);
+  ASSERT_EQ(kappa["flights"].size(), 2u);
+  for (const auto& f : kappa["flights"]) {
+    ASSERT_TRUE(f["standard_error"].is_number()) << f.dump();
+    const double v = f["value"], se = f["standard_error"];
+    EXPECT_GT(se, 0.0);
+    EXPECT_LT(se, 0.1 * 0.01) << "kappa is measured on each flight";
+    EXPECT_LT(std::fabs(v - 0.01), 4 * se + 1e-5) << f.dump();  // vehicles/finken3.yaml: kappa 0.01 m
+    EXPECT_TRUE(f["alone"].is_null()) << f.dump();
+  }
   const fs::path dir = fs::temp_directory_path() / "quadgen_agree";
   {  // the report's agreement table names each flight by its file, the whole path on hover
     std::ifstream in(dir / "out" / "report.html");
@@ -1635,6 +1652,30 @@ TEST(DiagnosisReport, AJointCauseTheFlightsDisagreeOnIsFlaggedWhereItIsNamed) {
   d.agreement.front().agree = true;
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find(says), std::string::npos);
   EXPECT_EQ(quadgen::diagnose::diagnosis_html(d, "log.csv", {}).find(says_html), std::string::npos);
+}
+
+// The base model's shared parameters per flight have a section of their own, after the named
+// effects' agreement, and one the flights disagree on is a next step and a summary line; a
+// diagnosis with no effect named still shows them (the section is not the effects' appendix).
+TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) {
+  namespace dg = quadgen::diagnose;
+  dg::Diagnosis d;
+  d.flights = {"a.csv", "b.csv"};
+  dg::ParameterAgreement c_w;
+  c_w.parameter = "c_w", c_w.named = true, c_w.agree = false, c_w.within_errors = false, c_w.q_p_value = 1e-4;
+  c_w.joint_value = 0.5;
+  dg::FlightEstimate e1{0.2, 0.05, 0.1, 0.3, NAN, NAN}, e2{1.5, 0.1, 1.3, 1.7, NAN, NAN};
+  c_w.flights = {e1, e2};
+  d.base_agreement.push_back(c_w);
+  const std::string html = dg::diagnosis_html(d, "log.csv", {});
+  const size_t section = html.find("<h2>Do the flights agree on the base model?</h2>");
+  ASSERT_NE(section, std::string::npos);
+  EXPECT_NE(html.find("<h3>c_w [", section), std::string::npos) << html.substr(section, 1500);
+  EXPECT_NE(html.find("<li>the flights disagree on the base model&#39;s c_w"), std::string::npos) << html;
+  EXPECT_NE(dg::diagnosis_summary(d).find("flights disagree on the base model's c_w"), std::string::npos)
+      << dg::diagnosis_summary(d);
+  d.base_agreement.front().agree = d.base_agreement.front().within_errors = true;
+  EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights disagree on the base model&#39;s c_w"), std::string::npos);
 }
 
 // Each plot beside the section whose numbers it draws, the candidates' tables folded, and a p
