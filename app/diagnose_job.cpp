@@ -13,6 +13,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "app/extended_model.hpp"
 #include "derive/geometry.hpp"
+#include "output/nearest_word.hpp"
 #include "output/numbers.hpp"
 #include "output/joined.hpp"
 #include "output/json_document.hpp"
@@ -61,9 +62,13 @@ struct AirframeReader {
   const SymbolicModel& all;
 
   void known(const std::string& name) const {
-    for (const auto& p : all.params)
+    std::vector<std::string> names;
+    for (const auto& p : all.params) {
       if (p.name == name) return;
-    throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model");
+      names.push_back(p.name);
+    }
+    throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model" +
+                                   output::did_you_mean(name, names));
   }
   double number(const nlohmann::json& v, const std::string& what) const {
     if (!v.is_number()) throw airframe_error(path, what + ": expected a number");

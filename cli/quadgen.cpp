@@ -22,9 +22,8 @@ bool unknown_command(const CLI::App& app, const std::string& word) {
     if (command->get_name() == word) return false;
     commands.push_back(command->get_name());
   }
-  const std::string nearest = quadgen::output::nearest_word(word, commands);
-  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: " << quadgen::output::joined(commands) << ")";
-  if (!nearest.empty()) std::cerr << "; did you mean '" << nearest << "'?";
+  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: "
+            << quadgen::output::joined(commands) << ")" << quadgen::output::did_you_mean(word, commands);
   if (word == "generate") std::cerr << "; 'derive' writes the generated C++ (model.hpp) with the derivation";
   std::cerr << "\nRun with --help for more information.\n";
   return true;

@@ -30,9 +30,8 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
   for (const auto& u : use) {
     const int c = runtime::index_in(names, u);
     if (c < 0) {
-      const std::string near = output::nearest_word(u, names);
       throw FitError("unknown residual channel '" + output::printable(u) + "' (channels: " + output::joined(names) + ")" +
-                     (near.empty() ? "" : "; did you mean '" + near + "'?"));
+                     output::did_you_mean(u, names));
     }
     used_.push_back(c);
   }

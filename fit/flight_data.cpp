@@ -89,7 +89,8 @@ std::map<std::string, YAML::Node> checked_keys(const std::string& path, const YA
   for (const auto& kv : map) {
     const std::string key = scalar_text(path, kv.first, where + ": key");
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + output::joined(allowed) + ")");
+      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + output::joined(allowed) + ")" +
+                                        output::did_you_mean(key, allowed));
     if (!out.emplace(key, kv.second).second)
       mapping_error(path, kv.first, where + ": duplicate key '" + key + "' (each of " + output::joined(allowed) + " at most once)");
   }
@@ -240,9 +241,7 @@ namespace {
 std::string missing_source(const runtime::CsvTable& raw, const ColumnMapping& m, const ColumnMapping::Entry& e) {
   const std::string where = m.path.empty() ? raw.path + ":1" : m.path + (e.line > 0 ? ":" + std::to_string(e.line) : "");
   std::string said = where + ": column '" + e.source + "' (for '" + e.target + "') is not in the header of " + raw.path;
-  if (const std::string near = output::nearest_word(e.source, raw.columns); !near.empty())
-    said += "; did you mean '" + near + "'?";
-  return said;
+  return said + output::did_you_mean(e.source, raw.columns);
 }
 
 }  // namespace

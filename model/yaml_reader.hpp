@@ -14,6 +14,7 @@
 
 #include "output/joined.hpp"
 #include "output/numbers.hpp"
+#include "output/nearest_word.hpp"
 #include "output/sinks.hpp"
 #include "model/vehicle.hpp"
 #include "runtime/flight_log.hpp"
@@ -109,7 +110,8 @@ struct YamlReader {
       const std::string key = kv.first.Scalar();
       if (allowed.count(key)) continue;
       fail(kv.first, "unknown key '" + output::printable(key) + "' in " + where + " (expected one of: " +
-                         output::joined(allowed) + ")");
+                         output::joined(allowed) + ")" +
+                         output::did_you_mean(key, std::vector<std::string>(allowed.begin(), allowed.end())));
     }
   }
 

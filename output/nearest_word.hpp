@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "output/sinks.hpp"
+
 namespace quadgen::output {
 
 // Edits (insert, delete, replace) between two words.
@@ -24,7 +26,8 @@ inline size_t edit_distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
-// Of `candidates`, the one `word` differs from only in case, else the nearest within
+// Of `candidates`, one that looks like `word` (lookalike_skeleton: an 'ay' for an 'аy' with a
+// Cyrillic а, which is two bytes apart), else the one `word` differs from only in case, else the nearest within
 // `max_edits` edits, and within a third of the word's length (leading dashes aside: 'w' is
 // not a slip for 't', nor '--x' for '--dt'); the first of equals; "" when none is that near.
 inline std::string nearest_word(const std::string& word, const std::vector<std::string>& candidates,
@@ -35,6 +38,9 @@ inline std::string nearest_word(const std::string& word, const std::vector<std::
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
   };
+  const std::string seen = lookalike_skeleton(word);
+  for (const auto& c : candidates)
+    if (c != word && lookalike_skeleton(c) == seen) return c;
   for (const auto& c : candidates)
     if (c != word && lower(c) == lower(word)) return c;
   std::string nearest;
@@ -42,6 +48,20 @@ inline std::string nearest_word(const std::string& word, const std::vector<std::
   for (const auto& c : candidates)
     if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
   return nearest;
+}
+
+// What an error adds after refusing `word` where one of `candidates` was expected: "; did you
+// mean 'near'?" as nearest_word finds it, and where the two look alike, what sets `word` apart
+// ("; did you mean 'ay'? (they look alike, but 'аy' has U+0430 CYRILLIC SMALL LETTER A)");
+// "" when no candidate is near.
+inline std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates,
+                                size_t max_edits = 2) {
+  const std::string near = nearest_word(word, candidates, max_edits);
+  if (near.empty()) return "";
+  std::string out = "; did you mean '" + printable(near) + "'?";
+  if (const std::string apart = lookalike_difference(word, near); !apart.empty())
+    out += " (they look alike, but '" + printable(word) + "' has " + apart + ")";
+  return out;
 }
 
 }  // namespace quadgen::output

@@ -1,11 +1,14 @@
 #include "output/sinks.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
 
+#include <unicode/uchar.h>
 #include <unicode/uspoof.h>
+#include <unicode/utf8.h>
 #include <unicode/utypes.h>
 
 #include "output/names.hpp"
@@ -197,14 +200,16 @@ std::string visible_skeleton(const std::string& s) {
 
 namespace {
 // One spoof checker for the process: configured once, then used read-only (ICU allows
-// concurrent use of a const checker).
+// concurrent use of a const checker). nullptr where ICU cannot give one (its data missing):
+// the skeleton falls back to the visible one rather than abort a report over a legend.
 const USpoofChecker* confusable_checker() {
-  static const USpoofChecker* const checker = [] {
+  static const USpoofChecker* const checker = []() -> const USpoofChecker* {
     UErrorCode status = U_ZERO_ERROR;
     USpoofChecker* sc = uspoof_open(&status);
     if (U_SUCCESS(status)) uspoof_setChecks(sc, USPOOF_CONFUSABLE, &status);
-    if (U_FAILURE(status)) throw std::runtime_error(std::string("ICU spoof checker: ") + u_errorName(status));
-    return sc;
+    if (U_SUCCESS(status)) return sc;
+    if (sc) uspoof_close(sc);
+    return nullptr;
   }();
   return checker;
 }
@@ -212,7 +217,7 @@ const USpoofChecker* confusable_checker() {
 
 std::string lookalike_skeleton(const std::string& s) {
   const std::string visible = visible_skeleton(s);  // valid UTF-8: invalid bytes are '?' there
-  if (visible.size() > static_cast<size_t>(INT32_MAX / 8)) return visible;
+  if (!confusable_checker() || visible.size() > static_cast<size_t>(INT32_MAX / 8)) return visible;
   std::string out(visible.size() * 3 + 16, '\0');
   for (int attempt = 0; attempt < 2; ++attempt) {
     UErrorCode status = U_ZERO_ERROR;
@@ -227,6 +232,28 @@ std::string lookalike_skeleton(const std::string& s) {
     return out;
   }
   return visible;
+}
+
+std::string lookalike_difference(const std::string& word, const std::string& near) {
+  if (word == near || lookalike_skeleton(word) != lookalike_skeleton(near)) return "";
+  std::vector<std::string> apart;
+  for_each_char(word, [&](const std::string& c) {
+    const bool plain = c.size() == 1 && !control(static_cast<unsigned char>(c[0]));
+    if (plain || near.find(c) != std::string::npos) return;
+    int32_t i = 0;
+    UChar32 cp = 0;
+    U8_NEXT(c.data(), i, static_cast<int32_t>(c.size()), cp);  // c is one valid character (for_each_char)
+    char hex[16], name[128] = "";
+    std::snprintf(hex, sizeof hex, "U+%04X", static_cast<unsigned>(cp));
+    UErrorCode status = U_ZERO_ERROR;
+    u_charName(cp, U_UNICODE_CHAR_NAME, name, sizeof name, &status);
+    const std::string said = std::string(hex) + (U_SUCCESS(status) && name[0] ? std::string(" ") + name : "");
+    if (std::find(apart.begin(), apart.end(), said) == apart.end()) apart.push_back(said);
+  });
+  if (apart.empty()) return "";
+  std::string out;
+  for (const auto& a : apart) out += (out.empty() ? "" : ", ") + a;
+  return out;
 }
 
 std::string csv_field(const std::string& s) {

@@ -31,6 +31,12 @@ std::string visible_skeleton(const std::string& s);
 // accent (NFC, NFD), a Latin "a" and a Cyrillic "а", "rn" and "m", "l" and "1". Coarser than
 // the visible skeleton: a caller numbering series that must be told apart uses this one.
 std::string lookalike_skeleton(const std::string& s);
+// Where `word` and `near` look alike (one lookalike_skeleton) but differ: what sets `word`
+// apart, each of its characters that `near` lacks and that is not plain ASCII, by code point
+// and Unicode name ("U+0430 CYRILLIC SMALL LETTER A", "U+200B ZERO WIDTH SPACE"); "" where
+// they do not look alike, or are equal. An error that refuses 'аy' and suggests 'ay' reads as
+// nonsense without it.
+std::string lookalike_difference(const std::string& word, const std::string& near);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
 // trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);

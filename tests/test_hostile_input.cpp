@@ -1707,6 +1707,21 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   EXPECT_EQ(quadgen::output::nearest_word("w", {"t", "x", "vbat"}), "");
   EXPECT_EQ(quadgen::output::nearest_word("--x", {"--dt", "--out"}), "");
   EXPECT_EQ(quadgen::output::nearest_word("motor_motor_M3", {"motor_motor_m3", "motor_motor_m4"}), "motor_motor_m3");
+  // A name spelt with a look-alike letter is no slip of a few bytes: found by its Unicode
+  // look-alike skeleton, and said with what sets it apart (else "unknown 'аy'; did you mean
+  // 'ay'?" reads as nonsense).
+  using quadgen::output::did_you_mean;
+  const std::string cyrillic_a = "\xD0\xB0";
+  EXPECT_EQ(did_you_mean(cyrillic_a + "y", {"ax", "ay", "az"}),
+            "; did you mean 'ay'? (they look alike, but '" + cyrillic_a + "y' has U+0430 CYRILLIC SMALL LETTER A)");
+  EXPECT_NE(did_you_mean("cafe\xCC\x81", {"caf\xC3\xA9", "cafe"}).find("U+0301 COMBINING ACUTE ACCENT"), std::string::npos);
+  EXPECT_NE(did_you_mean("fli\xE2\x80\x8Bght", {"flight"}).find("U+200B ZERO WIDTH SPACE"), std::string::npos);
+  EXPECT_EQ(did_you_mean("sise", {"size", "mass"}), "; did you mean 'size'?");  // a slip: no look-alike note
+  EXPECT_EQ(did_you_mean("zzzz", {"size", "mass"}), "");
+  expect_error({"derive", f3, "--effects", "rotor_dr" + cyrillic_a + "g", "--out", tmp / "o"}, 2,
+               "did you mean 'rotor_drag'? (they look alike, but 'rotor_dr" + cyrillic_a + "g' has U+0430 CYRILLIC SMALL LETTER A)");
+  expect_error({"diagnose", f3, "x.csv", "--m" + cyrillic_a + "pping", "M.yaml", "--out", tmp / "o"}, 109,
+               "'--mapping' for '--m" + cyrillic_a + "pping' (they look alike, but '--m" + cyrillic_a + "pping' has U+0430");
   // Files that are not logs are named as what they should have been.
   ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
   expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,

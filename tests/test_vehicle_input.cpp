@@ -130,6 +130,11 @@ TEST(VehicleInput, UnknownKey) {
   expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "sise: [0.056, 0.056, 0.072]"),
                "unknown key 'sise' in block 'upper_body' (expected one of:");
   expect_error(replace(finken_text(), "{name: B, position", "{name: B, positon"), "unknown key 'positon' in rotor 'B'");
+  // A slip is suggested back; a key spelt with a look-alike letter (a Cyrillic а in 'size',
+  // two bytes where one was meant) is said to look alike, with the letter that differs.
+  expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "sise: [0.056, 0.056, 0.072]"), "did you mean 'size'?");
+  expect_error(replace(finken_text(), "{name: B, position", "{name: B, positi\xD0\xBEn"),
+               "did you mean 'position'? (they look alike, but 'positi\xD0\xBEn' has U+043E CYRILLIC SMALL LETTER O)");
 }
 // A tilted rotor is said to be outside the model, not only an unknown key (a user trial: blocks
 // take orientation_deg, so a user tried it on a rotor).

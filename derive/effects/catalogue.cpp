@@ -103,8 +103,7 @@ std::string effect_of_parameter(const std::string& parameter) {
 }
 
 std::string missing_parameter_hint(const std::string& name, const std::vector<std::string>& model_parameters) {
-  if (const std::string near = output::nearest_word(name, model_parameters); !near.empty())
-    return "; did you mean '" + near + "'?";
+  if (const std::string near = output::did_you_mean(name, model_parameters); !near.empty()) return near;
   const std::string effect = effect_of_parameter(name);
   if (!effect_named(effect)) return "";
   std::vector<std::string> its;
@@ -213,7 +212,8 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
     if (item == "all")
       throw std::invalid_argument("effect list '" + text + "': 'all' stands alone (it is every effect); name effects or write all");
     if (!known.count(item)) {
-      throw std::invalid_argument("unknown effect '" + item + "' (known: " + catalogue_names() + ", or all)");
+      throw std::invalid_argument("unknown effect '" + output::printable(item) + "' (known: " + catalogue_names() +
+                                  ", or all)" + output::did_you_mean(item, std::vector<std::string>(known.begin(), known.end())));
     }
     if (!seen.insert(item).second) throw std::invalid_argument("effect '" + item + "' named twice");
     out.push_back(item);
