@@ -62,6 +62,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     f.upper = f.value + kZ95 * f.standard_error;
     f.statistic = statistic;
     f.p_value = p_value;
+    f.at_bound = on[i].free && fit::on_bound(on[i]);
     return f;
   };
   for (const auto& e : in.effects) {
@@ -117,7 +118,7 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
   // (The reader of --airframe gives 0 where a diagnosis has none.)
   a.reference_without_error = !(airframe_standard_error > 0 && std::isfinite(airframe_standard_error));
   // A flight without one cannot disagree, nor agree, and has no z.
-  const bool measured = f.standard_error > 0 && std::isfinite(f.standard_error);
+  const bool measured = flight_can_say(f) && std::isfinite(f.standard_error);
   const bool says = measured && !a.reference_without_error;
   const double se = a.reference_without_error ? f.standard_error : std::hypot(f.standard_error, airframe_standard_error);
   a.q = measured ? std::pow((f.value - airframe_value) / se, 2) : std::numeric_limits<double>::quiet_NaN();
@@ -135,7 +136,7 @@ void summarise_agreement(ParameterAgreement& a) {
   double sw = 0, swk = 0, lo = INFINITY, hi = -INFINITY;
   for (const auto& f : a.flights) {
     lo = std::min(lo, f.value), hi = std::max(hi, f.value);
-    if (!(f.standard_error > 0)) continue;
+    if (!flight_can_say(f)) continue;
     const double w = 1 / (f.standard_error * f.standard_error);
     sw += w, swk += w * f.value;
   }
@@ -143,7 +144,7 @@ void summarise_agreement(ParameterAgreement& a) {
   int counted = 0;
   bool every_flight_says = true, within = true;
   for (const auto& f : a.flights) {
-    if (!(f.standard_error > 0)) {
+    if (!flight_can_say(f)) {
       every_flight_says = false;  // a flight that cannot say: no agreement claimed, nor disagreement
       continue;
     }
@@ -205,13 +206,19 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in) 
 std::vector<ParameterAgreement> base_parameter_agreement(const AgreementInputs& in, const std::vector<std::string>& base) {
   std::vector<ParameterAgreement> out;
   if (base.empty() || in.training_parts.size() < 2) return out;
-  AgreementInputs held = in;
-  held.effects.clear();  // held at the joint fit: no effect refitted, none tested alone
+  // The named effects free beside the base parameters, from the joint fit's values (no test
+  // alone: `effects` empty); a suspect, which the joint fit does not hold, stays off.
+  AgreementInputs marginal = in;
+  marginal.effects.clear();
+  std::vector<std::string> free = base;
+  for (const auto& e : in.effects)
+    if (e.named) free.insert(free.end(), e.parameters.begin(), e.parameters.end());
   std::vector<std::map<std::string, FlightEstimate>> per_flight;
-  for (size_t k = 1; k <= in.training_parts.size(); ++k) per_flight.push_back(fit_one_flight(held, static_cast<int>(k), base));
+  for (size_t k = 1; k <= in.training_parts.size(); ++k) per_flight.push_back(fit_one_flight(marginal, static_cast<int>(k), free));
   for (const auto& name : base) {
     ParameterAgreement a;
     a.parameter = name;
+    a.base = true;
     a.named = true;  // part of every model: no suspect
     for (const auto& p : in.joint_fit)
       if (p.name == name) a.unit = p.unit, a.joint_value = p.value;

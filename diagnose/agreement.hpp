@@ -24,6 +24,9 @@ namespace quadgen::diagnose {
 struct FlightEstimate {
   double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
   double statistic = 0, p_value = 1;  // the effect on this flight alone: LR test against "off"
+  // Ended on a bound of its fit (fit::on_bound): its Wald interval is no interval (c_w at 0.05
+  // read [-2.5, 2.6]), so the flight cannot say, as one without a standard error cannot.
+  bool at_bound = false;
 };
 
 struct ParameterAgreement {
@@ -51,7 +54,12 @@ struct ParameterAgreement {
   // Against an airframe: its value came without a standard error, so the flight can neither
   // agree nor disagree with it.
   bool reference_without_error = false;
+  // A base model's parameter (base_parameter_agreement), not an effect's.
+  bool base = false;
 };
+
+// A flight that can say where the value lies: a standard error, and not on a bound.
+inline bool flight_can_say(const FlightEstimate& f) { return f.standard_error > 0 && !f.at_bound; }
 
 // The verdict in a word: "agree", "too uncertain" (within the errors, but apart by 30 % or
 // more, or a flight without a standard error) or "disagree".
@@ -69,7 +77,12 @@ inline const char* why_too_uncertain(const ParameterAgreement& a) {
   if (a.agree || !a.within_errors) return "";
   if (a.reference_without_error) return "the airframe's value has no standard error";
   for (const auto& f : a.flights)
+    if (f.at_bound) return "a flight's value on its bound cannot say";
+  for (const auto& f : a.flights)
     if (!(f.standard_error > 0)) return "a flight without a standard error cannot say";
+  // Flights measuring one value this loosely would spread by 30 % or more anyway (a review,
+  // helper-131: c_w's flights would spread by a median of 570 %): they cannot measure it.
+  if (a.spread_if_agree >= 0.3) return "the flights cannot measure it to 30 %: agreeing flights would spread as far";
   return "within the errors, but 30 % or more apart";
 }
 
@@ -103,8 +116,12 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
 
 // The base model's parameters the flights share (`base`: the frame's drag coefficient, the
 // torque ratio; each free in the joint fit and no flight's own), refitted together on each
-// flight's training part with every effect held at the joint fit (the flight's own thrust
-// constant and trims free), judged as an effect's are. The brief's "vehicle properties must
+// flight's training part with the named effects free beside them (the flight's own thrust
+// constant and trims free too), judged as an effect's are. Free beside them, not held: the
+// frame's drag and rotor drag have nearly one shape at walking speeds, and a drag coefficient
+// refitted with rotor drag held carried each flight's rotor-drag difference under intervals
+// far too narrow (a review, helper-131: r = 0.78 between the two over the five NanoBench
+// flights). The brief's "vehicle properties must
 // agree across flights" covers these as much as the named causes: a drag coefficient that
 // each flight alone sends to another bound is not the airframe's. `effect` is empty and no
 // "alone" test is made (statistic and p NaN): the base model has no "off".

@@ -217,6 +217,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
                           const std::vector<std::string>& flights, const std::string& reference_name,
                           const std::vector<Finding>& joint = {}) {
   for (const auto& a : list) {
+    const bool alone = !a.base;  // a base parameter has no "off" to test against
     const auto [band_lo, band_hi] = joint_interval(joint, a.parameter);
     double lo = a.joint_value, hi = a.joint_value;
     for (const auto& f : a.flights)
@@ -236,14 +237,15 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
-      << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th><th>alone: p</th>"
-         "<th style=\"width:40%\">at a glance</th></tr>\n";
+      << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
+      << "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
-        << num(f.value, prec) << "</td><td>" << interval(f.lower, f.upper, prec) << "</td><td>"
-        << esc(output::p_value_cell(f.p_value)) << "</td><td><div style=\"position:relative;height:14px\">";
+        << num(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>" << interval(f.lower, f.upper, prec)
+        << "</td><td>" << (alone ? esc(output::p_value_cell(f.p_value)) + "</td><td>" : "")
+        << "<div style=\"position:relative;height:14px\">";
       if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind
         h << "<div style=\"position:absolute;left:" << at(band_lo) << ";width:calc(" << at(band_hi) << " - " << at(band_lo)
           << ");top:0;bottom:0;background:#f4d6d6\"></div>";
@@ -255,7 +257,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
         << "border-radius:4px;background:#123\"></div></div></td></tr>\n";
     }
     // The strips' scale (a user trial, helper-106: bars without an axis).
-    h << "<tr><td colspan=\"4\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + unit_html(a.unit) + "]")
+    h << "<tr><td colspan=\"" << (alone ? 4 : 3) << "\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + unit_html(a.unit) + "]")
       << (std::isfinite(band_lo) && std::isfinite(band_hi) ? "; shaded: the joint fit's 95 % interval" : "")
       << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << num(lo, 3)
       << "</small><small>" << num(hi, 3) << "</small></div></td></tr>\n";
@@ -266,11 +268,14 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
 // The base model's shared parameters per flight, after the effects' table (what is named comes first).
 void base_agreement_section(std::ostringstream& h, const Diagnosis& d) {
   if (d.base_agreement.empty()) return;
-  h << "<h2>Do the flights agree on the base model?</h2>\n<p>The base model's parameters every flight shares "
-       "(the frame's drag coefficient, the torque ratio: those the joint fit fitted) refitted together on each "
-       "flight's training part alone, every named effect held at the joint fit (the flight's own trims and thrust "
-       "constant free). Bars, intervals and verdicts as for an effect's agreement; no \"alone\" test, since the base model has no "
-       "\"off\". Flights that disagree here are not one airframe's either: the parameter is carrying something "
+  std::string names;
+  for (const auto& a : d.base_agreement) names += (names.empty() ? "" : ", ") + esc(a.parameter);
+  h << "<h2>Do the flights agree on the base model?</h2>\n<p>The base model's parameters every flight shares and "
+       "the joint fit fitted (" << names << ") refitted together on each flight's training part alone, with the named "
+       "effects free beside them (their shapes may overlap: a frame's drag and rotor drag at walking speeds) and the "
+       "flight's own thrust constant, trims and motor gains free. Bars, intervals and verdicts as for an effect's "
+       "agreement; no \"alone\" test, since the base model has no \"off\". A value on its bound has no interval and "
+       "cannot say. Flights that disagree here are not one airframe's either: the parameter is carrying something "
        "that differs between them.</p>\n";
   agreement_table_html(h, d.base_agreement, d.flights, "joint");
 }

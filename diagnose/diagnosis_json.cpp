@@ -233,7 +233,7 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       // The one estimate shape (output/estimate.hpp), then what belongs to agreement.
-      json entry = output::estimate_json({f.value, a.unit, f.lower, f.upper, "", false});
+      json entry = output::estimate_json({f.value, a.unit, f.lower, f.upper, "", f.at_bound});
       entry["flight"] = k < flights.size() ? flights[k] : std::string();
       entry["standard_error"] = number_or_null(f.standard_error);
       // A base parameter has no test alone (no "off"): null.
@@ -243,6 +243,7 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
     out.push_back({{"parameter", a.parameter},
                    {"effect", a.effect},
                    {"named", a.named},
+                   {"base", a.base},
                    {"unit", a.unit},
                    {"joint_value", a.joint_value},
                    {"pooled", a.pooled},
