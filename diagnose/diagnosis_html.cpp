@@ -549,9 +549,20 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
             ? " One on its bound was held there: the model is strained, and a finding may stand in for what it lacks."
             : "")
     << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
-  for (const auto* p : base)
+  // Where the flights, each refitted alone, do not agree on it: the joint value is no one
+  // airframe's measurement (a review, helper-131: c_w 0.563 stood here without a caveat).
+  const auto flights_say = [&](const fit::FitParameter& p) -> std::string {
+    for (const auto& a : d.base_agreement)
+      if (a.parameter == p.name && !a.agree)
+        return std::string("the flights: ") + agreement_verdict(a) + " (<i>Do the flights agree on the base model?</i>)";
+    return "";
+  };
+  for (const auto* p : base) {
+    std::string note = on_bound(*p) ? "on its bound" : "";
+    if (const std::string said = flights_say(*p); !said.empty()) note += (note.empty() ? "" : "; ") + said;
     h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << unit_html(p->unit) << "</td><td>"
-      << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (on_bound(*p) ? " class=\"warn\">on its bound" : ">") << "</td></tr>\n";
+      << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (note.empty() ? ">" : " class=\"warn\">" + note) << "</td></tr>\n";
+  }
   h << "</table>\n";
 }
 

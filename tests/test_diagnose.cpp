@@ -1702,7 +1702,15 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   EXPECT_NE(html.find("<li>the flights disagree on the base model&#39;s c_w"), std::string::npos) << html;
   EXPECT_NE(dg::diagnosis_summary(d).find("flights disagree on the base model's c_w (spread"), std::string::npos)
       << dg::diagnosis_summary(d);
+  // The fitted parameters' table says it beside the joint value (no longer a bare 0.5).
+  d.search.final_fit = {{"c_w", "1", 0.5, 0.05, 3, true}};
+  const std::string with_table = dg::diagnosis_html(d, "log.csv", {});
+  const size_t row = with_table.find("<tr><td>c_w</td><td>0.5</td>");
+  ASSERT_NE(row, std::string::npos) << with_table;
+  const std::string row_text = with_table.substr(row, with_table.find("</tr>", row) - row);
+  EXPECT_NE(row_text.find("<td class=\"warn\">the flights: disagree"), std::string::npos) << row_text;
   d.base_agreement.front().agree = d.base_agreement.front().within_errors = true;
+  EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights: "), std::string::npos);
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights disagree on the base model&#39;s c_w"), std::string::npos);
 }
 
