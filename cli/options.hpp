@@ -46,15 +46,15 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
       if (word.rfind("--", 0) != 0) continue;
       not_understood += (not_understood.empty() ? "" : " ") + word;
       if (const std::string near = nearest_option(*command, word); !near.empty() && near != word) {
-        const std::string key = word.substr(0, word.find('=')), apart = output::lookalike_difference(key, near);
+        const std::string apart = output::lookalike_difference(word.substr(0, word.find('=')), near);
         suggestions += std::string(suggestions.empty() ? "" : ", ") + "'" + near + "' for '" + word + "'" +
-                       (apart.empty() ? "" : " (they look alike, but '" + key + "' has " + apart + ")");
+                       (apart.empty() ? "" : " (they look alike, but " + apart + ")");
       }
     }
   std::cerr << "quadgen: error: " << output::printable_error(e.what());
   if (!not_understood.empty() && dynamic_cast<const CLI::RequiredError*>(&e))
     std::cerr << " (not understood: " << output::printable_error(not_understood) << ")";
-  if (!suggestions.empty()) std::cerr << "; did you mean " << output::printable(suggestions) << "?";
+  if (!suggestions.empty()) std::cerr << "; did you mean " << output::printable_error(suggestions) << "?";
   std::cerr << "\nRun with --help for more information.\n";
   return e.get_exit_code();
 }

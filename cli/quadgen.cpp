@@ -22,8 +22,9 @@ bool unknown_command(const CLI::App& app, const std::string& word) {
     if (command->get_name() == word) return false;
     commands.push_back(command->get_name());
   }
-  std::cerr << "quadgen: error: unknown command '" << quadgen::output::printable(word) << "' (commands: "
-            << quadgen::output::joined(commands) << ")" << quadgen::output::did_you_mean(word, commands);
+  std::cerr << quadgen::output::printable_error("quadgen: error: unknown command '" + word + "' (commands: " +
+                                                quadgen::output::joined(commands) + ")" +
+                                                quadgen::output::did_you_mean(word, commands));
   if (word == "generate") std::cerr << "; 'derive' writes the generated C++ (model.hpp) with the derivation";
   std::cerr << "\nRun with --help for more information.\n";
   return true;

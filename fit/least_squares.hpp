@@ -111,7 +111,8 @@ std::vector<double> rms_by_channel(const std::vector<double>& r, size_t nc, Chan
 // RMS of each channel of a residual model at the given parameters.
 std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitParameter>& ps);
 
-// Whether p's value sits on its lower or upper bound (to 1e-9 of the bounds' span).
+// Whether p's value sits on its lower or upper bound (to 1e-9 of the bounds' span where the
+// span exceeds 1; to 1e-9 absolute below that).
 bool on_bound(const FitParameter& p);
 
 // Two passes: fit, estimate sigma and autocorrelation per channel, refit with weights.

@@ -51,16 +51,15 @@ inline std::string nearest_word(const std::string& word, const std::vector<std::
 }
 
 // What an error adds after refusing `word` where one of `candidates` was expected: "; did you
-// mean 'near'?" as nearest_word finds it, and where the two look alike, what sets `word` apart
-// ("; did you mean 'ay'? (they look alike, but 'аy' has U+0430 CYRILLIC SMALL LETTER A)");
+// mean 'near'?" as nearest_word finds it, and where the two look alike, what sets them apart
+// ("; did you mean 'ay'? (they look alike, but 'аy' has U+0430 CYRILLIC SMALL LETTER A (character 1))");
 // "" when no candidate is near.
 inline std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates,
                                 size_t max_edits = 2) {
   const std::string near = nearest_word(word, candidates, max_edits);
   if (near.empty()) return "";
   std::string out = "; did you mean '" + printable(near) + "'?";
-  if (const std::string apart = lookalike_difference(word, near); !apart.empty())
-    out += " (they look alike, but '" + printable(word) + "' has " + apart + ")";
+  if (const std::string apart = lookalike_difference(word, near); !apart.empty()) out += " (they look alike, but " + apart + ")";
   return out;
 }
 

@@ -234,25 +234,40 @@ std::string lookalike_skeleton(const std::string& s) {
   return visible;
 }
 
-std::string lookalike_difference(const std::string& word, const std::string& near) {
-  if (word == near || lookalike_skeleton(word) != lookalike_skeleton(near)) return "";
-  std::vector<std::string> apart;
-  for_each_char(word, [&](const std::string& c) {
-    const bool plain = c.size() == 1 && !control(static_cast<unsigned char>(c[0]));
-    if (plain || near.find(c) != std::string::npos) return;
+namespace {
+// The characters of `s` beyond plain printable ASCII, each by code point, Unicode name and
+// place ("U+0430 CYRILLIC SMALL LETTER A (character 1)"); the first five, then how many more
+// (a name of a thousand look-alike letters must not make a message of a hundred kB).
+std::string unusual_characters(const std::string& s) {
+  constexpr size_t kShown = 5;
+  std::vector<std::string> said;
+  size_t position = 0, more = 0;
+  for_each_char(s, [&](const std::string& c) {
+    ++position;
+    if (c.size() == 1 && !control(static_cast<unsigned char>(c[0]))) return;  // ASCII, or '?' for a byte not UTF-8
+    if (said.size() == kShown) return void(++more);
     int32_t i = 0;
     UChar32 cp = 0;
     U8_NEXT(c.data(), i, static_cast<int32_t>(c.size()), cp);  // c is one valid character (for_each_char)
     char hex[16], name[128] = "";
     std::snprintf(hex, sizeof hex, "U+%04X", static_cast<unsigned>(cp));
     UErrorCode status = U_ZERO_ERROR;
-    u_charName(cp, U_UNICODE_CHAR_NAME, name, sizeof name, &status);
-    const std::string said = std::string(hex) + (U_SUCCESS(status) && name[0] ? std::string(" ") + name : "");
-    if (std::find(apart.begin(), apart.end(), said) == apart.end()) apart.push_back(said);
+    u_charName(cp, U_EXTENDED_CHAR_NAME, name, sizeof name, &status);  // "<control-001B>" for a control
+    said.push_back(std::string(hex) + (U_SUCCESS(status) && name[0] ? std::string(" ") + name : "") + " (character " +
+                   std::to_string(position) + ")");
   });
-  if (apart.empty()) return "";
   std::string out;
-  for (const auto& a : apart) out += (out.empty() ? "" : ", ") + a;
+  for (const auto& a : said) out += (out.empty() ? "" : ", ") + a;
+  return more ? out + " and " + std::to_string(more) + " more" : out;
+}
+}  // namespace
+
+std::string lookalike_difference(const std::string& word, const std::string& near) {
+  if (word == near || lookalike_skeleton(word) != lookalike_skeleton(near)) return "";
+  const std::string in_word = unusual_characters(word), in_near = unusual_characters(near);
+  std::string out;
+  if (!in_word.empty()) out = "'" + printable(word) + "' has " + in_word;
+  if (!in_near.empty()) out += (out.empty() ? "" : "; ") + ("'" + printable(near) + "' has " + in_near);
   return out;
 }
 

@@ -1713,15 +1713,30 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   using quadgen::output::did_you_mean;
   const std::string cyrillic_a = "\xD0\xB0";
   EXPECT_EQ(did_you_mean(cyrillic_a + "y", {"ax", "ay", "az"}),
-            "; did you mean 'ay'? (they look alike, but '" + cyrillic_a + "y' has U+0430 CYRILLIC SMALL LETTER A)");
-  EXPECT_NE(did_you_mean("cafe\xCC\x81", {"caf\xC3\xA9", "cafe"}).find("U+0301 COMBINING ACUTE ACCENT"), std::string::npos);
-  EXPECT_NE(did_you_mean("fli\xE2\x80\x8Bght", {"flight"}).find("U+200B ZERO WIDTH SPACE"), std::string::npos);
+            "; did you mean 'ay'? (they look alike, but '" + cyrillic_a + "y' has U+0430 CYRILLIC SMALL LETTER A (character 1))");
+  // Both sides said: the precomposed and the combining accent.
+  EXPECT_EQ(did_you_mean("cafe\xCC\x81", {"caf\xC3\xA9", "cafe"}),
+            "; did you mean 'caf\xC3\xA9'? (they look alike, but 'cafe\xCC\x81' has U+0301 COMBINING ACUTE ACCENT "
+            "(character 5); 'caf\xC3\xA9' has U+00E9 LATIN SMALL LETTER E WITH ACUTE (character 4))");
+  // The odd letter in the candidate (a log's header with a zero-width space), not the word.
+  EXPECT_EQ(did_you_mean("gyro_x", {"gyro\xE2\x80\x8B_x", "gyro_y"}),
+            "; did you mean 'gyro\xE2\x80\x8B_x'? (they look alike, but 'gyro\xE2\x80\x8B_x' has U+200B ZERO WIDTH SPACE "
+            "(character 5))");
+  // Letters in another order are placed; a thousand of them do not make a message of kB.
+  EXPECT_NE(did_you_mean("a" + cyrillic_a + "b", {cyrillic_a + "ab"}).find("(character 2)"), std::string::npos);
+  std::string many;
+  for (int i = 0; i < 1000; ++i) many += cyrillic_a;
+  const std::string long_note = did_you_mean(many, {std::string(1000, 'a')});
+  EXPECT_NE(long_note.find("(character 5) and 995 more"), std::string::npos) << long_note.substr(0, 300);
+  EXPECT_LT(long_note.size(), 2 * 1000 + 2 * 1000 + 400u);  // the two words and five characters, no more
   EXPECT_EQ(did_you_mean("sise", {"size", "mass"}), "; did you mean 'size'?");  // a slip: no look-alike note
   EXPECT_EQ(did_you_mean("zzzz", {"size", "mass"}), "");
   expect_error({"derive", f3, "--effects", "rotor_dr" + cyrillic_a + "g", "--out", tmp / "o"}, 2,
-               "did you mean 'rotor_drag'? (they look alike, but 'rotor_dr" + cyrillic_a + "g' has U+0430 CYRILLIC SMALL LETTER A)");
+               "did you mean 'rotor_drag'? (they look alike, but 'rotor_dr" + cyrillic_a +
+                   "g' has U+0430 CYRILLIC SMALL LETTER A (character 9))");
   expect_error({"diagnose", f3, "x.csv", "--m" + cyrillic_a + "pping", "M.yaml", "--out", tmp / "o"}, 109,
-               "'--mapping' for '--m" + cyrillic_a + "pping' (they look alike, but '--m" + cyrillic_a + "pping' has U+0430");
+               "'--mapping' for '--m" + cyrillic_a + "pping' (they look alike, but '--m" + cyrillic_a +
+                   "pping' has U+0430 CYRILLIC SMALL LETTER A (character 4))");
   // Files that are not logs are named as what they should have been.
   ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
   expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,

@@ -229,7 +229,7 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
        "columns: duplicate key 'p'"},
       {"dup_top.yaml", "name: a\ncolumns:\n  p: {source: gyro}\nname: b\n", 4, "mapping: duplicate key 'name'"},
       {"top_key.yaml", "name: a\ncolumn:\n  p: {source: gyro}\n", 2,
-       "mapping: unknown key 'column' (allowed: name, columns, environment, frame)"},
+       "mapping: unknown key 'column' (allowed: name, columns, environment, frame); did you mean 'columns'?"},
       {"dimension.yaml", "columns:\n  p: {source: gyro, unit: m/s}\n", 2,
        "unit 'm/s' has dimension m s^-1, but 'p' is in rad/s (dimension s^-1)"},
       {"target.yaml", "columns:\n  vbatt: {source: gyro, unit: V}\n", 2, "'vbatt' is not a canonical column"},
@@ -275,6 +275,11 @@ TEST_F(Hostile, MappedRotorNamesAreBlamedOnTheMapping) {
   const std::string typo = write("typo.yaml", "columns:\n  t: {source: time}\n  u_M1: {source: M1}\n");
   const std::string wrong_case = message_of<FitError>([&] { read_log(log, typo, 0); });
   expect_located(wrong_case, typo, 3, "column 'M1' (for 'u_M1') is not in the header of " + log + "; did you mean 'm1'?");
+  // One spelt with a look-alike letter (a Cyrillic е in 'time'): suggested, and told apart.
+  const std::string cyrillic = write("cyrillic.yaml", "columns:\n  t: {source: tim\xD0\xB5}\n  u_M1: {source: m1}\n");
+  const std::string looks = message_of<FitError>([&] { read_log(log, cyrillic, 0); });
+  expect_located(looks, cyrillic, 2, "; did you mean 'time'? (they look alike, but 'tim\xD0\xB5' has U+0435 CYRILLIC SMALL "
+                                     "LETTER IE (character 4))");
   // The gyro not mapped: which body rates, and that the mapping should give them.
   const std::string no_gyro = write("nogyro.yaml", "columns:\n  t: {source: time}\n  u_M1: {source: m1}\n  u_M2: "
                                                    "{source: m2}\n  u_M3: {source: m3}\n  u_M4: {source: m4}\n");

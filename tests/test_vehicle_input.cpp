@@ -134,7 +134,8 @@ TEST(VehicleInput, UnknownKey) {
   // two bytes where one was meant) is said to look alike, with the letter that differs.
   expect_error(replace(finken_text(), "size: [0.056, 0.056, 0.072]", "sise: [0.056, 0.056, 0.072]"), "did you mean 'size'?");
   expect_error(replace(finken_text(), "{name: B, position", "{name: B, positi\xD0\xBEn"),
-               "did you mean 'position'? (they look alike, but 'positi\xD0\xBEn' has U+043E CYRILLIC SMALL LETTER O)");
+               "did you mean 'position'? (they look alike, but 'positi\xD0\xBEn' has U+043E CYRILLIC SMALL LETTER O "
+               "(character 7))");
 }
 // A tilted rotor is said to be outside the model, not only an unknown key (a user trial: blocks
 // take orientation_deg, so a user tried it on a rotor).
