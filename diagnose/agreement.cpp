@@ -35,12 +35,23 @@ std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, co
     p.name = n;
     const bool of_effect = std::find(named.begin(), named.end(), n) != named.end();
     p.free = of_effect || (per_flight && p.free);
-    // A base parameter (base_parameter_agreement) starts where the joint fit left it.
+    // An effect's parameter starts at its joint estimate; one not in `in.effects` (a base
+    // parameter, or an effect freed beside them in base_parameter_agreement) where the joint
+    // fit left it.
     if (of_effect && start.count(n)) p.value = std::clamp(start.at(n), p.lower, p.upper);
     ps.push_back(p);
   }
   return ps;
 }
+
+}  // namespace
+
+bool on_a_bound_that_is_not_off(const fit::FitParameter& p, double off) {
+  const bool at_off = std::isfinite(off) && std::fabs(p.value - off) < 1e-9 * std::max(1.0, p.upper - p.lower);
+  return fit::on_bound(p) && !at_off;
+}
+
+namespace {
 
 // One flight: its estimates of every named parameter and, per effect, the LR test against off
 // (a parameter of no effect in `in`, a base parameter, has no such test: statistic and p NaN).
@@ -52,7 +63,8 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
   const double cost_on = fit::solve_weighted(ee, on, weights, fo);
   const StandardErrors se = gauss_newton_standard_errors(ee, on, weights);
   std::map<std::string, FlightEstimate> out;
-  const auto estimate = [&](const std::string& name, double statistic, double p_value) {
+  // `off`: the effect's neutral value (NaN for a base parameter).
+  const auto estimate = [&](const std::string& name, double statistic, double p_value, double off) {
     const int i = in.model->param_index(name);
     FlightEstimate f;
     f.value = on[i].value;
@@ -62,7 +74,8 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     f.upper = f.value + kZ95 * f.standard_error;
     f.statistic = statistic;
     f.p_value = p_value;
-    f.at_bound = on[i].free && fit::on_bound(on[i]);
+    f.at_bound = on[i].free && on_a_bound_that_is_not_off(on[i], off);
+    if (f.at_bound) f.lower = f.upper = std::numeric_limits<double>::quiet_NaN();  // no interval to draw or print
     return f;
   };
   for (const auto& e : in.effects) {
@@ -79,18 +92,18 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     const fit::FitParameter& first = on[static_cast<size_t>(in.model->param_index(e.parameters.front()))];
     const double p_value =
         lr_p_value(statistic, static_cast<int>(e.parameters.size()), e.off.front(), first.lower, first.upper);
-    for (const auto& name : e.parameters) out[name] = estimate(name, statistic, p_value);
+    for (size_t j = 0; j < e.parameters.size(); ++j) out[e.parameters[j]] = estimate(e.parameters[j], statistic, p_value, e.off[j]);
   }
   const double none = std::numeric_limits<double>::quiet_NaN();
   for (const auto& name : named)
-    if (!out.count(name)) out[name] = estimate(name, none, none);
+    if (!out.count(name)) out[name] = estimate(name, none, none, none);
   return out;
 }
 
 // The median of the range, and P(range >= observed), by bisection on range_cdf.
 void spread_under_agreement(ParameterAgreement& a) {
   std::vector<double> sd;
-  for (const auto& f : a.flights) sd.push_back(f.standard_error);
+  for (const auto& f : a.flights) sd.push_back(flight_can_say(f) ? f.standard_error : std::numeric_limits<double>::quiet_NaN());
   const double scale = std::abs(a.joint_value);
   if (sd.size() < 2 || !(scale > 0) ||
       std::any_of(sd.begin(), sd.end(), [](double s) { return !(s > 0) || !std::isfinite(s); })) {

@@ -24,8 +24,9 @@ namespace quadgen::diagnose {
 struct FlightEstimate {
   double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
   double statistic = 0, p_value = 1;  // the effect on this flight alone: LR test against "off"
-  // Ended on a bound of its fit (fit::on_bound): its Wald interval is no interval (c_w at 0.05
-  // read [-2.5, 2.6]), so the flight cannot say, as one without a standard error cannot.
+  // Ended on a bound of its fit (fit::on_bound) that is not the effect's "off": its Wald
+  // interval is no interval (c_w at 0.05 read [-4.3, 4.4]; lower and upper are NaN then), so
+  // the flight cannot say, as one without a standard error cannot.
   bool at_bound = false;
 };
 
@@ -57,6 +58,14 @@ struct ParameterAgreement {
   // A base model's parameter (base_parameter_agreement), not an effect's.
   bool base = false;
 };
+
+// Whether a flight's refitted `p` ended on a bound that is not `off`, the effect's neutral
+// value (NaN for a base parameter, which has none): then its Wald interval is no interval and
+// the flight cannot say. A value on the bound that is its "off" (rotor drag 0, no delay, a
+// lag at its 1e-6 s floor) is the effect absent from that flight: a value like any other,
+// which may disagree with the flights that have it (a review, helper-132: an effect present on
+// four flights and absent on the fifth read "too uncertain").
+bool on_a_bound_that_is_not_off(const fit::FitParameter& p, double off);
 
 // A flight that can say where the value lies: a standard error, and not on a bound.
 inline bool flight_can_say(const FlightEstimate& f) { return f.standard_error > 0 && !f.at_bound; }

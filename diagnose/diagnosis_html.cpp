@@ -243,7 +243,8 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
-        << num(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>" << interval(f.lower, f.upper, prec)
+        << num(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>"
+        << (f.at_bound ? std::string("none") : interval(f.lower, f.upper, prec))
         << "</td><td>" << (alone ? esc(output::p_value_cell(f.p_value)) + "</td><td>" : "")
         << "<div style=\"position:relative;height:14px\">";
       if (std::isfinite(band_lo) && std::isfinite(band_hi))  // the joint fit's interval, behind

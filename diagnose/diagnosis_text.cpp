@@ -54,9 +54,12 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     const bool base = a.effect.empty();
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on "
        << (base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
-       << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value) << "):";
+       << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value)
+       << (*why_too_uncertain(a) ? std::string("; ") + why_too_uncertain(a) : "") << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
-      os << (k ? ", " : " ") << k + 1 << ": " << estimate(a.flights[k].value, a.flights[k].lower, a.flights[k].upper);
+      os << (k ? ", " : " ") << k + 1 << ": "
+         << (a.flights[k].at_bound ? num(a.flights[k].value, kEstimateDigits) + " (on its bound: no interval)"
+                                   : estimate(a.flights[k].value, a.flights[k].lower, a.flights[k].upper));
     os << "\n";
   }
   if (!words::airframe_from_one_flight(d).empty() && !d.airframe_check.empty())

@@ -1130,6 +1130,20 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   quadgen::diagnose::summarise_agreement(bound);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(bound), "too uncertain");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(bound), "a flight's value on its bound cannot say");
+  // Which bound cannot say: not the one that is the effect's "off" (the effect absent from
+  // that flight, a value that may disagree; a review, helper-132), any other, and any bound
+  // of a base parameter (no "off").
+  using quadgen::diagnose::on_a_bound_that_is_not_off;
+  const quadgen::fit::FitParameter drag_off{"rotor_drag.k", "N s^2/m", 0.0, 0.0, 1e-3, true},
+      drag_top{"rotor_drag.k", "N s^2/m", 1e-3, 0.0, 1e-3, true}, drag_inside{"rotor_drag.k", "N s^2/m", 1e-5, 0.0, 1e-3, true},
+      lag_floor{"motor_lag.tau", "s", 1e-6, 1e-6, 1.0, true}, gain_edge{"motor_gain.B", "1", -0.5, -0.5, 0.5, true},
+      c_w_floor{"c_w", "1", 0.05, 0.05, 3.0, true};
+  EXPECT_FALSE(on_a_bound_that_is_not_off(drag_off, 0.0));
+  EXPECT_TRUE(on_a_bound_that_is_not_off(drag_top, 0.0));
+  EXPECT_FALSE(on_a_bound_that_is_not_off(drag_inside, 0.0));
+  EXPECT_FALSE(on_a_bound_that_is_not_off(lag_floor, 1e-6));  // off_at_lower_bound: the lag's off is its floor
+  EXPECT_TRUE(on_a_bound_that_is_not_off(gain_edge, 0.0));
+  EXPECT_TRUE(on_a_bound_that_is_not_off(c_w_floor, NAN));
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(close), "");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(apart), "");
   ParameterAgreement against = loose;  // an airframe value without a standard error
@@ -1272,9 +1286,7 @@ TEST(MultiFlight, EachFlightIsRefittedUnderItsOwnNoise) {
 }
 
 TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
-  // The second flight also yaws against a torque ratio half as large again (kappa 0.015 m
-  // where the file and the first flight have 0.01 m): a base parameter that changes.
-  const json j = rotor_drag_on_two_flights("quadgen_disagree", 1e-5, 4e-5, "--set kappa=0.015");
+  const json j = rotor_drag_on_two_flights("quadgen_disagree", 1e-5, 4e-5);
   // One joint value fits neither flight: named or suspected, it is checked flight by flight.
   const json* a = agreement_of(j, "rotor_drag.k");
   ASSERT_NE(a, nullptr) << j["findings"].dump(1) << j["suspected"].dump(1) << j["agreement"].dump(1);
@@ -1282,7 +1294,21 @@ TEST(MultiFlight, AnEffectThatChangesBetweenFlightsIsReportedAsDisagreement) {
   EXPECT_LT((*a)["q_p_value"].get<double>(), 0.01) << a->dump(1);
   const double v1 = (*a)["flights"][0]["value"], v2 = (*a)["flights"][1]["value"];
   EXPECT_GT(v2, 2 * v1) << a->dump(1);  // each flight shows its own value
-  // The base model's kappa, refitted per flight: each flight's own, and a disagreement.
+}
+
+// An effect absent from one flight ends there on its "off", which is also its bound (rotor
+// drag 0): a value like any other, which disagrees with the other flight's, not a flight
+// that "cannot say" as one on another bound (a review, helper-132: present on four flights
+// and absent on a fifth read "too uncertain"). The second flight also yaws against a torque
+// ratio half as large again (kappa 0.015 m where the file and the first flight have 0.01 m):
+// a base parameter that changes is a disagreement too.
+TEST(MultiFlight, AnEffectAbsentFromOneFlightAndAnotherTorqueRatioAreDisagreements) {
+  const json j = rotor_drag_on_two_flights("quadgen_absent", 3e-5, 0.0, "--set kappa=0.015");
+  const json* a = agreement_of(j, "rotor_drag.k");
+  ASSERT_NE(a, nullptr) << j["findings"].dump(1) << j["suspected"].dump(1) << j["agreement"].dump(1);
+  EXPECT_EQ((*a)["verdict"], "disagree") << a->dump(1);
+  EXPECT_LT((*a)["flights"][1]["value"].get<double>(), 0.3 * (*a)["flights"][0]["value"].get<double>()) << a->dump(1);
+  EXPECT_FALSE((*a)["flights"][1]["at_bound"].get<bool>()) << a->dump(1);
   ASSERT_EQ(j["base_agreement"].size(), 1u) << j["base_agreement"].dump(1);
   const json& kappa = j["base_agreement"][0];
   EXPECT_EQ(kappa["verdict"], "disagree") << kappa.dump(1);
@@ -1709,6 +1735,13 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   ASSERT_NE(row, std::string::npos) << with_table;
   const std::string row_text = with_table.substr(row, with_table.find("</tr>", row) - row);
   EXPECT_NE(row_text.find("<td class=\"warn\">the flights: disagree"), std::string::npos) << row_text;
+  // A flight on its bound is shown without an interval, in the printout and the table.
+  dg::Diagnosis bound = d;
+  bound.base_agreement.front().flights[0] = dg::FlightEstimate{0.05, 0.5, NAN, NAN, NAN, NAN, true};
+  dg::summarise_agreement(bound.base_agreement.front());
+  EXPECT_NE(dg::diagnosis_summary(bound).find(": 1: 0.05 (on its bound: no interval), 2: 1.5 [1.3, 1.7]"), std::string::npos)
+      << dg::diagnosis_summary(bound);
+  EXPECT_NE(dg::diagnosis_html(bound, "log.csv", {}).find("<td>0.05 (on its bound)</td><td>none</td>"), std::string::npos);
   d.base_agreement.front().agree = d.base_agreement.front().within_errors = true;
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights: "), std::string::npos);
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights disagree on the base model&#39;s c_w"), std::string::npos);
