@@ -10,20 +10,28 @@
 
 namespace quadgen::output {
 
-// Edits (insert, delete, replace) between two words.
-inline size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
+// Edits (insert, delete, replace) between two words, counted up to `limit`: any number above
+// it reads limit + 1. Only cells within `limit` of the diagonal can stay within it, so the
+// work is length x (2 limit + 1): two names of 200 kB (a log's header, a mapping's source)
+// took length squared, 4e10 steps, before (a review, helper-132).
+inline size_t edit_distance(const std::string& a, const std::string& b, size_t limit) {
+  const size_t over = limit + 1, n = a.size(), m = b.size();
+  if ((n > m ? n - m : m - n) > limit) return over;
+  std::vector<size_t> row(m + 1, over), next(m + 1, over);
+  for (size_t j = 0; j <= std::min(m, limit); ++j) row[j] = j;
+  for (size_t i = 1; i <= n; ++i) {
+    const size_t from = i > limit ? i - limit : 1, to = std::min(m, i + limit);
+    std::fill(next.begin() + static_cast<long>(from > 1 ? from - 1 : 0), next.begin() + static_cast<long>(std::min(m, to + 1) + 1), over);
+    if (i <= limit) next[0] = i;
+    size_t best = next[0];
+    for (size_t j = from; j <= to; ++j) {
+      next[j] = std::min({row[j] + 1, next[j - 1] + 1, row[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1), over});
+      best = std::min(best, next[j]);
     }
+    if (best >= over) return over;  // every path already costs more than the limit
+    std::swap(row, next);
   }
-  return row[b.size()];
+  return std::min(row[m], over);
 }
 
 // Of `candidates`, one that looks like `word` (lookalike_skeleton: an 'ay' for an 'аy' with a
@@ -46,7 +54,7 @@ inline std::string nearest_word(const std::string& word, const std::vector<std::
   std::string nearest;
   size_t best = max_edits + 1;
   for (const auto& c : candidates)
-    if (const size_t d = edit_distance(word, c); d < best) best = d, nearest = c;
+    if (const size_t d = edit_distance(word, c, max_edits); d < best) best = d, nearest = c;
   return nearest;
 }
 

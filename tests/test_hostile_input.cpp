@@ -1737,6 +1737,34 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   expect_error({"diagnose", f3, "x.csv", "--m" + cyrillic_a + "pping", "M.yaml", "--out", tmp / "o"}, 109,
                "'--mapping' for '--m" + cyrillic_a + "pping' (they look alike, but '--m" + cyrillic_a +
                    "pping' has U+0430 CYRILLIC SMALL LETTER A (character 4))");
+  // The edits are counted within a band of the limit: the same counts as the whole table
+  // (an independent one here) for every pair of short words over a small alphabet, and two
+  // names of 200 kB are compared in length x 5 steps, not 4e10.
+  const auto full_table = [](const std::string& a, const std::string& b) {
+    std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+    for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (size_t i = 1; i <= a.size(); ++i)
+      for (size_t j = 1; j <= b.size(); ++j)
+        d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
+    return d[a.size()][b.size()];
+  };
+  std::vector<std::string> words = {""};
+  for (size_t len = 1; len <= 4; ++len)
+    for (size_t code = 0; code < (1u << (2 * len)) && words.size() < 200; code += 3) {
+      std::string w;
+      for (size_t k = 0; k < len; ++k) w += "abcd"[(code >> (2 * k)) & 3];
+      words.push_back(w);
+    }
+  for (const auto& a : words)
+    for (const auto& b : words)
+      for (size_t limit : {0u, 1u, 2u, 3u})
+        ASSERT_EQ(quadgen::output::edit_distance(a, b, limit), std::min(full_table(a, b), limit + 1))
+            << "'" << a << "' '" << b << "' " << limit;
+  const std::string huge(200000, 'x');
+  EXPECT_EQ(quadgen::output::edit_distance(huge, huge + "y", 2), 1u);
+  EXPECT_EQ(quadgen::output::edit_distance("y" + huge, huge + "y", 1), 2u);  // beyond the limit
+  EXPECT_EQ(quadgen::output::nearest_word(huge + "y", {huge + "z", "x"}), huge + "z");
   // Files that are not logs are named as what they should have been.
   ASSERT_EQ(run_quadgen({"simulate", cf, "--closed-loop", "--duration", "4", "--out", tmp / "f.csv"}, tmp.dir).rc, 0);
   expect_error({"fit", cf, tmp / "f.csv", "--mapping", tmp / "missing.yaml", "--out", tmp / "o"}, 2,
