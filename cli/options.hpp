@@ -45,11 +45,9 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
     for (const std::string& word : command->remaining()) {
       if (word.rfind("--", 0) != 0) continue;
       not_understood += (not_understood.empty() ? "" : " ") + word;
-      if (const std::string near = nearest_option(*command, word); !near.empty() && near != word) {
-        const std::string apart = output::lookalike_difference(word.substr(0, word.find('=')), near);
+      if (const std::string near = nearest_option(*command, word); !near.empty() && near != word)
         suggestions += std::string(suggestions.empty() ? "" : ", ") + "'" + near + "' for '" + word + "'" +
-                       (apart.empty() ? "" : " (they look alike, but " + apart + ")");
-      }
+                       output::lookalike_note(word.substr(0, word.find('=')), near);
     }
   std::cerr << "quadgen: error: " << output::printable_error(e.what());
   if (!not_understood.empty() && dynamic_cast<const CLI::RequiredError*>(&e))

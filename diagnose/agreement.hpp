@@ -130,9 +130,9 @@ std::vector<ParameterAgreement> per_flight_agreement(const AgreementInputs& in);
 // frame's drag and rotor drag have nearly one shape at walking speeds, and a drag coefficient
 // refitted with rotor drag held carried each flight's rotor-drag difference under intervals
 // far too narrow (a review, helper-131: r = 0.78 between the two over the five NanoBench
-// flights). The brief's "vehicle properties must
-// agree across flights" covers these as much as the named causes: a drag coefficient that
-// each flight alone sends to another bound is not the airframe's. `effect` is empty and no
+// flights). The brief's "vehicle properties must agree across flights" covers these as much
+// as the named causes: a drag coefficient that each flight alone sends to another bound is
+// not the airframe's. `effect` is empty and no
 // "alone" test is made (statistic and p NaN): the base model has no "off".
 std::vector<ParameterAgreement> base_parameter_agreement(const AgreementInputs& in, const std::vector<std::string>& base);
 

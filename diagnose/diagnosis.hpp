@@ -178,7 +178,7 @@ struct Diagnosis {
   // and whether the flights agree (agreement.hpp).
   std::vector<ParameterAgreement> agreement;
   // And the base model's shared parameters (c_w, kappa where fitted), each flight refitted
-  // with the effects held (base_parameter_agreement).
+  // with the named effects free beside them (base_parameter_agreement).
   std::vector<ParameterAgreement> base_agreement;
   // One flight diagnosed with an airframe: its named effects on this flight against it.
   std::string airframe_source;

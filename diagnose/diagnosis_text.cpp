@@ -51,9 +51,8 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.base_agreement) all.push_back(&a);
   for (const ParameterAgreement* pa : all) {
     const ParameterAgreement& a = *pa;
-    const bool base = a.effect.empty();
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on "
-       << (base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+       << (a.base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string("; ") + why_too_uncertain(a) : "") << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)

@@ -66,9 +66,7 @@ inline std::string did_you_mean(const std::string& word, const std::vector<std::
                                 size_t max_edits = 2) {
   const std::string near = nearest_word(word, candidates, max_edits);
   if (near.empty()) return "";
-  std::string out = "; did you mean '" + printable(near) + "'?";
-  if (const std::string apart = lookalike_difference(word, near); !apart.empty()) out += " (they look alike, but " + apart + ")";
-  return out;
+  return "; did you mean '" + printable(near) + "'?" + lookalike_note(word, near);
 }
 
 }  // namespace quadgen::output

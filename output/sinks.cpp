@@ -262,13 +262,13 @@ std::string unusual_characters(const std::string& s) {
 }
 }  // namespace
 
-std::string lookalike_difference(const std::string& word, const std::string& near) {
+std::string lookalike_note(const std::string& word, const std::string& near) {
   if (word == near || lookalike_skeleton(word) != lookalike_skeleton(near)) return "";
   const std::string in_word = unusual_characters(word), in_near = unusual_characters(near);
-  std::string out;
-  if (!in_word.empty()) out = "'" + printable(word) + "' has " + in_word;
-  if (!in_near.empty()) out += (out.empty() ? "" : "; ") + ("'" + printable(near) + "' has " + in_near);
-  return out;
+  std::string apart;
+  if (!in_word.empty()) apart = "'" + printable(word) + "' has " + in_word;
+  if (!in_near.empty()) apart += (apart.empty() ? "" : "; ") + ("'" + printable(near) + "' has " + in_near);
+  return apart.empty() ? "" : " (they look alike, but " + apart + ")";
 }
 
 std::string csv_field(const std::string& s) {

@@ -31,13 +31,14 @@ std::string visible_skeleton(const std::string& s);
 // accent (NFC, NFD), a Latin "a" and a Cyrillic "а", "rn" and "m", "l" and "1". Coarser than
 // the visible skeleton: a caller numbering series that must be told apart uses this one.
 std::string lookalike_skeleton(const std::string& s);
-// Where `word` and `near` look alike (one lookalike_skeleton) but differ: what sets them
-// apart, each one's characters beyond plain ASCII by code point, Unicode name and place
-// ("'аy' has U+0430 CYRILLIC SMALL LETTER A (character 1)"; the candidate's too, where the
-// odd letter is in the log's header and not in the user's word; five at most a side); ""
-// where they do not look alike, are equal, or differ only in ASCII ("rn" and "m"). An error
-// that refuses 'аy' and suggests 'ay' reads as nonsense without it.
-std::string lookalike_difference(const std::string& word, const std::string& near);
+// What an error adds after suggesting `near` for `word` where the two look alike (one
+// lookalike_skeleton) but differ: what sets them apart, each one's characters beyond plain
+// ASCII by code point, Unicode name and place (" (they look alike, but 'аy' has U+0430
+// CYRILLIC SMALL LETTER A (character 1))"; the candidate's too, where the odd letter is in the
+// log's header and not in the user's word; five at most a side); "" where they do not look
+// alike, are equal, or differ only in ASCII ("rn" and "m"). An error that refuses 'аy' and
+// suggests 'ay' reads as nonsense without it.
+std::string lookalike_note(const std::string& word, const std::string& near);
 
 // Text inside a C++ // comment on one line: ASCII printable characters stay, except '\' (a
 // trailing one would splice the next line into the comment), '%' and '?' before '?' (trigraphs);

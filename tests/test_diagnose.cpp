@@ -1716,7 +1716,7 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   dg::Diagnosis d;
   d.flights = {"a.csv", "b.csv"};
   dg::ParameterAgreement c_w;
-  c_w.parameter = "c_w", c_w.named = true, c_w.agree = false, c_w.within_errors = false, c_w.q_p_value = 1e-4;
+  c_w.parameter = "c_w", c_w.named = true, c_w.base = true, c_w.agree = false, c_w.within_errors = false, c_w.q_p_value = 1e-4;
   c_w.joint_value = 0.5;
   dg::FlightEstimate e1{0.2, 0.05, 0.1, 0.3, NAN, NAN}, e2{1.5, 0.1, 1.3, 1.7, NAN, NAN};
   c_w.flights = {e1, e2};
