@@ -70,6 +70,20 @@ bool on_a_bound_that_is_not_off(const fit::FitParameter& p, double off);
 // A flight that can say where the value lies: a standard error, and not on a bound.
 inline bool flight_can_say(const FlightEstimate& f) { return f.standard_error > 0 && !f.at_bound; }
 
+// A flight that measures the value: it can say, and its 95 % interval holds neither zero
+// nor the other sign, so the data tell the value from none. A base parameter no flight
+// measures (the frame's drag beside rotor drag on the NanoBench flights: three on the bound,
+// two at +-2000 % and +-200 %) is a value the fit chose, not one the flights show.
+inline bool flight_measures(const FlightEstimate& f) { return flight_can_say(f) && (f.lower > 0 || f.upper < 0); }
+
+inline size_t flights_measuring(const ParameterAgreement& a) {
+  size_t n = 0;
+  for (const auto& f : a.flights) n += flight_measures(f);
+  return n;
+}
+
+inline bool measured_by_no_flight(const ParameterAgreement& a) { return !a.flights.empty() && flights_measuring(a) == 0; }
+
 // The verdict in a word: "agree", "too uncertain" (within the errors, but apart by 30 % or
 // more, or a flight without a standard error) or "disagree".
 inline const char* agreement_verdict(const ParameterAgreement& a) {
@@ -85,6 +99,9 @@ inline bool flights_disagree(const ParameterAgreement& a) { return !a.agree && !
 inline const char* why_too_uncertain(const ParameterAgreement& a) {
   if (a.agree || !a.within_errors) return "";
   if (a.reference_without_error) return "the airframe's value has no standard error";
+  if (measured_by_no_flight(a))
+    return a.flights.size() > 1 ? "no flight measures it: each value is on its bound or its interval holds zero"
+                                : "the flight does not measure it: its value is on its bound or its interval holds zero";
   for (const auto& f : a.flights)
     if (f.at_bound) return "a flight's value on its bound cannot say";
   for (const auto& f : a.flights)

@@ -555,7 +555,8 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
   const auto flights_say = [&](const fit::FitParameter& p) -> std::string {
     for (const auto& a : d.base_agreement)
       if (a.parameter == p.name && !a.agree)
-        return std::string("the flights: ") + agreement_verdict(a) + " (<i>Do the flights agree on the base model?</i>)";
+        return std::string("the flights: ") + (measured_by_no_flight(a) ? "none measures it" : agreement_verdict(a)) +
+               " (<i>Do the flights agree on the base model?</i>)";
     return "";
   };
   for (const auto* p : base) {

@@ -254,6 +254,9 @@ json agreement_json(const std::vector<ParameterAgreement>& list, const std::vect
                    {"q_p_value", number_or_null(a.q_p_value)},
                    {"agree", a.agree},
                    {"verdict", agreement_verdict(a)},
+                   // How many flights tell the value from none (flight_measures): 0 for a value
+                   // only the fit chose.
+                   {"flights_measuring", flights_measuring(a)},
                    {"flights", per_flight}});
   }
   return out;

@@ -322,6 +322,15 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
       out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
                     "differs between the flights that lie apart (speed, battery, payload, the day) and diagnose them " +
                     "apart, or together without the odd one");
+  // A base parameter no flight measures (c_w beside rotor drag on the NanoBench flights): the
+  // report said "too uncertain" and the fitted-parameters table showed the joint value, with
+  // nothing to do about a value the flights cannot give.
+  for (const auto& a : d.base_agreement)
+    if (!flights_disagree(a) && measured_by_no_flight(a))
+      out.push_back("no flight measures the base model's " + a.parameter + " (each value on its bound or its interval " +
+                    "holding zero): the joint value is the fit's choice, not a measurement; hold it in the vehicle file " +
+                    "(fit: false) at a value you can defend, which these flights cannot contradict, or fly what " +
+                    "would measure it (for a drag coefficient: faster)");
   for (const auto& a : d.base_agreement)
     if (flights_disagree(a))
       out.push_back("the flights disagree on the base model's " + a.parameter + ": it carries something that differs " +

@@ -1144,6 +1144,28 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_FALSE(on_a_bound_that_is_not_off(lag_floor, 1e-6));  // off_at_lower_bound: the lag's off is its floor
   EXPECT_TRUE(on_a_bound_that_is_not_off(gain_edge, 0.0));
   EXPECT_TRUE(on_a_bound_that_is_not_off(c_w_floor, NAN));
+  // No flight measures it: each value on its bound or its interval holding zero (c_w on the
+  // NanoBench flights: 0.05 on the bound, 0.25 [-4.8, 5.3], 2.3 [-2.3, 6.8]). One flight
+  // whose interval clears zero measures it, and the reason is the bound's again.
+  ParameterAgreement unmeasured = judged(0.25, 2.3, 2.3);
+  unmeasured.flights.push_back(bound.flights[1]);
+  quadgen::diagnose::summarise_agreement(unmeasured);
+  EXPECT_EQ(quadgen::diagnose::flights_measuring(unmeasured), 0u);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(unmeasured), "too uncertain");
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unmeasured),
+               "no flight measures it: each value is on its bound or its interval holds zero");
+  unmeasured.flights[1].standard_error = 1.0, unmeasured.flights[1].lower = 0.34, unmeasured.flights[1].upper = 4.26;
+  quadgen::diagnose::summarise_agreement(unmeasured);
+  EXPECT_EQ(quadgen::diagnose::flights_measuring(unmeasured), 1u);
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unmeasured), "a flight's value on its bound cannot say");
+  // A negative value measured as such counts; against an airframe, one flight says it of itself.
+  EXPECT_TRUE(quadgen::diagnose::flight_measures({-1.0, 0.1, -1.2, -0.8, NAN, NAN}));
+  ParameterAgreement one = judged(0.25, 0.25, 2.3);
+  one.flights.resize(1);
+  EXPECT_TRUE(quadgen::diagnose::measured_by_no_flight(one));
+  one.agree = false, one.within_errors = true;
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(one),
+               "the flight does not measure it: its value is on its bound or its interval holds zero");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(close), "");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(apart), "");
   ParameterAgreement against = loose;  // an airframe value without a standard error
@@ -1742,6 +1764,28 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   EXPECT_NE(dg::diagnosis_summary(bound).find(": 1: 0.05 (on its bound: no interval), 2: 1.5 [1.3, 1.7]"), std::string::npos)
       << dg::diagnosis_summary(bound);
   EXPECT_NE(dg::diagnosis_html(bound, "log.csv", {}).find("<td>0.05 (on its bound)</td><td>none</td>"), std::string::npos);
+  EXPECT_EQ(dg::diagnosis_json(d, "log.csv")["base_agreement"][0]["flights_measuring"], 2);
+  EXPECT_EQ(with_table.find("no flight measures"), std::string::npos);
+  // No flight measures it (on its bound, or an interval holding zero): the fit chose the
+  // value; a next step says to hold it, and the table says none measures it.
+  dg::Diagnosis unmeasured = d;
+  unmeasured.base_agreement.front().flights = {dg::FlightEstimate{0.05, 0.5, NAN, NAN, NAN, NAN, true},
+                                               dg::FlightEstimate{1.5, 1.0, -0.46, 3.46, NAN, NAN}};
+  dg::summarise_agreement(unmeasured.base_agreement.front());
+  EXPECT_EQ(dg::diagnosis_json(unmeasured, "log.csv")["base_agreement"][0]["flights_measuring"], 0);
+  const std::string unmeasured_html = dg::diagnosis_html(unmeasured, "log.csv", {});
+  EXPECT_NE(unmeasured_html.find("<li>no flight measures the base model&#39;s c_w (each value on its bound or its "
+                                 "interval holding zero): the joint value is the fit&#39;s choice, not a measurement; "
+                                 "hold it in the vehicle file (fit: false)"),
+            std::string::npos)
+      << unmeasured_html;
+  EXPECT_NE(unmeasured_html.find("<td class=\"warn\">the flights: none measures it"), std::string::npos);
+  EXPECT_NE(dg::diagnosis_summary(unmeasured).find("too uncertain to agree on the base model's c_w"), std::string::npos);
+  EXPECT_NE(dg::diagnosis_summary(unmeasured).find("no flight measures it: each value is on its bound or its interval "
+                                                   "holds zero"),
+            std::string::npos)
+      << dg::diagnosis_summary(unmeasured);
+  EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("no flight measures"), std::string::npos);
   d.base_agreement.front().agree = d.base_agreement.front().within_errors = true;
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights: "), std::string::npos);
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights disagree on the base model&#39;s c_w"), std::string::npos);
