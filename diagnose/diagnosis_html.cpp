@@ -412,7 +412,9 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
   for (const auto& x : d.suspected)
     rows.push_back({x.candidate.effect, x.carried ? "warn" : "no",
                     std::string(x.carried ? "suspected, carried in the model for a named look-alike's values"
-                                          : "suspected, not in the model") + ": " + prose(x.failed),
+                                          : "suspected, not in the model") + ": " + prose(x.failed) +
+                        (x.candidate.evidence.implausible.empty() ? ""
+                                                                  : "; implausible here: " + esc(x.candidate.evidence.implausible)),
                     x.carried ? carried_values(d, x.candidate.effect) : estimates_cell(x.candidate.parameters, false),
                     "&ndash;"});
   for (const auto& e : d.search.left_at_limit)

@@ -90,6 +90,9 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
          << (p.at_bound ? " (on its bound)" : "");
     }
     os << " (" << x.failed << ")";
+    // Implausible here as well (the joint NanoBench diagnosis suspected a 4.6 m/s wind indoors
+    // and a ground-effect radius twice the rotor's, and said only that they failed held out).
+    if (!x.candidate.evidence.implausible.empty()) os << "; implausible here: " << x.candidate.evidence.implausible;
     if (x.carried) os << "; " << words::carried_suspect(*x.carried);
     os << "\n";
   }

@@ -338,7 +338,9 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
                     "tell from rotor drag); read its values per flight before taking the joint value as the airframe's");
   for (const auto& x : d.suspected)
     if (!x.carried)
-      out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")");
+      out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed +
+                    (x.candidate.evidence.implausible.empty() ? "" : "; implausible here: " + x.candidate.evidence.implausible) +
+                    ")");
   for (const auto& st : d.stand_ins)
     out.push_back("do not believe " + st.parameter + ": the model lacks something " + st.candidate.effect +
                   " absorbs; the channels it changes say where");

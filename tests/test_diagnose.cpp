@@ -1667,6 +1667,25 @@ TEST(DiagnosisReport, WhatToDoNextFollowsTheOutcomes) {
   const std::string html = quadgen::diagnose::diagnosis_html(d, "log.csv", {});
   EXPECT_NE(html.find("<h2>What to do next</h2>\n<ul>\n<li>fly this to tell input_delay from motor_lag"), std::string::npos)
       << html;
+  EXPECT_EQ(summary.find("implausible here"), std::string::npos);
+  // A suspect whose value is implausible here says so, in the line, the next step and the
+  // report's table (the joint NanoBench diagnosis suspected a 4.6 m/s wind indoors, and said
+  // only that it failed held out).
+  quadgen::diagnose::Diagnosis implausible = d;
+  implausible.suspected.front().candidate.evidence.implausible = "ground_effect.radius = 0.113 m outside [0, 0.0675]";
+  const std::string implausible_summary = quadgen::diagnose::diagnosis_summary(implausible);
+  EXPECT_NE(implausible_summary.find("suspected, not named: ground_effect (no held-out gain); implausible here: "
+                                     "ground_effect.radius = 0.113 m outside [0, 0.0675]\n"),
+            std::string::npos)
+      << implausible_summary;
+  EXPECT_NE(implausible_summary.find("next: do not put ground_effect in the vehicle file (suspected: no held-out gain; "
+                                     "implausible here: ground_effect.radius = 0.113 m outside [0, 0.0675])"),
+            std::string::npos)
+      << implausible_summary;
+  EXPECT_NE(quadgen::diagnose::diagnosis_html(implausible, "log.csv", {})
+                .find("suspected, not in the model: no held-out gain; implausible here: ground_effect.radius = 0.113 m "
+                      "outside [0, 0.0675]"),
+            std::string::npos);
   d.airframe_source = "joint/diagnosis.json", d.airframe_flights = 5;  // checked against a joint airframe already
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find("with other flights of the vehicle"), std::string::npos);
   d.airframe_flights = 1;  // an airframe from one flight's diagnosis: still worth a joint one
