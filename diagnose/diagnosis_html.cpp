@@ -237,7 +237,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
       << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
-      << ").</p>\n<table><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
+      << ").</p>\n<table class=\"agreement\"><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
       << "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
@@ -315,6 +315,9 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
        "table{border-collapse:collapse;margin:1em 0;display:block;max-width:100%;overflow-x:auto}"  // narrow screens scroll a table
        "table.glance td,table.glance th{text-align:left;vertical-align:top}.path{color:#555;overflow-wrap:anywhere}"
        "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+       // A number or an interval is read whole: rotor drag's per-flight values broke as
+       // "1.344e-" / "06" beside the bars (a screenshot, sixty-first session).
+       "table.agreement td:not(:first-child){white-space:nowrap}"
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
        ".headline{font-size:1.1em}h1,li{overflow-wrap:anywhere}</style></head><body>\n";  // long paths wrap

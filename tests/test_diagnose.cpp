@@ -1766,6 +1766,9 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   const size_t section = html.find("<h2>Do the flights agree on the base model?</h2>");
   ASSERT_NE(section, std::string::npos);
   EXPECT_NE(html.find("<h3>c_w [", section), std::string::npos) << html.substr(section, 1500);
+  // Its numbers are read whole, never broken as "1.344e-" / "06" beside the bars.
+  EXPECT_NE(html.find("<table class=\"agreement\"><tr><th>flight</th>", section), std::string::npos);
+  EXPECT_NE(html.find("table.agreement td:not(:first-child){white-space:nowrap}"), std::string::npos);
   EXPECT_NE(html.find("<li>the flights disagree on the base model&#39;s c_w"), std::string::npos) << html;
   EXPECT_NE(dg::diagnosis_summary(d).find("flights disagree on the base model's c_w (spread"), std::string::npos)
       << dg::diagnosis_summary(d);
