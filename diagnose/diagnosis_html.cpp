@@ -297,12 +297,13 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "(the other airframe values held at the joint fit, the flight's own trims and thrust constant free). Bars: "
        "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
        "joint estimate). \"Alone\": the effect's "
-       "likelihood-ratio test on that flight by itself. The flights agree when every interval holds the pooled "
-       "value and the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
+       "likelihood-ratio test on that flight by itself. The flights disagree when Cochran's Q rejects one "
+       "value at the 5 % level (one test per parameter), and agree when it does not, every flight can say and "
+       "the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
        "median spread the flights would show if each measured the pooled value with its own standard error, and the "
        "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
-       "wider, however well they agree: where every interval holds it and only the 30 % is missed, the verdict is "
-       "\"too uncertain\", not \"disagree\".</p>\n";
+       "wider, however well they agree: where Q does not reject one value and only the 30 % is missed, the verdict "
+       "is \"too uncertain\", not \"disagree\".</p>\n";
   agreement_table_html(h, d.agreement, d.flights, "joint", d.findings);
   base_agreement_section(h, d);
 }
@@ -560,7 +561,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
   const auto flights_say = [&](const fit::FitParameter& p) -> std::string {
     for (const auto& a : d.base_agreement)
       if (a.parameter == p.name && !a.agree)
-        return std::string("the flights: ") + (measured_by_no_flight(a) ? "none measures it" : agreement_verdict(a)) +
+        return std::string("the flights: ") + (unmeasured_base_parameter(a) ? "none tells it from zero" : agreement_verdict(a)) +
                " (<i>Do the flights agree on the base model?</i>)";
     return "";
   };

@@ -326,11 +326,20 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   // report said "too uncertain" and the fitted-parameters table showed the joint value, with
   // nothing to do about a value the flights cannot give.
   for (const auto& a : d.base_agreement)
-    if (!flights_disagree(a) && measured_by_no_flight(a))
-      out.push_back("no flight measures the base model's " + a.parameter + " (each value on its bound or its interval " +
-                    "holding zero): the joint value is the fit's choice, not a measurement; hold it in the vehicle file " +
-                    "(fit: false) at a value you can defend, which these flights cannot contradict, or fly what " +
-                    "would measure it (for a drag coefficient: faster)");
+    if (unmeasured_base_parameter(a)) {
+      // Where the flights that can say allow it: the intersection of their intervals.
+      double lo = -INFINITY, hi = INFINITY;
+      for (const auto& f : a.flights)
+        if (flight_can_say(f)) lo = std::max(lo, f.lower), hi = std::min(hi, f.upper);
+      const std::string allowed = std::isfinite(lo) && std::isfinite(hi) && lo <= hi
+                                      ? " inside every flight's interval ([" + num(lo, kEstimateDigits) + ", " +
+                                            num(hi, kEstimateDigits) + "])"
+                                      : "";
+      out.push_back("no flight tells the base model's " + a.parameter + " from zero, nor do the flights together " +
+                    "(each value on its bound or its interval holding zero): the joint value is the fit's choice, not a " +
+                    "measurement; hold it in the vehicle file (fit: false) at a value" + allowed + " that you can " +
+                    "defend, or fly what would measure it" + (a.parameter == "c_w" ? " (for the frame's drag: faster)" : ""));
+    }
   for (const auto& a : d.base_agreement)
     if (flights_disagree(a))
       out.push_back("the flights disagree on the base model's " + a.parameter + ": it carries something that differs " +
@@ -338,9 +347,10 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
                     "tell from rotor drag); read its values per flight before taking the joint value as the airframe's");
   for (const auto& x : d.suspected)
     if (!x.carried)
-      out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed +
-                    (x.candidate.evidence.implausible.empty() ? "" : "; implausible here: " + x.candidate.evidence.implausible) +
-                    ")");
+      out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")" +
+                    (x.candidate.evidence.implausible.empty()
+                         ? ""
+                         : "; its value is implausible here too: " + x.candidate.evidence.implausible));
   for (const auto& st : d.stand_ins)
     out.push_back("do not believe " + st.parameter + ": the model lacks something " + st.candidate.effect +
                   " absorbs; the channels it changes say where");

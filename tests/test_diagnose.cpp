@@ -1118,7 +1118,10 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_GT(loose.spread_if_agree, 0.3);
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(loose),
                "the flights cannot measure it to 30 %: agreeing flights would spread as far");
-  const ParameterAgreement tight_apart = judged(1.0, 1.4, 0.12);
+  // (Two flights 0.4 apart with errors of 0.12 each hold the pooled 1.2 in both intervals,
+  // yet differ by 2.4 standard errors of their difference: Q says disagree, p = 0.018.)
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(judged(1.0, 1.4, 0.12)), "disagree");
+  const ParameterAgreement tight_apart = judged(1.0, 1.4, 0.16);
   EXPECT_LT(tight_apart.spread_if_agree, 0.3);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(tight_apart), "too uncertain");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(tight_apart), "within the errors, but 30 % or more apart");
@@ -1148,24 +1151,44 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   // NanoBench flights: 0.05 on the bound, 0.25 [-4.8, 5.3], 2.3 [-2.3, 6.8]). One flight
   // whose interval clears zero measures it, and the reason is the bound's again.
   ParameterAgreement unmeasured = judged(0.25, 2.3, 2.3);
+  unmeasured.base = true;
   unmeasured.flights.push_back(bound.flights[1]);
   quadgen::diagnose::summarise_agreement(unmeasured);
   EXPECT_EQ(quadgen::diagnose::flights_measuring(unmeasured), 0u);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(unmeasured), "too uncertain");
-  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unmeasured),
-               "no flight measures it: each value is on its bound or its interval holds zero");
+  const char* no_flight = "no flight tells it from zero: each value is on its bound or its interval holds zero";
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unmeasured), no_flight);
+  EXPECT_TRUE(quadgen::diagnose::unmeasured_base_parameter(unmeasured));
+  // An effect's parameter is judged against its "off" by its test, not here.
+  ParameterAgreement effect = unmeasured;
+  effect.base = false;
+  EXPECT_STRNE(quadgen::diagnose::why_too_uncertain(effect), no_flight);
+  EXPECT_FALSE(quadgen::diagnose::unmeasured_base_parameter(effect));
+  // A flight without a standard error says nothing either way: its own reason stands.
+  ParameterAgreement no_error = unmeasured;
+  for (auto& f : no_error.flights) f.standard_error = NAN, f.lower = f.upper = NAN, f.at_bound = false;
+  quadgen::diagnose::summarise_agreement(no_error);
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(no_error), "a flight without a standard error cannot say");
+  EXPECT_FALSE(quadgen::diagnose::unmeasured_base_parameter(no_error));
+  // One flight that tells it from zero: the bound's reason again.
   unmeasured.flights[1].standard_error = 1.0, unmeasured.flights[1].lower = 0.34, unmeasured.flights[1].upper = 4.26;
   quadgen::diagnose::summarise_agreement(unmeasured);
   EXPECT_EQ(quadgen::diagnose::flights_measuring(unmeasured), 1u);
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unmeasured), "a flight's value on its bound cannot say");
-  // A negative value measured as such counts; against an airframe, one flight says it of itself.
+  EXPECT_FALSE(quadgen::diagnose::unmeasured_base_parameter(unmeasured));
+  // Eight flights at 0.8-1.2, each +- 0.65 (standard error), hold zero, but together (1.0 +-
+  // 0.23) they tell it from zero: no flight alone does, the flights do, nothing says to hold it.
+  ParameterAgreement together;
+  together.base = true, together.joint_value = 1.0;
+  for (int k = 0; k < 8; ++k) {
+    const double v = 0.8 + 0.4 * k / 7;
+    together.flights.push_back({v, 0.65, v - 1.96 * 0.65, v + 1.96 * 0.65, NAN, NAN});
+  }
+  quadgen::diagnose::summarise_agreement(together);
+  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(together), no_flight);
+  EXPECT_FALSE(quadgen::diagnose::unmeasured_base_parameter(together));
+  // A negative value measured as such counts.
   EXPECT_TRUE(quadgen::diagnose::flight_measures({-1.0, 0.1, -1.2, -0.8, NAN, NAN}));
-  ParameterAgreement one = judged(0.25, 0.25, 2.3);
-  one.flights.resize(1);
-  EXPECT_TRUE(quadgen::diagnose::measured_by_no_flight(one));
-  one.agree = false, one.within_errors = true;
-  EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(one),
-               "the flight does not measure it: its value is on its bound or its interval holds zero");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(close), "");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(apart), "");
   ParameterAgreement against = loose;  // an airframe value without a standard error
@@ -1195,6 +1218,40 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   quadgen::diagnose::summarise_agreement(twice);
   EXPECT_DOUBLE_EQ(twice.q, apart.q);
   EXPECT_NEAR(apart.q, 2 * std::pow(0.25 / 0.05, 2), 1e-9);  // each value 0.25 from the pooled 1.25
+}
+
+// Flights that measure one value, each with its own error, are said to disagree at the test's
+// level (5 %), however many they are: the verdict rests on Cochran's Q, one test per parameter.
+// The rule before the sixty-first session (every flight's 95 % interval holds the pooled
+// value) tested each flight and said "disagree" 14 % of the time for five flights and 32 % for
+// ten: this test failed with it. And a flight 4 standard errors off is found.
+TEST(MultiFlight, AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel) {
+  using quadgen::diagnose::ParameterAgreement;
+  std::mt19937 rng(61);
+  quadgen::runtime::Normal unit(0.0, 1.0);
+  const auto draw = [&](size_t flights, double shift_of_last) {
+    ParameterAgreement a;
+    a.joint_value = 1.0;
+    for (size_t k = 0; k < flights; ++k) {
+      quadgen::diagnose::FlightEstimate f;
+      f.standard_error = 0.02 * (1 + 2.0 * k / (flights - 1));  // unequal errors, 0.02-0.06
+      f.value = 1.0 + f.standard_error * (unit(rng) + (k + 1 == flights ? shift_of_last : 0.0));
+      f.lower = f.value - 1.96 * f.standard_error, f.upper = f.value + 1.96 * f.standard_error;
+      a.flights.push_back(f);
+    }
+    quadgen::diagnose::judge_heterogeneity(a);  // the verdict, without the spread's integral
+    return a;
+  };
+  constexpr int kDraws = 4000;  // 5 % of them: 200 +- 14
+  for (size_t flights : {2u, 5u, 10u}) {
+    int disagree = 0, found = 0;
+    for (int i = 0; i < kDraws; ++i) {
+      disagree += quadgen::diagnose::flights_disagree(draw(flights, 0.0));
+      found += quadgen::diagnose::flights_disagree(draw(flights, 4.0));
+    }
+    EXPECT_NEAR(static_cast<double>(disagree) / kDraws, 0.05, 0.015) << flights << " flights";
+    EXPECT_GT(static_cast<double>(found) / kDraws, 0.5) << flights << " flights";
+  }
 }
 
 // A flight checked against an airframe (diagnose --airframe): a flight without a standard
@@ -1673,19 +1730,25 @@ TEST(DiagnosisReport, WhatToDoNextFollowsTheOutcomes) {
   // only that it failed held out).
   quadgen::diagnose::Diagnosis implausible = d;
   implausible.suspected.front().candidate.evidence.implausible = "ground_effect.radius = 0.113 m outside [0, 0.0675]";
+  implausible.suspected.front().candidate.effect = "ground_effect";
   const std::string implausible_summary = quadgen::diagnose::diagnosis_summary(implausible);
   EXPECT_NE(implausible_summary.find("suspected, not named: ground_effect (no held-out gain); implausible here: "
                                      "ground_effect.radius = 0.113 m outside [0, 0.0675]\n"),
             std::string::npos)
       << implausible_summary;
-  EXPECT_NE(implausible_summary.find("next: do not put ground_effect in the vehicle file (suspected: no held-out gain; "
-                                     "implausible here: ground_effect.radius = 0.113 m outside [0, 0.0675])"),
+  EXPECT_NE(implausible_summary.find("next: do not put ground_effect in the vehicle file (suspected: no held-out gain); "
+                                     "its value is implausible here too: ground_effect.radius = 0.113 m outside [0, 0.0675]\n"),
             std::string::npos)
       << implausible_summary;
   EXPECT_NE(quadgen::diagnose::diagnosis_html(implausible, "log.csv", {})
                 .find("suspected, not in the model: no held-out gain; implausible here: ground_effect.radius = 0.113 m "
                       "outside [0, 0.0675]"),
             std::string::npos);
+  // Escaped in the report (the text carries a parameter's name, from the vehicle file).
+  implausible.suspected.front().candidate.evidence.implausible = "<b>x</b> = 1 outside [0, 0.5]";
+  const std::string escaped = quadgen::diagnose::diagnosis_html(implausible, "log.csv", {});
+  EXPECT_EQ(escaped.find("<b>x</b>"), std::string::npos);
+  EXPECT_NE(escaped.find("implausible here: &lt;b&gt;x&lt;/b&gt; = 1 outside [0, 0.5]"), std::string::npos);
   d.airframe_source = "joint/diagnosis.json", d.airframe_flights = 5;  // checked against a joint airframe already
   EXPECT_EQ(quadgen::diagnose::diagnosis_summary(d).find("with other flights of the vehicle"), std::string::npos);
   d.airframe_flights = 1;  // an airframe from one flight's diagnosis: still worth a joint one
@@ -1787,27 +1850,39 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
       << dg::diagnosis_summary(bound);
   EXPECT_NE(dg::diagnosis_html(bound, "log.csv", {}).find("<td>0.05 (on its bound)</td><td>none</td>"), std::string::npos);
   EXPECT_EQ(dg::diagnosis_json(d, "log.csv")["base_agreement"][0]["flights_measuring"], 2);
-  EXPECT_EQ(with_table.find("no flight measures"), std::string::npos);
-  // No flight measures it (on its bound, or an interval holding zero): the fit chose the
-  // value; a next step says to hold it, and the table says none measures it.
+  EXPECT_EQ(with_table.find("tells it from zero"), std::string::npos);
+  // No flight tells it from zero (on its bound, or an interval holding zero), nor do the
+  // flights together: the fit chose the value; a next step says to hold it inside every
+  // flight's interval, and the table says none tells it from zero.
   dg::Diagnosis unmeasured = d;
   unmeasured.base_agreement.front().flights = {dg::FlightEstimate{0.05, 0.5, NAN, NAN, NAN, NAN, true},
-                                               dg::FlightEstimate{1.5, 1.0, -0.46, 3.46, NAN, NAN}};
+                                               dg::FlightEstimate{1.5, 1.0, -0.46, 3.46, NAN, NAN},
+                                               dg::FlightEstimate{0.3, 1.5, -2.64, 3.24, NAN, NAN}};
   dg::summarise_agreement(unmeasured.base_agreement.front());
   EXPECT_EQ(dg::diagnosis_json(unmeasured, "log.csv")["base_agreement"][0]["flights_measuring"], 0);
+  const std::string step = "no flight tells the base model's c_w from zero, nor do the flights together (each value on "
+                           "its bound or its interval holding zero): the joint value is the fit's choice, not a "
+                           "measurement; hold it in the vehicle file (fit: false) at a value inside every flight's "
+                           "interval ([-0.46, 3.24]) that you can defend, or fly what would measure it (for the "
+                           "frame's drag: faster)";
+  const std::string unmeasured_summary = dg::diagnosis_summary(unmeasured);
+  EXPECT_NE(unmeasured_summary.find("next: " + step + "\n"), std::string::npos) << unmeasured_summary;
   const std::string unmeasured_html = dg::diagnosis_html(unmeasured, "log.csv", {});
-  EXPECT_NE(unmeasured_html.find("<li>no flight measures the base model&#39;s c_w (each value on its bound or its "
-                                 "interval holding zero): the joint value is the fit&#39;s choice, not a measurement; "
-                                 "hold it in the vehicle file (fit: false)"),
-            std::string::npos)
+  EXPECT_NE(unmeasured_html.find("<li>no flight tells the base model&#39;s c_w from zero"), std::string::npos)
       << unmeasured_html;
-  EXPECT_NE(unmeasured_html.find("<td class=\"warn\">the flights: none measures it"), std::string::npos);
-  EXPECT_NE(dg::diagnosis_summary(unmeasured).find("too uncertain to agree on the base model's c_w"), std::string::npos);
-  EXPECT_NE(dg::diagnosis_summary(unmeasured).find("no flight measures it: each value is on its bound or its interval "
-                                                   "holds zero"),
+  EXPECT_NE(unmeasured_html.find("<td class=\"warn\">the flights: none tells it from zero"), std::string::npos);
+  EXPECT_NE(unmeasured_summary.find("too uncertain to agree on the base model's c_w"), std::string::npos);
+  EXPECT_NE(unmeasured_summary.find("no flight tells it from zero: each value is on its bound or its interval holds zero"),
             std::string::npos)
-      << dg::diagnosis_summary(unmeasured);
-  EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("no flight measures"), std::string::npos);
+      << unmeasured_summary;
+  // Flights that agree on it, or disagree, get no such step, nor the table's note.
+  for (const bool agree : {true, false}) {
+    dg::Diagnosis judged = unmeasured;
+    judged.base_agreement.front().agree = agree, judged.base_agreement.front().within_errors = agree;
+    EXPECT_EQ(dg::diagnosis_summary(judged).find("no flight tells the base model"), std::string::npos) << agree;
+    EXPECT_EQ(dg::diagnosis_html(judged, "log.csv", {}).find("none tells it from zero"), std::string::npos) << agree;
+  }
+  EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("tells it from zero"), std::string::npos);
   d.base_agreement.front().agree = d.base_agreement.front().within_errors = true;
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights: "), std::string::npos);
   EXPECT_EQ(dg::diagnosis_html(d, "log.csv", {}).find("the flights disagree on the base model&#39;s c_w"), std::string::npos);
