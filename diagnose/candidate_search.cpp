@@ -354,7 +354,13 @@ CandidateSearch::HeldOutCosts CandidateSearch::held_out_costs_between(const fit:
   return {cost(valid, base_fit, between), cost(valid, own_fit, between)};
 }
 
+// The parameter farthest outside its plausible range (by the range's width), and how many
+// more are outside: a joint fit's wind has a value per flight, and the first alone (wind.x =
+// 4.6 m/s) hid that four more flights' winds were as far out (a review, helper-133).
 std::string CandidateSearch::implausible_estimate(const std::string& effect, const std::vector<FitParameter>& ps) const {
+  std::string farthest;
+  double farthest_by = -1;
+  int outside = 0;
   for (int i : effect_params_.at(effect)) {
     const FitParameter& p = ps[static_cast<size_t>(i)];
     double lo = 0, hi = 0;
@@ -362,10 +368,14 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
     if (!p.free ||
         !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
-    return p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" +
-           output::short_number(lo) + ", " + output::short_number(hi) + "]";
+    ++outside;
+    const double by = std::max(lo - p.value, p.value - hi) / std::max(hi - lo, 1e-300);
+    if (by <= farthest_by) continue;
+    farthest_by = by;
+    farthest = p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" +
+               output::short_number(lo) + ", " + output::short_number(hi) + "]";
   }
-  return "";
+  return outside > 1 ? farthest + " (and " + std::to_string(outside - 1) + " more)" : farthest;
 }
 
 double CandidateSearch::p_value_of(const std::string& effect, double statistic, int dof) const {

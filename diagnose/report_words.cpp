@@ -304,6 +304,32 @@ std::string environment_note(const Diagnosis& d) {
   return "";
 }
 
+namespace {
+
+// The flights that lie apart from the pooled value by more than 1.96 of their standard
+// errors (or, where none does, the farthest), by number as the agreement lines print them:
+// "flights 1 (high) and 4 (low)". A next step that said "the flights that lie apart" left the
+// reader to find them (a review, helper-133).
+std::string flights_apart(const ParameterAgreement& a) {
+  std::vector<std::pair<size_t, double>> z;
+  for (size_t k = 0; k < a.flights.size(); ++k)
+    if (flight_can_say(a.flights[k])) z.emplace_back(k, (a.flights[k].value - a.pooled) / a.flights[k].standard_error);
+  if (z.empty()) return "";
+  std::vector<std::pair<size_t, double>> apart;
+  for (const auto& e : z)
+    if (std::abs(e.second) > fit::kZ95) apart.push_back(e);
+  if (apart.empty())
+    apart.push_back(*std::max_element(z.begin(), z.end(),
+                                      [](const auto& x, const auto& y) { return std::abs(x.second) < std::abs(y.second); }));
+  std::string out = apart.size() > 1 ? "flights " : "flight ";
+  for (size_t i = 0; i < apart.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == apart.size() ? " and " : ", ") + std::to_string(apart[i].first + 1) +
+           (apart[i].second > 0 ? " (high)" : " (low)");
+  return out;
+}
+
+}  // namespace
+
 std::vector<std::string> next_steps(const Diagnosis& d) {
   std::vector<std::string> out;
   for (const auto& a : d.search.unresolved)
@@ -320,8 +346,9 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   for (const auto& a : d.agreement)
     if (a.named && flights_disagree(a))
       out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
-                    "differs between the flights that lie apart (speed, battery, payload, the day) and diagnose them " +
-                    "apart, or together without the odd one");
+                    "differs between the flights that lie apart from the pooled value, " + flights_apart(a) +
+                    ", and the others (speed, battery, payload, the day) and diagnose them apart, or together without "
+                    "the odd one");
   // A base parameter no flight measures (c_w beside rotor drag on the NanoBench flights): the
   // report said "too uncertain" and the fitted-parameters table showed the joint value, with
   // nothing to do about a value the flights cannot give.

@@ -802,6 +802,13 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
     const auto wind = std::find_if(first.begin(), first.end(), [](const json& c) { return c["effect"] == "wind"; });
     ASSERT_NE(wind, first.end());
     EXPECT_EQ((*wind)["implausible"].get<std::string>().empty(), where == "outdoor") << wind->dump(1);
+    // Both components are outside indoors: the farther (x, 1.5 m/s against y's -1) is said,
+    // and that one more is out.
+    if (where == "indoor") {
+      const std::string said = (*wind)["implausible"];
+      EXPECT_EQ(said.rfind("wind.x = 1.", 0), 0u) << said;
+      EXPECT_EQ(said.substr(said.size() - std::min(said.size(), std::string(" (and 1 more)").size())), " (and 1 more)") << said;
+    }
     if (where == "outdoor") {
       EXPECT_EQ(named(j), std::vector<std::string>{"wind"}) << j["stand_ins"].dump(1);
       EXPECT_TRUE(j["stand_ins"].empty());
@@ -2064,11 +2071,17 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   // A named cause the flights disagree on: a next step; one too uncertain to agree: none.
   dg::ParameterAgreement disagree;
   disagree.parameter = "rotor_drag.k", disagree.effect = "rotor_drag", disagree.named = true;
+  disagree.joint_value = 1.0;
+  for (double v : {1.0, 1.2, 1.0, 0.8}) disagree.flights.push_back({v, 0.05, v - 0.098, v + 0.098, NAN, NAN});
+  dg::summarise_agreement(disagree);
+  ASSERT_TRUE(dg::flights_disagree(disagree));
   d.agreement.push_back(disagree);
   const auto steps = dg::words::next_steps(d);
   EXPECT_TRUE(std::any_of(steps.begin(), steps.end(), [](const std::string& s) {
-    return s.rfind("the flights disagree on rotor_drag.k: its joint value is no one airframe's", 0) == 0;
-  }));
+    return s.rfind("the flights disagree on rotor_drag.k: its joint value is no one airframe's", 0) == 0 &&
+           // which flights, by the numbers of the agreement lines (4 standard errors each way)
+           s.find("lie apart from the pooled value, flights 2 (high) and 4 (low), and the others") != std::string::npos;
+  })) << steps.size();
   d.agreement.back().within_errors = true;
   const auto uncertain = dg::words::next_steps(d);
   EXPECT_TRUE(std::none_of(uncertain.begin(), uncertain.end(),
