@@ -75,6 +75,7 @@ std::map<std::string, FlightEstimate> fit_one_flight(const AgreementInputs& in, 
     f.statistic = statistic;
     f.p_value = p_value;
     f.at_bound = on[i].free && on_a_bound_that_is_not_off(on[i], off);
+    f.bound_lower = on[i].lower, f.bound_upper = on[i].upper;
     if (f.at_bound) f.lower = f.upper = std::numeric_limits<double>::quiet_NaN();  // no interval to draw or print
     return f;
   };

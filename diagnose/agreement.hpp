@@ -31,6 +31,9 @@ struct FlightEstimate {
   // interval is no interval (c_w at 0.05 read [-4.3, 4.4]; lower and upper are NaN then), so
   // the flight cannot say, as one without a standard error cannot.
   bool at_bound = false;
+  // The bounds of the parameter in the flight's fit (NaN: not known): which side a value on a
+  // bound sits on, and where a held value may lie.
+  double bound_lower = std::numeric_limits<double>::quiet_NaN(), bound_upper = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ParameterAgreement {
@@ -84,15 +87,27 @@ inline size_t flights_measuring(const ParameterAgreement& a) {
   return n;
 }
 
-// A base parameter that no flight tells from zero: each flight's value on its bound, or its
-// interval holding zero (the frame's drag beside rotor drag on the NanoBench flights: three on
-// the bound, two at +-2000 % and +-200 %). A flight without a standard error says nothing
-// either way (its own reason stands then), and an effect's parameter is judged against its
-// "off" by the test alone, not here (a CoG offset of 0.1 +- 0.3 mm is measured well).
+// A flight whose value ended on the bound nearer zero (c_w on its 0.05 of [0.05, 3]): the fit
+// wanted it smaller, so the flight does not tell it from zero. On the other bound (c_w at 3)
+// it wanted it larger, which is no sign of zero. Bounds not known: the value's side is not
+// known either, and it counts as the nearer.
+inline bool on_the_bound_nearer_zero(const FlightEstimate& f) {
+  if (!f.at_bound) return false;
+  if (!std::isfinite(f.bound_lower) || !std::isfinite(f.bound_upper)) return true;
+  const bool on_lower = std::abs(f.value - f.bound_lower) <= std::abs(f.value - f.bound_upper);
+  return std::abs(on_lower ? f.bound_lower : f.bound_upper) <= std::abs(on_lower ? f.bound_upper : f.bound_lower);
+}
+
+// A base parameter that no flight tells from zero: each flight's value on the bound nearer
+// zero, or its interval holding zero (the frame's drag beside rotor drag on the NanoBench
+// flights: three on the 0.05 bound, two at +-2000 % and +-200 %). A flight without a
+// standard error says nothing either way (its own reason stands then), and an effect's
+// parameter is judged against its "off" by the test alone, not here (a CoG offset of 0.1 +-
+// 0.3 mm is measured well).
 inline bool measured_by_no_flight(const ParameterAgreement& a) {
   if (!a.base || a.flights.empty()) return false;
   for (const auto& f : a.flights)
-    if (!f.at_bound && !(flight_can_say(f) && f.lower <= 0 && f.upper >= 0)) return false;
+    if (!on_the_bound_nearer_zero(f) && !(flight_can_say(f) && f.lower <= 0 && f.upper >= 0)) return false;
   return true;
 }
 

@@ -266,13 +266,19 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   return {f, why, std::nullopt};
 }
 
-// The first parameter of a finding outside its plausible range in this environment; false
-// when every value is plausible.
+// The parameter of a finding farthest outside its plausible range in this environment (by the
+// range's width, as a suspect's "implausible here" says it); false when every value is
+// plausible.
 bool implausible_parameter(const Finding& f, Environment where, const VehicleScales& scales, StandIn* out) {
+  double farthest_by = -1;
   for (const auto& p : f.parameters) {
     double lo = 0, hi = 0;
     std::string why;
     if (!outside_plausible_range(runtime::shared_name(p.name), p.value, where, scales, &lo, &hi, &why)) continue;
+    double by = std::max(lo - p.value, p.value - hi) / std::max(hi - lo, 1e-300);
+    if (std::isnan(by)) by = INFINITY;
+    if (!(by > farthest_by)) continue;
+    farthest_by = by;
     out->candidate = f;
     out->parameter = p.name;
     out->value = p.value;
@@ -280,9 +286,8 @@ bool implausible_parameter(const Finding& f, Environment where, const VehicleSca
     out->plausible_lower = lo;
     out->plausible_upper = hi;
     out->why = why;
-    return true;
   }
-  return false;
+  return farthest_by >= 0;
 }
 
 // Where each flight's held-out part begins: its first held-out sample on the (joined) clock.

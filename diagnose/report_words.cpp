@@ -311,9 +311,19 @@ namespace {
 // "flights 1 (high) and 4 (low)". A next step that said "the flights that lie apart" left the
 // reader to find them (a review, helper-133).
 std::string flights_apart(const ParameterAgreement& a) {
+  // Each residual against its own error, sqrt(se^2 - 1/sum w) (the pooled value moves with
+  // the flight): divided by se alone, a flight with a tiny error, which sets the pooled value,
+  // looked close and was never named (a review, helper-134); for two flights both residuals
+  // are then sqrt(Q), so both are named exactly when Q rejects.
+  double sw = 0;
+  for (const auto& f : a.flights)
+    if (flight_can_say(f)) sw += 1 / (f.standard_error * f.standard_error);
   std::vector<std::pair<size_t, double>> z;
-  for (size_t k = 0; k < a.flights.size(); ++k)
-    if (flight_can_say(a.flights[k])) z.emplace_back(k, (a.flights[k].value - a.pooled) / a.flights[k].standard_error);
+  for (size_t k = 0; k < a.flights.size(); ++k) {
+    const FlightEstimate& f = a.flights[k];
+    const double var = f.standard_error * f.standard_error - 1 / sw;
+    if (flight_can_say(f) && var > 0) z.emplace_back(k, (f.value - a.pooled) / std::sqrt(var));
+  }
   if (z.empty()) return "";
   std::vector<std::pair<size_t, double>> apart;
   for (const auto& e : z)
@@ -344,23 +354,31 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   // A named cause the flights disagree on (a user trial, helper-106: the report named it and
   // said the disagreement, but gave nothing to do about it).
   for (const auto& a : d.agreement)
-    if (a.named && flights_disagree(a))
+    if (a.named && flights_disagree(a)) {
+      const std::string apart = flights_apart(a);
       out.push_back("the flights disagree on " + a.parameter + ": its joint value is no one airframe's; compare what " +
-                    "differs between the flights that lie apart from the pooled value, " + flights_apart(a) +
-                    ", and the others (speed, battery, payload, the day) and diagnose them apart, or together without "
-                    "the odd one");
+                    "differs between the flights that lie apart from the pooled value" +
+                    (apart.empty() ? "" : ", " + apart + ", and the others") +
+                    " (speed, battery, payload, the day) and diagnose them apart, or together without the odd one");
+    }
   // A base parameter no flight measures (c_w beside rotor drag on the NanoBench flights): the
   // report said "too uncertain" and the fitted-parameters table showed the joint value, with
   // nothing to do about a value the flights cannot give.
   for (const auto& a : d.base_agreement)
     if (unmeasured_base_parameter(a)) {
-      // Where the flights that can say allow it: the intersection of their intervals.
+      // Where the flights that can say allow it, within the parameter's bounds: the
+      // intersection (every such interval holds zero, so it alone straddled zero and offered a
+      // negative drag coefficient; a review, helper-134).
       double lo = -INFINITY, hi = INFINITY;
-      for (const auto& f : a.flights)
-        if (flight_can_say(f)) lo = std::max(lo, f.lower), hi = std::min(hi, f.upper);
-      const std::string allowed = std::isfinite(lo) && std::isfinite(hi) && lo <= hi
-                                      ? " inside every flight's interval ([" + num(lo, kEstimateDigits) + ", " +
-                                            num(hi, kEstimateDigits) + "])"
+      bool any = false;
+      for (const auto& f : a.flights) {
+        if (flight_can_say(f)) lo = std::max(lo, f.lower), hi = std::min(hi, f.upper), any = true;
+        if (std::isfinite(f.bound_lower)) lo = std::max(lo, f.bound_lower);
+        if (std::isfinite(f.bound_upper)) hi = std::min(hi, f.bound_upper);
+      }
+      const std::string allowed = any && std::isfinite(lo) && std::isfinite(hi) && lo <= hi
+                                      ? " inside every flight's interval and its bounds ([" + num(lo, kEstimateDigits) +
+                                            ", " + num(hi, kEstimateDigits) + "])"
                                       : "";
       out.push_back("no flight tells the base model's " + a.parameter + " from zero, nor do the flights together " +
                     "(each value on its bound or its interval holding zero): the joint value is the fit's choice, not a " +

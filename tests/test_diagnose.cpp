@@ -784,7 +784,7 @@ TEST(BackwardPass, EarlyPickMadeRedundantIsRemoved) {
 // the same flight flown "outdoors" names it.
 TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
   const fs::path dir = fresh_directory("quadgen_wind_indoors");
-  const HiddenCase c{"wind", "wind", {{"wind.x", 1.5}, {"wind.y", -1.0}}, {}, "", 1};
+  const HiddenCase c{"wind", "wind", {{"wind.x", -1.0}, {"wind.y", 1.5}}, {}, "", 1};
   const fs::path log = fly(c, dir, "wind.csv", 60);
   for (const std::string where : {"indoor", "outdoor"}) {
     const fs::path out = dir / where;
@@ -802,11 +802,11 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
     const auto wind = std::find_if(first.begin(), first.end(), [](const json& c) { return c["effect"] == "wind"; });
     ASSERT_NE(wind, first.end());
     EXPECT_EQ((*wind)["implausible"].get<std::string>().empty(), where == "outdoor") << wind->dump(1);
-    // Both components are outside indoors: the farther (x, 1.5 m/s against y's -1) is said,
-    // and that one more is out.
+    // Both components are outside indoors: the farther (y, 1.5 m/s against x's -1; not the
+    // first) is said, and that one more is out.
     if (where == "indoor") {
       const std::string said = (*wind)["implausible"];
-      EXPECT_EQ(said.rfind("wind.x = 1.", 0), 0u) << said;
+      EXPECT_EQ(said.rfind("wind.y = 1.", 0), 0u) << said;
       EXPECT_EQ(said.substr(said.size() - std::min(said.size(), std::string(" (and 1 more)").size())), " (and 1 more)") << said;
     }
     if (where == "outdoor") {
@@ -818,6 +818,7 @@ TEST(Plausibility, SteadyWindIndoorsIsAStandInNotACause) {
     ASSERT_EQ(j["stand_ins"].size(), 1u) << j["suspected"].dump(1);
     const json& st = j["stand_ins"][0];
     EXPECT_EQ(st["effect"], "wind");
+    EXPECT_EQ(st["parameter"], "wind.y");  // the farther out of the two, as the suspect's words say
     EXPECT_EQ(st["plausible"], json({-0.5, 0.5}));
     EXPECT_GT(std::fabs(st["value"].get<double>()), 0.5);
     double without = 0, with = 0;  // what it absorbs: part of the (noise-dominated) translational residual
@@ -1089,8 +1090,8 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
   EXPECT_LT(o["q_p_value"].get<double>(), 1e-3) << o.dump(1);
 }
 
-// Flights whose intervals all hold the pooled value but lie 30 % or more apart are not said
-// to disagree (a user trial: an --airframe check said "disagrees" at p = 0.18): the verdict
+// Flights within their errors (Cochran's Q does not reject one value) but 30 % or more apart
+// are not said to disagree (a user trial: an --airframe check said "disagrees" at p = 0.18): the verdict
 // says they are too uncertain to agree. Closed forms: two flights, the pooled value their
 // inverse-variance mean.
 TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
@@ -1120,8 +1121,8 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(unsure), "too uncertain");
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(unsure), "a flight without a standard error cannot say");
   // Intervals of +-40 %: agreeing flights would spread by more than 30 % (median 38 %), so
-  // the flights cannot measure it that well (a review, helper-131); intervals of +-20 % that
-  // hold the pooled value while the values lie 33 % apart are within the errors only.
+  // the flights cannot measure it that well (a review, helper-131); intervals of +-26 %
+  // (standard errors 0.16) for values 33 % apart are within the errors only (Q p = 0.08).
   EXPECT_GT(loose.spread_if_agree, 0.3);
   EXPECT_STREQ(quadgen::diagnose::why_too_uncertain(loose),
                "the flights cannot measure it to 30 %: agreeing flights would spread as far");
@@ -1862,15 +1863,15 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   // flights together: the fit chose the value; a next step says to hold it inside every
   // flight's interval, and the table says none tells it from zero.
   dg::Diagnosis unmeasured = d;
-  unmeasured.base_agreement.front().flights = {dg::FlightEstimate{0.05, 0.5, NAN, NAN, NAN, NAN, true},
-                                               dg::FlightEstimate{1.5, 1.0, -0.46, 3.46, NAN, NAN},
-                                               dg::FlightEstimate{0.3, 1.5, -2.64, 3.24, NAN, NAN}};
+  unmeasured.base_agreement.front().flights = {dg::FlightEstimate{0.05, 0.5, NAN, NAN, NAN, NAN, true, 0.05, 3},
+                                               dg::FlightEstimate{1.5, 1.0, -0.46, 3.46, NAN, NAN, false, 0.05, 3},
+                                               dg::FlightEstimate{0.3, 1.5, -2.64, 3.24, NAN, NAN, false, 0.05, 3}};
   dg::summarise_agreement(unmeasured.base_agreement.front());
   EXPECT_EQ(dg::diagnosis_json(unmeasured, "log.csv")["base_agreement"][0]["flights_measuring"], 0);
   const std::string step = "no flight tells the base model's c_w from zero, nor do the flights together (each value on "
                            "its bound or its interval holding zero): the joint value is the fit's choice, not a "
                            "measurement; hold it in the vehicle file (fit: false) at a value inside every flight's "
-                           "interval ([-0.46, 3.24]) that you can defend, or fly what would measure it (for the "
+                           "interval and its bounds ([0.05, 3]) that you can defend, or fly what would measure it (for the "
                            "frame's drag: faster)";
   const std::string unmeasured_summary = dg::diagnosis_summary(unmeasured);
   EXPECT_NE(unmeasured_summary.find("next: " + step + "\n"), std::string::npos) << unmeasured_summary;
@@ -1882,6 +1883,11 @@ TEST(DiagnosisReport, TheBaseModelsAgreementIsShownAndADisagreementIsANextStep) 
   EXPECT_NE(unmeasured_summary.find("no flight tells it from zero: each value is on its bound or its interval holds zero"),
             std::string::npos)
       << unmeasured_summary;
+  // A flight on the far bound (c_w at 3 of [0.05, 3]: the fit wanted more) is no sign of zero.
+  dg::Diagnosis far_bound = unmeasured;
+  far_bound.base_agreement.front().flights[0].value = 3;
+  EXPECT_FALSE(dg::measured_by_no_flight(far_bound.base_agreement.front()));
+  EXPECT_EQ(dg::diagnosis_summary(far_bound).find("no flight tells the base model"), std::string::npos);
   // Flights that agree on it, or disagree, get no such step, nor the table's note.
   for (const bool agree : {true, false}) {
     dg::Diagnosis judged = unmeasured;
@@ -2082,6 +2088,20 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
            // which flights, by the numbers of the agreement lines (4 standard errors each way)
            s.find("lie apart from the pooled value, flights 2 (high) and 4 (low), and the others") != std::string::npos;
   })) << steps.size();
+  // A flight with a tiny error sets the pooled value: against its residual's own error (not
+  // its standard error) it lies far off, and is named with the others.
+  dg::Diagnosis tiny = d;
+  dg::ParameterAgreement& t = tiny.agreement.back();
+  t.flights.clear();
+  for (double v : {1.0, 1.3, 1.3, 1.3, 1.3}) {
+    const double se = v == 1.0 ? 0.01 : 0.1;
+    t.flights.push_back({v, se, v - 1.96 * se, v + 1.96 * se, NAN, NAN});
+  }
+  dg::summarise_agreement(t);
+  const auto tiny_steps = dg::words::next_steps(tiny);
+  EXPECT_TRUE(std::any_of(tiny_steps.begin(), tiny_steps.end(), [](const std::string& s) {
+    return s.find("flights 1 (low), 2 (high), 3 (high), 4 (high) and 5 (high), and the others") != std::string::npos;
+  }));
   d.agreement.back().within_errors = true;
   const auto uncertain = dg::words::next_steps(d);
   EXPECT_TRUE(std::none_of(uncertain.begin(), uncertain.end(),
