@@ -47,8 +47,7 @@ std::vector<fit::FitParameter> flight_start(const AgreementInputs& in, int k, co
 }  // namespace
 
 bool on_a_bound_that_is_not_off(const fit::FitParameter& p, double off) {
-  const bool at_off = std::isfinite(off) && std::fabs(p.value - off) < 1e-9 * std::max(1.0, p.upper - p.lower);
-  return fit::on_bound(p) && !at_off;
+  return fit::on_bound(p) && !(std::isfinite(off) && fit::sits_at(p, off));
 }
 
 namespace {
@@ -147,13 +146,12 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
 // nothing when called again: a second call doubled Q until the fifty-ninth session).
 void judge_heterogeneity(ParameterAgreement& a) {
   a.q = 0;
-  double sw = 0, swk = 0, lo = INFINITY, hi = -INFINITY;
+  double swk = 0, lo = INFINITY, hi = -INFINITY;
   for (const auto& f : a.flights) {
     lo = std::min(lo, f.value), hi = std::max(hi, f.value);
-    if (!flight_can_say(f)) continue;
-    const double w = 1 / (f.standard_error * f.standard_error);
-    sw += w, swk += w * f.value;
+    if (flight_can_say(f)) swk += 1 / (f.standard_error * f.standard_error) * f.value;
   }
+  const double sw = inverse_variance_sum(a);
   a.pooled = sw > 0 ? swk / sw : a.joint_value;
   int counted = 0;
   bool every_flight_says = true;
@@ -180,10 +178,8 @@ void judge_heterogeneity(ParameterAgreement& a) {
 
 bool unmeasured_base_parameter(const ParameterAgreement& a) {
   if (a.agree || !a.within_errors || !measured_by_no_flight(a)) return false;
-  double sw = 0, swk = 0;
-  for (const auto& f : a.flights)
-    if (flight_can_say(f)) sw += 1 / (f.standard_error * f.standard_error), swk += f.value / (f.standard_error * f.standard_error);
-  return !(sw > 0) || std::abs(swk / sw) <= kZ95 / std::sqrt(sw);
+  const double sw = inverse_variance_sum(a);  // a.pooled is their weighted mean (judge_heterogeneity)
+  return !(sw > 0) || std::abs(a.pooled) <= kZ95 / std::sqrt(sw);
 }
 
 void summarise_agreement(ParameterAgreement& a) {

@@ -77,6 +77,15 @@ bool on_a_bound_that_is_not_off(const fit::FitParameter& p, double off);
 // A flight that can say where the value lies: a standard error, and not on a bound.
 inline bool flight_can_say(const FlightEstimate& f) { return f.standard_error > 0 && !f.at_bound; }
 
+// Sum of 1 / se^2 over the flights that can say: the weight of the pooled value, whose
+// standard error is 1 / sqrt of it.
+inline double inverse_variance_sum(const ParameterAgreement& a) {
+  double sw = 0;
+  for (const auto& f : a.flights)
+    if (flight_can_say(f)) sw += 1 / (f.standard_error * f.standard_error);
+  return sw;
+}
+
 // A flight that tells the value from zero: it can say, and its 95 % interval holds neither
 // zero nor the other sign (diagnosis.json's `flights_measuring` counts them).
 inline bool flight_measures(const FlightEstimate& f) { return flight_can_say(f) && (f.lower > 0 || f.upper < 0); }

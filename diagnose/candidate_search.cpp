@@ -369,8 +369,7 @@ std::string CandidateSearch::implausible_estimate(const std::string& effect, con
         !outside_plausible_range(runtime::shared_name(p.name), p.value, opt_.environment, opt_.scales, &lo, &hi, &why))
       continue;
     ++outside;
-    double by = std::max(lo - p.value, p.value - hi) / std::max(hi - lo, 1e-300);
-    if (std::isnan(by)) by = INFINITY;  // a value that is no number is the farthest out
+    const double by = widths_outside(p.value, lo, hi);
     if (!(by > farthest_by)) continue;
     farthest_by = by;
     farthest = p.name + " = " + output::short_number(p.value) + output::unit_after_number(p.unit) + " outside [" +

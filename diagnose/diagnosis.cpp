@@ -275,8 +275,7 @@ bool implausible_parameter(const Finding& f, Environment where, const VehicleSca
     double lo = 0, hi = 0;
     std::string why;
     if (!outside_plausible_range(runtime::shared_name(p.name), p.value, where, scales, &lo, &hi, &why)) continue;
-    double by = std::max(lo - p.value, p.value - hi) / std::max(hi - lo, 1e-300);
-    if (std::isnan(by)) by = INFINITY;
+    const double by = widths_outside(p.value, lo, hi);
     if (!(by > farthest_by)) continue;
     farthest_by = by;
     out->candidate = f;

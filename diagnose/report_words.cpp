@@ -315,9 +315,7 @@ std::string flights_apart(const ParameterAgreement& a) {
   // the flight): divided by se alone, a flight with a tiny error, which sets the pooled value,
   // looked close and was never named (a review, helper-134); for two flights both residuals
   // are then sqrt(Q), so both are named exactly when Q rejects.
-  double sw = 0;
-  for (const auto& f : a.flights)
-    if (flight_can_say(f)) sw += 1 / (f.standard_error * f.standard_error);
+  const double sw = inverse_variance_sum(a);
   std::vector<std::pair<size_t, double>> z;
   for (size_t k = 0; k < a.flights.size(); ++k) {
     const FlightEstimate& f = a.flights[k];

@@ -397,10 +397,11 @@ std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitPar
   return rms_by_channel(r, m.channels().size(), [&](size_t i) { return m.channel_of(static_cast<int>(i)); });
 }
 
-bool on_bound(const FitParameter& p) {
-  const double tol = 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
-  return std::fabs(p.value - p.lower) < tol || std::fabs(p.value - p.upper) < tol;
+bool sits_at(const FitParameter& p, double x) {
+  return std::fabs(p.value - x) < 1e-9 * std::max(1.0, std::fabs(p.upper - p.lower));
 }
+
+bool on_bound(const FitParameter& p) { return sits_at(p, p.lower) || sits_at(p, p.upper); }
 
 std::vector<double> parameter_values(const std::vector<FitParameter>& ps) {
   std::vector<double> v;

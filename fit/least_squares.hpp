@@ -114,6 +114,8 @@ std::vector<double> channel_rms(const ResidualModel& m, const std::vector<FitPar
 // Whether p's value sits on its lower or upper bound (to 1e-9 of the bounds' span where the
 // span exceeds 1; to 1e-9 absolute below that).
 bool on_bound(const FitParameter& p);
+// Whether p's value sits at x, to on_bound's tolerance (an effect's "off" on a bound).
+bool sits_at(const FitParameter& p, double x);
 
 // Two passes: fit, estimate sigma and autocorrelation per channel, refit with weights.
 FitResult fit_least_squares(const ResidualModel& model, std::vector<FitParameter> params, const FitOptions& opt);

@@ -179,6 +179,11 @@ bool outside_plausible_range(const std::string& parameter, double value, Environ
   return plausible_range(parameter, where, scales, lower, upper, why) && !(value >= *lower && value <= *upper);
 }
 
+double widths_outside(double value, double lower, double upper) {
+  const double by = std::max(lower - value, value - upper) / std::max(upper - lower, 1e-300);
+  return std::isnan(by) ? INFINITY : by;
+}
+
 std::string outside_physical_domain(const std::string& parameter, double value) {
   const Effect* e = effect_named(effect_of_parameter(parameter));
   if (!e) return "";

@@ -81,6 +81,10 @@ bool plausible_range(const std::string& parameter, Environment where, const Vehi
 // stand-ins. False inside the range or without one.
 bool outside_plausible_range(const std::string& parameter, double value, Environment where, const VehicleScales& scales,
                              double* lower, double* upper, std::string* why);
+// How far `value` lies outside [lower, upper], in widths of the range (0 or less inside it;
+// infinity for a value that is no number): which of an effect's implausible parameters is
+// said, for a suspect and a stand-in alike.
+double widths_outside(double value, double lower, double upper);
 // Why `value` lies outside the values `parameter` can physically take (Effect::domain:
 // "must be 0 or above: ..."), or "" when it can, or when it is no effect's parameter.
 std::string outside_physical_domain(const std::string& parameter, double value);
