@@ -127,7 +127,7 @@ void command_gain_html(std::ostream& h, const Diagnosis& d, Figures& figures) {
   for (const auto& [flight, g] : rows) {
     if (!g->measured) continue;
     for (const auto& a : g->axes) {
-      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td title=\"" + esc(flight) + "\">" + esc(file_name_of(flight)) + "</td>")
+      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td class=\"flight\" title=\"" + esc(flight) + "\">" + esc(file_name_of(flight)) + "</td>")
         << "<td>" << esc(a.name) << "</td>";
       for (const auto& b : a.bands)
         if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << num(b.r, 2) << ")</td>";
@@ -242,7 +242,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
-      h << "<tr><td title=\"" << esc(path) << "\">" << k + 1 << ". " << esc(file_name_of(path)) << "</td><td>"
+      h << "<tr><td class=\"flight\" title=\"" << esc(path) << "\">" << k + 1 << ".&nbsp;" << esc(file_name_of(path)) << "</td><td>"
         << num(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>"
         << (f.at_bound ? std::string("none") : interval(f.lower, f.upper, prec))
         << "</td><td>" << (alone ? esc(output::p_value_cell(f.p_value)) + "</td><td>" : "")
@@ -319,6 +319,9 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
        // A number or an interval is read whole: rotor drag's per-flight values broke as
        // "1.344e-" / "06" beside the bars (a screenshot, sixty-first session).
        "table.agreement td:not(:first-child){white-space:nowrap}"
+       // A flight's file name longer than its column breaks anywhere rather than pushing
+       // the bars off the page (a review, helper-134); its number stays with it (&nbsp;).
+       "td.flight{min-width:8em;overflow-wrap:anywhere}"
        "th{background:#eee}td:first-child{text-align:left}.ok{color:#070}.no{color:#888}.warn{color:#a40}"
        "svg{max-width:100%;height:auto}pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
        ".headline{font-size:1.1em}h1,li{overflow-wrap:anywhere}</style></head><body>\n";  // long paths wrap

@@ -1054,7 +1054,7 @@ TEST(MultiFlight, EachFlightAloneShowsTheSameAirframeEffect) {
     std::ifstream in(dir / "out" / "report.html");
     const std::string html((std::istreambuf_iterator<char>(in)), {});
     const std::string whole = (dir / "b.csv").string();
-    EXPECT_NE(html.find("<td title=\"" + quadgen::output::html_text(whole) + "\">2. b.csv</td>"), std::string::npos)
+    EXPECT_NE(html.find("<td class=\"flight\" title=\"" + quadgen::output::html_text(whole) + "\">2.&nbsp;b.csv</td>"), std::string::npos)
         << html.substr(html.find("Do the flights agree?"), 3000);
   }
 
