@@ -263,7 +263,8 @@ DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job) {
   const auto model = make_model(all, &compiled);
   o.progress.say(std::string("[diagnose] evaluating it with ") +
                  (compiled ? "the compiled header in generated/, derived from the same equations"
-                           : "an interpreted tape of the equations (no compiled header matches this vehicle)"));
+                           : "the equations interpreted (no header compiled into quadgen matches this vehicle: normal for "
+                             "your own vehicle, the same numbers, slower; README, \"the tape\")"));
   fit::Flight valid;
   const diagnose::Diagnosis d = diagnose::diagnose_flights(v, all, *model, flights, o, &valid);
   return diagnosis_files(job, v, mp, d, valid, o.progress);

@@ -89,7 +89,8 @@ std::unique_ptr<runtime::DynamicModel> model_for(const Vehicle& v, const std::ve
   auto model = make_model(derive_model(v, derive_mass_properties(v), o), &compiled);
   if (how)
     *how = compiled ? "compiled header from generated/ (the derivation matches it)"
-                    : "interpreted tape (no matching generated header)";
+                    : "interpreted from the vehicle file (no header compiled into quadgen matches it: normal for "
+                      "your own vehicle, the same numbers, slower; README, \"the tape\")";
   return model;
 }
 

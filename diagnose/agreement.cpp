@@ -137,8 +137,9 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
   a.q = measured ? std::pow((f.value - airframe_value) / se, 2) : std::numeric_limits<double>::quiet_NaN();
   a.q_p_value = measured ? chi2_upper(a.q, 1.0) : std::numeric_limits<double>::quiet_NaN();
   a.spread = airframe_value != 0 ? std::abs(f.value - airframe_value) / std::abs(airframe_value) : INFINITY;
-  a.within_errors = !says || a.q < kZ95 * kZ95;
-  a.agree = says && a.q < kZ95 * kZ95 && a.spread < 0.3;
+  // The test of judge_heterogeneity with one flight: |z| < 1.96 at kAgreementLevel.
+  a.within_errors = !says || !(a.q_p_value < kAgreementLevel);
+  a.agree = says && a.within_errors && a.spread < kSpreadLimit;
   return a;
 }
 
@@ -172,7 +173,7 @@ void judge_heterogeneity(ParameterAgreement& a) {
   // AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel). Fewer than two flights that can say
   // test nothing (p = 1).
   const bool within = !(a.q_p_value < kAgreementLevel);
-  a.agree = every_flight_says && within && a.spread < 0.3;
+  a.agree = every_flight_says && within && a.spread < kSpreadLimit;
   a.within_errors = within;
 }
 

@@ -23,6 +23,8 @@ namespace quadgen::diagnose {
 
 // The level of the test that says flights disagree (Cochran's Q, one test per parameter).
 inline constexpr double kAgreementLevel = 0.05;
+// Flights agree only within this spread, (largest - smallest) / |joint value| (issue #14's 30 %).
+inline constexpr double kSpreadLimit = 0.3;
 
 struct FlightEstimate {
   double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
@@ -148,7 +150,7 @@ inline const char* why_too_uncertain(const ParameterAgreement& a) {
     if (!(f.standard_error > 0)) return "a flight without a standard error cannot say";
   // Flights measuring one value this loosely would spread by 30 % or more anyway (a review,
   // helper-131: c_w's flights would spread by a median of 570 %): they cannot measure it.
-  if (a.spread_if_agree >= 0.3) return "the flights cannot measure it to 30 %: agreeing flights would spread as far";
+  if (a.spread_if_agree >= kSpreadLimit) return "the flights cannot measure it to 30 %: agreeing flights would spread as far";
   return "within the errors, but 30 % or more apart";
 }
 

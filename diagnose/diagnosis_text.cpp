@@ -66,7 +66,9 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const auto& a : d.airframe_check)
     os << "this flight " << (a.agree ? "agrees" : a.within_errors ? "is too uncertain to agree" : "disagrees")
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
-       << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value) << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
+       // Which value is which: the flight's own diagnosis printed a third, all free, above
+       // (a newcomer's trial, helper-136).
+       << "here " << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value, "the airframe's ") << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*why_too_uncertain(a) ? std::string(": ") + why_too_uncertain(a) : "") << ")\n";
 }
 

@@ -98,29 +98,46 @@ std::string lower_or_higher(double before, double after, int digits) {
   return num(std::fabs(r), digits) + (r < 0 ? " % higher" : " % lower");
 }
 
-// The finding in one sentence (the effect's own words), from its values: a per-flight
-// parameter at its mean over the flights.
-// Where the first parameter is the reference (motor gains), one whose interval holds 0 on every
-// flight is not told apart from the reference: the sentence names the others and says so,
-// instead of "motor M2 gives 1.2 % more thrust" for a gain that may be none. Where every
-// interval holds 0 (the gains significant only together) all are named, and that is said.
-std::string headline(const Finding& f) {
-  const Effect& e = find_effect(f.effect);
-  std::set<std::string> apart;  // shared names with an interval away from 0 on some flight
-  for (const auto& p : f.parameters)
-    if (p.lower - p.numerical_allowance > 0 || p.upper + p.numerical_allowance < 0)
-      apart.insert(runtime::shared_name(p.name));
+namespace {
+
+// One flight's sentence (or the one flight's): `ps` are that flight's parameters, `reference`
+// the plain name of the reference parameter where the effect has one. Where the first
+// parameter is the reference (motor gains), one whose interval holds 0 is not told apart from
+// the reference: the sentence names the others and says so, instead of "motor M2 gives 1.2 %
+// more thrust" for a gain that may be none. Where every interval holds 0 (the gains
+// significant only together) all are named, and that is said.
+std::string flight_headline(const Effect& e, const std::vector<const EffectEstimate*>& ps, const std::string& reference) {
+  std::set<std::string> apart;  // shared names with an interval away from 0
+  for (const auto* p : ps)
+    if (p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0)
+      apart.insert(runtime::shared_name(p->name));
   const bool drop_unresolved = e.first_parameter_is_reference && !apart.empty();
-  std::vector<std::pair<std::string, double>> named;
+  std::map<std::string, double> values;
   size_t dropped = 0;
-  for (const auto& p : f.parameters) {
-    if (drop_unresolved && !apart.count(runtime::shared_name(p.name))) {
+  for (const auto* p : ps) {
+    if (drop_unresolved && !apart.count(runtime::shared_name(p->name))) {
       ++dropped;
       continue;
     }
-    named.emplace_back(p.name, p.value);
+    values[runtime::shared_name(p->name)] = p->value;
   }
-  const std::map<std::string, double> values = runtime::mean_over_flights(named);
+  std::string s = e.headline(values, reference);
+  if (dropped > 0) s += " The others are within their intervals of the reference.";
+  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() &&
+           std::all_of(ps.begin(), ps.end(),
+                       [](const EffectEstimate* p) { return std::isfinite(p->lower) && std::isfinite(p->upper); }))
+    s += " Each interval holds 0: the values are significant only together.";
+  return s;
+}
+
+}  // namespace
+
+// The finding in one sentence (the effect's own words), from its values. A per-flight effect
+// of several flights gets one sentence per flight: their mean described none of them (a
+// newcomer's trial, helper-136: "Motor FL gives 2.5 % more thrust" for 5 % on one flight and
+// none on the other).
+std::string headline(const Finding& f) {
+  const Effect& e = find_effect(f.effect);
   std::string reference;
   if (e.first_parameter_is_reference)
     for (const auto& p : f.evidence.parameters)
@@ -128,13 +145,23 @@ std::string headline(const Finding& f) {
         reference = p.name;
         break;
       }
-  std::string s = e.headline(values, reference);
-  if (values.size() < named.size()) s += " (mean over the flights; each flight's values below)";
-  if (dropped > 0) s += " The others are within their intervals of the reference.";
-  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() &&
-           std::all_of(f.parameters.begin(), f.parameters.end(),
-                       [](const EffectEstimate& p) { return std::isfinite(p.lower) && std::isfinite(p.upper); }))
-    s += " Each interval holds 0: the values are significant only together.";
+  std::map<int, std::vector<const EffectEstimate*>> by_flight;
+  for (const auto& p : f.parameters) by_flight[runtime::flight_of_name(p.name)].push_back(&p);
+  if (by_flight.size() <= 1) {
+    std::vector<const EffectEstimate*> all;
+    for (const auto& p : f.parameters) all.push_back(&p);
+    return flight_headline(e, all, reference);
+  }
+  std::string s;
+  for (const auto& [flight, ps] : by_flight) {
+    const bool any_apart = std::any_of(ps.begin(), ps.end(), [](const EffectEstimate* p) {
+      return p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0;
+    });
+    // A flight where nothing is told apart: the effect was named on the flights together, so
+    // "significant only together" would not be this flight's to claim.
+    s += (s.empty() ? "" : " ") + std::string("Flight ") + std::to_string(flight) + ": " +
+         (any_apart ? flight_headline(e, ps, reference) : std::string("none told apart from 0 (each interval holds it)."));
+  }
   return s;
 }
 
@@ -517,9 +544,9 @@ std::string estimate(double value, double lower, double upper) {
   return num(value, prec) + " " + interval(lower, upper, prec);
 }
 
-std::string estimate_against(double value, double lower, double upper, double other) {
+std::string estimate_against(double value, double lower, double upper, double other, const std::string& other_is) {
   const int prec = std::max(estimate_digits(value, lower, upper), estimate_digits(other, lower, upper));
-  return num(value, prec) + " " + interval(lower, upper, prec) + " against " + num(other, prec);
+  return num(value, prec) + " " + interval(lower, upper, prec) + " against " + other_is + num(other, prec);
 }
 
 std::string interval(double lower, double upper, int prec) {

@@ -105,7 +105,7 @@ int estimate_digits(double value, double lower, double upper);
 std::string estimate(double value, double lower, double upper);
 // The same against a value it is compared with, printed apart from the interval's sides too:
 // "-0.08 [-0.08004, -0.07996] against -0.0802" (it read "against -0.08").
-std::string estimate_against(double value, double lower, double upper, double other);
+std::string estimate_against(double value, double lower, double upper, double other, const std::string& other_is = "");
 
 // A check's lead: what it suggests, said once, and the numbers of each source that shows it
 // ("this flight" or "the flights together" for the diagnosis as a whole, "flight k (path)"

@@ -1210,9 +1210,10 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   d.airframe_check = {check};
   const std::string said = quadgen::diagnose::diagnosis_summary(d);
   EXPECT_NE(said.find("this flight is too uncertain to agree with the airframe on rotor_drag.k (refitted here, the "
-                      "airframe's other values held)"),
+                      "airframe's other values held): here "),
             std::string::npos)
       << said;
+  EXPECT_NE(said.find(" against the airframe's "), std::string::npos) << said;  // which value is which
   EXPECT_NE(said.find("p = 0.48: within the errors, but 30 % or more apart)"), std::string::npos) << said;
   check.flights[0].standard_error = NAN;
   d.airframe_check = {check};
@@ -2821,6 +2822,13 @@ TEST(ReportWords, TheMotorGainSentenceNamesOnlyGainsToldApartFromTheReference) {
   f.parameters[0].lower = 0.002;
   f.parameters[2].lower = 0.001;
   EXPECT_EQ(words::headline(f), "Motor M2 gives 1.2 % more thrust than motor M1; motor M3 8.0 % less; motor M4 0.20 % more.");
+  // Two flights of a joint diagnosis, each its own trims: one sentence per flight, not their
+  // mean (which read "M3 4 % less" for 8 % on one flight and none on the other).
+  f.parameters = {gain("motor_gain.M2", 0.001, -0.01, 0.012), gain("motor_gain.M3", -0.08, -0.09, -0.07),
+                  gain("motor_gain.M2@2", 0.002, -0.01, 0.014), gain("motor_gain.M3@2", 0.001, -0.01, 0.012)};
+  EXPECT_EQ(words::headline(f),
+            "Flight 1: Motor M3 gives 8.0 % less thrust than motor M1. The others are within their intervals of the "
+            "reference. Flight 2: none told apart from 0 (each interval holds it).");
 }
 
 // fitted_vehicle.yaml is the vehicle file as the diagnosis read it, with the fitted values
