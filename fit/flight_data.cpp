@@ -74,11 +74,19 @@ std::string scalar_text(const std::string& path, const YAML::Node& n, const std:
   return n.Scalar();
 }
 
+// By the one rule for numbers (output/numbers.hpp), as the vehicle file reads them: yaml-cpp's
+// own conversion read a scale of 1e-400 as 0 (a gyro column read as zeros without a word) and
+// took '1 ' but not ' 1' (a review, helper-135).
 double number_field(const std::string& path, const YAML::Node& n, const std::string& what) {
   const std::string text = scalar_text(path, n, what);
+  const bool blank_around = !text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
+                                              std::isspace(static_cast<unsigned char>(text.back())));
   double v = 0;
-  if (!YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-    mapping_error(path, n, what + ": expected a finite number, got '" + text + "'");
+  const output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, &v);
+  if (kind == output::NumberText::underflow)
+    mapping_error(path, n, what + ": '" + output::printable(text) + "' " + output::number_text_problem(kind));
+  if (kind != output::NumberText::finite)
+    mapping_error(path, n, what + ": expected a finite number, got '" + output::printable(text) + "'" + output::hexadecimal_hint(text));
   return v;
 }
 
@@ -131,7 +139,10 @@ ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key,
   const auto f = checked_keys(path, value, where, {"source", "scale", "offset", "unit"});
   if (!f.count("source")) mapping_error(path, key, where + ": missing 'source' (the log's column)");
   e.source = scalar_text(path, f.at("source"), where + ": source");
-  if (f.count("scale")) e.scale = number_field(path, f.at("scale"), where + ": scale");
+  if (f.count("scale")) {
+    e.scale = number_field(path, f.at("scale"), where + ": scale");
+    if (e.scale == 0) mapping_error(path, f.at("scale"), where + ": scale: 0 would read every value of the column as 0 (the offset alone)");
+  }
   if (f.count("offset")) e.offset = number_field(path, f.at("offset"), where + ": offset");
   if (f.count("unit")) {
     e.unit = scalar_text(path, f.at("unit"), where + ": unit");
@@ -154,11 +165,13 @@ ColumnMapping load_mapping(const std::string& path) {
 
 ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   YAML::Node root;
+  int dropped = -1;
   try {
-    root = YAML::Load(text);
+    root = load_one_document(text, &dropped);
   } catch (const YAML::ParserException& e) {
     throw FitError(path + ":" + std::to_string(e.mark.line + 1) + ": " + malformed_yaml(e, text));
   }
+  if (dropped >= 0) throw FitError(path + ":" + std::to_string(dropped + 1) + ": " + kSecondYamlDocument);
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
   m.path = path;

@@ -118,6 +118,10 @@ TEST_F(Hostile, FitReadersRefuseNonFiniteAndAbsurdValues) {
       write("heavy_stand.csv", std::string(kStandHeader) + "1e12,3000,3.9,1,1,1,1\n" + stand_rows(12));
   expect_located(message_of<FitError>([&] { read_thrust_stand(heavy); }), heavy, 2, "|weight| <= 1e9 g");
   EXPECT_EQ(read_thrust_stand(write("good_stand.csv", std::string(kStandHeader) + stand_rows(12))).size(), 12u);
+  // rpm4 after a missing rpm3 was left out without a word (a review, helper-135)
+  const std::string gap = write("gap_stand.csv", "weight[g],pwm,vbat[V],rpm1,rpm2,x3,rpm4\n" + stand_rows(12));
+  expect_located(message_of<FitError>([&] { read_thrust_stand(gap); }), gap, 1,
+                 "column 'rpm4' follows a gap: the rotor speeds are read as rpm1, rpm2, ... up to the first one missing (rpm3)");
 
   // nan and 1e160 in motor-step files
   const std::string head = "time_ms,throttle_percent,rpm\n0,0,0\n100,10,2000\n";
@@ -241,6 +245,16 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
       // The two units logs use that need the other spelling: each gets it in the message.
       {"gee.yaml", "columns:\n  az: {source: acc_z, unit: g}\n", 2, "for g as an acceleration write scale: 9.80665 and unit: m/s^2"},
       {"percent.yaml", "columns:\n  u_A: {source: m1, unit: \"%\"}\n", 2, "for a percentage write scale: 0.01 and unit: \"1\""},
+      // A second document was dropped without a word (yaml-cpp's Load; a review, helper-135).
+      // The one number rule: 1e-400 read as 0 and ' 1' / '1 ' judged apart until helper-135's
+      // review; a scale of 0 reads the whole column as its offset.
+      {"underflow.yaml", "columns:\n  p: {source: gyro, scale: 1e-400}\n", 2,
+       "column 'p': scale: '1e-400' is below the smallest number a double holds"},
+      {"blank.yaml", "columns:\n  p: {source: gyro, scale: '1 '}\n", 2, "column 'p': scale: expected a finite number, got '1 '"},
+      {"hex.yaml", "columns:\n  p: {source: gyro, offset: 0x10}\n", 2, "hexadecimal is not read"},
+      {"zero.yaml", "columns:\n  p: {source: gyro, scale: 0}\n", 2, "column 'p': scale: 0 would read every value"},
+      {"two_documents.yaml", "columns:\n  t: {source: t}\n...\ncolumns:\n  p: {source: gyro}\n", 4,
+       "a second YAML document starts here"},
   };
   for (const auto& c : cases) {
     const std::string path = write(c.name, c.yaml);
