@@ -70,6 +70,15 @@ struct AirframeReader {
     throw airframe_error(path, "'" + output::printable(name) + "' is no parameter of this vehicle's model" +
                                    output::did_you_mean(name, names));
   }
+  // The unit an entry gives is the model's (kappa in mm was read as metres by predict --params;
+  // a review, helper-135); an entry without one is taken as declared.
+  void same_unit(const nlohmann::json& entry, const std::string& name) const {
+    if (!entry.is_object() || !entry.contains("unit")) return;
+    const std::string& declared = all.params[all.param_index(name)].unit;
+    if (!entry["unit"].is_string() || entry["unit"].get<std::string>() != declared)
+      throw airframe_error(path, output::printable(name) + " is in " + output::printable(declared) + ", the file says " +
+                                     output::printable(entry["unit"].dump()));
+  }
   double number(const nlohmann::json& v, const std::string& what) const {
     if (!v.is_number()) throw airframe_error(path, what + ": expected a number");
     return v.get<double>();
@@ -95,6 +104,7 @@ struct AirframeReader {
     for (const auto& [parameter, p] : f["parameters"].items()) {
       if (p.value("reference", false)) continue;
       known(parameter);
+      same_unit(p, parameter);
       const double v = number(p.value("value", nlohmann::json()), parameter);
       // Compared with this flight's estimate: a value outside the parameter's bounds is no
       // estimate quadgen could have written, and an infinite one broke the comparison's test.
@@ -121,6 +131,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
     ref.values.push_back(runtime_parameter(p, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, false));
   for (const auto& [name, e] : j["airframe_fit"].items()) {
     read.known(name);
+    read.same_unit(e, name);
     for (auto& p : ref.values)
       if (p.name == name) p.value = std::clamp(read.number(e.value("value", nlohmann::json()), name), p.lower, p.upper);
   }
@@ -148,13 +159,9 @@ diagnose::AirframeReference load_airframe(const std::string& path, const Symboli
     throw std::runtime_error(e.what());
   }
   nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw airframe_error(path, "not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
-                                   "); expected the diagnosis.json of an earlier diagnose run");
-  }
-  if (const std::string problem = output::json_number_problem(text); !problem.empty())
+  if (const std::string problem =
+          output::parse_json_input(text, &j, "expected the diagnosis.json of an earlier diagnose run");
+      !problem.empty())
     throw airframe_error(path, problem);
   try {
     return read_airframe(j, path, all);

@@ -9,6 +9,7 @@
 #include "runtime/flight_log.hpp"
 #include "runtime/log_file.hpp"
 #include "runtime/per_flight_model.hpp"
+#include "output/json_document.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
@@ -32,14 +33,11 @@ ParameterSource::ParameterSource(const std::string& path) : path_(path) {
   } catch (const runtime::LogError& e) {
     throw std::invalid_argument(e.what());
   }
-  try {
-    json_ = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw std::invalid_argument(path + ": not JSON (the text stops parsing at byte " + std::to_string(e.byte) +
-                                "); --params takes the diagnosis.json or fit.json a diagnose or fit run writes (the "
-                                "fitted_parameters.yaml beside it is for derive --params)");
-  }
-  if (const std::string problem = output::json_number_problem(text); !problem.empty())
+  if (const std::string problem = output::parse_json_input(
+          text, &json_,
+          "--params takes the diagnosis.json or fit.json a diagnose or fit run writes (the fitted_parameters.yaml "
+          "beside it is for derive --params)");
+      !problem.empty())
     throw std::invalid_argument(path + ": " + problem);
   if (!json_.is_object()) throw std::invalid_argument(path + ": expected a diagnosis.json or fit.json object");
   if (json_.value("kind", nlohmann::json()) == "thrust_stand")
@@ -73,7 +71,13 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
   // The value an entry gives the model's parameter `index` (its own, or one flight's copy).
   const auto checked = [&](const std::string& name, const nlohmann::json& entry, int index) {
     const double value = entry["value"].get<double>();
-    const std::string problem = runtime::value_problem(declared[static_cast<size_t>(index)], value, true);
+    const runtime::Parameter& p = declared[static_cast<size_t>(index)];
+    // A unit the file gives is the model's, as derive --params requires: kappa in mm was read as
+    // metres (a review, helper-135). A hand-written entry without one is taken as declared.
+    if (entry.contains("unit") && (!entry["unit"].is_string() || entry["unit"].get<std::string>() != p.unit))
+      throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " is in " + output::printable(p.unit) +
+                                  ", the file says " + output::printable(entry["unit"].dump()));
+    const std::string problem = runtime::value_problem(p, value, true);
     if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
     return value;
   };

@@ -1506,6 +1506,21 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   expect_one_line_error(predict(params("tiny.json", R"("J_xy": {"value": 1e-400})")),
                         "tiny.json: the number 1e-400 is below the smallest number a double holds, so it would read as 0",
                         "J_xy 1e-400");
+  // A unit other than the model's (kappa in mm was taken as metres), a number beyond a double
+  // (nlohmann's bare message named no file) and a key given twice (the last kept without a
+  // word): a review, helper-135.
+  expect_one_line_error(predict(params("mm.json", R"("kappa": {"value": 2, "unit": "mm"})")),
+                        "mm.json: estimates.kappa is in m, the file says \"mm\"", "kappa in mm");
+  EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", params("m.json", R"("kappa": {"value": 0.002, "unit": "m"})"),
+                         "--validation", "1", "--out", tmp / "p"},
+                        tmp.dir)
+                .rc,
+            0);  // the model's own unit is taken
+  fs::remove_all(tmp / "p");
+  expect_one_line_error(predict(params("huge.json", R"("J_xy": {"value": 1e400})")),
+                        "huge.json: a number in it is beyond a double's range", "J_xy 1e400");
+  expect_one_line_error(predict(params("twice.json", R"("kappa": {"value": 0.002}, "kappa": {"value": 0.003})")),
+                        "twice.json: the key 'kappa' is given twice in one object", "kappa twice");
   EXPECT_FALSE(fs::exists(tmp / "p"));
   const auto simulate = [&](const std::string& setting) {
     return run_quadgen({"simulate", vehicle, "--closed-loop", "--duration", "1", "--set", setting, "--out", tmp / "s.csv"},
@@ -1813,6 +1828,10 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // A value too small for a double, which the JSON parser alone reads as 0 (as --params' test).
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("tiny.json", "motor_lag", "1e-400"), "--out", tmp / "o"},
                2, "tiny.json: the number 1e-400 is below the smallest number a double holds, so it would read as 0");
+  // A unit other than the model's (as --params' test).
+  write(tmp / "seconds.json", R"({"airframe_fit": {"kappa": {"value": 2, "unit": "mm"}}, "flight_parameters": [], "findings": []})");
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "seconds.json", "--out", tmp / "o"}, 2,
+               "seconds.json: kappa is in m, the file says \"mm\"");
 }
 
 // A user trial of the less-trodden paths (helper-79, 2026-12-03): simulate ignored --effects
