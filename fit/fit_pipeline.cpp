@@ -273,17 +273,29 @@ std::vector<runtime::Panel> flight_panels(runtime::DynamicModel& model, const Fl
 
 namespace {
 
-// The training and the validation part's residual models of the chosen formulation.
+// The training and the validation part's residual models of the chosen formulation; no
+// validation model where nothing is held out (--validation 0).
 struct FlightResiduals {
   std::unique_ptr<ResidualModel> train, valid;
 };
 FlightResiduals flight_residuals(runtime::DynamicModel& model, const Flight& train, const Flight& valid, bool accel,
                                  const FitJobOptions& o) {
-  if (o.formulation == "multiple_shooting")
-    return {std::make_unique<MultipleShootingModel>(model, train, o.window),
-            std::make_unique<MultipleShootingModel>(model, valid, o.window)};
-  return {std::make_unique<EquationErrorModel>(model, train, accel, o.channels),
-          std::make_unique<EquationErrorModel>(model, valid, accel)};
+  const bool shooting = o.formulation == "multiple_shooting";
+  FlightResiduals m;
+  m.train = shooting ? std::unique_ptr<ResidualModel>(std::make_unique<MultipleShootingModel>(model, train, o.window))
+                     : std::make_unique<EquationErrorModel>(model, train, accel, o.channels);
+  if (o.validation == 0) return m;
+  // A held-out part too short to evaluate is said to be that, not a fault of the log (its
+  // error read "is t in seconds?" for --validation 0.001; a review, helper-135).
+  try {
+    m.valid = shooting ? std::unique_ptr<ResidualModel>(std::make_unique<MultipleShootingModel>(model, valid, o.window))
+                       : std::make_unique<EquationErrorModel>(model, valid, accel);
+  } catch (const FitError& e) {
+    throw FitError("the held-out part (--validation " + output::short_number(o.validation) + ": the last " +
+                   std::to_string(valid.samples.size()) + " samples) cannot be evaluated; give a larger --validation, "
+                   "or 0 to hold nothing out. " + e.what());
+  }
+  return m;
 }
 
 // fit.json's "validation": each channel's RMS on the held-out part, nominal and fitted.
@@ -356,7 +368,7 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   const std::vector<std::string> rotors = rotor_names(v);
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
   const std::vector<FitParameter> params = starting_parameters(model, o);
-  const auto [train, valid] = split_by_time(flight, 1.0 - o.validation);
+  const auto [train, valid] = o.validation > 0 ? split_by_time(flight, 1.0 - o.validation) : std::pair<Flight, Flight>(flight, Flight{});
   const bool accel = uses_accelerometer(flight, o);
   const bool shooting = o.formulation == "multiple_shooting";
   const FlightResiduals m = flight_residuals(model, train, valid, accel, o);
@@ -371,7 +383,8 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   clock0 = std::chrono::steady_clock::now();
   const auto profiles = run_profiles(o, *m.train, best, fo);
   const double profile_seconds = seconds_since(clock0);
-  o.progress("[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples");
+  o.progress(m.valid ? "[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples"
+                     : std::string("[3/3] no validation: nothing held out (--validation 0)"));
   FitOutputs out;
   out.warnings = flight.notes;
   auto& j = out.json = fit_json(best, profiles);
@@ -382,12 +395,14 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
   j["formulation"] = shooting ? "multiple shooting: " + output::short_number(o.window) + " s windows from measured states, pose residuals"
                      : accel  ? "equation error: accelerometer specific force and gyro derivative"
                               : "equation error: differentiated velocity and gyro derivative";
-  j["validation"] = validation_json(*m.valid, params, best, o.validation, valid.samples.size());
+  j["validation"] = m.valid ? validation_json(*m.valid, params, best, o.validation, valid.samples.size())
+                            : nlohmann::ordered_json{{"fraction", 0}, {"samples", 0}, {"channels", nlohmann::ordered_json::array()}};
   j["fitted_channels"] = m.train->channels();
   j["timing_s"] = {{"fit", fit_seconds}, {"profiles", profile_seconds}};
   add_profile_plot(out, v.name + ": profile likelihood", profiles);
-  const double cut = valid.samples.empty() ? 0 : valid.samples.front().t;
-  add_plot(out, "fit.svg", v.name + ": fit vs data (validation from t = " + output::six_digits(cut) + " s)",
+  const std::string held_out = valid.samples.empty() ? std::string("nothing held out")
+                                                     : "validation from t = " + output::six_digits(valid.samples.front().t) + " s";
+  add_plot(out, "fit.svg", v.name + ": fit vs data (" + held_out + ")",
            flight_panels(model, flight, parameter_values(best.parameters)));
   out.summary = profile_summary(best, profiles);
   const auto fitted = m.train->channels();

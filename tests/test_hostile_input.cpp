@@ -1609,6 +1609,17 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   expect_one_line_error(run_quadgen({"fit", vehicle, tmp / "f.csv", "--channels", "ax,qdot,ax", "--out", tmp / "o"}, tmp.dir),
                         "--channels: 'ax' is given twice", "--channels ax,qdot,ax");
   EXPECT_FALSE(fs::exists(tmp / "o"));
+  // --validation 0, inside its range, always failed with "no stretch of the log is long enough
+  // ... is t in seconds?" (a review, helper-135): now nothing is held out; a held-out part too
+  // short to evaluate is said to be that.
+  const CliResult all = run_quadgen({"fit", vehicle, tmp / "f.csv", "--validation", "0", "--profiles", "none", "--out", tmp / "o"}, tmp.dir);
+  EXPECT_EQ(all.rc, 0) << all.err;
+  EXPECT_NE(all.err.find("no validation: nothing held out (--validation 0)"), std::string::npos) << all.err;
+  EXPECT_EQ(nlohmann::json::parse(read(fs::path(tmp / "o") / "fit.json"))["validation"]["samples"], 0);
+  fs::remove_all(tmp / "o");
+  expect_one_line_error(run_quadgen({"fit", vehicle, tmp / "f.csv", "--validation", "0.001", "--out", tmp / "o"}, tmp.dir),
+                        "the held-out part (--validation 0.001: the last ", "--validation 0.001");
+  EXPECT_FALSE(fs::exists(tmp / "o"));
 }
 
 // A manoeuvre whose rule picks no rotor of the vehicle flew as a hover and was written as the
