@@ -6,12 +6,14 @@
 #include "runtime/rigid_body_state.hpp"
 #include "output/numbers.hpp"
 #include "output/joined.hpp"
+#include "output/sinks.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <iomanip>
@@ -82,11 +84,13 @@ namespace {
   throw LogError(log.where_row(row) + ": " + what);
 }
 
-// A cell as it may appear in a one-line message: long or binary junk is cut short.
+// A cell as it may appear in a one-line message: long or binary junk is cut short (at a
+// whole character), control characters shown as \xNN as every message shows them (a tab
+// read '?' here, a NUL too, and a Cyrillic letter '??': a review, helper-135).
 std::string quoted_cell(const std::string& cell) {
-  std::string shown;
-  for (char c : cell.substr(0, 40)) shown += (c >= 0x20 && c < 0x7f) ? c : '?';
-  return "'" + shown + (cell.size() > 40 ? "...'" : "'");
+  size_t cut = std::min<size_t>(cell.size(), 40);
+  while (cut < cell.size() && cut > 0 && (static_cast<unsigned char>(cell[cut]) & 0xC0) == 0x80) --cut;
+  return "'" + output::printable(cell.substr(0, cut)) + (cut < cell.size() ? "...'" : "'");
 }
 
 // The cells of one line as RFC 4180 reads them: a cell in double quotes may hold commas, and
@@ -204,6 +208,14 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     if (t.columns.empty()) {
+      // Lines ended by a carriage return alone read as one line, the header then the first
+      // row's numbers as "duplicate column '0.35'" (a review, helper-135).
+      if (line.find('\r') != std::string::npos)
+        fail_at(path, lineno, "lines end in a carriage return alone (CR, as some old programs write them): save the log "
+                              "with LF or CRLF line ends");
+      if (line.find('\t') != std::string::npos && line.find(',') == std::string::npos)
+        fail_at(path, lineno, "the header holds tabs and no ',': quadgen reads comma-separated values (export the log "
+                              "with ',' between fields)");
       if (line.find(';') != std::string::npos && line.find(',') == std::string::npos)
         fail_at(path, lineno, "the header holds ';' and no ',': quadgen reads comma-separated values (export the log with ',' "
                               "between fields and '.' as the decimal point)");
@@ -216,7 +228,7 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
       split_cells(line, path, lineno, t.columns);
       std::set<std::string> seen;
       for (const auto& c : t.columns)
-        if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column '" + c + "'");
+        if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column " + quoted_cell(c));
       unreadable.resize(t.columns.size());
       continue;
     }
@@ -369,8 +381,20 @@ std::string missing_columns_message(const CsvTable& log, const std::vector<std::
   std::string list;
   for (const auto& c : missing) list += (list.empty() ? "'" : ", '") + c + "'";
   const std::string what = how.what.empty() ? "" : ": " + how.what;
+  // A header written "t, u_A, ..." or "U_A": the name is there with a blank or in another case
+  // (a review, helper-135: the message said only that 'u_A' was missing).
+  const auto folded = [](const std::string& s) {
+    const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
+    std::string f = a == std::string::npos ? "" : s.substr(a, b - a + 1);
+    for (auto& ch : f) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return f;
+  };
+  std::string near;
+  for (const auto& c : log.columns)
+    if (near.empty() && folded(c) == folded(missing.front()))
+      near = " (the header has " + quoted_cell(c) + ": column names are read exactly, blanks and case included)";
   if (log.named_by.empty())
-    return log.path + ":1: missing column" + (missing.size() > 1 ? "s " : " ") + list + what + how.hint_without_mapping;
+    return log.path + ":1: missing column" + (missing.size() > 1 ? "s " : " ") + list + what + near + how.hint_without_mapping;
   const std::string entry = "'" + missing.front() + ": {source: <the log's column>" +
                             (how.unit.empty() ? "" : ", unit: " + how.unit) + "}'";
   return log.named_by + ": maps no column of " + log.path + " to " + list + what +

@@ -812,6 +812,20 @@ TEST(FlightLog, ReplayRejectsWrongRotorNamesAndTime) {
   EXPECT_NE(message("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n").find("too few samples"), std::string::npos);
   EXPECT_NE(message("t;u_A;u_B;u_C;u_D\n0;1;1;1;1\n1;1;1;1;1\n").find("log.csv:1: the header holds ';' and no ','"),
             std::string::npos);
+  // A review (helper-135): tabs, lines ended by CR alone ("duplicate column '1'"), a header
+  // with blanks after the commas or in another case, and a NUL in a cell (shown as '?').
+  EXPECT_NE(message("t\tu_A\tu_B\tu_C\tu_D\n0\t1\t1\t1\t1\n").find("log.csv:1: the header holds tabs and no ','"),
+            std::string::npos);
+  EXPECT_NE(message("t,u_A,u_B,u_C,u_D\r0,1,1,1,1\r1,1,1,1,1\r").find("log.csv:1: lines end in a carriage return alone"),
+            std::string::npos);
+  EXPECT_NE(message("t, u_A, u_B, u_C, u_D\n0,1,1,1,1\n1,1,1,1,1\n")
+                .find("missing columns 'u_A', 'u_B', 'u_C', 'u_D': the rotor commands (the header has ' u_A': column names are "
+                      "read exactly, blanks and case included)"),
+            std::string::npos)
+      << message("t, u_A, u_B, u_C, u_D\n0,1,1,1,1\n1,1,1,1,1\n");
+  EXPECT_NE(message("t,U_A,u_B,u_C,u_D\n0,1,1,1,1\n1,1,1,1,1\n").find("(the header has 'U_A'"), std::string::npos);
+  const std::string nul = std::string("t,u_A,u_B,u_C,u_D\n0,1,1,1,1\n1") + '\0' + ",1,1,1,1\n";
+  EXPECT_NE(message(nul).find("got '1\\x00'"), std::string::npos) << message(nul);
 }
 
 // The README's command line: `quadgen simulate vehicles/finken3.yaml --scenario climb
