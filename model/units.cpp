@@ -119,9 +119,11 @@ Unit parse_unit(const std::string& text) {
   // factors are in the denominator ("N s/m", "kg/m^3", "1/s").
   Unit result;
   bool denominator = false;
+  int before_slash = 0, after_slash = 0;  // factors on each side
   std::string tok;
   auto flush = [&]() {
     if (tok.empty()) return;
+    ++(denominator ? after_slash : before_slash);
     Unit f = parse_factor(tok, text);
     if (denominator) {
       result.scale /= f.scale;
@@ -150,6 +152,10 @@ Unit parse_unit(const std::string& text) {
     }
   }
   flush();
+  // Separators alone (" ", "/", "** mm*/") read as 1 or as mm (a review, helper-135).
+  if (before_slash + after_slash == 0) throw UnitError("unit '" + text + "' holds no unit, only separators (write \"1\" for dimensionless)");
+  if (denominator && (before_slash == 0 || after_slash == 0))
+    throw UnitError("unit '" + text + "': nothing " + (before_slash == 0 ? "before" : "after") + " '/' (write 1/s for per second)");
   return result;
 }
 

@@ -14,6 +14,9 @@ TEST(Units, ParsesCompoundUnits) {
   EXPECT_NEAR(parse_unit("mm").scale, 1e-3, 1e-18);
   EXPECT_THROW(parse_unit("furlong"), UnitError);
   EXPECT_THROW(parse_unit("m^x"), UnitError);
+  // Separators alone read as 1, or as the one factor beside them (a review, helper-135).
+  for (const char* bad : {" ", "/", "*", "** mm*/", "m/", "/s"}) EXPECT_THROW(parse_unit(bad), UnitError) << bad;
+  EXPECT_EQ(parse_unit("1/s").dim, parse_unit("s^-1").dim);
 }
 
 // Exponents are parsed without std::stoi (whose overflow would reach Dimension::pow as UB)
