@@ -652,6 +652,11 @@ OutputDirectory::OutputDirectory(const std::string& dir, const std::string& comm
   const fs::path target = resolved(dir);
   dir_ = target.string();
   check_name_lengths(target);
+  // The rule simulate's files follow: a folder "x " or one with a line break in its name is a
+  // slip of a script or a paste more often than a wish (a review, helper-135).
+  if (!plain_file_name(target.filename().string()))
+    fail(target, "cannot be an output folder name (a control character or line break in it, a blank at its start or "
+                 "end, or a name beginning '.quadgen'); choose another");
   check_not_above_working_directory(target);
   check_not_input(target, inputs_);
   refuse_links_that_lead_nowhere(target);
