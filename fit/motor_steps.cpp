@@ -1,6 +1,7 @@
 #include "fit/motor_steps.hpp"
 
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "fit/flight_data.hpp"
@@ -61,6 +62,15 @@ std::vector<MotorStep> read_motor_steps(const std::string& path) {
     steps.push_back(s);
   }
   if (steps.empty()) throw FitError(path + ": no throttle steps found");
+  // The map rpm = a0 + a1 u + a2 u^2 has three coefficients: fewer commands to step to leave it
+  // undetermined, and the fit ended in "J^T J overflows ... a corrupt or mis-scaled sample?"
+  // with the solver's warnings on the terminal (a review, helper-135: one step 0 -> 50 %).
+  std::set<double> levels;
+  for (const auto& s : steps) levels.insert(s.u_new);
+  if (levels.size() < 3)
+    throw FitError(path + ": " + std::to_string(steps.size()) + " throttle step" + (steps.size() == 1 ? "" : "s") + " to " +
+                   std::to_string(levels.size()) + " command" + (levels.size() == 1 ? "" : "s") +
+                   ": the motor map rpm = a0 + a1 u + a2 u^2 needs steps to at least 3 different commands");
   return steps;
 }
 

@@ -1,6 +1,7 @@
 #include "fit/thrust_stand.hpp"
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <sstream>
 
@@ -71,6 +72,13 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
     out.push_back(s);
   }
   if (out.size() < 10) throw FitError(path + ": too few samples with the motors running");
+  // The motor map is quadratic in the command (three coefficients): a run at fewer commands
+  // cannot give it, and 50 identical rows ended in "J^T J overflows" (a review, helper-135).
+  std::set<double> commands;
+  for (const auto& s : out) commands.insert(s.u);
+  if (commands.size() < 3)
+    throw FitError(path + ": the motors ran at " + std::to_string(commands.size()) + " command" +
+                   (commands.size() == 1 ? "" : "s") + " (pwm): the motor map needs a run over at least 3 different commands");
   return out;
 }
 

@@ -132,6 +132,19 @@ TEST_F(Hostile, FitReadersRefuseNonFiniteAndAbsurdValues) {
   expect_located(message_of<FitError>([&] { read_motor_steps(big_steps); }), big_steps, 5, "'rpm' is 1e+160");
   const std::string thr_steps = write("thr_steps.csv", head + "200,150,3000\n");
   expect_located(message_of<FitError>([&] { read_motor_steps(thr_steps); }), thr_steps, 4, "throttle in [0, 100]");
+  // Too few commands for a quadratic map (one step ended in "J^T J overflows" and the solver's
+  // warnings; a review, helper-135): said, with the file.
+  const std::string one_step = write("one_step.csv", head + "200,10,2100\n300,10,2150\n");
+  EXPECT_NE(message_of<FitError>([&] { read_motor_steps(one_step); })
+                .find("one_step.csv: 1 throttle step to 1 command: the motor map rpm = a0 + a1 u + a2 u^2 needs steps to "
+                      "at least 3 different commands"),
+            std::string::npos);
+  EXPECT_EQ(read_motor_steps(write("three_steps.csv", head + "200,20,4000\n300,20,4100\n400,30,6000\n")).size(), 3u);
+  std::string same_stand = kStandHeader;
+  for (int k = 0; k < 50; ++k) same_stand += "20,30000,3.9,15000,15000,15000,15000\n";
+  EXPECT_NE(message_of<FitError>([&] { read_thrust_stand(write("same_stand.csv", same_stand)); })
+                .find("same_stand.csv: the motors ran at 1 command (pwm): the motor map needs a run over at least 3"),
+            std::string::npos);
 
   // one sample of 1e160 in a canonical flight log, found before any fitting
   std::string log = kCanonicalHeader;
