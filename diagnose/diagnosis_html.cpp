@@ -426,7 +426,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
                     "&ndash;"});
   for (const auto& e : d.search.left_at_limit)
     rows.push_back({e.effect, "no",
-                    "not tested: still significant where the search stopped (" + esc(output::p_is(e.p_value)) +
+                    "not taken: still significant where the search reached its limit (--max-effects; " + esc(output::p_is(e.p_value)) +
                         (e.implausible.empty() ? "" : "; implausible here: " + esc(e.implausible)) + ")",
                     "&ndash;", "&ndash;"});
   for (const auto& r : d.search.removed)
@@ -478,7 +478,7 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
     const double gain = reduction(d.metric_before, d.metric_after);
     h << "<li>With " << (d.findings.empty() ? "what it carries unnamed (below)" : d.findings.size() > 1 ? "them" : "it")
       << ", the model predicts the held-out part "
-      << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " (" << esc(d.metric) << " "
+      << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " than the base model (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
   }
   if (d.has_prediction)

@@ -100,8 +100,13 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   }
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << ": " << r.reason << "\n";
   if (!d.search.left_at_limit.empty()) {
+    // Effects taken, some perhaps dropped again: "limit of 5" beside four named read as a
+    // miscount (a newcomer's trial, helper-136).
     os << "the search stopped at its limit of " << d.search.steps.size()
-       << (d.search.steps.size() == 1 ? " effect" : " effects") << " (--max-effects); still significant in its last step:";
+       << (d.search.steps.size() == 1 ? " effect" : " effects") << " taken (--max-effects"
+       << (d.search.removed.empty() ? std::string()
+                                    : "; " + std::to_string(d.search.removed.size()) + " of them dropped by the backward pass above")
+       << "); still significant in its last step:";
     for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
       const auto& ev = d.search.left_at_limit[k];
       os << (k ? ", " : " ") << ev.effect << " (" << output::p_is(ev.p_value) << (ev.implausible.empty() ? "" : ", implausible")

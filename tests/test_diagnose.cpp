@@ -442,7 +442,7 @@ TEST(TwoEffects, WhatTheLimitLeftOutIsReported) {
   EXPECT_TRUE(listed) << taken << " taken; left: " << j["left_at_max_effects"].dump(1);
   std::ifstream printed(dir / "diagnose.log");
   const std::string text((std::istreambuf_iterator<char>(printed)), {});
-  const size_t line = text.find("the search stopped at its limit of 1 effect (--max-effects); still significant in its last step:");
+  const size_t line = text.find("the search stopped at its limit of 1 effect taken (--max-effects); still significant in its last step:");
   ASSERT_NE(line, std::string::npos) << text;
   EXPECT_NE(text.substr(line, text.find('\n', line) - line).find(" " + other + " (p "), std::string::npos) << text;
   // Without the limit nothing is left over.
@@ -2053,8 +2053,8 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(more.find("<td><b>attitude_bias</b></td><td class=\"warn\">in the model, not named: a stand-in for missing "
                       "physics (attitude_bias.roll outside [-0.05, 0.05])</td>"),
             std::string::npos);
-  EXPECT_NE(more.find("<td><b>inflow</b></td><td class=\"no\">not tested: still significant where the search stopped "
-                      "(p = 0.001; implausible here: &lt;b&gt;x&lt;/b&gt;)</td>"),
+  EXPECT_NE(more.find("<td><b>inflow</b></td><td class=\"no\">not taken: still significant where the search reached its limit "
+                      "(--max-effects; p = 0.001; implausible here: &lt;b&gt;x&lt;/b&gt;)</td>"),
             std::string::npos);
   EXPECT_NE(more.find("dropped by the backward pass: its held-out gain &lt;script&gt; vanished"), std::string::npos);
   EXPECT_EQ(more.find("<script>"), std::string::npos);
