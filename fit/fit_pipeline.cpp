@@ -214,7 +214,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   if (tau)
     s << ", 95 % profile interval " << interval_of(*tau) << " (" << tau->verdict << ")";
   if (thesis) s << "; thesis: " << kThesisMotorTau << " s";
-  s << "\n" << motor_map_lines(best.parameters, profiles, "the steps' command scale");
+  s << "\n" << motor_map_lines(best.parameters, profiles, "over the command throttle_percent / 100, a fraction 0..1 as the flight log's u_<rotor>");
   out.summary = s.str();
   return out;
 }
