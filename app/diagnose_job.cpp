@@ -72,12 +72,11 @@ struct AirframeReader {
   }
   // The unit an entry gives is the model's (kappa in mm was read as metres by predict --params;
   // a review, helper-135); an entry without one is taken as declared.
-  void same_unit(const nlohmann::json& entry, const std::string& name) const {
+  void same_unit(const nlohmann::json& entry, const std::string& where, const std::string& name) const {
     if (!entry.is_object() || !entry.contains("unit")) return;
-    const std::string& declared = all.params[all.param_index(name)].unit;
-    if (!entry["unit"].is_string() || entry["unit"].get<std::string>() != declared)
-      throw airframe_error(path, output::printable(name) + " is in " + output::printable(declared) + ", the file says " +
-                                     output::printable(entry["unit"].dump()));
+    const std::string given = entry["unit"].is_string() ? entry["unit"].get<std::string>() : entry["unit"].dump();
+    const std::string problem = runtime::unit_problem(runtime_parameter(all.params[all.param_index(name)]), given);
+    if (!problem.empty()) throw airframe_error(path, where + output::printable(name) + " " + problem);
   }
   double number(const nlohmann::json& v, const std::string& what) const {
     if (!v.is_number()) throw airframe_error(path, what + ": expected a number");
@@ -104,7 +103,7 @@ struct AirframeReader {
     for (const auto& [parameter, p] : f["parameters"].items()) {
       if (p.value("reference", false)) continue;
       known(parameter);
-      same_unit(p, parameter);
+      same_unit(p, "findings: ", parameter);
       const double v = number(p.value("value", nlohmann::json()), parameter);
       // Compared with this flight's estimate: a value outside the parameter's bounds is no
       // estimate quadgen could have written, and an infinite one broke the comparison's test.
@@ -131,7 +130,7 @@ diagnose::AirframeReference read_airframe(const nlohmann::json& j, const std::st
     ref.values.push_back(runtime_parameter(p, is_effect_parameter(p.name) ? diagnose::neutral_value(p) : p.nominal, false));
   for (const auto& [name, e] : j["airframe_fit"].items()) {
     read.known(name);
-    read.same_unit(e, name);
+    read.same_unit(e, "airframe_fit.", name);
     for (auto& p : ref.values)
       if (p.name == name) p.value = std::clamp(read.number(e.value("value", nlohmann::json()), name), p.lower, p.upper);
   }

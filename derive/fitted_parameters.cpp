@@ -67,7 +67,8 @@ void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitte
     for (auto& q : model.params)
       if (q.name == v.name) p = &q;
     if (!p) throw VehicleError(where + "no parameter '" + v.name + "' in this model (effects: " + model.effect_list(", ") + ")");
-    if (v.unit != p->unit) throw VehicleError(where + v.name + " is in " + p->unit + ", the file says " + v.unit);
+    if (const std::string u = runtime::unit_problem(runtime_parameter(*p), v.unit); !u.empty())
+      throw VehicleError(where + output::printable(v.name) + " " + u);
     const std::string problem = runtime::value_problem(runtime_parameter(*p), v.value, true);
     if (!problem.empty()) throw VehicleError(where + v.name + " " + problem);
     set_fitted_nominal(*p, v.value);

@@ -158,9 +158,15 @@ std::string headline(const Finding& f) {
       return p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0;
     });
     // A flight where nothing is told apart: the effect was named on the flights together, so
-    // "significant only together" would not be this flight's to claim.
+    // "significant only together" would not be this flight's to claim. An open interval holds
+    // nothing that can be said (a review, helper-137).
+    const bool all_closed = std::all_of(ps.begin(), ps.end(), [](const EffectEstimate* p) {
+      return std::isfinite(p->lower) && std::isfinite(p->upper);
+    });
     s += (s.empty() ? "" : " ") + std::string("Flight ") + std::to_string(flight) + ": " +
-         (any_apart ? flight_headline(e, ps, reference) : std::string("none told apart from 0 (each interval holds it)."));
+         (any_apart    ? flight_headline(e, ps, reference)
+          : all_closed ? std::string("none told apart from 0 (each interval holds it).")
+                       : std::string("none told apart from 0 (not every value has an interval)."));
   }
   return s;
 }

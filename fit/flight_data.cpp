@@ -74,15 +74,13 @@ std::string scalar_text(const std::string& path, const YAML::Node& n, const std:
   return n.Scalar();
 }
 
-// By the one rule for numbers (output/numbers.hpp), as the vehicle file reads them: yaml-cpp's
+// By the one rule for YAML numbers (yaml_number), as the vehicle file reads them: yaml-cpp's
 // own conversion read a scale of 1e-400 as 0 (a gyro column read as zeros without a word) and
 // took '1 ' but not ' 1' (a review, helper-135).
 double number_field(const std::string& path, const YAML::Node& n, const std::string& what) {
   const std::string text = scalar_text(path, n, what);
-  const bool blank_around = !text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
-                                              std::isspace(static_cast<unsigned char>(text.back())));
   double v = 0;
-  const output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, &v);
+  const output::NumberText kind = yaml_number(text, &v);
   if (kind == output::NumberText::underflow)
     mapping_error(path, n, what + ": '" + output::printable(text) + "' " + output::number_text_problem(kind));
   if (kind != output::NumberText::finite)

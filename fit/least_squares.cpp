@@ -10,7 +10,10 @@
 
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
+#if __has_include(<glog/logging.h>)  // Ceres 2.1 and 2.2 (Debian 12) log through glog
 #include <glog/logging.h>
+#define QUADGEN_CERES_LOGS_THROUGH_GLOG 1
+#endif
 
 namespace quadgen::fit {
 
@@ -264,11 +267,13 @@ double solve_weighted(const ResidualModel& model, std::vector<FitParameter>& par
   // Ceres' own warnings ("Linear solver failure ... Unable to perform dense Cholesky
   // factorization", through glog) reached the terminal between quadgen's lines: the fit's
   // outcome, said in quadgen's words, is what a user reads (a review, helper-135). Errors pass.
+#ifdef QUADGEN_CERES_LOGS_THROUGH_GLOG  // process-wide, once: quadgen is the program that logs
   static const bool quiet = [] {
     FLAGS_minloglevel = std::max(FLAGS_minloglevel, static_cast<int>(google::GLOG_ERROR));
     return true;
   }();
   (void)quiet;
+#endif
   ceres::Solve(so, &problem, &summary);
   // FAILURE is an evaluation or linear-solver error, most often a residual or Jacobian
   // entry that is not finite at the start; its cost (-1 when never evaluated) means nothing.

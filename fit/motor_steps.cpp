@@ -65,12 +65,16 @@ std::vector<MotorStep> read_motor_steps(const std::string& path) {
   // The map rpm = a0 + a1 u + a2 u^2 has three coefficients: fewer commands to step to leave it
   // undetermined, and the fit ended in "J^T J overflows ... a corrupt or mis-scaled sample?"
   // with the solver's warnings on the terminal (a review, helper-135: one step 0 -> 50 %).
+  // The levels the steps start from count as well; a motor off (0) gives the map no point
+  // (a second review, helper-137: 0 -> 30 -> 60 -> 0 passed as three).
   std::set<double> levels;
-  for (const auto& s : steps) levels.insert(s.u_new);
+  for (const auto& s : steps)
+    for (double u : {s.u_old, s.u_new})
+      if (u > 0) levels.insert(u);
   if (levels.size() < 3)
-    throw FitError(path + ": " + std::to_string(steps.size()) + " throttle step" + (steps.size() == 1 ? "" : "s") + " to " +
+    throw FitError(path + ": " + std::to_string(steps.size()) + " throttle step" + (steps.size() == 1 ? "" : "s") + " at " +
                    std::to_string(levels.size()) + " command" + (levels.size() == 1 ? "" : "s") +
-                   ": the motor map rpm = a0 + a1 u + a2 u^2 needs steps to at least 3 different commands");
+                   " above 0: the motor map rpm = a0 + a1 u + a2 u^2 needs at least 3 different ones");
   return steps;
 }
 

@@ -51,13 +51,15 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
     speed_columns.push_back(c);
   // The speeds are read rpm1, rpm2, ... up to the first missing one: an rpm4 after a missing
   // rpm3 was left out without a word, and the shared thrust coefficient came out doubled (a
-  // review, helper-135).
-  for (const auto& name : t.columns)
-    if (name.size() > 3 && name.compare(0, 3, "rpm") == 0 &&
-        name.find_first_not_of("0123456789", 3) == std::string::npos &&
-        std::stoul(name.substr(3, 9)) > speed_columns.size())
-      throw FitError(path + ":1: column '" + name + "' follows a gap: the rotor speeds are read as rpm1, rpm2, ... up to "
-                     "the first one missing (rpm" + std::to_string(speed_columns.size() + 1) + "); number them without gaps");
+  // review, helper-135); so were an rpm0 and an rpm01 (a second review, helper-137).
+  for (size_t c = 0; c < t.columns.size(); ++c) {
+    const std::string& name = t.columns[c];
+    if (name.size() > 3 && name.compare(0, 3, "rpm") == 0 && name.find_first_not_of("0123456789", 3) == std::string::npos &&
+        std::find(speed_columns.begin(), speed_columns.end(), static_cast<int>(c)) == speed_columns.end())
+      throw FitError(path + ":1: column '" + name + "' is not read: the rotor speeds are read as rpm1, rpm2, ... (from 1, "
+                     "no leading zeros) up to the first one missing (rpm" + std::to_string(speed_columns.size() + 1) +
+                     "); number them so");
+  }
   const double rpm = 2 * M_PI / 60;
   const int cw = t.column("weight[g]"), cu = t.column("pwm"), cv = t.column("vbat[V]");
   std::vector<StandSample> out;

@@ -54,27 +54,76 @@ inline std::string malformed_yaml(const YAML::ParserException& e, const std::str
   return "malformed YAML: " + output::printable(e.msg) + yaml_slip(text, e.mark.line, e.msg);
 }
 
+// The line (from 0, as yaml-cpp's marks count) where content after the first YAML document
+// starts, or -1. A line that begins with '---' or '...' and then ends or a blank is a document
+// marker wherever it stands (YAML 1.2's forbidden lines: not even a block scalar or a quoted
+// string holds one), so the lines alone tell: a '---' before any content opens the first
+// document, a '---' after content or any '...' ends it, and whatever is not blank or a comment
+// after that (on the marker's own line too) is a second document.
+inline int second_document_line(const std::string& text) {
+  const auto content = [](const std::string& s) {
+    const size_t at = s.find_first_not_of(" \t\r");
+    return at != std::string::npos && s[at] != '#';
+  };
+  bool opened = false, started = false, ended = false;  // a '---' seen, content seen, the document over
+  std::istringstream in(text);
+  std::string line;
+  for (int n = 0; std::getline(in, line); ++n) {
+    const bool marker = line.size() >= 3 && (line.compare(0, 3, "---") == 0 || line.compare(0, 3, "...") == 0) &&
+                        (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+    if (marker) {
+      const bool content_after = content(line.substr(3));  // "--- {a: 1}"
+      if (!ended && line[0] == '-' && !opened && !started) {  // the '---' that opens the first document
+        opened = true;
+        started = content_after;
+        continue;
+      }
+      if (ended && content_after) return n;
+      ended = true;  // a '...', or a '---' that starts a second document (an empty first one, too)
+      if (line[0] == '-' && content_after) return n;
+      continue;
+    }
+    if (!content(line) || (!started && line[0] == '%')) continue;  // blank, a comment, a directive
+    if (ended) return n;
+    started = true;
+  }
+  return -1;
+}
+
 // The one document of a YAML input. yaml-cpp's Load reads the first document and drops the
 // rest without a word: a '---' line in the middle of a vehicle file silently threw away every
 // key after it, its mass among them (a hostile-input review, helper-135). A later document
 // holding nothing (a trailing '---', comments) is harmless; one holding anything is an error.
-// Returns the line (from 0, as yaml-cpp's marks count) of the content the reader would have
-// dropped in `*dropped_line`, or -1; a parser error is thrown as yaml-cpp throws it.
+// Returns in `*dropped_line` the line second_document_line gives; a parser error is thrown as
+// yaml-cpp throws it. (Not YAML::LoadAll: the fuzzer found an input on which it never returns,
+// where Load takes 5 ms.)
 inline YAML::Node load_one_document(const std::string& text, int* dropped_line) {
-  const std::vector<YAML::Node> docs = YAML::LoadAll(text);
-  *dropped_line = -1;
-  for (size_t k = 1; k < docs.size(); ++k)
-    if (!docs[k].IsNull()) {
-      *dropped_line = docs[k].Mark().line;
-      break;
-    }
-  return docs.empty() ? YAML::Node() : docs.front();
+  *dropped_line = second_document_line(text);
+  return YAML::Load(text);
 }
 
 // What that error says, after "file:line: ".
 inline constexpr const char* kSecondYamlDocument =
     "a second YAML document starts here, after a '---' or '...' line: the file is read as one document, so "
     "remove that line (everything after it would be ignored)";
+
+// A YAML scalar's text as a number, by the rule the log cells and the command line follow
+// (output/numbers.hpp; yaml-cpp's own conversion read 1e-400 as 0 without a word), for every
+// YAML input (the vehicle file, fitted parameters, a column mapping's scale and offset).
+// A quoted or block scalar keeps its blanks: "1 " and a block's final newline were read by
+// yaml-cpp, " 1" was not; none is a number here (a review, helper-89). YAML's own words
+// .inf, -.Inf, .NaN are numbers, just not finite ones.
+inline output::NumberText yaml_number(const std::string& text, double* value) {
+  const bool blank_around = !text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
+                                              std::isspace(static_cast<unsigned char>(text.back())));
+  output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, value);
+  if (kind == output::NumberText::not_a_number) {
+    std::string lower = text;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower == ".inf" || lower == "+.inf" || lower == "-.inf" || lower == ".nan") kind = output::NumberText::not_finite;
+  }
+  return kind;
+}
 
 struct YamlReader {
   std::string path;
@@ -152,26 +201,14 @@ struct YamlReader {
     return n;
   }
 
-  // YAML's own words for them (.inf, -.Inf, .NaN), which are numbers, just not finite ones.
-  static bool yaml_infinity_or_nan(std::string text) {
-    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return text == ".inf" || text == "+.inf" || text == "-.inf" || text == ".nan";
-  }
-
   // By the rule the log cells and the command line follow (output/numbers.hpp): yaml-cpp's
   // own conversion read 1e-400 as 0 without a word.
   double number(const YAML::Node& n, const std::string& what) const {
     if (!n.IsScalar()) fail(n, "expected a number for " + what);
     const std::string& text = n.Scalar();
     const std::string shown = output::printable(text);
-    // A quoted or block scalar keeps its blanks: "1 " and a block's final newline were read by
-    // yaml-cpp, " 1" was not; none is a number here (a review, helper-89).
-    const bool blank_around = !text.empty() && (std::isspace(static_cast<unsigned char>(text.front())) ||
-                                                std::isspace(static_cast<unsigned char>(text.back())));
     double v = 0;
-    output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, &v);
-    if (kind == output::NumberText::not_a_number && yaml_infinity_or_nan(text)) kind = output::NumberText::not_finite;
-    switch (kind) {
+    switch (yaml_number(text, &v)) {
       case output::NumberText::finite: return v;
       case output::NumberText::not_a_number:
         fail(n, "expected a number for " + what + ", got '" + shown + "'" + output::hexadecimal_hint(text));

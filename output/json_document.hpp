@@ -47,7 +47,7 @@ inline std::string parse_json_input(const std::string& text, nlohmann::json* out
   } catch (const nlohmann::json::parse_error& e) {
     return "not JSON (the text stops parsing at byte " + std::to_string(e.byte) + "); " + expected;
   } catch (const nlohmann::json::out_of_range&) {
-    return "a number in it is beyond a double's range (above about 1.8e308)";
+    return "a number in it is beyond a double's range (about ±1.8e308)";
   }
   if (!twice.empty()) return "the key '" + printable(twice) + "' is given twice in one object (which value is meant?)";
   return json_number_problem(text);

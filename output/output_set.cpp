@@ -652,12 +652,15 @@ OutputDirectory::OutputDirectory(const std::string& dir, const std::string& comm
   const fs::path target = resolved(dir);
   dir_ = target.string();
   check_name_lengths(target);
-  // The rule simulate's files follow: a folder "x " or one with a line break in its name is a
-  // slip of a script or a paste more often than a wish (a review, helper-135).
-  if (!plain_file_name(target.filename().string()))
-    fail(target, "cannot be an output folder name (a control character or line break in it, a blank at its start or "
-                 "end, or a name beginning '.quadgen'); choose another");
   check_not_above_working_directory(target);
+  // The rule simulate's files follow, for every folder the run would create: a folder "x " or
+  // one with a line break in its name is a slip of a script or a paste more often than a wish
+  // (a review, helper-135; the parents too, helper-137). Folders that exist are the user's.
+  std::error_code ec;
+  for (fs::path p = target; p.has_filename() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path())
+    if (!plain_file_name(p.filename().string()))
+      fail(p, "cannot be an output folder name (a control character or line break in it, a blank at its start or "
+              "end, or a name beginning '.quadgen'); choose another");
   check_not_input(target, inputs_);
   refuse_links_that_lead_nowhere(target);
   check_replaceable(target, command_);

@@ -74,9 +74,11 @@ void ParameterSource::set(const runtime::DynamicModel& model, const nlohmann::js
     const runtime::Parameter& p = declared[static_cast<size_t>(index)];
     // A unit the file gives is the model's, as derive --params requires: kappa in mm was read as
     // metres (a review, helper-135). A hand-written entry without one is taken as declared.
-    if (entry.contains("unit") && (!entry["unit"].is_string() || entry["unit"].get<std::string>() != p.unit))
-      throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " is in " + output::printable(p.unit) +
-                                  ", the file says " + output::printable(entry["unit"].dump()));
+    if (entry.contains("unit")) {
+      const std::string given = entry["unit"].is_string() ? entry["unit"].get<std::string>() : entry["unit"].dump();
+      if (const std::string u = runtime::unit_problem(p, given); !u.empty())
+        throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + u);
+    }
     const std::string problem = runtime::value_problem(p, value, true);
     if (!problem.empty()) throw std::invalid_argument(path_ + ": " + key + "." + output::printable(name) + " " + problem);
     return value;

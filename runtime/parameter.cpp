@@ -3,8 +3,14 @@
 #include <cmath>
 
 #include "output/numbers.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::runtime {
+
+std::string unit_problem(const Parameter& p, const std::string& unit) {
+  if (unit == p.unit) return "";
+  return "is in " + output::printable(p.unit) + ", the file says '" + output::printable(unit) + "'";
+}
 
 std::string value_problem(const Parameter& p, double value, bool within_bounds) {
   using output::short_number;

@@ -23,4 +23,11 @@ struct Parameter {
 // truth may lie outside what a fit searches, so simulate checks no bounds.)
 std::string value_problem(const Parameter& p, double value, bool within_bounds);
 
+// Why a file's `unit` for `p` is not p's, or "" when it is: "is in m, the file says 'mm'". The
+// units quadgen writes (diagnosis.json, fit.json, fitted_parameters.yaml) are the declared
+// ones character for character, so a file of its own always passes; one rule for derive
+// --params, predict --params and diagnose --airframe (kappa in mm was read as metres by the
+// last two: a review, helper-135).
+std::string unit_problem(const Parameter& p, const std::string& unit);
+
 }  // namespace quadgen::runtime

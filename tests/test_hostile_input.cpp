@@ -802,8 +802,12 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   EXPECT_NE(r.err.find("cannot be an output folder name"), std::string::npos) << out::printable(r.err);
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << out::printable(r.err);
   EXPECT_FALSE(fs::exists(tmp / "o\x1b[31mRED"));
-  for (const char* slip : {"o ", " o", "o\nx"})
-    EXPECT_NE(run_quadgen({"derive", vehicle, "--out", tmp / slip}, tmp.dir).rc, 0) << out::printable(slip);
+  for (const char* slip : {"o ", " o", "o\nx", "p \n/o"}) {  // the last: a parent the run would create
+    const CliResult refused = run_quadgen({"derive", vehicle, "--out", tmp / slip}, tmp.dir);
+    EXPECT_NE(refused.rc, 0) << out::printable(slip);
+    EXPECT_NE(refused.err.find("cannot be an output folder name"), std::string::npos) << out::printable(refused.err);
+    EXPECT_FALSE(fs::exists(tmp / std::string(slip).substr(0, std::string(slip).find('/')))) << out::printable(slip);
+  }
   const CliResult odd = run_quadgen({"derive", vehicle, "--out", tmp / "o\xe2\x80\xae$(x)"}, tmp.dir);
   EXPECT_EQ(odd.rc, 0) << out::printable(odd.err);
   EXPECT_EQ(odd.err.find("\xe2\x80\xae"), std::string::npos) << out::printable(odd.err);
@@ -1519,7 +1523,7 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   // (nlohmann's bare message named no file) and a key given twice (the last kept without a
   // word): a review, helper-135.
   expect_one_line_error(predict(params("mm.json", R"("kappa": {"value": 2, "unit": "mm"})")),
-                        "mm.json: estimates.kappa is in m, the file says \"mm\"", "kappa in mm");
+                        "mm.json: estimates.kappa is in m, the file says 'mm'", "kappa in mm");
   EXPECT_EQ(run_quadgen({"predict", vehicle, tmp / "f.csv", "--params", params("m.json", R"("kappa": {"value": 0.002, "unit": "m"})"),
                          "--validation", "1", "--out", tmp / "p"},
                         tmp.dir)
@@ -1528,6 +1532,8 @@ TEST(Cli, ParameterValuesFromOutsideAreChecked) {
   fs::remove_all(tmp / "p");
   expect_one_line_error(predict(params("huge.json", R"("J_xy": {"value": 1e400})")),
                         "huge.json: a number in it is beyond a double's range", "J_xy 1e400");
+  expect_one_line_error(predict(params("huge_negative.json", R"("J_xy": {"value": -1e400})")),
+                        "huge_negative.json: a number in it is beyond a double's range", "J_xy -1e400");
   expect_one_line_error(predict(params("twice.json", R"("kappa": {"value": 0.002}, "kappa": {"value": 0.003})")),
                         "twice.json: the key 'kappa' is given twice in one object", "kappa twice");
   EXPECT_FALSE(fs::exists(tmp / "p"));
@@ -1848,10 +1854,14 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // A value too small for a double, which the JSON parser alone reads as 0 (as --params' test).
   expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", finding("tiny.json", "motor_lag", "1e-400"), "--out", tmp / "o"},
                2, "tiny.json: the number 1e-400 is below the smallest number a double holds, so it would read as 0");
-  // A unit other than the model's (as --params' test).
-  write(tmp / "seconds.json", R"({"airframe_fit": {"kappa": {"value": 2, "unit": "mm"}}, "flight_parameters": [], "findings": []})");
-  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "seconds.json", "--out", tmp / "o"}, 2,
-               "seconds.json: kappa is in m, the file says \"mm\"");
+  // A unit other than the model's (as --params' test), in the airframe's values and in a finding.
+  write(tmp / "mm_airframe.json", R"({"airframe_fit": {"kappa": {"value": 2, "unit": "mm"}}, "flight_parameters": [], "findings": []})");
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "mm_airframe.json", "--out", tmp / "o"}, 2,
+               "mm_airframe.json: airframe_fit.kappa is in m, the file says 'mm'");
+  write(tmp / "ms_finding.json", R"({"airframe_fit": {}, "flight_parameters": [], "findings": [{"effect": "motor_lag", )"
+                                 R"("parameters": {"motor_lag.tau": {"value": 30, "unit": "ms"}}}]})");
+  expect_error({"diagnose", cf, tmp / "missing.csv", "--airframe", tmp / "ms_finding.json", "--out", tmp / "o"}, 2,
+               "ms_finding.json: findings: motor_lag.tau is in s, the file says 'ms'");
 }
 
 // A user trial of the less-trodden paths (helper-79, 2026-12-03): simulate ignored --effects

@@ -118,10 +118,14 @@ TEST_F(Hostile, FitReadersRefuseNonFiniteAndAbsurdValues) {
       write("heavy_stand.csv", std::string(kStandHeader) + "1e12,3000,3.9,1,1,1,1\n" + stand_rows(12));
   expect_located(message_of<FitError>([&] { read_thrust_stand(heavy); }), heavy, 2, "|weight| <= 1e9 g");
   EXPECT_EQ(read_thrust_stand(write("good_stand.csv", std::string(kStandHeader) + stand_rows(12))).size(), 12u);
-  // rpm4 after a missing rpm3 was left out without a word (a review, helper-135)
+  // rpm4 after a missing rpm3 was left out without a word (a review, helper-135), and so were
+  // rpm0 and rpm01 (helper-137)
   const std::string gap = write("gap_stand.csv", "weight[g],pwm,vbat[V],rpm1,rpm2,x3,rpm4\n" + stand_rows(12));
   expect_located(message_of<FitError>([&] { read_thrust_stand(gap); }), gap, 1,
-                 "column 'rpm4' follows a gap: the rotor speeds are read as rpm1, rpm2, ... up to the first one missing (rpm3)");
+                 "column 'rpm4' is not read: the rotor speeds are read as rpm1, rpm2, ... (from 1, no leading zeros) up "
+                 "to the first one missing (rpm3)");
+  const std::string zero = write("zero_stand.csv", "weight[g],pwm,vbat[V],rpm0,rpm1,rpm2,rpm3\n" + stand_rows(12));
+  expect_located(message_of<FitError>([&] { read_thrust_stand(zero); }), zero, 1, "column 'rpm0' is not read");
 
   // nan and 1e160 in motor-step files
   const std::string head = "time_ms,throttle_percent,rpm\n0,0,0\n100,10,2000\n";
@@ -136,10 +140,14 @@ TEST_F(Hostile, FitReadersRefuseNonFiniteAndAbsurdValues) {
   // warnings; a review, helper-135): said, with the file.
   const std::string one_step = write("one_step.csv", head + "200,10,2100\n300,10,2150\n");
   EXPECT_NE(message_of<FitError>([&] { read_motor_steps(one_step); })
-                .find("one_step.csv: 1 throttle step to 1 command: the motor map rpm = a0 + a1 u + a2 u^2 needs steps to "
-                      "at least 3 different commands"),
+                .find("one_step.csv: 1 throttle step at 1 command above 0: the motor map rpm = a0 + a1 u + a2 u^2 needs at "
+                      "least 3 different ones"),
             std::string::npos);
   EXPECT_EQ(read_motor_steps(write("three_steps.csv", head + "200,20,4000\n300,20,4100\n400,30,6000\n")).size(), 3u);
+  // Off again counts no level: 0 -> 10 -> 20 -> 0 has two (helper-137)
+  EXPECT_NE(message_of<FitError>([&] { read_motor_steps(write("off_again.csv", head + "200,20,4000\n300,0,0\n")); })
+                .find("3 throttle steps at 2 commands above 0"),
+            std::string::npos);
   std::string same_stand = kStandHeader;
   for (int k = 0; k < 50; ++k) same_stand += "20,30000,3.9,15000,15000,15000,15000\n";
   EXPECT_NE(message_of<FitError>([&] { read_thrust_stand(write("same_stand.csv", same_stand)); })
@@ -264,6 +272,8 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
       {"underflow.yaml", "columns:\n  p: {source: gyro, scale: 1e-400}\n", 2,
        "column 'p': scale: '1e-400' is below the smallest number a double holds"},
       {"blank.yaml", "columns:\n  p: {source: gyro, scale: '1 '}\n", 2, "column 'p': scale: expected a finite number, got '1 '"},
+      {"blank_before.yaml", "columns:\n  p: {source: gyro, scale: ' 1'}\n", 2, "column 'p': scale: expected a finite number, got ' 1'"},
+      {"infinite.yaml", "columns:\n  p: {source: gyro, offset: .inf}\n", 2, "column 'p': offset: expected a finite number, got '.inf'"},
       {"hex.yaml", "columns:\n  p: {source: gyro, offset: 0x10}\n", 2, "hexadecimal is not read"},
       {"zero.yaml", "columns:\n  p: {source: gyro, scale: 0}\n", 2, "column 'p': scale: 0 would read every value"},
       {"two_documents.yaml", "columns:\n  t: {source: t}\n...\ncolumns:\n  p: {source: gyro}\n", 4,

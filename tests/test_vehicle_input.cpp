@@ -74,7 +74,7 @@ TEST(VehicleInput, ASecondYamlDocumentIsRefusedNotDropped) {
   EXPECT_NO_THROW(parse_vehicle("---\n" + text, "ok.yaml"));
   EXPECT_NO_THROW(parse_vehicle(text + "---\n# nothing more\n", "ok.yaml"));
   EXPECT_NO_THROW(parse_vehicle(text + "...\n", "ok.yaml"));
-}  // the column mapping's reader: HostileReaders.AMappingsSecondYamlDocumentIsRefused
+}  // the column mapping's reader: Hostile.MappingUnitsAreConvertedAndChecked (two_documents.yaml)
 // yaml-cpp's words for two common slips, said in a hand-writer's terms.
 TEST(VehicleInput, MalformedYamlNamesTheLikelySlip) {
   std::string tabbed = finken_text();
@@ -302,7 +302,7 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
   EXPECT_EQ(m.params[m.param_index("c_t")].nominal, 0.15);
   const std::pair<std::string, std::string> bad[] = {
       {head + "  wind.x: {value: 1, unit: \"m/s\"}\n", ":4: no parameter 'wind.x'"},
-      {head + "  kappa: {value: 0.01, unit: \"1\"}\n", ":4: kappa is in m, the file says 1"},
+      {head + "  kappa: {value: 0.01, unit: \"1\"}\n", ":4: kappa is in m, the file says '1'"},
       {head + "  motor_gain.C: {value: -0.9, unit: \"1\"}\n", ":4: motor_gain.C = -0.9 is outside its bounds"},
       {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
       {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: expected a finite number for c_w"},
