@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -40,9 +41,14 @@ inline std::string nearest_option(const CLI::App& command, const std::string& wo
 // option gets the nearest one back.
 inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
   if (e.get_exit_code() == 0) return app.exit(e);
-  std::string not_understood, suggestions;
+  std::string not_understood, suggestions, dash_file;
   for (const CLI::App* command : app.get_subcommands())
     for (const std::string& word : command->remaining()) {
+      // A log named "-x.csv" reads as an option, and CLI11 then says "logs is required" (a
+      // review, helper-135): the file is named, with the spelling that reads as a path.
+      std::error_code ec;
+      if (dash_file.empty() && word.size() > 1 && word[0] == '-' && std::filesystem::is_regular_file(word, ec))
+        dash_file = word;
       if (word.rfind("--", 0) != 0) continue;
       not_understood += (not_understood.empty() ? "" : " ") + word;
       if (const std::string near = nearest_option(*command, word); !near.empty() && near != word)
@@ -53,6 +59,9 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
   if (!not_understood.empty() && dynamic_cast<const CLI::RequiredError*>(&e))
     std::cerr << " (not understood: " << output::printable_error(not_understood) << ")";
   if (!suggestions.empty()) std::cerr << "; did you mean " << output::printable_error(suggestions) << "?";
+  if (!dash_file.empty())
+    std::cerr << "; '" << output::printable_error(dash_file) << "' is a file whose name reads as an option: write ./"
+              << output::printable_error(dash_file);
   std::cerr << "\nRun with --help for more information.\n";
   return e.get_exit_code();
 }

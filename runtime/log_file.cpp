@@ -29,6 +29,8 @@ const char* file_kind(mode_t m) {
 }  // namespace
 
 LogFile::LogFile(const std::string& path, const std::string& expected) : path_(path) {
+  // ": cannot open a vehicle file" read as a fault of quadgen's (a review, helper-135).
+  if (path.empty()) throw LogError("an empty path where " + expected + " was expected (an unset shell variable?)");
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) throw LogError(path + ": cannot open " + expected + ": " + std::strerror(errno));
   try {

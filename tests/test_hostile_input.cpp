@@ -1735,6 +1735,16 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   expect_error({"diagnos", f3, "--out", tmp / "o"}, 106, "unknown command 'diagnos' (commands: derive, simulate, fit, "
                                                           "diagnose, predict); did you mean 'diagnose'?");
   expect_error({"generate", f3, "--out", tmp / "o"}, 106, "'derive' writes the generated C++");
+  // An empty path (an unset shell variable) and a log whose name begins with '-' (read as an
+  // option: "logs is required" alone; a review, helper-135).
+  expect_error({"derive", "", "--out", tmp / "o"}, 2, "an empty path where a vehicle file was expected");
+  write(tmp / "-x.csv", "t,u_A\n");
+  {
+    const CliResult r = run_quadgen({"predict", f3, "-x.csv", "--out", tmp / "o"}, tmp.dir);
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("'-x.csv' is a file whose name reads as an option: write ./-x.csv"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp / "o"));
+  }
   // A misspelt required option: CLI11 alone says only that --out is missing.
   expect_error({"derive", f3, "--ouut", tmp / "o"}, 106,
                "--out is required (not understood: --ouut); did you mean '--out' for '--ouut'?");
