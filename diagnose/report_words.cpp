@@ -100,6 +100,12 @@ std::string lower_or_higher(double before, double after, int digits) {
 
 namespace {
 
+// An estimate whose interval (widened by its numerical allowance) holds no 0.
+bool told_apart_from_zero(const EffectEstimate* p) {
+  return p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0;
+}
+bool has_interval(const EffectEstimate* p) { return std::isfinite(p->lower) && std::isfinite(p->upper); }
+
 // One flight's sentence (or the one flight's): `ps` are that flight's parameters, `reference`
 // the plain name of the reference parameter where the effect has one. Where the first
 // parameter is the reference (motor gains), one whose interval holds 0 is not told apart from
@@ -109,8 +115,7 @@ namespace {
 std::string flight_headline(const Effect& e, const std::vector<const EffectEstimate*>& ps, const std::string& reference) {
   std::set<std::string> apart;  // shared names with an interval away from 0
   for (const auto* p : ps)
-    if (p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0)
-      apart.insert(runtime::shared_name(p->name));
+    if (told_apart_from_zero(p)) apart.insert(runtime::shared_name(p->name));
   const bool drop_unresolved = e.first_parameter_is_reference && !apart.empty();
   std::map<std::string, double> values;
   size_t dropped = 0;
@@ -123,9 +128,7 @@ std::string flight_headline(const Effect& e, const std::vector<const EffectEstim
   }
   std::string s = e.headline(values, reference);
   if (dropped > 0) s += " The others are within their intervals of the reference.";
-  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() &&
-           std::all_of(ps.begin(), ps.end(),
-                       [](const EffectEstimate* p) { return std::isfinite(p->lower) && std::isfinite(p->upper); }))
+  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() && std::all_of(ps.begin(), ps.end(), has_interval))
     s += " Each interval holds 0: the values are significant only together.";
   return s;
 }
@@ -154,18 +157,12 @@ std::string headline(const Finding& f) {
   }
   std::string s;
   for (const auto& [flight, ps] : by_flight) {
-    const bool any_apart = std::any_of(ps.begin(), ps.end(), [](const EffectEstimate* p) {
-      return p->lower - p->numerical_allowance > 0 || p->upper + p->numerical_allowance < 0;
-    });
     // A flight where nothing is told apart: the effect was named on the flights together, so
     // "significant only together" would not be this flight's to claim. An open interval holds
     // nothing that can be said (a review, helper-137).
-    const bool all_closed = std::all_of(ps.begin(), ps.end(), [](const EffectEstimate* p) {
-      return std::isfinite(p->lower) && std::isfinite(p->upper);
-    });
     s += (s.empty() ? "" : " ") + std::string("Flight ") + std::to_string(flight) + ": " +
-         (any_apart    ? flight_headline(e, ps, reference)
-          : all_closed ? std::string("none told apart from 0 (each interval holds it).")
+         (std::any_of(ps.begin(), ps.end(), told_apart_from_zero) ? flight_headline(e, ps, reference)
+          : std::all_of(ps.begin(), ps.end(), has_interval)       ? std::string("none told apart from 0 (each interval holds it).")
                        : std::string("none told apart from 0 (not every value has an interval)."));
   }
   return s;
