@@ -33,6 +33,15 @@ void check_row(const runtime::CsvTable& t, size_t row) {
   }
 }
 
+// The steady rotor speed at command u and its gradient in (a0, a1, a2): the map, and 0 with
+// the motor off. predict and evaluate both use it; evaluate once spelled the map itself and
+// zeroed only the old level, so a step down to 0 was fitted towards a0 (a review, helper-137).
+double steady_rpm(const double* p, double u, double grad[3]) {
+  const double on = u == 0 ? 0.0 : 1.0;
+  grad[0] = on, grad[1] = on * u, grad[2] = on * u * u;
+  return on * runtime::motor_map(p[0], p[1], p[2], u);
+}
+
 }  // namespace
 
 std::vector<MotorStep> read_motor_steps(const std::string& path) {
@@ -96,10 +105,11 @@ std::vector<FitParameter> MotorStepModel::parameters() const {
 
 double MotorStepModel::predict(const double* p, size_t k, double t) const {
   const MotorStep& s = steps_[k];
-  auto ss = [&](double u) { return u == 0 ? 0.0 : runtime::motor_map(p[0], p[1], p[2], u); };
+  double unused[3];
+  const double ss_old = steady_rpm(p, s.u_old, unused), ss_new = steady_rpm(p, s.u_new, unused);
   const double ts = s.t_before + p[kFirstStepTime + k];
-  if (t < ts) return ss(s.u_old);
-  return ss(s.u_new) + (ss(s.u_old) - ss(s.u_new)) * std::exp(-(t - ts) / p[kTau]);
+  if (t < ts) return ss_old;
+  return ss_new + (ss_old - ss_new) * std::exp(-(t - ts) / p[kTau]);
 }
 
 void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
@@ -107,8 +117,8 @@ void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
   int row = 0;
   for (size_t k = 0; k < steps_.size(); ++k) {
     const MotorStep& s = steps_[k];
-    const double uo = s.u_old, un = s.u_new, on = uo == 0 ? 0.0 : 1.0;
-    const double ss_old = on * (p[0] + p[1] * uo + p[2] * uo * uo), ss_new = p[0] + p[1] * un + p[2] * un * un;
+    double g_old[3], g_new[3];
+    const double ss_old = steady_rpm(p, s.u_old, g_old), ss_new = steady_rpm(p, s.u_new, g_new);
     const double ts = s.t_before + p[kFirstStepTime + k], tau = p[kTau];
     for (size_t i = 0; i < s.t.size(); ++i, ++row) {
       const double t = s.t[i];
@@ -117,9 +127,7 @@ void MotorStepModel::evaluate(const double* p, double* r, double* J) const {
       if (!J) continue;
       double* Jr = J + static_cast<size_t>(row) * np;
       for (int j = 0; j < np; ++j) Jr[j] = 0;
-      Jr[0] = (1 - e) + e * on;
-      Jr[1] = (1 - e) * un + e * on * uo;
-      Jr[2] = (1 - e) * un * un + e * on * uo * uo;
+      for (int c = 0; c < 3; ++c) Jr[c] = (1 - e) * g_new[c] + e * g_old[c];
       if (t >= ts) {
         Jr[3] = (ss_old - ss_new) * e * (t - ts) / (tau * tau);
         Jr[4 + k] = (ss_old - ss_new) * e / tau;

@@ -141,6 +141,41 @@ TEST(Fit, MotorStepModelJacobianMatchesFiniteDifferences) {
   }
 }
 
+// The residual is the plotted model minus the measurement on every step, a step down to the
+// motor off (0 rpm, not a0) included, and the Jacobian holds there too. evaluate zeroed only
+// the old level and fitted a step to 0 towards a0 (a review, helper-137).
+TEST(Fit, MotorStepModelFitsWhatItPlotsWithTheMotorSwitchedOff) {
+  std::vector<MotorStep> steps;
+  const double levels[] = {0.0, 0.3, 0.6, 0.9, 0.0, 0.5};
+  for (int k = 1; k < 6; ++k) {
+    MotorStep s;
+    s.t_before = k - 0.05, s.t_first = k + 0.05;
+    s.u_old = levels[k - 1], s.u_new = levels[k];
+    for (double t = s.t_first; t < k + 0.9; t += 0.1) s.t.push_back(t), s.rpm.push_back(1000.0 * k);
+    steps.push_back(s);
+  }
+  MotorStepModel m(steps);
+  std::vector<double> p;
+  for (const auto& q : m.parameters()) p.push_back(q.value);
+  const int nr = m.num_residuals(), np = static_cast<int>(p.size());
+  std::vector<double> r(nr), J(static_cast<size_t>(nr) * np), rp(nr), rm(nr);
+  m.evaluate(p.data(), r.data(), J.data());
+  int row = 0;
+  for (size_t k = 0; k < steps.size(); ++k)
+    for (size_t i = 0; i < steps[k].t.size(); ++i, ++row)
+      EXPECT_NEAR(r[row] + steps[k].rpm[i], m.predict(p.data(), k, steps[k].t[i]), 1e-9) << "step " << k + 1 << " sample " << i;
+  // Long after the step to 0, the model is at rest, not at a0 = 1500 rpm.
+  EXPECT_NEAR(m.predict(p.data(), 3, 4.85), 0.0, 1.0);
+  for (int j = 0; j < np; ++j) {
+    const double h = 1e-6 * std::max(1.0, std::fabs(p[j]));
+    auto pp = p, pm = p;
+    pp[j] += h, pm[j] -= h;
+    m.evaluate(pp.data(), rp.data(), nullptr);
+    m.evaluate(pm.data(), rm.data(), nullptr);
+    for (int i = 0; i < nr; ++i) EXPECT_NEAR(J[static_cast<size_t>(i) * np + j], (rp[i] - rm[i]) / (2 * h), 1e-3 * (1 + std::fabs(J[static_cast<size_t>(i) * np + j])));
+  }
+}
+
 // 95 % profile intervals of the lag must cover the truth in 90-99 % of 100 replicates.
 TEST(Fit, ProfileIntervalsCoverTheTruth) {
   const auto layout = read_motor_steps(test::source_path("data/finken3_motor_steps.csv"));
