@@ -80,10 +80,11 @@ std::vector<MotorStep> read_motor_steps(const std::string& path) {
   for (const auto& s : steps)
     for (double u : {s.u_old, s.u_new})
       if (u > 0) levels.insert(u);
-  if (levels.size() < 3)
+  if (levels.size() < runtime::kMotorMapCoefficients)
     throw FitError(path + ": " + std::to_string(steps.size()) + " throttle step" + (steps.size() == 1 ? "" : "s") + " at " +
                    std::to_string(levels.size()) + " command" + (levels.size() == 1 ? "" : "s") +
-                   " above 0: the motor map rpm = a0 + a1 u + a2 u^2 needs at least 3 different ones");
+                   " above 0: the motor map rpm = a0 + a1 u + a2 u^2 needs at least " +
+                   std::to_string(runtime::kMotorMapCoefficients) + " different ones");
   return steps;
 }
 

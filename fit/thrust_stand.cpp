@@ -78,9 +78,10 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
   // cannot give it, and 50 identical rows ended in "J^T J overflows" (a review, helper-135).
   std::set<double> commands;
   for (const auto& s : out) commands.insert(s.u);
-  if (commands.size() < 3)
+  if (commands.size() < runtime::kMotorMapCoefficients)
     throw FitError(path + ": the motors ran at " + std::to_string(commands.size()) + " command" +
-                   (commands.size() == 1 ? "" : "s") + " (pwm): the motor map needs a run over at least 3 different commands");
+                   (commands.size() == 1 ? "" : "s") + " (pwm): the motor map needs a run over at least " +
+                   std::to_string(runtime::kMotorMapCoefficients) + " different commands");
   return out;
 }
 

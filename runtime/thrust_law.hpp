@@ -27,6 +27,9 @@ template <typename T, typename U>
 T motor_map(const T& a0, const T& a1, const T& a2, const U& u) {
   return a0 + a1 * u + a2 * u * u;
 }
+// Its coefficients: a measurement at fewer different commands leaves the map undetermined
+// (the fits of motor steps and of a thrust stand refuse such files with this number).
+constexpr int kMotorMapCoefficients = 3;
 
 // One rotor's law in numbers, and its inverse: what it takes to turn a thrust into a command.
 struct ThrustLaw {
