@@ -7,6 +7,7 @@
 #include "app/diagnose_job.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "cli/options.hpp"
+#include "fit/log_reader.hpp"
 #include "output/output_set.hpp"
 #include "output/progress.hpp"
 #include "output/sinks.hpp"
@@ -26,12 +27,12 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--out", a.out, "output directory")->required();
   c->add_option("--mapping", j.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", j.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5))
+      ->check(finite_range(fit::kResampleRange))
       ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_option("--validation", o.validation_fraction, "fraction of the flight (at its end) held out")
-      ->check(finite_range(0.1, 0.6));
+      ->check(finite_range(diagnose::kDiagnoseValidationRange));
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
-      ->check(finite_range(1e-9, 0.2));
+      ->check(finite_range(diagnose::kAlphaRange));
   c->add_option("--max-effects", o.search.max_effects,
                 "forward-selection steps at most (each adds one effect; later tests may turn it down)")
       ->check(CLI::Range(1, static_cast<int>(diagnose::kMaxEffectsAllowed)));
@@ -45,11 +46,11 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
       ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
-  c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(0.1, 10.0));
+  c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(diagnose::kDiagnoseWindowRange));
   c->add_option("--window-stride", o.window_stride,
                 "time between the starts of the validation windows the held-out position error is taken over [s]: "
-                "0 (consecutive windows) or from 0.01 to below --window")
-      ->check(finite_range(0.0, 10.0));
+                "0 (consecutive windows) or from " + output::short_number(diagnose::kSmallestWindowStride) + " to below --window")
+      ->check(finite_range(0.0, diagnose::kDiagnoseWindowRange.hi));  // the rest: DiagnoseOptions::IsValid
   c->add_option("--airframe", j.airframe,
                 "diagnosis.json of an earlier diagnosis of this vehicle (best a joint one: its airframe is what several "
                 "flights share): also refit its named effects on this one flight and say whether the flight agrees with it");

@@ -13,6 +13,7 @@
 #include "output/sinks.hpp"
 #include "app/model_registry.hpp"
 #include "cli/options.hpp"
+#include "fit/log_reader.hpp"
 #include "output/output_set.hpp"
 #include "model/vehicle.hpp"
 
@@ -34,12 +35,12 @@ void add_fit(CLI::App& app, FitArgs& a) {
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--effects", a.effects, "comma-separated effects to add, or 'all': " + effect_names);
   c->add_option("--validation", a.options.validation, "fraction of the flight (at its end) held out for validation")
-      ->check(finite_range(0.0, 0.9));
+      ->check(finite_range(kFitValidationRange));
   c->add_option("--formulation", a.options.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
       ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
-  c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(0.01, 100));
+  c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(kFitWindowRange));
   c->add_option("--resample", a.options.resample, "resample the log onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5))
+      ->check(finite_range(kResampleRange))
       ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--translational", a.options.translational,

@@ -17,6 +17,7 @@
 
 #include "derive/dynamics.hpp"
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/accepted_range.hpp"
 #include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
 #include "output/output_set.hpp"
@@ -111,6 +112,9 @@ inline CLI::Validator finite_range(double lo, double hi) {
       },
       "in " + range_text(lo, hi));
 }
+
+// ... the range its options struct declares (output/accepted_range.hpp), which IsValid checks too.
+inline CLI::Validator finite_range(const output::AcceptedRange& r) { return finite_range(r.lo, r.hi); }
 
 // Switches a command's output in and says when it replaced an earlier run of the same
 // command in that folder (two runs given one --out keep only the second).

@@ -6,6 +6,7 @@
 #include "app/predict_job.hpp"
 #include "cli/commands.hpp"
 #include "cli/options.hpp"
+#include "fit/log_reader.hpp"
 #include "output/output_set.hpp"
 #include "output/progress.hpp"
 #include "predict/predict_flights.hpp"
@@ -23,9 +24,9 @@ void add_predict(CLI::App& app, PredictArgs& a) {
                 "parameter values from a fit.json or diagnosis.json (default: the vehicle file's nominal values)");
   c->add_option("--validation", a.options.validation,
                 "fraction of each flight (at its end) evaluated; 1 for flights no fit has seen")
-      ->check(finite_range(0.05, 1.0));
+      ->check(finite_range(predict::kPredictValidationRange));
   c->add_option("--resample", a.options.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
-      ->check(finite_range(0.1, 1e5))
+      ->check(finite_range(fit::kResampleRange))
       ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
   c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (c_t, motor trims, "
@@ -45,13 +46,13 @@ void add_predict(CLI::App& app, PredictArgs& a) {
   c->add_option("--controller-gain", a.options.controller_output_scale,
                 "with --controller: logged command counts per count of the loop's output (the firmware's battery "
                 "compensation between them; 1: none)")
-      ->check(finite_range(0.05, 20))
+      ->check(finite_range(predict::kControllerGainRange))
       ->needs(controller);
-  c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(0.001, 10));
+  c->add_option("--stride", a.options.prediction.start_stride, "seconds between rollout start points")->check(finite_range(predict::kStartStrideRange));
   c->add_option("--disturbance-window", a.options.prediction.disturbance_window,
                 "seconds of log before each start whose mean acceleration residual the open loop with the past "
                 "disturbance holds (0: that view is not run)")
-      ->check(finite_range(0.0, 10));
+      ->check(finite_range(predict::kDisturbanceWindowRange));
 }
 
 int run_predict(const PredictArgs& a) {

@@ -739,15 +739,15 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
     if (error) *error = why;
     return false;
   };
-  if (!(validation_fraction >= 0.1 && validation_fraction <= 0.6)) return fail("validation fraction: 0.1 to 0.6");
-  if (!(window >= 0.1 && window <= 10)) return fail("validation window: 0.1 to 10 s");
-  // Below 10 ms the starts would outnumber the samples of a 100 Hz log; from the window's
-  // length on, the windows would not overlap (consecutive windows are stride 0).
-  if (!(window_stride == 0 || (window_stride >= 0.01 && window_stride < window)))
-    return fail("window stride: 0 (consecutive windows) or from 0.01 s to below the window's length");
+  if (!kDiagnoseValidationRange.contains(validation_fraction))
+    return fail("validation fraction: " + kDiagnoseValidationRange.text());
+  if (!kDiagnoseWindowRange.contains(window)) return fail("validation window: " + kDiagnoseWindowRange.text("s"));
+  if (!(window_stride == 0 || (window_stride >= kSmallestWindowStride && window_stride < window)))
+    return fail("window stride: 0 (consecutive windows) or from " + output::short_number(kSmallestWindowStride) +
+                " s to below the window's length");
   if (translational != "auto" && translational != "pose" && translational != "accelerometer")
     return fail("translational channels: auto, pose or accelerometer");
-  if (!(search.alpha > 0 && search.alpha <= 0.2)) return fail("alpha: above 0, at most 0.2");
+  if (!kAlphaRange.contains(search.alpha)) return fail("alpha: " + kAlphaRange.text());
   if (search.max_effects < 1 || search.max_effects > static_cast<int>(kMaxEffectsAllowed))
     return fail("max effects: 1 to " + std::to_string(kMaxEffectsAllowed));
   if (!(unexplained_ratio > 1) || !(unexplained_p > 0 && unexplained_p < 1))

@@ -20,6 +20,7 @@
 #include "diagnose/term_discovery.hpp"
 #include "diagnose/validation.hpp"
 #include "model/vehicle.hpp"
+#include "output/accepted_range.hpp"
 
 namespace quadgen::diagnose {
 
@@ -27,6 +28,14 @@ namespace quadgen::diagnose {
 // its effect does not act on by hundredths of a per cent. Used where a gain is said to be paid
 // for by a kind of channel, and where the report says which held-out channels got worse.
 inline constexpr double kNegligibleChangePercent = 1.0;
+
+// The values DiagnoseOptions accepts (its IsValid and the command line's checks).
+inline constexpr output::AcceptedRange kDiagnoseValidationRange{0.1, 0.6};  // fraction held out
+inline constexpr output::AcceptedRange kDiagnoseWindowRange{0.1, 10};       // s
+// Below 10 ms the windows' starts would outnumber the samples of a 100 Hz log; from the
+// window's length on, the windows would not overlap (consecutive windows are stride 0).
+inline constexpr double kSmallestWindowStride = 0.01;  // s
+inline constexpr output::AcceptedRange kAlphaRange{1e-9, 0.2};
 
 struct DiagnoseOptions {
   double validation_fraction = 0.3;  // end of the flight, held out

@@ -167,11 +167,11 @@ bool FitJobOptions::IsValid(std::string* error) const {
     return false;
   };
   if (threads < 0) return fail("threads: 0 (one per core) or more");
-  if (!valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
-  if (!(validation >= 0 && validation <= 0.9)) return fail("validation fraction: 0 to 0.9");
+  if (!valid_resample_rate(resample)) return fail("resample: 0 or " + kResampleRange.text("Hz"));
+  if (!kFitValidationRange.contains(validation)) return fail("validation fraction: " + kFitValidationRange.text());
   if (formulation != "equation_error" && formulation != "multiple_shooting")
     return fail("formulation: equation_error or multiple_shooting");
-  if (!(window >= 0.01 && window <= 100)) return fail("window: 0.01 to 100 s");
+  if (!kFitWindowRange.contains(window)) return fail("window: " + kFitWindowRange.text("s"));
   if (!translational.empty() && translational != "pose" && translational != "accelerometer")
     return fail("translational: pose or accelerometer (empty: the accelerometer where logged)");
   return true;

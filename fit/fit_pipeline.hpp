@@ -15,6 +15,7 @@
 #include "fit/least_squares.hpp"
 #include "fit/profile_likelihood.hpp"
 #include "model/vehicle.hpp"
+#include "output/accepted_range.hpp"
 
 namespace quadgen::runtime {
 class DynamicModel;
@@ -26,6 +27,10 @@ enum class LogKind { kFlight, kMotorSteps, kThrustStand };
 
 // A ULog is a flight; a CSV is told apart by its columns.
 LogKind log_kind(const std::string& path);
+
+// The values FitJobOptions accepts (its IsValid and the command line's checks).
+inline constexpr output::AcceptedRange kFitValidationRange{0, 0.9};  // fraction held out
+inline constexpr output::AcceptedRange kFitWindowRange{0.01, 100};   // s
 
 struct FitJobOptions {
   bool robust = false;                 // Huber loss instead of squares

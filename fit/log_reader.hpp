@@ -16,6 +16,7 @@
 #include <string>
 
 #include "fit/flight_data.hpp"
+#include "output/accepted_range.hpp"
 #include "runtime/flight_log.hpp"
 #include "runtime/ulog.hpp"
 #include "runtime/usd_log.hpp"
@@ -35,8 +36,9 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
 // empty (`mapping` null) for a canonical CSV; a log of topics needs one. `resample_hz` > 0
 // resamples the result (a log of topics is always sampled at that rate, 100 Hz when 0).
 runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz);
-// The resample rates options accept: 0 (as logged) or 0.1 to 1e5 Hz.
-inline bool valid_resample_rate(double hz) { return hz == 0 || (hz >= 0.1 && hz <= 1e5); }
+// The resample rates options accept: 0 (as logged) or kResampleRange [Hz].
+inline constexpr output::AcceptedRange kResampleRange{0.1, 1e5};
+inline bool valid_resample_rate(double hz) { return hz == 0 || kResampleRange.contains(hz); }
 runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz);
 
 }  // namespace quadgen::fit

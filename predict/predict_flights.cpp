@@ -87,8 +87,24 @@ std::string percent(double fraction) {
 
 }  // namespace
 
+bool PredictFlightsOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or " + fit::kResampleRange.text("Hz"));
+  if (!kPredictValidationRange.contains(validation)) return fail("validation fraction: " + kPredictValidationRange.text());
+  if (!kControllerGainRange.contains(controller_output_scale))
+    return fail("controller gain: " + kControllerGainRange.text());
+  if (!kStartStrideRange.contains(prediction.start_stride)) return fail("start stride: " + kStartStrideRange.text("s"));
+  if (!kDisturbanceWindowRange.contains(prediction.disturbance_window))
+    return fail("disturbance window: " + kDisturbanceWindowRange.text("s"));
+  return true;
+}
+
 PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model, const std::vector<fit::FitParameter>& bounds,
                                  const std::vector<std::string>& logs, const PredictFlightsOptions& o) {
+  if (std::string error; !o.IsValid(&error)) throw std::invalid_argument("predict: " + error);
   if (o.calibrate && o.params.empty()) throw std::invalid_argument("--calibrate needs --params (a diagnosis.json)");
   if (o.calibrate && o.validation >= 1.0)
     throw std::invalid_argument("--calibrate needs a part before the evaluated one: --validation below 1");

@@ -13,6 +13,7 @@
 #include "runtime/dynamic_model.hpp"
 #include "fit/flight_data.hpp"
 #include "fit/least_squares.hpp"
+#include "output/accepted_range.hpp"
 #include "output/progress.hpp"
 #include "predict/prediction.hpp"
 #include "model/effect.hpp"
@@ -22,6 +23,12 @@ namespace quadgen::predict {
 
 // The controllers PredictFlightsOptions::set_point_controller may name (the CLI's choices too).
 inline const std::vector<std::string> kSetPointControllers = {"crazyflie-pid"};
+
+// The values PredictFlightsOptions accepts (its IsValid and the command line's checks).
+inline constexpr output::AcceptedRange kPredictValidationRange{0.05, 1};  // fraction evaluated
+inline constexpr output::AcceptedRange kControllerGainRange{0.05, 20};
+inline constexpr output::AcceptedRange kStartStrideRange{0.001, 10};      // s
+inline constexpr output::AcceptedRange kDisturbanceWindowRange{0, 10};    // s
 
 struct PredictFlightsOptions {
   // The column mapping for logs not in the canonical layout, read once (fit::load_mapping).
@@ -44,6 +51,10 @@ struct PredictFlightsOptions {
   double controller_output_scale = 1;  // runtime::AttitudePidOptions::output_scale
   PredictionOptions prediction;
   output::Progress progress;  // which log, calibration, notes; nowhere by default
+
+  // Ceres-style: false with a reason for a value no prediction can use (predict_flights
+  // throws it).
+  bool IsValid(std::string* error) const;
 };
 
 struct PredictedFlights {

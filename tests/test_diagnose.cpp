@@ -1425,6 +1425,9 @@ TEST(DiagnoseJob, RefusesOptionsNoDiagnosisCanUse) {
   job.options.search.alpha = std::nan("");
   EXPECT_FALSE(job.IsValid(&why));
   EXPECT_NE(why.find("alpha"), std::string::npos) << why;
+  job.options.search.alpha = 1e-12;  // the command line refused it and the library did not (one range now)
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_NE(why.find("alpha: 1e-09 to 0.2"), std::string::npos) << why;
   job.options.search.alpha = 0.01;
   job.options.window_stride = 0.001;  // a hundred thousand windows in a 100 s held-out part
   EXPECT_FALSE(job.IsValid(&why));

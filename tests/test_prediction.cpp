@@ -1101,3 +1101,34 @@ TEST(PredictionSummary, ATiltErrorThatFallsIsNoRecovery) {
   p.open_loop[0].tilt.add(0.9), p.open_loop[1].tilt = {}, p.open_loop[1].tilt.add(0.5);
   EXPECT_EQ(quadgen::app::prediction_summary(p).find("the tilt error falls"), std::string::npos);
 }
+
+// The prediction as a library call checks its options itself, with the ranges the command
+// line checks (one home each: predict_flights.hpp); before, only the command line did, and a
+// caller's --validation of 5 was read as "the whole flight and then some".
+TEST(PredictFlights, RefusesOptionsNoPredictionCanUse) {
+  quadgen::predict::PredictFlightsOptions o;
+  std::string why;
+  EXPECT_TRUE(o.IsValid(&why)) << why;  // the library's defaults are valid
+  o.validation = 5;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("validation fraction: 0.05 to 1"), std::string::npos) << why;
+  o.validation = 1;
+  EXPECT_TRUE(o.IsValid(&why)) << why;  // a flight no fit has seen, evaluated whole
+  o.prediction.start_stride = 0;  // every start at one instant: a rollout loop that never ends
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("start stride"), std::string::npos) << why;
+  o.prediction.start_stride = 0.05;
+  o.controller_output_scale = std::nan("");
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("controller gain"), std::string::npos) << why;
+  o.controller_output_scale = 1;
+  o.resample = 0.01;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("resample"), std::string::npos) << why;
+  o.resample = 0;
+  o.prediction.disturbance_window = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  const quadgen::Vehicle v = quadgen::load_vehicle(quadgen::test::source_path("vehicles/crazyflie21.yaml"));
+  CrazyflieModel model;
+  EXPECT_THROW(quadgen::predict::predict_flights(v, model, {}, {"no_such.csv"}, o), std::invalid_argument);
+}
