@@ -36,7 +36,7 @@ bool DiagnoseJob::IsValid(std::string* error) const {
   if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
   if (!airframe.empty() && logs.size() != 1)
     return fail("airframe: checks one flight against an airframe; several logs are diagnosed jointly instead");
-  if (!environment.empty() && environment != "indoor" && environment != "outdoor" && environment != "unknown")
+  if (!environment.empty() && !is_environment_name(environment))
     return fail("environment: indoor, outdoor or unknown");
   return options.IsValid(error);
 }

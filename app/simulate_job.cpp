@@ -522,6 +522,9 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
+  if (a.ground_height && !(std::fabs(*a.ground_height) <= kMaxGroundHeight))
+    throw std::invalid_argument("--ground " + output::six_digits(*a.ground_height) + ": expected a height within +-" +
+                                output::short_number(kMaxGroundHeight) + " m");
   const Vehicle vehicle = load_vehicle(a.vehicle);
   if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
   if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);
@@ -542,13 +545,16 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   const OpenLoop k = open_loop_context(m, vehicle, belief);  // also where a vehicle that cannot hover is said
   if (a.closed_loop && (a.ground_at_start || a.ground_height))
     throw std::invalid_argument("a ground is for a scenario or a replay; the closed-loop flight stays in the air");
+  SimulateJobResult result;
   try {
-    return a.closed_loop ? run_closed_loop(a, vehicle, belief, m) : run_open_loop(a, vehicle, k);
+    result = a.closed_loop ? run_closed_loop(a, vehicle, belief, m) : run_open_loop(a, vehicle, k);
   } catch (const DivergenceError& e) {
     const std::string cause = implausible_settings(a, vehicle);
     if (cause.empty()) throw;
     throw DivergenceError(e.what() + cause);
   }
+  render_svg(result.plot_title, result.plot, &result.svg, &result.plot_error);
+  return result;
 }
 
 }  // namespace quadgen::app

@@ -32,7 +32,7 @@ struct SimulateJob {
   // none by default; at the start's height (the log's first z; 0 for a scenario) with
   // ground_at_start, else at ground_height [m, world z of the body origin standing on it].
   bool ground_at_start = false;
-  std::optional<double> ground_height;
+  std::optional<double> ground_height;  // within +-kMaxGroundHeight
   // Closed loop: the flight generator's seed, trajectory, noise and disturbances, with its
   // defaults (its own duration is replaced by `duration`), and the true model's parameter
   // overrides.
@@ -42,10 +42,15 @@ struct SimulateJob {
   output::Progress progress;   // "simulating 5 s of ..."; nowhere by default
 };
 
+// A ground further from the origin than this [m] is a mistyped number, not a ground.
+inline constexpr double kMaxGroundHeight = 1e4;
+
 struct SimulateJobResult {
   std::string csv;                     // the trajectory, canonical flight-log layout
   std::string plot_title;
   std::vector<runtime::Panel> plot;    // translation, rotation, thrust; or position and commands
+  std::string svg;                     // the plot drawn (TRAJ.svg), or
+  std::string plot_error;              // why it could not be (no gnuplot)
   std::string summary;                 // what the command prints
   std::vector<std::string> notes;      // what the user should know about the flight (its commands' limits)
 };

@@ -3,7 +3,7 @@
 // The pipeline itself: app/diagnose_job.cpp.
 #include <iostream>
 
-#include "cli/commands.hpp"
+#include "cli/diagnose_command.hpp"
 #include "app/diagnose_job.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "cli/options.hpp"
@@ -28,7 +28,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--mapping", j.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", j.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(fit::kResampleRange))
-      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
+      ->default_str(fit::resample_default_text());
   c->add_option("--validation", o.validation_fraction, "fraction of the flight (at its end) held out")
       ->check(finite_range(diagnose::kDiagnoseValidationRange));
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
@@ -45,7 +45,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--environment", j.environment,
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
-      ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
+      ->check(CLI::IsMember(kEnvironmentNames));
   c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(diagnose::kDiagnoseWindowRange));
   c->add_option("--window-stride", o.window_stride,
                 "time between the starts of the validation windows the held-out position error is taken over [s]: "

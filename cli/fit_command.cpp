@@ -1,21 +1,19 @@
-// quadgen fit VEHICLE.yaml LOG --out DIR: flags to options; the fits are fit/fit_pipeline.
-// The kind of fit follows the log's layout; an option that kind does not use is refused.
-#include <algorithm>
+// quadgen fit VEHICLE.yaml LOG --out DIR: flags into an app::FitJob (defaults are the
+// library's), the job's files written as one output set. The kind of fit follows the log's
+// layout; an option that kind does not use is refused. The pipeline itself: app/fit_job.cpp.
 #include <iostream>
 #include <set>
-#include <sstream>
 
-#include "cli/commands.hpp"
-#include "derive/effects/effect_catalogue.hpp"
-#include "fit/fit_pipeline.hpp"
-#include "output/joined.hpp"
-#include "output/json_document.hpp"
-#include "output/sinks.hpp"
-#include "app/model_registry.hpp"
+#include "app/fit_job.hpp"
+#include "cli/fit_command.hpp"
 #include "cli/options.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
-#include "output/output_set.hpp"
 #include "model/vehicle.hpp"
+#include "output/joined.hpp"
+#include "output/names.hpp"
+#include "output/output_set.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::cli {
 
@@ -41,7 +39,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(kFitWindowRange));
   c->add_option("--resample", a.options.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(kResampleRange))
-      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
+      ->default_str(fit::resample_default_text());
   c->add_option("--channels", a.channels, "residual channels to fit (default all): ax,ay,az,pdot,qdot,rdot");
   c->add_option("--translational", a.options.translational,
                 "equation error: ax, ay, az from the accelerometer (body specific force at each sample) or from the "
@@ -62,27 +60,12 @@ void add_fit(CLI::App& app, FitArgs& a) {
 
 namespace {
 
-// A comma-separated option value; a name given twice is refused (a channel listed twice was
-// weighted twice in the fit), as --candidates and --effects refuse one.
-std::vector<std::string> split_list(const std::string& s, const std::string& option) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (item.empty()) continue;
-    if (std::find(out.begin(), out.end(), item) != out.end())
-      throw std::invalid_argument(option + ": '" + output::printable(item) + "' is given twice");
-    out.push_back(item);
-  }
-  return out;
-}
-
 FitJobOptions job_options(const FitArgs& a) {
   FitJobOptions o = a.options;
   o.profile_all_free = a.profiles != "none";
-  if (a.profiles != "all" && a.profiles != "none") o.profiles = split_list(a.profiles, "--profiles");
-  o.channels = split_list(a.channels, "--channels");
-  o.free = split_list(a.free, "--free");
+  if (a.profiles != "all" && a.profiles != "none") o.profiles = output::split_name_list(a.profiles, "--profiles");
+  o.channels = output::split_name_list(a.channels, "--channels");
+  o.free = output::split_name_list(a.free, "--free");
   o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   return o;
 }
@@ -109,31 +92,21 @@ void check_flight_options(const FitArgs& a) {
 }  // namespace
 
 int run_fit(const FitArgs& a) {
-  const Vehicle v = load_vehicle(a.vehicle);
-  if (const std::string note = fitted_section_note(v, "fit"); !note.empty()) std::cerr << note << "\n";
+  const Vehicle v = load_vehicle(a.vehicle);  // a bad file is reported before anything is created
   const LogKind kind = log_kind(a.log);
-  output::OutputDirectory out(a.out, "fit", {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
-  const FitJobOptions o = job_options(a);
-  FitOutputs result;
-  if (kind == LogKind::kMotorSteps) {
+  if (kind == LogKind::kMotorSteps)
     refuse_options(a, "a motor-step log", {"--out", "--robust", "--profiles", "--threads"});
-    result = fit_motor_steps_log(a.log, v, o);
-  } else if (kind == LogKind::kThrustStand) {
+  else if (kind == LogKind::kThrustStand)
     refuse_options(a, "a thrust-stand log", {"--out", "--robust", "--threads"});
-    result = fit_thrust_stand_log(a.log, v, o);
-  } else {
+  else
     check_flight_options(a);
-    std::string how;
-    const std::unique_ptr<runtime::DynamicModel> model = app::model_for(v, parse_effect_list(a.effects), &how);
-    std::cerr << "model: " << how << "\n";
-    result = fit_flight_log(a.log, v, *model, o);
-  }
-  out.add("fit.json", output::json_document(result.json));
-  for (const auto& [file, svg] : result.plots) out.add(file, svg);
-  for (const auto& err : result.plot_errors) std::cerr << "no plot " << output::printable_lines(err) << "\n";
+  output::OutputDirectory out(a.out, "fit", {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
+  const app::FitJobResult r = app::run_fit_job({a.vehicle, a.log, a.effects, job_options(a)}, v, kind);
+  for (const auto& [name, contents] : r.files) out.add(name, contents);
+  for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";
   commit_and_say(out, "fit");
-  std::cout << output::printable_lines(result.summary);
-  for (const auto& w : result.warnings) std::cerr << "quadgen: warning: " << output::printable(w) << "\n";
+  std::cout << output::printable_lines(r.summary);
+  for (const auto& w : r.warnings) std::cerr << "quadgen: warning: " << output::printable(w) << "\n";
   return 0;
 }
 

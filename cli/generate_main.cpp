@@ -19,10 +19,5 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return quadgen::cli::report_parse_error(app, e);
   }
-  try {
-    return quadgen::cli::run_derive(derive);
-  } catch (const std::exception& e) {
-    std::cerr << "quadgen: error: " << quadgen::output::printable_error(e.what()) << "\n";
-    return 2;
-  }
+  return quadgen::cli::run_reporting_errors([&] { return quadgen::cli::run_derive(derive); });
 }

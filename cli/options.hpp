@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -15,8 +16,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "derive/dynamics.hpp"
-#include "derive/effects/effect_catalogue.hpp"
 #include "output/accepted_range.hpp"
 #include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
@@ -24,6 +23,26 @@
 #include "output/sinks.hpp"
 
 namespace quadgen::cli {
+
+// Every error the programs report after their flags are read: "quadgen: error: " and one line
+// of a readable length, whatever the message quotes from a hostile input (newlines, escape
+// sequences, a name of 200 kB).
+inline void print_error(const std::string& what) {
+  std::cerr << "quadgen: error: " << output::printable_error(what) << "\n";
+}
+
+// Runs a subcommand; what it throws is reported by print_error, with exit code 2.
+template <class Run>
+int run_reporting_errors(const Run& run) {
+  try {
+    return run();
+  } catch (const std::bad_alloc&) {
+    print_error("out of memory: the input or the requested work is too large for this machine");
+  } catch (const std::exception& e) {
+    print_error(e.what());
+  }
+  return 2;
+}
 
 // The option of `command` nearest to `word` ("--maping" -> "--mapping"), as nearest_word
 // judges nearness; "" when none is near.
@@ -71,13 +90,9 @@ inline int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
 // accept (the effects' names depend on the vehicle's rotors, so they are given as patterns).
 inline const char* const kLogFormats =
     "CSV in the canonical layout, or any CSV, PX4 ULog or Crazyflie uSD log through --mapping";
-// The base parameters' names come from the derivation, the effects' from their descriptors.
-inline std::string parameter_names_help() {
-  std::string base;
-  for (const std::string& name : base_parameter_names()) base += name + ", ";
-  return "the vehicle's (" + base + "and vbat_ref with battery_sag; model.json lists a model's) and the effects' (" +
-         catalogue_parameter_names() + ")";
-}
+// The base parameters' names come from the derivation, the effects' from their descriptors
+// (options.cpp: the derivation's headers stay out of the commands that do not need them).
+std::string parameter_names_help();
 
 // A finite number of the whole text, or nothing (output/numbers.hpp: the rule of the vehicle
 // file and the log cells).

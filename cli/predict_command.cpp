@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "app/predict_job.hpp"
-#include "cli/commands.hpp"
+#include "cli/predict_command.hpp"
 #include "cli/options.hpp"
 #include "fit/log_reader.hpp"
 #include "output/output_set.hpp"
@@ -27,14 +27,14 @@ void add_predict(CLI::App& app, PredictArgs& a) {
       ->check(finite_range(predict::kPredictValidationRange));
   c->add_option("--resample", a.options.resample, "resample the logs onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(fit::kResampleRange))
-      ->default_str("none for a CSV, 100 Hz for a ULog or uSD log");
+      ->default_str(fit::resample_default_text());
   c->add_flag("--calibrate", a.options.calibrate,
               "for a log the --params diagnosis was not fitted to: fit the flight's own parameters (c_t, motor trims, "
               "marker frame, wind) on the part before the evaluated one, the airframe's held");
   c->add_option("--environment", a.environment,
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
                  "unknown); with --calibrate, a calibrated value beyond what is plausible there is said")
-      ->check(CLI::IsMember({"indoor", "outdoor", "unknown"}));
+      ->check(CLI::IsMember(kEnvironmentNames));
   c->add_flag("--linear-correction", a.options.linear_correction,
               "also the one-step errors after a linear correction fitted on the part before the evaluated one (on "
               "the nominal model: a linear-regression baseline on the same split)");
@@ -68,7 +68,7 @@ int run_predict(const PredictArgs& a) {
   commit_and_say(out, "predict");
   std::cout << output::printable_lines(r.summary) << "wrote " << output::printable(a.out) << "/prediction.json\n";
   if (!r.failure.empty()) {
-    std::cerr << "quadgen: error: " << r.failure << "\n";
+    print_error(r.failure);
     return 4;
   }
   return 0;

@@ -58,20 +58,12 @@ int main(int argc, char** argv) {
     return quadgen::cli::report_parse_error(app, e);
   }
   fit.given = quadgen::cli::given_options(app.get_subcommand("fit"));
-  try {
+  return quadgen::cli::run_reporting_errors([&] {
     if (app.got_subcommand("derive")) return quadgen::cli::run_derive(derive);
     if (app.got_subcommand("simulate")) return quadgen::cli::run_simulate(simulate);
     if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
     if (app.got_subcommand("diagnose")) return quadgen::cli::run_diagnose(diagnose);
     if (app.got_subcommand("predict")) return quadgen::cli::run_predict(predict);
-  } catch (const std::bad_alloc&) {
-    std::cerr << "quadgen: error: out of memory: the input or the requested work is too large for this machine\n";
-    return 2;
-  } catch (const std::exception& e) {
-    // One line of a readable length, whatever the message quotes from a hostile input
-    // (newlines, escape sequences, a name of 200 kB).
-    std::cerr << "quadgen: error: " << quadgen::output::printable_error(e.what()) << "\n";
-    return 2;
-  }
-  return 1;
+    return 1;
+  });
 }

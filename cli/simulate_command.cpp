@@ -4,48 +4,22 @@
 #include <filesystem>
 #include <iostream>
 
-#include "runtime/closed_loop.hpp"
-#include "runtime/attitude.hpp"
-#include "cli/commands.hpp"
+#include "app/simulate_job.hpp"
+#include "cli/simulate_command.hpp"
 #include "cli/options.hpp"
+#include "output/ascii.hpp"
+#include "derive/effects/effect_catalogue.hpp"
 #include "output/output_set.hpp"
 #include "output/progress.hpp"
 #include "output/sinks.hpp"
-#include "derive/dynamics.hpp"
-#include "derive/effects/effect_catalogue.hpp"
-#include "runtime/flight_log.hpp"
-#include "derive/geometry.hpp"
-#include "runtime/integrator.hpp"
-#include "runtime/plot.hpp"
-#include "runtime/scenarios.hpp"
-#include "app/simulate_job.hpp"
 
 namespace quadgen::cli {
 
-using namespace quadgen::runtime;
+namespace {
 
-void add_simulate(CLI::App& app, SimulateArgs& a) {
-  CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
-  c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
-  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust, on any layout: hover, climb, new_height "
-                                 "(every rotor alike); right, forward, yaw (the rotors on the -x side, on +y, or spinning "
-                                 "ccw, as A, D / C, D / A, C on the thesis' FINken 3)");
-  auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a flight log (canonical CSV, or any layout with --mapping)");
-  c->add_option("--mapping", a.job.mapping, "column mapping (YAML) for an --inputs log not in the canonical layout (a CSV, a PX4 ULog, a Crazyflie uSD log)")
-      ->needs(in);
-  auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
-                         "fly a smooth random trajectory under a cascaded controller (test flights); the controller runs and the "
-                         "log is written at 100 Hz (--rate and --integrator are for scenarios and replays)");
-  sc->excludes(in);
-  cl->excludes(sc)->excludes(in);
-  // Options of one mode are refused in the others (needs/excludes), never silently ignored.
-  c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
-  c->add_option("--set", a.set,
-                std::string("NAME=VALUE for a parameter of the simulated model (repeatable): in a closed loop any "
-                            "of the true model, which the controller does not know; in a scenario or a replay an "
-                            "effect's only; an effect's values are as docs/effects.md gives them (motor_gain.<rotor> "
-                            "is a relative change: thrust x (1 + value), 0 for none); names: ") +
-                    parameter_names_help());
+// The closed-loop test flight's trajectory, noise and disturbances: each refused without
+// --closed-loop (`cl`), never silently ignored.
+void add_closed_loop_options(CLI::App* c, SimulateArgs& a, CLI::Option* cl) {
   c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(0, 10))->needs(cl);
   c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(0, 100))->needs(cl);
   c->add_option("--gyro-bias", a.job.flight.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(-10, 10))->needs(cl);
@@ -70,6 +44,33 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   c->add_option("--angular-disturbance", a.job.flight.angular_disturbance,
                 "closed loop: random roll and pitch angular acceleration, 10 Hz low-passed white noise [rad/s^2 RMS] (outside the catalogue)")
       ->check(finite_range(0.0, 100.0))->needs(cl);
+}
+
+}  // namespace
+
+void add_simulate(CLI::App& app, SimulateArgs& a) {
+  CLI::App* c = app.add_subcommand("simulate", "simulate a vehicle for a scenario or a logged input sequence");
+  c->add_option("vehicle", a.job.vehicle, "vehicle description (YAML)")->required();
+  auto* sc = c->add_option("--scenario", a.job.scenario, "a thesis manoeuvre about each rotor's hover thrust, on any layout: hover, climb, new_height "
+                                 "(every rotor alike); right, forward, yaw (the rotors on the -x side, on +y, or spinning "
+                                 "ccw, as A, D / C, D / A, C on the thesis' FINken 3)");
+  auto* in = c->add_option("--inputs", a.job.inputs, "replay the motor commands of a flight log (canonical CSV, or any layout with --mapping)");
+  c->add_option("--mapping", a.job.mapping, "column mapping (YAML) for an --inputs log not in the canonical layout (a CSV, a PX4 ULog, a Crazyflie uSD log)")
+      ->needs(in);
+  auto* cl = c->add_flag("--closed-loop", a.job.closed_loop,
+                         "fly a smooth random trajectory under a cascaded controller (test flights); the controller runs and the "
+                         "log is written at 100 Hz (--rate and --integrator are for scenarios and replays)");
+  sc->excludes(in);
+  cl->excludes(sc)->excludes(in);
+  // Options of one mode are refused in the others (needs/excludes), never silently ignored.
+  c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
+  c->add_option("--set", a.set,
+                std::string("NAME=VALUE for a parameter of the simulated model (repeatable): in a closed loop any "
+                            "of the true model, which the controller does not know; in a scenario or a replay an "
+                            "effect's only; an effect's values are as docs/effects.md gives them (motor_gain.<rotor> "
+                            "is a relative change: thrust x (1 + value), 0 for none); names: ") +
+                    parameter_names_help());
+  add_closed_loop_options(c, a, cl);
   c->add_option("--duration", a.job.duration, "simulated time [s]")
       ->required()->check(finite_range(1e-6, 1e9))->default_str("");  // required: no default to show
   c->add_option("--out", a.out, "trajectory in the canonical flight-log layout (CSV); a plot goes beside it (.svg)")
@@ -90,8 +91,8 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
       ->check(CLI::Validator(
           [](std::string& s) -> std::string {
             double v = 0;
-            if (s == "start" || (parse_finite(s, &v) && std::fabs(v) <= 1e4)) return {};
-            return "'" + s + "': expected 'start' or a height in [-10000, 10000] m";
+            if (s == "start" || (parse_finite(s, &v) && std::fabs(v) <= app::kMaxGroundHeight)) return {};
+            return "'" + s + "': expected 'start' or a height in " + range_text(-app::kMaxGroundHeight, app::kMaxGroundHeight) + " m";
           },
           "start|HEIGHT"))
       ->excludes(cl);
@@ -107,8 +108,7 @@ namespace {
 std::string plot_path(const std::string& out) { return std::filesystem::path(out).replace_extension(".svg").string(); }
 
 output::OutputFiles output_for(const SimulateArgs& a) {
-  std::string extension = std::filesystem::path(a.out).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string extension = output::ascii_lower(std::filesystem::path(a.out).extension().string());
   if (extension != ".csv")
     throw std::invalid_argument("--out " + output::printable(a.out) +
                                 ": expected a .csv file name (the trajectory; its plot goes to the .svg beside it)");
@@ -137,9 +137,8 @@ int run_simulate(const SimulateArgs& a) {
   output::OutputFiles out = output_for(a);  // refused before the work, not after
   const app::SimulateJobResult r = app::run_simulate_job(job);
   out.set(0, r.csv);
-  std::string svg, err;  // the plot, when gnuplot can draw it
-  if (render_svg(r.plot_title, r.plot, &svg, &err)) out.set(1, svg);
-  else std::cerr << "no plot: " << err << "\n";
+  if (!r.svg.empty()) out.set(1, r.svg);
+  else std::cerr << "no plot: " << output::printable_lines(r.plot_error) << "\n";
   commit_and_say(out, "simulate");
   for (const auto& note : r.notes) std::cerr << output::printable(note) << "\n";
   std::cout << output::printable_lines(r.summary) << "; wrote " << output::printable(a.out) << "\n";

@@ -1,5 +1,7 @@
 #include "diagnose/candidate_search.hpp"
 
+#include "derive/symbolic_model.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>

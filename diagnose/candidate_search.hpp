@@ -30,15 +30,18 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "runtime/dynamic_model.hpp"
 #include "fit/equation_error.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/profile_likelihood.hpp"
 #include "output/progress.hpp"
 #include "derive/effects/effect_catalogue.hpp"
-#include "derive/symbolic_model.hpp"
+
+namespace quadgen {
+// derive/symbolic_model.hpp: only referred to here, so GiNaC stays out of the report writers.
+struct SymbolicModel;
+struct Variable;
+}
 
 namespace quadgen::diagnose {
 

@@ -366,6 +366,30 @@ std::string flights_apart(const ParameterAgreement& a) {
   return out;
 }
 
+// A base parameter no flight measures (c_w beside rotor drag on the NanoBench flights): the
+// report said "too uncertain" and the fitted-parameters table showed the joint value, with
+// nothing to do about a value the flights cannot give.
+std::string hold_unmeasured_step(const ParameterAgreement& a) {
+  // Where the flights that can say allow it, within the parameter's bounds: the intersection
+  // (every such interval holds zero, so it alone straddled zero and offered a negative drag
+  // coefficient; a review, helper-134).
+  double lo = -INFINITY, hi = INFINITY;
+  bool any = false;
+  for (const auto& f : a.flights) {
+    if (flight_can_say(f)) lo = std::max(lo, f.lower), hi = std::min(hi, f.upper), any = true;
+    if (std::isfinite(f.bound_lower)) lo = std::max(lo, f.bound_lower);
+    if (std::isfinite(f.bound_upper)) hi = std::min(hi, f.bound_upper);
+  }
+  const std::string allowed = any && std::isfinite(lo) && std::isfinite(hi) && lo <= hi
+                                  ? " inside every flight's interval and its bounds ([" + num(lo, kEstimateDigits) +
+                                        ", " + num(hi, kEstimateDigits) + "])"
+                                  : "";
+  return "no flight tells the base model's " + a.parameter + " from zero, nor do the flights together " +
+         "(each value on its bound or its interval holding zero): the joint value is the fit's choice, not a " +
+         "measurement; hold it in the vehicle file (fit: false) at a value" + allowed + " that you can " +
+         "defend, or fly what would measure it" + (a.parameter == "c_w" ? " (for the frame's drag: faster)" : "");
+}
+
 }  // namespace
 
 std::vector<std::string> next_steps(const Diagnosis& d) {
@@ -389,30 +413,8 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
                     (apart.empty() ? "" : ", " + apart + ", and the others") +
                     " (speed, battery, payload, the day) and diagnose them apart, or together without the odd one");
     }
-  // A base parameter no flight measures (c_w beside rotor drag on the NanoBench flights): the
-  // report said "too uncertain" and the fitted-parameters table showed the joint value, with
-  // nothing to do about a value the flights cannot give.
   for (const auto& a : d.base_agreement)
-    if (unmeasured_base_parameter(a)) {
-      // Where the flights that can say allow it, within the parameter's bounds: the
-      // intersection (every such interval holds zero, so it alone straddled zero and offered a
-      // negative drag coefficient; a review, helper-134).
-      double lo = -INFINITY, hi = INFINITY;
-      bool any = false;
-      for (const auto& f : a.flights) {
-        if (flight_can_say(f)) lo = std::max(lo, f.lower), hi = std::min(hi, f.upper), any = true;
-        if (std::isfinite(f.bound_lower)) lo = std::max(lo, f.bound_lower);
-        if (std::isfinite(f.bound_upper)) hi = std::min(hi, f.bound_upper);
-      }
-      const std::string allowed = any && std::isfinite(lo) && std::isfinite(hi) && lo <= hi
-                                      ? " inside every flight's interval and its bounds ([" + num(lo, kEstimateDigits) +
-                                            ", " + num(hi, kEstimateDigits) + "])"
-                                      : "";
-      out.push_back("no flight tells the base model's " + a.parameter + " from zero, nor do the flights together " +
-                    "(each value on its bound or its interval holding zero): the joint value is the fit's choice, not a " +
-                    "measurement; hold it in the vehicle file (fit: false) at a value" + allowed + " that you can " +
-                    "defend, or fly what would measure it" + (a.parameter == "c_w" ? " (for the frame's drag: faster)" : ""));
-    }
+    if (unmeasured_base_parameter(a)) out.push_back(hold_unmeasured_step(a));
   for (const auto& a : d.base_agreement)
     if (flights_disagree(a))
       out.push_back("the flights disagree on the base model's " + a.parameter + ": it carries something that differs " +

@@ -14,6 +14,7 @@
 
 #include "fit/grid_mean.hpp"
 #include "fit/least_squares.hpp"
+#include "model/effect.hpp"
 #include "model/yaml_reader.hpp"
 #include "output/numbers.hpp"
 #include "output/joined.hpp"
@@ -185,7 +186,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
     }
     if (top.count("environment")) {
       m.environment = scalar_text(path, top.at("environment"), "environment");
-      if (m.environment != "indoor" && m.environment != "outdoor" && m.environment != "unknown")
+      if (!is_environment_name(m.environment))
         mapping_error(path, top.at("environment"), "environment: expected indoor, outdoor or unknown");
     }
     std::set<std::string> targets;

@@ -171,7 +171,7 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
     if (!mapping)
       throw FitError(path + (ulog ? ": a ULog log" : ": a Crazyflie uSD log") +
                      " needs --mapping naming its signals as topic.field (docs/formats.md)");
-    const double rate = resample_hz > 0 ? resample_hz : 100.0;
+    const double rate = resample_hz > 0 ? resample_hz : kTopicLogRate;
     const runtime::CsvTable table = ulog ? topic_table(runtime::read_ulog(path), *mapping, rate)
                                          : topic_table(runtime::read_usd_log(path), *mapping, rate);
     runtime::CsvTable mapped = apply_mapping(table, *mapping);

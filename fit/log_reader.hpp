@@ -34,10 +34,16 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
 
 // Reads a log (CSV, ULog or uSD) and returns it in the canonical layout. `mapping_path` may be
 // empty (`mapping` null) for a canonical CSV; a log of topics needs one. `resample_hz` > 0
-// resamples the result (a log of topics is always sampled at that rate, 100 Hz when 0).
+// resamples the result (a log of topics is always sampled at that rate, kTopicLogRate when 0).
 runtime::CsvTable read_log(const std::string& path, const std::string& mapping_path, double resample_hz);
 // The resample rates options accept: 0 (as logged) or kResampleRange [Hz].
 inline constexpr output::AcceptedRange kResampleRange{0.1, 1e5};
+// A log of topics (ULog, uSD) is sampled onto one grid at this rate unless told another [Hz].
+inline constexpr double kTopicLogRate = 100;
+// The default in words, for --help.
+inline std::string resample_default_text() {
+  return "none for a CSV, " + output::short_number(kTopicLogRate) + " Hz for a ULog or uSD log";
+}
 inline bool valid_resample_rate(double hz) { return hz == 0 || kResampleRange.contains(hz); }
 runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz);
 

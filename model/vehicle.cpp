@@ -128,8 +128,15 @@ Block read_block(const Reader& r, const YAML::Node& n) {
   b.mass = r.positive(r.need(n, "mass", where), "mass of " + where + " [kg]");
   b.size = r.vec3(r.need(n, "size", where), "size of " + where + " [m]", true);
   b.centre = r.vec3(r.need(n, "centre", where), "centre of " + where + " [m]");
-  if (n["orientation_deg"])
+  if (n["orientation_deg"]) {
     b.yaw_pitch_roll_deg = r.vec3(n["orientation_deg"], "orientation of " + where + " [yaw, pitch, roll in deg]");
+    // An angle of 1e300 deg passed and turned the block by whatever sin(1e300) rounds to (a
+    // review, helper-135): beyond a whole turn an angle is a mistyped number.
+    for (double angle : b.yaw_pitch_roll_deg)
+      if (!(std::fabs(angle) <= 360))
+        r.fail(n["orientation_deg"], "orientation of " + where + ": " + output::six_digits(angle) +
+                                         " deg, expected each angle within +-360 deg");
+  }
   return b;
 }
 
@@ -240,9 +247,12 @@ void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v
 // A non-empty list of blocks or rotors (`what`), each read by `read` and named once.
 template <class Item, class ReadItem>
 std::vector<Item> read_named_list(const Reader& r, const YAML::Node& root, const char* key, const std::string& what,
-                                  ReadItem read) {
+                                  ReadItem read, size_t most) {
   const YAML::Node list = r.need(root, key, "the vehicle file");
   if (!list.IsSequence() || list.size() == 0) r.fail(list, "expected a non-empty list of " + std::string(key));
+  if (list.size() > most)
+    r.fail(list, std::to_string(list.size()) + " " + key + ": at most " + std::to_string(most) +
+                     " are derived (each adds equations and parameters; beyond this the derivation takes minutes)");
   std::vector<Item> items;
   std::set<std::string> names;
   for (const auto& node : list) {
@@ -308,8 +318,8 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
   if (const auto problem = output::vehicle_name_problem(v.name)) r.fail(name, "vehicle name '" + v.name + "': " + *problem);
   if (root["description"]) v.description = r.text(root["description"], "description");
   read_parameter_sections(r, root, v);
-  v.blocks = read_named_list<Block>(r, root, "blocks", "block", read_block);
-  v.rotors = read_named_list<Rotor>(r, root, "rotors", "rotor", read_rotor);
+  v.blocks = read_named_list<Block>(r, root, "blocks", "block", read_block, kMaxBlocks);
+  v.rotors = read_named_list<Rotor>(r, root, "rotors", "rotor", read_rotor, kMaxRotors);
   if (root["derived"]) read_derived(r, root["derived"], v);
   return v;
 }

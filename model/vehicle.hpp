@@ -69,6 +69,11 @@ inline constexpr DerivedQuantity kDerivedQuantities[] = {
     {"A_y", "m^2", "exposed area along the body axis"},
     {"A_z", "m^2", "exposed area along the body axis"}};
 
+// The most rotors and blocks a vehicle file may list (load_vehicle refuses more). A multirotor
+// has at most a few dozen rotors (a Volocopter 2X, 18); each rotor adds equations, inputs and
+// effect parameters, and 300 of them took minutes to derive (a review, helper-135).
+inline constexpr size_t kMaxRotors = 32, kMaxBlocks = 256;
+
 struct Vehicle {
   std::string name;
   std::string source_path;

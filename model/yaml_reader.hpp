@@ -13,6 +13,7 @@
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include "output/ascii.hpp"
 #include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
@@ -118,8 +119,7 @@ inline output::NumberText yaml_number(const std::string& text, double* value) {
                                               std::isspace(static_cast<unsigned char>(text.back())));
   output::NumberText kind = blank_around ? output::NumberText::not_a_number : output::read_number(text, value);
   if (kind == output::NumberText::not_a_number) {
-    std::string lower = text;
-    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string lower = output::ascii_lower(text);
     if (lower == ".inf" || lower == "+.inf" || lower == "-.inf" || lower == ".nan") kind = output::NumberText::not_finite;
   }
   return kind;

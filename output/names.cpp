@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <set>
+#include <stdexcept>
+
+#include "output/sinks.hpp"
 
 namespace quadgen::output {
 namespace {
@@ -105,6 +108,27 @@ std::optional<std::string> vehicle_name_problem(const std::string& name) {
   return "the name contains '" + with + "' or ends in '" + infix + "' or '" + all +
          "', which the code generator appends for a model with effects: two vehicles' models would share one C++ "
          "namespace (rename it, e.g. '" + instead + "')";
+}
+
+}  // namespace quadgen::output
+
+namespace quadgen::output {
+
+std::vector<std::string> split_name_list(const std::string& text, const std::string& what) {
+  std::vector<std::string> names;
+  if (text.empty()) return names;
+  if (text.front() == ',' || text.back() == ',' || text.find(",,") != std::string::npos)
+    throw std::invalid_argument(what + " '" + printable(text) + "' has an empty name (a ',' at an end or two in a row)");
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    const size_t end = std::min(text.find(',', begin), text.size());
+    const std::string name = text.substr(begin, end - begin);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      throw std::invalid_argument(what + ": '" + printable(name) + "' is given twice");
+    names.push_back(name);
+    begin = end + 1;
+  }
+  return names;
 }
 
 }  // namespace quadgen::output

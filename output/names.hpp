@@ -5,6 +5,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace quadgen::output {
 
@@ -30,5 +31,13 @@ std::optional<std::string> vehicle_name_problem(const std::string& name);
 
 // True for a C++ keyword or alternative token (class, int, and, ...).
 bool is_cpp_keyword(const std::string& word);
+
+// A comma-separated list of names as an option gives it ("ax,qdot"), by one rule for every
+// option that takes one (--effects, --candidates, --channels, --free, --profiles): an empty
+// name (a ',' at an end or two in a row) and a name given twice are refused with
+// std::invalid_argument, which begins with `what` (a channel listed twice was weighted twice
+// in a fit, and fit's lists had skipped empty names where the effect lists refused them).
+// The names are not checked otherwise: their owner knows which it accepts.
+std::vector<std::string> split_name_list(const std::string& text, const std::string& what);
 
 }  // namespace quadgen::output

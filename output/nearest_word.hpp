@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "output/ascii.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::output {
@@ -42,10 +43,7 @@ inline std::string nearest_word(const std::string& word, const std::vector<std::
                                 size_t max_edits = 2) {
   const size_t letters = word.size() - std::min(word.find_first_not_of('-'), word.size());
   max_edits = std::min(max_edits, letters / 3);
-  const auto lower = [](std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  };
+  const auto lower = [](const std::string& s) { return ascii_lower(s); };
   const std::string seen = lookalike_skeleton(word);
   for (const auto& c : candidates)
     if (c != word && lookalike_skeleton(c) == seen) return c;

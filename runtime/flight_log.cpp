@@ -1,5 +1,6 @@
 #include "runtime/flight_log.hpp"
 
+#include "output/ascii.hpp"
 #include "runtime/log_file.hpp"
 
 #include "runtime/attitude.hpp"
@@ -385,9 +386,7 @@ std::string missing_columns_message(const CsvTable& log, const std::vector<std::
   // (a review, helper-135: the message said only that 'u_A' was missing).
   const auto folded = [](const std::string& s) {
     const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
-    std::string f = a == std::string::npos ? "" : s.substr(a, b - a + 1);
-    for (auto& ch : f) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    return f;
+    return output::ascii_lower(a == std::string::npos ? "" : s.substr(a, b - a + 1));
   };
   std::string near;
   for (const auto& c : log.columns)

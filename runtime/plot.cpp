@@ -18,6 +18,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "output/ascii.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
 
@@ -150,7 +151,7 @@ std::optional<std::string> as_browser_reads(const std::string& tag) {
     if (const long code = c == '&' ? character_reference(tag, i, &end) : -1; code == -2) {
       return std::nullopt;
     } else if (code >= 0) {
-      c = code < 128 ? static_cast<char>(std::tolower(static_cast<int>(code))) : '?';
+      c = code < 128 ? output::ascii_lower(static_cast<char>(code)) : '?';
       i = end;
     }
     if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) out += c;
@@ -191,7 +192,7 @@ bool whole_inert_svg(const std::string& svg) {
   char quote = 0;
   bool in_tag = false;
   for (const char raw : svg) {
-    const char c = static_cast<char>(std::tolower(static_cast<unsigned char>(raw)));
+    const char c = output::ascii_lower(raw);
     if (!in_tag) {
       if (c != '<') continue;
       in_tag = true;

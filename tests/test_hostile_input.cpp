@@ -27,6 +27,8 @@
 #include <thread>
 
 #include "app/diagnose_job.hpp"
+#include "app/simulate_job.hpp"
+#include "output/names.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
@@ -2394,4 +2396,37 @@ TEST(Cli, ScenariosFollowTheVehiclesLayout) {
       if (std::string(scenario) == "hover") EXPECT_NEAR(last[t.column("z")], 0.0, 1e-6) << file;
       else EXPECT_GT(last[t.column("z")], 0.1) << file << " " << scenario;
     }
+}
+
+// A library call checks its inputs as the command line does (a review, helper-138: the ground's
+// limit and the fit's lists were the command line's alone): a ground 1e9 m away is refused by
+// run_simulate_job before any work, and every option's list of names is split by one rule.
+TEST(LibraryCalls, CheckTheirInputsAsTheCommandLineDoes) {
+  quadgen::app::SimulateJob job;
+  job.vehicle = source_path("vehicles/finken3.yaml");
+  job.scenario = "hover";
+  job.duration = 0.01;
+  job.ground_height = 1e9;
+  try {
+    quadgen::app::run_simulate_job(job);
+    ADD_FAILURE() << "a ground 1e9 m away was simulated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--ground 1e+09: expected a height within +-1e+04 m"), std::string::npos) << e.what();
+  }
+  using quadgen::output::split_name_list;
+  EXPECT_EQ(split_name_list("", "--channels"), std::vector<std::string>{});
+  EXPECT_EQ(split_name_list("ax,qdot", "--channels"), (std::vector<std::string>{"ax", "qdot"}));
+  const auto refused = [](const std::string& text, const std::string& expected) {
+    try {
+      split_name_list(text, "--channels");
+      ADD_FAILURE() << "'" << text << "' accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("ax,,qdot", "has an empty name");  // fit skipped it, derive refused it
+  refused(",ax", "has an empty name");
+  refused("ax,", "has an empty name");
+  refused("ax,qdot,ax", "--channels: 'ax' is given twice");
+  refused("a\x1b[2J,a\x1b[2J", "'a\\x1B[2J' is given twice");  // quoted printable
 }

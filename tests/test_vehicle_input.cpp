@@ -189,6 +189,32 @@ TEST(VehicleInput, NonFiniteNumber) {
   expect_error(replace(finken_text(), "mass: 0.132", "mass: .nan"), "finite");
   expect_error(replace(finken_text(), "value: 9.81", "value: .inf"), "finite");
 }
+// An angle beyond a whole turn, or more rotors than the derivation takes in reasonable time,
+// is a mistyped number or a hostile file, refused at its line (a review, helper-135: 1e300 deg
+// turned a block by whatever sin(1e300) rounds to; 300 rotors took minutes to derive).
+TEST(VehicleInput, AbsurdAnglesAndRotorCountsAreRefused) {
+  const std::string cf = [] {
+    std::ifstream in(test::source_path("vehicles/crazyflie21.yaml"));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }();
+  expect_error(replace(cf, "orientation_deg: [315, 0, 0]", "orientation_deg: [1e300, 0, 0]"),
+               "orientation of block 'arm_M1': 1e+300 deg, expected each angle within +-360 deg");
+  expect_error(replace(cf, "orientation_deg: [315, 0, 0]", "orientation_deg: [315, -361, 0]"), "-361 deg");
+  EXPECT_NO_THROW(parse_vehicle(replace(cf, "orientation_deg: [315, 0, 0]", "orientation_deg: [-360, 0, 360]"), "ok.yaml"));
+  std::string rotors;
+  for (size_t i = 0; i <= quadgen::kMaxRotors; ++i) {
+    const double a = 6.283185307179586 * static_cast<double>(i) / (quadgen::kMaxRotors + 1);
+    rotors += "  - {name: R" + std::to_string(i + 1) + ", position: [" + std::to_string(0.5 * std::cos(a)) + ", " +
+              std::to_string(0.5 * std::sin(a)) + ", 0], spin: " + (i % 2 ? "cw" : "ccw") +
+              ", radius: 0.0225, disc_area: 1.5904e-3}\n";
+  }
+  const std::string head = cf.substr(0, cf.find("rotors:")) + "rotors:\n";
+  expect_error(head + rotors, "33 rotors: at most 32 are derived");
+  const std::string fewer = rotors.substr(0, rotors.rfind("  - {name: R33"));  // the most taken
+  EXPECT_EQ(parse_vehicle(head + fewer, "ok.yaml").rotors.size(), quadgen::kMaxRotors);
+}
 TEST(VehicleInput, NotANumber) { expect_error(replace(finken_text(), "mass: 0.132", "mass: heavy"), "expected a number"); }
 TEST(VehicleInput, WrongUnitDimension) {
   expect_error(replace(finken_text(), "{value: 9.81, unit: m/s^2}", "{value: 9.81, unit: kg}"), "must have dimension");

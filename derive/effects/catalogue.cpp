@@ -8,6 +8,7 @@
 
 #include "derive/effects/definitions.hpp"
 #include "output/joined.hpp"
+#include "output/names.hpp"
 #include "output/numbers.hpp"
 #include "output/nearest_word.hpp"
 
@@ -133,7 +134,7 @@ Environment parse_environment(const std::string& text) {
   if (text == "indoor") return Environment::kIndoor;
   if (text == "outdoor") return Environment::kOutdoor;
   if (text == "unknown" || text.empty()) return Environment::kUnknown;
-  throw std::invalid_argument("unknown environment '" + text + "' (expected indoor, outdoor or unknown)");
+  throw std::invalid_argument("unknown environment '" + output::printable(text) + "' (expected " + output::joined(kEnvironmentNames) + ")");
 }
 
 std::string environment_name(Environment e) {
@@ -207,20 +208,15 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
     for (const auto& e : effect_catalogue()) out.push_back(e.name);
     return out;
   }
-  if (text.front() == ',' || text.back() == ',' || text.find(",,") != std::string::npos)
-    throw std::invalid_argument("effect list '" + text + "' has an empty name (a ',' at an end or two in a row)");
-  std::set<std::string> known, seen;
+  std::set<std::string> known;
   for (const auto& e : effect_catalogue()) known.insert(e.name);
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
+  for (const std::string& item : output::split_name_list(text, "effect list")) {
     if (item == "all")
       throw std::invalid_argument("effect list '" + text + "': 'all' stands alone (it is every effect); name effects or write all");
     if (!known.count(item)) {
       throw std::invalid_argument("unknown effect '" + output::printable(item) + "' (known: " + catalogue_names() +
                                   ", or all)" + output::did_you_mean(item, std::vector<std::string>(known.begin(), known.end())));
     }
-    if (!seen.insert(item).second) throw std::invalid_argument("effect '" + item + "' named twice");
     out.push_back(item);
   }
   return out;
