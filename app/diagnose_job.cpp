@@ -33,11 +33,11 @@ bool DiagnoseJob::IsValid(std::string* error) const {
   };
   if (vehicle.empty()) return fail("no vehicle file");
   if (logs.empty()) return fail("no flight log");
-  if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or 0.1 to 1e5 Hz");
+  if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or " + fit::kResampleRange.text("Hz"));
   if (!airframe.empty() && logs.size() != 1)
     return fail("airframe: checks one flight against an airframe; several logs are diagnosed jointly instead");
   if (!environment.empty() && !is_environment_name(environment))
-    return fail("environment: indoor, outdoor or unknown");
+    return fail("environment: " + output::joined(kEnvironmentNames));
   return options.IsValid(error);
 }
 

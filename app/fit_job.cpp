@@ -1,6 +1,7 @@
 #include "app/fit_job.hpp"
 
 #include <memory>
+#include <stdexcept>
 
 #include "app/model_registry.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -9,6 +10,7 @@
 namespace quadgen::app {
 
 FitJobResult run_fit_job(const FitJob& job, const Vehicle& v, fit::LogKind kind) {
+  if (std::string error; !job.options.IsValid(&error)) throw std::invalid_argument("fit: " + error);
   FitJobResult r;
   // Said as the work goes, before the fit's own steps (job.options.progress).
   if (const std::string note = fitted_section_note(v, "fit"); !note.empty()) job.options.progress(note);

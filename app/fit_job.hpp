@@ -11,7 +11,6 @@
 namespace quadgen::app {
 
 struct FitJob {
-  std::string vehicle;  // vehicle file (YAML)
   std::string log;      // a flight log, motor steps or a thrust stand
   std::string effects;  // a flight: comma-separated effects to add to the model, or "all"; "": none
   fit::FitJobOptions options;
@@ -24,8 +23,10 @@ struct FitJobResult {
   std::vector<std::string> warnings;  // what to look at before trusting the result (raw)
 };
 
-// `vehicle`: job.vehicle as load_vehicle read it; `kind`: fit::log_kind(job.log) (the command
-// line reads both first, the kind to refuse the options it does not take before any work).
+// `vehicle`: the vehicle file as load_vehicle read it; `kind`: fit::log_kind(job.log) (the
+// command line reads both first, the kind to refuse the flags it does not take before any
+// work). The options are checked (IsValid) before anything is built; which options a kind
+// uses is the command line's check (by the flags given), not the library's.
 // The vehicle's fitted section and the model fitted are said through job.options.progress.
 // Throws the layers' own errors (a bad log, with file and line) unchanged.
 FitJobResult run_fit_job(const FitJob& job, const Vehicle& vehicle, fit::LogKind kind);

@@ -108,6 +108,7 @@ void check_something_measured(const predict::Prediction& pooled, const PredictJo
 }  // namespace
 
 PredictJobResult run_predict_job(const PredictJob& job_in, const Vehicle& v) {
+  if (std::string error; !job_in.options.IsValid(&error)) throw std::invalid_argument("predict: " + error);  // before any work
   runtime::refuse_repeated_files(job_in.logs, "flight log");
   PredictJobResult r;
   PredictJob job = job_in;

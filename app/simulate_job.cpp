@@ -31,9 +31,6 @@ using namespace quadgen::runtime;
 
 namespace {
 
-// Work beyond these sizes is refused before it starts unless --no-size-limit is given: each
-// stored sample costs ~0.2 kB, so 1e7 of them is about 2 GB.
-constexpr double kMaxSteps = 1e7, kMaxRows = 1e7;
 
 void check_size(const SimulateJob& a, double steps, double rows) {
   if (a.no_size_limit) return;
@@ -524,7 +521,7 @@ SimulateJobResult run_simulate_job(const SimulateJob& a) {
   if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
   if (a.ground_height && !(std::fabs(*a.ground_height) <= kMaxGroundHeight))
     throw std::invalid_argument("--ground " + output::six_digits(*a.ground_height) + ": expected a height within +-" +
-                                output::short_number(kMaxGroundHeight) + " m");
+                                output::six_digits(kMaxGroundHeight) + " m");
   const Vehicle vehicle = load_vehicle(a.vehicle);
   if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
   if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);

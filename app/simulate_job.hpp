@@ -38,9 +38,13 @@ struct SimulateJob {
   // overrides.
   runtime::ClosedLoopOptions flight;
   std::vector<std::pair<std::string, double>> set;
-  bool no_size_limit = false;  // refuse runs beyond ~1e7 steps or rows unless set
+  bool no_size_limit = false;  // refuse runs beyond kMaxSteps steps or kMaxRows rows unless set
   output::Progress progress;   // "simulating 5 s of ..."; nowhere by default
 };
+
+// Work beyond these sizes is refused before it starts unless no_size_limit is set: each
+// stored sample costs ~0.2 kB, so 1e7 of them is about 2 GB.
+inline constexpr double kMaxSteps = 1e7, kMaxRows = 1e7;
 
 // A ground further from the origin than this [m] is a mistyped number, not a ground.
 inline constexpr double kMaxGroundHeight = 1e4;

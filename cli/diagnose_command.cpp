@@ -41,7 +41,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);
   c->add_option("--translational", o.translational, "translational channels: the differentiated velocity of the pose, or the accelerometer's specific "
                 "force; auto: the pose where the log has one, else the accelerometer")
-      ->check(CLI::IsMember({"auto", "pose", "accelerometer"}));
+      ->check(CLI::IsMember(diagnose::kTranslationalChoices));
   c->add_option("--environment", j.environment,
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")

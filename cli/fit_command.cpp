@@ -35,7 +35,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--validation", a.options.validation, "fraction of the flight (at its end) held out for validation")
       ->check(finite_range(kFitValidationRange));
   c->add_option("--formulation", a.options.formulation, "equation_error (IMU, accelerations) or multiple_shooting (pose, windows)")
-      ->check(CLI::IsMember({"equation_error", "multiple_shooting"}));
+      ->check(CLI::IsMember(kFitFormulations));
   c->add_option("--window", a.options.window, "multiple shooting: window length [s]")->check(finite_range(kFitWindowRange));
   c->add_option("--resample", a.options.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(kResampleRange))
@@ -44,7 +44,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
   c->add_option("--translational", a.options.translational,
                 "equation error: ax, ay, az from the accelerometer (body specific force at each sample) or from the "
                 "pose (world acceleration, the differentiated velocity, exact for commands held between samples)")
-      ->check(CLI::IsMember({"pose", "accelerometer"}))
+      ->check(CLI::IsMember(kTranslationalSources))
       ->default_str("the accelerometer where logged, else the pose");
   c->add_option("--free", a.free,
                 std::string("parameters to fit (comma-separated), overriding the vehicle file's fit flags: ") +
@@ -54,7 +54,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
                 "comma-separated names (as for --free)")
       ->capture_default_str();
   c->add_option("--threads", a.options.threads, "threads for the profiles (0: one per core)")
-      ->check(CLI::Range(0, 256))
+      ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
 }
 
@@ -101,7 +101,7 @@ int run_fit(const FitArgs& a) {
   else
     check_flight_options(a);
   output::OutputDirectory out(a.out, "fit", {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
-  const app::FitJobResult r = app::run_fit_job({a.vehicle, a.log, a.effects, job_options(a)}, v, kind);
+  const app::FitJobResult r = app::run_fit_job({a.log, a.effects, job_options(a)}, v, kind);
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   for (const auto& note : r.notes) std::cerr << output::printable_lines(note) << "\n";
   commit_and_say(out, "fit");

@@ -97,7 +97,8 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
           "start|HEIGHT"))
       ->excludes(cl);
   c->add_flag("--no-size-limit", a.job.no_size_limit,
-              "run even when the estimated work exceeds the limits (1e7 integration steps or output rows)");
+              "run even when the estimated work exceeds the limits (" + output::six_digits(app::kMaxSteps) +
+                  " integration steps, " + output::six_digits(app::kMaxRows) + " output rows)");
 }
 
 namespace {

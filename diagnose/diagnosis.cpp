@@ -22,6 +22,7 @@
 #include "runtime/thrust_law.hpp"
 #include "codegen/tape_builder.hpp"
 #include "output/joined.hpp"
+#include "output/names.hpp"
 #include "output/numbers.hpp"
 #include "runtime/rigid_body_state.hpp"
 
@@ -745,8 +746,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(window_stride == 0 || (window_stride >= kSmallestWindowStride && window_stride < window)))
     return fail("window stride: 0 (consecutive windows) or from " + output::short_number(kSmallestWindowStride) +
                 " s to below the window's length");
-  if (translational != "auto" && translational != "pose" && translational != "accelerometer")
-    return fail("translational channels: auto, pose or accelerometer");
+  if (!output::is_one_of(translational, kTranslationalChoices))
+    return fail("translational channels: " + output::joined(kTranslationalChoices));
   if (!kAlphaRange.contains(search.alpha)) return fail("alpha: " + kAlphaRange.text());
   if (search.max_effects < 1 || search.max_effects > static_cast<int>(kMaxEffectsAllowed))
     return fail("max effects: 1 to " + std::to_string(kMaxEffectsAllowed));

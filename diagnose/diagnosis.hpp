@@ -36,6 +36,7 @@ inline constexpr output::AcceptedRange kDiagnoseWindowRange{0.1, 10};       // s
 // window's length on, the windows would not overlap (consecutive windows are stride 0).
 inline constexpr double kSmallestWindowStride = 0.01;  // s
 inline constexpr output::AcceptedRange kAlphaRange{1e-9, 0.2};
+inline const std::vector<std::string> kTranslationalChoices = {"auto", "pose", "accelerometer"};
 
 struct DiagnoseOptions {
   double validation_fraction = 0.3;  // end of the flight, held out

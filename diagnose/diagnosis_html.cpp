@@ -124,10 +124,15 @@ void command_gain_html(std::ostream& h, const Diagnosis& d, Figures& figures) {
     << (d.command_gain_per_flight.empty() ? "" : "<th>flight</th>") << "<th>axis</th>";
   for (const auto& b : first->axes.front().bands) h << "<th>" << num(b.low_hz, 2) << "&ndash;" << num(b.high_hz, 2) << " Hz</th>";
   h << "</tr>\n";
-  for (const auto& [flight, g] : rows) {
+  // Flights numbered as in the agreement table and under the title: two logs whose names differ
+  // only by a trailing blank read alike (a review, helper-135).
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const auto& [flight, g] = rows[k];
     if (!g->measured) continue;
     for (const auto& a : g->axes) {
-      h << "<tr>" << (d.command_gain_per_flight.empty() ? "" : "<td class=\"flight\" title=\"" + esc(flight) + "\">" + esc(file_name_of(flight)) + "</td>")
+      h << "<tr>"
+        << (d.command_gain_per_flight.empty() ? "" : "<td class=\"flight\" title=\"" + esc(flight) + "\">" +
+                                                         std::to_string(k + 1) + ".&nbsp;" + esc(file_name_of(flight)) + "</td>")
         << "<td>" << esc(a.name) << "</td>";
       for (const auto& b : a.bands)
         if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << num(b.r, 2) << ")</td>";

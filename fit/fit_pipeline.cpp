@@ -16,6 +16,8 @@
 #include "fit/motor_steps.hpp"
 #include "fit/multiple_shooting.hpp"
 #include "runtime/plot.hpp"
+#include "output/joined.hpp"
+#include "output/names.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
 #include "fit/thrust_stand.hpp"
@@ -166,14 +168,13 @@ bool FitJobOptions::IsValid(std::string* error) const {
     if (error) *error = why;
     return false;
   };
-  if (threads < 0) return fail("threads: 0 (one per core) or more");
+  if (threads < 0 || threads > kMaxThreads) return fail("threads: 0 (one per core) to " + std::to_string(kMaxThreads));
   if (!valid_resample_rate(resample)) return fail("resample: 0 or " + kResampleRange.text("Hz"));
   if (!kFitValidationRange.contains(validation)) return fail("validation fraction: " + kFitValidationRange.text());
-  if (formulation != "equation_error" && formulation != "multiple_shooting")
-    return fail("formulation: equation_error or multiple_shooting");
+  if (!output::is_one_of(formulation, kFitFormulations)) return fail("formulation: " + output::joined(kFitFormulations));
   if (!kFitWindowRange.contains(window)) return fail("window: " + kFitWindowRange.text("s"));
-  if (!translational.empty() && translational != "pose" && translational != "accelerometer")
-    return fail("translational: pose or accelerometer (empty: the accelerometer where logged)");
+  if (!translational.empty() && !output::is_one_of(translational, kTranslationalSources))
+    return fail("translational: " + output::joined(kTranslationalSources) + " (empty: the accelerometer where logged)");
   return true;
 }
 

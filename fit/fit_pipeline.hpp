@@ -31,6 +31,9 @@ LogKind log_kind(const std::string& path);
 // The values FitJobOptions accepts (its IsValid and the command line's checks).
 inline constexpr output::AcceptedRange kFitValidationRange{0, 0.9};  // fraction held out
 inline constexpr output::AcceptedRange kFitWindowRange{0.01, 100};   // s
+inline constexpr int kMaxThreads = 256;                              // profile threads
+inline const std::vector<std::string> kFitFormulations = {"equation_error", "multiple_shooting"};
+inline const std::vector<std::string> kTranslationalSources = {"pose", "accelerometer"};  // or "": the default
 
 struct FitJobOptions {
   bool robust = false;                 // Huber loss instead of squares

@@ -187,7 +187,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
     if (top.count("environment")) {
       m.environment = scalar_text(path, top.at("environment"), "environment");
       if (!is_environment_name(m.environment))
-        mapping_error(path, top.at("environment"), "environment: expected indoor, outdoor or unknown");
+        mapping_error(path, top.at("environment"), "environment: expected one of " + output::joined(kEnvironmentNames));
     }
     std::set<std::string> targets;
     for (const auto& kv : top.at("columns")) {

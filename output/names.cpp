@@ -114,7 +114,8 @@ std::optional<std::string> vehicle_name_problem(const std::string& name) {
 
 namespace quadgen::output {
 
-std::vector<std::string> split_name_list(const std::string& text, const std::string& what) {
+std::vector<std::string> split_name_list(const std::string& text, const std::string& what,
+                                         const std::function<void(const std::string&)>& check_name) {
   std::vector<std::string> names;
   if (text.empty()) return names;
   if (text.front() == ',' || text.back() == ',' || text.find(",,") != std::string::npos)
@@ -123,6 +124,7 @@ std::vector<std::string> split_name_list(const std::string& text, const std::str
   while (begin <= text.size()) {
     const size_t end = std::min(text.find(',', begin), text.size());
     const std::string name = text.substr(begin, end - begin);
+    if (check_name) check_name(name);
     if (std::find(names.begin(), names.end(), name) != names.end())
       throw std::invalid_argument(what + ": '" + printable(name) + "' is given twice");
     names.push_back(name);

@@ -3,6 +3,7 @@
 // passes this rule is inert in every one of those sinks; each sink escapes anyway
 // (output/sinks.hpp), so that one missed check cannot become an injection.
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,12 +33,23 @@ std::optional<std::string> vehicle_name_problem(const std::string& name);
 // True for a C++ keyword or alternative token (class, int, and, ...).
 bool is_cpp_keyword(const std::string& word);
 
+// Whether `word` is one of `words` (an option's choices, declared once beside its options
+// struct and read by IsValid and the command line's check alike).
+inline bool is_one_of(const std::string& word, const std::vector<std::string>& words) {
+  for (const auto& w : words)
+    if (w == word) return true;
+  return false;
+}
+
 // A comma-separated list of names as an option gives it ("ax,qdot"), by one rule for every
 // option that takes one (--effects, --candidates, --channels, --free, --profiles): an empty
 // name (a ',' at an end or two in a row) and a name given twice are refused with
 // std::invalid_argument, which begins with `what` (a channel listed twice was weighted twice
 // in a fit, and fit's lists had skipped empty names where the effect lists refused them).
-// The names are not checked otherwise: their owner knows which it accepts.
-std::vector<std::string> split_name_list(const std::string& text, const std::string& what);
+// The names are not checked otherwise: their owner knows which it accepts, and may pass
+// `check_name`, called on each name before the repeat check (so a misspelt name given twice is
+// named as unknown, with its nearest known name, not as a repeat).
+std::vector<std::string> split_name_list(const std::string& text, const std::string& what,
+                                         const std::function<void(const std::string&)>& check_name = {});
 
 }  // namespace quadgen::output

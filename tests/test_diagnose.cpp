@@ -1471,6 +1471,21 @@ TEST(FlightScreening, CommandsAtTheirLimitMakeAFlightUnusable) {
   EXPECT_EQ(quadgen::diagnose::diagnosis_json(d, "b.csv")["flight_screening"][0]["left_out"], true);
 }
 
+// The command-gain table numbers its flights as the agreement table and the title do: two logs
+// whose names differ only by a trailing blank read alike there otherwise (a review, helper-135).
+TEST(DiagnosisReport, TheCommandGainTableNumbersItsFlights) {
+  quadgen::diagnose::Diagnosis d;
+  d.flights = {"x.csv", "x.csv "};
+  quadgen::diagnose::CommandGain g;
+  g.measured = true;
+  g.axes.push_back({"roll", {{0.8, 2.0, 0.9, 0.7, 0.01}}});
+  d.command_gain_per_flight = {g, g};
+  d.command_gain = g;
+  const std::string html = quadgen::diagnose::diagnosis_html(d, "x.csv", {});
+  EXPECT_NE(html.find(">1.&nbsp;x.csv</td><td>roll</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find(">2.&nbsp;x.csv </td><td>roll</td>"), std::string::npos) << html;
+}
+
 // An interval side the profile never closed is printed as "open", in the terminal summary
 // and in the report, never as a number or a bare dash (#16).
 TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {

@@ -164,8 +164,11 @@ TEST(Fit, MotorStepModelFitsWhatItPlotsWithTheMotorSwitchedOff) {
   for (size_t k = 0; k < steps.size(); ++k)
     for (size_t i = 0; i < steps[k].t.size(); ++i, ++row)
       EXPECT_NEAR(r[row] + steps[k].rpm[i], m.predict(p.data(), k, steps[k].t[i]), 1e-9) << "step " << k + 1 << " sample " << i;
-  // Long after the step to 0, the model is at rest, not at a0 = 1500 rpm.
+  // Long after the step to 0, the model is at rest, not at a0 = 1500 rpm: in the plot and in the
+  // residual the fit minimises (the step's last sample measured 4000 rpm).
   EXPECT_NEAR(m.predict(p.data(), 3, 4.85), 0.0, 1.0);
+  const int last_of_step_4 = static_cast<int>(steps[0].t.size() + steps[1].t.size() + steps[2].t.size() + steps[3].t.size()) - 1;
+  EXPECT_NEAR(r[last_of_step_4], -4000.0, 1.0);
   for (int j = 0; j < np; ++j) {
     const double h = 1e-6 * std::max(1.0, std::fabs(p[j]));
     auto pp = p, pm = p;

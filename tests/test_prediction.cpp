@@ -1128,6 +1128,7 @@ TEST(PredictFlights, RefusesOptionsNoPredictionCanUse) {
   o.resample = 0;
   o.prediction.disturbance_window = -1;
   EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("disturbance window: 0 to 10 s"), std::string::npos) << why;
   const quadgen::Vehicle v = quadgen::load_vehicle(quadgen::test::source_path("vehicles/crazyflie21.yaml"));
   CrazyflieModel model;
   EXPECT_THROW(quadgen::predict::predict_flights(v, model, {}, {"no_such.csv"}, o), std::invalid_argument);

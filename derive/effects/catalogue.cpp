@@ -210,16 +210,15 @@ std::vector<std::string> parse_effect_list(const std::string& text) {
   }
   std::set<std::string> known;
   for (const auto& e : effect_catalogue()) known.insert(e.name);
-  for (const std::string& item : output::split_name_list(text, "effect list")) {
+  return output::split_name_list(text, "effect list", [&](const std::string& item) {
     if (item == "all")
-      throw std::invalid_argument("effect list '" + text + "': 'all' stands alone (it is every effect); name effects or write all");
+      throw std::invalid_argument("effect list '" + output::printable(text) +
+                                  "': 'all' stands alone (it is every effect); name effects or write all");
     if (!known.count(item)) {
       throw std::invalid_argument("unknown effect '" + output::printable(item) + "' (known: " + catalogue_names() +
                                   ", or all)" + output::did_you_mean(item, std::vector<std::string>(known.begin(), known.end())));
     }
-    out.push_back(item);
-  }
-  return out;
+  });
 }
 
 std::string canonical_effect_list(const std::vector<std::string>& effects) {
