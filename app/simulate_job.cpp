@@ -515,13 +515,33 @@ std::string implausible_settings(const SimulateJob& a, const Vehicle& vehicle) {
 
 }  // namespace
 
+const output::AcceptedRange& flight_number_range(const std::string& option) {
+  for (const auto& n : kFlightNumbers)
+    if (option == n.option) return n.range;
+  throw std::invalid_argument("no closed-loop number " + option);
+}
+
+bool SimulateJob::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!kDurationRange.contains(duration)) return fail("--duration: " + kDurationRange.text("s"));
+  if (!kStepRange.contains(step)) return fail("--step: " + kStepRange.text("s"));
+  if (!kRateRange.contains(rate)) return fail("--rate: " + kRateRange.text("Hz"));
+  for (const auto& n : kFlightNumbers)
+    if (!n.range.contains(flight.*n.field)) return fail(std::string(n.option) + ": " + n.range.text());
+  if (ground_height && !(std::fabs(*ground_height) <= kMaxGroundHeight))
+    return fail("--ground " + output::six_digits(*ground_height) + ": expected a height within +-" +
+                output::six_digits(kMaxGroundHeight) + " m");
+  return true;
+}
+
 SimulateJobResult run_simulate_job(const SimulateJob& a) {
+  if (std::string error; !a.IsValid(&error)) throw std::invalid_argument(error);
   if (!a.closed_loop && a.scenario.empty() == a.inputs.empty())
     throw std::invalid_argument("give one of --scenario, --inputs or --closed-loop");
   if (!a.mapping.empty() && a.inputs.empty()) throw std::invalid_argument("--mapping reads an --inputs log: give one");
-  if (a.ground_height && !(std::fabs(*a.ground_height) <= kMaxGroundHeight))
-    throw std::invalid_argument("--ground " + output::six_digits(*a.ground_height) + ": expected a height within +-" +
-                                output::six_digits(kMaxGroundHeight) + " m");
   const Vehicle vehicle = load_vehicle(a.vehicle);
   if (const std::string note = fitted_section_note(vehicle, "simulate"); !note.empty()) a.progress.say(note);
   if (a.closed_loop) check_size(a, 0, a.duration * a.flight.log_rate);

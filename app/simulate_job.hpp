@@ -9,12 +9,40 @@
 #include <vector>
 
 #include "runtime/closed_loop.hpp"
+#include "output/accepted_range.hpp"
 #include "output/progress.hpp"
 #include "runtime/plot.hpp"
 
 namespace quadgen::app {
 
 inline constexpr double kMinStep = 1e-7;  // s, the smallest RK4 --step taken
+
+// The numbers SimulateJob accepts (its IsValid and the command line's checks read these).
+inline constexpr output::AcceptedRange kDurationRange{1e-6, 1e9};  // s
+inline constexpr output::AcceptedRange kStepRange{kMinStep, 1.0};  // s
+inline constexpr output::AcceptedRange kRateRange{1e-3, 1e6};      // Hz
+// The closed-loop test flight's, as --help names them, with the field each sets.
+struct FlightNumber {
+  const char* option;
+  double runtime::ClosedLoopOptions::*field;
+  output::AcceptedRange range;
+};
+inline const std::vector<FlightNumber> kFlightNumbers = {
+    {"--pose-noise", &runtime::ClosedLoopOptions::pose_noise, {0, 10}},
+    {"--gyro-noise", &runtime::ClosedLoopOptions::gyro_noise, {0, 100}},
+    {"--gyro-bias", &runtime::ClosedLoopOptions::gyro_bias, {-10, 10}},
+    {"--accel-noise", &runtime::ClosedLoopOptions::accel_noise, {0, 100}},
+    {"--accel-bias", &runtime::ClosedLoopOptions::accel_bias, {-100, 100}},
+    {"--amplitude", &runtime::ClosedLoopOptions::amplitude, {0, 20}},
+    {"--height", &runtime::ClosedLoopOptions::height, {0.05, 100}},
+    {"--height-amplitude", &runtime::ClosedLoopOptions::height_amplitude, {0, 10}},
+    {"--yaw-amplitude", &runtime::ClosedLoopOptions::yaw_amplitude, {0, 10}},
+    {"--excitation", &runtime::ClosedLoopOptions::excitation, {0, 5}},
+    {"--tether", &runtime::ClosedLoopOptions::tether_stiffness, {0, 100}},
+    {"--yaw-per-speed", &runtime::ClosedLoopOptions::yaw_per_forward_speed, {-50, 50}},
+    {"--angular-disturbance", &runtime::ClosedLoopOptions::angular_disturbance, {0, 100}}};
+// The range of the closed-loop number `option` sets (kFlightNumbers); throws for another name.
+const output::AcceptedRange& flight_number_range(const std::string& option);
 
 struct SimulateJob {
   std::string vehicle;      // vehicle file (YAML)
@@ -40,6 +68,10 @@ struct SimulateJob {
   std::vector<std::pair<std::string, double>> set;
   bool no_size_limit = false;  // refuse runs beyond kMaxSteps steps or kMaxRows rows unless set
   output::Progress progress;   // "simulating 5 s of ..."; nowhere by default
+
+  // Ceres-style: false with a reason for a number no simulation can use (run_simulate_job
+  // throws it before any work).
+  bool IsValid(std::string* error) const;
 };
 
 // Work beyond these sizes is refused before it starts unless no_size_limit is set: each

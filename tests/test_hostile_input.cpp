@@ -2422,6 +2422,23 @@ TEST(LibraryCalls, CheckTheirInputsAsTheCommandLineDoes) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("--ground 1e+09: expected a height within +-10000 m"), std::string::npos) << e.what();
   }
+  // Every number of the job, checked by the job with the ranges --help shows (they were the
+  // command line's alone: a caller's excitation of 50 rad/s was flown).
+  std::string why;
+  job.ground_height.reset();
+  EXPECT_TRUE(job.IsValid(&why)) << why;
+  job.flight.excitation = 6;
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_EQ(why, "--excitation: 0 to 5");
+  EXPECT_THROW(quadgen::app::run_simulate_job(job), std::invalid_argument);
+  job.flight.excitation = 0;
+  job.rate = std::nan("");
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_EQ(why, "--rate: 0.001 to 1e+06 Hz");
+  job.rate = 100;
+  job.duration = 0;  // the job's default: a caller must say how long
+  EXPECT_FALSE(job.IsValid(&why));
+  EXPECT_EQ(why.rfind("--duration", 0), 0u) << why;
   using quadgen::output::split_name_list;
   EXPECT_EQ(split_name_list("", "--channels"), std::vector<std::string>{});
   EXPECT_EQ(split_name_list("ax,qdot", "--channels"), (std::vector<std::string>{"ax", "qdot"}));
