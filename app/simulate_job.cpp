@@ -515,12 +515,6 @@ std::string implausible_settings(const SimulateJob& a, const Vehicle& vehicle) {
 
 }  // namespace
 
-const output::AcceptedRange& flight_number_range(const std::string& option) {
-  for (const auto& n : kFlightNumbers)
-    if (option == n.option) return n.range;
-  throw std::invalid_argument("no closed-loop number " + option);
-}
-
 bool SimulateJob::IsValid(std::string* error) const {
   const auto fail = [&](const std::string& why) {
     if (error) *error = why;

@@ -21,28 +21,41 @@ inline constexpr double kMinStep = 1e-7;  // s, the smallest RK4 --step taken
 inline constexpr output::AcceptedRange kDurationRange{1e-6, 1e9};  // s
 inline constexpr output::AcceptedRange kStepRange{kMinStep, 1.0};  // s
 inline constexpr output::AcceptedRange kRateRange{1e-3, 1e6};      // Hz
-// The closed-loop test flight's, as --help names them, with the field each sets.
+// The closed-loop test flight's, one row each: the option that sets it, its field, its range
+// and what --help says of it (the command line adds one option per row).
 struct FlightNumber {
   const char* option;
   double runtime::ClosedLoopOptions::*field;
   output::AcceptedRange range;
+  const char* help;
 };
 inline const std::vector<FlightNumber> kFlightNumbers = {
-    {"--pose-noise", &runtime::ClosedLoopOptions::pose_noise, {0, 10}},
-    {"--gyro-noise", &runtime::ClosedLoopOptions::gyro_noise, {0, 100}},
-    {"--gyro-bias", &runtime::ClosedLoopOptions::gyro_bias, {-10, 10}},
-    {"--accel-noise", &runtime::ClosedLoopOptions::accel_noise, {0, 100}},
-    {"--accel-bias", &runtime::ClosedLoopOptions::accel_bias, {-100, 100}},
-    {"--amplitude", &runtime::ClosedLoopOptions::amplitude, {0, 20}},
-    {"--height", &runtime::ClosedLoopOptions::height, {0.05, 100}},
-    {"--height-amplitude", &runtime::ClosedLoopOptions::height_amplitude, {0, 10}},
-    {"--yaw-amplitude", &runtime::ClosedLoopOptions::yaw_amplitude, {0, 10}},
-    {"--excitation", &runtime::ClosedLoopOptions::excitation, {0, 5}},
-    {"--tether", &runtime::ClosedLoopOptions::tether_stiffness, {0, 100}},
-    {"--yaw-per-speed", &runtime::ClosedLoopOptions::yaw_per_forward_speed, {-50, 50}},
-    {"--angular-disturbance", &runtime::ClosedLoopOptions::angular_disturbance, {0, 100}}};
-// The range of the closed-loop number `option` sets (kFlightNumbers); throws for another name.
-const output::AcceptedRange& flight_number_range(const std::string& option);
+    {"--pose-noise", &runtime::ClosedLoopOptions::pose_noise, {0, 10},
+     "closed loop: mocap noise [m, rad]"},
+    {"--gyro-noise", &runtime::ClosedLoopOptions::gyro_noise, {0, 100},
+     "closed loop: gyro noise [rad/s]"},
+    {"--gyro-bias", &runtime::ClosedLoopOptions::gyro_bias, {-10, 10},
+     "closed loop: gyro bias [rad/s]"},
+    {"--accel-noise", &runtime::ClosedLoopOptions::accel_noise, {0, 100},
+     "closed loop: accelerometer noise [m/s^2]"},
+    {"--accel-bias", &runtime::ClosedLoopOptions::accel_bias, {-100, 100},
+     "closed loop: accelerometer bias [m/s^2]"},
+    {"--amplitude", &runtime::ClosedLoopOptions::amplitude, {0, 20},
+     "closed loop: horizontal excursions of the trajectory [m]"},
+    {"--height", &runtime::ClosedLoopOptions::height, {0.05, 100},
+     "closed loop: mean height [m]"},
+    {"--height-amplitude", &runtime::ClosedLoopOptions::height_amplitude, {0, 10},
+     "closed loop: height excursions [m]"},
+    {"--yaw-amplitude", &runtime::ClosedLoopOptions::yaw_amplitude, {0, 10},
+     "closed loop: heading excursions [rad]"},
+    {"--excitation", &runtime::ClosedLoopOptions::excitation, {0, 5},
+     "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]"},
+    {"--tether", &runtime::ClosedLoopOptions::tether_stiffness, {0, 100},
+     "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)"},
+    {"--yaw-per-speed", &runtime::ClosedLoopOptions::yaw_per_forward_speed, {-50, 50},
+     "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)"},
+    {"--angular-disturbance", &runtime::ClosedLoopOptions::angular_disturbance, {0, 100},
+     "closed loop: random roll and pitch angular acceleration, 10 Hz low-passed white noise [rad/s^2 RMS] (outside the catalogue)"}};
 
 struct SimulateJob {
   std::string vehicle;      // vehicle file (YAML)

@@ -20,30 +20,8 @@ namespace {
 // The closed-loop test flight's trajectory, noise and disturbances: each refused without
 // --closed-loop (`cl`), never silently ignored.
 void add_closed_loop_options(CLI::App* c, SimulateArgs& a, CLI::Option* cl) {
-  c->add_option("--pose-noise", a.job.flight.pose_noise, "closed loop: mocap noise [m, rad]")->check(finite_range(app::flight_number_range("--pose-noise")))->needs(cl);
-  c->add_option("--gyro-noise", a.job.flight.gyro_noise, "closed loop: gyro noise [rad/s]")->check(finite_range(app::flight_number_range("--gyro-noise")))->needs(cl);
-  c->add_option("--gyro-bias", a.job.flight.gyro_bias, "closed loop: gyro bias [rad/s]")->check(finite_range(app::flight_number_range("--gyro-bias")))->needs(cl);
-  c->add_option("--accel-noise", a.job.flight.accel_noise, "closed loop: accelerometer noise [m/s^2]")
-      ->check(finite_range(app::flight_number_range("--accel-noise")))->needs(cl);
-  c->add_option("--accel-bias", a.job.flight.accel_bias, "closed loop: accelerometer bias [m/s^2]")
-      ->check(finite_range(app::flight_number_range("--accel-bias")))->needs(cl);
-  c->add_option("--amplitude", a.job.flight.amplitude, "closed loop: horizontal excursions of the trajectory [m]")
-      ->check(finite_range(app::flight_number_range("--amplitude")))->needs(cl);
-  c->add_option("--height", a.job.flight.height, "closed loop: mean height [m]")->check(finite_range(app::flight_number_range("--height")))->needs(cl);
-  c->add_option("--height-amplitude", a.job.flight.height_amplitude, "closed loop: height excursions [m]")
-      ->check(finite_range(app::flight_number_range("--height-amplitude")))->needs(cl);
-  c->add_option("--yaw-amplitude", a.job.flight.yaw_amplitude, "closed loop: heading excursions [rad]")
-      ->check(finite_range(app::flight_number_range("--yaw-amplitude")))->needs(cl);
-  c->add_option("--excitation", a.job.flight.excitation, "closed loop: multisine (1-8 Hz) on the rate set points [rad/s]")
-      ->check(finite_range(app::flight_number_range("--excitation")))->needs(cl);
-  c->add_option("--tether", a.job.flight.tether_stiffness, "closed loop: horizontal tether to the start point, stiffness [N/m] (an effect outside the catalogue)")
-      ->check(finite_range(app::flight_number_range("--tether")))->needs(cl);
-  c->add_option("--yaw-per-speed", a.job.flight.yaw_per_forward_speed,
-                "closed loop: yaw acceleration per m/s of forward body speed [rad/s^2 per m/s] (outside the catalogue)")
-      ->check(finite_range(app::flight_number_range("--yaw-per-speed")))->needs(cl);
-  c->add_option("--angular-disturbance", a.job.flight.angular_disturbance,
-                "closed loop: random roll and pitch angular acceleration, 10 Hz low-passed white noise [rad/s^2 RMS] (outside the catalogue)")
-      ->check(finite_range(app::flight_number_range("--angular-disturbance")))->needs(cl);
+  for (const app::FlightNumber& n : app::kFlightNumbers)
+    c->add_option(n.option, a.job.flight.*n.field, n.help)->check(finite_range(n.range))->needs(cl);
 }
 
 }  // namespace
