@@ -16,6 +16,7 @@
 #include "output/nearest_word.hpp"
 #include "output/numbers.hpp"
 #include "output/joined.hpp"
+#include "output/names.hpp"
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "fit/log_reader.hpp"
@@ -36,7 +37,7 @@ bool DiagnoseJob::IsValid(std::string* error) const {
   if (!fit::valid_resample_rate(resample)) return fail("resample: 0 or " + fit::kResampleRange.text("Hz"));
   if (!airframe.empty() && logs.size() != 1)
     return fail("airframe: checks one flight against an airframe; several logs are diagnosed jointly instead");
-  if (!environment.empty() && !is_environment_name(environment))
+  if (!environment.empty() && !output::is_one_of(environment, kEnvironmentNames))
     return fail("environment: " + output::joined(kEnvironmentNames));
   return options.IsValid(error);
 }

@@ -18,6 +18,7 @@
 #include "model/yaml_reader.hpp"
 #include "output/numbers.hpp"
 #include "output/joined.hpp"
+#include "output/names.hpp"
 #include "runtime/data_side_effects.hpp"
 #include "output/nearest_word.hpp"
 #include "runtime/attitude.hpp"
@@ -186,7 +187,7 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
     }
     if (top.count("environment")) {
       m.environment = scalar_text(path, top.at("environment"), "environment");
-      if (!is_environment_name(m.environment))
+      if (!output::is_one_of(m.environment, kEnvironmentNames))
         mapping_error(path, top.at("environment"), "environment: expected one of " + output::joined(kEnvironmentNames));
     }
     std::set<std::string> targets;

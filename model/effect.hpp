@@ -28,11 +28,6 @@ enum class Environment { kUnknown, kIndoor, kOutdoor };
 // Their names as files and the command line spell them (parse_environment reads them; a
 // mapping, DiagnoseJob::IsValid and --environment accept these and no other).
 inline const std::vector<std::string> kEnvironmentNames = {"indoor", "outdoor", "unknown"};
-inline bool is_environment_name(const std::string& text) {
-  for (const auto& name : kEnvironmentNames)
-    if (text == name) return true;
-  return false;
-}
 
 // The values of a parameter that the effect's physics can produce. A fitted value beyond
 // them is the effect standing in for something the model lacks, not the effect itself.
