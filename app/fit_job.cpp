@@ -10,7 +10,10 @@
 namespace quadgen::app {
 
 FitJobResult run_fit_job(const FitJob& job, const Vehicle& v, fit::LogKind kind) {
-  if (std::string error; !job.options.IsValid(&error)) throw std::invalid_argument("fit: " + error);
+  if (std::string error; !job.options.IsValidFor(kind, &error)) throw std::invalid_argument("fit: " + error);
+  if (!job.effects.empty())
+    if (const std::string why = fit::why_unused("effects", kind, job.options.formulation); !why.empty())
+      throw std::invalid_argument("fit: effects: " + why);
   FitJobResult r;
   // Said as the work goes, before the fit's own steps (job.options.progress).
   if (const std::string note = fitted_section_note(v, "fit"); !note.empty()) job.options.progress(note);

@@ -25,8 +25,8 @@ struct FitJobResult {
 
 // `vehicle`: the vehicle file as load_vehicle read it; `kind`: fit::log_kind(job.log) (the
 // command line reads both first, the kind to refuse the flags it does not take before any
-// work). The options are checked (IsValid) before anything is built; which options a kind
-// uses is the command line's check (by the flags given), not the library's.
+// work). The options are checked before anything is built (IsValidFor: an option set that
+// the log's kind does not read, effects on a log that is no flight included, is an error).
 // The vehicle's fitted section and the model fitted are said through job.options.progress.
 // Throws the layers' own errors (a bad log, with file and line) unchanged.
 FitJobResult run_fit_job(const FitJob& job, const Vehicle& vehicle, fit::LogKind kind);

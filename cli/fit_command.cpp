@@ -2,7 +2,6 @@
 // library's), the job's files written as one output set. The kind of fit follows the log's
 // layout; an option that kind does not use is refused. The pipeline itself: app/fit_job.cpp.
 #include <iostream>
-#include <set>
 
 #include "app/fit_job.hpp"
 #include "cli/fit_command.hpp"
@@ -10,7 +9,6 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
 #include "model/vehicle.hpp"
-#include "output/joined.hpp"
 #include "output/names.hpp"
 #include "output/output_set.hpp"
 #include "output/sinks.hpp"
@@ -70,23 +68,14 @@ FitJobOptions job_options(const FitArgs& a) {
   return o;
 }
 
-// The kind of fit follows the log's columns; an option that kind does not use is an error,
-// never silently dropped.
-void refuse_options(const FitArgs& a, const std::string& kind, const std::set<std::string>& used) {
-  for (const auto& opt : a.given)
-    if (!used.count(opt)) {
-      throw std::invalid_argument(opt + ": not used when fitting " + kind +
-                                  " (the log's columns choose the kind of fit); this kind takes " + output::joined(used));
-    }
-}
-
-void check_flight_options(const FitArgs& a) {
-  const bool shooting = a.options.formulation == "multiple_shooting";
-  if (a.given.count("--window") && !shooting) throw std::invalid_argument("--window: only with --formulation multiple_shooting");
-  if (a.given.count("--translational") && shooting)
-    throw std::invalid_argument("--translational: only with --formulation equation_error (multiple shooting fits the pose)");
-  if (a.given.count("--channels") && shooting)
-    throw std::invalid_argument("--channels: only with --formulation equation_error (multiple shooting fits the pose)");
+// The kind of fit follows the log's columns; a flag given that this kind does not read is an
+// error, never silently dropped (even at its default value). The rule is the library's.
+void refuse_unused_flags(const FitArgs& a, LogKind kind) {
+  for (const auto& flag : a.given) {
+    if (flag == "--out") continue;
+    if (const std::string why = why_unused(flag.substr(2), kind, a.options.formulation, "--"); !why.empty())
+      throw std::invalid_argument(flag + ": " + why);
+  }
 }
 
 }  // namespace
@@ -94,12 +83,7 @@ void check_flight_options(const FitArgs& a) {
 int run_fit(const FitArgs& a) {
   const Vehicle v = load_vehicle(a.vehicle);  // a bad file is reported before anything is created
   const LogKind kind = log_kind(a.log);
-  if (kind == LogKind::kMotorSteps)
-    refuse_options(a, "a motor-step log", {"--out", "--robust", "--profiles", "--threads"});
-  else if (kind == LogKind::kThrustStand)
-    refuse_options(a, "a thrust-stand log", {"--out", "--robust", "--threads"});
-  else
-    check_flight_options(a);
+  refuse_unused_flags(a, kind);
   output::OutputDirectory out(a.out, "fit", {a.vehicle, a.log, a.options.mapping});  // refused before the work, not after
   const app::FitJobResult r = app::run_fit_job({a.log, a.effects, job_options(a)}, v, kind);
   for (const auto& [name, contents] : r.files) out.add(name, contents);

@@ -178,15 +178,70 @@ bool FitJobOptions::IsValid(std::string* error) const {
   return true;
 }
 
+bool FitJobOptions::IsValidFor(LogKind kind, std::string* error) const {
+  if (!IsValid(error)) return false;
+  for (const auto& name : options_set(*this))
+    if (const std::string why = why_unused(name, kind, formulation); !why.empty()) {
+      if (error) *error = name + ": " + why;
+      return false;
+    }
+  return true;
+}
+
+std::string why_unused(const std::string& option, LogKind kind, const std::string& formulation, const std::string& prefix) {
+  // Motor steps fit a map and a lag, profiled; a thrust stand two laws whose intervals come
+  // from its own profiles of every coefficient. Neither has channels, a model or a hold-out.
+  const auto takes = [&](const std::string& what, const std::vector<std::string>& read) -> std::string {
+    if (output::is_one_of(option, read)) return "";
+    std::vector<std::string> flags;
+    for (const auto& r : read) flags.push_back(prefix + r);
+    return "not used when fitting " + what + " (the log's columns choose the kind of fit); this kind takes " +
+           output::joined(flags);
+  };
+  if (kind == LogKind::kMotorSteps) return takes("a motor-step log", {"robust", "profiles", "threads"});
+  if (kind == LogKind::kThrustStand) return takes("a thrust-stand log", {"robust", "threads"});
+  const bool shooting = formulation == "multiple_shooting";
+  if (option == "window" && !shooting) return "only with " + prefix + "formulation multiple_shooting";
+  if ((option == "translational" || option == "channels") && shooting)
+    return "only with " + prefix + "formulation equation_error (multiple shooting fits the pose)";
+  return "";
+}
+
+std::vector<std::string> options_set(const FitJobOptions& o) {
+  const FitJobOptions d;
+  std::vector<std::string> set;
+  const auto add = [&](const char* name, bool differs) {
+    if (differs) set.push_back(name);
+  };
+  add("robust", o.robust != d.robust);
+  add("profiles", o.profile_all_free != d.profile_all_free || !o.profiles.empty());
+  add("threads", o.threads != d.threads);
+  add("mapping", o.mapping != d.mapping);
+  add("resample", o.resample != d.resample);
+  add("validation", o.validation != d.validation);
+  add("formulation", o.formulation != d.formulation);
+  add("window", o.window != d.window);
+  add("channels", !o.channels.empty());
+  add("translational", o.translational != d.translational);
+  add("free", !o.free.empty());
+  return set;
+}
+
 LogKind log_kind(const std::string& path) {
   if (is_topic_log(path)) return LogKind::kFlight;
-  const runtime::CsvTable head = runtime::read_csv(path);
+  const runtime::CsvTable head = runtime::read_csv_header(path);
   if (head.column("throttle_percent") >= 0 && head.column("rpm") >= 0) return LogKind::kMotorSteps;
   if (head.column("weight[g]") >= 0 && head.column("rpm1") >= 0) return LogKind::kThrustStand;
   return LogKind::kFlight;
 }
 
+// Every fit's first step: options no fit can use, or that this kind does not read, refused.
+static void check_options(const FitJobOptions& o, LogKind kind) {
+  if (std::string error; !o.IsValidFor(kind, &error)) throw std::invalid_argument("fit: " + error);
+}
+
 FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
+  check_options(o, LogKind::kMotorSteps);
   MotorStepModel model(read_motor_steps(path));
   const FitOptions fo = fit_options(o);
   o.progress("[1/2] fitting motor map and lag to " + std::to_string(model.steps().size()) + " steps (" +
@@ -364,8 +419,7 @@ std::string profile_summary(const FitResult& best, const std::vector<Profile>& p
 }  // namespace
 
 FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
-  std::string error;
-  if (!o.IsValid(&error)) throw std::invalid_argument("fit: " + error);
+  check_options(o, LogKind::kFlight);
   const std::vector<std::string> rotors = rotor_names(v);
   const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
   const std::vector<FitParameter> params = starting_parameters(model, o);
@@ -453,6 +507,7 @@ std::vector<runtime::Panel> stand_panels(const std::vector<StandSample>& samples
 }  // namespace
 
 FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
+  check_options(o, LogKind::kThrustStand);
   const auto samples = read_thrust_stand(path);
   o.progress("thrust vs rotor speed and rotor speed vs command, " + std::to_string(samples.size()) + " samples");
   const double vref = param(v, "vbat_ref").nominal;

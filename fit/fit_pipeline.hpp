@@ -56,7 +56,21 @@ struct FitJobOptions {
 
   // Ceres-style: false with a reason for a value no fit can use.
   bool IsValid(std::string* error) const;
+  // IsValid, and no option set away from its default that a fit of `kind` does not read
+  // (options_unused_by): an option is refused, never dropped silently.
+  bool IsValidFor(LogKind kind, std::string* error) const;
 };
+
+// Which options a fit reads, named as the command line's flags without "--" (robust,
+// profiles, threads, mapping, resample, validation, formulation, window, channels,
+// translational, free; and app::FitJob's effects). Empty when a fit of `kind` with
+// `formulation` reads `option`, else why not, naming other options with `prefix` before
+// them ("--" for the command line). The one rule behind the command line's refusal of the
+// flags given and IsValidFor's of the options set.
+std::string why_unused(const std::string& option, LogKind kind, const std::string& formulation,
+                       const std::string& prefix = "");
+// The options of `o` set away from their defaults, named as above.
+std::vector<std::string> options_set(const FitJobOptions& o);
 
 // What a fit writes: fit.json, rendered plots (file name, SVG), plots that could not be
 // drawn (gnuplot missing: the fit still counts) and the lines the command prints.

@@ -193,8 +193,10 @@ void leave_out_unreadable(CsvTable& t, const std::vector<UnreadableColumn>& foun
 
 // The table from a source of lines ('\n' removed). size_hint (bytes, 0 if unknown) only
 // sizes the row vector, so that a large log is not copied again and again as it grows.
+// header_only: stop after the header (the table has its columns and no rows).
 template <class NextLine>
-CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned long long size_hint) {
+CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned long long size_hint,
+                     bool header_only = false) {
   CsvTable t;
   t.path = path;
   std::string line;
@@ -231,6 +233,7 @@ CsvTable parse_lines(NextLine&& next_line, const std::string& path, unsigned lon
       for (const auto& c : t.columns)
         if (!seen.insert(c).second) fail_at(path, lineno, "duplicate column " + quoted_cell(c));
       unreadable.resize(t.columns.size());
+      if (header_only) break;
       continue;
     }
     parse_row(line, t, lineno, row, unreadable, cells);
@@ -319,6 +322,13 @@ CsvTable read_csv(const std::string& path) {
   file.set_blocking();
   FdLines lines(file.fd(), path, file.limit());
   return parse_lines(lines, path, file.size());
+}
+
+CsvTable read_csv_header(const std::string& path) {
+  const LogFile file(path, "a CSV log");
+  file.set_blocking();
+  FdLines lines(file.fd(), path, file.limit());
+  return parse_lines(lines, path, file.size(), /*header_only=*/true);
 }
 
 std::string canonical_unit(const std::string& c) {

@@ -88,6 +88,9 @@ unsigned long long max_input_bytes();  // throws LogError for a malformed variab
 // read_csv refuses anything but a regular file (a FIFO or a device would block or never
 // end) and files above max_input_bytes(), and parses line by line.
 CsvTable read_csv(const std::string& path);
+// Only the header, checked as read_csv checks it: the columns, no rows (to tell a file's kind
+// without reading a large log twice).
+CsvTable read_csv_header(const std::string& path);
 CsvTable parse_csv(const std::string& text, const std::string& path);
 
 // Every value of a canonical column finite and within the sanity bounds above (t against

@@ -27,6 +27,8 @@
 #include "runtime/rigid_body_state.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/motor_steps.hpp"
+#include "fit/fit_pipeline.hpp"
+#include "model/vehicle.hpp"
 #include "fit/profile_likelihood.hpp"
 #include "tests/estimate_shape.hpp"
 #include "tests/test_helpers.hpp"
@@ -370,6 +372,51 @@ TEST(FitCli, MotorStepsOfTheThesis) {
   int tau_rows = 0;
   while (std::getline(csv, line)) tau_rows += line.find(R"(,"tau","delta chi2","profile",)") != std::string::npos;
   EXPECT_EQ(tau_rows, static_cast<int>(j["profiles"]["tau"].size()));
+}
+
+// An option the log's kind does not read is refused by the library too, not only by the
+// command line's flags (a caller's mapping was dropped silently on a motor-step log), and
+// the kind is told from the header alone (a large log is not read twice).
+TEST(Fit, AnOptionTheLogsKindDoesNotReadIsRefusedNotDropped) {
+  using namespace quadgen::fit;
+  std::string why;
+  FitJobOptions o;
+  for (LogKind k : {LogKind::kFlight, LogKind::kMotorSteps, LogKind::kThrustStand})
+    EXPECT_TRUE(o.IsValidFor(k, &why)) << why;  // the defaults suit every kind
+  o.mapping = "nanobench.yaml";
+  EXPECT_TRUE(o.IsValidFor(LogKind::kFlight, &why)) << why;
+  EXPECT_FALSE(o.IsValidFor(LogKind::kMotorSteps, &why));
+  EXPECT_EQ(why.rfind("mapping: not used when fitting a motor-step log", 0), 0u) << why;
+  EXPECT_NE(why.find("this kind takes robust, profiles, threads"), std::string::npos) << why;
+  const Vehicle v = load_vehicle(test::source_path("vehicles/finken3.yaml"));
+  const std::string steps = test::source_path("data/finken3_motor_steps.csv");
+  EXPECT_THROW(fit_motor_steps_log(steps, v, o), std::invalid_argument);
+  o = FitJobOptions{};
+  o.profile_all_free = false;  // estimates only: a motor-step fit takes it, a thrust stand does not
+  EXPECT_TRUE(o.IsValidFor(LogKind::kMotorSteps, &why)) << why;
+  EXPECT_FALSE(o.IsValidFor(LogKind::kThrustStand, &why));
+  EXPECT_EQ(why.rfind("profiles: ", 0), 0u) << why;
+  o = FitJobOptions{};
+  o.window = 1;  // a flight's window belongs to multiple shooting
+  EXPECT_FALSE(o.IsValidFor(LogKind::kFlight, &why));
+  EXPECT_EQ(why, "window: only with formulation multiple_shooting");
+  o.formulation = "multiple_shooting";
+  EXPECT_TRUE(o.IsValidFor(LogKind::kFlight, &why)) << why;
+  o.channels = {"ax"};
+  EXPECT_FALSE(o.IsValidFor(LogKind::kFlight, &why));
+  EXPECT_EQ(why.rfind("channels: only with formulation equation_error", 0), 0u) << why;
+  EXPECT_EQ(why_unused("window", LogKind::kFlight, "equation_error", "--"), "only with --formulation multiple_shooting");
+
+  const fs::path log = fs::temp_directory_path() / "quadgen_kind_from_header.csv";
+  { std::ofstream(log) << "time_ms,throttle_percent,rpm\n0,10,2000\n100,ten,2100\n"; }
+  EXPECT_EQ(log_kind(log.string()), LogKind::kMotorSteps);  // the bad row is the reader's to report
+  try {
+    read_motor_steps(log.string());
+    ADD_FAILURE() << "a row with 'ten' read";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(":3:"), std::string::npos) << e.what();
+  }
+  fs::remove(log);
 }
 
 // Multiple shooting recovers the thrust coefficient and yaw-torque coefficient from the
