@@ -36,7 +36,12 @@ inline constexpr output::AcceptedRange kDiagnoseWindowRange{0.1, 10};       // s
 // window's length on, the windows would not overlap (consecutive windows are stride 0).
 inline constexpr double kSmallestWindowStride = 0.01;  // s
 inline constexpr output::AcceptedRange kAlphaRange{1e-9, 0.2};
-inline const std::vector<std::string> kTranslationalChoices = {"auto", "pose", "accelerometer"};
+// "auto": the pose where the log has one, else the accelerometer; or one of the sources.
+inline const std::vector<std::string> kTranslationalChoices = [] {
+  std::vector<std::string> c{"auto"};
+  c.insert(c.end(), fit::kTranslationalSources.begin(), fit::kTranslationalSources.end());
+  return c;
+}();
 
 struct DiagnoseOptions {
   double validation_fraction = 0.3;  // end of the flight, held out

@@ -33,7 +33,6 @@ inline constexpr output::AcceptedRange kFitValidationRange{0, 0.9};  // fraction
 inline constexpr output::AcceptedRange kFitWindowRange{0.01, 100};   // s
 inline constexpr int kMaxThreads = 256;                              // profile threads
 inline const std::vector<std::string> kFitFormulations = {"equation_error", "multiple_shooting"};
-inline const std::vector<std::string> kTranslationalSources = {"pose", "accelerometer"};  // or "": the default
 
 struct FitJobOptions {
   bool robust = false;                 // Huber loss instead of squares

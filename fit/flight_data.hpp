@@ -89,6 +89,11 @@ struct Flight {
   std::vector<std::string> notes;
 };
 
+// Where a fit's translational channels (ax, ay, az) may come from: the pose's differentiated
+// velocity or the accelerometer's specific force (fit's --translational; diagnose's adds
+// "auto").
+inline const std::vector<std::string> kTranslationalSources = {"pose", "accelerometer"};
+
 struct FlightOptions {
   double derivative_window = 0.05;  // s, half-width of the local quadratic fit
   double min_samples = 20;

@@ -105,6 +105,13 @@ std::string printable_error(const std::string& message) {
          printable(message.substr(tail));
 }
 
+std::string printable_head(const std::string& s, size_t max_bytes) {
+  if (s.size() <= max_bytes) return printable(s);
+  size_t cut = max_bytes;
+  while (cut > 0 && utf8_continuation(s, cut)) --cut;
+  return printable(s.substr(0, cut)) + "...";
+}
+
 std::string printable_lines(const std::string& text) {
   std::string out;
   size_t start = 0;

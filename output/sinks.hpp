@@ -17,6 +17,9 @@ std::string printable(const std::string& s);
 // quoting a 200 kB name (a vehicle file's block, a log's column) keeps its head (where and
 // what) and its tail (what was expected), and says how many bytes it left out between them.
 std::string printable_error(const std::string& message);
+// The first at most `max_bytes` of `s` ending on a whole UTF-8 character, as printable makes
+// it, and "..." after it where something was cut (a quoted cell of a log).
+std::string printable_head(const std::string& s, size_t max_bytes);
 // Several lines for a terminal (a command's summary): each line as printable makes it, the
 // line breaks kept. Summaries quote log paths, which may carry escape sequences.
 std::string printable_lines(const std::string& text);

@@ -88,11 +88,7 @@ namespace {
 // A cell as it may appear in a one-line message: long or binary junk is cut short (at a
 // whole character), control characters shown as \xNN as every message shows them (a tab
 // read '?' here, a NUL too, and a Cyrillic letter '??': a review, helper-135).
-std::string quoted_cell(const std::string& cell) {
-  size_t cut = std::min<size_t>(cell.size(), 40);
-  while (cut < cell.size() && cut > 0 && (static_cast<unsigned char>(cell[cut]) & 0xC0) == 0x80) --cut;
-  return "'" + output::printable(cell.substr(0, cut)) + (cut < cell.size() ? "...'" : "'");
-}
+std::string quoted_cell(const std::string& cell) { return "'" + output::printable_head(cell, 40) + "'"; }
 
 // The cells of one line as RFC 4180 reads them: a cell in double quotes may hold commas, and
 // "" in it is one quote (a spreadsheet or pandas quotes a cell that holds a comma or a quote;

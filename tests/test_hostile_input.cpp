@@ -845,6 +845,10 @@ TEST(Cli, AHugeNameGivesAnErrorLineOfReadableLength) {
       EXPECT_EQ(shown.find('?'), std::string::npos) << ascii << " " << c.size();
     }
   EXPECT_EQ(out::printable_error("short\n"), "short\\x0A");
+  // A log's cell quoted in a message: its head cut on a whole character too.
+  EXPECT_EQ(out::printable_head("ab\xe2\x82\xac", 4), "ab...");
+  EXPECT_EQ(out::printable_head("ab\xe2\x82\xac", 5), "ab\xe2\x82\xac");
+  EXPECT_EQ(out::printable_head("a\tb", 40), "a\\x09b");
 }
 
 // ... and their colour and marker (a review, helper-107: a thinned series was drawn in
