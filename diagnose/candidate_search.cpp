@@ -956,7 +956,7 @@ void CandidateSearch::add_wald_estimates(SearchResult& r, const StandardErrors& 
     const double v = r.final_fit[i].value, z = fit::kZ95;
     r.estimates.push_back({r.final_fit[i].name, r.final_fit[i].unit, v, sd, finite ? v - z * sd : nan,
                            finite ? v + z * sd : nan, 0.0,
-                           finite ? "identifiable" : "structurally non-identifiable", "wald",
+                           finite ? fit::Identifiability::kIdentifiable : fit::Identifiability::kStructurallyNonIdentifiable, "wald",
                            fit::on_bound(r.final_fit[i])});
   }
 }

@@ -26,6 +26,7 @@
 #pragma once
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -83,7 +84,9 @@ struct EffectEstimate {
   // Added to both sides of the interval: the estimate's change when the interval
   // accelerations use the trapezoid instead of the midpoint rule.
   double numerical_allowance = 0;
-  std::string verdict;  // from the profile likelihood
+  // From the profile likelihood (or the Wald interval's existence); none: not assessed (a
+  // suspect's values, which are not profiled).
+  std::optional<fit::Identifiability> verdict;
   // How the interval was found: "profile" (profile likelihood), or "wald" (value +- 1.96
   // standard errors of the joint fit) for a flight's own copy of a per-flight parameter in
   // a joint diagnosis, where profiling every flight's copy would take hours.

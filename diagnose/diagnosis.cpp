@@ -259,7 +259,7 @@ Suspected held_out_suspect(const std::string& effect, const CandidateEvidence& e
   const double none = std::numeric_limits<double>::quiet_NaN();
   for (const auto& p : evidence.parameters)
     if (p.free && effect_of_parameter(p.name) == effect)
-      f.parameters.push_back({p.name, p.unit, p.value, none, none, none, 0, "", "none",
+      f.parameters.push_back({p.name, p.unit, p.value, none, none, none, 0, std::nullopt, "none",
                               fit::on_bound(p)});
   f.metric = "validation equation-error cost (weighted)";
   f.before = cost_without;

@@ -198,7 +198,9 @@ void per_flight_table(std::ostringstream& h, const Finding& f, size_t flights) {
     for (const auto* p : row)
       if (p)
         h << "<td>" << estimate(p->value, p->lower, p->upper)
-          << (p->verdict == "identifiable" ? "" : " <span class=\"warn\">(" + esc(p->verdict) + ")</span>") << "</td>";
+          << (!p->verdict || *p->verdict == fit::Identifiability::kIdentifiable
+                  ? ""
+                  : " <span class=\"warn\">(" + std::string(fit::identifiability_text(*p->verdict)) + ")</span>") << "</td>";
       else h << "<td>–</td>";
     h << "</tr>\n";
   }
@@ -531,7 +533,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
       for (const auto& p : f.parameters) {
         const int prec = estimate_digits(p.value, p.lower, p.upper);
         h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, prec) << "</td><td>" << interval(p.lower, p.upper, prec)
-          << "</td><td>" << unit_html(p.unit) << "</td><td>" << esc(p.verdict) << "</td></tr>\n";
+          << "</td><td>" << unit_html(p.unit) << "</td><td>" << (p.verdict ? fit::identifiability_text(*p.verdict) : "") << "</td></tr>\n";
       }
       h << "</table>\n";
     }

@@ -107,7 +107,7 @@ std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vect
     s << "  " << term << ": {value: " << p->value << ", unit: " << p->unit << "}";
     for (const auto& pr : profiles)
       if (pr.parameter == term)
-        s << "  # " << interval_of(pr) << " " << pr.verdict;
+        s << "  # " << interval_of(pr) << " " << identifiability_text(pr.verdict);
     s << "\n";
   }
   return s.str();
@@ -268,7 +268,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   std::ostringstream s;
   s << "tau = " << tau_s << " s";
   if (tau)
-    s << ", 95 % profile interval " << interval_of(*tau) << " (" << tau->verdict << ")";
+    s << ", 95 % profile interval " << interval_of(*tau) << " (" << identifiability_text(tau->verdict) << ")";
   if (thesis) s << "; thesis: " << kThesisMotorTau << " s";
   s << "\n" << motor_map_lines(best.parameters, profiles, "over the command throttle_percent / 100, a fraction 0..1 as the flight log's u_<rotor>");
   out.summary = s.str();
@@ -412,7 +412,7 @@ std::string delay_resolution_warning(const Flight& flight, const FitResult& best
 std::string profile_summary(const FitResult& best, const std::vector<Profile>& profiles) {
   std::ostringstream s;
   for (const auto& pr : profiles)
-    s << pr.parameter << " = " << best.parameters[pr.index].value << " " << interval_of(pr) << " " << pr.verdict << "\n";
+    s << pr.parameter << " = " << best.parameters[pr.index].value << " " << interval_of(pr) << " " << identifiability_text(pr.verdict) << "\n";
   return s.str();
 }
 
@@ -481,7 +481,7 @@ namespace {
 nlohmann::ordered_json per_motor_attempt(const StandFit& f) {  // verdicts only: no value at a bound is an estimate
   nlohmann::ordered_json attempt = nlohmann::ordered_json::object();
   for (const auto& pr : f.per_motor_profiles)
-    attempt[pr.parameter] = {{"identifiability", pr.verdict},
+    attempt[pr.parameter] = {{"identifiability", identifiability_text(pr.verdict)},
                              {"at_bound", std::count(f.per_motor.at_bound.begin(), f.per_motor.at_bound.end(), pr.parameter) > 0}};
   return attempt;
 }
@@ -553,11 +553,11 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
   std::ostringstream s;
   if (shared) {
-    s << "k = " << k << " N s² " << interval_of(*kp) << " (" << kp->verdict << "), shared by all motors: "
+    s << "k = " << k << " N s² " << interval_of(*kp) << " (" << identifiability_text(kp->verdict) << "), shared by all motors: "
       << f.coefficients_reason << "\n";
   } else {
     s << "k per motor:";
-    for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << f.thrust_profiles[i].verdict << ")";
+    for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << identifiability_text(f.thrust_profiles[i].verdict) << ")";
     s << "; mean " << k << " N s²\n";
   }
   s << "c_t = " << ct << "; ";

@@ -11,7 +11,7 @@ using output::number_or_null;
 
 output::Estimate estimate_of(const FitParameter& p, const Profile* profile, bool at_bound) {
   output::Estimate e{p.value, p.unit, NAN, NAN, "", at_bound};
-  if (profile) e.lower = profile->lower, e.upper = profile->upper, e.identifiability = profile->verdict;
+  if (profile) e.lower = profile->lower, e.upper = profile->upper, e.identifiability = identifiability_text(profile->verdict);
   return e;
 }
 
@@ -63,7 +63,7 @@ nlohmann::ordered_json fit_json(const FitResult& r, const std::vector<Profile>& 
 std::vector<runtime::Panel> profile_panels(const std::vector<Profile>& profiles) {
   std::vector<runtime::Panel> panels;
   for (const auto& pr : profiles) {
-    runtime::Panel p{pr.parameter + " (" + pr.verdict + ")", pr.parameter, "delta chi2", {}};
+    runtime::Panel p{pr.parameter + " (" + identifiability_text(pr.verdict) + ")", pr.parameter, "delta chi2", {}};
     runtime::Series s{"profile", {}, {}};
     for (const auto& q : pr.points) {
       s.x.push_back(q.value);

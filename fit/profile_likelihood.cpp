@@ -16,6 +16,15 @@
 
 namespace quadgen::fit {
 
+const char* identifiability_text(Identifiability verdict) {
+  switch (verdict) {
+    case Identifiability::kIdentifiable: return "identifiable";
+    case Identifiability::kPracticallyNonIdentifiable: return "practically non-identifiable";
+    case Identifiability::kStructurallyNonIdentifiable: return "structurally non-identifiable";
+  }
+  return "identifiable";  // not reached: every value is named above
+}
+
 double chi2_quantile(double p, double dof) { return boost::math::quantile(boost::math::chi_squared(dof), p); }
 
 namespace {
@@ -136,9 +145,9 @@ Profile assemble(const FitResult& best, int k, const ProfileOptions& po, const S
   // leaves ties in the library's order).
   std::stable_sort(pr.points.begin(), pr.points.end(), [](const auto& a, const auto& b) { return a.value < b.value; });
   if (!pr.lower_open && !pr.upper_open) {
-    pr.verdict = "identifiable";
+    pr.verdict = Identifiability::kIdentifiable;
   } else if (interior >= 3 && max_delta < 1e-3 * pr.threshold_pointwise) {
-    pr.verdict = "structurally non-identifiable";
+    pr.verdict = Identifiability::kStructurallyNonIdentifiable;
     // Which parameters moved along the flat profile, and their log-log slope against it.
     const auto& a = pr.points.front();
     const auto& b = pr.points.back();
@@ -157,7 +166,7 @@ Profile assemble(const FitResult& best, int k, const ProfileOptions& po, const S
     }
     pr.compensated_by = os.str();
   } else {
-    pr.verdict = "practically non-identifiable";
+    pr.verdict = Identifiability::kPracticallyNonIdentifiable;
   }
   return pr;
 }

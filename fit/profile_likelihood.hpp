@@ -12,6 +12,13 @@
 
 namespace quadgen::fit {
 
+// The profile's shape in a word (Raue et al.): both sides cross the threshold; a side stays
+// open; the profile is flat (another parameter compensates exactly).
+enum class Identifiability { kIdentifiable, kPracticallyNonIdentifiable, kStructurallyNonIdentifiable };
+// "identifiable", "practically non-identifiable", "structurally non-identifiable": the words
+// of fit.json's and diagnosis.json's "identifiability" (docs/formats.md).
+const char* identifiability_text(Identifiability verdict);
+
 struct ProfilePoint {
   double value;
   double delta_chi2;            // chi2(value) - chi2(best)
@@ -26,7 +33,7 @@ struct Profile {
   double threshold_simultaneous = 0; // chi2_{#free, 0.95}
   double lower = 0, upper = 0;       // 95 % pointwise interval (NaN side = open)
   bool lower_open = false, upper_open = false;
-  std::string verdict;  // identifiable | practically non-identifiable | structurally non-identifiable
+  Identifiability verdict = Identifiability::kIdentifiable;
   std::string compensated_by;  // for a flat profile: which parameters move with it, and how
 };
 

@@ -165,7 +165,7 @@ namespace {
 // Every free parameter's profile closed on both sides and no estimate on a bound.
 bool all_identified(const FitResult& r, const std::vector<Profile>& profiles) {
   if (!r.at_bound.empty()) return false;
-  return std::all_of(profiles.begin(), profiles.end(), [](const Profile& p) { return p.verdict == "identifiable"; });
+  return std::all_of(profiles.begin(), profiles.end(), [](const Profile& p) { return p.verdict == Identifiability::kIdentifiable; });
 }
 
 std::string percent(double fraction) {

@@ -1494,7 +1494,7 @@ TEST(DiagnosisReport, AnOpenIntervalSideReadsOpen) {
   f.effect = "motor_lag";
   quadgen::diagnose::EffectEstimate tau;
   tau.name = "motor_lag.tau", tau.unit = "s", tau.value = 0.05, tau.lower = 0.03, tau.upper = NAN;
-  tau.verdict = "practically non-identifiable";
+  tau.verdict = quadgen::fit::Identifiability::kPracticallyNonIdentifiable;
   f.parameters.push_back(tau);
   f.metric = "position RMSE [m]", f.before = 0.2, f.after = 0.1;
   d.findings.push_back(f);

@@ -235,7 +235,7 @@ TEST(Fit, MassAndThrustCoefficientAreStructurallyNonIdentifiable) {
   const FitResult best = fit_least_squares(m, ps, fo);
   const int ct = model.param_index("c_t"), mass = model.param_index("mass");
   const Profile p = profile_parameter(m, best, ct, fo, {});
-  EXPECT_EQ(p.verdict, "structurally non-identifiable");
+  EXPECT_EQ(p.verdict, Identifiability::kStructurallyNonIdentifiable);
   EXPECT_NE(p.compensated_by.find("mass"), std::string::npos) << p.compensated_by;
   EXPECT_NE(p.compensated_by.find("^1"), std::string::npos) << p.compensated_by;  // mass ∝ c_t^1
   // The ratio is pinned down even though neither parameter is.
@@ -246,7 +246,7 @@ TEST(Fit, MassAndThrustCoefficientAreStructurallyNonIdentifiable) {
   ps[mass].value = truth[mass];
   const FitResult alone = fit_least_squares(m, ps, fo);
   const Profile pa = profile_parameter(m, alone, ct, fo, {});
-  EXPECT_EQ(pa.verdict, "identifiable");
+  EXPECT_EQ(pa.verdict, Identifiability::kIdentifiable);
 }
 
 namespace {
@@ -468,7 +468,7 @@ TEST(Fit, MultipleShootingRecoversParametersFromPose) {
   for (const char* name : {"c_t", "kappa"}) {
     const int k = model.param_index(name);
     const Profile pr = profile_parameter(m, best, k, fo, {});
-    EXPECT_EQ(pr.verdict, "identifiable") << name;
+    EXPECT_EQ(pr.verdict, Identifiability::kIdentifiable) << name;
     // One seed: the 95 % interval may miss (1 in 20); 4 half-widths from the truth may not.
     const double sigma = (pr.upper - pr.lower) / (2 * 1.96);
     EXPECT_NEAR(best.parameters[k].value, truth[k], 4 * sigma) << name;
@@ -698,7 +698,7 @@ TEST(Fit, ParallelProfilesEqualSequentialOnes) {
   EXPECT_EQ(reported, 3);
   for (size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].parameter, b[i].parameter);
-    EXPECT_EQ(a[i].verdict, "identifiable") << a[i].parameter;
+    EXPECT_EQ(a[i].verdict, Identifiability::kIdentifiable) << a[i].parameter;
     EXPECT_EQ(a[i].lower, b[i].lower) << a[i].parameter;
     EXPECT_EQ(a[i].upper, b[i].upper) << a[i].parameter;
     ASSERT_EQ(a[i].points.size(), b[i].points.size());
@@ -761,7 +761,7 @@ TEST(Fit, ThrustStandFitsWhatTheDataIdentify) {
   EXPECT_EQ(together.coefficients, ThrustVsSpeed::Coefficients::kShared);
   EXPECT_FALSE(together.coefficients_reason.empty());
   ASSERT_EQ(together.thrust.parameters.size(), 2u);
-  EXPECT_EQ(together.thrust_profiles.front().verdict, "identifiable");
+  EXPECT_EQ(together.thrust_profiles.front().verdict, Identifiability::kIdentifiable);
   EXPECT_NEAR(together.thrust.parameters[0].value, 2e-8, 0.02e-8);
   EXPECT_TRUE(together.thrust.at_bound.empty());
   EXPECT_FALSE(together.voltage_exponent_identified);  // constant voltage: e is confounded
@@ -771,7 +771,7 @@ TEST(Fit, ThrustStandFitsWhatTheDataIdentify) {
   EXPECT_EQ(apart.coefficients, ThrustVsSpeed::Coefficients::kPerMotor);
   ASSERT_EQ(apart.thrust.parameters.size(), 5u);
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(apart.thrust_profiles[i].verdict, "identifiable");
+    EXPECT_EQ(apart.thrust_profiles[i].verdict, Identifiability::kIdentifiable);
     EXPECT_NEAR(apart.thrust.parameters[i].value, 2e-8, 0.05e-8) << i;
   }
   EXPECT_TRUE(apart.voltage_exponent_identified);
@@ -789,7 +789,7 @@ TEST(Fit, ThrustStandOfAnySizeAndRotorCount) {
   EXPECT_EQ(f.coefficients, ThrustVsSpeed::Coefficients::kPerMotor);
   ASSERT_EQ(f.thrust.parameters.size(), 7u);
   for (int i = 0; i < 6; ++i) {
-    EXPECT_EQ(f.thrust_profiles[i].verdict, "identifiable") << i;
+    EXPECT_EQ(f.thrust_profiles[i].verdict, Identifiability::kIdentifiable) << i;
     EXPECT_NEAR(f.thrust.parameters[i].value, 5e-6, 0.1e-6) << i;
   }
   EXPECT_TRUE(f.thrust.at_bound.empty());
