@@ -15,9 +15,11 @@ struct DeriveJob {
   std::string vehicle;  // vehicle file (YAML)
   std::string effects;  // comma-separated effects, or "all"; "": none (or the fitted ones)
   std::string params;   // fitted_parameters.yaml from diagnose: its effects and values; "": none
-  // Called before each step with its description ("mass properties of 13 blocks", "audit").
+  // Called before each step with its description ("mass properties of 13 blocks", "audit"):
+  // kDeriveJobSteps times.
   std::function<void(const std::string&)> progress;
 };
+inline constexpr int kDeriveJobSteps = 4;
 
 struct DeriveJobResult {
   std::vector<std::pair<std::string, std::string>> files;  // name, contents

@@ -25,10 +25,12 @@ int run_derive(const DeriveArgs& args) {
   const Vehicle vehicle = load_vehicle(args.vehicle);  // a bad file is reported before anything is created
   output::OutputDirectory out(args.out, "derive", {args.vehicle, args.params});  // refused before the work, not after
   app::DeriveJob job{args.vehicle, args.effects, args.params, {}};
+  const int steps = app::kDeriveJobSteps + 1;  // and the writing
   int step = 0;
-  job.progress = [&](const std::string& what) { std::cerr << "[" << ++step << "/5] " << what << "\n"; };
+  const auto say = [&](const std::string& what) { std::cerr << "[" << ++step << "/" << steps << "] " << what << "\n"; };
+  job.progress = say;
   const app::DeriveJobResult r = app::run_derive_job(job, vehicle);
-  std::cerr << "[5/5] writing " << output::printable(args.out) << "\n";
+  say("writing " + output::printable(args.out));
   for (const auto& [name, contents] : r.files) out.add(name, contents);
   commit_and_say(out, "derive");
   if (!r.note.empty()) std::cerr << "quadgen: note: " << output::printable_lines(r.note) << "\n";

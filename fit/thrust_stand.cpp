@@ -1,4 +1,5 @@
 #include "fit/thrust_stand.hpp"
+#include "output/numbers.hpp"
 
 #include <algorithm>
 #include <set>
@@ -168,13 +169,6 @@ bool all_identified(const FitResult& r, const std::vector<Profile>& profiles) {
   return std::all_of(profiles.begin(), profiles.end(), [](const Profile& p) { return p.verdict == Identifiability::kIdentifiable; });
 }
 
-std::string percent(double fraction) {
-  std::ostringstream os;
-  os.precision(2);
-  os << 100 * fraction << " %";
-  return os.str();
-}
-
 }  // namespace
 
 StandFit fit_stand(const std::vector<StandSample>& samples, double vref, const FitOptions& fo, const ProfileOptions& po) {
@@ -189,7 +183,7 @@ StandFit fit_stand(const std::vector<StandSample>& samples, double vref, const F
   } else {
     out.coefficients = ThrustVsSpeed::Coefficients::kShared;
     out.coefficients_reason = "the per-motor coefficients are not identifiable from this run (the " +
-                              std::to_string(samples.front().w.size()) + " speeds moved together: their ratios to the mean varied by " + percent(out.ratio_variation) +
+                              std::to_string(samples.front().w.size()) + " speeds moved together: their ratios to the mean varied by " + output::percent_text(out.ratio_variation) +
                               " RMS, too little to separate them against the thrust noise, so total thrust fixes only "
                               "sum k_i w_i^2): one coefficient k is fitted for all of them";
     ThrustVsSpeed shared(samples, ThrustVsSpeed::Coefficients::kShared);

@@ -25,6 +25,8 @@ std::string with_digits(double v, int digits) {
 
 std::string short_number(double v) { return with_digits(v, 3); }
 
+std::string percent_text(double fraction) { return short_number(100 * fraction) + " %"; }
+
 std::string six_digits(double v) { return with_digits(v, 6); }
 
 namespace {

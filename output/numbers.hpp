@@ -8,6 +8,8 @@ namespace quadgen::output {
 
 // Three significant digits ("0.0524", "1.32e-06", "208").
 std::string short_number(double v);
+// A fraction as per cent in a sentence, three significant digits ("3.4 %", "70 %").
+std::string percent_text(double fraction);
 // A p-value in a sentence, "p = 0.00288", or "p < 1e-300" where it is below what a double
 // holds well (a likelihood-ratio statistic of thousands on a real flight gives 0, and "p = 0"
 // claims certainty no test gives); and the same without "p" for a table's cell.

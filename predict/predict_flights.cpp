@@ -79,12 +79,6 @@ nlohmann::ordered_json implausible_calibration(const Vehicle& v, const runtime::
   return out;
 }
 
-std::string percent(double fraction) {
-  std::ostringstream s;
-  s << 100 * fraction;
-  return s.str();
-}
-
 }  // namespace
 
 bool PredictFlightsOptions::IsValid(std::string* error) const {
@@ -135,7 +129,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
     nlohmann::ordered_json implausible = nlohmann::ordered_json::array();
     if (o.calibrate && values.flight == 0 && !values.flight_params.empty()) {
       o.progress.say("  calibrating " + std::to_string(values.flight_params.size()) + " flight parameters on the first " +
-                 percent(1.0 - o.validation) + " %");
+                 output::percent_text(1.0 - o.validation));
       values.values = calibrate(model, values.values, values.flight_params, bounds, before);
       for (int k : values.flight_params) calibrated[model.param_names()[k]] = values.values[k];
       values.origin += ", flight parameters calibrated on the part before";

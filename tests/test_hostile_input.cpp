@@ -28,6 +28,7 @@
 
 #include "app/diagnose_job.hpp"
 #include "app/simulate_job.hpp"
+#include "app/derive_job.hpp"
 #include "output/names.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "derive/dynamics.hpp"
@@ -813,6 +814,17 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   const CliResult odd = run_quadgen({"derive", vehicle, "--out", tmp / "o\xe2\x80\xae$(x)"}, tmp.dir);
   EXPECT_EQ(odd.rc, 0) << out::printable(odd.err);
   EXPECT_EQ(odd.err.find("\xe2\x80\xae"), std::string::npos) << out::printable(odd.err);
+  // Its progress numbered from the job's own count of steps, the last one the writing.
+  const auto occurrences = [](const std::string& text, const std::string& part) {
+    int n = 0;
+    for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+    return n;
+  };
+  const int steps = quadgen::app::kDeriveJobSteps + 1;
+  const std::string of = "/" + std::to_string(steps) + "] ";
+  for (int k = 1; k <= steps; ++k)
+    EXPECT_EQ(occurrences(odd.err, "[" + std::to_string(k) + of), 1) << k << "\n" << out::printable(odd.err);
+  EXPECT_NE(odd.err.find("[" + std::to_string(steps) + of + "writing"), std::string::npos) << out::printable(odd.err);
 }
 
 // A name of 200 kB is refused in a line a person can read: its head (where, what) and its tail
