@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "derive/symbolic_functions.hpp"
+#include "output/sinks.hpp"
 
 namespace quadgen::codegen {
 using namespace GiNaC;
@@ -97,7 +98,7 @@ std::pair<numeric, int> ExpressionGraph::canon(const ex& e) {
     r = {1, constant(ex_to<numeric>(e.evalf()))};
   } else if (is_a<symbol>(e)) {
     auto v = vars_.find(e);
-    if (v == vars_.end()) throw std::runtime_error("emission: undeclared symbol " + ex_to<symbol>(e).get_name());
+    if (v == vars_.end()) throw std::runtime_error("emission: undeclared symbol " + output::printable(ex_to<symbol>(e).get_name()));
     const Op op = v->second.first == VarKind::state ? Op::state : v->second.first == VarKind::input ? Op::input : Op::param;
     r = {1, intern(Node{op, {}, 0, names_[e], v->second.second})};
   } else if (is_a<GiNaC::add>(e)) {

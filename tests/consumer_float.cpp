@@ -9,6 +9,7 @@
 #include <initializer_list>
 
 #include "generated/finken3_all_effects/model.hpp"
+#include "same_model_elsewhere/model.hpp"  // a copy at another path: one model (its include guard)
 
 namespace m = quadgen_generated::finken3_all_effects;
 
@@ -33,8 +34,8 @@ int main() {
   for (int i = 6; i < 10; ++i) x[i] /= qn;
   for (int i = 13; i < m::kNumStates; ++i) x[i] = 900.0 + 10.0 * i;
   double u[m::kNumInputs] = {0.4, 0.45, 0.5, 0.42, 3.0, 3.9};
-  double fd[m::kNumStates], Jd[m::kDfdxNnz], Pd[m::kDfdpNnz];
-  float ff[m::kNumStates], Jf[m::kDfdxNnz], Pf[m::kDfdpNnz];
+  double fd[m::kNumStates], Jd[m::kDfdxStorage], Pd[m::kDfdpStorage];
+  float ff[m::kNumStates], Jf[m::kDfdxStorage], Pf[m::kDfdpStorage];
   int bad = 0;
   double z = 0, radius = 0;
   auto check = [&](const double* d, const float* f, int n, const char* what) {

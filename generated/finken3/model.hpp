@@ -10,18 +10,24 @@
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
 // allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of dfdx is
-// d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass a null pointer of the Scalar type for any output
-// you do not need (static_cast<double*>(nullptr): a bare nullptr names no Scalar), or call
-// rhs(x, u, p, pre, f) for f alone.
+// d f[kDfdxRow[k]] / d x[kDfdxCol[k]], in an array of kDfdxStorage Scalars; pass a null
+// pointer of the Scalar type for a Jacobian you do not need (static_cast<double*>(nullptr): a
+// bare nullptr names no Scalar), or call rhs(x, u, p, pre, f) for f alone. f and h are always
+// written and must point to kNumStates and kNumOutputs Scalars. No output may share memory
+// with an input: outputs are written while inputs are still read (rhs(x, u, p, pre, x) is
+// wrong). Precomputed<Scalar> holds kNumPrecomputed Scalars: on a small task stack keep it in
+// static storage.
 // Conventions: SI units; world frame z up; body frame x, y in the rotor plane, z up, its
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
-// World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
-// below twice the thrust closer to it); f holds no contact force, so a simulation that lands
-// adds its own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as
-// given: clamp them to 0..1 first. Inputs named vbat (a battery voltage) must be positive;
-// the measurement h is indexed by Output, not State.
+// World z = 0 is the ground; f holds no contact force, so a simulation that lands adds its
+// own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
+// them to 0..1 first. The measurement h is indexed by Output, not State.
 #pragma once
+#ifndef QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f
+// The guard is named after the code's hash: the same model generated twice (one vehicle file
+// at two paths) and included twice is one, where #pragma once would see two files.
+#define QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -42,7 +48,7 @@ namespace finken3 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_8a60a2a775e8a0929929c7d30b062e76 {
+inline namespace model_286bbbf0bd2702e0dcd4f98d18e9ad6f {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -160,18 +166,23 @@ inline constexpr bool kParamFit[kNumParams] = {false, false, false, true, true, 
 inline constexpr int kInputDelayParam = -1;
 
 inline constexpr int kDfdxNnz = 66;
+inline constexpr int kDfdxStorage = 66;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfdxRow[66] = {0, 1, 2, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 6, 6, 6, 6, 6, 6, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 8, 8, 9, 9, 9, 9, 9, 9, 10, 10, 10, 11, 11, 11, 12, 12, 12};
 inline constexpr int kDfdxCol[66] = {3, 4, 5, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 7, 8, 9, 10, 11, 12, 6, 8, 9, 10, 11, 12, 6, 7, 9, 10, 11, 12, 6, 7, 8, 10, 11, 12, 10, 11, 12, 10, 11, 12, 10, 11, 12};
 inline constexpr int kDfduNnz = 24;
+inline constexpr int kDfduStorage = 24;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfduRow[24] = {3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 10, 10, 10, 10, 11, 11, 11, 11, 12, 12, 12, 12};
 inline constexpr int kDfduCol[24] = {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3};
 inline constexpr int kDfdpNnz = 103;
+inline constexpr int kDfdpStorage = 103;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfdpRow[103] = {3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12};
 inline constexpr int kDfdpCol[103] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 1, 3, 4, 5, 6, 7, 9, 10, 12, 13, 14, 15, 16, 17, 1, 3, 4, 5, 6, 7, 9, 10, 12, 13, 14, 15, 16, 17, 1, 3, 4, 5, 6, 7, 9, 10, 12, 13, 14, 15, 16, 17};
 inline constexpr int kDhdxNnz = 7;
+inline constexpr int kDhdxStorage = 7;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDhdxRow[7] = {0, 1, 2, 3, 4, 5, 6};
 inline constexpr int kDhdxCol[7] = {0, 1, 2, 6, 7, 8, 9};
 inline constexpr int kDhdpNnz = 0;
+inline constexpr int kDhdpStorage = 1;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDhdpRow[1] = {0};
 inline constexpr int kDhdpCol[1] = {0};
 
@@ -1512,6 +1523,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_8a60a2a775e8a0929929c7d30b062e76
+}  // inline namespace model_286bbbf0bd2702e0dcd4f98d18e9ad6f
 }  // namespace finken3
 }  // namespace quadgen_generated
+
+#endif  // QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f

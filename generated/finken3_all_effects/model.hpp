@@ -10,18 +10,30 @@
 //
 // Self-contained: only <cmath>, C++17. Scalar may be float, double or ceres::Jet. No heap
 // allocation, no exceptions. Jacobians are sparse (coordinate format): entry k of dfdx is
-// d f[kDfdxRow[k]] / d x[kDfdxCol[k]]; pass a null pointer of the Scalar type for any output
-// you do not need (static_cast<double*>(nullptr): a bare nullptr names no Scalar), or call
-// rhs(x, u, p, pre, f) for f alone.
+// d f[kDfdxRow[k]] / d x[kDfdxCol[k]], in an array of kDfdxStorage Scalars; pass a null
+// pointer of the Scalar type for a Jacobian you do not need (static_cast<double*>(nullptr): a
+// bare nullptr names no Scalar), or call rhs(x, u, p, pre, f) for f alone. f and h are always
+// written and must point to kNumStates and kNumOutputs Scalars. No output may share memory
+// with an input: outputs are written while inputs are still read (rhs(x, u, p, pre, x) is
+// wrong). Precomputed<Scalar> holds kNumPrecomputed Scalars: on a small task stack keep it in
+// static storage.
 // Conventions: SI units; world frame z up; body frame x, y in the rotor plane, z up, its
 // origin the vehicle file's reference point (position and velocity are the origin's, not the
 // centre of gravity's); attitude a unit quaternion body -> world, Hamilton, scalar first.
-// World z = 0 is the ground (ground_effect: the Cheeseman-Bennett law from z = R/2 up, held
-// below twice the thrust closer to it); f holds no contact force, so a simulation that lands
-// adds its own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as
-// given: clamp them to 0..1 first. Inputs named vbat (a battery voltage) must be positive;
-// the measurement h is indexed by Output, not State.
+// World z = 0 is the ground; f holds no contact force, so a simulation that lands adds its
+// own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
+// them to 0..1 first. The measurement h is indexed by Output, not State.
+// ground_effect: the Cheeseman-Bennett law from z = R/2 up, held below twice the thrust closer
+// to the ground.
+// The input vbat (a battery voltage) must be positive.
+// The rotor-speed rows relax at 1 / tau (motor_lag): an explicit integrator is stable only for
+// steps below about 2 tau (Euler) or 2.8 tau (RK4) of the fastest rotor, and the nominal tau
+// may be far below a fitted one: set the parameters before choosing the step.
 #pragma once
+#ifndef QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
+// The guard is named after the code's hash: the same model generated twice (one vehicle file
+// at two paths) and included twice is one, where #pragma once would see two files.
+#define QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -42,7 +54,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_b319ae727f27fc2cc3a56833e2461def {
+inline namespace model_a35abf4ef5c85b1bea74957146375309 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -189,18 +201,23 @@ inline constexpr bool kParamFit[kNumParams] = {false, false, false, true, true, 
 inline constexpr int kInputDelayParam = 30;
 
 inline constexpr int kDfdxNnz = 121;
+inline constexpr int kDfdxStorage = 121;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfdxRow[121] = {0, 1, 2, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 6, 6, 6, 6, 6, 6, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 8, 8, 9, 9, 9, 9, 9, 9, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 13, 14, 15, 16};
 inline constexpr int kDfdxCol[121] = {3, 4, 5, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 7, 8, 9, 10, 11, 12, 6, 8, 9, 10, 11, 12, 6, 7, 9, 10, 11, 12, 6, 7, 8, 10, 11, 12, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 13, 14, 15, 16};
 inline constexpr int kDfduNnz = 16;
+inline constexpr int kDfduStorage = 16;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfduRow[16] = {3, 3, 4, 4, 5, 5, 10, 10, 11, 11, 12, 12, 13, 14, 15, 16};
 inline constexpr int kDfduCol[16] = {4, 5, 4, 5, 4, 5, 4, 5, 4, 5, 4, 5, 0, 1, 2, 3};
 inline constexpr int kDfdpNnz = 192;
+inline constexpr int kDfdpStorage = 192;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDfdpRow[192] = {3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 11, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 12, 13, 13, 13, 13, 13, 14, 14, 14, 14, 14, 15, 15, 15, 15, 15, 16, 16, 16, 16, 16};
 inline constexpr int kDfdpCol[192] = {1, 2, 3, 4, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 31, 32, 33, 34, 35, 36, 39, 40, 41, 42, 43, 1, 2, 3, 4, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 31, 32, 33, 34, 35, 36, 39, 40, 41, 42, 43, 0, 1, 2, 3, 4, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 31, 32, 33, 34, 35, 36, 39, 40, 41, 42, 43, 1, 3, 4, 9, 10, 12, 13, 14, 15, 16, 17, 21, 22, 23, 24, 31, 32, 33, 34, 36, 39, 40, 41, 42, 43, 1, 3, 4, 9, 10, 12, 13, 14, 15, 16, 17, 21, 22, 23, 24, 31, 32, 33, 34, 36, 39, 40, 41, 42, 43, 1, 3, 4, 9, 10, 12, 13, 14, 15, 16, 17, 21, 22, 23, 24, 31, 32, 33, 34, 36, 39, 40, 41, 42, 43, 5, 6, 7, 25, 29, 5, 6, 7, 26, 29, 5, 6, 7, 27, 29, 5, 6, 7, 28, 29};
 inline constexpr int kDhdxNnz = 19;
+inline constexpr int kDhdxStorage = 19;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDhdxRow[19] = {0, 1, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 6, 6, 6, 6};
 inline constexpr int kDhdxCol[19] = {0, 1, 2, 6, 7, 8, 9, 6, 7, 8, 9, 6, 7, 8, 9, 6, 7, 8, 9};
 inline constexpr int kDhdpNnz = 8;
+inline constexpr int kDhdpStorage = 8;  // Scalars to allocate for it (at least 1)
 inline constexpr int kDhdpRow[8] = {3, 3, 4, 4, 5, 5, 6, 6};
 inline constexpr int kDhdpCol[8] = {37, 38, 37, 38, 37, 38, 37, 38};
 
@@ -2236,6 +2253,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_b319ae727f27fc2cc3a56833e2461def
+}  // inline namespace model_a35abf4ef5c85b1bea74957146375309
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
+
+#endif  // QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
