@@ -281,6 +281,95 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
                       : "the model's moment τ is not a 3-vector");
 }
 
+// a × b, written out here (not derive's cross) for the check below.
+matrix cross3(const matrix& a, const matrix& b) {
+  return matrix(3, 1, lst{a(1, 0) * b(2, 0) - a(2, 0) * b(1, 0), a(2, 0) * b(0, 0) - a(0, 0) * b(2, 0),
+                          a(0, 0) * b(1, 0) - a(1, 0) * b(0, 0)});
+}
+
+// The symbols of `e` replaced by the model's of the same name: an effect's formula is derived
+// on a scratch copy of the base model, whose symbols are its own.
+void collect_symbols(const ex& e, exset& out) {
+  if (is_a<symbol>(e)) out.insert(e);
+  for (size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
+}
+ex with_model_symbols(const SymbolicModel& m, const ex& e) {
+  exset found;
+  collect_symbols(e, found);
+  exmap to_model;
+  for (const ex& s : found)
+    for (const auto* list : {&m.states, &m.inputs, &m.params, &m.constants})
+      for (const auto& v : *list)
+        if (v.name == ex_to<symbol>(s).get_name()) to_model[s] = v.sym;
+  return e.subs(to_model);
+}
+
+// The CoG the model's translation rows take: the vehicle's (cog_x, cog_y, cog_z) moved by any
+// effect's Δc (cog_offset's).
+matrix model_cog(const SymbolicModel& m) {
+  auto P = [&](const char* n) { return m.params[m.param_index(n)].sym; };
+  matrix c(3, 1, lst{P("cog_x"), P("cog_y"), P("cog_z")});
+  for (const auto& f : m.effect_formulas)
+    for (const auto& line : f.lines)
+      if (line.first == "\\Delta c" && is_a<matrix>(line.second))
+        c = c.add(ex_to<matrix>(with_model_symbols(m, line.second)));
+  return c;
+}
+
+// Every symbol at a generic value (generic_values), the attitude a unit quaternion (R(q) below
+// is written for one), and dω/dt's symbols at the model's rows 10-12 there.
+exmap generic_values_with_unit_quaternion(const SymbolicModel& m, double step) {
+  using namespace runtime::rigid_body;
+  exmap at = generic_values(m, step, lst{});
+  double norm = 0;
+  for (int i = 0; i < 4; ++i) norm += std::pow(ex_to<numeric>(at[m.states[kAttitude + i].sym]).to_double(), 2);
+  for (int i = 0; i < 4; ++i)
+    at[m.states[kAttitude + i].sym] = ex_to<numeric>(at[m.states[kAttitude + i].sym]).to_double() / std::sqrt(norm);
+  for (size_t i = 0; i < m.omega_dot.size(); ++i) at[m.omega_dot[i]] = evalf(m.f(kBodyRate + i, 0).subs(at));
+  return at;
+}
+
+// The velocity rows: dv/dt = R(q) (F_body / m - dω/dt × c - ω × (ω × c)) - g e_z, with R(q)
+// written out in the audit, F_body the model's body force (section 4), c its CoG and dω/dt
+// the model's rows 10-12, in f's rows and in f_split's (where dω/dt are symbols, for the
+// Jacobians: equal to f once they are rows 10-12). Without this nothing in the
+// audit tied the translation rows to the attitude: a transposed R, gravity of the wrong sign
+// or a force not divided by the mass passed every other check, and the thesis comparison's
+// rows on the direction of travel would have read "agrees" (a review, helper-141, 2026-12-07).
+// Compared in numbers at two generic points, as Euler's equations are.
+AuditCheck check_translation_rows(const SymbolicModel& m) {
+  using namespace runtime::rigid_body;
+  const ex& force = m.intermediate("F_{body}");
+  bool rows = is_a<matrix>(force) && ex_to<matrix>(force).rows() == 3 && m.omega_dot.size() == 3 &&
+              m.f_split.rows() == m.f.rows();
+  const matrix c = model_cog(m);
+  matrix w(3, 1), w_dot(3, 1);
+  for (int i = 0; i < 3 && rows; ++i) w(i, 0) = m.states[kBodyRate + i].sym, w_dot(i, 0) = m.omega_dot[i];
+  const ex mass = m.params[m.param_index("mass")].sym, g = m.params[m.param_index("g")].sym;
+  ex q[4];
+  for (int i = 0; i < 4; ++i) q[i] = m.states[kAttitude + i].sym;
+  for (const double step : {0.6180339887498949, 0.4142135623730951}) {
+    if (!rows) break;
+    const exmap at = generic_values_with_unit_quaternion(m, step);
+    const matrix body = ex_to<matrix>(force).mul_scalar(1 / mass).sub(cross3(w_dot, c)).sub(cross3(w, cross3(w, c)));
+    const matrix world = body_to_world(q[0], q[1], q[2], q[3]).mul(body);
+    for (int i = 0; i < 3 && rows; ++i) {
+      const ex expected = evalf((world(i, 0) - (i == 2 ? g : ex(0))).subs(at));
+      for (const matrix* f : {&m.f, &m.f_split}) {
+        const ex row = evalf((*f)(kVelocity + i, 0).subs(at));
+        rows = rows && is_a<numeric>(row) && is_a<numeric>(expected) &&
+               abs(ex_to<numeric>(row - expected)).to_double() <=
+                   1e-12 * std::max({1.0, abs(ex_to<numeric>(row)).to_double(), abs(ex_to<numeric>(expected)).to_double()});
+      }
+    }
+  }
+  return make("translation", "velocity rows are R(q) F_body / m - g e_z with the CoG's transport", rows,
+              "each row of dv/dt equals R(q) (F_body / m - dω/dt × c - ω × (ω × c)) - g e_z to 1e-12 at two generic "
+              "points with a unit quaternion (R(q) written out in the audit; F_body of section 4; c the CoG with any "
+              "effect's Δc; dω/dt the model's rows, in f and as f_split's symbols): the one check that ties the "
+              "translation to the attitude");
+}
+
 }  // namespace
 
 // The substitutions that leave a model without torques: thrust (c_t = 0), gravity (g = 0),
@@ -392,6 +481,7 @@ AuditResult audit(const SymbolicModel& m, const MassProperties& mp) {
   add(check_rotation());
   add(check_quaternion_norm(m));
   add({check_euler_equations(m)});
+  add({check_translation_rows(m)});
   add(check_inertia(mp));
   add(check_energy(m));
   return r;

@@ -71,7 +71,7 @@ TEST(Model, AuditPassesForBundledVehiclesWithAllEffects) {
         EXPECT_TRUE(c.passed) << file << ": " << c.group << " " << c.name << ": " << c.detail;
         groups.insert(c.group);
       }
-      for (const char* g : {"units", "rotation", "inertia", "energy"}) EXPECT_EQ(groups.count(g), 1u) << file << ": no " << g << " check";
+      for (const char* g : {"units", "rotation", "translation", "inertia", "energy"}) EXPECT_EQ(groups.count(g), 1u) << file << ": no " << g << " check";
     }
   }
 }
@@ -132,6 +132,39 @@ TEST(Model, UnitCheckerRejectsInconsistentEquation) {
       found = true;
     }
   EXPECT_TRUE(found) << "no check dvy/dt";
+}
+
+// The velocity rows with the attitude's rotation transposed (the conjugate quaternion gives
+// R^T), with gravity's sign turned, or with a thrust share as if the mass were 10 % off: the audit's
+// translation check rejects each, in f or in f_split alike, and every other check passes
+// them (a review, helper-141: nothing tied the translation rows to the attitude).
+TEST(Model, TranslationCheckCatchesATransposedRotationAWrongGravityOrMass) {
+  using namespace runtime::rigid_body;
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel good = derive(v, {"cog_offset"});
+  const std::string check = "velocity rows are R(q) F_body / m - g e_z with the CoG's transport";
+  EXPECT_TRUE(check_passed(good, mp, check));
+  lst conjugate;
+  for (int i = 1; i < 4; ++i) conjugate.append(good.states[kAttitude + i].sym == -good.states[kAttitude + i].sym);
+  const ex g = good.params[good.param_index("g")].sym, mass = good.params[good.param_index("mass")].sym;
+  const ex thrust = ex_to<matrix>(good.intermediate("F_{body}"))(2, 0);
+  for (const bool split : {false, true}) {
+    auto with_rows = [&](auto change) {
+      SymbolicModel m = good;
+      matrix& f = split ? m.f_split : m.f;
+      for (int i = 0; i < 3; ++i) f(kVelocity + i, 0) = change(i, f(kVelocity + i, 0));
+      return m;
+    };
+    const SymbolicModel transposed = with_rows([&](int, const ex& row) { return row.subs(conjugate); });
+    const SymbolicModel gravity_up = with_rows([&](int i, const ex& row) { return i == 2 ? row + 2 * g : row; });
+    const SymbolicModel heavier = with_rows([&](int i, const ex& row) { return i == 2 ? row - thrust / mass / 10 : row; });
+    for (const SymbolicModel* m : {&transposed, &gravity_up, &heavier}) {
+      EXPECT_FALSE(check_passed(*m, mp, check)) << split;
+      for (const auto& c : audit(*m, mp).checks)
+        if (c.name != check) EXPECT_TRUE(c.passed) << split << " " << c.name;
+    }
+  }
 }
 
 // The rotational rows are replaced by a wrong law for a general (not diagonal) J: the thesis'
