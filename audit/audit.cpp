@@ -141,7 +141,9 @@ std::vector<AuditCheck> check_inertia(const MassProperties& mp) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (!normal(mp.inertia_cog(i, j) - mp.inertia_cog(j, i)).is_zero()) sym = false;
-  out.push_back(make("inertia", "symmetric", sym, "J_cg - J_cg^T = 0 symbolically"));
+  out.push_back(make("inertia", "symmetric", sym,
+                     "J_cg - J_cg^T = 0 symbolically (true by construction, R S R^T and symmetric shifts: a guard "
+                     "against a change of that construction, not evidence about the vehicle)"));
 
   const PrincipalMoments pm = principal_moments(mp.inertia_cog_value);
   const auto& l = pm.moments;

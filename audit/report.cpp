@@ -251,7 +251,7 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
   // What the units checks cannot see (a reviewer's trial, helper-103).
   md << "\n\nThe units checks count an angle as dimensionless (rad = 1, as SI does): they cannot tell degrees "
         "from radians or rev/s from rad/s. Such a slip shows only in numbers against a reference"
-     << (d.thesis.empty() ? "" : " (section 8 finds two in the thesis so)") << ".";
+     << (d.thesis.empty() ? "" : " (section 8 finds one in the thesis so, rad/s² printed as deg/s², and likely a second, rotor speeds in rev/s where rad/s were meant)") << ".";
   md << "\n\n| group | check | result | how |\n|---|---|---|---|\n";
   for (const auto& c : d.audit.checks)
     md << "| " << output::markdown_text(c.group) << " | " << output::markdown_text(c.name) << " | "

@@ -50,11 +50,16 @@ struct Numbers {  // the derived model at its nominal parameters
   std::array<double, 3> A, cog;
 };
 
+// l: the thesis' arm, rotor C's x (at (+l, +l) in its layout) as the vehicle file places it;
+// the thesis' 0.07465 m where the file has no rotor C (the comparison then says little).
 Numbers nominal(const SymbolicModel& model, const MassProperties& mp) {
   auto P = [&](const char* n) { return model.params[model.param_index(n)].nominal; };
+  double l = 0.07465;
+  for (const auto& c : model.constants)
+    if (c.name == "C.x") l = c.nominal;
   return Numbers{mp.mass_value, P("g"), P("rho"), P("c_w"),
                  mp.inertia_cog_value[0][0], mp.inertia_cog_value[1][1], mp.inertia_cog_value[2][2],
-                 0.07465, mp.areas_value, mp.cog_value};
+                 l, mp.areas_value, mp.cog_value};
 }
 
 // The pitch acceleration of the thesis' fly-right case (65): 0.2 N more on A and D, arm l,
@@ -194,14 +199,18 @@ void rotation_items(std::vector<ThesisItem>& out, const SymbolicModel& model, co
                  "M = (((F_C+F_D)-(F_A+F_B)) l, ((F_A+F_D)-(F_B+F_C)) l, -D_A+D_B-D_C+D_D)",
                  "τ = Σ (r_i - c) × F_i e_z + Σ ∓kappa F_i e_z, symbolically", torque_agrees,
                  torque_agrees ? "" : "torque differs",
-                 torque_agrees ? "identical when the CoG is at the origin and D_i = kappa F_i; a CoG offset along z "
-                                 "(c_z = " + fmt("%.2f mm", n.cog[2] * 1e3) +
-                                     ") leaves the moment of a thrust along body z unchanged, one in x or y would add to it"
-                               : "",
+                 (torque_agrees ? "identical when the CoG is at the origin and D_i = kappa F_i; a CoG offset along z "
+                                  "(c_z = " + fmt("%.2f mm", n.cog[2] * 1e3) +
+                                      ") leaves the moment of a thrust along body z unchanged, one in x or y would add to it"
+                                : std::string()) +
+                     "; the thesis' own numbers take D_i = l F_i: (61), (65) and (69) evaluate the yaw row as "
+                     "(-F_A + F_B - F_C + F_D) l / J_zz, a kappa of l = 74.65 mm where the vehicle file holds 10 mm "
+                     "(each case balances in yaw, so no number of theirs depends on it)",
                  std::string(kFromModel) +
                      ": its torque with the CoG at the origin and every rotor at (±l, ±l, 0), symbolically. The "
-                     "rotor layout is the one vehicles/finken3.yaml reads from (34) itself (Figure 2, which shows "
-                     "it, is not in the thesis' text), so this checks the algebra, not the layout"});
+                     "rotor layout and spin directions are the ones vehicles/finken3.yaml reads from (34) itself "
+                     "(Figure 2, which shows them, is not in the thesis' text), so this checks the algebra, not the "
+                     "layout"});
   gyroscopic_item(out, model, n);
 }
 
@@ -290,8 +299,33 @@ void compare_table1_block(Table1Comparison& c, const MassProperties& mp, int g) 
   if (!entries.empty()) compare_aligned_block(c, g, J, entries);
 }
 
+// Where Table 1 is no body's inertia, from its own numbers alone (a review, helper-141): every
+// body has J_aa + J_bb >= J_cc, since J_xx + J_yy - J_zz = 2 ∫ z^2 dm >= 0 (and cyclic); and a
+// motor block pair (thesis blocks 1 and 6: two 20 g blocks between z = 0 and z2 = 0.0218 m,
+// appendix A and 2.2.4.3) has 2 ∫ z^2 dm <= 2 (0.04 kg) (0.0218 m)^2.
+std::string table1_impossible() {
+  std::string out;
+  const auto add = [&](const std::string& s) { out += (out.empty() ? "" : "; ") + s; };
+  for (int g = 0; g < 6; ++g) {
+    const double* t = kTable1[g];
+    for (int k = 0; k < 3; ++k) {
+      const int a = (k + 1) % 3, b = (k + 2) % 3;
+      if (t[a] + t[b] < t[k])
+        add(fmt("block %.0f: ", g + 1) + kDiagonalEntry[std::min(a, b)] + " + " + kDiagonalEntry[std::max(a, b)] +
+            fmt(" = %.4g < ", t[a] + t[b]) + kDiagonalEntry[k] + fmt(" = %.4g", t[k]));
+    }
+    const double z2_bound = 2 * 0.04 * 0.0218 * 0.0218;
+    if ((g == 0 || g == 5) && t[0] + t[1] - t[2] > z2_bound)
+      add(fmt("block %.0f: J_xx + J_yy - J_zz = 2 ∫ z^2 dm = %.3g, above the %.2g two 20 g motor blocks between z = 0 "
+              "and 0.0218 m allow",
+              g + 1, t[0] + t[1] - t[2], z2_bound));
+  }
+  return out;
+}
+
 void table1_item(std::vector<ThesisItem>& out, const MassProperties& mp) {
   Table1Comparison c;
+  const std::string impossible = table1_impossible();
   for (int g = 0; g < 6; ++g) compare_table1_block(c, mp, g);
   // The blocks joined by "; ", none after the last (a review, helper-111).
   const auto joined_blocks = [](const std::ostringstream& os) {
@@ -310,6 +344,8 @@ void table1_item(std::vector<ThesisItem>& out, const MassProperties& mp) {
                                                           ? ", where a cuboid with the thesis' limits (2.2.4.3) and mass "
                                                             "(appendix A) gives the derived value"
                                                           : "")) +
+                     (impossible.empty() ? "" : "; and Table 1 is no body's inertia in places, from its own numbers (" +
+                                                    impossible + ")") +
                      (c.missing.empty() ? "" : "; the vehicle file has no block named " + c.missing + ", so those are not compared"),
                  (c.compared ? "largest per-entry difference " + percent(c.worst) + fmt(" (block %.0f, ", c.worst_block + 1) +
                                    kDiagonalEntry[c.worst_entry] + ")"
@@ -359,6 +395,22 @@ void inertia_items(std::vector<ThesisItem>& out, const MassProperties& mp, const
   inertia_tensor_item(out, mp, n);
 }
 
+// The thesis' A_z read as the blocks' footprints without the upper body, which sits on the
+// lower one and hides no more of the ground than it (a review, helper-141: within 0.06 %).
+std::string thesis_area_z_reading(const MassProperties& mp, double thesis_area_z) {
+  double without_upper = 0;
+  bool has_upper = false;
+  for (const auto& b : mp.blocks) {
+    if (b.name == "upper_body") has_upper = true;
+    else without_upper += b.areas_value[2];
+  }
+  if (!has_upper || std::fabs(pct(without_upper, thesis_area_z)) >= 1) return "";
+  return fmt("; the thesis' A_z is the blocks' sum without the upper body (%.5g m^2, ", without_upper) +
+         fmt("%+.2f %%", pct(without_upper, thesis_area_z)) +
+         "), which stands on the lower body: it counted the footprint once, where quadgen's sum counts the stacked "
+         "block again";
+}
+
 void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, const Numbers& n) {
   const double tA[3] = {7.985e-3, 7.575e-3, 1.2672e-2};
   out.push_back({"(30)-(32)", "exposed areas",
@@ -366,7 +418,8 @@ void geometry_items(std::vector<ThesisItem>& out, const MassProperties& mp, cons
                  fmt("A = (%.4g, %.4g, %.4g) m^2 (sum of block projections)", n.A[0], n.A[1], n.A[2]),
                  std::fabs(pct(n.A[0], tA[0])) < 1 && std::fabs(pct(n.A[1], tA[1])) < 1 && std::fabs(pct(n.A[2], tA[2])) < 1,
                  "the thesis does not state how blocks were combined; quadgen sums each block's "
-                 "projected area without occlusion (an upper bound), rotated blocks included",
+                 "projected area without occlusion (an upper bound), rotated blocks included" +
+                     thesis_area_z_reading(mp, tA[2]),
                  signed_percent(pct(n.A[0], tA[0])) + ", " + signed_percent(pct(n.A[1], tA[1])) + ", " +
                      signed_percent(pct(n.A[2], tA[2])) + " (thesis relative to derived)",
                  std::string(kFromArithmetic) + ": the blocks' projected areas, each within 1 %"});
@@ -486,8 +539,9 @@ bool near(double ours, double thesis, double fraction) { return std::fabs(ours -
 // The thesis' layout caveat, said wherever a verdict rests on which side C and D are.
 const char* const kLayoutCaveat =
     "with the rotor layout vehicles/finken3.yaml reads from (34) (C and D on +y; Figure 2, which shows the "
-    "layout, is not in the thesis' text). (34) and (81) cannot both hold in a right-handed z-up frame: were C "
-    "and D on -y, (81) would be right about the direction and (34)'s sign of M_x wrong";
+    "layout, is not in the thesis' text). (34) and (81) cannot both hold in a right-handed z-up frame: (81) is a "
+    "reflection whatever the layout, and were C and D on -y, (34)'s sign of M_x would be wrong too, the two "
+    "errors cancelling in the direction of travel";
 
 void simulated_items(std::vector<ThesisItem>& out, const Flights& f) {
   const std::string model_basis = std::string(kFromModel) + ": RK4 (1 ms) of the derived model with the thesis' "
@@ -603,7 +657,7 @@ void evaluation_items(std::vector<ThesisItem>& out, const Numbers& n, const Flig
                      "the true tilt after 1 s at this torque is " +
                      fmt("%.2g rad with the thesis' J_yy (%.2g with the derived one: the vehicle flips)",
                          0.5 * thesis_theta_dd, 0.5 * theta_dd),
-                 fmt("factor %.3g in the angular acceleration; at t = 0 the thrust is still vertical (the CoG's "
+                 fmt("factor %.3g (180 / pi) in the thesis' own angular acceleration; at t = 0 the thrust is still vertical (the CoG's "
                      "a_x is 0; the body origin's is -(dω/dt × c)_x), and a_x reaches 1.48 m/s^2 after %.3g s, not 1 s",
                      180 / M_PI, std::sqrt(2 * 7.824 * M_PI / 180 / theta_dd)),
                  std::string(kFromArithmetic) + ": 0.2 N l / J_yy with the thesis' J_yy (43) in deg/s^2 against "
