@@ -189,6 +189,9 @@ bool FitJobOptions::IsValidFor(LogKind kind, std::string* error) const {
 }
 
 std::string why_unused(const std::string& option, LogKind kind, const std::string& formulation, const std::string& prefix) {
+  // A new option or flag must say here which kinds read it (a name unknown here was let
+  // through on a flight log: a review, helper-142).
+  if (!output::is_one_of(option, kFitOptionNames)) throw std::logic_error("fit: no rule for the option '" + option + "'");
   // Motor steps fit a map and a lag, profiled; a thrust stand two laws whose intervals come
   // from its own profiles of every coefficient. Neither has channels, a model or a hold-out.
   const auto takes = [&](const std::string& what, const std::vector<std::string>& read) -> std::string {

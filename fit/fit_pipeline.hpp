@@ -56,13 +56,16 @@ struct FitJobOptions {
   // Ceres-style: false with a reason for a value no fit can use.
   bool IsValid(std::string* error) const;
   // IsValid, and no option set away from its default that a fit of `kind` does not read
-  // (options_unused_by): an option is refused, never dropped silently.
+  // (options_set, why_unused): an option is refused, never dropped silently.
   bool IsValidFor(LogKind kind, std::string* error) const;
 };
 
-// Which options a fit reads, named as the command line's flags without "--" (robust,
-// profiles, threads, mapping, resample, validation, formulation, window, channels,
-// translational, free; and app::FitJob's effects). Empty when a fit of `kind` with
+// The options a fit may be given, named as the command line's flags without "--" (the last is
+// app::FitJob's); why_unused throws std::logic_error for any other name.
+inline const std::vector<std::string> kFitOptionNames = {
+    "robust", "profiles", "threads", "mapping", "resample", "validation",
+    "formulation", "window", "channels", "translational", "free", "effects"};
+// Which options a fit reads (kFitOptionNames). Empty when a fit of `kind` with
 // `formulation` reads `option`, else why not, naming other options with `prefix` before
 // them ("--" for the command line). The one rule behind the command line's refusal of the
 // flags given and IsValidFor's of the options set.

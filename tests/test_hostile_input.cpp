@@ -29,6 +29,7 @@
 #include "app/diagnose_job.hpp"
 #include "app/simulate_job.hpp"
 #include "app/derive_job.hpp"
+#include "app/fit_job.hpp"
 #include "output/names.hpp"
 #include "diagnose/diagnosis_report.hpp"
 #include "derive/dynamics.hpp"
@@ -814,17 +815,6 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   const CliResult odd = run_quadgen({"derive", vehicle, "--out", tmp / "o\xe2\x80\xae$(x)"}, tmp.dir);
   EXPECT_EQ(odd.rc, 0) << out::printable(odd.err);
   EXPECT_EQ(odd.err.find("\xe2\x80\xae"), std::string::npos) << out::printable(odd.err);
-  // Its progress numbered from the job's own count of steps, the last one the writing.
-  const auto occurrences = [](const std::string& text, const std::string& part) {
-    int n = 0;
-    for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
-    return n;
-  };
-  const int steps = quadgen::app::kDeriveJobSteps + 1;
-  const std::string of = "/" + std::to_string(steps) + "] ";
-  for (int k = 1; k <= steps; ++k)
-    EXPECT_EQ(occurrences(odd.err, "[" + std::to_string(k) + of), 1) << k << "\n" << out::printable(odd.err);
-  EXPECT_NE(odd.err.find("[" + std::to_string(steps) + of + "writing"), std::string::npos) << out::printable(odd.err);
 }
 
 // A name of 200 kB is refused in a line a person can read: its head (where, what) and its tail
@@ -2426,6 +2416,47 @@ TEST(Cli, ScenariosFollowTheVehiclesLayout) {
 // A library call checks its inputs as the command line does (a review, helper-138: the ground's
 // limit and the fit's lists were the command line's alone): a ground 1e9 m away is refused by
 // run_simulate_job before any work, and every option's list of names is split by one rule.
+// A fit as a library call refuses what the log's kind does not read, as the command line
+// refuses the flag: effects on motor steps were dropped silently (a review, helper-142).
+TEST(LibraryCalls, AFitRefusesWhatItsLogsKindDoesNotRead) {
+  const quadgen::Vehicle f3 = quadgen::load_vehicle(source_path("vehicles/finken3.yaml"));
+  const std::string steps = source_path("data/finken3_motor_steps.csv");
+  const auto kind = quadgen::fit::log_kind(steps);
+  ASSERT_EQ(kind, quadgen::fit::LogKind::kMotorSteps);
+  const auto refused = [&](const quadgen::app::FitJob& job, const std::string& expected) {
+    try {
+      quadgen::app::run_fit_job(job, f3, kind);
+      ADD_FAILURE() << expected << ": fitted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("fit: " + expected + ": not used when fitting a motor-step log", 0), 0u)
+          << e.what();
+    }
+  };
+  refused({steps, "motor_lag", {}}, "effects");
+  quadgen::fit::FitJobOptions mapped;
+  mapped.mapping = source_path("data/mappings/nanobench.yaml");
+  refused({steps, "", mapped}, "mapping");
+  EXPECT_THROW(quadgen::fit::why_unused("windows", quadgen::fit::LogKind::kFlight, "equation_error"), std::logic_error);
+}
+
+// derive numbers its progress from the job's own count of steps, the writing last.
+TEST(Cli, DeriveNumbersItsStepsFromTheJobsCount) {
+  Scratch tmp;
+  const CliResult r = run_quadgen({"derive", source_path("vehicles/finken3.yaml"), "--out", tmp / "o"}, tmp.dir);
+  ASSERT_EQ(r.rc, 0) << out::printable(r.err);
+  const auto occurrences = [](const std::string& text, const std::string& part) {
+    int n = 0;
+    for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+    return n;
+  };
+  const int steps = quadgen::app::kDeriveJobSteps + 1;
+  const std::string of = "/" + std::to_string(steps) + "] ";
+  for (int k = 1; k <= steps; ++k)
+    EXPECT_EQ(occurrences(r.err, "[" + std::to_string(k) + of), 1) << k << "\n" << out::printable(r.err);
+  EXPECT_EQ(occurrences(r.err, "[" + std::to_string(steps + 1) + of), 0) << out::printable(r.err);
+  EXPECT_NE(r.err.find("[" + std::to_string(steps) + of + "writing"), std::string::npos) << out::printable(r.err);
+}
+
 TEST(LibraryCalls, CheckTheirInputsAsTheCommandLineDoes) {
   quadgen::app::SimulateJob job;
   job.vehicle = source_path("vehicles/finken3.yaml");

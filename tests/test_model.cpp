@@ -135,7 +135,8 @@ TEST(Model, UnitCheckerRejectsInconsistentEquation) {
 }
 
 // The velocity rows with the attitude's rotation transposed (the conjugate quaternion gives
-// R^T), with gravity's sign turned, or with a thrust share as if the mass were 10 % off: the audit's
+// R^T), with gravity's sign turned, with the mass 10 % off, or with the CoG's transport
+// acceleration taken about another point: the audit's
 // translation check rejects each, in f or in f_split alike, and every other check passes
 // them (a review, helper-141: nothing tied the translation rows to the attitude).
 TEST(Model, TranslationCheckCatchesATransposedRotationAWrongGravityOrMass) {
@@ -147,8 +148,9 @@ TEST(Model, TranslationCheckCatchesATransposedRotationAWrongGravityOrMass) {
   EXPECT_TRUE(check_passed(good, mp, check));
   lst conjugate;
   for (int i = 1; i < 4; ++i) conjugate.append(good.states[kAttitude + i].sym == -good.states[kAttitude + i].sym);
-  const ex g = good.params[good.param_index("g")].sym, mass = good.params[good.param_index("mass")].sym;
-  const ex thrust = ex_to<matrix>(good.intermediate("F_{body}"))(2, 0);
+  auto P = [&](const char* n) { return good.params[good.param_index(n)].sym; };
+  const ex g = P("g"), mass = P("mass");
+  const lst no_cog{P("cog_x") == 0, P("cog_y") == 0, P("cog_z") == 0};
   for (const bool split : {false, true}) {
     auto with_rows = [&](auto change) {
       SymbolicModel m = good;
@@ -158,8 +160,10 @@ TEST(Model, TranslationCheckCatchesATransposedRotationAWrongGravityOrMass) {
     };
     const SymbolicModel transposed = with_rows([&](int, const ex& row) { return row.subs(conjugate); });
     const SymbolicModel gravity_up = with_rows([&](int i, const ex& row) { return i == 2 ? row + 2 * g : row; });
-    const SymbolicModel heavier = with_rows([&](int i, const ex& row) { return i == 2 ? row - thrust / mass / 10 : row; });
-    for (const SymbolicModel* m : {&transposed, &gravity_up, &heavier}) {
+    const SymbolicModel heavier = with_rows([&](int, const ex& row) { return row.subs(mass == mass * 11 / 10); });
+    // the origin's transport acceleration as if the CoG sat at the origin (the offset's part kept)
+    const SymbolicModel no_transport = with_rows([&](int, const ex& row) { return row.subs(no_cog); });
+    for (const SymbolicModel* m : {&transposed, &gravity_up, &heavier, &no_transport}) {
       EXPECT_FALSE(check_passed(*m, mp, check)) << split;
       for (const auto& c : audit(*m, mp).checks)
         if (c.name != check) EXPECT_TRUE(c.passed) << split << " " << c.name;
@@ -961,13 +965,14 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   EXPECT_NE(cause.at("(65), (67), (68)").find("/ 0.0009541 kg m^2 = 15.648 rad/s^2, not deg/s^2: a unit error"),
             std::string::npos)
       << cause.at("(65), (67), (68)");
-  EXPECT_NE(cause.at("Table 1").find("block 3 (lower_body) J_yy by 137 %; block 4 (upper_body) J_zz by 4 %, where a "
+  EXPECT_NE(cause.at("Table 1").find("block 3 (lower_body) J_yy by 137 % (Table 1's entries there are no body's inertia: "
+                                     "below); block 4 (upper_body) J_zz by 4 % (not explained here), where a "
                                      "cuboid with the thesis' limits (2.2.4.3) and mass (appendix A) gives the derived value"),
             std::string::npos)
       << cause.at("Table 1");
   // Where Table 1 is no body's inertia (J_xx + J_yy >= J_zz for any body), and where the
   // thesis' A_z comes from: the blocks without the stacked upper body (a review, helper-141).
-  EXPECT_NE(cause.at("Table 1").find("block 2: J_xx + J_yy = 0.0001061 < J_zz = 0.0001646"), std::string::npos)
+  EXPECT_NE(cause.at("Table 1").find("block 2: J_xx + J_yy = 0.0001061 < J_zz = 0.0001646 kg m^2"), std::string::npos)
       << cause.at("Table 1");
   EXPECT_NE(cause.at("(30)-(32)").find("the blocks' sum without the upper body (0.012679 m^2, -0.06 %)"), std::string::npos)
       << cause.at("(30)-(32)");
@@ -979,8 +984,8 @@ TEST(Thesis, ComparisonFindsKnownDiscrepanciesAndAgreements) {
   for (const auto& t : compare_with_thesis(heavier, derive_model(heavier, mp2, {}), mp2))
     if (t.ref == "Table 1") {
       table_1 = true;
-      EXPECT_NE(t.cause.find("block 3 (lower_body) J_xx by 34 %, J_yy by 56 %, J_zz by 34 % (the vehicle file's block is "
-                             "not the thesis' cuboid)"),
+      EXPECT_NE(t.cause.find("block 3 (lower_body) J_xx by 34 %, J_yy by 56 %, J_zz by 34 % (Table 1's entries there are "
+                             "no body's inertia: below) (the vehicle file's block is not the thesis' cuboid)"),
                 std::string::npos)
           << t.cause;
       EXPECT_EQ(t.cause.find("gives the derived value"), std::string::npos) << t.cause;

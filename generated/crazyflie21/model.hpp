@@ -24,10 +24,10 @@
 // own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
 // them to 0..1 first. The measurement h is indexed by Output, not State.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_285c677c3f035f7fd30368ee21f36876
+#ifndef QUADGEN_GENERATED_model_b4117c3b5c463d2c2040864366e4a75b
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_285c677c3f035f7fd30368ee21f36876
+#define QUADGEN_GENERATED_model_b4117c3b5c463d2c2040864366e4a75b
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -48,7 +48,7 @@ namespace crazyflie21 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_285c677c3f035f7fd30368ee21f36876 {
+inline namespace model_b4117c3b5c463d2c2040864366e4a75b {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1459,18 +1459,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = crazyflie21::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21::kDfdxNnz;
+  static constexpr int kDfdxStorage = crazyflie21::kDfdxStorage;
   static constexpr const int* kDfdxRow = crazyflie21::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21::kDfdxCol;
   static constexpr int kDfduNnz = crazyflie21::kDfduNnz;
+  static constexpr int kDfduStorage = crazyflie21::kDfduStorage;
   static constexpr const int* kDfduRow = crazyflie21::kDfduRow;
   static constexpr const int* kDfduCol = crazyflie21::kDfduCol;
   static constexpr int kDfdpNnz = crazyflie21::kDfdpNnz;
+  static constexpr int kDfdpStorage = crazyflie21::kDfdpStorage;
   static constexpr const int* kDfdpRow = crazyflie21::kDfdpRow;
   static constexpr const int* kDfdpCol = crazyflie21::kDfdpCol;
   static constexpr int kDhdxNnz = crazyflie21::kDhdxNnz;
+  static constexpr int kDhdxStorage = crazyflie21::kDhdxStorage;
   static constexpr const int* kDhdxRow = crazyflie21::kDhdxRow;
   static constexpr const int* kDhdxCol = crazyflie21::kDhdxCol;
   static constexpr int kDhdpNnz = crazyflie21::kDhdpNnz;
+  static constexpr int kDhdpStorage = crazyflie21::kDhdpStorage;
   static constexpr const int* kDhdpRow = crazyflie21::kDhdpRow;
   static constexpr const int* kDhdpCol = crazyflie21::kDhdpCol;
   static constexpr const char* const* kStateNames = crazyflie21::kStateNames;
@@ -1521,8 +1526,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_285c677c3f035f7fd30368ee21f36876
+}  // inline namespace model_b4117c3b5c463d2c2040864366e4a75b
 }  // namespace crazyflie21
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_285c677c3f035f7fd30368ee21f36876
+#endif  // QUADGEN_GENERATED_model_b4117c3b5c463d2c2040864366e4a75b

@@ -30,10 +30,10 @@
 // steps below about 2 tau (Euler) or 2.8 tau (RK4) of the fastest rotor, and the nominal tau
 // may be far below a fitted one: set the parameters before choosing the step.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_5d9cbab9d31b8039167b07d8ae3cceaf
+#ifndef QUADGEN_GENERATED_model_b7f474ac0a30b3765438f0cafdb3d1da
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_5d9cbab9d31b8039167b07d8ae3cceaf
+#define QUADGEN_GENERATED_model_b7f474ac0a30b3765438f0cafdb3d1da
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -54,7 +54,7 @@ namespace crazyflie21_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_5d9cbab9d31b8039167b07d8ae3cceaf {
+inline namespace model_b7f474ac0a30b3765438f0cafdb3d1da {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2191,18 +2191,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = crazyflie21_all_effects::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21_all_effects::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_all_effects::kDfdxNnz;
+  static constexpr int kDfdxStorage = crazyflie21_all_effects::kDfdxStorage;
   static constexpr const int* kDfdxRow = crazyflie21_all_effects::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_all_effects::kDfdxCol;
   static constexpr int kDfduNnz = crazyflie21_all_effects::kDfduNnz;
+  static constexpr int kDfduStorage = crazyflie21_all_effects::kDfduStorage;
   static constexpr const int* kDfduRow = crazyflie21_all_effects::kDfduRow;
   static constexpr const int* kDfduCol = crazyflie21_all_effects::kDfduCol;
   static constexpr int kDfdpNnz = crazyflie21_all_effects::kDfdpNnz;
+  static constexpr int kDfdpStorage = crazyflie21_all_effects::kDfdpStorage;
   static constexpr const int* kDfdpRow = crazyflie21_all_effects::kDfdpRow;
   static constexpr const int* kDfdpCol = crazyflie21_all_effects::kDfdpCol;
   static constexpr int kDhdxNnz = crazyflie21_all_effects::kDhdxNnz;
+  static constexpr int kDhdxStorage = crazyflie21_all_effects::kDhdxStorage;
   static constexpr const int* kDhdxRow = crazyflie21_all_effects::kDhdxRow;
   static constexpr const int* kDhdxCol = crazyflie21_all_effects::kDhdxCol;
   static constexpr int kDhdpNnz = crazyflie21_all_effects::kDhdpNnz;
+  static constexpr int kDhdpStorage = crazyflie21_all_effects::kDhdpStorage;
   static constexpr const int* kDhdpRow = crazyflie21_all_effects::kDhdpRow;
   static constexpr const int* kDhdpCol = crazyflie21_all_effects::kDhdpCol;
   static constexpr const char* const* kStateNames = crazyflie21_all_effects::kStateNames;
@@ -2253,8 +2258,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_5d9cbab9d31b8039167b07d8ae3cceaf
+}  // inline namespace model_b7f474ac0a30b3765438f0cafdb3d1da
 }  // namespace crazyflie21_all_effects
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_5d9cbab9d31b8039167b07d8ae3cceaf
+#endif  // QUADGEN_GENERATED_model_b7f474ac0a30b3765438f0cafdb3d1da

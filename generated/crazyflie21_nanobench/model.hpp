@@ -24,10 +24,10 @@
 // own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
 // them to 0..1 first. The measurement h is indexed by Output, not State.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_c871943d097d3029f14f90a2055acb25
+#ifndef QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_c871943d097d3029f14f90a2055acb25
+#define QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -48,7 +48,7 @@ namespace crazyflie21_nanobench {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_c871943d097d3029f14f90a2055acb25 {
+inline namespace model_cbf38ed6349e25252993f6cf153d171e {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1547,18 +1547,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_nanobench::kDfdxNnz;
+  static constexpr int kDfdxStorage = crazyflie21_nanobench::kDfdxStorage;
   static constexpr const int* kDfdxRow = crazyflie21_nanobench::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_nanobench::kDfdxCol;
   static constexpr int kDfduNnz = crazyflie21_nanobench::kDfduNnz;
+  static constexpr int kDfduStorage = crazyflie21_nanobench::kDfduStorage;
   static constexpr const int* kDfduRow = crazyflie21_nanobench::kDfduRow;
   static constexpr const int* kDfduCol = crazyflie21_nanobench::kDfduCol;
   static constexpr int kDfdpNnz = crazyflie21_nanobench::kDfdpNnz;
+  static constexpr int kDfdpStorage = crazyflie21_nanobench::kDfdpStorage;
   static constexpr const int* kDfdpRow = crazyflie21_nanobench::kDfdpRow;
   static constexpr const int* kDfdpCol = crazyflie21_nanobench::kDfdpCol;
   static constexpr int kDhdxNnz = crazyflie21_nanobench::kDhdxNnz;
+  static constexpr int kDhdxStorage = crazyflie21_nanobench::kDhdxStorage;
   static constexpr const int* kDhdxRow = crazyflie21_nanobench::kDhdxRow;
   static constexpr const int* kDhdxCol = crazyflie21_nanobench::kDhdxCol;
   static constexpr int kDhdpNnz = crazyflie21_nanobench::kDhdpNnz;
+  static constexpr int kDhdpStorage = crazyflie21_nanobench::kDhdpStorage;
   static constexpr const int* kDhdpRow = crazyflie21_nanobench::kDhdpRow;
   static constexpr const int* kDhdpCol = crazyflie21_nanobench::kDhdpCol;
   static constexpr const char* const* kStateNames = crazyflie21_nanobench::kStateNames;
@@ -1609,8 +1614,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_c871943d097d3029f14f90a2055acb25
+}  // inline namespace model_cbf38ed6349e25252993f6cf153d171e
 }  // namespace crazyflie21_nanobench
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_c871943d097d3029f14f90a2055acb25
+#endif  // QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e

@@ -30,10 +30,10 @@
 // steps below about 2 tau (Euler) or 2.8 tau (RK4) of the fastest rotor, and the nominal tau
 // may be far below a fitted one: set the parameters before choosing the step.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_e06ffa0eab6e2cdd0159d117c7c2e980
+#ifndef QUADGEN_GENERATED_model_a78cc05c7679adce5bee9a2d9122dbac
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_e06ffa0eab6e2cdd0159d117c7c2e980
+#define QUADGEN_GENERATED_model_a78cc05c7679adce5bee9a2d9122dbac
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -54,7 +54,7 @@ namespace crazyflie21_nanobench_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_e06ffa0eab6e2cdd0159d117c7c2e980 {
+inline namespace model_a78cc05c7679adce5bee9a2d9122dbac {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2238,18 +2238,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = crazyflie21_nanobench_all_effects::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = crazyflie21_nanobench_all_effects::kRotorSpeedStates;
   static constexpr int kDfdxNnz = crazyflie21_nanobench_all_effects::kDfdxNnz;
+  static constexpr int kDfdxStorage = crazyflie21_nanobench_all_effects::kDfdxStorage;
   static constexpr const int* kDfdxRow = crazyflie21_nanobench_all_effects::kDfdxRow;
   static constexpr const int* kDfdxCol = crazyflie21_nanobench_all_effects::kDfdxCol;
   static constexpr int kDfduNnz = crazyflie21_nanobench_all_effects::kDfduNnz;
+  static constexpr int kDfduStorage = crazyflie21_nanobench_all_effects::kDfduStorage;
   static constexpr const int* kDfduRow = crazyflie21_nanobench_all_effects::kDfduRow;
   static constexpr const int* kDfduCol = crazyflie21_nanobench_all_effects::kDfduCol;
   static constexpr int kDfdpNnz = crazyflie21_nanobench_all_effects::kDfdpNnz;
+  static constexpr int kDfdpStorage = crazyflie21_nanobench_all_effects::kDfdpStorage;
   static constexpr const int* kDfdpRow = crazyflie21_nanobench_all_effects::kDfdpRow;
   static constexpr const int* kDfdpCol = crazyflie21_nanobench_all_effects::kDfdpCol;
   static constexpr int kDhdxNnz = crazyflie21_nanobench_all_effects::kDhdxNnz;
+  static constexpr int kDhdxStorage = crazyflie21_nanobench_all_effects::kDhdxStorage;
   static constexpr const int* kDhdxRow = crazyflie21_nanobench_all_effects::kDhdxRow;
   static constexpr const int* kDhdxCol = crazyflie21_nanobench_all_effects::kDhdxCol;
   static constexpr int kDhdpNnz = crazyflie21_nanobench_all_effects::kDhdpNnz;
+  static constexpr int kDhdpStorage = crazyflie21_nanobench_all_effects::kDhdpStorage;
   static constexpr const int* kDhdpRow = crazyflie21_nanobench_all_effects::kDhdpRow;
   static constexpr const int* kDhdpCol = crazyflie21_nanobench_all_effects::kDhdpCol;
   static constexpr const char* const* kStateNames = crazyflie21_nanobench_all_effects::kStateNames;
@@ -2300,8 +2305,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_e06ffa0eab6e2cdd0159d117c7c2e980
+}  // inline namespace model_a78cc05c7679adce5bee9a2d9122dbac
 }  // namespace crazyflie21_nanobench_all_effects
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_e06ffa0eab6e2cdd0159d117c7c2e980
+#endif  // QUADGEN_GENERATED_model_a78cc05c7679adce5bee9a2d9122dbac

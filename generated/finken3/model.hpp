@@ -24,10 +24,10 @@
 // own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
 // them to 0..1 first. The measurement h is indexed by Output, not State.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f
+#ifndef QUADGEN_GENERATED_model_b1b99b5f85d6ec8a90c85a78eafe6cf1
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f
+#define QUADGEN_GENERATED_model_b1b99b5f85d6ec8a90c85a78eafe6cf1
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -48,7 +48,7 @@ namespace finken3 {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_286bbbf0bd2702e0dcd4f98d18e9ad6f {
+inline namespace model_b1b99b5f85d6ec8a90c85a78eafe6cf1 {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -1461,18 +1461,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = finken3::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = finken3::kRotorSpeedStates;
   static constexpr int kDfdxNnz = finken3::kDfdxNnz;
+  static constexpr int kDfdxStorage = finken3::kDfdxStorage;
   static constexpr const int* kDfdxRow = finken3::kDfdxRow;
   static constexpr const int* kDfdxCol = finken3::kDfdxCol;
   static constexpr int kDfduNnz = finken3::kDfduNnz;
+  static constexpr int kDfduStorage = finken3::kDfduStorage;
   static constexpr const int* kDfduRow = finken3::kDfduRow;
   static constexpr const int* kDfduCol = finken3::kDfduCol;
   static constexpr int kDfdpNnz = finken3::kDfdpNnz;
+  static constexpr int kDfdpStorage = finken3::kDfdpStorage;
   static constexpr const int* kDfdpRow = finken3::kDfdpRow;
   static constexpr const int* kDfdpCol = finken3::kDfdpCol;
   static constexpr int kDhdxNnz = finken3::kDhdxNnz;
+  static constexpr int kDhdxStorage = finken3::kDhdxStorage;
   static constexpr const int* kDhdxRow = finken3::kDhdxRow;
   static constexpr const int* kDhdxCol = finken3::kDhdxCol;
   static constexpr int kDhdpNnz = finken3::kDhdpNnz;
+  static constexpr int kDhdpStorage = finken3::kDhdpStorage;
   static constexpr const int* kDhdpRow = finken3::kDhdpRow;
   static constexpr const int* kDhdpCol = finken3::kDhdpCol;
   static constexpr const char* const* kStateNames = finken3::kStateNames;
@@ -1523,8 +1528,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_286bbbf0bd2702e0dcd4f98d18e9ad6f
+}  // inline namespace model_b1b99b5f85d6ec8a90c85a78eafe6cf1
 }  // namespace finken3
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_286bbbf0bd2702e0dcd4f98d18e9ad6f
+#endif  // QUADGEN_GENERATED_model_b1b99b5f85d6ec8a90c85a78eafe6cf1

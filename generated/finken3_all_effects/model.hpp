@@ -30,10 +30,10 @@
 // steps below about 2 tau (Euler) or 2.8 tau (RK4) of the fastest rotor, and the nominal tau
 // may be far below a fitted one: set the parameters before choosing the step.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
+#ifndef QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
+#define QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -54,7 +54,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_a35abf4ef5c85b1bea74957146375309 {
+inline namespace model_da25e2301577d7fce9073d2ba631c294 {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -2191,18 +2191,23 @@ struct Model {
   static constexpr int kNumRotorSpeedStates = finken3_all_effects::kNumRotorSpeedStates;
   static constexpr const int* kRotorSpeedStates = finken3_all_effects::kRotorSpeedStates;
   static constexpr int kDfdxNnz = finken3_all_effects::kDfdxNnz;
+  static constexpr int kDfdxStorage = finken3_all_effects::kDfdxStorage;
   static constexpr const int* kDfdxRow = finken3_all_effects::kDfdxRow;
   static constexpr const int* kDfdxCol = finken3_all_effects::kDfdxCol;
   static constexpr int kDfduNnz = finken3_all_effects::kDfduNnz;
+  static constexpr int kDfduStorage = finken3_all_effects::kDfduStorage;
   static constexpr const int* kDfduRow = finken3_all_effects::kDfduRow;
   static constexpr const int* kDfduCol = finken3_all_effects::kDfduCol;
   static constexpr int kDfdpNnz = finken3_all_effects::kDfdpNnz;
+  static constexpr int kDfdpStorage = finken3_all_effects::kDfdpStorage;
   static constexpr const int* kDfdpRow = finken3_all_effects::kDfdpRow;
   static constexpr const int* kDfdpCol = finken3_all_effects::kDfdpCol;
   static constexpr int kDhdxNnz = finken3_all_effects::kDhdxNnz;
+  static constexpr int kDhdxStorage = finken3_all_effects::kDhdxStorage;
   static constexpr const int* kDhdxRow = finken3_all_effects::kDhdxRow;
   static constexpr const int* kDhdxCol = finken3_all_effects::kDhdxCol;
   static constexpr int kDhdpNnz = finken3_all_effects::kDhdpNnz;
+  static constexpr int kDhdpStorage = finken3_all_effects::kDhdpStorage;
   static constexpr const int* kDhdpRow = finken3_all_effects::kDhdpRow;
   static constexpr const int* kDhdpCol = finken3_all_effects::kDhdpCol;
   static constexpr const char* const* kStateNames = finken3_all_effects::kStateNames;
@@ -2253,8 +2258,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_a35abf4ef5c85b1bea74957146375309
+}  // inline namespace model_da25e2301577d7fce9073d2ba631c294
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_a35abf4ef5c85b1bea74957146375309
+#endif  // QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
