@@ -466,7 +466,7 @@ std::vector<AuditCheck> check_mass_property_units(const MassProperties& mp) {
     }
   };
   check("mass", mp.mass, kg);
-  check("centre of gravity", mp.cog(2, 0), m);
+  for (int i = 0; i < 3; ++i) check(std::string("centre of gravity c_") + "xyz"[i], mp.cog(i, 0), m);
   for (int i = 0; i < 3; ++i)
     for (int j = i; j < 3; ++j)
       check(std::string("inertia J_") + "xyz"[i] + "xyz"[j], mp.inertia_cog(i, j), kg * m * m);

@@ -332,7 +332,7 @@ std::string table1_impossible() {
     }
     const double z2_bound = 2 * 0.04 * 0.0218 * 0.0218;
     if ((g == 0 || g == 5) && t[0] + t[1] - t[2] > z2_bound)
-      add(fmt("block %.0f: J_xx + J_yy - J_zz = 2 ∫ z^2 dm = %.3g kg m^2, above the %.2g two 20 g motor blocks "
+      add(fmt("block %.0f: J_xx + J_yy - J_zz = 2 ∫ z^2 dm = %.3g kg m^2, above the %.2g kg m^2 that two 20 g motor blocks "
               "between z = 0 and 0.0218 m allow",
               g + 1, t[0] + t[1] - t[2], z2_bound));
   }
