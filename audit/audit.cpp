@@ -239,6 +239,14 @@ std::vector<AuditCheck> check_energy(const SymbolicModel& m) {
           check_world_angular_momentum(m, J, off)};
 }
 
+// Two evaluated expressions that are numbers agreeing to 1e-12 of the larger (or of 1): how
+// the audit compares a model's row with one written out apart, at generic points.
+bool numbers_agree(const ex& a, const ex& b) {
+  return is_a<numeric>(a) && is_a<numeric>(b) &&
+         abs(ex_to<numeric>(a - b)).to_double() <=
+             1e-12 * std::max({1.0, abs(ex_to<numeric>(a)).to_double(), abs(ex_to<numeric>(b)).to_double()});
+}
+
 // Every symbol of the model at a value of its own (0.5 to 1.5, no two alike, so that no
 // difference such as J_yy - J_zz vanishes by accident), J's off-diagonal entries at 0.
 exmap generic_values(const SymbolicModel& m, double step, const lst& diagonal) {
@@ -270,10 +278,7 @@ AuditCheck check_euler_equations(const SymbolicModel& m) {
     for (int i = 0; i < 3 && euler; ++i) {
       const int j = (i + 1) % 3, k = (i + 2) % 3;
       const ex written_out = (ex_to<matrix>(tau)(i, 0) + (J[j] - J[k]) * w[j] * w[k]) / J[i];
-      const ex row = evalf(m.f(kBodyRate + i, 0).subs(at)), euler_row = evalf(written_out.subs(at));
-      euler = is_a<numeric>(row) && is_a<numeric>(euler_row) &&
-              abs(ex_to<numeric>(row - euler_row)).to_double() <=
-                  1e-12 * std::max({1.0, abs(ex_to<numeric>(row)).to_double(), abs(ex_to<numeric>(euler_row)).to_double()});
+      euler = numbers_agree(evalf(m.f(kBodyRate + i, 0).subs(at)), evalf(written_out.subs(at)));
     }
   }
   return make("rotation", "body-rate rows are Euler's equations for a diagonal J", euler,
@@ -341,31 +346,26 @@ exmap generic_values_with_unit_quaternion(const SymbolicModel& m, double step) {
 // Compared in numbers at two generic points, as Euler's equations are.
 AuditCheck check_translation_rows(const SymbolicModel& m) {
   using namespace runtime::rigid_body;
+  const char* const name = "velocity rows are R(q) F_body / m - g e_z with the CoG's transport";
   const ex& force = m.intermediate("F_{body}");
-  bool rows = is_a<matrix>(force) && ex_to<matrix>(force).rows() == 3 && m.omega_dot.size() == 3 &&
-              m.f_split.rows() == m.f.rows();
+  if (!is_a<matrix>(force) || ex_to<matrix>(force).rows() != 3 || m.omega_dot.size() != 3 || m.f_split.rows() != m.f.rows())
+    return make("translation", name, false, "the model's F_body is not a 3-vector, or dω/dt has no symbols of its own");
   const matrix c = model_cog(m);
   matrix w(3, 1), w_dot(3, 1);
-  for (int i = 0; i < 3 && rows; ++i) w(i, 0) = m.states[kBodyRate + i].sym, w_dot(i, 0) = m.omega_dot[i];
+  for (int i = 0; i < 3; ++i) w(i, 0) = m.states[kBodyRate + i].sym, w_dot(i, 0) = m.omega_dot[i];
   const ex mass = m.params[m.param_index("mass")].sym, g = m.params[m.param_index("g")].sym;
   ex q[4];
   for (int i = 0; i < 4; ++i) q[i] = m.states[kAttitude + i].sym;
+  const matrix body = ex_to<matrix>(force).mul_scalar(1 / mass).sub(cross3(w_dot, c)).sub(cross3(w, cross3(w, c)));
+  const matrix world = body_to_world(q[0], q[1], q[2], q[3]).mul(body).sub(matrix(3, 1, lst{0, 0, g}));
+  bool rows = true;
   for (const double step : {0.6180339887498949, 0.4142135623730951}) {
-    if (!rows) break;
     const exmap at = generic_values_with_unit_quaternion(m, step);
-    const matrix body = ex_to<matrix>(force).mul_scalar(1 / mass).sub(cross3(w_dot, c)).sub(cross3(w, cross3(w, c)));
-    const matrix world = body_to_world(q[0], q[1], q[2], q[3]).mul(body);
-    for (int i = 0; i < 3 && rows; ++i) {
-      const ex expected = evalf((world(i, 0) - (i == 2 ? g : ex(0))).subs(at));
-      for (const matrix* f : {&m.f, &m.f_split}) {
-        const ex row = evalf((*f)(kVelocity + i, 0).subs(at));
-        rows = rows && is_a<numeric>(row) && is_a<numeric>(expected) &&
-               abs(ex_to<numeric>(row - expected)).to_double() <=
-                   1e-12 * std::max({1.0, abs(ex_to<numeric>(row)).to_double(), abs(ex_to<numeric>(expected)).to_double()});
-      }
-    }
+    for (int i = 0; i < 3; ++i)
+      for (const matrix* f : {&m.f, &m.f_split})
+        rows = rows && numbers_agree(evalf((*f)(kVelocity + i, 0).subs(at)), evalf(world(i, 0).subs(at)));
   }
-  return make("translation", "velocity rows are R(q) F_body / m - g e_z with the CoG's transport", rows,
+  return make("translation", name, rows,
               "each row of dv/dt equals R(q) (F_body / m - dω/dt × c - ω × (ω × c)) - g e_z to 1e-12 at two generic "
               "points with a unit quaternion (R(q) written out in the audit; F_body of section 4; c the CoG with any "
               "effect's Δc; dω/dt the model's rows, in f and as f_split's symbols): the one check that ties the "

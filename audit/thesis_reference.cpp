@@ -53,13 +53,20 @@ struct Numbers {  // the derived model at its nominal parameters
   std::array<double, 3> A, cog;
 };
 
-// l: the arm, rotor C's x (at (+l, +l) in the thesis' layout) as the vehicle file places it;
-// the thesis' where the file has no rotor C (the comparison then says little).
+// The arm l as the vehicle file places it: rotor C's x, at (+l, +l) in the thesis' layout;
+// nullptr where the file has no rotor C.
+const Variable* arm_constant(const SymbolicModel& model) {
+  for (const auto& c : model.constants)
+    if (c.name == "C.x") return &c;
+  return nullptr;
+}
+
+// l: arm_constant's value, the thesis' where the file has no rotor C (the comparison then
+// says little).
 Numbers nominal(const SymbolicModel& model, const MassProperties& mp) {
   auto P = [&](const char* n) { return model.params[model.param_index(n)].nominal; };
-  double l = kThesisL;
-  for (const auto& c : model.constants)
-    if (c.name == "C.x") l = c.nominal;
+  const Variable* arm = arm_constant(model);
+  const double l = arm ? arm->nominal : kThesisL;
   return Numbers{mp.mass_value, P("g"), P("rho"), P("c_w"),
                  mp.inertia_cog_value[0][0], mp.inertia_cog_value[1][1], mp.inertia_cog_value[2][2],
                  l, mp.areas_value, mp.cog_value};
@@ -179,9 +186,8 @@ bool torque_agrees_with_thesis(const SymbolicModel& model) {
   ex F[4];
   for (int i = 0; i < 4; ++i) F[i] = model.intermediate(rotor_thrust_name(std::string(1, "ABCD"[i]))).subs(neutral);
   const ex kappa = P("kappa");
-  ex l;
-  for (const auto& c : model.constants)
-    if (c.name == "C.x") l = c.sym;  // the thesis' l, rotor C at (+l, +l)
+  const Variable* arm = arm_constant(model);
+  const ex l = arm ? ex(arm->sym) : ex(0);
   const ex thesis[3] = {((F[2] + F[3]) - (F[0] + F[1])) * l, ((F[0] + F[3]) - (F[1] + F[2])) * l,
                         kappa * (-F[0] + F[1] - F[2] + F[3])};
   lst same_arm;  // the thesis' single l: every rotor at (±l, ±l, 0)

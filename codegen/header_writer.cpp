@@ -248,10 +248,7 @@ GeneratedHeader generate_header(const SymbolicModel& m, const EmitOptions& opt) 
   set_sparsity(d, lm);
   set_rotor_facts(d, opt, m.rotor_speed_states.size());
   // The comment's notes that hold only with an effect or an input of the model.
-  const auto has = [](const auto& names, const std::string& name) {
-    return std::find(names.begin(), names.end(), name) != names.end();
-  };
-  d.set("has_ground_effect", data(has(m.effects, "ground_effect")));
+  d.set("has_ground_effect", data(std::find(m.effects.begin(), m.effects.end(), "ground_effect") != m.effects.end()));
   d.set("has_vbat", data(std::any_of(m.inputs.begin(), m.inputs.end(), [](const Variable& v) { return v.name == "vbat"; })));
   d.set("has_rotor_speed_states", data(!m.rotor_speed_states.empty()));
   d.set("precompute_body", pre.body);

@@ -533,7 +533,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
       for (const auto& p : f.parameters) {
         const int prec = estimate_digits(p.value, p.lower, p.upper);
         h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, prec) << "</td><td>" << interval(p.lower, p.upper, prec)
-          << "</td><td>" << unit_html(p.unit) << "</td><td>" << (p.verdict ? fit::identifiability_text(*p.verdict) : "") << "</td></tr>\n";
+          << "</td><td>" << unit_html(p.unit) << "</td><td>" << fit::identifiability_text(p.verdict) << "</td></tr>\n";
       }
       h << "</table>\n";
     }

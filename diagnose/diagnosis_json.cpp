@@ -194,7 +194,7 @@ json finding_json(const Finding& f) {
         ps[p.name]["reference"] = true;
       }
   for (const auto& e : f.parameters) {
-    json pj = output::estimate_json({e.value, e.unit, e.lower, e.upper, e.verdict ? fit::identifiability_text(*e.verdict) : "", e.at_bound});
+    json pj = output::estimate_json({e.value, e.unit, e.lower, e.upper, fit::identifiability_text(e.verdict), e.at_bound});
     pj["standard_error"] = number_or_null(e.standard_error);
     pj["numerical_allowance"] = e.numerical_allowance;
     pj["interval_method"] = e.interval;

@@ -5,6 +5,7 @@
 // structurally non-identifiable (flat: other parameters compensate exactly).
 #pragma once
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ enum class Identifiability { kIdentifiable, kPracticallyNonIdentifiable, kStruct
 // "identifiable", "practically non-identifiable", "structurally non-identifiable": the words
 // of fit.json's and diagnosis.json's "identifiability" (docs/formats.md).
 const char* identifiability_text(Identifiability verdict);
+// The same, or "" for a verdict not assessed (a suspect's values, which are not profiled).
+inline const char* identifiability_text(const std::optional<Identifiability>& verdict) {
+  return verdict ? identifiability_text(*verdict) : "";
+}
 
 struct ProfilePoint {
   double value;

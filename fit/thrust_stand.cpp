@@ -1,5 +1,4 @@
 #include "fit/thrust_stand.hpp"
-#include "output/numbers.hpp"
 
 #include <algorithm>
 #include <set>
@@ -7,6 +6,7 @@
 #include <sstream>
 
 #include "fit/flight_data.hpp"
+#include "output/numbers.hpp"
 #include "runtime/flight_log.hpp"
 #include "runtime/thrust_law.hpp"
 

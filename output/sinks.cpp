@@ -94,12 +94,17 @@ constexpr size_t kErrorHead = 1000, kErrorTail = 600;
 bool utf8_continuation(const std::string& s, size_t i) {
   return i < s.size() && (static_cast<unsigned char>(s[i]) & 0xC0) == 0x80;
 }
+// `cut` moved back to the start of the character it falls in.
+size_t character_start(const std::string& s, size_t cut) {
+  while (cut > 0 && utf8_continuation(s, cut)) --cut;
+  return cut;
+}
 }  // namespace
 
 std::string printable_error(const std::string& message) {
   if (message.size() <= kErrorHead + kErrorTail + 100) return printable(message);
-  size_t head = kErrorHead, tail = message.size() - kErrorTail;
-  while (head > 0 && utf8_continuation(message, head)) --head;  // whole characters on both sides
+  const size_t head = character_start(message, kErrorHead);  // whole characters on both sides
+  size_t tail = message.size() - kErrorTail;
   while (utf8_continuation(message, tail)) ++tail;
   return printable(message.substr(0, head)) + " [... " + std::to_string(tail - head) + " bytes left out ...] " +
          printable(message.substr(tail));
@@ -107,9 +112,7 @@ std::string printable_error(const std::string& message) {
 
 std::string printable_head(const std::string& s, size_t max_bytes) {
   if (s.size() <= max_bytes) return printable(s);
-  size_t cut = max_bytes;
-  while (cut > 0 && utf8_continuation(s, cut)) --cut;
-  return printable(s.substr(0, cut)) + "...";
+  return printable(s.substr(0, character_start(s, max_bytes))) + "...";
 }
 
 std::string printable_lines(const std::string& text) {

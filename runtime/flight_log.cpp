@@ -313,19 +313,18 @@ CsvTable parse_csv(const std::string& text, const std::string& path) {
   return parse_lines([&](std::string& line) { return static_cast<bool>(std::getline(in, line)); }, path, text.size());
 }
 
-CsvTable read_csv(const std::string& path) {
+namespace {
+CsvTable read_csv_file(const std::string& path, bool header_only) {
   const LogFile file(path, "a CSV log");
   file.set_blocking();
   FdLines lines(file.fd(), path, file.limit());
-  return parse_lines(lines, path, file.size());
+  return parse_lines(lines, path, file.size(), header_only);
 }
+}  // namespace
 
-CsvTable read_csv_header(const std::string& path) {
-  const LogFile file(path, "a CSV log");
-  file.set_blocking();
-  FdLines lines(file.fd(), path, file.limit());
-  return parse_lines(lines, path, file.size(), /*header_only=*/true);
-}
+CsvTable read_csv(const std::string& path) { return read_csv_file(path, false); }
+
+CsvTable read_csv_header(const std::string& path) { return read_csv_file(path, true); }
 
 std::string canonical_unit(const std::string& c) {
   static const std::map<std::string, std::string> units = {
