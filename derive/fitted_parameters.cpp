@@ -10,7 +10,7 @@
 namespace quadgen {
 
 FittedParameters load_fitted_parameters(const std::string& path) {
-  const YamlReader r{path};
+  YamlReader r{path, {}};
   const YAML::Node file = r.parse(r.read_file("fitted-parameters file"));
   if (!file.IsMap()) throw VehicleError(path + ":1: expected 'effects' and 'parameters' (a fitted_parameters.yaml)");
   // The other files a user may hand over by mistake (YAML reads JSON too): name the one expected.

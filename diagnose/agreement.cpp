@@ -137,8 +137,9 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
   a.q = measured ? std::pow((f.value - airframe_value) / se, 2) : std::numeric_limits<double>::quiet_NaN();
   a.q_p_value = measured ? chi2_upper(a.q, 1.0) : std::numeric_limits<double>::quiet_NaN();
   a.spread = airframe_value != 0 ? std::abs(f.value - airframe_value) / std::abs(airframe_value) : INFINITY;
-  // The test of judge_heterogeneity with one flight: |z| < 1.96 at kAgreementLevel.
-  a.within_errors = !says || !(a.q_p_value < kAgreementLevel);
+  // The test of judge_heterogeneity with one flight: |z| < 1.96 at kAgreementLevel, or the
+  // two within kNegligibleSpread.
+  a.within_errors = !says || !(a.q_p_value < kAgreementLevel) || a.spread < kNegligibleSpread;
   a.agree = says && a.within_errors && a.spread < kSpreadLimit;
   return a;
 }
@@ -171,8 +172,9 @@ void judge_heterogeneity(ParameterAgreement& a) {
   // the rule until the sixty-first session, called flights that measure one value "disagree"
   // 14 % of the time for five flights and 32 % for ten (MultiFlight.
   // AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel). Fewer than two flights that can say
-  // test nothing (p = 1).
-  const bool within = !(a.q_p_value < kAgreementLevel);
+  // test nothing (p = 1). Values within kNegligibleSpread are within the errors whatever Q
+  // says (its note there: verdict_reason).
+  const bool within = !(a.q_p_value < kAgreementLevel) || a.spread < kNegligibleSpread;
   a.agree = every_flight_says && within && a.spread < kSpreadLimit;
   a.within_errors = within;
 }

@@ -25,6 +25,13 @@ namespace quadgen::diagnose {
 inline constexpr double kAgreementLevel = 0.05;
 // Flights agree only within this spread, (largest - smallest) / |joint value| (issue #14's 30 %).
 inline constexpr double kSpreadLimit = 0.3;
+// Values this close are one value whatever Cochran's Q says: a chosen margin, not a derived
+// one. Q weighs the differences by the standard errors alone, which reflect noise, not the
+// bias each flight's model error gives its estimate; where the noise is nearly nil the
+// bias alone decides. Noise-free generated flights "disagreed" on kappa at a spread of
+// 0.0002 % (sixty-second session). Real flights' differences sit far above it (rotor drag's
+// 20.6 % on the five NanoBench flights, Q's p = 0.013: still "disagree").
+inline constexpr double kNegligibleSpread = 0.01;
 
 struct FlightEstimate {
   double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
@@ -138,6 +145,12 @@ inline const char* agreement_verdict(const ParameterAgreement& a) {
 // named cause wherever it is named, and given a next step.
 inline bool flights_disagree(const ParameterAgreement& a) { return !a.agree && !a.within_errors; }
 
+// Cochran's Q rejects one value, yet the values are within kNegligibleSpread of each other:
+// agreeing by that margin, said beside the verdict so that an "agree" beside p = 0 reads right.
+inline bool agree_within_negligible_spread(const ParameterAgreement& a) {
+  return a.within_errors && a.q_p_value < kAgreementLevel;
+}
+
 // Why a verdict is "too uncertain" ("" for the other two): an airframe value or a flight that
 // has no standard error cannot say, else the values are within the errors but 30 % or more apart.
 inline const char* why_too_uncertain(const ParameterAgreement& a) {
@@ -152,6 +165,14 @@ inline const char* why_too_uncertain(const ParameterAgreement& a) {
   // helper-131: c_w's flights would spread by a median of 570 %): they cannot measure it.
   if (a.spread_if_agree >= kSpreadLimit) return "the flights cannot measure it to 30 %: agreeing flights would spread as far";
   return "within the errors, but 30 % or more apart";
+}
+
+// The words beside any verdict: why it is "too uncertain", or that the values agree to within
+// 1 % though Q rejects one value; "" otherwise.
+inline const char* verdict_reason(const ParameterAgreement& a) {
+  if (agree_within_negligible_spread(a))
+    return "Q rejects one value, but the values are within 1 % of each other: the difference is the fits' precision, not the airframe's";
+  return why_too_uncertain(a);
 }
 
 struct AgreementInputs {

@@ -241,7 +241,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     // A suspect's agreement in grey: green read as an endorsement of what is not named.
     h << "<h3>" << esc(a.parameter) << " [" << unit_html(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
-      << (*why_too_uncertain(a) ? std::string(" (") + why_too_uncertain(a) + ")" : "") << "</span></h3>\n<p>"
+      << (*verdict_reason(a) ? std::string(" (") + verdict_reason(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table class=\"agreement\"><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
@@ -305,7 +305,7 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
        "joint estimate). \"Alone\": the effect's "
        "likelihood-ratio test on that flight by itself. The flights disagree when Cochran's Q rejects one "
-       "value at the 5 % level (one test per parameter), and agree when it does not, every flight can say and "
+       "value at the 5 % level (one test per parameter) and the values are 1 % or more apart, and agree when it does not, every flight can say and "
        "the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
        "median spread the flights would show if each measured the pooled value with its own standard error, and the "
        "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "

@@ -506,12 +506,12 @@ std::string terms_gain_verdict(double gain_mean, double gain_standard_error) {
                "adding";
 }
 
-// What spread agreeing flights would show, beside the one seen: " (if they agree: median
-// 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
 std::string name_value(const std::string& name, double value, const std::string& unit, int prec) {
   return name + " = " + num(value, prec) + output::unit_after_number(unit);
 }
 
+// What spread agreeing flights would show, beside the one seen: " (if they agree: median
+// 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
 std::string spread_context(const ParameterAgreement& a) {
   if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
   return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, " + output::p_is(a.spread_p_value) + ")";

@@ -301,7 +301,7 @@ void read_derived(const Reader& r, const YAML::Node& d, Vehicle& v) {
 }
 
 Vehicle parse_vehicle_checked(const std::string& content, const std::string& path) {
-  const Reader r{{path}};
+  Reader r{{path, {}}};
   const YAML::Node root = r.parse(content);
   if (!root || root.IsNull()) throw VehicleError(path + ":1: empty vehicle file");
   r.require_map(root, "a vehicle description");
@@ -325,7 +325,7 @@ Vehicle parse_vehicle_checked(const std::string& content, const std::string& pat
 }
 }  // namespace
 
-Vehicle load_vehicle(const std::string& path) { return parse_vehicle(YamlReader{path}.read_file("vehicle file"), path); }
+Vehicle load_vehicle(const std::string& path) { return parse_vehicle(YamlReader{path, {}}.read_file("vehicle file"), path); }
 
 std::string fitted_section_note(const Vehicle& v, const std::string& command) {
   if (v.fitted_line == 0) return "";

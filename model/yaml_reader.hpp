@@ -125,13 +125,38 @@ inline output::NumberText yaml_number(const std::string& text, double* value) {
   return kind;
 }
 
+// The line (from 0) a value without text of its own belongs to. yaml-cpp marks an empty
+// value ("name:" and a line break) where the next token starts, a line or more later: the
+// error named the key after it. An explicit null (~, null) is a token and keeps its mark;
+// otherwise the last line before the mark with content (not blank, not only a comment)
+// is the key's.
+inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  const auto at = [&](int line) { return line >= 0 && line < static_cast<int>(lines.size()) ? lines[static_cast<size_t>(line)] : std::string(); };
+  const std::string here = at(mark.line);
+  if (mark.column >= 0 && static_cast<size_t>(mark.column) < here.size()) {
+    const std::string token = here.substr(static_cast<size_t>(mark.column), 4);
+    if (token[0] == '~' || token == "null" || token == "Null" || token == "NULL") return mark.line;
+  }
+  for (int line = std::min(mark.line, static_cast<int>(lines.size())) - 1; line >= 0; --line) {
+    const std::string l = at(line);
+    const size_t first = l.find_first_not_of(" \t\r");
+    if (first != std::string::npos && l[first] != '#') return line;
+  }
+  return mark.line;
+}
+
 struct YamlReader {
   std::string path;
+  std::string content;  // what parse() read: for the line of an empty value
 
   [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
     std::ostringstream os;
     os << path;
-    if (at.IsDefined() && at.Mark().line >= 0) os << ':' << at.Mark().line + 1;
+    if (at.IsDefined() && at.Mark().line >= 0)
+      os << ':' << (at.IsNull() ? empty_value_line(content, at.Mark()) : at.Mark().line) + 1;
     os << ": " << what;
     throw VehicleError(os.str());
   }
@@ -152,13 +177,14 @@ struct YamlReader {
     }
   }
 
-  YAML::Node parse(const std::string& content) const {
+  YAML::Node parse(const std::string& text) {
+    content = text;
     int dropped = -1;
     YAML::Node root;
     try {
-      root = load_one_document(content, &dropped);
+      root = load_one_document(text, &dropped);
     } catch (const YAML::ParserException& e) {
-      fail_at(e.mark, malformed_yaml(e, content));
+      fail_at(e.mark, malformed_yaml(e, text));
     }
     if (dropped >= 0) {
       YAML::Mark m;

@@ -1234,6 +1234,41 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
 // The rule before the sixty-first session (every flight's 95 % interval holds the pooled
 // value) tested each flight and said "disagree" 14 % of the time for five flights and 32 % for
 // ten: this test failed with it. And a flight 4 standard errors off is found.
+// Noise-free generated flights carry standard errors near machine precision, and the bias
+// each flight's model error gives its estimate then decides Cochran's Q: kappa "disagreed"
+// at a spread of 0.0002 % (sixty-second session). Values within 1 % agree whatever Q says,
+// with the reason beside the verdict; 2 % apart at the same errors still disagree, and an
+// airframe check judges one flight alike.
+TEST(MultiFlight, ValuesWithinOnePercentAgreeWhateverQSays) {
+  using quadgen::diagnose::ParameterAgreement;
+  const auto judged = [](std::vector<double> values, double se) {
+    ParameterAgreement a;
+    a.joint_value = values.front();
+    for (double v : values) {
+      quadgen::diagnose::FlightEstimate f;
+      f.value = v, f.standard_error = se, f.lower = v - 1.96 * se, f.upper = v + 1.96 * se;
+      a.flights.push_back(f);
+    }
+    quadgen::diagnose::summarise_agreement(a);
+    return a;
+  };
+  const ParameterAgreement noise_free = judged({0.01, 0.010000015, 0.01000002}, 1e-12);
+  EXPECT_LT(noise_free.q_p_value, 1e-100);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(noise_free), "agree");
+  EXPECT_NE(std::string(quadgen::diagnose::verdict_reason(noise_free)).find("within 1 %"), std::string::npos);
+  const ParameterAgreement two_percent = judged({1.0, 1.02}, 1e-6);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(two_percent), "disagree");
+  EXPECT_STREQ(quadgen::diagnose::verdict_reason(two_percent), "");
+  const ParameterAgreement tested = judged({1.0, 1.1}, 0.2);  // Q does not reject: no margin note
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(tested), "agree");
+  EXPECT_STREQ(quadgen::diagnose::verdict_reason(tested), "");
+  quadgen::diagnose::FlightEstimate here;
+  here.value = 1.005, here.standard_error = 1e-9, here.lower = here.value - 2e-9, here.upper = here.value + 2e-9;
+  EXPECT_TRUE(quadgen::diagnose::judge_against_airframe(here, 1.0, 1e-9).agree);
+  here.value = 1.05;
+  EXPECT_FALSE(quadgen::diagnose::judge_against_airframe(here, 1.0, 1e-9).within_errors);
+}
+
 TEST(MultiFlight, AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel) {
   using quadgen::diagnose::ParameterAgreement;
   std::mt19937 rng(61);

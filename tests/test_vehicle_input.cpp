@@ -60,6 +60,20 @@ TEST(VehicleInput, BundledFilesLoad) {
 
 TEST(VehicleInput, MalformedYaml) { expect_error("name: x\nblocks: [\n", "malformed YAML"); }
 
+// An empty value ("name:" and a line break) is marked by yaml-cpp where the next token
+// starts: the error named the line after the key, or further down past comments and blank
+// lines (sixty-second session's note). Named at its key's line now; an explicit null (~)
+// is a token of its own, on its own line.
+TEST(VehicleInput, AnEmptyValueIsNamedAtItsKeysLine) {
+  const std::string text = finken_text();
+  const int name_line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find("\nname: finken3") + 1), '\n'));
+  expect_error(replace(text, "\nname: finken3\n", "\nname:\n\n# a comment\n"),
+               "bad.yaml:" + std::to_string(name_line) + ": expected a name for vehicle name");
+  expect_error(replace(text, "\nname: finken3\n", "\nname:\n  ~\n"),
+               "bad.yaml:" + std::to_string(name_line + 1) + ": expected a name for vehicle name");
+  expect_error("name:\n", "bad.yaml:1: expected a name for vehicle name");  // at the end of the file
+}
+
 // A '---' line splits a file into two YAML documents, and yaml-cpp's Load reads the first
 // alone: the mass written after it was dropped without a word (a review, helper-135). Refused
 // at the line where the dropped content starts; an empty document after it, or a '---' that
