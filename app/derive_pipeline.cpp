@@ -3,6 +3,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "audit/mass_quadrature.hpp"
 #include "audit/report.hpp"
 #include "audit/vehicle_checks.hpp"
 #include "derive/fitted_parameters.hpp"
@@ -80,6 +81,7 @@ DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& m
   if (request.set_nominal) request.set_nominal(out.model);
   progress("audit");
   out.audit = audit(out.model, mass);
+  for (AuditCheck& c : check_mass_properties_by_quadrature(vehicle, mass)) out.audit.checks.push_back(std::move(c));
   out.hover_trim = nominal_hover_trim(vehicle, out.model);
   for (AuditCheck& c : check_vehicle_can_fly(vehicle, out.model, out.hover_trim)) out.audit.checks.push_back(std::move(c));
   if (request.thesis_comparison) out.thesis = compare_with_thesis(vehicle, out.model, mass);
