@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# First command of the README: install what is missing, build, and run the main job on bundled data.
+# First command of the README: install what is missing, build, and run the main job (the bundled
+# vehicles, a generated flight, and a real NanoBench flight where the reference data sits beside the clone).
 #   ./setup.sh            install + build + derive the bundled vehicles into out/, diagnose a
 #                         test flight with a hidden weak motor and the NanoBench flight, and
 #                         measure the extended model's prediction error on the latter

@@ -7,8 +7,9 @@ namespace quadgen::cli {
 
 std::string parameter_names_help() {
   std::string base;
-  for (const std::string& name : base_parameter_names()) base += name + ", ";
-  return "the vehicle's (" + base + "and vbat_ref with battery_sag; model.json lists a model's) and the effects' (" +
+  for (const std::string& name : base_parameter_names()) base += (base.empty() ? "" : ", ") + name;
+  // vbat_ref is the vehicle file's, but a model has it only with battery_sag.
+  return "the vehicle's (" + base + "; in a model with battery_sag also vbat_ref; model.json lists a model's) and the effects' (" +
          catalogue_parameter_names() + ")";
 }
 

@@ -44,13 +44,29 @@ int run_reporting_errors(const Run& run) {
   return 2;
 }
 
+// Whether `option` is `word` with at most three letters left out ("--out" in "--ouput" or
+// "--output"): a slip of a letter or a word's ending too many, which an edit count within a
+// third of a short word's length does not reach.
+inline bool within_three_extra_letters(const std::string& word, const std::string& option) {
+  if (word.size() <= option.size() || word.size() > option.size() + 3) return false;
+  size_t i = 0;
+  for (char c : word)
+    if (i < option.size() && c == option[i]) ++i;
+  return i == option.size();
+}
+
 // The option of `command` nearest to `word` ("--maping" -> "--mapping"), as nearest_word
-// judges nearness; "" when none is near.
+// judges nearness, else one the word holds with three letters or fewer added ("--ouput" ->
+// "--out": a newcomer's trial, helper-143); "" when none is near.
 inline std::string nearest_option(const CLI::App& command, const std::string& word) {
   std::vector<std::string> options;
   for (const CLI::Option* o : command.get_options())
     for (const std::string& name : o->get_lnames()) options.push_back("--" + name);
-  return output::nearest_word(word.substr(0, word.find('=')), options);
+  const std::string typed = word.substr(0, word.find('='));
+  if (std::string near = output::nearest_word(typed, options); !near.empty()) return near;
+  for (const std::string& o : options)
+    if (o.size() > 3 && within_three_extra_letters(typed, o)) return o;  // not "--x" in anything
+  return "";
 }
 
 // A command line CLI11 refused, reported as every other error is: one line, whatever the

@@ -488,9 +488,14 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
       << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " than the base model (" << esc(d.metric) << " "
       << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
   }
+  // Both lines together read as a contradiction ("77 % better", then "the velocity alone
+  // comes closer": a newcomer's trial, helper-143) unless the measures are told apart.
   if (d.has_prediction)
     if (const std::string against = predict::open_loop_against_no_model(d.prediction_after); !against.empty())
-      h << "<li>" << esc(against) << "</li>\n";
+      h << "<li>" << esc(against)
+        << (d.search.selected.empty() ? "" : " (The error at the horizon itself; the line above scores every point of "
+                                             "each window, most of them nearer its measured start.)")
+        << "</li>\n";
   // Where the extended model is worse, said beside the gain (a user trial, helper-106: a
   // channel 44 % worse was only in a table near the end).
   if (const std::string worse = worse_channels(d); !worse.empty())

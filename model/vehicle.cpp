@@ -46,6 +46,7 @@ struct Reader : YamlReader {
   // A name that becomes a C++ identifier, a CSV column, a plot label and report text: one
   // rule for all of them (output/names.hpp).
   std::string name(const YAML::Node& n, const std::string& what) const {
+    require_value(n, what, "a name");
     if (!n.IsScalar()) fail(n, "expected a name for " + what);
     const std::string s = n.Scalar();
     if (const auto problem = output::name_problem(s))
@@ -65,6 +66,8 @@ struct Reader : YamlReader {
     const Unit si = parse_unit(si_unit);
     p.dim = si.dim;
     double scale = 1.0;
+    require_value(n, "parameter " + name, "a number in " + (si_unit == "1" ? std::string("no unit") : si_unit) +
+                                              ", or {value, unit, bounds: [lo, hi], fit}");
     if (n.IsScalar()) {
       p.nominal = number(n, name);
     } else {

@@ -194,6 +194,13 @@ struct YamlReader {
     return root;
   }
 
+  // An empty value ("kappa:" and nothing) said as such: "expected a name for vehicle name"
+  // and "expected parameter kappa (a mapping of keys)" read as if something else had been
+  // written (a newcomer's trial, helper-143).
+  void require_value(const YAML::Node& n, const std::string& what, const std::string& expected) const {
+    if (n.IsNull()) fail(n, what + " has no value (expected " + expected + ")");
+  }
+
   void require_map(const YAML::Node& n, const std::string& what) const {
     if (!n.IsMap()) fail(n, "expected " + what + " (a mapping of keys)");
   }
@@ -230,6 +237,7 @@ struct YamlReader {
   // By the rule the log cells and the command line follow (output/numbers.hpp): yaml-cpp's
   // own conversion read 1e-400 as 0 without a word.
   double number(const YAML::Node& n, const std::string& what) const {
+    require_value(n, what, "a number");
     if (!n.IsScalar()) fail(n, "expected a number for " + what);
     const std::string& text = n.Scalar();
     const std::string shown = output::printable(text);
@@ -248,6 +256,7 @@ struct YamlReader {
   // Free text (a description, a unit): any printable characters and line breaks, no other
   // control characters (escape sequences would reach terminals and reports).
   std::string text(const YAML::Node& n, const std::string& what) const {
+    require_value(n, what, "text");
     if (!n.IsScalar()) fail(n, "expected text for " + what);
     for (unsigned char c : n.Scalar())
       if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) fail(n, "control character in " + what);

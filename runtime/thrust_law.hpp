@@ -62,8 +62,14 @@ inline double ThrustLaw::command_for(double thrust) const {
     if (thrust < lowest)
       return std::invalid_argument("thrust " + newtons(thrust) + " is below what the motor map gives at command 0 (" +
                                    newtons(lowest) + ")");
-    return std::invalid_argument("thrust " + newtons(thrust) + " is beyond the motor map (at most " +
-                                 newtons(thrust_at_speed(speed_at(1.0))) + " at command 1)");
+    // Tens to thousands of times beyond: most often masses in grams written as kilograms (a
+    // newcomer's trial, helper-143: a file without mass bounds got no word of it).
+    const double most = thrust_at_speed(speed_at(1.0)), times = thrust / most;
+    char slip[96] = "";
+    if (times > 30 && times < 3e4)
+      std::snprintf(slip, sizeof slip, ", %.3g times less: masses in grams written as kilograms?", times);
+    return std::invalid_argument("thrust " + newtons(thrust) + " is beyond the motor map (at most " + newtons(most) +
+                                 " at command 1" + slip + ")");
   };
   const double w = std::sqrt(thrust / k);
   // Solve a2 u^2 + a1 u + (a0 - w) = 0 for the root in [0, 1].

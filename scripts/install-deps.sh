@@ -14,6 +14,7 @@ packages=(
   libkainjow-mustache-dev               # text templates for generated code
   libicu-dev                            # Unicode look-alike skeletons (flight labels that must not read alike)
   gnuplot-nox                           # plots (SVG) of simulations and fits
+  python3                               # scripts/*.py (tables, checks; standard library only) and one test
   cmark-gfm                             # tests: hostile text rendered as GitHub renders Markdown
   clang libclang-rt-14-dev              # CI's sanitizer build (.ci/sanitize) and libFuzzer (scripts/fuzz.sh)
 )

@@ -45,6 +45,7 @@
 #include "runtime/plot.hpp"
 #include "runtime/flight_log.hpp"
 #include "app/model_registry.hpp"
+#include "cli/options.hpp"
 #include "audit/report.hpp"
 #include "output/sinks.hpp"
 #include "tests/test_helpers.hpp"
@@ -1765,6 +1766,11 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   // A misspelt required option: CLI11 alone says only that --out is missing.
   expect_error({"derive", f3, "--ouut", tmp / "o"}, 106,
                "--out is required (not understood: --ouut); did you mean '--out' for '--ouut'?");
+  // Letters too many are a slip too (a newcomer's trial, helper-143: --ouput got nothing).
+  expect_error({"derive", f3, "--ouput", tmp / "o"}, 106, "did you mean '--out' for '--ouput'?");
+  expect_error({"derive", f3, "--output", tmp / "o"}, 106, "did you mean '--out' for '--output'?");
+  EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--outputs", "--out"));
+  EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--tuo", "--out"));
   // A misspelt option gets the nearest of that command's options back; a word near none, nothing.
   expect_error({"diagnose", f3, "x.csv", "--maping", "M.yaml", "--out", tmp / "o"}, 109,
                "not expected: --maping; did you mean '--mapping' for '--maping'?");

@@ -1455,6 +1455,8 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     const auto c = checks_of(v);
     EXPECT_FALSE(c.at(trim).passed);
     EXPECT_NE(c.at(trim).detail.find("beyond the motor map"), std::string::npos) << c.at(trim).detail;
+    EXPECT_NE(c.at(trim).detail.find("times less: masses in grams written as kilograms?"), std::string::npos)
+        << c.at(trim).detail;
     EXPECT_TRUE(c.at(apart).passed);
   }
   {  // the centre of gravity outside the rotors: one would have to pull down

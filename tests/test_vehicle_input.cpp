@@ -68,10 +68,14 @@ TEST(VehicleInput, AnEmptyValueIsNamedAtItsKeysLine) {
   const std::string text = finken_text();
   const int name_line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find("\nname: finken3") + 1), '\n'));
   expect_error(replace(text, "\nname: finken3\n", "\nname:\n\n# a comment\n"),
-               "bad.yaml:" + std::to_string(name_line) + ": expected a name for vehicle name");
+               "bad.yaml:" + std::to_string(name_line) + ": vehicle name has no value (expected a name)");
   expect_error(replace(text, "\nname: finken3\n", "\nname:\n  ~\n"),
-               "bad.yaml:" + std::to_string(name_line + 1) + ": expected a name for vehicle name");
-  expect_error("name:\n", "bad.yaml:1: expected a name for vehicle name");  // at the end of the file
+               "bad.yaml:" + std::to_string(name_line + 1) + ": vehicle name has no value (expected a name)");
+  expect_error("name:\n", "bad.yaml:1: vehicle name has no value");  // at the end of the file
+  // A parameter's empty value says what it may be (not "(a mapping of keys)" alone).
+  const size_t kappa = text.find("\n  kappa:") + 1;
+  const std::string no_kappa = text.substr(0, kappa) + "  kappa:\n" + text.substr(text.find('\n', kappa) + 1);
+  expect_error(no_kappa, ": parameter kappa has no value (expected a number in m, or {value, unit, bounds: [lo, hi], fit})");
 }
 
 // A '---' line splits a file into two YAML documents, and yaml-cpp's Load reads the first
@@ -132,6 +136,23 @@ TEST(VehicleInput, GramsWrittenAsKilogramsAreNamed) {
   EXPECT_NE(quadgen::unit_slip(v, "J_zz", 1.24, j_zz).find("grams written as kilograms"), std::string::npos);
   EXPECT_NE(quadgen::unit_slip(v, "J_zz", 1240, j_zz).find("millimetres written as metres"), std::string::npos);
   EXPECT_EQ(quadgen::unit_slip(v, "J_zz", 2.5e-3, j_zz), "");
+  // One block in grams among the rest in kilograms (the Crazyflie's battery, 7.1 for 0.0071):
+  // that block is named, with its line.
+  quadgen::Vehicle one = quadgen::load_vehicle(quadgen::test::source_path("vehicles/crazyflie21.yaml"));
+  size_t battery = 0;
+  for (size_t b = 0; b < one.blocks.size(); ++b)
+    if (one.blocks[b].mass > one.blocks[battery].mass) battery = b;
+  one.blocks[battery].mass *= 1000;
+  try {
+    quadgen::derive_model(one, quadgen::derive_mass_properties(one), {});
+    ADD_FAILURE() << "a Crazyflie with one block in grams passed the mass bounds";
+  } catch (const quadgen::VehicleError& e) {
+    EXPECT_NE(std::string(e.what()).find("block '" + one.blocks[battery].name + "' at line " +
+                                         std::to_string(one.blocks[battery].line) + " has "),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("in grams? With"), std::string::npos) << e.what();
+  }
 }
 
 TEST(VehicleInput, MissingKey) { expect_error(replace(finken_text(), "name: finken3\n", ""), "missing key 'name'"); }
