@@ -2,20 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <string>
 
 #include <Eigen/Dense>
+
+#include "output/numbers.hpp"
 
 namespace quadgen {
 namespace {
 
 constexpr double kRelativeTolerance = 1e-9;
-constexpr double kPi = 3.14159265358979323846;
+// Below this a difference is printed as "below 1e-12": the digits of rounding noise would
+// change derivation.md (a checked-in golden file) with any change of summation order.
+constexpr double kPrintedFloor = 1e-12;
 
 // Block frame -> body frame, R = Rz(yaw) Ry(pitch) Rx(roll) as the vehicle file defines it,
-// composed from Eigen's axis-angle rotations (not derive's rotation_zyx).
+// composed from Eigen's axis-angle rotations (not derive's rotation_zyx). The tests build
+// the same matrix the same way on purpose (tests/test_geometry.cpp rotation_deg): each is a
+// check of derive that leans on neither derive nor the other.
 Eigen::Matrix3d block_to_body(const Vec3& yaw_pitch_roll_deg) {
-  const auto rad = [](double deg) { return deg * kPi / 180; };
+  const auto rad = [](double deg) { return deg * EIGEN_PI / 180; };
   return (Eigen::AngleAxisd(rad(yaw_pitch_roll_deg[0]), Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(rad(yaw_pitch_roll_deg[1]), Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(rad(yaw_pitch_roll_deg[2]), Eigen::Vector3d::UnitX()))
@@ -56,10 +62,7 @@ double hull_area(std::vector<Eigen::Vector2d> p) {
 }
 
 std::string relative_text(double relative) {
-  std::ostringstream os;
-  os.precision(2);
-  os << relative;
-  return os.str();
+  return relative < kPrintedFloor ? "below 1e-12" : output::short_number(relative);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 // block's own rotation matrix, and only the tests integrated independently: a review,
 // helper-141.)
 #pragma once
+#include <array>
 #include <vector>
 
 #include "audit/audit.hpp"
@@ -26,9 +27,9 @@ struct QuadratureMassProperties {
 QuadratureMassProperties mass_properties_by_quadrature(const Vehicle& v);
 
 // Mass, centre of gravity, inertia about it and projected areas of `mp` against the
-// quadrature's, each to a relative 1e-9 of its scale (the largest principal moment, the
-// largest block extent, the largest area): double rounding is ~1e-15, an error of the
-// derivation orders above it.
+// quadrature's, each to a relative 1e-9 of its scale (the total mass; the largest block
+// extent for the centre; the largest |J_ij|; the largest area): double rounding is ~1e-15,
+// an error of the derivation orders above it.
 std::vector<AuditCheck> check_mass_properties_by_quadrature(const Vehicle& v, const MassProperties& mp);
 
 }  // namespace quadgen

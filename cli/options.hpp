@@ -44,11 +44,14 @@ int run_reporting_errors(const Run& run) {
   return 2;
 }
 
-// Whether `option` is `word` with at most three letters left out ("--out" in "--ouput" or
-// "--output"): a slip of a letter or a word's ending too many, which an edit count within a
-// third of a short word's length does not reach.
+// Whether `option` is `word` with at most three letters left out, its first letter kept
+// ("--out" in "--ouput" or "--output", not in "--count" or "--about"): a slip of a letter or
+// a word's ending too many, which an edit count within a third of a short word's length does
+// not reach.
 inline bool within_three_extra_letters(const std::string& word, const std::string& option) {
   if (word.size() <= option.size() || word.size() > option.size() + 3) return false;
+  const size_t first = option.find_first_not_of('-');
+  if (first == std::string::npos || word.find_first_not_of('-') != first || word[first] != option[first]) return false;
   size_t i = 0;
   for (char c : word)
     if (i < option.size() && c == option[i]) ++i;
@@ -64,9 +67,10 @@ inline std::string nearest_option(const CLI::App& command, const std::string& wo
     for (const std::string& name : o->get_lnames()) options.push_back("--" + name);
   const std::string typed = word.substr(0, word.find('='));
   if (std::string near = output::nearest_word(typed, options); !near.empty()) return near;
+  std::string best;  // the fewest letters added; of equals, the first
   for (const std::string& o : options)
-    if (o.size() > 3 && within_three_extra_letters(typed, o)) return o;  // not "--x" in anything
-  return "";
+    if (o.size() > 3 && within_three_extra_letters(typed, o) && o.size() > best.size()) best = o;  // not "--x" in anything
+  return best;
 }
 
 // A command line CLI11 refused, reported as every other error is: one line, whatever the

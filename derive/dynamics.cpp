@@ -343,7 +343,8 @@ void assemble(ModelContext& c) {
 // A total far beyond what its bounds expect is most often a unit slip in the blocks: masses
 // in grams written as kilograms scale the mass and the inertia by 1000, sizes and positions
 // in millimetres written as metres the inertia and the areas by a million. Said with the
-// block that gives most of the mass; "" otherwise. `expected`: the bounds' geometric mean.
+// block that gives most of the mass, or, where one block a thousandth as heavy would put the
+// mass within its bounds, with that block; "" otherwise. `expected`: the bounds' geometric mean.
 std::string unit_slip(const Vehicle& v, const std::string& name, double value, const Parameter& declared) {
   if (!(declared.lower > 0) || !(value > 0)) return "";
   const double ratio = value / std::sqrt(declared.lower * declared.upper);

@@ -139,7 +139,7 @@ ParameterAgreement judge_against_airframe(const FlightEstimate& f, double airfra
   a.spread = airframe_value != 0 ? std::abs(f.value - airframe_value) / std::abs(airframe_value) : INFINITY;
   // The test of judge_heterogeneity with one flight: |z| < 1.96 at kAgreementLevel, or the
   // two within kNegligibleSpread.
-  a.within_errors = !says || !(a.q_p_value < kAgreementLevel) || a.spread < kNegligibleSpread;
+  a.within_errors = !says || within_errors_or_negligible(a.q_p_value, a.spread);
   a.agree = says && a.within_errors && a.spread < kSpreadLimit;
   return a;
 }
@@ -173,8 +173,8 @@ void judge_heterogeneity(ParameterAgreement& a) {
   // 14 % of the time for five flights and 32 % for ten (MultiFlight.
   // AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel). Fewer than two flights that can say
   // test nothing (p = 1). Values within kNegligibleSpread are within the errors whatever Q
-  // says (its note there: verdict_reason).
-  const bool within = !(a.q_p_value < kAgreementLevel) || a.spread < kNegligibleSpread;
+  // says (its note there: agreement_reason).
+  const bool within = within_errors_or_negligible(a.q_p_value, a.spread);
   a.agree = every_flight_says && within && a.spread < kSpreadLimit;
   a.within_errors = within;
 }

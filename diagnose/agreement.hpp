@@ -33,6 +33,13 @@ inline constexpr double kSpreadLimit = 0.3;
 // 20.6 % on the five NanoBench flights, Q's p = 0.013: still "disagree").
 inline constexpr double kNegligibleSpread = 0.01;
 
+// The one rule for "within the errors": the test (Cochran's Q, or against an airframe the
+// z test) does not reject one value at kAgreementLevel, or the values are within
+// kNegligibleSpread of each other. A NaN p-value (nothing tested) rejects nothing.
+inline bool within_errors_or_negligible(double p_value, double spread) {
+  return !(p_value < kAgreementLevel) || spread < kNegligibleSpread;
+}
+
 struct FlightEstimate {
   double value = 0, standard_error = 0, lower = 0, upper = 0;  // Wald 95 % interval; NaN sides: none
   double statistic = 0, p_value = 1;  // the effect on this flight alone: LR test against "off"
@@ -61,12 +68,13 @@ struct ParameterAgreement {
   double spread_if_agree = std::numeric_limits<double>::quiet_NaN();
   double spread_p_value = std::numeric_limits<double>::quiet_NaN();
   // Every flight can say (a standard error, not on a bound), the flights are within the
-  // errors, and the spread is below 30 %.
+  // errors (within_errors_or_negligible), and the spread is below 30 %.
   bool agree = false;
   // Within the errors though perhaps not agreeing: Cochran's Q over the flights that can say
   // does not reject one value at kAgreementLevel (against an airframe: the difference within
-  // 1.96 standard errors of both). Without `agree` only the 30 % is missed, or a flight cannot
-  // say: the values may well be one, measured too loosely to show it.
+  // 1.96 standard errors of both), or the values are within 1 % of each other. Without
+  // `agree` only the 30 % is missed, or a flight cannot say: the values may well be one,
+  // measured too loosely to show it.
   bool within_errors = false;
   // Against an airframe: its value came without a standard error, so the flight can neither
   // agree nor disagree with it.
@@ -136,7 +144,8 @@ inline bool measured_by_no_flight(const ParameterAgreement& a) {
 bool unmeasured_base_parameter(const ParameterAgreement& a);
 
 // The verdict in a word: "agree", "too uncertain" (within the errors, but apart by 30 % or
-// more, or a flight without a standard error) or "disagree".
+// more, or a flight without a standard error) or "disagree" (beyond the errors and 1 % or
+// more apart: within_errors_or_negligible).
 inline const char* agreement_verdict(const ParameterAgreement& a) {
   return a.agree ? "agree" : a.within_errors ? "too uncertain" : "disagree";
 }
@@ -145,10 +154,12 @@ inline const char* agreement_verdict(const ParameterAgreement& a) {
 // named cause wherever it is named, and given a next step.
 inline bool flights_disagree(const ParameterAgreement& a) { return !a.agree && !a.within_errors; }
 
-// Cochran's Q rejects one value, yet the values are within kNegligibleSpread of each other:
-// agreeing by that margin, said beside the verdict so that an "agree" beside p = 0 reads right.
+// The flights agree, though the test rejects one value, because the values are within
+// kNegligibleSpread of each other: said beside the verdict so that an "agree" beside p = 0
+// reads right. Only on "agree": a "too uncertain" verdict keeps its own reason (a flight on
+// its bound, an airframe value without a standard error; a review, helper-144).
 inline bool agree_within_negligible_spread(const ParameterAgreement& a) {
-  return a.within_errors && a.q_p_value < kAgreementLevel;
+  return a.agree && a.q_p_value < kAgreementLevel && a.spread < kNegligibleSpread;
 }
 
 // Why a verdict is "too uncertain" ("" for the other two): an airframe value or a flight that
@@ -168,10 +179,11 @@ inline const char* why_too_uncertain(const ParameterAgreement& a) {
 }
 
 // The words beside any verdict: why it is "too uncertain", or that the values agree to within
-// 1 % though Q rejects one value; "" otherwise.
-inline const char* verdict_reason(const ParameterAgreement& a) {
+// 1 % though the test rejects one value; "" otherwise.
+inline const char* agreement_reason(const ParameterAgreement& a) {
+  static_assert(kNegligibleSpread == 0.01, "the words below say 1 %");
   if (agree_within_negligible_spread(a))
-    return "Q rejects one value, but the values are within 1 % of each other: the difference is the fits' precision, not the airframe's";
+    return "the test rejects one value, but the values are within 1 % of each other, which counts as one value here";
   return why_too_uncertain(a);
 }
 
@@ -242,8 +254,8 @@ struct AirframeReference {
 
 // The airframe's named effects refitted on this flight's training part (the airframe's other
 // values held, this flight's own parameters free), each against the airframe's value: the
-// flight agrees when |z| = |k - k_airframe| / sqrt(se^2 + se_airframe^2) < 1.96 and the two
-// differ by less than 30 %. One entry per parameter, its `flights` this one flight.
+// flight agrees when |z| = |k - k_airframe| / sqrt(se^2 + se_airframe^2) < 1.96 or the two
+// differ by less than 1 %, and by less than 30 %. One entry per parameter, its `flights` this one flight.
 std::vector<ParameterAgreement> check_against_airframe(runtime::DynamicModel& model, const fit::Flight& training_part,
                                                        bool use_accelerometer, const std::vector<double>& weights,
                                                        const AirframeReference& airframe);

@@ -241,7 +241,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     // A suspect's agreement in grey: green read as an endorsement of what is not named.
     h << "<h3>" << esc(a.parameter) << " [" << unit_html(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
-      << (*verdict_reason(a) ? std::string(" (") + verdict_reason(a) + ")" : "") << "</span></h3>\n<p>"
+      << (*agreement_reason(a) ? std::string(" (") + agreement_reason(a) + ")" : "") << "</span></h3>\n<p>"
       << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
       << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table class=\"agreement\"><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
@@ -305,8 +305,8 @@ void agreement_html(std::ostringstream& h, const Diagnosis& d) {
        "each flight's 95 % interval (Wald); dot: its value; line: the joint value (a suspected candidate's own "
        "joint estimate). \"Alone\": the effect's "
        "likelihood-ratio test on that flight by itself. The flights disagree when Cochran's Q rejects one "
-       "value at the 5 % level (one test per parameter) and the values are 1 % or more apart, and agree when it does not, every flight can say and "
-       "the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
+       "value at the 5 % level (one test per parameter) and the values are 1 % or more apart; they agree when "
+       "neither holds, every flight can say and the spread (largest &minus; smallest over the joint value) is below 30 %. Beside the spread: the "
        "median spread the flights would show if each measured the pooled value with its own standard error, and the "
        "chance of one at least as large as seen: a limit of 30 % cannot be met by flights whose intervals are much "
        "wider, however well they agree: where Q does not reject one value and only the 30 % is missed, the verdict "
@@ -493,8 +493,10 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
   if (d.has_prediction)
     if (const std::string against = predict::open_loop_against_no_model(d.prediction_after); !against.empty())
       h << "<li>" << esc(against)
-        << (d.search.selected.empty() ? "" : " (The error at the horizon itself; the line above scores every point of "
-                                             "each window, most of them nearer its measured start.)")
+        << (d.search.selected.empty() || !predict::no_model_closer_at_longest_horizon(d.prediction_after)
+                ? ""
+                : " (The error at the horizon itself; the line above scores every point of each window, most of them "
+                  "nearer its measured start.)")
         << "</li>\n";
   // Where the extended model is worse, said beside the gain (a user trial, helper-106: a
   // channel 44 % worse was only in a table near the end).

@@ -54,7 +54,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on "
        << (a.base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value)
-       << (*verdict_reason(a) ? std::string("; ") + verdict_reason(a) : "") << "):";
+       << (*agreement_reason(a) ? std::string("; ") + agreement_reason(a) : "") << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << (k ? ", " : " ") << k + 1 << ": "
          << (a.flights[k].at_bound ? num(a.flights[k].value, kEstimateDigits) + " (on its bound: no interval)"
@@ -69,7 +69,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
        // Which value is which: the flight's own diagnosis printed a third, all free, above
        // (a newcomer's trial, helper-136).
        << "here " << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value, "the airframe's ") << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
-       << (*verdict_reason(a) ? std::string(": ") + verdict_reason(a) : "") << ")\n";
+       << (*agreement_reason(a) ? std::string(": ") + agreement_reason(a) : "") << ")\n";
 }
 
 // What was not named and why: look-alikes, stand-ins, suspects, what the backward pass

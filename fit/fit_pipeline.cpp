@@ -95,11 +95,9 @@ std::string interval_of(const Profile& pr) {
   return "[" + side(pr.lower, pr.lower_open) + ", " + side(pr.upper, pr.upper_open) + "]";
 }
 
-// " (its interval holds 0)" where the profile's interval holds zero: "identifiable" says the
-// profile closes, not that the value is told from zero (a newcomer read a2 = -656
-// [-1630, 318] "identifiable" as significant: helper-143).
-std::string holds_zero_note(const Profile& pr) {
-  return pr.lower <= 0 && pr.upper >= 0 ? " (its interval holds 0)" : "";
+// Beside a verdict whose interval holds zero (interval_holds_zero).
+std::string holds_zero_note(const Profile& pr, const FitParameter& p) {
+  return interval_holds_zero(pr, p) ? " (its interval holds 0)" : "";
 }
 
 // The motor map's three terms as the vehicle file's motor_map section takes them (values
@@ -114,7 +112,7 @@ std::string motor_map_lines(const std::vector<FitParameter>& ps, const std::vect
     s << "  " << term << ": {value: " << p->value << ", unit: " << p->unit << "}";
     for (const auto& pr : profiles)
       if (pr.parameter == term)
-        s << "  # " << interval_of(pr) << " " << identifiability_text(pr.verdict) << holds_zero_note(pr);
+        s << "  # " << interval_of(pr) << " " << identifiability_text(pr.verdict) << holds_zero_note(pr, *p);
     s << "\n";
   }
   return s.str();
@@ -423,7 +421,7 @@ std::string profile_summary(const FitResult& best, const std::vector<Profile>& p
   std::ostringstream s;
   for (const auto& pr : profiles)
     s << pr.parameter << " = " << best.parameters[pr.index].value << " " << interval_of(pr) << " " << identifiability_text(pr.verdict)
-      << holds_zero_note(pr) << "\n";
+      << holds_zero_note(pr, best.parameters[pr.index]) << "\n";
   return s.str();
 }
 

@@ -4,6 +4,7 @@
 // identifiable (crosses on both sides), practically non-identifiable (open on a side),
 // structurally non-identifiable (flat: other parameters compensate exactly).
 #pragma once
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -41,6 +42,14 @@ struct Profile {
   Identifiability verdict = Identifiability::kIdentifiable;
   std::string compensated_by;  // for a flat profile: which parameters move with it, and how
 };
+
+// Whether the profile's 95 % interval holds zero, an open side (NaN) reaching `p`'s bound.
+// "Identifiable" says the profile closes, not that the value is told from zero (a newcomer
+// read a2 = -656 [-1630, 318] "identifiable" as significant: helper-143).
+inline bool interval_holds_zero(const Profile& pr, const FitParameter& p) {
+  const double lower = std::isnan(pr.lower) ? p.lower : pr.lower, upper = std::isnan(pr.upper) ? p.upper : pr.upper;
+  return lower <= 0 && upper >= 0;
+}
 
 struct ProfileOptions {
   int max_steps_each_side = 30;

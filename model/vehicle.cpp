@@ -66,7 +66,7 @@ struct Reader : YamlReader {
     const Unit si = parse_unit(si_unit);
     p.dim = si.dim;
     double scale = 1.0;
-    require_value(n, "parameter " + name, "a number in " + (si_unit == "1" ? std::string("no unit") : si_unit) +
+    require_value(n, "parameter " + name, (si_unit == "1" ? std::string("a plain number") : "a number in " + si_unit) +
                                               ", or {value, unit, bounds: [lo, hi], fit}");
     if (n.IsScalar()) {
       p.nominal = number(n, name);

@@ -127,18 +127,24 @@ inline output::NumberText yaml_number(const std::string& text, double* value) {
 
 // The line (from 0) a value without text of its own belongs to. yaml-cpp marks an empty
 // value ("name:" and a line break) where the next token starts, a line or more later: the
-// error named the key after it. An explicit null (~, null) is a token and keeps its mark;
-// otherwise the last line before the mark with content (not blank, not only a comment)
-// is the key's.
+// error named the key after it. The mark's own line is kept where something stands before
+// the mark on it (an empty value inside a flow collection, "{value: , unit: m}", is marked
+// at the ',' or '}' after it, on its own line) or where the mark is an explicit null (~,
+// null: a token of its own); otherwise the last line before the mark with content (not
+// blank, not only a comment) is the key's.
 inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
   std::vector<std::string> lines;
   std::istringstream in(text);
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   const auto at = [&](int line) { return line >= 0 && line < static_cast<int>(lines.size()) ? lines[static_cast<size_t>(line)] : std::string(); };
   const std::string here = at(mark.line);
-  if (mark.column >= 0 && static_cast<size_t>(mark.column) < here.size()) {
-    const std::string token = here.substr(static_cast<size_t>(mark.column), 4);
-    if (token[0] == '~' || token == "null" || token == "Null" || token == "NULL") return mark.line;
+  const size_t column = mark.column >= 0 ? static_cast<size_t>(mark.column) : 0;
+  if (here.substr(0, column).find_first_not_of(" \t") != std::string::npos) return mark.line;
+  if (column < here.size()) {
+    const std::string rest = here.substr(column);
+    const size_t word = rest.find_first_of(" \t\r#,]}");
+    const std::string token = rest.substr(0, word);
+    if (token == "~" || token == "null" || token == "Null" || token == "NULL") return mark.line;
   }
   for (int line = std::min(mark.line, static_cast<int>(lines.size())) - 1; line >= 0; --line) {
     const std::string l = at(line);

@@ -346,6 +346,11 @@ std::string against_constant_velocity(const Prediction& p) {
 
 }  // namespace
 
+bool no_model_closer_at_longest_horizon(const Prediction& p) {
+  const auto at = open_loop_and_no_model_at_longest(p);
+  return at && at->model > at->none;
+}
+
 std::string open_loop_against_no_model(const Prediction& p) {
   const auto at = open_loop_and_no_model_at_longest(p);
   if (!at) return "";

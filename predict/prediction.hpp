@@ -159,6 +159,9 @@ std::string one_step_text(const OneStepErrors& e);
 // extrapolating the measured velocity with no model, and which is the closer ("" without
 // those views). A gain over the base model alone can hide that no model does better.
 std::string open_loop_against_no_model(const Prediction& p);
+// Whether, at the longest horizon, extrapolating the measured velocity comes closer than the
+// open loop (false without those views).
+bool no_model_closer_at_longest_horizon(const Prediction& p);
 
 // The layout of prediction.json (docs/formats.md): open_loop, attitude_replayed,
 // translation_replayed, open_loop_past_disturbance, disturbance_window_s, body_rates_held,

@@ -67,7 +67,7 @@ inline double ThrustLaw::command_for(double thrust) const {
     const double most = thrust_at_speed(speed_at(1.0)), times = thrust / most;
     char slip[96] = "";
     if (times > 30 && times < 3e4)
-      std::snprintf(slip, sizeof slip, ", %.3g times less: masses in grams written as kilograms?", times);
+      std::snprintf(slip, sizeof slip, "; %.3g times that is asked: masses in grams written as kilograms?", times);
     return std::invalid_argument("thrust " + newtons(thrust) + " is beyond the motor map (at most " + newtons(most) +
                                  " at command 1" + slip + ")");
   };

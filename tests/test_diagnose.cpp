@@ -1229,11 +1229,6 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_NEAR(apart.q, 2 * std::pow(0.25 / 0.05, 2), 1e-9);  // each value 0.25 from the pooled 1.25
 }
 
-// Flights that measure one value, each with its own error, are said to disagree at the test's
-// level (5 %), however many they are: the verdict rests on Cochran's Q, one test per parameter.
-// The rule before the sixty-first session (every flight's 95 % interval holds the pooled
-// value) tested each flight and said "disagree" 14 % of the time for five flights and 32 % for
-// ten: this test failed with it. And a flight 4 standard errors off is found.
 // Noise-free generated flights carry standard errors near machine precision, and the bias
 // each flight's model error gives its estimate then decides Cochran's Q: kappa "disagreed"
 // at a spread of 0.0002 % (sixty-second session). Values within 1 % agree whatever Q says,
@@ -1255,20 +1250,39 @@ TEST(MultiFlight, ValuesWithinOnePercentAgreeWhateverQSays) {
   const ParameterAgreement noise_free = judged({0.01, 0.010000015, 0.01000002}, 1e-12);
   EXPECT_LT(noise_free.q_p_value, 1e-100);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(noise_free), "agree");
-  EXPECT_NE(std::string(quadgen::diagnose::verdict_reason(noise_free)).find("within 1 %"), std::string::npos);
+  EXPECT_NE(std::string(quadgen::diagnose::agreement_reason(noise_free)).find("within 1 %"), std::string::npos);
   const ParameterAgreement two_percent = judged({1.0, 1.02}, 1e-6);
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(two_percent), "disagree");
-  EXPECT_STREQ(quadgen::diagnose::verdict_reason(two_percent), "");
+  EXPECT_STREQ(quadgen::diagnose::agreement_reason(two_percent), "");
   const ParameterAgreement tested = judged({1.0, 1.1}, 0.2);  // Q does not reject: no margin note
   EXPECT_STREQ(quadgen::diagnose::agreement_verdict(tested), "agree");
-  EXPECT_STREQ(quadgen::diagnose::verdict_reason(tested), "");
+  EXPECT_STREQ(quadgen::diagnose::agreement_reason(tested), "");
   quadgen::diagnose::FlightEstimate here;
   here.value = 1.005, here.standard_error = 1e-9, here.lower = here.value - 2e-9, here.upper = here.value + 2e-9;
   EXPECT_TRUE(quadgen::diagnose::judge_against_airframe(here, 1.0, 1e-9).agree);
   here.value = 1.05;
   EXPECT_FALSE(quadgen::diagnose::judge_against_airframe(here, 1.0, 1e-9).within_errors);
+  // A "too uncertain" verdict keeps its own reason, whatever the test says (a review,
+  // helper-144: the margin's words stood beside values 20 % apart): an airframe value
+  // without a standard error, 20 % off with p = 6e-5; a flight on its bound among flights
+  // whose test rejects one value.
+  here.value = 1.2, here.standard_error = 0.05;
+  const ParameterAgreement no_reference = quadgen::diagnose::judge_against_airframe(here, 1.0, 0.0);
+  EXPECT_LT(no_reference.q_p_value, 0.05);
+  EXPECT_STREQ(quadgen::diagnose::agreement_reason(no_reference), "the airframe's value has no standard error");
+  ParameterAgreement bound = judged({0.01, 0.010000015, 0.01000002}, 1e-12);
+  bound.flights.push_back(bound.flights.front());
+  bound.flights.back().at_bound = true;
+  quadgen::diagnose::summarise_agreement(bound);
+  EXPECT_STREQ(quadgen::diagnose::agreement_verdict(bound), "too uncertain");
+  EXPECT_STREQ(quadgen::diagnose::agreement_reason(bound), "a flight's value on its bound cannot say");
 }
 
+// Flights that measure one value, each with its own error, are said to disagree at the test's
+// level (5 %), however many they are: the verdict rests on Cochran's Q, one test per parameter.
+// The rule before the sixty-first session (every flight's 95 % interval holds the pooled
+// value) tested each flight and said "disagree" 14 % of the time for five flights and 32 % for
+// ten: this test failed with it. And a flight 4 standard errors off is found.
 TEST(MultiFlight, AgreeingFlightsAreSaidToDisagreeAtTheTestsLevel) {
   using quadgen::diagnose::ParameterAgreement;
   std::mt19937 rng(61);

@@ -753,6 +753,24 @@ std::vector<StandSample> synthetic_stand(double independent, bool voltage_varies
 // The stand fit reports what the data determine: per-motor coefficients only when the
 // speeds moved independently enough; otherwise one shared coefficient (and never a value
 // on a bound); the voltage exponent only when the voltage varied apart from the command.
+// "Identifiable" with an interval that holds zero is said so beside the verdict; an open side
+// reaches the parameter's bound (a newcomer's trial, helper-143; a review, helper-144).
+TEST(Fit, AnIntervalHoldingZeroIsSaidToHoldIt) {
+  Profile pr;
+  FitParameter p;
+  p.lower = -5, p.upper = 5;
+  pr.lower = -1, pr.upper = 2;
+  EXPECT_TRUE(interval_holds_zero(pr, p));
+  pr.lower = 0.5;
+  EXPECT_FALSE(interval_holds_zero(pr, p));
+  pr.lower = std::numeric_limits<double>::quiet_NaN();  // open below: down to the bound, -5
+  EXPECT_TRUE(interval_holds_zero(pr, p));
+  p.lower = 0.1;
+  EXPECT_FALSE(interval_holds_zero(pr, p));
+  pr.lower = -3, pr.upper = std::numeric_limits<double>::quiet_NaN(), p.upper = -0.5;  // open above, to -0.5
+  EXPECT_FALSE(interval_holds_zero(pr, p));
+}
+
 TEST(Fit, ThrustStandFitsWhatTheDataIdentify) {
   std::mt19937 rng(7);
   FitOptions fo;

@@ -1771,6 +1771,10 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   expect_error({"derive", f3, "--output", tmp / "o"}, 106, "did you mean '--out' for '--output'?");
   EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--outputs", "--out"));
   EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--tuo", "--out"));
+  // Its first letter kept: "--count" and "--about" are no slips for "--out", "--offset" none for "--set".
+  EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--count", "--out"));
+  EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--about", "--out"));
+  EXPECT_FALSE(quadgen::cli::within_three_extra_letters("--offset", "--set"));
   // A misspelt option gets the nearest of that command's options back; a word near none, nothing.
   expect_error({"diagnose", f3, "x.csv", "--maping", "M.yaml", "--out", tmp / "o"}, 109,
                "not expected: --maping; did you mean '--mapping' for '--maping'?");

@@ -1455,7 +1455,7 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     const auto c = checks_of(v);
     EXPECT_FALSE(c.at(trim).passed);
     EXPECT_NE(c.at(trim).detail.find("beyond the motor map"), std::string::npos) << c.at(trim).detail;
-    EXPECT_NE(c.at(trim).detail.find("times less: masses in grams written as kilograms?"), std::string::npos)
+    EXPECT_NE(c.at(trim).detail.find("times that is asked: masses in grams written as kilograms?"), std::string::npos)
         << c.at(trim).detail;
     EXPECT_TRUE(c.at(apart).passed);
   }

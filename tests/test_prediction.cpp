@@ -595,9 +595,11 @@ TEST(Prediction, WhatLimitsItIsSaidInWords) {
   EXPECT_EQ(quadgen::predict::open_loop_against_no_model(p),
             "Open loop, 1 s ahead of a measured state, the model is 1 m off; extrapolating the measured velocity with no "
             "model is 2 m off: the model is the closer.");
+  EXPECT_FALSE(quadgen::predict::no_model_closer_at_longest_horizon(p));
   p.constant_velocity = {row(1.0, 0.4, 0), row(0.5, 0.05, 0)};
   EXPECT_NE(quadgen::predict::open_loop_against_no_model(p).find("is 0.4 m off: at that horizon the velocity alone comes closer than the model."),
             std::string::npos);
+  EXPECT_TRUE(quadgen::predict::no_model_closer_at_longest_horizon(p));
   p.constant_velocity = {row(1.0, 2.0, 0), row(0.5, 0.05, 0)};
   EXPECT_EQ(s.find("Without the moment model"), std::string::npos) << s;  // that view not run
   p.body_rates_held = {row(1.0, 0.3, 0), row(0.5, 0.05, 0)};

@@ -72,6 +72,17 @@ TEST(VehicleInput, AnEmptyValueIsNamedAtItsKeysLine) {
   expect_error(replace(text, "\nname: finken3\n", "\nname:\n  ~\n"),
                "bad.yaml:" + std::to_string(name_line + 1) + ": vehicle name has no value (expected a name)");
   expect_error("name:\n", "bad.yaml:1: vehicle name has no value");  // at the end of the file
+  // A key whose name begins with "null" after an empty value is no explicit null; an empty
+  // value inside a flow mapping is on its own line (a review, helper-144).
+  YAML::Mark next_key;
+  next_key.line = 1, next_key.column = 0;
+  EXPECT_EQ(quadgen::empty_value_line("name:\nnull_bias: 1\n", next_key), 0);
+  EXPECT_EQ(quadgen::empty_value_line("name:\nnull # an explicit null\n", next_key), 1);
+  const size_t kappa_at = text.find("  kappa: {value: 0.01,");
+  ASSERT_NE(kappa_at, std::string::npos);
+  const int kappa_line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(kappa_at), '\n'));
+  expect_error(replace(text, "  kappa: {value: 0.01,", "  kappa: {value: ,"),
+               "bad.yaml:" + std::to_string(kappa_line) + ": ");
   // A parameter's empty value says what it may be (not "(a mapping of keys)" alone).
   const size_t kappa = text.find("\n  kappa:") + 1;
   const std::string no_kappa = text.substr(0, kappa) + "  kappa:\n" + text.substr(text.find('\n', kappa) + 1);
