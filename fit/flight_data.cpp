@@ -67,46 +67,54 @@ int measurement_column(const runtime::CsvTable& t, const std::string& name) {
 
 namespace {
 
-[[noreturn]] void mapping_error(const std::string& path, const YAML::Node& at, const std::string& what) {
-  throw FitError(path + ":" + std::to_string(at.Mark().line >= 0 ? at.Mark().line + 1 : 1) + ": " + what);
+// The mapping being read: its path for the errors, its text for the line of an empty value
+// (node_line: yaml-cpp marks one where the next token starts).
+struct MappingFile {
+  const std::string& path;
+  const std::string& text;
+};
+
+[[noreturn]] void mapping_error(const MappingFile& file, const YAML::Node& at, const std::string& what) {
+  const int line = node_line(file.text, at);
+  throw FitError(file.path + ":" + std::to_string(line >= 0 ? line + 1 : 1) + ": " + what);
 }
 
-std::string scalar_text(const std::string& path, const YAML::Node& n, const std::string& what) {
-  if (!n.IsScalar()) mapping_error(path, n, what + ": expected a single value");
+std::string scalar_text(const MappingFile& file, const YAML::Node& n, const std::string& what) {
+  if (!n.IsScalar()) mapping_error(file, n, what + ": expected a single value");
   return n.Scalar();
 }
 
 // By the one rule for YAML numbers (yaml_number), as the vehicle file reads them: yaml-cpp's
 // own conversion read a scale of 1e-400 as 0 (a gyro column read as zeros without a word) and
 // took '1 ' but not ' 1' (a review, helper-135).
-double number_field(const std::string& path, const YAML::Node& n, const std::string& what) {
-  const std::string text = scalar_text(path, n, what);
+double number_field(const MappingFile& file, const YAML::Node& n, const std::string& what) {
+  const std::string text = scalar_text(file, n, what);
   double v = 0;
   const output::NumberText kind = yaml_number(text, &v);
   if (kind == output::NumberText::underflow)
-    mapping_error(path, n, what + ": '" + output::printable(text) + "' " + output::number_text_problem(kind));
+    mapping_error(file, n, what + ": '" + output::printable(text) + "' " + output::number_text_problem(kind));
   if (kind != output::NumberText::finite)
-    mapping_error(path, n, what + ": expected a finite number, got '" + output::printable(text) + "'" + output::hexadecimal_hint(text));
+    mapping_error(file, n, what + ": expected a finite number, got '" + output::printable(text) + "'" + output::hexadecimal_hint(text));
   return v;
 }
 
 // The keys of a YAML map, each allowed and present once; returns key -> value node.
-std::map<std::string, YAML::Node> checked_keys(const std::string& path, const YAML::Node& map, const std::string& where,
+std::map<std::string, YAML::Node> checked_keys(const MappingFile& file, const YAML::Node& map, const std::string& where,
                                                const std::vector<std::string>& allowed) {
   std::map<std::string, YAML::Node> out;
   for (const auto& kv : map) {
-    const std::string key = scalar_text(path, kv.first, where + ": key");
+    const std::string key = scalar_text(file, kv.first, where + ": key");
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-      mapping_error(path, kv.first, where + ": unknown key '" + key + "' (allowed: " + output::joined(allowed) + ")" +
+      mapping_error(file, kv.first, where + ": unknown key '" + key + "' (allowed: " + output::joined(allowed) + ")" +
                                         output::did_you_mean(key, allowed));
     if (!out.emplace(key, kv.second).second)
-      mapping_error(path, kv.first, where + ": duplicate key '" + key + "' (each of " + output::joined(allowed) + " at most once)");
+      mapping_error(file, kv.first, where + ": duplicate key '" + key + "' (each of " + output::joined(allowed) + " at most once)");
   }
   return out;
 }
 
 // The unit conversion of one entry: checked against the canonical column's dimension.
-double unit_scale(const std::string& path, const YAML::Node& at, const std::string& target, const std::string& unit) {
+double unit_scale(const MappingFile& file, const YAML::Node& at, const std::string& target, const std::string& unit) {
   const std::string canonical = canonical_unit(target);
   Unit u, want;
   // The two units logs use that the unit parser reads otherwise or not at all: a percentage,
@@ -118,35 +126,35 @@ double unit_scale(const std::string& path, const YAML::Node& at, const std::stri
   try {
     u = parse_unit(unit);
   } catch (const UnitError& e) {
-    mapping_error(path, at, "column '" + target + "': " + e.what() + hint);
+    mapping_error(file, at, "column '" + target + "': " + e.what() + hint);
   }
   want = parse_unit(canonical);
   if (u.dim != want.dim)
-    mapping_error(path, at, "column '" + target + "': unit '" + unit + "' has dimension " + u.dim.str() + ", but '" + target +
+    mapping_error(file, at, "column '" + target + "': unit '" + unit + "' has dimension " + u.dim.str() + ", but '" + target +
                                 "' is in " + canonical + " (dimension " + want.dim.str() + ")" + hint);
   return u.scale / want.scale;
 }
 
-ColumnMapping::Entry parse_entry(const std::string& path, const YAML::Node& key, const YAML::Node& value) {
+ColumnMapping::Entry parse_entry(const MappingFile& file, const YAML::Node& key, const YAML::Node& value) {
   ColumnMapping::Entry e;
-  e.target = scalar_text(path, key, "column name");
+  e.target = scalar_text(file, key, "column name");
   e.line = key.Mark().line + 1;
   if (canonical_unit(e.target).empty())
-    mapping_error(path, key, "'" + output::printable(e.target) + "' is not a canonical column (expected one of " +
+    mapping_error(file, key, "'" + output::printable(e.target) + "' is not a canonical column (expected one of " +
                                  runtime::kCanonicalColumns + ")");
   const std::string where = "column '" + e.target + "'";
-  if (!value.IsMap()) mapping_error(path, key, where + ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}");
-  const auto f = checked_keys(path, value, where, {"source", "scale", "offset", "unit"});
-  if (!f.count("source")) mapping_error(path, key, where + ": missing 'source' (the log's column)");
-  e.source = scalar_text(path, f.at("source"), where + ": source");
+  if (!value.IsMap()) mapping_error(file, key, where + ": expected {source: COLUMN, scale: NUMBER, offset: NUMBER, unit: UNIT}");
+  const auto f = checked_keys(file, value, where, {"source", "scale", "offset", "unit"});
+  if (!f.count("source")) mapping_error(file, key, where + ": missing 'source' (the log's column)");
+  e.source = scalar_text(file, f.at("source"), where + ": source");
   if (f.count("scale")) {
-    e.scale = number_field(path, f.at("scale"), where + ": scale");
-    if (e.scale == 0) mapping_error(path, f.at("scale"), where + ": scale: 0 would read every value of the column as 0 (the offset alone)");
+    e.scale = number_field(file, f.at("scale"), where + ": scale");
+    if (e.scale == 0) mapping_error(file, f.at("scale"), where + ": scale: 0 would read every value of the column as 0 (the offset alone)");
   }
-  if (f.count("offset")) e.offset = number_field(path, f.at("offset"), where + ": offset");
+  if (f.count("offset")) e.offset = number_field(file, f.at("offset"), where + ": offset");
   if (f.count("unit")) {
-    e.unit = scalar_text(path, f.at("unit"), where + ": unit");
-    e.unit_scale = unit_scale(path, f.at("unit"), e.target, e.unit);
+    e.unit = scalar_text(file, f.at("unit"), where + ": unit");
+    e.unit_scale = unit_scale(file, f.at("unit"), e.target, e.unit);
   }
   return e;
 }
@@ -175,26 +183,27 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   if (!root.IsMap()) throw FitError(path + ":1: expected a mapping with 'name' and 'columns'");
   ColumnMapping m;
   m.path = path;
+  const MappingFile file{path, text};
   try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
-    const auto top = checked_keys(path, root, "mapping", {"name", "columns", "environment", "frame"});
+    const auto top = checked_keys(file, root, "mapping", {"name", "columns", "environment", "frame"});
     if (!top.count("columns") || !top.at("columns").IsMap())
       throw FitError(path + ":1: expected a 'columns' mapping (canonical column: {source, scale, offset, unit})");
-    m.name = top.count("name") ? scalar_text(path, top.at("name"), "name") : path;
+    m.name = top.count("name") ? scalar_text(file, top.at("name"), "name") : path;
     if (top.count("frame")) {
-      m.frame = scalar_text(path, top.at("frame"), "frame");
+      m.frame = scalar_text(file, top.at("frame"), "frame");
       if (m.frame != "enu_flu" && m.frame != "ned_frd")
-        mapping_error(path, top.at("frame"), "frame: expected enu_flu (the model's axes) or ned_frd (PX4's)");
+        mapping_error(file, top.at("frame"), "frame: expected enu_flu (the model's axes) or ned_frd (PX4's)");
     }
     if (top.count("environment")) {
-      m.environment = scalar_text(path, top.at("environment"), "environment");
+      m.environment = scalar_text(file, top.at("environment"), "environment");
       if (!output::is_one_of(m.environment, kEnvironmentNames))
-        mapping_error(path, top.at("environment"), "environment: expected one of " + output::joined(kEnvironmentNames));
+        mapping_error(file, top.at("environment"), "environment: expected one of " + output::joined(kEnvironmentNames));
     }
     std::set<std::string> targets;
     for (const auto& kv : top.at("columns")) {
-      ColumnMapping::Entry e = parse_entry(path, kv.first, kv.second);
+      ColumnMapping::Entry e = parse_entry(file, kv.first, kv.second);
       if (!targets.insert(e.target).second)
-        mapping_error(path, kv.first,
+        mapping_error(file, kv.first,
                       "columns: duplicate key '" + output::printable(e.target) + "' (each canonical column at most once)");
       m.entries.push_back(std::move(e));
     }

@@ -154,6 +154,13 @@ inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
   return mark.line;
 }
 
+// The line (from 0) an error about `at` names: its mark's, or for an empty value the line
+// of its key (empty_value_line); -1 where the node has no mark.
+inline int node_line(const std::string& text, const YAML::Node& at) {
+  if (!at.IsDefined() || at.Mark().line < 0) return -1;
+  return at.IsNull() ? empty_value_line(text, at.Mark()) : at.Mark().line;
+}
+
 struct YamlReader {
   std::string path;
   std::string content;  // what parse() read: for the line of an empty value
@@ -161,8 +168,7 @@ struct YamlReader {
   [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
     std::ostringstream os;
     os << path;
-    if (at.IsDefined() && at.Mark().line >= 0)
-      os << ':' << (at.IsNull() ? empty_value_line(content, at.Mark()) : at.Mark().line) + 1;
+    if (const int line = node_line(content, at); line >= 0) os << ':' << line + 1;
     os << ": " << what;
     throw VehicleError(os.str());
   }

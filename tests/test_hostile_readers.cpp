@@ -278,6 +278,10 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
       {"zero.yaml", "columns:\n  p: {source: gyro, scale: 0}\n", 2, "column 'p': scale: 0 would read every value"},
       {"two_documents.yaml", "columns:\n  t: {source: t}\n...\ncolumns:\n  p: {source: gyro}\n", 4,
        "a second YAML document starts here"},
+      // An empty value at its key's line, not at the next key's (sixty-fifth session, as the
+      // vehicle file's reader).
+      {"empty_source.yaml", "columns:\n  p:\n    source:\n\n    # the gyro\n    scale: 2\n", 3, "column 'p': source: expected a single value"},
+      {"empty_flow.yaml", "columns:\n  p: {source: gyro,\n      scale: , unit: deg/s}\n", 3, "column 'p': scale: expected a single value"},
   };
   for (const auto& c : cases) {
     const std::string path = write(c.name, c.yaml);
