@@ -23,7 +23,14 @@ struct QuadratureMassProperties {
   std::array<double, 3> cog{};    // m, body frame
   Mat3 inertia_cog{};             // kg m^2, about the centre of gravity, body axes
   std::array<double, 3> areas{};  // m^2, each block's projection along body x, y, z, summed (no occlusion, as the model)
+  // m^2, what the blocks cover seen along body x, y, z, overlaps counted once: not what the
+  // model's drag uses (the sum above), shown beside it so that a reader sees how much the sum
+  // counts twice (the thesis' A_z left the stacked upper body out). NaN beyond
+  // kMostBlocksForCoveredArea blocks (a union of polygons one at a time grows with their count).
+  std::array<double, 3> covered{};
+  size_t blocks = 0;
 };
+inline constexpr size_t kMostBlocksForCoveredArea = 200;
 QuadratureMassProperties mass_properties_by_quadrature(const Vehicle& v);
 
 // Mass, centre of gravity, inertia about it and projected areas of `mp` against the

@@ -9,7 +9,8 @@ packages=(
   libyaml-cpp-dev                       # vehicle files (keeps line numbers for error messages)
   libcli11-dev                          # command line
   nlohmann-json3-dev                    # model.json and friends
-  libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds
+  libboost-math-dev                     # chi-squared quantiles for profile-likelihood thresholds; brings
+                                        # libboost1.74-dev, whose Boost.Geometry the audit unites polygons with
   libssl-dev                            # SHA-256 of vehicle files (which generated header is whose)
   libkainjow-mustache-dev               # text templates for generated code
   libicu-dev                            # Unicode look-alike skeletons (flight labels that must not read alike)

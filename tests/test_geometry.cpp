@@ -143,6 +143,31 @@ TEST(Geometry, TheAuditsQuadratureAgreesAndCatchesAWrongBlock) {
   box.blocks = {Block{"box", 0.1, {0.1, 0.04, 0.02}, {0, 0, 0}, {90, 0, 0}, 1}};
   EXPECT_NEAR(mass_properties_by_quadrature(box).areas[2], 0.1 * 0.04, 1e-15);
   EXPECT_NEAR(mass_properties_by_quadrature(box).areas[0], 0.1 * 0.02, 1e-15);  // turned 90 degrees: its long side across x
+  // What the blocks cover, overlaps counted once: a box stacked on another covers from
+  // above what one does (the sum counts it twice), from the side what both do; moved half
+  // its length along x, it covers one and a half footprints from above.
+  Vehicle stacked = test::finken3();
+  stacked.blocks = {Block{"lower", 0.1, {0.1, 0.04, 0.02}, {0, 0, 0}, {0, 0, 0}, 1},
+                    Block{"upper", 0.1, {0.1, 0.04, 0.02}, {0, 0, 0.02}, {0, 0, 0}, 2}};
+  QuadratureMassProperties q = mass_properties_by_quadrature(stacked);
+  EXPECT_NEAR(q.areas[2], 2 * 0.1 * 0.04, 1e-15);
+  EXPECT_NEAR(q.covered[2], 0.1 * 0.04, 1e-12);
+  EXPECT_NEAR(q.covered[0], 2 * 0.04 * 0.02, 1e-12);
+  stacked.blocks[1].centre[0] = 0.05;
+  q = mass_properties_by_quadrature(stacked);
+  EXPECT_NEAR(q.covered[2], 1.5 * 0.1 * 0.04, 1e-12);
+  const std::vector<AuditCheck> said = check_mass_properties_by_quadrature(stacked, derive_mass_properties(stacked));
+  EXPECT_NE(said[2].detail.find("the blocks cover 0, 0, 25 % less than that sum along x, y, z"), std::string::npos)
+      << said[2].detail;
+  // Beyond 200 blocks the union (one polygon at a time) is not computed, and said so.
+  Vehicle many = stacked;
+  many.blocks.clear();
+  for (int k = 0; k <= static_cast<int>(kMostBlocksForCoveredArea); ++k)
+    many.blocks.push_back(Block{"b" + std::to_string(k), 0.001, {0.01, 0.01, 0.01}, {0.02 * k, 0, 0}, {0, 0, 0}, k + 1});
+  EXPECT_TRUE(std::isnan(mass_properties_by_quadrature(many).covered[2]));
+  EXPECT_NE(check_mass_properties_by_quadrature(many, derive_mass_properties(many))[2].detail.find(
+                "not computed for more than 200 blocks"),
+            std::string::npos);
 }
 
 TEST(Geometry, TiltedBlockHasProductsOfInertia) {
