@@ -186,8 +186,9 @@ ColumnMapping parse_mapping(const std::string& text, const std::string& path) {
   const MappingFile file{path, text};
   try {  // yaml-cpp's own errors (ill-formed nodes) still end as one file:line
     const auto top = checked_keys(file, root, "mapping", {"name", "columns", "environment", "frame"});
-    if (!top.count("columns") || !top.at("columns").IsMap())
-      throw FitError(path + ":1: expected a 'columns' mapping (canonical column: {source, scale, offset, unit})");
+    constexpr const char* kNoColumns = "expected a 'columns' mapping (canonical column: {source, scale, offset, unit})";
+    if (!top.count("columns")) throw FitError(path + ":1: " + kNoColumns);
+    if (!top.at("columns").IsMap()) mapping_error(file, top.at("columns"), kNoColumns);
     m.name = top.count("name") ? scalar_text(file, top.at("name"), "name") : path;
     if (top.count("frame")) {
       m.frame = scalar_text(file, top.at("frame"), "frame");

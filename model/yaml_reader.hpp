@@ -129,8 +129,8 @@ inline output::NumberText yaml_number(const std::string& text, double* value) {
 // value ("name:" and a line break) where the next token starts, a line or more later: the
 // error named the key after it. The mark's own line is kept where something stands before
 // the mark on it (an empty value inside a flow collection, "{value: , unit: m}", is marked
-// at the ',' or '}' after it, on its own line) or where the mark is an explicit null (~,
-// null: a token of its own); otherwise the last line before the mark with content (not
+// at the ',' or '}' after it, on its own line), where the mark is an empty key's ':', or
+// where the mark is an explicit null (~, null: a token of its own); otherwise the last line before the mark with content (not
 // blank, not only a comment) is the key's.
 inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
   std::vector<std::string> lines;
@@ -140,6 +140,9 @@ inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
   const std::string here = at(mark.line);
   const size_t column = mark.column >= 0 ? static_cast<size_t>(mark.column) : 0;
   if (here.substr(0, column).find_first_not_of(" \t") != std::string::npos) return mark.line;
+  // An empty key (": value") is marked at its ':' (a review, helper-145).
+  if (column < here.size() && here[column] == ':' && (column + 1 == here.size() || std::isspace(static_cast<unsigned char>(here[column + 1]))))
+    return mark.line;
   if (column < here.size()) {
     const std::string rest = here.substr(column);
     const size_t word = rest.find_first_of(" \t\r#,]}");

@@ -168,6 +168,16 @@ TEST(Geometry, TheAuditsQuadratureAgreesAndCatchesAWrongBlock) {
   EXPECT_NE(check_mass_properties_by_quadrature(many, derive_mass_properties(many))[2].detail.find(
                 "not computed for more than 200 blocks"),
             std::string::npos);
+  many.blocks.pop_back();  // 200: computed, none overlapping
+  EXPECT_NEAR(mass_properties_by_quadrature(many).covered[2], 200 * 1e-4, 1e-12);
+  // Footprints 1e20 m apart overflow Boost's integer rescaling, which throws: no number and
+  // the words say so, rather than an abort (a review, helper-145).
+  Vehicle far = stacked;
+  far.blocks[1].centre = {1e20, 0, 0};
+  const QuadratureMassProperties q_far = mass_properties_by_quadrature(far);
+  EXPECT_FALSE(std::isfinite(q_far.covered[2]));
+  EXPECT_NE(check_mass_properties_by_quadrature(far, derive_mass_properties(far))[2].detail.find("could not be computed"),
+            std::string::npos);
 }
 
 TEST(Geometry, TiltedBlockHasProductsOfInertia) {

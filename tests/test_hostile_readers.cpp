@@ -279,9 +279,12 @@ TEST_F(Hostile, MappingUnitsAreConvertedAndChecked) {
       {"two_documents.yaml", "columns:\n  t: {source: t}\n...\ncolumns:\n  p: {source: gyro}\n", 4,
        "a second YAML document starts here"},
       // An empty value at its key's line, not at the next key's (sixty-fifth session, as the
-      // vehicle file's reader).
+      // vehicle file's reader: before, line 6); inside a flow mapping and as an empty key, at
+      // its own line (those kept their line before too: guards of the rule's exceptions).
       {"empty_source.yaml", "columns:\n  p:\n    source:\n\n    # the gyro\n    scale: 2\n", 3, "column 'p': source: expected a single value"},
       {"empty_flow.yaml", "columns:\n  p: {source: gyro,\n      scale: , unit: deg/s}\n", 3, "column 'p': scale: expected a single value"},
+      {"empty_key.yaml", "columns:\n  : {source: gyro}\n", 2, "column name: expected a single value"},
+      {"empty_columns.yaml", "name: x\ncolumns:\n", 2, "expected a 'columns' mapping"},
   };
   for (const auto& c : cases) {
     const std::string path = write(c.name, c.yaml);
