@@ -13,6 +13,11 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+// Boost 1.74's Boost.Math, which Boost.Geometry includes, includes a header of its own that
+// Boost has since deprecated and says so in a note on every build: not ours to change.
+#define BOOST_ALLOW_DEPRECATED_HEADERS
+// The whole of Boost.Geometry: naming only the four algorithms used saves 0.5 s of this
+// file's 14 s; the time is the union's instantiation, not the headers.
 #include <boost/geometry.hpp>
 
 #include "output/numbers.hpp"

@@ -55,6 +55,12 @@ inline std::string malformed_yaml(const YAML::ParserException& e, const std::str
   return "malformed YAML: " + output::printable(e.msg) + yaml_slip(text, e.mark.line, e.msg);
 }
 
+// Whether a line of YAML holds anything: not blank, not only a comment.
+inline bool has_content(const std::string& line) {
+  const size_t first = line.find_first_not_of(" \t\r");
+  return first != std::string::npos && line[first] != '#';
+}
+
 // The line (from 0, as yaml-cpp's marks count) where content after the first YAML document
 // starts, or -1. A line that begins with '---' or '...' and then ends or a blank is a document
 // marker wherever it stands (YAML 1.2's forbidden lines: not even a block scalar or a quoted
@@ -62,10 +68,6 @@ inline std::string malformed_yaml(const YAML::ParserException& e, const std::str
 // document, a '---' after content or any '...' ends it, and whatever is not blank or a comment
 // after that (on the marker's own line too) is a second document.
 inline int second_document_line(const std::string& text) {
-  const auto content = [](const std::string& s) {
-    const size_t at = s.find_first_not_of(" \t\r");
-    return at != std::string::npos && s[at] != '#';
-  };
   bool opened = false, started = false, ended = false;  // a '---' seen, content seen, the document over
   std::istringstream in(text);
   std::string line;
@@ -73,7 +75,7 @@ inline int second_document_line(const std::string& text) {
     const bool marker = line.size() >= 3 && (line.compare(0, 3, "---") == 0 || line.compare(0, 3, "...") == 0) &&
                         (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
     if (marker) {
-      const bool content_after = content(line.substr(3));  // "--- {a: 1}"
+      const bool content_after = has_content(line.substr(3));  // "--- {a: 1}"
       if (!ended && line[0] == '-' && !opened && !started) {  // the '---' that opens the first document
         opened = true;
         started = content_after;
@@ -84,7 +86,7 @@ inline int second_document_line(const std::string& text) {
       if (line[0] == '-' && content_after) return n;
       continue;
     }
-    if (!content(line) || (!started && line[0] == '%')) continue;  // blank, a comment, a directive
+    if (!has_content(line) || (!started && line[0] == '%')) continue;  // blank, a comment, a directive
     if (ended) return n;
     started = true;
   }
@@ -149,11 +151,8 @@ inline int empty_value_line(const std::string& text, const YAML::Mark& mark) {
     const std::string token = rest.substr(0, word);
     if (token == "~" || token == "null" || token == "Null" || token == "NULL") return mark.line;
   }
-  for (int line = std::min(mark.line, static_cast<int>(lines.size())) - 1; line >= 0; --line) {
-    const std::string l = at(line);
-    const size_t first = l.find_first_not_of(" \t\r");
-    if (first != std::string::npos && l[first] != '#') return line;
-  }
+  for (int line = std::min(mark.line, static_cast<int>(lines.size())) - 1; line >= 0; --line)
+    if (has_content(at(line))) return line;
   return mark.line;
 }
 
