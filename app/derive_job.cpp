@@ -10,6 +10,7 @@
 #include "app/derive_pipeline.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/joined.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::app {
 
@@ -33,7 +34,7 @@ std::string source_of(const Vehicle& v, const MassProperties& mp, const Symbolic
   std::map<std::string, std::vector<std::string>> by_source;
   for (const auto& n : names) {
     const double nominal = model.params[model.param_index(n)].nominal;
-    const auto same = [&](double value) { return std::fabs(nominal - value) <= 1e-12 * std::max(std::fabs(value), 1e-300); };
+    const auto same = [&](double value) { return output::equal_but_for_rounding(nominal, value); };
     const bool given = v.derived_given.count(n) > 0;
     by_source[given && same(v.derived_overrides.at(n).nominal) ? "the file's `derived:`"
               : !given && same(blocks_value(mp, n))            ? "the blocks'"
@@ -80,8 +81,19 @@ std::string summary_of(const Vehicle& vehicle, const MassProperties& mp, const D
   };
   if (has("cog_offset.x") && (nominal("cog_offset.x") != 0 || nominal("cog_offset.y") != 0))
     os << ", moved by the fitted cog_offset (" << nominal("cog_offset.x") << ", " << nominal("cog_offset.y") << ") m";
-  os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz")
-     << " kg m²" << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
+  os << "; inertia J_xx, J_yy, J_zz " << nominal("J_xx") << ", " << nominal("J_yy") << ", " << nominal("J_zz") << " kg m²";
+  // A block off the symmetry planes (a camera under the nose) shows first in the products.
+  if (nominal("J_xy") != 0 || nominal("J_xz") != 0 || nominal("J_yz") != 0)
+    os << ", products J_xy, J_xz, J_yz " << nominal("J_xy") << ", " << nominal("J_xz") << ", " << nominal("J_yz") << " kg m²";
+  os << source_of(vehicle, mp, model, {"J_xx", "J_yy", "J_zz", "J_xy", "J_xz", "J_yz"}) << "\n";
+  // The hover commands a changed vehicle moves (a researcher's trial, helper-148: they were in
+  // model.json and derivation.md only).
+  if (d.why_trim_does_not_hold.empty() && d.hover_trim.found() && !d.hover_trim.commands.empty()) {
+    os << "hover command (the header's kHoverCommand):";
+    for (size_t i = 0; i < vehicle.rotors.size() && i < d.hover_trim.commands.size(); ++i)
+      os << (i ? ", " : " ") << vehicle.rotors[i].name << " " << output::six_digits(d.hover_trim.commands[i]);
+    os << "\n";
+  }
   for (const AuditCheck* w : d.audit.warnings())
     os << "warning: the vehicle: " << w->name << ": no; " << w->detail << "\n";
   if (!d.why_trim_does_not_hold.empty()) os << "note: the header declares no hover trim: " << d.why_trim_does_not_hold << "\n";

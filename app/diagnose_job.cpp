@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -207,6 +208,17 @@ std::string no_fitted_vehicle_note(const Vehicle& v) {
                "(quadgen derive VEHICLE --params fitted_parameters.yaml)";
 }
 
+// Every plot not drawn, said (a label gnuplot refused once lost three of six without a word:
+// helper-146); where none was drawn for one reason (gnuplot missing), that reason once.
+std::vector<std::string> plot_notes(const std::vector<std::string>& errors, bool none_drawn) {
+  std::set<std::string> reasons;
+  for (const std::string& e : errors) reasons.insert(e.substr(e.find(": ") + 2));
+  if (none_drawn && reasons.size() == 1) return {"no plots: " + *reasons.begin()};
+  std::vector<std::string> notes;
+  for (const std::string& e : errors) notes.push_back("no plot " + e);
+  return notes;
+}
+
 // What a diagnosis writes: the report, the extended model (and the model with the proposed
 // terms), the plots and their data.
 DiagnoseJobResult diagnosis_files(const DiagnoseJob& job, const Vehicle& v, const MassProperties& mp,
@@ -215,11 +227,11 @@ DiagnoseJobResult diagnosis_files(const DiagnoseJob& job, const Vehicle& v, cons
   const std::string diagnosed = logs_label(job.logs);  // what the outputs say was diagnosed
   const std::string fitted_to = logs_label(d.flights);  // a left-out log is not one of them
   const diagnose::ExtendedModelFiles ext = diagnose::extended_model(v, mp, d, job.vehicle, fitted_to);
-  std::string err;
+  std::vector<std::string> plot_errors;
   std::vector<std::pair<std::string, std::string>> plot_data;
-  const auto plots = diagnose::diagnosis_plots(d, valid, &err, &plot_data);
+  const auto plots = diagnose::diagnosis_plots(d, valid, &plot_errors, &plot_data);
   DiagnoseJobResult r;
-  if (plots.empty()) r.notes.push_back("no plots: " + err);
+  r.notes = plot_notes(plot_errors, plots.empty());
   r.files = {{"diagnosis.json", output::json_document(diagnose::diagnosis_json(d, diagnosed))},
              {"report.html", diagnose::diagnosis_html(d, diagnosed, plots)},
              {"extended_model.hpp", ext.header},

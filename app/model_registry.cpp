@@ -1,8 +1,5 @@
 #include "app/model_registry.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 #include "generated/crazyflie21/model.hpp"
 #include "generated/crazyflie21_all_effects/model.hpp"
 #include "generated/crazyflie21_nanobench/model.hpp"
@@ -13,6 +10,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "derive/geometry.hpp"
 #include "codegen/tape_builder.hpp"
+#include "output/numbers.hpp"
 
 namespace quadgen::app {
 
@@ -24,14 +22,12 @@ std::vector<std::string> names_of(const std::vector<Variable>& vars) {
   return out;
 }
 
-// Equal to 1e-12 relative, not bit for bit: a compiler that contracts a*b+c may round a
-// derived quantity differently from the machine that generated the header. The header's
-// array has the length of `vars` (names_equal checks it first).
+// Equal but for rounding: a compiler that contracts a*b+c may round a derived quantity
+// differently from the machine that generated the header. The header's array has the length
+// of `vars` (names_equal checks it first).
 bool values_equal(const double* header, const std::vector<Variable>& vars) {
-  for (size_t i = 0; i < vars.size(); ++i) {
-    const double a = vars[i].nominal, b = header[i];
-    if (!(std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b)))) return false;
-  }
+  for (size_t i = 0; i < vars.size(); ++i)
+    if (!output::equal_but_for_rounding(vars[i].nominal, header[i])) return false;
   return true;
 }
 

@@ -448,9 +448,9 @@ std::vector<Panel> simulation_plot(const OpenLoop& k, const SimulateJob& a, cons
   Series phi{"phi (roll)", tr.t, {}}, theta{"theta (pitch)", tr.t, {}}, psi{"psi (yaw)", tr.t, {}};
   for (const auto& x : tr.x) {
     const auto e = euler_angles(x.data());
-    phi.y.push_back(e[0] * 180 / M_PI);
-    theta.y.push_back(e[1] * 180 / M_PI);
-    psi.y.push_back(e[2] * 180 / M_PI);
+    phi.y.push_back(e[0] * runtime::kDegreesPerRadian);
+    theta.y.push_back(e[1] * runtime::kDegreesPerRadian);
+    psi.y.push_back(e[2] * runtime::kDegreesPerRadian);
   }
   rot.series = {phi, theta, psi};
   std::vector<double> ub(k.m.num_inputs());

@@ -59,7 +59,7 @@ void given_values(std::ostringstream& md, const Derivation& d) {
       const double given = d.vehicle.derived_overrides.at(q.name).nominal;
       const double used = d.model.params[d.model.param_index(q.name)].nominal;
       md << separator << "`" << q.name << "` = " << num(given) << " " << output::unit_for_reading(q.unit);
-      if (std::fabs(used - given) > 1e-12 * std::max(std::fabs(given), 1e-300))
+      if (!output::equal_but_for_rounding(used, given))
         md << " (replaced by the fitted " << num(used) << " " << output::unit_for_reading(q.unit) << ")";
       separator = "; ";
     }

@@ -7,6 +7,7 @@
 #include "app/derive_job.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/output_set.hpp"
+#include "output/progress.hpp"
 
 namespace quadgen::cli {
 
@@ -27,7 +28,10 @@ int run_derive(const DeriveArgs& args) {
   app::DeriveJob job{args.vehicle, args.effects, args.params, {}};
   const int steps = app::kDeriveJobSteps + 1;  // and the writing
   int step = 0;
-  const auto say = [&](const std::string& what) { std::cerr << "[" << ++step << "/" << steps << "] " << what << "\n"; };
+  const output::Progress terminal = output::terminal_progress();  // escapes what a line quotes
+  const auto say = [&](const std::string& what) {
+    terminal.say("[" + std::to_string(++step) + "/" + std::to_string(steps) + "] " + what);
+  };
   job.progress = say;
   const app::DeriveJobResult r = app::run_derive_job(job, vehicle);
   say("writing " + output::printable(args.out));

@@ -11,6 +11,7 @@
 #include "model/vehicle.hpp"
 #include "output/names.hpp"
 #include "output/output_set.hpp"
+#include "output/progress.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::cli {
@@ -64,7 +65,7 @@ FitJobOptions job_options(const FitArgs& a) {
   if (a.profiles != "all" && a.profiles != "none") o.profiles = output::split_name_list(a.profiles, "--profiles");
   o.channels = output::split_name_list(a.channels, "--channels");
   o.free = output::split_name_list(a.free, "--free");
-  o.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+  o.progress = output::terminal_progress().line;  // escapes what a line quotes (a name, a path)
   return o;
 }
 

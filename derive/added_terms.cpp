@@ -4,6 +4,7 @@
 
 #include "derive/dynamics.hpp"
 #include "model/units.hpp"
+#include "runtime/rigid_body_state.hpp"
 
 namespace quadgen {
 
@@ -60,19 +61,29 @@ Regressor regressor(ModelContext& c, const AddedTerm& t, const std::string& name
   return {a.value * b.value, a.dim * b.dim};
 }
 
+// Where a term acts: the channel it was found in (runtime::rigid_body's names) and its axis.
+struct Channel {
+  enum class Kind { kAngular, kWorldAcceleration, kBodyAcceleration } kind;
+  unsigned axis;
+};
+
+Channel channel_of(const std::string& name) {
+  namespace rb = runtime::rigid_body;
+  for (unsigned i = 0; i < 3; ++i) {
+    if (name == rb::kResidualChannels[3 + i]) return {Channel::Kind::kAngular, i};
+    if (name == rb::kWorldAccelerationChannels[i]) return {Channel::Kind::kWorldAcceleration, i};
+    if (name == rb::kResidualChannels[i]) return {Channel::Kind::kBodyAcceleration, i};
+  }
+  throw std::invalid_argument("added term: unknown channel '" + name + "'");
+}
+
 }  // namespace
 
 void add_terms(ModelContext& c, const std::vector<AddedTerm>& terms) {
-  const std::vector<std::string> angular = {"pdot", "qdot", "rdot"}, world = {"ax_world", "ay_world", "az_world"},
-                                 body = {"ax", "ay", "az"};
   for (const AddedTerm& t : terms) {
-    int axis = -1;
-    const std::vector<std::string>* kind = nullptr;
-    for (const auto* k : {&angular, &world, &body})
-      for (int i = 0; i < 3; ++i)
-        if ((*k)[static_cast<size_t>(i)] == t.channel) axis = i, kind = k;
-    if (!kind) throw std::invalid_argument("added term: unknown channel '" + t.channel + "'");
-    const Dimension channel_dim = parse_unit(kind == &angular ? "rad/s^2" : "m/s^2").dim;
+    const Channel channel = channel_of(t.channel);
+    const bool angular = channel.kind == Channel::Kind::kAngular;
+    const Dimension channel_dim = parse_unit(runtime::rigid_body::kResidualChannelUnits[angular ? 3 : 0]).dim;
     ex sum = 0;
     for (size_t k = 0; k < t.coefficients.size(); ++k) {
       const auto& [name, value] = t.coefficients[k];
@@ -85,12 +96,12 @@ void add_terms(ModelContext& c, const std::vector<AddedTerm>& terms) {
       sum += coefficient * r.value;
     }
     matrix unit_axis(3, 1);
-    unit_axis(static_cast<unsigned>(axis), 0) = 1;
-    if (kind == &angular) {
+    unit_axis(channel.axis, 0) = 1;
+    if (angular) {
       const ex xx = c.p("J_xx"), yy = c.p("J_yy"), zz = c.p("J_zz"), xy = c.p("J_xy"), xz = c.p("J_xz"), yz = c.p("J_yz");
       const matrix J(3, 3, GiNaC::lst{xx, xy, xz, xy, yy, yz, xz, yz, zz});
       c.extra_body_torque = c.extra_body_torque.add(J.mul(unit_axis).mul_scalar(sum));
-    } else if (kind == &world) {
+    } else if (channel.kind == Channel::Kind::kWorldAcceleration) {
       c.extra_body_force = c.extra_body_force.add(c.R.transpose().mul(unit_axis).mul_scalar(c.p("mass") * sum));
     } else {
       c.extra_body_force = c.extra_body_force.add(unit_axis.mul_scalar(c.p("mass") * sum));

@@ -272,8 +272,13 @@ void write_named_equations(const ModelContext& c, const matrix& v_air_body) {
   out.push_back({"\\tau", 0, "\\sum_i \\tau_i" + std::string(extra_torque ? " + \\Delta \\tau" : "")});
 }
 
-// Closes the equations once every effect has had its say.
-void assemble(ModelContext& c) {
+struct BodyLoads {
+  matrix force, torque;  // body frame, about the CoG
+};
+
+// The rotors' thrust and torque, the frame drag and the effects' extra force and torque,
+// each recorded among the model's named intermediates.
+BodyLoads body_loads(ModelContext& c) {
   SymbolicModel& m = c.model;
   const auto& rotors = c.vehicle.rotors;
   matrix force_body = c.extra_body_force;
@@ -295,39 +300,21 @@ void assemble(ModelContext& c) {
   m.intermediates.push_back({"F_{body}", force_body});
   m.intermediates.push_back({"\\tau", torque});
   write_named_equations(c, v_air_body);
+  return {force_body, torque};
+}
 
-  // Rotation about the centre of gravity: J dω/dt = τ − ω × Jω.
-  const matrix J = inertia_matrix(c);
-  const matrix Jinv = inverse_by_adjugate(J);
-  const matrix omega_dot = Jinv.mul(torque.sub(cross(c.omega, J.mul(c.omega))));
-  // Translation: the CoG obeys m a_cg = R F_b − m g e_z; the origin is offset from it
-  // by −c, so a_o = a_cg − R(ω̇ × c + ω × (ω × c)).
-  auto accel_world_for = [&](const matrix& w_dot) {
-    const matrix transport = cross(w_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
-    const matrix accel_body = force_body.mul_scalar(1 / c.p("mass")).sub(transport);
-    return c.R.mul(accel_body).sub(vec3(0, 0, c.p("g")));
-  };
-  const matrix accel_world = accel_world_for(omega_dot);
-  const matrix q_dot = quaternion_rate(c.q, c.omega);
+// Translation: the world acceleration of the body origin at angular acceleration `w_dot`. The
+// CoG obeys m a_cg = R F_b − m g e_z; the origin is offset from it by −c, so
+// a_o = a_cg − R(ω̇ × c + ω × (ω × c)).
+matrix origin_acceleration(ModelContext& c, const matrix& force_body, const matrix& w_dot) {
+  const matrix transport = cross(w_dot, c.cog).add(cross(c.omega, cross(c.omega, c.cog)));
+  const matrix accel_body = force_body.mul_scalar(1 / c.p("mass")).sub(transport);
+  return c.R.mul(accel_body).sub(vec3(0, 0, c.p("g")));
+}
 
-  const size_t n = m.states.size();
-  m.f = matrix(n, 1);
-  for (int i = 0; i < 3; ++i) {
-    m.f(i, 0) = c.velocity(i, 0);
-    m.f(3 + i, 0) = accel_world(i, 0);
-    m.f(10 + i, 0) = omega_dot(i, 0);
-  }
-  for (int i = 0; i < 4; ++i) m.f(6 + i, 0) = q_dot(i, 0);
-  for (size_t i = 0; i < c.extra_rates.size(); ++i) m.f(13 + i, 0) = c.extra_rates[i];
-  for (const ex& w : c.rotor_speed)
-    for (size_t i = 0; i < n; ++i)
-      if (w.is_equal(m.states[i].sym)) m.rotor_speed_states.push_back(i);
-
-  m.omega_dot = {symbol("omegadot_x"), symbol("omegadot_y"), symbol("omegadot_z")};
-  const matrix accel_split = accel_world_for(vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]));
-  m.f_split = m.f;
-  for (int i = 0; i < 3; ++i) m.f_split(3 + i, 0) = accel_split(i, 0);
-
+// What a log measures of the state: the position and the attitude as logged.
+void declare_pose_outputs(ModelContext& c) {
+  SymbolicModel& m = c.model;
   const char* out[][3] = {{"x", "m", "position x"}, {"y", "m", "position y"}, {"z", "m", "position z"},
                           {"qw", "1", "logged attitude w"}, {"qx", "1", "logged attitude x"},
                           {"qy", "1", "logged attitude y"}, {"qz", "1", "logged attitude z"}};
@@ -336,6 +323,38 @@ void assemble(ModelContext& c) {
     m.outputs.push_back(make_variable(out[i][0], out[i][1], out[i][2]));
     m.h(i, 0) = i < 3 ? c.position(i, 0) : c.measured_q(i - 3, 0);
   }
+}
+
+// Closes the equations once every effect has had its say.
+void assemble(ModelContext& c) {
+  SymbolicModel& m = c.model;
+  const BodyLoads loads = body_loads(c);
+  // Rotation about the centre of gravity: J dω/dt = τ − ω × Jω.
+  const matrix J = inertia_matrix(c);
+  const matrix Jinv = inverse_by_adjugate(J);
+  const matrix omega_dot = Jinv.mul(loads.torque.sub(cross(c.omega, J.mul(c.omega))));
+  const matrix accel_world = origin_acceleration(c, loads.force, omega_dot);
+  const matrix q_dot = quaternion_rate(c.q, c.omega);
+
+  const size_t n = m.states.size();
+  m.f = matrix(n, 1);
+  namespace rb = runtime::rigid_body;
+  for (unsigned i = 0; i < 3; ++i) {
+    m.f(rb::kPosition + i, 0) = c.velocity(i, 0);
+    m.f(rb::kVelocity + i, 0) = accel_world(i, 0);
+    m.f(rb::kBodyRate + i, 0) = omega_dot(i, 0);
+  }
+  for (unsigned i = 0; i < 4; ++i) m.f(rb::kAttitude + i, 0) = q_dot(i, 0);
+  for (unsigned i = 0; i < c.extra_rates.size(); ++i) m.f(rb::kNumStates + i, 0) = c.extra_rates[i];
+  for (const ex& w : c.rotor_speed)
+    for (size_t i = 0; i < n; ++i)
+      if (w.is_equal(m.states[i].sym)) m.rotor_speed_states.push_back(i);
+
+  m.omega_dot = {symbol("omegadot_x"), symbol("omegadot_y"), symbol("omegadot_z")};
+  const matrix accel_split = origin_acceleration(c, loads.force, vec3(m.omega_dot[0], m.omega_dot[1], m.omega_dot[2]));
+  m.f_split = m.f;
+  for (unsigned i = 0; i < 3; ++i) m.f_split(rb::kVelocity + i, 0) = accel_split(i, 0);
+  declare_pose_outputs(c);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <chrono>
 #include <thread>
 
@@ -92,8 +93,12 @@ std::vector<std::string> effect_parameters(const SymbolicModel& all, const std::
 
 std::vector<std::string> reference_parameters(const SymbolicModel& all) {
   std::vector<std::string> names;
-  for (const auto& p : all.params) names.push_back(p.name);
-  return quadgen::reference_parameters(names);
+  std::set<std::string> fitted;
+  for (const auto& p : all.params) {
+    names.push_back(p.name);
+    if (p.fit) fitted.insert(p.name);
+  }
+  return quadgen::reference_parameters(names, fitted);
 }
 
 std::string separating_manoeuvre(const std::string& a, const std::string& b) {

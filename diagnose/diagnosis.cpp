@@ -360,12 +360,21 @@ void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit:
 
 // Left over: slow structure the noise cannot explain. The final model carries the stronger
 // of each look-alike pair (either explains the discrepancy; only the name is open).
-std::vector<Unexplained> unexplained(const ResidualAnalysis& left, const DiagnoseOptions& opt) {
+// Of several flights, the window is told on the clock of the flight it starts in (the joined
+// clock's "t = 54.1..55.1 s" of two 30 s flights named neither: helper-148).
+std::vector<Unexplained> unexplained(const ResidualAnalysis& left, const DiagnoseOptions& opt,
+                                     const std::vector<double>& flight_starts) {
   std::vector<Unexplained> out;
   for (const auto& c : left.channels) {
     if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
     Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,
                   c.worst_window_mean, "", 0};
+    if (flight_starts.size() > 1) {
+      const auto later = std::upper_bound(flight_starts.begin(), flight_starts.end(), u.t0);
+      const size_t k = later == flight_starts.begin() ? 0 : static_cast<size_t>(later - flight_starts.begin()) - 1;
+      u.flight = static_cast<int>(k) + 1;
+      u.t0 -= flight_starts[k], u.t1 -= flight_starts[k];
+    }
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     out.push_back(u);
   }
@@ -390,9 +399,11 @@ std::vector<std::string> joint_candidates(std::vector<std::string> c, const fit:
 void set_formulation(bool accelerometer, Diagnosis& d) {
   d.formulation = accelerometer ? "equation error: accelerometer specific force (body) and gyro derivative"
                                 : "equation error: differentiated velocity (world) and gyro derivative";
-  d.channel_names = accelerometer ? std::vector<std::string>{"ax", "ay", "az", "pdot", "qdot", "rdot"}
-                                  : std::vector<std::string>{"ax_world", "ay_world", "az_world", "pdot", "qdot", "rdot"};
-  d.channel_units = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
+  namespace rb = runtime::rigid_body;
+  d.channel_names.assign(std::begin(rb::kResidualChannels), std::end(rb::kResidualChannels));
+  if (!accelerometer) std::copy(std::begin(rb::kWorldAccelerationChannels), std::end(rb::kWorldAccelerationChannels),
+                                d.channel_names.begin());
+  d.channel_units.assign(std::begin(rb::kResidualChannelUnits), std::end(rb::kResidualChannelUnits));
 }
 
 }  // namespace
@@ -830,6 +841,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
+  for (const auto& p : all_in.params)
+    if (effect_of_parameter(p.name).empty()) d.file_values[p.name] = p.nominal;
   const std::vector<fit::Flight> flights = usable_flights(flights_in, all_in, opt_in.progress, d);
   const bool joint = flights.size() > 1;
   const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
@@ -875,8 +888,8 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   analyse_what_is_wrong(v, used, all_ee, d);
   clock.say("validation of the base and the extended model; prediction error at horizons");
   measure_held_out(d, held_out_gain, model, valid, valid_ee);
-  d.unexplained = unexplained(d.after, opt);
   const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
+  d.unexplained = unexplained(d.after, opt, flight_starts);
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
 
   // 5. Beyond the catalogue: a term proposed from what is left, regenerated and tested.

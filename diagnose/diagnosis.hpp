@@ -3,6 +3,7 @@
 // report is diagnosis_report's job; the command line is cli/diagnose_command.cpp.
 #pragma once
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -157,9 +158,11 @@ struct StandIn {
 struct Unexplained {
   std::string channel, unit;
   double slow_rms = 0, ratio = 0, p_value = 1;
-  double t0 = 0, t1 = 0, worst_mean = 0;
+  double t0 = 0, t1 = 0, worst_mean = 0;  // t0, t1 on the clock of the flight they lie in [s]
   std::string signal;  // most correlated physical signal
   double r = 0;
+  // Of several flights diagnosed together, which one (1 = the first); 0 for one flight.
+  int flight = 0;
 };
 
 struct ChannelGain {
@@ -169,6 +172,8 @@ struct ChannelGain {
 
 struct Diagnosis {
   std::string vehicle, formulation;
+  // The vehicle file's value of each base-model parameter (its nominal), beside the fitted one.
+  std::map<std::string, double> file_values;
   std::vector<std::string> flights;  // the source of each flight diagnosed
   // Every flight given, screened (flight_screening.hpp); in a joint diagnosis the unusable
   // ones are not in `flights`.

@@ -572,7 +572,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     << (std::any_of(base.begin(), base.end(), [&](const fit::FitParameter* p) { return on_bound(*p); })
             ? " One on its bound was held there: the model is strained, and a finding may stand in for what it lacks."
             : "")
-    << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>unit</th><th>bounds</th><th></th></tr>\n";
+    << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>in the vehicle file</th><th>unit</th><th>bounds</th><th>note</th></tr>\n";
   // Where the flights, each refitted alone, do not agree on it: the joint value is no one
   // airframe's measurement (a review, helper-131: c_w 0.563 stood here without a caveat).
   const auto flights_say = [&](const fit::FitParameter& p) -> std::string {
@@ -585,7 +585,9 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
   for (const auto* p : base) {
     std::string note = on_bound(*p) ? "on its bound" : "";
     if (const std::string said = flights_say(*p); !said.empty()) note += (note.empty() ? "" : "; ") + said;
-    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>" << unit_html(p->unit) << "</td><td>"
+    const auto file = d.file_values.find(runtime::shared_name(p->name));  // a flight's copy: the file's one value
+    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>"
+      << (file == d.file_values.end() ? "&ndash;" : num(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
       << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (note.empty() ? ">" : " class=\"warn\">" + note) << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -651,7 +653,7 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
     h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
     for (const auto& u : d.unexplained)
       h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << unit_html(u.unit) << "</td><td>" << num(u.ratio, 3)
-        << "</td><td>" << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
+        << "</td><td>" << (u.flight ? "flight " + std::to_string(u.flight) + ": " : "") << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
         << "</td></tr>\n";
     h << "</table>\n";
   }

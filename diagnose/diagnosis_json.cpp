@@ -186,12 +186,14 @@ json settling_json(const Settling& s) {
 // without it -> with it, on held-out data, with its spread over validation folds), evidence.
 json finding_json(const Finding& f) {
   json ps = json::object();
-  const bool has_reference = find_effect(f.effect).first_parameter_is_reference;
-  if (has_reference)
+  const std::string& anchor = find_effect(f.effect).ratios_only_beside;
+  bool has_reference = false;  // held where the model fitted the anchor (reference_parameters)
+  if (!anchor.empty())
     for (const auto& p : f.evidence.parameters)
       if (effect_of_parameter(p.name) == f.effect && !p.free) {
         ps[p.name] = output::estimate_json({0.0, p.unit, 0.0, 0.0, "reference (held at 0)", false});
         ps[p.name]["reference"] = true;
+        has_reference = true;
       }
   for (const auto& e : f.parameters) {
     json pj = output::estimate_json({e.value, e.unit, e.lower, e.upper, fit::identifiability_text(e.verdict), e.at_bound});
@@ -221,7 +223,7 @@ json finding_json(const Finding& f) {
     fj["force_alone_gain"].update(fold_gains_json(f.force_alone));
   }
   if (has_reference)
-    fj["note"] = "c_t is fitted with these parameters, so only their ratios are identifiable: the first is the reference, held at 0";
+    fj["note"] = anchor + " is fitted with these parameters, so only their ratios are identifiable: the first is the reference, held at 0";
   return fj;
 }
 
@@ -400,6 +402,7 @@ json unexplained_json(const Diagnosis& d) {
                   {"ratio_to_noise", u.ratio},
                   {"p_value", u.p_value},
                   {"largest_in", {u.t0, u.t1}},
+                  {"flight", u.flight ? json(u.flight) : json(nullptr)},
                   {"mean_there", u.worst_mean},
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});

@@ -164,7 +164,8 @@ std::vector<runtime::Panel> command_gain_panels(const Diagnosis& d) {
 // plot: measured black, base model red, extended model blue.
 class PlotRenderer {
  public:
-  PlotRenderer(std::string* error, std::vector<std::pair<std::string, std::string>>* data) : error_(error), data_(data) {}
+  PlotRenderer(std::vector<std::string>* errors, std::vector<std::pair<std::string, std::string>>* data)
+      : errors_(errors), data_(data) {}
 
   void render(const std::string& name, const std::string& title, std::vector<runtime::Panel> panels) {
     for (auto& p : panels)
@@ -172,8 +173,9 @@ class PlotRenderer {
         for (const auto& [model, colour] : kColours)  // "base model, tilt" is the base model's too
           if (!model.empty() && (s.label == model || s.label.rfind(model + ",", 0) == 0)) s.color = colour;
     if (data_) data_->emplace_back(name.substr(0, name.rfind('.')) + ".csv", runtime::panels_csv(title, panels));
-    std::string svg;
-    if (runtime::render_svg(title, panels, &svg, error_)) svgs_.emplace_back(name, svg);
+    std::string svg, error;
+    if (runtime::render_svg(title, panels, &svg, &error)) svgs_.emplace_back(name, svg);
+    else if (errors_) errors_->push_back(name + ": " + error);
   }
   std::vector<std::pair<std::string, std::string>> svgs() && { return std::move(svgs_); }
 
@@ -181,7 +183,7 @@ class PlotRenderer {
   inline static const std::map<std::string, std::string> kColours = {{"measured", "#000000"},
                                                                      {"base model", "#d62728"},
                                                                      {"extended model", "#1f77b4"}};
-  std::string* error_;
+  std::vector<std::string>* errors_;
   std::vector<std::pair<std::string, std::string>>* data_;
   std::vector<std::pair<std::string, std::string>> svgs_;
 };
@@ -224,9 +226,9 @@ std::string what_to_look_for(const std::string& plot_name) {
 
 
 std::vector<std::pair<std::string, std::string>> diagnosis_plots(
-    const Diagnosis& d, const fit::Flight& valid, std::string* error,
+    const Diagnosis& d, const fit::Flight& valid, std::vector<std::string>* errors,
     std::vector<std::pair<std::string, std::string>>* data) {
-  PlotRenderer plots(error, data);
+  PlotRenderer plots(errors, data);
   if (!d.sim_before.t.empty()) {
     auto validation = validation_panels(d, valid), errors = simulation_error_panels(d);
     mark_flights(d, validation);

@@ -16,10 +16,11 @@ namespace quadgen::diagnose {
 
 nlohmann::ordered_json diagnosis_json(const Diagnosis& d, const std::string& log_path);
 
-// Plots as (file name, SVG text); empty when gnuplot is unavailable (`error` says why).
-// `data`, when given, receives each plot's series as (name.csv, CSV text), gnuplot or not.
+// Plots as (file name, SVG text); one not drawn is said in `errors` ("name.svg: why"), every
+// one when gnuplot is unavailable. `data`, when given, receives each plot's series as
+// (name.csv, CSV text), gnuplot or not.
 std::vector<std::pair<std::string, std::string>> diagnosis_plots(
-    const Diagnosis& d, const fit::Flight& validation, std::string* error,
+    const Diagnosis& d, const fit::Flight& validation, std::vector<std::string>* errors,
     std::vector<std::pair<std::string, std::string>>* data = nullptr);
 
 // What a reader should look for in one of diagnosis_plots' plots, by its file name ("" for

@@ -135,7 +135,8 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
-       << "x what noise gives, largest in t = " << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
+       << "x what noise gives, largest in " << (u.flight ? "flight " + std::to_string(u.flight) + " at " : "") << "t = "
+       << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
        << u.signal << " (r = " << num(u.r, 2) << ")\n";
   for (const auto& leads : {draft_leads(d), command_gain_leads(d)})
     for (const auto& lead : leads) {

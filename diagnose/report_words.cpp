@@ -116,7 +116,8 @@ std::string flight_headline(const Effect& e, const std::vector<const EffectEstim
   std::set<std::string> apart;  // shared names with an interval away from 0
   for (const auto* p : ps)
     if (told_apart_from_zero(p)) apart.insert(runtime::shared_name(p->name));
-  const bool drop_unresolved = e.first_parameter_is_reference && !apart.empty();
+  const bool ratios = !e.ratios_only_beside.empty();
+  const bool drop_unresolved = ratios && !apart.empty();
   std::map<std::string, double> values;
   size_t dropped = 0;
   for (const auto* p : ps) {
@@ -127,8 +128,8 @@ std::string flight_headline(const Effect& e, const std::vector<const EffectEstim
     values[runtime::shared_name(p->name)] = p->value;
   }
   std::string s = e.headline(values, reference);
-  if (dropped > 0) s += " The others are within their intervals of the reference.";
-  else if (e.first_parameter_is_reference && apart.empty() && !values.empty() && std::all_of(ps.begin(), ps.end(), has_interval))
+  if (dropped > 0) s += reference.empty() ? " The others' intervals hold 0 (no change)." : " The others are within their intervals of the reference.";
+  else if (ratios && apart.empty() && !values.empty() && std::all_of(ps.begin(), ps.end(), has_interval))
     s += " Each interval holds 0: the values are significant only together.";
   return s;
 }
@@ -142,7 +143,7 @@ std::string flight_headline(const Effect& e, const std::vector<const EffectEstim
 std::string headline(const Finding& f) {
   const Effect& e = find_effect(f.effect);
   std::string reference;
-  if (e.first_parameter_is_reference)
+  if (!e.ratios_only_beside.empty())  // held where the model fitted what it stands beside
     for (const auto& p : f.evidence.parameters)
       if (effect_of_parameter(p.name) == f.effect && !p.free && runtime::flight_of_name(p.name) == 1) {
         reference = p.name;
@@ -413,13 +414,26 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
                     (apart.empty() ? "" : ", " + apart + ", and the others") +
                     " (speed, battery, payload, the day) and diagnose them apart, or together without the odd one");
     }
+  // A suspected one too: flights of a vehicle changed between them (a camera added, the CoG
+  // moved) showed it only here, beside "do not put it in the vehicle file" (a researcher's
+  // trial, helper-148).
+  for (const auto& a : d.agreement)
+    if (!a.named && flights_disagree(a)) {
+      const std::string apart = flights_apart(a);
+      out.push_back("the flights disagree on the suspected " + a.parameter + (apart.empty() ? "" : ", " + apart + " lying apart") +
+                    ": one airframe gives it one value; if the vehicle changed between the flights (a block moved or "
+                    "added, other propellers), diagnose each flight alone, or one against another's airframe (--airframe)");
+    }
   for (const auto& a : d.base_agreement)
     if (unmeasured_base_parameter(a)) out.push_back(hold_unmeasured_step(a));
   for (const auto& a : d.base_agreement)
     if (flights_disagree(a))
       out.push_back("the flights disagree on the base model's " + a.parameter + ": it carries something that differs " +
-                    "between them (for a drag coefficient: a drag the model lacks, or one the flights' speeds cannot " +
-                    "tell from rotor drag); read its values per flight before taking the joint value as the airframe's");
+                    "between them (" + (a.parameter == "c_w" ? "a drag the model lacks, or one the flights' speeds cannot "
+                                                               "tell from rotor drag"
+                                                             : "a property the vehicle file gives one value, or something "
+                                                               "the model lacks") +
+                    "); read its values per flight before taking the joint value as the airframe's");
   for (const auto& x : d.suspected)
     if (!x.carried)
       out.push_back("do not put " + x.candidate.effect + " in the vehicle file (suspected: " + x.failed + ")" +

@@ -25,7 +25,7 @@ EquationErrorModel::EquationErrorModel(runtime::DynamicModel& model, Flight flig
                                        std::vector<std::string> use, Derivatives d, double window)
     : model_(&model), flight_(std::move(flight)), accel_(use_accelerometer), g_index_(model.param_index("g")),
       data_side_(model), extra_(model), derivatives_(d) {
-  const auto names = all_names();
+  const auto names = channel_names();
   if (use.empty()) use = names;
   for (const auto& u : use) {
     const int c = runtime::index_in(names, u);
@@ -181,13 +181,13 @@ void EquationErrorModel::build_filter(double window) {
   }
 }
 
-std::vector<std::string> EquationErrorModel::all_names() const {
-  if (accel_) return {"ax", "ay", "az", "pdot", "qdot", "rdot"};
-  return {"ax", "ay", "az", "pdot", "qdot", "rdot"};  // world-frame accelerations when no accelerometer
+// The same names whichever frame the acceleration is in (fit.json's channels).
+std::vector<std::string> EquationErrorModel::channel_names() {
+  return {std::begin(kResidualChannels), std::end(kResidualChannels)};
 }
 
 std::vector<std::string> EquationErrorModel::channels() const {
-  const auto names = all_names();
+  const auto names = channel_names();
   std::vector<std::string> out;
   for (int c : used_) out.push_back(names[c]);
   return out;

@@ -157,7 +157,7 @@ class EquationErrorModel : public ResidualModel {
   template <class Part>
   void split_over_cores(size_t lo, size_t hi, const double* p, const std::vector<int>* columns,
                         const Part& part) const;
-  std::vector<std::string> all_names() const;
+  static std::vector<std::string> channel_names();  // all six, in order
   // The used channels (evaluate_packed) or all six (evaluate6) of every row, the Jacobian
   // packed to `columns`.
   void evaluate_packed(const double* p, double* r, double* J, const std::vector<int>& columns) const;

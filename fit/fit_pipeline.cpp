@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "runtime/thrust_law.hpp"
@@ -298,12 +299,17 @@ std::vector<FitParameter> starting_parameters(const runtime::DynamicModel& model
     return params;
   }
   std::vector<std::string> names;
-  for (const auto& p : params) names.push_back(p.name);
-  for (const auto& ref : reference_parameters(names))
+  std::set<std::string> fitted;
+  for (const auto& p : params) {
+    names.push_back(p.name);
+    if (p.free) fitted.insert(p.name);
+  }
+  for (const auto& ref : reference_parameters(names, fitted))
     for (auto& p : params)
       if (p.name == ref && p.free) {
         p.free = false;
-        o.progress("holding " + output::printable(ref) + " at 0: beside c_t only ratios to it are identifiable (--free overrides)");
+        o.progress("holding " + output::printable(ref) + " at 0: beside " + find_effect(effect_of_parameter(ref)).ratios_only_beside +
+                   " only ratios to it are identifiable (--free overrides)");
       }
   return params;
 }
@@ -513,22 +519,25 @@ std::vector<runtime::Panel> stand_panels(const std::vector<StandSample>& samples
   return {{"thrust vs mean rotor speed", "rad/s", "N", {meas, model}}};
 }
 
-}  // namespace
+// How many thrust constants the stand fit has: one shared, or one per motor (the first
+// parameters of its thrust law).
+size_t thrust_constants(const StandFit& f, size_t motors) {
+  return f.coefficients == ThrustVsSpeed::Coefficients::kShared ? 1 : motors;
+}
 
-FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
-  check_options(o, LogKind::kThrustStand);
-  const auto samples = read_thrust_stand(path);
-  o.progress("thrust vs rotor speed and rotor speed vs command, " + std::to_string(samples.size()) + " samples");
-  const double vref = param(v, "vbat_ref").nominal;
-  const StandFit f = fit_stand(samples, vref, fit_options(o), profile_options(o));
-  const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
-  const int n_k = shared ? 1 : static_cast<int>(samples.front().w.size());
+// The thrust constant k the stand gives: the shared one, or the mean of the motors' own.
+double stand_thrust_constant(const StandFit& f, size_t motors) {
+  const size_t n_k = thrust_constants(f, motors);
   double k = 0;
-  for (int i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / n_k;
-  const Rotor& r0 = v.rotors.front();
-  const double ct = runtime::thrust_coefficient_c_t(k, param(v, "rho").nominal, r0.disc_area, r0.radius);
-  FitOutputs out;
-  auto& j = out.json;
+  for (size_t i = 0; i < n_k; ++i) k += f.thrust.parameters[i].value / static_cast<double>(n_k);
+  return k;
+}
+
+// fit.json of a stand fit: both laws with their profiles, and the summary a vehicle file takes.
+nlohmann::ordered_json stand_json(const std::string& path, const Vehicle& v, const StandFit& f, double k, double ct,
+                                  double vref) {
+  const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
+  nlohmann::ordered_json j;
   j["kind"] = "thrust_stand";
   j["vehicle"] = v.name;
   j["log"] = path;
@@ -541,12 +550,12 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   }
   j["speed_vs_command"] = fit_json(f.speed, f.speed_profiles);
   if (!f.voltage_exponent_identified) j["speed_vs_command"]["why"] = f.voltage_reason;
-  const Profile* kp = shared ? &f.thrust_profiles.front() : nullptr;
   // k as an estimate: with its profile when one coefficient is shared, else the plain mean.
   output::Estimate k_estimate{k, "N s^2", NAN, NAN, "", false};
-  if (kp) {
+  if (shared) {
     const FitParameter& shared_k = f.thrust.parameters.front();
-    k_estimate = estimate_of(shared_k, kp, std::count(f.thrust.at_bound.begin(), f.thrust.at_bound.end(), shared_k.name) > 0);
+    k_estimate = estimate_of(shared_k, &f.thrust_profiles.front(),
+                             std::count(f.thrust.at_bound.begin(), f.thrust.at_bound.end(), shared_k.name) > 0);
   }
   j["summary"] = {{"k", output::estimate_json(k_estimate)},
                   {"coefficients", shared ? "one shared by all motors" : "mean of the per-motor coefficients"},
@@ -556,17 +565,20 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
                                                                                 : nlohmann::ordered_json(nullptr)},
                   {"vbat_ref_V", vref}};
   j["published"] = published_crazyflie();
-  std::vector<Profile> all = f.thrust_profiles;
-  all.insert(all.end(), f.speed_profiles.begin(), f.speed_profiles.end());
-  add_profile_plot(out, v.name + ": thrust stand profiles", all);
-  add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
+  return j;
+}
+
+// What the terminal prints of a stand fit: k, c_t, the voltage law and the motor map's lines.
+std::string stand_summary(const StandFit& f, size_t motors, double k, double ct, double vref) {
   std::ostringstream s;
-  if (shared) {
-    s << "k = " << k << " N s² " << interval_of(*kp) << " (" << identifiability_text(kp->verdict) << "), shared by all motors: "
+  if (f.coefficients == ThrustVsSpeed::Coefficients::kShared) {
+    const Profile& kp = f.thrust_profiles.front();
+    s << "k = " << k << " N s² " << interval_of(kp) << " (" << identifiability_text(kp.verdict) << "), shared by all motors: "
       << f.coefficients_reason << "\n";
   } else {
     s << "k per motor:";
-    for (int i = 0; i < n_k; ++i) s << " " << f.thrust.parameters[i].value << " (" << identifiability_text(f.thrust_profiles[i].verdict) << ")";
+    for (size_t i = 0; i < thrust_constants(f, motors); ++i)
+      s << " " << f.thrust.parameters[i].value << " (" << identifiability_text(f.thrust_profiles[i].verdict) << ")";
     s << "; mean " << k << " N s²\n";
   }
   s << "c_t = " << ct << "; ";
@@ -577,7 +589,29 @@ FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const
   if (f.voltage_exponent_identified) where << "at vbat_ref = " << vref << " V";
   else where << "at the stand's voltage at each command";
   s << motor_map_lines(f.speed.parameters, f.speed_profiles, where.str());
-  out.summary = s.str();
+  return s.str();
+}
+
+}  // namespace
+
+FitOutputs fit_thrust_stand_log(const std::string& path, const Vehicle& v, const FitJobOptions& o) {
+  check_options(o, LogKind::kThrustStand);
+  const auto samples = read_thrust_stand(path);
+  o.progress("thrust vs rotor speed and rotor speed vs command, " + std::to_string(samples.size()) + " samples");
+  const double vref = param(v, "vbat_ref").nominal;
+  const StandFit f = fit_stand(samples, vref, fit_options(o), profile_options(o));
+  const size_t motors = samples.front().w.size();
+  const double k = stand_thrust_constant(f, motors);
+  const Rotor& r0 = v.rotors.front();
+  const double ct = runtime::thrust_coefficient_c_t(k, param(v, "rho").nominal, r0.disc_area, r0.radius);
+  FitOutputs out;
+  out.json = stand_json(path, v, f, k, ct, vref);
+  std::vector<Profile> all = f.thrust_profiles;
+  all.insert(all.end(), f.speed_profiles.begin(), f.speed_profiles.end());
+  add_profile_plot(out, v.name + ": thrust stand profiles", all);
+  const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
+  add_plot(out, "fit.svg", v.name + ": thrust stand", stand_panels(samples, f, shared));
+  out.summary = stand_summary(f, motors, k, ct, vref);
   return out;
 }
 

@@ -525,7 +525,7 @@ void check_accelerometer_unit(const std::string& path, const Flight& f) {
     for (const auto& sample : S) {
       measured.push_back(Eigen::Vector3d(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]).norm());
       // What the pose says it must be: |a - g|, the acceleration less gravity (z up).
-      from_pose.push_back(Eigen::Vector3d(sample.acc_world[0], sample.acc_world[1], sample.acc_world[2] + 9.80665).norm());
+      from_pose.push_back(Eigen::Vector3d(sample.acc_world[0], sample.acc_world[1], sample.acc_world[2] + kStandardGravity).norm());
     }
     const double median = median_of(measured);
     // Near 1 where flight gives near 9.8; with a pose, only where the pose says so too (a drop

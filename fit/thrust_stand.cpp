@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "fit/flight_data.hpp"
+#include "model/units.hpp"
 #include "output/numbers.hpp"
 #include "runtime/flight_log.hpp"
 #include "runtime/thrust_law.hpp"
@@ -66,7 +67,7 @@ std::vector<StandSample> read_thrust_stand(const std::string& path) {
   std::vector<StandSample> out;
   for (size_t k = 0; k < t.rows.size(); ++k) {
     StandSample s;
-    s.thrust = checked(t, k, cw, -1e9, 1e9, "|weight| <= 1e9 g") * 1e-3 * 9.80665;  // grams-force -> N
+    s.thrust = checked(t, k, cw, -1e9, 1e9, "|weight| <= 1e9 g") * 1e-3 * kStandardGravity;  // grams-force -> N
     s.u = checked(t, k, cu, 0, 65535, "a PWM command in [0, 65535]") / 65535.0;
     s.vbat = checked(t, k, cv, 0, 1000, "a battery voltage in [0, 1000] V");
     for (int c : speed_columns) s.w.push_back(checked(t, k, c, 0, 1e9, "a rotor speed in [0, 1e9] rpm") * rpm);

@@ -54,7 +54,7 @@ struct PhysicalDomain {
 
 // One sentence in words for a person reading a report ("Motor C gives 8 % less thrust than
 // motor A"), from the fitted values by parameter name; `reference` is the parameter held at
-// off (first_parameter_is_reference), or empty.
+// off (the first parameter, where only ratios are identifiable: ratios_only_beside), or empty.
 using Headline = std::function<std::string(const std::map<std::string, double>& values, const std::string& reference)>;
 
 // One home per effect: its symbolic change, and what fits and the diagnosis need to know
@@ -75,9 +75,13 @@ struct Effect {
   // "Off" is the parameters' lower bound, not their nominal value (a nominal rotor lag of
   // 1 ms keeps simulations non-stiff; equation error has no such limit).
   bool off_at_lower_bound = false;
-  // Beside c_t only ratios between the parameters are identifiable: the first is the
-  // reference, held at off.
-  bool first_parameter_is_reference = false;
+  // The parameter beside which only ratios between this effect's parameters are identifiable
+  // ("c_t" for the motor gains: all four 10 % up is c_t 10 % up). Where the model fits it, the
+  // effect's first parameter is the reference, held at off; where it is held (a vehicle file
+  // without `fit: true`), every one is free, and a gain common to all motors is measured as
+  // such (a researcher's trial, helper-148: with c_t held, a 1.2 % thrust change came out as
+  // three motors 0.5-2.6 % stronger than the first). Empty: no reference.
+  std::string ratios_only_beside;
   // A property of the flight rather than of the airframe (a motor trim that changes when a
   // motor or the battery is re-seated, the wind of the day): when several flights are
   // diagnosed together, each flight has its own values (runtime::PerFlightModel).

@@ -23,6 +23,10 @@ struct Dimension {
   std::string str() const;  // e.g. "kg m s^-2", "1"
 };
 
+// Standard gravity [m/s^2] (CGPM 1901): a gram-force in newtons is 1e-3 of it, and an
+// accelerometer logged in g reads in m/s^2 times it.
+inline constexpr double kStandardGravity = 9.80665;
+
 // A parsed unit: value_in_SI = value_in_unit * scale.
 struct Unit {
   double scale = 1.0;

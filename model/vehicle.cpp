@@ -54,6 +54,47 @@ struct Reader : YamlReader {
     return s;
   }
 
+  // The factor from a parameter's written unit to its SI unit, which must have its dimension.
+  double unit_scale(const YAML::Node& unit, const std::string& name, const Unit& si) const {
+    Unit u;
+    try {
+      u = parse_unit(text(unit, "unit of " + name));
+    } catch (const UnitError& e) {
+      fail(unit, e.what());
+    }
+    if (u.dim != si.dim) fail(unit, "unit of " + name + " must have dimension " + si.dim.str() + ", got " + u.dim.str());
+    return u.scale / si.scale;
+  }
+
+  // A parameter's bounds [lower, upper], in the value's unit (`scale` to SI), around its value.
+  void read_bounds(const YAML::Node& n, double scale, Parameter& p) const {
+    const std::string& name = p.name;
+    const YAML::Node b = n["bounds"];
+    if (!b.IsSequence() || b.size() != 2) fail(b, "expected bounds [lower, upper] for " + name);
+    p.lower = number(b[0], "lower bound of " + name) * scale;
+    p.upper = number(b[1], "upper bound of " + name) * scale;
+    if (!(p.lower < p.upper)) fail(b, "expected lower < upper in bounds of " + name);
+    if (p.nominal >= p.lower && p.nominal <= p.upper) return;
+    const std::string unit = n["unit"] ? " " + n["unit"].as<std::string>() : "";
+    const auto twelve_digits = [](double v) {
+      std::ostringstream os;
+      os.precision(12);
+      os << v;
+      return os.str();
+    };
+    fail(b, "nominal value of " + name + ", " + twelve_digits(p.nominal / scale) + unit + ", lies outside its bounds [" +
+                twelve_digits(p.lower / scale) + ", " + twelve_digits(p.upper / scale) + "]" + unit +
+                (unit.empty() ? "" : " (bounds are in the value's unit)"));
+  }
+
+  bool fit_flag(const YAML::Node& fit, const std::string& name) const {
+    try {
+      return fit.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(fit, "expected true or false for fit of " + name);
+    }
+  }
+
   // A parameter is either a bare number (in the SI unit) or
   // {value, unit, bounds: [lo, hi], fit: bool}.
   Parameter parameter(const YAML::Node& n, const std::string& name, const std::string& si_unit,
@@ -73,45 +114,11 @@ struct Reader : YamlReader {
     } else {
       require_map(n, "parameter " + name);
       only_keys(n, {"value", "unit", "bounds", "fit", "source"}, "parameter " + name);
-      if (n["unit"]) {
-        Unit u;
-        try {
-          u = parse_unit(text(n["unit"], "unit of " + name));
-        } catch (const UnitError& e) {
-          fail(n["unit"], e.what());
-        }
-        if (u.dim != si.dim)
-          fail(n["unit"], "unit of " + name + " must have dimension " + si.dim.str() + ", got " + u.dim.str());
-        scale = u.scale / si.scale;
-      }
+      if (n["unit"]) scale = unit_scale(n["unit"], name, si);
       p.nominal = number(need(n, "value", "parameter " + name), name) * scale;
       if (scale != 1.0) p.as_written = n["value"].Scalar() + " " + n["unit"].Scalar();
-      if (n["bounds"]) {
-        const YAML::Node b = n["bounds"];
-        if (!b.IsSequence() || b.size() != 2) fail(b, "expected bounds [lower, upper] for " + name);
-        p.lower = number(b[0], "lower bound of " + name) * scale;
-        p.upper = number(b[1], "upper bound of " + name) * scale;
-        if (!(p.lower < p.upper)) fail(b, "expected lower < upper in bounds of " + name);
-        if (p.nominal < p.lower || p.nominal > p.upper) {
-          const std::string unit = n["unit"] ? " " + n["unit"].as<std::string>() : "";
-          const auto shortest_text = [](double v) {
-            std::ostringstream os;
-            os.precision(12);
-            os << v;
-            return os.str();
-          };
-          fail(b, "nominal value of " + name + ", " + shortest_text(p.nominal / scale) + unit + ", lies outside its bounds [" +
-                      shortest_text(p.lower / scale) + ", " + shortest_text(p.upper / scale) + "]" + unit +
-                      (unit.empty() ? "" : " (bounds are in the value's unit)"));
-        }
-      }
-      if (n["fit"]) {
-        try {
-          p.fit = n["fit"].as<bool>();
-        } catch (const YAML::Exception&) {
-          fail(n["fit"], "expected true or false for fit of " + name);
-        }
-      }
+      if (n["bounds"]) read_bounds(n, scale, p);
+      if (n["fit"]) p.fit = fit_flag(n["fit"], name);
       if (p.fit && !n["bounds"]) fail(n, "parameter " + name + " is to be fitted but has no bounds");
     }
     if (p.lower == 0 && p.upper == 0) {  // no bounds given: the nominal value only

@@ -1,5 +1,6 @@
 #include "output/numbers.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -40,6 +41,10 @@ std::string p_value_cell(double p) {
 }
 
 std::string p_is(double p) { return (below_printed(p) ? "p " : "p = ") + p_value_cell(p); }
+
+bool equal_but_for_rounding(double a, double b) {
+  return std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b));
+}
 
 std::string full_number(double v) {
   // std::to_chars without a format gives the shortest text that reads back as v, plain or

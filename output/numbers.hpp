@@ -26,6 +26,10 @@ std::string full_number(double v);
 // "a then b" with six significant digits, or as many more as tell them apart: a log whose time
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
 std::string one_then_other(double a, double b);
+// Equal to 1e-12 relative, not bit for bit: the same value carried through another path (a
+// file's number read again, a header compiled where a*b+c is contracted) may differ in its
+// last bits. Not equal where either is NaN.
+bool equal_but_for_rounding(double a, double b);
 // A unit as a person reads it: every power raised ("kg m^2" -> "kg m²", "s^-1" -> "s⁻¹"); a
 // '^' not followed by digits is kept ("R^T"). For sentences, tables and plot axes (the SVG;
 // the CSV beside it keeps the label as declared). The fields a program reads keep the unit as

@@ -733,6 +733,14 @@ OutputFiles::OutputFiles(const std::vector<std::string>& paths, const std::strin
   if (fs::exists(fs::symlink_status(parent / kManifestName, manifest_ec)))
     fail(parent, "is the output directory of another quadgen run (it holds " + std::string(kManifestName) +
                      "); a file written there would make it refuse its next run: choose another folder");
+  // The records are replaced at the end, after the files are moved: one that cannot be (a
+  // directory there) failed the run with its files already in place (helper-146).
+  for (const char* name : {kFilesRecordName, kPendingRecordName}) {
+    struct stat st {};
+    if (::lstat((parent / name).c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      fail(parent / name, "exists and is not a regular file (a link or a directory): quadgen keeps its record of the "
+                          "files it wrote there under this name; remove it or choose another folder");
+  }
   // A file already at a path is replaced only if the record beside it says this command
   // wrote it there and it is unchanged since: a flight log of the user's looks like a
   // trajectory, a plot of theirs may be gnuplot's too.

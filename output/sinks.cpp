@@ -313,7 +313,7 @@ std::string gnuplot_string(const std::string& s) {
   }
   std::string out = "'";
   for_each_char(safe, [&](const std::string& c) {
-    if (c == "'") out += "''";
+    if (c == "'") out += "'.\"'\".'";  // see gnuplot_string's comment
     else if (c.size() == 1 && control(static_cast<unsigned char>(c[0]))) out += ' ';
     else if (invisible_control(c)) out += printable(c);  // shown, not obeyed, in the SVG and the page it lands in
     else if (c == "\xEF\xBF\xBE" || c == "\xEF\xBF\xBF") out += '?';

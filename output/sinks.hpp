@@ -55,8 +55,11 @@ std::string cpp_string_literal(const std::string& s);
 // throws std::invalid_argument naming `what` otherwise. The generator's last line of defence.
 const std::string& checked_cpp_identifier(const std::string& s, const std::string& what);
 
-// A gnuplot single-quoted string, quotes included. Inside single quotes gnuplot expands neither
-// backquotes nor macros and knows one escape ('' for '); control characters, which would end
+// A gnuplot string expression of single-quoted strings, quotes included. Inside single quotes
+// gnuplot expands neither backquotes nor macros. Its one escape there ('' for ') fails where
+// the quote opens the text or follows one ("'b.csv" read as '' and then b.csv: the plot was
+// lost, a hostile-input review, helper-146), so each ' is its own double-quoted string joined
+// by gnuplot's '.' ('it'."'".'s'), which every label context takes. Control characters, which would end
 // the command line, become spaces, and the bidirectional controls are shown as \xNN (as
 // printable does): the SVG gnuplot writes lands in report.html. The & of "&#x", which the SVG
 // terminal would pass on as a character reference, is written as &#x26; (shown as &). Labels

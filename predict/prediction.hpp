@@ -55,7 +55,7 @@ struct PredictionOptions {
   double start_stride = 0.05;  // s between start points (5 samples at 100 Hz)
   double step = 1e-3;          // s, RK4 step
   // A start whose horizon crosses a gap in the log (trimmed ground contact) is not counted.
-  double max_gap = 0.1;  // s, as Rollout::kMaxGap
+  double max_gap = Rollout::kMaxGap;  // s
   // Seconds of log before each start from which the open loop with the past disturbance
   // takes the disturbance it holds (Rollout::past_disturbance); 0: that view is not run.
   double disturbance_window = 0.5;

@@ -6,6 +6,10 @@
 
 namespace quadgen::runtime {
 
+// Angles in degrees where people or a firmware read them (plots, reports, the Crazyflie's
+// attitude loop, which works in degrees).
+inline constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+
 inline std::array<double, 3> euler_zyx(double w, double x, double y, double z) {
   const double sin_theta = std::fmax(-1.0, std::fmin(1.0, 2 * (w * y - z * x)));
   return {std::atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y)), std::asin(sin_theta),

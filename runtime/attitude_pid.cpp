@@ -5,11 +5,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "runtime/attitude.hpp"
+
 namespace quadgen::runtime {
 
 namespace {
 
-constexpr double kDegPerRad = 57.29577951308232;
+constexpr double kDegPerRad = kDegreesPerRadian;  // short: the loop's formulas read it often
 
 double clamp_to(double v, double limit) { return limit > 0 ? std::clamp(v, -limit, limit) : v; }
 

@@ -20,6 +20,15 @@ inline constexpr int kNumStates = 13;  // the first state an effect adds
 inline constexpr const char* kStateNames[kNumStates] = {"x",  "y",  "z",  "vx", "vy", "vz", "qw",
                                                         "qx", "qy", "qz", "p",  "q",  "r"};
 
+// The derivatives an equation-error fit compares with the model's, its residual's six
+// channels as --channels, fit.json and a term found beyond the catalogue name them: the
+// acceleration, then the angular acceleration (the gyro's derivative). The acceleration is the
+// accelerometer's specific force in body axes or the differentiated velocity in world axes:
+// fit calls both ax, ay, az; a diagnosis tells the world ones apart by their own names.
+inline constexpr const char* kResidualChannels[6] = {"ax", "ay", "az", "pdot", "qdot", "rdot"};
+inline constexpr const char* kWorldAccelerationChannels[3] = {"ax_world", "ay_world", "az_world"};
+inline constexpr const char* kResidualChannelUnits[6] = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
+
 // The velocity in body axes, R^T v, of a state vector.
 inline std::array<double, 3> body_velocity(const double* x) {
   const Rotation R = rotation_matrix(&x[kAttitude]);

@@ -2073,6 +2073,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   d.at_bounds = {d.search.final_fit[2]};
   d.channel_names = {"az_world"}, d.channel_units = {"m/s^2"};
   d.channel_gain = {{"az_world", 0.2575, 0.371}};
+  d.file_values["c_w"] = 1.1;  // beside the fitted value; kappa's is not given: a dash
   const std::string html = dg::diagnosis_html(d, "dir/B3.csv", {{"validation.svg", "<svg></svg>"}});
   const size_t glance = html.find("<table class=\"glance\">"), findings = html.find("<h2>Findings</h2>");
   ASSERT_NE(glance, std::string::npos);
@@ -2096,10 +2097,10 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(html.find("<figcaption><b>What to look for:</b> the held-out part"), std::string::npos);
   const size_t base = html.find("<h2>The vehicle's own parameters, as fitted</h2>");
   ASSERT_NE(base, std::string::npos);
-  EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on its bound</td></tr>", base),
+  EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>1.1</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on its bound</td></tr>", base),
             std::string::npos);
   EXPECT_EQ(html.find("<tr><td>mass</td>", base), std::string::npos);  // held, not fitted
-  EXPECT_NE(html.find("<tr><td>kappa</td><td>0.5</td><td>&lt;b&gt;m²</td>", base), std::string::npos);  // raised, then escaped
+  EXPECT_NE(html.find("<tr><td>kappa</td><td>0.5</td><td>&ndash;</td><td>&lt;b&gt;m²</td>", base), std::string::npos);  // raised, then escaped
   const std::string summary = dg::diagnosis_summary(d);
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
                          "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s² (44.1 % higher)\n"),

@@ -63,6 +63,7 @@ namespace {
 const std::vector<std::string>& hostile_strings() {
   static const std::vector<std::string> s = {
       "a'b\"c",
+      "'leading quote, doubled '' and closing'",
       "x\nsystem \"touch PWNED\"\n#",
       "x'\nsystem \"touch PWNED\"\nset title 'y",
       "`touch PWNED`",
@@ -453,6 +454,20 @@ TEST(Sinks, GnuplotRunsNoCommandAndDrawsTheLabelsAsText) {
     EXPECT_EQ(svg.find("\xef\xbf\xbe"), std::string::npos) << out::printable(s);
   }
   EXPECT_TRUE(fs::is_empty(tmp.dir));  // nothing left behind: no data or script files
+}
+
+// Every quote of a label reaches the plot as text: gnuplot's '' escape lost a plot whose label
+// began with a quote or held two together (a hostile-input review, helper-146).
+TEST(Sinks, GnuplotDrawsEveryQuoteOfALabel) {
+  for (const std::string label : {"'b.csv", "it''s", "end'", "''", "'"}) {
+    quadgen::runtime::Panel p;
+    p.title = "panel " + label;
+    p.series.push_back({"series " + label, {0, 1, 2}, {1, 0, 1}});
+    std::string svg, err;
+    ASSERT_TRUE(quadgen::runtime::render_svg("plot " + label, {p}, &svg, &err)) << label << ": " << err;
+    for (const std::string shown : {"plot " + label, "panel " + label, "series " + label})
+      EXPECT_NE(svg.find(">" + shown + "<"), std::string::npos) << shown;
+  }
 }
 
 // The second line of defence behind gnuplot's escaping: an SVG whose tags hold script is
@@ -1198,6 +1213,28 @@ TEST(DataLoss, SimulateRecordCannotBeForgedThroughANameOrAnEdit) {
   expect_one_line_error(simulate_to(tmp / "flight07.csv"), "is not a file 'quadgen simulate' wrote there", "forged line");
   expect_one_line_error(simulate_to(tmp / "run.csv"), "is not a file 'quadgen simulate' wrote there", "edited record");
   EXPECT_EQ(read(tmp / "flight07.csv"), flight);
+}
+
+// A record that is a directory or a link is refused before anything is written: a directory
+// failed the run after its files were moved into place, every later run too, and a link was
+// replaced without a word (a hostile-input review, helper-146).
+TEST(DataLoss, ARecordThatIsNoRegularFileIsRefusedBeforeTheWork) {
+  Scratch tmp;
+  const std::string vehicle = source_path("vehicles/finken3.yaml");
+  write(tmp / "elsewhere.txt", "the user's");
+  for (const std::string record : {".quadgen-files", ".quadgen-files-pending"})
+    for (const bool directory : {true, false}) {
+      const fs::path dir = fs::path(tmp.dir) / (record.substr(1) + (directory ? "_dir" : "_link"));
+      fs::create_directories(dir);
+      if (directory) fs::create_directories(dir / record);
+      else fs::create_symlink(tmp / "elsewhere.txt", dir / record);
+      const auto r = run_quadgen({"simulate", vehicle, "--scenario", "hover", "--duration", "0.1", "--out",
+                                  (dir / "run.csv").string()}, tmp.dir);
+      expect_one_line_error(r, "is not a regular file", record + (directory ? " a directory" : " a link"));
+      EXPECT_FALSE(fs::exists(dir / "run.csv")) << record;
+      EXPECT_FALSE(fs::exists(dir / "run.svg")) << record;
+    }
+  EXPECT_EQ(read(tmp / "elsewhere.txt"), "the user's");
 }
 
 // The manifests' hash is FNV-1a 64 as published (test vectors of Fowler, Noll and Vo); a
@@ -2101,7 +2138,8 @@ TEST(Sinks, APlotsAxesRaiseTheirPowersAndItsCsvKeepsThem) {
   const std::vector<Panel> panels{{"a", "k [N s^2]", "m/s^2'; system('touch PWNED')", {Series{"s", {0, 1}, {0, 1}}}}};
   const std::string script = quadgen::runtime::gnuplot_script("t", panels);
   EXPECT_NE(script.find("set xlabel 'k [N s²]' noenhanced"), std::string::npos) << script;
-  EXPECT_NE(script.find("set ylabel 'm/s²''; system(''touch PWNED'')' noenhanced"), std::string::npos) << script;
+  EXPECT_NE(script.find("set ylabel 'm/s²'.\"'\".'; system('.\"'\".'touch PWNED'.\"'\".')' noenhanced"), std::string::npos)
+      << script;
   const std::string csv = quadgen::runtime::panels_csv("t", panels);
   EXPECT_NE(csv.find("k [N s^2]"), std::string::npos) << csv;
   EXPECT_EQ(csv.find("²"), std::string::npos) << csv;

@@ -856,7 +856,10 @@ TEST(Effects, DescriptorsReferToWhatTheEffectsDeclare) {
   }
   std::vector<std::string> names;
   for (const auto& p : all.params) names.push_back(p.name);
-  EXPECT_EQ(reference_parameters(names), (std::vector<std::string>{"motor_gain.A", "motor_lag_spread.A"}));
+  // The first of each effect's parameters where what they stand beside is fitted, none where it is held.
+  EXPECT_EQ(reference_parameters(names, {"c_t", "motor_lag.tau"}), (std::vector<std::string>{"motor_gain.A", "motor_lag_spread.A"}));
+  EXPECT_EQ(reference_parameters(names, {"motor_lag.tau"}), (std::vector<std::string>{"motor_lag_spread.A"}));
+  EXPECT_EQ(reference_parameters(names, {}), (std::vector<std::string>{}));
   EXPECT_THROW(find_effect("tether"), std::invalid_argument);
 }
 
@@ -1067,6 +1070,14 @@ TEST(Effects, EachFindingReadsAsASentence) {
             "The logged attitude is off by 1.7° in roll and -1.1° in pitch.");
   EXPECT_EQ(find_effect("cog_offset").headline({{"cog_offset.x", 0.01}, {"cog_offset.y", -0.005}}, ""),
             "The centre of gravity sits 10.0 mm ahead of and 5.0 mm right of where the blocks put it.");
+  // A component below 1 % of the other is left out (helper-148: "and 3.5e-06 mm left of").
+  EXPECT_EQ(find_effect("cog_offset").headline({{"cog_offset.x", 0.0037}, {"cog_offset.y", 3.5e-9}}, ""),
+            "The centre of gravity sits 3.7 mm ahead of where the blocks put it.");
+  EXPECT_EQ(find_effect("cog_offset").headline({{"cog_offset.x", -1e-7}, {"cog_offset.y", 0.002}}, ""),
+            "The centre of gravity sits 2.0 mm left of where the blocks put it.");
+  // No reference (c_t held): each motor against the model's thrust, not against another motor.
+  EXPECT_EQ(find_effect("motor_gain").headline({{"motor_gain.A", 0.012}, {"motor_gain.B", -0.01}}, ""),
+            "Motor A gives 1.2 % more thrust; motor B 1.0 % less.");
 }
 
 // A term found beyond the catalogue changes its channel by exactly the term: an angular

@@ -114,13 +114,14 @@ std::string missing_parameter_hint(const std::string& name, const std::vector<st
   return "; " + effect + "'s parameters here: " + output::joined(its);
 }
 
-std::vector<std::string> reference_parameters(const std::vector<std::string>& names) {
+std::vector<std::string> reference_parameters(const std::vector<std::string>& names, const std::set<std::string>& fitted) {
   std::vector<std::string> out;
   std::set<std::string> seen;
   for (const auto& n : names) {
     const std::string e = effect_of_parameter(n);
     if (e.empty() || !seen.insert(e).second) continue;
-    if (find_effect(e).first_parameter_is_reference) out.push_back(n);
+    const std::string& anchor = find_effect(e).ratios_only_beside;
+    if (!anchor.empty() && fitted.count(anchor)) out.push_back(n);
   }
   return out;
 }

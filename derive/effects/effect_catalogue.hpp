@@ -2,6 +2,7 @@
 // self-contained change of the model, described in its own file of this folder (effect.hpp
 // says what such a description holds); at its parameters' off values the model is unchanged.
 #pragma once
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,9 +51,10 @@ inline bool is_effect_parameter(const std::string& parameter) { return !effect_o
 std::string missing_parameter_hint(const std::string& name, const std::vector<std::string>& model_parameters);
 
 // Of these parameter names (in model order), those held at off whatever the fit flags
-// say: the first parameter of each effect identifiable only as ratios (motor_gain's first
-// rotor, when c_t is fitted beside the gains).
-std::vector<std::string> reference_parameters(const std::vector<std::string>& parameter_names);
+// say: the first parameter of each effect identifiable only as ratios beside a parameter
+// among `fitted` (motor_gain's first rotor where c_t is fitted; Effect::ratios_only_beside).
+std::vector<std::string> reference_parameters(const std::vector<std::string>& parameter_names,
+                                              const std::set<std::string>& fitted);
 
 // The value at which a parameter means "off": an effect parameter's nominal value, or its
 // lower bound for effects off there; a base-model parameter's nominal value.

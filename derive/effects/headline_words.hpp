@@ -4,6 +4,8 @@
 #include <map>
 #include <string>
 
+#include "runtime/attitude.hpp"
+
 namespace quadgen::headline {
 
 // A number for a sentence: between 0.01 and 10,000 with fixed decimals, none from 100 ("208"),
@@ -35,6 +37,6 @@ struct MotorComparisonWords {
 std::string motor_comparison(const std::map<std::string, double>& values, const std::string& reference,
                              const MotorComparisonWords& w);
 
-constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+using runtime::kDegreesPerRadian;
 
 }  // namespace quadgen::headline

@@ -1,5 +1,6 @@
-// motor_gain: the thrust of each rotor scaled by (1 + gain). Beside c_t only the ratios
-// between rotors are identifiable, so the first rotor is the reference.
+// motor_gain: the thrust of each rotor scaled by (1 + gain). Beside a fitted c_t only the
+// ratios between rotors are identifiable, so the first rotor is the reference; beside a held
+// c_t each rotor's gain is its own.
 
 #include "derive/effects/definitions.hpp"
 #include "derive/dynamics.hpp"
@@ -31,7 +32,7 @@ Effect motor_gain() {
   e.meaning = "thrust of each rotor scaled by (1 + value)";
   e.apply = terms;
   e.parameter_names = "motor_gain.<rotor>";  // as --help lists them
-  e.first_parameter_is_reference = true;
+  e.ratios_only_beside = "c_t";
   // The NanoBench flights of one Crazyflie trim their motors differently on every flight
   // (M4/M1 mean duty 1.03-1.20; docs/crazyflie_evidence.md).
   e.per_flight = true;

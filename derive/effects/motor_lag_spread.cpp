@@ -36,7 +36,7 @@ Effect motor_lag_spread() {
   e.meaning = "each motor's time constant motor_lag.tau (1 + value): motors that follow a command at different speeds";
   e.apply = terms;
   e.parameter_names = "motor_lag_spread.<rotor>";  // as --help lists them
-  e.first_parameter_is_reference = true;
+  e.ratios_only_beside = "motor_lag.tau";
   e.refines = "motor_lag";
   // No published spread of one batch's time constants was found; the ARPL log's authors give
   // one time constant for all four motors of their Crazyflie (0.072 s).
