@@ -11,6 +11,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/joined.hpp"
 #include "output/numbers.hpp"
+#include "output/progress.hpp"
 
 namespace quadgen::app {
 
@@ -122,7 +123,7 @@ DeriveJobResult run_derive_job(const DeriveJob& job, const Vehicle& vehicle) {
   r.files = {{"model.json", d.model_json}, {"derivation.md", d.derivation_md}, {"model.hpp", d.header.content}};
   r.audit_passed = d.audit.all_passed();
   r.note = note;
-  r.summary = summary_of(vehicle, mass_properties, d, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  r.summary = summary_of(vehicle, mass_properties, d, output::seconds_since(t0));
   return r;
 }
 

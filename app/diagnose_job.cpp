@@ -181,6 +181,15 @@ std::string logs_label(const std::vector<std::string>& paths) {
   return output::joined(paths, ", ", [](const std::string& p) { return output::shell_path(p); });
 }
 
+std::vector<std::string> plot_notes(const std::vector<std::string>& errors, bool none_drawn) {
+  std::set<std::string> reasons;
+  for (const std::string& e : errors) reasons.insert(e.substr(e.find(": ") + 2));
+  if (none_drawn && reasons.size() == 1) return {"no plots: " + *reasons.begin()};
+  std::vector<std::string> notes;
+  for (const std::string& e : errors) notes.push_back("no plot " + e);
+  return notes;
+}
+
 namespace {
 
 // The options the job's flags give beyond its DiagnoseOptions: the candidates, the environment.
@@ -206,17 +215,6 @@ std::string no_fitted_vehicle_note(const Vehicle& v) {
              : "note: no fitted_vehicle.yaml: a fitted: section cannot be added to this vehicle file's "
                "YAML (a flow-style or indented top level); fitted_parameters.yaml holds the values "
                "(quadgen derive VEHICLE --params fitted_parameters.yaml)";
-}
-
-// Every plot not drawn, said (a label gnuplot refused once lost three of six without a word:
-// helper-146); where none was drawn for one reason (gnuplot missing), that reason once.
-std::vector<std::string> plot_notes(const std::vector<std::string>& errors, bool none_drawn) {
-  std::set<std::string> reasons;
-  for (const std::string& e : errors) reasons.insert(e.substr(e.find(": ") + 2));
-  if (none_drawn && reasons.size() == 1) return {"no plots: " + *reasons.begin()};
-  std::vector<std::string> notes;
-  for (const std::string& e : errors) notes.push_back("no plot " + e);
-  return notes;
 }
 
 // What a diagnosis writes: the report, the extended model (and the model with the proposed

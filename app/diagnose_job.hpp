@@ -39,6 +39,11 @@ struct DiagnoseJobResult {
 // such a path never reads as two.
 std::string logs_label(const std::vector<std::string>& paths);
 
+// The notes for plots not drawn (each error "name.svg: why"): every one said ("no plot
+// name.svg: why"; a label gnuplot refused once lost three of six without a word: helper-146);
+// where none was drawn for one reason (gnuplot missing), that reason once ("no plots: why").
+std::vector<std::string> plot_notes(const std::vector<std::string>& errors, bool none_drawn);
+
 // Throws std::invalid_argument for an invalid job, and the layers' own errors (a bad vehicle
 // file or log, with file and line) unchanged.
 DiagnoseJobResult run_diagnose_job(const DiagnoseJob& job);

@@ -27,21 +27,19 @@ size_t tree_size(const ex& e, size_t limit) {
   return n;
 }
 
-std::string num(double v) { return output::six_digits(v); }
-
 void section_vehicle(std::ostringstream& md, const Derivation& d) {
   md << "## 1. Vehicle\n\n" << output::markdown_text(d.vehicle.description) << "\n\n";
   md << "| block | mass [kg] | size a × b × c [m] | centre [m] | yaw, pitch, roll [deg] |\n|---|---|---|---|---|\n";
   for (const Block& b : d.vehicle.blocks)
-    md << "| " << output::markdown_text(b.name) << " | " << num(b.mass) << " | " << num(b.size[0]) << " × " << num(b.size[1]) << " × "
-       << num(b.size[2]) << " | (" << num(b.centre[0]) << ", " << num(b.centre[1]) << ", " << num(b.centre[2])
-       << ") | " << num(b.yaw_pitch_roll_deg[0]) << ", " << num(b.yaw_pitch_roll_deg[1]) << ", "
-       << num(b.yaw_pitch_roll_deg[2]) << " |\n";
+    md << "| " << output::markdown_text(b.name) << " | " << output::six_digits(b.mass) << " | " << output::six_digits(b.size[0]) << " × " << output::six_digits(b.size[1]) << " × "
+       << output::six_digits(b.size[2]) << " | (" << output::six_digits(b.centre[0]) << ", " << output::six_digits(b.centre[1]) << ", " << output::six_digits(b.centre[2])
+       << ") | " << output::six_digits(b.yaw_pitch_roll_deg[0]) << ", " << output::six_digits(b.yaw_pitch_roll_deg[1]) << ", "
+       << output::six_digits(b.yaw_pitch_roll_deg[2]) << " |\n";
   md << "\n| rotor | position [m] | spin (from above) | r_p [m] | A_p [m²] |\n|---|---|---|---|---|\n";
   for (const Rotor& r : d.vehicle.rotors)
-    md << "| " << output::markdown_text(r.name) << " | (" << num(r.position[0]) << ", " << num(r.position[1]) << ", "
-       << num(r.position[2]) << ") | " << (r.spin == Spin::ccw ? "ccw" : "cw") << " | " << num(r.radius)
-       << " | " << num(r.disc_area) << " |\n";
+    md << "| " << output::markdown_text(r.name) << " | (" << output::six_digits(r.position[0]) << ", " << output::six_digits(r.position[1]) << ", "
+       << output::six_digits(r.position[2]) << ") | " << (r.spin == Spin::ccw ? "ccw" : "cw") << " | " << output::six_digits(r.radius)
+       << " | " << output::six_digits(r.disc_area) << " |\n";
   md << "\n";
 }
 
@@ -58,9 +56,9 @@ void given_values(std::ostringstream& md, const Derivation& d) {
     if (d.vehicle.derived_given.count(q.name)) {
       const double given = d.vehicle.derived_overrides.at(q.name).nominal;
       const double used = d.model.params[d.model.param_index(q.name)].nominal;
-      md << separator << "`" << q.name << "` = " << num(given) << " " << output::unit_for_reading(q.unit);
+      md << separator << "`" << q.name << "` = " << output::six_digits(given) << " " << output::unit_for_reading(q.unit);
       if (!output::equal_but_for_rounding(used, given))
-        md << " (replaced by the fitted " << num(used) << " " << output::unit_for_reading(q.unit) << ")";
+        md << " (replaced by the fitted " << output::six_digits(used) << " " << output::unit_for_reading(q.unit) << ")";
       separator = "; ";
     }
   md << ".\n\n";
@@ -86,20 +84,20 @@ void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
      << "| block | J_xx | J_yy | J_zz | J_xy | J_xz | J_yz | A_x | A_y | A_z |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& b : mp.blocks) {
     const auto& J = b.inertia_origin_value;
-    md << "| " << output::markdown_text(b.name) << " | " << num(J[0][0]) << " | " << num(J[1][1]) << " | " << num(J[2][2]) << " | "
-       << num(J[0][1]) << " | " << num(J[0][2]) << " | " << num(J[1][2]) << " | " << num(b.areas_value[0])
-       << " | " << num(b.areas_value[1]) << " | " << num(b.areas_value[2]) << " |\n";
+    md << "| " << output::markdown_text(b.name) << " | " << output::six_digits(J[0][0]) << " | " << output::six_digits(J[1][1]) << " | " << output::six_digits(J[2][2]) << " | "
+       << output::six_digits(J[0][1]) << " | " << output::six_digits(J[0][2]) << " | " << output::six_digits(J[1][2]) << " | " << output::six_digits(b.areas_value[0])
+       << " | " << output::six_digits(b.areas_value[1]) << " | " << output::six_digits(b.areas_value[2]) << " |\n";
   }
   const auto& Jc = mp.inertia_cog_value;
   // $`...`$: GitHub's Markdown would read the TeX's "\_" in $...$ as an escaped "_" (a subscript).
-  md << "\nTotals: $`m = " << tex.tex(mp.mass) << "`$ = **" << num(mp.mass_value) << " kg**; centre of gravity "
-     << "$c = \\frac{1}{m}\\sum m_i c_i$ = **(" << num(mp.cog_value[0]) << ", " << num(mp.cog_value[1]) << ", "
-     << num(mp.cog_value[2]) << ") m**; exposed areas **(" << num(mp.areas_value[0]) << ", "
-     << num(mp.areas_value[1]) << ", " << num(mp.areas_value[2]) << ") m²**.\n\n"
+  md << "\nTotals: $`m = " << tex.tex(mp.mass) << "`$ = **" << output::six_digits(mp.mass_value) << " kg**; centre of gravity "
+     << "$c = \\frac{1}{m}\\sum m_i c_i$ = **(" << output::six_digits(mp.cog_value[0]) << ", " << output::six_digits(mp.cog_value[1]) << ", "
+     << output::six_digits(mp.cog_value[2]) << ") m**; exposed areas **(" << output::six_digits(mp.areas_value[0]) << ", "
+     << output::six_digits(mp.areas_value[1]) << ", " << output::six_digits(mp.areas_value[2]) << ") m²**.\n\n"
      << "Inertia about the centre of gravity, $J_{cg} = J_o - m(|c|^2 I - c c^T)$ [kg m²]:\n\n"
-     << "```math\nJ_{cg} = \\begin{pmatrix}" << num(Jc[0][0]) << " & " << num(Jc[0][1]) << " & " << num(Jc[0][2])
-     << " \\\\ " << num(Jc[1][0]) << " & " << num(Jc[1][1]) << " & " << num(Jc[1][2]) << " \\\\ "
-     << num(Jc[2][0]) << " & " << num(Jc[2][1]) << " & " << num(Jc[2][2]) << "\\end{pmatrix}\n```\n\n"
+     << "```math\nJ_{cg} = \\begin{pmatrix}" << output::six_digits(Jc[0][0]) << " & " << output::six_digits(Jc[0][1]) << " & " << output::six_digits(Jc[0][2])
+     << " \\\\ " << output::six_digits(Jc[1][0]) << " & " << output::six_digits(Jc[1][1]) << " & " << output::six_digits(Jc[1][2]) << " \\\\ "
+     << output::six_digits(Jc[2][0]) << " & " << output::six_digits(Jc[2][1]) << " & " << output::six_digits(Jc[2][2]) << "\\end{pmatrix}\n```\n\n"
      << "These stay expressions in the block symbols ($m_i, a_i, b_i, c_i, x_i, y_i, z_i$): a changed "
         "vehicle file re-derives them. They enter the dynamics as parameters `mass`, `cog_*`, `J_*`, `A_*` "
         "with these nominal values, so that a fit may free them.\n\n";
@@ -233,7 +231,7 @@ void variable_table(std::ostringstream& md, const std::string& title, const std:
     const auto& v = vars[i];
     md << "| " << i << " | " << output::markdown_code(v.name) << " | " << output::markdown_text(output::unit_for_reading(v.unit)) << " | ";
     if (params)
-      md << num(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + num(v.lower) + ", " + num(v.upper) + "]")
+      md << output::six_digits(v.nominal) << " | " << (v.lower == v.upper ? std::string("-") : "[" + output::six_digits(v.lower) + ", " + output::six_digits(v.upper) + "]")
          << " | " << (v.fit ? "yes" : "no") << " | ";
     md << output::markdown_text(v.doc)
        << (v.as_written.empty() ? "" : " (the vehicle file: " + output::markdown_text(v.as_written) + ")") << " |\n";
@@ -265,7 +263,7 @@ void section_audit(std::ostringstream& md, const Derivation& d) {
     md << "**The hover trim above is the base model's; the header declares this model's own:** "
        << output::markdown_text(d.trim_moved_by_effects) << ". Commands";
     for (size_t i = 0; i < d.hover_trim.commands.size() && i < d.vehicle.rotors.size(); ++i)
-      md << (i ? ", " : " ") << output::markdown_text(d.vehicle.rotors[i].name) << " " << num(d.hover_trim.commands[i]);
+      md << (i ? ", " : " ") << output::markdown_text(d.vehicle.rotors[i].name) << " " << output::six_digits(d.hover_trim.commands[i]);
     md << "; |f| = " << output::short_number(d.hover_residual) << " there.\n\n";
   }
 }

@@ -24,6 +24,7 @@
 #include "output/joined.hpp"
 #include "output/names.hpp"
 #include "output/numbers.hpp"
+#include "output/progress.hpp"
 #include "runtime/rigid_body_state.hpp"
 
 namespace quadgen::diagnose {
@@ -360,21 +361,12 @@ void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit:
 
 // Left over: slow structure the noise cannot explain. The final model carries the stronger
 // of each look-alike pair (either explains the discrepancy; only the name is open).
-// Of several flights, the window is told on the clock of the flight it starts in (the joined
-// clock's "t = 54.1..55.1 s" of two 30 s flights named neither: helper-148).
-std::vector<Unexplained> unexplained(const ResidualAnalysis& left, const DiagnoseOptions& opt,
-                                     const std::vector<double>& flight_starts) {
+std::vector<Unexplained> unexplained(const ResidualAnalysis& left, const DiagnoseOptions& opt) {
   std::vector<Unexplained> out;
   for (const auto& c : left.channels) {
     if (!(c.slow_p_value < opt.unexplained_p && c.slow_ratio > opt.unexplained_ratio)) continue;
     Unexplained u{c.name, c.unit, c.slow_rms, c.slow_ratio, c.slow_p_value, c.worst_window_t0, c.worst_window_t1,
                   c.worst_window_mean, "", 0};
-    if (flight_starts.size() > 1) {
-      const auto later = std::upper_bound(flight_starts.begin(), flight_starts.end(), u.t0);
-      const size_t k = later == flight_starts.begin() ? 0 : static_cast<size_t>(later - flight_starts.begin()) - 1;
-      u.flight = static_cast<int>(k) + 1;
-      u.t0 -= flight_starts[k], u.t1 -= flight_starts[k];
-    }
     if (!c.correlations.empty()) u.signal = c.correlations.front().signal, u.r = c.correlations.front().r;
     out.push_back(u);
   }
@@ -407,6 +399,17 @@ void set_formulation(bool accelerometer, Diagnosis& d) {
 }
 
 }  // namespace
+
+void place_on_their_flights(std::vector<Unexplained>& windows, const std::vector<fit::Flight>& flights) {
+  if (flights.size() < 2) return;
+  const std::vector<double> starts = fit::joined_start_times(flights), offsets = fit::join_offsets(flights);
+  for (Unexplained& u : windows) {
+    const size_t k = static_cast<size_t>(std::max(0, fit::joined_flight_at(starts, u.t0)));
+    u.flight = static_cast<int>(k) + 1;
+    u.t0 -= offsets[k];
+    u.t1 = std::min(u.t1 - offsets[k], flights[k].samples.back().t);  // not into the gap or the next flight
+  }
+}
 
 AgreementInputs agreement_inputs(const Diagnosis& d, const SymbolicModel& all, runtime::DynamicModel& model,
                                  const std::vector<fit::Flight>& flights, double validation_fraction, bool accelerometer,
@@ -598,7 +601,7 @@ void add_suspects_of_the_search(Diagnosis& d) {
 }
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+using output::seconds_since;
 
 // The held-out part, base against extended model: the report's metric (with its windowed
 // simulations), the errors at horizons as published models report them (without a pose,
@@ -888,8 +891,9 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   analyse_what_is_wrong(v, used, all_ee, d);
   clock.say("validation of the base and the extended model; prediction error at horizons");
   measure_held_out(d, held_out_gain, model, valid, valid_ee);
+  d.unexplained = unexplained(d.after, opt);
+  place_on_their_flights(d.unexplained, flights);
   const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
-  d.unexplained = unexplained(d.after, opt, flight_starts);
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
 
   // 5. Beyond the catalogue: a term proposed from what is left, regenerated and tested.

@@ -165,6 +165,12 @@ struct Unexplained {
   int flight = 0;
 };
 
+// Of several flights diagnosed together, each window told on the clock of the flight it
+// starts in, as that log alone reads it (the joined clock's "t = 54.1..55.1 s" of two 30 s
+// flights named neither: a researcher's trial, helper-148), ending with that flight. One
+// flight: unchanged.
+void place_on_their_flights(std::vector<Unexplained>& windows, const std::vector<fit::Flight>& flights);
+
 struct ChannelGain {
   std::string channel;
   double before = 0, after = 0;  // validation equation-error RMS

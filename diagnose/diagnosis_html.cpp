@@ -116,13 +116,13 @@ void command_gain_html(std::ostream& h, const Diagnosis& d, Figures& figures) {
   h << "<h2>The answer to the commands</h2>\n<p>Gain of the measured on the base model's accelerations, band by band "
        "(1: the motor map's slope at the operating point is right), with the correlation and the delay of the model "
        "that correlates best. The lowest band carries the controller's answer to slow disturbances. A band whose "
-       "correlation is below " << num(CommandGain::kMinR, 2) << " shows no gain: there the commands explain too "
+       "correlation is below " << significant(CommandGain::kMinR, 2) << " shows no gain: there the commands explain too "
        "little of the measured (a closed loop that only answers disturbances, no excitation) for the gain to mean "
        "the slope. Even well correlated, a closed loop reads low in band (generated flights with an exact map: "
        "0.55-0.8 at 4-8 Hz), so a gain below 1 is a lead, not a measurement of the map.</p>\n"
        "<table><tr>"
     << (d.command_gain_per_flight.empty() ? "" : "<th>flight</th>") << "<th>axis</th>";
-  for (const auto& b : first->axes.front().bands) h << "<th>" << num(b.low_hz, 2) << "&ndash;" << num(b.high_hz, 2) << " Hz</th>";
+  for (const auto& b : first->axes.front().bands) h << "<th>" << significant(b.low_hz, 2) << "&ndash;" << significant(b.high_hz, 2) << " Hz</th>";
   h << "</tr>\n";
   // Flights numbered as in the agreement table and under the title: two logs whose names differ
   // only by a trailing blank read alike (a review, helper-135).
@@ -135,8 +135,8 @@ void command_gain_html(std::ostream& h, const Diagnosis& d, Figures& figures) {
                                                          std::to_string(k + 1) + ".&nbsp;" + esc(file_name_of(flight)) + "</td>")
         << "<td>" << esc(a.name) << "</td>";
       for (const auto& b : a.bands)
-        if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << num(b.r, 2) << ")</td>";
-        else h << "<td>" << num(b.gain, 2) << " (r " << num(b.r, 2) << ", " << num(1000 * b.delay_s, 2) << " ms)</td>";
+        if (b.r < CommandGain::kMinR) h << "<td>&mdash; (r " << significant(b.r, 2) << ")</td>";
+        else h << "<td>" << significant(b.gain, 2) << " (r " << significant(b.r, 2) << ", " << significant(1000 * b.delay_s, 2) << " ms)</td>";
       h << "</tr>\n";
     }
   }
@@ -163,7 +163,7 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
       const auto& c = t.coefficients[i];
       h << (i ? "<br>" : "") << esc(c.regressor) << ": " << estimate(c.value, c.lower, c.upper) << " " << unit_html(c.unit);
     }
-    h << "</td><td>" << num(t.valid_rms_before, 3) << " &rarr; " << num(t.valid_rms_after, 3) << " " << unit_html(t.unit)
+    h << "</td><td>" << significant(t.valid_rms_before, 3) << " &rarr; " << significant(t.valid_rms_after, 3) << " " << unit_html(t.unit)
       << "</td><td>" << verdict_cell(t) << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -171,8 +171,8 @@ void discovered_terms_html(std::ostream& h, const Diagnosis& d) {
   if (g.measured)
     h << "<p>With the proposed terms regenerated into the model (<code>discovered_model.hpp</code>) and simulated like an "
          "effect: "
-      << esc(g.metric) << " " << num(g.before, 3) << " &rarr; " << num(g.after, 3) << " (gain per held-out fold "
-      << num(g.gain_mean, 3) << " &plusmn; " << num(g.gain_standard_error, 3) << ")"
+      << esc(g.metric) << " " << significant(g.before, 3) << " &rarr; " << significant(g.after, 3) << " (gain per held-out fold "
+      << significant(g.gain_mean, 3) << " &plusmn; " << significant(g.gain_standard_error, 3) << ")"
       << esc(terms_gain_verdict(g.gain_mean, g.gain_standard_error)) << ".</p>\n";
   else if (!g.note.empty())
     h << "<p>" << esc(g.note) << ".</p>\n";
@@ -232,7 +232,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
         if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
     const double pad = 0.05 * (hi - lo) + 1e-300;
     lo -= pad, hi += pad;
-    const auto at = [&](double v) { return num(100 * (v - lo) / (hi - lo), 4) + "%"; };
+    const auto at = [&](double v) { return significant(100 * (v - lo) / (hi - lo), 4) + "%"; };
     // One precision for the table: each flight's value apart from its interval's sides, and
     // the reference's apart from them too (a review, helper-119: "-0.08 against -0.08").
     int prec = kEstimateDigits;
@@ -242,15 +242,15 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     h << "<h3>" << esc(a.parameter) << " [" << unit_html(a.unit) << "]" << (a.named ? "" : " (suspected, not named)")
       << ": <span class=\"" << (!a.named ? "no" : a.agree ? "ok" : "warn") << "\">" << agreement_verdict(a)
       << (*agreement_reason(a) ? std::string(" (") + agreement_reason(a) + ")" : "") << "</span></h3>\n<p>"
-      << esc(reference_name) << " " << num(a.joint_value, prec) << ", pooled " << num(a.pooled, prec) << ", spread "
-      << num(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << num(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
+      << esc(reference_name) << " " << significant(a.joint_value, prec) << ", pooled " << significant(a.pooled, prec) << ", spread "
+      << significant(100 * a.spread, 3) << " %" << esc(spread_context(a)) << ", Cochran's Q = " << significant(a.q, 3) << " (" << esc(output::p_is(a.q_p_value))
       << ").</p>\n<table class=\"agreement\"><tr><th>flight</th><th>value</th><th>95 % interval</th>" << (alone ? "<th>alone: p</th>" : "")
       << "<th style=\"width:40%\">at a glance</th></tr>\n";
     for (size_t k = 0; k < a.flights.size(); ++k) {
       const FlightEstimate& f = a.flights[k];
       const std::string path = k < flights.size() ? flights[k] : std::string();
       h << "<tr><td class=\"flight\" title=\"" << esc(path) << "\">" << k + 1 << ".&nbsp;" << esc(file_name_of(path)) << "</td><td>"
-        << num(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>"
+        << significant(f.value, prec) << (f.at_bound ? " (on its bound)" : "") << "</td><td>"
         << (f.at_bound ? std::string("none") : interval(f.lower, f.upper, prec))
         << "</td><td>" << (alone ? esc(output::p_value_cell(f.p_value)) + "</td><td>" : "")
         << "<div style=\"position:relative;height:14px\">";
@@ -267,8 +267,8 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
     // The strips' scale (a user trial, helper-106: bars without an axis).
     h << "<tr><td colspan=\"" << (alone ? 4 : 3) << "\"><small>scale of the bars" << (output::unit_after_number(a.unit).empty() ? "" : " [" + unit_html(a.unit) + "]")
       << (std::isfinite(band_lo) && std::isfinite(band_hi) ? "; shaded: the joint fit's 95 % interval" : "")
-      << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << num(lo, 3)
-      << "</small><small>" << num(hi, 3) << "</small></div></td></tr>\n";
+      << "</small></td><td><div style=\"display:flex;justify-content:space-between\"><small>" << significant(lo, 3)
+      << "</small><small>" << significant(hi, 3) << "</small></div></td></tr>\n";
     h << "</table>\n";
   }
 }
@@ -349,8 +349,8 @@ void head_html(std::ostringstream& h, const Diagnosis& d, const std::string& log
     h << " held-out samples (the end of each of " << d.flights.size() << " flights, diagnosed jointly: one set of "
       << "vehicle parameters)";
   else
-    h << " held-out samples from t = " << num(d.t_split, 4) << " s";
-  h << "; diagnosed in " << num(d.seconds, 3) << " s.</p>\n";
+    h << " held-out samples from t = " << significant(d.t_split, 4) << " s";
+  h << "; diagnosed in " << significant(d.seconds, 3) << " s.</p>\n";
   for (const auto& note : screening_notes(d)) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
   if (const std::string note = environment_note(d); !note.empty()) h << "<p class=\"warn\">" << esc(note) << "</p>\n";
 }
@@ -403,7 +403,7 @@ GlanceRow named_row(const Diagnosis& d, const Finding& f) {
       css = "warn";
     }
   return {f.effect, css, verdict, estimates_cell(f.parameters, true),
-          num(f.before) + " &rarr; " + num(f.after) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
+          significant(f.before) + " &rarr; " + significant(f.after) + " (" + lower_or_higher(f.before, f.after, 3) + ")" +
               (f.metric == d.metric ? "" : "<br><small>" + esc(f.metric) + "</small>")};
 }
 
@@ -418,7 +418,7 @@ std::vector<GlanceRow> glance_rows(const Diagnosis& d) {
   for (const auto& st : d.stand_ins)
     rows.push_back({st.candidate.effect, "warn",
                     "in the model, not named: a stand-in for missing physics (" + esc(st.parameter) + " outside [" +
-                        num(st.plausible_lower, 3) + ", " + num(st.plausible_upper, 3) + "])",
+                        significant(st.plausible_lower, 3) + ", " + significant(st.plausible_upper, 3) + "])",
                     carried_values(d, st.candidate.effect), "&ndash;"});
   for (const auto& a : d.search.unresolved)
     rows.push_back({a.a, "warn", "in the model, not named: the data cannot tell it from " + esc(a.b),
@@ -485,8 +485,8 @@ void in_short_html(std::ostringstream& h, const Diagnosis& d) {
     const double gain = reduction(d.metric_before, d.metric_after);
     h << "<li>With " << (d.findings.empty() ? "what it carries unnamed (below)" : d.findings.size() > 1 ? "them" : "it")
       << ", the model predicts the held-out part "
-      << num(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " than the base model (" << esc(d.metric) << " "
-      << num(d.metric_before) << " &rarr; " << num(d.metric_after) << ").</li>\n";
+      << significant(std::fabs(gain), 2) << (gain < 0 ? " % worse" : " % better") << " than the base model (" << esc(d.metric) << " "
+      << significant(d.metric_before) << " &rarr; " << significant(d.metric_after) << ").</li>\n";
   }
   // Both lines together read as a contradiction ("77 % better", then "the velocity alone
   // comes closer": a newcomer's trial, helper-143) unless the measures are told apart.
@@ -523,7 +523,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
   for (const auto& f : d.findings) {
     h << "<h3>" << esc(f.effect) << flights_own_tag(d, f.effect)
       << "</h3>\n<p class=\"headline\"><b>" << esc(headline(f)) << "</b> Held out: "
-      << esc(f.metric) << " " << num(f.before) << " without it &rarr; " << num(f.after) << " with it ("
+      << esc(f.metric) << " " << significant(f.before) << " without it &rarr; " << significant(f.after) << " with it ("
       << lower_or_higher(f.before, f.after, 3) << ")" << prose(beside_gain_text(f)) << ".</p>\n";
     if (const std::string caveat = one_flight_caveat(d, f.effect); !caveat.empty())
       h << "<p class=\"warn\">" << esc(caveat) << ".</p>\n";
@@ -539,13 +539,13 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
       h << "<table><tr><th>parameter</th><th>value</th><th>95 % interval</th><th>unit</th><th>identifiability</th></tr>\n";
       for (const auto& p : f.parameters) {
         const int prec = estimate_digits(p.value, p.lower, p.upper);
-        h << "<tr><td>" << esc(p.name) << "</td><td>" << num(p.value, prec) << "</td><td>" << interval(p.lower, p.upper, prec)
+        h << "<tr><td>" << esc(p.name) << "</td><td>" << significant(p.value, prec) << "</td><td>" << interval(p.lower, p.upper, prec)
           << "</td><td>" << unit_html(p.unit) << "</td><td>" << fit::identifiability_text(p.verdict) << "</td></tr>\n";
       }
       h << "</table>\n";
     }
-    h << "<p>Evidence: LR statistic " << num(f.evidence.statistic) << " on " << f.evidence.dof << " dof, "
-      << esc(output::p_is(f.evidence.p_value)) << " (level " << num(f.evidence.level, 3) << "), &Delta;BIC " << num(f.evidence.delta_bic)
+    h << "<p>Evidence: LR statistic " << significant(f.evidence.statistic) << " on " << f.evidence.dof << " dof, "
+      << esc(output::p_is(f.evidence.p_value)) << " (level " << significant(f.evidence.level, 3) << "), &Delta;BIC " << significant(f.evidence.delta_bic)
       << ".</p>\n";
   }
   figures.show(h, {"profiles.svg"});
@@ -586,8 +586,8 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     std::string note = on_bound(*p) ? "on its bound" : "";
     if (const std::string said = flights_say(*p); !said.empty()) note += (note.empty() ? "" : "; ") + said;
     const auto file = d.file_values.find(runtime::shared_name(p->name));  // a flight's copy: the file's one value
-    h << "<tr><td>" << esc(p->name) << "</td><td>" << num(p->value, kEstimateDigits) << "</td><td>"
-      << (file == d.file_values.end() ? "&ndash;" : num(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
+    h << "<tr><td>" << esc(p->name) << "</td><td>" << significant(p->value, kEstimateDigits) << "</td><td>"
+      << (file == d.file_values.end() ? "&ndash;" : significant(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
       << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (note.empty() ? ">" : " class=\"warn\">" + note) << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -608,12 +608,12 @@ void stand_ins_html(std::ostringstream& h, const Diagnosis& d) {
          "extended model and is not named.</p>\n<table><tr><th>effect</th><th>value</th><th>plausible</th><th>why</th>"
          "<th>training residual RMS it absorbs (without &rarr; with)</th></tr>\n";
     for (const auto& st : d.stand_ins) {
-      h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << num(st.value, kEstimateDigits) << " "
-        << unit_html(st.unit) << "</td><td>[" << num(st.plausible_lower) << ", " << num(st.plausible_upper) << "]</td><td>"
+      h << "<tr><td>" << esc(st.candidate.effect) << flights_own_tag(d, st.candidate.effect) << "</td><td>" << esc(st.parameter) << " = " << significant(st.value, kEstimateDigits) << " "
+        << unit_html(st.unit) << "</td><td>[" << significant(st.plausible_lower) << ", " << significant(st.plausible_upper) << "]</td><td>"
         << prose(st.why) << "</td><td>";
       for (size_t c = 0; c < st.channels.size(); ++c)
-        h << (c ? "; " : "") << esc(st.channels[c]) << " " << num(st.rms_without[c], 3) << " &rarr; "
-          << num(st.rms_with[c], 3);
+        h << (c ? "; " : "") << esc(st.channels[c]) << " " << significant(st.rms_without[c], 3) << " &rarr; "
+          << significant(st.rms_with[c], 3);
       h << "</td></tr>\n";
     }
     h << "</table>\n";
@@ -652,8 +652,8 @@ void unexplained_html(std::ostringstream& h, const Diagnosis& d) {
   if (!d.unexplained.empty()) {
     h << "<h2>Unexplained discrepancies</h2>\n<table><tr><th>channel</th><th>slow RMS</th><th>x noise</th><th>largest in [s]</th><th>most correlated with</th><th>r</th></tr>\n";
     for (const auto& u : d.unexplained)
-      h << "<tr><td>" << esc(u.channel) << "</td><td>" << num(u.slow_rms) << " " << unit_html(u.unit) << "</td><td>" << num(u.ratio, 3)
-        << "</td><td>" << (u.flight ? "flight " + std::to_string(u.flight) + ": " : "") << num(u.t0, 4) << "&ndash;" << num(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << num(u.r, 2)
+      h << "<tr><td>" << esc(u.channel) << "</td><td>" << significant(u.slow_rms) << " " << unit_html(u.unit) << "</td><td>" << significant(u.ratio, 3)
+        << "</td><td>" << (u.flight ? "flight " + std::to_string(u.flight) + ": " : "") << significant(u.t0, 4) << "&ndash;" << significant(u.t1, 4) << "</td><td>" << esc(u.signal) << "</td><td>" << significant(u.r, 2)
         << "</td></tr>\n";
     h << "</table>\n";
   }
@@ -673,11 +673,11 @@ void horizon_table_html(std::ostringstream& h, const Diagnosis& d) {
   // The mean of `quantity` at the i-th horizon of a view, "–" where the view has no such row.
   const auto mean_at = [](const std::vector<predict::HorizonErrors>& rows, size_t i,
                           predict::ErrorStats predict::HorizonErrors::*quantity) -> std::string {
-    return i < rows.size() ? num((rows[i].*quantity).mean()) : "–";
+    return i < rows.size() ? significant((rows[i].*quantity).mean()) : "–";
   };
   using H = predict::HorizonErrors;
   for (size_t i = 0; i < a.open_loop.size() && i < b.open_loop.size(); ++i)
-    h << "<tr><td>" << num(a.open_loop[i].horizon) << "</td><td>" << mean_at(b.open_loop, i, &H::position) << "</td><td>"
+    h << "<tr><td>" << significant(a.open_loop[i].horizon) << "</td><td>" << mean_at(b.open_loop, i, &H::position) << "</td><td>"
       << mean_at(a.open_loop, i, &H::position) << "</td><td>" << mean_at(a.open_loop, i, &H::tilt) << "</td><td>"
       << mean_at(a.open_loop, i, &H::heading) << "</td><td>" << mean_at(a.attitude_replayed, i, &H::position)
       << "</td><td>" << mean_at(a.translation_replayed, i, &H::tilt) << "</td><td>"
@@ -709,9 +709,9 @@ void validation_channels_html(std::ostringstream& h, const Diagnosis& d) {
   h << "<h2>Held-out error per channel</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS base</th><th>RMS extended</th>"
        "<th>reduction %</th></tr>\n";
   for (const auto& c : d.channel_gain)
-    h << "<tr><td>" << esc(c.channel) << "</td><td>" << unit_html(channel_unit(d, c.channel)) << "</td><td>" << num(c.before)
-      << "</td><td>" << num(c.after) << "</td><td" << (got_worse(c) ? " class=\"warn\"" : "") << ">"
-      << num(reduction(c.before, c.after), 3) << "</td></tr>\n";
+    h << "<tr><td>" << esc(c.channel) << "</td><td>" << unit_html(channel_unit(d, c.channel)) << "</td><td>" << significant(c.before)
+      << "</td><td>" << significant(c.after) << "</td><td" << (got_worse(c) ? " class=\"warn\"" : "") << ">"
+      << significant(reduction(c.before, c.after), 3) << "</td></tr>\n";
   h << "</table>\n";
 }
 
@@ -719,11 +719,11 @@ void base_residuals_html(std::ostringstream& h, const Diagnosis& d, Figures& fig
   h << "<h2>What the base model gets wrong</h2>\n<table><tr><th>channel</th><th>unit</th><th>RMS</th><th>bias</th>"
        "<th>corr. time [samples]</th><th>slow / noise</th><th>strongest correlations (r)</th></tr>\n";
   for (const auto& c : d.before.channels) {
-    h << "<tr><td>" << esc(c.name) << "</td><td>" << unit_html(channel_unit(d, c.name)) << "</td><td>" << num(c.rms) << "</td><td>"
-      << num(c.bias) << "</td><td>" << num(c.tau_int, 3)
-      << "</td><td>" << num(c.slow_ratio, 3) << "</td><td>";
+    h << "<tr><td>" << esc(c.name) << "</td><td>" << unit_html(channel_unit(d, c.name)) << "</td><td>" << significant(c.rms) << "</td><td>"
+      << significant(c.bias) << "</td><td>" << significant(c.tau_int, 3)
+      << "</td><td>" << significant(c.slow_ratio, 3) << "</td><td>";
     for (size_t i = 0; i < c.correlations.size() && i < 3; ++i)
-      h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << num(c.correlations[i].r, 2) << ")";
+      h << (i ? ", " : "") << esc(c.correlations[i].signal) << " (" << significant(c.correlations[i].r, 2) << ")";
     h << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -746,8 +746,8 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
       << "<table><tr><th>effect</th><th>LR</th><th>dof</th><th>p</th><th>&Delta;BIC</th><th>&Delta;AIC</th><th>held-out gain % "
          "(equation error)</th><th>verdict</th></tr>\n";
     for (const auto& c : st.candidates)
-      h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << num(c.statistic) << "</td><td>" << c.dof << "</td><td>" << esc(output::p_value_cell(c.p_value))
-        << "</td><td>" << num(c.delta_bic) << "</td><td>" << num(c.delta_aic) << "</td><td>" << num(c.validation_gain_percent, 3)
+      h << "<tr><td>" << (c.effect == st.selected ? "<b>" + esc(c.effect) + "</b> (taken)" : esc(c.effect)) << "</td><td>" << significant(c.statistic) << "</td><td>" << c.dof << "</td><td>" << esc(output::p_value_cell(c.p_value))
+        << "</td><td>" << significant(c.delta_bic) << "</td><td>" << significant(c.delta_aic) << "</td><td>" << significant(c.validation_gain_percent, 3)
         // significant but implausible in orange: a stand-in, not a cause (a user trial, helper-106)
         << "</td><td class=\"" << (!c.significant ? "no\">" + esc(c.why_not) : c.implausible.empty() ? "ok\">significant" : "warn\">significant")
         << (c.implausible.empty() ? "" : "; implausible here: " + esc(c.implausible)) << "</td></tr>\n";

@@ -96,7 +96,7 @@ std::vector<runtime::Panel> residual_panels(const Diagnosis& d, size_t stride) {
 std::string residuals_title(const Diagnosis& d) {
   return d.vehicle + ": equation-error residuals (" +
          (d.flights.size() > 1 ? std::to_string(d.flights.size()) + " flights joined, 1 s apart; the end of each held out"
-                               : "validation from t = " + num(d.t_split, 4) + " s") +
+                               : "validation from t = " + significant(d.t_split, 4) + " s") +
          ")";
 }
 

@@ -35,7 +35,7 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
     os << "named " << f.effect << flights_own_note(d, f.effect) << ":";
     for (const auto& p : f.parameters)  // a list, comma-separated (a review, helper-111)
       os << (&p == &f.parameters.front() ? " " : ", ") << p.name << " = " << estimate(p.value, p.lower, p.upper);
-    os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << num(f.before) << " -> " << num(f.after)
+    os << "; held out " << (f.metric == d.metric ? "" : f.metric + " ") << significant(f.before) << " -> " << significant(f.after)
        << beside_gain_text(f);
     for (const auto& a : d.agreement)
       if (a.effect == f.effect && flights_disagree(a)) os << "; the flights disagree on " << a.parameter << " (below)";
@@ -52,12 +52,12 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
   for (const ParameterAgreement* pa : all) {
     const ParameterAgreement& a = *pa;
     os << "flights " << (a.agree ? "agree" : a.within_errors ? "are too uncertain to agree" : "disagree") << " on "
-       << (a.base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << num(100 * a.spread, 3)
+       << (a.base ? "the base model's " : "") << a.parameter << (a.named ? "" : " (suspected)") << " (spread " << significant(100 * a.spread, 3)
        << " %" << spread_context(a) << ", Cochran's Q " << output::p_is(a.q_p_value)
        << (*agreement_reason(a) ? std::string("; ") + agreement_reason(a) : "") << "):";
     for (size_t k = 0; k < a.flights.size(); ++k)
       os << (k ? ", " : " ") << k + 1 << ": "
-         << (a.flights[k].at_bound ? num(a.flights[k].value, kEstimateDigits) + " (on its bound: no interval)"
+         << (a.flights[k].at_bound ? significant(a.flights[k].value, kEstimateDigits) + " (on its bound: no interval)"
                                    : estimate(a.flights[k].value, a.flights[k].lower, a.flights[k].upper));
     os << "\n";
   }
@@ -68,7 +68,7 @@ void write_agreement(std::ostream& os, const Diagnosis& d) {
        << " with the airframe on " << a.parameter << " (refitted here, the airframe's other values held): "
        // Which value is which: the flight's own diagnosis printed a third, all free, above
        // (a newcomer's trial, helper-136).
-       << "here " << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value, "the airframe's ") << " (" << num(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
+       << "here " << estimate_against(a.flights.front().value, a.flights.front().lower, a.flights.front().upper, a.joint_value, "the airframe's ") << " (" << significant(100 * a.spread, 3) << " % apart, " << output::p_is(a.q_p_value)
        << (*agreement_reason(a) ? std::string(": ") + agreement_reason(a) : "") << ")\n";
 }
 
@@ -81,8 +81,8 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   for (const auto& st : d.stand_ins)
     os << "stands in for missing physics, not named: " << st.candidate.effect << flights_own_note(d, st.candidate.effect)
        << " (" << st.parameter << " = "
-       << num(st.value, kEstimateDigits) << output::unit_after_number(st.unit) << " lies outside [" << num(st.plausible_lower) << ", "
-       << num(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
+       << significant(st.value, kEstimateDigits) << output::unit_after_number(st.unit) << " lies outside [" << significant(st.plausible_lower) << ", "
+       << significant(st.plausible_upper) << "], the plausible range" << (d.environment == "unknown" ? "" : " " + d.environment + "s")
        << ": " << st.why << ")\n";
   for (const auto& x : d.suspected) {
     os << "suspected, not named: " << x.candidate.effect << flights_own_note(d, x.candidate.effect);
@@ -134,10 +134,10 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
     os << "caution: " << name_value(p.name, p.value, p.unit, kEstimateDigits)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";
   for (const auto& u : d.unexplained)
-    os << "unexplained: " << u.channel << " residual has slow structure " << num(u.ratio, 3)
+    os << "unexplained: " << u.channel << " residual has slow structure " << significant(u.ratio, 3)
        << "x what noise gives, largest in " << (u.flight ? "flight " + std::to_string(u.flight) + " at " : "") << "t = "
-       << num(u.t0, 3) << ".." << num(u.t1, 3) << " s, most correlated with "
-       << u.signal << " (r = " << num(u.r, 2) << ")\n";
+       << significant(u.t0, 3) << ".." << significant(u.t1, 3) << " s, most correlated with "
+       << u.signal << " (r = " << significant(u.r, 2) << ")\n";
   for (const auto& leads : {draft_leads(d), command_gain_leads(d)})
     for (const auto& lead : leads) {
       os << lead.claim << "\n";
@@ -150,8 +150,8 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
          << t.verdict_reason << "\n";
   if (d.terms_gain.measured)
     os << "  with the proposed terms regenerated into the model (discovered_model.hpp): " << d.terms_gain.metric << " "
-       << num(d.terms_gain.before) << " -> " << num(d.terms_gain.after) << " (per-fold gain " << num(d.terms_gain.gain_mean, 3)
-       << " +- " << num(d.terms_gain.gain_standard_error, 3) << ")"
+       << significant(d.terms_gain.before) << " -> " << significant(d.terms_gain.after) << " (per-fold gain " << significant(d.terms_gain.gain_mean, 3)
+       << " +- " << significant(d.terms_gain.gain_standard_error, 3) << ")"
        << terms_gain_verdict(d.terms_gain.gain_mean, d.terms_gain.gain_standard_error) << "\n";
   if (d.has_prediction)
     if (const std::string limits = predict::what_limits_prediction(d.prediction_after); !limits.empty())
@@ -170,8 +170,8 @@ std::string diagnosis_summary(const Diagnosis& d) {
   // The whole gain, and where it is paid for (a user trial, helper-106: only report.html said
   // either).
   if (!d.search.selected.empty())
-    os << "held out, the extended model against the base model: " << d.metric << " " << num(d.metric_before) << " -> "
-       << num(d.metric_after) << " (" << lower_or_higher(d.metric_before, d.metric_after, 3) << ")\n";
+    os << "held out, the extended model against the base model: " << d.metric << " " << significant(d.metric_before) << " -> "
+       << significant(d.metric_after) << " (" << lower_or_higher(d.metric_before, d.metric_after, 3) << ")\n";
   if (const std::string worse = worse_channels(d); !worse.empty())
     os << "worse with the extended model on the held-out part: " << worse << "\n";
   write_agreement(os, d);

@@ -32,17 +32,17 @@ OneLead draft_lead(const DraftSignature& d) {
   std::string claim = "hypothesis (not a named cause): the slow roll/pitch residual follows the horizontal force as air "
                       "moving through the rotors would, on axis ";
   for (size_t i = 0; i < axes.size(); ++i) claim += (i ? " and " : "") + axes[i];
-  claim += " (1 s means, the velocity along the axis partialled out, p <= " + num(DraftSignature::kLevel, 2) +
+  claim += " (1 s means, the velocity along the axis partialled out, p <= " + significant(DraftSignature::kLevel, 2) +
            " on both parts); no logged signal measures the air";
   std::string numbers;
   for (const auto& p : d.parts) {
     numbers += (numbers.empty() ? "" : "; ") + p.name;
     for (const auto& axis : axes) {
       const auto& pair = axis == "y (roll)" ? p.y_roll : p.x_pitch;
-      numbers += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + num(pair.r, 2) + ", " +
-                 output::p_is(pair.p) + ", slope " + num(pair.slope, 3) + " against " + num(pair.draft_slope, 3);
+      numbers += (axes.size() > 1 ? " " + axis.substr(0, 1) + ":" : "") + " r = " + significant(pair.r, 2) + ", " +
+                 output::p_is(pair.p) + ", slope " + significant(pair.slope, 3) + " against " + significant(pair.draft_slope, 3);
     }
-    if (p.implied_speed > 0) numbers += ", draft at most " + num(p.implied_speed, 2) + " m/s";
+    if (p.implied_speed > 0) numbers += ", draft at most " + significant(p.implied_speed, 2) + " m/s";
   }
   return {claim, numbers};
 }
@@ -60,11 +60,11 @@ OneLead command_gain_lead(const CommandGain& g) {
       "a stand) or the controller answers a disturbance at these frequencies, which reads the same in closed loop; a "
       "flight with a known excitation added to the rate set points separates them";
   const std::string numbers =
-      "at " + num(roll.low_hz, 2) + "-" + num(roll.high_hz, 2) + " Hz roll " + num(roll.gain, 2) + " (r = " +
-      num(roll.r, 2) + ", " + num(1000 * roll.delay_s, 2) + " ms later), pitch " + num(pitch.gain, 2) + " (r = " +
-      num(pitch.r, 2) + ", " + num(1000 * pitch.delay_s, 2) + " ms later), vertical " + num(vertical.gain, 2) +
-      " (r = " + num(vertical.r, 2) + ") of the map's; if it is the map: motor_map slope " + num(g.suggested_slope(), 2) +
-      " with pivot " + num(g.hover_command, 2) + " (the mean command)";
+      "at " + significant(roll.low_hz, 2) + "-" + significant(roll.high_hz, 2) + " Hz roll " + significant(roll.gain, 2) + " (r = " +
+      significant(roll.r, 2) + ", " + significant(1000 * roll.delay_s, 2) + " ms later), pitch " + significant(pitch.gain, 2) + " (r = " +
+      significant(pitch.r, 2) + ", " + significant(1000 * pitch.delay_s, 2) + " ms later), vertical " + significant(vertical.gain, 2) +
+      " (r = " + significant(vertical.r, 2) + ") of the map's; if it is the map: motor_map slope " + significant(g.suggested_slope(), 2) +
+      " with pivot " + significant(g.hover_command, 2) + " (the mean command)";
   return {claim, numbers};
 }
 
@@ -95,7 +95,7 @@ double reduction(double before, double after) {
 
 std::string lower_or_higher(double before, double after, int digits) {
   const double r = reduction(before, after);
-  return num(std::fabs(r), digits) + (r < 0 ? " % higher" : " % lower");
+  return significant(std::fabs(r), digits) + (r < 0 ? " % higher" : " % lower");
 }
 
 namespace {
@@ -382,8 +382,8 @@ std::string hold_unmeasured_step(const ParameterAgreement& a) {
     if (std::isfinite(f.bound_upper)) hi = std::min(hi, f.bound_upper);
   }
   const std::string allowed = any && std::isfinite(lo) && std::isfinite(hi) && lo <= hi
-                                  ? " inside every flight's interval and its bounds ([" + num(lo, kEstimateDigits) +
-                                        ", " + num(hi, kEstimateDigits) + "])"
+                                  ? " inside every flight's interval and its bounds ([" + significant(lo, kEstimateDigits) +
+                                        ", " + significant(hi, kEstimateDigits) + "])"
                                   : "";
   return "no flight tells the base model's " + a.parameter + " from zero, nor do the flights together " +
          "(each value on its bound or its interval holding zero): the joint value is the fit's choice, not a " +
@@ -461,7 +461,7 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
   return out;
 }
 
-std::string num(double v, int prec) {
+std::string significant(double v, int prec) {
   if (!std::isfinite(v)) return "–";
   std::ostringstream os;
   os.precision(prec);
@@ -480,13 +480,13 @@ std::vector<Lead> command_gain_leads(const Diagnosis& d) {
 std::string judged_by_text(const Finding& f) {
   if (f.accepted_by == Finding::kByForceModelAlone)
     return "; accepted by the force model alone: with the measured attitude replayed the held-out position RMSE is " +
-           num(f.force_alone.mean, 3) + " m +- " + num(f.force_alone.standard_error, 3) +
-           " m lower per fold, and the equation-error cost " + num(f.one_step.cost.mean, 3) + " % +- " +
-           num(f.one_step.cost.standard_error, 3) +
+           significant(f.force_alone.mean, 3) + " m +- " + significant(f.force_alone.standard_error, 3) +
+           " m lower per fold, and the equation-error cost " + significant(f.one_step.cost.mean, 3) + " % +- " +
+           significant(f.one_step.cost.standard_error, 3) +
            " % lower, neither kind of channel worse (the open loop is dominated by the moment model's attitude drift)";
   if (f.accepted_by != Finding::kByOneStep || f.one_step.cost.per_fold.empty()) return "";
-  return "; accepted by its one-step gain: held-out equation-error cost " + num(f.one_step.cost.mean, 3) +
-         " % +- " + num(f.one_step.cost.standard_error, 3) + " % lower per fold" +
+  return "; accepted by its one-step gain: held-out equation-error cost " + significant(f.one_step.cost.mean, 3) +
+         " % +- " + significant(f.one_step.cost.standard_error, 3) + " % lower per fold" +
          (f.rollouts ? ", the rollouts unchanged within their spread" : " (no pose logged: no rollouts)");
 }
 
@@ -496,7 +496,7 @@ std::string beside_gain_text(const Finding& f) {
       !f.comparison || f.comparison->settled
           ? ""
           : "; the model without it had not settled its weights after " + std::to_string(f.comparison->refits) +
-                " refits (last change " + num(f.comparison->last_change_percent, 2) + " %)";
+                " refits (last change " + significant(f.comparison->last_change_percent, 2) + " %)";
   return judged_by_text(f) + unsettled;
 }
 
@@ -521,14 +521,14 @@ std::string terms_gain_verdict(double gain_mean, double gain_standard_error) {
 }
 
 std::string name_value(const std::string& name, double value, const std::string& unit, int prec) {
-  return name + " = " + num(value, prec) + output::unit_after_number(unit);
+  return name + " = " + significant(value, prec) + output::unit_after_number(unit);
 }
 
 // What spread agreeing flights would show, beside the one seen: " (if they agree: median
 // 41 %, p = 0.62)"; nothing where it cannot be computed (one flight, no standard error).
 std::string spread_context(const ParameterAgreement& a) {
   if (!std::isfinite(a.spread_if_agree) || a.flights.size() < 2) return "";
-  return " (if they agree: median " + num(100 * a.spread_if_agree, 2) + " %, " + output::p_is(a.spread_p_value) + ")";
+  return " (if they agree: median " + significant(100 * a.spread_if_agree, 2) + " %, " + output::p_is(a.spread_p_value) + ")";
 }
 
 std::string channel_unit(const Diagnosis& d, const std::string& channel) {
@@ -543,7 +543,7 @@ std::string worse_channels(const Diagnosis& d) {
   std::string out;
   for (const auto& c : d.channel_gain)
     if (got_worse(c))
-      out += (out.empty() ? "" : "; ") + c.channel + " " + num(c.before) + " -> " + num(c.after) +
+      out += (out.empty() ? "" : "; ") + c.channel + " " + significant(c.before) + " -> " + significant(c.after) +
              output::unit_after_number(channel_unit(d, c.channel)) + " (" + lower_or_higher(c.before, c.after, 3) + ")";
   return out;
 }
@@ -551,7 +551,7 @@ std::string worse_channels(const Diagnosis& d) {
 // A 95 % interval; a side the profile never closed (NaN) reads "open", not as a number.
 int estimate_digits(double value, double lower, double upper) {
   const auto apart = [](double a, double b, int prec) {
-    return !std::isfinite(a) || !std::isfinite(b) || a == b || num(a, prec) != num(b, prec);
+    return !std::isfinite(a) || !std::isfinite(b) || a == b || significant(a, prec) != significant(b, prec);
   };
   int prec = kEstimateDigits;
   while (prec < 12 && !(apart(value, lower, prec) && apart(value, upper, prec) && apart(lower, upper, prec))) ++prec;
@@ -560,16 +560,16 @@ int estimate_digits(double value, double lower, double upper) {
 
 std::string estimate(double value, double lower, double upper) {
   const int prec = estimate_digits(value, lower, upper);
-  return num(value, prec) + " " + interval(lower, upper, prec);
+  return significant(value, prec) + " " + interval(lower, upper, prec);
 }
 
 std::string estimate_against(double value, double lower, double upper, double other, const std::string& other_is) {
   const int prec = std::max(estimate_digits(value, lower, upper), estimate_digits(other, lower, upper));
-  return num(value, prec) + " " + interval(lower, upper, prec) + " against " + other_is + num(other, prec);
+  return significant(value, prec) + " " + interval(lower, upper, prec) + " against " + other_is + significant(other, prec);
 }
 
 std::string interval(double lower, double upper, int prec) {
-  const auto side = [&](double v) { return std::isfinite(v) ? num(v, prec) : std::string("open"); };
+  const auto side = [&](double v) { return std::isfinite(v) ? significant(v, prec) : std::string("open"); };
   return "[" + side(lower) + ", " + side(upper) + "]";
 }
 

@@ -88,7 +88,7 @@ std::vector<std::string> next_steps(const Diagnosis& d);
 
 // A number with `prec` significant digits ("–" where it is not finite); a 95 % interval,
 // "open" on a side its profile never closed.
-std::string num(double v, int prec = 4);
+std::string significant(double v, int prec = 4);
 std::string interval(double lower, double upper, int prec = 4);
 // The significant digits of an estimate and its interval wherever one is printed (the
 // terminal, the report's tables), so that a value reads the same in each: one page printed a

@@ -20,6 +20,7 @@
 #include "output/joined.hpp"
 #include "output/names.hpp"
 #include "output/numbers.hpp"
+#include "output/progress.hpp"
 #include "output/sinks.hpp"
 #include "fit/thrust_stand.hpp"
 
@@ -36,10 +37,6 @@ nlohmann::ordered_json published_crazyflie() {
            {{"2.2e-8", "crazyflie_mhmp simulation model of the Crazyflie 2.0 (k = 2.2e-8 N s^2)"},
             {"2.3e-8", "UPenn MEAM 620 flightsim crazyflie_params.py, inferred from 14.5 g at 2500 rad/s"}}},
           {"torque_to_thrust_m", {{"0.005964552", "Förster 2015 (ETH Zürich), as used in Crazyflie firmware ports"}}}};
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Profiles take minutes: say as each one is done.
@@ -94,6 +91,13 @@ std::string side(double v, bool open) {
 // A profile's 95 % interval as printed: "[lower, upper]", an open side as side() says it.
 std::string interval_of(const Profile& pr) {
   return "[" + side(pr.lower, pr.lower_open) + ", " + side(pr.upper, pr.upper_open) + "]";
+}
+
+// fit.json's kind of fit, the vehicle and the log, after what the fit wrote.
+void add_what_was_fitted(nlohmann::ordered_json& j, const std::string& kind, const Vehicle& v, const std::string& path) {
+  j["kind"] = kind;
+  j["vehicle"] = v.name;
+  j["log"] = path;
 }
 
 // Beside a verdict whose interval holds zero (interval_holds_zero).
@@ -264,9 +268,7 @@ FitOutputs fit_motor_steps_log(const std::string& path, const Vehicle& v, const 
   const double tau_s = best.parameters[MotorStepModel::kTau].value;
   FitOutputs out;
   auto& j = out.json = fit_json(best, profiles);
-  j["kind"] = "motor_steps";
-  j["vehicle"] = v.name;
-  j["log"] = path;
+  add_what_was_fitted(j, "motor_steps", v, path);
   const bool thesis = is_thesis_vehicle(v);  // the thesis' value belongs to its vehicle only
   if (thesis)
     j["comparison"] = {{"thesis_tau_s", kThesisMotorTau},
@@ -448,19 +450,17 @@ FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::Dy
              std::to_string(std::count_if(params.begin(), params.end(), [](auto& p) { return p.free; })) + " free parameters");
   auto clock0 = std::chrono::steady_clock::now();
   const FitResult best = fit_least_squares(*m.train, params, fo);
-  const double fit_seconds = seconds_since(clock0);
+  const double fit_seconds = output::seconds_since(clock0);
   o.progress("[2/3] profile likelihood (fit took " + output::short_number(fit_seconds) + " s)");
   clock0 = std::chrono::steady_clock::now();
   const auto profiles = run_profiles(o, *m.train, best, fo);
-  const double profile_seconds = seconds_since(clock0);
+  const double profile_seconds = output::seconds_since(clock0);
   o.progress(m.valid ? "[3/3] validation on the last " + std::to_string(valid.samples.size()) + " samples"
                      : std::string("[3/3] no validation: nothing held out (--validation 0)"));
   FitOutputs out;
   out.warnings = flight.notes;
   auto& j = out.json = fit_json(best, profiles);
-  j["kind"] = shooting ? "flight_multiple_shooting" : "flight_equation_error";
-  j["vehicle"] = v.name;
-  j["log"] = path;
+  add_what_was_fitted(j, shooting ? "flight_multiple_shooting" : "flight_equation_error", v, path);
   j["mapping"] = o.mapping;
   j["formulation"] = shooting ? "multiple shooting: " + output::short_number(o.window) + " s windows from measured states, pose residuals"
                      : accel  ? "equation error: accelerometer specific force and gyro derivative"
@@ -538,9 +538,7 @@ nlohmann::ordered_json stand_json(const std::string& path, const Vehicle& v, con
                                   double vref) {
   const bool shared = f.coefficients == ThrustVsSpeed::Coefficients::kShared;
   nlohmann::ordered_json j;
-  j["kind"] = "thrust_stand";
-  j["vehicle"] = v.name;
-  j["log"] = path;
+  add_what_was_fitted(j, "thrust_stand", v, path);
   j["thrust_vs_speed"] = fit_json(f.thrust, f.thrust_profiles);
   j["thrust_vs_speed"]["coefficients"] = shared ? "shared" : "per_motor";
   j["thrust_vs_speed"]["motor_speed_ratio_variation_rms"] = f.ratio_variation;

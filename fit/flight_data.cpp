@@ -816,9 +816,6 @@ std::pair<Flight, Flight> split_by_time(const Flight& f, double frac) {
   return {a, b};
 }
 
-namespace {
-
-// Each flight's clock offset in the joined log (see join_flights).
 std::vector<double> join_offsets(const std::vector<Flight>& flights, double gap) {
   std::vector<double> offsets;
   double end = 0;
@@ -830,6 +827,8 @@ std::vector<double> join_offsets(const std::vector<Flight>& flights, double gap)
   }
   return offsets;
 }
+
+namespace {
 
 Flight empty_join(const std::vector<Flight>& flights) {
   Flight out;

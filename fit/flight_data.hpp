@@ -156,6 +156,8 @@ std::pair<Flight, Flight> split_each_by_time(const std::vector<Flight>& flights,
                                              double gap = 1.0);
 // Where each flight begins on that joined clock.
 std::vector<double> joined_start_times(const std::vector<Flight>& flights, double gap = 1.0);
+// Each flight's clock offset in the joined log: its own time t reads t + offset there.
+std::vector<double> join_offsets(const std::vector<Flight>& flights, double gap = 1.0);
 // Which of the joined flights (0-based, by those start times, ascending) time t lies in; -1
 // before the first.
 int joined_flight_at(const std::vector<double>& starts, double t);

@@ -1,6 +1,7 @@
 #include "fit/profile_likelihood.hpp"
 #include "fit/evaluation_threads.hpp"
 #include "output/numbers.hpp"
+#include "output/progress.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -223,7 +224,7 @@ std::vector<Profile> profile_all(const ResidualModel& model, const FitResult& be
       sides[j] = walk(m, best, params[i], j % 2 == 0 ? -1.0 : 1.0, fo, po, stop);
       std::lock_guard<std::mutex> lock(mutex);
       if (++sides_done[i] == 2 && po.progress) {
-        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[i]).count();
+        const double s = output::seconds_since(started[i]);
         po.progress(best.parameters[params[i]].name, ++profiles_done, static_cast<int>(params.size()), s);
       }
     }

@@ -80,7 +80,9 @@ struct Effect {
   // effect's first parameter is the reference, held at off; where it is held (a vehicle file
   // without `fit: true`), every one is free, and a gain common to all motors is measured as
   // such (a researcher's trial, helper-148: with c_t held, a 1.2 % thrust change came out as
-  // three motors 0.5-2.6 % stronger than the first). Empty: no reference.
+  // three motors 0.5-2.6 % stronger than the first). Empty: no reference. One parameter only:
+  // a file that holds c_t but fits rho, or the whole motor map, scales every rotor alike
+  // through those instead, and its common gain is again (nearly) not identifiable.
   std::string ratios_only_beside;
   // A property of the flight rather than of the airframe (a motor trim that changes when a
   // motor or the battery is re-seated, the wind of the day): when several flights are

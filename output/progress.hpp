@@ -24,13 +24,18 @@ struct Progress {
   }
 };
 
+// Seconds on the steady clock since `start`: what a job's timings and progress lines report.
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // Where a long job spends its time, phase by phase: "[diagnose] base model fitted (12 s)"
 // counts from where the last phase ended.
 class PhaseTimer {
  public:
   explicit PhaseTimer(const Progress& progress) : progress_(progress) {}
   // Seconds since the last phase ended (or the timer started).
-  double seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  double seconds() const { return seconds_since(start_); }
   // Says "[diagnose] <what> (N s)" and starts the next phase.
   void done(const std::string& what) {
     progress_.say("[diagnose] " + what + " (" + std::to_string(static_cast<int>(seconds())) + " s)");

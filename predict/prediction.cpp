@@ -435,14 +435,16 @@ nlohmann::ordered_json stats_json(const ErrorStats& s) {
 double rms_of(const ErrorStats& s) { return s.rms(); }
 
 nlohmann::ordered_json one_step_json(const OneStepErrors& o) {
-  const auto num = output::number_or_null;
+  using output::number_or_null;
   return {{"specific_force_m_s2",
-           {{"x", num(rms_of(o.specific_force[0]))}, {"y", num(rms_of(o.specific_force[1]))}, {"z", num(rms_of(o.specific_force[2]))}}},
+           {{"x", number_or_null(rms_of(o.specific_force[0]))},
+            {"y", number_or_null(rms_of(o.specific_force[1]))},
+            {"z", number_or_null(rms_of(o.specific_force[2]))}}},
           {"angular_acceleration_rad_s2",
-           {{"x", num(rms_of(o.angular_acceleration[0]))},
-            {"y", num(rms_of(o.angular_acceleration[1]))},
-            {"z", num(rms_of(o.angular_acceleration[2]))}}},
-          {"vertical_acceleration_world_m_s2", num(rms_of(o.vertical_acceleration_world))},
+           {{"x", number_or_null(rms_of(o.angular_acceleration[0]))},
+            {"y", number_or_null(rms_of(o.angular_acceleration[1]))},
+            {"z", number_or_null(rms_of(o.angular_acceleration[2]))}}},
+          {"vertical_acceleration_world_m_s2", number_or_null(rms_of(o.vertical_acceleration_world))},
           {"samples", o.vertical_acceleration_world.count},
           {"measured_from", o.source},
           {"statistic", "RMS of model - measured over samples"}};

@@ -1229,6 +1229,43 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
   EXPECT_NEAR(apart.q, 2 * std::pow(0.25 / 0.05, 2), 1e-9);  // each value 0.25 from the pooled 1.25
 }
 
+// Of flights diagnosed together, an unexplained window is told on the clock of the flight it
+// lies in, as that log alone reads it, and ends with it (a researcher's trial, helper-148: the
+// joined clock's "t = 54.1..55.1 s" of two 30 s flights; then a review, helper-149: the time
+// since the first kept sample is not the log's own clock, which a take-off delays).
+TEST(MultiFlight, AnUnexplainedWindowIsToldOnItsFlightsClock) {
+  const auto flight_from = [](double first, double last) {
+    quadgen::fit::Flight f;
+    for (double t = first; t <= last + 1e-9; t += 0.5) {
+      quadgen::fit::FlightSample s;
+      s.t = t;
+      f.samples.push_back(s);
+    }
+    return f;
+  };
+  // Flight 2 is kept from 2 s of its own clock on; joined 1 s after flight 1's last sample
+  // (10 s), its 2 s read 11 s there: its own time is the joined time less 9 s.
+  const std::vector<quadgen::fit::Flight> flights = {flight_from(0.5, 10.0), flight_from(2.0, 6.0)};
+  std::vector<quadgen::diagnose::Unexplained> windows(3);
+  windows[0].t0 = 5.0, windows[0].t1 = 6.0;    // in flight 1
+  windows[1].t0 = 12.0, windows[1].t1 = 13.5;  // in flight 2, own 3.0..4.5
+  windows[2].t0 = 14.0, windows[2].t1 = 16.0;  // in flight 2 to beyond its end (15 joined, 6 own)
+  std::vector<quadgen::diagnose::Unexplained> one = windows;
+  quadgen::diagnose::place_on_their_flights(windows, flights);
+  EXPECT_EQ(windows[0].flight, 1);
+  EXPECT_DOUBLE_EQ(windows[0].t0, 5.0);
+  EXPECT_DOUBLE_EQ(windows[0].t1, 6.0);
+  EXPECT_EQ(windows[1].flight, 2);
+  EXPECT_DOUBLE_EQ(windows[1].t0, 3.0);
+  EXPECT_DOUBLE_EQ(windows[1].t1, 4.5);
+  EXPECT_EQ(windows[2].flight, 2);
+  EXPECT_DOUBLE_EQ(windows[2].t0, 5.0);
+  EXPECT_DOUBLE_EQ(windows[2].t1, 6.0);
+  quadgen::diagnose::place_on_their_flights(one, {flights[0]});  // one flight: its own clock already
+  EXPECT_EQ(one[1].flight, 0);
+  EXPECT_DOUBLE_EQ(one[1].t0, 12.0);
+}
+
 // Noise-free generated flights carry standard errors near machine precision, and the bias
 // each flight's model error gives its estimate then decides Cochran's Q: kappa "disagreed"
 // at a spread of 0.0002 % (sixty-second session). Values within 1 % agree whatever Q says,
@@ -2924,6 +2961,48 @@ TEST(FittedVehicle, IsTheFileAsItWasReadNotAsItIsNow) {
   { std::ofstream(dir / "indented.yaml") << indented; }
   EXPECT_EQ(quadgen::diagnose::fitted_vehicle_yaml(quadgen::load_vehicle((dir / "indented.yaml").string()), fitted), "");
   fs::remove_all(dir);
+}
+
+// Beside a fitted c_t only the motor gains' ratios are identifiable and the first rotor's is
+// held at 0; beside a held c_t every gain is free (a researcher's trial, helper-148: a common
+// thrust change came out as three motors stronger than the first). The lag spread's reference
+// follows motor_lag.tau, which a derived lag always fits. The diagnosis' finding then says
+// which, if any, was held.
+TEST(ExtendedModel, TheMotorGainsReferenceIsHeldOnlyWhereCtIsFitted) {
+  quadgen::Vehicle v = quadgen::load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml");
+  const quadgen::MassProperties mp = quadgen::derive_mass_properties(v);
+  const quadgen::DeriveOptions gains{{"motor_gain", "motor_lag", "motor_lag_spread"}, {}};
+  ASSERT_TRUE(v.params.at("c_t").fit);
+  EXPECT_EQ(quadgen::diagnose::reference_parameters(quadgen::derive_model(v, mp, gains)),
+            (std::vector<std::string>{"motor_gain.A", "motor_lag_spread.A"}));
+  v.params.at("c_t").fit = false;
+  EXPECT_EQ(quadgen::diagnose::reference_parameters(quadgen::derive_model(v, mp, gains)),
+            (std::vector<std::string>{"motor_lag_spread.A"}));
+  // A finding with every gain free has no reference row and no note; one with M1 held has both.
+  quadgen::diagnose::Diagnosis d;
+  d.vehicle = "finken3";
+  quadgen::diagnose::Finding f;
+  f.effect = "motor_gain";
+  f.evidence.parameters = {{"motor_gain.A", "1", 0.01, -0.5, 0.5, true}, {"motor_gain.B", "1", 0.02, -0.5, 0.5, true}};
+  d.findings = {f};
+  const auto all_free = quadgen::diagnose::diagnosis_json(d, "log.csv")["findings"][0];
+  EXPECT_FALSE(all_free.contains("note"));
+  EXPECT_FALSE(all_free["parameters"].contains("motor_gain.A"));  // no estimates given: no rows but a reference's
+  d.findings[0].evidence.parameters[0].free = false;
+  const auto one_held = quadgen::diagnose::diagnosis_json(d, "log.csv")["findings"][0];
+  EXPECT_EQ(one_held["parameters"]["motor_gain.A"]["reference"], true);
+  EXPECT_NE(one_held["note"].get<std::string>().find("c_t is fitted"), std::string::npos);
+}
+
+// Every plot a diagnosis did not draw is said, one note each; gnuplot missing, once (a
+// label gnuplot refused lost three of six plots without a word: helper-146).
+TEST(ExtendedModel, EveryPlotNotDrawnIsSaid) {
+  EXPECT_EQ(quadgen::app::plot_notes({}, false), (std::vector<std::string>{}));
+  EXPECT_EQ(quadgen::app::plot_notes({"a.svg: gnuplot is not installed", "b.svg: gnuplot is not installed"}, true),
+            (std::vector<std::string>{"no plots: gnuplot is not installed"}));
+  EXPECT_EQ(quadgen::app::plot_notes({"a.svg: gnuplot failed: x"}, false), (std::vector<std::string>{"no plot a.svg: gnuplot failed: x"}));
+  EXPECT_EQ(quadgen::app::plot_notes({"a.svg: one", "b.svg: two"}, true),
+            (std::vector<std::string>{"no plot a.svg: one", "no plot b.svg: two"}));
 }
 
 // The extended model's derivation shows the value the diagnosis fitted; the vehicle file's
