@@ -404,10 +404,13 @@ void place_on_their_flights(std::vector<Unexplained>& windows, const std::vector
   if (flights.size() < 2) return;
   const std::vector<double> starts = fit::joined_start_times(flights), offsets = fit::join_offsets(flights);
   for (Unexplained& u : windows) {
-    const size_t k = static_cast<size_t>(std::max(0, fit::joined_flight_at(starts, u.t0)));
+    // A window is cut by sample count across the joined log, so it may reach over a join:
+    // it belongs to the flight its middle lies in, and is cut to that flight's samples.
+    const size_t k = static_cast<size_t>(std::max(0, fit::joined_flight_at(starts, 0.5 * (u.t0 + u.t1))));
     u.flight = static_cast<int>(k) + 1;
-    u.t0 -= offsets[k];
-    u.t1 = std::min(u.t1 - offsets[k], flights[k].samples.back().t);  // not into the gap or the next flight
+    u.t0_joined = u.t0;
+    u.t0 = std::max(u.t0 - offsets[k], flights[k].samples.front().t);
+    u.t1 = std::min(u.t1 - offsets[k], flights[k].samples.back().t);
   }
 }
 

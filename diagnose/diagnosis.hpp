@@ -161,14 +161,16 @@ struct Unexplained {
   double t0 = 0, t1 = 0, worst_mean = 0;  // t0, t1 on the clock of the flight they lie in [s]
   std::string signal;  // most correlated physical signal
   double r = 0;
-  // Of several flights diagnosed together, which one (1 = the first); 0 for one flight.
+  // Of several flights diagnosed together, which one (1 = the first; 0 for one flight), and
+  // where the window starts on the joined clock of the residual plots [s].
   int flight = 0;
+  double t0_joined = 0;
 };
 
-// Of several flights diagnosed together, each window told on the clock of the flight it
-// starts in, as that log alone reads it (the joined clock's "t = 54.1..55.1 s" of two 30 s
-// flights named neither: a researcher's trial, helper-148), ending with that flight. One
-// flight: unchanged.
+// Of several flights diagnosed together, each window told on the clock of the flight its
+// middle lies in, in seconds from that log's first row, cut to that flight's samples (the
+// joined clock's "t = 54.1..55.1 s" of two 30 s flights named neither: a researcher's trial,
+// helper-148), and its start on the joined clock kept for the plots. One flight: unchanged.
 void place_on_their_flights(std::vector<Unexplained>& windows, const std::vector<fit::Flight>& flights);
 
 struct ChannelGain {

@@ -403,6 +403,7 @@ json unexplained_json(const Diagnosis& d) {
                   {"p_value", u.p_value},
                   {"largest_in", {u.t0, u.t1}},
                   {"flight", u.flight ? json(u.flight) : json(nullptr)},
+                  {"starts_on_joined_clock", u.flight ? json(u.t0_joined) : json(nullptr)},
                   {"mean_there", u.worst_mean},
                   {"most_correlated_signal", u.signal},
                   {"r", u.r}});

@@ -136,7 +136,8 @@ void write_what_is_left(std::ostream& os, const Diagnosis& d) {
   for (const auto& u : d.unexplained)
     os << "unexplained: " << u.channel << " residual has slow structure " << significant(u.ratio, 3)
        << "x what noise gives, largest in " << (u.flight ? "flight " + std::to_string(u.flight) + " at " : "") << "t = "
-       << significant(u.t0, 3) << ".." << significant(u.t1, 3) << " s, most correlated with "
+       << significant(u.t0, 3) << ".." << significant(u.t1, 3) << " s"
+       << (u.flight ? " (from " + significant(u.t0_joined, 3) + " s on the plots' joined clock)" : "") << ", most correlated with "
        << u.signal << " (r = " << significant(u.r, 2) << ")\n";
   for (const auto& leads : {draft_leads(d), command_gain_leads(d)})
     for (const auto& lead : leads) {

@@ -93,7 +93,7 @@ std::string interval_of(const Profile& pr) {
   return "[" + side(pr.lower, pr.lower_open) + ", " + side(pr.upper, pr.upper_open) + "]";
 }
 
-// fit.json's kind of fit, the vehicle and the log, after what the fit wrote.
+// fit.json's kind of fit, the vehicle and the log.
 void add_what_was_fitted(nlohmann::ordered_json& j, const std::string& kind, const Vehicle& v, const std::string& path) {
   j["kind"] = kind;
   j["vehicle"] = v.name;

@@ -1230,7 +1230,7 @@ TEST(MultiFlight, FlightsTooUncertainToAgreeAreNotSaidToDisagree) {
 }
 
 // Of flights diagnosed together, an unexplained window is told on the clock of the flight it
-// lies in, as that log alone reads it, and ends with it (a researcher's trial, helper-148: the
+// lies in, from that log's first row, and ends with it (a researcher's trial, helper-148: the
 // joined clock's "t = 54.1..55.1 s" of two 30 s flights; then a review, helper-149: the time
 // since the first kept sample is not the log's own clock, which a take-off delays).
 TEST(MultiFlight, AnUnexplainedWindowIsToldOnItsFlightsClock) {
@@ -1246,10 +1246,13 @@ TEST(MultiFlight, AnUnexplainedWindowIsToldOnItsFlightsClock) {
   // Flight 2 is kept from 2 s of its own clock on; joined 1 s after flight 1's last sample
   // (10 s), its 2 s read 11 s there: its own time is the joined time less 9 s.
   const std::vector<quadgen::fit::Flight> flights = {flight_from(0.5, 10.0), flight_from(2.0, 6.0)};
-  std::vector<quadgen::diagnose::Unexplained> windows(3);
+  // Windows are cut by sample count over the joined log, so one may reach over the join (10 to
+  // 11 joined): it belongs to the flight its middle lies in, cut to that flight's samples.
+  std::vector<quadgen::diagnose::Unexplained> windows(4);
   windows[0].t0 = 5.0, windows[0].t1 = 6.0;    // in flight 1
   windows[1].t0 = 12.0, windows[1].t1 = 13.5;  // in flight 2, own 3.0..4.5
-  windows[2].t0 = 14.0, windows[2].t1 = 16.0;  // in flight 2 to beyond its end (15 joined, 6 own)
+  windows[2].t0 = 9.5, windows[2].t1 = 11.5;   // middle 10.5, in flight 1 (or the gap): its 9.5..10
+  windows[3].t0 = 10.5, windows[3].t1 = 12.5;  // middle 11.5, in flight 2: own 2.0 (its first sample)..3.5
   std::vector<quadgen::diagnose::Unexplained> one = windows;
   quadgen::diagnose::place_on_their_flights(windows, flights);
   EXPECT_EQ(windows[0].flight, 1);
@@ -1258,9 +1261,13 @@ TEST(MultiFlight, AnUnexplainedWindowIsToldOnItsFlightsClock) {
   EXPECT_EQ(windows[1].flight, 2);
   EXPECT_DOUBLE_EQ(windows[1].t0, 3.0);
   EXPECT_DOUBLE_EQ(windows[1].t1, 4.5);
-  EXPECT_EQ(windows[2].flight, 2);
-  EXPECT_DOUBLE_EQ(windows[2].t0, 5.0);
-  EXPECT_DOUBLE_EQ(windows[2].t1, 6.0);
+  EXPECT_DOUBLE_EQ(windows[1].t0_joined, 12.0);  // where the plots show it
+  EXPECT_EQ(windows[2].flight, 1);
+  EXPECT_DOUBLE_EQ(windows[2].t0, 9.5);
+  EXPECT_DOUBLE_EQ(windows[2].t1, 10.0);
+  EXPECT_EQ(windows[3].flight, 2);
+  EXPECT_DOUBLE_EQ(windows[3].t0, 2.0);
+  EXPECT_DOUBLE_EQ(windows[3].t1, 3.5);
   quadgen::diagnose::place_on_their_flights(one, {flights[0]});  // one flight: its own clock already
   EXPECT_EQ(one[1].flight, 0);
   EXPECT_DOUBLE_EQ(one[1].t0, 12.0);
