@@ -10,6 +10,7 @@
 #include "app/derive_pipeline.hpp"
 #include "derive/fitted_parameters.hpp"
 #include "output/numbers.hpp"
+#include "output/joined.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::diagnose {
@@ -28,9 +29,7 @@ std::string fitted_parameters_yaml(const Vehicle& v, const Diagnosis& d) {
     if (selected(d, e))
       y << "\n# " << e << ": one value per flight in diagnosis.json; here their mean over the " << d.flights.size()
         << " flights";
-  y << "\nvehicle: " << v.name << "\neffects: [";
-  for (size_t i = 0; i < d.search.selected.size(); ++i) y << (i ? ", " : "") << d.search.selected[i];
-  y << "]\nparameters:\n";
+  y << "\nvehicle: " << v.name << "\neffects: [" << output::joined(d.search.selected) << "]\nparameters:\n";
   for (const auto& p : d.airframe_fit)
     // The shortest text that reads back as the same double: derive --params regenerates the
     // same values, and a fitted 0.05 reads "0.05".

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "output/joined.hpp"
+
 namespace quadgen::codegen {
 
 namespace {
@@ -122,9 +124,7 @@ class Printer {
         return "Scalar(1.0)/" + factor(n.args[0]);
       case Kind::call: {
         out_.ops_after += 1;
-        std::string s = n.text + "(";
-        for (size_t i = 0; i < n.args.size(); ++i) s += (i ? ", " : "") + expr(n.args[i], false);
-        return s + ")";
+        return n.text + "(" + output::joined(n.args, ", ", [&](const auto& a) { return expr(a, false); }) + ")";
       }
       case Kind::leaf: return n.text;
     }

@@ -12,6 +12,7 @@
 #include "codegen/cpp_printer.hpp"
 #include "codegen/lowered_model.hpp"
 #include "derive/exact_number.hpp"
+#include "output/joined.hpp"
 #include "output/names.hpp"
 #include "output/sinks.hpp"
 #include "derive/effects/effect_catalogue.hpp"
@@ -38,9 +39,7 @@ std::string ident(const std::string& name) {
 }
 
 std::string quoted_list(const std::vector<Variable>& vs) {
-  std::string s = "{";
-  for (size_t i = 0; i < vs.size(); ++i) s += (i ? ", " : "") + output::cpp_string_literal(vs[i].name);
-  return s + "}";
+  return "{" + output::joined(vs, ", ", [](const Variable& v) { return output::cpp_string_literal(v.name); }) + "}";
 }
 
 // A nominal value as C++: never "inf" or "nan", identifiers the including project may define.
@@ -72,9 +71,7 @@ data variables(const std::vector<Variable>& vs) {
 }
 
 std::string int_list(const std::vector<int>& v) {
-  std::string s = "{";
-  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
-  return s + (v.empty() ? "0}" : "}");
+  return "{" + output::joined(v, ", ", [](int i) { return std::to_string(i); }) + (v.empty() ? "0}" : "}");
 }
 
 }  // namespace
@@ -140,9 +137,7 @@ void set_variable_tables(data& d, const SymbolicModel& m) {
   d.set("param_names", quoted_list(m.params));
   d.set("output_names", quoted_list(m.outputs));
   const auto table = [](const std::vector<Variable>& vs, auto entry) {
-    std::string out = "{";
-    for (size_t i = 0; i < vs.size(); ++i) out += (i ? ", " : "") + entry(vs[i]);
-    return out + "}";
+    return "{" + output::joined(vs, ", ", entry) + "}";
   };
   d.set("nominal_params", table(m.params, [](const Variable& v) { return number(v.nominal); }));
   d.set("param_units", table(m.params, [](const Variable& v) { return output::cpp_string_literal(v.unit); }));

@@ -650,11 +650,11 @@ struct FlightModels {
   std::vector<double> later_starts;  // where flights 2..K begin on the joined clock
   std::vector<std::string> per_flight_names;
 };
+// `starts`: where each flight begins on the joined clock (fit::joined_start_times).
 FlightModels per_flight_models(const SymbolicModel& all_in, runtime::DynamicModel& model_in,
-                               const std::vector<fit::Flight>& flights, const std::vector<std::string>& candidates,
+                               const std::vector<double>& starts, const std::vector<std::string>& candidates,
                                Diagnosis& d) {
   FlightModels m;
-  const auto starts = fit::joined_start_times(flights);
   m.later_starts.assign(starts.begin() + 1, starts.end());
   m.per_flight_names = per_flight_parameters(all_in, candidates);
   m.model = std::make_unique<runtime::PerFlightModel>(model_in, m.later_starts, m.per_flight_names);
@@ -672,10 +672,12 @@ bool use_accelerometer(const std::string& translational, const fit::Flight& flig
 }
 
 // The training part and the held-out end (of each flight, when there are several), recorded
-// in `d`; a part too short to fit or judge is refused.
+// in `d`; a part too short to fit or judge is refused. `flight_starts`: where each flight
+// begins on the joined clock ({0} for one flight).
 std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::Flight>& flights,
-                                                         const fit::Flight& flight, double validation_fraction,
-                                                         Diagnosis& d) {
+                                                         const fit::Flight& flight,
+                                                         const std::vector<double>& flight_starts,
+                                                         double validation_fraction, Diagnosis& d) {
   const bool joint = flights.size() > 1;
   auto parts = joint ? fit::split_each_by_time(flights, 1.0 - validation_fraction)
                      : fit::split_by_time(flight, 1.0 - validation_fraction);
@@ -691,7 +693,7 @@ std::pair<fit::Flight, fit::Flight> split_for_validation(const std::vector<fit::
   d.train_samples = train.samples.size();
   d.valid_samples = valid.samples.size();
   d.t_split = valid.samples.front().t;
-  d.validation_starts = held_out_starts(valid, joint ? fit::joined_start_times(flights) : std::vector<double>{0.0});
+  d.validation_starts = held_out_starts(valid, flight_starts);
   return parts;
 }
 
@@ -852,15 +854,16 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   const std::vector<fit::Flight> flights = usable_flights(flights_in, all_in, opt_in.progress, d);
   const bool joint = flights.size() > 1;
   const fit::Flight flight = joint ? fit::join_flights(flights) : flights.front();
+  const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
   DiagnoseOptions opt = opt_in;
   if (joint) opt.search.candidates = joint_candidates(opt.search.candidates, flight);
-  const FlightModels fm = joint ? per_flight_models(all_in, model_in, flights, opt.search.candidates, d)
+  const FlightModels fm = joint ? per_flight_models(all_in, model_in, flight_starts, opt.search.candidates, d)
                                 : FlightModels{};
   const SymbolicModel& all = joint ? fm.all : all_in;
   runtime::DynamicModel& model = joint ? *fm.model : model_in;
   const bool accel = use_accelerometer(opt.translational, flight);
   set_formulation(accel, d);
-  const auto parts = split_for_validation(flights, flight, opt.validation_fraction, d);
+  const auto parts = split_for_validation(flights, flight, flight_starts, opt.validation_fraction, d);
   const fit::Flight &train = parts.first, &valid = parts.second;
   *validation_out = valid;
   const fit::EquationErrorModel train_ee(model, train, accel), valid_ee(model, valid, accel),
@@ -896,7 +899,6 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   measure_held_out(d, held_out_gain, model, valid, valid_ee);
   d.unexplained = unexplained(d.after, opt);
   place_on_their_flights(d.unexplained, flights);
-  const std::vector<double> flight_starts = joint ? fit::joined_start_times(flights) : std::vector<double>{0.0};
   lead_signatures(d, v, used, valid, all_ee, accel, flight_starts);
 
   // 5. Beyond the catalogue: a term proposed from what is left, regenerated and tested.

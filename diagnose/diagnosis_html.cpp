@@ -13,6 +13,7 @@
 #include "derive/effects/effect_catalogue.hpp"
 #include "diagnose/report_words.hpp"
 #include "fit/fit_report.hpp"
+#include "output/joined.hpp"
 #include "output/estimate.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
@@ -276,8 +277,7 @@ void agreement_table_html(std::ostringstream& h, const std::vector<ParameterAgre
 // The base model's shared parameters per flight, after the effects' table (what is named comes first).
 void base_agreement_section(std::ostringstream& h, const Diagnosis& d) {
   if (d.base_agreement.empty()) return;
-  std::string names;
-  for (const auto& a : d.base_agreement) names += (names.empty() ? "" : ", ") + esc(a.parameter);
+  const std::string names = output::joined(d.base_agreement, ", ", [](const auto& a) { return esc(a.parameter); });
   h << "<h2>Do the flights agree on the base model?</h2>\n<p>The base model's parameters every flight shares and "
        "the joint fit fitted (" << names << ") refitted together on each flight's training part alone, with the named "
        "effects free beside them (their shapes may overlap: a frame's drag and rotor drag at walking speeds) and the "
@@ -516,7 +516,7 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
   if (d.findings.empty()) h << "<p>None.</p>\n";
   if (!d.per_flight_effects.empty()) {
     h << "<p>One value per flight for ";
-    for (size_t i = 0; i < d.per_flight_effects.size(); ++i) h << (i ? ", " : "") << esc(d.per_flight_effects[i]);
+    h << output::joined(d.per_flight_effects, ", ", [](const std::string& e) { return esc(e); });
     h << " (" << esc(flights_own(d)) << "): a plain name is flight 1's, <i>name</i>@<i>k</i> flight "
          "<i>k</i>'s (flights numbered as under the title).</p>\n";
   }

@@ -187,14 +187,13 @@ json settling_json(const Settling& s) {
 json finding_json(const Finding& f) {
   json ps = json::object();
   const std::string& anchor = find_effect(f.effect).ratios_only_beside;
-  bool has_reference = false;  // held where the model fitted the anchor (reference_parameters)
-  if (!anchor.empty())
-    for (const auto& p : f.evidence.parameters)
-      if (effect_of_parameter(p.name) == f.effect && !p.free) {
-        ps[p.name] = output::estimate_json({0.0, p.unit, 0.0, 0.0, "reference (held at 0)", false});
-        ps[p.name]["reference"] = true;
-        has_reference = true;
-      }
+  const std::string reference = held_reference(f);
+  const bool has_reference = !reference.empty();
+  for (const auto& p : f.evidence.parameters)
+    if (p.name == reference) {
+      ps[p.name] = output::estimate_json({0.0, p.unit, 0.0, 0.0, "reference (held at 0)", false});
+      ps[p.name]["reference"] = true;
+    }
   for (const auto& e : f.parameters) {
     json pj = output::estimate_json({e.value, e.unit, e.lower, e.upper, fit::identifiability_text(e.verdict), e.at_bound});
     pj["standard_error"] = number_or_null(e.standard_error);

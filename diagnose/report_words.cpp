@@ -140,15 +140,23 @@ std::string flight_headline(const Effect& e, const std::vector<const EffectEstim
 // of several flights gets one sentence per flight: their mean described none of them (a
 // newcomer's trial, helper-136: "Motor FL gives 2.5 % more thrust" for 5 % on one flight and
 // none on the other).
+std::string held_reference(const Finding& f) {
+  // By the one rule that holds it in the fit, and held there: not any held parameter of
+  // the effect.
+  std::vector<std::string> names;
+  std::set<std::string> fitted;
+  for (const auto& p : f.evidence.parameters) {
+    names.push_back(p.name);
+    if (p.free) fitted.insert(p.name);
+  }
+  for (const auto& name : quadgen::reference_parameters(names, fitted))
+    if (effect_of_parameter(name) == f.effect && !fitted.count(name)) return name;
+  return "";
+}
+
 std::string headline(const Finding& f) {
   const Effect& e = find_effect(f.effect);
-  std::string reference;
-  if (!e.ratios_only_beside.empty())  // held where the model fitted what it stands beside
-    for (const auto& p : f.evidence.parameters)
-      if (effect_of_parameter(p.name) == f.effect && !p.free && runtime::flight_of_name(p.name) == 1) {
-        reference = p.name;
-        break;
-      }
+  const std::string reference = held_reference(f);
   std::map<int, std::vector<const EffectEstimate*>> by_flight;
   for (const auto& p : f.parameters) by_flight[runtime::flight_of_name(p.name)].push_back(&p);
   if (by_flight.size() <= 1) {

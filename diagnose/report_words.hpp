@@ -19,6 +19,9 @@ double reduction(double before, double after);
 std::string lower_or_higher(double before, double after, int digits);
 // A finding in one sentence ("Motor M4 gives 6.9 % less thrust than motor M1").
 std::string headline(const Finding& f);
+// The parameter of a finding's effect its fit held as the reference (reference_parameters:
+// the first of an effect identifiable only as ratios beside a fitted anchor, and held), or "".
+std::string held_reference(const Finding& f);
 // Said where the airframe a flight is checked against came from one flight's diagnosis ("" else).
 std::string airframe_from_one_flight(const Diagnosis& d);
 // A suspect carried for a named look-alike's sake, in one sentence.

@@ -449,17 +449,18 @@ namespace {
 // entries (p, q, r: lines 12, 13, 14) for log.csv", or the log's path alone where it names its
 // own columns.
 std::string log_and_entries(const runtime::CsvTable& log, std::initializer_list<const char*> columns, const char* what) {
-  std::string names, lines;
+  std::vector<std::string> names, lines;
   int first = -1;
   for (const char* name : columns) {
     const int c = log.column(name);
     if (c < 0 || static_cast<size_t>(c) >= log.name_lines.size()) continue;
     if (first < 0) first = c;
-    names += (names.empty() ? "" : ", ") + std::string(name);
-    lines += (lines.empty() ? "" : ", ") + std::to_string(log.name_lines[static_cast<size_t>(c)]);
+    names.push_back(name);
+    lines.push_back(std::to_string(log.name_lines[static_cast<size_t>(c)]));
   }
   if (log.named_by.empty() || first < 0) return log.path;
-  return log.where_named(first) + ": " + what + "'s entries (" + names + ": lines " + lines + ") for " + log.path;
+  return log.where_named(first) + ": " + what + "'s entries (" + output::joined(names) + ": lines " +
+         output::joined(lines) + ") for " + log.path;
 }
 
 // Two unit mistakes a mapping can make that no dimension check sees, because the unit is

@@ -229,7 +229,7 @@ void read_parameter_sections(const Reader& r, const YAML::Node& root, Vehicle& v
   read_section(r, root, v, "frame", {{"c_w", "1", true, "drag coefficient of the frame"}});
   read_section(r, root, v, "rotor_model",
                {{"c_t", "1", true, "thrust coefficient of F = c_t rho A_p (omega r_p)^2"},
-                {"kappa", "m", true, "yaw torque per thrust, Q = kappa F"}});
+                {"kappa", "m", true, "yaw torque per thrust, Q = kappa F (a flight measures kappa / J_zz)"}});
   read_section(r, root, v, "motor_map",
                {{"a0", "rad/s", true, "the motor map's speed at command 0 (its constant term)"},
                 {"a1", "rad/s", true, "rotor speed per command"},

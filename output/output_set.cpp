@@ -24,6 +24,7 @@
 
 #include "output/file_identity.hpp"
 #include "output/fnv1a.hpp"
+#include "output/joined.hpp"
 #include "output/sinks.hpp"
 
 namespace quadgen::output {
@@ -264,8 +265,8 @@ bool unchanged_since(const fs::path& p, const std::string& recorded, const Manif
 }
 
 std::string first_names(const std::vector<std::string>& names) {
-  std::string out;
-  for (size_t i = 0; i < names.size() && i < 3; ++i) out += (i ? ", " : "") + printable(names[i]);
+  const std::vector<std::string> first(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(std::min<size_t>(3, names.size())));
+  const std::string out = joined(first, ", ", [](const std::string& n) { return printable(n); });
   return names.size() > 3 ? out + ", ..." : out;
 }
 

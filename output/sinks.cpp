@@ -11,6 +11,7 @@
 #include <unicode/utf8.h>
 #include <unicode/utypes.h>
 
+#include "output/joined.hpp"
 #include "output/names.hpp"
 
 namespace quadgen::output {
@@ -266,8 +267,7 @@ std::string unusual_characters(const std::string& s) {
     said.push_back(std::string(hex) + (U_SUCCESS(status) && name[0] ? std::string(" ") + name : "") + " (character " +
                    std::to_string(position) + ")");
   });
-  std::string out;
-  for (const auto& a : said) out += (out.empty() ? "" : ", ") + a;
+  const std::string out = joined(said);
   return more ? out + " and " + std::to_string(more) + " more" : out;
 }
 }  // namespace

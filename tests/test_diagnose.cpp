@@ -1248,26 +1248,31 @@ TEST(MultiFlight, AnUnexplainedWindowIsToldOnItsFlightsClock) {
   const std::vector<quadgen::fit::Flight> flights = {flight_from(0.5, 10.0), flight_from(2.0, 6.0)};
   // Windows are cut by sample count over the joined log, so one may reach over the join (10 to
   // 11 joined): it belongs to the flight its middle lies in, cut to that flight's samples.
-  std::vector<quadgen::diagnose::Unexplained> windows(4);
-  windows[0].t0 = 5.0, windows[0].t1 = 6.0;    // in flight 1
-  windows[1].t0 = 12.0, windows[1].t1 = 13.5;  // in flight 2, own 3.0..4.5
-  windows[2].t0 = 9.5, windows[2].t1 = 11.5;   // middle 10.5, in flight 1 (or the gap): its 9.5..10
-  windows[3].t0 = 10.5, windows[3].t1 = 12.5;  // middle 11.5, in flight 2: own 2.0 (its first sample)..3.5
+  struct Case {
+    double joined_t0, joined_t1;  // as cut
+    int flight;
+    double t0, t1;  // on that flight's own clock
+  };
+  const Case cases[] = {
+      {5.0, 6.0, 1, 5.0, 6.0},    // in flight 1
+      {12.0, 13.5, 2, 3.0, 4.5},  // in flight 2
+      {9.5, 11.5, 1, 9.5, 10.0},  // middle 10.5, in flight 1 (or the gap): cut at its last sample
+      {10.5, 12.5, 2, 2.0, 3.5},  // middle 11.5, in flight 2: from its first sample
+  };
+  std::vector<quadgen::diagnose::Unexplained> windows;
+  for (const Case& c : cases) {
+    windows.emplace_back();
+    windows.back().t0 = c.joined_t0, windows.back().t1 = c.joined_t1;
+  }
   std::vector<quadgen::diagnose::Unexplained> one = windows;
   quadgen::diagnose::place_on_their_flights(windows, flights);
-  EXPECT_EQ(windows[0].flight, 1);
-  EXPECT_DOUBLE_EQ(windows[0].t0, 5.0);
-  EXPECT_DOUBLE_EQ(windows[0].t1, 6.0);
-  EXPECT_EQ(windows[1].flight, 2);
-  EXPECT_DOUBLE_EQ(windows[1].t0, 3.0);
-  EXPECT_DOUBLE_EQ(windows[1].t1, 4.5);
-  EXPECT_DOUBLE_EQ(windows[1].t0_joined, 12.0);  // where the plots show it
-  EXPECT_EQ(windows[2].flight, 1);
-  EXPECT_DOUBLE_EQ(windows[2].t0, 9.5);
-  EXPECT_DOUBLE_EQ(windows[2].t1, 10.0);
-  EXPECT_EQ(windows[3].flight, 2);
-  EXPECT_DOUBLE_EQ(windows[3].t0, 2.0);
-  EXPECT_DOUBLE_EQ(windows[3].t1, 3.5);
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    SCOPED_TRACE("window " + std::to_string(i));
+    EXPECT_EQ(windows[i].flight, cases[i].flight);
+    EXPECT_DOUBLE_EQ(windows[i].t0, cases[i].t0);
+    EXPECT_DOUBLE_EQ(windows[i].t1, cases[i].t1);
+    EXPECT_DOUBLE_EQ(windows[i].t0_joined, cases[i].joined_t0);  // where the plots show it
+  }
   quadgen::diagnose::place_on_their_flights(one, {flights[0]});  // one flight: its own clock already
   EXPECT_EQ(one[1].flight, 0);
   EXPECT_DOUBLE_EQ(one[1].t0, 12.0);
@@ -2913,7 +2918,8 @@ TEST(ReportWords, TheMotorGainSentenceNamesOnlyGainsToldApartFromTheReference) {
   using namespace quadgen::diagnose;
   Finding f;
   f.effect = "motor_gain";
-  f.evidence.parameters.push_back({"motor_gain.M1", "1", 0, -0.5, 0.5, false});
+  // M1 held beside a fitted c_t: the reference (reference_parameters).
+  f.evidence.parameters = {{"c_t", "1", 0.14, 0.01, 1, true}, {"motor_gain.M1", "1", 0, -0.5, 0.5, false}};
   const auto gain = [](const char* name, double value, double lower, double upper) {
     EffectEstimate e;
     e.name = name, e.value = value, e.lower = lower, e.upper = upper;
@@ -2990,15 +2996,27 @@ TEST(ExtendedModel, TheMotorGainsReferenceIsHeldOnlyWhereCtIsFitted) {
   d.vehicle = "finken3";
   quadgen::diagnose::Finding f;
   f.effect = "motor_gain";
-  f.evidence.parameters = {{"motor_gain.A", "1", 0.01, -0.5, 0.5, true}, {"motor_gain.B", "1", 0.02, -0.5, 0.5, true}};
+  f.evidence.parameters = {{"c_t", "1", 0.14, 0.01, 1, true},
+                           {"motor_gain.A", "1", 0.01, -0.5, 0.5, true},
+                           {"motor_gain.B", "1", 0.02, -0.5, 0.5, true}};
   d.findings = {f};
   const auto all_free = quadgen::diagnose::diagnosis_json(d, "log.csv")["findings"][0];
   EXPECT_FALSE(all_free.contains("note"));
   EXPECT_FALSE(all_free["parameters"].contains("motor_gain.A"));  // no estimates given: no rows but a reference's
-  d.findings[0].evidence.parameters[0].free = false;
+  d.findings[0].evidence.parameters[1].free = false;
   const auto one_held = quadgen::diagnose::diagnosis_json(d, "log.csv")["findings"][0];
+  ASSERT_TRUE(one_held["parameters"].contains("motor_gain.A"));
   EXPECT_EQ(one_held["parameters"]["motor_gain.A"]["reference"], true);
+  ASSERT_TRUE(one_held.contains("note"));
   EXPECT_NE(one_held["note"].get<std::string>().find("c_t is fitted"), std::string::npos);
+  EXPECT_EQ(quadgen::diagnose::words::held_reference(d.findings[0]), "motor_gain.A");
+  // A gain held beside a held c_t is no reference (the rule that holds it in the fit, not
+  // any held parameter of the effect): no reference row, no note, no "than motor A".
+  d.findings[0].evidence.parameters[0].free = false;
+  const auto ct_held = quadgen::diagnose::diagnosis_json(d, "log.csv")["findings"][0];
+  EXPECT_FALSE(ct_held["parameters"].contains("motor_gain.A"));
+  EXPECT_FALSE(ct_held.contains("note"));
+  EXPECT_EQ(quadgen::diagnose::words::held_reference(d.findings[0]), "");
 }
 
 // Every plot a diagnosis did not draw is said, one note each; gnuplot missing, once (a

@@ -24,10 +24,10 @@
 // own (quadgen's is runtime/ground_contact.hpp). Motor commands are evaluated as given: clamp
 // them to 0..1 first. The measurement h is indexed by Output, not State.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e
+#ifndef QUADGEN_GENERATED_model_1cc8d0871ca260f4d2ad1cb64eef078c
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e
+#define QUADGEN_GENERATED_model_1cc8d0871ca260f4d2ad1cb64eef078c
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -48,7 +48,7 @@ namespace crazyflie21_nanobench {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::crazyflie21_nanobench::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_cbf38ed6349e25252993f6cf153d171e {
+inline namespace model_1cc8d0871ca260f4d2ad1cb64eef078c {
 
 inline constexpr int kNumStates = 13;
 inline constexpr int kNumInputs = 4;
@@ -119,7 +119,7 @@ struct Param {
     rho = 1,  // rho [kg/m^3] air density
     c_w = 2,  // c_w [1] drag coefficient of the frame
     c_t = 3,  // c_t [1] thrust coefficient of F = c_t rho A_p (omega r_p)^2
-    kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F
+    kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F (a flight measures kappa / J_zz)
     motor_a0 = 5,  // motor_a0 [rad/s] the motor map's speed at command 0 (its constant term)
     motor_a1 = 6,  // motor_a1 [rad/s] rotor speed per command
     motor_a2 = 7,  // motor_a2 [rad/s] rotor speed per command squared
@@ -1614,8 +1614,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_cbf38ed6349e25252993f6cf153d171e
+}  // inline namespace model_1cc8d0871ca260f4d2ad1cb64eef078c
 }  // namespace crazyflie21_nanobench
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_cbf38ed6349e25252993f6cf153d171e
+#endif  // QUADGEN_GENERATED_model_1cc8d0871ca260f4d2ad1cb64eef078c

@@ -30,10 +30,10 @@
 // steps below about 2 tau (Euler) or 2.8 tau (RK4) of the fastest rotor, and the nominal tau
 // may be far below a fitted one: set the parameters before choosing the step.
 #pragma once
-#ifndef QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
+#ifndef QUADGEN_GENERATED_model_fe7ef5b7fd2b9bf02f35b8500ca0301b
 // The guard is named after the code's hash: the same model generated twice (one vehicle file
 // at two paths) and included twice is one, where #pragma once would see two files.
-#define QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
+#define QUADGEN_GENERATED_model_fe7ef5b7fd2b9bf02f35b8500ca0301b
 
 #if (defined(_MSVC_LANG) ? _MSVC_LANG : __cplusplus) < 201703L
 #error "quadgen: the generated model needs C++17 (inline variables)"
@@ -54,7 +54,7 @@ namespace finken3_all_effects {
 // its name) then link as two, where otherwise one would silently take the other's functions
 // (the one-definition rule; found in a user trial). Code names them as before,
 // quadgen_generated::finken3_all_effects::rhs; both in one translation unit are ambiguous, an error.
-inline namespace model_da25e2301577d7fce9073d2ba631c294 {
+inline namespace model_fe7ef5b7fd2b9bf02f35b8500ca0301b {
 
 inline constexpr int kNumStates = 17;
 inline constexpr int kNumInputs = 6;
@@ -131,7 +131,7 @@ struct Param {
     rho = 1,  // rho [kg/m^3] air density
     c_w = 2,  // c_w [1] drag coefficient of the frame
     c_t = 3,  // c_t [1] thrust coefficient of F = c_t rho A_p (omega r_p)^2
-    kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F
+    kappa = 4,  // kappa [m] yaw torque per thrust, Q = kappa F (a flight measures kappa / J_zz)
     motor_a0 = 5,  // motor_a0 [rad/s] the motor map's speed at command 0 (its constant term)
     motor_a1 = 6,  // motor_a1 [rad/s] rotor speed per command
     motor_a2 = 7,  // motor_a2 [rad/s] rotor speed per command squared
@@ -2258,8 +2258,8 @@ struct Model {
   }
 };
 
-}  // inline namespace model_da25e2301577d7fce9073d2ba631c294
+}  // inline namespace model_fe7ef5b7fd2b9bf02f35b8500ca0301b
 }  // namespace finken3_all_effects
 }  // namespace quadgen_generated
 
-#endif  // QUADGEN_GENERATED_model_da25e2301577d7fce9073d2ba631c294
+#endif  // QUADGEN_GENERATED_model_fe7ef5b7fd2b9bf02f35b8500ca0301b
