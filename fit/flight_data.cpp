@@ -275,6 +275,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   out.lines = raw.lines;
   out.resampled_hz = raw.resampled_hz;
   out.time_from_topics_start = raw.time_from_topics_start;
+  out.notes = raw.notes;
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);
@@ -783,6 +784,7 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   check_euler_range(log);
   Flight f;
   f.source = log.path;
+  f.notes = log.notes;  // what reading it noticed (a slow topic, dropouts)
   if (static_cast<double>(log.rows.size()) < o.min_samples)
     throw FitError(log.path + ": too few samples (" + std::to_string(log.rows.size()) + ", need " +
                    std::to_string(static_cast<int>(o.min_samples)) + ")");

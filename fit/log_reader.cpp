@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "fit/grid_mean.hpp"
 #include "fit/least_squares.hpp"  // FitError
@@ -28,15 +29,44 @@ struct Signal {
   std::vector<double> t, v;
   double gap = 0;
   std::vector<size_t> breaks;
+  double median_interval = 0;  // s
 };
 
+// A topic as a mapping names it: "actuator_outputs" (instance 0) or "actuator_outputs[1]",
+// the second instance of a topic logged more than once (PX4 logs up to three of
+// actuator_outputs; with DShot the motors may be on another than the first).
+std::string topic_label(const runtime::LogTopic& t) {
+  return t.multi_id == 0 ? t.name : t.name + "[" + std::to_string(t.multi_id) + "]";
+}
+
 const runtime::LogTopic& find_topic(const runtime::TopicLog& log, const std::string& topic, const std::string& source) {
-  if (const runtime::LogTopic* tp = log.find(topic)) return *tp;
-  const std::string have = output::joined(log.topics, ", ", [](const runtime::LogTopic& t) { return t.name; });
+  std::string name = topic;
+  int instance = 0;
+  if (const auto open = topic.find('['); open != std::string::npos) {
+    const std::string digits = topic.substr(open + 1, topic.size() - open - 2);
+    if (topic.back() != ']' || digits.empty() || digits.size() > 3 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      throw FitError(log.path + ": '" + source + "': a topic's instance is written topic[k].field, k a number (0 to 255)");
+    name = topic.substr(0, open);
+    instance = std::stoi(digits);
+  }
+  if (const runtime::LogTopic* tp = log.find(name, instance)) return *tp;
+  std::vector<std::string> instances;
+  for (const auto& t : log.topics)
+    if (t.name == name) instances.push_back(topic_label(t));
+  if (!instances.empty())
+    throw FitError(log.path + ": no instance " + std::to_string(instance) + " of topic '" + name + "' for '" + source +
+                   "' (the log has " + output::joined(instances) + "; name one as topic[k].field)");
+  const std::string have = output::joined(log.topics, ", ", topic_label);
   throw FitError(log.path + ": no topic '" + topic + "' for '" + source + "' (the log has: " + have + ")");
 }
 
-// PX4 logs NaN for values not set yet: such samples are left out, not interpolated over.
+// PX4 logs NaN for values not set yet, and a battery voltage of exactly 0 where it is not
+// known (battery_status.voltage_v): such samples are left out, not interpolated over.
+bool unset(const ColumnMapping::Entry& e, double value) {
+  return !std::isfinite(value) || (e.target == "vbat" && value == 0);
+}
+
 Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
   const std::string topic = e.source.substr(0, dot);
@@ -49,7 +79,7 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   Signal s{e.source, e.target, {}, {}, 0, {}};
   for (const auto& row : tp.rows) {
     const double t = row[0] * 1e-6;
-    if (!std::isfinite(row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
+    if (unset(e, row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
     s.t.push_back(t);
     s.v.push_back(row[c]);
   }
@@ -57,7 +87,8 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   std::vector<double> dt;
   for (size_t k = 1; k < s.t.size(); ++k) dt.push_back(s.t[k] - s.t[k - 1]);
   std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-  s.gap = std::max(3 * dt[dt.size() / 2], 0.1);  // a dropout or a paused topic beyond this
+  s.median_interval = dt[dt.size() / 2];
+  s.gap = std::max(3 * s.median_interval, 0.1);  // a dropout or a paused topic beyond this
   for (size_t k = 0; k + 1 < s.t.size(); ++k)
     if (s.t[k + 1] - s.t[k] > s.gap) s.breaks.push_back(k);
   return s;
@@ -117,6 +148,27 @@ void wrap_roll(runtime::CsvTable& t) {
     for (auto& row : t.rows) row[static_cast<size_t>(c)] = wrapped_to_pi(row[static_cast<size_t>(c)]);
 }
 
+// Signals logged more slowly than the grid, one note per topic: between their samples the
+// grid holds straight lines, and what changed faster is not in the log (PX4's default logging
+// profile writes actuator_outputs and vehicle_local_position at 10 Hz: a review, helper-152).
+std::vector<std::string> slow_signal_notes(const std::vector<Signal>& signals, double rate_hz, const std::string& path) {
+  std::map<std::string, std::pair<double, std::vector<std::string>>> slow;  // topic: interval, sources
+  for (const auto& s : signals)
+    if (s.median_interval > 1.5 / rate_hz) {
+      auto& [interval, sources] = slow[s.source.substr(0, s.source.find('.'))];
+      interval = std::max(interval, s.median_interval);
+      sources.push_back(s.source);
+    }
+  std::vector<std::string> notes;
+  for (const auto& [topic, slowest] : slow)
+    notes.push_back(path + ": " + output::joined(slowest.second) + " logged every " +
+                    output::short_number(slowest.first * 1e3) + " ms, slower than the " + output::short_number(rate_hz) +
+                    " Hz grid: between its samples the grid holds straight lines, and what changed faster is not in "
+                    "the log (a PX4 log's topics are faster with SDLOG_PROFILE's system-identification or high-rate "
+                    "profile)");
+  return notes;
+}
+
 // A cap on the table a few bytes of timestamps could ask for: 2^28 cells (2 GiB of doubles).
 constexpr double kMaxCells = 268435456.0;
 
@@ -146,6 +198,7 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   out.path = log.path;
   out.resampled_hz = rate_hz;
   out.time_from_topics_start = true;
+  out.notes = slow_signal_notes(signals, rate_hz, log.path);
   out.columns.push_back("t");
   for (const auto& s : signals) out.columns.push_back(s.source);
   // Grid points inside a gap of any signal are left out: the table then has a gap there too,
@@ -165,6 +218,18 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   return out;
 }
 
+std::vector<std::string> ulog_notes(const runtime::Ulog& log) {
+  std::vector<std::string> notes;
+  if (log.dropouts > 0)
+    notes.push_back(log.path + ": the logger dropped data " + std::to_string(log.dropouts) + " time" +
+                    (log.dropouts == 1 ? "" : "s") + " (" + output::short_number(log.dropout_ms) +
+                    " ms in all): a signal's pause longer than three of its intervals and 0.1 s is a gap, not bridged");
+  if (log.truncated)
+    notes.push_back(log.path + ": the log ends inside a message (byte " + std::to_string(log.truncated_at) +
+                    ", as after a power loss): that message is dropped, everything before it read");
+  return notes;
+}
+
 runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping, double resample_hz) {
   if (is_topic_log(path)) {
     const bool ulog = is_ulog(path);
@@ -172,8 +237,14 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
       throw FitError(path + (ulog ? ": a ULog log" : ": a Crazyflie uSD log") +
                      " needs --mapping naming its signals as topic.field (docs/formats.md)");
     const double rate = resample_hz > 0 ? resample_hz : kTopicLogRate;
-    const runtime::CsvTable table = ulog ? topic_table(runtime::read_ulog(path), *mapping, rate)
-                                         : topic_table(runtime::read_usd_log(path), *mapping, rate);
+    runtime::CsvTable table;
+    if (ulog) {
+      const runtime::Ulog log = runtime::read_ulog(path);
+      table = topic_table(log, *mapping, rate);
+      for (const auto& note : ulog_notes(log)) table.notes.push_back(note);
+    } else {
+      table = topic_table(runtime::read_usd_log(path), *mapping, rate);
+    }
     runtime::CsvTable mapped = apply_mapping(table, *mapping);
     wrap_roll(mapped);
     return mapped;

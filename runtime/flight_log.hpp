@@ -47,6 +47,9 @@ struct CsvTable {
   // Above 0 where the rows are not the file's lines but samples at this rate (a CSV log
   // resampled, a ULog or uSD log's topics on a grid): a row is then named by its time.
   double resampled_hz = 0;
+  // What reading a binary log noticed that a person should know before trusting it (a topic
+  // slower than the grid, logger dropouts, a cut-off end): carried into the flight's notes.
+  std::vector<std::string> notes;
   bool time_from_topics_start = false;  // t counts from the mapped topics' common start (ULog, uSD)
   // Where row `row` is, for a message: "log.csv:94", or "log.csv (the row at t = 2.49 s,
   // resampled at 37 Hz)".

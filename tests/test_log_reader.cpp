@@ -12,6 +12,7 @@
 #include "runtime/attitude.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/log_reader.hpp"
+#include "output/joined.hpp"
 #include "tests/ulog_writer.hpp"
 
 using namespace quadgen;
@@ -148,13 +149,13 @@ TEST(LogReader, UnsetValuesAreSkippedGapsStayGapsQuaternionSignsAligned) {
   }
   const std::string log = write_file("quadgen_gaps.ulg", w.bytes());
   const std::string mapping = write_file("quadgen_gaps.yaml",
-                                         "name: gaps\ncolumns:\n  t: {source: t}\n  vbat: {source: a.v}\n"
+                                         "name: gaps\ncolumns:\n  t: {source: t}\n  x: {source: a.v}\n"
                                          "  qw: {source: \"q.q[0]\"}\n  qx: {source: \"q.q[1]\"}\n"
                                          "  qy: {source: \"q.q[2]\"}\n  qz: {source: \"q.q[3]\"}\n");
   const runtime::CsvTable t = fit::read_log(log, mapping, 200.0);
   bool gap = false;
   for (size_t k = 0; k < t.rows.size(); ++k) {
-    const double s = t.rows[k][0], v = t.rows[k][t.column("vbat")];
+    const double s = t.rows[k][0], v = t.rows[k][t.column("x")];
     EXPECT_TRUE(std::isfinite(v)) << s;
     EXPECT_NEAR(v, s, 1e-5) << s;  // the NaN samples are bridged by their neighbours
     EXPECT_FALSE(s > 1.0 + 1e-9 && s < 1.5 - 1e-9) << "a row inside the pause at " << s;
@@ -271,4 +272,65 @@ TEST(LogReader, MissingTopicsAndFieldsAreNamedWithWhatTheLogHas) {
   } catch (const fit::FitError& e) {
     EXPECT_NE(std::string(e.what()).find("needs --mapping"), std::string::npos);
   }
+}
+
+// What a real PX4 log does that the first fixtures did not (a review, helper-152): the motors
+// on the second instance of actuator_outputs (DShot on a board with an IO), named
+// topic[k].field; a topic logged at 10 Hz, slower than the grid, said; a battery voltage of
+// exactly 0 (PX4's "not known") left out like a NaN; the logger's dropouts said.
+TEST(LogReader, AnInstanceIsNamedASlowTopicSaidAnUnknownVoltageLeftOut) {
+  Writer w;
+  w.flag_bits()
+      .format("actuator_outputs:uint64_t timestamp;float[2] output;")
+      .format("battery_status:uint64_t timestamp;float voltage_v;");
+  w.add(0, 0, "actuator_outputs").add(1, 1, "actuator_outputs").add(0, 2, "battery_status");
+  for (int k = 0; k <= 200; ++k) {
+    const std::uint64_t t = 1000000 + 10000 * static_cast<std::uint64_t>(k);
+    w.data(0, le(t, 8) + f32(1500) + f32(1500));                                 // 100 Hz, not the motors
+    if (k % 10 == 0) w.data(1, le(t, 8) + f32(1200 + k) + f32(1200));             // 10 Hz, the motors
+    w.data(2, le(t, 8) + f32(k < 50 ? 0.0f : 4.0f));                              // unknown for 0.5 s
+    if (k == 100) w.msg('O', le(20, 2));                                          // a 20 ms dropout
+  }
+  const std::string log = write_file("quadgen_instances.ulg", w.bytes());
+  const auto mapped = [&](const std::string& motor_source) {
+    return fit::read_log(log,
+                         write_file("quadgen_instances.yaml", "name: inst\ncolumns:\n  t: {source: t}\n"
+                                                              "  vbat: {source: battery_status.voltage_v}\n"
+                                                              "  u_M1: {source: \"" + motor_source +
+                                                                  "\", scale: 0.001, offset: -1}\n"),
+                         100.0);
+  };
+  const runtime::CsvTable t = mapped("actuator_outputs[1].output[0]");
+  ASSERT_GT(t.rows.size(), 100u);
+  for (const auto& row : t.rows) {
+    EXPECT_NEAR(row[t.column("vbat")], 4.0, 1e-6) << row[0];  // no 0 V averaged in
+    EXPECT_GT(row[t.column("u_M1")], 0.2 - 1e-6) << row[0];   // instance 1's 1200.., not instance 0's 1500
+    EXPECT_LT(row[t.column("u_M1")], 0.4 + 1e-6) << row[0];
+  }
+  const std::string notes = output::joined(t.notes, "\n");
+  EXPECT_NE(notes.find("actuator_outputs[1].output[0] logged every 100 ms, slower than the 100 Hz grid"),
+            std::string::npos)
+      << notes;
+  EXPECT_EQ(notes.find("battery_status"), std::string::npos) << notes;  // logged at the grid's rate
+  EXPECT_NE(notes.find("dropped data 1 time (20 ms in all)"), std::string::npos) << notes;
+  // Instance 0 is the plain name; an instance the log lacks is named with those it has.
+  const runtime::CsvTable first = mapped("actuator_outputs.output[0]");
+  EXPECT_NEAR(first.rows.front()[first.column("u_M1")], 0.5, 1e-6);  // instance 0's 1500
+  const auto error = [&](const std::string& source) {
+    try {
+      mapped(source);
+    } catch (const fit::FitError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error("actuator_outputs[2].output[0]")
+                .find("no instance 2 of topic 'actuator_outputs' for 'actuator_outputs[2].output[0]' (the log has "
+                      "actuator_outputs, actuator_outputs[1]; name one as topic[k].field)"),
+            std::string::npos)
+      << error("actuator_outputs[2].output[0]");
+  EXPECT_NE(error("actuator_outputs[one].output[0]").find("a topic's instance is written topic[k].field"),
+            std::string::npos);
+  EXPECT_NE(error("actuator_outputs[1.output[0]").find("a topic's instance is written topic[k].field"), std::string::npos)
+      << error("actuator_outputs[1.output[0]");
 }
