@@ -355,6 +355,13 @@ static void add_mass_properties(nlohmann::ordered_json& j, const Derivation& d) 
                       {"areas", d.mass.areas_value},
                       {"inertia_about_origin", d.mass.inertia_origin_value}};
   j["areas"] = {used("A_x"), used("A_y"), used("A_z")};
+  // Each quantity's unit, from the parameter it is (a reviewer: model.json had none).
+  const auto unit = [&](const char* name) { return d.model.params[d.model.param_index(name)].unit; };
+  j["units"] = {{"mass", unit("mass")},
+                {"cog", unit("cog_x")},
+                {"inertia", unit("J_xx")},
+                {"areas", unit("A_x")},
+                {"inertia_about_origin", unit("J_xx")}};
 }
 
 // States, inputs, parameters or outputs: name, unit, meaning; a parameter's value, bounds and

@@ -13,6 +13,7 @@
 
 #include "derive/dynamics.hpp"
 #include "derive/geometry.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "derive/runtime_view.hpp"
 #include "runtime/allocation_matrix.hpp"
@@ -28,14 +29,20 @@ AuditCheck advisory(const std::string& name, bool ok, const std::string& detail)
   return c;
 }
 
-// Rounding residue (1e-17 N beside 0.13 N) reads as 0, as the trim's reason does.
+// Rounding residue (1e-17 N beside 0.13 N) reads as 0, as the trim's reason does, and values
+// equal but for it print alike (two rotors' 1.2535 N read "1.254, ..., 1.253" at four digits:
+// a derivation reviewer, helper-151).
 std::string numbers(const Eigen::VectorXd& x, const char* unit) {
-  std::ostringstream os;
-  os.precision(4);
   const double scale = x.size() ? x.cwiseAbs().maxCoeff() : 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << (std::abs(x(i)) <= 1e-9 * scale ? 0.0 : x(i));
-  if (*unit) os << " " << unit;
-  return os.str();
+  std::vector<double> shown;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    double v = std::abs(x(i)) <= 1e-9 * scale ? 0.0 : x(i);
+    for (double earlier : shown)
+      if (std::abs(v - earlier) <= 1e-9 * scale) v = earlier;
+    shown.push_back(v);
+  }
+  const std::string list = output::joined(shown, ", ", [](double v) { return output::six_digits(v); });
+  return *unit ? list + " " + unit : list;
 }
 
 AuditCheck check_motor_map(const std::vector<runtime::ThrustLaw>& laws) {
@@ -44,7 +51,7 @@ AuditCheck check_motor_map(const std::vector<runtime::ThrustLaw>& laws) {
   std::ostringstream os;
   os.precision(5);
   os << "d(speed)/d(command) = a1 + 2 a2 u is " << l.a1 << " rad/s at u = 0 and " << l.a1 + 2 * l.a2
-     << " at u = 1 (the map as the model turns it)";
+     << " rad/s at u = 1 (the map as the model turns it)";
   return advisory("the motor map rises with the command", rises, os.str());
 }
 
@@ -52,7 +59,7 @@ AuditCheck check_motor_map(const std::vector<runtime::ThrustLaw>& laws) {
 // and newton-metres of arms of centimetres), which leaves the rank as it is: roll and pitch
 // by the longest arm together, so that a row of rounding noise (sin 180 deg) stays noise, and
 // yaw by its largest entry.
-AuditCheck check_controllable(const Eigen::MatrixXd& B) {
+AuditCheck check_controllable(const Eigen::MatrixXd& B, double weight) {
   Eigen::MatrixXd scaled = B;
   const double arm = std::max(B.row(1).cwiseAbs().maxCoeff(), B.row(2).cwiseAbs().maxCoeff());
   if (arm > 0) scaled.middleRows(1, 2) /= arm;
@@ -77,6 +84,13 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
               (lost(3) >= 0.25 * lost.maxCoeff() ? " (do the spins cancel? as many ccw as cw rotors, placed in pairs)"
                                                  : " (where are the rotors?)");
   }
+  // Spins that do not balance pass the rank and show only in the trim's spread: said here
+  // (a hexacopter with four rotors of one spin, a derivation reviewer: helper-151).
+  const double each = weight / static_cast<double>(B.cols()), unbalanced = B.row(3).sum() * each;
+  if (B.cols() > 0 && std::abs(unbalanced) > 1e-9 * B.row(3).cwiseAbs().sum() * each)
+    detail += "; equal thrusts (" + output::six_digits(each) + " N each) leave a yaw moment of " +
+              output::six_digits(unbalanced) + " N m: the spins do not balance, and the hover trim holds it with unequal "
+              "thrusts";
   return advisory("thrust, roll, pitch and yaw can be set apart", rank == 4, detail);
 }
 
@@ -85,7 +99,11 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B) {
 AuditCheck check_hover_trim(const runtime::HoverTrim& trim, double weight) {
   const Eigen::VectorXd F =
       Eigen::Map<const Eigen::VectorXd>(trim.thrusts.data(), static_cast<Eigen::Index>(trim.thrusts.size()));
-  std::string detail = "thrusts for hover " + numbers(F, "N") + " (weight " + output::six_digits(weight) + " N)";
+  // More rotors than conditions: the trim is the least-norm one of a family (runtime::hover_trim).
+  std::string detail = std::string(F.size() > 4 ? "thrusts for hover (the least-norm set: one of many for more than "
+                                                  "four rotors) "
+                                                : "thrusts for hover ") +
+                       numbers(F, "N") + " (weight " + output::six_digits(weight) + " N)";
   if (trim.found()) {
     const Eigen::VectorXd u =
         Eigen::Map<const Eigen::VectorXd>(trim.commands.data(), static_cast<Eigen::Index>(trim.commands.size()));
@@ -294,7 +312,7 @@ AuditCheck check_one_scale(const Vehicle& v) {
   std::ostringstream fine;
   fine.precision(4);
   fine << "the blocks lie within " << reach << " m of the origin (a bound: centre plus half diagonal), the rotors reach "
-       << farthest << " m; every disc_area at most pi r^2";
+       << farthest << " m; every disc_area at most pi r^2 (1 % over allowed for rounding)";
   return advisory("rotors and blocks on one scale", found.empty(), found.empty() ? fine.str() : found);
 }
 
@@ -508,7 +526,7 @@ std::vector<AuditCheck> check_vehicle_can_fly(const Vehicle& v, const SymbolicMo
           check_orientations_in_degrees(v),
           check_inertia_used(v, m),
           check_motor_map(b.thrust_laws),
-          check_controllable(B),
+          check_controllable(B, b.mass * b.g),
           check_hover_trim(trim, b.mass * b.g),
           check_hover_above_the_bottom(trim),
           check_hover_below_the_top(trim)};

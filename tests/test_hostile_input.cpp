@@ -841,13 +841,14 @@ TEST(Cli, AHugeNameGivesAnErrorLineOfReadableLength) {
   std::string text = read(source_path("vehicles/finken3.yaml"));
   const std::string block = "{name: upper_body,";
   ASSERT_NE(text.find(block), std::string::npos);
+  const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + text.find(block), '\n'));
   text.replace(text.find(block), block.size(), "{name: " + std::string(200000, 'a') + ",");
   write(tmp.dir / "huge.yaml", text);
   const CliResult r = run_quadgen({"derive", tmp / "huge.yaml", "--out", tmp / "o"}, tmp.dir);
   EXPECT_NE(r.rc, 0);
   EXPECT_LT(r.err.size(), 2000u) << r.err.substr(0, 300);
   EXPECT_EQ(r.err.rfind("quadgen: error: ", 0), 0u) << r.err.substr(0, 300);
-  EXPECT_NE(r.err.find("huge.yaml:43"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find("huge.yaml:" + line + ":"), std::string::npos) << r.err.substr(0, 300);
   EXPECT_NE(r.err.find(" bytes left out ...] aaa"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(std::string("(allowed: ") + out::name_rule() + ")\n"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(tmp / "o"));
@@ -2327,6 +2328,8 @@ TEST(Cli, DeriveSaysWhereItsMassPropertiesComeFrom) {
   EXPECT_EQ(model.at("mass").get<double>(), 0.4);
   EXPECT_NEAR(model.at("from_blocks").at("mass").get<double>(), 0.387, 1e-9);
   EXPECT_EQ(model.at("inertia")[0][1].get<double>(), 0.002);  // the file's J_xy, not the blocks' 0
+  EXPECT_EQ(model.at("units"), nlohmann::json::parse(R"({"mass": "kg", "cog": "m", "inertia": "kg m^2", "areas": "m^2",
+                                                          "inertia_about_origin": "kg m^2"})"));
   // A given mass or principal moment that no body has is refused at its line (it passed the
   // audit, and the trim blamed a motor map in rpm).
   std::string zero = text;

@@ -1484,6 +1484,27 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     EXPECT_FALSE(c.at(apart).passed);
     EXPECT_NE(c.at(apart).detail.find("cannot set apart thrust and yaw"), std::string::npos) << c.at(apart).detail;
   }
+  {  // a hexacopter with one spin mirrored (four of one spin, two of the other): rank 4 and a
+     // trim, so every check passes; the unbalanced yaw is said, and the trim's thrusts are the
+     // least-norm set (a derivation reviewer, helper-151). Its two rotors of equal thrust print
+     // alike (at four digits they read 1.254 and 1.253).
+    Vehicle v = load_vehicle(test::source_path("vehicles/hexa_plus.yaml"));
+    EXPECT_EQ(checks_of(v).at(apart).detail.find("do not balance"), std::string::npos) << checks_of(v).at(apart).detail;
+    v.rotors[0].spin = v.rotors[0].spin == Spin::ccw ? Spin::cw : Spin::ccw;
+    const auto c = checks_of(v);
+    EXPECT_TRUE(c.at(apart).passed);
+    EXPECT_NE(c.at(apart).detail.find("N each) leave a yaw moment of"), std::string::npos) << c.at(apart).detail;
+    EXPECT_NE(c.at(apart).detail.find("the spins do not balance"), std::string::npos) << c.at(apart).detail;
+    ASSERT_TRUE(c.at(trim).passed) << c.at(trim).detail;
+    EXPECT_NE(c.at(trim).detail.find("the least-norm set"), std::string::npos) << c.at(trim).detail;
+    const runtime::HoverTrim t = nominal_hover_trim(v, derive_model(v, derive_mass_properties(v), {}));
+    ASSERT_EQ(t.thrusts.size(), 6u);
+    EXPECT_NEAR(t.thrusts[1], t.thrusts[5], 1e-9);  // R2 and R6 mirror each other
+    const std::string r2 = quadgen::output::six_digits(t.thrusts[1]);
+    EXPECT_NE(c.at(trim).detail.find(r2 + ", " + quadgen::output::six_digits(t.thrusts[2])), std::string::npos);
+    EXPECT_NE(c.at(trim).detail.find(", " + r2 + " N (weight"), std::string::npos) << c.at(trim).detail;
+    EXPECT_EQ(checks_of(good).at(trim).detail.find("least-norm"), std::string::npos);  // four rotors: one trim
+  }
   {  // a motor map's term in rpm written without its unit (read as rad/s, 9.5 times too fast):
      // hover at the very bottom of the range, where fit and diagnose take a rotor for idle
     Vehicle v = good;

@@ -2,6 +2,7 @@
 // one-line errors naming file and line, non-zero exit, no output left behind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -137,7 +138,10 @@ TEST(VehicleInput, GramsWrittenAsKilogramsAreNamed) {
     quadgen::derive_model(v, quadgen::derive_mass_properties(v), {});
     ADD_FAILURE() << "a 387 kg FINken 3 passed the mass bounds";
   } catch (const quadgen::VehicleError& e) {
-    EXPECT_NE(std::string(e.what()).find("masses in grams written as kilograms? The heaviest block, 'lower_body' at line 46"),
+    const auto at = text.find("name: lower_body");
+    ASSERT_NE(at, std::string::npos);
+    const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+    EXPECT_NE(std::string(e.what()).find("masses in grams written as kilograms? The heaviest block, 'lower_body' at line " + line),
               std::string::npos)
         << e.what();
   }
