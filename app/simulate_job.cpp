@@ -315,6 +315,7 @@ std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vect
 // has one, as fit, diagnose and predict read logs; x0 takes the log's first pose where it has one.
 InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector<double>& x0) {
   const CsvTable log = fit::read_log(a.inputs, a.mapping, 0);
+  for (const auto& note : log.notes) a.progress.say(note);  // a topic slower than the grid, dropouts
   // What a user may not guess when a column is missing: a log of another layout needs a mapping.
   validate_canonical(log, k.rotors,
                      a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout (t, u_<rotor>; "

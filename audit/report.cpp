@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "audit/tex_writer.hpp"
+#include "derive/runtime_view.hpp"
+#include "runtime/allocation_matrix.hpp"
 #include "derive/effects/effect_catalogue.hpp"
 #include "output/joined.hpp"
 #include "output/json_document.hpp"
@@ -64,6 +66,25 @@ void given_values(std::ostringstream& md, const Derivation& d) {
   md << ".\n\n";
 }
 
+// What one newton of each rotor does about the centre of gravity the model uses: the
+// allocation the closed loop and the hover trim solve with, printed so that a reader checks
+// arms, spins and signs by eye (a referee asked for it: only its rank was printed, helper-151).
+void allocation_table(std::ostringstream& md, const Derivation& d) {
+  const Eigen::MatrixXd B = runtime::allocation_matrix(nominal_controller_belief(d.vehicle, d.model));
+  md << "What one newton of each rotor's thrust does about that centre of gravity (the allocation the closed loop "
+        "and the hover trim solve with; section 7 checks its rank): roll and pitch moments are the rotor's arms, "
+        "the yaw moment its reaction, -kappa per newton for a counter-clockwise rotor (it turns the body "
+        "clockwise), +kappa for a clockwise one:\n\n| per newton of | "
+     << output::joined(d.vehicle.rotors, " | ", [](const Rotor& r) { return output::markdown_text(r.name); }) << " |\n|---|";
+  for (Eigen::Index i = 0; i < B.cols(); ++i) md << "---|";
+  const char* rows[4] = {"thrust [N]", "roll moment [N m]", "pitch moment [N m]", "yaw moment [N m]"};
+  for (Eigen::Index r = 0; r < 4; ++r) {
+    md << "\n| " << rows[r] << " |";
+    for (Eigen::Index i = 0; i < B.cols(); ++i) md << " " << output::six_digits(B(r, i)) << " |";
+  }
+  md << "\n\n";
+}
+
 void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
   const MassProperties& mp = d.mass;
   md << "## 2. Mass properties by exact integration\n\n"
@@ -102,6 +123,7 @@ void section_mass(std::ostringstream& md, const Derivation& d, TexWriter& tex) {
         "vehicle file re-derives them. They enter the dynamics as parameters `mass`, `cog_*`, `J_*`, `A_*` "
         "with these nominal values, so that a fit may free them.\n\n";
   given_values(md, d);
+  allocation_table(md, d);
 }
 
 // An equation a reader can follow: up to this many nodes it is written out, beyond it named.

@@ -89,8 +89,8 @@ AuditCheck check_controllable(const Eigen::MatrixXd& B, double weight) {
   const double each = weight / static_cast<double>(B.cols()), unbalanced = B.row(3).sum() * each;
   if (B.cols() > 0 && std::abs(unbalanced) > 1e-9 * B.row(3).cwiseAbs().sum() * each)
     detail += "; equal thrusts (" + output::six_digits(each) + " N each) leave a yaw moment of " +
-              output::six_digits(unbalanced) + " N m: the spins do not balance, and the hover trim holds it with unequal "
-              "thrusts";
+              output::six_digits(unbalanced) + " N m: the spins do not balance" +
+              (rank == 4 ? ", and unequal thrusts must hold it" : "");
   return advisory("thrust, roll, pitch and yaw can be set apart", rank == 4, detail);
 }
 

@@ -569,8 +569,10 @@ void read_signals(const runtime::CsvTable& log, Flight& f) {
     throw FitError(log.where_named() + ": need a pose (" + pose + ") or an accelerometer (ax, ay, az)" +
                    (lacks.empty() ? "" : "; " + lacks));
   // Part of a pose logged: the user may expect it read.
-  if (!lacks.empty())
+  if (!lacks.empty()) {
     f.notes.push_back(log.where_named() + ": no pose is read, only the accelerometer: a pose needs " + pose + "; " + lacks);
+    f.pose_partly_logged = true;
+  }
 }
 
 // The log's columns as the samples take them: time from the first row, the states (velocities

@@ -85,8 +85,10 @@ struct Flight {
   bool has_accelerometer = false, has_gyro = false, has_pose = false, has_vbat = false;
   bool has_attitude_ref = false;  // phi_ref and theta_ref logged
   // What the log holds but the loader could not read, for the user ("log.csv:1: no pose is
-  // read: ..."); the commands pass them on (fit's warnings, diagnose's and predict's notes).
+  // read: ..."), and what reading a binary log noticed (a topic slower than the grid); the
+  // commands pass them on (fit's warnings, diagnose's and predict's notes).
   std::vector<std::string> notes;
+  bool pose_partly_logged = false;  // a note says why the part of a pose logged is not read
 };
 
 // Where a fit's translational channels (ax, ay, az) may come from: the pose's differentiated

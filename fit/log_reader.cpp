@@ -83,7 +83,11 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
     s.t.push_back(t);
     s.v.push_back(row[c]);
   }
-  if (s.t.size() < 2) throw FitError(log.path + ": '" + e.source + "' has fewer than two finite samples");
+  if (s.t.size() < 2)
+    throw FitError(log.path + ": '" + e.source + "' has fewer than two samples with a value" +
+                   (e.target == "vbat" ? " (NaN or 0 V, PX4's \"not known\"): a log without a battery voltage is read "
+                                         "without it, so leave vbat out of the mapping"
+                                       : " (NaN is PX4's \"not set\")"));
   std::vector<double> dt;
   for (size_t k = 1; k < s.t.size(); ++k) dt.push_back(s.t[k] - s.t[k - 1]);
   std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
@@ -151,10 +155,11 @@ void wrap_roll(runtime::CsvTable& t) {
 // Signals logged more slowly than the grid, one note per topic: between their samples the
 // grid holds straight lines, and what changed faster is not in the log (PX4's default logging
 // profile writes actuator_outputs and vehicle_local_position at 10 Hz: a review, helper-152).
+// The battery voltage is left out: it changes slowly, and PX4 logs it at 5 Hz.
 std::vector<std::string> slow_signal_notes(const std::vector<Signal>& signals, double rate_hz, const std::string& path) {
   std::map<std::string, std::pair<double, std::vector<std::string>>> slow;  // topic: interval, sources
   for (const auto& s : signals)
-    if (s.median_interval > 1.5 / rate_hz) {
+    if (s.median_interval > 1.5 / rate_hz && s.target != "vbat") {
       auto& [interval, sources] = slow[s.source.substr(0, s.source.find('.'))];
       interval = std::max(interval, s.median_interval);
       sources.push_back(s.source);
@@ -164,8 +169,7 @@ std::vector<std::string> slow_signal_notes(const std::vector<Signal>& signals, d
     notes.push_back(path + ": " + output::joined(slowest.second) + " logged every " +
                     output::short_number(slowest.first * 1e3) + " ms, slower than the " + output::short_number(rate_hz) +
                     " Hz grid: between its samples the grid holds straight lines, and what changed faster is not in "
-                    "the log (a PX4 log's topics are faster with SDLOG_PROFILE's system-identification or high-rate "
-                    "profile)");
+                    "the log");
   return notes;
 }
 
@@ -241,6 +245,11 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
     if (ulog) {
       const runtime::Ulog log = runtime::read_ulog(path);
       table = topic_table(log, *mapping, rate);
+      // How to log faster (docs.px4.io, "Logging": the logging profiles raise other topics'
+      // rates, not actuator_outputs' or vehicle_local_position's: helper-153).
+      if (!table.notes.empty())
+        table.notes.push_back(path + ": PX4 logs a topic faster when a line of etc/logging/logger_topics.txt on its "
+                              "SD card names it (with no interval: at full rate; docs.px4.io, \"Logging\")");
       for (const auto& note : ulog_notes(log)) table.notes.push_back(note);
     } else {
       table = topic_table(runtime::read_usd_log(path), *mapping, rate);

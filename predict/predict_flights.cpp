@@ -22,7 +22,7 @@ fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlights
   const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
   for (const auto& note : flight.notes) o.progress.say(note);  // why a logged pose is not read
   if (!flight.has_pose)
-    o.progress.say(path + (flight.notes.empty() ? ": no pose logged" : "") +
+    o.progress.say(path + (flight.pose_partly_logged ? "" : ": no pose logged") +
                    ": one-step errors only (rollouts need a measured state)");
   if (!o.set_point_controller.empty() && !flight.has_attitude_ref)
     throw fit::FitError(path + ":1: --controller " + o.set_point_controller +

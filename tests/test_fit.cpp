@@ -561,6 +561,22 @@ TEST(FitData, ResamplingALogFasterThanTheGridFoldsNothingIntoTheSlowBand) {
   EXPECT_LT(worst, 0.02);
 }
 
+// What reading a log noticed (a ULog's topic slower than the grid, its dropouts) reaches the
+// flight's notes, which the commands print (a review, helper-153: the copy had no test).
+TEST(FitData, TheLogsNotesBecomeTheFlightsNotes) {
+  std::string text = "t,u_A,u_B,u_C,u_D,x,y,z,qw,qx,qy,qz,p,q,r\n";
+  for (int k = 0; k < 60; ++k) text += std::to_string(0.01 * k) + ",0.5,0.5,0.5,0.5,0,0,1,1,0,0,0,0,0,0\n";
+  runtime::CsvTable log = runtime::parse_csv(text, "n.csv");
+  log.notes = {"n.csv: a note of the reader"};
+  FlightOptions all_rows;
+  all_rows.airborne_only = false;
+  all_rows.edge_trim = 0;
+  const Flight f = load_flight(log, {"A", "B", "C", "D"}, all_rows);
+  ASSERT_FALSE(f.notes.empty());
+  EXPECT_EQ(f.notes.front(), "n.csv: a note of the reader");
+  EXPECT_FALSE(f.pose_partly_logged);
+}
+
 // A log may give its attitude as Z-Y-X Euler angles instead of a quaternion (docs/formats.md):
 // the flight read from the angles has the attitude Eigen composes from them, Rz Ry Rx, at
 // angles that wrap (yaw past pi), tilt far and pitch near its singularity.

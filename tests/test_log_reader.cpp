@@ -312,6 +312,7 @@ TEST(LogReader, AnInstanceIsNamedASlowTopicSaidAnUnknownVoltageLeftOut) {
             std::string::npos)
       << notes;
   EXPECT_EQ(notes.find("battery_status"), std::string::npos) << notes;  // logged at the grid's rate
+  EXPECT_NE(notes.find("etc/logging/logger_topics.txt"), std::string::npos) << notes;  // how PX4 logs it faster
   EXPECT_NE(notes.find("dropped data 1 time (20 ms in all)"), std::string::npos) << notes;
   // Instance 0 is the plain name; an instance the log lacks is named with those it has.
   const runtime::CsvTable first = mapped("actuator_outputs.output[0]");
@@ -333,4 +334,20 @@ TEST(LogReader, AnInstanceIsNamedASlowTopicSaidAnUnknownVoltageLeftOut) {
             std::string::npos);
   EXPECT_NE(error("actuator_outputs[1.output[0]").find("a topic's instance is written topic[k].field"), std::string::npos)
       << error("actuator_outputs[1.output[0]");
+  // A battery voltage that is never known: the error says to leave vbat out.
+  Writer none;
+  none.flag_bits().format("battery_status:uint64_t timestamp;float voltage_v;").add(0, 0, "battery_status");
+  for (int k = 0; k <= 20; ++k) none.data(0, le(1000000 + 10000 * static_cast<std::uint64_t>(k), 8) + f32(0.0f));
+  try {
+    fit::read_log(write_file("quadgen_no_voltage.ulg", none.bytes()),
+                  write_file("quadgen_no_voltage.yaml",
+                             "name: v\ncolumns:\n  t: {source: t}\n  vbat: {source: battery_status.voltage_v}\n"),
+                  100.0);
+    ADD_FAILURE() << "a voltage never known was read";
+  } catch (const fit::FitError& e) {
+    EXPECT_NE(std::string(e.what()).find("(NaN or 0 V, PX4's \"not known\"): a log without a battery voltage is read "
+                                         "without it, so leave vbat out of the mapping"),
+              std::string::npos)
+        << e.what();
+  }
 }

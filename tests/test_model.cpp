@@ -1483,6 +1483,9 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     const auto c = checks_of(v);
     EXPECT_FALSE(c.at(apart).passed);
     EXPECT_NE(c.at(apart).detail.find("cannot set apart thrust and yaw"), std::string::npos) << c.at(apart).detail;
+    // unbalanced, and no thrusts hold it: not said to be held (a review, helper-153)
+    EXPECT_NE(c.at(apart).detail.find("the spins do not balance"), std::string::npos) << c.at(apart).detail;
+    EXPECT_EQ(c.at(apart).detail.find("must hold it"), std::string::npos) << c.at(apart).detail;
   }
   {  // a hexacopter with one spin mirrored (four of one spin, two of the other): rank 4 and a
      // trim, so every check passes; the unbalanced yaw is said, and the trim's thrusts are the
@@ -1494,7 +1497,8 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
     const auto c = checks_of(v);
     EXPECT_TRUE(c.at(apart).passed);
     EXPECT_NE(c.at(apart).detail.find("N each) leave a yaw moment of"), std::string::npos) << c.at(apart).detail;
-    EXPECT_NE(c.at(apart).detail.find("the spins do not balance"), std::string::npos) << c.at(apart).detail;
+    EXPECT_NE(c.at(apart).detail.find("the spins do not balance, and unequal thrusts must hold it"), std::string::npos)
+        << c.at(apart).detail;
     ASSERT_TRUE(c.at(trim).passed) << c.at(trim).detail;
     EXPECT_NE(c.at(trim).detail.find("the least-norm set"), std::string::npos) << c.at(trim).detail;
     const runtime::HoverTrim t = nominal_hover_trim(v, derive_model(v, derive_mass_properties(v), {}));
@@ -1716,4 +1720,23 @@ TEST(Derive, ModelJsonHoldsTheHoverTrimAtFullPrecision) {
   for (double& c : rounded) c = std::round(c * 1e4) / 1e4;
   const std::vector<double> g = test::eval_f(m, x, rounded);
   EXPECT_GT(std::max(std::fabs(g[10]), std::fabs(g[11])), 1e-4);
+}
+
+// derivation.md prints the allocation (a referee could check spins and arms only through its
+// rank, helper-151): each rotor's arm about the centre of gravity and its yaw reaction, the
+// values written here from the FINken 3's file (l = 0.07465 m on the diagonals, A and C
+// counter-clockwise, kappa 0.01 m): roll = y, pitch = -x, yaw = -kappa for ccw.
+TEST(DerivationReport, TheAllocationIsPrintedRotorByRotor) {
+  const Vehicle v = test::finken3();
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive_model(v, mp, {});
+  const AuditResult no_audit;
+  const std::vector<ThesisItem> no_thesis;
+  const std::string md = derivation_markdown({v, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
+  EXPECT_NE(md.find("| per newton of | A | B | C | D |\n|---|---|---|---|---|\n| thrust [N] | 1 | 1 | 1 | 1 |\n"
+                    "| roll moment [N m] | -0.07465 | -0.07465 | 0.07465 | 0.07465 |\n"
+                    "| pitch moment [N m] | 0.07465 | -0.07465 | -0.07465 | 0.07465 |\n"
+                    "| yaw moment [N m] | -0.01 | 0.01 | -0.01 | 0.01 |\n"),
+            std::string::npos)
+      << md.substr(md.find("per newton of") == std::string::npos ? 0 : md.find("per newton of"), 400);
 }
