@@ -38,6 +38,16 @@ SymbolicModel derive(const Vehicle& v, std::vector<std::string> effects = {}) {
   return derive_model(v, derive_mass_properties(v), o);
 }
 
+// derivation.md of the vehicle's model with these options, without an audit, a thesis
+// comparison or a hover trim: the sections the derivation itself writes.
+std::string bare_derivation_markdown(const Vehicle& v, const DeriveOptions& o = {}) {
+  const MassProperties mp = derive_mass_properties(v);
+  const SymbolicModel m = derive_model(v, mp, o);
+  const AuditResult no_audit;
+  const std::vector<ThesisItem> no_thesis;
+  return derivation_markdown({v, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
+}
+
 // Whether the audit of m with mp passed its check `name` (a test failure where it has none).
 bool check_passed(const SymbolicModel& m, const MassProperties& mp, const std::string& name) {
   for (const auto& c : audit(m, mp).checks)
@@ -922,13 +932,9 @@ TEST(Report, AParameterShowsTheFilesValueWhereItsUnitWasConverted) {
 TEST(Report, DerivationIsTheSameWhateverTheSymbolCreationOrder) {
   const Vehicle v = test::finken3();
   const auto markdown = [&] {
-    const MassProperties mp = derive_mass_properties(v);
     DeriveOptions o;
     o.effects = parse_effect_list("all");
-    const SymbolicModel m = derive_model(v, mp, o);
-    const AuditResult no_audit;
-    const std::vector<ThesisItem> no_thesis;
-    return derivation_markdown({v, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
+    return bare_derivation_markdown(v, o);
   };
   const std::string first = markdown();
   std::vector<symbol> noise;
@@ -1439,20 +1445,12 @@ TEST(VehicleChecks, TheMistakesANewVehicleMakesAreWarnedOf) {
               std::string::npos);
     EXPECT_NE(checks_of(good).at(inertia).detail.find("(the blocks' tensor, as in the inertia checks"), std::string::npos);
     // derivation.md says the model uses the given value, not the blocks' it lists.
-    const Vehicle given = with_j_xy("1e-5");
-    const MassProperties mp = derive_mass_properties(given);
-    const SymbolicModel m = derive_model(given, mp, {});
-    const AuditResult no_audit;
-    const std::vector<ThesisItem> no_thesis;
-    const std::string md = derivation_markdown({given, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
+    const std::string md = bare_derivation_markdown(with_j_xy("1e-5"));
     EXPECT_NE(md.find("The vehicle file's `derived:` section gives measured values in place of the blocks', and the "
                       "model uses these"),
               std::string::npos);
     EXPECT_NE(md.find("minus the products of inertia): `J_xy` = 1e-05 kg m².\n"), std::string::npos);
-    EXPECT_EQ(derivation_markdown({good, derive_mass_properties(good), derive_model(good, derive_mass_properties(good), {}),
-                                   no_audit, no_thesis, runtime::HoverTrim{}})
-                  .find("section gives measured values"),
-              std::string::npos);
+    EXPECT_EQ(bare_derivation_markdown(good).find("section gives measured values"), std::string::npos);
     // A prolate tensor beyond the triangle inequality: J_zz larger than J_xx + J_yy.
     const auto flat = checks_of(parse_vehicle(text + "  J_zz: {value: 0.005, unit: kg m^2}\n", "flat.yaml"));
     EXPECT_FALSE(flat.at(inertia).passed);
@@ -1727,12 +1725,7 @@ TEST(Derive, ModelJsonHoldsTheHoverTrimAtFullPrecision) {
 // values written here from the FINken 3's file (l = 0.07465 m on the diagonals, A and C
 // counter-clockwise, kappa 0.01 m): roll = y, pitch = -x, yaw = -kappa for ccw.
 TEST(DerivationReport, TheAllocationIsPrintedRotorByRotor) {
-  const Vehicle v = test::finken3();
-  const MassProperties mp = derive_mass_properties(v);
-  const SymbolicModel m = derive_model(v, mp, {});
-  const AuditResult no_audit;
-  const std::vector<ThesisItem> no_thesis;
-  const std::string md = derivation_markdown({v, mp, m, no_audit, no_thesis, runtime::HoverTrim{}});
+  const std::string md = bare_derivation_markdown(test::finken3());
   EXPECT_NE(md.find("| per newton of | A | B | C | D |\n|---|---|---|---|---|\n| thrust [N] | 1 | 1 | 1 | 1 |\n"
                     "| roll moment [N m] | -0.07465 | -0.07465 | 0.07465 | 0.07465 |\n"
                     "| pitch moment [N m] | 0.07465 | -0.07465 | -0.07465 | 0.07465 |\n"
