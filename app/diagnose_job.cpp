@@ -21,6 +21,7 @@
 #include "output/json_document.hpp"
 #include "output/sinks.hpp"
 #include "fit/log_reader.hpp"
+#include "fit/read_flight.hpp"
 #include "app/model_registry.hpp"
 #include "model/vehicle.hpp"
 #include "runtime/log_file.hpp"
@@ -46,10 +47,9 @@ bool DiagnoseJob::IsValid(std::string* error) const {
 namespace {
 
 std::vector<fit::Flight> load_flights(const DiagnoseJob& job, const Vehicle& v, const fit::ColumnMapping& mapping) {
-  const std::vector<std::string> rotors = rotor_names(v);
   std::vector<fit::Flight> flights;
   for (const auto& path : job.logs)
-    flights.push_back(fit::load_flight(fit::read_log(path, job.mapping.empty() ? nullptr : &mapping, job.resample), rotors, {}));
+    flights.push_back(fit::read_flight(path, job.mapping.empty() ? nullptr : &mapping, job.resample, v));
   return flights;
 }
 

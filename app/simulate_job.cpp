@@ -16,6 +16,7 @@
 #include "runtime/flight_log.hpp"
 #include "derive/geometry.hpp"
 #include "fit/log_reader.hpp"
+#include "fit/read_flight.hpp"
 #include "runtime/ground_contact.hpp"
 #include "runtime/integrator.hpp"
 #include "app/model_registry.hpp"
@@ -313,9 +314,13 @@ std::shared_ptr<InputSignal> battery_signal(const CsvTable& log, const std::vect
 
 // A replay of a log's commands (and battery voltage), read through the job's mapping when it
 // has one, as fit, diagnose and predict read logs; x0 takes the log's first pose where it has one.
-InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, std::vector<double>& x0) {
-  const CsvTable log = fit::read_log(a.inputs, a.mapping, 0);
+InputFunction replay_inputs(const OpenLoop& k, const SimulateJob& a, const Vehicle& vehicle, std::vector<double>& x0) {
+  const fit::ColumnMapping mapping = a.mapping.empty() ? fit::ColumnMapping{} : fit::load_mapping(a.mapping);
+  const CsvTable log = fit::read_log(a.inputs, a.mapping.empty() ? nullptr : &mapping, 0);
   for (const auto& note : log.notes) a.progress.say(note);  // a topic slower than the grid, dropouts
+  // The log's own motor places against the vehicle file's (fit/read_flight.hpp): a replay of
+  // commands onto the wrong rotors flies another vehicle.
+  for (const auto& note : fit::logged_rotor_notes(a.inputs, log.parameters, mapping, vehicle)) a.progress.say(note);
   // What a user may not guess when a column is missing: a log of another layout needs a mapping.
   validate_canonical(log, k.rotors,
                      a.mapping.empty() ? "; simulate --inputs reads a log in the canonical layout (t, u_<rotor>; "
@@ -475,7 +480,7 @@ SimulateJobResult run_open_loop(const SimulateJob& a, const Vehicle& vehicle, co
   std::vector<double> x0(m.num_states(), 0.0);
   x0[rigid_body::kAttitude] = 1.0;
   const InputFunction inputs =
-      a.scenario.empty() ? replay_inputs(k, a, x0) : scenario_inputs(k, find_scenario(a.scenario));
+      a.scenario.empty() ? replay_inputs(k, a, vehicle, x0) : scenario_inputs(k, find_scenario(a.scenario));
   start_rotor_speeds(k, inputs, x0);
   Stats stats;
   std::ostringstream starting;

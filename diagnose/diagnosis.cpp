@@ -477,6 +477,11 @@ std::vector<fit::Flight> usable_flights(const std::vector<fit::Flight>& flights_
     const fit::Flight& f = flights_in[k];
     flights.push_back(predict::fill_missing_signals(f, all.params[all.param_index("vbat_ref")].nominal));
     d.flights.push_back(f.source);
+    // What reading the log noticed (a topic slower than the grid, the logger's dropouts, a
+    // cut-off end, no pose, idle motors in the air): the job says it before the work, and the
+    // diagnosis keeps it, so diagnosis.json and the report carry it too (they did not: a
+    // review, helper-152).
+    d.notes.insert(d.notes.end(), f.notes.begin(), f.notes.end());
   }
   return flights;
 }

@@ -240,8 +240,9 @@ struct Diagnosis {
   // Free parameters of the final model that ended on a bound: the model is strained there,
   // and a finding may stand in for physics the catalogue lacks.
   std::vector<fit::FitParameter> at_bounds;
-  // What a reader should know before trusting the held-out numbers (a held-out part whose
-  // folds are too short for their windows): diagnosis.json "notes", the report, the summary.
+  // What a reader should know before trusting the held-out numbers (what reading each used
+  // log noticed, fit::Flight::notes; a finding whose per-fold gain and whole-part numbers
+  // disagree): diagnosis.json "notes", the report, the summary.
   std::vector<std::string> notes;
   // The final fit as the airframe's parameters: per-flight values averaged over the flights
   // (what the extended header and fitted_parameters.yaml carry). One flight: the final fit.

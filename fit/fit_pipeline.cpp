@@ -14,6 +14,7 @@
 #include "fit/equation_error.hpp"
 #include "fit/fit_report.hpp"
 #include "fit/log_reader.hpp"
+#include "fit/read_flight.hpp"
 #include "fit/motor_steps.hpp"
 #include "fit/multiple_shooting.hpp"
 #include "runtime/plot.hpp"
@@ -437,8 +438,7 @@ std::string profile_summary(const FitResult& best, const std::vector<Profile>& p
 
 FitOutputs fit_flight_log(const std::string& path, const Vehicle& v, runtime::DynamicModel& model, const FitJobOptions& o) {
   check_options(o, LogKind::kFlight);
-  const std::vector<std::string> rotors = rotor_names(v);
-  const Flight flight = load_flight(read_log(path, o.mapping, o.resample), rotors, {});
+  const Flight flight = read_flight(path, o.mapping, o.resample, v);
   const std::vector<FitParameter> params = starting_parameters(model, o);
   const auto [train, valid] = o.validation > 0 ? split_by_time(flight, 1.0 - o.validation) : std::pair<Flight, Flight>(flight, Flight{});
   const bool accel = uses_accelerometer(flight, o);

@@ -276,6 +276,7 @@ runtime::CsvTable apply_mapping(const runtime::CsvTable& raw, const ColumnMappin
   out.resampled_hz = raw.resampled_hz;
   out.time_from_topics_start = raw.time_from_topics_start;
   out.notes = raw.notes;
+  out.parameters = raw.parameters;
   std::vector<int> src;
   for (const auto& e : m.entries) {
     const int c = raw.column(e.source);

@@ -45,7 +45,7 @@ const runtime::LogTopic& find_topic(const runtime::TopicLog& log, const std::str
   if (const auto open = topic.find('['); open != std::string::npos) {
     const std::string digits = topic.substr(open + 1, topic.size() - open - 2);
     if (topic.back() != ']' || digits.empty() || digits.size() > 3 ||
-        digits.find_first_not_of("0123456789") != std::string::npos)
+        digits.find_first_not_of("0123456789") != std::string::npos || (digits.size() > 1 && digits[0] == '0'))
       throw FitError(log.path + ": '" + source + "': a topic's instance is written topic[k].field, k a number (0 to 255)");
     name = topic.substr(0, open);
     instance = std::stoi(digits);
@@ -67,6 +67,16 @@ bool unset(const ColumnMapping::Entry& e, double value) {
   return !std::isfinite(value) || (e.target == "vbat" && value == 0);
 }
 
+// PX4's actuator_outputs says in `noutputs` how many of its channels the driver set; a channel
+// at or beyond it is not a command (it reads 0: throttle -1 through PWM's usual mapping). For
+// a field "name[i]" of a topic with that field: the column of noutputs and i, else -1.
+std::pair<int, long> channel_count_column(const runtime::LogTopic& tp, const std::string& field) {
+  const int count = tp.column("noutputs");
+  const auto open = field.rfind('[');
+  if (count < 0 || open == std::string::npos || field.back() != ']') return {-1, 0};
+  return {count, std::stol(field.substr(open + 1, field.size() - open - 2))};
+}
+
 Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
   const std::string topic = e.source.substr(0, dot);
@@ -77,12 +87,21 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
                    output::joined(tp.fields) + ")");
   }
   Signal s{e.source, e.target, {}, {}, 0, {}};
+  const auto [count, channel] = channel_count_column(tp, e.source.substr(dot + 1));
+  double most_channels = 0;
   for (const auto& row : tp.rows) {
     const double t = row[0] * 1e-6;
+    if (count >= 0) most_channels = std::max(most_channels, row[count]);
+    if (count >= 0 && !(static_cast<double>(channel) < row[count])) continue;  // a channel the driver did not set
     if (unset(e, row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
     s.t.push_back(t);
     s.v.push_back(row[c]);
   }
+  if (s.t.size() < 2 && count >= 0 && !(static_cast<double>(channel) < most_channels))
+    throw FitError(log.path + ": '" + e.source + "' is a channel its driver never set: every message of '" + topic +
+                   "' has noutputs " + output::short_number(most_channels) + " or fewer" +
+                   (most_channels >= 1 ? " (channels 0.." + output::short_number(most_channels - 1) + ")" : "") +
+                   "; which channel drives which motor is PX4's PWM_MAIN_FUNCn (or the AUX, DShot ones)");
   if (s.t.size() < 2)
     throw FitError(log.path + ": '" + e.source + "' has fewer than two samples with a value" +
                    (e.target == "vbat" ? " (NaN or 0 V, PX4's \"not known\"): a log without a battery voltage is read "
@@ -251,6 +270,7 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
         table.notes.push_back(path + ": PX4 logs a topic faster when a line of etc/logging/logger_topics.txt on its "
                               "SD card names it (with no interval: at full rate; docs.px4.io, \"Logging\")");
       for (const auto& note : ulog_notes(log)) table.notes.push_back(note);
+      table.parameters = log.parameters;
     } else {
       table = topic_table(runtime::read_usd_log(path), *mapping, rate);
     }

@@ -7,6 +7,7 @@
 
 #include "derive/effects/effect_catalogue.hpp"
 #include "fit/log_reader.hpp"
+#include "fit/read_flight.hpp"
 #include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
@@ -17,9 +18,8 @@ namespace quadgen::predict {
 namespace {
 
 fit::Flight load(const std::string& path, const Vehicle& v, const PredictFlightsOptions& o) {
-  const std::vector<std::string> rotors = rotor_names(v);
-  const runtime::CsvTable log = fit::read_log(path, o.mapping ? &*o.mapping : nullptr, o.resample);
-  const fit::Flight flight = fill_missing_signals(fit::load_flight(log, rotors, {}), param(v, "vbat_ref").nominal);
+  const fit::Flight flight =
+      fill_missing_signals(fit::read_flight(path, o.mapping ? &*o.mapping : nullptr, o.resample, v), param(v, "vbat_ref").nominal);
   for (const auto& note : flight.notes) o.progress.say(note);  // why a logged pose is not read
   if (!flight.has_pose)
     o.progress.say(path + (flight.pose_partly_logged ? "" : ": no pose logged") +
@@ -143,6 +143,7 @@ PredictedFlights predict_flights(const Vehicle& v, runtime::DynamicModel& model,
     if (!calibrated.empty()) j["calibrated"] = calibrated;
     if (!implausible.empty()) j["calibrated_implausible"] = implausible;
     j["evaluated_from_s"] = evaluated.samples.empty() ? 0.0 : evaluated.samples.front().t;
+    if (!whole.notes.empty()) j["notes"] = whole.notes;  // what reading the log noticed, said on the terminal too
     flights.push_back(j);
     out.pooled.merge(p);
   }

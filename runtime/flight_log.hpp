@@ -1,6 +1,7 @@
 // Flight logs as CSV: reading with line-exact errors, the canonical layout of
 // docs/formats.md "Flight log" (validation against a model's rotor names), and writing trajectories.
 #pragma once
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,6 +51,9 @@ struct CsvTable {
   // What reading a binary log noticed that a person should know before trusting it (a topic
   // slower than the grid, logger dropouts, a cut-off end): carried into the flight's notes.
   std::vector<std::string> notes;
+  // The log's own configuration when it has one (a ULog's parameters when logging started):
+  // where PX4 placed its motors, for fit/read_flight.hpp's check. Empty for other logs.
+  std::map<std::string, double> parameters;
   bool time_from_topics_start = false;  // t counts from the mapped topics' common start (ULog, uSD)
   // Where row `row` is, for a message: "log.csv:94", or "log.csv (the row at t = 2.49 s,
   // resampled at 37 Hz)".

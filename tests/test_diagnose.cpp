@@ -2811,8 +2811,9 @@ TEST(NoPose, AGainIsJudgedOnFourFoldsOfTheOneStepCost) {
   const fs::path dir = fresh_directory("quadgen_no_pose");
   const HiddenCase c{"weak_motor", "motor_gain", {{"motor_gain.C", -0.08}}, {}, "", 1};
   const fs::path log = fly(c, dir, "flight.csv", 40);
+  // x alone of the pose: not read, and the flight's note says why.
   std::ofstream(dir / "imu_only.yaml") << "name: imu_only\ncolumns:\n"
-                                       << "  t: {source: t, unit: s}\n"
+                                       << "  t: {source: t, unit: s}\n  x: {source: x, unit: m}\n"
                                        << "  p: {source: p, unit: rad/s}\n  q: {source: q, unit: rad/s}\n  r: {source: r, unit: rad/s}\n"
                                        << "  ax: {source: ax, unit: m/s^2}\n  ay: {source: ay, unit: m/s^2}\n  az: {source: az, unit: m/s^2}\n"
                                        << "  u_A: {source: u_A, unit: \"1\"}\n  u_B: {source: u_B, unit: \"1\"}\n"
@@ -2831,6 +2832,14 @@ TEST(NoPose, AGainIsJudgedOnFourFoldsOfTheOneStepCost) {
     EXPECT_EQ(f["gain"]["fold_gains"], f["one_step_gain"]["fold_gains"]) << f["effect"];
     EXPECT_EQ(f["accepted_by"], "one-step equation error") << f["effect"];
   }
+  // Why the x logged is not read is the log's note: said before the work, and kept in the
+  // diagnosis (diagnosis.json "notes", the report's cautions), which had it on the terminal only.
+  ASSERT_FALSE(j["notes"].empty());
+  EXPECT_EQ(j["notes"][0].get<std::string>().find(log.string() + " (columns named by "), 0u) << j["notes"].dump(1);
+  EXPECT_NE(j["notes"][0].get<std::string>().find("no pose is read, only the accelerometer"), std::string::npos);
+  std::ifstream report_in(dir / "out" / "report.html");
+  const std::string report((std::istreambuf_iterator<char>(report_in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("Caution: " + log.string()), std::string::npos);
   std::ifstream said_in(dir / "diagnose.log");
   const std::string said((std::istreambuf_iterator<char>(said_in)), std::istreambuf_iterator<char>());
   EXPECT_NE(said.find("lower per fold (no pose logged: no rollouts)"), std::string::npos) << said;

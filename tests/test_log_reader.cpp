@@ -12,6 +12,7 @@
 #include "runtime/attitude.hpp"
 #include "fit/least_squares.hpp"
 #include "fit/log_reader.hpp"
+#include "fit/read_flight.hpp"
 #include "output/joined.hpp"
 #include "tests/ulog_writer.hpp"
 
@@ -33,10 +34,13 @@ std::string write_file(const std::string& name, const std::string& bytes) {
 const double kQned[4] = {0.8031189202104505, 0.2, -0.3, 0.4743416490252569};  // |q| = 1
 const double kGyroFrd[3] = {0.1, 0.2, 0.3}, kAccFrd[3] = {0.5, -0.4, -9.7};
 
-std::string px4_log() {
+// `parameters`: PX4 parameters logged when logging started ("float NAME" or "int32_t NAME").
+std::string px4_log(const std::vector<std::pair<std::string, double>>& parameters = {}) {
   Writer w;
-  w.flag_bits()
-      .format("vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;")
+  w.flag_bits();
+  for (const auto& [key, value] : parameters)
+    w.key_value('P', key, key.rfind("float ", 0) == 0 ? f32(static_cast<float>(value)) : le(static_cast<std::uint32_t>(value), 4));
+  w.format("vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;")
       .format("vehicle_attitude:uint64_t timestamp;float[4] q;")
       .format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;float[3] accelerometer_m_s2;")
       .format("actuator_outputs:uint64_t timestamp;float[4] output;")
@@ -334,6 +338,9 @@ TEST(LogReader, AnInstanceIsNamedASlowTopicSaidAnUnknownVoltageLeftOut) {
             std::string::npos);
   EXPECT_NE(error("actuator_outputs[1.output[0]").find("a topic's instance is written topic[k].field"), std::string::npos)
       << error("actuator_outputs[1.output[0]");
+  // "[01]" is not read as instance 1: a number is written without leading zeros.
+  EXPECT_NE(error("actuator_outputs[01].output[0]").find("a topic's instance is written topic[k].field"),
+            std::string::npos);
   // A battery voltage that is never known: the error says to leave vbat out.
   Writer none;
   none.flag_bits().format("battery_status:uint64_t timestamp;float voltage_v;").add(0, 0, "battery_status");
@@ -350,4 +357,144 @@ TEST(LogReader, AnInstanceIsNamedASlowTopicSaidAnUnknownVoltageLeftOut) {
               std::string::npos)
         << e.what();
   }
+}
+
+// PX4's actuator_outputs says in noutputs how many channels its driver set; the rest read 0
+// (a PWM of 0 us, throttle -1 through the usual mapping), which a mapping must not take for a
+// motor's command (a review, helper-152): such samples are left out, and a channel no message
+// set is refused with what the log has.
+TEST(LogReader, ChannelsBeyondNoutputsAreNotCommands) {
+  Writer w;
+  w.flag_bits().format("actuator_outputs:uint64_t timestamp;uint32_t noutputs;float[8] output;");
+  w.add(0, 0, "actuator_outputs");
+  for (int k = 0; k <= 200; ++k) {
+    const std::uint64_t t = 1000000 + 10000 * static_cast<std::uint64_t>(k);
+    const std::uint32_t channels = k < 50 ? 0 : 4;  // the driver starts after 0.5 s
+    std::string m = le(t, 8) + le(channels, 4);
+    for (std::uint32_t i = 0; i < 8; ++i) m += f32(i < channels ? 1500.0f : 0.0f);
+    w.data(0, m);
+  }
+  const std::string log = write_file("quadgen_noutputs.ulg", w.bytes());
+  const auto mapped = [&](const std::string& channel) {
+    return fit::read_log(log,
+                         write_file("quadgen_noutputs.yaml", "name: n\ncolumns:\n  t: {source: t}\n  u_M1: {source: "
+                                                             "\"actuator_outputs.output[" + channel +
+                                                                 "]\", scale: 0.001, offset: -1}\n"),
+                         100.0);
+  };
+  const runtime::CsvTable t = mapped("3");
+  ASSERT_GT(t.rows.size(), 100u);
+  EXPECT_LT(t.rows.size(), 160u);  // from the driver's start on: 1.5 s of the 2 s
+  for (const auto& row : t.rows) EXPECT_NEAR(row[t.column("u_M1")], 0.5, 1e-6) << row[0];  // never the 0 us
+  try {
+    mapped("5");
+    ADD_FAILURE() << "a channel the driver never set was read";
+  } catch (const fit::FitError& e) {
+    EXPECT_NE(std::string(e.what()).find("'actuator_outputs.output[5]' is a channel its driver never set: every message "
+                                         "of 'actuator_outputs' has noutputs 4 or fewer (channels 0..3)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+namespace {
+
+// PX4's quadrotor X as its airframe 4001 sets it (CA_ROTORn_PX/PY forward-right-down, m; KM
+// > 0 counter-clockwise seen from above; PWM_MAIN_FUNCn = 100 + motor): motor 1 front-right
+// ccw, 2 rear-left ccw, 3 front-left cw, 4 rear-right cw, written here from those rules.
+std::map<std::string, double> px4_quad_x() {
+  std::map<std::string, double> p{{"CA_ROTOR_COUNT", 4}};
+  const double places[4][3] = {{0.15, 0.15, 0.05}, {-0.15, -0.15, 0.05}, {0.15, -0.15, -0.05}, {-0.15, 0.15, -0.05}};
+  for (int n = 0; n < 4; ++n) {
+    const std::string key = "CA_ROTOR" + std::to_string(n) + "_";
+    p[key + "PX"] = places[n][0];
+    p[key + "PY"] = places[n][1];
+    p[key + "KM"] = places[n][2];
+    p["PWM_MAIN_FUNC" + std::to_string(n + 1)] = 101 + n;
+  }
+  return p;
+}
+
+// A mapping of the vehicle's u_M1..u_M4 to these sources.
+fit::ColumnMapping motors_from(const std::vector<std::string>& sources) {
+  std::string text = "name: motors\ncolumns:\n  t: {source: t}\n";
+  for (size_t i = 0; i < sources.size(); ++i)
+    text += "  u_M" + std::to_string(i + 1) + ": {source: \"" + sources[i] + "\", scale: 0.001, offset: -1}\n";
+  return fit::load_mapping(write_file("quadgen_motors.yaml", text));
+}
+
+}  // namespace
+
+// The Crazyflie numbers its motors clockwise from front-right (vehicles/crazyflie21.yaml), PX4
+// its quadrotor X otherwise: mapped channel for channel, three of the four u_ columns read a
+// motor the log places elsewhere, and the notes say where and which rotor sits there. Mapped
+// by place, nothing is said; a spin, a count, two output-function families that disagree and
+// actuator_motors are checked as well.
+TEST(LoggedRotors, TheLogsMotorPlacesAreComparedWithTheVehicleFile) {
+  const Vehicle cf = load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/crazyflie21.yaml");
+  const auto notes = [&](const std::map<std::string, double>& p, const std::vector<std::string>& sources) {
+    return fit::logged_rotor_notes("f.ulg", p, motors_from(sources), cf);
+  };
+  const std::vector<std::string> by_channel{"actuator_outputs.output[0]", "actuator_outputs.output[1]",
+                                            "actuator_outputs.output[2]", "actuator_outputs.output[3]"};
+  const auto wrong = notes(px4_quad_x(), by_channel);
+  ASSERT_EQ(wrong.size(), 3u) << output::joined(wrong, "\n");
+  EXPECT_EQ(wrong[0].rfind("f.ulg: u_M2 reads actuator_outputs.output[1], PX4's motor 2 (PWM_MAIN_FUNC2 = 102), which "
+                           "the log's CA_ROTOR1_PX/PY place rear-left (x -0.15, y 0.15 m, forward-left-up); the vehicle "
+                           "file's M2 (", 0), 0u) << wrong[0];
+  EXPECT_NE(wrong[0].find(") sits rear-right, its M3 where that motor is"), std::string::npos) << wrong[0];
+  EXPECT_NE(wrong[1].find("u_M3 reads actuator_outputs.output[2], PX4's motor 3"), std::string::npos) << wrong[1];
+  EXPECT_NE(wrong[1].find("its M4 where that motor is"), std::string::npos) << wrong[1];
+  EXPECT_NE(wrong[2].find("its M2 where that motor is"), std::string::npos) << wrong[2];
+  // Each u_ column mapped to its own rotor's channel: M2 rear-right is PX4's motor 4, M3
+  // rear-left motor 2, M4 front-left motor 3, with their spins.
+  const std::vector<std::string> by_place{"actuator_outputs.output[0]", "actuator_outputs.output[3]",
+                                          "actuator_outputs.output[1]", "actuator_outputs.output[2]"};
+  EXPECT_TRUE(notes(px4_quad_x(), by_place).empty()) << output::joined(notes(px4_quad_x(), by_place), "\n");
+  // A spin the other way is said; so is another rotor count.
+  auto flipped = px4_quad_x();
+  flipped["CA_ROTOR0_KM"] = -0.05;
+  const auto spin = notes(flipped, by_place);
+  ASSERT_EQ(spin.size(), 1u) << output::joined(spin, "\n");
+  EXPECT_NE(spin[0].find("u_M1 reads actuator_outputs.output[0], PX4's motor 1 (PWM_MAIN_FUNC1 = 101), which the log's "
+                         "CA_ROTOR0_KM (-0.05) spins clockwise seen from above; the vehicle file's M1 ("),
+            std::string::npos)
+      << spin[0];
+  EXPECT_NE(spin[0].find(") spins counter-clockwise"), std::string::npos) << spin[0];
+  auto six = px4_quad_x();
+  six["CA_ROTOR_COUNT"] = 6;
+  const auto counted = notes(six, by_place);
+  ASSERT_EQ(counted.size(), 1u) << output::joined(counted, "\n");
+  EXPECT_NE(counted[0].find("the log's CA_ROTOR_COUNT is 6"), std::string::npos) << counted[0];
+  EXPECT_NE(counted[0].find("has 4 rotors"), std::string::npos) << counted[0];
+  // Two families naming other motors for channel 1 (a board with an IO and UAVCAN ESCs): which
+  // driver logged the instance the log does not say, so u_M2 is not judged.
+  auto two_families = px4_quad_x();
+  two_families["UAVCAN_EC_FUNC2"] = 103;
+  EXPECT_EQ(notes(two_families, by_channel).size(), 2u);
+  // actuator_motors.control[k] is motor k + 1, whatever the output functions.
+  auto motors_topic = by_place;
+  motors_topic[1] = "actuator_motors.control[3]";
+  EXPECT_TRUE(notes(px4_quad_x(), motors_topic).empty());
+  motors_topic[1] = "actuator_motors.control[1]";  // motor 2, rear-left: not M2's place
+  EXPECT_EQ(notes(px4_quad_x(), motors_topic).size(), 1u);
+  // Without the parameters (a CSV, a uSD log, PX4 before v1.14) nothing is judged.
+  EXPECT_TRUE(notes({}, by_channel).empty());
+}
+
+// The parameters reach the check from a ULog through the reading of a flight.
+TEST(LoggedRotors, AUlogsParametersReachTheFlightsNotes) {
+  std::vector<std::pair<std::string, double>> logged;
+  for (const auto& [name, value] : px4_quad_x())
+    logged.push_back({(name == "CA_ROTOR_COUNT" || name.rfind("PWM", 0) == 0 ? "int32_t " : "float ") + name, value});
+  const std::string log = write_file("quadgen_px4_params.ulg", px4_log(logged));
+  std::string mapping = kMapping;
+  mapping += "  u_M2: {source: \"actuator_outputs.output[1]\", scale: 0.001, offset: -1}\n"
+             "  u_M3: {source: \"actuator_outputs.output[2]\", scale: 0.001, offset: -1}\n"
+             "  u_M4: {source: \"actuator_outputs.output[3]\", scale: 0.001, offset: -1}\n";
+  const Vehicle cf = load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/crazyflie21.yaml");
+  const fit::Flight f = fit::read_flight(log, write_file("quadgen_px4_params.yaml", mapping), 100.0, cf);
+  int placed = 0;
+  for (const auto& note : f.notes) placed += note.find("where that motor is") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(placed, 3) << output::joined(f.notes, "\n");
 }

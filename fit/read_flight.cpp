@@ -1,0 +1,168 @@
+#include "fit/read_flight.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "fit/log_reader.hpp"
+#include "output/joined.hpp"
+#include "output/numbers.hpp"
+
+namespace quadgen::fit {
+
+namespace {
+
+// PX4's output functions "Motor 1".."Motor 12" (src/lib/mixer_module/output_functions.yaml).
+constexpr double kMotorFunction1 = 101, kMotorFunctionLast = 112;
+// A logged motor within this of its rotor's direction from the rotors' centre is that rotor:
+// under half the spacing of an octocopter's (45 degrees).
+constexpr double kSameDirection = 20 * M_PI / 180;
+
+// The number k of a field "name[k]", or -1.
+long index_of(const std::string& field, const std::string& name) {
+  if (field.size() < name.size() + 3 || field.compare(0, name.size() + 1, name + "[") != 0 || field.back() != ']') return -1;
+  const std::string digits = field.substr(name.size() + 1, field.size() - name.size() - 2);
+  if (digits.empty() || digits.size() > 3 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stol(digits);
+}
+
+// The PX4 motor (1, 2, ...) a mapped source reads, and the log's words for it; motor 0 where
+// the log does not say.
+struct LoggedMotor {
+  int motor = 0;
+  std::string how;
+};
+
+LoggedMotor motor_of(const std::string& source, const std::map<std::string, double>& parameters) {
+  const auto dot = source.find('.');
+  if (dot == std::string::npos) return {};
+  const std::string topic = source.substr(0, source.find('[') < dot ? source.find('[') : dot);
+  const std::string field = source.substr(dot + 1);
+  if (topic == "actuator_motors") {
+    const long k = index_of(field, "control");
+    return k < 0 ? LoggedMotor{} : LoggedMotor{static_cast<int>(k) + 1, "actuator_motors.control[k] is motor k + 1"};
+  }
+  const long channel = topic == "actuator_outputs" ? index_of(field, "output") : -1;
+  if (channel < 0) return {};
+  // Every output-function family naming a motor for this channel (PWM_MAIN_FUNC1 is channel 0).
+  const std::string suffix = "_FUNC" + std::to_string(channel + 1);
+  std::map<int, std::vector<std::string>> motors;
+  for (const auto& [name, value] : parameters)
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        value >= kMotorFunction1 && value <= kMotorFunctionLast && value == std::floor(value))
+      motors[static_cast<int>(value - kMotorFunction1) + 1].push_back(name + " = " + output::short_number(value));
+  if (motors.size() != 1) return {};  // none, or families that disagree: which driver logged it is not said
+  return {motors.begin()->first, output::joined(motors.begin()->second)};
+}
+
+// A rotor in the model's forward-left-up axes, and its spin: +1 counter-clockwise seen from
+// above, -1 clockwise, 0 not said.
+struct Place {
+  double x = 0, y = 0;
+  int spin = 0;
+};
+
+std::optional<Place> logged_place(const std::map<std::string, double>& parameters, int motor) {
+  const std::string key = "CA_ROTOR" + std::to_string(motor - 1) + "_";
+  const auto px = parameters.find(key + "PX"), py = parameters.find(key + "PY"), km = parameters.find(key + "KM");
+  if (px == parameters.end() || py == parameters.end()) return std::nullopt;
+  const int spin = km == parameters.end() ? 0 : (km->second > 0 ? 1 : (km->second < 0 ? -1 : 0));
+  return Place{px->second, -py->second, spin};  // forward-right-down -> forward-left-up
+}
+
+double centre_x(const std::vector<Place>& places) {
+  double s = 0;
+  for (const auto& p : places) s += p.x;
+  return places.empty() ? 0 : s / static_cast<double>(places.size());
+}
+double centre_y(const std::vector<Place>& places) {
+  double s = 0;
+  for (const auto& p : places) s += p.y;
+  return places.empty() ? 0 : s / static_cast<double>(places.size());
+}
+
+double angle_between(double a, double b) { return std::fabs(std::remainder(a - b, 2 * M_PI)); }
+
+// "front-left" for a direction (rad, 0 forward, counter-clockwise seen from above).
+std::string direction_word(double azimuth) {
+  static const char* const kWords[8] = {"front", "front-left", "left", "rear-left", "rear", "rear-right", "right", "front-right"};
+  const long sector = std::lround(azimuth / (M_PI / 4));
+  return kWords[((sector % 8) + 8) % 8];
+}
+
+std::string spin_word(int spin) { return spin > 0 ? "counter-clockwise" : "clockwise"; }
+
+// The logged motors as PX4 places them (those with a position), motor number -> place.
+std::map<int, Place> logged_places(const std::map<std::string, double>& parameters, int count) {
+  std::map<int, Place> places;
+  for (int m = 1; m <= count; ++m)
+    if (const auto p = logged_place(parameters, m)) places[m] = *p;
+  return places;
+}
+
+}  // namespace
+
+std::vector<std::string> logged_rotor_notes(const std::string& path, const std::map<std::string, double>& parameters,
+                                            const ColumnMapping& mapping, const Vehicle& v) {
+  const auto count_it = parameters.find("CA_ROTOR_COUNT");
+  if (count_it == parameters.end() || !(count_it->second >= 1)) return {};
+  std::vector<std::string> notes;
+  const int count = static_cast<int>(std::min(count_it->second, 64.0));
+  if (static_cast<size_t>(count) != v.rotors.size())
+    notes.push_back(path + ": the log's CA_ROTOR_COUNT is " + std::to_string(count) + " (PX4 allocated thrust to " +
+                    std::to_string(count) + " motors), the vehicle file " + v.source_path + " has " +
+                    std::to_string(v.rotors.size()) + " rotors");
+  const std::map<int, Place> logged = logged_places(parameters, count);
+  std::vector<Place> logged_list, file_list;
+  for (const auto& [m, p] : logged) logged_list.push_back(p);
+  for (const auto& r : v.rotors) file_list.push_back({r.position[0], r.position[1], spin_sign(r)});
+  const double lx = centre_x(logged_list), ly = centre_y(logged_list), fx = centre_x(file_list), fy = centre_y(file_list);
+  for (size_t i = 0; i < v.rotors.size(); ++i) {
+    const Rotor& rotor = v.rotors[i];
+    const auto entry = std::find_if(mapping.entries.begin(), mapping.entries.end(),
+                                    [&](const ColumnMapping::Entry& e) { return e.target == "u_" + rotor.name; });
+    if (entry == mapping.entries.end()) continue;
+    const LoggedMotor m = motor_of(entry->source, parameters);
+    const auto place = logged.find(m.motor);
+    if (m.motor == 0 || place == logged.end()) continue;
+    const double dx = place->second.x - lx, dy = place->second.y - ly;
+    if (std::hypot(dx, dy) < 1e-6) continue;  // at the centre: a position not set
+    const double azimuth = std::atan2(dy, dx);
+    const auto direction = [&](size_t j) { return std::atan2(file_list[j].y - fy, file_list[j].x - fx); };
+    size_t nearest = i;
+    for (size_t j = 0; j < v.rotors.size(); ++j)
+      if (angle_between(azimuth, direction(j)) < angle_between(azimuth, direction(nearest)) - 1e-9) nearest = j;
+    const std::string head = path + ": u_" + rotor.name + " reads " + entry->source + ", PX4's motor " +
+                             std::to_string(m.motor) + " (" + m.how + "), which the log's CA_ROTOR" +
+                             std::to_string(m.motor - 1) + "_";
+    const std::string where_file = v.source_path + ":" + std::to_string(rotor.line);
+    if (angle_between(azimuth, direction(i)) > kSameDirection && nearest != i) {
+      notes.push_back(head + "PX/PY place " + direction_word(azimuth) + " (x " + output::short_number(place->second.x) +
+                      ", y " + output::short_number(place->second.y) + " m, forward-left-up); the vehicle file's " +
+                      rotor.name + " (" + where_file + ") sits " + direction_word(direction(i)) + ", its " +
+                      v.rotors[nearest].name + " where that motor is: number the vehicle file's rotors as the log's "
+                      "motors, or map each u_ column to its own rotor's channel (data/mappings/px4.yaml says how)");
+    } else if (place->second.spin != 0 && place->second.spin != spin_sign(rotor)) {
+      notes.push_back(head + "KM (" + output::short_number(parameters.at("CA_ROTOR" + std::to_string(m.motor - 1) + "_KM")) +
+                      ") spins " + spin_word(place->second.spin) + " seen from above; the vehicle file's " + rotor.name +
+                      " (" + where_file + ") spins " + spin_word(spin_sign(rotor)));
+    }
+  }
+  return notes;
+}
+
+Flight read_flight(const std::string& path, const ColumnMapping* mapping, double resample_hz, const Vehicle& v) {
+  const runtime::CsvTable log = read_log(path, mapping, resample_hz);
+  Flight flight = load_flight(log, rotor_names(v), {});
+  if (mapping)
+    for (auto& note : logged_rotor_notes(path, log.parameters, *mapping, v)) flight.notes.push_back(std::move(note));
+  return flight;
+}
+
+Flight read_flight(const std::string& path, const std::string& mapping_path, double resample_hz, const Vehicle& v) {
+  if (mapping_path.empty()) return read_flight(path, static_cast<const ColumnMapping*>(nullptr), resample_hz, v);
+  const ColumnMapping m = load_mapping(mapping_path);
+  return read_flight(path, &m, resample_hz, v);
+}
+
+}  // namespace quadgen::fit
