@@ -129,7 +129,8 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
 // What the model still gets wrong: parameters at a bound, slow residual structure, the
 // checks' leads, proposed terms, and what limits the prediction.
 void write_what_is_left(std::ostream& os, const Diagnosis& d) {
-  for (const auto& note : d.notes) os << "caution: " << note << "\n";
+  // A note may quote a log's path, a line of its own each (a path may hold a line break).
+  for (const auto& note : d.notes) os << "caution: " << output::printable(note) << "\n";
   for (const auto& p : d.at_bounds)
     os << "caution: " << name_value(p.name, p.value, p.unit, kEstimateDigits)
        << (std::fabs(p.value - p.lower) <= std::fabs(p.value - p.upper) ? " (lower bound)" : " (upper bound)") << " — the model is strained there; a finding may stand in for missing physics\n";

@@ -77,6 +77,41 @@ std::pair<int, long> channel_count_column(const runtime::LogTopic& tp, const std
   return {count, std::stol(field.substr(open + 1, field.size() - open - 2))};
 }
 
+// When a field's value was measured, in microseconds. PX4 stamps a message when it is
+// published (`timestamp`, column 0); a topic estimated from a sensor carries the sensor's time
+// as `timestamp_sample` (vehicle_attitude, vehicle_local_position: a few ms earlier), and
+// sensor_combined its accelerometer's offset from the gyro's time (`accelerometer_timestamp_
+// relative`, INT32_MAX where not valid; a review, helper-152). Joined on the publication time,
+// the accelerometer and the attitude would sit ms away from the gyro on the grid.
+class SampleTime {
+ public:
+  SampleTime(const runtime::LogTopic& tp, const std::string& field) : sample_(tp.column("timestamp_sample")) {
+    for (size_t c = 0; c < tp.fields.size(); ++c) {
+      const std::string& name = tp.fields[c];
+      const std::string suffix = "_timestamp_relative";
+      if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+      const std::string sensor = name.substr(0, name.size() - suffix.size());
+      const bool of_sensor = field == sensor || field.compare(0, sensor.size() + 1, sensor + "_") == 0 ||
+                             field.compare(0, sensor.size() + 1, sensor + "[") == 0;
+      if (of_sensor && field != name) relative_ = static_cast<int>(c);
+    }
+  }
+  // Microseconds, or NaN where the row says its time is not valid.
+  double of(const std::vector<double>& row) const {
+    double us = sample_ >= 0 && row[static_cast<size_t>(sample_)] > 0 ? row[static_cast<size_t>(sample_)] : row[0];
+    if (relative_ >= 0) {
+      const double offset = row[static_cast<size_t>(relative_)];
+      if (offset == kInvalidRelative) return std::numeric_limits<double>::quiet_NaN();
+      us += offset;
+    }
+    return us;
+  }
+
+ private:
+  static constexpr double kInvalidRelative = 2147483647;  // PX4's RELATIVE_TIMESTAMP_INVALID
+  int sample_ = -1, relative_ = -1;
+};
+
 Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
   const std::string topic = e.source.substr(0, dot);
@@ -89,8 +124,10 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   Signal s{e.source, e.target, {}, {}, 0, {}};
   const auto [count, channel] = channel_count_column(tp, e.source.substr(dot + 1));
   double most_channels = 0;
+  const SampleTime sample_time(tp, e.source.substr(dot + 1));
   for (const auto& row : tp.rows) {
-    const double t = row[0] * 1e-6;
+    const double t = sample_time.of(row) * 1e-6;
+    if (std::isnan(t)) continue;
     if (count >= 0) most_channels = std::max(most_channels, row[count]);
     if (count >= 0 && !(static_cast<double>(channel) < row[count])) continue;  // a channel the driver did not set
     if (unset(e, row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
@@ -247,6 +284,12 @@ std::vector<std::string> ulog_notes(const runtime::Ulog& log) {
     notes.push_back(log.path + ": the logger dropped data " + std::to_string(log.dropouts) + " time" +
                     (log.dropouts == 1 ? "" : "s") + " (" + output::short_number(log.dropout_ms) +
                     " ms in all): a signal's pause longer than three of its intervals and 0.1 s is a gap, not bridged");
+  for (const auto& skip : log.skipped)
+    notes.push_back(log.path + ": the log is corrupt at byte " + std::to_string(skip.from) + " (" + skip.cause +
+                    "): reading resumed at its next sync message, byte " + std::to_string(skip.to) + " (" +
+                    std::to_string(skip.to - skip.from) +
+                    " bytes skipped: what they held is lost, a gap in the signals where it lasts longer than their gap "
+                    "threshold)");
   if (log.truncated)
     notes.push_back(log.path + ": the log ends inside a message (byte " + std::to_string(log.truncated_at) +
                     ", as after a power loss): that message is dropped, everything before it read");

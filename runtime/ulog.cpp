@@ -182,6 +182,7 @@ class Parser {
 
   void read_header();
   std::optional<Msg> message_at(std::size_t pos, std::size_t end) const;
+  bool resync(std::size_t& pos, std::size_t end, const std::string& cause);
   std::vector<std::size_t> flag_bits(const Msg& m) const;
   void handle(const Msg& m);
 
@@ -267,6 +268,26 @@ std::vector<std::size_t> Parser::flag_bits(const Msg& m) const {
   return ends;
 }
 
+// The spec's message types; in the Data section another is taken for corruption where a sync
+// message follows it (below), else skipped by its size as the spec asks of later types.
+bool known_type(char type) { return std::strchr("BFIMPQARDLCSO", type) != nullptr && type != '\0'; }
+
+// A sync message whole, header included: size 8, 'S', the spec's magic.
+constexpr char kSyncMessage[] = {0x08, 0x00, 'S', 0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, static_cast<char>(0xBB), 0x12};
+
+// In the Data section, after a corrupt message at `pos`: the next sync message before `end`
+// becomes the reading position, the skip kept for the notes; false where none follows.
+bool Parser::resync(std::size_t& pos, std::size_t end, const std::string& cause) {
+  if (!in_data_) return false;
+  const std::string_view rest = std::string_view(b_).substr(0, end);
+  const std::size_t sync = rest.find(std::string_view(kSyncMessage, sizeof kSyncMessage), pos + 1);
+  if (sync == std::string_view::npos) return false;
+  const std::string prefix = out_.path + ": ";
+  out_.skipped.push_back({pos, sync, cause.compare(0, prefix.size(), prefix) == 0 ? cause.substr(prefix.size()) : cause});
+  pos = sync;
+  return true;
+}
+
 Ulog Parser::run() {
   read_header();
   std::size_t pos = kHeaderBytes;
@@ -276,8 +297,21 @@ Ulog Parser::run() {
     pos += kMsgHeaderBytes + m->body.size();
   }
   for (const std::size_t end : ends) {
-    while (const auto m = message_at(pos, end)) {
-      handle(*m);
+    while (pos < end) {
+      const auto m = message_at(pos, end);
+      if (!m) {  // runs past the end: cut off, unless a sync message follows (a corrupt size)
+        if (resync(pos, end, "byte " + std::to_string(pos) + ": a message whose size runs past the end")) continue;
+        break;
+      }
+      if (in_data_ && !known_type(m->type) &&
+          resync(pos, end, "byte " + std::to_string(pos) + ": unknown message type " + std::to_string(static_cast<unsigned char>(m->type))))
+        continue;
+      try {
+        handle(*m);
+      } catch (const LogError& e) {
+        if (!resync(pos, end, e.what())) throw;
+        continue;
+      }
       pos += kMsgHeaderBytes + m->body.size();
     }
     if (pos < end && !out_.truncated) {

@@ -6,11 +6,16 @@
 //   (logging stops mid-message on power loss; the spec asks for exactly this). The same
 //   holds at the start of appended data ('B' message, DATA_APPENDED). Ulog::truncated says
 //   that this happened and where.
-// - Anything else that does not fit the spec throws LogError "path: byte N: cause", N the
-//   offset of the message at fault. There is no resynchronisation on 'S' messages: a
-//   corrupt log is reported, not silently shortened.
-// - Message types this reader does not use ('M', 'Q', 'L', 'C', 'S') and unknown ones are
-//   skipped by their size (forward compatibility); unknown incompatible flag bits are refused.
+// - In the Data section, a message that does not fit the spec (or of a type the spec does not
+//   name) is skipped to the next sync ('S') message, as the spec intends them for, when one
+//   follows: Ulog::skipped says where and why, and the readers say it as a note of the flight
+//   (a corrupt log is reported, not silently shortened). A message running past the end is
+//   such a corruption too when a sync message follows it. Without a sync message after it,
+//   and anywhere in the Definitions section, anything that does not fit the spec throws
+//   LogError "path: byte N: cause", N the offset of the message at fault; a type the spec does
+//   not name is then skipped by its size (forward compatibility).
+// - Message types this reader does not use ('M', 'Q', 'L', 'C', 'S') are skipped by their
+//   size; unknown incompatible flag bits are refused.
 // - Formats are checked when they are subscribed: an unused format naming an unknown type
 //   is no error. A subscribed format must not be recursive, nest deeper than
 //   kUlogMaxNesting, have arrays longer than kUlogMaxArray (or of length 0) or exceed
@@ -62,6 +67,13 @@ struct Ulog : TopicLog {  // path, topics (in order of first subscription), find
   std::vector<std::string> info;
   int dropouts = 0;  // 'O' messages and their total duration
   double dropout_ms = 0;
+  // Stretches skipped after a corrupt message in the Data section (see above): the corrupt
+  // message's offset, the sync message's where reading resumed, and what was wrong.
+  struct Skip {
+    std::uint64_t from = 0, to = 0;
+    std::string cause;
+  };
+  std::vector<Skip> skipped;
   bool truncated = false;                                                  // a cut-off message was dropped (see above)
   std::uint64_t truncated_at = 0;                                          // the byte offset of the first one
 };

@@ -498,3 +498,40 @@ TEST(LoggedRotors, AUlogsParametersReachTheFlightsNotes) {
   for (const auto& note : f.notes) placed += note.find("where that motor is") != std::string::npos ? 1 : 0;
   EXPECT_EQ(placed, 3) << output::joined(f.notes, "\n");
 }
+
+// A value is placed at the time it was measured, not published (a review, helper-152): PX4's
+// estimates carry the sensor's `timestamp_sample` (here 4 ms before publication), and
+// sensor_combined its accelerometer's offset from the gyro's time (`accelerometer_timestamp_
+// relative`, here -2.5 ms; INT32_MAX where not valid). Each signal is 10/s times its true
+// time, so on the grid all three agree; joined on publication times they were 0.04 and 0.025
+// apart.
+TEST(LogReader, ValuesArePlacedAtTheirSensorsTimeNotTheirPublication) {
+  Writer w;
+  w.flag_bits()
+      .format("imu:uint64_t timestamp;float gyro;int32_t accelerometer_timestamp_relative;float accelerometer_m_s2;")
+      .format("att:uint64_t timestamp;uint64_t timestamp_sample;float v;")
+      .add(0, 0, "imu")
+      .add(0, 1, "att");
+  const auto seconds = [](double us) { return (us - 1e6) * 1e-6; };
+  for (int k = 0; k <= 400; ++k) {
+    const std::uint64_t t = 1000000 + 5000 * static_cast<std::uint64_t>(k);
+    const bool invalid = k == 200;  // an accelerometer time not valid: its sample is left out
+    const std::int32_t relative = invalid ? 2147483647 : -2500;
+    w.data(0, le(t, 8) + f32(static_cast<float>(10 * seconds(t))) + le(static_cast<std::uint32_t>(relative), 4) +
+                  f32(invalid ? 999.0f : static_cast<float>(10 * seconds(t - 2500.0))));
+    w.data(1, le(t, 8) + le(t - 4000, 8) + f32(static_cast<float>(10 * seconds(t - 4000.0))));
+  }
+  const runtime::CsvTable table =
+      fit::read_log(write_file("quadgen_sample_times.ulg", w.bytes()),
+                    write_file("quadgen_sample_times.yaml", "name: s\ncolumns:\n  t: {source: t}\n"
+                                                            "  p: {source: imu.gyro}\n  q: {source: att.v}\n"
+                                                            "  ax: {source: imu.accelerometer_m_s2}\n"),
+                    100.0);
+  ASSERT_GT(table.rows.size(), 150u);
+  const int p = table.column("p"), q = table.column("q"), ax = table.column("ax");
+  for (size_t k = 2; k + 2 < table.rows.size(); ++k) {
+    const auto& row = table.rows[k];
+    EXPECT_NEAR(row[static_cast<size_t>(q)], row[static_cast<size_t>(p)], 1e-4) << row[0];
+    EXPECT_NEAR(row[static_cast<size_t>(ax)], row[static_cast<size_t>(p)], 1e-4) << row[0];
+  }
+}

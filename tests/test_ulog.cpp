@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/log_reader.hpp"  // ulog_notes
 #include "runtime/ulog.hpp"
 #include "tests/ulog_writer.hpp"
 
@@ -378,4 +379,53 @@ TEST(Ulog, ReadUlogReadsRegularFilesOnly) {
   std::ofstream((dir / "cut.ulg").string(), std::ios::binary) << bytes.substr(0, bytes.size() - 5);
   EXPECT_TRUE(read_ulog((dir / "cut.ulg").string()).truncated);
   fs::remove_all(dir);
+}
+
+// A corrupt message in the Data section is skipped to the next sync message, as the spec
+// intends them for (real PX4 logs have such stretches: PX4/pyulog#31, #51): the rows before
+// and after it are kept, what lay between is lost, and the skip is said with its bytes and
+// cause. Three corruptions: a data message for no subscription, a size running past the end,
+// a type the spec does not name. Without a sync message after it the log is refused, as
+// before (ErrorsNameFileOffsetAndCause); a later type with none after it is skipped by its
+// size (the fixture's 'Y').
+TEST(Ulog, ACorruptMessageIsSkippedToTheNextSyncMessage) {
+  const auto corrupt_then_sync = [](const std::string& corruption, std::size_t* from, std::size_t* to) {
+    Writer w = probe_log();
+    w.data(0, probe_bytes(p0, true));
+    *from = w.bytes().size();
+    w.bytes() += corruption;
+    w.data(0, probe_bytes(p1, true));  // after the corruption, before the sync: lost
+    *to = w.bytes().size();
+    w.msg('S', kSyncMagic).data(0, probe_bytes(p2, true));
+    return w.bytes();
+  };
+  const std::string unknown_id = le(2 + 45, 2) + "D" + le(7, 2) + probe_bytes(p1, false);
+  const std::string huge = le(65535, 2) + "D" + le(0, 2);
+  const std::string unnamed = le(3, 2) + "Z" + "abc";
+  const std::string causes[3] = {"data message for unknown msg_id 7", "a message whose size runs past the end",
+                                 "unknown message type 90"};
+  const std::string corruptions[3] = {unknown_id, huge, unnamed};
+  for (int k = 0; k < 3; ++k) {
+    SCOPED_TRACE(causes[k]);
+    std::size_t from = 0, to = 0;
+    const Ulog log = parse_ulog(corrupt_then_sync(corruptions[k], &from, &to), "c.ulg");
+    ASSERT_EQ(log.topics.size(), 1u);
+    expect_rows(log.topics[0], {probe_row(p0), probe_row(p2)});
+    ASSERT_EQ(log.skipped.size(), 1u);
+    EXPECT_EQ(log.skipped[0].from, from);
+    EXPECT_EQ(log.skipped[0].to, to);
+    EXPECT_EQ(log.skipped[0].cause, "byte " + std::to_string(from) + ": " + causes[k]);
+    EXPECT_FALSE(log.truncated);
+    const auto notes = quadgen::fit::ulog_notes(log);
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], "c.ulg: the log is corrupt at byte " + std::to_string(from) + " (byte " + std::to_string(from) +
+                            ": " + causes[k] + "): reading resumed at its next sync message, byte " + std::to_string(to) +
+                            " (" + std::to_string(to - from) +
+                            " bytes skipped: what they held is lost, a gap in the signals where it lasts longer than "
+                            "their gap threshold)");
+  }
+  // The Definitions section has no such recovery: a broken format is refused though a sync follows.
+  Writer d;
+  d.flag_bits().format("t uint64_t timestamp").format("u:uint64_t timestamp;").add(0, 0, "u").msg('S', kSyncMagic);
+  EXPECT_NE(error_of(d.bytes()).find("has no ':'"), std::string::npos) << error_of(d.bytes());
 }
