@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 
 #include "fit/grid_mean.hpp"
 #include "fit/least_squares.hpp"  // FitError
@@ -29,6 +30,9 @@ struct Signal {
   std::vector<double> t, v;
   double gap = 0;
   std::vector<size_t> breaks;
+  // Samples k after which the estimator was reset (a jump, not motion): a gap like a time gap.
+  std::vector<size_t> resets;
+  std::vector<std::string> reset_counters;  // the counters that changed
   double median_interval = 0;  // s
 };
 
@@ -112,6 +116,22 @@ class SampleTime {
   int sample_ = -1, relative_ = -1;
 };
 
+// PX4's estimator resets its states now and then (a yaw alignment at take-off, a GPS glitch)
+// and counts each in the topic (`xy_reset_counter`, `quat_reset_counter`, ...): the value
+// jumps there, which read as motion would be a spike of acceleration. Every counter of the
+// topic is watched, not only the field's own: a reset costs a sample interval, a jump read as
+// motion spoils a fit (a review, helper-152).
+std::vector<int> reset_counter_columns(const runtime::LogTopic& tp) {
+  std::vector<int> columns;
+  const std::string suffix = "reset_counter";
+  for (size_t c = 0; c < tp.fields.size(); ++c) {
+    const std::string& name = tp.fields[c];
+    if (name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+      columns.push_back(static_cast<int>(c));
+  }
+  return columns;
+}
+
 Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
   const std::string topic = e.source.substr(0, dot);
@@ -125,15 +145,27 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   const auto [count, channel] = channel_count_column(tp, e.source.substr(dot + 1));
   double most_channels = 0;
   const SampleTime sample_time(tp, e.source.substr(dot + 1));
+  const std::vector<int> counters = reset_counter_columns(tp);
+  const std::vector<double>* last_kept = nullptr;
+  std::set<std::string> changed;
   for (const auto& row : tp.rows) {
     const double t = sample_time.of(row) * 1e-6;
     if (std::isnan(t)) continue;
     if (count >= 0) most_channels = std::max(most_channels, row[count]);
     if (count >= 0 && !(static_cast<double>(channel) < row[count])) continue;  // a channel the driver did not set
     if (unset(e, row[c]) || (!s.t.empty() && t <= s.t.back())) continue;  // unset, repeated or out of order
+    bool reset = false;
+    for (const int k : counters)
+      if (last_kept && (*last_kept)[static_cast<size_t>(k)] != row[static_cast<size_t>(k)]) {
+        reset = true;
+        changed.insert(tp.fields[static_cast<size_t>(k)]);
+      }
+    if (reset) s.resets.push_back(s.t.size() - 1);
+    last_kept = &row;
     s.t.push_back(t);
     s.v.push_back(row[c]);
   }
+  s.reset_counters.assign(changed.begin(), changed.end());
   if (s.t.size() < 2 && count >= 0 && !(static_cast<double>(channel) < most_channels))
     throw FitError(log.path + ": '" + e.source + "' is a channel its driver never set: every message of '" + topic +
                    "' has noutputs " + output::short_number(most_channels) + " or fewer" +
@@ -150,7 +182,7 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   s.median_interval = dt[dt.size() / 2];
   s.gap = std::max(3 * s.median_interval, 0.1);  // a dropout or a paused topic beyond this
   for (size_t k = 0; k + 1 < s.t.size(); ++k)
-    if (s.t[k + 1] - s.t[k] > s.gap) s.breaks.push_back(k);
+    if (s.t[k + 1] - s.t[k] > s.gap || std::binary_search(s.resets.begin(), s.resets.end(), k)) s.breaks.push_back(k);
   return s;
 }
 
@@ -174,7 +206,8 @@ bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
   if (it == s.t.begin()) return false;
   if (it == s.t.end() && t - s.t.back() > 1e-9) return false;
   const size_t k = static_cast<size_t>(it - s.t.begin()) - 1;  // the last sample at or before t
-  if (it != s.t.end() && s.t[k + 1] - s.t[k] > s.gap) return false;
+  if (it != s.t.end() && (s.t[k + 1] - s.t[k] > s.gap || std::binary_search(s.resets.begin(), s.resets.end(), k)))
+    return false;
   const auto next_break = std::lower_bound(s.breaks.begin(), s.breaks.end(), k);
   const size_t last = next_break == s.breaks.end() ? s.t.size() - 1 : *next_break;
   const size_t first = next_break == s.breaks.begin() ? 0 : *(next_break - 1) + 1;
@@ -229,12 +262,31 @@ std::vector<std::string> slow_signal_notes(const std::vector<Signal>& signals, d
   return notes;
 }
 
+// The estimator's resets, one note per topic (find_signal says why they are gaps).
+std::vector<std::string> reset_notes(const std::vector<Signal>& signals, const std::string& path) {
+  std::map<std::string, std::pair<size_t, std::set<std::string>>> resets;  // topic: resets, counters
+  for (const auto& s : signals)
+    if (!s.resets.empty()) {
+      auto& [count, counters] = resets[s.source.substr(0, s.source.find('.'))];
+      count = std::max(count, s.resets.size());
+      counters.insert(s.reset_counters.begin(), s.reset_counters.end());
+    }
+  std::vector<std::string> notes;
+  for (const auto& [topic, r] : resets)
+    notes.push_back(path + ": the estimate in " + topic + " was reset " + std::to_string(r.first) + " time" +
+                    (r.first == 1 ? "" : "s") + " (" + output::joined(r.second) +
+                    " changed): its signals have a gap at each, where the value jumps, rather than a jump read as "
+                    "motion");
+  return notes;
+}
+
 // A cap on the table a few bytes of timestamps could ask for: 2^28 cells (2 GiB of doubles).
 constexpr double kMaxCells = 268435456.0;
 
 }  // namespace
 
-runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz) {
+runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz,
+                              const std::string& how_to_log_faster) {
   if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw FitError(log.path + ": sampling rate must be positive");
   std::vector<Signal> signals;
   double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
@@ -259,6 +311,8 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
   out.resampled_hz = rate_hz;
   out.time_from_topics_start = true;
   out.notes = slow_signal_notes(signals, rate_hz, log.path);
+  if (!out.notes.empty() && !how_to_log_faster.empty()) out.notes.push_back(how_to_log_faster);
+  for (auto& note : reset_notes(signals, log.path)) out.notes.push_back(std::move(note));
   out.columns.push_back("t");
   for (const auto& s : signals) out.columns.push_back(s.source);
   // Grid points inside a gap of any signal are left out: the table then has a gap there too,
@@ -306,12 +360,11 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
     runtime::CsvTable table;
     if (ulog) {
       const runtime::Ulog log = runtime::read_ulog(path);
-      table = topic_table(log, *mapping, rate);
       // How to log faster (docs.px4.io, "Logging": the logging profiles raise other topics'
       // rates, not actuator_outputs' or vehicle_local_position's: helper-153).
-      if (!table.notes.empty())
-        table.notes.push_back(path + ": PX4 logs a topic faster when a line of etc/logging/logger_topics.txt on its "
-                              "SD card names it (with no interval: at full rate; docs.px4.io, \"Logging\")");
+      table = topic_table(log, *mapping, rate,
+                          path + ": PX4 logs a topic faster when a line of etc/logging/logger_topics.txt on its SD "
+                                 "card names it (with no interval: at full rate; docs.px4.io, \"Logging\")");
       for (const auto& note : ulog_notes(log)) table.notes.push_back(note);
       table.parameters = log.parameters;
     } else {

@@ -31,8 +31,10 @@ bool is_topic_log(const std::string& path);
 // The signals a mapping uses, from a log of topics, on a uniform grid at `rate_hz`: "t" and one
 // column per source. Throws FitError naming a missing topic or field and what the log has.
 // A topic logged more than once is named by its instance, `topic[k].field` (instance 0 without
-// the brackets). Its notes (CsvTable::notes) name the signals logged more slowly than the grid.
-runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz);
+// the brackets). Its notes (CsvTable::notes) name the signals logged more slowly than the grid
+// (followed by `how_to_log_faster` where there are any) and the estimator's resets (gaps).
+runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping& m, double rate_hz,
+                              const std::string& how_to_log_faster = "");
 // What a person should know of a ULog before trusting it: the logger's dropouts, a cut-off end.
 std::vector<std::string> ulog_notes(const runtime::Ulog& log);
 
