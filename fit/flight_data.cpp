@@ -410,14 +410,15 @@ namespace {
 // Too few airborne samples is most often a unit: time in ms (the edge trim then takes all of
 // it), commands that never pass min_command, a height in mm. The message gives what tells.
 [[noreturn]] void throw_too_few_airborne(const std::string& path, const std::vector<double>& trel, const Flight& f,
-                                         const FlightOptions& o) {
+                                         const FlightOptions& o, bool landed_logged) {
   std::vector<double> dt;
   for (size_t k = 1; k < trel.size(); ++k) dt.push_back(trel[k] - trel[k - 1]);
   std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
   std::ostringstream os;
   os << path << ": too few airborne samples (" << f.samples.size() << " of " << trel.size() << "; need "
      << static_cast<int>(o.min_samples) << "): a sample counts when every motor command is above " << o.min_command
-     << (f.has_pose ? " and z above " + output::short_number(o.min_height) + " m" : std::string()) << ", more than "
+     << (f.has_pose ? " and z above " + output::short_number(o.min_height) + " m" : std::string())
+     << (landed_logged ? ", the log's landed flag below 0.5" : "") << ", more than "
      << o.edge_trim << " s from either end; the log spans " << trel.back() << " s with a median sample interval of "
      << dt[dt.size() / 2] << " s (is t in seconds?)";
   throw FitError(os.str());
@@ -584,6 +585,7 @@ struct FlightColumns {
   std::vector<std::vector<double>> acc, rate_dot;  // world acceleration, body-rate derivative
   std::vector<double> ax, ay, az, vbat, phi_ref, theta_ref;
   std::vector<std::vector<double>> commands;      // per rotor
+  std::vector<double> landed;                     // the controller's landed flag; empty where not logged
 };
 
 FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::string>& rotors, const Flight& f,
@@ -608,6 +610,7 @@ FlightColumns read_columns(const runtime::CsvTable& log, const std::vector<std::
   }
   c.ax = col("ax"), c.ay = col("ay"), c.az = col("az"), c.vbat = col("vbat");
   c.phi_ref = col("phi_ref"), c.theta_ref = col("theta_ref");
+  if (log.column("landed") >= 0) c.landed = log.values("landed");
   for (const auto& r : rotors) c.commands.push_back(log.values("u_" + r));
   return c;
 }
@@ -637,10 +640,13 @@ FlightSample sample_at(const FlightColumns& c, size_t k, const runtime::CsvTable
   return fs;
 }
 
-// Whether a sample is kept: airborne (every command above min_command and, with a pose, above
-// min_height) unless all rows are asked for, and away from the log's ends.
-bool kept(const FlightSample& fs, const Flight& f, double duration, const FlightOptions& o) {
-  bool airborne = std::all_of(fs.u.begin(), fs.u.end(), [&](double uc) { return uc > o.min_command; });
+// Whether a sample is kept: airborne (every command above min_command, with a pose above
+// min_height, and not on the ground by the log's landed flag) unless all rows are asked for,
+// and away from the log's ends. The flag is what tells an armed idle on the ground from flight
+// where the height is an estimator's, which drifts on the ground by more than min_height (a
+// review of the PX4 reading, helper-152).
+bool kept(const FlightSample& fs, const Flight& f, double duration, const FlightOptions& o, bool landed) {
+  bool airborne = !landed && std::all_of(fs.u.begin(), fs.u.end(), [&](double uc) { return uc > o.min_command; });
   if (f.has_pose) airborne = airborne && fs.x[2] > o.min_height;
   const bool edge = fs.t < o.edge_trim || duration - fs.t < o.edge_trim;
   return (!o.airborne_only || airborne) && !edge;
@@ -656,8 +662,8 @@ namespace {
 struct IdleInTheAir {
   enum Kind : char { kOnTheGround, kRunning, kIdle };
   std::vector<Kind> kinds;  // per row
-  void count(const FlightSample& fs, const Flight& f, const FlightOptions& o) {
-    if (!f.has_pose || !o.airborne_only || !(fs.x[2] > o.min_height)) return kinds.push_back(kOnTheGround);
+  void count(const FlightSample& fs, const Flight& f, const FlightOptions& o, bool landed) {
+    if (!f.has_pose || !o.airborne_only || !(fs.x[2] > o.min_height) || landed) return kinds.push_back(kOnTheGround);
     const bool idle = std::any_of(fs.u.begin(), fs.u.end(), [&](double uc) { return !(uc > o.min_command); });
     kinds.push_back(idle ? kIdle : kRunning);
   }
@@ -796,10 +802,12 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   IdleInTheAir idle;
   for (size_t k = 0; k < columns.t.size(); ++k) {
     FlightSample fs = sample_at(columns, k, log);
-    idle.count(fs, f, o);
-    if (kept(fs, f, columns.t.back(), o)) f.samples.push_back(std::move(fs));
+    const bool landed = !columns.landed.empty() && columns.landed[k] >= 0.5;  // on the ground for most of the row
+    idle.count(fs, f, o, landed);
+    if (kept(fs, f, columns.t.back(), o, landed)) f.samples.push_back(std::move(fs));
   }
-  if (static_cast<double>(f.samples.size()) < o.min_samples) throw_too_few_airborne(log.path, columns.t, f, o);
+  if (static_cast<double>(f.samples.size()) < o.min_samples)
+    throw_too_few_airborne(log.path, columns.t, f, o, !columns.landed.empty());
   if (const std::string note = idle.note(log.where_named(), o); !note.empty()) f.notes.push_back(note);
   check_gyro_against_attitude(log_and_entries(log, {"p", "q", "r"}, "the gyro"), f,
                               attitude_columns(log) == AttitudeColumns::kEuler);

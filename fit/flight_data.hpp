@@ -99,8 +99,9 @@ inline const std::vector<std::string> kTranslationalSources = {"pose", "accelero
 struct FlightOptions {
   double derivative_window = 0.05;  // s, half-width of the local quadratic fit
   double min_samples = 20;
-  // Keep only airborne samples: every command above min_command and, with a pose, the
-  // height above min_height. Ground contact is not in the model.
+  // Keep only airborne samples: every command above min_command, with a pose the height above
+  // min_height, and where the log has the controller's landed flag (column `landed`) that
+  // flag below 0.5. Ground contact is not in the model.
   bool airborne_only = true;
   double min_command = 0.05;
   double min_height = 0.1;

@@ -86,10 +86,18 @@ std::pair<int, long> channel_count_column(const runtime::LogTopic& tp, const std
 // as `timestamp_sample` (vehicle_attitude, vehicle_local_position: a few ms earlier), and
 // sensor_combined its accelerometer's offset from the gyro's time (`accelerometer_timestamp_
 // relative`, INT32_MAX where not valid; a review, helper-152). Joined on the publication time,
-// the accelerometer and the attitude would sit ms away from the gyro on the grid.
+// the accelerometer and the attitude would sit ms away from the gyro on the grid. A command or
+// set point acts when it is published: its `timestamp_sample` (actuator_motors has one) is the
+// time of the gyro sample it was computed from, and placing it there would move every command
+// earlier by the controller's latency (a review, helper-155).
+bool is_command_topic(const std::string& topic) {
+  return topic.rfind("actuator_", 0) == 0 || topic.find("setpoint") != std::string::npos;
+}
+
 class SampleTime {
  public:
-  SampleTime(const runtime::LogTopic& tp, const std::string& field) : sample_(tp.column("timestamp_sample")) {
+  SampleTime(const runtime::LogTopic& tp, const std::string& field)
+      : sample_(is_command_topic(tp.name) ? -1 : tp.column("timestamp_sample")) {
     for (size_t c = 0; c < tp.fields.size(); ++c) {
       const std::string& name = tp.fields[c];
       const std::string suffix = "_timestamp_relative";
@@ -116,6 +124,23 @@ class SampleTime {
   int sample_ = -1, relative_ = -1;
 };
 
+// A flag published when it changes (and PX4's landed flag once a second besides) holds its
+// value until the next sample; drawn as straight lines it would cross 0.5 up to half a second
+// early. A copy of the old value half a microsecond before each change makes the line a step.
+void hold_between_samples(Signal& s) {
+  std::vector<double> t, v;
+  for (size_t k = 0; k < s.t.size(); ++k) {
+    if (k > 0 && s.v[k] != s.v[k - 1] && s.t[k] - 0.5e-6 > s.t[k - 1]) {
+      t.push_back(s.t[k] - 0.5e-6);
+      v.push_back(s.v[k - 1]);
+    }
+    t.push_back(s.t[k]);
+    v.push_back(s.v[k]);
+  }
+  s.t = std::move(t);
+  s.v = std::move(v);
+}
+
 // PX4's estimator resets its states now and then (a yaw alignment at take-off, a GPS glitch)
 // and counts each in the topic (`xy_reset_counter`, `quat_reset_counter`, ...): the value
 // jumps there, which read as motion would be a spike of acceleration. Every counter of the
@@ -141,7 +166,9 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
     throw FitError(log.path + ": topic '" + topic + "' has no field for '" + e.source + "' (fields: " +
                    output::joined(tp.fields) + ")");
   }
-  Signal s{e.source, e.target, {}, {}, 0, {}};
+  Signal s;
+  s.source = e.source;
+  s.target = e.target;
   const auto [count, channel] = channel_count_column(tp, e.source.substr(dot + 1));
   double most_channels = 0;
   const SampleTime sample_time(tp, e.source.substr(dot + 1));
@@ -166,6 +193,7 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
     s.v.push_back(row[c]);
   }
   s.reset_counters.assign(changed.begin(), changed.end());
+  if (e.target == "landed" && s.resets.empty()) hold_between_samples(s);
   if (s.t.size() < 2 && count >= 0 && !(static_cast<double>(channel) < most_channels))
     throw FitError(log.path + ": '" + e.source + "' is a channel its driver never set: every message of '" + topic +
                    "' has noutputs " + output::short_number(most_channels) + " or fewer" +
@@ -244,11 +272,12 @@ void wrap_roll(runtime::CsvTable& t) {
 // Signals logged more slowly than the grid, one note per topic: between their samples the
 // grid holds straight lines, and what changed faster is not in the log (PX4's default logging
 // profile writes actuator_outputs and vehicle_local_position at 10 Hz: a review, helper-152).
-// The battery voltage is left out: it changes slowly, and PX4 logs it at 5 Hz.
+// The battery voltage is left out: it changes slowly, and PX4 logs it at 5 Hz; so is the landed
+// flag, published when it changes.
 std::vector<std::string> slow_signal_notes(const std::vector<Signal>& signals, double rate_hz, const std::string& path) {
   std::map<std::string, std::pair<double, std::vector<std::string>>> slow;  // topic: interval, sources
   for (const auto& s : signals)
-    if (s.median_interval > 1.5 / rate_hz && s.target != "vbat") {
+    if (s.median_interval > 1.5 / rate_hz && s.target != "vbat" && s.target != "landed") {
       auto& [interval, sources] = slow[s.source.substr(0, s.source.find('.'))];
       interval = std::max(interval, s.median_interval);
       sources.push_back(s.source);
@@ -338,12 +367,24 @@ std::vector<std::string> ulog_notes(const runtime::Ulog& log) {
     notes.push_back(log.path + ": the logger dropped data " + std::to_string(log.dropouts) + " time" +
                     (log.dropouts == 1 ? "" : "s") + " (" + output::short_number(log.dropout_ms) +
                     " ms in all): a signal's pause longer than three of its intervals and 0.1 s is a gap, not bridged");
-  for (const auto& skip : log.skipped)
-    notes.push_back(log.path + ": the log is corrupt at byte " + std::to_string(skip.from) + " (" + skip.cause +
-                    "): reading resumed at its next sync message, byte " + std::to_string(skip.to) + " (" +
-                    std::to_string(skip.to - skip.from) +
-                    " bytes skipped: what they held is lost, a gap in the signals where it lasts longer than their gap "
-                    "threshold)");
+  // One note however many stretches were skipped (a log may be corrupt in many places).
+  if (!log.skipped.empty()) {
+    std::uint64_t bytes = 0;
+    for (const auto& skip : log.skipped) bytes += skip.to - skip.from;
+    const auto& first = log.skipped.front();
+    const bool one = log.skipped.size() == 1;
+    notes.push_back(log.path + ": reading found the log corrupt " +
+                    (one ? "at byte " + std::to_string(first.from) + " (" + first.cause + "): reading resumed at its next sync message, byte " + std::to_string(first.to)
+                         : "in " + std::to_string(log.skipped.size()) + " places (the first at byte " + std::to_string(first.from) + ": " + first.cause +
+                               "): each time reading resumed at the next sync message") +
+                    " (" + std::to_string(bytes) + " bytes skipped" + (one ? "" : " in all") +
+                    ": what they held is lost, a gap in the signals where it lasts longer than their gap threshold" +
+                    (log.data_without_subscription > 0
+                         ? "; " + std::to_string(log.data_without_subscription) +
+                               " data messages after it of subscriptions lost with it skipped too"
+                         : "") +
+                    ")");
+  }
   if (log.truncated)
     notes.push_back(log.path + ": the log ends inside a message (byte " + std::to_string(log.truncated_at) +
                     ", as after a power loss): that message is dropped, everything before it read");

@@ -27,7 +27,7 @@ long index_of(const std::string& field, const std::string& name) {
 }
 
 // The PX4 motor (1, 2, ...) a mapped source reads, and the log's words for it; motor 0 where
-// the log does not say.
+// the log does not say, with `how` naming the channel's functions where none is a motor.
 struct LoggedMotor {
   int motor = 0;
   std::string how;
@@ -47,11 +47,15 @@ LoggedMotor motor_of(const std::string& source, const std::map<std::string, doub
   // Every output-function family naming a motor for this channel (PWM_MAIN_FUNC1 is channel 0).
   const std::string suffix = "_FUNC" + std::to_string(channel + 1);
   std::map<int, std::vector<std::string>> motors;
+  std::vector<std::string> functions;  // every family's function for the channel
   for (const auto& [name, value] : parameters)
-    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-        value >= kMotorFunction1 && value <= kMotorFunctionLast && value == std::floor(value))
-      motors[static_cast<int>(value - kMotorFunction1) + 1].push_back(name + " = " + output::short_number(value));
-  if (motors.size() != 1) return {};  // none, or families that disagree: which driver logged it is not said
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      functions.push_back(name + " = " + output::short_number(value));
+      if (value >= kMotorFunction1 && value <= kMotorFunctionLast && value == std::floor(value))
+        motors[static_cast<int>(value - kMotorFunction1) + 1].push_back(functions.back());
+    }
+  if (motors.empty()) return {0, output::joined(functions)};  // a channel set to no motor (or not set at all)
+  if (motors.size() > 1) return {};  // families that disagree: which driver logged the instance is not said
   return {motors.begin()->first, output::joined(motors.begin()->second)};
 }
 
@@ -65,7 +69,8 @@ struct Place {
 std::optional<Place> logged_place(const std::map<std::string, double>& parameters, int motor) {
   const std::string key = "CA_ROTOR" + std::to_string(motor - 1) + "_";
   const auto px = parameters.find(key + "PX"), py = parameters.find(key + "PY"), km = parameters.find(key + "KM");
-  if (px == parameters.end() || py == parameters.end()) return std::nullopt;
+  // (0, 0), PX4's default, is a position never set: a rotor at the CoG lifts nothing to judge.
+  if (px == parameters.end() || py == parameters.end() || (px->second == 0 && py->second == 0)) return std::nullopt;
   const int spin = km == parameters.end() ? 0 : (km->second > 0 ? 1 : (km->second < 0 ? -1 : 0));
   return Place{px->second, -py->second, spin};  // forward-right-down -> forward-left-up
 }
@@ -112,26 +117,45 @@ std::vector<std::string> logged_rotor_notes(const std::string& path, const std::
     notes.push_back(path + ": the log's CA_ROTOR_COUNT is " + std::to_string(count) + " (PX4 allocated thrust to " +
                     std::to_string(count) + " motors), the vehicle file " + v.source_path + " has " +
                     std::to_string(v.rotors.size()) + " rotors");
+  // Directions: the log's from PX4's origin, the CoG (a motor whose place is not set moves no
+  // centre); the file's from its rotors' centre (a file's body origin may be anywhere).
   const std::map<int, Place> logged = logged_places(parameters, count);
-  std::vector<Place> logged_list, file_list;
-  for (const auto& [m, p] : logged) logged_list.push_back(p);
+  std::vector<Place> file_list;
   for (const auto& r : v.rotors) file_list.push_back({r.position[0], r.position[1], spin_sign(r)});
-  const double lx = centre_x(logged_list), ly = centre_y(logged_list), fx = centre_x(file_list), fy = centre_y(file_list);
+  const double fx = centre_x(file_list), fy = centre_y(file_list);
   for (size_t i = 0; i < v.rotors.size(); ++i) {
     const Rotor& rotor = v.rotors[i];
     const auto entry = std::find_if(mapping.entries.begin(), mapping.entries.end(),
                                     [&](const ColumnMapping::Entry& e) { return e.target == "u_" + rotor.name; });
     if (entry == mapping.entries.end()) continue;
     const LoggedMotor m = motor_of(entry->source, parameters);
+    if (m.motor == 0 && !m.how.empty()) {
+      notes.push_back(path + ": u_" + rotor.name + " reads " + entry->source + ", a channel whose output function is no " +
+                      "motor (" + m.how + "; 101..112 are motors 1..12): the channel that drives this rotor is the " +
+                      "one whose function is its motor");
+      continue;
+    }
+    if (m.motor > count) {
+      notes.push_back(path + ": u_" + rotor.name + " reads " + entry->source + ", PX4's motor " + std::to_string(m.motor) +
+                      " (" + m.how + "), but the log's CA_ROTOR_COUNT is " + std::to_string(count) +
+                      ": PX4 allocated no thrust to it");
+      continue;
+    }
     const auto place = logged.find(m.motor);
     if (m.motor == 0 || place == logged.end()) continue;
-    const double dx = place->second.x - lx, dy = place->second.y - ly;
-    if (std::hypot(dx, dy) < 1e-6) continue;  // at the centre: a position not set
+    const double dx = place->second.x, dy = place->second.y;
     const double azimuth = std::atan2(dy, dx);
     const auto direction = [&](size_t j) { return std::atan2(file_list[j].y - fy, file_list[j].x - fx); };
+    // The file's rotor nearest in direction; of two in one direction (a coaxial pair) the one
+    // spinning as the logged motor does.
+    const auto nearer = [&](size_t j, size_t than) {
+      const double a = angle_between(azimuth, direction(j)), b = angle_between(azimuth, direction(than));
+      if (std::fabs(a - b) > 1e-9) return a < b;
+      return file_list[j].spin == place->second.spin && file_list[than].spin != place->second.spin;
+    };
     size_t nearest = i;
     for (size_t j = 0; j < v.rotors.size(); ++j)
-      if (angle_between(azimuth, direction(j)) < angle_between(azimuth, direction(nearest)) - 1e-9) nearest = j;
+      if (nearer(j, nearest)) nearest = j;
     const std::string head = path + ": u_" + rotor.name + " reads " + entry->source + ", PX4's motor " +
                              std::to_string(m.motor) + " (" + m.how + "), which the log's CA_ROTOR" +
                              std::to_string(m.motor - 1) + "_";

@@ -26,8 +26,10 @@ Flight read_flight(const std::string& path, const std::string& mapping_path, dou
 // every fit then absorbs into something else (issue #14 asks for exactly this check).
 //
 // One note per u_ column whose logged motor sits nearer another of the vehicle file's rotors
-// (by its direction from the rotors' centre) or spins the other way, and one if the log counts
-// other rotors than the file. A motor is known for `actuator_motors.control[k]` (motor k + 1)
+// (by its direction from the CoG, the file's rotors' from their centre) or spins the other way,
+// one for a column whose channel's function is no motor or a motor beyond the count, and one if
+// the log counts other rotors than the file. A motor whose place is PX4's default (0, 0) is
+// not judged. A motor is known for `actuator_motors.control[k]` (motor k + 1)
 // and for `actuator_outputs[i].output[c]` where the log's output functions give channel c + 1
 // one motor; where two families give it different motors (which driver logged instance i the
 // log does not say) or none, that column is not judged. Empty without the parameters (CSV

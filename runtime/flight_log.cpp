@@ -332,6 +332,7 @@ std::string canonical_unit(const std::string& c) {
       {"vz", "m/s"},    {"qw", "1"},      {"qx", "1"},        {"qy", "1"},      {"qz", "1"},      {"phi", "rad"},
       {"theta", "rad"}, {"psi", "rad"},   {"p", "rad/s"},     {"q", "rad/s"},   {"r", "rad/s"},   {"ax", "m/s^2"},
       {"ay", "m/s^2"},  {"az", "m/s^2"},  {"vbat", "V"},     {"phi_ref", "rad"}, {"theta_ref", "rad"},
+      {"landed", "1"},
   };
   const auto it = units.find(c);
   if (it != units.end()) return it->second;
@@ -352,6 +353,8 @@ void check_values(const CsvTable& log) {
   // A battery voltage is positive: battery_sag scales thrust by a power of it and its
   // derivatives take its logarithm, so 0 (a logger before its first reading) would be NaN.
   const int vbat = log.column("vbat");
+  // The flight controller's landed flag, 1 on the ground (a grid mean of it lies between).
+  const int landed = log.column("landed");
   std::vector<size_t> canonical;
   for (size_t c = 0; c < log.columns.size(); ++c)
     if (!canonical_unit(log.columns[c]).empty()) canonical.push_back(c);
@@ -369,6 +372,11 @@ void check_values(const CsvTable& log) {
                 "column 'vbat' is " + output::six_digits(v) +
                     " V; a battery voltage must be positive (a logger writes 0 before its first reading: drop those "
                     "rows, or the column where battery_sag is not wanted)");
+      if (static_cast<int>(c) == landed && !(v >= 0 && v <= 1))
+        fail_at_row(log, i,
+                    "column 'landed' is " + output::six_digits(v) +
+                        "; expected the flight controller's landed flag, 0 in the air to 1 on the ground (PX4's "
+                        "vehicle_land_detected.landed)");
       if (throttle[c] && v > kMaxThrottle)
         fail_at_row(log, i,
                 "column '" + log.columns[c] + "' is " + output::six_digits(v) + "; expected a throttle fraction 0..1 (" +

@@ -74,7 +74,7 @@ std::string canonical_unit(const std::string& column);
 // Their names, for messages.
 inline const char* const kCanonicalColumns =
     "t, x, y, z, vx, vy, vz, qw, qx, qy, qz, phi, theta, psi, p, q, r, ax, ay, az, vbat, u_<rotor>, w_<rotor>, "
-    "phi_ref, theta_ref";
+    "phi_ref, theta_ref, landed";
 
 // Sanity bounds on numbers in logs: a value beyond them is a corrupt or mis-scaled log,
 // and letting it through overflows the fit (squares of 1e160 are inf). In canonical SI

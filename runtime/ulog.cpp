@@ -163,6 +163,14 @@ struct KeyValue {
   std::string_view value;
 };
 
+// The spec's message types; in the Data section another is taken for corruption where no
+// sensible message follows it and a sync message does (Parser::run), else skipped by its size
+// as the spec asks of later types.
+bool known_type(char type) { return std::strchr("BFIMPQARDLCSO", type) != nullptr && type != '\0'; }
+
+// A sync message whole, header included: size 8, 'S', the spec's magic.
+constexpr char kSyncMessage[] = {0x08, 0x00, 'S', 0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, static_cast<char>(0xBB), 0x12};
+
 class Parser {
  public:
   Parser(const std::string& bytes, const std::string& path) : b_(bytes) { out_.path = path; }
@@ -183,6 +191,16 @@ class Parser {
   void read_header();
   std::optional<Msg> message_at(std::size_t pos, std::size_t end) const;
   bool resync(std::size_t& pos, std::size_t end, const std::string& cause);
+  std::size_t next_sync(std::size_t from, std::size_t end);
+  // Whether the message after m ends the stretch or is whole and of a type the spec names.
+  bool followed_by_a_message(const Msg& m, std::size_t end) const {
+    const std::size_t next = m.at + kMsgHeaderBytes + m.body.size();
+    const auto after = message_at(next, end);
+    return next == end || (after && known_type(after->type));
+  }
+  struct SyncSearch {
+    std::size_t from = std::string::npos, end = 0, found = std::string::npos;
+  } sync_search_;
   std::vector<std::size_t> flag_bits(const Msg& m) const;
   void handle(const Msg& m);
 
@@ -268,20 +286,23 @@ std::vector<std::size_t> Parser::flag_bits(const Msg& m) const {
   return ends;
 }
 
-// The spec's message types; in the Data section another is taken for corruption where a sync
-// message follows it (below), else skipped by its size as the spec asks of later types.
-bool known_type(char type) { return std::strchr("BFIMPQARDLCSO", type) != nullptr && type != '\0'; }
 
-// A sync message whole, header included: size 8, 'S', the spec's magic.
-constexpr char kSyncMessage[] = {0x08, 0x00, 'S', 0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, static_cast<char>(0xBB), 0x12};
+// The first sync message at or after `from` and before `end`, or npos. The last search is kept:
+// many corrupt messages before one sync message (or none) cost one scan, not one each.
+std::size_t Parser::next_sync(std::size_t from, std::size_t end) {
+  if (!(sync_search_.from <= from && sync_search_.end == end && (sync_search_.found == std::string::npos || sync_search_.found >= from))) {
+    const std::string_view rest = std::string_view(b_).substr(0, end);
+    sync_search_ = {from, end, rest.find(std::string_view(kSyncMessage, sizeof kSyncMessage), from)};
+  }
+  return sync_search_.found;
+}
 
 // In the Data section, after a corrupt message at `pos`: the next sync message before `end`
 // becomes the reading position, the skip kept for the notes; false where none follows.
 bool Parser::resync(std::size_t& pos, std::size_t end, const std::string& cause) {
   if (!in_data_) return false;
-  const std::string_view rest = std::string_view(b_).substr(0, end);
-  const std::size_t sync = rest.find(std::string_view(kSyncMessage, sizeof kSyncMessage), pos + 1);
-  if (sync == std::string_view::npos) return false;
+  const std::size_t sync = next_sync(pos + 1, end);
+  if (sync == std::string::npos) return false;
   const std::string prefix = out_.path + ": ";
   out_.skipped.push_back({pos, sync, cause.compare(0, prefix.size(), prefix) == 0 ? cause.substr(prefix.size()) : cause});
   pos = sync;
@@ -303,7 +324,9 @@ Ulog Parser::run() {
         if (resync(pos, end, "byte " + std::to_string(pos) + ": a message whose size runs past the end")) continue;
         break;
       }
-      if (in_data_ && !known_type(m->type) &&
+      // A type the spec does not name is a later version's when a sensible message follows it
+      // (skipped by its size, as the spec asks), corruption when none does.
+      if (in_data_ && !known_type(m->type) && !followed_by_a_message(*m, end) &&
           resync(pos, end, "byte " + std::to_string(pos) + ": unknown message type " + std::to_string(static_cast<unsigned char>(m->type))))
         continue;
       try {
@@ -458,10 +481,14 @@ void Parser::subscribe(const Msg& m) {
   if (!formats_.count(name)) fail(m.at, "subscription to undefined format " + quoted_from_log(name));
   if (subs_.count(msg_id)) fail(m.at, "msg_id " + std::to_string(msg_id) + " subscribed twice");
   const Layout& l = layout(name, m.at);
-  const auto [it, added] = topic_of_.emplace(std::make_pair(name, multi_id), out_.topics.size());
-  if (added) {
+  // Charged before anything is kept: a throw leaves no half-made topic behind for a reading
+  // resumed at a sync message to write into (a review, helper-155).
+  const auto key = std::make_pair(name, multi_id);
+  auto it = topic_of_.find(key);
+  if (it == topic_of_.end()) {
     charge(kTopicCost + l.cost, m.at);
     out_.topics.push_back({name, multi_id, l.names, {}});
+    it = topic_of_.emplace(key, out_.topics.size() - 1).first;
   }
   subs_[msg_id] = {it->second, &l};
 }
@@ -470,6 +497,10 @@ void Parser::data(const Msg& m) {
   require(m, 2, "msg_id");
   const auto msg_id = static_cast<std::uint16_t>(little_endian(m.body.data(), 2));
   const auto s = subs_.find(msg_id);
+  if (s == subs_.end() && !out_.skipped.empty()) {  // its subscription may have been in a skipped stretch
+    ++out_.data_without_subscription;
+    return;
+  }
   if (s == subs_.end()) fail(m.at, "data message for unknown msg_id " + std::to_string(msg_id));
   const Layout& l = *s->second.layout;
   LogTopic& topic = out_.topics[s->second.topic];

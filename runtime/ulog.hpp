@@ -7,10 +7,14 @@
 //   holds at the start of appended data ('B' message, DATA_APPENDED). Ulog::truncated says
 //   that this happened and where.
 // - In the Data section, a message that does not fit the spec (or of a type the spec does not
-//   name) is skipped to the next sync ('S') message, as the spec intends them for, when one
-//   follows: Ulog::skipped says where and why, and the readers say it as a note of the flight
-//   (a corrupt log is reported, not silently shortened). A message running past the end is
-//   such a corruption too when a sync message follows it. Without a sync message after it,
+//   name, where no sensible message follows it) is skipped to the next sync ('S') message, as
+//   the spec intends them for (PX4 writes one every 500 ms), when one follows. Ulog::skipped
+//   says where and why, and the readers say it as a note of the flight (a corrupt log is
+//   reported, not silently shortened); the offset kept is where the corruption was found,
+//   which may lie after where it began (messages the spec tolerates, such as 'O' and 'P', may
+//   have been read from its bytes). A message running past the end is such a corruption too
+//   when a sync message follows it; after a skip, a data message of a msg_id never subscribed
+//   is skipped by its size and counted (its 'A' may have been skipped). Without a sync after it,
 //   and anywhere in the Definitions section, anything that does not fit the spec throws
 //   LogError "path: byte N: cause", N the offset of the message at fault; a type the spec does
 //   not name is then skipped by its size (forward compatibility).
@@ -74,6 +78,9 @@ struct Ulog : TopicLog {  // path, topics (in order of first subscription), find
     std::string cause;
   };
   std::vector<Skip> skipped;
+  // Data messages after a skipped stretch for a msg_id never subscribed (its 'A' may have been
+  // in the stretch): skipped by their size and counted.
+  int data_without_subscription = 0;
   bool truncated = false;                                                  // a cut-off message was dropped (see above)
   std::uint64_t truncated_at = 0;                                          // the byte offset of the first one
 };

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -484,6 +485,43 @@ TEST_F(Hostile, EulerDegreesMillisecondsAndIdleRotorsInTheAirAreSaid) {
     if (row[col(landing, "t")] > 9.5)
       for (const char* u : {"u_A", "u_B", "u_C", "u_D"}) row[col(landing, u)] = 0;
   EXPECT_EQ(idle_note(load_flight(landing, rotors, {})), "");
+}
+
+// A PX4 log's height is an estimator's, which drifts on the ground by more than the 0.1 m the
+// airborne test asks, and PX4 idles its armed motors above the 0.05 command it asks (a review
+// of the PX4 reading, helper-152): the controller's landed flag (column `landed`, PX4's
+// vehicle_land_detected.landed) keeps such rows out whatever their height and commands, the
+// error says so when too few are left, and a flag beyond 0..1 is refused at its line.
+TEST_F(Hostile, TheLandedFlagKeepsAnArmedIdleOnTheGroundOut) {
+  const std::string log = (dir_ / "flight.csv").string();
+  const runtime::CsvTable table = generated_flight(log);
+  ASSERT_FALSE(HasFailure());
+  const std::vector<std::string> rotors = {"A", "B", "C", "D"};
+  const size_t tc = static_cast<size_t>(table.column("t"));
+  const auto flagged = [&](const std::function<double(double)>& landed_at) {
+    runtime::CsvTable t = table;
+    t.columns.push_back("landed");
+    for (auto& row : t.rows) row.push_back(landed_at(row[tc] - table.rows.front()[tc]));
+    return t;
+  };
+  const Flight plain = load_flight(table, rotors, {});
+  const Flight later = load_flight(flagged([](double t) { return t <= 3 ? 1.0 : 0.0; }), rotors, {});
+  size_t after_three = 0;
+  for (const auto& s : plain.samples) after_three += s.t > 3 ? 1 : 0;
+  ASSERT_GT(after_three, 100u);
+  EXPECT_LT(after_three, plain.samples.size());  // the flag, not the flight, leaves rows out
+  EXPECT_EQ(later.samples.size(), after_three);
+  for (const auto& s : later.samples) EXPECT_GT(s.t, 3.0);
+  // A grid mean of the flag at 0.5 or above is on the ground; just below it is not.
+  EXPECT_EQ(load_flight(flagged([](double) { return 0.49; }), rotors, {}).samples.size(), plain.samples.size());
+  const std::string none = message_of<FitError>([&] { load_flight(flagged([](double) { return 0.5; }), rotors, {}); });
+  EXPECT_NE(none.find("too few airborne samples (0 of "), std::string::npos) << none;
+  EXPECT_NE(none.find("the log's landed flag below 0.5"), std::string::npos) << none;
+  const std::string bad = message_of<runtime::LogError>([&] { load_flight(flagged([](double t) { return t > 5 ? 2.0 : 0.0; }), rotors, {}); });
+  EXPECT_EQ(bad.rfind(log + ":", 0), 0u) << bad;
+  EXPECT_NE(bad.find("column 'landed' is 2; expected the flight controller's landed flag, 0 in the air to 1 on the ground"),
+            std::string::npos)
+      << bad;
 }
 
 // Defect 2, compatibility: the bundled NanoBench mapping's units are the canonical ones,

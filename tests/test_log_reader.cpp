@@ -478,6 +478,29 @@ TEST(LoggedRotors, TheLogsMotorPlacesAreComparedWithTheVehicleFile) {
   EXPECT_TRUE(notes(px4_quad_x(), motors_topic).empty());
   motors_topic[1] = "actuator_motors.control[1]";  // motor 2, rear-left: not M2's place
   EXPECT_EQ(notes(px4_quad_x(), motors_topic).size(), 1u);
+  // A channel whose function is no motor, and a motor beyond the count, are said.
+  auto servo = px4_quad_x();
+  servo["PWM_MAIN_FUNC2"] = 0;  // disabled
+  const auto no_motor = notes(servo, by_place);
+  ASSERT_EQ(no_motor.size(), 1u) << output::joined(no_motor, "\n");
+  EXPECT_EQ(no_motor[0], "f.ulg: u_M3 reads actuator_outputs.output[1], a channel whose output function is no motor "
+                         "(PWM_MAIN_FUNC2 = 0; 101..112 are motors 1..12): the channel that drives this rotor is the one "
+                         "whose function is its motor");
+  auto fifth = px4_quad_x();
+  fifth["PWM_MAIN_FUNC2"] = 105;
+  const auto beyond = notes(fifth, by_place);
+  ASSERT_EQ(beyond.size(), 1u) << output::joined(beyond, "\n");
+  EXPECT_NE(beyond[0].find("u_M3 reads actuator_outputs.output[1], PX4's motor 5 (PWM_MAIN_FUNC2 = 105), but the log's "
+                           "CA_ROTOR_COUNT is 4"),
+            std::string::npos)
+      << beyond[0];
+  // A motor whose place is PX4's default (0, 0) is not judged, and moves no other's direction.
+  auto unset = px4_quad_x();
+  unset["CA_ROTOR1_PX"] = unset["CA_ROTOR1_PY"] = 0;
+  const auto two = notes(unset, by_channel);
+  ASSERT_EQ(two.size(), 2u) << output::joined(two, "\n");
+  EXPECT_NE(two[0].find("u_M3 reads"), std::string::npos) << two[0];
+  EXPECT_NE(two[1].find("u_M4 reads"), std::string::npos) << two[1];
   // Without the parameters (a CSV, a uSD log, PX4 before v1.14) nothing is judged.
   EXPECT_TRUE(notes({}, by_channel).empty());
 }
@@ -510,8 +533,10 @@ TEST(LogReader, ValuesArePlacedAtTheirSensorsTimeNotTheirPublication) {
   w.flag_bits()
       .format("imu:uint64_t timestamp;float gyro;int32_t accelerometer_timestamp_relative;float accelerometer_m_s2;")
       .format("att:uint64_t timestamp;uint64_t timestamp_sample;float v;")
+      .format("actuator_motors:uint64_t timestamp;uint64_t timestamp_sample;float control;")
       .add(0, 0, "imu")
-      .add(0, 1, "att");
+      .add(0, 1, "att")
+      .add(0, 2, "actuator_motors");
   const auto seconds = [](double us) { return (us - 1e6) * 1e-6; };
   for (int k = 0; k <= 400; ++k) {
     const std::uint64_t t = 1000000 + 5000 * static_cast<std::uint64_t>(k);
@@ -520,19 +545,23 @@ TEST(LogReader, ValuesArePlacedAtTheirSensorsTimeNotTheirPublication) {
     w.data(0, le(t, 8) + f32(static_cast<float>(10 * seconds(t))) + le(static_cast<std::uint32_t>(relative), 4) +
                   f32(invalid ? 999.0f : static_cast<float>(10 * seconds(t - 2500.0))));
     w.data(1, le(t, 8) + le(t - 4000, 8) + f32(static_cast<float>(10 * seconds(t - 4000.0))));
+    // a command acts when published; its timestamp_sample is the gyro sample it came from
+    w.data(2, le(t, 8) + le(t - 3000, 8) + f32(static_cast<float>(10 * seconds(t))));
   }
   const runtime::CsvTable table =
       fit::read_log(write_file("quadgen_sample_times.ulg", w.bytes()),
                     write_file("quadgen_sample_times.yaml", "name: s\ncolumns:\n  t: {source: t}\n"
                                                             "  p: {source: imu.gyro}\n  q: {source: att.v}\n"
-                                                            "  ax: {source: imu.accelerometer_m_s2}\n"),
+                                                            "  ax: {source: imu.accelerometer_m_s2}\n"
+                                                            "  r: {source: actuator_motors.control}\n"),
                     100.0);
   ASSERT_GT(table.rows.size(), 150u);
-  const int p = table.column("p"), q = table.column("q"), ax = table.column("ax");
+  const int p = table.column("p"), q = table.column("q"), ax = table.column("ax"), r = table.column("r");
   for (size_t k = 2; k + 2 < table.rows.size(); ++k) {
     const auto& row = table.rows[k];
     EXPECT_NEAR(row[static_cast<size_t>(q)], row[static_cast<size_t>(p)], 1e-4) << row[0];
     EXPECT_NEAR(row[static_cast<size_t>(ax)], row[static_cast<size_t>(p)], 1e-4) << row[0];
+    EXPECT_NEAR(row[static_cast<size_t>(r)], row[static_cast<size_t>(p)], 1e-4) << row[0];
   }
 }
 
@@ -567,4 +596,60 @@ TEST(LogReader, AnEstimatorResetIsAGapNotAJump) {
                        "have a gap at each"),
             std::string::npos)
       << notes;
+}
+
+// PX4 publishes its landed flag when it changes and once a second besides: the flag holds its
+// value between samples (drawn as a straight line it would cross 0.5 up to half a second early),
+// and a flag logged at 1 Hz is no slow topic to be said.
+TEST(LogReader, TheLandedFlagHoldsItsValueBetweenSamples) {
+  Writer w;
+  w.flag_bits()
+      .format("imu:uint64_t timestamp;float gyro;")
+      .format("vehicle_land_detected:uint64_t timestamp;bool landed;")
+      .add(0, 0, "imu")
+      .add(0, 1, "vehicle_land_detected");
+  for (int k = 0; k <= 400; ++k) {
+    const std::uint64_t t = 1000000 + 10000 * static_cast<std::uint64_t>(k);  // 100 Hz, 4 s
+    w.data(0, le(t, 8) + f32(0.0f));
+    if (k % 100 == 0 || k == 270) w.data(1, le(t, 8) + le(k < 270 ? 1 : 0, 1));  // take-off at 2.7 s
+  }
+  const runtime::CsvTable t =
+      fit::read_log(write_file("quadgen_landed.ulg", w.bytes()),
+                    write_file("quadgen_landed.yaml", "name: l\ncolumns:\n  t: {source: t}\n  p: {source: imu.gyro}\n"
+                                                      "  landed: {source: vehicle_land_detected.landed}\n"),
+                    100.0);
+  const int landed = t.column("landed");
+  for (const auto& row : t.rows) {
+    const double at = row[0], flag = row[static_cast<size_t>(landed)];
+    if (at < 2.69) EXPECT_NEAR(flag, 1.0, 1e-9) << at;  // straight lines from 2.0 s would fall below 0.5 at 2.35 s
+    if (at > 2.71) EXPECT_NEAR(flag, 0.0, 1e-9) << at;
+  }
+  EXPECT_TRUE(t.notes.empty()) << output::joined(t.notes, "\n");
+}
+
+// A hexacopter's rotors 60 degrees apart, the log's airframe written from the vehicle file
+// itself (forward-left-up to forward-right-down, spin to KM's sign): in the file's order
+// nothing is said; two neighbours swapped in the log, each column names the other rotor.
+TEST(LoggedRotors, AHexacopterSwappedPairIsNamed) {
+  const Vehicle hexa = load_vehicle(std::string(QUADGEN_SOURCE_DIR) + "/vehicles/hexa_plus.yaml");
+  ASSERT_EQ(hexa.rotors.size(), 6u);
+  std::map<std::string, double> p{{"CA_ROTOR_COUNT", 6}};
+  std::string mapping = "name: hexa\ncolumns:\n  t: {source: t}\n";
+  for (int n = 0; n < 6; ++n) {
+    const Rotor& r = hexa.rotors[static_cast<size_t>(n)];
+    const std::string key = "CA_ROTOR" + std::to_string(n) + "_";
+    p[key + "PX"] = r.position[0];
+    p[key + "PY"] = -r.position[1];
+    p[key + "KM"] = spin_sign(r) * 0.05;
+    p["PWM_MAIN_FUNC" + std::to_string(n + 1)] = 101 + n;
+    mapping += "  u_" + r.name + ": {source: \"actuator_outputs.output[" + std::to_string(n) + "]\", scale: 0.001, offset: -1}\n";
+  }
+  const fit::ColumnMapping m = fit::load_mapping(write_file("quadgen_hexa.yaml", mapping));
+  EXPECT_TRUE(fit::logged_rotor_notes("h.ulg", p, m, hexa).empty());
+  std::swap(p["PWM_MAIN_FUNC2"], p["PWM_MAIN_FUNC3"]);  // channel 1 drives motor 3, channel 2 motor 2
+  const auto swapped = fit::logged_rotor_notes("h.ulg", p, m, hexa);
+  ASSERT_EQ(swapped.size(), 2u) << output::joined(swapped, "\n");
+  EXPECT_NE(swapped[0].find("u_R2 reads actuator_outputs.output[1], PX4's motor 3"), std::string::npos) << swapped[0];
+  EXPECT_NE(swapped[0].find("its R3 where that motor is"), std::string::npos) << swapped[0];
+  EXPECT_NE(swapped[1].find("its R2 where that motor is"), std::string::npos) << swapped[1];
 }
