@@ -800,12 +800,19 @@ Flight load_flight(const runtime::CsvTable& log, const std::vector<std::string>&
   read_signals(log, f);
   const FlightColumns columns = read_columns(log, rotors, f, o);
   IdleInTheAir idle;
+  size_t flagged = 0;  // rows the landed flag alone keeps out
   for (size_t k = 0; k < columns.t.size(); ++k) {
     FlightSample fs = sample_at(columns, k, log);
     const bool landed = !columns.landed.empty() && columns.landed[k] >= 0.5;  // on the ground for most of the row
     idle.count(fs, f, o, landed);
     if (kept(fs, f, columns.t.back(), o, landed)) f.samples.push_back(std::move(fs));
+    else if (landed && kept(fs, f, columns.t.back(), o, false)) ++flagged;
   }
+  // Said, as the flag decides silently where a column of that name means something else.
+  if (flagged > 0)
+    f.notes.push_back(log.where_named() + ": " + std::to_string(flagged) +
+                      " rows the controller's landed flag marks on the ground are left out (by their height and "
+                      "commands alone they would count as airborne)");
   if (static_cast<double>(f.samples.size()) < o.min_samples)
     throw_too_few_airborne(log.path, columns.t, f, o, !columns.landed.empty());
   if (const std::string note = idle.note(log.where_named(), o); !note.empty()) f.notes.push_back(note);

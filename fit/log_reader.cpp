@@ -30,7 +30,8 @@ struct Signal {
   std::vector<double> t, v;
   double gap = 0;
   std::vector<size_t> breaks;
-  // Samples k after which the estimator was reset (a jump, not motion): a gap like a time gap.
+  // Samples k after which the estimator was reset (a jump, not motion): a gap like a time gap,
+  // and around it no grid point from kResetMargin before sample k to as long after k + 1.
   std::vector<size_t> resets;
   std::vector<std::string> reset_counters;  // the counters that changed
   double median_interval = 0;  // s
@@ -142,20 +143,37 @@ void hold_between_samples(Signal& s) {
 }
 
 // PX4's estimator resets its states now and then (a yaw alignment at take-off, a GPS glitch)
-// and counts each in the topic (`xy_reset_counter`, `quat_reset_counter`, ...): the value
-// jumps there, which read as motion would be a spike of acceleration. Every counter of the
-// topic is watched, not only the field's own: a reset costs a sample interval, a jump read as
-// motion spoils a fit (a review, helper-152).
-std::vector<int> reset_counter_columns(const runtime::LogTopic& tp) {
+// and counts each in the topic: the value jumps there, which read as motion would be a spike
+// of acceleration (a review, helper-152). A counter `P_reset_counter` belongs to the fields it
+// counts: PX4's xy (x, y), vxy (vx, vy), quat (q[...]), lat_lon (lat, lon), else the field P
+// itself or P's elements and members (z, vz, dist_bottom, heading, alt); a yaw reset then
+// cuts the attitude, not the position (helper-156).
+bool counts_resets_of(const std::string& prefix, const std::string& field) {
+  static const std::map<std::string, std::vector<std::string>> kGroups = {
+      {"xy", {"x", "y"}}, {"vxy", {"vx", "vy"}}, {"quat", {"q"}}, {"lat_lon", {"lat", "lon"}}};
+  const auto group = kGroups.find(prefix);
+  const std::vector<std::string> names = group == kGroups.end() ? std::vector<std::string>{prefix} : group->second;
+  for (const auto& n : names)
+    if (field == n || field.compare(0, n.size() + 1, n + "[") == 0 || field.compare(0, n.size() + 1, n + ".") == 0)
+      return true;
+  return false;
+}
+
+std::vector<int> reset_counter_columns(const runtime::LogTopic& tp, const std::string& field) {
   std::vector<int> columns;
-  const std::string suffix = "reset_counter";
+  const std::string suffix = "_reset_counter";
   for (size_t c = 0; c < tp.fields.size(); ++c) {
     const std::string& name = tp.fields[c];
-    if (name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        counts_resets_of(name.substr(0, name.size() - suffix.size()), field))
       columns.push_back(static_cast<int>(c));
   }
   return columns;
 }
+
+// Around a reset no grid point is read: the table's hole must outlast what reads across a
+// short one (a rollout's and multiple shooting's 0.1 s, the derivatives' 0.05 s window).
+constexpr double kResetMargin = 0.1;  // s
 
 Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) {
   const auto dot = e.source.find('.');
@@ -172,7 +190,7 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   const auto [count, channel] = channel_count_column(tp, e.source.substr(dot + 1));
   double most_channels = 0;
   const SampleTime sample_time(tp, e.source.substr(dot + 1));
-  const std::vector<int> counters = reset_counter_columns(tp);
+  const std::vector<int> counters = reset_counter_columns(tp, e.source.substr(dot + 1));
   const std::vector<double>* last_kept = nullptr;
   std::set<std::string> changed;
   for (const auto& row : tp.rows) {
@@ -193,7 +211,6 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
     s.v.push_back(row[c]);
   }
   s.reset_counters.assign(changed.begin(), changed.end());
-  if (e.target == "landed" && s.resets.empty()) hold_between_samples(s);
   if (s.t.size() < 2 && count >= 0 && !(static_cast<double>(channel) < most_channels))
     throw FitError(log.path + ": '" + e.source + "' is a channel its driver never set: every message of '" + topic +
                    "' has noutputs " + output::short_number(most_channels) + " or fewer" +
@@ -209,6 +226,13 @@ Signal find_signal(const runtime::TopicLog& log, const ColumnMapping::Entry& e) 
   std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
   s.median_interval = dt[dt.size() / 2];
   s.gap = std::max(3 * s.median_interval, 0.1);  // a dropout or a paused topic beyond this
+  // The landed flag, published when it changes and at least once a second: its intervals say
+  // little of a dropout (a burst of changes near the ground shortens their median), so only a
+  // pause beyond 3 s is a gap; held as a step, its steps measured before (helper-156).
+  if (e.target == "landed" && s.resets.empty()) {
+    s.gap = std::max(s.gap, 3.0);
+    hold_between_samples(s);
+  }
   for (size_t k = 0; k + 1 < s.t.size(); ++k)
     if (s.t[k + 1] - s.t[k] > s.gap || std::binary_search(s.resets.begin(), s.resets.end(), k)) s.breaks.push_back(k);
   return s;
@@ -234,8 +258,9 @@ bool value_on_grid(const Signal& s, double t, double half_step, double* v) {
   if (it == s.t.begin()) return false;
   if (it == s.t.end() && t - s.t.back() > 1e-9) return false;
   const size_t k = static_cast<size_t>(it - s.t.begin()) - 1;  // the last sample at or before t
-  if (it != s.t.end() && (s.t[k + 1] - s.t[k] > s.gap || std::binary_search(s.resets.begin(), s.resets.end(), k)))
-    return false;
+  if (it != s.t.end() && s.t[k + 1] - s.t[k] > s.gap) return false;
+  for (const size_t r : s.resets)  // a few at most
+    if (t > s.t[r] - kResetMargin && t < s.t[r + 1] + kResetMargin) return false;
   const auto next_break = std::lower_bound(s.breaks.begin(), s.breaks.end(), k);
   const size_t last = next_break == s.breaks.end() ? s.t.size() - 1 : *next_break;
   const size_t first = next_break == s.breaks.begin() ? 0 : *(next_break - 1) + 1;
@@ -405,7 +430,8 @@ runtime::CsvTable read_log(const std::string& path, const ColumnMapping* mapping
       // rates, not actuator_outputs' or vehicle_local_position's: helper-153).
       table = topic_table(log, *mapping, rate,
                           path + ": PX4 logs a topic faster when a line of etc/logging/logger_topics.txt on its SD "
-                                 "card names it (with no interval: at full rate; docs.px4.io, \"Logging\")");
+                                 "card names it (with no interval: at full rate; docs.px4.io, \"Logging\"); the file "
+                                 "takes the place of PX4's default list, so it must name every topic the mapping reads");
       for (const auto& note : ulog_notes(log)) table.notes.push_back(note);
       table.parameters = log.parameters;
     } else {

@@ -26,6 +26,7 @@
 #include "fit/motor_steps.hpp"
 #include "fit/thrust_stand.hpp"
 #include "model/vehicle.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 
 using namespace quadgen;
@@ -512,6 +513,12 @@ TEST_F(Hostile, TheLandedFlagKeepsAnArmedIdleOnTheGroundOut) {
   EXPECT_LT(after_three, plain.samples.size());  // the flag, not the flight, leaves rows out
   EXPECT_EQ(later.samples.size(), after_three);
   for (const auto& s : later.samples) EXPECT_GT(s.t, 3.0);
+  // Said, with how many rows the flag alone kept out.
+  const std::string said = output::joined(later.notes, "\n");
+  EXPECT_NE(said.find(std::to_string(plain.samples.size() - after_three) +
+                      " rows the controller's landed flag marks on the ground are left out"),
+            std::string::npos)
+      << said;
   // A grid mean of the flag at 0.5 or above is on the ground; just below it is not.
   EXPECT_EQ(load_flight(flagged([](double) { return 0.49; }), rotors, {}).samples.size(), plain.samples.size());
   const std::string none = message_of<FitError>([&] { load_flight(flagged([](double) { return 0.5; }), rotors, {}); });

@@ -1142,12 +1142,13 @@ TEST(PredictFlights, RefusesOptionsNoPredictionCanUse) {
 
 namespace {
 
-// A generated Crazyflie flight written as PX4 would log it (a review of the PX4 reading,
-// helper-152, had only ever read logs, never flown one through a command): north-east-down
-// positions, the forward-right-down attitude, gyro and specific force, PWM outputs on
-// channels in PX4's quadrotor-X motor order (motor 1 front-right, 2 rear-left, 3 front-left,
-// 4 rear-right: the Crazyflie's M1, M3, M4, M2), the battery, the landed flag and the
-// airframe's parameters (CA_ROTORn_*, PWM_MAIN_FUNCn), at the CSV's 100 Hz. The conversion is
+// A generated Crazyflie flight written in PX4's axes, topics and units (the PX4 reading had
+// only ever been read, never flown through a command): north-east-down positions, the
+// forward-right-down attitude, gyro and specific force, PWM outputs on channels in PX4's
+// quadrotor-X motor order (motor 1 front-right, 2 rear-left, 3 front-left, 4 rear-right: the
+// Crazyflie's M1, M3, M4, M2), the battery, the landed flag as PX4 publishes it (at a change
+// and once a second) and the airframe's parameters (CA_ROTORn_*, PWM_MAIN_FUNCn), every other
+// topic at the CSV's 100 Hz (not PX4's default rates, which would blur what is compared). The conversion is
 // written here from the axes' definitions, not from the reader's formulas.
 std::string px4_log_of(const quadgen::runtime::CsvTable& csv) {
   using namespace quadgen::test;
@@ -1178,6 +1179,8 @@ std::string px4_log_of(const quadgen::runtime::CsvTable& csv) {
   enu_to_ned << 0, 1, 0, 1, 0, 0, 0, 0, -1;
   const Eigen::Matrix3d frd_to_flu = Eigen::Vector3d(1, -1, -1).asDiagonal();
   const auto f = [](double v) { return f32(static_cast<float>(v)); };
+  bool flag = true;  // the first row publishes
+  double last_flag = -10;
   for (const auto& row : csv.rows) {
     const std::string t = le(1000000 + static_cast<std::uint64_t>(std::llround(at(row, "t") * 1e6)), 8);
     w.data(0, t + f(at(row, "y")) + f(at(row, "x")) + f(-at(row, "z")) + f(at(row, "vy")) + f(at(row, "vx")) +
@@ -1191,7 +1194,15 @@ std::string px4_log_of(const quadgen::runtime::CsvTable& csv) {
     for (int c = 0; c < 16; ++c) outputs += f(c < 4 ? 1000 + 1000 * at(row, rotor_of_motor[c]) : 0.0);
     w.data(3, outputs);
     w.data(4, t + f(at(row, "vbat")));
-    w.data(5, t + le(0, 1));
+    // The landed flag as PX4 publishes it: at a change and once a second; here landed for the
+    // last 1.5 s of the log (the motors still running: only the flag keeps those rows out).
+    const bool landed = at(row, "t") >= at(csv.rows.back(), "t") - 1.5;
+    const double since_flag = at(row, "t") - last_flag;
+    if (landed != flag || since_flag >= 1.0 - 1e-9) {
+      w.data(5, t + le(landed ? 1 : 0, 1));
+      flag = landed;
+      last_flag = at(row, "t");
+    }
   }
   return w.bytes();
 }
@@ -1245,7 +1256,13 @@ TEST(PredictFlights, APx4LogOfAGeneratedFlightIsReadAsTheFlight) {
   EXPECT_LT(half_second(from_csv), 0.01);
   EXPECT_GE(half_second(from_ulg), 0.0);
   EXPECT_LT(half_second(from_ulg), half_second(from_csv) + 1e-3) << from_ulg["open_loop"].dump();
-  EXPECT_FALSE(from_ulg["flights"][0].contains("notes")) << from_ulg["flights"][0]["notes"].dump(1);
+  // The flag's last 1.5 s are left out, and said; nothing is said of the rotors.
+  EXPECT_LT(from_ulg["start_points"].get<double>(), from_csv["start_points"].get<double>());
+  ASSERT_TRUE(from_ulg["flights"][0].contains("notes"));
+  ASSERT_EQ(from_ulg["flights"][0]["notes"].size(), 1u) << from_ulg["flights"][0]["notes"].dump(1);
+  EXPECT_NE(from_ulg["flights"][0]["notes"][0].get<std::string>().find("the controller's landed flag marks on the ground"),
+            std::string::npos)
+      << from_ulg["flights"][0]["notes"].dump(1);
   const nlohmann::json by_channel = predict(ulg, source_path("data/mappings/px4.yaml"), "channel");
   ASSERT_TRUE(by_channel["flights"][0].contains("notes"));
   int placed = 0;
