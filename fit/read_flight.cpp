@@ -105,6 +105,65 @@ std::map<int, Place> logged_places(const std::map<std::string, double>& paramete
   return places;
 }
 
+// What the log says of the motor the vehicle file's rotor i is read from, against that rotor:
+// a note where they differ, else "". `file` holds the file's rotors, `fx`, `fy` their centre.
+struct RotorJudge {
+  const std::string& path;
+  const std::map<std::string, double>& parameters;
+  const Vehicle& v;
+  int count;
+  const std::map<int, Place>& logged;
+  const std::vector<Place>& file;
+  double fx, fy;
+
+  double direction(size_t j) const { return std::atan2(file[j].y - fy, file[j].x - fx); }
+
+  // The file's rotor nearest in direction to `azimuth`; of two in one direction (a coaxial
+  // pair) the one spinning as the logged motor does.
+  size_t nearest(double azimuth, int spin, size_t start) const {
+    const auto nearer = [&](size_t j, size_t than) {
+      const double a = angle_between(azimuth, direction(j)), b = angle_between(azimuth, direction(than));
+      if (std::fabs(a - b) > 1e-9) return a < b;
+      return file[j].spin == spin && file[than].spin != spin;
+    };
+    size_t best = start;
+    for (size_t j = 0; j < file.size(); ++j)
+      if (nearer(j, best)) best = j;
+    return best;
+  }
+
+  std::string note(size_t i, const std::string& source) const {
+    const Rotor& rotor = v.rotors[i];
+    const LoggedMotor m = motor_of(source, parameters);
+    const std::string column = path + ": u_" + rotor.name + " reads " + source;
+    if (m.motor == 0 && !m.how.empty())
+      return column + ", a channel whose output function is no motor (" + m.how +
+             "; 101..112 are motors 1..12): the channel that drives this rotor is the one whose function is its motor";
+    if (m.motor > count)
+      return column + ", PX4's motor " + std::to_string(m.motor) + " (" + m.how + "), but the log's CA_ROTOR_COUNT is " +
+             std::to_string(count) + ": PX4 allocated no thrust to it";
+    const auto place = logged.find(m.motor);
+    if (m.motor == 0 || place == logged.end()) return "";
+    const Place& p = place->second;
+    const double azimuth = std::atan2(p.y, p.x);  // from the CoG, PX4's origin
+    const std::string head = column + ", PX4's motor " + std::to_string(m.motor) + " (" + m.how +
+                             "), which the log's CA_ROTOR" + std::to_string(m.motor - 1) + "_";
+    const std::string where_file = v.source_path + ":" + std::to_string(rotor.line);
+    const size_t there = nearest(azimuth, p.spin, i);
+    if (angle_between(azimuth, direction(i)) > kSameDirection && there != i)
+      return head + "PX/PY place " + direction_word(azimuth) + " (x " + output::short_number(p.x) + ", y " +
+             output::short_number(p.y) + " m, forward-left-up); the vehicle file's " + rotor.name + " (" + where_file +
+             ") sits " + direction_word(direction(i)) + ", its " + v.rotors[there].name +
+             " where that motor is: number the vehicle file's rotors as the log's motors, or map each u_ column to its "
+             "own rotor's channel (data/mappings/px4.yaml says how)";
+    if (p.spin != 0 && p.spin != spin_sign(rotor))
+      return head + "KM (" + output::short_number(parameters.at("CA_ROTOR" + std::to_string(m.motor - 1) + "_KM")) +
+             ") spins " + spin_word(p.spin) + " seen from above; the vehicle file's " + rotor.name + " (" + where_file +
+             ") spins " + spin_word(spin_sign(rotor));
+    return "";
+  }
+};
+
 }  // namespace
 
 std::vector<std::string> logged_rotor_notes(const std::string& path, const std::map<std::string, double>& parameters,
@@ -122,55 +181,12 @@ std::vector<std::string> logged_rotor_notes(const std::string& path, const std::
   const std::map<int, Place> logged = logged_places(parameters, count);
   std::vector<Place> file_list;
   for (const auto& r : v.rotors) file_list.push_back({r.position[0], r.position[1], spin_sign(r)});
-  const double fx = centre_x(file_list), fy = centre_y(file_list);
+  const RotorJudge judge{path, parameters, v, count, logged, file_list, centre_x(file_list), centre_y(file_list)};
   for (size_t i = 0; i < v.rotors.size(); ++i) {
-    const Rotor& rotor = v.rotors[i];
     const auto entry = std::find_if(mapping.entries.begin(), mapping.entries.end(),
-                                    [&](const ColumnMapping::Entry& e) { return e.target == "u_" + rotor.name; });
+                                    [&](const ColumnMapping::Entry& e) { return e.target == "u_" + v.rotors[i].name; });
     if (entry == mapping.entries.end()) continue;
-    const LoggedMotor m = motor_of(entry->source, parameters);
-    if (m.motor == 0 && !m.how.empty()) {
-      notes.push_back(path + ": u_" + rotor.name + " reads " + entry->source + ", a channel whose output function is no " +
-                      "motor (" + m.how + "; 101..112 are motors 1..12): the channel that drives this rotor is the " +
-                      "one whose function is its motor");
-      continue;
-    }
-    if (m.motor > count) {
-      notes.push_back(path + ": u_" + rotor.name + " reads " + entry->source + ", PX4's motor " + std::to_string(m.motor) +
-                      " (" + m.how + "), but the log's CA_ROTOR_COUNT is " + std::to_string(count) +
-                      ": PX4 allocated no thrust to it");
-      continue;
-    }
-    const auto place = logged.find(m.motor);
-    if (m.motor == 0 || place == logged.end()) continue;
-    const double dx = place->second.x, dy = place->second.y;
-    const double azimuth = std::atan2(dy, dx);
-    const auto direction = [&](size_t j) { return std::atan2(file_list[j].y - fy, file_list[j].x - fx); };
-    // The file's rotor nearest in direction; of two in one direction (a coaxial pair) the one
-    // spinning as the logged motor does.
-    const auto nearer = [&](size_t j, size_t than) {
-      const double a = angle_between(azimuth, direction(j)), b = angle_between(azimuth, direction(than));
-      if (std::fabs(a - b) > 1e-9) return a < b;
-      return file_list[j].spin == place->second.spin && file_list[than].spin != place->second.spin;
-    };
-    size_t nearest = i;
-    for (size_t j = 0; j < v.rotors.size(); ++j)
-      if (nearer(j, nearest)) nearest = j;
-    const std::string head = path + ": u_" + rotor.name + " reads " + entry->source + ", PX4's motor " +
-                             std::to_string(m.motor) + " (" + m.how + "), which the log's CA_ROTOR" +
-                             std::to_string(m.motor - 1) + "_";
-    const std::string where_file = v.source_path + ":" + std::to_string(rotor.line);
-    if (angle_between(azimuth, direction(i)) > kSameDirection && nearest != i) {
-      notes.push_back(head + "PX/PY place " + direction_word(azimuth) + " (x " + output::short_number(place->second.x) +
-                      ", y " + output::short_number(place->second.y) + " m, forward-left-up); the vehicle file's " +
-                      rotor.name + " (" + where_file + ") sits " + direction_word(direction(i)) + ", its " +
-                      v.rotors[nearest].name + " where that motor is: number the vehicle file's rotors as the log's "
-                      "motors, or map each u_ column to its own rotor's channel (data/mappings/px4.yaml says how)");
-    } else if (place->second.spin != 0 && place->second.spin != spin_sign(rotor)) {
-      notes.push_back(head + "KM (" + output::short_number(parameters.at("CA_ROTOR" + std::to_string(m.motor - 1) + "_KM")) +
-                      ") spins " + spin_word(place->second.spin) + " seen from above; the vehicle file's " + rotor.name +
-                      " (" + where_file + ") spins " + spin_word(spin_sign(rotor)));
-    }
+    if (std::string note = judge.note(i, entry->source); !note.empty()) notes.push_back(std::move(note));
   }
   return notes;
 }
