@@ -43,17 +43,30 @@ struct GeneratedFlight {
   double mean_thrust_per_mass = 0;  // m/s^2, over the flight: |a_world + g e_z|
 };
 
+// An empty folder of this test process's own under the temporary folder.
+fs::path fresh_directory(const std::string& stem) {
+  const fs::path dir = fs::temp_directory_path() / (stem + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// `quadgen simulate VEHICLE FLAGS --out CSV` (the vehicle file relative to the source tree),
+// its output not shown: the command's exit status.
+int simulate(const std::string& vehicle, const std::string& flags, const std::string& csv) {
+  return std::system((std::string(QUADGEN_BINARY) + " simulate " + source_path(vehicle) + " " + flags + " --out " + csv +
+                      " > /dev/null 2>&1")
+                         .c_str());
+}
+
 // A 12 s closed-loop flight of `vehicle` (its rotors `rotors`, the battery voltage its file
 // refers to `vbat_ref`) simulated with these extra `simulate` flags, loaded as predict loads it.
 quadgen::fit::Flight simulated_flight(const std::string& vehicle, const std::vector<std::string>& rotors, double vbat_ref,
                                       const std::string& extra_flags) {
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_prediction_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = fresh_directory("quadgen_prediction");
   const std::string csv = (dir / "f.csv").string();
-  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path(vehicle) +
-                          " --closed-loop --duration 12 --seed 4 --pose-noise 0 " + extra_flags + " --out " + csv +
-                          " > /dev/null 2>&1";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("simulate failed");
+  if (simulate(vehicle, "--closed-loop --duration 12 --seed 4 --pose-noise 0 " + extra_flags, csv) != 0)
+    throw std::runtime_error("simulate failed");
   auto f = quadgen::predict::fill_missing_signals(quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), rotors, {}),
                                                   vbat_ref);
   fs::remove_all(dir);
@@ -715,13 +728,11 @@ TEST(PredictParameters, EachLogGetsItsFlightsValuesOrTheAirframes) {
 // weak) is calibrated on its first 70 % with everything else held, comes back, and the
 // held-out 30 % is then predicted better than with the trim of another flight.
 TEST(PredictParameters, CalibrationRecoversTheFlightsOwnTrim) {
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_predict_calibrate_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = fresh_directory("quadgen_predict_calibrate");
   const std::string csv = (dir / "f.csv").string();
-  const std::string cmd = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/finken3.yaml") +
-                          " --closed-loop --duration 20 --seed 7 --effects motor_gain --set motor_gain.C=-0.08 --out " +
-                          csv + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  ASSERT_EQ(simulate("vehicles/finken3.yaml",
+                     "--closed-loop --duration 20 --seed 7 --effects motor_gain --set motor_gain.C=-0.08", csv),
+            0);
   const auto whole = quadgen::predict::fill_missing_signals(
       quadgen::fit::load_flight(quadgen::runtime::read_csv(csv), {"A", "B", "C", "D"}, {}), 4.0);
   fs::remove_all(dir);
@@ -745,16 +756,10 @@ TEST(PredictParameters, CalibrationRecoversTheFlightsOwnTrim) {
 // wind of 1.5 m/s indoors) is said, on the terminal and in prediction.json, as diagnose
 // says a stand-in; the same calibration where a wind is plausible (outdoors) says nothing.
 TEST(PredictParameters, ACalibratedValueBeyondItsPlausibleRangeIsSaid) {
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_predict_implausible_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_directory("quadgen_predict_implausible");
   const std::string csv = (dir / "f.csv").string(), params = (dir / "diagnosis.json").string();
   const std::string vehicle = source_path("vehicles/finken3.yaml");
-  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + vehicle +
-                         " --closed-loop --duration 20 --seed 3 --effects wind --set wind.x=1.5 --out " + csv +
-                         " > /dev/null 2>&1")
-                            .c_str()),
-            0);
+  ASSERT_EQ(simulate("vehicles/finken3.yaml", "--closed-loop --duration 20 --seed 3 --effects wind --set wind.x=1.5", csv), 0);
   // The airframe of another flight, with the wind as each flight's own quantity.
   std::ofstream(params) << R"({"final_fit": {}, "flights": ["another.csv"], "flight_parameters": ["wind.x", "wind.y"]})";
   for (const std::string where : {"indoor", "outdoor"}) {
@@ -1026,12 +1031,9 @@ TEST(FlyingSetPoints, ALogWithoutSetPointsIsRefusedByName) {
   quadgen::fit::Flight f = crazyflie_own_flight();
   f.has_attitude_ref = false;
   EXPECT_TRUE(quadgen::predict::evaluate_prediction(m, m.params(), f, flying_options()).set_points_flown.empty());
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_set_points_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = fresh_directory("quadgen_set_points_cli");
   const std::string flown = (dir / "flown.csv").string(), log = (dir / "f.csv").string();
-  const std::string sim = std::string(QUADGEN_BINARY) + " simulate " + source_path("vehicles/crazyflie21.yaml") +
-                          " --closed-loop --duration 3 --out " + flown + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(sim.c_str()), 0);
+  ASSERT_EQ(simulate("vehicles/crazyflie21.yaml", "--closed-loop --duration 3", flown), 0);
   {  // the same flight without its last two columns (phi_ref, theta_ref)
     std::ifstream in(flown);
     std::ofstream out(log);
@@ -1215,15 +1217,10 @@ std::string px4_log_of(const quadgen::runtime::CsvTable& csv) {
 // Mapped channel for channel, as px4.yaml ships, three columns read motors the log places at
 // other rotors: each is said (in prediction.json too) and the prediction falls apart.
 TEST(PredictFlights, APx4LogOfAGeneratedFlightIsReadAsTheFlight) {
-  const fs::path dir = fs::temp_directory_path() / ("quadgen_px4_flight_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_directory("quadgen_px4_flight");
   const std::string csv = (dir / "f.csv").string(), ulg = (dir / "f.ulg").string();
   const std::string vehicle = source_path("vehicles/crazyflie21.yaml");
-  ASSERT_EQ(std::system((std::string(QUADGEN_BINARY) + " simulate " + vehicle +
-                         " --closed-loop --duration 12 --seed 4 --pose-noise 0 --out " + csv + " > /dev/null 2>&1")
-                            .c_str()),
-            0);
+  ASSERT_EQ(simulate("vehicles/crazyflie21.yaml", "--closed-loop --duration 12 --seed 4 --pose-noise 0", csv), 0);
   std::ofstream(ulg, std::ios::binary) << px4_log_of(quadgen::runtime::read_csv(csv));
   std::ifstream shipped_in(source_path("data/mappings/px4.yaml"));
   const std::string shipped((std::istreambuf_iterator<char>(shipped_in)), std::istreambuf_iterator<char>());
