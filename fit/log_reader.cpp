@@ -20,6 +20,12 @@ bool is_ulog(const std::string& path) {
 
 bool is_topic_log(const std::string& path) { return is_ulog(path) || runtime::is_usd_log(path); }
 
+std::optional<std::string> stem_before(const std::string& name, const std::string& suffix) {
+  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return std::nullopt;
+  return name.substr(0, name.size() - suffix.size());
+}
+
 namespace {
 
 // One mapped signal: its topic's timestamps (s) and finite values, the longest interval
@@ -101,9 +107,9 @@ class SampleTime {
       : sample_(is_command_topic(tp.name) ? -1 : tp.column("timestamp_sample")) {
     for (size_t c = 0; c < tp.fields.size(); ++c) {
       const std::string& name = tp.fields[c];
-      const std::string suffix = "_timestamp_relative";
-      if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
-      const std::string sensor = name.substr(0, name.size() - suffix.size());
+      const auto stem = stem_before(name, "_timestamp_relative");
+      if (!stem) continue;
+      const std::string& sensor = *stem;
       const bool of_sensor = field == sensor || field.compare(0, sensor.size() + 1, sensor + "_") == 0 ||
                              field.compare(0, sensor.size() + 1, sensor + "[") == 0;
       if (of_sensor && field != name) relative_ = static_cast<int>(c);
@@ -161,13 +167,9 @@ bool counts_resets_of(const std::string& prefix, const std::string& field) {
 
 std::vector<int> reset_counter_columns(const runtime::LogTopic& tp, const std::string& field) {
   std::vector<int> columns;
-  const std::string suffix = "_reset_counter";
-  for (size_t c = 0; c < tp.fields.size(); ++c) {
-    const std::string& name = tp.fields[c];
-    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-        counts_resets_of(name.substr(0, name.size() - suffix.size()), field))
+  for (size_t c = 0; c < tp.fields.size(); ++c)
+    if (const auto stem = stem_before(tp.fields[c], "_reset_counter"); stem && counts_resets_of(*stem, field))
       columns.push_back(static_cast<int>(c));
-  }
   return columns;
 }
 

@@ -13,6 +13,7 @@
 // A mapping's `frame: ned_frd` then turns PX4's north-east-down world and forward-right-down
 // body axes into the model's east-north-up world and forward-left-up body axes.
 #pragma once
+#include <optional>
 #include <string>
 
 #include "fit/flight_data.hpp"
@@ -37,6 +38,10 @@ runtime::CsvTable topic_table(const runtime::TopicLog& log, const ColumnMapping&
                               const std::string& how_to_log_faster = "");
 // What a person should know of a ULog before trusting it: the logger's dropouts, a cut-off end.
 std::vector<std::string> ulog_notes(const runtime::Ulog& log);
+// The part of a logged field's or parameter's name before `suffix` ("accelerometer" of
+// "accelerometer_timestamp_relative", "PWM_MAIN" of "PWM_MAIN_FUNC1"), or nothing where the
+// name does not end in it after at least one character.
+std::optional<std::string> stem_before(const std::string& name, const std::string& suffix);
 
 // Reads a log (CSV, ULog or uSD) and returns it in the canonical layout. `mapping_path` may be
 // empty (`mapping` null) for a canonical CSV; a log of topics needs one. `resample_hz` > 0

@@ -49,7 +49,7 @@ LoggedMotor motor_of(const std::string& source, const std::map<std::string, doub
   std::map<int, std::vector<std::string>> motors;
   std::vector<std::string> functions;  // every family's function for the channel
   for (const auto& [name, value] : parameters)
-    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+    if (stem_before(name, suffix)) {
       functions.push_back(name + " = " + output::short_number(value));
       if (value >= kMotorFunction1 && value <= kMotorFunctionLast && value == std::floor(value))
         motors[static_cast<int>(value - kMotorFunction1) + 1].push_back(functions.back());
@@ -75,15 +75,12 @@ std::optional<Place> logged_place(const std::map<std::string, double>& parameter
   return Place{px->second, -py->second, spin};  // forward-right-down -> forward-left-up
 }
 
-double centre_x(const std::vector<Place>& places) {
-  double s = 0;
-  for (const auto& p : places) s += p.x;
-  return places.empty() ? 0 : s / static_cast<double>(places.size());
-}
-double centre_y(const std::vector<Place>& places) {
-  double s = 0;
-  for (const auto& p : places) s += p.y;
-  return places.empty() ? 0 : s / static_cast<double>(places.size());
+// The mean place of `places` (x, y), the origin for none.
+std::pair<double, double> centre(const std::vector<Place>& places) {
+  double x = 0, y = 0;
+  for (const auto& p : places) x += p.x, y += p.y;
+  const double n = places.empty() ? 1 : static_cast<double>(places.size());
+  return {x / n, y / n};
 }
 
 double angle_between(double a, double b) { return std::fabs(std::remainder(a - b, 2 * M_PI)); }
@@ -181,7 +178,8 @@ std::vector<std::string> logged_rotor_notes(const std::string& path, const std::
   const std::map<int, Place> logged = logged_places(parameters, count);
   std::vector<Place> file_list;
   for (const auto& r : v.rotors) file_list.push_back({r.position[0], r.position[1], spin_sign(r)});
-  const RotorJudge judge{path, parameters, v, count, logged, file_list, centre_x(file_list), centre_y(file_list)};
+  const auto [fx, fy] = centre(file_list);
+  const RotorJudge judge{path, parameters, v, count, logged, file_list, fx, fy};
   for (size_t i = 0; i < v.rotors.size(); ++i) {
     const auto entry = std::find_if(mapping.entries.begin(), mapping.entries.end(),
                                     [&](const ColumnMapping::Entry& e) { return e.target == "u_" + v.rotors[i].name; });
