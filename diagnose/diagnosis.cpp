@@ -346,6 +346,17 @@ std::vector<fit::FitParameter> airframe_values(const std::vector<fit::FitParamet
   return out;
 }
 
+// Every free parameter of the final fit with its standard error, as the findings' Wald
+// intervals have theirs (a user trial: the thrust constant the thesis fitted with an interval
+// came out of a diagnosis as a bare number). Infinite where the direction is confounded.
+std::map<std::string, double> final_standard_errors(const fit::EquationErrorModel& train, const SearchResult& s) {
+  const StandardErrors se = gauss_newton_standard_errors(train, s.final_fit, s.final_weights);
+  std::map<std::string, double> out;
+  for (size_t i = 0; i < s.final_fit.size(); ++i)
+    if (s.final_fit[i].free) out[s.final_fit[i].name] = se.confounded[i] ? INFINITY : se.value[i];
+  return out;
+}
+
 // What is wrong, before and after, over the whole flight (`used`: the samples with
 // residuals): the residuals of the base and the final fit and their analysis.
 void analyse_what_is_wrong(const Vehicle& v, const fit::Flight& used, const fit::EquationErrorModel& all_ee,
@@ -911,6 +922,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
   for (const auto& p : d.search.final_fit)
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
   d.airframe_fit = airframe_values(d.search.final_fit);
+  d.final_standard_errors = final_standard_errors(train_ee, d.search);
   d.seconds = seconds_since(clock.start);
   return d;
 }

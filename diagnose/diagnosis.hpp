@@ -247,6 +247,10 @@ struct Diagnosis {
   // The final fit as the airframe's parameters: per-flight values averaged over the flights
   // (what the extended header and fitted_parameters.yaml carry). One flight: the final fit.
   std::vector<fit::FitParameter> airframe_fit;
+  // Standard errors of the final fit's free parameters (Gauss-Newton, under the final
+  // weights), by name; infinite where the data cannot determine the parameter (a direction
+  // of the normal matrix the fit cannot see). diagnosis.json gives each a Wald interval.
+  std::map<std::string, double> final_standard_errors;
   std::string metric;
   double metric_before = 0, metric_after = 0;
   WindowedSimulation sim_before, sim_after;  // validation part

@@ -551,6 +551,15 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
   figures.show(h, {"profiles.svg"});
 }
 
+// A final-fit parameter's Wald interval (value +- 1.96 standard errors); a dash on a bound
+// or where the data cannot determine it.
+std::string wald_interval_html(const Diagnosis& d, const fit::FitParameter& p) {
+  const auto se = d.final_standard_errors.find(p.name);
+  if (se == d.final_standard_errors.end() || !std::isfinite(se->second) || fit::on_bound(p)) return "&ndash;";
+  const double lower = p.value - fit::kZ95 * se->second, upper = p.value + fit::kZ95 * se->second;
+  return interval(lower, upper, estimate_digits(p.value, lower, upper));
+}
+
 // The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...), as the
 // final fit has them, with those on a bound marked as the summary's caution marks them (a
 // user trial, helper-106: the baseline every gain is measured against was not shown, and its
@@ -572,7 +581,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     << (std::any_of(base.begin(), base.end(), [&](const fit::FitParameter* p) { return on_bound(*p); })
             ? " One on its bound was held there: the model is strained, and a finding may stand in for what it lacks."
             : "")
-    << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>in the vehicle file</th><th>unit</th><th>bounds</th><th>note</th></tr>\n";
+    << "</p>\n<table><tr><th>parameter</th><th>fitted</th><th>95 % interval</th><th>in the vehicle file</th><th>unit</th><th>bounds</th><th>note</th></tr>\n";
   // Where the flights, each refitted alone, do not agree on it: the joint value is no one
   // airframe's measurement (a review, helper-131: c_w 0.563 stood here without a caveat).
   const auto flights_say = [&](const fit::FitParameter& p) -> std::string {
@@ -587,7 +596,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     if (const std::string said = flights_say(*p); !said.empty()) note += (note.empty() ? "" : "; ") + said;
     const auto file = d.file_values.find(runtime::shared_name(p->name));  // a flight's copy: the file's one value
     h << "<tr><td>" << esc(p->name) << "</td><td>" << significant(p->value, kEstimateDigits) << "</td><td>"
-      << (file == d.file_values.end() ? "&ndash;" : significant(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
+      << wald_interval_html(d, *p) << "</td><td>" << (file == d.file_values.end() ? "&ndash;" : significant(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
       << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (note.empty() ? ">" : " class=\"warn\">" + note) << "</td></tr>\n";
   }
   h << "</table>\n";

@@ -45,13 +45,38 @@ json evidence_json(const CandidateEvidence& e) {
           {"implausible", e.implausible}};
 }
 
-// The free parameters of a fit, each in the one estimate shape: intervals are only computed
-// for the named effects' parameters (findings), so here they stay null.
-json parameters_json(const std::vector<fit::FitParameter>& ps) {
+// The free parameters of a fit, each in the one estimate shape. With standard errors (the
+// final fit's), a Wald interval and "standard_error" after the shape; none on a bound (the
+// curvature there is not the likelihood's) or where the error is infinite (confounded).
+// Without (the base fit), the interval stays null.
+json parameters_json(const std::vector<fit::FitParameter>& ps, const std::map<std::string, double>* errors = nullptr) {
   json j = json::object();
-  for (const auto& p : ps)
-    if (p.free) j[p.name] = output::estimate_json({p.value, p.unit, NAN, NAN, "", fit::on_bound(p)});
+  for (const auto& p : ps) {
+    if (!p.free) continue;
+    const auto se = errors ? errors->find(p.name) : std::map<std::string, double>::const_iterator{};
+    const bool known = errors && se != errors->end();
+    const bool wald = known && std::isfinite(se->second) && !fit::on_bound(p);
+    const double half = wald ? fit::kZ95 * se->second : NAN;
+    j[p.name] = output::estimate_json({p.value, p.unit, p.value - half, p.value + half, "", fit::on_bound(p)});
+    if (!known) continue;
+    j[p.name]["standard_error"] = output::number_or_null(se->second);
+    j[p.name]["interval_method"] = wald ? json("wald") : json(nullptr);
+  }
   return j;
+}
+
+// The airframe's values carry the final fit's errors where they are the final fit's own
+// (a shared parameter); a mean over the flights' copies has none here.
+std::map<std::string, double> airframe_standard_errors(const Diagnosis& d) {
+  std::map<std::string, double> out;
+  for (const auto& p : d.airframe_fit) {
+    const bool copied = std::any_of(d.search.final_fit.begin(), d.search.final_fit.end(), [&](const fit::FitParameter& q) {
+      return runtime::flight_of_name(q.name) != 1 && runtime::shared_name(q.name) == p.name;
+    });
+    const auto se = d.final_standard_errors.find(p.name);
+    if (!copied && se != d.final_standard_errors.end()) out[p.name] = se->second;
+  }
+  return out;
 }
 
 // Effects the extended model carries without naming them: the stronger of a look-alike pair
@@ -552,9 +577,14 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["selection"] = selection_json(d.search);
   j["candidates_considered"] = d.candidates;
   j["base_fit"] = parameters_json(d.search.base_fit);
-  j["final_fit"] = parameters_json(d.search.final_fit);
+  j["final_fit"] = parameters_json(d.search.final_fit, &d.final_standard_errors);
   // For predicting other flights (quadgen predict): the airframe's values.
-  j["airframe_fit"] = parameters_json(d.airframe_fit.empty() ? d.search.final_fit : d.airframe_fit);
+  if (d.airframe_fit.empty()) {
+    j["airframe_fit"] = parameters_json(d.search.final_fit, &d.final_standard_errors);
+  } else {
+    const auto errors = airframe_standard_errors(d);
+    j["airframe_fit"] = parameters_json(d.airframe_fit, &errors);
+  }
   json scopes = json::object();
   for (const auto& e : d.candidates) scopes[e] = scope(e);
   j["effect_scopes"] = scopes;

@@ -195,6 +195,37 @@ void expect_estimate(const json& j, const std::string& effect, const std::string
   EXPECT_GE(ci[1].get<double>(), truth) << name << " " << ci.dump();
 }
 
+// Every free parameter of the final fit has a standard error and, off its bounds, the Wald
+// interval value +- 1.96 of it. Checked against two independent things: each named
+// parameter's profile-likelihood interval (refits, not the curvature), which it must match
+// in width; and the base parameters' truth (the vehicle file's values, which the flight was
+// simulated with), which it must hold.
+void expect_final_fit_intervals(const json& j, const HiddenCase& c) {
+  const quadgen::Vehicle v = quadgen::load_vehicle(vehicle_file(c));
+  for (const auto& [name, e] : j["final_fit"].items()) {
+    ASSERT_TRUE(e.contains("standard_error")) << name;
+    if (e["interval_method"] != "wald") continue;
+    const double value = e["value"], se = e["standard_error"], lower = e["ci95"][0], upper = e["ci95"][1];
+    EXPECT_GT(se, 0) << name;
+    EXPECT_NEAR(upper - value, 1.959963984540054 * se, 1e-9 * std::fabs(value) + 1e-12 * se) << name;
+    EXPECT_NEAR(value - lower, upper - value, 1e-9 * (std::fabs(value) + upper - value)) << name;
+    if (name.find('.') == std::string::npos && v.params.count(name)) {
+      const double truth = quadgen::param(v, name).nominal;
+      EXPECT_LE(lower, truth) << name << " " << e.dump();
+      EXPECT_GE(upper, truth) << name << " " << e.dump();
+    }
+  }
+  for (const auto& f : j["findings"])
+    for (const auto& [name, e] : f["parameters"].items()) {
+      const json& wald = j["final_fit"][name];
+      if (e["interval_method"] != "profile" || !e["ci95"][0].is_number() || !e["ci95"][1].is_number()) continue;
+      ASSERT_EQ(wald["interval_method"], "wald") << name;
+      const double profile_width = e["ci95"][1].get<double>() - e["ci95"][0].get<double>();
+      const double wald_width = wald["ci95"][1].get<double>() - wald["ci95"][0].get<double>();
+      EXPECT_NEAR(wald_width / profile_width, 1.0, 0.05) << name << ": Wald " << wald.dump() << ", profile " << e.dump();
+    }
+}
+
 class HiddenEffect : public ::testing::TestWithParam<HiddenCase> {};
 
 TEST_P(HiddenEffect, IsNamedWithItsParameters) {
@@ -208,6 +239,7 @@ TEST_P(HiddenEffect, IsNamedWithItsParameters) {
   for (const char* fit : {"base_fit", "final_fit", "airframe_fit"})
     for (const auto& [name, e] : j[fit].items()) EXPECT_TRUE(quadgen::test::has_estimate_shape(e)) << fit << " " << name;
   for (const auto& name : j["parameters_at_bounds"]) EXPECT_TRUE(j["final_fit"].contains(name.get<std::string>())) << name;
+  expect_final_fit_intervals(j, c);
 }
 
 std::vector<HiddenCase> single_effects() {
@@ -2123,6 +2155,7 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   d.channel_names = {"az_world"}, d.channel_units = {"m/s^2"};
   d.channel_gain = {{"az_world", 0.2575, 0.371}};
   d.file_values["c_w"] = 1.1;  // beside the fitted value; kappa's is not given: a dash
+  d.final_standard_errors = {{"c_w", 0.2}, {"kappa", 0.1}};  // c_w's on its bound: no interval
   const std::string html = dg::diagnosis_html(d, "dir/B3.csv", {{"validation.svg", "<svg></svg>"}});
   const size_t glance = html.find("<table class=\"glance\">"), findings = html.find("<h2>Findings</h2>");
   ASSERT_NE(glance, std::string::npos);
@@ -2146,10 +2179,20 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_NE(html.find("<figcaption><b>What to look for:</b> the held-out part"), std::string::npos);
   const size_t base = html.find("<h2>The vehicle's own parameters, as fitted</h2>");
   ASSERT_NE(base, std::string::npos);
-  EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>1.1</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on its bound</td></tr>", base),
+  EXPECT_NE(html.find("<tr><td>c_w</td><td>3</td><td>&ndash;</td><td>1.1</td><td>1</td><td>[0, 3]</td><td class=\"warn\">on "
+                      "its bound</td></tr>",
+                      base),
             std::string::npos);
   EXPECT_EQ(html.find("<tr><td>mass</td>", base), std::string::npos);  // held, not fitted
-  EXPECT_NE(html.find("<tr><td>kappa</td><td>0.5</td><td>&ndash;</td><td>&lt;b&gt;m²</td>", base), std::string::npos);  // raised, then escaped
+  EXPECT_NE(html.find("<tr><td>kappa</td><td>0.5</td><td>[0.304, 0.696]</td><td>&ndash;</td><td>&lt;b&gt;m²</td>", base),
+            std::string::npos);  // raised, then escaped
+  const auto fits = dg::diagnosis_json(d, "dir/B3.csv")["final_fit"];
+  EXPECT_TRUE(fits["c_w"]["ci95"][0].is_null() && fits["c_w"]["ci95"][1].is_null()) << fits["c_w"];  // on its bound
+  EXPECT_TRUE(fits["c_w"]["interval_method"].is_null());
+  EXPECT_EQ(fits["c_w"]["standard_error"], 0.2);
+  EXPECT_NEAR(fits["kappa"]["ci95"][0].get<double>(), 0.5 - 1.959963984540054 * 0.1, 1e-12) << fits["kappa"];
+  EXPECT_EQ(fits["kappa"]["interval_method"], "wald");
+  EXPECT_FALSE(fits["wind.x"].contains("standard_error"));  // none given: the base fit's shape
   const std::string summary = dg::diagnosis_summary(d);
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
                          "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s² (44.1 % higher)\n"),
