@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
   quadgen::cli::add_diagnose(app, diagnose);
   quadgen::cli::PredictArgs predict;
   quadgen::cli::add_predict(app, predict);
+  quadgen::cli::CompareArgs compare;
+  quadgen::cli::add_compare(app, compare);
   std::vector<char*> args(argv, argv + argc);
   std::string help = "--help";
   if (argc > 1 && std::string(argv[1]) == "help") args[1] = help.data();  // `quadgen help` as git has it
@@ -64,6 +66,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("fit")) return quadgen::cli::run_fit(fit);
     if (app.got_subcommand("diagnose")) return quadgen::cli::run_diagnose(diagnose);
     if (app.got_subcommand("predict")) return quadgen::cli::run_predict(predict);
+    if (app.got_subcommand("compare")) return quadgen::cli::run_compare(compare);
     return 1;
   });
 }

@@ -185,7 +185,7 @@ TEST(Cli, VersionPrintsTheProjectVersion) {
 // Every number a subcommand takes shows its default in --help ("--window FLOAT:...=0.5"),
 // and the effect names are listed where --effects is offered.
 TEST(Cli, HelpShowsTheDefaultOfEveryNumberAndTheEffectNames) {
-  for (const char* command : {"derive", "simulate", "fit", "diagnose", "predict"}) {
+  for (const char* command : {"derive", "simulate", "fit", "diagnose", "predict", "compare"}) {
     FILE* p = ::popen((std::string(QUADGEN_BINARY) + " " + command + " --help 2>&1").c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string out;
@@ -201,7 +201,8 @@ TEST(Cli, HelpShowsTheDefaultOfEveryNumberAndTheEffectNames) {
       ++numbers;
       EXPECT_NE(line.find('='), std::string::npos) << command << " " << m[1] << ": no default in '" << line << "'";
     }
-    if (std::string(command) != "derive") EXPECT_GT(numbers, 0) << command;  // derive takes no number
+    const bool takes_numbers = std::string(command) != "derive" && std::string(command) != "compare";
+    if (takes_numbers) EXPECT_GT(numbers, 0) << command;
     if (out.find("--effects") != std::string::npos) EXPECT_NE(out.find("blade_flapping"), std::string::npos) << command;
   }
 }
@@ -1789,7 +1790,7 @@ TEST(Cli, NewcomerMistakesAreNamed) {
   };
   // A misspelt or imagined command.
   expect_error({"diagnos", f3, "--out", tmp / "o"}, 106, "unknown command 'diagnos' (commands: derive, simulate, fit, "
-                                                          "diagnose, predict); did you mean 'diagnose'?");
+                                                          "diagnose, predict, compare); did you mean 'diagnose'?");
   expect_error({"generate", f3, "--out", tmp / "o"}, 106, "'derive' writes the generated C++");
   // An empty path (an unset shell variable) and a log whose name begins with '-' (read as an
   // option: "logs is required" alone; a review, helper-135).

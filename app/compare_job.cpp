@@ -1,0 +1,48 @@
+#include "app/compare_job.hpp"
+
+#include "app/derive_pipeline.hpp"
+#include "audit/derivation_comparison.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+
+namespace quadgen::app {
+
+namespace {
+
+struct Derived {
+  Vehicle vehicle;
+  SymbolicModel model;
+  std::string note;
+};
+
+// The symbolic model derive would emit for the file: its effects, its fitted values as the
+// nominal ones. Not audited or generated: the comparison needs the equations only.
+Derived derive_for_comparison(const std::string& path, const std::string& effects) {
+  Derived d{load_vehicle(path), {}, ""};
+  DeriveRequest request;
+  request.derive.effects = parse_effect_list(effects);
+  d.note = use_fitted_values(request, d.vehicle, path, "", !effects.empty());
+  d.model = derive_model(d.vehicle, derive_mass_properties(d.vehicle), request.derive);
+  if (request.set_nominal) request.set_nominal(d.model);
+  return d;
+}
+
+}  // namespace
+
+CompareJobResult run_compare_job(const CompareJob& job) {
+  const auto progress = [&](const std::string& what) {
+    if (job.progress) job.progress(what);
+  };
+  progress("deriving A");
+  const Derived a = derive_for_comparison(job.vehicle_a, job.effects);
+  progress("deriving B");
+  const Derived b = derive_for_comparison(job.vehicle_b, job.effects);
+  progress("comparing");
+  const DerivationComparison c = compare_derivations({a.vehicle, a.model}, {b.vehicle, b.model});
+  CompareJobResult r;
+  r.text = comparison_text(c, job.vehicle_a, job.vehicle_b);
+  r.note = a.note + (a.note.empty() || b.note.empty() ? "" : "\n") + b.note;
+  r.same = c.same();
+  return r;
+}
+
+}  // namespace quadgen::app

@@ -1,0 +1,34 @@
+// quadgen compare A.yaml B.yaml [--effects e1,e2|all]
+#include <iostream>
+
+#include "app/compare_job.hpp"
+#include "cli/compare_command.hpp"
+#include "cli/options.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "output/progress.hpp"
+#include "output/sinks.hpp"
+
+namespace quadgen::cli {
+
+void add_compare(CLI::App& app, CompareArgs& args) {
+  CLI::App* c = app.add_subcommand(
+      "compare", "what differs between the derivations of two vehicle files: blocks, rotors, values, equations");
+  c->add_option("vehicle_a", args.vehicle_a, "vehicle description A (YAML)")->required();
+  c->add_option("vehicle_b", args.vehicle_b, "vehicle description B (YAML)")->required();
+  c->add_option("--effects", args.effects,
+                "comma-separated effects to derive both with, or 'all' (default: each file's fitted ones, or none): " +
+                    catalogue_names());
+}
+
+int run_compare(const CompareArgs& args) {
+  const output::Progress terminal = output::terminal_progress();
+  int step = 0;
+  app::CompareJob job{args.vehicle_a, args.vehicle_b, args.effects,
+                      [&](const std::string& what) { terminal.say("[" + std::to_string(++step) + "/3] " + what); }};
+  const app::CompareJobResult r = app::run_compare_job(job);
+  if (!r.note.empty()) std::cerr << "quadgen: note: " << output::printable_lines(r.note) << "\n";
+  std::cout << output::printable_lines(r.text);
+  return r.same ? 0 : 1;
+}
+
+}  // namespace quadgen::cli

@@ -1,0 +1,175 @@
+// quadgen compare: two derivations side by side (audit/derivation_comparison.hpp). The
+// expectations come from the physics of the change, not from the comparison's own output: a
+// rotor moved along body x changes the pitch torque and nothing about the kinematics; an
+// expression rewritten is the same function; one changed by a part in 1e7 is not.
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "audit/derivation_comparison.hpp"
+#include "derive/dynamics.hpp"
+#include "derive/effects/effect_catalogue.hpp"
+#include "tests/test_helpers.hpp"
+
+namespace {
+
+using quadgen::test::source_path;
+
+std::string finken3_text() {
+  std::ifstream in(source_path("vehicles/finken3.yaml"));
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? s : s.replace(at, from.size(), to);
+}
+
+struct Side {
+  quadgen::Vehicle vehicle;
+  quadgen::SymbolicModel model;
+};
+
+Side derive(const std::string& text, const std::string& effects = "") {
+  Side s{quadgen::parse_vehicle(text, "vehicles/x.yaml"), {}};
+  quadgen::DeriveOptions opt;
+  opt.effects = quadgen::parse_effect_list(effects);
+  s.model = quadgen::derive_model(s.vehicle, quadgen::derive_mass_properties(s.vehicle), opt);
+  return s;
+}
+
+quadgen::DerivationComparison compare(const Side& a, const Side& b) {
+  return quadgen::compare_derivations({a.vehicle, a.model}, {b.vehicle, b.model});
+}
+
+const quadgen::EquationComparison& equation(const quadgen::DerivationComparison& c, const std::string& name) {
+  for (const auto& e : c.equations)
+    if (e.name == name) return e;
+  throw std::out_of_range("no equation " + name);
+}
+
+TEST(DerivationComparison, AFileIsTheSameAsItself) {
+  const Side a = derive(finken3_text()), b = derive(finken3_text());
+  const auto c = compare(a, b);
+  EXPECT_TRUE(c.same()) << quadgen::comparison_text(c, "a", "b");
+  // f (13 states), h (7 outputs), the four thrusts and the three-vectors drag, F_body, tau.
+  EXPECT_EQ(c.equations.size(), 13u + 7u + 4u + 9u);
+  EXPECT_NE(quadgen::comparison_text(c, "a", "b").find("the two derivations are the same"), std::string::npos);
+}
+
+// Rotor A moved along body x only, its thrust along body z: r x F = (y F, -x F, 0), so the
+// pitch torque changes, the roll torque and the yaw (drag) torque do not, nor any thrust or
+// kinematic row; the angular accelerations all change (the inertia couples them through the
+// gyroscopic terms and the off-diagonal entries), and so do the translation rows, which
+// carry the origin's transport acceleration (dω/dt × r_cog).
+TEST(DerivationComparison, ARotorMovedAlongXChangesThePitchTorqueOnly) {
+  const std::string from = "{name: A, position: [-0.07465, -0.07465, 0]";
+  const Side a = derive(finken3_text()), b = derive(replaced(finken3_text(), from, "{name: A, position: [-0.08, -0.07465, 0]"));
+  const auto c = compare(a, b);
+  EXPECT_FALSE(c.same());
+  ASSERT_EQ(c.rotors_changed.size(), 1u);
+  EXPECT_EQ(c.rotors_changed[0], "A: position (-0.07465, -0.07465, 0) -> (-0.08, -0.07465, 0) m");
+  ASSERT_EQ(c.constants.size(), 1u);
+  EXPECT_EQ(c.constants[0].name, "A.x");
+  EXPECT_TRUE(c.parameter_values.empty()) << "no block moved: the mass properties are the same";
+  EXPECT_FALSE(equation(c, "\\tau[1]").same);
+  EXPECT_TRUE(equation(c, "\\tau[0]").same);
+  EXPECT_TRUE(equation(c, "\\tau[2]").same);
+  for (const char* same : {"F_{\\mathrm{A}}", "F_{body}[2]", "dx/dt", "dqw/dt", "x", "qw"}) EXPECT_TRUE(equation(c, same).same) << same;
+  EXPECT_FALSE(equation(c, "dq/dt").same);
+  for (const auto& e : c.equations) EXPECT_TRUE(e.only_in_a.empty() && e.only_in_b.empty()) << e.name;
+  const std::string text = quadgen::comparison_text(c, "a", "b");
+  EXPECT_NE(text.find("differs: \\tau[1] (intermediate)"), std::string::npos) << text;
+  EXPECT_NE(text.find("the same symbols, other numbers"), std::string::npos) << text;
+}
+
+// A value alone: every equation is the same function; what differs is the value.
+TEST(DerivationComparison, AParameterValueLeavesTheEquationsTheSame) {
+  const Side a = derive(finken3_text()),
+             b = derive(replaced(finken3_text(), "c_t: {value: 0.14175,", "c_t: {value: 0.15,"));
+  const auto c = compare(a, b);
+  EXPECT_FALSE(c.same());
+  ASSERT_EQ(c.parameter_values.size(), 1u);
+  EXPECT_EQ(c.parameter_values[0].name, "c_t");
+  EXPECT_EQ(c.parameter_values[0].b, 0.15);
+  for (const auto& e : c.equations) EXPECT_TRUE(e.same) << e.name;
+  // A block's mass: the mass properties derived from the blocks differ, said as values.
+  const Side d = derive(replaced(finken3_text(), "{name: motor_A, mass: 0.02,", "{name: motor_A, mass: 0.025,"));
+  const auto m = compare(a, d);
+  ASSERT_EQ(m.blocks_changed.size(), 1u);
+  EXPECT_EQ(m.blocks_changed[0], "motor_A: mass 0.02 -> 0.025 kg");
+  std::vector<std::string> names;
+  for (const auto& v : m.parameter_values) names.push_back(v.name);
+  for (const char* derived : {"mass", "cog_x", "cog_y", "J_xx", "J_zz"})
+    EXPECT_NE(std::find(names.begin(), names.end(), derived), names.end()) << derived;
+  EXPECT_NEAR(m.parameter_values[0].b - m.parameter_values[0].a, 0.005, 1e-15);  // the mass first, up by the block's
+  EXPECT_TRUE(m.parameter_settings.empty()) << "held quantities' bounds are their values, said once";
+}
+
+TEST(DerivationComparison, AnEffectAddsItsParametersToTheRowsItChanges) {
+  const Side a = derive(finken3_text()), b = derive(finken3_text(), "rotor_drag");
+  const auto c = compare(a, b);
+  EXPECT_EQ(c.effects_only_b, std::vector<std::string>{"rotor_drag"});
+  EXPECT_EQ(c.parameters_only_b, std::vector<std::string>{"rotor_drag.k"});
+  const auto& vx = equation(c, "dvx/dt");
+  EXPECT_FALSE(vx.same);
+  EXPECT_EQ(vx.only_in_b, std::vector<std::string>{"rotor_drag.k"});
+  EXPECT_TRUE(equation(c, "dqw/dt").same);
+}
+
+// The test is of functions, not of text: f's first velocity row expanded is the same
+// function; changed by a part in 1e7 it is not.
+TEST(DerivationComparison, FunctionsNotTextAreCompared) {
+  const Side a = derive(finken3_text());
+  Side b = derive(finken3_text());
+  const size_t vx = b.model.state_index("vx");
+  b.model.f(vx, 0) = b.model.f(vx, 0).expand();
+  ASSERT_NE(b.model.f(vx, 0), a.model.f(vx, 0)) << "expanding changed nothing: the test tests nothing";
+  EXPECT_TRUE(compare(a, b).same());
+  b.model.f(vx, 0) = b.model.f(vx, 0) * GiNaC::numeric(10000001, 10000000);
+  const auto c = compare(a, b);
+  EXPECT_FALSE(equation(c, "dvx/dt").same);
+  EXPECT_NEAR(equation(c, "dvx/dt").largest_relative_difference, 1e-7, 1e-9);
+}
+
+// Names from the files reach the terminal: what they hold is shown, never executed.
+TEST(DerivationComparison, NamesFromTheFilesArePrintedHarmlessly) {
+  quadgen::DerivationComparison c;
+  c.blocks_only_a = {"arm\x1b]0;owned\x07\nIn short: the two derivations are the same."};
+  c.parameter_values = {{"c_t\r", "1\x1b[2J", 1, 2}};
+  const std::string text = quadgen::comparison_text(c, "a\x1b[31m.yaml", "b.yaml");
+  EXPECT_EQ(text.find('\x1b'), std::string::npos) << text;
+  EXPECT_EQ(text.find('\r'), std::string::npos) << text;
+  EXPECT_EQ(text.find('\x07'), std::string::npos) << text;
+  EXPECT_EQ(text.find("\nIn short: the two derivations are the same."), std::string::npos) << text;
+}
+
+int run(const std::string& args, std::string* out) {
+  FILE* p = ::popen((std::string(QUADGEN_BINARY) + " compare " + args + " 2>&1").c_str(), "r");
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out->append(buf, n);
+  const int status = ::pclose(p);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(DerivationComparison, TheCommandSaysSameDifferentOrWrongByItsExitCode) {
+  const std::string f3 = "'" + source_path("vehicles/finken3.yaml") + "'";
+  std::string out;
+  EXPECT_EQ(run(f3 + " " + f3, &out), 0) << out;
+  const std::string dir = ::testing::TempDir();
+  const std::string moved = dir + "/quadgen_compare_moved.yaml", broken = dir + "/quadgen_compare_broken.yaml";
+  std::ofstream(moved) << replaced(finken3_text(), "c_t: {value: 0.14175,", "c_t: {value: 0.15,");
+  out.clear();
+  EXPECT_EQ(run(f3 + " '" + moved + "'", &out), 1) << out;
+  EXPECT_NE(out.find("parameter values (A -> B): c_t 0.14175 -> 0.15 (+5.82 %)"), std::string::npos) << out;
+  std::ofstream(broken) << replaced(finken3_text(), "c_t: {value: 0.14175,", "c_t: {value: fast,");
+  out.clear();
+  EXPECT_EQ(run(f3 + " '" + broken + "'", &out), 2) << out;
+  EXPECT_NE(out.find("quadgen_compare_broken.yaml:29"), std::string::npos) << out;
+}
+
+}  // namespace
