@@ -156,16 +156,18 @@ int run(const std::string& args, std::string* out) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-TEST(DerivationComparison, TheCommandSaysSameDifferentOrWrongByItsExitCode) {
+TEST(DerivationComparison, TheCommandSaysSameDifferentOrWrongByItsExitCodeWhenAsked) {
   const std::string f3 = "'" + source_path("vehicles/finken3.yaml") + "'";
   std::string out;
-  EXPECT_EQ(run(f3 + " " + f3, &out), 0) << out;
+  EXPECT_EQ(run(f3 + " " + f3 + " --exit-code", &out), 0) << out;
   const std::string dir = ::testing::TempDir();
   const std::string moved = dir + "/quadgen_compare_moved.yaml", broken = dir + "/quadgen_compare_broken.yaml";
   std::ofstream(moved) << replaced(finken3_text(), "c_t: {value: 0.14175,", "c_t: {value: 0.15,");
   out.clear();
-  EXPECT_EQ(run(f3 + " '" + moved + "'", &out), 1) << out;
+  EXPECT_EQ(run(f3 + " '" + moved + "' --exit-code", &out), 1) << out;
   EXPECT_NE(out.find("parameter values (A -> B): c_t 0.14175 -> 0.15 (+5.82 %)"), std::string::npos) << out;
+  out.clear();
+  EXPECT_EQ(run(f3 + " '" + moved + "'", &out), 0) << "a comparison done is a success: " << out;
   std::ofstream(broken) << replaced(finken3_text(), "c_t: {value: 0.14175,", "c_t: {value: fast,");
   out.clear();
   EXPECT_EQ(run(f3 + " '" + broken + "'", &out), 2) << out;
