@@ -230,7 +230,7 @@ bool DerivationComparison::same() const {
          std::all_of(equations.begin(), equations.end(), [](const EquationComparison& e) { return e.same; });
 }
 
-DerivationComparison compare_derivations(const Derivation& a, const Derivation& b, const ComparisonOptions& opt) {
+DerivationComparison compare_derivations(const DerivationSide& a, const DerivationSide& b, const ComparisonOptions& opt) {
   DerivationComparison c;
   c.effects_only_a = only_in_first(a.model.effects, b.model.effects);
   c.effects_only_b = only_in_first(b.model.effects, a.model.effects);

@@ -21,7 +21,7 @@
 namespace quadgen {
 
 // One side of the comparison: the vehicle file as read, and what derive made of it.
-struct Derivation {
+struct DerivationSide {
   const Vehicle& vehicle;
   const SymbolicModel& model;
 };
@@ -61,7 +61,7 @@ struct ComparisonOptions {
   double relative_tolerance = 1e-9;  // relative to the larger magnitude of the two values
 };
 
-DerivationComparison compare_derivations(const Derivation& a, const Derivation& b, const ComparisonOptions& opt = {});
+DerivationComparison compare_derivations(const DerivationSide& a, const DerivationSide& b, const ComparisonOptions& opt = {});
 
 // The comparison as a person reads it, every name from a file made printable; `label_a` and
 // `label_b` say which is which (the files' paths).
