@@ -551,13 +551,10 @@ void findings_html(std::ostringstream& h, const Diagnosis& d, Figures& figures) 
   figures.show(h, {"profiles.svg"});
 }
 
-// A final-fit parameter's Wald interval (value +- 1.96 standard errors); a dash on a bound
-// or where the data cannot determine it.
-std::string wald_interval_html(const Diagnosis& d, const fit::FitParameter& p) {
-  const auto se = d.final_standard_errors.find(p.name);
-  if (se == d.final_standard_errors.end() || !std::isfinite(se->second) || fit::on_bound(p)) return "&ndash;";
-  const double lower = p.value - fit::kZ95 * se->second, upper = p.value + fit::kZ95 * se->second;
-  return interval(lower, upper, estimate_digits(p.value, lower, upper));
+// A final-fit parameter's Wald interval; a dash where it has none.
+std::string wald_cell(const Diagnosis& d, const fit::FitParameter& p) {
+  const auto [lower, upper] = wald_interval(d, p);
+  return std::isnan(lower) ? "&ndash;" : interval(lower, upper, estimate_digits(p.value, lower, upper));
 }
 
 // The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...), as the
@@ -565,9 +562,7 @@ std::string wald_interval_html(const Diagnosis& d, const fit::FitParameter& p) {
 // user trial, helper-106: the baseline every gain is measured against was not shown, and its
 // c_w sat on a bound). A joint diagnosis' per-flight copies ("c_t@2") are one row each.
 void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
-  std::vector<const fit::FitParameter*> base;
-  for (const auto& p : d.search.final_fit)
-    if (p.free && runtime::shared_name(p.name).find('.') == std::string::npos) base.push_back(&p);
+  const std::vector<const fit::FitParameter*> base = base_parameters(d);
   const auto on_bound = [&](const fit::FitParameter& p) {
     return std::any_of(d.at_bounds.begin(), d.at_bounds.end(), [&](const fit::FitParameter& b) { return b.name == p.name; });
   };
@@ -596,7 +591,7 @@ void base_parameters_html(std::ostringstream& h, const Diagnosis& d) {
     if (const std::string said = flights_say(*p); !said.empty()) note += (note.empty() ? "" : "; ") + said;
     const auto file = d.file_values.find(runtime::shared_name(p->name));  // a flight's copy: the file's one value
     h << "<tr><td>" << esc(p->name) << "</td><td>" << significant(p->value, kEstimateDigits) << "</td><td>"
-      << wald_interval_html(d, *p) << "</td><td>" << (file == d.file_values.end() ? "&ndash;" : significant(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
+      << wald_cell(d, *p) << "</td><td>" << (file == d.file_values.end() ? "&ndash;" : significant(file->second, kEstimateDigits)) << "</td><td>" << unit_html(p->unit) << "</td><td>"
       << interval(p->lower, p->upper, kEstimateDigits) << "</td><td" << (note.empty() ? ">" : " class=\"warn\">" + note) << "</td></tr>\n";
   }
   h << "</table>\n";

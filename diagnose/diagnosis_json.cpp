@@ -53,14 +53,11 @@ json parameters_json(const std::vector<fit::FitParameter>& ps, const std::map<st
   json j = json::object();
   for (const auto& p : ps) {
     if (!p.free) continue;
-    const auto se = errors ? errors->find(p.name) : std::map<std::string, double>::const_iterator{};
-    const bool known = errors && se != errors->end();
-    const bool wald = known && std::isfinite(se->second) && !fit::on_bound(p);
-    const double half = wald ? fit::kZ95 * se->second : NAN;
-    j[p.name] = output::estimate_json({p.value, p.unit, p.value - half, p.value + half, "", fit::on_bound(p)});
-    if (!known) continue;
-    j[p.name]["standard_error"] = output::number_or_null(se->second);
-    j[p.name]["interval_method"] = wald ? json("wald") : json(nullptr);
+    const auto [lower, upper] = errors ? wald_interval(p, *errors) : std::pair<double, double>{NAN, NAN};
+    j[p.name] = output::estimate_json({p.value, p.unit, lower, upper, "", fit::on_bound(p)});
+    if (!errors || !errors->count(p.name)) continue;
+    j[p.name]["standard_error"] = output::number_or_null(errors->at(p.name));
+    j[p.name]["interval_method"] = std::isnan(lower) ? json(nullptr) : json("wald");
   }
   return j;
 }

@@ -44,6 +44,24 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
   }
 }
 
+// The vehicle's own parameters as fitted, with their Wald intervals and the file's values
+// (the report's table): the thesis fitted its thrust constant with an interval, and a
+// diagnosis printed the effects' alone.
+void write_base_parameters(std::ostream& os, const Diagnosis& d) {
+  const auto base = base_parameters(d);
+  if (base.empty()) return;
+  os << "the vehicle's own parameters, as fitted (95 % Wald interval; the vehicle file's value):";
+  for (const auto* p : base) {
+    const auto [lower, upper] = wald_interval(d, *p);
+    const auto file = d.file_values.find(runtime::shared_name(p->name));
+    os << (p == base.front() ? " " : "; ") << p->name << " = "
+       << (std::isnan(lower) ? significant(p->value, kEstimateDigits) + (fit::on_bound(*p) ? " (on its bound)" : "")
+                             : estimate(p->value, lower, upper))
+       << (file == d.file_values.end() ? "" : " (" + significant(file->second, kEstimateDigits) + ")");
+  }
+  os << "\n";
+}
+
 // Whether the flights of a joint diagnosis agree, or this flight with an airframe found before.
 void write_agreement(std::ostream& os, const Diagnosis& d) {
   std::vector<const ParameterAgreement*> all;
@@ -176,6 +194,7 @@ std::string diagnosis_summary(const Diagnosis& d) {
        << significant(d.metric_after) << " (" << lower_or_higher(d.metric_before, d.metric_after, 3) << ")\n";
   if (const std::string worse = worse_channels(d); !worse.empty())
     os << "worse with the extended model on the held-out part: " << worse << "\n";
+  write_base_parameters(os, d);
   write_agreement(os, d);
   write_not_named(os, d);
   write_what_is_left(os, d);

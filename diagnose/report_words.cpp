@@ -566,6 +566,24 @@ int estimate_digits(double value, double lower, double upper) {
   return prec;
 }
 
+std::vector<const fit::FitParameter*> base_parameters(const Diagnosis& d) {
+  std::vector<const fit::FitParameter*> base;
+  for (const auto& p : d.search.final_fit)
+    if (p.free && runtime::shared_name(p.name).find('.') == std::string::npos) base.push_back(&p);
+  return base;
+}
+
+std::pair<double, double> wald_interval(const fit::FitParameter& p, const std::map<std::string, double>& errors) {
+  const auto se = errors.find(p.name);
+  // On a bound the curvature is not the likelihood's (the interval would cross the bound).
+  if (se == errors.end() || !std::isfinite(se->second) || fit::on_bound(p)) return {NAN, NAN};
+  return {p.value - fit::kZ95 * se->second, p.value + fit::kZ95 * se->second};
+}
+
+std::pair<double, double> wald_interval(const Diagnosis& d, const fit::FitParameter& p) {
+  return wald_interval(p, d.final_standard_errors);
+}
+
 std::string estimate(double value, double lower, double upper) {
   const int prec = estimate_digits(value, lower, upper);
   return significant(value, prec) + " " + interval(lower, upper, prec);

@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <optional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,6 +75,14 @@ std::string environment_note(const Diagnosis& d);
 // "wind.x = -0.296 m/s", "motor_gain.M2 = 0.027" (no unit for a dimensionless value), with
 // `prec` significant digits: a value in a sentence or a cell.
 std::string name_value(const std::string& name, double value, const std::string& unit, int prec = 4);
+// The base model's parameters the fit freed (the thrust constant, kappa, c_w, ...; a joint
+// diagnosis' per-flight copies "c_t@2" each), in the final fit's order.
+std::vector<const fit::FitParameter*> base_parameters(const Diagnosis& d);
+// A final-fit parameter's 95 % Wald interval (value +- 1.96 standard errors); NaN sides on a
+// bound or where the data cannot determine it (diagnosis.json's `ci95` the same).
+// `errors` by name as Diagnosis::final_standard_errors has them.
+std::pair<double, double> wald_interval(const fit::FitParameter& p, const std::map<std::string, double>& errors);
+std::pair<double, double> wald_interval(const Diagnosis& d, const fit::FitParameter& p);
 // The unit of a residual channel, as the diagnosis names its channels ("" for none).
 std::string channel_unit(const Diagnosis& d, const std::string& channel);
 // The held-out channels the extended model gets more than 1 % worse than the base model
