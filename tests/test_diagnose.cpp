@@ -2194,6 +2194,10 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_EQ(fits["kappa"]["interval_method"], "wald");
   EXPECT_FALSE(fits["wind.x"].contains("standard_error"));  // none given: the base fit's shape
   const std::string summary = dg::diagnosis_summary(d);
+  EXPECT_NE(summary.find("the vehicle's own parameters, as fitted (95 % Wald interval; the vehicle file's value): c_w = 3 "
+                         "(on its bound) (1.1); kappa = 0.5 [0.304, 0.696]\n"),
+            std::string::npos)
+      << summary;
   EXPECT_NE(summary.find("held out, the extended model against the base model: position RMSE [m] 1.2 -> 0.45 (62.5 % lower)\n"
                          "worse with the extended model on the held-out part: az_world 0.2575 -> 0.371 m/s² (44.1 % higher)\n"),
             std::string::npos) << summary;
