@@ -20,9 +20,14 @@ Derived derive_for_comparison(const std::string& path, const std::string& effect
   Derived d{load_vehicle(path), {}, ""};
   DeriveRequest request;
   request.derive.effects = parse_effect_list(effects);
-  d.note = use_fitted_values(request, d.vehicle, path, "", !effects.empty());
-  d.model = derive_model(d.vehicle, derive_mass_properties(d.vehicle), request.derive);
-  if (request.set_nominal) request.set_nominal(d.model);
+  try {
+    d.note = use_fitted_values(request, d.vehicle, path, "", !effects.empty());
+  } catch (const std::exception& e) {
+    // derive's words ("leave it out") would change what the other file is derived with.
+    throw std::invalid_argument(std::string(e.what()) + "; compare derives both files with --effects: compare " + path +
+                                " without it (its fitted effects), against a file without a fitted: section");
+  }
+  d.model = requested_model(d.vehicle, derive_mass_properties(d.vehicle), request);
   return d;
 }
 

@@ -71,14 +71,19 @@ static void judge_hover_trim(const Vehicle& vehicle, DerivedModel& out) {
                                (own.found() ? "|f| = " + output::short_number(own_residual) + " at the one found" : own.why_not);
 }
 
+SymbolicModel requested_model(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
+  SymbolicModel model = derive_model(vehicle, mass, request.derive);
+  if (request.set_nominal) request.set_nominal(model);
+  return model;
+}
+
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request) {
   auto progress = [&](const char* step) {
     if (request.progress) request.progress(step);
   };
   DerivedModel out;
   progress("equations of motion and Jacobians");
-  out.model = derive_model(vehicle, mass, request.derive);
-  if (request.set_nominal) request.set_nominal(out.model);
+  out.model = requested_model(vehicle, mass, request);
   progress("audit");
   out.audit = audit(out.model, mass);
   for (AuditCheck& c : check_mass_properties_by_quadrature(vehicle, mass)) out.audit.checks.push_back(std::move(c));

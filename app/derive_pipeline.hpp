@@ -61,4 +61,8 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
 
 DerivedModel run_derive_pipeline(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request);
 
+// The pipeline's first step alone: the symbolic model with the request's effects and nominal
+// values, neither audited nor generated (quadgen compare needs its equations only).
+SymbolicModel requested_model(const Vehicle& vehicle, const MassProperties& mass, const DeriveRequest& request);
+
 }  // namespace quadgen

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "derive/exact_number.hpp"
 #include "output/joined.hpp"
 #include "output/numbers.hpp"
 #include "output/sinks.hpp"
@@ -22,6 +23,8 @@ std::vector<std::string> names_of(const std::vector<T>& items, Name name) {
   return out;
 }
 
+const auto name_of = [](const auto& x) { return x.name; };
+
 std::vector<std::string> only_in_first(const std::vector<std::string>& a, const std::vector<std::string>& b) {
   std::vector<std::string> out;
   for (const auto& x : a)
@@ -29,35 +32,40 @@ std::vector<std::string> only_in_first(const std::vector<std::string>& a, const 
   return out;
 }
 
+// Where both lists hold the same names in another order: "what: a, b -> b, a" (the names both
+// have, each list's order). The generated arrays follow the order.
+void compare_order(const std::string& what, const std::vector<std::string>& a, const std::vector<std::string>& b,
+                   std::vector<std::string>& out) {
+  std::vector<std::string> in_a, in_b;
+  for (const auto& x : a)
+    if (std::find(b.begin(), b.end(), x) != b.end()) in_a.push_back(x);
+  for (const auto& x : b)
+    if (std::find(a.begin(), a.end(), x) != a.end()) in_b.push_back(x);
+  if (in_a != in_b) out.push_back(what + ": " + output::joined(in_a) + " -> " + output::joined(in_b));
+}
+
 // Exactly equal, or both NaN: a vehicle file's numbers are compared as read, not as rounded.
 bool same_number(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
-// "0.07465 -> 0.08", with as many digits as tell the two apart.
-std::string a_to_b(double a, double b) {
-  std::string t = output::one_then_other(a, b);
-  return t.replace(t.find(" then "), 6, " -> ");
-}
+std::string a_to_b(double a, double b) { return output::one_then_other(a, b, " -> "); }
 
-std::string vec_text(const Vec3& v) {
-  return "(" + output::six_digits(v[0]) + ", " + output::six_digits(v[1]) + ", " + output::six_digits(v[2]) + ")";
-}
-
-// What differs between two things of one name: "centre (0.1, 0, 0) -> (0.12, 0, 0) m".
+// What differs between two things of one name: "mass 0.02 -> 0.025 kg", one part each.
 struct Differences {
   std::vector<std::string> parts;
   void number(const std::string& what, double a, double b, const std::string& unit) {
     if (!same_number(a, b)) parts.push_back(what + " " + a_to_b(a, b) + unit);
   }
-  void vector(const std::string& what, const Vec3& a, const Vec3& b, const std::string& unit) {
-    if (a != b) parts.push_back(what + " " + vec_text(a) + " -> " + vec_text(b) + unit);
+  // Component by component, only those that differ: "position x -0.07465 -> -0.08 m".
+  void vector(const std::string& what, const Vec3& a, const Vec3& b, const std::array<const char*, 3>& axes,
+              const std::string& unit) {
+    for (size_t i = 0; i < 3; ++i) number(what + " " + axes[i], a[i], b[i], unit);
   }
   void text(const std::string& what, const std::string& a, const std::string& b) {
     if (a != b) parts.push_back(what + " " + a + " -> " + b);
   }
 };
 
-// For each name in both lists: what differs, as "name: part; part". `describe` fills a
-// Differences from the two items.
+// For each name in both lists: what differs, as "name: part; part".
 template <class T, class Describe>
 std::vector<std::string> changed(const std::vector<T>& a, const std::vector<T>& b, Describe describe) {
   std::vector<std::string> out;
@@ -71,20 +79,22 @@ std::vector<std::string> changed(const std::vector<T>& a, const std::vector<T>& 
   return out;
 }
 
+constexpr std::array<const char*, 3> kXyz{"x", "y", "z"}, kYawPitchRoll{"yaw", "pitch", "roll"};
+
 void compare_vehicles(const Vehicle& a, const Vehicle& b, DerivationComparison& c) {
-  const auto name = [](const auto& x) { return x.name; };
-  c.blocks_only_a = only_in_first(names_of(a.blocks, name), names_of(b.blocks, name));
-  c.blocks_only_b = only_in_first(names_of(b.blocks, name), names_of(a.blocks, name));
+  c.vehicle_name_a = a.name, c.vehicle_name_b = b.name;
+  c.blocks_only_a = only_in_first(names_of(a.blocks, name_of), names_of(b.blocks, name_of));
+  c.blocks_only_b = only_in_first(names_of(b.blocks, name_of), names_of(a.blocks, name_of));
   c.blocks_changed = changed(a.blocks, b.blocks, [](const Block& x, const Block& y, Differences& d) {
     d.number("mass", x.mass, y.mass, " kg");
-    d.vector("size", x.size, y.size, " m");
-    d.vector("centre", x.centre, y.centre, " m");
-    d.vector("yaw, pitch, roll", x.yaw_pitch_roll_deg, y.yaw_pitch_roll_deg, " deg");
+    d.vector("size", x.size, y.size, kXyz, " m");
+    d.vector("centre", x.centre, y.centre, kXyz, " m");
+    d.vector("orientation", x.yaw_pitch_roll_deg, y.yaw_pitch_roll_deg, kYawPitchRoll, " deg");
   });
-  c.rotors_only_a = only_in_first(names_of(a.rotors, name), names_of(b.rotors, name));
-  c.rotors_only_b = only_in_first(names_of(b.rotors, name), names_of(a.rotors, name));
+  c.rotors_only_a = only_in_first(names_of(a.rotors, name_of), names_of(b.rotors, name_of));
+  c.rotors_only_b = only_in_first(names_of(b.rotors, name_of), names_of(a.rotors, name_of));
   c.rotors_changed = changed(a.rotors, b.rotors, [](const Rotor& x, const Rotor& y, Differences& d) {
-    d.vector("position", x.position, y.position, " m");
+    d.vector("position", x.position, y.position, kXyz, " m");
     d.text("spin", x.spin == Spin::ccw ? "ccw" : "cw", y.spin == Spin::ccw ? "ccw" : "cw");
     d.number("radius", x.radius, y.radius, " m");
     d.number("disc area", x.disc_area, y.disc_area, " m^2");
@@ -92,9 +102,8 @@ void compare_vehicles(const Vehicle& a, const Vehicle& b, DerivationComparison& 
 }
 
 void compare_parameters(const SymbolicModel& a, const SymbolicModel& b, DerivationComparison& c) {
-  const auto name = [](const Variable& v) { return v.name; };
-  c.parameters_only_a = only_in_first(names_of(a.params, name), names_of(b.params, name));
-  c.parameters_only_b = only_in_first(names_of(b.params, name), names_of(a.params, name));
+  c.parameters_only_a = only_in_first(names_of(a.params, name_of), names_of(b.params, name_of));
+  c.parameters_only_b = only_in_first(names_of(b.params, name_of), names_of(a.params, name_of));
   for (const auto& p : a.params)
     for (const auto& q : b.params) {
       if (p.name != q.name) continue;
@@ -111,10 +120,21 @@ void compare_parameters(const SymbolicModel& a, const SymbolicModel& b, Derivati
   for (const auto& k : a.constants)
     for (const auto& l : b.constants)
       if (k.name == l.name && !same_number(k.nominal, l.nominal)) c.constants.push_back({k.name, k.unit, k.nominal, l.nominal});
-  c.states_only_a = only_in_first(names_of(a.states, name), names_of(b.states, name));
-  c.states_only_b = only_in_first(names_of(b.states, name), names_of(a.states, name));
-  c.inputs_only_a = only_in_first(names_of(a.inputs, name), names_of(b.inputs, name));
-  c.inputs_only_b = only_in_first(names_of(b.inputs, name), names_of(a.inputs, name));
+  c.constants_only_a = only_in_first(names_of(a.constants, name_of), names_of(b.constants, name_of));
+  c.constants_only_b = only_in_first(names_of(b.constants, name_of), names_of(a.constants, name_of));
+}
+
+void compare_structure(const SymbolicModel& a, const SymbolicModel& b, DerivationComparison& c) {
+  c.effects_only_a = only_in_first(a.effects, b.effects);
+  c.effects_only_b = only_in_first(b.effects, a.effects);
+  c.states_only_a = only_in_first(names_of(a.states, name_of), names_of(b.states, name_of));
+  c.states_only_b = only_in_first(names_of(b.states, name_of), names_of(a.states, name_of));
+  c.inputs_only_a = only_in_first(names_of(a.inputs, name_of), names_of(b.inputs, name_of));
+  c.inputs_only_b = only_in_first(names_of(b.inputs, name_of), names_of(a.inputs, name_of));
+  compare_order("states", names_of(a.states, name_of), names_of(b.states, name_of), c.order_changes);
+  compare_order("inputs", names_of(a.inputs, name_of), names_of(b.inputs, name_of), c.order_changes);
+  compare_order("parameters", names_of(a.params, name_of), names_of(b.params, name_of), c.order_changes);
+  compare_order("outputs", names_of(a.outputs, name_of), names_of(b.outputs, name_of), c.order_changes);
 }
 
 std::set<std::string> symbol_names(const GiNaC::ex& e) {
@@ -124,47 +144,44 @@ std::set<std::string> symbol_names(const GiNaC::ex& e) {
   return out;
 }
 
-// Every symbol of a model by name: states, inputs, parameters, constants and the symbols the
-// derivation keeps inside f (dω/dt is not among them: f has it replaced).
-std::map<std::string, GiNaC::symbol> symbols_by_name(const SymbolicModel& m) {
-  std::map<std::string, GiNaC::symbol> out;
-  for (const auto* list : {&m.states, &m.inputs, &m.params, &m.constants})
-    for (const auto& v : *list) out.emplace(v.name, v.sym);
-  return out;
-}
-
-// One random point: a value for every symbol name either model has (the same value under
-// one name in both), positive and of the order of the parameter's nominal value, so that
-// square roots and denominators stay real and away from their poles. Constants are each
-// model's own (their differences are the geometry's), so they are not drawn.
-std::map<std::string, double> random_point(const SymbolicModel& a, const SymbolicModel& b, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> factor(0.5, 1.5);
-  std::map<std::string, double> out;
+// One random point: an exact rational for every state, input and parameter name either model
+// has (the same under one name in both). States and inputs are +-(0.5 .. 1.5), the sign drawn
+// too, so that |v| and sign branches are met both ways; parameters keep their nominal sign and
+// order (0.5 .. 1.5 times it), so that roots of positive quantities stay real and denominators
+// away from their poles. Constants are each model's own (their differences are the geometry's).
+// The engine's raw draws, not a distribution's, keep the points the same on every standard library.
+std::map<std::string, GiNaC::numeric> random_point(const SymbolicModel& a, const SymbolicModel& b, std::mt19937& rng) {
+  const auto factor = [&] { return GiNaC::numeric(static_cast<long>(32 + rng() % 65), 64); };
+  std::map<std::string, GiNaC::numeric> out;
   for (const auto* m : {&a, &b}) {
     for (const auto* list : {&m->states, &m->inputs})
-      for (const auto& v : *list) out.emplace(v.name, factor(rng));
-    for (const auto& p : m->params) out.emplace(p.name, factor(rng) * (p.nominal != 0 ? std::fabs(p.nominal) : 1.0));
+      for (const auto& v : *list)
+        if (!out.count(v.name)) out.emplace(v.name, factor() * (rng() % 2 ? 1 : -1));
+    for (const auto& p : m->params)
+      if (!out.count(p.name)) out.emplace(p.name, factor() * (p.nominal != 0 ? exact(p.nominal) : GiNaC::numeric(1)));
   }
   return out;
 }
 
-GiNaC::lst substitution(const SymbolicModel& m, const std::map<std::string, double>& point) {
+GiNaC::lst substitution(const SymbolicModel& m, const std::map<std::string, GiNaC::numeric>& point) {
   GiNaC::lst l = m.constant_substitution();
-  for (const auto& [name, sym] : symbols_by_name(m)) {
-    const auto v = point.find(name);
-    if (v != point.end()) l.append(sym == GiNaC::numeric(v->second));
-  }
+  for (const auto* list : {&m.states, &m.inputs, &m.params})
+    for (const auto& v : *list) l.append(v.sym == point.at(v.name));
   return l;
 }
 
-// |a - b| relative to the larger magnitude; complex values (a square root of a negative
-// number at a point) compare by their modulus. NaN where either is no number.
+// |a - b| relative to the larger magnitude, at 40 digits (exact where both are rationals);
+// complex values (a root of a negative number) compare by their modulus. NaN where either
+// side is no number.
 double relative_difference(const GiNaC::ex& a, const GiNaC::ex& b) {
+  const int digits = GiNaC::Digits;
+  GiNaC::Digits = 40;
   const GiNaC::ex x = a.evalf(), y = b.evalf();
+  GiNaC::Digits = digits;
   if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::is_a<GiNaC::numeric>(y)) return NAN;
   const GiNaC::numeric u = GiNaC::ex_to<GiNaC::numeric>(x), v = GiNaC::ex_to<GiNaC::numeric>(y);
-  const double diff = GiNaC::abs(u - v).to_double(), scale = std::max(GiNaC::abs(u).to_double(), GiNaC::abs(v).to_double());
-  return scale == 0 ? diff : diff / scale;
+  const GiNaC::numeric scale = std::max(GiNaC::abs(u), GiNaC::abs(v));
+  return scale.is_zero() ? 0.0 : (GiNaC::abs(u - v) / scale).to_double();
 }
 
 struct NamedExpression {
@@ -172,80 +189,104 @@ struct NamedExpression {
   GiNaC::ex e;
 };
 
+// A TeX name as plain text for a terminal: "F_{\mathrm{M1}}" -> "F_M1", "\tau" -> "tau".
+std::string plain(std::string tex) {
+  for (size_t at; (at = tex.find("\\mathrm")) != std::string::npos;) tex.erase(at, 7);
+  tex.erase(std::remove_if(tex.begin(), tex.end(), [](char ch) { return ch == '\\' || ch == '{' || ch == '}'; }), tex.end());
+  return tex;
+}
+
 // The equations of a model by name: d<state>/dt, the outputs, the intermediates (a vector one
-// entry each: "\tau[0]").
+// entry each: "tau[0]").
 std::vector<NamedExpression> equations_of(const SymbolicModel& m) {
   std::vector<NamedExpression> out;
   for (size_t i = 0; i < m.states.size(); ++i) out.push_back({"d" + m.states[i].name + "/dt", "right-hand side", m.f(i, 0)});
   for (size_t i = 0; i < m.outputs.size(); ++i) out.push_back({m.outputs[i].name, "measurement", m.h(i, 0)});
-  for (const auto& [name, e] : m.intermediates) {
+  for (const auto& [tex, e] : m.intermediates) {
     if (!GiNaC::is_a<GiNaC::matrix>(e)) {
-      out.push_back({name, "intermediate", e});
+      out.push_back({plain(tex), "intermediate", e});
       continue;
     }
     const auto& mat = GiNaC::ex_to<GiNaC::matrix>(e);
-    for (unsigned k = 0; k < mat.nops(); ++k) out.push_back({name + "[" + std::to_string(k) + "]", "intermediate", mat.op(k)});
+    for (unsigned k = 0; k < mat.nops(); ++k) out.push_back({plain(tex) + "[" + std::to_string(k) + "]", "intermediate", mat.op(k)});
   }
   return out;
 }
 
+// One equation in both models at the points (substitutions per point, A's and B's).
+EquationComparison compare_equation(const NamedExpression& x, const NamedExpression& y, const SymbolicModel& a,
+                                    const SymbolicModel& b, const std::vector<std::pair<GiNaC::lst, GiNaC::lst>>& points,
+                                    double tolerance) {
+  EquationComparison q{x.name, x.kind, true, 0, 0, {}, {}};
+  const auto sa = symbol_names(x.e.subs(a.constant_substitution())), sb = symbol_names(y.e.subs(b.constant_substitution()));
+  std::set_difference(sa.begin(), sa.end(), sb.begin(), sb.end(), std::back_inserter(q.only_in_a));
+  std::set_difference(sb.begin(), sb.end(), sa.begin(), sa.end(), std::back_inserter(q.only_in_b));
+  for (const auto& [at_a, at_b] : points) {
+    const double d = relative_difference(x.e.subs(at_a), y.e.subs(at_b));
+    if (std::isnan(d)) ++q.points_not_compared;
+    else q.largest_relative_difference = std::max(q.largest_relative_difference, d);
+  }
+  q.same = q.points_not_compared == 0 && q.largest_relative_difference <= tolerance;
+  return q;
+}
+
 void compare_equations(const SymbolicModel& a, const SymbolicModel& b, const ComparisonOptions& opt, DerivationComparison& c) {
-  std::mt19937_64 rng(opt.seed);
-  std::vector<GiNaC::lst> subs_a, subs_b;
+  std::mt19937 rng(opt.seed);
+  std::vector<std::pair<GiNaC::lst, GiNaC::lst>> points;
   for (int k = 0; k < opt.points; ++k) {
     const auto point = random_point(a, b, rng);
-    subs_a.push_back(substitution(a, point));
-    subs_b.push_back(substitution(b, point));
+    points.emplace_back(substitution(a, point), substitution(b, point));
   }
   c.points = opt.points;
-  const auto eb = equations_of(b);
-  for (const auto& x : equations_of(a)) {
+  const auto ea = equations_of(a), eb = equations_of(b);
+  for (const auto& x : ea) {
     const auto y = std::find_if(eb.begin(), eb.end(), [&](const NamedExpression& e) { return e.name == x.name; });
-    if (y == eb.end()) continue;  // its state or intermediate is only in one model: said there
-    EquationComparison q{x.name, x.kind, true, 0, {}, {}};
-    const auto sa = symbol_names(x.e.subs(a.constant_substitution())), sb = symbol_names(y->e.subs(b.constant_substitution()));
-    std::set_difference(sa.begin(), sa.end(), sb.begin(), sb.end(), std::back_inserter(q.only_in_a));
-    std::set_difference(sb.begin(), sb.end(), sa.begin(), sa.end(), std::back_inserter(q.only_in_b));
-    for (int k = 0; k < opt.points; ++k) {
-      const double d = relative_difference(x.e.subs(subs_a[k]), y->e.subs(subs_b[k]));
-      if (!(d <= opt.relative_tolerance)) q.same = false;
-      if (!(d <= q.largest_relative_difference)) q.largest_relative_difference = d;  // NaN stays NaN
-    }
-    if (!q.only_in_a.empty() || !q.only_in_b.empty()) q.same = false;
-    if (q.same) q.largest_relative_difference = 0;
-    c.equations.push_back(std::move(q));
+    if (y != eb.end()) c.equations.push_back(compare_equation(x, *y, a, b, points, opt.relative_tolerance));
   }
+  // Those of a state, an output or a rotor only one side has are said with it; an
+  // intermediate (the drag, say) is said here.
+  const auto intermediates = [](const std::vector<NamedExpression>& es) {
+    std::vector<std::string> out;
+    for (const auto& e : es)
+      if (e.kind == "intermediate") out.push_back(e.name);
+    return out;
+  };
+  c.equations_only_a = only_in_first(intermediates(ea), intermediates(eb));
+  c.equations_only_b = only_in_first(intermediates(eb), intermediates(ea));
 }
 
 }  // namespace
 
 bool DerivationComparison::same() const {
-  const bool vehicles = blocks_only_a.empty() && blocks_only_b.empty() && blocks_changed.empty() && rotors_only_a.empty() &&
-                        rotors_only_b.empty() && rotors_changed.empty();
+  const bool vehicles = vehicle_name_a == vehicle_name_b && blocks_only_a.empty() && blocks_only_b.empty() &&
+                        blocks_changed.empty() && rotors_only_a.empty() && rotors_only_b.empty() && rotors_changed.empty();
   const bool values = parameters_only_a.empty() && parameters_only_b.empty() && parameter_values.empty() &&
-                      parameter_settings.empty() && constants.empty();
+                      parameter_settings.empty() && constants.empty() && constants_only_a.empty() && constants_only_b.empty();
   const bool structure = effects_only_a.empty() && effects_only_b.empty() && states_only_a.empty() &&
-                         states_only_b.empty() && inputs_only_a.empty() && inputs_only_b.empty();
+                         states_only_b.empty() && inputs_only_a.empty() && inputs_only_b.empty() && order_changes.empty() &&
+                         equations_only_a.empty() && equations_only_b.empty();
   return vehicles && values && structure &&
          std::all_of(equations.begin(), equations.end(), [](const EquationComparison& e) { return e.same; });
 }
 
 DerivationComparison compare_derivations(const DerivationSide& a, const DerivationSide& b, const ComparisonOptions& opt) {
   DerivationComparison c;
-  c.effects_only_a = only_in_first(a.model.effects, b.model.effects);
-  c.effects_only_b = only_in_first(b.model.effects, a.model.effects);
   compare_vehicles(a.vehicle, b.vehicle, c);
   compare_parameters(a.model, b.model, c);
+  compare_structure(a.model, b.model, c);
   compare_equations(a.model, b.model, opt, c);
   return c;
 }
 
 namespace {
 
-// "label: a, b" with every name made printable; nothing where there is nothing.
+std::string printable_list(const std::vector<std::string>& items, const std::string& separator = "; ") {
+  return output::joined(items, separator, [](const std::string& x) { return output::printable(x); });
+}
+
+// "  label: a; b" with every name made printable; nothing where there is nothing.
 void list_line(std::ostringstream& s, const std::string& label, const std::vector<std::string>& items) {
-  if (items.empty()) return;
-  s << "  " << label << ": " << output::joined(items, "; ", [](const std::string& x) { return output::printable(x); }) << "\n";
+  if (!items.empty()) s << "  " << label << ": " << printable_list(items) << "\n";
 }
 
 void only_lines(std::ostringstream& s, const std::string& what, const std::vector<std::string>& a,
@@ -254,37 +295,66 @@ void only_lines(std::ostringstream& s, const std::string& what, const std::vecto
   list_line(s, what + " only in B", b);
 }
 
+// "c_t 0.14175 -> 0.15 (+5.82 %)".
 std::string change_text(const NumberChange& n) {
-  std::string t = output::printable(n.name) + " " + a_to_b(n.a, n.b) +
-                  output::printable(output::unit_after_number(n.unit));
-  if (n.a != 0 && std::isfinite(n.a) && std::isfinite(n.b)) t += std::string(" (") + (n.b > n.a ? "+" : "") + output::percent_text((n.b - n.a) / std::fabs(n.a)) + ")";
+  std::string t = n.name + " " + a_to_b(n.a, n.b) + output::unit_after_number(n.unit);
+  if (n.a != 0 && std::isfinite(n.a) && std::isfinite(n.b))
+    t += std::string(" (") + (n.b > n.a ? "+" : "") + output::percent_text((n.b - n.a) / std::fabs(n.a)) + ")";
   return t;
+}
+
+std::vector<std::string> change_texts(const std::vector<NumberChange>& changes) {
+  std::vector<std::string> out;
+  for (const auto& n : changes) out.push_back(change_text(n));
+  return out;
+}
+
+void vehicle_lines(std::ostringstream& s, const DerivationComparison& c) {
+  const std::string before = s.str();
+  if (c.vehicle_name_a != c.vehicle_name_b)
+    s << "  vehicle name (in the generated code): " << output::printable(c.vehicle_name_a) << " -> "
+      << output::printable(c.vehicle_name_b) << "\n";
+  only_lines(s, "effects", c.effects_only_a, c.effects_only_b);
+  list_line(s, "blocks changed", c.blocks_changed);
+  only_lines(s, "blocks", c.blocks_only_a, c.blocks_only_b);
+  list_line(s, "rotors changed", c.rotors_changed);
+  only_lines(s, "rotors", c.rotors_only_a, c.rotors_only_b);
+  list_line(s, "parameter values (A -> B)", change_texts(c.parameter_values));
+  list_line(s, "parameter settings", c.parameter_settings);
+  only_lines(s, "parameters", c.parameters_only_a, c.parameters_only_b);
+  list_line(s, "constants (A -> B)", change_texts(c.constants));
+  only_lines(s, "constants", c.constants_only_a, c.constants_only_b);
+  only_lines(s, "states", c.states_only_a, c.states_only_b);
+  only_lines(s, "inputs", c.inputs_only_a, c.inputs_only_b);
+  list_line(s, "in another order (A -> B)", c.order_changes);
+  if (s.str() == before) s << "  nothing differs\n";
+}
+
+std::string differing_text(const EquationComparison& e) {
+  std::string t = "  differs: " + output::printable(e.name) + " (" + e.kind + ")";
+  if (e.largest_relative_difference > 0)
+    t += ", relative difference up to " + output::short_number(e.largest_relative_difference);
+  if (e.points_not_compared > 0)
+    t += ", no number at " + std::to_string(e.points_not_compared) + " point" + (e.points_not_compared == 1 ? "" : "s");
+  if (e.only_in_a.empty() && e.only_in_b.empty()) t += "; the same symbols, other numbers (geometry or constants)";
+  if (!e.only_in_a.empty()) t += "; symbols only in A: " + printable_list(e.only_in_a, ", ");
+  if (!e.only_in_b.empty()) t += "; symbols only in B: " + printable_list(e.only_in_b, ", ");
+  return t + "\n";
 }
 
 void equation_lines(std::ostringstream& s, const DerivationComparison& c) {
   std::vector<std::string> same;
-  std::vector<const EquationComparison*> differ;
-  for (const auto& e : c.equations) (e.same ? same.push_back(e.name) : differ.push_back(&e));
+  for (const auto& e : c.equations)
+    if (e.same) same.push_back(e.name + (e.only_in_a.empty() && e.only_in_b.empty() ? "" : " (written with other symbols)"));
   s << "equations: " << c.equations.size() << " in both, each evaluated at " << c.points
     << " random points (the models' symbols matched by name, each model's own constants)\n";
-  if (!same.empty())
-    s << "  the same function (" << same.size() << "): "
-      << output::joined(same, ", ", [](const std::string& x) { return output::printable(x); }) << "\n";
-  for (const auto* e : differ) {
-    s << "  differs: " << output::printable(e->name) << " (" << e->kind << "), relative difference up to "
-      << (std::isnan(e->largest_relative_difference) ? std::string("(not a number at a point)")
-                                                      : output::short_number(e->largest_relative_difference));
-    if (e->only_in_a.empty() && e->only_in_b.empty()) s << "; the same symbols, other numbers (geometry or constants)";
-    const auto names = [](const std::vector<std::string>& v) {
-      return output::joined(v, ", ", [](const std::string& x) { return output::printable(x); });
-    };
-    if (!e->only_in_a.empty()) s << "; symbols only in A: " << names(e->only_in_a);
-    if (!e->only_in_b.empty()) s << "; symbols only in B: " << names(e->only_in_b);
-    s << "\n";
-  }
+  if (!same.empty()) s << "  the same function (" << same.size() << "): " << printable_list(same, ", ") << "\n";
+  for (const auto& e : c.equations)
+    if (!e.same) s << differing_text(e);
+  only_lines(s, "intermediate quantities", c.equations_only_a, c.equations_only_b);
 }
 
-// What differs, counted: "3 of 33 equations, the effects, 2 parameter values".
+// What differs, counted: "3 of 33 equations, 1 effect, 2 parameter values".
 std::string in_short(const DerivationComparison& c) {
   std::vector<std::string> parts;
   const auto differing = std::count_if(c.equations.begin(), c.equations.end(), [](const EquationComparison& e) { return !e.same; });
@@ -292,15 +362,18 @@ std::string in_short(const DerivationComparison& c) {
   const auto count = [&](size_t n, const std::string& one, const std::string& many) {
     if (n > 0) parts.push_back(std::to_string(n) + " " + (n == 1 ? one : many));
   };
+  count(c.vehicle_name_a != c.vehicle_name_b, "vehicle name", "");
   count(c.effects_only_a.size() + c.effects_only_b.size(), "effect", "effects");
   count(c.blocks_only_a.size() + c.blocks_only_b.size() + c.blocks_changed.size(), "block", "blocks");
   count(c.rotors_only_a.size() + c.rotors_only_b.size() + c.rotors_changed.size(), "rotor", "rotors");
   count(c.parameters_only_a.size() + c.parameters_only_b.size(), "parameter of one side", "parameters of one side");
   count(c.parameter_values.size(), "parameter value", "parameter values");
   count(c.parameter_settings.size(), "parameter's bounds or fit flag", "parameters' bounds or fit flags");
-  count(c.constants.size(), "constant", "constants");
+  count(c.constants.size() + c.constants_only_a.size() + c.constants_only_b.size(), "constant", "constants");
   count(c.states_only_a.size() + c.states_only_b.size() + c.inputs_only_a.size() + c.inputs_only_b.size(),
         "state or input of one side", "states or inputs of one side");
+  count(c.order_changes.size(), "list in another order", "lists in another order");
+  count(c.equations_only_a.size() + c.equations_only_b.size(), "intermediate of one side", "intermediates of one side");
   return output::joined(parts, ", ");
 }
 
@@ -310,23 +383,7 @@ std::string comparison_text(const DerivationComparison& c, const std::string& la
   std::ostringstream s;
   s << "A: " << output::printable(label_a) << "\nB: " << output::printable(label_b) << "\n";
   s << "vehicle files and the values derived from them:\n";
-  const std::string before = s.str();
-  only_lines(s, "effects", c.effects_only_a, c.effects_only_b);
-  list_line(s, "blocks changed", c.blocks_changed);
-  only_lines(s, "blocks", c.blocks_only_a, c.blocks_only_b);
-  list_line(s, "rotors changed", c.rotors_changed);
-  only_lines(s, "rotors", c.rotors_only_a, c.rotors_only_b);
-  std::vector<std::string> values;
-  for (const auto& n : c.parameter_values) values.push_back(change_text(n));
-  s << (values.empty() ? "" : "  parameter values (A -> B): " + output::joined(values, "; ") + "\n");
-  list_line(s, "parameter settings", c.parameter_settings);
-  only_lines(s, "parameters", c.parameters_only_a, c.parameters_only_b);
-  std::vector<std::string> constants;
-  for (const auto& n : c.constants) constants.push_back(change_text(n));
-  s << (constants.empty() ? "" : "  constants (A -> B): " + output::joined(constants, "; ") + "\n");
-  only_lines(s, "states", c.states_only_a, c.states_only_b);
-  only_lines(s, "inputs", c.inputs_only_a, c.inputs_only_b);
-  if (s.str() == before) s << "  nothing differs\n";
+  vehicle_lines(s, c);
   equation_lines(s, c);
   s << "In short: " << (c.same() ? "the two derivations are the same." : "the derivations differ in " + in_short(c) + ".") << "\n";
   return s.str();

@@ -5,11 +5,14 @@
 // Equations are compared as functions, not as text: each right-hand side, measurement and
 // intermediate quantity (each rotor's thrust, drag, F_body, tau) is evaluated at a few random
 // points, the two models' symbols matched by name and given the same values, each model's
-// constants (rotor geometry) its own. Two expressions that agree at random points of all
-// their symbols are the same function with overwhelming probability (a polynomial identity
-// test, Schwartz 1980); a difference at any point is certain. Which parameter values differ is
-// said apart from this, so a changed block reads as "mass and J_xx have other values", and a
-// changed arm as "the torque rows differ: same symbols, other numbers".
+// constants (rotor geometry) its own. The points are rationals and the evaluation exact (to
+// 40 digits where a root or a function leaves an irrational), so a difference of a part in
+// 1e15 is seen. Agreement at random points is the polynomial identity test (Schwartz 1980) for
+// rational functions; for the rest (|v| in the frame drag, roots) it is evidence, not proof,
+// which the random signs of the states make harder to fool. A difference at any point is
+// certain. Which parameter values differ is said apart from this, so a changed block reads as
+// "mass and J_xx have other values", and a changed arm as "the torque rows differ: the same
+// symbols, other numbers".
 #pragma once
 #include <string>
 #include <vector>
@@ -33,14 +36,16 @@ struct NumberChange {
 
 // An equation (a row of f or h, or an intermediate quantity) in both models.
 struct EquationComparison {
-  std::string name;  // the state's derivative ("q_dot"), the output, or the intermediate ("\\tau")
+  std::string name;  // plain text: the state's derivative ("dq/dt"), the output, the intermediate ("tau[1]")
   std::string kind;  // "right-hand side", "measurement", "intermediate"
-  bool same = false;
+  bool same = false;  // the same value at every point
   double largest_relative_difference = 0;  // over the points; 0 where the same
+  int points_not_compared = 0;  // where a side is no number (a pole, a symbol left): counted as differing
   std::vector<std::string> only_in_a, only_in_b;  // symbols one side's expression has and the other's lacks
 };
 
 struct DerivationComparison {
+  std::string vehicle_name_a, vehicle_name_b;  // the name goes into the generated code
   std::vector<std::string> effects_only_a, effects_only_b;
   std::vector<std::string> blocks_only_a, blocks_only_b, blocks_changed;  // changed: "name: what"
   std::vector<std::string> rotors_only_a, rotors_only_b, rotors_changed;
@@ -48,8 +53,13 @@ struct DerivationComparison {
   std::vector<NumberChange> parameter_values;   // nominal values that differ
   std::vector<std::string> parameter_settings;  // bounds, unit or fit flag that differ: "name: what"
   std::vector<NumberChange> constants;          // rotor geometry and other fixed numbers
+  std::vector<std::string> constants_only_a, constants_only_b;
   std::vector<std::string> states_only_a, states_only_b, inputs_only_a, inputs_only_b;
+  // States, inputs, parameters or outputs both have in another order ("inputs: u_M1, u_M2 ->
+  // u_M2, u_M1"): the generated code's arrays are laid out in that order.
+  std::vector<std::string> order_changes;
   std::vector<EquationComparison> equations;  // those in both models
+  std::vector<std::string> equations_only_a, equations_only_b;  // an intermediate one side has
   int points = 0;                             // random points each equation was evaluated at
 
   bool same() const;
@@ -58,7 +68,9 @@ struct DerivationComparison {
 struct ComparisonOptions {
   int points = 3;
   unsigned seed = 1;
-  double relative_tolerance = 1e-9;  // relative to the larger magnitude of the two values
+  // Relative to the larger magnitude of the two values: above the 40-digit evaluation's
+  // rounding, far below any change a vehicle file can make.
+  double relative_tolerance = 1e-30;
 };
 
 DerivationComparison compare_derivations(const DerivationSide& a, const DerivationSide& b, const ComparisonOptions& opt = {});

@@ -45,25 +45,37 @@ json evidence_json(const CandidateEvidence& e) {
           {"implausible", e.implausible}};
 }
 
-// The free parameters of a fit, each in the one estimate shape. With standard errors (the
-// final fit's), a Wald interval and "standard_error" after the shape; none on a bound (the
-// curvature there is not the likelihood's) or where the error is infinite (confounded).
-// Without (the base fit), the interval stays null.
-json parameters_json(const std::vector<fit::FitParameter>& ps, const std::map<std::string, double>* errors = nullptr) {
+// The free parameters of a fit, each in the one estimate shape, no interval (the base fit).
+json parameters_json(const std::vector<fit::FitParameter>& ps) {
+  json j = json::object();
+  for (const auto& p : ps)
+    if (p.free) j[p.name] = output::estimate_json({p.value, p.unit, NAN, NAN, "", fit::on_bound(p)});
+  return j;
+}
+
+// A fitted parameter with its standard error and one interval: a selected effect's own (its
+// profile, widened by the numerical allowance, as under findings: one parameter, one
+// interval in a file), else the Wald interval of wald_interval. `errors` by name; a name
+// missing from it (a mean over the flights' own copies) has its error and interval null.
+json fitted_parameters_json(const Diagnosis& d, const std::vector<fit::FitParameter>& ps,
+                            const std::map<std::string, double>& errors) {
   json j = json::object();
   for (const auto& p : ps) {
     if (!p.free) continue;
-    const auto [lower, upper] = errors ? wald_interval(p, *errors) : std::pair<double, double>{NAN, NAN};
+    const auto se = errors.find(p.name);
+    const auto e = std::find_if(d.search.estimates.begin(), d.search.estimates.end(),
+                                [&](const EffectEstimate& x) { return x.name == p.name; });
+    const bool own = se != errors.end() && e != d.search.estimates.end();
+    const auto [lower, upper] = own ? std::pair{e->lower, e->upper} : wald_interval(p, errors);
     j[p.name] = output::estimate_json({p.value, p.unit, lower, upper, "", fit::on_bound(p)});
-    if (!errors || !errors->count(p.name)) continue;
-    j[p.name]["standard_error"] = output::number_or_null(errors->at(p.name));
-    j[p.name]["interval_method"] = std::isnan(lower) ? json(nullptr) : json("wald");
+    j[p.name]["standard_error"] = output::number_or_null(se == errors.end() ? NAN : se->second);
+    j[p.name]["interval_method"] = own ? json(e->interval) : std::isnan(lower) ? json(nullptr) : json("wald");
   }
   return j;
 }
 
 // The airframe's values carry the final fit's errors where they are the final fit's own
-// (a shared parameter); a mean over the flights' copies has none here.
+// (a shared parameter); a mean over the flights' copies is left out (its error null).
 std::map<std::string, double> airframe_standard_errors(const Diagnosis& d) {
   std::map<std::string, double> out;
   for (const auto& p : d.airframe_fit) {
@@ -574,14 +586,9 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["selection"] = selection_json(d.search);
   j["candidates_considered"] = d.candidates;
   j["base_fit"] = parameters_json(d.search.base_fit);
-  j["final_fit"] = parameters_json(d.search.final_fit, &d.final_standard_errors);
+  j["final_fit"] = fitted_parameters_json(d, d.search.final_fit, d.final_standard_errors);
   // For predicting other flights (quadgen predict): the airframe's values.
-  if (d.airframe_fit.empty()) {
-    j["airframe_fit"] = parameters_json(d.search.final_fit, &d.final_standard_errors);
-  } else {
-    const auto errors = airframe_standard_errors(d);
-    j["airframe_fit"] = parameters_json(d.airframe_fit, &errors);
-  }
+  j["airframe_fit"] = d.airframe_fit.empty() ? j["final_fit"] : fitted_parameters_json(d, d.airframe_fit, airframe_standard_errors(d));
   json scopes = json::object();
   for (const auto& e : d.candidates) scopes[e] = scope(e);
   j["effect_scopes"] = scopes;

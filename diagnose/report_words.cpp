@@ -576,7 +576,8 @@ std::vector<const fit::FitParameter*> base_parameters(const Diagnosis& d) {
 std::pair<double, double> wald_interval(const fit::FitParameter& p, const std::map<std::string, double>& errors) {
   const auto se = errors.find(p.name);
   // On a bound the curvature is not the likelihood's (the interval would cross the bound).
-  if (se == errors.end() || !std::isfinite(se->second) || fit::on_bound(p)) return {NAN, NAN};
+  // A zero error is no interval either (as add_wald_estimates has it for the findings).
+  if (se == errors.end() || !(std::isfinite(se->second) && se->second > 0) || fit::on_bound(p)) return {NAN, NAN};
   return {p.value - fit::kZ95 * se->second, p.value + fit::kZ95 * se->second};
 }
 

@@ -82,10 +82,10 @@ std::string unit_after_number(const std::string& unit) {
   return unit.empty() || unit == "1" ? "" : " " + unit_for_reading(unit);
 }
 
-std::string one_then_other(double a, double b) {
+std::string one_then_other(double a, double b, const std::string& separator) {
   for (int digits = 6;; ++digits) {
     const std::string x = with_digits(a, digits), y = with_digits(b, digits);
-    if (x != y || a == b || digits >= 17) return x + " then " + y;
+    if (x != y || a == b || digits >= 17) return x + separator + y;
   }
 }
 

@@ -25,7 +25,8 @@ std::string six_digits(double v);
 std::string full_number(double v);
 // "a then b" with six significant digits, or as many more as tell them apart: a log whose time
 // goes back by a microsecond at 0.5 s read "0.500000 then 0.500000" (a review, helper-88).
-std::string one_then_other(double a, double b);
+// `separator` between them: " then " in a sentence, " -> " in a list of changes.
+std::string one_then_other(double a, double b, const std::string& separator = " then ");
 // Equal to 1e-12 relative, not bit for bit: the same value carried through another path (a
 // file's number read again, a header compiled where a*b+c is contracted) may differ in its
 // last bits. Not equal where either is NaN.

@@ -195,15 +195,17 @@ void expect_estimate(const json& j, const std::string& effect, const std::string
   EXPECT_GE(ci[1].get<double>(), truth) << name << " " << ci.dump();
 }
 
-// Every free parameter of the final fit has a standard error and, off its bounds, the Wald
-// interval value +- 1.96 of it. Checked against two independent things: each named
-// parameter's profile-likelihood interval (refits, not the curvature), which it must match
-// in width; and the base parameters' truth (the vehicle file's values, which the flight was
-// simulated with), which it must hold.
+// Every free parameter of the final fit has a standard error and one interval: a named
+// effect's its finding's, any other the Wald interval value +- 1.96 standard errors. The
+// errors are checked against two independent things: each named parameter's profile-
+// likelihood interval (refits, not the curvature), whose width 2 x 1.96 errors must match;
+// and the base parameters' truth (the vehicle file's values, which the flight was simulated
+// with), which their intervals must hold.
 void expect_final_fit_intervals(const json& j, const HiddenCase& c) {
   const quadgen::Vehicle v = quadgen::load_vehicle(vehicle_file(c));
-  for (const auto& [name, e] : j["final_fit"].items()) {
-    ASSERT_TRUE(e.contains("standard_error")) << name;
+  const json& fits = j["final_fit"];
+  for (const auto& [name, e] : fits.items()) {
+    ASSERT_TRUE(e.contains("standard_error") && e.contains("interval_method")) << name;
     if (e["interval_method"] != "wald") continue;
     const double value = e["value"], se = e["standard_error"], lower = e["ci95"][0], upper = e["ci95"][1];
     EXPECT_GT(se, 0) << name;
@@ -217,12 +219,15 @@ void expect_final_fit_intervals(const json& j, const HiddenCase& c) {
   }
   for (const auto& f : j["findings"])
     for (const auto& [name, e] : f["parameters"].items()) {
-      const json& wald = j["final_fit"][name];
-      if (e["interval_method"] != "profile" || !e["ci95"][0].is_number() || !e["ci95"][1].is_number()) continue;
-      ASSERT_EQ(wald["interval_method"], "wald") << name;
+      // A motor gain's reference rotor is held (not in final_fit), an open side has no width.
+      if (e.value("interval_method", "") != "profile" || !fits.contains(name)) continue;
+      if (!e["ci95"][0].is_number() || !e["ci95"][1].is_number()) continue;
+      const json& fitted = fits[name];
+      EXPECT_EQ(fitted["interval_method"], "profile") << name;
+      EXPECT_EQ(fitted["ci95"], e["ci95"]) << name << ": one parameter, one interval in a file";
       const double profile_width = e["ci95"][1].get<double>() - e["ci95"][0].get<double>();
-      const double wald_width = wald["ci95"][1].get<double>() - wald["ci95"][0].get<double>();
-      EXPECT_NEAR(wald_width / profile_width, 1.0, 0.05) << name << ": Wald " << wald.dump() << ", profile " << e.dump();
+      const double wald_width = 2 * 1.959963984540054 * fitted["standard_error"].get<double>();
+      EXPECT_NEAR(wald_width / profile_width, 1.0, 0.05) << name << ": standard error " << fitted.dump() << ", profile " << e.dump();
     }
 }
 
@@ -2192,7 +2197,15 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   EXPECT_EQ(fits["c_w"]["standard_error"], 0.2);
   EXPECT_NEAR(fits["kappa"]["ci95"][0].get<double>(), 0.5 - 1.959963984540054 * 0.1, 1e-12) << fits["kappa"];
   EXPECT_EQ(fits["kappa"]["interval_method"], "wald");
-  EXPECT_FALSE(fits["wind.x"].contains("standard_error"));  // none given: the base fit's shape
+  EXPECT_TRUE(fits["wind.x"]["standard_error"].is_null());  // none known: null, as the interval
+  // The airframe's wind is the mean of the flights' copies: its error and interval null, the keys there.
+  d.airframe_fit = {{"wind.x", "m/s", -0.098, -5, 5, true}, {"c_w", "1", 3.0, 0, 3, true}};
+  d.final_standard_errors["wind.x"] = 0.01;
+  d.final_standard_errors["wind.x@2"] = 0.02;
+  const auto airframe = dg::diagnosis_json(d, "dir/B3.csv")["airframe_fit"];
+  EXPECT_TRUE(airframe["wind.x"]["standard_error"].is_null() && airframe["wind.x"]["ci95"][0].is_null()) << airframe;
+  EXPECT_TRUE(airframe["wind.x"]["interval_method"].is_null()) << airframe;
+  EXPECT_EQ(airframe["c_w"]["standard_error"], 0.2) << airframe;  // shared: the final fit's own
   const std::string summary = dg::diagnosis_summary(d);
   EXPECT_NE(summary.find("the vehicle's own parameters, as fitted (95 % Wald interval; the vehicle file's value): c_w = 3 "
                          "(on its bound) (1.1); kappa = 0.5 [0.304, 0.696]\n"),
