@@ -131,6 +131,8 @@ void compare_structure(const SymbolicModel& a, const SymbolicModel& b, Derivatio
   c.states_only_b = only_in_first(names_of(b.states, name_of), names_of(a.states, name_of));
   c.inputs_only_a = only_in_first(names_of(a.inputs, name_of), names_of(b.inputs, name_of));
   c.inputs_only_b = only_in_first(names_of(b.inputs, name_of), names_of(a.inputs, name_of));
+  c.outputs_only_a = only_in_first(names_of(a.outputs, name_of), names_of(b.outputs, name_of));
+  c.outputs_only_b = only_in_first(names_of(b.outputs, name_of), names_of(a.outputs, name_of));
   compare_order("states", names_of(a.states, name_of), names_of(b.states, name_of), c.order_changes);
   compare_order("inputs", names_of(a.inputs, name_of), names_of(b.inputs, name_of), c.order_changes);
   compare_order("parameters", names_of(a.params, name_of), names_of(b.params, name_of), c.order_changes);
@@ -148,17 +150,24 @@ std::set<std::string> symbol_names(const GiNaC::ex& e) {
 // has (the same under one name in both). States and inputs are +-(0.5 .. 1.5), the sign drawn
 // too, so that |v| and sign branches are met both ways; parameters keep their nominal sign and
 // order (0.5 .. 1.5 times it), so that roots of positive quantities stay real and denominators
-// away from their poles. Constants are each model's own (their differences are the geometry's).
+// away from their poles; one whose nominal value is 0 (an effect's neutral value, a product
+// of inertia) is drawn inside its bounds, a quarter to three quarters of the way up, or is 1
+// without finite bounds. Constants are each model's own (their differences are the geometry's).
 // The engine's raw draws, not a distribution's, keep the points the same on every standard library.
 std::map<std::string, GiNaC::numeric> random_point(const SymbolicModel& a, const SymbolicModel& b, std::mt19937& rng) {
   const auto factor = [&] { return GiNaC::numeric(static_cast<long>(32 + rng() % 65), 64); };
+  const auto parameter = [&](const Variable& p) {
+    if (p.nominal != 0) return factor() * exact(p.nominal);
+    if (!(std::isfinite(p.lower) && std::isfinite(p.upper) && p.lower < p.upper)) return GiNaC::numeric(1);
+    return exact(p.lower) + factor() / 2 * (exact(p.upper) - exact(p.lower));
+  };
   std::map<std::string, GiNaC::numeric> out;
   for (const auto* m : {&a, &b}) {
     for (const auto* list : {&m->states, &m->inputs})
       for (const auto& v : *list)
         if (!out.count(v.name)) out.emplace(v.name, factor() * (rng() % 2 ? 1 : -1));
     for (const auto& p : m->params)
-      if (!out.count(p.name)) out.emplace(p.name, factor() * (p.nominal != 0 ? exact(p.nominal) : GiNaC::numeric(1)));
+      if (!out.count(p.name)) out.emplace(p.name, parameter(p));
   }
   return out;
 }
@@ -170,14 +179,25 @@ GiNaC::lst substitution(const SymbolicModel& m, const std::map<std::string, GiNa
   return l;
 }
 
-// |a - b| relative to the larger magnitude, at 40 digits (exact where both are rationals);
-// complex values (a root of a negative number) compare by their modulus. NaN where either
-// side is no number.
-double relative_difference(const GiNaC::ex& a, const GiNaC::ex& b) {
-  const int digits = GiNaC::Digits;
-  GiNaC::Digits = 40;
-  const GiNaC::ex x = a.evalf(), y = b.evalf();
-  GiNaC::Digits = digits;
+// GiNaC's working precision is one setting for the process: set for a scope, restored on
+// the way out whatever happens (a test binary's later tests would run at 40 digits).
+struct DigitsFor {
+  explicit DigitsFor(long digits) : saved(GiNaC::Digits) { GiNaC::Digits = digits; }
+  ~DigitsFor() { GiNaC::Digits = saved; }
+  long saved;
+};
+
+// |a - b| at a point, relative to the larger magnitude, at 40 digits (exact where both are
+// rationals); complex values (a root of a negative number) by the modulus of the difference.
+// NaN where either side is no number there: a symbol left, or a pole (GiNaC throws on 1/0).
+double relative_difference(const GiNaC::ex& a, const GiNaC::lst& at_a, const GiNaC::ex& b, const GiNaC::lst& at_b) {
+  GiNaC::ex x, y;
+  try {
+    const DigitsFor forty(40);
+    x = a.subs(at_a).evalf(), y = b.subs(at_b).evalf();
+  } catch (const std::exception&) {
+    return NAN;
+  }
   if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::is_a<GiNaC::numeric>(y)) return NAN;
   const GiNaC::numeric u = GiNaC::ex_to<GiNaC::numeric>(x), v = GiNaC::ex_to<GiNaC::numeric>(y);
   const GiNaC::numeric scale = std::max(GiNaC::abs(u), GiNaC::abs(v));
@@ -222,7 +242,7 @@ EquationComparison compare_equation(const NamedExpression& x, const NamedExpress
   std::set_difference(sa.begin(), sa.end(), sb.begin(), sb.end(), std::back_inserter(q.only_in_a));
   std::set_difference(sb.begin(), sb.end(), sa.begin(), sa.end(), std::back_inserter(q.only_in_b));
   for (const auto& [at_a, at_b] : points) {
-    const double d = relative_difference(x.e.subs(at_a), y.e.subs(at_b));
+    const double d = relative_difference(x.e, at_a, y.e, at_b);
     if (std::isnan(d)) ++q.points_not_compared;
     else q.largest_relative_difference = std::max(q.largest_relative_difference, d);
   }
@@ -263,7 +283,8 @@ bool DerivationComparison::same() const {
   const bool values = parameters_only_a.empty() && parameters_only_b.empty() && parameter_values.empty() &&
                       parameter_settings.empty() && constants.empty() && constants_only_a.empty() && constants_only_b.empty();
   const bool structure = effects_only_a.empty() && effects_only_b.empty() && states_only_a.empty() &&
-                         states_only_b.empty() && inputs_only_a.empty() && inputs_only_b.empty() && order_changes.empty() &&
+                         states_only_b.empty() && inputs_only_a.empty() && inputs_only_b.empty() && outputs_only_a.empty() &&
+                         outputs_only_b.empty() && order_changes.empty() &&
                          equations_only_a.empty() && equations_only_b.empty();
   return vehicles && values && structure &&
          std::all_of(equations.begin(), equations.end(), [](const EquationComparison& e) { return e.same; });
@@ -326,6 +347,7 @@ void vehicle_lines(std::ostringstream& s, const DerivationComparison& c) {
   only_lines(s, "constants", c.constants_only_a, c.constants_only_b);
   only_lines(s, "states", c.states_only_a, c.states_only_b);
   only_lines(s, "inputs", c.inputs_only_a, c.inputs_only_b);
+  only_lines(s, "outputs", c.outputs_only_a, c.outputs_only_b);
   list_line(s, "in another order (A -> B)", c.order_changes);
   if (s.str() == before) s << "  nothing differs\n";
 }
@@ -362,7 +384,7 @@ std::string in_short(const DerivationComparison& c) {
   const auto count = [&](size_t n, const std::string& one, const std::string& many) {
     if (n > 0) parts.push_back(std::to_string(n) + " " + (n == 1 ? one : many));
   };
-  count(c.vehicle_name_a != c.vehicle_name_b, "vehicle name", "");
+  if (c.vehicle_name_a != c.vehicle_name_b) parts.push_back("the vehicle name");
   count(c.effects_only_a.size() + c.effects_only_b.size(), "effect", "effects");
   count(c.blocks_only_a.size() + c.blocks_only_b.size() + c.blocks_changed.size(), "block", "blocks");
   count(c.rotors_only_a.size() + c.rotors_only_b.size() + c.rotors_changed.size(), "rotor", "rotors");
@@ -370,8 +392,9 @@ std::string in_short(const DerivationComparison& c) {
   count(c.parameter_values.size(), "parameter value", "parameter values");
   count(c.parameter_settings.size(), "parameter's bounds or fit flag", "parameters' bounds or fit flags");
   count(c.constants.size() + c.constants_only_a.size() + c.constants_only_b.size(), "constant", "constants");
-  count(c.states_only_a.size() + c.states_only_b.size() + c.inputs_only_a.size() + c.inputs_only_b.size(),
-        "state or input of one side", "states or inputs of one side");
+  count(c.states_only_a.size() + c.states_only_b.size() + c.inputs_only_a.size() + c.inputs_only_b.size() +
+            c.outputs_only_a.size() + c.outputs_only_b.size(),
+        "state, input or output of one side", "states, inputs or outputs of one side");
   count(c.order_changes.size(), "list in another order", "lists in another order");
   count(c.equations_only_a.size() + c.equations_only_b.size(), "intermediate of one side", "intermediates of one side");
   return output::joined(parts, ", ");

@@ -54,7 +54,7 @@ struct DerivationComparison {
   std::vector<std::string> parameter_settings;  // bounds, unit or fit flag that differ: "name: what"
   std::vector<NumberChange> constants;          // rotor geometry and other fixed numbers
   std::vector<std::string> constants_only_a, constants_only_b;
-  std::vector<std::string> states_only_a, states_only_b, inputs_only_a, inputs_only_b;
+  std::vector<std::string> states_only_a, states_only_b, inputs_only_a, inputs_only_b, outputs_only_a, outputs_only_b;
   // States, inputs, parameters or outputs both have in another order ("inputs: u_M1, u_M2 ->
   // u_M2, u_M1"): the generated code's arrays are laid out in that order.
   std::vector<std::string> order_changes;

@@ -69,7 +69,8 @@ json fitted_parameters_json(const Diagnosis& d, const std::vector<fit::FitParame
     const auto [lower, upper] = own ? std::pair{e->lower, e->upper} : wald_interval(p, errors);
     j[p.name] = output::estimate_json({p.value, p.unit, lower, upper, "", fit::on_bound(p)});
     j[p.name]["standard_error"] = output::number_or_null(se == errors.end() ? NAN : se->second);
-    j[p.name]["interval_method"] = own ? json(e->interval) : std::isnan(lower) ? json(nullptr) : json("wald");
+    // A flight's copy the data cannot separate has no Wald interval (add_wald_estimates): no method.
+    j[p.name]["interval_method"] = std::isnan(lower) && std::isnan(upper) ? json(nullptr) : own ? json(e->interval) : json("wald");
   }
   return j;
 }

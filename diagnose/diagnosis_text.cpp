@@ -50,7 +50,9 @@ void write_findings(std::ostream& os, const Diagnosis& d) {
 void write_base_parameters(std::ostream& os, const Diagnosis& d) {
   const auto base = base_parameters(d);
   if (base.empty()) return;
-  os << "the vehicle's own parameters, as fitted (95 % Wald interval; the vehicle file's value):";
+  const bool copies = std::any_of(base.begin(), base.end(), [](const fit::FitParameter* p) { return p->name.find('@') != std::string::npos; });
+  os << "the vehicle's own parameters, as fitted (95 % Wald interval; the vehicle file's value"
+     << (copies ? "; name@k: flight k's own copy, the plain name flight 1's" : "") << "):";
   for (const auto* p : base) {
     const auto [lower, upper] = wald_interval(d, *p);
     const auto file = d.file_values.find(runtime::shared_name(p->name));

@@ -206,6 +206,8 @@ void expect_final_fit_intervals(const json& j, const HiddenCase& c) {
   const json& fits = j["final_fit"];
   for (const auto& [name, e] : fits.items()) {
     ASSERT_TRUE(e.contains("standard_error") && e.contains("interval_method")) << name;
+    // A base parameter off its bounds is determined by these flights: it has its Wald interval.
+    if (name.find('.') == std::string::npos && !e["at_bound"].get<bool>()) EXPECT_EQ(e["interval_method"], "wald") << name;
     if (e["interval_method"] != "wald") continue;
     const double value = e["value"], se = e["standard_error"], lower = e["ci95"][0], upper = e["ci95"][1];
     EXPECT_GT(se, 0) << name;
@@ -2202,6 +2204,24 @@ TEST(DiagnosisReport, EveryVerdictIsInOneTableAtTheTop) {
   d.airframe_fit = {{"wind.x", "m/s", -0.098, -5, 5, true}, {"c_w", "1", 3.0, 0, 3, true}};
   d.final_standard_errors["wind.x"] = 0.01;
   d.final_standard_errors["wind.x@2"] = 0.02;
+  // A selected effect's parameter keeps its own interval (a profile here); a flight's copy the
+  // data cannot separate has none (add_wald_estimates' NaN), and no method either.
+  dg::EffectEstimate own = estimate("wind.x", "m/s", -0.296, -0.31, -0.28);
+  dg::EffectEstimate lost = estimate("wind.x@2", "m/s", 0.1, NAN, NAN);
+  lost.interval = "wald";
+  d.search.estimates = {own, lost};
+  d.final_standard_errors["wind.x@2"] = INFINITY;
+  const auto with_own = dg::diagnosis_json(d, "dir/B3.csv")["final_fit"];
+  EXPECT_EQ(with_own["wind.x"]["interval_method"], "profile") << with_own;
+  EXPECT_EQ(with_own["wind.x"]["ci95"][0], -0.31) << with_own;
+  EXPECT_TRUE(with_own["wind.x@2"]["interval_method"].is_null()) << with_own;
+  EXPECT_TRUE(with_own["wind.x@2"]["standard_error"].is_null()) << with_own;
+  dg::Diagnosis joint = d;  // a base parameter per flight: the summary says what @k means
+  joint.search.final_fit = {{"c_t", "1", 0.014, 0.002, 0.2, true}, {"c_t@2", "1", 0.0143, 0.002, 0.2, true}};
+  EXPECT_EQ(dg::diagnosis_summary(d).find("name@k: flight k's own copy"), std::string::npos);
+  EXPECT_NE(dg::diagnosis_summary(joint).find("name@k: flight k's own copy, the plain name flight 1's): c_t = 0.014"),
+            std::string::npos)
+      << dg::diagnosis_summary(joint);
   const auto airframe = dg::diagnosis_json(d, "dir/B3.csv")["airframe_fit"];
   EXPECT_TRUE(airframe["wind.x"]["standard_error"].is_null() && airframe["wind.x"]["ci95"][0].is_null()) << airframe;
   EXPECT_TRUE(airframe["wind.x"]["interval_method"].is_null()) << airframe;
