@@ -1,11 +1,8 @@
 #include "app/compare_job.hpp"
 
-#include <set>
-
 #include "app/derive_pipeline.hpp"
 #include "audit/derivation_comparison.hpp"
 #include "derive/effects/effect_catalogue.hpp"
-#include "derive/fitted_parameters.hpp"
 #include "output/joined.hpp"
 #include "output/sinks.hpp"
 
@@ -25,16 +22,14 @@ Derived derive_for_comparison(const std::string& path, const std::string& effect
   Derived d{load_vehicle(path), {}, ""};
   DeriveRequest request;
   request.derive.effects = parse_effect_list(effects);
-  // derive's words for this ("leave it out") would not say that --effects is both files'.
-  if (!effects.empty() && d.vehicle.fitted_line > 0) {
-    const auto fitted = load_fitted_parameters(path).effects;
-    if (std::set<std::string>(fitted.begin(), fitted.end()) !=
-        std::set<std::string>(request.derive.effects.begin(), request.derive.effects.end()))
-      throw std::invalid_argument(output::printable(path) + ": its fitted: section's effects (" + output::joined(fitted) +
-                                  ") are not --effects; compare derives both files with --effects: leave it out to "
-                                  "derive each file with its own fitted effects (none without a fitted: section)");
+  try {
+    d.note = use_fitted_values(request, d.vehicle, path, "", !effects.empty());
+  } catch (const EffectsNotTheFittedOnes& e) {
+    // derive's words for this ("leave it out") would not say that --effects is both files'.
+    throw std::invalid_argument(output::printable(path) + ": its fitted: section's effects (" + output::joined(e.fitted) +
+                                ") are not --effects; compare derives both files with --effects: leave it out to "
+                                "derive each file with its own fitted effects (none without a fitted: section)");
   }
-  d.note = use_fitted_values(request, d.vehicle, path, "", !effects.empty());
   d.model = requested_model(d.vehicle, derive_mass_properties(d.vehicle), request);
   return d;
 }

@@ -22,7 +22,7 @@ std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, co
   const auto& wanted = request.derive.effects;
   if (!effects_given) request.derive.effects = fitted.effects;
   else if (std::set<std::string>(wanted.begin(), wanted.end()) != std::set<std::string>(fitted.effects.begin(), fitted.effects.end()))
-    throw std::invalid_argument("--effects differs from the effects " + params + " was fitted with; leave it out");
+    throw EffectsNotTheFittedOnes("--effects differs from the effects " + params + " was fitted with; leave it out", fitted.effects);
   request.set_nominal = [fitted](SymbolicModel& m) { apply_fitted_parameters(m, fitted); };
   request.emit.regenerate_flags = params == vehicle_path ? "" : " --params " + output::shell_path(params);
   request.emit.parameter_source = "fitted values from " + params;

@@ -4,7 +4,9 @@
 // model both run it; what differs between them is in DeriveRequest.
 #pragma once
 #include <functional>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "audit/audit.hpp"
@@ -51,9 +53,18 @@ struct DerivedModel {
   std::string model_json, derivation_md;
 };
 
+// --effects given beside fitted values of other effects: its own type, so that a command whose
+// --effects means something else (compare's, for both files) can say it in its own words.
+struct EffectsNotTheFittedOnes : std::invalid_argument {
+  EffectsNotTheFittedOnes(const std::string& what, std::vector<std::string> fitted_effects)
+      : std::invalid_argument(what), fitted(std::move(fitted_effects)) {}
+  std::vector<std::string> fitted;
+};
+
 // Gives `request` fitted values as nominal ones: from `params_path` (a fitted_parameters.yaml),
 // or from the vehicle file's own `fitted:` section; both at once is an error. Without
-// `effects_given` the effects are the fitted ones; given, they must be the same set.
+// `effects_given` the effects are the fitted ones; given, they must be the same set
+// (EffectsNotTheFittedOnes otherwise).
 // Returns a note for the user where the values were fitted for another vehicle (by name): they
 // may still be wanted (the same airframe under another name), but never silently.
 std::string use_fitted_values(DeriveRequest& request, const Vehicle& vehicle, const std::string& vehicle_path,

@@ -233,12 +233,13 @@ std::vector<NamedExpression> equations_of(const SymbolicModel& m) {
   return out;
 }
 
-// One equation in both models at the points (substitutions per point, A's and B's).
-EquationComparison compare_equation(const NamedExpression& x, const NamedExpression& y, const SymbolicModel& a,
-                                    const SymbolicModel& b, const std::vector<std::pair<GiNaC::lst, GiNaC::lst>>& points,
-                                    double tolerance) {
+// One equation in both models at the points (substitutions per point, A's and B's); the
+// symbols each side has once its constants (`constants_a`, `constants_b`) are put in.
+EquationComparison compare_equation(const NamedExpression& x, const NamedExpression& y, const GiNaC::lst& constants_a,
+                                    const GiNaC::lst& constants_b,
+                                    const std::vector<std::pair<GiNaC::lst, GiNaC::lst>>& points, double tolerance) {
   EquationComparison q{x.name, x.kind, true, 0, 0, {}, {}};
-  const auto sa = symbol_names(x.e.subs(a.constant_substitution())), sb = symbol_names(y.e.subs(b.constant_substitution()));
+  const auto sa = symbol_names(x.e.subs(constants_a)), sb = symbol_names(y.e.subs(constants_b));
   std::set_difference(sa.begin(), sa.end(), sb.begin(), sb.end(), std::back_inserter(q.only_in_a));
   std::set_difference(sb.begin(), sb.end(), sa.begin(), sa.end(), std::back_inserter(q.only_in_b));
   for (const auto& [at_a, at_b] : points) {
@@ -259,9 +260,11 @@ void compare_equations(const SymbolicModel& a, const SymbolicModel& b, const Com
   }
   c.points = opt.points;
   const auto ea = equations_of(a), eb = equations_of(b);
+  const GiNaC::lst constants_a = a.constant_substitution(), constants_b = b.constant_substitution();
   for (const auto& x : ea) {
     const auto y = std::find_if(eb.begin(), eb.end(), [&](const NamedExpression& e) { return e.name == x.name; });
-    if (y != eb.end()) c.equations.push_back(compare_equation(x, *y, a, b, points, opt.relative_tolerance));
+    if (y != eb.end())
+      c.equations.push_back(compare_equation(x, *y, constants_a, constants_b, points, opt.relative_tolerance));
   }
   // Those of a state, an output or a rotor only one side has are said with it; an
   // intermediate (the drag, say) is said here.
