@@ -492,7 +492,7 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
 }
 
 SearchResult CandidateSearch::run() {
-  output::PhaseTimer phase(opt_.progress);  // the serial parts between the parallel steps
+  output::JobClock phase(opt_.progress, "diagnose");  // the serial parts between the parallel steps
   SearchResult res;
   std::set<std::string> base;
   std::vector<FitParameter> current = fit_base(res);
@@ -539,7 +539,7 @@ std::vector<FitParameter> CandidateSearch::fit_base(SearchResult& res) {
 }
 
 bool CandidateSearch::take_step(int round, std::set<std::string>& base, std::vector<FitParameter>& current,
-                                SearchResult& res, output::PhaseTimer& phase) {
+                                SearchResult& res, output::JobClock& phase) {
   SelectionStep step;
   step.base_effects.assign(base.begin(), base.end());
   const double base_valid = cost(valid_, current);
@@ -547,7 +547,7 @@ bool CandidateSearch::take_step(int round, std::set<std::string>& base, std::vec
   std::vector<std::string> todo;
   for (const auto& e : candidates_)  // the level stays alpha / all candidates: each may be tested
     if (!base.count(e) && testable_beside(e, base)) todo.push_back(e);
-  phase.restart();
+  phase.restart_phase();
   step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
   phase.done("step " + std::to_string(round + 1) + ": " + std::to_string(step.candidates.size()) +
              " candidates fitted");

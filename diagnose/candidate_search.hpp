@@ -376,7 +376,7 @@ class CandidateSearch {
   // into it (with its look-alikes checked) and the model refitted. False when none is
   // significant: the forward search stops.
   bool take_step(int round, std::set<std::string>& base, std::vector<fit::FitParameter>& current, SearchResult& r,
-                 output::PhaseTimer& phase);
+                 output::JobClock& phase);
   void backward_pass(SearchResult& r, std::set<std::string>& base, std::vector<fit::FitParameter>& current);
   // CandidateEvidence::implausible of this effect's estimates in `ps`.
   std::string implausible_estimate(const std::string& effect, const std::vector<fit::FitParameter>& ps) const;

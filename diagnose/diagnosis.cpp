@@ -620,7 +620,6 @@ void add_suspects_of_the_search(Diagnosis& d) {
 }
 
 using Clock = std::chrono::steady_clock;
-using output::seconds_since;
 
 // The held-out part, base against extended model: the report's metric (with its windowed
 // simulations), the errors at horizons as published models report them (without a pose,
@@ -793,19 +792,6 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
 
 namespace {
 
-// "[diagnose] 212 s: ..." - where a long diagnosis spends its time, counted from its start
-// (output::PhaseTimer counts each phase from the last one's end instead: "... (12 s)").
-struct StageClock {
-  const output::Progress& progress;
-  Clock::time_point start = Clock::now();
-  void say(const std::string& what) const {
-    progress.say("[diagnose] " + std::to_string(static_cast<int>(seconds_since(start))) + " s: " + what);
-  }
-  // "... (12.3 s)", "(0.41 s)": how long the stage begun at `since` took (whole seconds read
-  // "(0 s)" for every step of a short flight: a user trial, helper-106).
-  static std::string took(Clock::time_point since) { return " (" + output::short_number(seconds_since(since)) + " s)"; }
-};
-
 // The base model's parameters the joint fit fitted for all flights alike: free, no flight's
 // own copy, of no effect (c_w and kappa for the bundled vehicles; c_t is each flight's).
 std::vector<std::string> shared_base_parameters(const std::vector<fit::FitParameter>& joint_fit,
@@ -821,7 +807,7 @@ std::vector<std::string> shared_base_parameters(const std::vector<fit::FitParame
 // Step 3: do the joined flights agree, or does this one flight show an airframe diagnosed before?
 void compare_flights(Diagnosis& d, bool joint, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                      const std::vector<fit::Flight>& flights, const FlightModels& fm, const fit::Flight& train,
-                     bool accel, const DiagnoseOptions& opt, const StageClock& clock) {
+                     bool accel, const DiagnoseOptions& opt, const output::JobClock& clock) {
   const auto start = Clock::now();
   if (joint) {
     const AgreementInputs in =
@@ -829,13 +815,13 @@ void compare_flights(Diagnosis& d, bool joint, const SymbolicModel& all_in, runt
     d.agreement = per_flight_agreement(in);
     d.base_agreement = base_parameter_agreement(in, shared_base_parameters(d.search.final_fit, fm.per_flight_names));
     clock.say("agreement: " + std::to_string(d.agreement.size() + d.base_agreement.size()) + " parameters on " +
-              std::to_string(flights.size()) + " flights" + StageClock::took(start));
+              std::to_string(flights.size()) + " flights" + output::took_since(start));
   } else if (opt.airframe) {
     d.airframe_source = opt.airframe->source;
     d.airframe_flights = opt.airframe->flights;
     d.airframe_check = check_against_airframe(model_in, train, accel, d.search.final_weights, *opt.airframe);
     clock.say("against the airframe of " + opt.airframe->source + ": " + std::to_string(d.airframe_check.size()) +
-              " parameters" + StageClock::took(start));
+              " parameters" + output::took_since(start));
   }
 }
 
@@ -845,7 +831,7 @@ void look_beyond_the_catalogue(Diagnosis& d, const Vehicle& v, const SymbolicMod
                                const fit::Flight& train, const fit::EquationErrorModel& train_ee,
                                const fit::Flight& valid, const fit::EquationErrorModel& valid_ee,
                                const std::vector<double>& flight_starts, const HeldOutGain& held_out_gain,
-                               const StageClock& clock) {
+                               const output::JobClock& clock) {
   clock.say("beyond the catalogue: sparse regression on what the final model leaves");
   const SearchResult& s = d.search;
   d.discovered = discover_terms(rows_of(train, train_ee), train_ee.all_channels(s.final_fit), rows_of(valid, valid_ee),
@@ -861,7 +847,7 @@ void look_beyond_the_catalogue(Diagnosis& d, const Vehicle& v, const SymbolicMod
 Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtime::DynamicModel& model_in,
                            const std::vector<fit::Flight>& flights_in, const DiagnoseOptions& opt_in,
                            fit::Flight* validation_out) {
-  const StageClock clock{opt_in.progress};
+  const output::JobClock clock(opt_in.progress, "diagnose");
   if (flights_in.empty()) throw fit::FitError("diagnose: no flight");
   Diagnosis d;
   d.vehicle = v.name;
@@ -923,7 +909,7 @@ Diagnosis diagnose_flights(const Vehicle& v, const SymbolicModel& all_in, runtim
     if (p.free && fit::on_bound(p)) d.at_bounds.push_back(p);
   d.airframe_fit = airframe_values(d.search.final_fit);
   d.final_standard_errors = final_standard_errors(train_ee, d.search);
-  d.seconds = seconds_since(clock.start);
+  d.seconds = clock.seconds();
   return d;
 }
 

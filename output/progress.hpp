@@ -6,6 +6,8 @@
 #include <functional>
 #include <string>
 
+#include "output/numbers.hpp"
+
 namespace quadgen::output {
 
 struct Progress {
@@ -29,24 +31,37 @@ inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Where a long job spends its time, phase by phase: "[diagnose] base model fitted (12 s)"
-// counts from where the last phase ended.
-class PhaseTimer {
+// " (12.3 s)", " (0.41 s)": how long something begun at `since` took. Not whole seconds, which
+// read "(0 s)" for every step of a short flight (a user trial, helper-106).
+inline std::string took_since(std::chrono::steady_clock::time_point since) {
+  return " (" + short_number(seconds_since(since)) + " s)";
+}
+
+// Where a long job spends its time, in one voice: "[diagnose] 5 s: validation ..." says how far
+// into the job a stage begins, "[diagnose] base model fitted (0.41 s)" how long a phase took,
+// counted from where the last one ended.
+class JobClock {
  public:
-  explicit PhaseTimer(const Progress& progress) : progress_(progress) {}
-  // Seconds since the last phase ended (or the timer started).
+  using Clock = std::chrono::steady_clock;
+  JobClock(const Progress& progress, std::string job) : progress_(progress), job_(std::move(job)) {}
+  // Seconds since the job began.
   double seconds() const { return seconds_since(start_); }
-  // Says "[diagnose] <what> (N s)" and starts the next phase.
-  void done(const std::string& what) {
-    progress_.say("[diagnose] " + what + " (" + std::to_string(static_cast<int>(seconds())) + " s)");
-    restart();
+  // "[job] N s: <what>": a stage begins.
+  void say(const std::string& what) const {
+    progress_.say("[" + job_ + "] " + std::to_string(static_cast<int>(seconds())) + " s: " + what);
   }
-  void restart() { start_ = Clock::now(); }
+  // "[job] <what> (x s)": a phase ended; the next one starts.
+  void done(const std::string& what) {
+    progress_.say("[" + job_ + "] " + what + took_since(phase_start_));
+    restart_phase();
+  }
+  // The next phase starts now (work before it, e.g. a parallel step's own counter, not counted).
+  void restart_phase() { phase_start_ = Clock::now(); }
 
  private:
-  using Clock = std::chrono::steady_clock;
   const Progress& progress_;
-  Clock::time_point start_ = Clock::now();
+  std::string job_;
+  Clock::time_point start_ = Clock::now(), phase_start_ = start_;
 };
 
 // Standard error, one report at a time: lines as they come, every control character shown as
