@@ -494,13 +494,23 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
 SearchResult CandidateSearch::run() {
   output::JobClock phase(opt_.progress, "diagnose");  // the serial parts between the parallel steps
   SearchResult res;
+  res.max_effects = static_cast<size_t>(opt_.max_effects);
   std::set<std::string> base;
   std::vector<FitParameter> current = fit_base(res);
   phase.done("base model fitted");
-  for (int round = 0; round < opt_.max_effects; ++round)
-    if (!take_step(round, base, current, res, phase)) break;
-  backward_pass(res, base, current);
-  phase.done("backward elimination");
+  // Forward steps until nothing more is significant or the model is full, then the backward
+  // pass. An effect it drops gives its place back and the forward search goes on, without
+  // the dropped ones (never tried again, so the search cannot cycle: each round drops one
+  // for good or ends it).
+  for (int round = 0;;) {
+    bool full = false, more = true;
+    while (more && !(full = base.size() >= res.max_effects)) more = take_step(round++, base, current, res, phase);
+    const size_t dropped_before = res.removed.size();
+    backward_pass(res, base, current);
+    phase.done("backward elimination");
+    if (!full || res.removed.size() == dropped_before) break;
+    res.left_at_limit.clear();  // said of a full model that is not the final one
+  }
   const auto in_model = [&](const CandidateEvidence& ev) {
     return std::find(res.selected.begin(), res.selected.end(), ev.effect) != res.selected.end();
   };
@@ -545,8 +555,11 @@ bool CandidateSearch::take_step(int round, std::set<std::string>& base, std::vec
   const double base_valid = cost(valid_, current);
   const std::vector<double> base_ss = channel_noise(train_, current).ss;
   std::vector<std::string> todo;
+  const auto dropped = [&](const std::string& e) {
+    return std::any_of(res.removed.begin(), res.removed.end(), [&](const Removal& r) { return r.effect == e; });
+  };
   for (const auto& e : candidates_)  // the level stays alpha / all candidates: each may be tested
-    if (!base.count(e) && testable_beside(e, base)) todo.push_back(e);
+    if (!base.count(e) && !dropped(e) && testable_beside(e, base)) todo.push_back(e);
   phase.restart_phase();
   step.candidates = evaluate_all(todo, base, current, base_ss, base_valid, round);
   phase.done("step " + std::to_string(round + 1) + ": " + std::to_string(step.candidates.size()) +
@@ -573,7 +586,7 @@ bool CandidateSearch::take_step(int round, std::set<std::string>& base, std::vec
   weights_ = weights_at(current);
   double c = 0;
   current = fit_with(base, current, &c);
-  if (round + 1 == opt_.max_effects)  // (a look-alike of the one taken is reported as ambiguous)
+  if (base.size() >= res.max_effects)  // the model is full (a look-alike of the one taken is reported as ambiguous)
     for (size_t k = 1; k < step.candidates.size() && step.candidates[k].significant; ++k)
       if (std::none_of(step.ambiguities.begin(), step.ambiguities.end(),
                        [&](const Ambiguity& a) { return a.b == step.candidates[k].effect; }))

@@ -52,11 +52,13 @@ constexpr size_t kMaxEffectsAllowed = 10;
 
 struct SearchOptions {
   double alpha = 0.01;   // family-wise level of one selection step
-  // Forward-selection steps at most. On real logs every step finds something significant on
-  // the training data and the held-out tests decide afterwards, so the cap binds: at 3 it
-  // ended the search on all six NanoBench flights before an airframe effect the others show
-  // was tried (a stand-in and a trim took the slots); 5 leaves room for those and for the
-  // per-flight nuisances (docs/validation.md, 2026-11-25).
+  // Effects the final model may hold at most. On real logs every step finds something
+  // significant on the training data and the held-out tests decide afterwards, so the cap
+  // binds: at 3 it ended the search on all six NanoBench flights before an airframe effect
+  // the others show was tried (a stand-in and a trim took the slots); 5 leaves room for those
+  // and for the per-flight nuisances (docs/validation.md, 2026-11-25). An effect the backward
+  // pass drops gives its place back: until 2026-12-07 the cap counted forward steps, and B3
+  // rep 2 ended with four effects while rotor drag was still significant (p = 1e-11).
   int max_effects = 5;  // at most kMaxEffectsAllowed
   double ambiguity_ratio = 0.5;  // runner-up statistic / winner's above which both are tested together
   std::vector<std::string> candidates;  // effects to consider (default: all that the log supports)
@@ -179,6 +181,7 @@ struct SearchResult {
   // in its last step besides the one it took (against that step's base model), strongest
   // first. Empty when it stopped because nothing more was significant.
   std::vector<CandidateEvidence> left_at_limit;
+  size_t max_effects = 0;  // the limit it ran with (SearchOptions::max_effects)
   std::vector<fit::FitParameter> base_fit, final_fit;  // a final model without effects is the base fit
   std::vector<double> base_weights, final_weights;
   Settling final_settling;  // how final_weights came to be

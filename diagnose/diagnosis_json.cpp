@@ -559,6 +559,7 @@ json diagnosis_json(const Diagnosis& d, const std::string& log_path) {
   j["stand_ins"] = stand_ins_json(d);
   j["removed_by_backward_pass"] = removed_json(d.search);
   j["left_at_max_effects"] = left_at_limit_json(d.search);
+  j["max_effects"] = d.search.max_effects;
   j["ambiguous"] = ambiguous_json(d.search);
   j["agreement"] = agreement_json(d.agreement, d.flights);
   j["base_agreement"] = agreement_json(d.base_agreement, d.flights);

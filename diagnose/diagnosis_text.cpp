@@ -120,13 +120,11 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   }
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << ": " << r.reason << "\n";
   if (!d.search.left_at_limit.empty()) {
-    // Effects taken, some perhaps dropped again: "limit of 5" beside four named read as a
-    // miscount (a newcomer's trial, helper-136).
-    os << "the search stopped at its limit of " << d.search.steps.size()
-       << (d.search.steps.size() == 1 ? " effect" : " effects") << " taken (--max-effects"
-       << (d.search.removed.empty() ? std::string()
-                                    : "; " + std::to_string(d.search.removed.size()) + " of them dropped by the backward pass above")
-       << "); still significant in its last step:";
+    // Effects in the model, named or carried: "limit of 5" beside four named would read as a
+    // miscount (a newcomer's trial, helper-136) if it did not say so.
+    const size_t limit = d.search.max_effects;
+    os << "the search stopped at its limit of " << limit << (limit == 1 ? " effect" : " effects")
+       << " in the model (--max-effects); still significant in its last step:";
     for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
       const auto& ev = d.search.left_at_limit[k];
       os << (k ? ", " : " ") << ev.effect << " (" << output::p_is(ev.p_value) << (ev.implausible.empty() ? "" : ", implausible")
@@ -138,7 +136,7 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
     const bool only_implausible =
         std::all_of(d.search.left_at_limit.begin(), d.search.left_at_limit.end(),
                     [](const CandidateEvidence& ev) { return !ev.implausible.empty(); });
-    if (d.search.steps.size() >= kMaxEffectsAllowed) os << "; --max-effects is at its largest";
+    if (limit >= kMaxEffectsAllowed) os << "; --max-effects is at its largest";
     else if (only_implausible) os << "; what is still significant is implausible here: taken in a further step it would be "
                                      "a stand-in for missing physics, not a cause";
     else os << "; a larger --max-effects may name more (each further effect must pass the same tests)";

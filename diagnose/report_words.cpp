@@ -455,7 +455,7 @@ std::vector<std::string> next_steps(const Diagnosis& d) {
     out.push_back("check the units and the number of " + p.name + " before widening its bounds (the vehicle file's, or "
                   "the effect's own)");
   if (!d.search.left_at_limit.empty()) {
-    const size_t limit = d.search.steps.size(), wider = std::min(limit + d.search.left_at_limit.size(), kMaxEffectsAllowed);
+    const size_t limit = d.search.max_effects, wider = std::min(limit + d.search.left_at_limit.size(), kMaxEffectsAllowed);
     out.push_back(wider > limit ? "rerun with --max-effects " + std::to_string(wider) + " to see what is left tested (this "
                                   "run's limit, " + std::to_string(limit) + ", binds)"
                                 : "what is left untested stays so: --max-effects is at its largest, " + std::to_string(limit));
@@ -569,7 +569,7 @@ int estimate_digits(double value, double lower, double upper) {
 std::vector<const fit::FitParameter*> base_parameters(const Diagnosis& d) {
   std::vector<const fit::FitParameter*> base;
   for (const auto& p : d.search.final_fit)
-    if (p.free && runtime::shared_name(p.name).find('.') == std::string::npos) base.push_back(&p);
+    if (p.free && !is_effect_parameter(runtime::shared_name(p.name))) base.push_back(&p);
   return base;
 }
 
