@@ -34,8 +34,8 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--alpha", o.search.alpha, "family-wise significance level of each selection step")
       ->check(finite_range(diagnose::kAlphaRange));
   c->add_option("--max-effects", o.search.max_effects,
-                "effects the extended model may hold at most (each forward step adds one, the backward pass may give a place "
-                "back; later tests may turn an effect down)")
+                "effects the search may select at most, named or carried (each forward step adds one; one the backward pass "
+                "drops gives its place back; the held-out tests may then turn effects down)")
       ->check(CLI::Range(1, static_cast<int>(diagnose::kMaxEffectsAllowed)));
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,

@@ -21,6 +21,7 @@
 #include "diagnose/validation.hpp"
 #include "fit/evaluation_threads.hpp"
 #include "fit/normal_matrix.hpp"
+#include "output/joined.hpp"
 #include "output/numbers.hpp"
 
 namespace quadgen::diagnose {
@@ -491,6 +492,20 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
   return out;
 }
 
+// A removal's "beside the other effects of the final model" holds only where the search
+// ended with that model: after a place given back it went on, and the effect was tested
+// beside the model of its round, which the reason then names (a review, helper-159).
+static void say_what_a_removal_was_tested_beside(SearchResult& r, const std::set<std::string>& final_model) {
+  const std::string final_words = " beside the other effects of the final model";
+  for (auto& removal : r.removed) {
+    const auto at = removal.reason.find(final_words);
+    if (at == std::string::npos || std::set<std::string>(removal.beside.begin(), removal.beside.end()) == final_model)
+      continue;
+    removal.reason.replace(at, final_words.size(),
+                           " beside " + output::joined(removal.beside) + " (the model then; the search went on after it)");
+  }
+}
+
 SearchResult CandidateSearch::run() {
   output::JobClock phase(opt_.progress, "diagnose");  // the serial parts between the parallel steps
   SearchResult res;
@@ -511,6 +526,7 @@ SearchResult CandidateSearch::run() {
     if (!full || res.removed.size() == dropped_before) break;
     res.left_at_limit.clear();  // said of a full model that is not the final one
   }
+  say_what_a_removal_was_tested_beside(res, base);
   const auto in_model = [&](const CandidateEvidence& ev) {
     return std::find(res.selected.begin(), res.selected.end(), ev.effect) != res.selected.end();
   };
@@ -644,9 +660,10 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       if (p < level) continue;
       const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
       const double gain = percent_lower(cost(valid_, smaller), cost(valid_, current));
-      r.removed.push_back({e, "no longer significant" + beside + " (" + output::p_is(p) + ")", p, gain});
+      const std::vector<std::string> others(without.begin(), without.end());
+      r.removed.push_back({e, "no longer significant" + beside + " (" + output::p_is(p) + ")", p, gain, others});
       for (const auto& g : going(e)) {
-        if (g != e) r.removed.push_back({g, "taken out with " + e + ", whose terms it scales", p, gain});
+        if (g != e) r.removed.push_back({g, "taken out with " + e + ", whose terms it scales", p, gain, others});
         r.selected.erase(std::find(r.selected.begin(), r.selected.end(), g));
         r.carried.erase(std::remove(r.carried.begin(), r.carried.end(), g), r.carried.end());
       }

@@ -46,8 +46,9 @@ struct Variable;
 
 namespace quadgen::diagnose {
 
-// The largest forward search a diagnosis runs (--max-effects, DiagnoseOptions::IsValid): each
-// step refits every remaining candidate, and on the real flights five already bind.
+// The largest model a diagnosis' search selects (--max-effects, DiagnoseOptions::IsValid): each
+// step refits every remaining candidate, and on the real flights five already bind. (Places the
+// backward pass gives back add steps: at most one per candidate dropped.)
 constexpr size_t kMaxEffectsAllowed = 10;
 
 struct SearchOptions {
@@ -170,6 +171,7 @@ struct Removal {
   double p_value = 1;
   // The held-out equation-error cost's change, for the record: 100 (1 - with / without).
   double validation_gain_percent = 0;
+  std::vector<std::string> beside;  // the effects it was tested beside (the model of that round)
 };
 
 struct SearchResult {

@@ -743,6 +743,15 @@ void candidates_html(std::ostringstream& h, const Diagnosis& d) {
     const auto& st = d.search.steps[s];
     h << "<details><summary>Step " << s + 1 << " (model: base";
     for (const auto& e : st.base_effects) h << " + " << esc(e);
+    // A step after a place the backward pass gave back: its model lacks an earlier step's pick.
+    std::vector<std::string> dropped;
+    for (size_t before = 0; before < s; ++before) {
+      const std::string& e = d.search.steps[before].selected;
+      if (!e.empty() && std::find(st.base_effects.begin(), st.base_effects.end(), e) == st.base_effects.end() &&
+          std::find(dropped.begin(), dropped.end(), e) == dropped.end())
+        dropped.push_back(e);
+    }
+    if (!dropped.empty()) h << "; after the backward pass dropped " << esc(output::joined(dropped));
     h << "): " << (st.selected.empty() ? "nothing taken" : "took " + esc(st.selected)) << "</summary>\n<p>" << (st.selected.empty() ? "Nothing taken (" + esc(st.outcome) + ")." : "Taken: <b>" + esc(st.selected) + "</b>" + (st.outcome == "selected" ? "." : " (" + esc(st.outcome) + ")."))
       << " Ranked: the significant first, among them the plausible before the implausible, then by LR statistic. "
          "Held-out gain: how much lower the equation error (the one-step accelerations' weighted cost) is on the "

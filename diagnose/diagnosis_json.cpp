@@ -382,7 +382,7 @@ json stand_ins_json(const Diagnosis& d) {
 json removed_json(const SearchResult& s) {
   json removed = json::array();
   for (const auto& r : s.removed)
-    removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value},
+    removed.push_back({{"effect", r.effect}, {"reason", r.reason}, {"p_value", r.p_value}, {"tested_beside", r.beside},
                        {"validation_gain_percent", r.validation_gain_percent}});
   return removed;
 }

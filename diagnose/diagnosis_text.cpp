@@ -120,11 +120,12 @@ void write_not_named(std::ostream& os, const Diagnosis& d) {
   }
   for (const auto& r : d.search.removed) os << "dropped by the backward pass: " << r.effect << ": " << r.reason << "\n";
   if (!d.search.left_at_limit.empty()) {
-    // Effects in the model, named or carried: "limit of 5" beside four named would read as a
-    // miscount (a newcomer's trial, helper-136) if it did not say so.
+    // The selection's model, not the findings: acceptance may turn some of its effects down
+    // and carry a suspect, so "limit of 5" beside four named read as a miscount (a newcomer's
+    // trial, helper-136; a review, helper-159).
     const size_t limit = d.search.max_effects;
-    os << "the search stopped at its limit of " << limit << (limit == 1 ? " effect" : " effects")
-       << " in the model (--max-effects); still significant in its last step:";
+    os << "the search stopped with its model full (--max-effects " << limit << ": the effects it selected, "
+       << "before the held-out tests); still significant in its last step:";
     for (size_t k = 0; k < d.search.left_at_limit.size(); ++k) {
       const auto& ev = d.search.left_at_limit[k];
       os << (k ? ", " : " ") << ev.effect << " (" << output::p_is(ev.p_value) << (ev.implausible.empty() ? "" : ", implausible")
