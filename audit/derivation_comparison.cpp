@@ -102,8 +102,6 @@ void compare_vehicles(const Vehicle& a, const Vehicle& b, DerivationComparison& 
 }
 
 void compare_parameters(const SymbolicModel& a, const SymbolicModel& b, DerivationComparison& c) {
-  c.parameters_only_a = only_in_first(names_of(a.params, name_of), names_of(b.params, name_of));
-  c.parameters_only_b = only_in_first(names_of(b.params, name_of), names_of(a.params, name_of));
   for (const auto& p : a.params)
     for (const auto& q : b.params) {
       if (p.name != q.name) continue;
@@ -124,19 +122,23 @@ void compare_parameters(const SymbolicModel& a, const SymbolicModel& b, Derivati
   c.constants_only_b = only_in_first(names_of(b.constants, name_of), names_of(a.constants, name_of));
 }
 
+// One list of the generated code's (states, inputs, parameters, outputs): the names one side
+// alone has, and the order of those both have.
+void compare_list(const std::string& what, const std::vector<Variable>& a, const std::vector<Variable>& b,
+                  std::vector<std::string>& only_a, std::vector<std::string>& only_b, DerivationComparison& c) {
+  const auto na = names_of(a, name_of), nb = names_of(b, name_of);
+  only_a = only_in_first(na, nb);
+  only_b = only_in_first(nb, na);
+  compare_order(what, na, nb, c.order_changes);
+}
+
 void compare_structure(const SymbolicModel& a, const SymbolicModel& b, DerivationComparison& c) {
   c.effects_only_a = only_in_first(a.effects, b.effects);
   c.effects_only_b = only_in_first(b.effects, a.effects);
-  c.states_only_a = only_in_first(names_of(a.states, name_of), names_of(b.states, name_of));
-  c.states_only_b = only_in_first(names_of(b.states, name_of), names_of(a.states, name_of));
-  c.inputs_only_a = only_in_first(names_of(a.inputs, name_of), names_of(b.inputs, name_of));
-  c.inputs_only_b = only_in_first(names_of(b.inputs, name_of), names_of(a.inputs, name_of));
-  c.outputs_only_a = only_in_first(names_of(a.outputs, name_of), names_of(b.outputs, name_of));
-  c.outputs_only_b = only_in_first(names_of(b.outputs, name_of), names_of(a.outputs, name_of));
-  compare_order("states", names_of(a.states, name_of), names_of(b.states, name_of), c.order_changes);
-  compare_order("inputs", names_of(a.inputs, name_of), names_of(b.inputs, name_of), c.order_changes);
-  compare_order("parameters", names_of(a.params, name_of), names_of(b.params, name_of), c.order_changes);
-  compare_order("outputs", names_of(a.outputs, name_of), names_of(b.outputs, name_of), c.order_changes);
+  compare_list("states", a.states, b.states, c.states_only_a, c.states_only_b, c);
+  compare_list("inputs", a.inputs, b.inputs, c.inputs_only_a, c.inputs_only_b, c);
+  compare_list("parameters", a.params, b.params, c.parameters_only_a, c.parameters_only_b, c);
+  compare_list("outputs", a.outputs, b.outputs, c.outputs_only_a, c.outputs_only_b, c);
 }
 
 std::set<std::string> symbol_names(const GiNaC::ex& e) {

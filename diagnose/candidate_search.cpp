@@ -492,11 +492,14 @@ std::vector<CandidateEvidence> CandidateSearch::evaluate_all(const std::vector<s
   return out;
 }
 
-// A removal's "beside the other effects of the final model" holds only where the search
-// ended with that model: after a place given back it went on, and the effect was tested
-// beside the model of its round, which the reason then names (a review, helper-159).
+// What a backward pass's removal says it was tested beside, until the search is over.
+const std::string kBesideTheFinalModel = " beside the other effects of the final model";
+
+// A removal's kBesideTheFinalModel holds only where the search ended with that model: after a
+// place given back it went on, and the effect was tested beside the model of its round, which
+// the reason then names (a review, helper-159).
 static void say_what_a_removal_was_tested_beside(SearchResult& r, const std::set<std::string>& final_model) {
-  const std::string final_words = " beside the other effects of the final model";
+  const std::string& final_words = kBesideTheFinalModel;
   for (auto& removal : r.removed) {
     const auto at = removal.reason.find(final_words);
     if (at == std::string::npos || std::set<std::string>(removal.beside.begin(), removal.beside.end()) == final_model)
@@ -658,7 +661,7 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       // likelihood ratio needs, and a held-out comparison of the two leaned on them (the
       // helix's thrust decay was dropped that way). Its held-out change is kept as a record.
       if (p < level) continue;
-      const std::string beside = base.size() > 1 ? " beside the other effects of the final model" : "";
+      const std::string beside = base.size() > 1 ? kBesideTheFinalModel : "";
       const double gain = percent_lower(cost(valid_, smaller), cost(valid_, current));
       const std::vector<std::string> others(without.begin(), without.end());
       r.removed.push_back({e, "no longer significant" + beside + " (" + output::p_is(p) + ")", p, gain, others});
