@@ -498,6 +498,10 @@ const std::string kBesideTheFinalModel = " beside the other effects of the final
 // A removal's kBesideTheFinalModel holds only where the search ended with that model: after a
 // place given back it went on, and the effect was tested beside the model of its round, which
 // the reason then names (a review, helper-159).
+std::string no_longer_significant_reason(const std::vector<std::string>& others, double p) {
+  return "no longer significant" + (others.empty() ? std::string() : kBesideTheFinalModel) + " (" + output::p_is(p) + ")";
+}
+
 static void say_what_a_removal_was_tested_beside(SearchResult& r, const std::set<std::string>& final_model) {
   const std::string& final_words = kBesideTheFinalModel;
   for (auto& removal : r.removed) {
@@ -661,10 +665,9 @@ void CandidateSearch::backward_pass(SearchResult& r, std::set<std::string>& base
       // likelihood ratio needs, and a held-out comparison of the two leaned on them (the
       // helix's thrust decay was dropped that way). Its held-out change is kept as a record.
       if (p < level) continue;
-      const std::string beside = base.size() > 1 ? kBesideTheFinalModel : "";
       const double gain = percent_lower(cost(valid_, smaller), cost(valid_, current));
       const std::vector<std::string> others(without.begin(), without.end());
-      r.removed.push_back({e, "no longer significant" + beside + " (" + output::p_is(p) + ")", p, gain, others});
+      r.removed.push_back({e, no_longer_significant_reason(others, p), p, gain, others});
       for (const auto& g : going(e)) {
         if (g != e) r.removed.push_back({g, "taken out with " + e + ", whose terms it scales", p, gain, others});
         r.selected.erase(std::find(r.selected.begin(), r.selected.end(), g));

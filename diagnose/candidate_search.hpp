@@ -233,6 +233,12 @@ double chi2_upper(double x, double dof);
 // the agreement check both judge by it.
 double lr_p_value(double statistic, int dof, double off, double lower, double upper);
 
+// The reason the backward pass gives for dropping an effect that is no longer significant
+// (p) beside `others`, the effects left in the model without it and what it takes along:
+// "beside the other effects of the final model" only where there are such effects (the
+// search's end names them instead where it went on after the drop).
+std::string no_longer_significant_reason(const std::vector<std::string>& others, double p);
+
 // Channel weights 1 / (sigma sqrt(tau_int)) from the residuals of `m` at `ps`: the weights
 // under which a weighted cost is -2 log-likelihood (each channel's noise and its
 // correlation time), as the search weighs its fits.

@@ -844,6 +844,20 @@ TEST(BackwardPass, EarlyPickMadeRedundantIsRemoved) {
   EXPECT_NE(html.find("; after the backward pass dropped battery_sag): "), std::string::npos);
 }
 
+// A removal's reason says "beside the other effects" only where the model keeps some: an
+// effect dropped with nothing beside it but its own refinements (which go with it) was
+// tested against the bare base model (until 2026-12-08 the words stood whenever the model
+// held more than the effect, its refinements counted).
+TEST(BackwardPass, ARemovalSaysBesideOtherEffectsOnlyWhereThereAreSome) {
+  using quadgen::diagnose::no_longer_significant_reason;
+  const std::string alone = no_longer_significant_reason({}, 0.3);
+  EXPECT_EQ(alone.find("beside"), std::string::npos) << alone;
+  EXPECT_EQ(alone.find("no longer significant ("), 0u) << alone;
+  const std::string beside = no_longer_significant_reason({"rotor_drag"}, 0.3);
+  EXPECT_NE(beside.find("beside the other effects of the final model ("), std::string::npos) << beside;
+  EXPECT_NE(alone.find(quadgen::output::p_is(0.3)), std::string::npos) << alone;
+}
+
 // Several flights of one vehicle diagnosed jointly: the weak motor of two flights with
 // different trajectories is named once, with one estimate that holds for both, and the
 // end of each flight is held out.
