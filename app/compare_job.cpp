@@ -48,7 +48,8 @@ CompareJobResult run_compare_job(const CompareJob& job) {
   const DerivationComparison c = compare_derivations({a.vehicle, a.model}, {b.vehicle, b.model});
   CompareJobResult r;
   r.text = comparison_text(c, job.vehicle_a, job.vehicle_b);
-  r.note = a.note + (a.note.empty() || b.note.empty() ? "" : "\n") + b.note;
+  for (const auto& [side, note] : {std::pair{"A", a.note}, std::pair{"B", b.note}})
+    if (!note.empty()) r.notes.push_back(std::string(side) + ": " + note);
   r.same = c.same();
   return r;
 }

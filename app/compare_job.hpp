@@ -4,6 +4,7 @@
 #pragma once
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace quadgen::app {
 
@@ -15,7 +16,7 @@ struct CompareJob {
 
 struct CompareJobResult {
   std::string text;  // what the command prints
-  std::string note;  // a file's fitted values for another vehicle; "" if none
+  std::vector<std::string> notes;  // "A: ..." or "B: ...": a file's fitted values for another vehicle
   bool same = false;
 };
 

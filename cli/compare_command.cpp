@@ -1,5 +1,6 @@
 // quadgen compare A.yaml B.yaml [--effects e1,e2|all]
 #include <iostream>
+#include <stdexcept>
 
 #include "app/compare_job.hpp"
 #include "cli/compare_command.hpp"
@@ -27,8 +28,10 @@ int run_compare(const CompareArgs& args) {
   app::CompareJob job{args.vehicle_a, args.vehicle_b, args.effects,
                       [&](const std::string& what) { terminal.say("[" + std::to_string(++step) + "/3] " + what); }};
   const app::CompareJobResult r = app::run_compare_job(job);
-  if (!r.note.empty()) std::cerr << "quadgen: note: " << output::printable_lines(r.note) << "\n";
-  std::cout << output::printable_lines(r.text);
+  for (const std::string& note : r.notes) std::cerr << "quadgen: note: " << output::printable_error(note) << "\n";
+  std::cout << output::printable_lines(r.text) << std::flush;
+  // A comparison nobody received is no success: a full disk or a closed pipe (helper-161).
+  if (!std::cout) throw std::runtime_error("cannot write the comparison to standard output");
   return r.same || !args.exit_code ? 0 : 1;
 }
 

@@ -36,7 +36,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
   c->add_option("--max-effects", o.search.max_effects,
                 "effects the search may select at most, named or carried (each forward step adds one; one the backward pass "
                 "drops gives its place back; the held-out tests may then turn effects down)")
-      ->check(CLI::Range(1, static_cast<int>(diagnose::kMaxEffectsAllowed)));
+      ->check(whole_number_in(1, static_cast<long long>(diagnose::kMaxEffectsAllowed)));
   const std::string effect_names = catalogue_names();  // --help lists what --effects accepts
   c->add_option("--candidates", j.candidates,
                 "comma-separated effects to consider (default: all the log supports): " + effect_names);

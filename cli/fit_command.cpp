@@ -53,7 +53,7 @@ void add_fit(CLI::App& app, FitArgs& a) {
                 "comma-separated names (as for --free)")
       ->capture_default_str();
   c->add_option("--threads", a.options.threads, "threads for the profiles (0: one per core)")
-      ->check(CLI::Range(0, kMaxThreads))
+      ->check(whole_number_in(0, kMaxThreads))
       ->capture_default_str();
 }
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <new>
 #include <set>
 #include <sstream>
@@ -143,6 +144,26 @@ inline CLI::Validator finite_range(double lo, double hi) {
         double v = 0;
         if (!parse_finite(s, &v)) return "'" + s + "' " + why_not_finite(s) + " (accepted: " + range_text(lo, hi) + ")";
         if (v < lo || v > hi) return s + " is outside the accepted range " + range_text(lo, hi);
+        return {};
+      },
+      "in " + range_text(lo, hi));
+}
+
+// A whole number within [lo, hi], in decimal: CLI11 reads "010" as octal 8 and "0x2" as 2
+// (a hostile-input audit, helper-161: --max-effects 010 ran with 8), so only digits pass, and
+// leading zeros are taken off before CLI11 converts. Text that is no number is told so, not
+// "not in range".
+inline CLI::Validator whole_number_in(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        const bool minus = !s.empty() && s[0] == '-';
+        std::string digits = s.substr(minus || (!s.empty() && s[0] == '+') ? 1 : 0);
+        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos)
+          return "'" + s + "' is not a whole number in decimal digits (accepted: " + range_text(lo, hi) + ")";
+        digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        const long long v = digits.size() > 15 ? (minus ? lo - 1 : hi + 1) : (minus ? -1 : 1) * std::stoll(digits);
+        if (v < lo || v > hi) return s + " is outside the accepted range " + range_text(lo, hi);
+        s = std::to_string(v);
         return {};
       },
       "in " + range_text(lo, hi));

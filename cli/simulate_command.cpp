@@ -41,7 +41,9 @@ void add_simulate(CLI::App& app, SimulateArgs& a) {
   sc->excludes(in);
   cl->excludes(sc)->excludes(in);
   // Options of one mode are refused in the others (needs/excludes), never silently ignored.
-  c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")->needs(cl);
+  c->add_option("--seed", a.job.flight.seed, "closed loop: random trajectory and noise seed")
+      ->check(whole_number_in(0, std::numeric_limits<unsigned>::max()))
+      ->needs(cl);
   c->add_option("--set", a.set,
                 std::string("NAME=VALUE for a parameter of the simulated model (repeatable): in a closed loop any "
                             "of the true model, which the controller does not know; in a scenario or a replay an "

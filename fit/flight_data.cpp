@@ -164,7 +164,7 @@ ColumnMapping::Entry parse_entry(const MappingFile& file, const YAML::Node& key,
 ColumnMapping load_mapping(const std::string& path) {
   std::string text;
   try {  // opened as a log is: a FIFO or a directory is refused, not waited on; size-limited
-    text = runtime::LogFile(path, "a column mapping (YAML)").read_all();
+    text = runtime::LogFile(path, "a column mapping (YAML)", runtime::kMaxYamlBytes).read_all();
   } catch (const runtime::LogError& e) {
     throw FitError(e.what());
   }

@@ -185,7 +185,7 @@ struct YamlReader {
   // at most max_input_bytes(), and a read cut short is an error, never taken as the file.
   std::string read_file(const std::string& what) const {
     try {
-      return runtime::LogFile(path, "a " + what).read_all();
+      return runtime::LogFile(path, "a " + what, runtime::kMaxYamlBytes).read_all();
     } catch (const runtime::LogError& e) {
       throw VehicleError(e.what());
     }

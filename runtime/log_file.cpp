@@ -2,6 +2,7 @@
 
 #include "output/file_identity.hpp"
 
+#include <algorithm>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -26,9 +27,17 @@ const char* file_kind(mode_t m) {
   return "not a regular file";
 }
 
+// What a file above its limit is told: a log's limit can be raised, a YAML file's is its kind's.
+std::string above_the_limit(unsigned long long limit, bool of_its_kind) {
+  return "above the limit of " + std::to_string(limit) +
+         (of_its_kind ? " bytes for this kind of file (a few kilobytes is usual)"
+                      : " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+}
+
 }  // namespace
 
-LogFile::LogFile(const std::string& path, const std::string& expected) : path_(path) {
+LogFile::LogFile(const std::string& path, const std::string& expected, unsigned long long limit)
+    : path_(path), expected_(expected), given_limit_(limit) {
   // ": cannot open a vehicle file" read as a fault of quadgen's (a review, helper-135).
   if (path.empty()) throw LogError("an empty path where " + expected + " was expected (an unset shell variable?)");
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -39,10 +48,9 @@ LogFile::LogFile(const std::string& path, const std::string& expected) : path_(p
     if (!S_ISREG(st.st_mode))
       throw LogError(path + ": " + file_kind(st.st_mode) + ", not a regular file (expected " + expected + ")");
     size_ = static_cast<unsigned long long>(st.st_size);
-    limit_ = max_input_bytes();
+    limit_ = limit ? std::min(limit, max_input_bytes()) : max_input_bytes();  // the variable may lower a kind's
     if (size_ > limit_)
-      throw LogError(path + ": " + std::to_string(size_) + " bytes, above the limit of " + std::to_string(limit_) +
-                     " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+      throw LogError(path + ": " + std::to_string(size_) + " bytes, " + above_the_limit(limit_, limit_ == limit));
   } catch (...) {
     ::close(fd_);
     throw;
@@ -83,11 +91,11 @@ std::string LogFile::read_all() const {
   for (;;) {
     const ssize_t n = ::read(fd_, buf, sizeof buf);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw LogError(path_ + ": cannot read log: " + std::strerror(errno));
+    if (n < 0) throw LogError(path_ + ": cannot read " + expected_ + ": " + std::strerror(errno));
     if (n == 0) return bytes;
     bytes.append(buf, static_cast<std::size_t>(n));
     if (bytes.size() > limit_)  // it grew while being read
-      throw LogError(path_ + ": more than " + std::to_string(limit_) + " bytes (set QUADGEN_MAX_INPUT_BYTES to raise it)");
+      throw LogError(path_ + ": it grew while read, " + above_the_limit(limit_, limit_ == given_limit_));
   }
 }
 

@@ -14,9 +14,16 @@ namespace quadgen::runtime {
 // blocking, so that a FIFO is not waited on.
 std::string read_head(const std::string& path, std::size_t n);
 
+// Largest vehicle file, column mapping or fitted-parameter file, in bytes: yaml-cpp builds
+// about 270 bytes of nodes for a byte of a flow list (a hostile-input audit, helper-161: a 5 MB
+// vehicle file took 1.3 GB), and the largest such file quadgen writes is a few kilobytes.
+constexpr unsigned long long kMaxYamlBytes = 1ULL << 20;
+
 class LogFile {
  public:
-  LogFile(const std::string& path, const std::string& expected);
+  // `limit`: the most bytes accepted; 0 for max_input_bytes() (a log's), which also lowers a
+  // smaller one. A YAML file's is kMaxYamlBytes: its parser holds a few hundred bytes a byte.
+  LogFile(const std::string& path, const std::string& expected, unsigned long long limit = 0);
   ~LogFile();
   LogFile(const LogFile&) = delete;
   LogFile& operator=(const LogFile&) = delete;
@@ -30,9 +37,9 @@ class LogFile {
   void set_blocking() const;
 
  private:
-  std::string path_;
+  std::string path_, expected_;
   int fd_ = -1;
-  unsigned long long size_ = 0, limit_ = 0;
+  unsigned long long size_ = 0, limit_ = 0, given_limit_ = 0;
 };
 
 // Refuses a file named twice among `paths`, by its name or by what it is (a hard or symbolic

@@ -834,6 +834,35 @@ TEST(Cli, ParseErrorsQuoteNoControlCharacters) {
   EXPECT_EQ(odd.err.find("\xe2\x80\xae"), std::string::npos) << out::printable(odd.err);
 }
 
+// Whole numbers on the command line are decimal: CLI11 alone read "011" as octal 9 and "0x2"
+// as 2 (--max-effects 010 ran with 8; a hostile-input audit, helper-161), and told "abc" it
+// was "not in range". Refused before any work, with what was expected.
+TEST(Cli, WholeNumbersAreDecimalDigits) {
+  Scratch tmp;
+  const std::string vehicle = std::string(QUADGEN_SOURCE_DIR) + "/vehicles/finken3.yaml";
+  const auto diagnose_with = [&](const std::string& n) {
+    return run_quadgen({"diagnose", vehicle, tmp / "none.csv", "--out", tmp / "o", "--max-effects", n}, tmp.dir);
+  };
+  for (const char* not_a_number : {"0x2", "abc", "1e1", "5.0", ""}) {
+    const CliResult r = diagnose_with(not_a_number);
+    EXPECT_NE(r.rc, 0) << not_a_number;
+    EXPECT_NE(r.err.find("is not a whole number in decimal digits (accepted: [1, 10])"), std::string::npos)
+        << out::printable(r.err);
+  }
+  for (const char* outside : {"011", "0", "-1", "99999999999999999999"}) {
+    const CliResult r = diagnose_with(outside);
+    EXPECT_NE(r.rc, 0) << outside;
+    EXPECT_NE(r.err.find(std::string(outside) + " is outside the accepted range [1, 10]"), std::string::npos)
+        << out::printable(r.err);
+  }
+  // "010" is ten: accepted, and the run goes on to the missing log.
+  const CliResult ten = diagnose_with("010");
+  EXPECT_NE(ten.err.find("none.csv"), std::string::npos) << out::printable(ten.err);
+  EXPECT_FALSE(fs::exists(tmp / "o"));
+  const CliResult hex_seed = run_quadgen({"simulate", vehicle, "--seed", "0x10", "--out", tmp / "s.csv"}, tmp.dir);
+  EXPECT_NE(hex_seed.err.find("'0x10' is not a whole number"), std::string::npos) << out::printable(hex_seed.err);
+}
+
 // A name of 200 kB is refused in a line a person can read: its head (where, what) and its tail
 // (what was expected), the bytes between them counted, not printed (a review of the eighth
 // audit: a 200 kB block name gave a 200 kB error line); a cut never splits a UTF-8 character.

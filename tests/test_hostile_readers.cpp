@@ -19,6 +19,7 @@
 #include <string>
 
 #include "fit/flight_data.hpp"
+#include "runtime/log_file.hpp"
 #include "runtime/attitude.hpp"
 #include "runtime/flight_log.hpp"
 #include "fit/log_reader.hpp"
@@ -831,6 +832,24 @@ TEST_F(Hostile, FlightLogRefusesNonRegularFilesAndHugeOnes) {
   EXPECT_EQ(runtime::read_csv(path).rows.size(), 3u);
   ::unsetenv("QUADGEN_MAX_INPUT_BYTES");
   EXPECT_EQ(runtime::max_input_bytes(), 2ULL << 30);
+  // A YAML file has a limit of its kind, far below a log's: yaml-cpp holds about 270 bytes of
+  // nodes a byte of a flow list, and a 5 MB vehicle file took 1.3 GB (helper-161). A mapping
+  // the same; at the limit the file is read (and refused for what it holds, not its size).
+  std::string flow = "name: big\nsource: [";
+  while (flow.size() < runtime::kMaxYamlBytes) flow += "1,";
+  flow += "1]\n";
+  const std::string flow_path = write("flow.yaml", flow);
+  const std::string refused = message_of<VehicleError>([&] { load_vehicle(flow_path); });
+  EXPECT_NE(refused.find(flow_path + ": " + std::to_string(flow.size()) + " bytes, above the limit of " +
+                         std::to_string(runtime::kMaxYamlBytes) + " bytes for this kind of file"),
+            std::string::npos)
+      << refused;
+  EXPECT_NE(message_of<FitError>([&] { load_mapping(flow_path); }).find("bytes for this kind of file"), std::string::npos);
+  flow.resize(runtime::kMaxYamlBytes - 3);
+  flow.resize(flow.rfind(',') + 1);
+  flow += "1]\n";
+  EXPECT_EQ(message_of<VehicleError>([&] { load_vehicle(write("flow_at.yaml", flow)); }).find("bytes for this kind of file"),
+            std::string::npos);
 }
 
 // Defect 4: non-finite and absurd values in a canonical log, with their lines, also
