@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "derive/effects/effect_catalogue.hpp"
+#include "output/nearest_word.hpp"
 #include "output/sinks.hpp"
 #include "model/yaml_reader.hpp"
 #include "runtime/parameter.hpp"
@@ -66,7 +67,13 @@ void apply_fitted_parameters(SymbolicModel& model, const FittedParameters& fitte
     Variable* p = nullptr;
     for (auto& q : model.params)
       if (q.name == v.name) p = &q;
-    if (!p) throw VehicleError(where + "no parameter '" + v.name + "' in this model (effects: " + model.effect_list(", ") + ")");
+    if (!p) {
+      std::vector<std::string> names;
+      for (const auto& q : model.params) names.push_back(q.name);
+      const std::string effects = model.effect_list(", ");
+      throw VehicleError(where + "no parameter '" + output::printable(v.name) + "' in this model (effects: " +
+                         (effects.empty() ? "none" : effects) + ")" + output::did_you_mean(v.name, names));
+    }
     if (const std::string u = runtime::unit_problem(runtime_parameter(*p), v.unit); !u.empty())
       throw VehicleError(where + output::printable(v.name) + " " + u);
     const std::string problem = runtime::value_problem(runtime_parameter(*p), v.value, true);

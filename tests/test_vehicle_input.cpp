@@ -381,6 +381,12 @@ TEST(FittedParameters, AppliedOrRefusedWithTheirLine) {
       {head + "  kappa: {value: 0.01, unit: \"1\"}\n", ":4: kappa is in m, the file says '1'"},
       {head + "  motor_gain.C: {value: -0.9, unit: \"1\"}\n", ":4: motor_gain.C = -0.9 is outside its bounds"},
       {"effects: [tether]\nparameters: {}\n", ":1: unknown effect 'tether'"},
+      // Named as --effects names it: a slip with its correction, an invisible character escaped
+      // and said (helper-161: printed raw, so the message seemed to refuse a right name).
+      {"effects: [motor_gian]\nparameters: {}\n", ":1: unknown effect 'motor_gian'; did you mean 'motor_gain'?"},
+      {"effects: [\"motor\\u200b_gain\"]\nparameters: {}\n",
+       ":1: unknown effect 'motor\xe2\x80\x8b_gain'; did you mean 'motor_gain'? (they look alike, but"},
+      {head + "  c_tt: {value: 0.15, unit: \"1\"}\n", ":4: no parameter 'c_tt' in this model (effects: motor_gain); did you mean 'c_t'?"},
       {head + "  c_w: {value: .nan, unit: \"1\"}\n", ":4: expected a finite number for c_w"},
       {head + "  c_w: {value: 1e-400, unit: \"1\"}\n", ":4: '1e-400' for c_w is below the smallest number a double holds"},
       {head + "  c_w: {value: 0x10, unit: \"1\"}\n", ":4: expected a number for c_w, got '0x10'; hexadecimal is not read"},

@@ -64,7 +64,11 @@ const Effect* effect_named(const std::string& name) {
 
 const Effect& find_effect(const std::string& name) {
   if (const Effect* e = effect_named(name)) return *e;
-  throw std::invalid_argument("unknown effect '" + name + "'");
+  // As --effects says it (a hostile-input audit, helper-161: a fitted: section's zero-width
+  // character printed raw, with no "did you mean").
+  std::vector<std::string> known;
+  for (const auto& e : effect_catalogue()) known.push_back(e.name);
+  throw std::invalid_argument("unknown effect '" + output::printable(name) + "'" + output::did_you_mean(name, known));
 }
 
 bool are_look_alikes(const std::string& x, const std::string& y) {
