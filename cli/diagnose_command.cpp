@@ -24,7 +24,10 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                     ". Several flights of the same vehicle are diagnosed jointly, with one set of vehicle parameters "
                     "and the end of each flight held out")
       ->required();
-  c->add_option("--out", a.out, "output directory")->required();
+  c->add_option("--out", a.out,
+                "output directory (created; an earlier diagnose output there is replaced, a folder holding anything "
+                "else is refused)")
+      ->required();
   c->add_option("--mapping", j.mapping, "column mapping (YAML) for logs not in the canonical layout");
   c->add_option("--resample", j.resample, "resample the log onto a uniform grid at this rate [Hz] first")
       ->check(finite_range(fit::kResampleRange))
@@ -47,7 +50,7 @@ void add_diagnose(CLI::App& app, DiagnoseArgs& a) {
                  "where the flights were flown: indoor, outdoor or unknown (default: the mapping's environment, else "
                  "unknown); a finding beyond what is plausible there is reported as a stand-in for missing physics")
       ->check(CLI::IsMember(kEnvironmentNames));
-  c->add_option("--window", o.window, "validation simulation window [s]")->check(finite_range(diagnose::kDiagnoseWindowRange));
+  c->add_option("--window", o.window, "length of each open-loop simulation the held-out position error is scored over [s]")->check(finite_range(diagnose::kDiagnoseWindowRange));
   c->add_option("--window-stride", o.window_stride,
                 "time between the starts of the validation windows the held-out position error is taken over [s]: "
                 "0 (consecutive windows) or from " + output::short_number(diagnose::kSmallestWindowStride) + " to below --window")
